@@ -1,0 +1,59 @@
+//! Rigid-body dynamics algorithms as free functions `algo(&model, &mut data, ...)`, writing
+//! their results into [`crate::Data`]. Vectors are slices of length `model.nv` in joint units
+//! (rad, m, rad/s, m/s, rad/s^2, m/s^2); torques are N m (revolute) or N (prismatic).
+//!
+//! Internally every algorithm runs over bodies; for models with mimic couplings the body
+//! coordinates are mapped from and to the degrees of freedom here.
+
+pub mod crba;
+pub mod derivatives;
+pub mod forward_dynamics;
+pub mod kinematics;
+pub mod rnea;
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::data::Data;
+use crate::error::Result;
+use crate::model::Model;
+
+/// Checks the state vectors and writes the body coordinates into `data`.
+pub(crate) fn load_state(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    qd: Option<&[f64]>,
+    qdd: Option<&[f64]>,
+) -> Result<()> {
+    model.check_vector("q", q)?;
+    if let Some(qd) = qd {
+        model.check_vector("qd", qd)?;
+    }
+    if let Some(qdd) = qdd {
+        model.check_vector("qdd", qdd)?;
+    }
+    for (i, b) in model.bodies.iter().enumerate() {
+        data.qb[i] = b.multiplier * q[b.dof] + b.offset;
+        data.vb[i] = qd.map_or(0.0, |v| b.multiplier * v[b.dof]);
+        data.ab[i] = qdd.map_or(0.0, |a| b.multiplier * a[b.dof]);
+    }
+    Ok(())
+}
+
+/// `out[dof] = sum over bodies i of that dof of multiplier_i * body[i]`.
+pub(crate) fn contract_vector(model: &Model, body: &DVector<f64>, out: &mut DVector<f64>) {
+    out.fill(0.0);
+    for (i, b) in model.bodies.iter().enumerate() {
+        out[b.dof] += b.multiplier * body[i];
+    }
+}
+
+/// `out = C^T body C` with `C[i, dof_i] = multiplier_i`.
+pub(crate) fn contract_matrix(model: &Model, body: &DMatrix<f64>, out: &mut DMatrix<f64>) {
+    out.fill(0.0);
+    for (i, bi) in model.bodies.iter().enumerate() {
+        for (j, bj) in model.bodies.iter().enumerate() {
+            out[(bi.dof, bj.dof)] += bi.multiplier * bj.multiplier * body[(i, j)];
+        }
+    }
+}

@@ -1,0 +1,85 @@
+//! Recursive Newton-Euler inverse dynamics, in body frames (Featherstone, RBDA Table 5.1).
+
+use nalgebra::DVector;
+
+use super::{contract_vector, load_state};
+use crate::data::Data;
+use crate::error::Result;
+use crate::model::Model;
+use crate::spatial::Motion;
+
+/// Inverse dynamics `tau = M(q) qdd + c(q, qd) + g(q)` (rigid bodies only: no friction).
+///
+/// - `q` (rad or m), `qd` (rad/s or m/s), `qdd` (rad/s^2 or m/s^2): length `model.nv` each.
+/// - `gravity`: include `g(q)` (gravity `model.gravity`, along -z of the base frame).
+///
+/// Writes `data.tau` (`nv`, N m or N). Fails on a wrong length or a non-finite entry.
+pub fn rnea(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: &[f64], gravity: bool) -> Result<()> {
+    load_state(model, data, q, Some(qd), Some(qdd))?;
+    let mut out = std::mem::take(&mut data.tau);
+    rnea_loaded(model, data, gravity, &mut out);
+    data.tau = out;
+    Ok(())
+}
+
+/// Gravity torque `g(q)` (N m or N): the torque that holds the robot at rest at `q`.
+/// Writes `data.g` (`nv`).
+pub fn gravity_torque(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
+    load_state(model, data, q, None, None)?;
+    let mut out = std::mem::take(&mut data.g);
+    rnea_loaded(model, data, true, &mut out);
+    data.g = out;
+    Ok(())
+}
+
+/// Bias torque `c(q, qd) + g(q)` (Coriolis, centrifugal and, with `gravity`, gravity terms):
+/// the inverse dynamics at zero acceleration. Writes `data.bias` (`nv`).
+pub fn bias_torque(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], gravity: bool) -> Result<()> {
+    load_state(model, data, q, Some(qd), None)?;
+    let mut out = std::mem::take(&mut data.bias);
+    rnea_loaded(model, data, gravity, &mut out);
+    data.bias = out;
+    Ok(())
+}
+
+/// RNEA on the body coordinates already in `data` (`qb`, `vb`, `ab`); torques into `out`.
+pub(crate) fn rnea_loaded(model: &Model, data: &mut Data, gravity: bool, out: &mut DVector<f64>) {
+    // The base accelerates upwards at g instead of applying gravity to every body.
+    let a0 = Motion::new(
+        nalgebra::Vector3::zeros(),
+        if gravity { -model.gravity } else { nalgebra::Vector3::zeros() },
+    );
+    for (i, b) in model.bodies.iter().enumerate() {
+        let x = b.pose_in_parent(data.qb[i]);
+        let s = b.motion_subspace();
+        let vj = s.scale(data.vb[i]);
+        let (vp, ap) = match b.parent {
+            Some(p) => (data.v[p], data.a[p]),
+            None => (Motion::zeros(), a0),
+        };
+        let v = x.act_inv_motion(&vp) + vj;
+        let a = x.act_inv_motion(&ap) + s.scale(data.ab[i]) + v.cross(&vj);
+        let h = b.inertia.apply(&v);
+        data.f[i] = b.inertia.apply(&a) + v.cross_force(&h);
+        data.li_mi[i] = x;
+        data.v[i] = v;
+        data.a[i] = a;
+    }
+    let coupled = model.coupled;
+    for i in (0..model.nbodies()).rev() {
+        let b = &model.bodies[i];
+        let t = b.motion_subspace().dot(&data.f[i]);
+        if coupled {
+            data.tau_b[i] = t;
+        } else {
+            out[i] = t;
+        }
+        if let Some(p) = b.parent {
+            let fp = data.li_mi[i].act_force(&data.f[i]);
+            data.f[p] += fp;
+        }
+    }
+    if coupled {
+        contract_vector(model, &data.tau_b, out);
+    }
+}

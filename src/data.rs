@@ -1,0 +1,108 @@
+//! Preallocated work buffers and results of the algorithms, one per [`Model`] (Pinocchio's
+//! `Data`). Create it once with [`Data::new`] and reuse it for every sample: the algorithms do
+//! not allocate.
+
+use nalgebra::{DMatrix, DVector, Matrix6, Vector6};
+
+use crate::model::Model;
+use crate::spatial::{Force, Inertia, Motion, Se3};
+
+/// Buffers and results. Results are in degree-of-freedom coordinates (`nv`), in the units of the
+/// joints (rad, m, N m, N).
+#[derive(Clone, Debug)]
+pub struct Data {
+    /// Joint torques from [`crate::rnea`] (`nv`).
+    pub tau: DVector<f64>,
+    /// Gravity torque `g(q)` from [`crate::gravity_torque`] (`nv`).
+    pub g: DVector<f64>,
+    /// Bias torque `c(q, qd) + g(q)` from [`crate::bias_torque`] (`nv`).
+    pub bias: DVector<f64>,
+    /// Mass matrix `M(q)` from [`crate::mass_matrix`] or [`crate::rnea_derivatives`] (`nv x nv`,
+    /// both triangles filled).
+    pub m: DMatrix<f64>,
+    /// Accelerations from [`crate::forward_dynamics`] (`nv`).
+    pub qdd: DVector<f64>,
+    /// `d tau / d q` from [`crate::rnea_derivatives`] (`nv x nv`, row = torque, column = joint).
+    pub dtau_dq: DMatrix<f64>,
+    /// `d tau / d qd` from [`crate::rnea_derivatives`] (`nv x nv`).
+    pub dtau_dv: DMatrix<f64>,
+
+    // Body coordinates (one per body; equal to the dof ones for uncoupled models).
+    pub(crate) qb: Vec<f64>,
+    pub(crate) vb: Vec<f64>,
+    pub(crate) ab: Vec<f64>,
+    // Local-frame recursion.
+    pub(crate) li_mi: Vec<Se3>,
+    pub(crate) v: Vec<Motion>,
+    pub(crate) a: Vec<Motion>,
+    pub(crate) f: Vec<Force>,
+    pub(crate) ic: Vec<Inertia>,
+    // World-frame recursion of the derivatives.
+    pub(crate) o_mi: Vec<Se3>,
+    pub(crate) ov: Vec<Motion>,
+    pub(crate) oa_gf: Vec<Motion>,
+    pub(crate) of: Vec<Force>,
+    pub(crate) o_ycrb: Vec<Matrix6<f64>>,
+    pub(crate) do_ycrb: Vec<Matrix6<f64>>,
+    pub(crate) j: Vec<Vector6<f64>>,
+    pub(crate) dvdq: Vec<Vector6<f64>>,
+    pub(crate) dadq: Vec<Vector6<f64>>,
+    pub(crate) dadv: Vec<Vector6<f64>>,
+    pub(crate) dfda: Vec<Vector6<f64>>,
+    pub(crate) dfdq: Vec<Vector6<f64>>,
+    pub(crate) dfdv: Vec<Vector6<f64>>,
+    pub(crate) dytj: Vec<Vector6<f64>>,
+    // Body-level results (coupled models only).
+    pub(crate) tau_b: DVector<f64>,
+    pub(crate) m_b: DMatrix<f64>,
+    pub(crate) dq_b: DMatrix<f64>,
+    pub(crate) dv_b: DMatrix<f64>,
+    // Cholesky factor scratch for forward dynamics.
+    pub(crate) chol: DMatrix<f64>,
+}
+
+impl Data {
+    /// Buffers sized for `model`.
+    pub fn new(model: &Model) -> Self {
+        let n = model.nv;
+        let nb = model.nbodies();
+        let v6 = vec![Vector6::zeros(); nb];
+        let m6 = vec![Matrix6::zeros(); nb];
+        Self {
+            tau: DVector::zeros(n),
+            g: DVector::zeros(n),
+            bias: DVector::zeros(n),
+            m: DMatrix::zeros(n, n),
+            qdd: DVector::zeros(n),
+            dtau_dq: DMatrix::zeros(n, n),
+            dtau_dv: DMatrix::zeros(n, n),
+            qb: vec![0.0; nb],
+            vb: vec![0.0; nb],
+            ab: vec![0.0; nb],
+            li_mi: vec![Se3::identity(); nb],
+            v: vec![Motion::zeros(); nb],
+            a: vec![Motion::zeros(); nb],
+            f: vec![Force::zeros(); nb],
+            ic: vec![Inertia::zeros(); nb],
+            o_mi: vec![Se3::identity(); nb],
+            ov: vec![Motion::zeros(); nb],
+            oa_gf: vec![Motion::zeros(); nb],
+            of: vec![Force::zeros(); nb],
+            o_ycrb: m6.clone(),
+            do_ycrb: m6,
+            j: v6.clone(),
+            dvdq: v6.clone(),
+            dadq: v6.clone(),
+            dadv: v6.clone(),
+            dfda: v6.clone(),
+            dfdq: v6.clone(),
+            dfdv: v6.clone(),
+            dytj: v6,
+            tau_b: DVector::zeros(if model.coupled { nb } else { 0 }),
+            m_b: DMatrix::zeros(if model.coupled { nb } else { 0 }, if model.coupled { nb } else { 0 }),
+            dq_b: DMatrix::zeros(if model.coupled { nb } else { 0 }, if model.coupled { nb } else { 0 }),
+            dv_b: DMatrix::zeros(if model.coupled { nb } else { 0 }, if model.coupled { nb } else { 0 }),
+            chol: DMatrix::zeros(n, n),
+        }
+    }
+}

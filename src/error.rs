@@ -1,0 +1,161 @@
+//! The one error type of the library. Every variant carries the context a user needs to find
+//! the problem: the file, line, element, joint, argument or index involved.
+
+use std::fmt;
+
+/// Where a URDF element stands: the source (a file path or `<string>`) and, when known, the
+/// 1-based line of the element.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Location {
+    pub source: String,
+    pub line: Option<u32>,
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(line) => write!(f, "{}:{}", self.source, line),
+            None => write!(f, "{}", self.source),
+        }
+    }
+}
+
+/// All errors of perturbid_rs.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
+
+    /// The URDF is not well-formed XML or does not follow the URDF schema.
+    #[error("{source_name}: not a valid URDF: {message}")]
+    UrdfSyntax { source_name: String, message: String },
+
+    /// A joint type the library does not model (floating, planar, spherical).
+    #[error("{location}: joint '{joint}' is of type {kind}; only revolute, continuous, prismatic and fixed joints are supported (a floating base is not modelled)")]
+    UnsupportedJoint {
+        location: Location,
+        joint: String,
+        kind: String,
+    },
+
+    /// The kinematic graph does not have exactly one root link.
+    #[error("{source_name}: the URDF must have exactly one root link (a link that is no joint's child), found {}: {}", roots.len(), roots.join(", "))]
+    RootCount {
+        source_name: String,
+        roots: Vec<String>,
+    },
+
+    /// Links that cannot be reached from the root: the joints form a cycle.
+    #[error("{source_name}: the joints form a cycle through link(s) {}", links.join(", "))]
+    Cycle {
+        source_name: String,
+        links: Vec<String>,
+    },
+
+    /// A link is the child of two joints.
+    #[error("{location}: link '{link}' is the child of joint '{first}' and again of joint '{second}'")]
+    DuplicateChild {
+        location: Location,
+        link: String,
+        first: String,
+        second: String,
+    },
+
+    /// Two elements share a name.
+    #[error("{location}: {element} name '{name}' is used twice")]
+    DuplicateName {
+        location: Location,
+        element: &'static str,
+        name: String,
+    },
+
+    /// A joint names a link that does not exist.
+    #[error("{location}: joint '{joint}' names {role} link '{link}', which does not exist")]
+    UnknownLink {
+        location: Location,
+        joint: String,
+        role: &'static str,
+        link: String,
+    },
+
+    /// A joint name given by the user or by a mimic tag does not exist or cannot be used there.
+    #[error("{context}: {message}")]
+    JointReference { context: String, message: String },
+
+    /// A link inertia that no rigid body can have.
+    #[error("{location}: link '{link}' has a physically invalid inertia: {reason}")]
+    InvalidInertia {
+        location: Location,
+        link: String,
+        reason: String,
+    },
+
+    /// A moving joint whose subtree carries no mass and no inertia: M(q) would be singular.
+    #[error("{location}: joint '{joint}' moves nothing: the links behind it have no mass and no inertia, so the mass matrix would be singular")]
+    MasslessSubtree { location: Location, joint: String },
+
+    /// A joint axis of zero length or with non-finite components.
+    #[error("{location}: joint '{joint}' has axis {axis:?}, which is not a finite non-zero vector")]
+    InvalidAxis {
+        location: Location,
+        joint: String,
+        axis: [f64; 3],
+    },
+
+    /// A revolute or prismatic joint without a `<limit>` element (required by the URDF spec).
+    #[error("{location}: {kind} joint '{joint}' has no <limit> element (the URDF specification requires one; use type=\"continuous\" for an unlimited revolute joint)")]
+    MissingLimit {
+        location: Location,
+        joint: String,
+        kind: &'static str,
+    },
+
+    /// A number in the URDF that is NaN or infinite where a finite value is required.
+    #[error("{location}: {element} '{name}': {field} is {value}, expected a finite number")]
+    NonFiniteUrdf {
+        location: Location,
+        element: &'static str,
+        name: String,
+        field: &'static str,
+        value: f64,
+    },
+
+    /// An argument of the wrong length or shape.
+    #[error("{argument}: expected {expected}, got {got}")]
+    Shape {
+        argument: String,
+        expected: String,
+        got: String,
+    },
+
+    /// An argument holding NaN or infinity.
+    #[error("{argument}: entry {index} is {value}, expected a finite number")]
+    NonFiniteInput {
+        argument: String,
+        index: usize,
+        value: f64,
+    },
+
+    /// An argument outside its admissible range (not a shape problem).
+    #[error("{argument}: {message}")]
+    InvalidArgument { argument: String, message: String },
+
+    /// A numerical failure, e.g. a mass matrix that is not positive definite.
+    #[error("{operation}: {message}")]
+    Numerical { operation: String, message: String },
+
+    /// A built-in robot or variant name that does not exist.
+    #[error("unknown robot '{name}'; built-in robots: {}", available.join(", "))]
+    UnknownRobot {
+        name: String,
+        available: Vec<String>,
+    },
+}
+
+/// `Result` with the library's [`Error`].
+pub type Result<T> = std::result::Result<T, Error>;

@@ -1,0 +1,33 @@
+//! perturbid_rs: identification of robot manipulator dynamics about an operating point
+//! (Kinsheel & Taha, ICARCV 2010) and by the classical direct method.
+//!
+//! The dynamics core follows Pinocchio's design: an immutable [`Model`] built once from a URDF
+//! ([`model_from_urdf_file`], [`model_from_urdf_str`], or a built-in robot from [`robots`]), a
+//! [`Data`] of preallocated buffers, and algorithms as free functions that write into it:
+//! [`rnea`], [`gravity_torque`], [`bias_torque`], [`mass_matrix`], [`forward_dynamics`],
+//! [`rnea_derivatives`], and [`linearize`] for the local model at an operating point.
+//!
+//! Units: SI throughout (rad, m, s, kg, N m). Frames: the base frame with gravity along -z;
+//! spatial quantities as described in [`spatial`].
+
+pub mod algorithms;
+pub mod data;
+pub mod error;
+pub mod linearization;
+pub mod model;
+pub mod robots;
+pub mod spatial;
+pub mod urdf;
+
+#[cfg(feature = "python")]
+mod python;
+
+pub use algorithms::crba::mass_matrix;
+pub use algorithms::derivatives::rnea_derivatives;
+pub use algorithms::forward_dynamics::forward_dynamics;
+pub use algorithms::rnea::{bias_torque, gravity_torque, rnea};
+pub use data::Data;
+pub use error::{Error, Result};
+pub use linearization::{linearize, Linearization};
+pub use model::{Body, JointKind, JointLimits, Model};
+pub use urdf::{model_from_urdf_file, model_from_urdf_str, LoadOptions};

@@ -1,0 +1,231 @@
+//! The immutable robot model: a kinematic tree of rigid bodies, each behind one revolute or
+//! prismatic joint, built once (from a URDF, see [`crate::urdf`]) and shared by all algorithms.
+//!
+//! Two index spaces:
+//! - **bodies** `0..model.nbodies()`: one per moving joint of the tree, in depth-first order, so
+//!   the subtree of body `i` is the contiguous range `i..bodies[i].subtree_end` and a parent
+//!   always comes before its children. Bodies behind fixed or locked joints are merged into
+//!   their parent body.
+//! - **degrees of freedom** `0..model.nv`: the generalised coordinates `q, qd, qdd, tau` that
+//!   users see. A body's joint coordinate is `multiplier * q[dof] + offset`: 1 and 0 for an
+//!   ordinary joint, the URDF `<mimic>` values for a coupled joint, which adds no degree of
+//!   freedom of its own.
+
+use nalgebra::Vector3;
+
+use crate::error::{Error, Location, Result};
+use crate::spatial::{Inertia, Motion, Se3};
+
+/// Standard gravity (m/s^2) along -z of the base frame.
+pub const STANDARD_GRAVITY: f64 = 9.81;
+
+/// The kind of a moving joint.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JointKind {
+    /// Rotation about `axis`; coordinate in rad.
+    Revolute,
+    /// Translation along `axis`; coordinate in m.
+    Prismatic,
+}
+
+/// One rigid body of the tree with the joint that carries it.
+#[derive(Clone, Debug)]
+pub struct Body {
+    /// URDF name of the joint that moves this body.
+    pub joint: String,
+    /// URDF name of the link this body starts at (links merged into it behind fixed joints are
+    /// not named here).
+    pub link: String,
+    /// Parent body, `None` for a body attached to the fixed base.
+    pub parent: Option<usize>,
+    /// One past the last body of this body's subtree (depth-first order).
+    pub subtree_end: usize,
+    /// Pose of the joint frame at zero joint coordinate in the parent body's frame (the base
+    /// frame when `parent` is `None`).
+    pub placement: Se3,
+    pub kind: JointKind,
+    /// Unit joint axis in the joint (= body) frame.
+    pub axis: Vector3<f64>,
+    /// Spatial inertia of the body, with everything rigidly attached to it, in its own frame.
+    pub inertia: Inertia,
+    /// The degree of freedom that drives this body.
+    pub dof: usize,
+    /// Joint coordinate = `multiplier * q[dof] + offset` (mimic coupling).
+    pub multiplier: f64,
+    pub offset: f64,
+}
+
+impl Body {
+    /// The joint's motion subspace: the body's twist per unit joint velocity, in its own frame.
+    #[inline]
+    pub fn motion_subspace(&self) -> Motion {
+        match self.kind {
+            JointKind::Revolute => Motion::new(self.axis, Vector3::zeros()),
+            JointKind::Prismatic => Motion::new(Vector3::zeros(), self.axis),
+        }
+    }
+
+    /// Pose of this body's frame in the parent's frame at joint coordinate `x` (rad or m).
+    #[inline]
+    pub fn pose_in_parent(&self, x: f64) -> Se3 {
+        joint_pose(self.kind, &self.placement, &self.axis, x)
+    }
+}
+
+/// Pose of a joint's child frame in its parent frame: the joint `placement` followed by the
+/// joint motion of coordinate `x` (rad or m) about or along the unit `axis`.
+#[inline]
+pub fn joint_pose(kind: JointKind, placement: &Se3, axis: &Vector3<f64>, x: f64) -> Se3 {
+    match kind {
+        JointKind::Revolute => placement.compose(&Se3::rotation_about(axis, x)),
+        JointKind::Prismatic => Se3 {
+            rotation: placement.rotation,
+            translation: placement.translation + placement.rotation * (axis * x),
+        },
+    }
+}
+
+/// Per-degree-of-freedom data from the URDF: limits and `<dynamics>`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointLimits {
+    /// Position limits (rad or m); infinite for continuous joints.
+    pub lower: f64,
+    pub upper: f64,
+    /// Speed limit (rad/s or m/s); infinite when the URDF gives none.
+    pub velocity: f64,
+    /// Effort limit (N m or N); infinite when the URDF gives none.
+    pub effort: f64,
+    /// Acceleration limit (rad/s^2 or m/s^2), from URDF 1.2 `acceleration`; infinite if absent.
+    pub acceleration: f64,
+    /// Viscous friction coefficient (N m s/rad or N s/m), URDF `<dynamics damping>`.
+    pub damping: f64,
+    /// Coulomb friction (N m or N), URDF `<dynamics friction>`.
+    pub friction: f64,
+}
+
+/// The robot model. Immutable once built; algorithms take `&Model` and a [`crate::Data`].
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// Robot name from the URDF.
+    pub name: String,
+    /// Where the model came from (file path, `<string>` or a built-in name).
+    pub source: String,
+    /// Moving bodies in depth-first order.
+    pub bodies: Vec<Body>,
+    /// Number of degrees of freedom.
+    pub nv: usize,
+    /// Joint name of every degree of freedom (the independent, non-mimic joints).
+    pub joint_names: Vec<String>,
+    /// Joint kind of every degree of freedom.
+    pub joint_kinds: Vec<JointKind>,
+    /// Limits and friction of every degree of freedom.
+    pub limits: Vec<JointLimits>,
+    /// Gravity acceleration in the base frame (m/s^2); `(0, 0, -9.81)`.
+    pub gravity: Vector3<f64>,
+    /// Name of the root (base) link.
+    pub root_link: String,
+    /// Mass (kg) fixed to the base, which no joint moves (reported, unused by dynamics).
+    pub base_mass: f64,
+    /// `true` when some body is driven through a mimic coupling or a degree of freedom drives
+    /// several bodies; algorithms then map between body and dof coordinates.
+    pub coupled: bool,
+    /// Line of each moving joint in its URDF source, by body index (for error messages).
+    pub(crate) joint_lines: Vec<Option<u32>>,
+}
+
+impl Model {
+    /// Number of moving bodies (>= `nv` when joints are coupled).
+    pub fn nbodies(&self) -> usize {
+        self.bodies.len()
+    }
+
+    /// Index of the degree of freedom named `name`, if any.
+    pub fn joint_index(&self, name: &str) -> Option<usize> {
+        self.joint_names.iter().position(|n| n == name)
+    }
+
+    /// Lower position limits, one per dof (rad or m).
+    pub fn lower(&self) -> Vec<f64> {
+        self.limits.iter().map(|l| l.lower).collect()
+    }
+
+    /// Upper position limits, one per dof (rad or m).
+    pub fn upper(&self) -> Vec<f64> {
+        self.limits.iter().map(|l| l.upper).collect()
+    }
+
+    /// Speed limits, one per dof (rad/s or m/s).
+    pub fn velocity_limit(&self) -> Vec<f64> {
+        self.limits.iter().map(|l| l.velocity).collect()
+    }
+
+    /// Effort limits, one per dof (N m or N).
+    pub fn effort_limit(&self) -> Vec<f64> {
+        self.limits.iter().map(|l| l.effort).collect()
+    }
+
+    /// Acceleration limits, one per dof (rad/s^2 or m/s^2).
+    pub fn acceleration_limit(&self) -> Vec<f64> {
+        self.limits.iter().map(|l| l.acceleration).collect()
+    }
+
+    /// Total moving mass (kg).
+    pub fn moving_mass(&self) -> f64 {
+        self.bodies.iter().map(|b| b.inertia.mass).sum()
+    }
+
+    /// Checks that `x` has one entry per degree of freedom and holds finite numbers.
+    pub fn check_vector(&self, argument: &str, x: &[f64]) -> Result<()> {
+        check_finite_vector(argument, x, self.nv)
+    }
+
+    /// Fails when a degree of freedom drives no mass (M(q) singular). Run by the builders.
+    pub(crate) fn check_every_dof_moves_mass(&self) -> Result<()> {
+        let n = self.nbodies();
+        // "weight" of each subtree: mass plus trace of the rotational inertia.
+        let mut weight = vec![0.0; n];
+        for i in (0..n).rev() {
+            let b = &self.bodies[i];
+            weight[i] += b.inertia.mass + b.inertia.inertia_com.trace();
+            if let Some(p) = b.parent {
+                weight[p] += weight[i];
+            }
+        }
+        for dof in 0..self.nv {
+            let moved: f64 = (0..n)
+                .filter(|&i| self.bodies[i].dof == dof)
+                .map(|i| weight[i])
+                .sum();
+            if moved <= 0.0 {
+                let i = (0..n).find(|&i| self.bodies[i].dof == dof).unwrap_or(0);
+                return Err(Error::MasslessSubtree {
+                    location: Location {
+                        source: self.source.clone(),
+                        line: self.joint_lines.get(i).copied().flatten(),
+                    },
+                    joint: self.joint_names[dof].clone(),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Checks length `n` and finiteness of a vector argument.
+pub(crate) fn check_finite_vector(argument: &str, x: &[f64], n: usize) -> Result<()> {
+    if x.len() != n {
+        return Err(Error::Shape {
+            argument: argument.to_string(),
+            expected: format!("{n} values (one per degree of freedom)"),
+            got: format!("{} values", x.len()),
+        });
+    }
+    if let Some((index, &value)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        return Err(Error::NonFiniteInput {
+            argument: argument.to_string(),
+            index,
+            value,
+        });
+    }
+    Ok(())
+}

@@ -1,0 +1,54 @@
+//! The CRS A465 arm of Kinsheel & Taha (ICARCV 2010), as documented in the project's A465 notes:
+//! six revolute joints, frames parallel to the base at q = 0 (arm pointing up).
+//!
+//! Variants:
+//! - `kinsheel2010` (default): the `physical` set plus a rotor inertia lumped into each link
+//!   about its joint axis, fitted to the paper's Tables 2 and 3. Its link inertias break the
+//!   triangle inequality on purpose, so it is loaded with that check off.
+//! - `physical`: inertial parameters estimated from a CAD export (16 kg moving mass).
+
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::urdf::{model_from_urdf_str, LoadOptions};
+
+pub const DEFAULT_VARIANT: &str = "kinsheel2010";
+pub const VARIANTS: &[&str] = &["kinsheel2010", "physical"];
+
+const KINSHEEL2010: &str = include_str!("a465_kinsheel2010.urdf");
+const PHYSICAL: &str = include_str!("a465_physical.urdf");
+
+/// Gear ratios of joints 1-6 (motor turns per joint turn), from the A465 user guide.
+pub const GEAR_RATIOS: [f64; 6] = [100.0, 100.0, 100.0, 101.0, 100.0, 101.0];
+
+/// The paper's Table 2 operating point: joint positions q* (rad).
+pub const TABLE2_Q: [f64; 6] = [0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0];
+/// Table 2: joint velocities qd* (rad/s).
+pub const TABLE2_QD: [f64; 6] = [0.0890, -0.1060, 0.0220, 0.0560, 0.0110, 0.0140];
+/// Table 2: joint accelerations qdd* (rad/s^2).
+pub const TABLE2_QDD: [f64; 6] = [-0.1550, -0.5000, 0.0340, -0.2910, -0.0080, 0.1710];
+/// Table 2: nominal torques Tn (N m), gravity and friction excluded.
+pub const TABLE2_TORQUE: [f64; 6] = [-1.1883, -3.4797, -1.7304, -0.1377, -0.4466, 0.0539];
+/// Table 3: first column of D at the operating point, "actual" row.
+pub const TABLE3_D_COLUMN1: [f64; 6] = [9.956, 0.0, 0.0, -1.37, 0.0, -0.27];
+
+/// The URDF text of a variant.
+pub fn urdf(variant: &str) -> Result<&'static str> {
+    match variant {
+        "kinsheel2010" => Ok(KINSHEEL2010),
+        "physical" => Ok(PHYSICAL),
+        _ => Err(Error::UnknownRobot {
+            name: format!("a465:{variant}"),
+            available: VARIANTS.iter().map(|v| format!("a465:{v}")).collect(),
+        }),
+    }
+}
+
+/// The A465 model of a variant (`"kinsheel2010"` or `"physical"`).
+pub fn model(variant: &str) -> Result<Model> {
+    let text = urdf(variant)?;
+    let options = LoadOptions {
+        check_triangle_inequality: variant != "kinsheel2010",
+        ..LoadOptions::default()
+    };
+    model_from_urdf_str(text, &format!("a465:{variant}"), &options)
+}

@@ -1,0 +1,21 @@
+//! Robots built into the library (embedded in the binary and the Python wheel).
+
+pub mod a465;
+
+use crate::error::{Error, Result};
+use crate::model::Model;
+
+/// Built-in robot names accepted by [`builtin`].
+pub const BUILTIN: &[&str] = &["a465", "a465:kinsheel2010", "a465:physical"];
+
+/// A built-in robot by name: `a465` (the `kinsheel2010` variant) or `a465:VARIANT`.
+pub fn builtin(name: &str) -> Result<Model> {
+    let (robot, variant) = name.split_once(':').unwrap_or((name, a465::DEFAULT_VARIANT));
+    match robot {
+        "a465" => a465::model(variant),
+        _ => Err(Error::UnknownRobot {
+            name: name.to_string(),
+            available: BUILTIN.iter().map(|s| s.to_string()).collect(),
+        }),
+    }
+}

@@ -1,0 +1,440 @@
+//! Spatial algebra (Featherstone's notation) on nalgebra: 6-D motion and force vectors, rigid
+//! transforms and spatial inertias.
+//!
+//! Conventions, used everywhere in the crate:
+//! - a [`Motion`] (twist) holds the angular velocity `angular` (rad/s) and the linear velocity
+//!   `linear` (m/s) of the point at the origin of the frame it is expressed in;
+//! - a [`Force`] (wrench) holds the moment `angular` (N m) about the frame origin and the force
+//!   `linear` (N);
+//! - as 6-vectors and 6x6 matrices, the order is `[angular; linear]`;
+//! - an [`Se3`] `aXb` is the pose of frame b in frame a: `p_a = rotation * p_b + translation`.
+
+use nalgebra::{Matrix3, Matrix6, Rotation3, Unit, Vector3, Vector6};
+
+/// Skew-symmetric matrix of `v`: `skew(v) * x == v.cross(&x)`.
+#[inline]
+pub fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
+}
+
+/// A spatial motion vector (twist or spatial acceleration).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Motion {
+    pub angular: Vector3<f64>,
+    pub linear: Vector3<f64>,
+}
+
+impl Motion {
+    pub const fn new(angular: Vector3<f64>, linear: Vector3<f64>) -> Self {
+        Self { angular, linear }
+    }
+
+    pub fn zeros() -> Self {
+        Self::default()
+    }
+
+    /// Motion cross product `self x m` (the derivative of `m` in a frame moving with `self`).
+    #[inline]
+    pub fn cross(&self, m: &Motion) -> Motion {
+        Motion {
+            angular: self.angular.cross(&m.angular),
+            linear: self.angular.cross(&m.linear) + self.linear.cross(&m.angular),
+        }
+    }
+
+    /// Force cross product `self x* f`.
+    #[inline]
+    pub fn cross_force(&self, f: &Force) -> Force {
+        Force {
+            angular: self.angular.cross(&f.angular) + self.linear.cross(&f.linear),
+            linear: self.angular.cross(&f.linear),
+        }
+    }
+
+    /// Power pairing `self . f` (W).
+    #[inline]
+    pub fn dot(&self, f: &Force) -> f64 {
+        self.angular.dot(&f.angular) + self.linear.dot(&f.linear)
+    }
+
+    #[inline]
+    pub fn scale(&self, s: f64) -> Motion {
+        Motion {
+            angular: self.angular * s,
+            linear: self.linear * s,
+        }
+    }
+
+    /// `[angular; linear]`.
+    #[inline]
+    pub fn to_vector(&self) -> Vector6<f64> {
+        Vector6::new(
+            self.angular.x,
+            self.angular.y,
+            self.angular.z,
+            self.linear.x,
+            self.linear.y,
+            self.linear.z,
+        )
+    }
+
+    /// Inverse of [`Motion::to_vector`].
+    #[inline]
+    pub fn from_vector(v: &Vector6<f64>) -> Motion {
+        Motion {
+            angular: Vector3::new(v[0], v[1], v[2]),
+            linear: Vector3::new(v[3], v[4], v[5]),
+        }
+    }
+
+    /// The 6x6 matrix of `self x .` acting on motion vectors.
+    pub fn cross_matrix(&self) -> Matrix6<f64> {
+        let mut m = Matrix6::zeros();
+        let w = skew(&self.angular);
+        m.fixed_view_mut::<3, 3>(0, 0).copy_from(&w);
+        m.fixed_view_mut::<3, 3>(3, 3).copy_from(&w);
+        m.fixed_view_mut::<3, 3>(3, 0).copy_from(&skew(&self.linear));
+        m
+    }
+
+    /// The 6x6 matrix of `self x* .` acting on force vectors (`-cross_matrix()^T`).
+    pub fn cross_force_matrix(&self) -> Matrix6<f64> {
+        let mut m = Matrix6::zeros();
+        let w = skew(&self.angular);
+        m.fixed_view_mut::<3, 3>(0, 0).copy_from(&w);
+        m.fixed_view_mut::<3, 3>(3, 3).copy_from(&w);
+        m.fixed_view_mut::<3, 3>(0, 3).copy_from(&skew(&self.linear));
+        m
+    }
+}
+
+impl std::ops::Add for Motion {
+    type Output = Motion;
+    #[inline]
+    fn add(self, o: Motion) -> Motion {
+        Motion {
+            angular: self.angular + o.angular,
+            linear: self.linear + o.linear,
+        }
+    }
+}
+
+impl std::ops::Sub for Motion {
+    type Output = Motion;
+    #[inline]
+    fn sub(self, o: Motion) -> Motion {
+        Motion {
+            angular: self.angular - o.angular,
+            linear: self.linear - o.linear,
+        }
+    }
+}
+
+/// A spatial force vector (wrench or momentum).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Force {
+    pub angular: Vector3<f64>,
+    pub linear: Vector3<f64>,
+}
+
+impl Force {
+    pub fn zeros() -> Self {
+        Self::default()
+    }
+
+    /// `[angular; linear]`.
+    #[inline]
+    pub fn to_vector(&self) -> Vector6<f64> {
+        Vector6::new(
+            self.angular.x,
+            self.angular.y,
+            self.angular.z,
+            self.linear.x,
+            self.linear.y,
+            self.linear.z,
+        )
+    }
+
+    /// The 6x6 matrix `X` with `X m == m x* self` for every motion `m`.
+    pub fn cross_matrix_of_motion(&self) -> Matrix6<f64> {
+        let mut m = Matrix6::zeros();
+        let n = -skew(&self.angular);
+        let f = -skew(&self.linear);
+        m.fixed_view_mut::<3, 3>(0, 0).copy_from(&n);
+        m.fixed_view_mut::<3, 3>(0, 3).copy_from(&f);
+        m.fixed_view_mut::<3, 3>(3, 0).copy_from(&f);
+        m
+    }
+}
+
+impl std::ops::Add for Force {
+    type Output = Force;
+    #[inline]
+    fn add(self, o: Force) -> Force {
+        Force {
+            angular: self.angular + o.angular,
+            linear: self.linear + o.linear,
+        }
+    }
+}
+
+impl std::ops::AddAssign for Force {
+    #[inline]
+    fn add_assign(&mut self, o: Force) {
+        self.angular += o.angular;
+        self.linear += o.linear;
+    }
+}
+
+/// A rigid transform `aXb`: the pose of frame b expressed in frame a.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Se3 {
+    pub rotation: Matrix3<f64>,
+    pub translation: Vector3<f64>,
+}
+
+impl Default for Se3 {
+    fn default() -> Self {
+        Self::identity()
+    }
+}
+
+impl Se3 {
+    pub fn identity() -> Self {
+        Self {
+            rotation: Matrix3::identity(),
+            translation: Vector3::zeros(),
+        }
+    }
+
+    pub fn new(rotation: Matrix3<f64>, translation: Vector3<f64>) -> Self {
+        Self {
+            rotation,
+            translation,
+        }
+    }
+
+    /// From a URDF `<origin xyz rpy>`: fixed-axis roll about x, then pitch about y, then yaw
+    /// about z (`R = Rz(yaw) Ry(pitch) Rx(roll)`), translation `xyz` (m).
+    pub fn from_xyz_rpy(xyz: [f64; 3], rpy: [f64; 3]) -> Self {
+        let r = Rotation3::from_euler_angles(rpy[0], rpy[1], rpy[2]);
+        Self::new(*r.matrix(), Vector3::new(xyz[0], xyz[1], xyz[2]))
+    }
+
+    /// Rotation by `angle` (rad) about the unit vector `axis`.
+    pub fn rotation_about(axis: &Vector3<f64>, angle: f64) -> Self {
+        let r = Rotation3::from_axis_angle(&Unit::new_unchecked(*axis), angle);
+        Self::new(*r.matrix(), Vector3::zeros())
+    }
+
+    /// Composition `aXc = self(aXb) * other(bXc)`.
+    #[inline]
+    pub fn compose(&self, other: &Se3) -> Se3 {
+        Se3 {
+            rotation: self.rotation * other.rotation,
+            translation: self.translation + self.rotation * other.translation,
+        }
+    }
+
+    pub fn inverse(&self) -> Se3 {
+        let rt = self.rotation.transpose();
+        Se3 {
+            rotation: rt,
+            translation: -(rt * self.translation),
+        }
+    }
+
+    /// Expresses a motion given in frame b in frame a.
+    #[inline]
+    pub fn act_motion(&self, m: &Motion) -> Motion {
+        let w = self.rotation * m.angular;
+        Motion {
+            angular: w,
+            linear: self.rotation * m.linear + self.translation.cross(&w),
+        }
+    }
+
+    /// Expresses a motion given in frame a in frame b.
+    #[inline]
+    pub fn act_inv_motion(&self, m: &Motion) -> Motion {
+        Motion {
+            angular: self.rotation.tr_mul(&m.angular),
+            linear: self
+                .rotation
+                .tr_mul(&(m.linear - self.translation.cross(&m.angular))),
+        }
+    }
+
+    /// Expresses a force given in frame b in frame a.
+    #[inline]
+    pub fn act_force(&self, f: &Force) -> Force {
+        let lin = self.rotation * f.linear;
+        Force {
+            angular: self.rotation * f.angular + self.translation.cross(&lin),
+            linear: lin,
+        }
+    }
+
+    /// Expresses an inertia given in frame b in frame a.
+    #[inline]
+    pub fn act_inertia(&self, i: &Inertia) -> Inertia {
+        Inertia {
+            mass: i.mass,
+            com: self.rotation * i.com + self.translation,
+            inertia_com: self.rotation * i.inertia_com * self.rotation.transpose(),
+        }
+    }
+}
+
+/// A rigid-body spatial inertia: mass (kg), centre of mass `com` (m) and rotational inertia
+/// about the centre of mass `inertia_com` (kg m^2), all expressed in the body's frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inertia {
+    pub mass: f64,
+    pub com: Vector3<f64>,
+    pub inertia_com: Matrix3<f64>,
+}
+
+impl Default for Inertia {
+    fn default() -> Self {
+        Self::zeros()
+    }
+}
+
+impl Inertia {
+    pub fn zeros() -> Self {
+        Self {
+            mass: 0.0,
+            com: Vector3::zeros(),
+            inertia_com: Matrix3::zeros(),
+        }
+    }
+
+    pub fn new(mass: f64, com: Vector3<f64>, inertia_com: Matrix3<f64>) -> Self {
+        Self {
+            mass,
+            com,
+            inertia_com,
+        }
+    }
+
+    /// Momentum `I v` of a body moving with twist `v`.
+    #[inline]
+    pub fn apply(&self, v: &Motion) -> Force {
+        let lin = (v.linear - self.com.cross(&v.angular)) * self.mass;
+        Force {
+            angular: self.inertia_com * v.angular + self.com.cross(&lin),
+            linear: lin,
+        }
+    }
+
+    /// Rotational inertia about the frame origin (kg m^2).
+    pub fn inertia_origin(&self) -> Matrix3<f64> {
+        let c = &self.com;
+        self.inertia_com
+            + (Matrix3::identity() * c.norm_squared() - c * c.transpose()) * self.mass
+    }
+
+    /// The inertia of two bodies rigidly joined (both expressed in the same frame).
+    pub fn add(&self, other: &Inertia) -> Inertia {
+        let mass = self.mass + other.mass;
+        if mass <= 0.0 {
+            return Inertia {
+                mass: 0.0,
+                com: Vector3::zeros(),
+                inertia_com: self.inertia_com + other.inertia_com,
+            };
+        }
+        let com = (self.com * self.mass + other.com * other.mass) / mass;
+        let shifted = |i: &Inertia| {
+            let d = i.com - com;
+            i.inertia_com + (Matrix3::identity() * d.norm_squared() - d * d.transpose()) * i.mass
+        };
+        Inertia {
+            mass,
+            com,
+            inertia_com: shifted(self) + shifted(other),
+        }
+    }
+
+    /// The 6x6 matrix in `[angular; linear]` order.
+    pub fn to_matrix(&self) -> Matrix6<f64> {
+        let mut m = Matrix6::zeros();
+        let cx = skew(&self.com) * self.mass;
+        m.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&self.inertia_origin());
+        m.fixed_view_mut::<3, 3>(0, 3).copy_from(&cx);
+        m.fixed_view_mut::<3, 3>(3, 0).copy_from(&cx.transpose());
+        m.fixed_view_mut::<3, 3>(3, 3)
+            .copy_from(&(Matrix3::identity() * self.mass));
+        m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample_inertia() -> Inertia {
+        Inertia::new(
+            2.5,
+            Vector3::new(0.1, -0.2, 0.3),
+            Matrix3::new(0.3, 0.01, 0.02, 0.01, 0.2, 0.03, 0.02, 0.03, 0.25),
+        )
+    }
+
+    #[test]
+    fn inertia_matrix_matches_apply() {
+        let i = sample_inertia();
+        let v = Motion::new(Vector3::new(0.3, -1.0, 2.0), Vector3::new(1.5, 0.2, -0.7));
+        let a = i.to_matrix() * v.to_vector();
+        assert!((a - i.apply(&v).to_vector()).norm() < 1e-12);
+    }
+
+    #[test]
+    fn transforms_preserve_power_and_invert() {
+        let x = Se3::from_xyz_rpy([0.1, 0.2, -0.3], [0.4, -0.5, 0.6]);
+        let v = Motion::new(Vector3::new(0.3, -1.0, 2.0), Vector3::new(1.5, 0.2, -0.7));
+        let f = sample_inertia().apply(&v);
+        // power is frame-invariant
+        let p1 = v.dot(&f);
+        let p2 = x.act_motion(&v).dot(&x.act_force(&f));
+        assert!((p1 - p2).abs() < 1e-12);
+        let back = x.act_inv_motion(&x.act_motion(&v));
+        assert!((back.to_vector() - v.to_vector()).norm() < 1e-12);
+        let inv = x.inverse().compose(&x);
+        assert!((inv.rotation - Matrix3::identity()).norm() < 1e-12);
+        assert!(inv.translation.norm() < 1e-12);
+        // inertia transform: I_a (X v) == X* (I_b v)
+        let ia = x.act_inertia(&sample_inertia());
+        let lhs = ia.apply(&x.act_motion(&v)).to_vector();
+        let rhs = x.act_force(&sample_inertia().apply(&v)).to_vector();
+        assert!((lhs - rhs).norm() < 1e-12);
+    }
+
+    #[test]
+    fn cross_matrices_match_products() {
+        let v = Motion::new(Vector3::new(0.3, -1.0, 2.0), Vector3::new(1.5, 0.2, -0.7));
+        let m = Motion::new(Vector3::new(-0.2, 0.4, 0.1), Vector3::new(0.5, -0.3, 0.9));
+        let f = sample_inertia().apply(&m);
+        assert!((v.cross_matrix() * m.to_vector() - v.cross(&m).to_vector()).norm() < 1e-12);
+        assert!(
+            (v.cross_force_matrix() * f.to_vector() - v.cross_force(&f).to_vector()).norm()
+                < 1e-12
+        );
+        assert!(
+            (f.cross_matrix_of_motion() * m.to_vector() - m.cross_force(&f).to_vector()).norm()
+                < 1e-12
+        );
+    }
+
+    #[test]
+    fn adding_inertias_is_consistent_with_apply() {
+        let a = sample_inertia();
+        let b = Se3::from_xyz_rpy([0.3, 0.0, 0.1], [0.0, 0.2, 0.0]).act_inertia(&a);
+        let v = Motion::new(Vector3::new(0.3, -1.0, 2.0), Vector3::new(1.5, 0.2, -0.7));
+        let sum = a.add(&b).apply(&v).to_vector();
+        let parts = (a.apply(&v) + b.apply(&v)).to_vector();
+        assert!((sum - parts).norm() < 1e-12);
+    }
+}
