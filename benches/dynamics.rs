@@ -10,16 +10,46 @@ fn dynamics(c: &mut Criterion) {
     let mut data = Data::new(&model);
     let (q, qd, qdd) = (TABLE2_Q, TABLE2_QD, TABLE2_QDD);
     c.bench_function("rnea/a465/1", |b| {
-        b.iter(|| rnea(&model, &mut data, black_box(&q), black_box(&qd), black_box(&qdd), true).unwrap())
+        b.iter(|| {
+            rnea(
+                &model,
+                &mut data,
+                black_box(&q),
+                black_box(&qd),
+                black_box(&qdd),
+                true,
+            )
+            .unwrap()
+        })
     });
     c.bench_function("mass_matrix/a465/1", |b| {
         b.iter(|| mass_matrix(&model, &mut data, black_box(&q)).unwrap())
     });
     c.bench_function("rnea_derivatives/a465/1", |b| {
-        b.iter(|| rnea_derivatives(&model, &mut data, black_box(&q), black_box(&qd), black_box(&qdd), true).unwrap())
+        b.iter(|| {
+            rnea_derivatives(
+                &model,
+                &mut data,
+                black_box(&q),
+                black_box(&qd),
+                black_box(&qdd),
+                true,
+            )
+            .unwrap()
+        })
     });
     c.bench_function("linearize/a465/1", |b| {
-        b.iter(|| linearize(&model, &mut data, black_box(&q), black_box(&qd), black_box(&qdd), true).unwrap())
+        b.iter(|| {
+            linearize(
+                &model,
+                &mut data,
+                black_box(&q),
+                black_box(&qd),
+                black_box(&qdd),
+                true,
+            )
+            .unwrap()
+        })
     });
 }
 

@@ -99,9 +99,18 @@ impl Data {
             dfdv: v6.clone(),
             dytj: v6,
             tau_b: DVector::zeros(if model.coupled { nb } else { 0 }),
-            m_b: DMatrix::zeros(if model.coupled { nb } else { 0 }, if model.coupled { nb } else { 0 }),
-            dq_b: DMatrix::zeros(if model.coupled { nb } else { 0 }, if model.coupled { nb } else { 0 }),
-            dv_b: DMatrix::zeros(if model.coupled { nb } else { 0 }, if model.coupled { nb } else { 0 }),
+            m_b: DMatrix::zeros(
+                if model.coupled { nb } else { 0 },
+                if model.coupled { nb } else { 0 },
+            ),
+            dq_b: DMatrix::zeros(
+                if model.coupled { nb } else { 0 },
+                if model.coupled { nb } else { 0 },
+            ),
+            dv_b: DMatrix::zeros(
+                if model.coupled { nb } else { 0 },
+                if model.coupled { nb } else { 0 },
+            ),
             chol: DMatrix::zeros(n, n),
         }
     }

@@ -33,7 +33,10 @@ pub enum Error {
 
     /// The URDF is not well-formed XML or does not follow the URDF schema.
     #[error("{source_name}: not a valid URDF: {message}")]
-    UrdfSyntax { source_name: String, message: String },
+    UrdfSyntax {
+        source_name: String,
+        message: String,
+    },
 
     /// A joint type the library does not model (floating, planar, spherical).
     #[error("{location}: joint '{joint}' is of type {kind}; only revolute, continuous, prismatic and fixed joints are supported (a floating base is not modelled)")]
@@ -58,7 +61,9 @@ pub enum Error {
     },
 
     /// A link is the child of two joints.
-    #[error("{location}: link '{link}' is the child of joint '{first}' and again of joint '{second}'")]
+    #[error(
+        "{location}: link '{link}' is the child of joint '{first}' and again of joint '{second}'"
+    )]
     DuplicateChild {
         location: Location,
         link: String,
@@ -100,7 +105,9 @@ pub enum Error {
     MasslessSubtree { location: Location, joint: String },
 
     /// A joint axis of zero length or with non-finite components.
-    #[error("{location}: joint '{joint}' has axis {axis:?}, which is not a finite non-zero vector")]
+    #[error(
+        "{location}: joint '{joint}' has axis {axis:?}, which is not a finite non-zero vector"
+    )]
     InvalidAxis {
         location: Location,
         joint: String,

@@ -93,7 +93,8 @@ impl Motion {
         let w = skew(&self.angular);
         m.fixed_view_mut::<3, 3>(0, 0).copy_from(&w);
         m.fixed_view_mut::<3, 3>(3, 3).copy_from(&w);
-        m.fixed_view_mut::<3, 3>(3, 0).copy_from(&skew(&self.linear));
+        m.fixed_view_mut::<3, 3>(3, 0)
+            .copy_from(&skew(&self.linear));
         m
     }
 
@@ -103,7 +104,8 @@ impl Motion {
         let w = skew(&self.angular);
         m.fixed_view_mut::<3, 3>(0, 0).copy_from(&w);
         m.fixed_view_mut::<3, 3>(3, 3).copy_from(&w);
-        m.fixed_view_mut::<3, 3>(0, 3).copy_from(&skew(&self.linear));
+        m.fixed_view_mut::<3, 3>(0, 3)
+            .copy_from(&skew(&self.linear));
         m
     }
 }
@@ -331,8 +333,7 @@ impl Inertia {
     /// Rotational inertia about the frame origin (kg m^2).
     pub fn inertia_origin(&self) -> Matrix3<f64> {
         let c = &self.com;
-        self.inertia_com
-            + (Matrix3::identity() * c.norm_squared() - c * c.transpose()) * self.mass
+        self.inertia_com + (Matrix3::identity() * c.norm_squared() - c * c.transpose()) * self.mass
     }
 
     /// The inertia of two bodies rigidly joined (both expressed in the same frame).
@@ -419,8 +420,7 @@ mod tests {
         let f = sample_inertia().apply(&m);
         assert!((v.cross_matrix() * m.to_vector() - v.cross(&m).to_vector()).norm() < 1e-12);
         assert!(
-            (v.cross_force_matrix() * f.to_vector() - v.cross_force(&f).to_vector()).norm()
-                < 1e-12
+            (v.cross_force_matrix() * f.to_vector() - v.cross_force(&f).to_vector()).norm() < 1e-12
         );
         assert!(
             (f.cross_matrix_of_motion() * m.to_vector() - m.cross_force(&f).to_vector()).norm()

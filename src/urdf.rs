@@ -150,7 +150,13 @@ impl<'a> Builder<'a> {
         }
     }
 
-    fn finite(&self, element: &'static str, name: &str, field: &'static str, values: &[f64]) -> Result<()> {
+    fn finite(
+        &self,
+        element: &'static str,
+        name: &str,
+        field: &'static str,
+        values: &[f64],
+    ) -> Result<()> {
         if let Some(&value) = values.iter().find(|v| !v.is_finite()) {
             let location = if element == "link" {
                 self.link_location(name)
@@ -201,12 +207,15 @@ impl<'a> Builder<'a> {
                 });
             }
             let lookup = |role: &'static str, link: &str| {
-                link_index.get(link).copied().ok_or_else(|| Error::UnknownLink {
-                    location: self.joint_location(&joint.name),
-                    joint: joint.name.clone(),
-                    role,
-                    link: link.to_string(),
-                })
+                link_index
+                    .get(link)
+                    .copied()
+                    .ok_or_else(|| Error::UnknownLink {
+                        location: self.joint_location(&joint.name),
+                        joint: joint.name.clone(),
+                        role,
+                        link: link.to_string(),
+                    })
             };
             let p = lookup("parent", &joint.parent.link)?;
             let c = lookup("child", &joint.child.link)?;
@@ -305,18 +314,34 @@ impl<'a> Builder<'a> {
             for &j in children[v.link].iter().rev() {
                 let joint = &robot.joints[j];
                 let child = link_index[joint.child.link.as_str()];
-                let placement = pose.compose(&Se3::from_xyz_rpy(joint.origin.xyz.0, joint.origin.rpy.0));
+                let placement =
+                    pose.compose(&Se3::from_xyz_rpy(joint.origin.xyz.0, joint.origin.rpy.0));
                 let next = match roles[j] {
                     Role::Rigid { position } => {
                         let pose = if joint.joint_type == urdf_rs::JointType::Fixed {
                             placement
                         } else {
                             let axis = Vector3::from(joint.axis.xyz.0);
-                            joint_pose(joint_kind(&joint.joint_type), &placement, &(axis / axis.norm()), position)
+                            joint_pose(
+                                joint_kind(&joint.joint_type),
+                                &placement,
+                                &(axis / axis.norm()),
+                                position,
+                            )
                         };
-                        Visit { link: child, body, pose, joint: None }
+                        Visit {
+                            link: child,
+                            body,
+                            pose,
+                            joint: None,
+                        }
                     }
-                    Role::Moving { .. } => Visit { link: child, body, pose: placement, joint: Some(j) },
+                    Role::Moving { .. } => Visit {
+                        link: child,
+                        body,
+                        pose: placement,
+                        joint: Some(j),
+                    },
                 };
                 stack.push(next);
             }
@@ -364,7 +389,9 @@ impl<'a> Builder<'a> {
             }
         }
         let coupled = bodies.len() != joint_names.len()
-            || bodies.iter().any(|b| b.multiplier != 1.0 || b.offset != 0.0);
+            || bodies
+                .iter()
+                .any(|b| b.multiplier != 1.0 || b.offset != 0.0);
         let joint_lines = bodies
             .iter()
             .map(|b| self.lines.joints.get(&b.joint).map(|j| j.0))
@@ -441,7 +468,12 @@ impl<'a> Builder<'a> {
             });
         }
         if let Some(d) = &joint.dynamics {
-            self.finite("joint", name, "dynamics damping/friction", &[d.damping, d.friction])?;
+            self.finite(
+                "joint",
+                name,
+                "dynamics damping/friction",
+                &[d.damping, d.friction],
+            )?;
         }
         if let Some(m) = &joint.mimic {
             self.finite(
@@ -462,16 +494,26 @@ impl<'a> Builder<'a> {
         self.finite("link", name, "inertial origin xyz", &inertial.origin.xyz.0)?;
         self.finite("link", name, "inertial origin rpy", &inertial.origin.rpy.0)?;
         self.finite("link", name, "mass", &[inertial.mass.value])?;
-        self.finite("link", name, "inertia", &[i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz])?;
+        self.finite(
+            "link",
+            name,
+            "inertia",
+            &[i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz],
+        )?;
         let invalid = |reason: String| Error::InvalidInertia {
             location: self.link_location(name),
             link: name.to_string(),
             reason,
         };
         if inertial.mass.value < 0.0 {
-            return Err(invalid(format!("mass {} kg is negative", inertial.mass.value)));
+            return Err(invalid(format!(
+                "mass {} kg is negative",
+                inertial.mass.value
+            )));
         }
-        let m = Matrix3::new(i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz);
+        let m = Matrix3::new(
+            i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz,
+        );
         let mut eig: Vec<f64> = m.symmetric_eigenvalues().iter().copied().collect();
         eig.sort_by(|a, b| a.total_cmp(b));
         // "Rounding": URDFs print inertias to a few significant digits.
@@ -536,7 +578,11 @@ impl<'a> Builder<'a> {
             let (mut leader, mut multiplier, mut offset) = (j, 1.0, 0.0);
             let mut steps = 0;
             while let Some(m) = &joints[leader].mimic {
-                let context = format!("{}: joint '{}' <mimic>", self.joint_location(&joints[leader].name), joints[leader].name);
+                let context = format!(
+                    "{}: joint '{}' <mimic>",
+                    self.joint_location(&joints[leader].name),
+                    joints[leader].name
+                );
                 let Some(&next) = joint_index.get(m.joint.as_str()) else {
                     return Err(Error::JointReference {
                         context,
@@ -593,7 +639,9 @@ fn link_inertia(link: &urdf_rs::Link) -> Inertia {
     let local = Inertia::new(
         inertial.mass.value,
         Vector3::zeros(),
-        Matrix3::new(i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz),
+        Matrix3::new(
+            i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz,
+        ),
     );
     frame.act_inertia(&local)
 }
@@ -608,9 +656,19 @@ fn joint_limits(joint: &urdf_rs::Joint) -> JointLimits {
         .unwrap_or((0.0, 0.0));
     // A continuous joint's <limit> may be absent (urdf-rs then reports zeros) or give only
     // effort and velocity: zeros there mean "not given".
-    let given = |v: f64| if continuous && v == 0.0 { f64::INFINITY } else { v };
+    let given = |v: f64| {
+        if continuous && v == 0.0 {
+            f64::INFINITY
+        } else {
+            v
+        }
+    };
     JointLimits {
-        lower: if continuous { f64::NEG_INFINITY } else { l.lower },
+        lower: if continuous {
+            f64::NEG_INFINITY
+        } else {
+            l.lower
+        },
         upper: if continuous { f64::INFINITY } else { l.upper },
         velocity: given(l.velocity),
         effort: given(l.effort),

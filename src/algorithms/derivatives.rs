@@ -61,7 +61,11 @@ fn derivatives_loaded(
     // Base acceleration with gravity folded in: the base accelerates upwards at g.
     let minus_g = Motion::new(
         Vector3::zeros(),
-        if gravity { -model.gravity } else { Vector3::zeros() },
+        if gravity {
+            -model.gravity
+        } else {
+            Vector3::zeros()
+        },
     );
     for (i, b) in model.bodies.iter().enumerate() {
         let x = b.pose_in_parent(data.qb[i]);
@@ -87,8 +91,8 @@ fn derivatives_loaded(
 
         let ymat = oy.to_matrix();
         data.o_ycrb[i] = ymat;
-        data.do_ycrb[i] = ov.cross_force_matrix() * ymat - ymat * ov.cross_matrix()
-            + oh.cross_matrix_of_motion();
+        data.do_ycrb[i] =
+            ov.cross_force_matrix() * ymat - ymat * ov.cross_matrix() + oh.cross_matrix_of_motion();
 
         let jv = j.to_vector();
         data.j[i] = jv;

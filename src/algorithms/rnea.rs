@@ -14,7 +14,14 @@ use crate::spatial::Motion;
 /// - `gravity`: include `g(q)` (gravity `model.gravity`, along -z of the base frame).
 ///
 /// Writes `data.tau` (`nv`, N m or N). Fails on a wrong length or a non-finite entry.
-pub fn rnea(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], qdd: &[f64], gravity: bool) -> Result<()> {
+pub fn rnea(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    gravity: bool,
+) -> Result<()> {
     load_state(model, data, q, Some(qd), Some(qdd))?;
     let mut out = std::mem::take(&mut data.tau);
     rnea_loaded(model, data, gravity, &mut out);
@@ -34,7 +41,13 @@ pub fn gravity_torque(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
 
 /// Bias torque `c(q, qd) + g(q)` (Coriolis, centrifugal and, with `gravity`, gravity terms):
 /// the inverse dynamics at zero acceleration. Writes `data.bias` (`nv`).
-pub fn bias_torque(model: &Model, data: &mut Data, q: &[f64], qd: &[f64], gravity: bool) -> Result<()> {
+pub fn bias_torque(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    qd: &[f64],
+    gravity: bool,
+) -> Result<()> {
     load_state(model, data, q, Some(qd), None)?;
     let mut out = std::mem::take(&mut data.bias);
     rnea_loaded(model, data, gravity, &mut out);
@@ -47,7 +60,11 @@ pub(crate) fn rnea_loaded(model: &Model, data: &mut Data, gravity: bool, out: &m
     // The base accelerates upwards at g instead of applying gravity to every body.
     let a0 = Motion::new(
         nalgebra::Vector3::zeros(),
-        if gravity { -model.gravity } else { nalgebra::Vector3::zeros() },
+        if gravity {
+            -model.gravity
+        } else {
+            nalgebra::Vector3::zeros()
+        },
     );
     for (i, b) in model.bodies.iter().enumerate() {
         let x = b.pose_in_parent(data.qb[i]);

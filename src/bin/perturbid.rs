@@ -6,7 +6,11 @@ use clap::{Parser, Subcommand};
 use perturbid_rs::{robots, urdf, Model};
 
 #[derive(Parser)]
-#[command(name = "perturbid", version, about = "Robot dynamics identification about an operating point")]
+#[command(
+    name = "perturbid",
+    version,
+    about = "Robot dynamics identification about an operating point"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -30,22 +34,46 @@ fn load(robot: &str) -> perturbid_rs::Result<Model> {
 }
 
 fn fmt_limit(x: f64) -> String {
-    if x.is_infinite() { "-".to_string() } else { format!("{x:.4}") }
+    if x.is_infinite() {
+        "-".to_string()
+    } else {
+        format!("{x:.4}")
+    }
 }
 
 fn run(cli: Cli) -> perturbid_rs::Result<()> {
     match cli.command {
         Command::Info { robot } => {
             let model = load(&robot)?;
-            println!("robot {} ({}), {} degrees of freedom, {} moving bodies, root link '{}'",
-                model.name, model.source, model.nv, model.nbodies(), model.root_link);
-            println!("moving mass {:.4} kg, mass fixed to the base {:.4} kg", model.moving_mass(), model.base_mass);
-            println!("{:<16} {:<10} {:>10} {:>10} {:>10} {:>10} {:>10}", "joint", "kind", "lower", "upper", "velocity", "accel", "effort");
+            println!(
+                "robot {} ({}), {} degrees of freedom, {} moving bodies, root link '{}'",
+                model.name,
+                model.source,
+                model.nv,
+                model.nbodies(),
+                model.root_link
+            );
+            println!(
+                "moving mass {:.4} kg, mass fixed to the base {:.4} kg",
+                model.moving_mass(),
+                model.base_mass
+            );
+            println!(
+                "{:<16} {:<10} {:>10} {:>10} {:>10} {:>10} {:>10}",
+                "joint", "kind", "lower", "upper", "velocity", "accel", "effort"
+            );
             for (i, name) in model.joint_names.iter().enumerate() {
                 let l = &model.limits[i];
-                println!("{:<16} {:<10} {:>10} {:>10} {:>10} {:>10} {:>10}", name,
+                println!(
+                    "{:<16} {:<10} {:>10} {:>10} {:>10} {:>10} {:>10}",
+                    name,
                     format!("{:?}", model.joint_kinds[i]).to_lowercase(),
-                    fmt_limit(l.lower), fmt_limit(l.upper), fmt_limit(l.velocity), fmt_limit(l.acceleration), fmt_limit(l.effort));
+                    fmt_limit(l.lower),
+                    fmt_limit(l.upper),
+                    fmt_limit(l.velocity),
+                    fmt_limit(l.acceleration),
+                    fmt_limit(l.effort)
+                );
             }
             Ok(())
         }

@@ -10,7 +10,9 @@ pub const BUILTIN: &[&str] = &["a465", "a465:kinsheel2010", "a465:physical"];
 
 /// A built-in robot by name: `a465` (the `kinsheel2010` variant) or `a465:VARIANT`.
 pub fn builtin(name: &str) -> Result<Model> {
-    let (robot, variant) = name.split_once(':').unwrap_or((name, a465::DEFAULT_VARIANT));
+    let (robot, variant) = name
+        .split_once(':')
+        .unwrap_or((name, a465::DEFAULT_VARIANT));
     match robot {
         "a465" => a465::model(variant),
         _ => Err(Error::UnknownRobot {

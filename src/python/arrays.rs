@@ -1,0 +1,84 @@
+//! numpy in and out: one sample as shape `(n,)` or a batch as `(k, n)`; results shaped to match.
+
+use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+
+use crate::error::Error;
+
+/// Arguments of one call, copied into contiguous row-major buffers so that the Rust work can
+/// run without the GIL.
+pub(crate) struct Batch {
+    /// Number of samples.
+    pub k: usize,
+    /// Whether the call was given single samples (shape `(n,)`).
+    pub single: bool,
+    /// One buffer per argument, `k * n` values each, sample after sample.
+    pub columns: Vec<Vec<f64>>,
+}
+
+/// Reads `args` (name, array-like), each of shape `(n,)` or `(k, n)`, all with the same `k`.
+pub(crate) fn read_batch(
+    n: usize,
+    args: &[(&str, &PyArrayLikeDyn<'_, f64, AllowTypeChange>)],
+) -> Result<Batch, Error> {
+    // (number of samples, whether given as a batch) of the first argument
+    let mut first: Option<(usize, bool)> = None;
+    let mut columns = Vec::with_capacity(args.len());
+    for (name, arr) in args {
+        let shape = arr.shape().to_vec();
+        let this = match shape.as_slice() {
+            [len] if *len == n => (1, false),
+            [rows, len] if *len == n => (*rows, true),
+            _ => {
+                return Err(Error::Shape {
+                    argument: name.to_string(),
+                    expected: format!("shape ({n},) or (k, {n})"),
+                    got: format!("shape {shape:?}"),
+                })
+            }
+        };
+        match first {
+            None => first = Some(this),
+            Some(prev) if prev != this => {
+                return Err(Error::Shape {
+                    argument: name.to_string(),
+                    expected: if prev.1 {
+                        format!("shape ({}, {n}) like the first argument", prev.0)
+                    } else {
+                        format!("shape ({n},) like the first argument")
+                    },
+                    got: format!("shape {shape:?}"),
+                });
+            }
+            _ => {}
+        }
+        let values: Vec<f64> = arr.as_array().iter().copied().collect();
+        if let Some((index, &value)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(Error::NonFiniteInput {
+                argument: name.to_string(),
+                index,
+                value,
+            });
+        }
+        columns.push(values);
+    }
+    let (k, batched) = first.unwrap_or((0, false));
+    Ok(Batch {
+        k,
+        single: !batched,
+        columns,
+    })
+}
+
+/// A numpy array of `values` with shape `dims` prefixed by `k` unless `single`.
+pub(crate) fn to_numpy<'py>(
+    py: Python<'py>,
+    values: Vec<f64>,
+    k: usize,
+    single: bool,
+    dims: &[usize],
+) -> PyResult<Bound<'py, PyAny>> {
+    let mut shape: Vec<usize> = if single { Vec::new() } else { vec![k] };
+    shape.extend_from_slice(dims);
+    Ok(PyArray1::from_vec(py, values).reshape(shape)?.into_any())
+}

@@ -1,0 +1,357 @@
+//! `perturbid_rs.Robot`: a robot model with its dynamics, on numpy arrays.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::sync::{Mutex, MutexGuard};
+
+use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn};
+use pyo3::prelude::*;
+
+use super::arrays::{read_batch, to_numpy};
+use super::linearization::PyLinearization;
+use crate::error::Result;
+use crate::{robots, urdf, Data, Model};
+
+type ArrayLike<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+
+/// A robot model (immutable) with the dynamics algorithms.
+///
+/// Build it with `Robot.from_urdf(path)`, `Robot.from_urdf_string(text)` or
+/// `perturbid_rs.robots.a465()`. Every method takes numpy float64 arrays (anything
+/// convertible): one sample as shape `(n,)` or a batch of `k` samples as shape `(k, n)`, and
+/// returns arrays shaped to match. Units: rad, rad/s, rad/s^2 and N m for revolute joints;
+/// m, m/s, m/s^2 and N for prismatic ones. Gravity is 9.81 m/s^2 along -z of the base frame.
+#[pyclass(name = "Robot", module = "perturbid_rs", frozen)]
+pub(crate) struct PyRobot {
+    model: Model,
+    data: Mutex<Data>,
+}
+
+impl PyRobot {
+    fn new(model: Model) -> Self {
+        let data = Mutex::new(Data::new(&model));
+        Self { model, data }
+    }
+
+    fn data(&self) -> MutexGuard<'_, Data> {
+        self.data
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    /// Evaluates `f` on every sample of `args` with the GIL released; `f` writes one sample's
+    /// result (`out_dims` values, row-major) into its output slice.
+    fn map_samples<'py, F>(
+        &self,
+        py: Python<'py>,
+        args: &[(&str, &ArrayLike<'py>)],
+        out_dims: &[usize],
+        f: F,
+    ) -> PyResult<Bound<'py, PyAny>>
+    where
+        F: Fn(&Model, &mut Data, [&[f64]; 3], &mut [f64]) -> Result<()> + Send + Sync,
+    {
+        let n = self.model.nv;
+        let batch = read_batch(n, args)?;
+        let size: usize = out_dims.iter().product();
+        let mut out = vec![0.0; batch.k * size];
+        py.detach(|| -> Result<()> {
+            let mut data = self.data();
+            for s in 0..batch.k {
+                let mut rows: [&[f64]; 3] = [&[]; 3];
+                for (row, column) in rows.iter_mut().zip(&batch.columns) {
+                    *row = &column[s * n..(s + 1) * n];
+                }
+                f(
+                    &self.model,
+                    &mut data,
+                    rows,
+                    &mut out[s * size..(s + 1) * size],
+                )?;
+            }
+            Ok(())
+        })?;
+        to_numpy(py, out, batch.k, batch.single, out_dims)
+    }
+}
+
+fn copy_matrix(m: &nalgebra::DMatrix<f64>, out: &mut [f64]) {
+    let n = m.ncols();
+    for r in 0..m.nrows() {
+        for c in 0..n {
+            out[r * n + c] = m[(r, c)];
+        }
+    }
+}
+
+fn load_options(
+    lock: Option<BTreeMap<String, f64>>,
+    check_triangle_inequality: bool,
+) -> urdf::LoadOptions {
+    urdf::LoadOptions {
+        lock: lock.unwrap_or_default(),
+        check_triangle_inequality,
+    }
+}
+
+#[pymethods]
+impl PyRobot {
+    /// Loads a robot from a URDF file.
+    ///
+    /// `lock` maps joint names to positions (rad or m) at which those joints are held: they
+    /// become fixed (mimic joints following them too). `check_triangle_inequality=False`
+    /// accepts link inertias that no rigid body has (e.g. a rotor inertia lumped about one
+    /// axis). Raises `ModelError` naming the file, line and element of any problem.
+    #[staticmethod]
+    #[pyo3(signature = (path, lock=None, check_triangle_inequality=true))]
+    fn from_urdf(
+        py: Python<'_>,
+        path: PathBuf,
+        lock: Option<BTreeMap<String, f64>>,
+        check_triangle_inequality: bool,
+    ) -> PyResult<Self> {
+        let options = load_options(lock, check_triangle_inequality);
+        let model = py.detach(|| urdf::model_from_urdf_file(&path, &options))?;
+        Ok(Self::new(model))
+    }
+
+    /// Loads a robot from URDF text; see `from_urdf`.
+    #[staticmethod]
+    #[pyo3(signature = (text, lock=None, check_triangle_inequality=true))]
+    fn from_urdf_string(
+        py: Python<'_>,
+        text: &str,
+        lock: Option<BTreeMap<String, f64>>,
+        check_triangle_inequality: bool,
+    ) -> PyResult<Self> {
+        let options = load_options(lock, check_triangle_inequality);
+        let model = py.detach(|| urdf::model_from_urdf_str(text, "<string>", &options))?;
+        Ok(Self::new(model))
+    }
+
+    /// A built-in robot by name: "a465", "a465:kinsheel2010", "a465:physical".
+    #[staticmethod]
+    fn builtin(name: &str) -> PyResult<Self> {
+        Ok(Self::new(robots::builtin(name)?))
+    }
+
+    /// Robot name from the URDF.
+    #[getter]
+    fn name(&self) -> &str {
+        &self.model.name
+    }
+
+    /// Number of degrees of freedom (mimic joints add none, locked joints are removed).
+    #[getter]
+    fn n(&self) -> usize {
+        self.model.nv
+    }
+
+    /// Names of the joints of the degrees of freedom, in coordinate order.
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        self.model.joint_names.clone()
+    }
+
+    /// Lower position limits, shape (n,) (rad or m; -inf for continuous joints).
+    #[getter]
+    fn lower<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.model.lower())
+    }
+
+    /// Upper position limits, shape (n,) (rad or m; +inf for continuous joints).
+    #[getter]
+    fn upper<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.model.upper())
+    }
+
+    /// Speed limits, shape (n,) (rad/s or m/s; inf where the URDF gives none).
+    #[getter]
+    fn velocity_limit<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.model.velocity_limit())
+    }
+
+    /// Effort limits, shape (n,) (N m or N; inf where the URDF gives none).
+    #[getter]
+    fn effort_limit<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.model.effort_limit())
+    }
+
+    /// Acceleration limits, shape (n,) (rad/s^2 or m/s^2; URDF 1.2 `acceleration`, else inf).
+    #[getter]
+    fn acceleration_limit<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.model.acceleration_limit())
+    }
+
+    /// Viscous friction coefficients from URDF `<dynamics damping>`, shape (n,).
+    #[getter]
+    fn damping<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.model.limits.iter().map(|l| l.damping).collect())
+    }
+
+    /// Coulomb friction from URDF `<dynamics friction>`, shape (n,).
+    #[getter]
+    fn friction<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.model.limits.iter().map(|l| l.friction).collect())
+    }
+
+    /// Total mass of the moving links (kg).
+    #[getter]
+    fn mass(&self) -> f64 {
+        self.model.moving_mass()
+    }
+
+    /// Inverse dynamics `tau = M(q) qdd + c(q, qd) [+ g(q)]` (rigid bodies, no friction).
+    /// q, qd, qdd: (n,) or (k, n). Returns tau with the same shape.
+    #[pyo3(signature = (q, qd, qdd, gravity=true))]
+    fn rnea<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayLike<'py>,
+        qd: ArrayLike<'py>,
+        qdd: ArrayLike<'py>,
+        gravity: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.map_samples(
+            py,
+            &[("q", &q), ("qd", &qd), ("qdd", &qdd)],
+            &[self.model.nv],
+            |m, d, x, out| {
+                crate::rnea(m, d, x[0], x[1], x[2], gravity)?;
+                out.copy_from_slice(d.tau.as_slice());
+                Ok(())
+            },
+        )
+    }
+
+    /// Gravity torque g(q): the torque holding the robot at rest. q: (n,) or (k, n).
+    fn gravity<'py>(&self, py: Python<'py>, q: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.map_samples(py, &[("q", &q)], &[self.model.nv], |m, d, x, out| {
+            crate::gravity_torque(m, d, x[0])?;
+            out.copy_from_slice(d.g.as_slice());
+            Ok(())
+        })
+    }
+
+    /// Bias torque c(q, qd) [+ g(q)]: the inverse dynamics at zero acceleration.
+    #[pyo3(signature = (q, qd, gravity=true))]
+    fn bias<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayLike<'py>,
+        qd: ArrayLike<'py>,
+        gravity: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.map_samples(
+            py,
+            &[("q", &q), ("qd", &qd)],
+            &[self.model.nv],
+            |m, d, x, out| {
+                crate::bias_torque(m, d, x[0], x[1], gravity)?;
+                out.copy_from_slice(d.bias.as_slice());
+                Ok(())
+            },
+        )
+    }
+
+    /// Joint-space mass matrix M(q), symmetric positive definite. q: (n,) or (k, n); returns
+    /// (n, n) or (k, n, n).
+    fn mass_matrix<'py>(&self, py: Python<'py>, q: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.model.nv;
+        self.map_samples(py, &[("q", &q)], &[n, n], |m, d, x, out| {
+            crate::mass_matrix(m, d, x[0])?;
+            copy_matrix(&d.m, out);
+            Ok(())
+        })
+    }
+
+    /// Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) [- g(q)]). Shapes as `rnea`.
+    #[pyo3(signature = (q, qd, tau, gravity=true))]
+    fn forward_dynamics<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayLike<'py>,
+        qd: ArrayLike<'py>,
+        tau: ArrayLike<'py>,
+        gravity: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.map_samples(
+            py,
+            &[("q", &q), ("qd", &qd), ("tau", &tau)],
+            &[self.model.nv],
+            |m, d, x, out| {
+                crate::forward_dynamics(m, d, x[0], x[1], x[2], gravity)?;
+                out.copy_from_slice(d.qdd.as_slice());
+                Ok(())
+            },
+        )
+    }
+
+    /// The linearisation at the operating point (q, qd, qdd), computed analytically:
+    /// `tau - T* ~= D dqdd + H dqd + G dq`. Returns a `Linearization` (see its attributes);
+    /// with a batch (k, n) every attribute gains a leading axis k.
+    #[pyo3(signature = (q, qd, qdd, gravity=true))]
+    fn linearize<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayLike<'py>,
+        qd: ArrayLike<'py>,
+        qdd: ArrayLike<'py>,
+        gravity: bool,
+    ) -> PyResult<PyLinearization> {
+        let n = self.model.nv;
+        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
+        let k = batch.k;
+        let (mut torque, mut dm, mut hm, mut gm, mut gs) = (
+            vec![0.0; k * n],
+            vec![0.0; k * n * n],
+            vec![0.0; k * n * n],
+            vec![0.0; k * n * n],
+            vec![0.0; k * n * n],
+        );
+        py.detach(|| -> Result<()> {
+            let mut data = self.data();
+            let c = &batch.columns;
+            for s in 0..k {
+                let r = s * n..(s + 1) * n;
+                let lin = crate::linearize(
+                    &self.model,
+                    &mut data,
+                    &c[0][r.clone()],
+                    &c[1][r.clone()],
+                    &c[2][r.clone()],
+                    gravity,
+                )?;
+                torque[r].copy_from_slice(lin.torque.as_slice());
+                let rr = s * n * n..(s + 1) * n * n;
+                copy_matrix(&lin.d, &mut dm[rr.clone()]);
+                copy_matrix(&lin.h, &mut hm[rr.clone()]);
+                copy_matrix(&lin.g, &mut gm[rr.clone()]);
+                copy_matrix(&lin.g_static, &mut gs[rr]);
+            }
+            Ok(())
+        })?;
+        let single = batch.single;
+        Ok(PyLinearization {
+            torque: to_numpy(py, torque, k, single, &[n])?.unbind(),
+            d: to_numpy(py, dm, k, single, &[n, n])?.unbind(),
+            h: to_numpy(py, hm, k, single, &[n, n])?.unbind(),
+            g: to_numpy(py, gm, k, single, &[n, n])?.unbind(),
+            g_static: to_numpy(py, gs, k, single, &[n, n])?.unbind(),
+        })
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Robot(name={:?}, n={}, joints={:?})",
+            self.model.name, self.model.nv, self.model.joint_names
+        )
+    }
+}
+
+/// The URDF text of a built-in A465 variant ("kinsheel2010" or "physical").
+#[pyfunction]
+#[pyo3(signature = (variant="kinsheel2010"))]
+pub(crate) fn a465_urdf(variant: &str) -> PyResult<&'static str> {
+    Ok(robots::a465::urdf(variant)?)
+}

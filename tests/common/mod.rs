@@ -1,0 +1,83 @@
+//! Shared helpers of the Rust integration tests: random URDF trees and numeric comparisons.
+#![allow(dead_code)]
+
+use nalgebra::DMatrix;
+
+/// A deterministic pseudo-random generator (splitmix64) so helpers need no extra crate.
+pub struct Rng(pub u64);
+
+impl Rng {
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E3779B97F4A7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [lo, hi).
+    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
+    }
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.next_u64() % n as u64) as usize
+    }
+    pub fn vector(&mut self, n: usize, scale: f64) -> Vec<f64> {
+        (0..n).map(|_| self.uniform(-scale, scale)).collect()
+    }
+}
+
+/// A random kinematic tree as URDF text: `nlinks` links below a massless base, each attached to
+/// a random earlier link by a revolute, continuous, prismatic or fixed joint (the first joint
+/// always moves), with random origins, axes and physically valid inertias.
+pub fn random_tree_urdf(seed: u64, nlinks: usize) -> String {
+    let mut r = Rng(seed);
+    let mut s = String::from("<robot name=\"random\">\n  <link name=\"base\"/>\n");
+    for k in 1..=nlinks {
+        // principal moments from a random mass distribution: always a valid rigid body
+        let (a, b, c) = (
+            r.uniform(0.01, 0.2),
+            r.uniform(0.01, 0.2),
+            r.uniform(0.01, 0.2),
+        );
+        s += &format!(
+            "  <link name=\"l{k}\"><inertial><origin xyz=\"{} {} {}\" rpy=\"{} {} {}\"/><mass value=\"{}\"/>\
+             <inertia ixx=\"{}\" ixy=\"0\" ixz=\"0\" iyy=\"{}\" iyz=\"0\" izz=\"{}\"/></inertial></link>\n",
+            r.uniform(-0.2, 0.2), r.uniform(-0.2, 0.2), r.uniform(-0.2, 0.2),
+            r.uniform(-3.0, 3.0), r.uniform(-1.5, 1.5), r.uniform(-3.0, 3.0),
+            r.uniform(0.2, 3.0), b + c, a + c, a + b
+        );
+    }
+    for k in 1..=nlinks {
+        let parent = if k == 1 {
+            "base".to_string()
+        } else {
+            format!("l{}", r.below(k))
+        };
+        let parent = if parent == "l0" {
+            "base".to_string()
+        } else {
+            parent
+        };
+        let kind = if k == 1 {
+            "revolute"
+        } else {
+            ["revolute", "continuous", "prismatic", "fixed", "revolute"][r.below(5)]
+        };
+        s += &format!(
+            "  <joint name=\"j{k}\" type=\"{kind}\"><parent link=\"{parent}\"/><child link=\"l{k}\"/>\
+             <origin xyz=\"{} {} {}\" rpy=\"{} {} {}\"/><axis xyz=\"{} {} {}\"/>\
+             <limit lower=\"-2\" upper=\"2\" effort=\"100\" velocity=\"3\"/></joint>\n",
+            r.uniform(-0.3, 0.3), r.uniform(-0.3, 0.3), r.uniform(0.0, 0.4),
+            r.uniform(-3.0, 3.0), r.uniform(-1.5, 1.5), r.uniform(-3.0, 3.0),
+            r.uniform(-1.0, 1.0), r.uniform(-1.0, 1.0), r.uniform(0.2, 1.0)
+        );
+    }
+    s + "</robot>\n"
+}
+
+/// max |a - b| / max(1, max |b|).
+pub fn rel_err(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+    assert_eq!(a.shape(), b.shape());
+    let scale = b.amax().max(1.0);
+    (a - b).amax() / scale
+}

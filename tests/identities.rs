@@ -1,0 +1,229 @@
+//! Algorithms checked against each other and against finite differences, on the A465 and on
+//! random kinematic trees with revolute, continuous, prismatic and fixed joints.
+
+mod common;
+
+use common::{random_tree_urdf, rel_err, Rng};
+use nalgebra::{DMatrix, DVector};
+use perturbid_rs::{
+    bias_torque, forward_dynamics, gravity_torque, linearize, mass_matrix, model_from_urdf_str,
+    rnea, rnea_derivatives, robots, Data, LoadOptions, Model,
+};
+use proptest::prelude::*;
+
+fn tau(model: &Model, q: &[f64], qd: &[f64], qdd: &[f64], gravity: bool) -> DVector<f64> {
+    let mut data = Data::new(model);
+    rnea(model, &mut data, q, qd, qdd, gravity).unwrap();
+    data.tau.clone()
+}
+
+/// Central-difference Jacobian of tau along q (`which = 0`) or qd (`which = 1`).
+fn fd_jacobian(model: &Model, q: &[f64], qd: &[f64], qdd: &[f64], which: usize) -> DMatrix<f64> {
+    let n = model.nv;
+    let h = 1e-6;
+    let mut jac = DMatrix::zeros(n, n);
+    for j in 0..n {
+        let (mut qp, mut qm, mut vp, mut vm) = (q.to_vec(), q.to_vec(), qd.to_vec(), qd.to_vec());
+        if which == 0 {
+            qp[j] += h;
+            qm[j] -= h;
+        } else {
+            vp[j] += h;
+            vm[j] -= h;
+        }
+        let d = (tau(model, &qp, &vp, qdd, true) - tau(model, &qm, &vm, qdd, true)) / (2.0 * h);
+        jac.set_column(j, &d);
+    }
+    jac
+}
+
+fn check_all_identities(model: &Model, rng: &mut Rng) {
+    let n = model.nv;
+    let mut data = Data::new(model);
+    let q = rng.vector(n, 1.5);
+    let qd = rng.vector(n, 2.0);
+    let qdd = rng.vector(n, 3.0);
+    // M qdd = rnea(q, 0, qdd) - g(q)
+    mass_matrix(model, &mut data, &q).unwrap();
+    let m = data.m.clone();
+    assert!((&m - m.transpose()).amax() < 1e-12);
+    gravity_torque(model, &mut data, &q).unwrap();
+    let lhs = &m * DVector::from_column_slice(&qdd);
+    let rhs = tau(model, &q, &vec![0.0; n], &qdd, true) - &data.g;
+    assert!((lhs - &rhs).amax() < 1e-9 * rhs.amax().max(1.0));
+    // rnea = M qdd + bias
+    bias_torque(model, &mut data, &q, &qd, true).unwrap();
+    let full = tau(model, &q, &qd, &qdd, true);
+    let recomposed = &m * DVector::from_column_slice(&qdd) + &data.bias;
+    assert!((&full - recomposed).amax() < 1e-9 * full.amax().max(1.0));
+    // forward_dynamics(rnea(q, qd, qdd)) = qdd
+    forward_dynamics(model, &mut data, &q, &qd, full.as_slice(), true).unwrap();
+    let back = data.qdd.clone();
+    assert!(
+        (back - DVector::from_column_slice(&qdd)).amax() < 1e-8,
+        "forward dynamics round trip"
+    );
+    // the derivatives: tau and M agree with rnea and crba, dq and dv with finite differences
+    rnea_derivatives(model, &mut data, &q, &qd, &qdd, true).unwrap();
+    assert!((&data.tau - &full).amax() < 1e-10 * full.amax().max(1.0));
+    assert!(rel_err(&data.m, &m) < 1e-12);
+    let fd_q = fd_jacobian(model, &q, &qd, &qdd, 0);
+    let fd_v = fd_jacobian(model, &q, &qd, &qdd, 1);
+    assert!(
+        rel_err(&data.dtau_dq, &fd_q) < 1e-6,
+        "dtau/dq\n{}\nvs fd\n{}",
+        data.dtau_dq,
+        fd_q
+    );
+    assert!(
+        rel_err(&data.dtau_dv, &fd_v) < 1e-6,
+        "dtau/dqd\n{}\nvs fd\n{}",
+        data.dtau_dv,
+        fd_v
+    );
+    // the linearisation is made of those pieces; Gs is the gravity stiffness
+    let lin = linearize(model, &mut data, &q, &qd, &qdd, true).unwrap();
+    assert!(rel_err(&lin.h, &fd_v) < 1e-6);
+    let zero = vec![0.0; n];
+    assert!(rel_err(&lin.g_static, &fd_jacobian(model, &q, &zero, &zero, 0)) < 1e-6);
+}
+
+#[test]
+fn identities_hold_on_the_a465() {
+    let mut rng = Rng(1);
+    for variant in ["kinsheel2010", "physical"] {
+        let model = robots::a465::model(variant).unwrap();
+        for _ in 0..20 {
+            check_all_identities(&model, &mut rng);
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+    #[test]
+    fn identities_hold_on_random_trees(seed in any::<u64>(), nlinks in 1usize..9) {
+        let text = random_tree_urdf(seed, nlinks);
+        let model = model_from_urdf_str(&text, "random", &LoadOptions::default()).unwrap();
+        let mut rng = Rng(seed ^ 0xABCD);
+        check_all_identities(&model, &mut rng);
+    }
+}
+
+#[test]
+fn gravity_off_removes_exactly_g() {
+    let model = robots::builtin("a465:physical").unwrap();
+    let mut rng = Rng(3);
+    let mut data = Data::new(&model);
+    let (q, qd, qdd) = (rng.vector(6, 1.0), rng.vector(6, 1.0), rng.vector(6, 1.0));
+    gravity_torque(&model, &mut data, &q).unwrap();
+    let diff = tau(&model, &q, &qd, &qdd, true) - tau(&model, &q, &qd, &qdd, false);
+    assert!((diff - &data.g).amax() < 1e-12);
+    let lin = linearize(&model, &mut data, &q, &qd, &qdd, false).unwrap();
+    assert!(lin.g_static.amax() == 0.0);
+}
+
+#[test]
+fn wrong_lengths_and_nan_are_errors_not_panics() {
+    let model = robots::builtin("a465").unwrap();
+    let mut data = Data::new(&model);
+    let e = rnea(&model, &mut data, &[0.0; 5], &[0.0; 6], &[0.0; 6], true).unwrap_err();
+    assert!(e.to_string().contains("q: expected 6 values"), "{e}");
+    let e = rnea(
+        &model,
+        &mut data,
+        &[0.0; 6],
+        &[0.0, f64::NAN, 0.0, 0.0, 0.0, 0.0],
+        &[0.0; 6],
+        true,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("qd: entry 1 is NaN"), "{e}");
+    let e = forward_dynamics(&model, &mut data, &[0.0; 6], &[0.0; 6], &[0.0; 7], true).unwrap_err();
+    assert!(e.to_string().starts_with("tau:"), "{e}");
+}
+
+/// A planar chain with a coupled joint: `b` follows `a` with multiplier 2 and offset 0.1.
+fn mimic_pair(mimic: bool) -> String {
+    let mimic_tag = if mimic {
+        r#"<mimic joint="a" multiplier="2" offset="0.1"/>"#
+    } else {
+        ""
+    };
+    format!(
+        r#"<robot name="m">
+  <link name="base"/>
+  <link name="l1"><inertial><origin xyz="0.3 0 0"/><mass value="2"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/></inertial></link>
+  <link name="l2"><inertial><origin xyz="0.2 0.1 0"/><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.015"/></inertial></link>
+  <link name="l3"><inertial><origin xyz="0.1 0 0.05"/><mass value="0.5"/><inertia ixx="0.002" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.003"/></inertial></link>
+  <joint name="a" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="10" velocity="2"/></joint>
+  <joint name="b" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.6 0 0"/><axis xyz="0 1 1"/><limit lower="-3" upper="3" effort="10" velocity="2"/>{mimic_tag}</joint>
+  <joint name="c" type="prismatic"><parent link="l2"/><child link="l3"/><origin xyz="0.4 0 0"/><axis xyz="1 0 0"/><limit lower="-1" upper="1" effort="10" velocity="2"/></joint>
+</robot>"#
+    )
+}
+
+#[test]
+fn mimic_joint_is_the_chain_rule_of_the_uncoupled_model() {
+    let coupled = model_from_urdf_str(&mimic_pair(true), "mimic", &LoadOptions::default()).unwrap();
+    let free = model_from_urdf_str(&mimic_pair(false), "free", &LoadOptions::default()).unwrap();
+    assert_eq!(coupled.nv, 2);
+    assert_eq!(coupled.joint_names, ["a", "c"]);
+    // C maps (a, c) velocities to (a, b, c)
+    let c = DMatrix::from_row_slice(3, 2, &[1.0, 0.0, 2.0, 0.0, 0.0, 1.0]);
+    let mut rng = Rng(11);
+    for _ in 0..10 {
+        let (q, qd, qdd) = (rng.vector(2, 1.0), rng.vector(2, 1.0), rng.vector(2, 1.0));
+        let qf = [q[0], 2.0 * q[0] + 0.1, q[1]];
+        let qdf = [qd[0], 2.0 * qd[0], qd[1]];
+        let qddf = [qdd[0], 2.0 * qdd[0], qdd[1]];
+        let expected = c.transpose() * tau(&free, &qf, &qdf, &qddf, true);
+        let got = tau(&coupled, &q, &qd, &qdd, true);
+        assert!((got - &expected).amax() < 1e-12);
+        let (mut dc, mut df) = (Data::new(&coupled), Data::new(&free));
+        mass_matrix(&coupled, &mut dc, &q).unwrap();
+        mass_matrix(&free, &mut df, &qf).unwrap();
+        assert!((&dc.m - c.transpose() * &df.m * &c).amax() < 1e-12);
+        // derivatives of the coupled model against finite differences
+        rnea_derivatives(&coupled, &mut dc, &q, &qd, &qdd, true).unwrap();
+        assert!(rel_err(&dc.dtau_dq, &fd_jacobian(&coupled, &q, &qd, &qdd, 0)) < 1e-6);
+        assert!(rel_err(&dc.dtau_dv, &fd_jacobian(&coupled, &q, &qd, &qdd, 1)) < 1e-6);
+        assert!((&dc.m - c.transpose() * &df.m * &c).amax() < 1e-12);
+    }
+    let mut rng = Rng(5);
+    check_all_identities(&coupled, &mut rng);
+}
+
+#[test]
+fn locked_joint_is_the_full_model_with_that_joint_held() {
+    let free = model_from_urdf_str(&mimic_pair(false), "free", &LoadOptions::default()).unwrap();
+    let mut options = LoadOptions::default();
+    options.lock.insert("b".to_string(), 0.7);
+    let locked = model_from_urdf_str(&mimic_pair(false), "locked", &options).unwrap();
+    assert_eq!(locked.joint_names, ["a", "c"]);
+    let mut rng = Rng(12);
+    for _ in 0..10 {
+        let (q, qd, qdd) = (rng.vector(2, 1.0), rng.vector(2, 1.0), rng.vector(2, 1.0));
+        let full = tau(
+            &free,
+            &[q[0], 0.7, q[1]],
+            &[qd[0], 0.0, qd[1]],
+            &[qdd[0], 0.0, qdd[1]],
+            true,
+        );
+        let got = tau(&locked, &q, &qd, &qdd, true);
+        assert!((got[0] - full[0]).abs() < 1e-12 && (got[1] - full[2]).abs() < 1e-12);
+    }
+    // locking the leader locks its follower too
+    let mut options = LoadOptions::default();
+    options.lock.insert("a".to_string(), 0.3);
+    let both = model_from_urdf_str(&mimic_pair(true), "both", &options).unwrap();
+    assert_eq!(both.joint_names, ["c"]);
+    let mut options = LoadOptions::default();
+    options.lock.insert("b".to_string(), 0.3);
+    let e = model_from_urdf_str(&mimic_pair(true), "m.urdf", &options).unwrap_err();
+    assert!(e.to_string().contains("lock that joint instead"), "{e}");
+    let mut options = LoadOptions::default();
+    options.lock.insert("zz".to_string(), 0.3);
+    assert!(model_from_urdf_str(&mimic_pair(true), "m.urdf", &options).is_err());
+}
