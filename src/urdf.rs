@@ -235,7 +235,7 @@ impl<'a> Builder<'a> {
             .filter(|&l| parent_joint[l].is_none())
             .collect();
         if roots.len() != 1 {
-            if roots.is_empty() {
+            if roots.is_empty() && !robot.links.is_empty() {
                 return Err(Error::Cycle {
                     source_name: self.source.to_string(),
                     links: robot.links.iter().map(|l| l.name.clone()).collect(),

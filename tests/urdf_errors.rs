@@ -257,3 +257,10 @@ fn limits_dynamics_and_acceleration_are_kept() {
     assert_eq!(a465.limits[3].acceleration, 24.958);
     assert!(a465.limits[0].effort.is_infinite());
 }
+
+#[test]
+fn an_empty_robot_has_no_root() {
+    let e = load("<robot name=\"empty\"></robot>");
+    assert!(matches!(e, Error::RootCount { .. }), "{e}");
+    assert!(e.to_string().contains("found 0"), "{e}");
+}

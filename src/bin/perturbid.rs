@@ -41,11 +41,15 @@ fn fmt_limit(x: f64) -> String {
     }
 }
 
-fn run(cli: Cli) -> perturbid_rs::Result<()> {
+/// Runs a subcommand; returns what it prints on standard output.
+fn run(cli: Cli) -> perturbid_rs::Result<String> {
+    use std::fmt::Write;
+    let mut out = String::new();
     match cli.command {
         Command::Info { robot } => {
             let model = load(&robot)?;
-            println!(
+            let _ = writeln!(
+                out,
                 "robot {} ({}), {} degrees of freedom, {} moving bodies, root link '{}'",
                 model.name,
                 model.source,
@@ -53,18 +57,21 @@ fn run(cli: Cli) -> perturbid_rs::Result<()> {
                 model.nbodies(),
                 model.root_link
             );
-            println!(
+            let _ = writeln!(
+                out,
                 "moving mass {:.4} kg, mass fixed to the base {:.4} kg",
                 model.moving_mass(),
                 model.base_mass
             );
-            println!(
+            let _ = writeln!(
+                out,
                 "{:<16} {:<10} {:>10} {:>10} {:>10} {:>10} {:>10}",
                 "joint", "kind", "lower", "upper", "velocity", "accel", "effort"
             );
             for (i, name) in model.joint_names.iter().enumerate() {
                 let l = &model.limits[i];
-                println!(
+                let _ = writeln!(
+                    out,
                     "{:<16} {:<10} {:>10} {:>10} {:>10} {:>10} {:>10}",
                     name,
                     format!("{:?}", model.joint_kinds[i]).to_lowercase(),
@@ -75,14 +82,18 @@ fn run(cli: Cli) -> perturbid_rs::Result<()> {
                     fmt_limit(l.effort)
                 );
             }
-            Ok(())
         }
     }
+    Ok(out)
 }
 
 fn main() -> ExitCode {
     match run(Cli::parse()) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(text) => {
+            // A closed pipe (`perturbid info a465 | head`) is not an error worth a panic.
+            let _ = std::io::Write::write_all(&mut std::io::stdout().lock(), text.as_bytes());
+            ExitCode::SUCCESS
+        }
         Err(e) => {
             eprintln!("perturbid: {e}");
             ExitCode::FAILURE

@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-pin = pytest.importorskip("pinocchio")
+import pinocchio as pin  # the oracle: a missing oracle is a failure, not a skip
 
 import perturbid_rs as pr  # noqa: E402
 
@@ -18,19 +17,10 @@ def erd_dir() -> Path:
     """The robots folder of the example-robot-data package (installed under cmeel.prefix)."""
     import sysconfig
 
-    candidates = [
-        Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix/share/example-robot-data/robots",
-    ]
-    try:
-        import example_robot_data  # noqa: F401
-
-        candidates.append(Path(example_robot_data.getModelPath("ur_description/urdf/ur5_robot.urdf")))
-    except Exception:
-        pass
-    for c in candidates:
-        if c.is_dir():
-            return c
-    pytest.skip("example-robot-data is not installed")
+    path = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix/share/example-robot-data/robots"
+    if not path.is_dir():
+        pytest.fail(f"example-robot-data is not installed (no {path}); pip install example-robot-data")
+    return path
 
 
 @dataclass

@@ -1,0 +1,75 @@
+"""Bad input raises a clear exception of the library's hierarchy; nothing crashes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import perturbid_rs as pr
+
+
+@pytest.fixture
+def robot():
+    return pr.robots.a465()
+
+
+def test_hierarchy():
+    for cls in (pr.ModelError, pr.InputError, pr.NumericalError, pr.FileError):
+        assert issubclass(cls, pr.PerturbidError)
+    assert issubclass(pr.PerturbidError, Exception)
+
+
+def test_wrong_shapes(robot):
+    z = np.zeros(6)
+    with pytest.raises(pr.InputError, match=r"q: expected shape \(6,\) or \(k, 6\), got shape \[5\]"):
+        robot.rnea(np.zeros(5), z, z)
+    with pytest.raises(pr.InputError, match="qd: expected shape"):
+        robot.rnea(z, np.zeros((2, 3, 6)), z)
+    with pytest.raises(pr.InputError, match="qdd: expected shape \\(3, 6\\) like the first argument"):
+        robot.rnea(np.zeros((3, 6)), np.zeros((3, 6)), np.zeros((4, 6)))
+    with pytest.raises(pr.InputError, match="like the first argument"):
+        robot.rnea(np.zeros((1, 6)), z, z)
+
+
+def test_non_finite_input(robot):
+    z = np.zeros(6)
+    bad = z.copy()
+    bad[2] = np.nan
+    with pytest.raises(pr.InputError, match="qd: entry 2 is NaN"):
+        robot.rnea(z, bad, z)
+    with pytest.raises(pr.InputError, match="tau: entry 2 is NaN"):
+        robot.forward_dynamics(z, z, bad)
+
+
+def test_non_numeric_input(robot):
+    with pytest.raises((TypeError, ValueError)):
+        robot.rnea(["a"] * 6, np.zeros(6), np.zeros(6))
+
+
+def test_lists_and_ints_are_accepted(robot):
+    assert robot.rnea([0] * 6, [0] * 6, [0] * 6).dtype == np.float64
+
+
+def test_bad_urdfs():
+    with pytest.raises(pr.FileError, match="nope.urdf"):
+        pr.Robot.from_urdf("/nope/nope.urdf")
+    with pytest.raises(pr.ModelError, match="not a valid URDF"):
+        pr.Robot.from_urdf_string("<robot name='x'><link></robot>")
+    with pytest.raises(pr.ModelError, match="<string>:1: joint 'j' is of type floating"):
+        pr.Robot.from_urdf_string(
+            "<robot name='x'><link name='a'/><link name='b'/><joint name='j' type='floating'>"
+            "<parent link='a'/><child link='b'/></joint></robot>"
+        )
+    with pytest.raises(pr.ModelError, match="triangle inequality"):
+        pr.Robot.from_urdf_string(pr.robots.a465_urdf("kinsheel2010"))
+    relaxed = pr.Robot.from_urdf_string(pr.robots.a465_urdf("kinsheel2010"), check_triangle_inequality=False)
+    assert relaxed.n == 6
+    with pytest.raises(pr.ModelError, match="lock 'nope'"):
+        pr.Robot.from_urdf_string(pr.robots.a465_urdf("physical"), lock={"nope": 0.0})
+    with pytest.raises(pr.ModelError, match="unknown robot"):
+        pr.robots.a465("nope")
+
+
+def test_lock_removes_the_joint():
+    r = pr.Robot.from_urdf_string(pr.robots.a465_urdf("physical"), lock={"joint6": 0.3})
+    assert r.n == 5 and "joint6" not in r.joint_names
