@@ -2,7 +2,9 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use perturbid_rs::robots::a465::{TABLE2_Q, TABLE2_QD, TABLE2_QDD};
-use perturbid_rs::{linearize, mass_matrix, rnea, rnea_derivatives, robots, Data};
+use perturbid_rs::{
+    forward_dynamics, gravity_torque, linearize, mass_matrix, rnea, rnea_derivatives, robots, Data,
+};
 use std::hint::black_box;
 
 fn dynamics(c: &mut Criterion) {
@@ -24,6 +26,23 @@ fn dynamics(c: &mut Criterion) {
     });
     c.bench_function("mass_matrix/a465/1", |b| {
         b.iter(|| mass_matrix(&model, &mut data, black_box(&q)).unwrap())
+    });
+    c.bench_function("gravity/a465/1", |b| {
+        b.iter(|| gravity_torque(&model, &mut data, black_box(&q)).unwrap())
+    });
+    let tau = TABLE2_QDD;
+    c.bench_function("forward_dynamics/a465/1", |b| {
+        b.iter(|| {
+            forward_dynamics(
+                &model,
+                &mut data,
+                black_box(&q),
+                black_box(&qd),
+                black_box(&tau),
+                true,
+            )
+            .unwrap()
+        })
     });
     c.bench_function("rnea_derivatives/a465/1", |b| {
         b.iter(|| {

@@ -68,6 +68,8 @@ impl Data {
         let nb = model.nbodies();
         let v6 = vec![Vector6::zeros(); nb];
         let m6 = vec![Matrix6::zeros(); nb];
+        // body-level results are only needed when bodies and dofs differ
+        let nc = if model.coupled { nb } else { 0 };
         Self {
             tau: DVector::zeros(n),
             g: DVector::zeros(n),
@@ -98,19 +100,10 @@ impl Data {
             dfdq: v6.clone(),
             dfdv: v6.clone(),
             dytj: v6,
-            tau_b: DVector::zeros(if model.coupled { nb } else { 0 }),
-            m_b: DMatrix::zeros(
-                if model.coupled { nb } else { 0 },
-                if model.coupled { nb } else { 0 },
-            ),
-            dq_b: DMatrix::zeros(
-                if model.coupled { nb } else { 0 },
-                if model.coupled { nb } else { 0 },
-            ),
-            dv_b: DMatrix::zeros(
-                if model.coupled { nb } else { 0 },
-                if model.coupled { nb } else { 0 },
-            ),
+            tau_b: DVector::zeros(nc),
+            m_b: DMatrix::zeros(nc, nc),
+            dq_b: DMatrix::zeros(nc, nc),
+            dv_b: DMatrix::zeros(nc, nc),
             chol: DMatrix::zeros(n, n),
         }
     }

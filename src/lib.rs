@@ -28,6 +28,6 @@ pub use algorithms::forward_dynamics::forward_dynamics;
 pub use algorithms::rnea::{bias_torque, gravity_torque, rnea};
 pub use data::Data;
 pub use error::{Error, Result};
-pub use linearization::{linearize, Linearization};
+pub use linearization::{linearize, linearize_into, Linearization};
 pub use model::{Body, JointKind, JointLimits, Model};
 pub use urdf::{model_from_urdf_file, model_from_urdf_str, LoadOptions};

@@ -3,9 +3,9 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::algorithms::derivatives::rnea_derivatives;
+use crate::algorithms::derivatives::derivatives_at;
 use crate::data::Data;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::Model;
 
 /// The linearisation of the inverse dynamics at `P = (q*, qd*, qdd*)`. Torques in N m (or N),
@@ -25,6 +25,19 @@ pub struct Linearization {
     pub g_static: DMatrix<f64>,
 }
 
+impl Linearization {
+    /// A linearisation of `nv` joints filled with zeros (a buffer for [`linearize_into`]).
+    pub fn zeros(nv: usize) -> Self {
+        Self {
+            torque: DVector::zeros(nv),
+            d: DMatrix::zeros(nv, nv),
+            h: DMatrix::zeros(nv, nv),
+            g: DMatrix::zeros(nv, nv),
+            g_static: DMatrix::zeros(nv, nv),
+        }
+    }
+}
+
 /// Linearises the inverse dynamics at `(q, qd, qdd)` (length `model.nv` each), analytically.
 /// `gravity` switches gravity on in every term.
 pub fn linearize(
@@ -35,15 +48,38 @@ pub fn linearize(
     qdd: &[f64],
     gravity: bool,
 ) -> Result<Linearization> {
-    let zeros = vec![0.0; model.nv];
-    rnea_derivatives(model, data, q, &zeros, &zeros, gravity)?;
-    let g_static = data.dtau_dq.clone();
-    rnea_derivatives(model, data, q, qd, qdd, gravity)?;
-    Ok(Linearization {
-        torque: data.tau.clone(),
-        d: data.m.clone(),
-        h: data.dtau_dv.clone(),
-        g: data.dtau_dq.clone(),
-        g_static,
-    })
+    let mut out = Linearization::zeros(model.nv);
+    linearize_into(model, data, q, qd, qdd, gravity, &mut out)?;
+    Ok(out)
+}
+
+/// [`linearize`] into a preallocated `out` (from [`Linearization::zeros`]): no allocation.
+/// Fails if `out` is not sized for `model.nv`.
+pub fn linearize_into(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    gravity: bool,
+    out: &mut Linearization,
+) -> Result<()> {
+    if out.torque.len() != model.nv || out.d.shape() != (model.nv, model.nv) {
+        return Err(Error::Shape {
+            argument: "out".to_string(),
+            expected: format!("a Linearization of {} joints", model.nv),
+            got: format!("{} joints", out.torque.len()),
+        });
+    }
+    model.check_vector("qd", qd)?;
+    model.check_vector("qdd", qdd)?;
+    // At rest first: Gs = d tau / d q at (q, 0, 0).
+    derivatives_at(model, data, q, None, None, gravity)?;
+    out.g_static.copy_from(&data.dtau_dq);
+    derivatives_at(model, data, q, Some(qd), Some(qdd), gravity)?;
+    out.torque.copy_from(&data.tau);
+    out.d.copy_from(&data.m);
+    out.h.copy_from(&data.dtau_dv);
+    out.g.copy_from(&data.dtau_dq);
+    Ok(())
 }

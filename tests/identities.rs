@@ -227,3 +227,25 @@ fn locked_joint_is_the_full_model_with_that_joint_held() {
     options.lock.insert("zz".to_string(), 0.3);
     assert!(model_from_urdf_str(&mimic_pair(true), "m.urdf", &options).is_err());
 }
+
+#[test]
+fn linearize_into_reuses_its_buffer_and_checks_its_size() {
+    let model = robots::builtin("a465").unwrap();
+    let mut data = Data::new(&model);
+    let mut rng = Rng(21);
+    let (q, qd, qdd) = (rng.vector(6, 1.0), rng.vector(6, 1.0), rng.vector(6, 1.0));
+    let mut out = perturbid_rs::Linearization::zeros(6);
+    perturbid_rs::linearize_into(&model, &mut data, &q, &qd, &qdd, true, &mut out).unwrap();
+    assert_eq!(
+        out,
+        linearize(&model, &mut data, &q, &qd, &qdd, true).unwrap()
+    );
+    let mut wrong = perturbid_rs::Linearization::zeros(5);
+    let e = perturbid_rs::linearize_into(&model, &mut data, &q, &qd, &qdd, true, &mut wrong)
+        .unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("out: expected a Linearization of 6 joints"),
+        "{e}"
+    );
+}

@@ -25,7 +25,19 @@ pub fn rnea_derivatives(
     qdd: &[f64],
     gravity: bool,
 ) -> Result<()> {
-    load_state(model, data, q, Some(qd), Some(qdd))?;
+    derivatives_at(model, data, q, Some(qd), Some(qdd), gravity)
+}
+
+/// [`rnea_derivatives`] with `qd` and `qdd` optional (absent = zero).
+pub(crate) fn derivatives_at(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    qd: Option<&[f64]>,
+    qdd: Option<&[f64]>,
+    gravity: bool,
+) -> Result<()> {
+    load_state(model, data, q, qd, qdd)?;
     let mut tau = std::mem::take(&mut data.tau);
     let mut m = std::mem::take(&mut data.m);
     let mut dq = std::mem::take(&mut data.dtau_dq);

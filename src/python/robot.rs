@@ -311,16 +311,18 @@ impl PyRobot {
         );
         py.detach(|| -> Result<()> {
             let mut data = self.data();
+            let mut lin = crate::Linearization::zeros(n);
             let c = &batch.columns;
             for s in 0..k {
                 let r = s * n..(s + 1) * n;
-                let lin = crate::linearize(
+                crate::linearize_into(
                     &self.model,
                     &mut data,
                     &c[0][r.clone()],
                     &c[1][r.clone()],
                     &c[2][r.clone()],
                     gravity,
+                    &mut lin,
                 )?;
                 torque[r].copy_from_slice(lin.torque.as_slice());
                 let rr = s * n * n..(s + 1) * n * n;
