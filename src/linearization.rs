@@ -71,15 +71,13 @@ pub fn linearize_into(
             got: format!("{} joints", out.torque.len()),
         });
     }
-    model.check_vector("qd", qd)?;
-    model.check_vector("qdd", qdd)?;
-    // At rest first: Gs = d tau / d q at (q, 0, 0).
-    derivatives_at(model, data, q, None, None, gravity)?;
-    out.g_static.copy_from(&data.dtau_dq);
     derivatives_at(model, data, q, Some(qd), Some(qdd), gravity)?;
     out.torque.copy_from(&data.tau);
     out.d.copy_from(&data.m);
     out.h.copy_from(&data.dtau_dv);
     out.g.copy_from(&data.dtau_dq);
+    // At rest: Gs = d tau / d q at (q, 0, 0).
+    derivatives_at(model, data, q, None, None, gravity)?;
+    out.g_static.copy_from(&data.dtau_dq);
     Ok(())
 }

@@ -169,6 +169,17 @@ impl Model {
         self.limits.iter().map(|l| l.acceleration).collect()
     }
 
+    /// Spatial acceleration given to the fixed base in the Newton-Euler recursions: upwards at g
+    /// when `gravity` is on (instead of applying gravity to every body), zero otherwise.
+    #[inline]
+    pub fn base_acceleration(&self, gravity: bool) -> Motion {
+        if gravity {
+            Motion::new(Vector3::zeros(), -self.gravity)
+        } else {
+            Motion::zeros()
+        }
+    }
+
     /// Total moving mass (kg).
     pub fn moving_mass(&self) -> f64 {
         self.bodies.iter().map(|b| b.inertia.mass).sum()

@@ -2,7 +2,7 @@
 //! "Analytical derivatives of rigid body dynamics algorithms" (RSS 2018), carried out in the
 //! base frame. Exact (no finite differences), O(n^2) for a chain.
 
-use nalgebra::{DMatrix, DVector, Vector3};
+use nalgebra::{DMatrix, DVector};
 
 use super::{contract_matrix, contract_vector, load_state};
 use crate::data::Data;
@@ -70,18 +70,9 @@ fn derivatives_loaded(
     dq: &mut DMatrix<f64>,
     dv: &mut DMatrix<f64>,
 ) {
-    // Base acceleration with gravity folded in: the base accelerates upwards at g.
-    let minus_g = Motion::new(
-        Vector3::zeros(),
-        if gravity {
-            -model.gravity
-        } else {
-            Vector3::zeros()
-        },
-    );
+    let minus_g = model.base_acceleration(gravity);
     for (i, b) in model.bodies.iter().enumerate() {
         let x = b.pose_in_parent(data.qb[i]);
-        data.li_mi[i] = x;
         let o_mi = match b.parent {
             Some(p) => data.o_mi[p].compose(&x),
             None => x,

@@ -57,15 +57,7 @@ pub fn bias_torque(
 
 /// RNEA on the body coordinates already in `data` (`qb`, `vb`, `ab`); torques into `out`.
 pub(crate) fn rnea_loaded(model: &Model, data: &mut Data, gravity: bool, out: &mut DVector<f64>) {
-    // The base accelerates upwards at g instead of applying gravity to every body.
-    let a0 = Motion::new(
-        nalgebra::Vector3::zeros(),
-        if gravity {
-            -model.gravity
-        } else {
-            nalgebra::Vector3::zeros()
-        },
-    );
+    let a0 = model.base_acceleration(gravity);
     for (i, b) in model.bodies.iter().enumerate() {
         let x = b.pose_in_parent(data.qb[i]);
         let s = b.motion_subspace();

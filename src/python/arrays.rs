@@ -52,15 +52,8 @@ pub(crate) fn read_batch(
             }
             _ => {}
         }
-        let values: Vec<f64> = arr.as_array().iter().copied().collect();
-        if let Some((index, &value)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(Error::NonFiniteInput {
-                argument: name.to_string(),
-                index,
-                value,
-            });
-        }
-        columns.push(values);
+        // Finiteness is checked by the algorithms, sample by sample (see `in_sample`).
+        columns.push(arr.as_array().iter().copied().collect());
     }
     let (k, batched) = first.unwrap_or((0, false));
     Ok(Batch {
@@ -68,6 +61,31 @@ pub(crate) fn read_batch(
         single: !batched,
         columns,
     })
+}
+
+impl Batch {
+    /// An error raised at sample `s` of this batch, its argument renamed `name[s]` for a batch.
+    pub fn in_sample(&self, s: usize, e: Error) -> Error {
+        if self.single {
+            return e;
+        }
+        match e {
+            Error::NonFiniteInput {
+                argument,
+                index,
+                value,
+            } => Error::NonFiniteInput {
+                argument: format!("{argument}[{s}]"),
+                index,
+                value,
+            },
+            Error::Numerical { operation, message } => Error::Numerical {
+                operation: format!("{operation} (sample {s})"),
+                message,
+            },
+            other => other,
+        }
+    }
 }
 
 /// A numpy array of `values` with shape `dims` prefixed by `k` unless `single`.

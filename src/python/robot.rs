@@ -67,7 +67,8 @@ impl PyRobot {
                     &mut data,
                     rows,
                     &mut out[s * size..(s + 1) * size],
-                )?;
+                )
+                .map_err(|e| batch.in_sample(s, e))?;
             }
             Ok(())
         })?;
@@ -323,7 +324,8 @@ impl PyRobot {
                     &c[2][r.clone()],
                     gravity,
                     &mut lin,
-                )?;
+                )
+                .map_err(|e| batch.in_sample(s, e))?;
                 torque[r].copy_from_slice(lin.torque.as_slice());
                 let rr = s * n * n..(s + 1) * n * n;
                 copy_matrix(&lin.d, &mut dm[rr.clone()]);

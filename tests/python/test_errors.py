@@ -39,6 +39,12 @@ def test_non_finite_input(robot):
         robot.rnea(z, bad, z)
     with pytest.raises(pr.InputError, match="tau: entry 2 is NaN"):
         robot.forward_dynamics(z, z, bad)
+    batch = np.zeros((3, 6))
+    batch[1, 4] = np.inf
+    with pytest.raises(pr.InputError, match=r"qdd\[1\]: entry 4 is inf"):
+        robot.rnea(np.zeros((3, 6)), np.zeros((3, 6)), batch)
+    with pytest.raises(pr.InputError, match=r"qd\[1\]: entry 4 is inf"):
+        robot.linearize(np.zeros((3, 6)), batch, np.zeros((3, 6)))
 
 
 def test_non_numeric_input(robot):
