@@ -156,6 +156,57 @@ pub enum Error {
     #[error("{operation}: {message}")]
     Numerical { operation: String, message: String },
 
+    /// A planned trajectory breaks a joint limit.
+    #[error("{context}: joint '{joint}' at t = {time:.4} s: {quantity} {value:.6} {unit} is outside the limit +-{limit:.6} {unit}{hint}")]
+    LimitViolation {
+        /// What was being planned, e.g. `experiment 'D' of the plan`.
+        context: String,
+        joint: String,
+        /// Time from the start of the trajectory (s).
+        time: f64,
+        /// `position`, `velocity` or `acceleration`.
+        quantity: &'static str,
+        value: f64,
+        /// For positions the limit is printed as the violated bound.
+        limit: f64,
+        unit: &'static str,
+        /// A suggestion, starting with "; " (or empty).
+        hint: String,
+    },
+
+    /// A position outside `[lower, upper]` (kept apart from [`Error::LimitViolation`] because the
+    /// range is not symmetric).
+    #[error("{context}: joint '{joint}' at t = {time:.4} s: position {value:.6} is outside [{lower:.6}, {upper:.6}]{hint}")]
+    PositionLimit {
+        context: String,
+        joint: String,
+        time: f64,
+        value: f64,
+        lower: f64,
+        upper: f64,
+        hint: String,
+    },
+
+    /// A least-squares design matrix without full column rank: the data do not excite some
+    /// directions.
+    #[error("{context}: the design matrix ({rows} x {cols}) has rank {rank} < {cols}; not excited: {missing}")]
+    RankDeficient {
+        context: String,
+        rows: usize,
+        cols: usize,
+        rank: usize,
+        /// The missing directions in terms of the named columns.
+        missing: String,
+    },
+
+    /// A recording that cannot be used: too short, unordered time, too few samples, ...
+    #[error("{recording}: {message}")]
+    Recording { recording: String, message: String },
+
+    /// A JSON document that is not a valid plan or model.
+    #[error("{context}: {message}")]
+    Json { context: String, message: String },
+
     /// A built-in robot or variant name that does not exist.
     #[error("unknown robot '{name}'; built-in robots: {}", available.join(", "))]
     UnknownRobot {

@@ -13,10 +13,16 @@
 pub mod algorithms;
 pub mod data;
 pub mod error;
+pub mod json;
 pub mod linearization;
+pub mod local;
 pub mod model;
+pub mod recording;
+pub mod regression;
 pub mod robots;
+pub mod simulation;
 pub mod spatial;
+pub mod trajectory;
 pub mod urdf;
 
 #[cfg(feature = "python")]
@@ -31,3 +37,6 @@ pub use error::{Error, Result};
 pub use linearization::{linearize, linearize_into, Linearization};
 pub use model::{Body, JointKind, JointLimits, Model};
 pub use urdf::{model_from_urdf_file, model_from_urdf_str, LoadOptions};
+pub use local::{identify_local, plan_experiments, LocalModel, OperatingPoint, Plan, PlanOptions};
+pub use recording::Recording;
+pub use simulation::{simulate_plan, Friction, SimulationOptions};

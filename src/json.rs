@@ -1,0 +1,45 @@
+//! JSON helpers shared by the saved plans and models: matrices as lists of rows, so a person can
+//! read them and other tools can load them.
+
+/// Serde adapter for `nalgebra::DMatrix<f64>` as a list of rows (`[[a11, a12], [a21, a22]]`).
+pub mod rows {
+    use nalgebra::DMatrix;
+    use serde::{de::Error as _, Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(m: &DMatrix<f64>, s: S) -> Result<S::Ok, S::Error> {
+        let rows: Vec<Vec<f64>> = m.row_iter().map(|r| r.iter().copied().collect()).collect();
+        rows.serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<DMatrix<f64>, D::Error> {
+        let rows = Vec::<Vec<f64>>::deserialize(d)?;
+        from_rows(&rows).map_err(D::Error::custom)
+    }
+
+    /// A matrix from rows of equal length.
+    pub fn from_rows(rows: &[Vec<f64>]) -> Result<DMatrix<f64>, String> {
+        let ncols = rows.first().map_or(0, Vec::len);
+        if let Some((i, r)) = rows.iter().enumerate().find(|(_, r)| r.len() != ncols) {
+            return Err(format!("matrix row {} has {} entries, row 1 has {}", i + 1, r.len(), ncols));
+        }
+        Ok(DMatrix::from_fn(rows.len(), ncols, |i, j| rows[i][j]))
+    }
+}
+
+/// Serde adapter for `Option<DMatrix<f64>>` as a list of rows or `null`.
+pub mod option_rows {
+    use nalgebra::DMatrix;
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(m: &Option<DMatrix<f64>>, s: S) -> Result<S::Ok, S::Error> {
+        match m {
+            Some(m) => super::rows::serialize(m, s),
+            None => s.serialize_none(),
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<DMatrix<f64>>, D::Error> {
+        let rows = Option::<Vec<Vec<f64>>>::deserialize(d)?;
+        rows.map(|r| super::rows::from_rows(&r).map_err(serde::de::Error::custom)).transpose()
+    }
+}

@@ -1,0 +1,224 @@
+//! The separated least-squares identification of the local model (METHOD.md section 4) from a
+//! plan and one recording per experiment.
+
+use nalgebra::DMatrix;
+
+use super::crossing::{detect_offset, values_at, CrossingValues, FitOptions};
+use super::model::{Estimate, Estimator, LocalModel, LOCAL_MODEL_FORMAT};
+use super::operating_point::OperatingPoint;
+use super::plan::{Experiment, ExperimentKind, Plan};
+use crate::error::{Error, Result};
+use crate::recording::Recording;
+use crate::regression::{least_squares, LeastSquares};
+
+/// Where the crossing times come from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CrossingTimes {
+    /// The plan's times, the recording starting with the plan (t = 0 at the plan's start).
+    Planned,
+    /// The plan's times shifted by the offset between plan and recording found in the data
+    /// (searched within `+-max_shift` s).
+    Detected { max_shift: f64 },
+}
+
+/// Options of [`identify_local`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IdentifyOptions {
+    pub times: CrossingTimes,
+    pub fit: FitOptions,
+    pub estimator: Estimator,
+}
+
+impl Default for IdentifyOptions {
+    /// Planned times, the default fit, the separated estimator.
+    fn default() -> Self {
+        Self { times: CrossingTimes::Planned, fit: FitOptions::default(), estimator: Estimator::Separated }
+    }
+}
+
+/// The values read at every crossing of one experiment (and its reference posture).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExperimentValues {
+    pub kind: ExperimentKind,
+    /// Offset (s) added to the planned times.
+    pub offset: f64,
+    pub crossings: Vec<CrossingValues>,
+    pub reference: Option<CrossingValues>,
+}
+
+/// Reads the values at every crossing of `experiment` from `rec`.
+pub fn experiment_values(experiment: &Experiment, rec: &Recording, options: &IdentifyOptions) -> Result<ExperimentValues> {
+    let offset = match options.times {
+        CrossingTimes::Planned => 0.0,
+        CrossingTimes::Detected { max_shift } => detect_offset(experiment, rec, max_shift)?,
+    };
+    let half = options.fit.window.unwrap_or(experiment.window);
+    if !(half.is_finite() && half > 0.0) {
+        return Err(Error::InvalidArgument { argument: "window".into(), message: format!("{half}; expected a positive number of seconds") });
+    }
+    let name = experiment.kind.name();
+    let crossings = experiment
+        .crossings
+        .iter()
+        .enumerate()
+        .map(|(k, c)| values_at(rec, c.time + offset, half, &options.fit, &format!("experiment '{name}', crossing {k}")))
+        .collect::<Result<Vec<_>>>()?;
+    let reference = experiment
+        .reference
+        .as_ref()
+        .map(|c| values_at(rec, c.time + offset, half, &options.fit, &format!("experiment '{name}', reference posture")))
+        .transpose()?;
+    Ok(ExperimentValues { kind: experiment.kind, offset, crossings, reference })
+}
+
+fn state(c: &CrossingValues, v: usize) -> &[f64] {
+    match v {
+        0 => &c.q,
+        1 => &c.qd,
+        _ => &c.qdd,
+    }
+}
+
+fn estimate(ls: LeastSquares) -> Estimate {
+    Estimate {
+        cond: ls.cond,
+        residual_rms: ls.residual_rms.iter().copied().collect(),
+        crossings: ls.rows,
+        matrix: ls.coef,
+        stderr: ls.stderr,
+    }
+}
+
+/// Identifies the local model from `plan` and `recordings` (one per experiment of the plan, in
+/// the plan's order, each with the plan's N joints).
+///
+/// `T*` is the mean torque at the nominal crossings, and the model's operating point the mean
+/// state there. For G, H and D: `Y` rows `tau_k - T*`, `X` rows the measured deltas of the
+/// perturbed variable from that point; G-static: `tau_k - tau_ref` against `q_k - q_ref` at the
+/// reference posture. One least-squares solve each (faer SVD). The combined estimate stacks the
+/// nominal, G, H and D crossings against `[dqdd dqd dq]`.
+pub fn identify_local(plan: &Plan, recordings: &[Recording], options: &IdentifyOptions) -> Result<LocalModel> {
+    let n = plan.n();
+    if recordings.len() != plan.experiments.len() {
+        return Err(Error::InvalidArgument {
+            argument: "recordings".into(),
+            message: format!(
+                "{} recordings for {} experiments ({}); give one per experiment, in the plan's order",
+                recordings.len(),
+                plan.experiments.len(),
+                plan.experiments.iter().map(|e| e.kind.name()).collect::<Vec<_>>().join(", ")
+            ),
+        });
+    }
+    let mut values = Vec::new();
+    for (e, r) in plan.experiments.iter().zip(recordings) {
+        if r.n != n {
+            return Err(Error::Recording {
+                recording: r.name.clone(),
+                message: format!("{} joints; the plan (experiment '{}') has {n}", r.n, e.kind.name()),
+            });
+        }
+        values.push(experiment_values(e, r, options)?);
+    }
+    let find = |kind| values.iter().find(|v: &&ExperimentValues| v.kind == kind);
+    let names = |prefix: &str| -> Vec<String> { plan.joint_names.iter().map(|j| format!("{prefix}({j})")).collect() };
+
+    // T* and the measured operating point
+    let nominal = find(ExperimentKind::Nominal);
+    let needs_nominal = values.iter().any(|v| matches!(v.kind, ExperimentKind::GDynamic | ExperimentKind::H | ExperimentKind::D));
+    let (torque, torque_stderr, op) = match nominal {
+        Some(v) => {
+            let k = v.crossings.len() as f64;
+            let mean = |f: &dyn Fn(&CrossingValues) -> &[f64]| -> Vec<f64> {
+                (0..n).map(|j| v.crossings.iter().map(|c| f(c)[j]).sum::<f64>() / k).collect()
+            };
+            let tau = mean(&|c| &c.tau);
+            let se = (0..n)
+                .map(|j| {
+                    let ss: f64 = v.crossings.iter().map(|c| (c.tau[j] - tau[j]).powi(2)).sum();
+                    if k > 1.0 { (ss / (k - 1.0) / k).sqrt() } else { f64::NAN }
+                })
+                .collect();
+            let op = OperatingPoint { q: mean(&|c| &c.q), qd: mean(&|c| &c.qd), qdd: mean(&|c| &c.qdd) };
+            (tau, se, op)
+        }
+        None if needs_nominal => {
+            return Err(Error::InvalidArgument {
+                argument: "plan".into(),
+                message: "the plan has no nominal experiment, which the G, H and D regressions need for T*".into(),
+            })
+        }
+        None => (vec![f64::NAN; n], vec![f64::NAN; n], plan.op.clone()),
+    };
+    let op_state = [op.q.clone(), op.qd.clone(), op.qdd.clone()];
+
+    let separated = |kind: ExperimentKind, prefix: &str| -> Result<Option<Estimate>> {
+        let Some(v) = find(kind) else { return Ok(None) };
+        let var = kind.perturbed().expect("perturbed experiment");
+        let k = v.crossings.len();
+        let (base_tau, base_x): (&[f64], &[f64]) = match &v.reference {
+            Some(r) => (&r.tau, &r.q),
+            None => (&torque, &op_state[var]),
+        };
+        let x = DMatrix::from_fn(k, n, |i, j| state(&v.crossings[i], var)[j] - base_x[j]);
+        let y = DMatrix::from_fn(k, n, |i, j| v.crossings[i].tau[j] - base_tau[j]);
+        let ls = least_squares(&x, &y, &format!("experiment '{}'", kind.name()), &names(prefix))?;
+        Ok(Some(estimate(ls)))
+    };
+    let d = separated(ExperimentKind::D, "dqdd")?;
+    let h = separated(ExperimentKind::H, "dqd")?;
+    let g = separated(ExperimentKind::GDynamic, "dq")?;
+    let g_static = separated(ExperimentKind::GStatic, "dq")?;
+
+    let combined = if d.is_some() && h.is_some() && g.is_some() {
+        let rows: Vec<&CrossingValues> = values
+            .iter()
+            .filter(|v| v.kind != ExperimentKind::GStatic)
+            .flat_map(|v| v.crossings.iter())
+            .collect();
+        let x = DMatrix::from_fn(rows.len(), 3 * n, |i, c| {
+            let var = 2 - c / n; // columns: dqdd, dqd, dq
+            state(rows[i], var)[c % n] - op_state[var][c % n]
+        });
+        let y = DMatrix::from_fn(rows.len(), n, |i, j| rows[i].tau[j] - torque[j]);
+        let columns: Vec<String> = [names("dqdd"), names("dqd"), names("dq")].concat();
+        Some(estimate(least_squares(&x, &y, "combined estimate (nominal, G, H, D)", &columns)?))
+    } else {
+        None
+    };
+
+    let (d, h, g) = match (options.estimator, &combined) {
+        (Estimator::Separated, _) => (d, h, g),
+        (Estimator::Combined, Some(c)) => {
+            let block = |b: usize| Estimate {
+                matrix: c.matrix.columns(b * n, n).into_owned(),
+                stderr: c.stderr.columns(b * n, n).into_owned(),
+                cond: c.cond,
+                residual_rms: c.residual_rms.clone(),
+                crossings: c.crossings,
+            };
+            (Some(block(0)), Some(block(1)), Some(block(2)))
+        }
+        (Estimator::Combined, None) => {
+            return Err(Error::InvalidArgument {
+                argument: "estimator".into(),
+                message: "the combined estimator needs the nominal, G, H and D experiments".into(),
+            })
+        }
+    };
+    Ok(LocalModel {
+        format: LOCAL_MODEL_FORMAT.into(),
+        robot: plan.robot.clone(),
+        joint_names: plan.joint_names.clone(),
+        op,
+        planned_op: plan.op.clone(),
+        estimator: options.estimator,
+        torque,
+        torque_stderr,
+        d,
+        h,
+        g,
+        g_static,
+        combined,
+    })
+}

@@ -1,0 +1,145 @@
+//! The identified local model `tau ~= T* + D* dqdd + H* dqd + G* dq` near the operating point,
+//! with its uncertainty; saved as JSON.
+
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+use super::operating_point::OperatingPoint;
+use crate::error::{Error, Result};
+use crate::model::check_finite_vector;
+
+/// Version tag of the JSON format.
+pub const LOCAL_MODEL_FORMAT: &str = "perturbid-local-model/1";
+
+/// One identified matrix with its statistics.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Estimate {
+    /// N x N (row = torque, column = joint); N x 3N `[D H G]` for the combined estimate.
+    #[serde(with = "crate::json::rows")]
+    pub matrix: DMatrix<f64>,
+    /// cond(X) of the design, columns scaled to unit norm (see [`crate::regression`]).
+    pub cond: f64,
+    /// Per-joint RMS of the regression residuals (N m).
+    pub residual_rms: Vec<f64>,
+    /// Standard error of every entry of `matrix` (same shape).
+    #[serde(with = "crate::json::rows")]
+    pub stderr: DMatrix<f64>,
+    /// Crossings (rows) used.
+    pub crossings: usize,
+}
+
+/// Which estimate fills `D`, `H` and `G`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Estimator {
+    /// One regression per experiment with its own perturbed variable (the paper).
+    Separated,
+    /// All crossings stacked, `Gamma = [D H G] [dqdd; dqd; dq]`, with the measured deltas of
+    /// every variable (absorbs tracking errors; METHOD.md section 4).
+    Combined,
+}
+
+impl Estimator {
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "separated" => Ok(Estimator::Separated),
+            "combined" => Ok(Estimator::Combined),
+            other => Err(Error::InvalidArgument {
+                argument: "estimator".into(),
+                message: format!("'{other}'; expected 'separated' or 'combined'"),
+            }),
+        }
+    }
+}
+
+/// The local model at an operating point.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LocalModel {
+    pub format: String,
+    pub robot: String,
+    pub joint_names: Vec<String>,
+    /// The operating point as measured at the nominal crossings (mean), where `torque` holds;
+    /// predictions are deltas from it.
+    pub op: OperatingPoint,
+    /// The operating point the plan asked for.
+    pub planned_op: OperatingPoint,
+    pub estimator: Estimator,
+    /// `T*` (N m): mean torque at the nominal crossings.
+    pub torque: Vec<f64>,
+    /// Standard error of `T*` (sample standard deviation / sqrt(K)).
+    pub torque_stderr: Vec<f64>,
+    /// `D*`, `H*`, `G*` (dynamic) and `Gs` (static), when their experiment was run.
+    pub d: Option<Estimate>,
+    pub h: Option<Estimate>,
+    pub g: Option<Estimate>,
+    pub g_static: Option<Estimate>,
+    /// The combined estimate `[D H G]` (N x 3N), when the G, H and D experiments were run.
+    pub combined: Option<Estimate>,
+}
+
+impl LocalModel {
+    /// Number of joints.
+    pub fn n(&self) -> usize {
+        self.torque.len()
+    }
+
+    fn part<'a>(e: &'a Option<Estimate>, name: &str) -> Result<&'a DMatrix<f64>> {
+        e.as_ref().map(|e| &e.matrix).ok_or_else(|| Error::InvalidArgument {
+            argument: "predict".into(),
+            message: format!("the model has no {name}: its plan had no {name} experiment"),
+        })
+    }
+
+    /// Predicted torque (N m, length N) at `(q, qd, qdd)` (length N each):
+    /// `T* + D* (qdd - qdd*) + H* (qd - qd*) + G* (q - q*)`.
+    pub fn predict(&self, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<Vec<f64>> {
+        let n = self.n();
+        check_finite_vector("q", q, n)?;
+        check_finite_vector("qd", qd, n)?;
+        check_finite_vector("qdd", qdd, n)?;
+        let (d, h, g) = (Self::part(&self.d, "D")?, Self::part(&self.h, "H")?, Self::part(&self.g, "G")?);
+        let delta = |x: &[f64], x0: &[f64]| DVector::from_fn(n, |j, _| x[j] - x0[j]);
+        let tau = DVector::from_column_slice(&self.torque)
+            + d * delta(qdd, &self.op.qdd)
+            + h * delta(qd, &self.op.qd)
+            + g * delta(q, &self.op.q);
+        Ok(tau.as_slice().to_vec())
+    }
+
+    /// The model as pretty-printed JSON (matrices as lists of rows).
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a local model always serialises")
+    }
+
+    /// A model from [`LocalModel::to_json`] text; checks the format tag and every shape.
+    pub fn from_json(text: &str) -> Result<Self> {
+        let m: LocalModel = serde_json::from_str(text).map_err(|e| Error::Json {
+            context: "local model".into(),
+            message: format!("line {}, column {}: {e}", e.line(), e.column()),
+        })?;
+        let bad = |message: String| Error::Json { context: "local model".into(), message };
+        if m.format != LOCAL_MODEL_FORMAT {
+            return Err(bad(format!("format '{}', expected '{LOCAL_MODEL_FORMAT}'", m.format)));
+        }
+        let n = m.n();
+        for (what, len) in [
+            ("joint_names", m.joint_names.len()),
+            ("torque_stderr", m.torque_stderr.len()),
+            ("op.q", m.op.q.len()),
+            ("op.qd", m.op.qd.len()),
+            ("op.qdd", m.op.qdd.len()),
+        ] {
+            if len != n {
+                return Err(bad(format!("{what} has {len} entries, torque has {n}")));
+            }
+        }
+        for (what, e, cols) in [("D", &m.d, n), ("H", &m.h, n), ("G", &m.g, n), ("G_static", &m.g_static, n), ("combined", &m.combined, 3 * n)] {
+            if let Some(e) = e {
+                if e.matrix.shape() != (n, cols) || e.stderr.shape() != (n, cols) || e.residual_rms.len() != n {
+                    return Err(bad(format!("{what} is not {n} x {cols}")));
+                }
+            }
+        }
+        Ok(m)
+    }
+}

@@ -1,0 +1,162 @@
+//! The perturbations of an experiment (the paper's Sec. IV): K deltas of the perturbed variable
+//! around the operating point, in symmetric `+delta, -delta` pairs.
+
+use nalgebra::DMatrix;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rand_distr::StandardNormal;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+
+/// How the K perturbations are chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Design {
+    /// The paper's draws near the nominal (its Fig. 1): every joint uniform in `[-size, size]`,
+    /// seeded.
+    Random,
+    /// A designed set with `cond(X) = 1` once each column is divided by its joint's size: the
+    /// columns of a Sylvester-Hadamard matrix when K/2 is a power of two >= N (every joint at
+    /// full size in every crossing), otherwise seeded random orthonormal columns.
+    Orthogonal,
+}
+
+impl Design {
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "random" => Ok(Design::Random),
+            "orthogonal" | "designed" => Ok(Design::Orthogonal),
+            other => Err(Error::InvalidArgument {
+                argument: "design".into(),
+                message: format!("'{other}' is not a design; expected 'random' or 'orthogonal'"),
+            }),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Design::Random => "random",
+            Design::Orthogonal => "orthogonal",
+        }
+    }
+}
+
+/// A perturbation size: per joint, in the variable's units, or as a fraction of the joint's
+/// limit (position: of the range `upper - lower`; velocity and acceleration: of the limit).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Size {
+    Absolute(Vec<f64>),
+    Fraction(f64),
+}
+
+impl Size {
+    /// The size of every joint. `limits` are the joint's limits of this variable (range for
+    /// positions); where a limit is infinite, `fallback` (absolute, in the variable's units)
+    /// is used.
+    pub fn resolve(&self, argument: &str, limits: &[f64], fallback: f64) -> Result<Vec<f64>> {
+        let sizes: Vec<f64> = match self {
+            Size::Absolute(v) => {
+                if v.len() != limits.len() {
+                    return Err(Error::Shape {
+                        argument: argument.into(),
+                        expected: format!("{} sizes (one per joint)", limits.len()),
+                        got: format!("{} sizes", v.len()),
+                    });
+                }
+                v.clone()
+            }
+            Size::Fraction(f) => limits
+                .iter()
+                .map(|&l| if l.is_finite() { f * l } else { fallback })
+                .collect(),
+        };
+        if let Some((j, s)) = sizes.iter().enumerate().find(|(_, s)| !(s.is_finite() && **s > 0.0)) {
+            return Err(Error::InvalidArgument {
+                argument: format!("{argument}[{j}]"),
+                message: format!("perturbation size {s}; expected a positive finite number"),
+            });
+        }
+        Ok(sizes)
+    }
+}
+
+/// Default perturbation sizes: 1 % of the position range, 5 % of the speed limit, 5 % of the
+/// acceleration limit; where a limit is infinite, 0.02 rad, 0.1 rad/s, 0.5 rad/s^2.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Sizes {
+    pub position: Size,
+    pub velocity: Size,
+    pub acceleration: Size,
+}
+
+impl Default for Sizes {
+    fn default() -> Self {
+        Self {
+            position: Size::Fraction(0.01),
+            velocity: Size::Fraction(0.05),
+            acceleration: Size::Fraction(0.05),
+        }
+    }
+}
+
+/// Fallback sizes where a limit is infinite (position, velocity, acceleration).
+pub const FALLBACK_SIZES: [f64; 3] = [0.02, 0.1, 0.5];
+
+/// `count x n` perturbations of `design`, joint `j` scaled by `size[j]`. With `symmetric`, rows
+/// come in pairs `(+delta, -delta)` (rows `2i` and `2i + 1`), which needs an even `count >= 2n`;
+/// otherwise `count >= n`. Seeded by `seed`.
+pub fn perturbations(design: Design, count: usize, size: &[f64], symmetric: bool, seed: u64) -> Result<DMatrix<f64>> {
+    let n = size.len();
+    let needed = if symmetric { 2 * n } else { n };
+    if count < needed || (symmetric && count % 2 == 1) {
+        return Err(Error::InvalidArgument {
+            argument: "n (perturbations per experiment)".into(),
+            message: if symmetric {
+                format!("{count}; symmetric pairs need an even number >= 2N = {needed}")
+            } else {
+                format!("{count}; need at least N = {n}")
+            },
+        });
+    }
+    let m = if symmetric { count / 2 } else { count };
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let unit = match design {
+        Design::Random => DMatrix::from_fn(m, n, |_, _| rng.random_range(-1.0..=1.0)),
+        Design::Orthogonal => orthogonal_unit(m, n, &mut rng),
+    };
+    let mut out = DMatrix::zeros(count, n);
+    for i in 0..m {
+        for j in 0..n {
+            let v = unit[(i, j)] * size[j];
+            if symmetric {
+                out[(2 * i, j)] = v;
+                out[(2 * i + 1, j)] = -v;
+            } else {
+                out[(i, j)] = v;
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// An `m x n` matrix (m >= n) with orthogonal columns of equal norm and entries in [-1, 1].
+fn orthogonal_unit(m: usize, n: usize, rng: &mut ChaCha8Rng) -> DMatrix<f64> {
+    if m.is_power_of_two() && m >= n {
+        // Sylvester: H[i][j] = (-1)^popcount(i & j). Skip the all-ones column when possible so
+        // that no crossing moves every joint the same way.
+        let skip = usize::from(m > n);
+        return DMatrix::from_fn(m, n, |i, j| {
+            if (i & (j + skip)).count_ones() % 2 == 0 {
+                1.0
+            } else {
+                -1.0
+            }
+        });
+    }
+    let g = DMatrix::from_fn(m, n, |_, _| rng.sample::<f64, _>(StandardNormal));
+    let q = g.qr().q();
+    let max = q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    q / max
+}

@@ -1,0 +1,398 @@
+//! The experiment plan (the paper's Table 1): for an operating point, the nominal, G-static,
+//! G-dynamic, H and D experiments, each a continuous trajectory that starts and ends at rest and
+//! passes the perturbed operating point K times.
+
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+use super::operating_point::OperatingPoint;
+use super::perturbation::{perturbations, Design, Sizes, FALLBACK_SIZES};
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::trajectory::{check_limits, transition, Segment, SegmentKind, Trajectory, TransitionLimits};
+
+/// The kind of an experiment (METHOD.md section 3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub enum ExperimentKind {
+    /// Step 1: K crossings of P itself; `T*` is the mean torque.
+    #[serde(rename = "nominal")]
+    Nominal,
+    /// Step 2: at rest at `q* + dq_k`; `tau_k - tau_rest(q*) = Gs dq_k`.
+    #[serde(rename = "G_static")]
+    GStatic,
+    /// Extension: crossings of `(q* + dq_k, qd*, qdd*)`; `tau_k - T* = G* dq_k`.
+    #[serde(rename = "G")]
+    GDynamic,
+    /// Step 3: crossings of `(q*, qd* + dqd_k, qdd*)`; `tau_k - T* = H* dqd_k`.
+    #[serde(rename = "H")]
+    H,
+    /// Step 4: crossings of `(q*, qd*, qdd* + dqdd_k)`; `tau_k - T* = D* dqdd_k`.
+    #[serde(rename = "D")]
+    D,
+}
+
+impl ExperimentKind {
+    pub const ALL: [ExperimentKind; 5] = [
+        ExperimentKind::Nominal,
+        ExperimentKind::GStatic,
+        ExperimentKind::GDynamic,
+        ExperimentKind::H,
+        ExperimentKind::D,
+    ];
+
+    /// The name used in files and messages: `nominal`, `G_static`, `G`, `H`, `D`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ExperimentKind::Nominal => "nominal",
+            ExperimentKind::GStatic => "G_static",
+            ExperimentKind::GDynamic => "G",
+            ExperimentKind::H => "H",
+            ExperimentKind::D => "D",
+        }
+    }
+
+    pub fn parse(name: &str) -> Result<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name).ok_or_else(|| Error::InvalidArgument {
+            argument: "experiments".into(),
+            message: format!("'{name}' is not an experiment; expected one of nominal, G_static, G, H, D"),
+        })
+    }
+
+    /// Which state variable the experiment perturbs: 0 = position, 1 = velocity,
+    /// 2 = acceleration, `None` for the nominal experiment.
+    pub fn perturbed(self) -> Option<usize> {
+        match self {
+            ExperimentKind::Nominal => None,
+            ExperimentKind::GStatic | ExperimentKind::GDynamic => Some(0),
+            ExperimentKind::H => Some(1),
+            ExperimentKind::D => Some(2),
+        }
+    }
+}
+
+/// A planned crossing: the time (s from the start of the experiment) and the state the robot
+/// passes then.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Crossing {
+    pub time: f64,
+    pub q: Vec<f64>,
+    pub qd: Vec<f64>,
+    pub qdd: Vec<f64>,
+}
+
+/// One experiment: its perturbations, its crossings and its trajectory.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Experiment {
+    pub kind: ExperimentKind,
+    /// `K x N` planned perturbations of the perturbed variable (zeros for the nominal one).
+    #[serde(with = "crate::json::rows")]
+    pub deltas: DMatrix<f64>,
+    /// The K crossings in time order.
+    pub crossings: Vec<Crossing>,
+    /// G-static only: the rest posture at `q*` the static torques are measured against.
+    pub reference: Option<Crossing>,
+    /// Half-width (s) of the window around each crossing time in which the planned trajectory is
+    /// exactly the crossing's quadratic (or the rest posture).
+    pub window: f64,
+    pub trajectory: Trajectory,
+}
+
+impl Experiment {
+    /// Duration (s).
+    pub fn duration(&self) -> f64 {
+        self.trajectory.end() - self.trajectory.start()
+    }
+}
+
+/// Options of [`plan_experiments`]; [`PlanOptions::default`] documents the defaults.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanOptions {
+    /// Experiments to plan (default: all five, in the order of [`ExperimentKind::ALL`]).
+    pub experiments: Vec<ExperimentKind>,
+    /// Perturbation design (default [`Design::Random`], as in the paper).
+    pub design: Design,
+    /// Perturbations per experiment, K (default `2 N`).
+    pub count: Option<usize>,
+    /// Symmetric `+-` pairs (default true): cancels the even-order terms of H and G.
+    pub symmetric: bool,
+    pub seed: u64,
+    /// Sampling rate of the trajectories (Hz, default 1000).
+    pub rate: f64,
+    pub sizes: Sizes,
+    /// Half-width of each crossing window (s, default 0.05): the trajectory is the crossing's
+    /// quadratic on `[t_c - window, t_c + window]`.
+    pub window: f64,
+    /// How long each static posture is held (s, default 1.0).
+    pub dwell: f64,
+    /// Fraction of the speed and acceleration limits transitions may use (default 0.8).
+    pub margin: f64,
+    /// Speed and acceleration bounds for transitions of joints whose URDF gives none
+    /// (default 1 rad/s and 4 rad/s^2).
+    pub default_velocity: f64,
+    pub default_acceleration: f64,
+    /// Shortest transition (s, default 0.2); the longest tried is 30 s.
+    pub min_transition: f64,
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        Self {
+            experiments: ExperimentKind::ALL.to_vec(),
+            design: Design::Random,
+            count: None,
+            symmetric: true,
+            seed: 0,
+            rate: 1000.0,
+            sizes: Sizes::default(),
+            window: 0.05,
+            dwell: 1.0,
+            margin: 0.8,
+            default_velocity: 1.0,
+            default_acceleration: 4.0,
+            min_transition: 0.2,
+        }
+    }
+}
+
+/// A plan: the operating point and its experiments, for one robot.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Plan {
+    /// Robot name and joint names (the plan is only valid for this robot).
+    pub robot: String,
+    pub joint_names: Vec<String>,
+    pub op: OperatingPoint,
+    /// Sampling rate (Hz) of the trajectories.
+    pub rate: f64,
+    pub design: Design,
+    pub seed: u64,
+    pub experiments: Vec<Experiment>,
+}
+
+impl Plan {
+    /// Number of joints.
+    pub fn n(&self) -> usize {
+        self.op.n()
+    }
+
+    /// The experiment of `kind`, if planned.
+    pub fn experiment(&self, kind: ExperimentKind) -> Option<&Experiment> {
+        self.experiments.iter().find(|e| e.kind == kind)
+    }
+
+    /// The plan as pretty-printed JSON.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a plan always serialises")
+    }
+
+    /// A plan from [`Plan::to_json`] text.
+    pub fn from_json(text: &str) -> Result<Self> {
+        let plan: Plan = serde_json::from_str(text).map_err(|e| Error::Json {
+            context: "plan".into(),
+            message: format!("line {}, column {}: {e}", e.line(), e.column()),
+        })?;
+        let n = plan.n();
+        let bad = |m: String| Error::Json { context: "plan".into(), message: m };
+        if plan.joint_names.len() != n || plan.op.qd.len() != n || plan.op.qdd.len() != n {
+            return Err(bad(format!("the operating point and joint names disagree on the number of joints ({n})")));
+        }
+        for e in &plan.experiments {
+            if e.trajectory.n != n || e.deltas.ncols() != n || e.trajectory.segments.is_empty() {
+                return Err(bad(format!("experiment '{}' is not for {n} joints", e.kind.name())));
+            }
+            if e.trajectory.segments.iter().any(|s| s.coeffs.len() != n) {
+                return Err(bad(format!("experiment '{}' has a segment that is not for {n} joints", e.kind.name())));
+            }
+        }
+        if !(plan.rate.is_finite() && plan.rate > 0.0) {
+            return Err(bad(format!("rate {} is not a positive number", plan.rate)));
+        }
+        Ok(plan)
+    }
+}
+
+/// Plans the experiments at `op` for `model`.
+///
+/// Every experiment is one trajectory sampled at `options.rate`: from rest at `q*`, quintic
+/// transitions (C2) lead into each crossing window, where the trajectory is the crossing's
+/// quadratic (eq. 11) for `+-window`, and finally back to rest at `q*`. The G-static experiment
+/// instead holds `q*` (the reference) and then each `q* + dq_k` at rest for `dwell`. Crossing
+/// times lie on the sampling grid. Transitions are as short as the limits (times `margin`)
+/// allow. The sampled plan is checked against the model's position, velocity and acceleration
+/// limits; a plan that breaks one is refused with the experiment, joint, time and limit.
+pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOptions) -> Result<Plan> {
+    op.check(model)?;
+    let n = model.nv;
+    let o = options;
+    if !(o.rate.is_finite() && o.rate > 0.0) {
+        return Err(Error::InvalidArgument { argument: "rate".into(), message: format!("{}; expected a positive number of Hz", o.rate) });
+    }
+    let window_samples = (o.window * o.rate).round() as usize;
+    if window_samples < 2 {
+        return Err(Error::InvalidArgument {
+            argument: "window".into(),
+            message: format!("{} s holds fewer than 2 samples each side at {} Hz", o.window, o.rate),
+        });
+    }
+    let dwell_samples = (o.dwell * o.rate).round() as usize;
+    if dwell_samples < 4 {
+        return Err(Error::InvalidArgument { argument: "dwell".into(), message: format!("{} s is too short at {} Hz", o.dwell, o.rate) });
+    }
+    if !(o.margin > 0.0 && o.margin <= 1.0) {
+        return Err(Error::InvalidArgument { argument: "margin".into(), message: format!("{}; expected a fraction in (0, 1]", o.margin) });
+    }
+    let count = o.count.unwrap_or(2 * n);
+    let range: Vec<f64> = model.limits.iter().map(|l| l.upper - l.lower).collect();
+    let sizes = [
+        o.sizes.position.resolve("position size", &range, FALLBACK_SIZES[0])?,
+        o.sizes.velocity.resolve("velocity size", &model.velocity_limit(), FALLBACK_SIZES[1])?,
+        o.sizes.acceleration.resolve("acceleration size", &model.acceleration_limit(), FALLBACK_SIZES[2])?,
+    ];
+    let lim = TransitionLimits {
+        lower: model.lower(),
+        upper: model.upper(),
+        velocity: model.limits.iter().map(|l| o.margin * if l.velocity.is_finite() { l.velocity } else { o.default_velocity }).collect(),
+        acceleration: model
+            .limits
+            .iter()
+            .map(|l| o.margin * if l.acceleration.is_finite() { l.acceleration } else { o.default_acceleration })
+            .collect(),
+    };
+    let mut experiments = Vec::new();
+    for (index, &kind) in o.experiments.iter().enumerate() {
+        if o.experiments[..index].contains(&kind) {
+            return Err(Error::InvalidArgument { argument: "experiments".into(), message: format!("'{}' is listed twice", kind.name()) });
+        }
+        let seed = o.seed.wrapping_add(1000 * index as u64 + 1);
+        let deltas = match kind.perturbed() {
+            None => DMatrix::zeros(count, n),
+            Some(v) => perturbations(o.design, count, &sizes[v], o.symmetric, seed)?,
+        };
+        let mut b = Builder::new(n, o.rate, &lim, o.min_transition, &op.q);
+        let rest_at = |q: &[f64]| Crossing { time: 0.0, q: q.to_vec(), qd: vec![0.0; n], qdd: vec![0.0; n] };
+        let (crossings, reference, window) = if kind == ExperimentKind::GStatic {
+            let reference = b.dwell(SegmentKind::Reference, rest_at(&op.q), dwell_samples);
+            let crossings = (0..count)
+                .map(|k| {
+                    let q: Vec<f64> = (0..n).map(|j| op.q[j] + deltas[(k, j)]).collect();
+                    b.dwell(SegmentKind::Dwell { index: k }, rest_at(&q), dwell_samples)
+                })
+                .collect();
+            // Fit windows: the middle 80 % of each dwell.
+            (crossings, Some(reference), 0.4 * dwell_samples as f64 / o.rate)
+        } else {
+            let crossings = (0..count)
+                .map(|k| {
+                    let mut c = Crossing { time: 0.0, q: op.q.clone(), qd: op.qd.clone(), qdd: op.qdd.clone() };
+                    let target = match kind.perturbed() {
+                        Some(0) => &mut c.q,
+                        Some(1) => &mut c.qd,
+                        Some(_) => &mut c.qdd,
+                        None => &mut c.q,
+                    };
+                    for j in 0..n {
+                        target[j] += deltas[(k, j)];
+                    }
+                    b.crossing(k, c, window_samples)
+                })
+                .collect();
+            (crossings, None, window_samples as f64 / o.rate)
+        };
+        let trajectory = b.finish(&op.q);
+        let context = format!("experiment '{}' of the plan", kind.name());
+        check_limits(
+            model,
+            &trajectory.sample(o.rate),
+            &context,
+            "; reduce the perturbation sizes or move the operating point away from the limit",
+        )?;
+        experiments.push(Experiment { kind, deltas, crossings, reference, window, trajectory });
+    }
+    Ok(Plan {
+        robot: model.name.clone(),
+        joint_names: model.joint_names.clone(),
+        op: op.clone(),
+        rate: o.rate,
+        design: o.design,
+        seed: o.seed,
+        experiments,
+    })
+}
+
+/// Builds one experiment's trajectory on the sampling grid (times are sample counts / rate).
+struct Builder<'a> {
+    n: usize,
+    rate: f64,
+    lim: &'a TransitionLimits,
+    min_transition: f64,
+    /// Current end of the trajectory (samples) and the state there (`[q, qd, qdd]` per joint).
+    now: usize,
+    state: Option<Vec<[f64; 3]>>,
+    segments: Vec<Segment>,
+}
+
+impl<'a> Builder<'a> {
+    /// Starts at rest at `start`.
+    fn new(n: usize, rate: f64, lim: &'a TransitionLimits, min_transition: f64, start: &[f64]) -> Self {
+        let state = Some(start.iter().map(|&q| [q, 0.0, 0.0]).collect());
+        Self { n, rate, lim, min_transition, now: 0, state, segments: Vec::new() }
+    }
+
+    fn time(&self, samples: usize) -> f64 {
+        samples as f64 / self.rate
+    }
+
+    /// Appends a transition from the current state to `to` (none if already there).
+    fn go_to(&mut self, to: Vec<[f64; 3]>) {
+        let from = self.state.take().expect("the builder always has a state");
+        if from == to {
+            self.state = Some(to);
+            return;
+        }
+        let samples = transition(&from, &to, self.lim, self.rate, self.min_transition, 30.0);
+        let duration = samples as f64 / self.rate;
+        let coeffs = (0..self.n)
+            .map(|j| crate::trajectory::quintic(from[j][0], from[j][1], from[j][2], to[j][0], to[j][1], to[j][2], duration))
+            .collect();
+        let t0 = self.time(self.now);
+        self.now += samples;
+        self.segments.push(Segment { kind: SegmentKind::Transition, t0, t1: self.time(self.now), t_ref: t0, coeffs });
+        self.state = Some(to);
+    }
+
+    /// Holds the rest posture `c.q` for `samples`; returns `c` with its time set to the middle.
+    fn dwell(&mut self, kind: SegmentKind, mut c: Crossing, samples: usize) -> Crossing {
+        self.go_to(c.q.iter().map(|&q| [q, 0.0, 0.0]).collect());
+        let (t0, t1) = (self.time(self.now), self.time(self.now + samples));
+        c.time = self.time(self.now + samples / 2);
+        let zero = vec![0.0; self.n];
+        self.segments.push(Segment::quadratic(kind, t0, t1, c.time, &c.q, &zero, &zero));
+        self.now += samples;
+        c
+    }
+
+    /// The crossing window of `c` (quadratic for `+-half` samples); returns `c` with its time.
+    fn crossing(&mut self, index: usize, mut c: Crossing, half: usize) -> Crossing {
+        let h = self.time(half);
+        let start = (0..self.n)
+            .map(|j| [c.q[j] - c.qd[j] * h + 0.5 * c.qdd[j] * h * h, c.qd[j] - c.qdd[j] * h, c.qdd[j]])
+            .collect();
+        self.go_to(start);
+        let t0 = self.time(self.now);
+        c.time = self.time(self.now + half);
+        let t1 = self.time(self.now + 2 * half);
+        self.segments.push(Segment::quadratic(SegmentKind::Crossing { index }, t0, t1, c.time, &c.q, &c.qd, &c.qdd));
+        self.now += 2 * half;
+        self.state = Some(
+            (0..self.n)
+                .map(|j| [c.q[j] + c.qd[j] * h + 0.5 * c.qdd[j] * h * h, c.qd[j] + c.qdd[j] * h, c.qdd[j]])
+                .collect(),
+        );
+        c
+    }
+
+    /// Ends at rest at `q`.
+    fn finish(mut self, q: &[f64]) -> Trajectory {
+        self.go_to(q.iter().map(|&q| [q, 0.0, 0.0]).collect());
+        Trajectory { n: self.n, segments: self.segments }
+    }
+}

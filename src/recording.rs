@@ -1,0 +1,93 @@
+//! A recording: what a robot logs while it runs a trajectory.
+
+use crate::error::{Error, Result};
+
+/// Sampled measurements of one run, row-major (`q[i * n + j]` is joint `j` at sample `i`).
+///
+/// `t` in s (strictly increasing), `q` in rad (or m), `tau` in N m (or N); the optional `qd`
+/// (rad/s) and `qdd` (rad/s^2) when the robot logs them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Recording {
+    /// What the recording is (a file name, or the experiment it rehearses): used in messages.
+    pub name: String,
+    pub n: usize,
+    pub t: Vec<f64>,
+    pub q: Vec<f64>,
+    pub tau: Vec<f64>,
+    pub qd: Option<Vec<f64>>,
+    pub qdd: Option<Vec<f64>>,
+}
+
+impl Recording {
+    /// Checks and builds a recording of `n` joints: `t` of length K >= 2, strictly increasing;
+    /// `q`, `tau` (and `qd`, `qdd` when given) of length `K n`; every value finite. Errors name
+    /// the sample (0-based) and joint.
+    pub fn new(
+        name: impl Into<String>,
+        n: usize,
+        t: Vec<f64>,
+        q: Vec<f64>,
+        tau: Vec<f64>,
+        qd: Option<Vec<f64>>,
+        qdd: Option<Vec<f64>>,
+    ) -> Result<Self> {
+        let r = Self { name: name.into(), n, t, q, tau, qd, qdd };
+        r.check()?;
+        Ok(r)
+    }
+
+    fn error(&self, message: String) -> Error {
+        Error::Recording { recording: self.name.clone(), message }
+    }
+
+    fn check(&self) -> Result<()> {
+        let k = self.t.len();
+        if self.n == 0 {
+            return Err(self.error("a recording needs at least one joint".into()));
+        }
+        if k < 2 {
+            return Err(self.error(format!("{k} samples; a recording needs at least 2")));
+        }
+        if let Some(i) = self.t.iter().position(|v| !v.is_finite()) {
+            return Err(self.error(format!("t at sample {i} is {}, expected a finite number", self.t[i])));
+        }
+        if let Some(i) = (1..k).find(|&i| self.t[i] <= self.t[i - 1]) {
+            return Err(self.error(format!(
+                "time is not increasing at sample {i}: t = {} after {}",
+                self.t[i],
+                self.t[i - 1]
+            )));
+        }
+        let columns = [("q", Some(&self.q)), ("tau", Some(&self.tau)), ("qd", self.qd.as_ref()), ("qdd", self.qdd.as_ref())];
+        for (what, values) in columns {
+            let Some(values) = values else { continue };
+            if values.len() != k * self.n {
+                return Err(self.error(format!(
+                    "{what} has {} values, expected {k} samples x {} joints = {}",
+                    values.len(),
+                    self.n,
+                    k * self.n
+                )));
+            }
+            if let Some(p) = values.iter().position(|v| !v.is_finite()) {
+                return Err(self.error(format!(
+                    "{what} of joint {} at sample {} (t = {}) is {}, expected a finite number",
+                    p % self.n + 1,
+                    p / self.n,
+                    self.t[p / self.n],
+                    values[p]
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+}

@@ -1,0 +1,147 @@
+//! Linear least squares on faer, with the statistics an identification needs: the condition
+//! number of the design, residual RMS and coefficient standard errors, and a rank-deficient
+//! design reported with the directions it does not excite.
+
+use faer::linalg::solvers::Svd;
+use faer::Mat;
+use nalgebra::{DMatrix, DVector};
+
+use crate::error::{Error, Result};
+
+/// The least-squares solution of `Y ~= X A^T` (`X`: K x p regressors, `Y`: K x m outputs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LeastSquares {
+    /// `A`, m x p: output `i` = `sum_j A[i, j] x_j`.
+    pub coef: DMatrix<f64>,
+    /// Condition number (2-norm, ratio of extreme singular values) of `X` after scaling each
+    /// column to unit norm, so it does not depend on units; 1 for an orthogonal design.
+    pub cond: f64,
+    /// Per output, the RMS of the residuals `Y - X A^T` (m).
+    pub residual_rms: DVector<f64>,
+    /// Standard error of every coefficient, m x p: `sigma_i sqrt((X^T X)^-1_jj)` with
+    /// `sigma_i^2 = |r_i|^2 / (K - p)`. NaN when K = p (no residual degrees of freedom).
+    pub stderr: DMatrix<f64>,
+    /// Number of rows K.
+    pub rows: usize,
+}
+
+/// Relative singular-value threshold below which a design counts as rank deficient.
+pub const RANK_TOLERANCE: f64 = 1e-10;
+
+/// Solves `Y ~= X A^T` by a thin SVD of the column-scaled `X` (one decomposition for all m
+/// outputs). `context` and `columns` (the names of X's p columns) go into the error when `X`
+/// does not have full column rank, which names the missing directions. Fails on shapes that do
+/// not match, K < p, or non-finite entries.
+pub fn least_squares(x: &DMatrix<f64>, y: &DMatrix<f64>, context: &str, columns: &[String]) -> Result<LeastSquares> {
+    let (k, p) = x.shape();
+    let m = y.ncols();
+    if y.nrows() != k || columns.len() != p {
+        return Err(Error::Shape {
+            argument: format!("{context}: least squares"),
+            expected: format!("Y with {k} rows like X and {p} column names"),
+            got: format!("Y {} x {m}, {} names", y.nrows(), columns.len()),
+        });
+    }
+    if p == 0 || k < p {
+        return Err(Error::RankDeficient {
+            context: context.into(),
+            rows: k,
+            cols: p,
+            rank: k.min(p),
+            missing: format!("{k} equations cannot determine {p} unknowns; add samples"),
+        });
+    }
+    if let Some(i) = x.iter().chain(y.iter()).position(|v| !v.is_finite()) {
+        return Err(Error::Numerical {
+            operation: context.into(),
+            message: format!("non-finite value in the least-squares data (entry {i})"),
+        });
+    }
+    let scale: Vec<f64> = (0..p).map(|j| x.column(j).norm()).collect();
+    if let Some(j) = scale.iter().position(|&s| s == 0.0) {
+        return Err(Error::RankDeficient {
+            context: context.into(),
+            rows: k,
+            cols: p,
+            rank: p - 1,
+            missing: format!("{} (the column is all zeros)", columns[j]),
+        });
+    }
+    let xs = Mat::<f64>::from_fn(k, p, |i, j| x[(i, j)] / scale[j]);
+    let svd = Svd::new_thin(xs.as_ref()).map_err(|e| Error::Numerical {
+        operation: context.into(),
+        message: format!("the SVD did not converge: {e:?}"),
+    })?;
+    let (u, v) = (svd.U(), svd.V());
+    let s: Vec<f64> = (0..p).map(|i| svd.S().column_vector()[i]).collect();
+    let smax = s.iter().cloned().fold(0.0, f64::max);
+    let smin = s.iter().cloned().fold(f64::INFINITY, f64::min);
+    let weak: Vec<usize> = (0..p).filter(|&i| s[i] <= RANK_TOLERANCE * smax).collect();
+    if !weak.is_empty() {
+        let missing = weak
+            .iter()
+            .map(|&i| describe_direction(&(0..p).map(|j| v[(j, i)] / scale[j]).collect::<Vec<_>>(), columns))
+            .collect::<Vec<_>>()
+            .join("; ");
+        return Err(Error::RankDeficient { context: context.into(), rows: k, cols: p, rank: p - weak.len(), missing });
+    }
+    // A^T (scaled) = V S^-1 U^T Y
+    let mut uty = vec![0.0; p * m];
+    for i in 0..p {
+        for c in 0..m {
+            let mut acc = 0.0;
+            for r in 0..k {
+                acc += u[(r, i)] * y[(r, c)];
+            }
+            uty[i * m + c] = acc / s[i];
+        }
+    }
+    let mut coef = DMatrix::zeros(m, p);
+    let mut cov_diag = vec![0.0; p];
+    for j in 0..p {
+        for i in 0..p {
+            let vji = v[(j, i)];
+            for c in 0..m {
+                coef[(c, j)] += vji * uty[i * m + c];
+            }
+            cov_diag[j] += vji * vji / (s[i] * s[i]);
+        }
+        for c in 0..m {
+            coef[(c, j)] /= scale[j];
+        }
+        cov_diag[j] /= scale[j] * scale[j];
+    }
+    let residual = y - x * coef.transpose();
+    let dof = (k - p) as f64;
+    let mut residual_rms = DVector::zeros(m);
+    let mut stderr = DMatrix::zeros(m, p);
+    for c in 0..m {
+        let ss = residual.column(c).norm_squared();
+        residual_rms[c] = (ss / k as f64).sqrt();
+        let sigma = if k > p { (ss / dof).sqrt() } else { f64::NAN };
+        for j in 0..p {
+            stderr[(c, j)] = sigma * cov_diag[j].sqrt();
+        }
+    }
+    Ok(LeastSquares { coef, cond: smax / smin, residual_rms, stderr, rows: k })
+}
+
+/// `0.71 dq1 - 0.71 dq2`: a direction in terms of named columns (largest entries first,
+/// entries below 5 % of the largest left out).
+fn describe_direction(d: &[f64], columns: &[String]) -> String {
+    let norm = d.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let max = d.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let mut terms: Vec<(usize, f64)> = d.iter().map(|v| v / norm).enumerate().filter(|(_, v)| v.abs() >= 0.05 * max / norm).collect();
+    terms.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+    let sign = if terms.first().is_some_and(|t| t.1 < 0.0) { -1.0 } else { 1.0 };
+    let mut out = String::new();
+    for (i, (j, v)) in terms.iter().enumerate() {
+        let v = v * sign;
+        if i == 0 {
+            out.push_str(&format!("{v:.3} {}", columns[*j]));
+        } else {
+            out.push_str(&format!(" {} {:.3} {}", if v < 0.0 { '-' } else { '+' }, v.abs(), columns[*j]));
+        }
+    }
+    out
+}

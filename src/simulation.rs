@@ -1,0 +1,164 @@
+//! Measurement simulation: the torques a robot would log along a trajectory, with friction,
+//! noise and encoder quantisation, so a user can rehearse before touching the robot.
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Normal};
+
+use crate::algorithms::rnea::rnea;
+use crate::data::Data;
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::recording::Recording;
+use crate::trajectory::Samples;
+
+/// Joint friction `tau_f = viscous * qd + coulomb * sign(qd)` (per joint; N m s/rad and N m),
+/// with `sign(0) = 0`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Friction {
+    pub viscous: Vec<f64>,
+    pub coulomb: Vec<f64>,
+}
+
+impl Friction {
+    /// No friction.
+    pub fn none(n: usize) -> Self {
+        Self { viscous: vec![0.0; n], coulomb: vec![0.0; n] }
+    }
+
+    /// The URDF's `<dynamics damping friction>` of every joint.
+    pub fn from_model(model: &Model) -> Self {
+        Self {
+            viscous: model.limits.iter().map(|l| l.damping).collect(),
+            coulomb: model.limits.iter().map(|l| l.friction).collect(),
+        }
+    }
+
+    /// Friction torque of joint `j` at speed `qd`.
+    pub fn torque(&self, j: usize, qd: f64) -> f64 {
+        let sign = if qd > 0.0 {
+            1.0
+        } else if qd < 0.0 {
+            -1.0
+        } else {
+            0.0
+        };
+        self.viscous[j] * qd + self.coulomb[j] * sign
+    }
+}
+
+/// What to simulate. Noise levels are standard deviations per joint; zero switches a term off.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimulationOptions {
+    /// Gravity on (default) or off (as if compensated).
+    pub gravity: bool,
+    pub friction: Friction,
+    /// Gaussian noise on the logged torques (N m).
+    pub torque_noise: Vec<f64>,
+    /// Gaussian noise on the logged positions (rad), applied before quantisation.
+    pub position_noise: Vec<f64>,
+    /// Encoder resolution (rad per count); 0 = none. Positions are rounded to whole counts.
+    pub quantization: Vec<f64>,
+    pub seed: u64,
+}
+
+impl SimulationOptions {
+    /// Gravity on, the model's URDF friction, no noise, no quantisation, seed 0.
+    pub fn new(model: &Model) -> Self {
+        let n = model.nv;
+        Self {
+            gravity: true,
+            friction: Friction::from_model(model),
+            torque_noise: vec![0.0; n],
+            position_noise: vec![0.0; n],
+            quantization: vec![0.0; n],
+            seed: 0,
+        }
+    }
+
+    fn check(&self, n: usize) -> Result<()> {
+        for (what, v) in [
+            ("friction viscous", &self.friction.viscous),
+            ("friction coulomb", &self.friction.coulomb),
+            ("torque_noise", &self.torque_noise),
+            ("position_noise", &self.position_noise),
+            ("quantization", &self.quantization),
+        ] {
+            crate::model::check_finite_vector(what, v, n)?;
+            if what != "friction viscous" && what != "friction coulomb" {
+                if let Some(j) = v.iter().position(|&x| x < 0.0) {
+                    return Err(Error::InvalidArgument {
+                        argument: format!("{what}[{j}]"),
+                        message: format!("{}; expected a value >= 0", v[j]),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Simulates what a robot logs along `samples` (its true `t, q, qd, qdd`): the torque
+/// `tau = rnea(q, qd, qdd) + tau_f(qd)` (gravity per `options`) plus noise, and the position
+/// plus noise, quantised. The recording holds `t`, `q` and `tau` only (a robot's velocity and
+/// acceleration estimates are not simulated). `stream` separates the random streams of several
+/// recordings made with one seed.
+pub fn simulate_samples(
+    model: &Model,
+    samples: &Samples,
+    options: &SimulationOptions,
+    stream: u64,
+    name: &str,
+) -> Result<Recording> {
+    let n = model.nv;
+    if samples.n != n {
+        return Err(Error::Shape {
+            argument: "samples".into(),
+            expected: format!("{n} joints"),
+            got: format!("{} joints", samples.n),
+        });
+    }
+    options.check(n)?;
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+    rng.set_stream(stream);
+    let gauss = Normal::new(0.0, 1.0).expect("unit normal");
+    let mut data = Data::new(model);
+    let k = samples.len();
+    let (mut q, mut tau) = (Vec::with_capacity(k * n), Vec::with_capacity(k * n));
+    for i in 0..k {
+        let (qi, qdi) = (samples.q_at(i), samples.qd_at(i));
+        rnea(model, &mut data, qi, qdi, samples.qdd_at(i), options.gravity)?;
+        for j in 0..n {
+            let t = data.tau[j] + options.friction.torque(j, qdi[j]) + options.torque_noise[j] * gauss.sample(&mut rng);
+            tau.push(t);
+            let mut p = qi[j] + options.position_noise[j] * gauss.sample(&mut rng);
+            if options.quantization[j] > 0.0 {
+                p = (p / options.quantization[j]).round() * options.quantization[j];
+            }
+            q.push(p);
+        }
+    }
+    Recording::new(name, n, samples.t.clone(), q, tau, None, None)
+}
+
+/// Simulates one recording per experiment of `plan` (in the plan's order) for `model`, which
+/// must have the plan's joints. Each experiment gets its own random stream of `options.seed`.
+pub fn simulate_plan(model: &Model, plan: &crate::local::Plan, options: &SimulationOptions) -> Result<Vec<Recording>> {
+    if plan.joint_names != model.joint_names {
+        return Err(Error::InvalidArgument {
+            argument: "plan".into(),
+            message: format!(
+                "the plan is for joints [{}] of '{}', the robot '{}' has [{}]",
+                plan.joint_names.join(", "),
+                plan.robot,
+                model.name,
+                model.joint_names.join(", ")
+            ),
+        });
+    }
+    plan.experiments
+        .iter()
+        .enumerate()
+        .map(|(i, e)| simulate_samples(model, &e.trajectory.sample(plan.rate), options, i as u64, &format!("simulated experiment '{}'", e.kind.name())))
+        .collect()
+}
