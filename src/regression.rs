@@ -132,7 +132,8 @@ fn describe_direction(d: &[f64], columns: &[String]) -> String {
     let norm = d.iter().map(|v| v * v).sum::<f64>().sqrt();
     let max = d.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let mut terms: Vec<(usize, f64)> = d.iter().map(|v| v / norm).enumerate().filter(|(_, v)| v.abs() >= 0.05 * max / norm).collect();
-    terms.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+    // largest first; equal magnitudes (to 1e-6) in column order
+    terms.sort_by_key(|&(j, v)| (-(v.abs() * 1e6).round() as i64, j));
     let sign = if terms.first().is_some_and(|t| t.1 < 0.0) { -1.0 } else { 1.0 };
     let mut out = String::new();
     for (i, (j, v)) in terms.iter().enumerate() {

@@ -1,12 +1,17 @@
-//! The paper's method end to end in Rust: plan, simulate, identify, against the analytic
-//! linearisation of the dynamics core.
+//! The paper's method end to end in Rust: plan, simulate, identify, checked against the analytic
+//! linearisation of the dynamics core, exact identities and the paper's Table 3.
 
 mod common;
 
-use nalgebra::DMatrix;
-use perturbid_rs::local::{identify_local, plan_experiments, Design, ExperimentKind, IdentifyOptions, OperatingPoint, PlanOptions};
+use common::Rng;
+use nalgebra::{DMatrix, DVector};
+use perturbid_rs::local::{
+    identify_local, plan_experiments, CrossingTimes, Design, Estimator, ExperimentKind, IdentifyOptions, LocalModel,
+    OperatingPoint, Plan, PlanOptions, Size, Sizes,
+};
+use perturbid_rs::regression::least_squares;
 use perturbid_rs::robots::a465;
-use perturbid_rs::{linearize, simulate_plan, Data, Model, SimulationOptions};
+use perturbid_rs::{linearize, rnea, simulate_plan, Data, Error, Friction, Linearization, Model, Recording, SimulationOptions};
 
 fn table2() -> OperatingPoint {
     OperatingPoint::new(a465::TABLE2_Q.to_vec(), a465::TABLE2_QD.to_vec(), a465::TABLE2_QDD.to_vec()).unwrap()
@@ -16,34 +21,347 @@ fn rel(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
     (a - b).norm() / b.norm()
 }
 
-fn run(model: &Model, op: &OperatingPoint, plan_opts: &PlanOptions, sim: &SimulationOptions) -> perturbid_rs::LocalModel {
+fn noise_free(model: &Model, gravity: bool) -> SimulationOptions {
+    let mut sim = SimulationOptions::new(model);
+    sim.gravity = gravity;
+    sim.friction = Friction::none(model.nv);
+    sim
+}
+
+fn identify(model: &Model, op: &OperatingPoint, plan_opts: &PlanOptions, sim: &SimulationOptions) -> (Plan, LocalModel) {
     let plan = plan_experiments(model, op, plan_opts).unwrap();
     let recs = simulate_plan(model, &plan, sim).unwrap();
-    let deg: usize = std::env::var("DEG").map(|v| v.parse().unwrap()).unwrap_or(2);
-    let w: Option<f64> = std::env::var("WIN").ok().map(|v| v.parse().unwrap());
-    let mut o = IdentifyOptions::default();
-    o.fit.torque_degree = deg;
-    o.fit.window = w;
-    identify_local(&plan, &recs, &o).unwrap()
+    let m = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    (plan, m)
+}
+
+fn truth(model: &Model, op: &OperatingPoint, gravity: bool) -> Linearization {
+    let mut data = Data::new(model);
+    linearize(model, &mut data, &op.q, &op.qd, &op.qdd, gravity).unwrap()
+}
+
+fn mat(e: &Option<perturbid_rs::local::Estimate>) -> &DMatrix<f64> {
+    &e.as_ref().unwrap().matrix
+}
+
+/// The paper's experiment: D* = M(q*) and H* = d tau/d qd to 1e-9, T* = tau(P), Table 3's row.
+#[test]
+fn a465_table2_noise_free_d_h_exact() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let op = table2();
+    let lin = truth(&model, &op, false);
+    for design in [Design::Random, Design::Orthogonal] {
+        let (_, m) = identify(&model, &op, &PlanOptions { design, ..PlanOptions::default() }, &noise_free(&model, false));
+        assert!(rel(mat(&m.d), &lin.d) < 1e-9, "{design:?}: D* {:e}", rel(mat(&m.d), &lin.d));
+        assert!(rel(mat(&m.h), &lin.h) < 1e-9, "{design:?}: H* {:e}", rel(mat(&m.h), &lin.h));
+        let t = DVector::from_vec(m.torque.clone());
+        assert!((&t - &lin.torque).norm() < 1e-9 * lin.torque.norm());
+        // Table 3, "perturbation method" row, and Table 2's Tn (gravity excluded).
+        for i in 0..6 {
+            assert!((mat(&m.d)[(i, 0)] - a465::TABLE3_D_COLUMN1[i]).abs() < 0.005, "D{}1", i + 1);
+            assert!((m.torque[i] - a465::TABLE2_TORQUE[i]).abs() < 0.01, "T{}", i + 1);
+        }
+        if design == Design::Orthogonal {
+            for e in [&m.d, &m.h, &m.g, &m.g_static] {
+                assert!((e.as_ref().unwrap().cond - 1.0).abs() < 1e-9);
+            }
+        }
+    }
+}
+
+/// `|G_est - G*| <= |R| / sigma_min(X)`, R the exact remainder `tau(q* + dq_k) - T* - G* dq_k`
+/// computed by RNEA; and the error falls as the size squared (symmetric pairs cancel even
+/// orders). Same for Gs at rest with gravity.
+#[test]
+fn g_within_the_taylor_bound() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let op = table2();
+    let lin = truth(&model, &op, true);
+    let mut data = Data::new(&model);
+    let mut errors = vec![];
+    for scale in [1.0, 0.5] {
+        let opts = PlanOptions {
+            sizes: Sizes { position: Size::Fraction(0.01 * scale), ..Sizes::default() },
+            ..PlanOptions::default()
+        };
+        let (plan, m) = identify(&model, &op, &opts, &noise_free(&model, true));
+        for (kind, est, exact, qd, qdd, t0) in [
+            (ExperimentKind::GDynamic, mat(&m.g), &lin.g, &op.qd, &op.qdd, lin.torque.clone()),
+            (ExperimentKind::GStatic, mat(&m.g_static), &lin.g_static, &vec![0.0; 6], &vec![0.0; 6], {
+                perturbid_rs::gravity_torque(&model, &mut data, &op.q).unwrap();
+                data.g.clone()
+            }),
+        ] {
+            let x = &plan.experiment(kind).unwrap().deltas;
+            let mut r = DMatrix::zeros(x.nrows(), 6);
+            for k in 0..x.nrows() {
+                let q: Vec<f64> = (0..6).map(|j| op.q[j] + x[(k, j)]).collect();
+                rnea(&model, &mut data, &q, qd, qdd, true).unwrap();
+                let rem = &data.tau - &t0 - exact * x.row(k).transpose();
+                r.set_row(k, &rem.transpose());
+            }
+            let smin = x.clone().svd(false, false).singular_values.min();
+            let bound = r.norm() / smin;
+            let err = (est - exact).norm();
+            assert!(err <= bound * 1.0001 + 1e-9, "{kind:?} scale {scale}: error {err:e} > bound {bound:e}");
+            errors.push(err);
+        }
+    }
+    // halving the size quarters the error (even orders cancel, the cubic term remains)
+    for i in 0..2 {
+        let ratio = errors[i + 2] / errors[i];
+        assert!((0.2..0.3).contains(&ratio), "error ratio {ratio}");
+    }
+}
+
+/// Other operating points (random, inside the limits) of both A465 variants.
+#[test]
+fn other_operating_points() {
+    let mut rng = Rng(7);
+    for variant in ["kinsheel2010", "physical"] {
+        let model = a465::model(variant).unwrap();
+        for _ in 0..3 {
+            let q: Vec<f64> = (0..6).map(|j| 0.6 * rng.uniform(model.limits[j].lower, model.limits[j].upper)).collect();
+            let op = OperatingPoint::new(q, rng.vector(6, 0.5), rng.vector(6, 1.5)).unwrap();
+            let lin = truth(&model, &op, true);
+            let (_, m) = identify(&model, &op, &PlanOptions { design: Design::Orthogonal, ..PlanOptions::default() }, &noise_free(&model, true));
+            assert!(rel(mat(&m.d), &lin.d) < 1e-9, "{variant} D {:e}", rel(mat(&m.d), &lin.d));
+            assert!(rel(mat(&m.h), &lin.h) < 1e-9, "{variant} H {:e}", rel(mat(&m.h), &lin.h));
+            assert!(rel(mat(&m.g), &lin.g) < 0.02, "{variant} G {:e}", rel(mat(&m.g), &lin.g));
+        }
+    }
+}
+
+/// The common-mode claim: gravity and friction change T* and G, not D*; H* only by the
+/// viscous slope. Velocities stay away from zero so Coulomb friction keeps its sign.
+#[test]
+fn common_mode_gravity_and_friction() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let op = OperatingPoint::new(a465::TABLE2_Q.to_vec(), vec![0.4, -0.35, 0.3, 0.5, -0.4, 0.45], a465::TABLE2_QDD.to_vec()).unwrap();
+    let opts = PlanOptions {
+        sizes: Sizes { velocity: Size::Absolute(vec![0.1; 6]), ..Sizes::default() },
+        ..PlanOptions::default()
+    };
+    let (_, rigid) = identify(&model, &op, &opts, &noise_free(&model, false));
+    let mut sim = noise_free(&model, true);
+    let viscous = vec![2.0, 1.5, 1.0, 0.5, 0.4, 0.3];
+    sim.friction = Friction { viscous: viscous.clone(), coulomb: vec![3.0, 2.5, 2.0, 1.0, 0.8, 0.5] };
+    let (_, full) = identify(&model, &op, &opts, &sim);
+    assert!(rel(mat(&full.d), mat(&rigid.d)) < 1e-9);
+    let h_expected = mat(&rigid.h) + DMatrix::from_diagonal(&DVector::from_vec(viscous));
+    assert!(rel(mat(&full.h), &h_expected) < 1e-9);
+    // ... while the nominal torque moved by gravity and friction
+    assert!((DVector::from_vec(full.torque.clone()) - DVector::from_vec(rigid.torque.clone())).norm() > 1.0);
+}
+
+/// With torque noise the D* error falls about as 1/sqrt(K).
+#[test]
+fn noise_error_falls_as_one_over_sqrt_k() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let op = table2();
+    let lin = truth(&model, &op, true);
+    let mut mean_err = vec![];
+    for k in [16, 64, 256] {
+        let mut acc = 0.0;
+        let seeds = 12;
+        for seed in 0..seeds {
+            let opts = PlanOptions {
+                experiments: vec![ExperimentKind::Nominal, ExperimentKind::D],
+                design: Design::Orthogonal,
+                count: Some(k),
+                seed,
+                ..PlanOptions::default()
+            };
+            let mut sim = noise_free(&model, true);
+            sim.torque_noise = vec![0.05; 6];
+            sim.seed = 100 + seed;
+            let (_, m) = identify(&model, &op, &opts, &sim);
+            acc += (mat(&m.d) - &lin.d).norm();
+        }
+        mean_err.push(acc / seeds as f64);
+    }
+    for i in 0..2 {
+        let ratio = mean_err[i] / mean_err[i + 1]; // K x4 -> error /2
+        assert!((1.6..2.5).contains(&ratio), "errors {mean_err:?}");
+    }
 }
 
 #[test]
-fn a465_noise_free_table2() {
+fn plan_trajectories_pass_the_crossings_c2_from_rest_to_rest() {
     let model = a465::model("kinsheel2010").unwrap();
-    let op = table2();
-    let mut sim = SimulationOptions::new(&model);
-    sim.gravity = false;
-    for design in [Design::Random, Design::Orthogonal] {
-        let opts = PlanOptions { design, ..PlanOptions::default() };
-        let m = run(&model, &op, &opts, &sim);
-        let mut data = Data::new(&model);
-        let lin = linearize(&model, &mut data, &op.q, &op.qd, &op.qdd, false).unwrap();
-        let d = &m.d.as_ref().unwrap().matrix;
-        let h = &m.h.as_ref().unwrap().matrix;
-        let g = &m.g.as_ref().unwrap().matrix;
-        println!("{design:?} D {:e} H {:e} G {:e} T {:e}", rel(d, &lin.d), rel(h, &lin.h), rel(g, &lin.g),
-            (nalgebra::DVector::from_vec(m.torque.clone()) - &lin.torque).norm());
-        println!("cond D {} H {} G {}", m.d.as_ref().unwrap().cond, m.h.as_ref().unwrap().cond, m.g.as_ref().unwrap().cond);
-        println!("Gs {:?}", m.g_static.as_ref().map(|e| e.matrix.norm()));
+    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
+    assert_eq!(plan.experiments.len(), 5);
+    for e in &plan.experiments {
+        assert_eq!(e.crossings.len(), 12);
+        let s = e.trajectory.sample(plan.rate);
+        let last = s.len() - 1;
+        for j in 0..6 {
+            assert_eq!(s.qd_at(0)[j], 0.0);
+            assert_eq!(s.qdd_at(0)[j], 0.0);
+            assert!(s.qd_at(last)[j].abs() < 1e-9 && s.qdd_at(last)[j].abs() < 1e-9);
+            assert!((s.q_at(last)[j] - plan.op.q[j]).abs() < 1e-9);
+        }
+        for c in &e.crossings {
+            let i = (c.time * plan.rate).round() as usize;
+            assert!((s.t[i] - c.time).abs() < 1e-12, "crossing on the grid");
+            for j in 0..6 {
+                assert!((s.q_at(i)[j] - c.q[j]).abs() < 1e-12);
+                assert!((s.qd_at(i)[j] - c.qd[j]).abs() < 1e-12);
+                assert!((s.qdd_at(i)[j] - c.qdd[j]).abs() < 1e-12);
+            }
+        }
+        for w in e.trajectory.segments.windows(2) {
+            assert_eq!(w[0].t1, w[1].t0);
+            for j in 0..6 {
+                let (a, b) = (w[0].eval(j, w[0].t1), w[1].eval(j, w[1].t0));
+                assert!((a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9 && (a.2 - b.2).abs() < 1e-8, "C2 at {}", w[0].t1);
+            }
+        }
+        // the planned perturbations are exactly the crossing deltas
+        if let Some(v) = e.kind.perturbed() {
+            for (k, c) in e.crossings.iter().enumerate() {
+                let (x, x0) = match v {
+                    0 => (&c.q, &plan.op.q),
+                    1 => (&c.qd, &plan.op.qd),
+                    _ => (&c.qdd, &plan.op.qdd),
+                };
+                for j in 0..6 {
+                    assert!((x[j] - x0[j] - e.deltas[(k, j)]).abs() < 1e-12);
+                }
+            }
+        }
     }
 }
+
+#[test]
+fn plans_breaking_limits_are_refused_with_joint_and_time() {
+    let model = a465::model("kinsheel2010").unwrap();
+    // joint 2 (shoulder) 0.01 rad inside its upper limit: a 1 % of range position step breaks it
+    let mut q = a465::TABLE2_Q.to_vec();
+    q[1] = model.limits[1].upper - 0.01;
+    let op = OperatingPoint::new(q, a465::TABLE2_QD.to_vec(), a465::TABLE2_QDD.to_vec()).unwrap();
+    let err = plan_experiments(&model, &op, &PlanOptions::default()).unwrap_err();
+    let msg = err.to_string();
+    assert!(matches!(err, Error::PositionLimit { .. }), "{msg}");
+    assert!(msg.contains("shoulder") || msg.contains("joint2") || msg.contains(&model.joint_names[1]), "{msg}");
+    assert!(msg.contains("t = ") && msg.contains("experiment"), "{msg}");
+    // velocity near its limit: the H experiment exceeds it
+    let mut qd = a465::TABLE2_QD.to_vec();
+    qd[0] = 0.99 * model.limits[0].velocity;
+    let op = OperatingPoint::new(a465::TABLE2_Q.to_vec(), qd, a465::TABLE2_QDD.to_vec()).unwrap();
+    let err = plan_experiments(&model, &op, &PlanOptions::default()).unwrap_err();
+    assert!(matches!(err, Error::LimitViolation { quantity: "velocity", .. }), "{err}");
+    assert!(err.to_string().contains(&model.joint_names[0]));
+    // an operating point outside the limits, and bad options
+    let mut q = a465::TABLE2_Q.to_vec();
+    q[2] = 3.0;
+    let op = OperatingPoint::new(q, vec![0.0; 6], vec![0.0; 6]).unwrap();
+    assert!(plan_experiments(&model, &op, &PlanOptions::default()).unwrap_err().to_string().contains("joint"));
+    let bad = PlanOptions { count: Some(7), ..PlanOptions::default() };
+    assert!(plan_experiments(&model, &table2(), &bad).unwrap_err().to_string().contains("even number"));
+    assert!(OperatingPoint::new(vec![0.0; 6], vec![0.0; 5], vec![0.0; 6]).is_err());
+}
+
+#[test]
+fn recordings_with_problems_get_clear_errors() {
+    let t = vec![0.0, 0.001, 0.002];
+    let e = Recording::new("r", 1, vec![0.0, 0.002, 0.001], vec![0.0; 3], vec![0.0; 3], None, None).unwrap_err();
+    assert!(e.to_string().contains("not increasing at sample 2"), "{e}");
+    let e = Recording::new("r", 1, t.clone(), vec![0.0, f64::NAN, 0.0], vec![0.0; 3], None, None).unwrap_err();
+    assert!(e.to_string().contains("q of joint 1 at sample 1"), "{e}");
+    let e = Recording::new("r", 2, t.clone(), vec![0.0; 3], vec![0.0; 6], None, None).unwrap_err();
+    assert!(e.to_string().contains("expected 3 samples x 2 joints"), "{e}");
+    assert!(Recording::new("r", 1, vec![0.0], vec![0.0], vec![0.0], None, None).is_err());
+
+    let model = a465::model("kinsheel2010").unwrap();
+    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
+    let mut recs = simulate_plan(&model, &plan, &noise_free(&model, true)).unwrap();
+    // too short: cut the D recording in half
+    let d = plan.experiments.iter().position(|e| e.kind == ExperimentKind::D).unwrap();
+    let r = &recs[d];
+    let half = r.len() / 2;
+    recs[d] = Recording::new("cut", 6, r.t[..half].to_vec(), r.q[..half * 6].to_vec(), r.tau[..half * 6].to_vec(), None, None).unwrap();
+    let e = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("cut: experiment 'D', crossing") && e.to_string().contains("too short"), "{e}");
+    // too few samples per window: decimate to 50 Hz
+    let r = simulate_plan(&model, &plan, &noise_free(&model, true)).unwrap().remove(d);
+    let keep: Vec<usize> = (0..r.len()).step_by(20).collect();
+    recs[d] = Recording::new(
+        "sparse",
+        6,
+        keep.iter().map(|&i| r.t[i]).collect(),
+        keep.iter().flat_map(|&i| r.q[i * 6..i * 6 + 6].to_vec()).collect(),
+        keep.iter().flat_map(|&i| r.tau[i * 6..i * 6 + 6].to_vec()).collect(),
+        None,
+        None,
+    )
+    .unwrap();
+    let e = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("samples in the") && e.to_string().contains("need at least"), "{e}");
+    // wrong number of recordings
+    recs.pop();
+    assert!(identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap_err().to_string().contains("one per experiment"));
+}
+
+#[test]
+fn rank_deficient_design_names_the_missing_direction() {
+    let x = DMatrix::from_row_slice(4, 3, &[1.0, 1.0, 0.0, -1.0, -1.0, 0.0, 0.0, 0.0, 1.0, 2.0, 2.0, -1.0]);
+    let y = DMatrix::from_element(4, 2, 1.0);
+    let names: Vec<String> = ["dq(a)", "dq(b)", "dq(c)"].map(String::from).to_vec();
+    let e = least_squares(&x, &y, "experiment 'G'", &names).unwrap_err();
+    let msg = e.to_string();
+    assert!(matches!(e, Error::RankDeficient { rank: 2, .. }), "{msg}");
+    assert!(msg.contains("0.707 dq(a) - 0.707 dq(b)"), "{msg}");
+    // Phi theta = tau: an exact linear system is solved exactly
+    let x = DMatrix::from_fn(10, 3, |i, j| ((i * 7 + j * 3) % 5) as f64 - 2.0 + 0.1 * j as f64);
+    let a = DMatrix::from_row_slice(2, 3, &[1.0, -2.0, 0.5, 3.0, 0.0, -1.0]);
+    let ls = least_squares(&x, &(&x * a.transpose()), "exact", &names).unwrap();
+    assert!((ls.coef - a).norm() < 1e-12);
+    assert!(ls.residual_rms.norm() < 1e-12);
+}
+
+#[test]
+fn detected_crossing_times_recover_a_shifted_log() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let op = table2();
+    let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+    let recs: Vec<Recording> = simulate_plan(&model, &plan, &noise_free(&model, false))
+        .unwrap()
+        .into_iter()
+        .map(|mut r| {
+            r.t.iter_mut().for_each(|t| *t += 0.137);
+            r
+        })
+        .collect();
+    let opts = IdentifyOptions { times: CrossingTimes::Detected { max_shift: 0.5 }, ..IdentifyOptions::default() };
+    let m = identify_local(&plan, &recs, &opts).unwrap();
+    let lin = truth(&model, &op, false);
+    assert!(rel(mat(&m.d), &lin.d) < 1e-8, "{:e}", rel(mat(&m.d), &lin.d));
+}
+
+#[test]
+fn combined_estimator_and_json_round_trip() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let op = table2();
+    let plan = plan_experiments(&model, &op, &PlanOptions { design: Design::Orthogonal, ..PlanOptions::default() }).unwrap();
+    let recs = simulate_plan(&model, &plan, &noise_free(&model, true)).unwrap();
+    let opts = IdentifyOptions { estimator: Estimator::Combined, ..IdentifyOptions::default() };
+    let m = identify_local(&plan, &recs, &opts).unwrap();
+    let lin = truth(&model, &op, true);
+    assert_eq!(m.combined.as_ref().unwrap().matrix.shape(), (6, 18));
+    assert!(rel(mat(&m.d), &lin.d) < 1e-3, "{:e}", rel(mat(&m.d), &lin.d));
+    assert!(rel(mat(&m.g), &lin.g) < 2e-3, "{:e}", rel(mat(&m.g), &lin.g));
+    // predict: T* at P, and the local model's own linear law
+    let p = m.predict(&op.q, &op.qd, &op.qdd).unwrap();
+    assert!((DVector::from_vec(p) - &lin.torque).norm() < 1e-6);
+    let back = LocalModel::from_json(&m.to_json()).unwrap();
+    assert!(back == m, "the JSON round trip changed the model");
+    let plan_back = Plan::from_json(&plan.to_json()).unwrap();
+    assert!(plan_back == plan, "the JSON round trip changed the plan");
+    let e = LocalModel::from_json("{\"format\": 3}").unwrap_err();
+    assert!(e.to_string().contains("line 1"), "{e}");
+    let broken = m.to_json().replace(LOCAL_FORMAT, "something-else/9");
+    assert!(LocalModel::from_json(&broken).unwrap_err().to_string().contains("format"));
+}
+
+const LOCAL_FORMAT: &str = "perturbid-local-model/1";

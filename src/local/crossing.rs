@@ -25,10 +25,12 @@ pub struct CrossingValues {
 pub struct FitOptions {
     /// Half-width of the fit window (s); `None`: the plan's window for the experiment.
     pub window: Option<f64>,
-    /// Degree of the polynomial fitted to the torque (default 4: its bias on a smooth torque is
-    /// O(window^6), small enough for exact noise-free tests, at 1.25x the noise of a quadratic
-    /// fit). Positions are always
-    /// fitted with a quadratic, exact on a crossing segment.
+    /// Degree of the polynomial fitted to the torque (default 6). The torque along a crossing
+    /// window is smooth but not polynomial; the bias of the fit is O((window * rate of change)^
+    /// (degree + 2)), below 1e-9 relative on the A465 with the default window. Against white
+    /// noise of n samples its standard error at the centre is about sqrt(4.8 / n) sigma (degree
+    /// 2: sqrt(2.25 / n), degree 4: sqrt(3.5 / n)). Positions are always fitted with a
+    /// quadratic, exact on a crossing segment.
     pub torque_degree: usize,
     /// Take qd (and qdd) from the recording's own columns, fitted like the torque, instead of
     /// differentiating the position fit (default false).
@@ -37,7 +39,7 @@ pub struct FitOptions {
 
 impl Default for FitOptions {
     fn default() -> Self {
-        Self { window: None, torque_degree: 4, recorded_derivatives: false }
+        Self { window: None, torque_degree: 6, recorded_derivatives: false }
     }
 }
 

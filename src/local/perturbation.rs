@@ -16,9 +16,9 @@ pub enum Design {
     /// The paper's draws near the nominal (its Fig. 1): every joint uniform in `[-size, size]`,
     /// seeded.
     Random,
-    /// A designed set with `cond(X) = 1` once each column is divided by its joint's size: the
-    /// columns of a Sylvester-Hadamard matrix when K/2 is a power of two >= N (every joint at
-    /// full size in every crossing), otherwise seeded random orthonormal columns.
+    /// A designed set with `cond(X) = 1` once each column is divided by its joint's size:
+    /// Sylvester-Hadamard columns (every joint at full size in every crossing) when K/2 is a
+    /// multiple of the power of two above N, otherwise seeded random orthonormal columns.
     Orthogonal,
 }
 
@@ -142,18 +142,17 @@ pub fn perturbations(design: Design, count: usize, size: &[f64], symmetric: bool
 }
 
 /// An `m x n` matrix (m >= n) with orthogonal columns of equal norm and entries in [-1, 1].
+///
+/// When `m` is a multiple of `p`, the smallest power of two `>= n` (`> n` when possible, to skip
+/// the all-ones column), the rows of the `p x p` Sylvester-Hadamard matrix repeated: entries
+/// +-1, every joint at full size in every crossing. Otherwise seeded random orthonormal columns
+/// scaled so the largest entry is 1.
 fn orthogonal_unit(m: usize, n: usize, rng: &mut ChaCha8Rng) -> DMatrix<f64> {
-    if m.is_power_of_two() && m >= n {
-        // Sylvester: H[i][j] = (-1)^popcount(i & j). Skip the all-ones column when possible so
-        // that no crossing moves every joint the same way.
-        let skip = usize::from(m > n);
-        return DMatrix::from_fn(m, n, |i, j| {
-            if (i & (j + skip)).count_ones() % 2 == 0 {
-                1.0
-            } else {
-                -1.0
-            }
-        });
+    let p = (n + 1).next_power_of_two();
+    let (p, skip) = if m % p == 0 { (p, 1) } else { (n.next_power_of_two(), usize::from(n.next_power_of_two() > n)) };
+    if m % p == 0 && p >= n + skip {
+        // Sylvester: H[i][j] = (-1)^popcount(i & j)
+        return DMatrix::from_fn(m, n, |i, j| if ((i % p) & (j + skip)).count_ones() % 2 == 0 { 1.0 } else { -1.0 });
     }
     let g = DMatrix::from_fn(m, n, |_, _| rng.sample::<f64, _>(StandardNormal));
     let q = g.qr().q();
