@@ -12,28 +12,50 @@ Quick start::
     robot = perturbid_rs.robots.a465()          # the paper's CRS A465
     tau = robot.rnea(q, qd, qdd)                 # (n,) or (k, n)
     lin = robot.linearize(q, qd, qdd)            # lin.torque, lin.D, lin.H, lin.G, lin.G_static
+
+    # the paper's method: plan, rehearse (or record on the robot), identify
+    op = perturbid_rs.OperatingPoint(q, qd, qdd)
+    plan = perturbid_rs.plan_experiments(robot, op, design="orthogonal", seed=1)
+    recordings = perturbid_rs.simulate(robot, plan, torque_noise=0.05, seed=2)
+    model = perturbid_rs.identify_local(plan, recordings)   # model.D, model.stderr["D"], ...
 """
 
 from ._core import (
+    Experiment,
     FileError,
     InputError,
     Linearization,
+    LocalModel,
     ModelError,
     NumericalError,
+    OperatingPoint,
     PerturbidError,
+    Plan,
+    Recording,
     Robot,
     __version__,
+    identify_local,
+    plan_experiments,
+    simulate,
 )
 from . import robots
 
 __all__ = [
+    "Experiment",
     "FileError",
     "InputError",
     "Linearization",
+    "LocalModel",
     "ModelError",
     "NumericalError",
+    "OperatingPoint",
     "PerturbidError",
+    "Plan",
+    "Recording",
     "Robot",
     "__version__",
+    "identify_local",
+    "plan_experiments",
     "robots",
+    "simulate",
 ]

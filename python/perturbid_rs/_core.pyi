@@ -117,3 +117,175 @@ class Robot:
 
 def a465_urdf(variant: str = "kinsheel2010") -> str:
     """The URDF text of a built-in A465 variant."""
+
+# --- the paper's method -------------------------------------------------------------------
+
+class OperatingPoint:
+    """P = (q*, qd*, qdd*): rad, rad/s, rad/s^2 (m for prismatic joints), each shape (n,)."""
+    def __init__(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> None: ...
+    @property
+    def q(self) -> NDArray[np.float64]: ...
+    @property
+    def qd(self) -> NDArray[np.float64]: ...
+    @property
+    def qdd(self) -> NDArray[np.float64]: ...
+    @property
+    def n(self) -> int: ...
+
+class Experiment:
+    """One experiment of a plan: a rest-to-rest trajectory through K crossings."""
+    @property
+    def kind(self) -> str:
+        """'nominal', 'G_static', 'G', 'H' or 'D'."""
+    @property
+    def t(self) -> NDArray[np.float64]:
+        """Sample times (s), shape (m,)."""
+    @property
+    def q(self) -> NDArray[np.float64]:
+        """Positions, shape (m, n)."""
+    @property
+    def qd(self) -> NDArray[np.float64]: ...
+    @property
+    def qdd(self) -> NDArray[np.float64]: ...
+    @property
+    def crossing_times(self) -> NDArray[np.float64]:
+        """Times (s) of the K crossings, shape (K,)."""
+    @property
+    def reference_time(self) -> Optional[float]:
+        """G_static only: time of the reference rest posture at q*."""
+    @property
+    def deltas(self) -> NDArray[np.float64]:
+        """Planned perturbations of the perturbed variable, shape (K, n)."""
+    @property
+    def window(self) -> float:
+        """Half-width (s) of the exact quadratic window around each crossing."""
+    @property
+    def duration(self) -> float: ...
+
+class Plan:
+    """The experiments at an operating point for one robot."""
+    @property
+    def op(self) -> OperatingPoint: ...
+    @property
+    def rate(self) -> float: ...
+    @property
+    def robot(self) -> str: ...
+    @property
+    def joint_names(self) -> list[str]: ...
+    @property
+    def design(self) -> str: ...
+    @property
+    def experiments(self) -> list[Experiment]: ...
+    def experiment(self, kind: str) -> Experiment: ...
+    def __len__(self) -> int: ...
+    def to_json(self) -> str: ...
+    @staticmethod
+    def from_json(text: str) -> "Plan": ...
+
+class Recording:
+    """What a robot logs: t (s, (m,)), q (rad, (m, n)), tau (N m, (m, n)), optional qd, qdd."""
+    def __init__(
+        self,
+        t: ArrayLike,
+        q: ArrayLike,
+        tau: ArrayLike,
+        qd: Optional[ArrayLike] = None,
+        qdd: Optional[ArrayLike] = None,
+        name: str = "recording",
+    ) -> None: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def n(self) -> int: ...
+    @property
+    def t(self) -> NDArray[np.float64]: ...
+    @property
+    def q(self) -> NDArray[np.float64]: ...
+    @property
+    def tau(self) -> NDArray[np.float64]: ...
+    @property
+    def qd(self) -> Optional[NDArray[np.float64]]: ...
+    @property
+    def qdd(self) -> Optional[NDArray[np.float64]]: ...
+    def __len__(self) -> int: ...
+
+class LocalModel:
+    """tau ~= T* + D (qdd - qdd*) + H (qd - qd*) + G (q - q*), with its uncertainty."""
+    @property
+    def torque(self) -> NDArray[np.float64]: ...
+    @property
+    def D(self) -> Optional[NDArray[np.float64]]: ...
+    @property
+    def H(self) -> Optional[NDArray[np.float64]]: ...
+    @property
+    def G(self) -> Optional[NDArray[np.float64]]: ...
+    @property
+    def G_static(self) -> Optional[NDArray[np.float64]]: ...
+    @property
+    def combined(self) -> Optional[NDArray[np.float64]]:
+        """The combined estimate [D H G], shape (n, 3n)."""
+    @property
+    def cond(self) -> dict[str, float]: ...
+    @property
+    def stderr(self) -> dict[str, NDArray[np.float64]]: ...
+    @property
+    def residual_rms(self) -> dict[str, NDArray[np.float64]]: ...
+    @property
+    def op(self) -> OperatingPoint: ...
+    @property
+    def planned_op(self) -> OperatingPoint: ...
+    @property
+    def joint_names(self) -> list[str]: ...
+    @property
+    def estimator(self) -> str: ...
+    def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:
+        """Predicted torques (N m), shape (n,) or (k, n)."""
+    def to_json(self) -> str: ...
+    @staticmethod
+    def from_json(text: str) -> "LocalModel": ...
+
+def plan_experiments(
+    robot: Robot,
+    op: OperatingPoint,
+    design: str = "random",
+    n: Optional[int] = None,
+    seed: int = 0,
+    rate: float = 1000.0,
+    *,
+    experiments: Optional[list[str]] = None,
+    dq: Optional[ArrayLike] = None,
+    dqd: Optional[ArrayLike] = None,
+    dqdd: Optional[ArrayLike] = None,
+    dq_fraction: float = 0.01,
+    dqd_fraction: float = 0.05,
+    dqdd_fraction: float = 0.05,
+    window: float = 0.05,
+    dwell: float = 1.0,
+    margin: float = 0.8,
+    symmetric: bool = True,
+) -> Plan:
+    """Plans the nominal, G_static, G, H and D experiments at op; refuses plans breaking limits."""
+
+def simulate(
+    robot: Robot,
+    plan: Plan,
+    gravity: bool = True,
+    friction: Union[bool, Mapping[str, ArrayLike], None] = None,
+    torque_noise: Optional[ArrayLike] = None,
+    position_noise: Optional[ArrayLike] = None,
+    quantization: Optional[ArrayLike] = None,
+    seed: int = 0,
+) -> list[Recording]:
+    """One simulated Recording per experiment of the plan."""
+
+def identify_local(
+    plan: Plan,
+    recordings: list[Recording],
+    crossing_times: str = "planned",
+    max_shift: float = 1.0,
+    window: Optional[float] = None,
+    torque_degree: int = 6,
+    recorded_derivatives: bool = False,
+    estimator: str = "separated",
+) -> LocalModel:
+    """The local model from a plan and one recording per experiment."""

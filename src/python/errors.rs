@@ -2,8 +2,10 @@
 //!
 //! - `PerturbidError(Exception)`: base of everything the library raises;
 //! - `ModelError`: a URDF or robot model that cannot be built;
-//! - `InputError`: an argument of the wrong shape, with NaN/inf, or out of range;
-//! - `NumericalError`: a numerical failure (e.g. a mass matrix not positive definite);
+//! - `InputError`: an argument of the wrong shape, with NaN/inf, or out of range; a plan that
+//!   breaks the joint limits; a recording or JSON document that cannot be used;
+//! - `NumericalError`: a numerical failure (e.g. a mass matrix not positive definite, a
+//!   regression whose data do not excite every direction);
 //! - `FileError`: a file that cannot be read or written.
 
 use pyo3::create_exception;
@@ -58,10 +60,16 @@ impl From<Error> for PyErr {
         let msg = e.to_string();
         match e {
             Error::Io { .. } => FileError::new_err(msg),
-            Error::Shape { .. } | Error::NonFiniteInput { .. } | Error::InvalidArgument { .. } => {
+            Error::Shape { .. }
+            | Error::NonFiniteInput { .. }
+            | Error::InvalidArgument { .. }
+            | Error::LimitViolation { .. }
+            | Error::PositionLimit { .. }
+            | Error::Recording { .. }
+            | Error::Json { .. } => {
                 InputError::new_err(msg)
             }
-            Error::Numerical { .. } => NumericalError::new_err(msg),
+            Error::Numerical { .. } | Error::RankDeficient { .. } => NumericalError::new_err(msg),
             Error::UrdfSyntax { .. }
             | Error::UnsupportedJoint { .. }
             | Error::RootCount { .. }

@@ -5,6 +5,7 @@
 mod arrays;
 mod errors;
 mod linearization;
+mod local;
 mod robot;
 
 use pyo3::prelude::*;
@@ -14,6 +15,14 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<robot::PyRobot>()?;
     m.add_class::<linearization::PyLinearization>()?;
+    m.add_class::<local::PyOperatingPoint>()?;
+    m.add_class::<local::PyPlan>()?;
+    m.add_class::<local::PyExperiment>()?;
+    m.add_class::<local::PyRecording>()?;
+    m.add_class::<local::PyLocalModel>()?;
+    m.add_function(wrap_pyfunction!(local::plan_experiments, m)?)?;
+    m.add_function(wrap_pyfunction!(local::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(local::identify_local, m)?)?;
     errors::register(m)?;
     m.add_function(wrap_pyfunction!(robot::a465_urdf, m)?)?;
     Ok(())

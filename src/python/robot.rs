@@ -23,7 +23,7 @@ type ArrayLike<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 /// m, m/s, m/s^2 and N for prismatic ones. Gravity is 9.81 m/s^2 along -z of the base frame.
 #[pyclass(name = "Robot", module = "perturbid_rs", frozen)]
 pub(crate) struct PyRobot {
-    model: Model,
+    pub(crate) model: Model,
     data: Mutex<Data>,
 }
 

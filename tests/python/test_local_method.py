@@ -1,0 +1,172 @@
+"""The paper's method from Python: plan, simulate, identify, against Pinocchio (the oracle)."""
+
+import json
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import perturbid_rs as pr
+from conftest import erd_dir, pair_from_text, pair_from_urdf
+
+TABLE2 = (
+    [0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0],
+    [0.0890, -0.1060, 0.0220, 0.0560, 0.0110, 0.0140],
+    [-0.1550, -0.5000, 0.0340, -0.2910, -0.0080, 0.1710],
+)
+
+
+def rel(a, b):
+    return np.linalg.norm(np.asarray(a) - np.asarray(b)) / np.linalg.norm(b)
+
+
+def oracle(pair, q, qd, qdd, gravity=True):
+    """(T*, D*, H*, G*) from Pinocchio's RNEA derivatives, in our joint order."""
+    model = pair.model
+    if not gravity:
+        model = pin.Model(pair.model)
+        model.gravity.linear[:] = 0.0
+    data = model.createData()
+    dq, dv, da = pin.computeRNEADerivatives(model, data, pair.q(q), pair.v(qd), pair.v(qdd))
+    tau = pin.rnea(model, data, pair.q(q), pair.v(qd), pair.v(qdd))
+    da = np.triu(da) + np.triu(da, 1).T
+    return pair.vec(tau), pair.mat(da), pair.mat(dv), pair.mat(dq)
+
+
+def taylor_bound(pair, op, deltas, g_true, qd, qdd, t0):
+    """|G_est - G*| <= |R| / sigma_min(X), R_k = tau(q* + dq_k) - T* - G* dq_k by Pinocchio."""
+    r = []
+    for dq in deltas:
+        tau = pin.rnea(pair.model, pair.data, pair.q(op.q + dq), pair.v(qd), pair.v(qdd))
+        r.append(pair.vec(tau) - t0 - g_true @ dq)
+    return np.linalg.norm(r) / np.linalg.svd(deltas, compute_uv=False).min()
+
+
+@pytest.fixture(scope="module")
+def a465():
+    return pair_from_text(pr.robots.a465_urdf("kinsheel2010"), check_triangle_inequality=False)
+
+
+@pytest.fixture(scope="module")
+def ur5():
+    return pair_from_urdf(erd_dir() / "ur_description/urdf/ur5_robot.urdf")
+
+
+def test_a465_table2_matches_pinocchio(a465):
+    op = pr.OperatingPoint(*TABLE2)
+    plan = pr.plan_experiments(a465.ours, op, design="random", seed=3)
+    recs = pr.simulate(a465.ours, plan, gravity=False, friction=False)
+    model = pr.identify_local(plan, recs)
+    t, d, h, _ = oracle(a465, op.q, op.qd, op.qdd, gravity=False)
+    assert rel(model.D, d) < 1e-9
+    assert rel(model.H, h) < 1e-9
+    assert rel(model.torque, t) < 1e-9
+    # Table 3's perturbation row and Table 2's Tn, to the paper's digits
+    np.testing.assert_allclose(model.D[:, 0], [9.956, 0, 0, -1.37, 0, -0.27], atol=0.005)
+    np.testing.assert_allclose(model.torque, [-1.1883, -3.4797, -1.7304, -0.1377, -0.4466, 0.0539], atol=0.01)
+
+
+@pytest.mark.parametrize("design", ["random", "orthogonal"])
+def test_ur5_matches_pinocchio(ur5, design):
+    rng = np.random.default_rng(11)
+    q = rng.uniform(-1.5, 1.5, 6)
+    op = pr.OperatingPoint(q, rng.uniform(-0.4, 0.4, 6), rng.uniform(-1, 1, 6))
+    plan = pr.plan_experiments(ur5.ours, op, design=design, seed=5)
+    recs = pr.simulate(ur5.ours, plan, friction=False)
+    model = pr.identify_local(plan, recs)
+    t, d, h, g = oracle(ur5, op.q, op.qd, op.qdd)
+    assert rel(model.D, d) < 1e-9
+    assert rel(model.H, h) < 1e-9
+    assert rel(model.torque, t) < 1e-9
+    bound = taylor_bound(ur5, op, plan.experiment("G").deltas, g, op.qd, op.qdd, t)
+    assert np.linalg.norm(model.G - g) <= bound * 1.0001 + 1e-9
+    # G static against Pinocchio's gravity derivatives
+    gs = ur5.mat(pin.computeGeneralizedGravityDerivatives(ur5.model, ur5.data, ur5.q(op.q)))
+    g0 = ur5.vec(pin.computeGeneralizedGravity(ur5.model, ur5.data, ur5.q(op.q)))
+    zero = np.zeros(6)
+    bound = taylor_bound(ur5, op, plan.experiment("G_static").deltas, gs, zero, zero, g0)
+    assert np.linalg.norm(model.G_static - gs) <= bound * 1.0001 + 1e-9
+
+
+def test_workflow_shapes_uncertainty_and_json():
+    robot = pr.robots.a465()
+    op = pr.OperatingPoint(*TABLE2)
+    plan = pr.plan_experiments(robot, op, design="orthogonal", n=16, seed=1)
+    assert [e.kind for e in plan.experiments] == ["nominal", "G_static", "G", "H", "D"]
+    e = plan.experiment("D")
+    assert e.q.shape == (len(e.t), 6) and e.deltas.shape == (16, 6)
+    assert e.crossing_times.shape == (16,)
+    i = np.rint(e.crossing_times * plan.rate).astype(int)
+    np.testing.assert_allclose(e.qdd[i], op.qdd + e.deltas, atol=1e-12)
+    np.testing.assert_allclose(e.q[[0, -1]], [op.q, op.q], atol=1e-12)
+    assert plan.experiment("G_static").reference_time is not None
+    assert pr.Plan.from_json(plan.to_json()).to_json() == plan.to_json()
+
+    recs = pr.simulate(robot, plan, torque_noise=0.02, position_noise=1e-5, quantization=1e-6, seed=4)
+    assert len(recs) == 5 and recs[0].q.shape == (len(recs[0].t), 6) and recs[0].qd is None
+    model = pr.identify_local(plan, recs)
+    truth = robot.linearize(op.q, op.qd, op.qdd)
+    # the estimate is within a few standard errors of the truth
+    z = np.abs(model.D - truth.D) / model.stderr["D"]
+    assert np.median(z) < 3 and z.max() < 8, z
+    assert set(model.cond) == {"D", "H", "G", "G_static"}
+    assert all(1 <= c < 1.1 for c in model.cond.values()), model.cond  # measured deltas: near 1
+    assert model.stderr["torque"].shape == (6,) and model.residual_rms["H"].shape == (6,)
+    # predict: one sample and a batch
+    m = model.op  # the operating point as measured at the nominal crossings, where T* holds
+    np.testing.assert_allclose(model.predict(m.q, m.qd, m.qdd), model.torque, atol=1e-12)
+    assert np.abs(m.q - op.q).max() < 1e-4
+    batch = model.predict(np.tile(m.q, (3, 1)), np.tile(m.qd, (3, 1)), np.tile(m.qdd, (3, 1)) + [[0.0], [0.1], [0.2]])
+    np.testing.assert_allclose(batch[2], model.torque + model.D @ np.full(6, 0.2), atol=1e-9)
+    back = pr.LocalModel.from_json(model.to_json())
+    np.testing.assert_array_equal(back.D, model.D)
+    np.testing.assert_array_equal(back.stderr["G"], model.stderr["G"])
+    doc = json.loads(model.to_json())
+    assert doc["format"] == "perturbid-local-model/1" and len(doc["d"]["matrix"]) == 6
+    combined = pr.identify_local(plan, recs, estimator="combined")
+    assert combined.combined.shape == (6, 18) and combined.estimator == "combined"
+
+
+def test_real_recording_from_arrays_and_shifted_clock():
+    robot = pr.robots.a465()
+    op = pr.OperatingPoint(*TABLE2)
+    plan = pr.plan_experiments(robot, op, experiments=["nominal", "D"], seed=2)
+    sims = pr.simulate(robot, plan)
+    # as if logged by a robot whose clock started 0.25 s before the plan, with qd logged
+    recs = [pr.Recording(r.t + 0.25, r.q, r.tau, qd=np.gradient(r.q, r.t, axis=0), name=f"log{i}") for i, r in enumerate(sims)]
+    model = pr.identify_local(plan, recs, crossing_times="detected", max_shift=0.5)
+    assert rel(model.D, robot.mass_matrix(op.q)) < 1e-8
+    assert model.H is None and model.G is None
+    with pytest.raises(pr.InputError, match="no H"):
+        model.predict(op.q, op.qd, op.qdd)
+
+
+def test_errors():
+    robot = pr.robots.a465()
+    q = list(TABLE2[0])
+    q[1] = robot.upper[1] - 0.005
+    with pytest.raises(pr.InputError, match=r"joint2.*t = .*outside"):
+        pr.plan_experiments(robot, pr.OperatingPoint(q, TABLE2[1], TABLE2[2]))
+    with pytest.raises(pr.InputError, match="design"):
+        pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2), design="latin")
+    with pytest.raises(pr.InputError, match="experiments"):
+        pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2), experiments=["X"])
+    with pytest.raises(pr.InputError, match="qd"):
+        pr.OperatingPoint([0, 0], [0], [0, 0])
+    with pytest.raises(pr.InputError, match="not increasing at sample 2"):
+        pr.Recording([0, 1, 0.5], np.zeros((3, 2)), np.zeros((3, 2)))
+    with pytest.raises(pr.InputError, match="tau"):
+        pr.Recording([0, 1, 2], np.zeros((3, 2)), np.zeros((3, 3)))
+    with pytest.raises(pr.InputError, match="q of joint 2 at sample 1"):
+        pr.Recording([0, 1, 2], [[0, 0], [0, np.nan], [0, 0]], np.zeros((3, 2)))
+    plan = pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2), experiments=["nominal", "D"])
+    recs = pr.simulate(robot, plan)
+    with pytest.raises(pr.InputError, match="one per experiment"):
+        pr.identify_local(plan, recs[:1])
+    short = pr.Recording(recs[1].t[:2000], recs[1].q[:2000], recs[1].tau[:2000], name="short.csv")
+    with pytest.raises(pr.InputError, match="short.csv: experiment 'D', crossing .*too short"):
+        pr.identify_local(plan, [recs[0], short])
+    with pytest.raises(pr.InputError, match="line 1"):
+        pr.LocalModel.from_json("{")
+    with pytest.raises(pr.InputError, match="friction"):
+        pr.simulate(robot, plan, friction="lots")
