@@ -12,14 +12,17 @@
 
 pub mod algorithms;
 pub mod data;
+pub mod direct;
 pub mod error;
 pub mod json;
 pub mod linearization;
 pub mod local;
 pub mod model;
+pub mod preprocess;
 pub mod recording;
 pub mod regression;
 pub mod robots;
+pub mod signal;
 pub mod simulation;
 pub mod spatial;
 pub mod trajectory;

@@ -78,11 +78,15 @@ pub fn least_squares(x: &DMatrix<f64>, y: &DMatrix<f64>, context: &str, columns:
     let smin = s.iter().cloned().fold(f64::INFINITY, f64::min);
     let weak: Vec<usize> = (0..p).filter(|&i| s[i] <= RANK_TOLERANCE * smax).collect();
     if !weak.is_empty() {
-        let missing = weak
+        let mut missing = weak
             .iter()
+            .take(3)
             .map(|&i| describe_direction(&(0..p).map(|j| v[(j, i)] / scale[j]).collect::<Vec<_>>(), columns))
             .collect::<Vec<_>>()
             .join("; ");
+        if weak.len() > 3 {
+            missing.push_str(&format!("; and {} more directions", weak.len() - 3));
+        }
         return Err(Error::RankDeficient { context: context.into(), rows: k, cols: p, rank: p - weak.len(), missing });
     }
     // A^T (scaled) = V S^-1 U^T Y
@@ -126,14 +130,16 @@ pub fn least_squares(x: &DMatrix<f64>, y: &DMatrix<f64>, context: &str, columns:
     Ok(LeastSquares { coef, cond: smax / smin, residual_rms, stderr, rows: k })
 }
 
-/// `0.71 dq1 - 0.71 dq2`: a direction in terms of named columns (largest entries first,
-/// entries below 5 % of the largest left out).
+/// `0.71 dq1 - 0.71 dq2`: a direction in terms of named columns (the 6 largest entries, largest
+/// first; entries below 5 % of the largest left out).
 fn describe_direction(d: &[f64], columns: &[String]) -> String {
     let norm = d.iter().map(|v| v * v).sum::<f64>().sqrt();
     let max = d.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let mut terms: Vec<(usize, f64)> = d.iter().map(|v| v / norm).enumerate().filter(|(_, v)| v.abs() >= 0.05 * max / norm).collect();
     // largest first; equal magnitudes (to 1e-6) in column order
     terms.sort_by_key(|&(j, v)| (-(v.abs() * 1e6).round() as i64, j));
+    let more = terms.len().saturating_sub(6);
+    terms.truncate(6);
     let sign = if terms.first().is_some_and(|t| t.1 < 0.0) { -1.0 } else { 1.0 };
     let mut out = String::new();
     for (i, (j, v)) in terms.iter().enumerate() {
@@ -143,6 +149,9 @@ fn describe_direction(d: &[f64], columns: &[String]) -> String {
         } else {
             out.push_str(&format!(" {} {:.3} {}", if v < 0.0 { '-' } else { '+' }, v.abs(), columns[*j]));
         }
+    }
+    if more > 0 {
+        out.push_str(&format!(" + ... ({more} smaller terms)"));
     }
     out
 }

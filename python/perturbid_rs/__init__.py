@@ -18,11 +18,19 @@ Quick start::
     plan = perturbid_rs.plan_experiments(robot, op, design="orthogonal", seed=1)
     recordings = perturbid_rs.simulate(robot, plan, torque_noise=0.05, seed=2)
     model = perturbid_rs.identify_local(plan, recordings)   # model.D, model.stderr["D"], ...
+
+    # the direct method: excitation, base parameters, globally linearised model
+    design = perturbid_rs.design_excitation(robot, harmonics=5, base_frequency=0.1, seed=0)
+    fit = perturbid_rs.identify_base_parameters(robot, q, qd, qdd, tau)   # (k, n) samples
 """
 
 from ._core import (
+    BaseParameterModel,
+    ExcitationDesign,
     Experiment,
     FileError,
+    FourierTrajectory,
+    GlobalLinearModel,
     InputError,
     Linearization,
     LocalModel,
@@ -33,16 +41,24 @@ from ._core import (
     Plan,
     Recording,
     Robot,
-    __version__,
+    design_excitation,
+    identify_base_parameters,
+    identify_global_linear,
     identify_local,
     plan_experiments,
+    preprocess,
     simulate,
+    __version__,
 )
 from . import robots
 
 __all__ = [
+    "BaseParameterModel",
+    "ExcitationDesign",
     "Experiment",
     "FileError",
+    "FourierTrajectory",
+    "GlobalLinearModel",
     "InputError",
     "Linearization",
     "LocalModel",
@@ -53,9 +69,13 @@ __all__ = [
     "Plan",
     "Recording",
     "Robot",
-    "__version__",
+    "design_excitation",
+    "identify_base_parameters",
+    "identify_global_linear",
     "identify_local",
     "plan_experiments",
+    "preprocess",
     "robots",
     "simulate",
+    "__version__",
 ]

@@ -110,6 +110,11 @@ class Robot:
         """Bias torque c(q, qd) + g(q), shape (n,) or (k, n)."""
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]:
         """Mass matrix M(q), shape (n, n) or (k, n, n)."""
+    def regressor(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, gravity: bool = True) -> NDArray[np.float64]:
+        """Joint-torque regressor, shape (n, 10 b) or (k, n, 10 b): regressor @ parameters == rnea."""
+    @property
+    def parameters(self) -> NDArray[np.float64]:
+        """The model's inertial parameters (10 per moving body, Pinocchio's order), shape (10 b,)."""
     def forward_dynamics(self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, gravity: bool = True) -> NDArray[np.float64]:
         """Accelerations qdd, shape (n,) or (k, n)."""
     def linearize(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, gravity: bool = True) -> Linearization:
@@ -289,3 +294,130 @@ def identify_local(
     estimator: str = "separated",
 ) -> LocalModel:
     """The local model from a plan and one recording per experiment."""
+
+# --- the direct method ----------------------------------------------------------------------
+
+class FourierTrajectory:
+    """Eq. 16: q_i(t) = q0_i + sum_l a_il/(w_f l) sin(w_f l t) - b_il/(w_f l) cos(w_f l t).
+    a, b: (n, L) in rad/s; q0: (n,) rad; w_f rad/s or base_frequency Hz (default 0.1)."""
+    def __init__(self, a: ArrayLike, b: ArrayLike, q0: ArrayLike, *, w_f: Optional[float] = None, base_frequency: Optional[float] = None) -> None: ...
+    def sample(self, t: Union[float, ArrayLike]) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """(q, qd, qdd) at t: (k, n) each for t of shape (k,), (n,) for a scalar."""
+    @property
+    def a(self) -> NDArray[np.float64]: ...
+    @property
+    def b(self) -> NDArray[np.float64]: ...
+    @property
+    def q0(self) -> NDArray[np.float64]: ...
+    @property
+    def w_f(self) -> float: ...
+    @property
+    def period(self) -> float: ...
+    @property
+    def harmonics(self) -> int: ...
+    def to_json(self) -> str: ...
+    @staticmethod
+    def from_json(text: str) -> "FourierTrajectory": ...
+
+class ExcitationDesign:
+    @property
+    def trajectory(self) -> FourierTrajectory: ...
+    @property
+    def cond(self) -> float: ...
+    @property
+    def value(self) -> float: ...
+    @property
+    def evaluations(self) -> int: ...
+    def sample(self, t: Union[float, ArrayLike]) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...
+
+class BaseParameterModel:
+    @property
+    def theta_base(self) -> NDArray[np.float64]: ...
+    @property
+    def stderr(self) -> NDArray[np.float64]: ...
+    @property
+    def names(self) -> list[str]: ...
+    @property
+    def full_names(self) -> list[str]: ...
+    @property
+    def kept(self) -> list[int]: ...
+    @property
+    def dropped(self) -> list[int]: ...
+    @property
+    def K(self) -> NDArray[np.float64]: ...
+    @property
+    def residual_rms(self) -> NDArray[np.float64]: ...
+    @property
+    def sigma(self) -> NDArray[np.float64]: ...
+    @property
+    def cond(self) -> float: ...
+    @property
+    def samples(self) -> int: ...
+    def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]: ...
+    def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]: ...
+    def to_json(self) -> str: ...
+
+class GlobalLinearModel:
+    @property
+    def D(self) -> NDArray[np.float64]: ...
+    @property
+    def H(self) -> NDArray[np.float64]: ...
+    @property
+    def G(self) -> NDArray[np.float64]: ...
+    @property
+    def torque(self) -> NDArray[np.float64]: ...
+    @property
+    def stderr(self) -> dict[str, NDArray[np.float64]]: ...
+    @property
+    def residual_rms(self) -> NDArray[np.float64]: ...
+    @property
+    def cond(self) -> float: ...
+    @property
+    def op(self) -> OperatingPoint: ...
+    def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]: ...
+    def to_json(self) -> str: ...
+
+def design_excitation(
+    robot: Robot,
+    harmonics: int = 5,
+    base_frequency: float = 0.1,
+    criterion: str = "cond",
+    seed: int = 0,
+    *,
+    rest: bool = True,
+    samples: int = 100,
+    margin: float = 0.9,
+    max_evaluations: int = 2000,
+    friction: Union[bool, list[str], None] = None,
+    progress: bool = False,
+) -> ExcitationDesign: ...
+
+def identify_base_parameters(
+    robot: Robot,
+    q: ArrayLike,
+    qd: ArrayLike,
+    qdd: ArrayLike,
+    tau: ArrayLike,
+    friction: Union[bool, list[str], None] = None,
+    weighting: str = "wls",
+    gravity: bool = True,
+    tolerance: float = 1e-8,
+    seed: int = 0,
+) -> BaseParameterModel: ...
+
+def identify_global_linear(op: OperatingPoint, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, tau: ArrayLike) -> GlobalLinearModel: ...
+
+def preprocess(
+    t: ArrayLike,
+    q: ArrayLike,
+    tau: ArrayLike,
+    qd: Optional[ArrayLike] = None,
+    *,
+    rate: float = 1000.0,
+    cutoff: Optional[float] = 10.0,
+    order: int = 4,
+    decimate: int = 10,
+    trim: float = 0.5,
+    filter_position: bool = False,
+    name: str = "recording",
+) -> Recording: ...

@@ -2,11 +2,32 @@
 
 use crate::data::Data;
 use crate::model::Model;
+use crate::spatial::Motion;
 
 /// Poses `data.li_mi[i]` of every body in its parent's frame for the body coordinates in
 /// `data.qb` (set by the caller from `q`).
 pub(crate) fn update_placements(model: &Model, data: &mut Data) {
     for (i, b) in model.bodies.iter().enumerate() {
         data.li_mi[i] = b.pose_in_parent(data.qb[i]);
+    }
+}
+
+/// The forward pass of the Newton-Euler recursion on the body coordinates in `data` (`qb`, `vb`,
+/// `ab`): every body's pose in its parent `li_mi`, twist `v` and spatial acceleration `a` in
+/// its own frame, the base accelerating upwards at `g` when `gravity` (so `a` includes gravity).
+pub(crate) fn motion_pass(model: &Model, data: &mut Data, gravity: bool) {
+    let a0 = model.base_acceleration(gravity);
+    for (i, b) in model.bodies.iter().enumerate() {
+        let x = b.pose_in_parent(data.qb[i]);
+        let s = b.motion_subspace();
+        let vj = s.scale(data.vb[i]);
+        let (vp, ap) = match b.parent {
+            Some(p) => (data.v[p], data.a[p]),
+            None => (Motion::zeros(), a0),
+        };
+        let v = x.act_inv_motion(&vp) + vj;
+        data.a[i] = x.act_inv_motion(&ap) + s.scale(data.ab[i]) + v.cross(&vj);
+        data.li_mi[i] = x;
+        data.v[i] = v;
     }
 }

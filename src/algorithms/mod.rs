@@ -9,6 +9,7 @@ pub mod crba;
 pub mod derivatives;
 pub mod forward_dynamics;
 pub mod kinematics;
+pub mod regressor;
 pub mod rnea;
 
 use nalgebra::{DMatrix, DVector};

@@ -2,11 +2,11 @@
 
 use nalgebra::DVector;
 
+use super::kinematics::motion_pass;
 use super::{contract_vector, load_state};
 use crate::data::Data;
 use crate::error::Result;
 use crate::model::Model;
-use crate::spatial::Motion;
 
 /// Inverse dynamics `tau = M(q) qdd + c(q, qd) + g(q)` (rigid bodies only: no friction).
 ///
@@ -57,22 +57,10 @@ pub fn bias_torque(
 
 /// RNEA on the body coordinates already in `data` (`qb`, `vb`, `ab`); torques into `out`.
 pub(crate) fn rnea_loaded(model: &Model, data: &mut Data, gravity: bool, out: &mut DVector<f64>) {
-    let a0 = model.base_acceleration(gravity);
+    motion_pass(model, data, gravity);
     for (i, b) in model.bodies.iter().enumerate() {
-        let x = b.pose_in_parent(data.qb[i]);
-        let s = b.motion_subspace();
-        let vj = s.scale(data.vb[i]);
-        let (vp, ap) = match b.parent {
-            Some(p) => (data.v[p], data.a[p]),
-            None => (Motion::zeros(), a0),
-        };
-        let v = x.act_inv_motion(&vp) + vj;
-        let a = x.act_inv_motion(&ap) + s.scale(data.ab[i]) + v.cross(&vj);
-        let h = b.inertia.apply(&v);
-        data.f[i] = b.inertia.apply(&a) + v.cross_force(&h);
-        data.li_mi[i] = x;
-        data.v[i] = v;
-        data.a[i] = a;
+        let h = b.inertia.apply(&data.v[i]);
+        data.f[i] = b.inertia.apply(&data.a[i]) + data.v[i].cross_force(&h);
     }
     let coupled = model.coupled;
     for i in (0..model.nbodies()).rev() {

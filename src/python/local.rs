@@ -308,18 +308,25 @@ fn matrix_rows(name: &str, a: &ArrayLike<'_>, m: usize, n: Option<usize>) -> Res
     }
 }
 
-#[pymethods]
 impl PyRecording {
-    #[new]
-    #[pyo3(signature = (t, q, tau, qd=None, qdd=None, name="recording"))]
-    fn new(t: ArrayLike<'_>, q: ArrayLike<'_>, tau: ArrayLike<'_>, qd: Option<ArrayLike<'_>>, qdd: Option<ArrayLike<'_>>, name: &str) -> PyResult<Self> {
+    /// A checked recording from numpy arrays.
+    pub(crate) fn build(t: ArrayLike<'_>, q: ArrayLike<'_>, tau: ArrayLike<'_>, qd: Option<ArrayLike<'_>>, qdd: Option<ArrayLike<'_>>, name: &str) -> Result<Recording> {
         let t = vector("t", &t)?;
         let m = t.len();
         let (n, q) = matrix_rows("q", &q, m, None)?;
         let (_, tau) = matrix_rows("tau", &tau, m, Some(n))?;
         let qd = qd.map(|a| matrix_rows("qd", &a, m, Some(n)).map(|r| r.1)).transpose()?;
         let qdd = qdd.map(|a| matrix_rows("qdd", &a, m, Some(n)).map(|r| r.1)).transpose()?;
-        Ok(Self { rec: Arc::new(Recording::new(name, n, t, q, tau, qd, qdd)?) })
+        Recording::new(name, n, t, q, tau, qd, qdd)
+    }
+}
+
+#[pymethods]
+impl PyRecording {
+    #[new]
+    #[pyo3(signature = (t, q, tau, qd=None, qdd=None, name="recording"))]
+    fn new(t: ArrayLike<'_>, q: ArrayLike<'_>, tau: ArrayLike<'_>, qd: Option<ArrayLike<'_>>, qdd: Option<ArrayLike<'_>>, name: &str) -> PyResult<Self> {
+        Ok(Self { rec: Arc::new(Self::build(t, q, tau, qd, qdd, name)?) })
     }
     #[getter]
     fn name(&self) -> String {

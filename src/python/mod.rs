@@ -3,6 +3,7 @@
 //! onto the Python exception hierarchy, the GIL released around Rust work.
 
 mod arrays;
+mod direct;
 mod errors;
 mod linearization;
 mod local;
@@ -23,6 +24,14 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(local::plan_experiments, m)?)?;
     m.add_function(wrap_pyfunction!(local::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(local::identify_local, m)?)?;
+    m.add_class::<direct::PyFourier>()?;
+    m.add_class::<direct::PyExcitationDesign>()?;
+    m.add_class::<direct::PyBaseModel>()?;
+    m.add_class::<direct::PyGlobalLinear>()?;
+    m.add_function(wrap_pyfunction!(direct::design_excitation, m)?)?;
+    m.add_function(wrap_pyfunction!(direct::identify_base_parameters, m)?)?;
+    m.add_function(wrap_pyfunction!(direct::identify_global_linear, m)?)?;
+    m.add_function(wrap_pyfunction!(direct::preprocess, m)?)?;
     errors::register(m)?;
     m.add_function(wrap_pyfunction!(robot::a465_urdf, m)?)?;
     Ok(())

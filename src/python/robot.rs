@@ -266,6 +266,34 @@ impl PyRobot {
         })
     }
 
+    /// Joint-torque regressor Phi(q, qd, qdd): `Phi @ theta == rnea(q, qd, qdd)` with `theta`
+    /// the 10 inertial parameters of every moving body in Pinocchio's order
+    /// `[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]` (kg, kg m, kg m^2; about the body's
+    /// joint frame), body after body (see `parameters`). Returns (n, 10 b) or (k, n, 10 b).
+    #[pyo3(signature = (q, qd, qdd, gravity=true))]
+    fn regressor<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayLike<'py>,
+        qd: ArrayLike<'py>,
+        qdd: ArrayLike<'py>,
+        gravity: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (n, p) = (self.model.nv, 10 * self.model.nbodies());
+        self.map_samples(py, &[("q", &q), ("qd", &qd), ("qdd", &qdd)], &[n, p], move |m, d, x, out| {
+            let mut y = nalgebra::DMatrix::zeros(n, p);
+            crate::algorithms::regressor::joint_torque_regressor(m, d, x[0], x[1], x[2], gravity, &mut y)?;
+            copy_matrix(&y, out);
+            Ok(())
+        })
+    }
+
+    /// The model's own inertial parameters, shape (10 b,), in the order of `regressor`.
+    #[getter]
+    fn parameters<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, crate::algorithms::regressor::model_parameters(&self.model).as_slice().to_vec())
+    }
+
     /// Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) [- g(q)]). Shapes as `rnea`.
     #[pyo3(signature = (q, qd, tau, gravity=true))]
     fn forward_dynamics<'py>(

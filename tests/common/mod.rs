@@ -81,3 +81,24 @@ pub fn rel_err(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
     let scale = b.amax().max(1.0);
     (a - b).amax() / scale
 }
+
+/// A planar chain with a coupled joint: `b` follows `a` with multiplier 2 and offset 0.1.
+pub fn mimic_pair(mimic: bool) -> String {
+    let mimic_tag = if mimic {
+        r#"<mimic joint="a" multiplier="2" offset="0.1"/>"#
+    } else {
+        ""
+    };
+    format!(
+        r#"<robot name="m">
+  <link name="base"/>
+  <link name="l1"><inertial><origin xyz="0.3 0 0"/><mass value="2"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/></inertial></link>
+  <link name="l2"><inertial><origin xyz="0.2 0.1 0"/><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.015"/></inertial></link>
+  <link name="l3"><inertial><origin xyz="0.1 0 0.05"/><mass value="0.5"/><inertia ixx="0.002" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.003"/></inertial></link>
+  <joint name="a" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="10" velocity="2"/></joint>
+  <joint name="b" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.6 0 0"/><axis xyz="0 1 1"/><limit lower="-3" upper="3" effort="10" velocity="2"/>{mimic_tag}</joint>
+  <joint name="c" type="prismatic"><parent link="l2"/><child link="l3"/><origin xyz="0.4 0 0"/><axis xyz="1 0 0"/><limit lower="-1" upper="1" effort="10" velocity="2"/></joint>
+</robot>"#
+    )
+}
+

@@ -1,0 +1,136 @@
+//! Base parameters: the identifiable linear combinations of the full parameters, found by a
+//! column-pivoted QR of the regressor stacked over random states.
+
+use faer::linalg::solvers::ColPivQr;
+use faer::Mat;
+use nalgebra::{DMatrix, DVector};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use super::parameters::{regressor_matrix, Batch, ParameterLayout};
+use crate::error::{Error, Result};
+use crate::model::Model;
+
+/// The base parameters of a layout: `theta_base = theta[kept] + K theta[dropped]`, and
+/// `Phi theta = Phi[:, kept] theta_base` for every state.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BaseParameters {
+    pub layout: ParameterLayout,
+    /// Indices (ascending) of the full parameters kept as base columns.
+    pub kept: Vec<usize>,
+    /// Indices (ascending) of the full parameters that are combinations of the kept columns.
+    pub dropped: Vec<usize>,
+    /// `len(kept) x len(dropped)`: `Phi[:, dropped[d]] = sum_i K[i, d] Phi[:, kept[i]]`.
+    #[serde(with = "crate::json::rows")]
+    pub k: DMatrix<f64>,
+    /// Relative tolerance on `|R_ii| / |R_00|` that decided the rank.
+    pub tolerance: f64,
+}
+
+/// Default relative rank tolerance of the pivoted QR.
+pub const BASE_TOLERANCE: f64 = 1e-8;
+
+impl BaseParameters {
+    /// Number of base parameters.
+    pub fn len(&self) -> usize {
+        self.kept.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.kept.is_empty()
+    }
+
+    /// The base parameters of a full parameter vector.
+    pub fn from_full(&self, theta: &DVector<f64>) -> Result<DVector<f64>> {
+        if theta.len() != self.layout.len() {
+            return Err(Error::Shape {
+                argument: "theta".into(),
+                expected: format!("{} full parameters", self.layout.len()),
+                got: format!("{}", theta.len()),
+            });
+        }
+        let kept = DVector::from_iterator(self.kept.len(), self.kept.iter().map(|&i| theta[i]));
+        let dropped = DVector::from_iterator(self.dropped.len(), self.dropped.iter().map(|&i| theta[i]));
+        Ok(kept + &self.k * dropped)
+    }
+
+    /// Names of the base parameters: the kept parameter's name, `+ c * other` for every dropped
+    /// parameter merged into it (coefficients below `1e-9` left out).
+    pub fn names(&self) -> Vec<String> {
+        self.kept
+            .iter()
+            .enumerate()
+            .map(|(i, &c)| {
+                let mut s = self.layout.names[c].clone();
+                for (d, &dc) in self.dropped.iter().enumerate() {
+                    let v = self.k[(i, d)];
+                    if v.abs() > 1e-9 {
+                        s.push_str(&format!(" {} {:.4} {}", if v < 0.0 { '-' } else { '+' }, v.abs(), self.layout.names[dc]));
+                    }
+                }
+                s
+            })
+            .collect()
+    }
+
+    /// The base columns of a full regressor.
+    pub fn select(&self, phi: &DMatrix<f64>) -> DMatrix<f64> {
+        phi.select_columns(self.kept.iter())
+    }
+
+    /// Base parameters of `layout` for `model` from `samples` random states (uniform positions
+    /// within the limits, or +-pi where unlimited; speeds and accelerations uniform in +-1 rad/s
+    /// and +-1 rad/s^2 scaled to the limits when given), seeded; with or without `gravity`.
+    pub fn from_random_states(model: &Model, layout: &ParameterLayout, gravity: bool, samples: usize, tolerance: f64, seed: u64) -> Result<Self> {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let (mut q, mut qd, mut qdd) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..samples {
+            for lim in &model.limits {
+                let (lo, hi) = if lim.lower.is_finite() && lim.upper.is_finite() { (lim.lower, lim.upper) } else { (-std::f64::consts::PI, std::f64::consts::PI) };
+                q.push(rng.random_range(lo..=hi));
+                let v = if lim.velocity.is_finite() { lim.velocity } else { 1.0 };
+                qd.push(rng.random_range(-v..=v));
+                let a = if lim.acceleration.is_finite() { lim.acceleration } else { 1.0 };
+                qdd.push(rng.random_range(-a..=a));
+            }
+        }
+        let phi = regressor_matrix(model, layout, &Batch { q: &q, qd: &qd, qdd: &qdd }, gravity)?;
+        Self::from_regressor(layout.clone(), &phi, tolerance)
+    }
+
+    /// Base parameters from a stacked regressor `phi` (rows >= columns) by a column-pivoted QR
+    /// (faer): a column is kept when `|R_ii| > tolerance |R_00|`.
+    pub fn from_regressor(layout: ParameterLayout, phi: &DMatrix<f64>, tolerance: f64) -> Result<Self> {
+        let (m, p) = phi.shape();
+        if p != layout.len() || m < p {
+            return Err(Error::Shape {
+                argument: "regressor".into(),
+                expected: format!("at least {p} rows and {} columns", layout.len()),
+                got: format!("{m} x {p}"),
+            });
+        }
+        let a = Mat::<f64>::from_fn(m, p, |i, j| phi[(i, j)]);
+        let qr = ColPivQr::new(a.as_ref());
+        let r = qr.R();
+        let perm: Vec<usize> = qr.P().arrays().0.to_vec();
+        let r00 = r[(0, 0)].abs();
+        let rank = (0..p).take_while(|&i| r[(i, i)].abs() > tolerance * r00).count();
+        if rank == 0 {
+            return Err(Error::Numerical { operation: "base parameters".into(), message: "the regressor is zero".into() });
+        }
+        // K (pivot order) = R11^-1 R12
+        let r11 = DMatrix::from_fn(rank, rank, |i, j| if j >= i { r[(i, j)] } else { 0.0 });
+        let r12 = DMatrix::from_fn(rank, p - rank, |i, j| r[(i, rank + j)]);
+        let kp = r11.solve_upper_triangular(&r12).ok_or_else(|| Error::Numerical {
+            operation: "base parameters".into(),
+            message: "singular triangular factor".into(),
+        })?;
+        let mut kept: Vec<(usize, usize)> = (0..rank).map(|i| (perm[i], i)).collect();
+        let mut dropped: Vec<(usize, usize)> = (rank..p).map(|i| (perm[i], i - rank)).collect();
+        kept.sort();
+        dropped.sort();
+        let k = DMatrix::from_fn(rank, p - rank, |i, d| kp[(kept[i].1, dropped[d].1)]);
+        Ok(Self { layout, kept: kept.iter().map(|x| x.0).collect(), dropped: dropped.iter().map(|x| x.0).collect(), k, tolerance })
+    }
+}

@@ -1,0 +1,302 @@
+//! Excitation design (Swevers et al. 2007): the Fourier coefficients that make the base
+//! regressor best conditioned, subject to the joint limits, optimised by COBYLA (the `cobyla`
+//! crate: derivative-free, with nonlinear inequality constraints).
+
+use std::cell::RefCell;
+
+use faer::Mat;
+use nalgebra::DMatrix;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::base::{BaseParameters, BASE_TOLERANCE};
+use super::parameters::{regressor_matrix, Batch, FrictionTerms, ParameterLayout};
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::trajectory::{check_limits, FourierTrajectory};
+
+/// What the design minimises.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Criterion {
+    /// `log10 cond(Phi_base)`, the 2-norm condition number of the stacked base regressor.
+    Cond,
+    /// `-log det(Phi_base^T Phi_base) / p` (D-optimality).
+    LogDet,
+}
+
+impl Criterion {
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "cond" => Ok(Criterion::Cond),
+            "logdet" | "log_det" => Ok(Criterion::LogDet),
+            other => Err(Error::InvalidArgument { argument: "criterion".into(), message: format!("'{other}'; expected 'cond' or 'logdet'") }),
+        }
+    }
+}
+
+/// Options of [`design_excitation`]; the defaults are Swevers': 5 harmonics of 0.1 Hz.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExcitationOptions {
+    pub harmonics: usize,
+    /// Base frequency (Hz); the trajectory's period is its inverse.
+    pub base_frequency: f64,
+    pub criterion: Criterion,
+    /// Start and end (every period) at rest: `qd(0) = qdd(0) = 0` (default true).
+    pub rest: bool,
+    /// Samples per period in the criterion's regressor (default 100).
+    pub samples: usize,
+    /// Fraction of the position range, speed and acceleration limits the design may use
+    /// (default 0.9).
+    pub margin: f64,
+    /// Bounds for joints whose URDF gives none (default 1 rad/s, 4 rad/s^2).
+    pub default_velocity: f64,
+    pub default_acceleration: f64,
+    /// Friction terms in the regressor (default viscous and Coulomb).
+    pub friction: FrictionTerms,
+    /// COBYLA's budget of criterion evaluations (default 2000).
+    pub max_evaluations: usize,
+    pub seed: u64,
+}
+
+impl Default for ExcitationOptions {
+    fn default() -> Self {
+        Self {
+            harmonics: 5,
+            base_frequency: 0.1,
+            criterion: Criterion::Cond,
+            rest: true,
+            samples: 100,
+            margin: 0.9,
+            default_velocity: 1.0,
+            default_acceleration: 4.0,
+            friction: FrictionTerms { viscous: true, coulomb: true, offset: false },
+            max_evaluations: 2000,
+            seed: 0,
+        }
+    }
+}
+
+/// The designed excitation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExcitationDesign {
+    pub trajectory: FourierTrajectory,
+    /// Value of the criterion at the design.
+    pub value: f64,
+    /// cond(Phi_base) at the design (2-norm).
+    pub cond: f64,
+    /// Criterion evaluations used.
+    pub evaluations: usize,
+}
+
+/// Progress of the design: evaluations so far and the best feasible criterion value.
+pub type Progress<'a> = &'a mut dyn FnMut(usize, f64);
+
+struct Problem<'a> {
+    model: &'a Model,
+    base: BaseParameters,
+    o: &'a ExcitationOptions,
+    w_f: f64,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    vel: Vec<f64>,
+    acc: Vec<f64>,
+    /// Criterion sample times and (finer) limit check times.
+    t_fit: Vec<f64>,
+    t_check: Vec<f64>,
+}
+
+impl Problem<'_> {
+    fn free_per_joint(&self) -> usize {
+        let l = self.o.harmonics;
+        if self.o.rest { 2 * (l - 1) + 1 } else { 2 * l + 1 }
+    }
+
+    /// The trajectory of a decision vector (rest constraints eliminated).
+    fn trajectory(&self, x: &[f64]) -> FourierTrajectory {
+        let (n, l, f) = (self.model.nv, self.o.harmonics, self.free_per_joint());
+        let mut a = DMatrix::zeros(n, l);
+        let mut b = DMatrix::zeros(n, l);
+        let mut q0 = vec![0.0; n];
+        for i in 0..n {
+            let xi = &x[i * f..(i + 1) * f];
+            if self.o.rest {
+                for k in 1..l {
+                    a[(i, k)] = xi[k - 1];
+                    b[(i, k)] = xi[l - 1 + k - 1];
+                }
+                a[(i, 0)] = -(1..l).map(|k| a[(i, k)]).sum::<f64>();
+                b[(i, 0)] = -(1..l).map(|k| (k + 1) as f64 * b[(i, k)]).sum::<f64>();
+            } else {
+                for k in 0..l {
+                    a[(i, k)] = xi[k];
+                    b[(i, k)] = xi[l + k];
+                }
+            }
+            q0[i] = xi[f - 1];
+        }
+        FourierTrajectory { w_f: self.w_f, q0, a, b }
+    }
+
+    /// Constraint values (>= 0 when satisfied): per joint, the normalised slack of position
+    /// (both sides), speed and acceleration over the check grid.
+    fn constraints(&self, traj: &FourierTrajectory) -> Vec<f64> {
+        let n = self.model.nv;
+        let mut out = vec![f64::INFINITY; 4 * n];
+        for &t in &self.t_check {
+            for i in 0..n {
+                let (q, v, a) = traj.eval(i, t);
+                let span = (self.upper[i] - self.lower[i]).max(1e-9);
+                out[4 * i] = out[4 * i].min((self.upper[i] - q) / span);
+                out[4 * i + 1] = out[4 * i + 1].min((q - self.lower[i]) / span);
+                out[4 * i + 2] = out[4 * i + 2].min(1.0 - v.abs() / self.vel[i]);
+                out[4 * i + 3] = out[4 * i + 3].min(1.0 - a.abs() / self.acc[i]);
+            }
+        }
+        out
+    }
+
+    /// (criterion, cond) of a trajectory.
+    fn criterion(&self, traj: &FourierTrajectory) -> (f64, f64) {
+        let s = traj.sample(&self.t_fit);
+        let phi = match regressor_matrix(self.model, &self.base.layout, &Batch { q: &s.q, qd: &s.qd, qdd: &s.qdd }, true) {
+            Ok(p) => self.base.select(&p),
+            Err(_) => return (f64::INFINITY, f64::INFINITY),
+        };
+        let m = Mat::<f64>::from_fn(phi.nrows(), phi.ncols(), |i, j| phi[(i, j)]);
+        let sv = match m.singular_values() {
+            Ok(sv) => sv,
+            Err(_) => return (f64::INFINITY, f64::INFINITY),
+        };
+        let (max, min) = sv.iter().fold((0.0f64, f64::INFINITY), |(a, b), &v| (a.max(v), b.min(v)));
+        let cond = if min > 0.0 { max / min } else { f64::INFINITY };
+        let value = match self.o.criterion {
+            Criterion::Cond => cond.log10(),
+            Criterion::LogDet => -sv.iter().map(|v| 2.0 * v.max(1e-300).ln()).sum::<f64>() / sv.len() as f64,
+        };
+        (value, cond)
+    }
+}
+
+/// Designs a Fourier excitation for `model` (METHOD.md section 8): COBYLA minimises the
+/// criterion over the coefficients and offsets subject to the limits (times `margin`), from a
+/// seeded random feasible start. `progress` is called every 100 evaluations. The result is
+/// checked against the full limits at 1 kHz over one period.
+pub fn design_excitation(model: &Model, options: &ExcitationOptions, progress: Option<Progress<'_>>) -> Result<ExcitationDesign> {
+    let o = options;
+    if o.harmonics == 0 || (o.rest && o.harmonics < 2) {
+        return Err(Error::InvalidArgument { argument: "harmonics".into(), message: format!("{}; need at least 2 to start at rest", o.harmonics) });
+    }
+    if !(o.base_frequency.is_finite() && o.base_frequency > 0.0) {
+        return Err(Error::InvalidArgument { argument: "base_frequency".into(), message: format!("{} Hz; expected a positive number", o.base_frequency) });
+    }
+    if !(o.margin > 0.0 && o.margin <= 1.0) {
+        return Err(Error::InvalidArgument { argument: "margin".into(), message: format!("{}; expected a fraction in (0, 1]", o.margin) });
+    }
+    let n = model.nv;
+    let layout = ParameterLayout::new(model, o.friction);
+    let base = BaseParameters::from_random_states(model, &layout, true, 200.max(layout.len()), BASE_TOLERANCE, o.seed)?;
+    if o.samples * n < base.len() {
+        return Err(Error::InvalidArgument {
+            argument: "samples".into(),
+            message: format!("{} samples x {n} joints cannot determine {} base parameters", o.samples, base.len()),
+        });
+    }
+    let w_f = 2.0 * std::f64::consts::PI * o.base_frequency;
+    let period = 1.0 / o.base_frequency;
+    let m = o.margin;
+    let (mut lower, mut upper) = (vec![0.0; n], vec![0.0; n]);
+    for (i, lim) in model.limits.iter().enumerate() {
+        let (lo, hi) = if lim.lower.is_finite() && lim.upper.is_finite() { (lim.lower, lim.upper) } else { (-std::f64::consts::PI, std::f64::consts::PI) };
+        let (c, h) = (0.5 * (lo + hi), 0.5 * (hi - lo) * m);
+        (lower[i], upper[i]) = (c - h, c + h);
+    }
+    let p = Problem {
+        model,
+        base,
+        o,
+        w_f,
+        vel: model.limits.iter().map(|l| m * if l.velocity.is_finite() { l.velocity } else { o.default_velocity }).collect(),
+        acc: model.limits.iter().map(|l| m * if l.acceleration.is_finite() { l.acceleration } else { o.default_acceleration }).collect(),
+        lower,
+        upper,
+        t_fit: (0..o.samples).map(|k| period * k as f64 / o.samples as f64).collect(),
+        t_check: (0..400).map(|k| period * k as f64 / 400.0).collect(),
+    };
+    // seeded random start, shrunk until feasible
+    let f = p.free_per_joint();
+    let mut rng = ChaCha8Rng::seed_from_u64(o.seed);
+    let mut x = vec![0.0; n * f];
+    let mut bounds = vec![(0.0, 0.0); n * f];
+    for i in 0..n {
+        let amp = p.vel[i] / o.harmonics as f64;
+        for k in 0..f - 1 {
+            x[i * f + k] = rng.random_range(-amp..=amp);
+            bounds[i * f + k] = (-p.vel[i], p.vel[i]);
+        }
+        x[i * f + f - 1] = 0.5 * (p.lower[i] + p.upper[i]);
+        bounds[i * f + f - 1] = (p.lower[i], p.upper[i]);
+    }
+    for _ in 0..60 {
+        if p.constraints(&p.trajectory(&x)).iter().all(|&c| c >= 0.0) {
+            break;
+        }
+        for i in 0..n {
+            for k in 0..f - 1 {
+                x[i * f + k] *= 0.8;
+            }
+        }
+    }
+    let evaluations = RefCell::new(0usize);
+    let best = RefCell::new(f64::INFINITY);
+    let progress = RefCell::new(progress);
+    let cache: RefCell<(Vec<f64>, Vec<f64>)> = RefCell::new((Vec::new(), Vec::new()));
+    let constraints_of = |x: &[f64]| -> Vec<f64> {
+        let mut c = cache.borrow_mut();
+        if c.0 != x {
+            *c = (x.to_vec(), p.constraints(&p.trajectory(x)));
+        }
+        c.1.clone()
+    };
+    let objective = |x: &[f64], _: &mut ()| -> f64 {
+        let (value, _) = p.criterion(&p.trajectory(x));
+        let mut e = evaluations.borrow_mut();
+        *e += 1;
+        if constraints_of(x).iter().all(|&c| c >= 0.0) && value < *best.borrow() {
+            *best.borrow_mut() = value;
+        }
+        if *e % 100 == 0 {
+            if let Some(cb) = progress.borrow_mut().as_mut() {
+                cb(*e, *best.borrow());
+            }
+        }
+        value
+    };
+    let cons: Vec<_> = (0..4 * n).map(|c| { let cf = &constraints_of; move |x: &[f64], _: &mut ()| cf(x)[c] }).collect();
+    let rhobeg = p.vel.iter().cloned().fold(f64::INFINITY, f64::min) / (4.0 * o.harmonics as f64);
+    let result = cobyla::minimize(
+        objective,
+        &x,
+        &bounds,
+        &cons,
+        (),
+        o.max_evaluations,
+        cobyla::RhoBeg::All(rhobeg),
+        Some(cobyla::StopTols { ftol_rel: 1e-6, ..cobyla::StopTols::default() }),
+    );
+    let x = match result {
+        Ok((_, x, _)) | Err((_, x, _)) => x,
+    };
+    // make sure of the limits: shrink the amplitudes about q0 until the full check passes
+    let mut traj = p.trajectory(&x);
+    for _ in 0..200 {
+        if p.constraints(&traj).iter().all(|&c| c >= 0.0) {
+            break;
+        }
+        traj.a *= 0.99;
+        traj.b *= 0.99;
+    }
+    check_limits(model, &traj.sample_periods(1.0, 1000.0), "designed excitation", "; lower the margin")?;
+    let (value, cond) = p.criterion(&traj);
+    let evaluations = *evaluations.borrow();
+    Ok(ExcitationDesign { trajectory: traj, value, cond, evaluations })
+}

@@ -1,0 +1,154 @@
+//! Base-parameter identification (the direct method, METHOD.md section 8b): ordinary or weighted
+//! least squares of `tau = Phi_base(q, qd, qdd) theta_base` over all samples.
+
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+use super::base::{BaseParameters, BASE_TOLERANCE};
+use super::parameters::{regressor_matrix, Batch, FrictionTerms, ParameterLayout};
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::regression::least_squares;
+
+/// Ordinary or weighted least squares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Weighting {
+    Ols,
+    /// Rows of joint `j` divided by `sigma_j`, the RMS of joint `j`'s OLS residuals (Swevers et
+    /// al.: the maximum-likelihood estimate for independent per-joint noise).
+    Wls,
+}
+
+/// Options of [`identify_base_parameters`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct BaseOptions {
+    pub friction: FrictionTerms,
+    pub weighting: Weighting,
+    /// Whether the torques include gravity (default true).
+    pub gravity: bool,
+    /// Relative rank tolerance of the pivoted QR (default 1e-8).
+    pub tolerance: f64,
+    /// Random states used to find the base parameters (default 200) and their seed.
+    pub states: usize,
+    pub seed: u64,
+}
+
+impl Default for BaseOptions {
+    fn default() -> Self {
+        Self { friction: FrictionTerms::ALL, weighting: Weighting::Wls, gravity: true, tolerance: BASE_TOLERANCE, states: 200, seed: 0 }
+    }
+}
+
+/// An identified base-parameter model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BaseModel {
+    pub robot: String,
+    pub joint_names: Vec<String>,
+    pub base: BaseParameters,
+    pub gravity: bool,
+    pub weighting: Weighting,
+    /// The identified base parameters (SI units of each combination).
+    pub theta: Vec<f64>,
+    /// Their standard errors.
+    pub stderr: Vec<f64>,
+    /// Per joint, the RMS of the torque residuals of the fit (N m).
+    pub residual_rms: Vec<f64>,
+    /// Per joint, the noise level used as weight (N m; 1 for OLS).
+    pub sigma: Vec<f64>,
+    /// cond(Phi_base) of the (weighted) fit, columns scaled to unit norm.
+    pub cond: f64,
+    /// Samples used.
+    pub samples: usize,
+}
+
+/// Identifies the base parameters of `model` from samples `q`, `qd`, `qdd`, `tau` (row-major,
+/// `k x nv` each; rad, rad/s, rad/s^2, N m).
+pub fn identify_base_parameters(model: &Model, batch: &Batch<'_>, tau: &[f64], options: &BaseOptions) -> Result<BaseModel> {
+    let nv = model.nv;
+    let k = batch.samples(nv)?;
+    if tau.len() != k * nv {
+        return Err(Error::Shape { argument: "tau".into(), expected: format!("{k} samples x {nv} joints like q"), got: format!("{} values", tau.len()) });
+    }
+    if let Some(i) = tau.iter().position(|v| !v.is_finite()) {
+        return Err(Error::NonFiniteInput { argument: format!("tau[{}]", i / nv), index: i % nv, value: tau[i] });
+    }
+    let layout = ParameterLayout::new(model, options.friction);
+    let base = BaseParameters::from_random_states(model, &layout, options.gravity, options.states.max(layout.len() / nv + 1), options.tolerance, options.seed)?;
+    let phi = base.select(&regressor_matrix(model, &layout, batch, options.gravity)?);
+    let names = base.names();
+    let y = DMatrix::from_column_slice(k * nv, 1, tau);
+    let fit = |sigma: &[f64]| {
+        let mut x = phi.clone();
+        let mut yw = y.clone();
+        for r in 0..k * nv {
+            let w = 1.0 / sigma[r % nv];
+            x.row_mut(r).scale_mut(w);
+            yw[r] *= w;
+        }
+        least_squares(&x, &yw, "base-parameter identification", &names)
+    };
+    let ones = vec![1.0; nv];
+    let mut ls = fit(&ones)?;
+    let residual_rms = |theta: &DMatrix<f64>| -> Vec<f64> {
+        let r = &y - &phi * theta.transpose();
+        (0..nv).map(|j| ((0..k).map(|s| r[s * nv + j].powi(2)).sum::<f64>() / k as f64).sqrt()).collect()
+    };
+    let mut sigma = ones.clone();
+    if options.weighting == Weighting::Wls {
+        sigma = residual_rms(&ls.coef).iter().map(|&s| if s > 0.0 { s } else { 1.0 }).collect();
+        ls = fit(&sigma)?;
+    }
+    Ok(BaseModel {
+        robot: model.name.clone(),
+        joint_names: model.joint_names.clone(),
+        gravity: options.gravity,
+        weighting: options.weighting,
+        theta: ls.coef.row(0).iter().copied().collect(),
+        stderr: ls.stderr.row(0).iter().copied().collect(),
+        residual_rms: residual_rms(&ls.coef),
+        sigma,
+        cond: ls.cond,
+        samples: k,
+        base,
+    })
+}
+
+impl BaseModel {
+    fn check(&self, model: &Model) -> Result<()> {
+        if model.joint_names != self.joint_names || model.nbodies() != self.base.layout.nbodies {
+            return Err(Error::InvalidArgument {
+                argument: "robot".into(),
+                message: format!("the model was identified for '{}' with joints [{}]", self.robot, self.joint_names.join(", ")),
+            });
+        }
+        Ok(())
+    }
+
+    /// Predicted torques (row-major `k x nv`, N m) at a batch of states of `model` (the robot it
+    /// was identified for).
+    pub fn predict(&self, model: &Model, batch: &Batch<'_>) -> Result<Vec<f64>> {
+        self.check(model)?;
+        let phi = self.base.select(&regressor_matrix(model, &self.base.layout, batch, self.gravity)?);
+        Ok((phi * DVector::from_column_slice(&self.theta)).as_slice().to_vec())
+    }
+
+    /// The mass matrix `M(q)` (`nv x nv`) of the identified parameters at `q`: column `j` is
+    /// `Phi(q, 0, e_j) theta - Phi(q, 0, 0) theta` (METHOD.md section 8b).
+    pub fn mass_matrix(&self, model: &Model, q: &[f64]) -> Result<DMatrix<f64>> {
+        self.check(model)?;
+        let nv = model.nv;
+        crate::model::check_finite_vector("q", q, nv)?;
+        let mut qs = Vec::with_capacity((nv + 1) * nv);
+        let mut qdd = vec![0.0; (nv + 1) * nv];
+        for s in 0..=nv {
+            qs.extend_from_slice(q);
+            if s > 0 {
+                qdd[s * nv + s - 1] = 1.0;
+            }
+        }
+        let zeros = vec![0.0; (nv + 1) * nv];
+        let tau = self.predict(model, &Batch { q: &qs, qd: &zeros, qdd: &qdd })?;
+        Ok(DMatrix::from_fn(nv, nv, |i, j| tau[(j + 1) * nv + i] - tau[i]))
+    }
+}

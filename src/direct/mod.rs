@@ -1,0 +1,16 @@
+//! The classical direct method the paper compares with (Swevers et al. 2007; METHOD.md section
+//! 8): Fourier excitation ([`crate::trajectory::fourier`]) designed by [`design_excitation`],
+//! the regressor of the inertial and friction parameters, base parameters by pivoted QR,
+//! OLS/WLS identification, and the globally linearised model.
+
+pub mod base;
+pub mod excitation;
+pub mod global_linear;
+pub mod identify;
+pub mod parameters;
+
+pub use base::BaseParameters;
+pub use excitation::{design_excitation, Criterion, ExcitationDesign, ExcitationOptions};
+pub use global_linear::{identify_global_linear, GlobalLinearModel};
+pub use identify::{identify_base_parameters, BaseModel, BaseOptions, Weighting};
+pub use parameters::{regressor_matrix, Batch, FrictionTerms, ParameterLayout};

@@ -1,0 +1,164 @@
+//! The parameter vector of the direct method: 10 inertial parameters per moving body
+//! (Pinocchio's order) followed by the friction parameters per joint, and the regressor of a
+//! batch of samples for it.
+
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+use crate::algorithms::regressor::{joint_torque_regressor, model_parameters, PARAMETER_NAMES, PARAMS_PER_BODY};
+use crate::data::Data;
+use crate::error::{Error, Result};
+use crate::model::Model;
+
+/// Which per-joint friction parameters are identified with the inertial ones.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FrictionTerms {
+    /// Viscous friction `fv qd` (N m s/rad).
+    pub viscous: bool,
+    /// Coulomb friction `fc sign(qd)` (N m).
+    pub coulomb: bool,
+    /// A constant torque offset (N m), e.g. a sensor bias.
+    pub offset: bool,
+}
+
+impl FrictionTerms {
+    pub const NONE: FrictionTerms = FrictionTerms { viscous: false, coulomb: false, offset: false };
+    pub const ALL: FrictionTerms = FrictionTerms { viscous: true, coulomb: true, offset: true };
+
+    /// Names of the terms switched on, in column order (`viscous`, `coulomb`, `offset`).
+    pub fn names(&self) -> Vec<&'static str> {
+        [("viscous", self.viscous), ("coulomb", self.coulomb), ("offset", self.offset)]
+            .into_iter()
+            .filter_map(|(n, on)| on.then_some(n))
+            .collect()
+    }
+}
+
+/// The full parameter layout for a model: `10 * nbodies` inertial parameters (body after body)
+/// and then, joint after joint, the friction terms switched on.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ParameterLayout {
+    pub nv: usize,
+    pub nbodies: usize,
+    pub friction: FrictionTerms,
+    /// A name for every parameter, e.g. `link2.mcx` or `joint3.viscous`.
+    pub names: Vec<String>,
+}
+
+impl ParameterLayout {
+    pub fn new(model: &Model, friction: FrictionTerms) -> Self {
+        let mut names = Vec::new();
+        for b in &model.bodies {
+            names.extend(PARAMETER_NAMES.iter().map(|p| format!("{}.{p}", b.link)));
+        }
+        for j in &model.joint_names {
+            names.extend(friction.names().iter().map(|t| format!("{j}.{t}")));
+        }
+        Self { nv: model.nv, nbodies: model.nbodies(), friction, names }
+    }
+
+    /// Number of parameters.
+    pub fn len(&self) -> usize {
+        self.names.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.names.is_empty()
+    }
+
+    /// The full parameter vector of `model` itself: its URDF inertias and friction
+    /// (`<dynamics damping friction>`; offsets 0).
+    pub fn model_parameters(&self, model: &Model) -> DVector<f64> {
+        let mut theta = model_parameters(model).as_slice().to_vec();
+        for lim in &model.limits {
+            for t in self.friction.names() {
+                theta.push(match t {
+                    "viscous" => lim.damping,
+                    "coulomb" => lim.friction,
+                    _ => 0.0,
+                });
+            }
+        }
+        DVector::from_vec(theta)
+    }
+}
+
+/// Row-major joint states of a batch: sample `s` of joint `j` at `[s * nv + j]`.
+#[derive(Clone, Copy, Debug)]
+pub struct Batch<'a> {
+    pub q: &'a [f64],
+    pub qd: &'a [f64],
+    pub qdd: &'a [f64],
+}
+
+impl<'a> Batch<'a> {
+    /// Checks that the three arrays hold the same whole number of samples of `nv` joints;
+    /// returns that number.
+    pub fn samples(&self, nv: usize) -> Result<usize> {
+        let k = self.q.len() / nv.max(1);
+        for (name, x) in [("q", self.q), ("qd", self.qd), ("qdd", self.qdd)] {
+            if x.len() != k * nv || x.len() % nv != 0 {
+                return Err(Error::Shape {
+                    argument: name.into(),
+                    expected: format!("{k} samples x {nv} joints like q"),
+                    got: format!("{} values", x.len()),
+                });
+            }
+        }
+        Ok(k)
+    }
+
+    pub fn row(x: &'a [f64], s: usize, nv: usize) -> &'a [f64] {
+        &x[s * nv..(s + 1) * nv]
+    }
+}
+
+/// The identification regressor of a batch: `(k nv) x layout.len()`, row `s * nv + j` the torque
+/// of joint `j` at sample `s` per unit of each parameter. `gravity` includes gravity.
+pub fn regressor_matrix(model: &Model, layout: &ParameterLayout, batch: &Batch<'_>, gravity: bool) -> Result<DMatrix<f64>> {
+    let nv = model.nv;
+    let k = batch.samples(nv)?;
+    let mut out = DMatrix::zeros(k * nv, layout.len());
+    fill_regressor(model, layout, batch, gravity, 0..k, &mut out, 0)?;
+    Ok(out)
+}
+
+/// Writes the regressor rows of samples `range` into `out` from row `row0` on.
+pub(crate) fn fill_regressor(
+    model: &Model,
+    layout: &ParameterLayout,
+    batch: &Batch<'_>,
+    gravity: bool,
+    range: std::ops::Range<usize>,
+    out: &mut DMatrix<f64>,
+    row0: usize,
+) -> Result<()> {
+    let nv = model.nv;
+    let ni = PARAMS_PER_BODY * model.nbodies();
+    let terms = layout.friction.names();
+    let mut data = Data::new(model);
+    let mut y = DMatrix::zeros(nv, ni);
+    for (r, s) in range.enumerate() {
+        let (q, qd, qdd) = (Batch::row(batch.q, s, nv), Batch::row(batch.qd, s, nv), Batch::row(batch.qdd, s, nv));
+        joint_torque_regressor(model, &mut data, q, qd, qdd, gravity, &mut y).map_err(|e| in_sample(e, s))?;
+        let base = row0 + r * nv;
+        out.view_mut((base, 0), (nv, ni)).copy_from(&y);
+        for j in 0..nv {
+            for (t, name) in terms.iter().enumerate() {
+                out[(base + j, ni + j * terms.len() + t)] = match *name {
+                    "viscous" => qd[j],
+                    "coulomb" => qd[j].signum() * f64::from(u8::from(qd[j] != 0.0)),
+                    _ => 1.0,
+                };
+            }
+        }
+    }
+    Ok(())
+}
+
+fn in_sample(e: Error, s: usize) -> Error {
+    match e {
+        Error::NonFiniteInput { argument, index, value } => Error::NonFiniteInput { argument: format!("{argument}[{s}]"), index, value },
+        other => other,
+    }
+}

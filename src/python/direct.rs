@@ -1,0 +1,441 @@
+//! The direct method in Python: `FourierTrajectory`, `design_excitation`,
+//! `identify_base_parameters` (`BaseParameterModel`), `identify_global_linear`
+//! (`GlobalLinearModel`) and `preprocess`.
+
+use std::sync::Arc;
+
+use nalgebra::DMatrix;
+use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use super::arrays::{read_batch, to_numpy};
+use super::local::{PyOperatingPoint, PyRecording};
+use super::robot::PyRobot;
+use crate::direct::excitation::ExcitationDesign;
+use crate::direct::{
+    design_excitation as design_rs, identify_base_parameters as base_rs, identify_global_linear as global_rs, BaseModel,
+    BaseOptions, Batch, Criterion, ExcitationOptions, FrictionTerms, GlobalLinearModel, Weighting,
+};
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::preprocess::{preprocess as preprocess_rs, PreprocessOptions};
+use crate::recording::Recording;
+use crate::trajectory::FourierTrajectory;
+
+type ArrayLike<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+
+fn mat<'py>(py: Python<'py>, m: &DMatrix<f64>) -> PyResult<Bound<'py, PyAny>> {
+    let values: Vec<f64> = m.transpose().iter().copied().collect();
+    to_numpy(py, values, m.nrows(), false, &[m.ncols()])
+}
+
+fn matrix(name: &str, a: &ArrayLike<'_>) -> Result<DMatrix<f64>> {
+    match a.shape() {
+        [r, c] => Ok(DMatrix::from_row_iterator(*r, *c, a.as_array().iter().copied())),
+        s => Err(Error::Shape { argument: name.into(), expected: "a 2-D array (joints x harmonics)".into(), got: format!("shape {s:?}") }),
+    }
+}
+
+/// A Fourier excitation (eq. 16): `q_i(t) = q0_i + sum_l a_il/(w_f l) sin(w_f l t) -
+/// b_il/(w_f l) cos(w_f l t)`. `a`, `b`: (n, L) in rad/s; `q0`: (n,) in rad; the base
+/// pulsation `w_f` in rad/s, or `base_frequency` in Hz (default 0.1 Hz).
+#[pyclass(name = "FourierTrajectory", module = "perturbid_rs", frozen)]
+#[derive(Clone)]
+pub(crate) struct PyFourier {
+    pub traj: FourierTrajectory,
+}
+
+#[pymethods]
+impl PyFourier {
+    #[new]
+    #[pyo3(signature = (a, b, q0, *, w_f=None, base_frequency=None))]
+    fn new(a: ArrayLike<'_>, b: ArrayLike<'_>, q0: ArrayLike<'_>, w_f: Option<f64>, base_frequency: Option<f64>) -> PyResult<Self> {
+        let w_f = match (w_f, base_frequency) {
+            (Some(_), Some(_)) => {
+                return Err(Error::InvalidArgument { argument: "w_f".into(), message: "give w_f or base_frequency, not both".into() }.into())
+            }
+            (Some(w), None) => w,
+            (None, f) => 2.0 * std::f64::consts::PI * f.unwrap_or(0.1),
+        };
+        let q0: Vec<f64> = q0.as_array().iter().copied().collect();
+        Ok(Self { traj: FourierTrajectory::new(w_f, q0, matrix("a", &a)?, matrix("b", &b)?)? })
+    }
+    /// Positions, velocities and accelerations at times `t` (s): a tuple of three arrays of
+    /// shape (k, n) for `t` of shape (k,), or (n,) for a scalar `t`.
+    fn sample<'py>(&self, py: Python<'py>, t: &Bound<'py, PyAny>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let (times, single) = match t.extract::<f64>() {
+            Ok(x) => (vec![x], true),
+            Err(_) => {
+                let a: ArrayLike<'_> = t.extract()?;
+                (a.as_array().iter().copied().collect(), false)
+            }
+        };
+        let s = self.traj.sample(&times);
+        let n = self.traj.n();
+        Ok((to_numpy(py, s.q, times.len(), single, &[n])?, to_numpy(py, s.qd, times.len(), single, &[n])?, to_numpy(py, s.qdd, times.len(), single, &[n])?))
+    }
+    #[getter]
+    fn a<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        mat(py, &self.traj.a)
+    }
+    #[getter]
+    fn b<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        mat(py, &self.traj.b)
+    }
+    #[getter]
+    fn q0<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.traj.q0)
+    }
+    #[getter]
+    fn w_f(&self) -> f64 {
+        self.traj.w_f
+    }
+    #[getter]
+    fn period(&self) -> f64 {
+        self.traj.period()
+    }
+    #[getter]
+    fn harmonics(&self) -> usize {
+        self.traj.harmonics()
+    }
+    fn to_json(&self) -> String {
+        serde_json::to_string_pretty(&self.traj).expect("serialisable")
+    }
+    #[staticmethod]
+    fn from_json(text: &str) -> PyResult<Self> {
+        let t: FourierTrajectory = serde_json::from_str(text).map_err(|e| Error::Json { context: "Fourier trajectory".into(), message: e.to_string() })?;
+        Ok(Self { traj: FourierTrajectory::new(t.w_f, t.q0, t.a, t.b)? })
+    }
+    fn __repr__(&self) -> String {
+        format!("FourierTrajectory(n={}, harmonics={}, period={:.3} s)", self.traj.n(), self.traj.harmonics(), self.traj.period())
+    }
+}
+
+/// A designed excitation: `trajectory` (a FourierTrajectory), `cond` (cond of the base
+/// regressor), `value` (the criterion) and `evaluations`.
+#[pyclass(name = "ExcitationDesign", module = "perturbid_rs", frozen)]
+pub(crate) struct PyExcitationDesign {
+    design: ExcitationDesign,
+}
+
+#[pymethods]
+impl PyExcitationDesign {
+    #[getter]
+    fn trajectory(&self) -> PyFourier {
+        PyFourier { traj: self.design.trajectory.clone() }
+    }
+    #[getter]
+    fn cond(&self) -> f64 {
+        self.design.cond
+    }
+    #[getter]
+    fn value(&self) -> f64 {
+        self.design.value
+    }
+    #[getter]
+    fn evaluations(&self) -> usize {
+        self.design.evaluations
+    }
+    /// `trajectory.sample(t)`.
+    fn sample<'py>(&self, py: Python<'py>, t: &Bound<'py, PyAny>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        self.trajectory().sample(py, t)
+    }
+    fn __repr__(&self) -> String {
+        format!("ExcitationDesign(cond={:.4}, evaluations={})", self.design.cond, self.design.evaluations)
+    }
+}
+
+fn friction_terms(value: &Bound<'_, PyAny>) -> PyResult<FrictionTerms> {
+    if let Ok(b) = value.extract::<bool>() {
+        return Ok(if b { FrictionTerms::ALL } else { FrictionTerms::NONE });
+    }
+    let names: Vec<String> = value.extract().map_err(|_| Error::InvalidArgument {
+        argument: "friction".into(),
+        message: "expected True, False or a list of 'viscous', 'coulomb', 'offset'".into(),
+    })?;
+    let mut f = FrictionTerms::NONE;
+    for n in &names {
+        match n.as_str() {
+            "viscous" => f.viscous = true,
+            "coulomb" => f.coulomb = true,
+            "offset" => f.offset = true,
+            other => return Err(Error::InvalidArgument { argument: "friction".into(), message: format!("'{other}' is not a friction term (viscous, coulomb, offset)") }.into()),
+        }
+    }
+    Ok(f)
+}
+
+/// Designs a Fourier excitation for `robot` minimising `criterion` ('cond' or 'logdet') of the
+/// base regressor subject to the limits (times `margin`), starting and ending at rest when
+/// `rest`. COBYLA, seeded; `progress=True` prints the progress to stderr.
+#[pyfunction]
+#[pyo3(signature = (robot, harmonics=5, base_frequency=0.1, criterion="cond", seed=0, *, rest=true, samples=100, margin=0.9, max_evaluations=2000, friction=None, progress=false))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn design_excitation(
+    py: Python<'_>,
+    robot: &PyRobot,
+    harmonics: usize,
+    base_frequency: f64,
+    criterion: &str,
+    seed: u64,
+    rest: bool,
+    samples: usize,
+    margin: f64,
+    max_evaluations: usize,
+    friction: Option<Bound<'_, PyAny>>,
+    progress: bool,
+) -> PyResult<PyExcitationDesign> {
+    let mut o = ExcitationOptions { harmonics, base_frequency, criterion: Criterion::parse(criterion)?, seed, rest, samples, margin, max_evaluations, ..ExcitationOptions::default() };
+    if let Some(f) = friction {
+        o.friction = friction_terms(&f)?;
+    }
+    let design = py.detach(|| {
+        let mut report = |e: usize, best: f64| eprintln!("excitation design: {e} evaluations, best criterion {best:.4}");
+        design_rs(&robot.model, &o, if progress { Some(&mut report) } else { None })
+    })?;
+    Ok(PyExcitationDesign { design })
+}
+
+/// Row-major (k, n) samples of three arrays and optionally a fourth.
+fn states(n: usize, q: &ArrayLike<'_>, qd: &ArrayLike<'_>, qdd: &ArrayLike<'_>, tau: Option<&ArrayLike<'_>>) -> Result<Vec<Vec<f64>>> {
+    let mut args = vec![("q", q), ("qd", qd), ("qdd", qdd)];
+    if let Some(t) = tau {
+        args.push(("tau", t));
+    }
+    Ok(read_batch(n, &args)?.columns)
+}
+
+/// An identified base-parameter model (the direct method).
+///
+/// - `theta_base` (p,), `stderr` (p,), `names` (p,): the base parameters, each a kept full
+///   parameter with the dropped ones merged into it;
+/// - `kept`, `dropped` (indices into the full parameters: 10 per body in `Robot.regressor`
+///   order, then the friction terms per joint), `K` (p, len(dropped)):
+///   `theta_base = theta[kept] + K @ theta[dropped]`;
+/// - `residual_rms`, `sigma` (n,): per-joint fit residuals and WLS weights (N m); `cond`;
+/// - `predict(q, qd, qdd)` torques; `mass_matrix(q)` M(q) from the identified parameters.
+#[pyclass(name = "BaseParameterModel", module = "perturbid_rs", frozen)]
+pub(crate) struct PyBaseModel {
+    fit: BaseModel,
+    model: Arc<Model>,
+}
+
+#[pymethods]
+impl PyBaseModel {
+    #[getter]
+    fn theta_base<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.fit.theta)
+    }
+    #[getter]
+    fn stderr<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.fit.stderr)
+    }
+    #[getter]
+    fn names(&self) -> Vec<String> {
+        self.fit.base.names()
+    }
+    #[getter]
+    fn full_names(&self) -> Vec<String> {
+        self.fit.base.layout.names.clone()
+    }
+    #[getter]
+    fn kept(&self) -> Vec<usize> {
+        self.fit.base.kept.clone()
+    }
+    #[getter]
+    fn dropped(&self) -> Vec<usize> {
+        self.fit.base.dropped.clone()
+    }
+    #[getter(K)]
+    fn k<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        mat(py, &self.fit.base.k)
+    }
+    #[getter]
+    fn residual_rms<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.fit.residual_rms)
+    }
+    #[getter]
+    fn sigma<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.fit.sigma)
+    }
+    #[getter]
+    fn cond(&self) -> f64 {
+        self.fit.cond
+    }
+    #[getter]
+    fn samples(&self) -> usize {
+        self.fit.samples
+    }
+    /// Predicted torques (N m) at `q`, `qd`, `qdd`: (n,) each or (k, n).
+    fn predict<'py>(&self, py: Python<'py>, q: ArrayLike<'py>, qd: ArrayLike<'py>, qdd: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.model.nv;
+        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
+        let c = &batch.columns;
+        let tau = py.detach(|| self.fit.predict(&self.model, &Batch { q: &c[0], qd: &c[1], qdd: &c[2] }))?;
+        to_numpy(py, tau, batch.k, batch.single, &[n])
+    }
+    /// M(q) from the identified parameters: (n, n), or (k, n, n) for q of shape (k, n).
+    fn mass_matrix<'py>(&self, py: Python<'py>, q: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.model.nv;
+        let batch = read_batch(n, &[("q", &q)])?;
+        let mut out = Vec::with_capacity(batch.k * n * n);
+        for s in 0..batch.k {
+            let m = self.fit.mass_matrix(&self.model, &batch.columns[0][s * n..(s + 1) * n]).map_err(|e| batch.in_sample(s, e))?;
+            out.extend(m.transpose().iter());
+        }
+        to_numpy(py, out, batch.k, batch.single, &[n, n])
+    }
+    fn to_json(&self) -> String {
+        serde_json::to_string_pretty(&self.fit).expect("serialisable")
+    }
+    fn __repr__(&self) -> String {
+        format!("BaseParameterModel(robot='{}', base parameters={}, samples={}, cond={:.4})", self.fit.robot, self.fit.theta.len(), self.fit.samples, self.fit.cond)
+    }
+}
+
+/// Identifies the base parameters of `robot` from samples `q`, `qd`, `qdd`, `tau` (each (k, n);
+/// rad, rad/s, rad/s^2, N m). `friction`: True (viscous, Coulomb and offset per joint), False,
+/// or a list of those names; `weighting`: 'wls' (default) or 'ols'; `gravity`: whether `tau`
+/// includes gravity; `tolerance`: relative rank tolerance of the pivoted QR.
+#[pyfunction]
+#[pyo3(signature = (robot, q, qd, qdd, tau, friction=None, weighting="wls", gravity=true, tolerance=1e-8, seed=0))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn identify_base_parameters(
+    py: Python<'_>,
+    robot: &PyRobot,
+    q: ArrayLike<'_>,
+    qd: ArrayLike<'_>,
+    qdd: ArrayLike<'_>,
+    tau: ArrayLike<'_>,
+    friction: Option<Bound<'_, PyAny>>,
+    weighting: &str,
+    gravity: bool,
+    tolerance: f64,
+    seed: u64,
+) -> PyResult<PyBaseModel> {
+    let weighting = match weighting {
+        "wls" => Weighting::Wls,
+        "ols" => Weighting::Ols,
+        other => return Err(Error::InvalidArgument { argument: "weighting".into(), message: format!("'{other}'; expected 'ols' or 'wls'") }.into()),
+    };
+    let friction = match friction {
+        Some(f) => friction_terms(&f)?,
+        None => FrictionTerms::ALL,
+    };
+    let options = BaseOptions { friction, weighting, gravity, tolerance, seed, ..BaseOptions::default() };
+    let model = &robot.model;
+    let c = states(model.nv, &q, &qd, &qdd, Some(&tau))?;
+    let fit = py.detach(|| base_rs(model, &Batch { q: &c[0], qd: &c[1], qdd: &c[2] }, &c[3], &options))?;
+    Ok(PyBaseModel { fit, model: Arc::new(model.clone()) })
+}
+
+/// The globally linearised model: constant D, H, G and an offset about an operating point.
+/// `D`, `H`, `G` (n, n); `torque` (n,) the fitted torque at the operating point; `stderr` dict;
+/// `residual_rms` (n,); `cond`; `predict(q, qd, qdd)`.
+#[pyclass(name = "GlobalLinearModel", module = "perturbid_rs", frozen)]
+pub(crate) struct PyGlobalLinear {
+    fit: GlobalLinearModel,
+}
+
+#[pymethods]
+impl PyGlobalLinear {
+    #[getter(D)]
+    fn d<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        mat(py, &self.fit.d)
+    }
+    #[getter(H)]
+    fn h<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        mat(py, &self.fit.h)
+    }
+    #[getter(G)]
+    fn g<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        mat(py, &self.fit.g)
+    }
+    #[getter]
+    fn torque<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.fit.offset)
+    }
+    #[getter]
+    fn stderr<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let n = self.fit.offset.len();
+        let s = &self.fit.stderr;
+        let d = PyDict::new(py);
+        d.set_item("torque", PyArray1::from_iter(py, s.column(0).iter().copied()))?;
+        for (k, name) in ["D", "H", "G"].iter().enumerate() {
+            d.set_item(*name, mat(py, &s.columns(1 + k * n, n).into_owned())?)?;
+        }
+        Ok(d)
+    }
+    #[getter]
+    fn residual_rms<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.fit.residual_rms)
+    }
+    #[getter]
+    fn cond(&self) -> f64 {
+        self.fit.cond
+    }
+    #[getter]
+    fn op(&self) -> PyOperatingPoint {
+        PyOperatingPoint { op: self.fit.op.clone() }
+    }
+    /// `T + D (qdd - qdd*) + H (qd - qd*) + G (q - q*)`: (n,) each or (k, n).
+    fn predict<'py>(&self, py: Python<'py>, q: ArrayLike<'py>, qd: ArrayLike<'py>, qdd: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let f = &self.fit;
+        let n = f.offset.len();
+        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
+        let mut out = Vec::with_capacity(batch.k * n);
+        for s in 0..batch.k {
+            let x = |c: usize, o: &[f64]| nalgebra::DVector::from_fn(n, |j, _| batch.columns[c][s * n + j] - o[j]);
+            let tau = nalgebra::DVector::from_column_slice(&f.offset) + &f.d * x(2, &f.op.qdd) + &f.h * x(1, &f.op.qd) + &f.g * x(0, &f.op.q);
+            out.extend(tau.iter());
+        }
+        to_numpy(py, out, batch.k, batch.single, &[n])
+    }
+    fn to_json(&self) -> String {
+        serde_json::to_string_pretty(&self.fit).expect("serialisable")
+    }
+}
+
+/// Fits the globally linearised model at `op` to samples `q`, `qd`, `qdd`, `tau` (each (k, n)).
+#[pyfunction]
+pub(crate) fn identify_global_linear(
+    py: Python<'_>,
+    op: &PyOperatingPoint,
+    q: ArrayLike<'_>,
+    qd: ArrayLike<'_>,
+    qdd: ArrayLike<'_>,
+    tau: ArrayLike<'_>,
+) -> PyResult<PyGlobalLinear> {
+    let c = states(op.op.n(), &q, &qd, &qdd, Some(&tau))?;
+    let fit = py.detach(|| global_rs(&op.op, &Batch { q: &c[0], qd: &c[1], qdd: &c[2] }, &c[3]))?;
+    Ok(PyGlobalLinear { fit })
+}
+
+/// Preprocesses a real recording: resample `t`, `q`, `tau` (and `qd` when logged) onto a
+/// uniform grid at `rate` Hz, zero-phase Butterworth low-pass (`order`, `cutoff` Hz; None = no
+/// filter) on qd and tau (and q with `filter_position`), qdd by differentiating the filtered
+/// qd, drop `trim` s at both ends and keep every `decimate`-th sample. Returns a Recording with
+/// qd and qdd.
+#[pyfunction]
+#[pyo3(signature = (t, q, tau, qd=None, *, rate=1000.0, cutoff=Some(10.0), order=4, decimate=10, trim=0.5, filter_position=false, name="recording"))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn preprocess(
+    py: Python<'_>,
+    t: ArrayLike<'_>,
+    q: ArrayLike<'_>,
+    tau: ArrayLike<'_>,
+    qd: Option<ArrayLike<'_>>,
+    rate: f64,
+    cutoff: Option<f64>,
+    order: usize,
+    decimate: usize,
+    trim: f64,
+    filter_position: bool,
+    name: &str,
+) -> PyResult<PyRecording> {
+    let rec = PyRecording::build(t, q, tau, qd, None, name)?;
+    let options = PreprocessOptions { rate, cutoff, order, filter_position, trim, decimate };
+    let out: Recording = py.detach(|| preprocess_rs(&rec, &options))?;
+    Ok(PyRecording { rec: Arc::new(out) })
+}

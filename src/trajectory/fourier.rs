@@ -1,0 +1,98 @@
+//! Fourier excitation trajectories (Swevers et al. 2007; the paper's eq. 16):
+//! `q_i(t) = q_i0 + sum_l [a_il / (w_f l) sin(w_f l t) - b_il / (w_f l) cos(w_f l t)]`.
+
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+use super::samples::Samples;
+use crate::error::{Error, Result};
+
+/// A periodic excitation of `n` joints with `L` harmonics of the base pulsation `w_f` (rad/s;
+/// period `2 pi / w_f`). `a` and `b` are `n x L` (rad/s: they are velocity amplitudes), `q0`
+/// the offsets (rad).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FourierTrajectory {
+    pub w_f: f64,
+    pub q0: Vec<f64>,
+    #[serde(with = "crate::json::rows")]
+    pub a: DMatrix<f64>,
+    #[serde(with = "crate::json::rows")]
+    pub b: DMatrix<f64>,
+}
+
+impl FourierTrajectory {
+    /// Checks the shapes (`a`, `b`: `len(q0) x L`, `L >= 1`), finiteness and `w_f > 0`.
+    pub fn new(w_f: f64, q0: Vec<f64>, a: DMatrix<f64>, b: DMatrix<f64>) -> Result<Self> {
+        let n = q0.len();
+        if !(w_f.is_finite() && w_f > 0.0) {
+            return Err(Error::InvalidArgument { argument: "base pulsation".into(), message: format!("{w_f}; expected a positive number of rad/s") });
+        }
+        for (name, m) in [("a", &a), ("b", &b)] {
+            if m.nrows() != n || m.ncols() == 0 || m.ncols() != a.ncols() {
+                return Err(Error::Shape {
+                    argument: name.into(),
+                    expected: format!("{n} x L (one row per joint, L >= 1 harmonics, a and b alike)"),
+                    got: format!("{} x {}", m.nrows(), m.ncols()),
+                });
+            }
+        }
+        for (name, v) in [("q0", &DMatrix::from_row_slice(1, n, &q0)), ("a", &a), ("b", &b)] {
+            if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                return Err(Error::NonFiniteInput { argument: name.into(), index: i, value: v[i] });
+            }
+        }
+        Ok(Self { w_f, q0, a, b })
+    }
+
+    /// Number of joints.
+    pub fn n(&self) -> usize {
+        self.q0.len()
+    }
+
+    /// Number of harmonics L.
+    pub fn harmonics(&self) -> usize {
+        self.a.ncols()
+    }
+
+    /// Period (s).
+    pub fn period(&self) -> f64 {
+        2.0 * std::f64::consts::PI / self.w_f
+    }
+
+    /// Position, velocity and acceleration of joint `i` at `t` (s), analytically.
+    pub fn eval(&self, i: usize, t: f64) -> (f64, f64, f64) {
+        let (mut q, mut v, mut acc) = (self.q0[i], 0.0, 0.0);
+        for l in 0..self.harmonics() {
+            let w = self.w_f * (l + 1) as f64;
+            let (s, c) = (w * t).sin_cos();
+            let (a, b) = (self.a[(i, l)], self.b[(i, l)]);
+            q += (a * s - b * c) / w;
+            v += a * c + b * s;
+            acc += w * (-a * s + b * c);
+        }
+        (q, v, acc)
+    }
+
+    /// Samples at the times `t` (s).
+    pub fn sample(&self, t: &[f64]) -> Samples {
+        let n = self.n();
+        let mut out = Samples::with_capacity(n, t.len());
+        for &ti in t {
+            out.t.push(ti);
+            for i in 0..n {
+                let (q, v, a) = self.eval(i, ti);
+                out.q.push(q);
+                out.qd.push(v);
+                out.qdd.push(a);
+            }
+        }
+        out
+    }
+
+    /// Samples over `periods` periods at `rate` Hz, from t = 0.
+    pub fn sample_periods(&self, periods: f64, rate: f64) -> Samples {
+        let count = (periods * self.period() * rate).round() as usize + 1;
+        let t: Vec<f64> = (0..count).map(|i| i as f64 / rate).collect();
+        self.sample(&t)
+    }
+}
