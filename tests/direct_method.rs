@@ -289,3 +289,63 @@ fn preprocessing_recovers_velocity_and_acceleration_from_irregular_samples() {
     let short = Recording::new("short", 6, t[..500].to_vec(), s.q[..3000].to_vec(), s.qd[..3000].to_vec(), None, None).unwrap();
     assert!(preprocess(&short, &PreprocessOptions::default()).unwrap_err().to_string().contains("short"));
 }
+
+/// The example-robot-data Panda URDF, found through the Python installation that the test
+/// script sets up (`pip install example-robot-data`).
+fn panda_urdf() -> std::path::PathBuf {
+    let out = std::process::Command::new(std::env::var("PYTHON").unwrap_or_else(|_| "python3".into()))
+        .args(["-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"])
+        .output()
+        .expect("python3 runs");
+    let purelib = String::from_utf8(out.stdout).unwrap();
+    let path = std::path::Path::new(purelib.trim()).join("cmeel.prefix/share/example-robot-data/robots/panda_description/urdf/panda.urdf");
+    assert!(path.is_file(), "{} is missing: pip install example-robot-data (tests/run_all.sh does)", path.display());
+    path
+}
+
+/// Real data (shared/data/panda-gaz2019): the reference protocol reaches the reference
+/// validation errors joint by joint with OLS, and WLS beats them on average.
+#[test]
+fn panda_real_data_matches_the_reference() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/panda-gaz2019");
+    let text = std::fs::read_to_string(dir.join("excitation.csv")).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+    let (mut t, mut q, mut qd, mut tau) = (vec![], vec![], vec![], vec![]);
+    for line in text.lines().skip(1) {
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        t.push(v[0]);
+        q.extend_from_slice(&v[1..8]);
+        qd.extend_from_slice(&v[8..15]);
+        tau.extend_from_slice(&v[15..22]);
+    }
+    let mut lock = std::collections::BTreeMap::new();
+    lock.insert("panda_finger_joint1".to_string(), 0.0);
+    let model = perturbid_rs::model_from_urdf_file(panda_urdf(), &LoadOptions { lock, ..LoadOptions::default() }).unwrap();
+    let rec = preprocess(&Recording::new("panda", 7, t, q, tau, Some(qd), None).unwrap(), &PreprocessOptions::default()).unwrap();
+    let k = rec.len();
+    let split = (0.7 * k as f64) as usize * 7;
+    let (qd, qdd) = (rec.qd.as_ref().unwrap(), rec.qdd.as_ref().unwrap());
+    let reference = [5.8, 1.1, 2.1, 1.0, 6.6, 5.9, 19.6];
+    let mut means = vec![];
+    for weighting in [Weighting::Ols, Weighting::Wls] {
+        let fit_batch = Batch { q: &rec.q[..split], qd: &qd[..split], qdd: &qdd[..split] };
+        let fit = identify_base_parameters(&model, &fit_batch, &rec.tau[..split], &BaseOptions { weighting, ..BaseOptions::default() }).unwrap();
+        assert_eq!(fit.theta.len(), 64);
+        let p = fit.predict(&model, &Batch { q: &rec.q[split..], qd: &qd[split..], qdd: &qdd[split..] }).unwrap();
+        let measured = &rec.tau[split..];
+        let rel: Vec<f64> = (0..7)
+            .map(|j| {
+                let idx = (j..p.len()).step_by(7);
+                let e: f64 = idx.clone().map(|i| (p[i] - measured[i]).powi(2)).sum();
+                let m: f64 = idx.map(|i| measured[i].powi(2)).sum();
+                100.0 * (e / m).sqrt()
+            })
+            .collect();
+        if weighting == Weighting::Ols {
+            for j in 0..7 {
+                assert!(rel[j] <= reference[j] + 0.05, "joint {}: {:.2} % > {} %", j + 1, rel[j], reference[j]);
+            }
+        }
+        means.push(rel.iter().sum::<f64>() / 7.0);
+    }
+    assert!(means[1] < reference.iter().sum::<f64>() / 7.0, "WLS mean {:.2} %", means[1]);
+}

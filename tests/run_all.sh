@@ -1,16 +1,18 @@
 #!/usr/bin/env bash
 # Every test of the project: the Rust tests (release build), then the Python package built from
 # the same target directory and its tests against Pinocchio. Installs the test dependencies
-# named in pyproject.toml ([project.optional-dependencies] test) first.
+# named in pyproject.toml ([project.optional-dependencies] test) first. Real-data tests read
+# ../shared/data beside the repository.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 PY=${PYTHON:-python3}
 
-cargo test --release
-cargo bench --no-run --quiet
-
+# test dependencies first: the Rust Panda test finds example-robot-data's URDF through Python
 deps=$("$PY" -c "import tomllib; print(' '.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies']['test']))")
 "$PY" -m pip install --quiet $deps
+
+PYTHON="$PY" cargo test --release
+cargo bench --no-run --quiet
 
 rm -rf target/wheels
 "$PY" -m maturin build --release --quiet -o target/wheels
