@@ -10,6 +10,9 @@
 //! Units: SI throughout (rad, m, s, kg, N m). Frames: the base frame with gravity along -z;
 //! spatial quantities as described in [`spatial`].
 
+// Errors carry their context (file, line, joint, time) by value; they are the cold path.
+#![allow(clippy::result_large_err)]
+
 pub mod algorithms;
 pub mod data;
 pub mod direct;

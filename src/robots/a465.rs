@@ -21,6 +21,7 @@ const PHYSICAL: &str = include_str!("a465_physical.urdf");
 pub const GEAR_RATIOS: [f64; 6] = [100.0, 100.0, 100.0, 101.0, 100.0, 101.0];
 
 /// The paper's Table 2 operating point: joint positions q* (rad).
+#[allow(clippy::approx_constant)] // the paper's printed values, not pi/4 etc.
 pub const TABLE2_Q: [f64; 6] = [0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0];
 /// Table 2: joint velocities qd* (rad/s).
 pub const TABLE2_QD: [f64; 6] = [0.0890, -0.1060, 0.0220, 0.0560, 0.0110, 0.0140];
