@@ -9,7 +9,7 @@ use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::arrays::{read_batch, to_numpy};
+use super::arrays::{matrix_to_numpy as mat, read_batch, to_numpy};
 use super::local::{PyOperatingPoint, PyRecording};
 use super::robot::PyRobot;
 use crate::direct::excitation::ExcitationDesign;
@@ -24,11 +24,6 @@ use crate::recording::Recording;
 use crate::trajectory::FourierTrajectory;
 
 type ArrayLike<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
-
-fn mat<'py>(py: Python<'py>, m: &DMatrix<f64>) -> PyResult<Bound<'py, PyAny>> {
-    let values: Vec<f64> = m.transpose().iter().copied().collect();
-    to_numpy(py, values, m.nrows(), false, &[m.ncols()])
-}
 
 fn matrix(name: &str, a: &ArrayLike<'_>) -> Result<DMatrix<f64>> {
     match a.shape() {

@@ -3,12 +3,11 @@
 
 use std::sync::Arc;
 
-use nalgebra::DMatrix;
 use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use super::arrays::{read_batch, to_numpy};
+use super::arrays::{matrix_to_numpy as mat, read_batch, to_numpy};
 use super::robot::PyRobot;
 use crate::error::{Error, Result};
 use crate::local::{
@@ -22,11 +21,6 @@ type ArrayLike<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 
 fn vec1<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyAny> {
     PyArray1::from_slice(py, v).into_any()
-}
-
-fn mat<'py>(py: Python<'py>, m: &DMatrix<f64>) -> PyResult<Bound<'py, PyAny>> {
-    let values: Vec<f64> = m.transpose().iter().copied().collect(); // row-major
-    to_numpy(py, values, m.nrows(), false, &[m.ncols()])
 }
 
 fn rows<'py>(py: Python<'py>, v: &[f64], n: usize) -> PyResult<Bound<'py, PyAny>> {
