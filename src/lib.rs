@@ -14,16 +14,20 @@
 #![allow(clippy::result_large_err)]
 
 pub mod algorithms;
+pub mod cli;
 pub mod data;
 pub mod direct;
 pub mod error;
+pub mod io;
 pub mod json;
 pub mod linearization;
 pub mod local;
 pub mod model;
+pub mod paper;
 pub mod preprocess;
 pub mod recording;
 pub mod regression;
+pub mod report;
 pub mod robots;
 pub mod signal;
 pub mod simulation;

@@ -1,4 +1,5 @@
-"""``python -m perturbid_rs``: the paper's experiment on the built-in A465. The robot passes the
+"""``python -m perturbid_rs``: the paper's experiment on the built-in A465 (with arguments,
+the ``perturbid`` command line: ``python -m perturbid_rs paper --out DIR``). The robot passes the
 operating point of Kinsheel & Taha (2010), Table 2, in the planned nominal, G, H and D
 experiments; the simulated recordings (gravity and friction excluded, as in the paper) give the
 local model by the separated regressions, shown beside the paper's Table 2 (nominal torques)
@@ -26,6 +27,10 @@ def row(label: str, values, fmt: str = "8.3f") -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
+    if argv:
+        from ._core import cli
+
+        return cli(["perturbid", *argv])
     robot = robots.a465("kinsheel2010")
     op = OperatingPoint(Q, QD, QDD)
     plan = plan_experiments(robot, op, design="random", seed=0)

@@ -421,3 +421,6 @@ def preprocess(
     filter_position: bool = False,
     name: str = "recording",
 ) -> Recording: ...
+
+def cli(argv: list[str]) -> int:
+    """Runs the perturbid command line (argv[0] is the program name); returns the exit status."""

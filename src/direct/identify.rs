@@ -10,6 +10,9 @@ use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::regression::least_squares;
 
+/// Version tag of the JSON format of [`BaseModel`].
+pub const BASE_MODEL_FORMAT: &str = "perturbid-base-model/1";
+
 /// Ordinary or weighted least squares.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -43,6 +46,8 @@ impl Default for BaseOptions {
 /// An identified base-parameter model.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BaseModel {
+    /// `perturbid-base-model/1`.
+    pub format: String,
     pub robot: String,
     pub joint_names: Vec<String>,
     pub base: BaseParameters,
@@ -100,6 +105,7 @@ pub fn identify_base_parameters(model: &Model, batch: &Batch<'_>, tau: &[f64], o
         ls = fit(&sigma)?;
     }
     Ok(BaseModel {
+        format: BASE_MODEL_FORMAT.into(),
         robot: model.name.clone(),
         joint_names: model.joint_names.clone(),
         gravity: options.gravity,
@@ -115,6 +121,25 @@ pub fn identify_base_parameters(model: &Model, batch: &Batch<'_>, tau: &[f64], o
 }
 
 impl BaseModel {
+    /// The model as pretty-printed JSON.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a base model always serialises")
+    }
+
+    /// A model from [`BaseModel::to_json`] text; checks the format and the shapes.
+    pub fn from_json(text: &str) -> Result<Self> {
+        let bad = |message: String| Error::Json { context: "base-parameter model".into(), message };
+        let m: BaseModel = serde_json::from_str(text).map_err(|e| bad(format!("line {}, column {}: {e}", e.line(), e.column())))?;
+        if m.format != BASE_MODEL_FORMAT {
+            return Err(bad(format!("format '{}', expected '{BASE_MODEL_FORMAT}'", m.format)));
+        }
+        let p = m.base.kept.len();
+        if m.theta.len() != p || m.stderr.len() != p || m.base.k.shape() != (p, m.base.dropped.len()) || p + m.base.dropped.len() != m.base.layout.len() {
+            return Err(bad("the base parameters, their map and the layout disagree in size".into()));
+        }
+        Ok(m)
+    }
+
     fn check(&self, model: &Model) -> Result<()> {
         if model.joint_names != self.joint_names || model.nbodies() != self.base.layout.nbodies {
             return Err(Error::InvalidArgument {

@@ -3,6 +3,7 @@
 //! onto the Python exception hierarchy, the GIL released around Rust work.
 
 mod arrays;
+mod cli;
 mod direct;
 mod errors;
 mod linearization;
@@ -32,6 +33,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(direct::identify_base_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(direct::identify_global_linear, m)?)?;
     m.add_function(wrap_pyfunction!(direct::preprocess, m)?)?;
+    m.add_function(wrap_pyfunction!(cli::cli, m)?)?;
     errors::register(m)?;
     m.add_function(wrap_pyfunction!(robot::a465_urdf, m)?)?;
     Ok(())

@@ -1,0 +1,246 @@
+//! `perturbid excite`, `identify-direct` and `predict`.
+
+use std::fmt::Write;
+use std::path::PathBuf;
+
+use clap::Args;
+
+use super::files::{load_json, load_robot, load_table};
+use super::out_dir;
+use super::progress::Progress;
+use crate::direct::identify::BASE_MODEL_FORMAT;
+use crate::direct::{design_excitation, identify_base_parameters, BaseModel, BaseOptions, Batch, Criterion, ExcitationOptions, FrictionTerms, Weighting};
+use crate::error::{Error, Result};
+use crate::io::{read_recording, read_states, samples_table, write_atomic, Table};
+use crate::local::LocalModel;
+use crate::preprocess::{preprocess, PreprocessOptions};
+
+#[derive(Args)]
+pub(crate) struct ExciteArgs {
+    /// The robot (URDF file or built-in name).
+    robot: String,
+    /// Output folder: excitation.json (the coefficients) and excitation.csv (one period, t, q, qd, qdd).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Harmonics per joint (L).
+    #[arg(long, default_value_t = 5)]
+    harmonics: usize,
+    /// Base frequency (Hz).
+    #[arg(long, default_value_t = 0.1)]
+    base_frequency: f64,
+    /// cond (of the base regressor) or logdet (of its information matrix).
+    #[arg(long, default_value = "cond")]
+    criterion: String,
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Budget of criterion evaluations.
+    #[arg(long, default_value_t = 2000)]
+    max_evaluations: usize,
+    /// Sampling rate of excitation.csv (Hz).
+    #[arg(long, default_value_t = 1000.0)]
+    rate: f64,
+    /// Fraction of the limits the excitation may use.
+    #[arg(long, default_value_t = 0.9)]
+    margin: f64,
+}
+
+pub(crate) fn excite(a: ExciteArgs) -> Result<String> {
+    let model = load_robot(&a.robot)?;
+    let o = ExcitationOptions {
+        harmonics: a.harmonics,
+        base_frequency: a.base_frequency,
+        criterion: Criterion::parse(&a.criterion)?,
+        seed: a.seed,
+        max_evaluations: a.max_evaluations,
+        margin: a.margin,
+        ..ExcitationOptions::default()
+    };
+    let progress = Progress::new();
+    let mut report = |e: usize, best: f64| progress.update(&format!("excitation design: {e}/{} evaluations, best {best:.4}", a.max_evaluations));
+    let design = design_excitation(&model, &o, Some(&mut report))?;
+    progress.done();
+    let dir = out_dir(&a.out);
+    let traj = &design.trajectory;
+    write_atomic(dir.join("excitation.json"), serde_json::to_string_pretty(traj).expect("serialisable").as_bytes())?;
+    write_atomic(dir.join("excitation.csv"), samples_table(&traj.sample_periods(1.0, a.rate), "").to_csv().as_bytes())?;
+    Ok(format!(
+        "excitation: {} harmonics of {} Hz (period {:.1} s), cond(Phi_base) {:.2} after {} evaluations\n-> {} and {}\n",
+        a.harmonics,
+        a.base_frequency,
+        traj.period(),
+        design.cond,
+        design.evaluations,
+        dir.join("excitation.json").display(),
+        dir.join("excitation.csv").display()
+    ))
+}
+
+#[derive(Args)]
+pub(crate) struct IdentifyDirectArgs {
+    /// The robot (URDF file or built-in name).
+    robot: String,
+    /// The recording CSV: t, q1..qN, tau1..tauN, optional qd1..qN (and qdd1..qN, which skips
+    /// preprocessing unless --preprocess is given).
+    data: PathBuf,
+    /// Where to write the base-parameter model (JSON).
+    #[arg(long, default_value = "base_model.json")]
+    out: PathBuf,
+    /// Friction terms per joint, comma separated from viscous, coulomb, offset; or none.
+    #[arg(long, value_delimiter = ',', default_value = "viscous,coulomb,offset")]
+    friction: Vec<String>,
+    /// wls (weights from the per-joint residuals) or ols.
+    #[arg(long, default_value = "wls")]
+    weighting: String,
+    /// The torques exclude gravity.
+    #[arg(long)]
+    no_gravity: bool,
+    /// Preprocess even when the file has qdd columns.
+    #[arg(long)]
+    preprocess: bool,
+    /// Preprocessing: uniform rate (Hz), low-pass cutoff (Hz), decimation, trim (s).
+    #[arg(long, default_value_t = 1000.0)]
+    rate: f64,
+    #[arg(long, default_value_t = 10.0)]
+    cutoff: f64,
+    #[arg(long, default_value_t = 10)]
+    decimate: usize,
+    #[arg(long, default_value_t = 0.5)]
+    trim: f64,
+    /// Fit on the first (1 - FRACTION) of the samples and report the errors on the rest.
+    #[arg(long, default_value_t = 0.3)]
+    validate: f64,
+}
+
+fn friction_terms(names: &[String]) -> Result<FrictionTerms> {
+    let mut f = FrictionTerms::NONE;
+    for n in names {
+        match n.trim() {
+            "viscous" => f.viscous = true,
+            "coulomb" => f.coulomb = true,
+            "offset" => f.offset = true,
+            "none" | "" => {}
+            other => return Err(Error::InvalidArgument { argument: "--friction".into(), message: format!("'{other}'; expected viscous, coulomb, offset or none") }),
+        }
+    }
+    Ok(f)
+}
+
+pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
+    let model = load_robot(&a.robot)?;
+    let progress = Progress::new();
+    progress.update(&format!("reading {}", a.data.display()));
+    let mut rec = read_recording(&load_table(&a.data)?, &model.joint_names)?;
+    let mut out = String::new();
+    if rec.qdd.is_none() || a.preprocess {
+        progress.update("preprocessing");
+        let o = PreprocessOptions { rate: a.rate, cutoff: Some(a.cutoff), decimate: a.decimate, trim: a.trim, ..PreprocessOptions::default() };
+        rec = preprocess(&rec, &o)?;
+        let _ = writeln!(out, "preprocessed: {} Hz, {} Hz zero-phase low-pass, every {}th sample, {} s trimmed: {} samples", a.rate, a.cutoff, a.decimate, a.trim, rec.len());
+    }
+    if !(0.0..1.0).contains(&a.validate) {
+        return Err(Error::InvalidArgument { argument: "--validate".into(), message: format!("{}; expected a fraction in [0, 1)", a.validate) });
+    }
+    let n = model.nv;
+    let k = rec.len();
+    let split = ((1.0 - a.validate) * k as f64).round() as usize;
+    let (qd, qdd) = (rec.qd.clone().expect("preprocessed"), rec.qdd.clone().expect("preprocessed"));
+    let weighting = match a.weighting.as_str() {
+        "wls" => Weighting::Wls,
+        "ols" => Weighting::Ols,
+        other => return Err(Error::InvalidArgument { argument: "--weighting".into(), message: format!("'{other}'; expected wls or ols") }),
+    };
+    let options = BaseOptions { friction: friction_terms(&a.friction)?, weighting, gravity: !a.no_gravity, ..BaseOptions::default() };
+    progress.update(&format!("identifying on {split} samples"));
+    let r = 0..split * n;
+    let fit = identify_base_parameters(&model, &Batch { q: &rec.q[r.clone()], qd: &qd[r.clone()], qdd: &qdd[r.clone()] }, &rec.tau[r], &options)?;
+    progress.done();
+    write_atomic(&a.out, fit.to_json().as_bytes())?;
+    let _ = writeln!(out, "{} base parameters from {} samples, cond {:.3e} -> {}", fit.theta.len(), split, fit.cond, a.out.display());
+    let _ = writeln!(out, "{:<48} {:>14} {:>12}", "base parameter", "value", "std. error");
+    for ((name, v), s) in fit.base.names().iter().zip(&fit.theta).zip(&fit.stderr) {
+        let name = if name.len() > 48 { format!("{}...", &name[..45]) } else { name.clone() };
+        let _ = writeln!(out, "{name:<48} {v:>14.6} {s:>12.2e}");
+    }
+    if split < k {
+        let r = split * n..k * n;
+        let p = fit.predict(&model, &Batch { q: &rec.q[r.clone()], qd: &qd[r.clone()], qdd: &qdd[r.clone()] })?;
+        let _ = writeln!(out, "validation on the last {} samples: per joint RMS (N m) and relative RMS (%)", k - split);
+        for j in 0..n {
+            let (mut e, mut m) = (0.0, 0.0);
+            for (i, pv) in p.iter().enumerate().skip(j).step_by(n) {
+                let meas = rec.tau[split * n + i];
+                e += (pv - meas).powi(2);
+                m += meas * meas;
+            }
+            let cnt = (k - split) as f64;
+            let _ = writeln!(out, "  {:<16} {:>10.4} {:>8.2}", model.joint_names[j], (e / cnt).sqrt(), 100.0 * (e / m).sqrt());
+        }
+    }
+    Ok(out)
+}
+
+#[derive(Args)]
+pub(crate) struct PredictArgs {
+    /// A saved model: a local model (perturbid identify) or a base-parameter model
+    /// (perturbid identify-direct).
+    model: PathBuf,
+    /// States CSV: t, q1..qN, qd1..qN, qdd1..qN (tau1..tauN optional, to compare).
+    data: PathBuf,
+    /// Output CSV: t, tau1..tauN predicted.
+    #[arg(long, default_value = "predicted.csv")]
+    out: PathBuf,
+    /// The robot, for a base-parameter model (URDF file or built-in name).
+    #[arg(long)]
+    robot: Option<String>,
+}
+
+pub(crate) fn predict(a: PredictArgs) -> Result<String> {
+    let text = crate::io::read_text(&a.model)?;
+    let is_base = text.contains(BASE_MODEL_FORMAT);
+    let (joints, tau_of): (Vec<String>, Box<dyn Fn(&[f64], &[f64], &[f64]) -> Result<Vec<f64>>>) = if is_base {
+        let fit = load_json(&a.model, BaseModel::from_json)?;
+        let robot = a.robot.as_deref().ok_or_else(|| Error::InvalidArgument {
+            argument: "--robot".into(),
+            message: format!("a base-parameter model needs its robot ('{}'): give --robot", fit.robot),
+        })?;
+        let model = load_robot(robot)?;
+        let joints = fit.joint_names.clone();
+        (joints, Box::new(move |q, qd, qdd| fit.predict(&model, &Batch { q, qd, qdd })))
+    } else {
+        let m = load_json(&a.model, LocalModel::from_json)?;
+        let joints = m.joint_names.clone();
+        let n = joints.len();
+        (
+            joints,
+            Box::new(move |q, qd, qdd| {
+                let mut out = Vec::with_capacity(q.len());
+                for s in 0..q.len() / n {
+                    let r = s * n..(s + 1) * n;
+                    out.extend(m.predict(&q[r.clone()], &qd[r.clone()], &qdd[r])?);
+                }
+                Ok(out)
+            }),
+        )
+    };
+    let states = read_states(&load_table(&a.data)?, &joints)?;
+    let tau = tau_of(&states.q, &states.qd, &states.qdd)?;
+    let n = joints.len();
+    let mut columns = vec!["t".to_string()];
+    columns.extend((1..=n).map(|j| format!("tau{j}")));
+    let mut table = Table::new("", columns);
+    for (i, t) in states.t.iter().enumerate() {
+        let mut row = vec![*t];
+        row.extend_from_slice(&tau[i * n..(i + 1) * n]);
+        table.push(&row);
+    }
+    write_atomic(&a.out, table.to_csv().as_bytes())?;
+    let mut out = format!("{} predicted torques -> {}\n", states.t.len(), a.out.display());
+    if let Some(meas) = &states.tau {
+        let _ = writeln!(out, "against the measured torques: per joint RMS error (N m)");
+        for j in 0..n {
+            let e: f64 = (0..states.t.len()).map(|i| (tau[i * n + j] - meas[i * n + j]).powi(2)).sum::<f64>() / states.t.len() as f64;
+            let _ = writeln!(out, "  {:<16} {:>10.4}", joints[j], e.sqrt());
+        }
+    }
+    Ok(out)
+}

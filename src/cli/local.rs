@@ -1,0 +1,247 @@
+//! `perturbid plan`, `simulate` and `identify`: the paper's method on files.
+
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use serde::Deserialize;
+
+use super::files::{load_json, load_robot, load_table};
+use super::out_dir;
+use crate::error::{Error, Result};
+use crate::io::{read_recording, recording_table, samples_table, write_atomic};
+use crate::local::{
+    identify_local, plan_experiments, CrossingTimes, Design, Estimator, ExperimentKind, IdentifyOptions, LocalModel, OperatingPoint, Plan,
+    PlanOptions, Size,
+};
+use crate::recording::Recording;
+use crate::simulation::{simulate_plan, Friction, SimulationOptions};
+
+#[derive(Args)]
+pub(crate) struct PlanArgs {
+    /// The robot (URDF file or built-in name).
+    robot: String,
+    /// The operating point: JSON {"q": [...], "qd": [...], "qdd": [...]} (rad, rad/s, rad/s^2).
+    #[arg(long)]
+    op: PathBuf,
+    /// Output folder: plan.json and <experiment>.csv (t, q1..qN, qd1..qN, qdd1..qN).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Perturbation design: random (the paper's draws) or orthogonal (cond(X) = 1).
+    #[arg(long, default_value = "random")]
+    design: String,
+    /// Perturbations per experiment (default 2N, in +- pairs).
+    #[arg(long)]
+    n: Option<usize>,
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Sampling rate of the trajectories (Hz).
+    #[arg(long, default_value_t = 1000.0)]
+    rate: f64,
+    /// Experiments, comma separated, from nominal, G_static, G, H, D.
+    #[arg(long, value_delimiter = ',', default_value = "nominal,G_static,G,H,D")]
+    experiments: Vec<String>,
+    /// Position perturbation: fraction of the joint range (default 0.01) ...
+    #[arg(long, default_value_t = 0.01)]
+    dq_fraction: f64,
+    /// ... velocity perturbation: fraction of the speed limit ...
+    #[arg(long, default_value_t = 0.05)]
+    dqd_fraction: f64,
+    /// ... acceleration perturbation: fraction of the acceleration limit.
+    #[arg(long, default_value_t = 0.05)]
+    dqdd_fraction: f64,
+    /// Absolute position perturbation for every joint (rad), instead of the fraction.
+    #[arg(long)]
+    dq: Option<f64>,
+    /// Absolute velocity perturbation (rad/s).
+    #[arg(long)]
+    dqd: Option<f64>,
+    /// Absolute acceleration perturbation (rad/s^2).
+    #[arg(long)]
+    dqdd: Option<f64>,
+    /// Half-width of each crossing window (s).
+    #[arg(long, default_value_t = 0.05)]
+    window: f64,
+    /// How long each static posture is held (s).
+    #[arg(long, default_value_t = 1.0)]
+    dwell: f64,
+}
+
+#[derive(Deserialize)]
+struct OpFile {
+    q: Vec<f64>,
+    qd: Vec<f64>,
+    qdd: Vec<f64>,
+}
+
+fn load_op(path: &Path) -> Result<OperatingPoint> {
+    load_json(path, |text| {
+        let op: OpFile = serde_json::from_str(text).map_err(|e| Error::Json {
+            context: "operating point".into(),
+            message: format!("line {}, column {}: {e}; expected {{\"q\": [...], \"qd\": [...], \"qdd\": [...]}}", e.line(), e.column()),
+        })?;
+        OperatingPoint::new(op.q, op.qd, op.qdd)
+    })
+}
+
+fn size(abs: Option<f64>, fraction: f64, n: usize) -> Size {
+    match abs {
+        Some(v) => Size::Absolute(vec![v; n]),
+        None => Size::Fraction(fraction),
+    }
+}
+
+pub(crate) fn plan(a: PlanArgs) -> Result<String> {
+    let model = load_robot(&a.robot)?;
+    let op = load_op(&a.op)?;
+    let n = model.nv;
+    let mut o = PlanOptions {
+        design: Design::parse(&a.design)?,
+        count: a.n,
+        seed: a.seed,
+        rate: a.rate,
+        window: a.window,
+        dwell: a.dwell,
+        experiments: a.experiments.iter().map(|k| ExperimentKind::parse(k.trim())).collect::<Result<_>>()?,
+        ..PlanOptions::default()
+    };
+    o.sizes.position = size(a.dq, a.dq_fraction, n);
+    o.sizes.velocity = size(a.dqd, a.dqd_fraction, n);
+    o.sizes.acceleration = size(a.dqdd, a.dqdd_fraction, n);
+    let plan = plan_experiments(&model, &op, &o)?;
+    let dir = out_dir(&a.out);
+    let mut out = String::new();
+    for e in &plan.experiments {
+        let path = dir.join(format!("{}.csv", e.kind.name()));
+        write_atomic(&path, samples_table(&e.trajectory.sample(plan.rate), "").to_csv().as_bytes())?;
+        let _ = writeln!(out, "{:<9} {:>3} crossings, {:>7.2} s  -> {}", e.kind.name(), e.crossings.len(), e.duration(), path.display());
+    }
+    let path = dir.join("plan.json");
+    write_atomic(&path, plan.to_json().as_bytes())?;
+    let _ = writeln!(out, "plan -> {}", path.display());
+    Ok(out)
+}
+
+#[derive(Args)]
+pub(crate) struct SimulateArgs {
+    /// The robot (URDF file or built-in name).
+    robot: String,
+    /// The plan (plan.json from `perturbid plan`).
+    plan: PathBuf,
+    /// Output folder: one <experiment>.csv per experiment (t, q1..qN, tau1..tauN).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Leave gravity out of the torques (as if compensated).
+    #[arg(long)]
+    no_gravity: bool,
+    /// Leave the URDF's friction (<dynamics damping friction>) out.
+    #[arg(long)]
+    no_friction: bool,
+    /// Gaussian torque noise (N m, standard deviation).
+    #[arg(long, default_value_t = 0.0)]
+    torque_noise: f64,
+    /// Gaussian position noise (rad, standard deviation).
+    #[arg(long, default_value_t = 0.0)]
+    position_noise: f64,
+    /// Encoder resolution (rad per count; 0 = none).
+    #[arg(long, default_value_t = 0.0)]
+    quantization: f64,
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+}
+
+pub(crate) fn simulate(a: SimulateArgs) -> Result<String> {
+    let model = load_robot(&a.robot)?;
+    let plan = load_json(&a.plan, Plan::from_json)?;
+    let n = model.nv;
+    let mut o = SimulationOptions::new(&model);
+    o.gravity = !a.no_gravity;
+    if a.no_friction {
+        o.friction = Friction::none(n);
+    }
+    o.torque_noise = vec![a.torque_noise; n];
+    o.position_noise = vec![a.position_noise; n];
+    o.quantization = vec![a.quantization; n];
+    o.seed = a.seed;
+    let recs = simulate_plan(&model, &plan, &o)?;
+    let dir = out_dir(&a.out);
+    let mut out = String::new();
+    for (e, r) in plan.experiments.iter().zip(&recs) {
+        let path = dir.join(format!("{}.csv", e.kind.name()));
+        write_atomic(&path, recording_table(r, "").to_csv().as_bytes())?;
+        let _ = writeln!(out, "{:<9} {:>7} samples -> {}", e.kind.name(), r.len(), path.display());
+    }
+    Ok(out)
+}
+
+#[derive(Args)]
+pub(crate) struct IdentifyArgs {
+    /// The plan (plan.json).
+    plan: PathBuf,
+    /// The recordings: one CSV per experiment in the plan's order, or one folder holding
+    /// <experiment>.csv for each (t, q1..qN, tau1..tauN; qd, qdd optional).
+    #[arg(required = true)]
+    recordings: Vec<PathBuf>,
+    /// Where to write the local model (JSON).
+    #[arg(long, default_value = "local_model.json")]
+    out: PathBuf,
+    /// Find the offset between the plan and the recordings' clock in the data.
+    #[arg(long)]
+    detect_times: bool,
+    /// Largest offset searched by --detect-times (s).
+    #[arg(long, default_value_t = 1.0)]
+    max_shift: f64,
+    /// Half-width of the fits around each crossing (s; default: the plan's window).
+    #[arg(long)]
+    window: Option<f64>,
+    /// separated (the paper) or combined (all crossings in one regression).
+    #[arg(long, default_value = "separated")]
+    estimator: String,
+}
+
+fn fmt_matrix(out: &mut String, name: &str, m: &nalgebra::DMatrix<f64>, se: &nalgebra::DMatrix<f64>) {
+    let _ = writeln!(out, "{name} (standard errors in brackets):");
+    for i in 0..m.nrows() {
+        let cells: Vec<String> = (0..m.ncols()).map(|j| format!("{:>9.4} [{:.1e}]", m[(i, j)], se[(i, j)])).collect();
+        let _ = writeln!(out, "  {}", cells.join(" "));
+    }
+}
+
+pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
+    let plan = load_json(&a.plan, Plan::from_json)?;
+    let files: Vec<PathBuf> = if a.recordings.len() == 1 && a.recordings[0].is_dir() {
+        plan.experiments.iter().map(|e| a.recordings[0].join(format!("{}.csv", e.kind.name()))).collect()
+    } else {
+        a.recordings.clone()
+    };
+    if files.len() != plan.experiments.len() {
+        return Err(Error::InvalidArgument {
+            argument: "RECORDINGS".into(),
+            message: format!(
+                "{} files for {} experiments ({}); give one CSV per experiment in that order, or a folder",
+                files.len(),
+                plan.experiments.len(),
+                plan.experiments.iter().map(|e| e.kind.name()).collect::<Vec<_>>().join(", ")
+            ),
+        });
+    }
+    let recs: Vec<Recording> = files.iter().map(|f| read_recording(&load_table(f)?, &plan.joint_names)).collect::<Result<_>>()?;
+    let options = IdentifyOptions {
+        times: if a.detect_times { CrossingTimes::Detected { max_shift: a.max_shift } } else { CrossingTimes::Planned },
+        fit: crate::local::FitOptions { window: a.window, ..Default::default() },
+        estimator: Estimator::parse(&a.estimator)?,
+    };
+    let model: LocalModel = identify_local(&plan, &recs, &options)?;
+    write_atomic(&a.out, model.to_json().as_bytes())?;
+    let mut out = String::new();
+    let _ = writeln!(out, "local model of '{}' ({} estimator) -> {}", model.robot, a.estimator, a.out.display());
+    let t: Vec<String> = model.torque.iter().zip(&model.torque_stderr).map(|(t, s)| format!("{t:.4} [{s:.1e}]")).collect();
+    let _ = writeln!(out, "T* (N m): {}", t.join(", "));
+    for (name, e) in [("D*", &model.d), ("H*", &model.h), ("G*", &model.g), ("Gs", &model.g_static)] {
+        if let Some(e) = e {
+            let _ = writeln!(out, "{name}: cond(X) {:.3}, {} crossings, residual RMS max {:.2e} N m", e.cond, e.crossings, e.residual_rms.iter().cloned().fold(0.0, f64::max));
+            fmt_matrix(&mut out, name, &e.matrix, &e.stderr);
+        }
+    }
+    Ok(out)
+}

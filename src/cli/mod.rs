@@ -1,0 +1,101 @@
+//! The `perturbid` command line: the same program whether built with cargo (`src/bin`) or
+//! installed by pip (a console script calling [`main_with_args`] through the extension module).
+
+mod direct;
+mod files;
+mod info;
+mod local;
+mod paper;
+mod progress;
+
+use std::ffi::OsString;
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand};
+
+use crate::error::Result;
+
+#[derive(Parser)]
+#[command(
+    name = "perturbid",
+    version,
+    about = "Robot dynamics identification about an operating point (Kinsheel & Taha 2010) and by the direct method",
+    after_help = "ROBOT is a URDF file or a built-in robot: a465 (= a465:kinsheel2010), a465:physical.\n\
+CSV files have a header: t, q1..qN, optional qd1..qN and qdd1..qN, tau1..tauN (or q_<joint>, qd_<joint>, ... named after the URDF's joints)."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print a robot's joints, limits and masses.
+    Info(info::InfoArgs),
+    /// Plan the experiments at an operating point: writes plan.json and one trajectory CSV per
+    /// experiment (t, q, qd, qdd) for the robot controller.
+    Plan(local::PlanArgs),
+    /// Simulate what the robot would log running a plan: one recording CSV per experiment.
+    Simulate(local::SimulateArgs),
+    /// Identify the local model from a plan and its recordings; writes the model (JSON) and
+    /// prints T*, D*, H*, G* with condition numbers and standard errors.
+    Identify(local::IdentifyArgs),
+    /// Design a Fourier excitation for the direct method (COBYLA): writes excitation.json and
+    /// the sampled trajectory CSV.
+    Excite(direct::ExciteArgs),
+    /// Identify base parameters (the direct method) from a recording CSV; writes the model
+    /// (JSON) and prints the fit.
+    IdentifyDirect(direct::IdentifyDirectArgs),
+    /// Torques predicted by a saved model (local or base-parameter) at the states of a CSV.
+    Predict(direct::PredictArgs),
+    /// Reproduce the paper (Tables 2 and 3, Figs. 3-5) on the built-in A465: report.md, CSV,
+    /// JSON and SVG figures in --out.
+    Paper(paper::PaperArgs),
+}
+
+/// Where a subcommand writes: a folder or a file.
+pub(crate) fn out_dir(out: &Option<PathBuf>) -> PathBuf {
+    out.clone().unwrap_or_else(|| PathBuf::from("."))
+}
+
+fn run(cli: Cli) -> Result<String> {
+    match cli.command {
+        Command::Info(a) => info::run(a),
+        Command::Plan(a) => local::plan(a),
+        Command::Simulate(a) => local::simulate(a),
+        Command::Identify(a) => local::identify(a),
+        Command::Excite(a) => direct::excite(a),
+        Command::IdentifyDirect(a) => direct::identify_direct(a),
+        Command::Predict(a) => direct::predict(a),
+        Command::Paper(a) => paper::run(a),
+    }
+}
+
+/// Runs the command line with `args` (the program name first); prints results on stdout and
+/// a one-line error on stderr; returns the exit status (0 on success, 1 on an error, 2 on a
+/// usage error).
+pub fn main_with_args<I, T>(args: I) -> i32
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString> + Clone,
+{
+    let cli = match Cli::try_parse_from(args) {
+        Ok(c) => c,
+        Err(e) => {
+            let code = e.exit_code();
+            let _ = e.print();
+            return code;
+        }
+    };
+    match run(cli) {
+        Ok(text) => {
+            // A closed pipe (`perturbid info a465 | head`) is not an error worth a panic.
+            let _ = std::io::Write::write_all(&mut std::io::stdout().lock(), text.as_bytes());
+            0
+        }
+        Err(e) => {
+            eprintln!("perturbid: {e}");
+            1
+        }
+    }
+}
