@@ -1,6 +1,8 @@
-"""The README's Python example runs as written."""
+"""The README's Python examples run as written, and its main command prints what it shows."""
 
 import re
+import subprocess
+import sysconfig
 from pathlib import Path
 
 
@@ -10,3 +12,12 @@ def test_readme_python_example_runs():
     assert blocks, "README has no python example"
     for code in blocks:
         exec(compile(code, "README.md", "exec"), {})
+
+
+def test_readme_main_command_prints_what_it_shows(tmp_path):
+    text = (Path(__file__).parents[2] / "README.md").read_text()
+    assert "pip install . && perturbid paper --out paper" in text
+    shown = re.search(r"prints \(in about 5 s\):\n\n```\n(.*?)```", text, re.S).group(1)
+    exe = Path(sysconfig.get_path("scripts")) / "perturbid"
+    out = subprocess.run([str(exe), "paper", "--out", "paper"], cwd=tmp_path, capture_output=True, text=True, check=True)
+    assert out.stdout == shown
