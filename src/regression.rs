@@ -23,6 +23,9 @@ pub struct LeastSquares {
     pub stderr: DMatrix<f64>,
     /// Number of rows K.
     pub rows: usize,
+    /// The diagonal of `(X^T X)^-1` (p): with a noise level `sigma`, the standard errors are
+    /// `sigma * sqrt(cov_diag)`.
+    pub cov_diag: Vec<f64>,
 }
 
 /// Relative singular-value threshold below which a design counts as rank deficient.
@@ -127,7 +130,7 @@ pub fn least_squares(x: &DMatrix<f64>, y: &DMatrix<f64>, context: &str, columns:
             stderr[(c, j)] = sigma * cov_diag[j].sqrt();
         }
     }
-    Ok(LeastSquares { coef, cond: smax / smin, residual_rms, stderr, rows: k })
+    Ok(LeastSquares { coef, cond: smax / smin, residual_rms, stderr, rows: k, cov_diag })
 }
 
 /// `0.71 dq1 - 0.71 dq2`: a direction in terms of named columns (the 6 largest entries, largest

@@ -349,3 +349,35 @@ fn panda_real_data_matches_the_reference() {
     }
     assert!(means[1] < reference.iter().sum::<f64>() / 7.0, "WLS mean {:.2} %", means[1]);
 }
+
+/// The chunked TSQR solve equals one dense least-squares solve over the whole regressor
+/// (coefficients, standard errors, cond), across several chunks and with noise.
+#[test]
+fn streaming_solve_equals_the_dense_solve() {
+    use perturbid_rs::direct::streaming::{residual_rms, solve, CHUNK};
+    use perturbid_rs::regression::least_squares;
+    let model = a465::model("physical").unwrap();
+    let layout = ParameterLayout::new(&model, FrictionTerms::ALL);
+    let base = BaseParameters::from_random_states(&model, &layout, true, 200, 1e-8, 0).unwrap();
+    let mut rng = Rng(17);
+    let k = 2 * CHUNK + 123;
+    let (q, qd, qdd) = random_states(&model, k, &mut rng);
+    let mut tau = torques(&model, &q, &qd, &qdd, true);
+    tau.iter_mut().for_each(|t| *t += rng.uniform(-0.1, 0.1));
+    let batch = Batch { q: &q, qd: &qd, qdd: &qdd };
+    let sigma = [1.0, 2.0, 0.5, 1.0, 1.5, 0.7];
+    let names = base.names();
+    let streamed = solve(&model, &base, &batch, &tau, true, &sigma, &names).unwrap();
+    let mut phi = base.select(&regressor_matrix(&model, &layout, &batch, true).unwrap());
+    let mut y = DMatrix::from_column_slice(k * 6, 1, &tau);
+    for r in 0..k * 6 {
+        phi.row_mut(r).scale_mut(1.0 / sigma[r % 6]);
+        y[r] /= sigma[r % 6];
+    }
+    let dense = least_squares(&phi, &y, "dense", &names).unwrap();
+    assert!((&streamed.coef - &dense.coef).amax() < 1e-9 * dense.coef.amax(), "{}", (&streamed.coef - &dense.coef).amax());
+    assert!((&streamed.stderr - &dense.stderr).amax() < 1e-8 * dense.stderr.amax());
+    assert!((streamed.cond - dense.cond).abs() < 1e-6 * dense.cond);
+    let rms = residual_rms(&model, &base, &batch, &tau, true, streamed.coef.as_slice()).unwrap();
+    assert!(rms.iter().all(|r| (0.05..0.07).contains(r)), "{rms:?}"); // uniform +-0.1: 0.0577
+}

@@ -6,9 +6,9 @@ use serde::{Deserialize, Serialize};
 
 use super::base::{BaseParameters, BASE_TOLERANCE};
 use super::parameters::{regressor_matrix, Batch, FrictionTerms, ParameterLayout};
+use super::streaming;
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::regression::least_squares;
 
 /// Version tag of the JSON format of [`BaseModel`].
 pub const BASE_MODEL_FORMAT: &str = "perturbid-base-model/1";
@@ -80,29 +80,15 @@ pub fn identify_base_parameters(model: &Model, batch: &Batch<'_>, tau: &[f64], o
     }
     let layout = ParameterLayout::new(model, options.friction);
     let base = BaseParameters::from_random_states(model, &layout, options.gravity, options.states.max(layout.len() / nv + 1), options.tolerance, options.seed)?;
-    let phi = base.select(&regressor_matrix(model, &layout, batch, options.gravity)?);
     let names = base.names();
-    let y = DMatrix::from_column_slice(k * nv, 1, tau);
-    let fit = |sigma: &[f64]| {
-        let mut x = phi.clone();
-        let mut yw = y.clone();
-        for r in 0..k * nv {
-            let w = 1.0 / sigma[r % nv];
-            x.row_mut(r).scale_mut(w);
-            yw[r] *= w;
-        }
-        least_squares(&x, &yw, "base-parameter identification", &names)
-    };
-    let ones = vec![1.0; nv];
-    let mut ls = fit(&ones)?;
-    let residual_rms = |theta: &DMatrix<f64>| -> Vec<f64> {
-        let r = &y - &phi * theta.transpose();
-        (0..nv).map(|j| ((0..k).map(|s| r[s * nv + j].powi(2)).sum::<f64>() / k as f64).sqrt()).collect()
-    };
-    let mut sigma = ones.clone();
+    let g = options.gravity;
+    let mut sigma = vec![1.0; nv];
+    let mut ls = streaming::solve(model, &base, batch, tau, g, &sigma, &names)?;
+    let mut rms = streaming::residual_rms(model, &base, batch, tau, g, ls.coef.as_slice())?;
     if options.weighting == Weighting::Wls {
-        sigma = residual_rms(&ls.coef).iter().map(|&s| if s > 0.0 { s } else { 1.0 }).collect();
-        ls = fit(&sigma)?;
+        sigma = rms.iter().map(|&s| if s > 0.0 { s } else { 1.0 }).collect();
+        ls = streaming::solve(model, &base, batch, tau, g, &sigma, &names)?;
+        rms = streaming::residual_rms(model, &base, batch, tau, g, ls.coef.as_slice())?;
     }
     Ok(BaseModel {
         format: BASE_MODEL_FORMAT.into(),
@@ -112,7 +98,7 @@ pub fn identify_base_parameters(model: &Model, batch: &Batch<'_>, tau: &[f64], o
         weighting: options.weighting,
         theta: ls.coef.row(0).iter().copied().collect(),
         stderr: ls.stderr.row(0).iter().copied().collect(),
-        residual_rms: residual_rms(&ls.coef),
+        residual_rms: rms,
         sigma,
         cond: ls.cond,
         samples: k,

@@ -8,6 +8,7 @@ pub mod excitation;
 pub mod global_linear;
 pub mod identify;
 pub mod parameters;
+pub mod streaming;
 
 pub use base::BaseParameters;
 pub use excitation::{design_excitation, Criterion, ExcitationDesign, ExcitationOptions};
