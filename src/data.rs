@@ -59,6 +59,8 @@ pub struct Data {
     pub(crate) dv_b: DMatrix<f64>,
     // Cholesky factor scratch for forward dynamics.
     pub(crate) chol: DMatrix<f64>,
+    /// Scratch for the joint-torque regressor (`nv x 10 nbodies`).
+    pub(crate) regressor: DMatrix<f64>,
 }
 
 impl Data {
@@ -105,6 +107,7 @@ impl Data {
             dq_b: DMatrix::zeros(nc, nc),
             dv_b: DMatrix::zeros(nc, nc),
             chol: DMatrix::zeros(n, n),
+            regressor: DMatrix::zeros(n, 10 * model.nbodies()),
         }
     }
 }

@@ -137,7 +137,7 @@ pub(crate) fn fill_regressor(
     let ni = PARAMS_PER_BODY * model.nbodies();
     let terms = layout.friction.names();
     let mut data = Data::new(model);
-    let mut y = DMatrix::zeros(nv, ni);
+    let mut y = std::mem::take(&mut data.regressor);
     for (r, s) in range.enumerate() {
         let (q, qd, qdd) = (Batch::row(batch.q, s, nv), Batch::row(batch.qd, s, nv), Batch::row(batch.qdd, s, nv));
         joint_torque_regressor(model, &mut data, q, qd, qdd, gravity, &mut y).map_err(|e| in_sample(e, s))?;

@@ -56,25 +56,34 @@ impl PyRobot {
         let size: usize = out_dims.iter().product();
         let mut out = vec![0.0; batch.k * size];
         py.detach(|| -> Result<()> {
-            let mut data = self.data();
-            for s in 0..batch.k {
-                let mut rows: [&[f64]; 3] = [&[]; 3];
-                for (row, column) in rows.iter_mut().zip(&batch.columns) {
-                    *row = &column[s * n..(s + 1) * n];
+            let run = |data: &mut Data, first: usize, out: &mut [f64]| -> Result<()> {
+                for (i, o) in out.chunks_mut(size.max(1)).enumerate() {
+                    let s = first + i;
+                    let mut rows: [&[f64]; 3] = [&[]; 3];
+                    for (row, column) in rows.iter_mut().zip(&batch.columns) {
+                        *row = &column[s * n..(s + 1) * n];
+                    }
+                    f(&self.model, data, rows, o).map_err(|e| batch.in_sample(s, e))?;
                 }
-                f(
-                    &self.model,
-                    &mut data,
-                    rows,
-                    &mut out[s * size..(s + 1) * size],
-                )
-                .map_err(|e| batch.in_sample(s, e))?;
+                Ok(())
+            };
+            if batch.k < PARALLEL_BATCH || size == 0 {
+                return run(&mut self.data(), 0, &mut out);
             }
-            Ok(())
+            // large batches: chunks in parallel, one Data per chunk (no per-sample allocation)
+            use rayon::prelude::*;
+            out.par_chunks_mut(PARALLEL_CHUNK * size)
+                .enumerate()
+                .try_for_each(|(c, o)| run(&mut Data::new(&self.model), c * PARALLEL_CHUNK, o))
         })?;
         to_numpy(py, out, batch.k, batch.single, out_dims)
     }
 }
+
+/// Batches of at least this many samples run in parallel (rayon), in chunks of
+/// `PARALLEL_CHUNK` samples.
+const PARALLEL_BATCH: usize = 4096;
+const PARALLEL_CHUNK: usize = 1024;
 
 fn copy_matrix(m: &nalgebra::DMatrix<f64>, out: &mut [f64]) {
     let n = m.ncols();
@@ -281,10 +290,11 @@ impl PyRobot {
     ) -> PyResult<Bound<'py, PyAny>> {
         let (n, p) = (self.model.nv, 10 * self.model.nbodies());
         self.map_samples(py, &[("q", &q), ("qd", &qd), ("qdd", &qdd)], &[n, p], move |m, d, x, out| {
-            let mut y = nalgebra::DMatrix::zeros(n, p);
-            crate::algorithms::regressor::joint_torque_regressor(m, d, x[0], x[1], x[2], gravity, &mut y)?;
+            let mut y = std::mem::take(&mut d.regressor);
+            let r = crate::algorithms::regressor::joint_torque_regressor(m, d, x[0], x[1], x[2], gravity, &mut y);
             copy_matrix(&y, out);
-            Ok(())
+            d.regressor = y;
+            r
         })
     }
 
