@@ -59,6 +59,8 @@ pub struct Data {
     pub(crate) dv_b: DMatrix<f64>,
     // Cholesky factor scratch for forward dynamics.
     pub(crate) chol: DMatrix<f64>,
+    /// Motion subspaces of the bodies in the base frame (regressor).
+    pub(crate) s_world: Vec<Motion>,
     /// Scratch for the joint-torque regressor (`nv x 10 nbodies`).
     pub(crate) regressor: DMatrix<f64>,
 }
@@ -108,6 +110,7 @@ impl Data {
             dv_b: DMatrix::zeros(nc, nc),
             chol: DMatrix::zeros(n, n),
             regressor: DMatrix::zeros(n, 10 * model.nbodies()),
+            s_world: vec![Motion::zeros(); model.nbodies()],
         }
     }
 }

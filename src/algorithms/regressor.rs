@@ -1,7 +1,7 @@
 //! The joint-torque regressor `tau = Phi(q, qd, qdd) theta`: inverse dynamics linear in the
 //! inertial parameters (Pinocchio's `computeJointTorqueRegressor`, same parameter order).
 
-use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, Vector3};
 
 use super::kinematics::motion_pass;
 use super::load_state;
@@ -34,29 +34,32 @@ pub fn model_parameters(model: &Model) -> DVector<f64> {
     )
 }
 
-/// The 10 unit rotational inertias (entry of `[Ixx, Ixy, Iyy, Ixz, Iyz, Izz]` set to 1).
-fn unit_inertia(p: usize) -> Matrix3<f64> {
-    let (r, c) = [(0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)][p];
-    let mut m = Matrix3::zeros();
-    m[(r, c)] = 1.0;
-    m[(c, r)] = 1.0;
-    m
-}
-
 /// The wrench (in the body frame) per unit of each of the 10 parameters of a body with twist
 /// `v` and spatial acceleration `a` (gravity included): `f = Y(v, a) theta_body`.
 pub fn body_regressor(v: &Motion, a: &Motion) -> [Force; 10] {
-    let (w, alpha) = (v.angular, a.angular);
+    let (w, al) = (v.angular, a.angular);
     let ac = a.linear + w.cross(&v.linear); // classical acceleration of the origin
+    let zero = Vector3::zeros();
     let mut out = [Force::zeros(); 10];
-    out[0] = Force { angular: Vector3::zeros(), linear: ac };
+    out[0] = Force { angular: zero, linear: ac };
     for k in 0..3 {
         let e = Vector3::ith(k, 1.0);
-        out[1 + k] = Force { angular: e.cross(&ac), linear: alpha.cross(&e) + w.cross(&w.cross(&e)) };
+        out[1 + k] = Force { angular: e.cross(&ac), linear: al.cross(&e) + w.cross(&w.cross(&e)) };
     }
+    // I_p x for the unit inertias of [Ixx, Ixy, Iyy, Ixz, Iyz, Izz]
+    let unit = |x: &Vector3<f64>| {
+        [
+            Vector3::new(x.x, 0.0, 0.0),
+            Vector3::new(x.y, x.x, 0.0),
+            Vector3::new(0.0, x.y, 0.0),
+            Vector3::new(x.z, 0.0, x.x),
+            Vector3::new(0.0, x.z, x.y),
+            Vector3::new(0.0, 0.0, x.z),
+        ]
+    };
+    let (ia, iw) = (unit(&al), unit(&w));
     for p in 0..6 {
-        let i = unit_inertia(p);
-        out[4 + p] = Force { angular: i * alpha + w.cross(&(i * w)), linear: Vector3::zeros() };
+        out[4 + p] = Force { angular: ia[p] + w.cross(&iw[p]), linear: zero };
     }
     out
 }
@@ -85,23 +88,27 @@ pub fn joint_torque_regressor(
     }
     load_state(model, data, q, Some(qd), Some(qdd))?;
     motion_pass(model, data, gravity);
+    // base-frame poses and motion subspaces: each column's wrench is moved to the base frame
+    // once, then projected on every ancestor's axis there (Pinocchio's approach)
+    for (i, b) in model.bodies.iter().enumerate() {
+        data.o_mi[i] = match b.parent {
+            Some(p) => data.o_mi[p].compose(&data.li_mi[i]),
+            None => data.li_mi[i],
+        };
+        data.s_world[i] = data.o_mi[i].act_motion(&b.motion_subspace());
+    }
     out.fill(0.0);
     for i in 0..nb {
         let columns = body_regressor(&data.v[i], &data.a[i]);
-        for (c, f0) in columns.iter().enumerate() {
+        let x = data.o_mi[i];
+        for (c, f) in columns.iter().enumerate() {
+            let fw = x.act_force(f);
             let col = PARAMS_PER_BODY * i + c;
-            let mut f = *f0;
-            let mut j = i;
-            loop {
-                let b = &model.bodies[j];
-                out[(b.dof, col)] += b.multiplier * b.motion_subspace().dot(&f);
-                match b.parent {
-                    Some(p) => {
-                        f = data.li_mi[j].act_force(&f);
-                        j = p;
-                    }
-                    None => break,
-                }
+            let mut j = Some(i);
+            while let Some(k) = j {
+                let b = &model.bodies[k];
+                out[(b.dof, col)] += b.multiplier * data.s_world[k].dot(&fw);
+                j = b.parent;
             }
         }
     }
