@@ -221,7 +221,7 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
                 "{} files for {} experiments ({}); give one CSV per experiment in that order, or a folder",
                 files.len(),
                 plan.experiments.len(),
-                plan.experiments.iter().map(|e| e.kind.name()).collect::<Vec<_>>().join(", ")
+                plan.kinds()
             ),
         });
     }

@@ -106,7 +106,7 @@ pub fn identify_local(plan: &Plan, recordings: &[Recording], options: &IdentifyO
                 "{} recordings for {} experiments ({}); give one per experiment, in the plan's order",
                 recordings.len(),
                 plan.experiments.len(),
-                plan.experiments.iter().map(|e| e.kind.name()).collect::<Vec<_>>().join(", ")
+                plan.kinds()
             ),
         });
     }

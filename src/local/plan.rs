@@ -174,6 +174,11 @@ impl Plan {
         self.op.n()
     }
 
+    /// The experiments' names in order, comma separated (for messages).
+    pub fn kinds(&self) -> String {
+        self.experiments.iter().map(|e| e.kind.name()).collect::<Vec<_>>().join(", ")
+    }
+
     /// The experiment of `kind`, if planned.
     pub fn experiment(&self, kind: ExperimentKind) -> Option<&Experiment> {
         self.experiments.iter().find(|e| e.kind == kind)
