@@ -5,7 +5,10 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use perturbid_rs::algorithms::regressor::joint_torque_regressor;
 use perturbid_rs::robots::a465::{TABLE2_Q, TABLE2_QD, TABLE2_QDD};
-use perturbid_rs::{forward_dynamics, gravity_torque, linearize, mass_matrix, rnea, rnea_derivatives, robots, Data, Model};
+use perturbid_rs::{
+    forward_dynamics, gravity_torque, linearize, mass_matrix, rnea, rnea_derivatives, robots, Data,
+    Model,
+};
 use std::hint::black_box;
 
 const BATCH: usize = 100_000;
@@ -14,9 +17,15 @@ const BATCH: usize = 100_000;
 pub fn states(model: &Model) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let n = model.nv;
     let wave = |i: usize, j: usize, f: f64| (f * (i as f64) * 1e-3 + j as f64).sin();
-    let q = (0..BATCH * n).map(|x| TABLE2_Q[x % n] + 0.5 * wave(x / n, x % n, 1.0)).collect();
-    let qd = (0..BATCH * n).map(|x| TABLE2_QD[x % n] + wave(x / n, x % n, 2.0)).collect();
-    let qdd = (0..BATCH * n).map(|x| TABLE2_QDD[x % n] + wave(x / n, x % n, 3.0)).collect();
+    let q = (0..BATCH * n)
+        .map(|x| TABLE2_Q[x % n] + 0.5 * wave(x / n, x % n, 1.0))
+        .collect();
+    let qd = (0..BATCH * n)
+        .map(|x| TABLE2_QD[x % n] + wave(x / n, x % n, 2.0))
+        .collect();
+    let qdd = (0..BATCH * n)
+        .map(|x| TABLE2_QDD[x % n] + wave(x / n, x % n, 3.0))
+        .collect();
     (q, qd, qdd)
 }
 
@@ -28,21 +37,48 @@ fn dynamics(c: &mut Criterion) {
     let n = model.nv;
     let mut y = nalgebra::DMatrix::zeros(n, 10 * model.nbodies());
     let kernels: [(&str, Kernel); 6] = [
-        ("rnea", |m, d, q, qd, qdd| rnea(m, d, q, qd, qdd, true).unwrap()),
+        ("rnea", |m, d, q, qd, qdd| {
+            rnea(m, d, q, qd, qdd, true).unwrap()
+        }),
         ("mass_matrix", |m, d, q, _, _| mass_matrix(m, d, q).unwrap()),
         ("gravity", |m, d, q, _, _| gravity_torque(m, d, q).unwrap()),
-        ("forward_dynamics", |m, d, q, qd, tau| forward_dynamics(m, d, q, qd, tau, true).unwrap()),
-        ("rnea_derivatives", |m, d, q, qd, qdd| rnea_derivatives(m, d, q, qd, qdd, true).unwrap()),
+        ("forward_dynamics", |m, d, q, qd, tau| {
+            forward_dynamics(m, d, q, qd, tau, true).unwrap()
+        }),
+        ("rnea_derivatives", |m, d, q, qd, qdd| {
+            rnea_derivatives(m, d, q, qd, qdd, true).unwrap()
+        }),
         ("linearize", |m, d, q, qd, qdd| {
             linearize(m, d, q, qd, qdd, true).unwrap();
         }),
     ];
     let (bq, bqd, bqdd) = states(&model);
     for (name, f) in kernels {
-        c.bench_function(&format!("{name}/a465/1"), |b| b.iter(|| f(&model, &mut data, black_box(&TABLE2_Q), black_box(&TABLE2_QD), black_box(&TABLE2_QDD))));
+        c.bench_function(&format!("{name}/a465/1"), |b| {
+            b.iter(|| {
+                f(
+                    &model,
+                    &mut data,
+                    black_box(&TABLE2_Q),
+                    black_box(&TABLE2_QD),
+                    black_box(&TABLE2_QDD),
+                )
+            })
+        });
     }
     c.bench_function("regressor/a465/1", |b| {
-        b.iter(|| joint_torque_regressor(&model, &mut data, black_box(&TABLE2_Q), black_box(&TABLE2_QD), black_box(&TABLE2_QDD), true, &mut y).unwrap())
+        b.iter(|| {
+            joint_torque_regressor(
+                &model,
+                &mut data,
+                black_box(&TABLE2_Q),
+                black_box(&TABLE2_QD),
+                black_box(&TABLE2_QDD),
+                true,
+                &mut y,
+            )
+            .unwrap()
+        })
     });
     let mut group = c.benchmark_group("batch");
     group.sample_size(10);
@@ -60,7 +96,16 @@ fn dynamics(c: &mut Criterion) {
         b.iter(|| {
             for s in 0..BATCH {
                 let r = s * n..(s + 1) * n;
-                joint_torque_regressor(&model, &mut data, &bq[r.clone()], &bqd[r.clone()], &bqdd[r], true, &mut y).unwrap();
+                joint_torque_regressor(
+                    &model,
+                    &mut data,
+                    &bq[r.clone()],
+                    &bqd[r.clone()],
+                    &bqdd[r],
+                    true,
+                    &mut y,
+                )
+                .unwrap();
             }
         })
     });

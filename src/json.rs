@@ -20,7 +20,12 @@ pub mod rows {
     pub fn from_rows(rows: &[Vec<f64>]) -> Result<DMatrix<f64>, String> {
         let ncols = rows.first().map_or(0, Vec::len);
         if let Some((i, r)) = rows.iter().enumerate().find(|(_, r)| r.len() != ncols) {
-            return Err(format!("matrix row {} has {} entries, row 1 has {}", i + 1, r.len(), ncols));
+            return Err(format!(
+                "matrix row {} has {} entries, row 1 has {}",
+                i + 1,
+                r.len(),
+                ncols
+            ));
         }
         Ok(DMatrix::from_fn(rows.len(), ncols, |i, j| rows[i][j]))
     }
@@ -40,6 +45,7 @@ pub mod option_rows {
 
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<DMatrix<f64>>, D::Error> {
         let rows = Option::<Vec<Vec<f64>>>::deserialize(d)?;
-        rows.map(|r| super::rows::from_rows(&r).map_err(serde::de::Error::custom)).transpose()
+        rows.map(|r| super::rows::from_rows(&r).map_err(serde::de::Error::custom))
+            .transpose()
     }
 }

@@ -8,10 +8,16 @@ use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
 use crate::data::Data;
-use crate::direct::{design_excitation, identify_base_parameters, identify_global_linear, BaseOptions, Batch, ExcitationOptions, FrictionTerms, Weighting};
+use crate::direct::{
+    design_excitation, identify_base_parameters, identify_global_linear, BaseOptions, Batch,
+    ExcitationOptions, FrictionTerms, Weighting,
+};
 use crate::error::Result;
 use crate::io::{write_atomic, Table};
-use crate::local::{identify_local, plan_experiments, Design, IdentifyOptions, LocalModel, OperatingPoint, PlanOptions};
+use crate::local::{
+    identify_local, plan_experiments, Design, IdentifyOptions, LocalModel, OperatingPoint,
+    PlanOptions,
+};
 use crate::report::{markdown, svg};
 use crate::robots::a465;
 use crate::simulation::{simulate_plan, simulate_samples, Friction, SimulationOptions};
@@ -34,7 +40,11 @@ pub struct PaperOptions {
 
 impl Default for PaperOptions {
     fn default() -> Self {
-        Self { seed: 0, torque_noise: 0.0, design_evaluations: 800 }
+        Self {
+            seed: 0,
+            torque_noise: 0.0,
+            design_evaluations: 800,
+        }
     }
 }
 
@@ -99,7 +109,11 @@ fn column0(m: &DMatrix<f64>) -> Vec<f64> {
 pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Result<PaperResult> {
     let model = a465::model("kinsheel2010")?;
     let n = model.nv;
-    let op = OperatingPoint::new(a465::TABLE2_Q.to_vec(), a465::TABLE2_QD.to_vec(), a465::TABLE2_QDD.to_vec())?;
+    let op = OperatingPoint::new(
+        a465::TABLE2_Q.to_vec(),
+        a465::TABLE2_QD.to_vec(),
+        a465::TABLE2_QDD.to_vec(),
+    )?;
     let mut sim = SimulationOptions::new(&model);
     sim.gravity = false; // the paper assumes gravity and friction compensated
     sim.friction = Friction::none(n);
@@ -107,24 +121,48 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
     sim.seed = options.seed;
 
     progress("perturbation method: planning and simulating the nominal, G, H and D experiments");
-    let plan = plan_experiments(&model, &op, &PlanOptions { design: Design::Random, seed: options.seed, ..PlanOptions::default() })?;
+    let plan = plan_experiments(
+        &model,
+        &op,
+        &PlanOptions {
+            design: Design::Random,
+            seed: options.seed,
+            ..PlanOptions::default()
+        },
+    )?;
     let recordings = simulate_plan(&model, &plan, &sim)?;
     let local = identify_local(&plan, &recordings, &IdentifyOptions::default())?;
     let d_local = &local.d.as_ref().expect("planned").matrix;
 
     progress("direct method: designing the Fourier excitation (10 harmonics of 0.05 Hz)");
-    let ex = ExcitationOptions { harmonics: 10, base_frequency: 0.05, max_evaluations: options.design_evaluations, seed: options.seed, ..ExcitationOptions::default() };
+    let ex = ExcitationOptions {
+        harmonics: 10,
+        base_frequency: 0.05,
+        max_evaluations: options.design_evaluations,
+        seed: options.seed,
+        ..ExcitationOptions::default()
+    };
     let design = design_excitation(&model, &ex, None)?;
     progress("direct method: simulating the excitation and fitting both direct models");
     let samples = design.trajectory.sample_periods(1.0, 50.0);
     let rec = simulate_samples(&model, &samples, &sim, 99, "excitation")?;
-    let batch = Batch { q: &samples.q, qd: &samples.qd, qdd: &samples.qdd };
+    let batch = Batch {
+        q: &samples.q,
+        qd: &samples.qd,
+        qdd: &samples.qdd,
+    };
     let global = identify_global_linear(&op, &batch, &rec.tau)?;
     let base = identify_base_parameters(
         &model,
         &batch,
         &rec.tau,
-        &BaseOptions { friction: FrictionTerms::NONE, weighting: Weighting::Ols, gravity: false, seed: options.seed, ..BaseOptions::default() },
+        &BaseOptions {
+            friction: FrictionTerms::NONE,
+            weighting: Weighting::Ols,
+            gravity: false,
+            seed: options.seed,
+            ..BaseOptions::default()
+        },
     )?;
     let mut data = Data::new(&model);
     mass_matrix(&model, &mut data, &op.q)?;
@@ -147,17 +185,39 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
     let mut global_tau = Vec::with_capacity(q.len());
     for k in 0..ts.len() {
         let r = k * n..(k + 1) * n;
-        rnea(&model, &mut data, &q[r.clone()], &qd[r.clone()], &qdd[r.clone()], false)?;
+        rnea(
+            &model,
+            &mut data,
+            &q[r.clone()],
+            &qd[r.clone()],
+            &qdd[r.clone()],
+            false,
+        )?;
         actual_tau.extend(data.tau.iter());
         local_tau.extend(local.predict(&q[r.clone()], &qd[r.clone()], &qdd[r.clone()])?);
         let x = |v: &[f64], o: &[f64]| DVector::from_fn(n, |j, _| v[j] - o[j]);
-        let g = DVector::from_column_slice(&global.offset) + &global.d * x(&qdd[r.clone()], &op.qdd) + &global.h * x(&qd[r.clone()], &op.qd) + &global.g * x(&q[r.clone()], &op.q);
+        let g = DVector::from_column_slice(&global.offset)
+            + &global.d * x(&qdd[r.clone()], &op.qdd)
+            + &global.h * x(&qd[r.clone()], &op.qd)
+            + &global.g * x(&q[r.clone()], &op.q);
         global_tau.extend(g.iter());
     }
-    let base_tau = base.predict(&model, &Batch { q: &q, qd: &qd, qdd: &qdd })?;
+    let base_tau = base.predict(
+        &model,
+        &Batch {
+            q: &q,
+            qd: &qd,
+            qdd: &qdd,
+        },
+    )?;
     let pick = |v: &[f64], j: usize| -> Vec<f64> { (0..ts.len()).map(|k| v[k * n + j]).collect() };
     let rms = |a: &[f64], b: &[f64], mask: &dyn Fn(f64) -> bool| -> f64 {
-        let e: Vec<f64> = ts.iter().zip(a.iter().zip(b)).filter(|(t, _)| mask(**t)).map(|(_, (x, y))| (x - y).powi(2)).collect();
+        let e: Vec<f64> = ts
+            .iter()
+            .zip(a.iter().zip(b))
+            .filter(|(t, _)| mask(**t))
+            .map(|(_, (x, y))| (x - y).powi(2))
+            .collect();
         (e.iter().sum::<f64>() / e.len() as f64).sqrt()
     };
     let near = 0.5;
@@ -199,10 +259,15 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
         d_global_linear: column0(&global.d),
         d_base_parameters: column0(&m_base),
         d_direct_paper: TABLE3_DIRECT.to_vec(),
-        cond_local: [("D", &local.d), ("H", &local.h), ("G", &local.g), ("G_static", &local.g_static)]
-            .iter()
-            .filter_map(|(k, e)| e.as_ref().map(|e| (k.to_string(), e.cond)))
-            .collect(),
+        cond_local: [
+            ("D", &local.d),
+            ("H", &local.h),
+            ("G", &local.g),
+            ("G_static", &local.g_static),
+        ]
+        .iter()
+        .filter_map(|(k, e)| e.as_ref().map(|e| (k.to_string(), e.cond)))
+        .collect(),
         excitation_cond: design.cond,
         excitation_harmonics: ex.harmonics,
         excitation_frequency: ex.base_frequency,
@@ -233,9 +298,21 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
     };
     let n = r.op.q.len();
     // tables as CSV
-    let mut t2 = Table::new("table2.csv", ["joint", "q", "qd", "qdd", "T_identified", "Tn_paper"].map(String::from).to_vec());
+    let mut t2 = Table::new(
+        "table2.csv",
+        ["joint", "q", "qd", "qdd", "T_identified", "Tn_paper"]
+            .map(String::from)
+            .to_vec(),
+    );
     for j in 0..n {
-        t2.push(&[(j + 1) as f64, r.op.q[j], r.op.qd[j], r.op.qdd[j], r.torque_identified[j], r.torque_paper[j]]);
+        t2.push(&[
+            (j + 1) as f64,
+            r.op.q[j],
+            r.op.qd[j],
+            r.op.qdd[j],
+            r.torque_identified[j],
+            r.torque_paper[j],
+        ]);
     }
     put("table2.csv", t2.to_csv().as_bytes())?;
     let rows3: [(&str, &Vec<f64>); 7] = [
@@ -249,10 +326,21 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
     ];
     let mut t3 = String::from("row,D11,D21,D31,D41,D51,D61\n");
     for (name, v) in &rows3 {
-        t3.push_str(&format!("{name},{}\n", v.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(",")));
+        t3.push_str(&format!(
+            "{name},{}\n",
+            v.iter()
+                .map(|x| format!("{x}"))
+                .collect::<Vec<_>>()
+                .join(",")
+        ));
     }
     put("table3.csv", t3.as_bytes())?;
-    put("results.json", serde_json::to_string_pretty(r).expect("serialisable").as_bytes())?;
+    put(
+        "results.json",
+        serde_json::to_string_pretty(r)
+            .expect("serialisable")
+            .as_bytes(),
+    )?;
     if let Some(m) = &r.local_model {
         put("local_model.json", m.to_json().as_bytes())?;
     }
@@ -266,7 +354,12 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
     for k in 0..r.figures[0].t.len() {
         let mut row = vec![r.figures[0].t[k]];
         for f in &r.figures {
-            row.extend([f.actual[k], f.local[k], f.global_linear[k], f.base_parameters[k]]);
+            row.extend([
+                f.actual[k],
+                f.local[k],
+                f.global_linear[k],
+                f.base_parameters[k],
+            ]);
         }
         curves.push(&row);
     }
@@ -275,13 +368,50 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
     for (i, f) in r.figures.iter().enumerate() {
         let name = format!("fig{}_joint{}.svg", i + 3, f.joint);
         let series = [
-            svg::Series { name: "actual", color: "black", dash: "", x: &f.t, y: &f.actual },
-            svg::Series { name: "local model (perturbation method)", color: "#d62728", dash: "6 4", x: &f.t, y: &f.local },
-            svg::Series { name: "direct: globally linearised", color: "#1f77b4", dash: "2 3", x: &f.t, y: &f.global_linear },
-            svg::Series { name: "direct: base parameters", color: "#2ca02c", dash: "10 3 2 3", x: &f.t, y: &f.base_parameters },
+            svg::Series {
+                name: "actual",
+                color: "black",
+                dash: "",
+                x: &f.t,
+                y: &f.actual,
+            },
+            svg::Series {
+                name: "local model (perturbation method)",
+                color: "#d62728",
+                dash: "6 4",
+                x: &f.t,
+                y: &f.local,
+            },
+            svg::Series {
+                name: "direct: globally linearised",
+                color: "#1f77b4",
+                dash: "2 3",
+                x: &f.t,
+                y: &f.global_linear,
+            },
+            svg::Series {
+                name: "direct: base parameters",
+                color: "#2ca02c",
+                dash: "10 3 2 3",
+                x: &f.t,
+                y: &f.base_parameters,
+            },
         ];
-        let title = format!("Fig. {}: joint {} torque along a trajectory through the operating point (t = 0)", i + 3, f.joint);
-        put(&name, svg::line_plot(&title, "time from the operating point (s)", "torque (N m)", &series).as_bytes())?;
+        let title = format!(
+            "Fig. {}: joint {} torque along a trajectory through the operating point (t = 0)",
+            i + 3,
+            f.joint
+        );
+        put(
+            &name,
+            svg::line_plot(
+                &title,
+                "time from the operating point (s)",
+                "torque (N m)",
+                &series,
+            )
+            .as_bytes(),
+        )?;
         fig_names.push(name);
     }
     put("report.md", markdown_report(r, &fig_names).as_bytes())?;
@@ -290,7 +420,8 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
 
 fn markdown_report(r: &PaperResult, figs: &[String]) -> String {
     let n = r.op.q.len();
-    let mut s = String::from("# Kinsheel & Taha (ICARCV 2010) reproduced on the built-in CRS A465\n\n");
+    let mut s =
+        String::from("# Kinsheel & Taha (ICARCV 2010) reproduced on the built-in CRS A465\n\n");
     s.push_str(
         "Robot: the `kinsheel2010` A465 model (see `shared/A465.md`). Gravity and friction are excluded from the simulated \
          torques, as the paper assumes them compensated. Everything below is computed by `perturbid paper`; \
@@ -300,11 +431,32 @@ fn markdown_report(r: &PaperResult, figs: &[String]) -> String {
     let rows: Vec<Vec<String>> = (0..n)
         .map(|j| {
             let mut row = vec![format!("{}", j + 1)];
-            row.extend(markdown::cells(&[r.op.q[j], r.op.qd[j], r.op.qdd[j], r.torque_identified[j], r.torque_paper[j], r.torque_identified[j] - r.torque_paper[j]], 4));
+            row.extend(markdown::cells(
+                &[
+                    r.op.q[j],
+                    r.op.qd[j],
+                    r.op.qdd[j],
+                    r.torque_identified[j],
+                    r.torque_paper[j],
+                    r.torque_identified[j] - r.torque_paper[j],
+                ],
+                4,
+            ));
             row
         })
         .collect();
-    s.push_str(&markdown::table(&["joint", "q* (rad)", "qd* (rad/s)", "qdd* (rad/s²)", "T* identified (N m)", "Tn paper (N m)", "difference"], &rows));
+    s.push_str(&markdown::table(
+        &[
+            "joint",
+            "q* (rad)",
+            "qd* (rad/s)",
+            "qdd* (rad/s²)",
+            "T* identified (N m)",
+            "Tn paper (N m)",
+            "difference",
+        ],
+        &rows,
+    ));
     s.push_str("\n## Table 3: first column of D at the operating point\n\n");
     let header = ["", "D11", "D21", "D31", "D41", "D51", "D61"];
     let rows = vec![
@@ -318,7 +470,11 @@ fn markdown_report(r: &PaperResult, figs: &[String]) -> String {
         fmt_row("direct method, paper", &r.d_direct_paper, 3),
     ];
     s.push_str(&markdown::table(&header, &rows));
-    let cond: Vec<String> = r.cond_local.iter().map(|(k, c)| format!("{k} {c:.2}")).collect();
+    let cond: Vec<String> = r
+        .cond_local
+        .iter()
+        .map(|(k, c)| format!("{k} {c:.2}"))
+        .collect();
     s.push_str(&format!(
         "\ncond(X) of the perturbation designs (random, as in the paper; 12 crossings each): {}. Excitation of the direct method: \
          {} harmonics of {} Hz designed for cond(Phi_base) = {:.1}; {} base parameters.\n",
@@ -338,17 +494,39 @@ fn markdown_report(r: &PaperResult, figs: &[String]) -> String {
         .iter()
         .map(|e| {
             let mut row = vec![format!("{}", e.joint)];
-            row.extend(markdown::cells(&[e.local_near, e.global_linear_near, e.base_parameters_near, e.local_all, e.global_linear_all, e.base_parameters_all], 4));
+            row.extend(markdown::cells(
+                &[
+                    e.local_near,
+                    e.global_linear_near,
+                    e.base_parameters_near,
+                    e.local_all,
+                    e.global_linear_all,
+                    e.base_parameters_all,
+                ],
+                4,
+            ));
             row
         })
         .collect();
     s.push_str(&markdown::table(
-        &["joint", "local, near P", "global linear, near P", "base parameters, near P", "local, all", "global linear, all", "base parameters, all"],
+        &[
+            "joint",
+            "local, near P",
+            "global linear, near P",
+            "base parameters, near P",
+            "local, all",
+            "global linear, all",
+            "base parameters, all",
+        ],
         &rows,
     ));
     s.push_str("\n(RMS torque errors in N m; near P: within 0.5 s of the operating point.)\n\n## Comparison with the paper\n\n");
-    let max_t = (0..n).map(|j| (r.torque_identified[j] - r.torque_paper[j]).abs()).fold(0.0, f64::max);
-    let max_d = (0..n).map(|j| (r.d_perturbation[j] - r.d_actual[j]).abs()).fold(0.0, f64::max);
+    let max_t = (0..n)
+        .map(|j| (r.torque_identified[j] - r.torque_paper[j]).abs())
+        .fold(0.0, f64::max);
+    let max_d = (0..n)
+        .map(|j| (r.d_perturbation[j] - r.d_actual[j]).abs())
+        .fold(0.0, f64::max);
     let local_wins_near = r.errors.iter().all(|e| e.local_near < e.global_linear_near);
     let global_wins_all = r.errors.iter().all(|e| e.global_linear_all < e.local_all);
     let global_loses_all = r.errors.iter().all(|e| e.global_linear_all > e.local_all);

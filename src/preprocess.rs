@@ -29,7 +29,14 @@ pub struct PreprocessOptions {
 
 impl Default for PreprocessOptions {
     fn default() -> Self {
-        Self { rate: 1000.0, cutoff: Some(10.0), order: 4, filter_position: false, trim: 0.5, decimate: 10 }
+        Self {
+            rate: 1000.0,
+            cutoff: Some(10.0),
+            order: 4,
+            filter_position: false,
+            trim: 0.5,
+            decimate: 10,
+        }
     }
 }
 
@@ -42,7 +49,10 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     if !(o.rate.is_finite() && o.rate > 0.0) || o.decimate == 0 || !(o.trim >= 0.0) {
         return Err(Error::InvalidArgument {
             argument: "preprocess options".into(),
-            message: format!("rate {} Hz, decimate {}, trim {} s; expected rate > 0, decimate >= 1, trim >= 0", o.rate, o.decimate, o.trim),
+            message: format!(
+                "rate {} Hz, decimate {}, trim {} s; expected rate > 0, decimate >= 1, trim >= 0",
+                o.rate, o.decimate, o.trim
+            ),
         });
     }
     let n = rec.n;
@@ -50,11 +60,18 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     let count = ((t1 - t0) * o.rate).floor() as usize + 1;
     let grid: Vec<f64> = (0..count).map(|i| t0 + i as f64 / o.rate).collect();
     let dt = 1.0 / o.rate;
-    let filter = o.cutoff.map(|c| butterworth_lowpass(o.order, c, o.rate)).transpose()?;
-    let column = |x: &[f64], j: usize| -> Vec<f64> { (0..rec.len()).map(|i| x[i * n + j]).collect() };
+    let filter = o
+        .cutoff
+        .map(|c| butterworth_lowpass(o.order, c, o.rate))
+        .transpose()?;
+    let column =
+        |x: &[f64], j: usize| -> Vec<f64> { (0..rec.len()).map(|i| x[i * n + j]).collect() };
     let smooth = |x: Vec<f64>| -> Result<Vec<f64>> {
         match &filter {
-            Some(f) => filtfilt(f, &x).map_err(|e| Error::Recording { recording: rec.name.clone(), message: format!("too short to filter: {e}") }),
+            Some(f) => filtfilt(f, &x).map_err(|e| Error::Recording {
+                recording: rec.name.clone(),
+                message: format!("too short to filter: {e}"),
+            }),
             None => Ok(x),
         }
     };
@@ -75,11 +92,19 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     if count <= 2 * skip + 1 {
         return Err(Error::Recording {
             recording: rec.name.clone(),
-            message: format!("{:.3} s long; trimming {} s at both ends leaves nothing", t1 - t0, o.trim),
+            message: format!(
+                "{:.3} s long; trimming {} s at both ends leaves nothing",
+                t1 - t0,
+                o.trim
+            ),
         });
     }
     let keep: Vec<usize> = (skip..count - skip).step_by(o.decimate).collect();
-    let rows = |c: &Vec<Vec<f64>>| -> Vec<f64> { keep.iter().flat_map(|&i| (0..n).map(move |j| c[j][i])).collect() };
+    let rows = |c: &Vec<Vec<f64>>| -> Vec<f64> {
+        keep.iter()
+            .flat_map(|&i| (0..n).map(move |j| c[j][i]))
+            .collect()
+    };
     Recording::new(
         format!("{} (preprocessed)", rec.name),
         n,

@@ -31,13 +31,24 @@ impl Recording {
         qd: Option<Vec<f64>>,
         qdd: Option<Vec<f64>>,
     ) -> Result<Self> {
-        let r = Self { name: name.into(), n, t, q, tau, qd, qdd };
+        let r = Self {
+            name: name.into(),
+            n,
+            t,
+            q,
+            tau,
+            qd,
+            qdd,
+        };
         r.check()?;
         Ok(r)
     }
 
     fn error(&self, message: String) -> Error {
-        Error::Recording { recording: self.name.clone(), message }
+        Error::Recording {
+            recording: self.name.clone(),
+            message,
+        }
     }
 
     fn check(&self) -> Result<()> {
@@ -49,7 +60,10 @@ impl Recording {
             return Err(self.error(format!("{k} samples; a recording needs at least 2")));
         }
         if let Some(i) = self.t.iter().position(|v| !v.is_finite()) {
-            return Err(self.error(format!("t at sample {i} is {}, expected a finite number", self.t[i])));
+            return Err(self.error(format!(
+                "t at sample {i} is {}, expected a finite number",
+                self.t[i]
+            )));
         }
         if let Some(i) = (1..k).find(|&i| self.t[i] <= self.t[i - 1]) {
             return Err(self.error(format!(
@@ -58,7 +72,12 @@ impl Recording {
                 self.t[i - 1]
             )));
         }
-        let columns = [("q", Some(&self.q)), ("tau", Some(&self.tau)), ("qd", self.qd.as_ref()), ("qdd", self.qdd.as_ref())];
+        let columns = [
+            ("q", Some(&self.q)),
+            ("tau", Some(&self.tau)),
+            ("qd", self.qd.as_ref()),
+            ("qdd", self.qdd.as_ref()),
+        ];
         for (what, values) in columns {
             let Some(values) = values else { continue };
             if values.len() != k * self.n {

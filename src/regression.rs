@@ -35,7 +35,12 @@ pub const RANK_TOLERANCE: f64 = 1e-10;
 /// outputs). `context` and `columns` (the names of X's p columns) go into the error when `X`
 /// does not have full column rank, which names the missing directions. Fails on shapes that do
 /// not match, K < p, or non-finite entries.
-pub fn least_squares(x: &DMatrix<f64>, y: &DMatrix<f64>, context: &str, columns: &[String]) -> Result<LeastSquares> {
+pub fn least_squares(
+    x: &DMatrix<f64>,
+    y: &DMatrix<f64>,
+    context: &str,
+    columns: &[String],
+) -> Result<LeastSquares> {
     let (k, p) = x.shape();
     let m = y.ncols();
     if y.nrows() != k || columns.len() != p {
@@ -84,13 +89,24 @@ pub fn least_squares(x: &DMatrix<f64>, y: &DMatrix<f64>, context: &str, columns:
         let mut missing = weak
             .iter()
             .take(3)
-            .map(|&i| describe_direction(&(0..p).map(|j| v[(j, i)] / scale[j]).collect::<Vec<_>>(), columns))
+            .map(|&i| {
+                describe_direction(
+                    &(0..p).map(|j| v[(j, i)] / scale[j]).collect::<Vec<_>>(),
+                    columns,
+                )
+            })
             .collect::<Vec<_>>()
             .join("; ");
         if weak.len() > 3 {
             missing.push_str(&format!("; and {} more directions", weak.len() - 3));
         }
-        return Err(Error::RankDeficient { context: context.into(), rows: k, cols: p, rank: p - weak.len(), missing });
+        return Err(Error::RankDeficient {
+            context: context.into(),
+            rows: k,
+            cols: p,
+            rank: p - weak.len(),
+            missing,
+        });
     }
     // A^T (scaled) = V S^-1 U^T Y
     let mut uty = vec![0.0; p * m];
@@ -130,7 +146,14 @@ pub fn least_squares(x: &DMatrix<f64>, y: &DMatrix<f64>, context: &str, columns:
             stderr[(c, j)] = sigma * cov_diag[j].sqrt();
         }
     }
-    Ok(LeastSquares { coef, cond: smax / smin, residual_rms, stderr, rows: k, cov_diag })
+    Ok(LeastSquares {
+        coef,
+        cond: smax / smin,
+        residual_rms,
+        stderr,
+        rows: k,
+        cov_diag,
+    })
 }
 
 /// `0.71 dq1 - 0.71 dq2`: a direction in terms of named columns (the 6 largest entries, largest
@@ -138,19 +161,33 @@ pub fn least_squares(x: &DMatrix<f64>, y: &DMatrix<f64>, context: &str, columns:
 fn describe_direction(d: &[f64], columns: &[String]) -> String {
     let norm = d.iter().map(|v| v * v).sum::<f64>().sqrt();
     let max = d.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    let mut terms: Vec<(usize, f64)> = d.iter().map(|v| v / norm).enumerate().filter(|(_, v)| v.abs() >= 0.05 * max / norm).collect();
+    let mut terms: Vec<(usize, f64)> = d
+        .iter()
+        .map(|v| v / norm)
+        .enumerate()
+        .filter(|(_, v)| v.abs() >= 0.05 * max / norm)
+        .collect();
     // largest first; equal magnitudes (to 1e-6) in column order
     terms.sort_by_key(|&(j, v)| (-(v.abs() * 1e6).round() as i64, j));
     let more = terms.len().saturating_sub(6);
     terms.truncate(6);
-    let sign = if terms.first().is_some_and(|t| t.1 < 0.0) { -1.0 } else { 1.0 };
+    let sign = if terms.first().is_some_and(|t| t.1 < 0.0) {
+        -1.0
+    } else {
+        1.0
+    };
     let mut out = String::new();
     for (i, (j, v)) in terms.iter().enumerate() {
         let v = v * sign;
         if i == 0 {
             out.push_str(&format!("{v:.3} {}", columns[*j]));
         } else {
-            out.push_str(&format!(" {} {:.3} {}", if v < 0.0 { '-' } else { '+' }, v.abs(), columns[*j]));
+            out.push_str(&format!(
+                " {} {:.3} {}",
+                if v < 0.0 { '-' } else { '+' },
+                v.abs(),
+                columns[*j]
+            ));
         }
     }
     if more > 0 {

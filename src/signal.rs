@@ -41,12 +41,18 @@ pub fn butterworth_lowpass(order: usize, cutoff: f64, rate: f64) -> Result<Vec<B
         let zi = ((fs2 - re) * im + (fs2 + re) * im) / den;
         let (a1, a2) = (-2.0 * zr, zr * zr + zi * zi);
         let g = (1.0 + a1 + a2) / 4.0;
-        sections.push(Biquad { b: [g, 2.0 * g, g], a: [a1, a2] });
+        sections.push(Biquad {
+            b: [g, 2.0 * g, g],
+            a: [a1, a2],
+        });
     }
     if order % 2 == 1 {
         let z = (fs2 - wc) / (fs2 + wc);
         let g = (1.0 - z) / 2.0;
-        sections.push(Biquad { b: [g, g, 0.0], a: [-z, 0.0] });
+        sections.push(Biquad {
+            b: [g, g, 0.0],
+            a: [-z, 0.0],
+        });
     }
     Ok(sections)
 }
@@ -71,7 +77,10 @@ pub fn filtfilt(sections: &[Biquad], x: &[f64]) -> Result<Vec<f64>> {
     let pad = 3 * (2 * sections.len() + 1);
     let n = x.len();
     if n <= pad {
-        return Err(Error::InvalidArgument { argument: "signal".into(), message: format!("{n} samples; zero-phase filtering needs more than {pad}") });
+        return Err(Error::InvalidArgument {
+            argument: "signal".into(),
+            message: format!("{n} samples; zero-phase filtering needs more than {pad}"),
+        });
     }
     let mut ext = Vec::with_capacity(n + 2 * pad);
     ext.extend((1..=pad).rev().map(|i| 2.0 * x[0] - x[i]));

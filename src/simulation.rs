@@ -23,7 +23,10 @@ pub struct Friction {
 impl Friction {
     /// No friction.
     pub fn none(n: usize) -> Self {
-        Self { viscous: vec![0.0; n], coulomb: vec![0.0; n] }
+        Self {
+            viscous: vec![0.0; n],
+            coulomb: vec![0.0; n],
+        }
     }
 
     /// The URDF's `<dynamics damping friction>` of every joint.
@@ -127,9 +130,18 @@ pub fn simulate_samples(
     let (mut q, mut tau) = (Vec::with_capacity(k * n), Vec::with_capacity(k * n));
     for i in 0..k {
         let (qi, qdi) = (samples.q_at(i), samples.qd_at(i));
-        rnea(model, &mut data, qi, qdi, samples.qdd_at(i), options.gravity)?;
+        rnea(
+            model,
+            &mut data,
+            qi,
+            qdi,
+            samples.qdd_at(i),
+            options.gravity,
+        )?;
         for j in 0..n {
-            let t = data.tau[j] + options.friction.torque(j, qdi[j]) + options.torque_noise[j] * gauss.sample(&mut rng);
+            let t = data.tau[j]
+                + options.friction.torque(j, qdi[j])
+                + options.torque_noise[j] * gauss.sample(&mut rng);
             tau.push(t);
             let mut p = qi[j] + options.position_noise[j] * gauss.sample(&mut rng);
             if options.quantization[j] > 0.0 {
@@ -143,7 +155,11 @@ pub fn simulate_samples(
 
 /// Simulates one recording per experiment of `plan` (in the plan's order) for `model`, which
 /// must have the plan's joints. Each experiment gets its own random stream of `options.seed`.
-pub fn simulate_plan(model: &Model, plan: &crate::local::Plan, options: &SimulationOptions) -> Result<Vec<Recording>> {
+pub fn simulate_plan(
+    model: &Model,
+    plan: &crate::local::Plan,
+    options: &SimulationOptions,
+) -> Result<Vec<Recording>> {
     if plan.joint_names != model.joint_names {
         return Err(Error::InvalidArgument {
             argument: "plan".into(),
@@ -159,6 +175,14 @@ pub fn simulate_plan(model: &Model, plan: &crate::local::Plan, options: &Simulat
     plan.experiments
         .iter()
         .enumerate()
-        .map(|(i, e)| simulate_samples(model, &e.trajectory.sample(plan.rate), options, i as u64, &format!("simulated experiment '{}'", e.kind.name())))
+        .map(|(i, e)| {
+            simulate_samples(
+                model,
+                &e.trajectory.sample(plan.rate),
+                options,
+                i as u64,
+                &format!("simulated experiment '{}'", e.kind.name()),
+            )
+        })
         .collect()
 }

@@ -24,7 +24,10 @@ fn tmp(name: &str) -> PathBuf {
 /// Runs and expects success; returns stdout.
 fn ok(args: &[&str]) -> String {
     let out = bin().args(args).output().unwrap();
-    let (so, se) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    let (so, se) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
     assert!(out.status.success(), "perturbid {args:?} failed: {se}");
     so.into_owned()
 }
@@ -34,8 +37,14 @@ fn fails(args: &[&str], needles: &[&str]) -> String {
     let out = bin().args(args).output().unwrap();
     let se = String::from_utf8_lossy(&out.stderr).into_owned();
     assert!(!out.status.success(), "perturbid {args:?} should fail");
-    assert!(!se.contains("panicked") && !se.contains("RUST_BACKTRACE"), "panic: {se}");
-    assert!(se.starts_with("perturbid: ") && se.trim_end().lines().count() == 1, "not one line: {se}");
+    assert!(
+        !se.contains("panicked") && !se.contains("RUST_BACKTRACE"),
+        "panic: {se}"
+    );
+    assert!(
+        se.starts_with("perturbid: ") && se.trim_end().lines().count() == 1,
+        "not one line: {se}"
+    );
     for n in needles {
         assert!(se.contains(n), "'{n}' not in: {se}");
     }
@@ -53,7 +62,10 @@ fn s(p: &Path) -> &str {
 /// No file named `name` and no temporary file in `dir`.
 fn nothing_written(dir: &Path, name: &str) {
     assert!(!dir.join(name).exists(), "{name} was written");
-    let tmp = std::fs::read_dir(dir).unwrap().filter_map(|e| e.ok()).any(|e| e.file_name().to_string_lossy().ends_with(".tmp"));
+    let tmp = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .any(|e| e.file_name().to_string_lossy().ends_with(".tmp"));
     assert!(!tmp, "a temporary file was left in {}", dir.display());
 }
 
@@ -61,54 +73,144 @@ fn nothing_written(dir: &Path, name: &str) {
 fn plan_simulate_identify_predict() {
     let d = tmp("local");
     let op = d.join("op.json");
-    write(&op, r#"{"q": [0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0], "qd": [0.089, -0.106, 0.022, 0.056, 0.011, 0.014], "qdd": [-0.155, -0.5, 0.034, -0.291, -0.008, 0.171]}"#);
-    let out = ok(&["plan", "a465", "--op", s(&op), "--out", s(&d.join("plan")), "--design", "orthogonal", "--experiments", "nominal,H,D,G"]);
+    write(
+        &op,
+        r#"{"q": [0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0], "qd": [0.089, -0.106, 0.022, 0.056, 0.011, 0.014], "qdd": [-0.155, -0.5, 0.034, -0.291, -0.008, 0.171]}"#,
+    );
+    let out = ok(&[
+        "plan",
+        "a465",
+        "--op",
+        s(&op),
+        "--out",
+        s(&d.join("plan")),
+        "--design",
+        "orthogonal",
+        "--experiments",
+        "nominal,H,D,G",
+    ]);
     assert!(out.contains("plan.json"), "{out}");
     let header = std::fs::read_to_string(d.join("plan/D.csv")).unwrap();
-    assert!(header.starts_with("t,q1,q2,q3,q4,q5,q6,qd1,"), "{}", &header[..40]);
-    ok(&["simulate", "a465", s(&d.join("plan/plan.json")), "--out", s(&d.join("rec")), "--no-gravity"]);
-    let out = ok(&["identify", s(&d.join("plan/plan.json")), s(&d.join("rec")), "--out", s(&d.join("model.json"))]);
-    assert!(out.contains("D*: cond(X) 1.000") && out.contains("T* (N m)"), "{out}");
-    let model = LocalModel::from_json(&std::fs::read_to_string(d.join("model.json")).unwrap()).unwrap();
+    assert!(
+        header.starts_with("t,q1,q2,q3,q4,q5,q6,qd1,"),
+        "{}",
+        &header[..40]
+    );
+    ok(&[
+        "simulate",
+        "a465",
+        s(&d.join("plan/plan.json")),
+        "--out",
+        s(&d.join("rec")),
+        "--no-gravity",
+    ]);
+    let out = ok(&[
+        "identify",
+        s(&d.join("plan/plan.json")),
+        s(&d.join("rec")),
+        "--out",
+        s(&d.join("model.json")),
+    ]);
+    assert!(
+        out.contains("D*: cond(X) 1.000") && out.contains("T* (N m)"),
+        "{out}"
+    );
+    let model =
+        LocalModel::from_json(&std::fs::read_to_string(d.join("model.json")).unwrap()).unwrap();
     let m = a465::model("kinsheel2010").unwrap();
     let mut data = Data::new(&m);
     mass_matrix(&m, &mut data, &a465::TABLE2_Q).unwrap();
     let dm = &model.d.as_ref().unwrap().matrix;
     assert!((dm - &data.m).norm() < 1e-8 * data.m.norm());
     // files given one by one in the plan's order work too
-    let files: Vec<String> = ["nominal", "H", "D", "G"].iter().map(|k| d.join(format!("rec/{k}.csv")).display().to_string()).collect();
+    let files: Vec<String> = ["nominal", "H", "D", "G"]
+        .iter()
+        .map(|k| d.join(format!("rec/{k}.csv")).display().to_string())
+        .collect();
     let (plan_json, model2) = (d.join("plan/plan.json"), d.join("model2.json"));
     let mut args = vec!["identify", s(&plan_json)];
     args.extend(files.iter().map(String::as_str));
     args.extend(["--out", s(&model2), "--estimator", "combined"]);
     ok(&args);
     // predict at the plan's D trajectory states
-    let out = ok(&["predict", s(&d.join("model.json")), s(&d.join("plan/D.csv")), "--out", s(&d.join("pred.csv"))]);
+    let out = ok(&[
+        "predict",
+        s(&d.join("model.json")),
+        s(&d.join("plan/D.csv")),
+        "--out",
+        s(&d.join("pred.csv")),
+    ]);
     assert!(out.contains("predicted torques"), "{out}");
-    let pred = Table::parse("pred", &std::fs::read_to_string(d.join("pred.csv")).unwrap()).unwrap();
-    assert_eq!(pred.columns, ["t", "tau1", "tau2", "tau3", "tau4", "tau5", "tau6"]);
+    let pred = Table::parse(
+        "pred",
+        &std::fs::read_to_string(d.join("pred.csv")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(
+        pred.columns,
+        ["t", "tau1", "tau2", "tau3", "tau4", "tau5", "tau6"]
+    );
 }
 
 #[test]
 fn excite_identify_direct_predict() {
     let d = tmp("direct");
-    let out = ok(&["excite", "a465", "--out", s(&d), "--max-evaluations", "200", "--rate", "100"]);
+    let out = ok(&[
+        "excite",
+        "a465",
+        "--out",
+        s(&d),
+        "--max-evaluations",
+        "200",
+        "--rate",
+        "100",
+    ]);
     assert!(out.contains("cond(Phi_base)"), "{out}");
-    let traj: FourierTrajectory = serde_json::from_str(&std::fs::read_to_string(d.join("excitation.json")).unwrap()).unwrap();
+    let traj: FourierTrajectory =
+        serde_json::from_str(&std::fs::read_to_string(d.join("excitation.json")).unwrap()).unwrap();
     assert_eq!(traj.harmonics(), 5);
     // a recording with qd and qdd, noise-free: identification without preprocessing is exact
     let model = a465::model("kinsheel2010").unwrap();
     let samples = traj.sample_periods(1.0, 100.0);
-    let mut rec = simulate_samples(&model, &samples, &SimulationOptions::new(&model), 0, "x").unwrap();
+    let mut rec =
+        simulate_samples(&model, &samples, &SimulationOptions::new(&model), 0, "x").unwrap();
     rec.qd = Some(samples.qd.clone());
     rec.qdd = Some(samples.qdd.clone());
     write(&d.join("log.csv"), &recording_table(&rec, "").to_csv());
-    let out = ok(&["identify-direct", "a465", s(&d.join("log.csv")), "--out", s(&d.join("base.json")), "--friction", "none", "--validate", "0.3"]);
-    assert!(out.contains("base parameters from") && out.contains("validation"), "{out}");
-    let out = ok(&["predict", s(&d.join("base.json")), s(&d.join("log.csv")), "--robot", "a465", "--out", s(&d.join("pred.csv"))]);
-    let worst: f64 = out.lines().skip(2).filter_map(|l| l.split_whitespace().last()?.parse::<f64>().ok()).fold(0.0, f64::max);
+    let out = ok(&[
+        "identify-direct",
+        "a465",
+        s(&d.join("log.csv")),
+        "--out",
+        s(&d.join("base.json")),
+        "--friction",
+        "none",
+        "--validate",
+        "0.3",
+    ]);
+    assert!(
+        out.contains("base parameters from") && out.contains("validation"),
+        "{out}"
+    );
+    let out = ok(&[
+        "predict",
+        s(&d.join("base.json")),
+        s(&d.join("log.csv")),
+        "--robot",
+        "a465",
+        "--out",
+        s(&d.join("pred.csv")),
+    ]);
+    let worst: f64 = out
+        .lines()
+        .skip(2)
+        .filter_map(|l| l.split_whitespace().last()?.parse::<f64>().ok())
+        .fold(0.0, f64::max);
     assert!(worst < 1e-6, "{out}");
-    fails(&["predict", s(&d.join("base.json")), s(&d.join("log.csv"))], &["--robot"]);
+    fails(
+        &["predict", s(&d.join("base.json")), s(&d.join("log.csv"))],
+        &["--robot"],
+    );
 }
 
 #[test]
@@ -116,8 +218,20 @@ fn bad_inputs_get_one_line_errors_and_no_output() {
     let d = tmp("errors");
     let plan_dir = d.join("plan");
     let op = d.join("op.json");
-    write(&op, r#"{"q": [0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0], "qd": [0.089, -0.106, 0.022, 0.056, 0.011, 0.014], "qdd": [-0.155, -0.5, 0.034, -0.291, -0.008, 0.171]}"#);
-    ok(&["plan", "a465", "--op", s(&op), "--out", s(&plan_dir), "--experiments", "nominal,D"]);
+    write(
+        &op,
+        r#"{"q": [0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0], "qd": [0.089, -0.106, 0.022, 0.056, 0.011, 0.014], "qdd": [-0.155, -0.5, 0.034, -0.291, -0.008, 0.171]}"#,
+    );
+    ok(&[
+        "plan",
+        "a465",
+        "--op",
+        s(&op),
+        "--out",
+        s(&plan_dir),
+        "--experiments",
+        "nominal,D",
+    ]);
     let plan = plan_dir.join("plan.json");
     let model = d.join("model.json");
     let csv = |name: &str, text: &str| -> String {
@@ -128,34 +242,109 @@ fn bad_inputs_get_one_line_errors_and_no_output() {
     let header = "t,q1,q2,q3,q4,q5,q6,tau1,tau2,tau3,tau4,tau5,tau6";
     let row = |t: f64| format!("{t},0,0,0,0,0,0,0,0,0,0,0,0");
     // a missing file
-    fails(&["identify", s(&plan), s(&d.join("nope.csv")), s(&d.join("nope2.csv")), "--out", s(&model)], &["nope.csv"]);
+    fails(
+        &[
+            "identify",
+            s(&plan),
+            s(&d.join("nope.csv")),
+            s(&d.join("nope2.csv")),
+            "--out",
+            s(&model),
+        ],
+        &["nope.csv"],
+    );
     // a missing column
-    let f = csv("missing.csv", &format!("t,q1,q2,q3,q4,q5,tau1,tau2,tau3,tau4,tau5,tau6\n0,0,0,0,0,0,0,0,0,0,0,0\n"));
-    fails(&["identify", s(&plan), &f, &f, "--out", s(&model)], &["missing.csv", "missing column(s) q6"]);
+    let f = csv(
+        "missing.csv",
+        &format!("t,q1,q2,q3,q4,q5,tau1,tau2,tau3,tau4,tau5,tau6\n0,0,0,0,0,0,0,0,0,0,0,0\n"),
+    );
+    fails(
+        &["identify", s(&plan), &f, &f, "--out", s(&model)],
+        &["missing.csv", "missing column(s) q6"],
+    );
     // an extra column
     let f = csv("extra.csv", &format!("{header},x\n{},1\n", row(0.0)));
-    fails(&["identify", s(&plan), &f, &f, "--out", s(&model)], &["extra.csv", "unexpected column 'x'"]);
+    fails(
+        &["identify", s(&plan), &f, &f, "--out", s(&model)],
+        &["extra.csv", "unexpected column 'x'"],
+    );
     // a non-number, with its line and column
-    let f = csv("word.csv", &format!("{header}\n{}\n0.001,0,0,zero,0,0,0,0,0,0,0,0,0\n", row(0.0)));
-    fails(&["identify", s(&plan), &f, &f, "--out", s(&model)], &["word.csv", "line 3, column 'q3'", "'zero' is not a number"]);
+    let f = csv(
+        "word.csv",
+        &format!("{header}\n{}\n0.001,0,0,zero,0,0,0,0,0,0,0,0,0\n", row(0.0)),
+    );
+    fails(
+        &["identify", s(&plan), &f, &f, "--out", s(&model)],
+        &["word.csv", "line 3, column 'q3'", "'zero' is not a number"],
+    );
     // NaN
-    let f = csv("nan.csv", &format!("{header}\n0,0,0,0,0,0,0,NaN,0,0,0,0,0\n"));
-    fails(&["identify", s(&plan), &f, &f, "--out", s(&model)], &["nan.csv", "line 2, column 'tau1'", "finite"]);
+    let f = csv(
+        "nan.csv",
+        &format!("{header}\n0,0,0,0,0,0,0,NaN,0,0,0,0,0\n"),
+    );
+    fails(
+        &["identify", s(&plan), &f, &f, "--out", s(&model)],
+        &["nan.csv", "line 2, column 'tau1'", "finite"],
+    );
     // time not increasing
-    let f = csv("time.csv", &format!("{header}\n{}\n{}\n{}\n", row(0.0), row(0.002), row(0.001)));
-    fails(&["identify", s(&plan), &f, &f, "--out", s(&model)], &["time.csv", "time does not increase at data row 3"]);
+    let f = csv(
+        "time.csv",
+        &format!("{header}\n{}\n{}\n{}\n", row(0.0), row(0.002), row(0.001)),
+    );
+    fails(
+        &["identify", s(&plan), &f, &f, "--out", s(&model)],
+        &["time.csv", "time does not increase at data row 3"],
+    );
     // fewer joints than the robot has
     let f = csv("few.csv", "t,q1,q2,tau1,tau2\n0,0,0,0,0\n0.1,0,0,0,0\n");
-    fails(&["identify", s(&plan), &f, &f, "--out", s(&model)], &["few.csv", "the robot has 6 joints"]);
+    fails(
+        &["identify", s(&plan), &f, &f, "--out", s(&model)],
+        &["few.csv", "the robot has 6 joints"],
+    );
     // an unknown robot; a bad operating point; a plan breaking the limits
     fails(&["info", "a466"], &["unknown robot 'a466'", "a465"]);
-    write(&d.join("bad_op.json"), r#"{"q": [0, 0], "qd": [0, 0], "qdd": [0, 0]}"#);
-    fails(&["plan", "a465", "--op", s(&d.join("bad_op.json")), "--out", s(&d.join("p2"))], &["operating point q", "6"]);
-    write(&d.join("edge.json"), r#"{"q": [0, 1.5705, 0, 0, 0, 0], "qd": [0, 0, 0, 0, 0, 0], "qdd": [0, 0, 0, 0, 0, 0]}"#);
-    fails(&["plan", "a465", "--op", s(&d.join("edge.json")), "--out", s(&d.join("p3"))], &["joint2", "t = ", "outside"]);
+    write(
+        &d.join("bad_op.json"),
+        r#"{"q": [0, 0], "qd": [0, 0], "qdd": [0, 0]}"#,
+    );
+    fails(
+        &[
+            "plan",
+            "a465",
+            "--op",
+            s(&d.join("bad_op.json")),
+            "--out",
+            s(&d.join("p2")),
+        ],
+        &["operating point q", "6"],
+    );
+    write(
+        &d.join("edge.json"),
+        r#"{"q": [0, 1.5705, 0, 0, 0, 0], "qd": [0, 0, 0, 0, 0, 0], "qdd": [0, 0, 0, 0, 0, 0]}"#,
+    );
+    fails(
+        &[
+            "plan",
+            "a465",
+            "--op",
+            s(&d.join("edge.json")),
+            "--out",
+            s(&d.join("p3")),
+        ],
+        &["joint2", "t = ", "outside"],
+    );
     assert!(!d.join("p3/plan.json").exists());
     write(&d.join("broken.json"), "{\"robot\": ");
-    fails(&["simulate", "a465", s(&d.join("broken.json")), "--out", s(&d.join("r"))], &["broken.json", "line 1"]);
+    fails(
+        &[
+            "simulate",
+            "a465",
+            s(&d.join("broken.json")),
+            "--out",
+            s(&d.join("r")),
+        ],
+        &["broken.json", "line 1"],
+    );
     nothing_written(&d, "model.json");
     // usage errors exit with 2 and no panic
     let out = bin().args(["plan"]).output().unwrap();
@@ -167,13 +356,28 @@ fn paper_reproduction() {
     let d = tmp("paper");
     let out = ok(&["paper", "--out", s(&d)]);
     assert!(out.contains("Table 3"), "{out}");
-    for f in ["report.md", "table2.csv", "table3.csv", "results.json", "fig3_joint2.svg", "fig4_joint3.svg", "fig5_joint4.svg", "figures.csv"] {
+    for f in [
+        "report.md",
+        "table2.csv",
+        "table3.csv",
+        "results.json",
+        "fig3_joint2.svg",
+        "fig4_joint3.svg",
+        "fig5_joint4.svg",
+        "figures.csv",
+    ] {
         assert!(d.join(f).is_file(), "{f} missing");
     }
     let t3 = std::fs::read_to_string(d.join("table3.csv")).unwrap();
     let row = |name: &str| -> Vec<f64> {
-        let line = t3.lines().find(|l| l.starts_with(&format!("{name},"))).unwrap();
-        line.split(',').skip(1).map(|x| x.parse().unwrap()).collect()
+        let line = t3
+            .lines()
+            .find(|l| l.starts_with(&format!("{name},")))
+            .unwrap();
+        line.split(',')
+            .skip(1)
+            .map(|x| x.parse().unwrap())
+            .collect()
     };
     // A465.md: the first column of M(q*) within 0.002 of the paper's "actual" row
     for (a, p) in row("actual").iter().zip(a465::TABLE3_D_COLUMN1) {
@@ -183,12 +387,18 @@ fn paper_reproduction() {
     for (a, p) in row("perturbation").iter().zip(row("perturbation_paper")) {
         assert!((a - p).abs() < 0.006, "perturbation {a} vs {p}");
     }
-    let t2 = Table::parse("t2", &std::fs::read_to_string(d.join("table2.csv")).unwrap()).unwrap();
+    let t2 = Table::parse(
+        "t2",
+        &std::fs::read_to_string(d.join("table2.csv")).unwrap(),
+    )
+    .unwrap();
     for (t, p) in t2.column(4).iter().zip(t2.column(5)) {
         assert!((t - p).abs() < 0.01, "T* {t} vs Tn {p}");
     }
     let report = std::fs::read_to_string(d.join("report.md")).unwrap();
-    assert!(report.contains("## Table 2") && report.contains("![fig3_joint2.svg](fig3_joint2.svg)"));
+    assert!(
+        report.contains("## Table 2") && report.contains("![fig3_joint2.svg](fig3_joint2.svg)")
+    );
     // deterministic: a second run writes the same numbers
     let d2 = tmp("paper2");
     ok(&["paper", "--out", s(&d2)]);

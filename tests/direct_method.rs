@@ -7,8 +7,9 @@ use common::{mimic_pair, random_tree_urdf, Rng};
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::algorithms::regressor::{joint_torque_regressor, model_parameters};
 use perturbid_rs::direct::{
-    design_excitation, identify_base_parameters, identify_global_linear, regressor_matrix, BaseOptions, BaseParameters, Batch,
-    Criterion, ExcitationOptions, FrictionTerms, ParameterLayout, Weighting,
+    design_excitation, identify_base_parameters, identify_global_linear, regressor_matrix,
+    BaseOptions, BaseParameters, Batch, Criterion, ExcitationOptions, FrictionTerms,
+    ParameterLayout, Weighting,
 };
 use perturbid_rs::local::OperatingPoint;
 use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
@@ -22,7 +23,10 @@ fn random_states(model: &Model, k: usize, rng: &mut Rng) -> (Vec<f64>, Vec<f64>,
     let mut q = Vec::new();
     for _ in 0..k {
         for j in 0..n {
-            let (lo, hi) = (model.limits[j].lower.max(-3.0), model.limits[j].upper.min(3.0));
+            let (lo, hi) = (
+                model.limits[j].lower.max(-3.0),
+                model.limits[j].upper.min(3.0),
+            );
             q.push(rng.uniform(lo, hi));
         }
     }
@@ -35,7 +39,15 @@ fn torques(model: &Model, q: &[f64], qd: &[f64], qdd: &[f64], gravity: bool) -> 
     (0..q.len() / n)
         .flat_map(|s| {
             let r = s * n..(s + 1) * n;
-            rnea(model, &mut data, &q[r.clone()], &qd[r.clone()], &qdd[r], gravity).unwrap();
+            rnea(
+                model,
+                &mut data,
+                &q[r.clone()],
+                &qd[r.clone()],
+                &qdd[r],
+                gravity,
+            )
+            .unwrap();
             data.tau.as_slice().to_vec()
         })
         .collect()
@@ -44,9 +56,15 @@ fn torques(model: &Model, q: &[f64], qd: &[f64], qdd: &[f64], gravity: bool) -> 
 /// `Phi(q, qd, qdd) theta = rnea(q, qd, qdd)` with the model's own parameters.
 #[test]
 fn regressor_times_parameters_is_rnea() {
-    let mut models = vec![a465::model("kinsheel2010").unwrap(), a465::model("physical").unwrap()];
+    let mut models = vec![
+        a465::model("kinsheel2010").unwrap(),
+        a465::model("physical").unwrap(),
+    ];
     for seed in 0..6 {
-        models.push(model_from_urdf_str(&random_tree_urdf(seed, 7), "tree", &LoadOptions::default()).unwrap());
+        models.push(
+            model_from_urdf_str(&random_tree_urdf(seed, 7), "tree", &LoadOptions::default())
+                .unwrap(),
+        );
     }
     models.push(model_from_urdf_str(&mimic_pair(true), "mimic", &LoadOptions::default()).unwrap());
     let mut rng = Rng(3);
@@ -60,10 +78,23 @@ fn regressor_times_parameters_is_rnea() {
             let n = model.nv;
             for s in 0..5 {
                 let r = s * n..(s + 1) * n;
-                joint_torque_regressor(model, &mut data, &q[r.clone()], &qd[r.clone()], &qdd[r.clone()], gravity, &mut y).unwrap();
+                joint_torque_regressor(
+                    model,
+                    &mut data,
+                    &q[r.clone()],
+                    &qd[r.clone()],
+                    &qdd[r.clone()],
+                    gravity,
+                    &mut y,
+                )
+                .unwrap();
                 let tau = &y * &theta;
                 let e = DVector::from_column_slice(&expected[r]);
-                assert!((&tau - &e).amax() < 1e-10 * (1.0 + e.amax()), "{}: {tau} vs {e}", model.name);
+                assert!(
+                    (&tau - &e).amax() < 1e-10 * (1.0 + e.amax()),
+                    "{}: {tau} vs {e}",
+                    model.name
+                );
             }
         }
     }
@@ -85,17 +116,34 @@ fn base_parameters_reproduce_the_full_regressor() {
     }
     let tb = base.from_full(&theta).unwrap();
     let (q, qd, qdd) = random_states(&model, 50, &mut rng);
-    let phi = regressor_matrix(&model, &layout, &Batch { q: &q, qd: &qd, qdd: &qdd }, true).unwrap();
+    let phi = regressor_matrix(
+        &model,
+        &layout,
+        &Batch {
+            q: &q,
+            qd: &qd,
+            qdd: &qdd,
+        },
+        true,
+    )
+    .unwrap();
     let full = &phi * &theta;
     let reduced = base.select(&phi) * &tb;
-    assert!((&full - &reduced).amax() < 1e-9 * full.amax(), "{}", (&full - &reduced).amax());
+    assert!(
+        (&full - &reduced).amax() < 1e-9 * full.amax(),
+        "{}",
+        (&full - &reduced).amax()
+    );
     // the rank is a property of the kinematics: the 6R A465 has fewer base parameters than 78
     assert!(base.len() < 60 && base.len() > 30, "{}", base.len());
     assert_eq!(base.kept.len() + base.dropped.len(), 78);
     // every friction column of a joint is identifiable
     assert!(base.kept.iter().filter(|&&c| c >= 60).count() == 18);
     // names tell which parameters merged
-    assert!(base.names().iter().any(|n| n.contains(" + ") || n.contains(" - ")));
+    assert!(base
+        .names()
+        .iter()
+        .any(|n| n.contains(" + ") || n.contains(" - ")));
 }
 
 fn a465_excitation() -> FourierTrajectory {
@@ -104,7 +152,13 @@ fn a465_excitation() -> FourierTrajectory {
     let mut rng = Rng(21);
     let a = DMatrix::from_fn(n, 5, |_, _| rng.uniform(-0.12, 0.12));
     let b = DMatrix::from_fn(n, 5, |_, _| rng.uniform(-0.12, 0.12));
-    FourierTrajectory::new(2.0 * std::f64::consts::PI * 0.1, vec![0.2, 0.3, -0.4, 0.1, 0.5, -0.2], a, b).unwrap()
+    FourierTrajectory::new(
+        2.0 * std::f64::consts::PI * 0.1,
+        vec![0.2, 0.3, -0.4, 0.1, 0.5, -0.2],
+        a,
+        b,
+    )
+    .unwrap()
 }
 
 /// Noise-free simulated A465 data: held-out torques to 1e-8 and M(q*) to 1e-8 relative, with
@@ -122,10 +176,28 @@ fn base_parameter_identification_is_exact_without_noise() {
             let (j, v) = (i % 6, s.qd[i]);
             *t += viscous[j] * v + coulomb[j] * v.signum();
         }
-        let friction = FrictionTerms { viscous: true, coulomb: true, offset: false };
+        let friction = FrictionTerms {
+            viscous: true,
+            coulomb: true,
+            offset: false,
+        };
         for weighting in [Weighting::Ols, Weighting::Wls] {
-            let opts = BaseOptions { friction, weighting, ..BaseOptions::default() };
-            let fit = identify_base_parameters(&model, &Batch { q: &s.q, qd: &s.qd, qdd: &s.qdd }, &tau, &opts).unwrap();
+            let opts = BaseOptions {
+                friction,
+                weighting,
+                ..BaseOptions::default()
+            };
+            let fit = identify_base_parameters(
+                &model,
+                &Batch {
+                    q: &s.q,
+                    qd: &s.qd,
+                    qdd: &s.qdd,
+                },
+                &tau,
+                &opts,
+            )
+            .unwrap();
             // held-out states
             let mut rng = Rng(4);
             let (q, qd, qdd) = random_states(&model, 30, &mut rng);
@@ -133,14 +205,31 @@ fn base_parameter_identification_is_exact_without_noise() {
             for (i, t) in expected.iter_mut().enumerate() {
                 *t += viscous[i % 6] * qd[i] + coulomb[i % 6] * qd[i].signum();
             }
-            let predicted = fit.predict(&model, &Batch { q: &q, qd: &qd, qdd: &qdd }).unwrap();
+            let predicted = fit
+                .predict(
+                    &model,
+                    &Batch {
+                        q: &q,
+                        qd: &qd,
+                        qdd: &qdd,
+                    },
+                )
+                .unwrap();
             let (e, p) = (DVector::from_vec(expected), DVector::from_vec(predicted));
-            assert!((&e - &p).norm() < 1e-8 * e.norm(), "{variant} {weighting:?}: {:e}", (&e - &p).norm() / e.norm());
+            assert!(
+                (&e - &p).norm() < 1e-8 * e.norm(),
+                "{variant} {weighting:?}: {:e}",
+                (&e - &p).norm() / e.norm()
+            );
             let qs = a465::TABLE2_Q;
             let mut data = Data::new(&model);
             mass_matrix(&model, &mut data, &qs).unwrap();
             let m = fit.mass_matrix(&model, &qs).unwrap();
-            assert!((&m - &data.m).norm() < 1e-8 * data.m.norm(), "{:e}", (&m - &data.m).norm() / data.m.norm());
+            assert!(
+                (&m - &data.m).norm() < 1e-8 * data.m.norm(),
+                "{:e}",
+                (&m - &data.m).norm() / data.m.norm()
+            );
             assert!(fit.cond.is_finite() && fit.samples == s.len());
         }
     }
@@ -151,9 +240,18 @@ fn base_parameter_identification_is_exact_without_noise() {
 #[test]
 fn global_linear_model() {
     let model = a465::model("kinsheel2010").unwrap();
-    let op = OperatingPoint::new(a465::TABLE2_Q.to_vec(), a465::TABLE2_QD.to_vec(), a465::TABLE2_QDD.to_vec()).unwrap();
+    let op = OperatingPoint::new(
+        a465::TABLE2_Q.to_vec(),
+        a465::TABLE2_QD.to_vec(),
+        a465::TABLE2_QDD.to_vec(),
+    )
+    .unwrap();
     let mut rng = Rng(8);
-    let (d, h, g) = (DMatrix::from_fn(6, 6, |_, _| rng.uniform(-1.0, 1.0)), DMatrix::from_fn(6, 6, |_, _| rng.uniform(-1.0, 1.0)), DMatrix::from_fn(6, 6, |_, _| rng.uniform(-1.0, 1.0)));
+    let (d, h, g) = (
+        DMatrix::from_fn(6, 6, |_, _| rng.uniform(-1.0, 1.0)),
+        DMatrix::from_fn(6, 6, |_, _| rng.uniform(-1.0, 1.0)),
+        DMatrix::from_fn(6, 6, |_, _| rng.uniform(-1.0, 1.0)),
+    );
     let t0 = DVector::from_fn(6, |i, _| i as f64 - 2.0);
     let (q, qd, qdd) = random_states(&model, 40, &mut rng);
     let mut tau = Vec::new();
@@ -161,16 +259,41 @@ fn global_linear_model() {
         let x = |v: &[f64], o: &[f64]| DVector::from_fn(6, |j, _| v[s * 6 + j] - o[j]);
         tau.extend((&t0 + &d * x(&qdd, &op.qdd) + &h * x(&qd, &op.qd) + &g * x(&q, &op.q)).iter());
     }
-    let lin = identify_global_linear(&op, &Batch { q: &q, qd: &qd, qdd: &qdd }, &tau).unwrap();
-    assert!((&lin.d - &d).amax() < 1e-10 && (&lin.h - &h).amax() < 1e-10 && (&lin.g - &g).amax() < 1e-10);
+    let lin = identify_global_linear(
+        &op,
+        &Batch {
+            q: &q,
+            qd: &qd,
+            qdd: &qdd,
+        },
+        &tau,
+    )
+    .unwrap();
+    assert!(
+        (&lin.d - &d).amax() < 1e-10
+            && (&lin.h - &h).amax() < 1e-10
+            && (&lin.g - &g).amax() < 1e-10
+    );
     assert!((DVector::from_vec(lin.offset.clone()) - &t0).amax() < 1e-10);
 
     // One period of L harmonics spans only 2L + 1 functions of time, and q, qd and qdd all live
     // in it: with 5 harmonics the 19 columns [1 dqdd dqd dq] have rank 11, and the error says so.
     let s = a465_excitation().sample_periods(1.0, 100.0);
     let tau = torques(&model, &s.q, &s.qd, &s.qdd, false);
-    let e = identify_global_linear(&op, &Batch { q: &s.q, qd: &s.qd, qdd: &s.qdd }, &tau).unwrap_err();
-    assert!(e.to_string().contains("rank 11 < 19") && e.to_string().contains("more directions"), "{e}");
+    let e = identify_global_linear(
+        &op,
+        &Batch {
+            q: &s.q,
+            qd: &s.qd,
+            qdd: &s.qdd,
+        },
+        &tau,
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("rank 11 < 19") && e.to_string().contains("more directions"),
+        "{e}"
+    );
     // 10 harmonics of 0.05 Hz excite all 19
     let mut rng = Rng(30);
     let rich = FourierTrajectory::new(
@@ -182,11 +305,23 @@ fn global_linear_model() {
     .unwrap();
     let s = rich.sample_periods(1.0, 50.0);
     let tau = torques(&model, &s.q, &s.qd, &s.qdd, false);
-    let lin = identify_global_linear(&op, &Batch { q: &s.q, qd: &s.qd, qdd: &s.qdd }, &tau).unwrap();
+    let lin = identify_global_linear(
+        &op,
+        &Batch {
+            q: &s.q,
+            qd: &s.qd,
+            qdd: &s.qdd,
+        },
+        &tau,
+    )
+    .unwrap();
     let mut data = Data::new(&model);
     mass_matrix(&model, &mut data, &op.q).unwrap();
     let rel = (&lin.d - &data.m).norm() / data.m.norm();
-    assert!(rel > 0.05, "D_g should be a workspace average, not M(q*): {rel}");
+    assert!(
+        rel > 0.05,
+        "D_g should be a workspace average, not M(q*): {rel}"
+    );
     // D_g[0][0] lies within the range M_11 takes along the excitation
     let m11: Vec<f64> = (0..s.len())
         .map(|i| {
@@ -194,8 +329,16 @@ fn global_linear_model() {
             data.m[(0, 0)]
         })
         .collect();
-    let (lo, hi) = m11.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
-    assert!(lin.d[(0, 0)] > lo - 0.5 && lin.d[(0, 0)] < hi + 0.5, "{} not in [{lo}, {hi}]", lin.d[(0, 0)]);
+    let (lo, hi) = m11
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    assert!(
+        lin.d[(0, 0)] > lo - 0.5 && lin.d[(0, 0)] < hi + 0.5,
+        "{} not in [{lo}, {hi}]",
+        lin.d[(0, 0)]
+    );
 }
 
 #[test]
@@ -213,8 +356,20 @@ fn fourier_derivatives_are_analytic() {
             assert!((q - q_next).abs() < 1e-9, "periodic");
         }
     }
-    assert!(FourierTrajectory::new(1.0, vec![0.0; 2], DMatrix::zeros(2, 3), DMatrix::zeros(3, 3)).is_err());
-    assert!(FourierTrajectory::new(0.0, vec![0.0; 2], DMatrix::zeros(2, 3), DMatrix::zeros(2, 3)).is_err());
+    assert!(FourierTrajectory::new(
+        1.0,
+        vec![0.0; 2],
+        DMatrix::zeros(2, 3),
+        DMatrix::zeros(3, 3)
+    )
+    .is_err());
+    assert!(FourierTrajectory::new(
+        0.0,
+        vec![0.0; 2],
+        DMatrix::zeros(2, 3),
+        DMatrix::zeros(2, 3)
+    )
+    .is_err());
 }
 
 #[test]
@@ -222,7 +377,10 @@ fn excitation_design_respects_limits_starts_at_rest_and_improves() {
     let model = a465::model("kinsheel2010").unwrap();
     let mut calls = 0;
     let mut progress = |_: usize, _: f64| calls += 1;
-    let opts = ExcitationOptions { max_evaluations: 600, ..ExcitationOptions::default() };
+    let opts = ExcitationOptions {
+        max_evaluations: 600,
+        ..ExcitationOptions::default()
+    };
     let design = design_excitation(&model, &opts, Some(&mut progress)).unwrap();
     assert!(calls >= 1);
     let traj = &design.trajectory;
@@ -237,14 +395,36 @@ fn excitation_design_respects_limits_starts_at_rest_and_improves() {
         for j in 0..6 {
             let lim = &model.limits[j];
             assert!(s.q_at(k)[j] >= lim.lower && s.q_at(k)[j] <= lim.upper);
-            assert!(s.qd_at(k)[j].abs() <= lim.velocity && s.qdd_at(k)[j].abs() <= lim.acceleration);
+            assert!(
+                s.qd_at(k)[j].abs() <= lim.velocity && s.qdd_at(k)[j].abs() <= lim.acceleration
+            );
         }
     }
     // better conditioned than the seeded start: compare with a design given no budget
-    let start = design_excitation(&model, &ExcitationOptions { max_evaluations: 1, ..ExcitationOptions::default() }, None).unwrap();
-    assert!(design.cond < start.cond, "{} vs {}", design.cond, start.cond);
-    let logdet = ExcitationOptions { criterion: Criterion::LogDet, max_evaluations: 200, ..ExcitationOptions::default() };
-    assert!(design_excitation(&model, &logdet, None).unwrap().value.is_finite());
+    let start = design_excitation(
+        &model,
+        &ExcitationOptions {
+            max_evaluations: 1,
+            ..ExcitationOptions::default()
+        },
+        None,
+    )
+    .unwrap();
+    assert!(
+        design.cond < start.cond,
+        "{} vs {}",
+        design.cond,
+        start.cond
+    );
+    let logdet = ExcitationOptions {
+        criterion: Criterion::LogDet,
+        max_evaluations: 200,
+        ..ExcitationOptions::default()
+    };
+    assert!(design_excitation(&model, &logdet, None)
+        .unwrap()
+        .value
+        .is_finite());
 }
 
 #[test]
@@ -252,13 +432,21 @@ fn zero_phase_butterworth_has_the_analytic_gain() {
     let rate = 1000.0;
     let f = butterworth_lowpass(4, 10.0, rate).unwrap();
     for &freq in &[2.0, 10.0, 25.0] {
-        let x: Vec<f64> = (0..20000).map(|i| (2.0 * std::f64::consts::PI * freq * i as f64 / rate).sin()).collect();
+        let x: Vec<f64> = (0..20000)
+            .map(|i| (2.0 * std::f64::consts::PI * freq * i as f64 / rate).sin())
+            .collect();
         let y = filtfilt(&f, &x).unwrap();
         // |H|^2 of a bilinear Butterworth: 1 / (1 + (tan(w/2) / tan(wc/2))^(2N)); filtfilt squares |H|
-        let r = (std::f64::consts::PI * freq / rate).tan() / (std::f64::consts::PI * 10.0 / rate).tan();
+        let r =
+            (std::f64::consts::PI * freq / rate).tan() / (std::f64::consts::PI * 10.0 / rate).tan();
         let gain = 1.0 / (1.0 + r.powi(8));
         for i in 8000..12000 {
-            assert!((y[i] - gain * x[i]).abs() < 1e-6, "{freq} Hz: {} vs {}", y[i], gain * x[i]);
+            assert!(
+                (y[i] - gain * x[i]).abs() < 1e-6,
+                "{freq} Hz: {} vs {}",
+                y[i],
+                gain * x[i]
+            );
         }
     }
     assert!(butterworth_lowpass(4, 600.0, rate).is_err());
@@ -280,26 +468,60 @@ fn preprocessing_recovers_velocity_and_acceleration_from_irregular_samples() {
     let truth = traj.sample(&out.t);
     let qd = out.qd.as_ref().unwrap();
     let qdd = out.qdd.as_ref().unwrap();
-    let err = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+    let err = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
+    };
     let scale = |a: &[f64]| a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    assert!(err(qd, &truth.qd) < 1e-3 * scale(&truth.qd), "qd {}", err(qd, &truth.qd));
-    assert!(err(qdd, &truth.qdd) < 1e-2 * scale(&truth.qdd), "qdd {}", err(qdd, &truth.qdd));
+    assert!(
+        err(qd, &truth.qd) < 1e-3 * scale(&truth.qd),
+        "qd {}",
+        err(qd, &truth.qd)
+    );
+    assert!(
+        err(qdd, &truth.qdd) < 1e-2 * scale(&truth.qdd),
+        "qdd {}",
+        err(qdd, &truth.qdd)
+    );
     assert!(err(&out.q, &truth.q) < 1e-6);
     assert!((out.t[1] - out.t[0] - 0.01).abs() < 1e-12 && (out.t[0] - 0.5).abs() < 1e-12);
-    let short = Recording::new("short", 6, t[..500].to_vec(), s.q[..3000].to_vec(), s.qd[..3000].to_vec(), None, None).unwrap();
-    assert!(preprocess(&short, &PreprocessOptions::default()).unwrap_err().to_string().contains("short"));
+    let short = Recording::new(
+        "short",
+        6,
+        t[..500].to_vec(),
+        s.q[..3000].to_vec(),
+        s.qd[..3000].to_vec(),
+        None,
+        None,
+    )
+    .unwrap();
+    assert!(preprocess(&short, &PreprocessOptions::default())
+        .unwrap_err()
+        .to_string()
+        .contains("short"));
 }
 
 /// The example-robot-data Panda URDF, found through the Python installation that the test
 /// script sets up (`pip install example-robot-data`).
 fn panda_urdf() -> std::path::PathBuf {
-    let out = std::process::Command::new(std::env::var("PYTHON").unwrap_or_else(|_| "python3".into()))
-        .args(["-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"])
-        .output()
-        .expect("python3 runs");
+    let out =
+        std::process::Command::new(std::env::var("PYTHON").unwrap_or_else(|_| "python3".into()))
+            .args([
+                "-c",
+                "import sysconfig; print(sysconfig.get_paths()['purelib'])",
+            ])
+            .output()
+            .expect("python3 runs");
     let purelib = String::from_utf8(out.stdout).unwrap();
-    let path = std::path::Path::new(purelib.trim()).join("cmeel.prefix/share/example-robot-data/robots/panda_description/urdf/panda.urdf");
-    assert!(path.is_file(), "{} is missing: pip install example-robot-data (tests/run_all.sh does)", path.display());
+    let path = std::path::Path::new(purelib.trim())
+        .join("cmeel.prefix/share/example-robot-data/robots/panda_description/urdf/panda.urdf");
+    assert!(
+        path.is_file(),
+        "{} is missing: pip install example-robot-data (tests/run_all.sh does)",
+        path.display()
+    );
     path
 }
 
@@ -308,7 +530,8 @@ fn panda_urdf() -> std::path::PathBuf {
 #[test]
 fn panda_real_data_matches_the_reference() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/panda-gaz2019");
-    let text = std::fs::read_to_string(dir.join("excitation.csv")).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+    let text = std::fs::read_to_string(dir.join("excitation.csv"))
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
     let (mut t, mut q, mut qd, mut tau) = (vec![], vec![], vec![], vec![]);
     for line in text.lines().skip(1) {
         let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
@@ -319,18 +542,51 @@ fn panda_real_data_matches_the_reference() {
     }
     let mut lock = std::collections::BTreeMap::new();
     lock.insert("panda_finger_joint1".to_string(), 0.0);
-    let model = perturbid_rs::model_from_urdf_file(panda_urdf(), &LoadOptions { lock, ..LoadOptions::default() }).unwrap();
-    let rec = preprocess(&Recording::new("panda", 7, t, q, tau, Some(qd), None).unwrap(), &PreprocessOptions::default()).unwrap();
+    let model = perturbid_rs::model_from_urdf_file(
+        panda_urdf(),
+        &LoadOptions {
+            lock,
+            ..LoadOptions::default()
+        },
+    )
+    .unwrap();
+    let rec = preprocess(
+        &Recording::new("panda", 7, t, q, tau, Some(qd), None).unwrap(),
+        &PreprocessOptions::default(),
+    )
+    .unwrap();
     let k = rec.len();
     let split = (0.7 * k as f64) as usize * 7;
     let (qd, qdd) = (rec.qd.as_ref().unwrap(), rec.qdd.as_ref().unwrap());
     let reference = [5.8, 1.1, 2.1, 1.0, 6.6, 5.9, 19.6];
     let mut means = vec![];
     for weighting in [Weighting::Ols, Weighting::Wls] {
-        let fit_batch = Batch { q: &rec.q[..split], qd: &qd[..split], qdd: &qdd[..split] };
-        let fit = identify_base_parameters(&model, &fit_batch, &rec.tau[..split], &BaseOptions { weighting, ..BaseOptions::default() }).unwrap();
+        let fit_batch = Batch {
+            q: &rec.q[..split],
+            qd: &qd[..split],
+            qdd: &qdd[..split],
+        };
+        let fit = identify_base_parameters(
+            &model,
+            &fit_batch,
+            &rec.tau[..split],
+            &BaseOptions {
+                weighting,
+                ..BaseOptions::default()
+            },
+        )
+        .unwrap();
         assert_eq!(fit.theta.len(), 64);
-        let p = fit.predict(&model, &Batch { q: &rec.q[split..], qd: &qd[split..], qdd: &qdd[split..] }).unwrap();
+        let p = fit
+            .predict(
+                &model,
+                &Batch {
+                    q: &rec.q[split..],
+                    qd: &qd[split..],
+                    qdd: &qdd[split..],
+                },
+            )
+            .unwrap();
         let measured = &rec.tau[split..];
         let rel: Vec<f64> = (0..7)
             .map(|j| {
@@ -342,12 +598,22 @@ fn panda_real_data_matches_the_reference() {
             .collect();
         if weighting == Weighting::Ols {
             for j in 0..7 {
-                assert!(rel[j] <= reference[j] + 0.05, "joint {}: {:.2} % > {} %", j + 1, rel[j], reference[j]);
+                assert!(
+                    rel[j] <= reference[j] + 0.05,
+                    "joint {}: {:.2} % > {} %",
+                    j + 1,
+                    rel[j],
+                    reference[j]
+                );
             }
         }
         means.push(rel.iter().sum::<f64>() / 7.0);
     }
-    assert!(means[1] < reference.iter().sum::<f64>() / 7.0, "WLS mean {:.2} %", means[1]);
+    assert!(
+        means[1] < reference.iter().sum::<f64>() / 7.0,
+        "WLS mean {:.2} %",
+        means[1]
+    );
 }
 
 /// The chunked TSQR solve equals one dense least-squares solve over the whole regressor
@@ -364,7 +630,11 @@ fn streaming_solve_equals_the_dense_solve() {
     let (q, qd, qdd) = random_states(&model, k, &mut rng);
     let mut tau = torques(&model, &q, &qd, &qdd, true);
     tau.iter_mut().for_each(|t| *t += rng.uniform(-0.1, 0.1));
-    let batch = Batch { q: &q, qd: &qd, qdd: &qdd };
+    let batch = Batch {
+        q: &q,
+        qd: &qd,
+        qdd: &qdd,
+    };
     let sigma = [1.0, 2.0, 0.5, 1.0, 1.5, 0.7];
     let names = base.names();
     let streamed = solve(&model, &base, &batch, &tau, true, &sigma, &names).unwrap();
@@ -375,7 +645,11 @@ fn streaming_solve_equals_the_dense_solve() {
         y[r] /= sigma[r % 6];
     }
     let dense = least_squares(&phi, &y, "dense", &names).unwrap();
-    assert!((&streamed.coef - &dense.coef).amax() < 1e-9 * dense.coef.amax(), "{}", (&streamed.coef - &dense.coef).amax());
+    assert!(
+        (&streamed.coef - &dense.coef).amax() < 1e-9 * dense.coef.amax(),
+        "{}",
+        (&streamed.coef - &dense.coef).amax()
+    );
     assert!((&streamed.stderr - &dense.stderr).amax() < 1e-8 * dense.stderr.amax());
     assert!((streamed.cond - dense.cond).abs() < 1e-6 * dense.cond);
     let rms = residual_rms(&model, &base, &batch, &tau, true, streamed.coef.as_slice()).unwrap();

@@ -6,15 +6,23 @@ mod common;
 use common::Rng;
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::local::{
-    identify_local, plan_experiments, CrossingTimes, Design, Estimator, ExperimentKind, IdentifyOptions, LocalModel,
-    OperatingPoint, Plan, PlanOptions, Size, Sizes,
+    identify_local, plan_experiments, CrossingTimes, Design, Estimator, ExperimentKind,
+    IdentifyOptions, LocalModel, OperatingPoint, Plan, PlanOptions, Size, Sizes,
 };
 use perturbid_rs::regression::least_squares;
 use perturbid_rs::robots::a465;
-use perturbid_rs::{linearize, rnea, simulate_plan, Data, Error, Friction, Linearization, Model, Recording, SimulationOptions};
+use perturbid_rs::{
+    linearize, rnea, simulate_plan, Data, Error, Friction, Linearization, Model, Recording,
+    SimulationOptions,
+};
 
 fn table2() -> OperatingPoint {
-    OperatingPoint::new(a465::TABLE2_Q.to_vec(), a465::TABLE2_QD.to_vec(), a465::TABLE2_QDD.to_vec()).unwrap()
+    OperatingPoint::new(
+        a465::TABLE2_Q.to_vec(),
+        a465::TABLE2_QD.to_vec(),
+        a465::TABLE2_QDD.to_vec(),
+    )
+    .unwrap()
 }
 
 fn rel(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
@@ -28,7 +36,12 @@ fn noise_free(model: &Model, gravity: bool) -> SimulationOptions {
     sim
 }
 
-fn identify(model: &Model, op: &OperatingPoint, plan_opts: &PlanOptions, sim: &SimulationOptions) -> (Plan, LocalModel) {
+fn identify(
+    model: &Model,
+    op: &OperatingPoint,
+    plan_opts: &PlanOptions,
+    sim: &SimulationOptions,
+) -> (Plan, LocalModel) {
     let plan = plan_experiments(model, op, plan_opts).unwrap();
     let recs = simulate_plan(model, &plan, sim).unwrap();
     let m = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
@@ -51,15 +64,39 @@ fn a465_table2_noise_free_d_h_exact() {
     let op = table2();
     let lin = truth(&model, &op, false);
     for design in [Design::Random, Design::Orthogonal] {
-        let (_, m) = identify(&model, &op, &PlanOptions { design, ..PlanOptions::default() }, &noise_free(&model, false));
-        assert!(rel(mat(&m.d), &lin.d) < 1e-9, "{design:?}: D* {:e}", rel(mat(&m.d), &lin.d));
-        assert!(rel(mat(&m.h), &lin.h) < 1e-9, "{design:?}: H* {:e}", rel(mat(&m.h), &lin.h));
+        let (_, m) = identify(
+            &model,
+            &op,
+            &PlanOptions {
+                design,
+                ..PlanOptions::default()
+            },
+            &noise_free(&model, false),
+        );
+        assert!(
+            rel(mat(&m.d), &lin.d) < 1e-9,
+            "{design:?}: D* {:e}",
+            rel(mat(&m.d), &lin.d)
+        );
+        assert!(
+            rel(mat(&m.h), &lin.h) < 1e-9,
+            "{design:?}: H* {:e}",
+            rel(mat(&m.h), &lin.h)
+        );
         let t = DVector::from_vec(m.torque.clone());
         assert!((&t - &lin.torque).norm() < 1e-9 * lin.torque.norm());
         // Table 3, "perturbation method" row, and Table 2's Tn (gravity excluded).
         for i in 0..6 {
-            assert!((mat(&m.d)[(i, 0)] - a465::TABLE3_D_COLUMN1[i]).abs() < 0.005, "D{}1", i + 1);
-            assert!((m.torque[i] - a465::TABLE2_TORQUE[i]).abs() < 0.01, "T{}", i + 1);
+            assert!(
+                (mat(&m.d)[(i, 0)] - a465::TABLE3_D_COLUMN1[i]).abs() < 0.005,
+                "D{}1",
+                i + 1
+            );
+            assert!(
+                (m.torque[i] - a465::TABLE2_TORQUE[i]).abs() < 0.01,
+                "T{}",
+                i + 1
+            );
         }
         if design == Design::Orthogonal {
             for e in [&m.d, &m.h, &m.g, &m.g_static] {
@@ -81,16 +118,33 @@ fn g_within_the_taylor_bound() {
     let mut errors = vec![];
     for scale in [1.0, 0.5] {
         let opts = PlanOptions {
-            sizes: Sizes { position: Size::Fraction(0.01 * scale), ..Sizes::default() },
+            sizes: Sizes {
+                position: Size::Fraction(0.01 * scale),
+                ..Sizes::default()
+            },
             ..PlanOptions::default()
         };
         let (plan, m) = identify(&model, &op, &opts, &noise_free(&model, true));
         for (kind, est, exact, qd, qdd, t0) in [
-            (ExperimentKind::GDynamic, mat(&m.g), &lin.g, &op.qd, &op.qdd, lin.torque.clone()),
-            (ExperimentKind::GStatic, mat(&m.g_static), &lin.g_static, &vec![0.0; 6], &vec![0.0; 6], {
-                perturbid_rs::gravity_torque(&model, &mut data, &op.q).unwrap();
-                data.g.clone()
-            }),
+            (
+                ExperimentKind::GDynamic,
+                mat(&m.g),
+                &lin.g,
+                &op.qd,
+                &op.qdd,
+                lin.torque.clone(),
+            ),
+            (
+                ExperimentKind::GStatic,
+                mat(&m.g_static),
+                &lin.g_static,
+                &vec![0.0; 6],
+                &vec![0.0; 6],
+                {
+                    perturbid_rs::gravity_torque(&model, &mut data, &op.q).unwrap();
+                    data.g.clone()
+                },
+            ),
         ] {
             let x = &plan.experiment(kind).unwrap().deltas;
             let mut r = DMatrix::zeros(x.nrows(), 6);
@@ -103,7 +157,10 @@ fn g_within_the_taylor_bound() {
             let smin = x.clone().svd(false, false).singular_values.min();
             let bound = r.norm() / smin;
             let err = (est - exact).norm();
-            assert!(err <= bound * 1.0001 + 1e-9, "{kind:?} scale {scale}: error {err:e} > bound {bound:e}");
+            assert!(
+                err <= bound * 1.0001 + 1e-9,
+                "{kind:?} scale {scale}: error {err:e} > bound {bound:e}"
+            );
             errors.push(err);
         }
     }
@@ -121,13 +178,35 @@ fn other_operating_points() {
     for variant in ["kinsheel2010", "physical"] {
         let model = a465::model(variant).unwrap();
         for _ in 0..3 {
-            let q: Vec<f64> = (0..6).map(|j| 0.6 * rng.uniform(model.limits[j].lower, model.limits[j].upper)).collect();
+            let q: Vec<f64> = (0..6)
+                .map(|j| 0.6 * rng.uniform(model.limits[j].lower, model.limits[j].upper))
+                .collect();
             let op = OperatingPoint::new(q, rng.vector(6, 0.5), rng.vector(6, 1.5)).unwrap();
             let lin = truth(&model, &op, true);
-            let (_, m) = identify(&model, &op, &PlanOptions { design: Design::Orthogonal, ..PlanOptions::default() }, &noise_free(&model, true));
-            assert!(rel(mat(&m.d), &lin.d) < 1e-9, "{variant} D {:e}", rel(mat(&m.d), &lin.d));
-            assert!(rel(mat(&m.h), &lin.h) < 1e-9, "{variant} H {:e}", rel(mat(&m.h), &lin.h));
-            assert!(rel(mat(&m.g), &lin.g) < 0.02, "{variant} G {:e}", rel(mat(&m.g), &lin.g));
+            let (_, m) = identify(
+                &model,
+                &op,
+                &PlanOptions {
+                    design: Design::Orthogonal,
+                    ..PlanOptions::default()
+                },
+                &noise_free(&model, true),
+            );
+            assert!(
+                rel(mat(&m.d), &lin.d) < 1e-9,
+                "{variant} D {:e}",
+                rel(mat(&m.d), &lin.d)
+            );
+            assert!(
+                rel(mat(&m.h), &lin.h) < 1e-9,
+                "{variant} H {:e}",
+                rel(mat(&m.h), &lin.h)
+            );
+            assert!(
+                rel(mat(&m.g), &lin.g) < 0.02,
+                "{variant} G {:e}",
+                rel(mat(&m.g), &lin.g)
+            );
         }
     }
 }
@@ -137,21 +216,35 @@ fn other_operating_points() {
 #[test]
 fn common_mode_gravity_and_friction() {
     let model = a465::model("kinsheel2010").unwrap();
-    let op = OperatingPoint::new(a465::TABLE2_Q.to_vec(), vec![0.4, -0.35, 0.3, 0.5, -0.4, 0.45], a465::TABLE2_QDD.to_vec()).unwrap();
+    let op = OperatingPoint::new(
+        a465::TABLE2_Q.to_vec(),
+        vec![0.4, -0.35, 0.3, 0.5, -0.4, 0.45],
+        a465::TABLE2_QDD.to_vec(),
+    )
+    .unwrap();
     let opts = PlanOptions {
-        sizes: Sizes { velocity: Size::Absolute(vec![0.1; 6]), ..Sizes::default() },
+        sizes: Sizes {
+            velocity: Size::Absolute(vec![0.1; 6]),
+            ..Sizes::default()
+        },
         ..PlanOptions::default()
     };
     let (_, rigid) = identify(&model, &op, &opts, &noise_free(&model, false));
     let mut sim = noise_free(&model, true);
     let viscous = vec![2.0, 1.5, 1.0, 0.5, 0.4, 0.3];
-    sim.friction = Friction { viscous: viscous.clone(), coulomb: vec![3.0, 2.5, 2.0, 1.0, 0.8, 0.5] };
+    sim.friction = Friction {
+        viscous: viscous.clone(),
+        coulomb: vec![3.0, 2.5, 2.0, 1.0, 0.8, 0.5],
+    };
     let (_, full) = identify(&model, &op, &opts, &sim);
     assert!(rel(mat(&full.d), mat(&rigid.d)) < 1e-9);
     let h_expected = mat(&rigid.h) + DMatrix::from_diagonal(&DVector::from_vec(viscous));
     assert!(rel(mat(&full.h), &h_expected) < 1e-9);
     // ... while the nominal torque moved by gravity and friction
-    assert!((DVector::from_vec(full.torque.clone()) - DVector::from_vec(rigid.torque.clone())).norm() > 1.0);
+    assert!(
+        (DVector::from_vec(full.torque.clone()) - DVector::from_vec(rigid.torque.clone())).norm()
+            > 1.0
+    );
 }
 
 /// With torque noise the D* error falls about as 1/sqrt(K).
@@ -214,7 +307,13 @@ fn plan_trajectories_pass_the_crossings_c2_from_rest_to_rest() {
             assert_eq!(w[0].t1, w[1].t0);
             for j in 0..6 {
                 let (a, b) = (w[0].eval(j, w[0].t1), w[1].eval(j, w[1].t0));
-                assert!((a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9 && (a.2 - b.2).abs() < 1e-8, "C2 at {}", w[0].t1);
+                assert!(
+                    (a.0 - b.0).abs() < 1e-9
+                        && (a.1 - b.1).abs() < 1e-9
+                        && (a.2 - b.2).abs() < 1e-8,
+                    "C2 at {}",
+                    w[0].t1
+                );
             }
         }
         // the planned perturbations are exactly the crossing deltas
@@ -243,69 +342,146 @@ fn plans_breaking_limits_are_refused_with_joint_and_time() {
     let err = plan_experiments(&model, &op, &PlanOptions::default()).unwrap_err();
     let msg = err.to_string();
     assert!(matches!(err, Error::PositionLimit { .. }), "{msg}");
-    assert!(msg.contains("shoulder") || msg.contains("joint2") || msg.contains(&model.joint_names[1]), "{msg}");
+    assert!(
+        msg.contains("shoulder") || msg.contains("joint2") || msg.contains(&model.joint_names[1]),
+        "{msg}"
+    );
     assert!(msg.contains("t = ") && msg.contains("experiment"), "{msg}");
     // velocity near its limit: the H experiment exceeds it
     let mut qd = a465::TABLE2_QD.to_vec();
     qd[0] = 0.99 * model.limits[0].velocity;
     let op = OperatingPoint::new(a465::TABLE2_Q.to_vec(), qd, a465::TABLE2_QDD.to_vec()).unwrap();
     let err = plan_experiments(&model, &op, &PlanOptions::default()).unwrap_err();
-    assert!(matches!(err, Error::LimitViolation { quantity: "velocity", .. }), "{err}");
+    assert!(
+        matches!(
+            err,
+            Error::LimitViolation {
+                quantity: "velocity",
+                ..
+            }
+        ),
+        "{err}"
+    );
     assert!(err.to_string().contains(&model.joint_names[0]));
     // an operating point outside the limits, and bad options
     let mut q = a465::TABLE2_Q.to_vec();
     q[2] = 3.0;
     let op = OperatingPoint::new(q, vec![0.0; 6], vec![0.0; 6]).unwrap();
-    assert!(plan_experiments(&model, &op, &PlanOptions::default()).unwrap_err().to_string().contains("joint"));
-    let bad = PlanOptions { count: Some(7), ..PlanOptions::default() };
-    assert!(plan_experiments(&model, &table2(), &bad).unwrap_err().to_string().contains("even number"));
+    assert!(plan_experiments(&model, &op, &PlanOptions::default())
+        .unwrap_err()
+        .to_string()
+        .contains("joint"));
+    let bad = PlanOptions {
+        count: Some(7),
+        ..PlanOptions::default()
+    };
+    assert!(plan_experiments(&model, &table2(), &bad)
+        .unwrap_err()
+        .to_string()
+        .contains("even number"));
     assert!(OperatingPoint::new(vec![0.0; 6], vec![0.0; 5], vec![0.0; 6]).is_err());
 }
 
 #[test]
 fn recordings_with_problems_get_clear_errors() {
     let t = vec![0.0, 0.001, 0.002];
-    let e = Recording::new("r", 1, vec![0.0, 0.002, 0.001], vec![0.0; 3], vec![0.0; 3], None, None).unwrap_err();
+    let e = Recording::new(
+        "r",
+        1,
+        vec![0.0, 0.002, 0.001],
+        vec![0.0; 3],
+        vec![0.0; 3],
+        None,
+        None,
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("not increasing at sample 2"), "{e}");
-    let e = Recording::new("r", 1, t.clone(), vec![0.0, f64::NAN, 0.0], vec![0.0; 3], None, None).unwrap_err();
+    let e = Recording::new(
+        "r",
+        1,
+        t.clone(),
+        vec![0.0, f64::NAN, 0.0],
+        vec![0.0; 3],
+        None,
+        None,
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("q of joint 1 at sample 1"), "{e}");
     let e = Recording::new("r", 2, t.clone(), vec![0.0; 3], vec![0.0; 6], None, None).unwrap_err();
-    assert!(e.to_string().contains("expected 3 samples x 2 joints"), "{e}");
+    assert!(
+        e.to_string().contains("expected 3 samples x 2 joints"),
+        "{e}"
+    );
     assert!(Recording::new("r", 1, vec![0.0], vec![0.0], vec![0.0], None, None).is_err());
 
     let model = a465::model("kinsheel2010").unwrap();
     let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
     let mut recs = simulate_plan(&model, &plan, &noise_free(&model, true)).unwrap();
     // too short: cut the D recording in half
-    let d = plan.experiments.iter().position(|e| e.kind == ExperimentKind::D).unwrap();
+    let d = plan
+        .experiments
+        .iter()
+        .position(|e| e.kind == ExperimentKind::D)
+        .unwrap();
     let r = &recs[d];
     let half = r.len() / 2;
-    recs[d] = Recording::new("cut", 6, r.t[..half].to_vec(), r.q[..half * 6].to_vec(), r.tau[..half * 6].to_vec(), None, None).unwrap();
-    let e = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap_err();
-    assert!(e.to_string().contains("cut: experiment 'D', crossing") && e.to_string().contains("too short"), "{e}");
-    // too few samples per window: decimate to 50 Hz
-    let r = simulate_plan(&model, &plan, &noise_free(&model, true)).unwrap().remove(d);
-    let keep: Vec<usize> = (0..r.len()).step_by(20).collect();
     recs[d] = Recording::new(
-        "sparse",
+        "cut",
         6,
-        keep.iter().map(|&i| r.t[i]).collect(),
-        keep.iter().flat_map(|&i| r.q[i * 6..i * 6 + 6].to_vec()).collect(),
-        keep.iter().flat_map(|&i| r.tau[i * 6..i * 6 + 6].to_vec()).collect(),
+        r.t[..half].to_vec(),
+        r.q[..half * 6].to_vec(),
+        r.tau[..half * 6].to_vec(),
         None,
         None,
     )
     .unwrap();
     let e = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap_err();
-    assert!(e.to_string().contains("samples in the") && e.to_string().contains("need at least"), "{e}");
+    assert!(
+        e.to_string().contains("cut: experiment 'D', crossing")
+            && e.to_string().contains("too short"),
+        "{e}"
+    );
+    // too few samples per window: decimate to 50 Hz
+    let r = simulate_plan(&model, &plan, &noise_free(&model, true))
+        .unwrap()
+        .remove(d);
+    let keep: Vec<usize> = (0..r.len()).step_by(20).collect();
+    recs[d] = Recording::new(
+        "sparse",
+        6,
+        keep.iter().map(|&i| r.t[i]).collect(),
+        keep.iter()
+            .flat_map(|&i| r.q[i * 6..i * 6 + 6].to_vec())
+            .collect(),
+        keep.iter()
+            .flat_map(|&i| r.tau[i * 6..i * 6 + 6].to_vec())
+            .collect(),
+        None,
+        None,
+    )
+    .unwrap();
+    let e = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap_err();
+    assert!(
+        e.to_string().contains("samples in the") && e.to_string().contains("need at least"),
+        "{e}"
+    );
     // wrong number of recordings
     recs.pop();
-    assert!(identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap_err().to_string().contains("one per experiment"));
+    assert!(identify_local(&plan, &recs, &IdentifyOptions::default())
+        .unwrap_err()
+        .to_string()
+        .contains("one per experiment"));
 }
 
 #[test]
 fn rank_deficient_design_names_the_missing_direction() {
-    let x = DMatrix::from_row_slice(4, 3, &[1.0, 1.0, 0.0, -1.0, -1.0, 0.0, 0.0, 0.0, 1.0, 2.0, 2.0, -1.0]);
+    let x = DMatrix::from_row_slice(
+        4,
+        3,
+        &[
+            1.0, 1.0, 0.0, -1.0, -1.0, 0.0, 0.0, 0.0, 1.0, 2.0, 2.0, -1.0,
+        ],
+    );
     let y = DMatrix::from_element(4, 2, 1.0);
     let names: Vec<String> = ["dq(a)", "dq(b)", "dq(c)"].map(String::from).to_vec();
     let e = least_squares(&x, &y, "experiment 'G'", &names).unwrap_err();
@@ -313,7 +489,9 @@ fn rank_deficient_design_names_the_missing_direction() {
     assert!(matches!(e, Error::RankDeficient { rank: 2, .. }), "{msg}");
     assert!(msg.contains("0.707 dq(a) - 0.707 dq(b)"), "{msg}");
     // Phi theta = tau: an exact linear system is solved exactly
-    let x = DMatrix::from_fn(10, 3, |i, j| ((i * 7 + j * 3) % 5) as f64 - 2.0 + 0.1 * j as f64);
+    let x = DMatrix::from_fn(10, 3, |i, j| {
+        ((i * 7 + j * 3) % 5) as f64 - 2.0 + 0.1 * j as f64
+    });
     let a = DMatrix::from_row_slice(2, 3, &[1.0, -2.0, 0.5, 3.0, 0.0, -1.0]);
     let ls = least_squares(&x, &(&x * a.transpose()), "exact", &names).unwrap();
     assert!((ls.coef - a).norm() < 1e-12);
@@ -333,24 +511,50 @@ fn detected_crossing_times_recover_a_shifted_log() {
             r
         })
         .collect();
-    let opts = IdentifyOptions { times: CrossingTimes::Detected { max_shift: 0.5 }, ..IdentifyOptions::default() };
+    let opts = IdentifyOptions {
+        times: CrossingTimes::Detected { max_shift: 0.5 },
+        ..IdentifyOptions::default()
+    };
     let m = identify_local(&plan, &recs, &opts).unwrap();
     let lin = truth(&model, &op, false);
-    assert!(rel(mat(&m.d), &lin.d) < 1e-8, "{:e}", rel(mat(&m.d), &lin.d));
+    assert!(
+        rel(mat(&m.d), &lin.d) < 1e-8,
+        "{:e}",
+        rel(mat(&m.d), &lin.d)
+    );
 }
 
 #[test]
 fn combined_estimator_and_json_round_trip() {
     let model = a465::model("kinsheel2010").unwrap();
     let op = table2();
-    let plan = plan_experiments(&model, &op, &PlanOptions { design: Design::Orthogonal, ..PlanOptions::default() }).unwrap();
+    let plan = plan_experiments(
+        &model,
+        &op,
+        &PlanOptions {
+            design: Design::Orthogonal,
+            ..PlanOptions::default()
+        },
+    )
+    .unwrap();
     let recs = simulate_plan(&model, &plan, &noise_free(&model, true)).unwrap();
-    let opts = IdentifyOptions { estimator: Estimator::Combined, ..IdentifyOptions::default() };
+    let opts = IdentifyOptions {
+        estimator: Estimator::Combined,
+        ..IdentifyOptions::default()
+    };
     let m = identify_local(&plan, &recs, &opts).unwrap();
     let lin = truth(&model, &op, true);
     assert_eq!(m.combined.as_ref().unwrap().matrix.shape(), (6, 18));
-    assert!(rel(mat(&m.d), &lin.d) < 1e-3, "{:e}", rel(mat(&m.d), &lin.d));
-    assert!(rel(mat(&m.g), &lin.g) < 2e-3, "{:e}", rel(mat(&m.g), &lin.g));
+    assert!(
+        rel(mat(&m.d), &lin.d) < 1e-3,
+        "{:e}",
+        rel(mat(&m.d), &lin.d)
+    );
+    assert!(
+        rel(mat(&m.g), &lin.g) < 2e-3,
+        "{:e}",
+        rel(mat(&m.g), &lin.g)
+    );
     // predict: T* at P, and the local model's own linear law
     let p = m.predict(&op.q, &op.qd, &op.qdd).unwrap();
     assert!((DVector::from_vec(p) - &lin.torque).norm() < 1e-6);
@@ -361,7 +565,10 @@ fn combined_estimator_and_json_round_trip() {
     let e = LocalModel::from_json("{\"format\": 3}").unwrap_err();
     assert!(e.to_string().contains("line 1"), "{e}");
     let broken = m.to_json().replace(LOCAL_FORMAT, "something-else/9");
-    assert!(LocalModel::from_json(&broken).unwrap_err().to_string().contains("format"));
+    assert!(LocalModel::from_json(&broken)
+        .unwrap_err()
+        .to_string()
+        .contains("format"));
 }
 
 const LOCAL_FORMAT: &str = "perturbid-local-model/1";

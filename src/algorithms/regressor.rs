@@ -15,14 +15,27 @@ pub const PARAMS_PER_BODY: usize = 10;
 
 /// Names of the 10 parameters of a body, in order: `m, mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz,
 /// Izz`.
-pub const PARAMETER_NAMES: [&str; 10] = ["m", "mcx", "mcy", "mcz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz"];
+pub const PARAMETER_NAMES: [&str; 10] = [
+    "m", "mcx", "mcy", "mcz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz",
+];
 
 /// The 10 inertial parameters of a body in Pinocchio's order `[m, m cx, m cy, m cz, Ixx, Ixy,
 /// Iyy, Ixz, Iyz, Izz]` (kg, kg m, kg m^2), the inertia about the body (joint) frame's origin.
 pub fn dynamic_parameters(inertia: &Inertia) -> [f64; 10] {
     let h = inertia.com * inertia.mass;
     let i = inertia.inertia_origin();
-    [inertia.mass, h.x, h.y, h.z, i[(0, 0)], i[(0, 1)], i[(1, 1)], i[(0, 2)], i[(1, 2)], i[(2, 2)]]
+    [
+        inertia.mass,
+        h.x,
+        h.y,
+        h.z,
+        i[(0, 0)],
+        i[(0, 1)],
+        i[(1, 1)],
+        i[(0, 2)],
+        i[(1, 2)],
+        i[(2, 2)],
+    ]
 }
 
 /// The inertial parameters of every moving body, stacked (`10 * nbodies`), so that
@@ -30,7 +43,10 @@ pub fn dynamic_parameters(inertia: &Inertia) -> [f64; 10] {
 pub fn model_parameters(model: &Model) -> DVector<f64> {
     DVector::from_iterator(
         PARAMS_PER_BODY * model.nbodies(),
-        model.bodies.iter().flat_map(|b| dynamic_parameters(&b.inertia)),
+        model
+            .bodies
+            .iter()
+            .flat_map(|b| dynamic_parameters(&b.inertia)),
     )
 }
 
@@ -41,10 +57,16 @@ pub fn body_regressor(v: &Motion, a: &Motion) -> [Force; 10] {
     let ac = a.linear + w.cross(&v.linear); // classical acceleration of the origin
     let zero = Vector3::zeros();
     let mut out = [Force::zeros(); 10];
-    out[0] = Force { angular: zero, linear: ac };
+    out[0] = Force {
+        angular: zero,
+        linear: ac,
+    };
     for k in 0..3 {
         let e = Vector3::ith(k, 1.0);
-        out[1 + k] = Force { angular: e.cross(&ac), linear: al.cross(&e) + w.cross(&w.cross(&e)) };
+        out[1 + k] = Force {
+            angular: e.cross(&ac),
+            linear: al.cross(&e) + w.cross(&w.cross(&e)),
+        };
     }
     // I_p x for the unit inertias of [Ixx, Ixy, Iyy, Ixz, Iyz, Izz]
     let unit = |x: &Vector3<f64>| {
@@ -59,7 +81,10 @@ pub fn body_regressor(v: &Motion, a: &Motion) -> [Force; 10] {
     };
     let (ia, iw) = (unit(&al), unit(&w));
     for p in 0..6 {
-        out[4 + p] = Force { angular: ia[p] + w.cross(&iw[p]), linear: zero };
+        out[4 + p] = Force {
+            angular: ia[p] + w.cross(&iw[p]),
+            linear: zero,
+        };
     }
     out
 }

@@ -9,7 +9,10 @@ use super::files::{load_json, load_robot, load_table};
 use super::out_dir;
 use super::progress::Progress;
 use crate::direct::identify::BASE_MODEL_FORMAT;
-use crate::direct::{design_excitation, identify_base_parameters, BaseModel, BaseOptions, Batch, Criterion, ExcitationOptions, FrictionTerms, Weighting};
+use crate::direct::{
+    design_excitation, identify_base_parameters, BaseModel, BaseOptions, Batch, Criterion,
+    ExcitationOptions, FrictionTerms, Weighting,
+};
 use crate::error::{Error, Result};
 use crate::io::{read_recording, read_states, samples_table, write_atomic, Table};
 use crate::local::LocalModel;
@@ -56,13 +59,28 @@ pub(crate) fn excite(a: ExciteArgs) -> Result<String> {
         ..ExcitationOptions::default()
     };
     let progress = Progress::new();
-    let mut report = |e: usize, best: f64| progress.update(&format!("excitation design: {e}/{} evaluations, best {best:.4}", a.max_evaluations));
+    let mut report = |e: usize, best: f64| {
+        progress.update(&format!(
+            "excitation design: {e}/{} evaluations, best {best:.4}",
+            a.max_evaluations
+        ))
+    };
     let design = design_excitation(&model, &o, Some(&mut report))?;
     progress.done();
     let dir = out_dir(&a.out);
     let traj = &design.trajectory;
-    write_atomic(dir.join("excitation.json"), serde_json::to_string_pretty(traj).expect("serialisable").as_bytes())?;
-    write_atomic(dir.join("excitation.csv"), samples_table(&traj.sample_periods(1.0, a.rate), "").to_csv().as_bytes())?;
+    write_atomic(
+        dir.join("excitation.json"),
+        serde_json::to_string_pretty(traj)
+            .expect("serialisable")
+            .as_bytes(),
+    )?;
+    write_atomic(
+        dir.join("excitation.csv"),
+        samples_table(&traj.sample_periods(1.0, a.rate), "")
+            .to_csv()
+            .as_bytes(),
+    )?;
     Ok(format!(
         "excitation: {} harmonics of {} Hz (period {:.1} s), cond(Phi_base) {:.2} after {} evaluations\n-> {} and {}\n",
         a.harmonics,
@@ -119,7 +137,12 @@ fn friction_terms(names: &[String]) -> Result<FrictionTerms> {
             "coulomb" => f.coulomb = true,
             "offset" => f.offset = true,
             "none" | "" => {}
-            other => return Err(Error::InvalidArgument { argument: "--friction".into(), message: format!("'{other}'; expected viscous, coulomb, offset or none") }),
+            other => {
+                return Err(Error::InvalidArgument {
+                    argument: "--friction".into(),
+                    message: format!("'{other}'; expected viscous, coulomb, offset or none"),
+                })
+            }
         }
     }
     Ok(f)
@@ -133,38 +156,95 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     let mut out = String::new();
     if rec.qdd.is_none() || a.preprocess {
         progress.update("preprocessing");
-        let o = PreprocessOptions { rate: a.rate, cutoff: Some(a.cutoff), decimate: a.decimate, trim: a.trim, ..PreprocessOptions::default() };
+        let o = PreprocessOptions {
+            rate: a.rate,
+            cutoff: Some(a.cutoff),
+            decimate: a.decimate,
+            trim: a.trim,
+            ..PreprocessOptions::default()
+        };
         rec = preprocess(&rec, &o)?;
         let _ = writeln!(out, "preprocessed: {} Hz, {} Hz zero-phase low-pass, every {}th sample, {} s trimmed: {} samples", a.rate, a.cutoff, a.decimate, a.trim, rec.len());
     }
     if !(0.0..1.0).contains(&a.validate) {
-        return Err(Error::InvalidArgument { argument: "--validate".into(), message: format!("{}; expected a fraction in [0, 1)", a.validate) });
+        return Err(Error::InvalidArgument {
+            argument: "--validate".into(),
+            message: format!("{}; expected a fraction in [0, 1)", a.validate),
+        });
     }
     let n = model.nv;
     let k = rec.len();
     let split = ((1.0 - a.validate) * k as f64).round() as usize;
-    let (qd, qdd) = (rec.qd.clone().expect("preprocessed"), rec.qdd.clone().expect("preprocessed"));
+    let (qd, qdd) = (
+        rec.qd.clone().expect("preprocessed"),
+        rec.qdd.clone().expect("preprocessed"),
+    );
     let weighting = match a.weighting.as_str() {
         "wls" => Weighting::Wls,
         "ols" => Weighting::Ols,
-        other => return Err(Error::InvalidArgument { argument: "--weighting".into(), message: format!("'{other}'; expected wls or ols") }),
+        other => {
+            return Err(Error::InvalidArgument {
+                argument: "--weighting".into(),
+                message: format!("'{other}'; expected wls or ols"),
+            })
+        }
     };
-    let options = BaseOptions { friction: friction_terms(&a.friction)?, weighting, gravity: !a.no_gravity, ..BaseOptions::default() };
+    let options = BaseOptions {
+        friction: friction_terms(&a.friction)?,
+        weighting,
+        gravity: !a.no_gravity,
+        ..BaseOptions::default()
+    };
     progress.update(&format!("identifying on {split} samples"));
     let r = 0..split * n;
-    let fit = identify_base_parameters(&model, &Batch { q: &rec.q[r.clone()], qd: &qd[r.clone()], qdd: &qdd[r.clone()] }, &rec.tau[r], &options)?;
+    let fit = identify_base_parameters(
+        &model,
+        &Batch {
+            q: &rec.q[r.clone()],
+            qd: &qd[r.clone()],
+            qdd: &qdd[r.clone()],
+        },
+        &rec.tau[r],
+        &options,
+    )?;
     progress.done();
     write_atomic(&a.out, fit.to_json().as_bytes())?;
-    let _ = writeln!(out, "{} base parameters from {} samples, cond {:.3e} -> {}", fit.theta.len(), split, fit.cond, a.out.display());
-    let _ = writeln!(out, "{:<48} {:>14} {:>12}", "base parameter", "value", "std. error");
+    let _ = writeln!(
+        out,
+        "{} base parameters from {} samples, cond {:.3e} -> {}",
+        fit.theta.len(),
+        split,
+        fit.cond,
+        a.out.display()
+    );
+    let _ = writeln!(
+        out,
+        "{:<48} {:>14} {:>12}",
+        "base parameter", "value", "std. error"
+    );
     for ((name, v), s) in fit.base.names().iter().zip(&fit.theta).zip(&fit.stderr) {
-        let name = if name.len() > 48 { format!("{}...", &name[..45]) } else { name.clone() };
+        let name = if name.len() > 48 {
+            format!("{}...", &name[..45])
+        } else {
+            name.clone()
+        };
         let _ = writeln!(out, "{name:<48} {v:>14.6} {s:>12.2e}");
     }
     if split < k {
         let r = split * n..k * n;
-        let p = fit.predict(&model, &Batch { q: &rec.q[r.clone()], qd: &qd[r.clone()], qdd: &qdd[r.clone()] })?;
-        let _ = writeln!(out, "validation on the last {} samples: per joint RMS (N m) and relative RMS (%)", k - split);
+        let p = fit.predict(
+            &model,
+            &Batch {
+                q: &rec.q[r.clone()],
+                qd: &qd[r.clone()],
+                qdd: &qdd[r.clone()],
+            },
+        )?;
+        let _ = writeln!(
+            out,
+            "validation on the last {} samples: per joint RMS (N m) and relative RMS (%)",
+            k - split
+        );
         for j in 0..n {
             let (mut e, mut m) = (0.0, 0.0);
             for (i, pv) in p.iter().enumerate().skip(j).step_by(n) {
@@ -173,7 +253,13 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
                 m += meas * meas;
             }
             let cnt = (k - split) as f64;
-            let _ = writeln!(out, "  {:<16} {:>10.4} {:>8.2}", model.joint_names[j], (e / cnt).sqrt(), 100.0 * (e / m).sqrt());
+            let _ = writeln!(
+                out,
+                "  {:<16} {:>10.4} {:>8.2}",
+                model.joint_names[j],
+                (e / cnt).sqrt(),
+                100.0 * (e / m).sqrt()
+            );
         }
     }
     Ok(out)
@@ -197,15 +283,24 @@ pub(crate) struct PredictArgs {
 pub(crate) fn predict(a: PredictArgs) -> Result<String> {
     let text = crate::io::read_text(&a.model)?;
     let is_base = text.contains(BASE_MODEL_FORMAT);
-    let (joints, tau_of): (Vec<String>, Box<dyn Fn(&[f64], &[f64], &[f64]) -> Result<Vec<f64>>>) = if is_base {
+    let (joints, tau_of): (
+        Vec<String>,
+        Box<dyn Fn(&[f64], &[f64], &[f64]) -> Result<Vec<f64>>>,
+    ) = if is_base {
         let fit = load_json(&a.model, BaseModel::from_json)?;
         let robot = a.robot.as_deref().ok_or_else(|| Error::InvalidArgument {
             argument: "--robot".into(),
-            message: format!("a base-parameter model needs its robot ('{}'): give --robot", fit.robot),
+            message: format!(
+                "a base-parameter model needs its robot ('{}'): give --robot",
+                fit.robot
+            ),
         })?;
         let model = load_robot(robot)?;
         let joints = fit.joint_names.clone();
-        (joints, Box::new(move |q, qd, qdd| fit.predict(&model, &Batch { q, qd, qdd })))
+        (
+            joints,
+            Box::new(move |q, qd, qdd| fit.predict(&model, &Batch { q, qd, qdd })),
+        )
     } else {
         let m = load_json(&a.model, LocalModel::from_json)?;
         let joints = m.joint_names.clone();
@@ -234,11 +329,21 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
         table.push(&row);
     }
     write_atomic(&a.out, table.to_csv().as_bytes())?;
-    let mut out = format!("{} predicted torques -> {}\n", states.t.len(), a.out.display());
+    let mut out = format!(
+        "{} predicted torques -> {}\n",
+        states.t.len(),
+        a.out.display()
+    );
     if let Some(meas) = &states.tau {
-        let _ = writeln!(out, "against the measured torques: per joint RMS error (N m)");
+        let _ = writeln!(
+            out,
+            "against the measured torques: per joint RMS error (N m)"
+        );
         for j in 0..n {
-            let e: f64 = (0..states.t.len()).map(|i| (tau[i * n + j] - meas[i * n + j]).powi(2)).sum::<f64>() / states.t.len() as f64;
+            let e: f64 = (0..states.t.len())
+                .map(|i| (tau[i * n + j] - meas[i * n + j]).powi(2))
+                .sum::<f64>()
+                / states.t.len() as f64;
             let _ = writeln!(out, "  {:<16} {:>10.4}", joints[j], e.sqrt());
         }
     }

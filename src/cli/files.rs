@@ -26,7 +26,10 @@ pub(crate) fn load_table(path: &Path) -> Result<Table> {
 pub(crate) fn load_json<T>(path: &Path, parse: impl Fn(&str) -> Result<T>) -> Result<T> {
     let text = read_text(path)?;
     parse(&text).map_err(|e| match e {
-        Error::Json { context, message } => Error::Json { context: format!("{} ({context})", path.display()), message },
+        Error::Json { context, message } => Error::Json {
+            context: format!("{} ({context})", path.display()),
+            message,
+        },
         other => other,
     })
 }

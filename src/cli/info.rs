@@ -33,8 +33,17 @@ pub(crate) fn run(a: InfoArgs) -> Result<String> {
         model.nbodies(),
         model.root_link
     );
-    let _ = writeln!(out, "moving mass {:.4} kg, mass fixed to the base {:.4} kg", model.moving_mass(), model.base_mass);
-    let _ = writeln!(out, "{:<16} {:<10} {:>10} {:>10} {:>10} {:>10} {:>10}", "joint", "kind", "lower", "upper", "velocity", "accel", "effort");
+    let _ = writeln!(
+        out,
+        "moving mass {:.4} kg, mass fixed to the base {:.4} kg",
+        model.moving_mass(),
+        model.base_mass
+    );
+    let _ = writeln!(
+        out,
+        "{:<16} {:<10} {:>10} {:>10} {:>10} {:>10} {:>10}",
+        "joint", "kind", "lower", "upper", "velocity", "accel", "effort"
+    );
     for (i, name) in model.joint_names.iter().enumerate() {
         let l = &model.limits[i];
         let _ = writeln!(

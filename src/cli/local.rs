@@ -11,8 +11,8 @@ use super::out_dir;
 use crate::error::{Error, Result};
 use crate::io::{read_recording, recording_table, samples_table, write_atomic};
 use crate::local::{
-    identify_local, plan_experiments, CrossingTimes, Design, Estimator, ExperimentKind, IdentifyOptions, LocalModel, OperatingPoint, Plan,
-    PlanOptions, Size,
+    identify_local, plan_experiments, CrossingTimes, Design, Estimator, ExperimentKind,
+    IdentifyOptions, LocalModel, OperatingPoint, Plan, PlanOptions, Size,
 };
 use crate::recording::Recording;
 use crate::simulation::{simulate_plan, Friction, SimulationOptions};
@@ -78,7 +78,11 @@ fn load_op(path: &Path) -> Result<OperatingPoint> {
     load_json(path, |text| {
         let op: OpFile = serde_json::from_str(text).map_err(|e| Error::Json {
             context: "operating point".into(),
-            message: format!("line {}, column {}: {e}; expected {{\"q\": [...], \"qd\": [...], \"qdd\": [...]}}", e.line(), e.column()),
+            message: format!(
+                "line {}, column {}: {e}; expected {{\"q\": [...], \"qd\": [...], \"qdd\": [...]}}",
+                e.line(),
+                e.column()
+            ),
         })?;
         OperatingPoint::new(op.q, op.qd, op.qdd)
     })
@@ -102,7 +106,11 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
         rate: a.rate,
         window: a.window,
         dwell: a.dwell,
-        experiments: a.experiments.iter().map(|k| ExperimentKind::parse(k.trim())).collect::<Result<_>>()?,
+        experiments: a
+            .experiments
+            .iter()
+            .map(|k| ExperimentKind::parse(k.trim()))
+            .collect::<Result<_>>()?,
         ..PlanOptions::default()
     };
     o.sizes.position = size(a.dq, a.dq_fraction, n);
@@ -113,8 +121,20 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
     let mut out = String::new();
     for e in &plan.experiments {
         let path = dir.join(format!("{}.csv", e.kind.name()));
-        write_atomic(&path, samples_table(&e.trajectory.sample(plan.rate), "").to_csv().as_bytes())?;
-        let _ = writeln!(out, "{:<9} {:>3} crossings, {:>7.2} s  -> {}", e.kind.name(), e.crossings.len(), e.duration(), path.display());
+        write_atomic(
+            &path,
+            samples_table(&e.trajectory.sample(plan.rate), "")
+                .to_csv()
+                .as_bytes(),
+        )?;
+        let _ = writeln!(
+            out,
+            "{:<9} {:>3} crossings, {:>7.2} s  -> {}",
+            e.kind.name(),
+            e.crossings.len(),
+            e.duration(),
+            path.display()
+        );
     }
     let path = dir.join("plan.json");
     write_atomic(&path, plan.to_json().as_bytes())?;
@@ -169,7 +189,13 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<String> {
     for (e, r) in plan.experiments.iter().zip(&recs) {
         let path = dir.join(format!("{}.csv", e.kind.name()));
         write_atomic(&path, recording_table(r, "").to_csv().as_bytes())?;
-        let _ = writeln!(out, "{:<9} {:>7} samples -> {}", e.kind.name(), r.len(), path.display());
+        let _ = writeln!(
+            out,
+            "{:<9} {:>7} samples -> {}",
+            e.kind.name(),
+            r.len(),
+            path.display()
+        );
     }
     Ok(out)
 }
@@ -199,10 +225,17 @@ pub(crate) struct IdentifyArgs {
     estimator: String,
 }
 
-fn fmt_matrix(out: &mut String, name: &str, m: &nalgebra::DMatrix<f64>, se: &nalgebra::DMatrix<f64>) {
+fn fmt_matrix(
+    out: &mut String,
+    name: &str,
+    m: &nalgebra::DMatrix<f64>,
+    se: &nalgebra::DMatrix<f64>,
+) {
     let _ = writeln!(out, "{name} (standard errors in brackets):");
     for i in 0..m.nrows() {
-        let cells: Vec<String> = (0..m.ncols()).map(|j| format!("{:>9.4} [{:.1e}]", m[(i, j)], se[(i, j)])).collect();
+        let cells: Vec<String> = (0..m.ncols())
+            .map(|j| format!("{:>9.4} [{:.1e}]", m[(i, j)], se[(i, j)]))
+            .collect();
         let _ = writeln!(out, "  {}", cells.join(" "));
     }
 }
@@ -210,7 +243,10 @@ fn fmt_matrix(out: &mut String, name: &str, m: &nalgebra::DMatrix<f64>, se: &nal
 pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
     let plan = load_json(&a.plan, Plan::from_json)?;
     let files: Vec<PathBuf> = if a.recordings.len() == 1 && a.recordings[0].is_dir() {
-        plan.experiments.iter().map(|e| a.recordings[0].join(format!("{}.csv", e.kind.name()))).collect()
+        plan.experiments
+            .iter()
+            .map(|e| a.recordings[0].join(format!("{}.csv", e.kind.name())))
+            .collect()
     } else {
         a.recordings.clone()
     };
@@ -225,21 +261,55 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
             ),
         });
     }
-    let recs: Vec<Recording> = files.iter().map(|f| read_recording(&load_table(f)?, &plan.joint_names)).collect::<Result<_>>()?;
+    let recs: Vec<Recording> = files
+        .iter()
+        .map(|f| read_recording(&load_table(f)?, &plan.joint_names))
+        .collect::<Result<_>>()?;
     let options = IdentifyOptions {
-        times: if a.detect_times { CrossingTimes::Detected { max_shift: a.max_shift } } else { CrossingTimes::Planned },
-        fit: crate::local::FitOptions { window: a.window, ..Default::default() },
+        times: if a.detect_times {
+            CrossingTimes::Detected {
+                max_shift: a.max_shift,
+            }
+        } else {
+            CrossingTimes::Planned
+        },
+        fit: crate::local::FitOptions {
+            window: a.window,
+            ..Default::default()
+        },
         estimator: Estimator::parse(&a.estimator)?,
     };
     let model: LocalModel = identify_local(&plan, &recs, &options)?;
     write_atomic(&a.out, model.to_json().as_bytes())?;
     let mut out = String::new();
-    let _ = writeln!(out, "local model of '{}' ({} estimator) -> {}", model.robot, a.estimator, a.out.display());
-    let t: Vec<String> = model.torque.iter().zip(&model.torque_stderr).map(|(t, s)| format!("{t:.4} [{s:.1e}]")).collect();
+    let _ = writeln!(
+        out,
+        "local model of '{}' ({} estimator) -> {}",
+        model.robot,
+        a.estimator,
+        a.out.display()
+    );
+    let t: Vec<String> = model
+        .torque
+        .iter()
+        .zip(&model.torque_stderr)
+        .map(|(t, s)| format!("{t:.4} [{s:.1e}]"))
+        .collect();
     let _ = writeln!(out, "T* (N m): {}", t.join(", "));
-    for (name, e) in [("D*", &model.d), ("H*", &model.h), ("G*", &model.g), ("Gs", &model.g_static)] {
+    for (name, e) in [
+        ("D*", &model.d),
+        ("H*", &model.h),
+        ("G*", &model.g),
+        ("Gs", &model.g_static),
+    ] {
         if let Some(e) = e {
-            let _ = writeln!(out, "{name}: cond(X) {:.3}, {} crossings, residual RMS max {:.2e} N m", e.cond, e.crossings, e.residual_rms.iter().cloned().fold(0.0, f64::max));
+            let _ = writeln!(
+                out,
+                "{name}: cond(X) {:.3}, {} crossings, residual RMS max {:.2e} N m",
+                e.cond,
+                e.crossings,
+                e.residual_rms.iter().cloned().fold(0.0, f64::max)
+            );
             fmt_matrix(&mut out, name, &e.matrix, &e.stderr);
         }
     }

@@ -9,7 +9,9 @@ pub(crate) struct Progress {
 
 impl Progress {
     pub fn new() -> Self {
-        Self { on: std::io::stderr().is_terminal() }
+        Self {
+            on: std::io::stderr().is_terminal(),
+        }
     }
 
     /// Replaces the current progress line with `msg`.

@@ -51,7 +51,8 @@ impl BaseParameters {
             });
         }
         let kept = DVector::from_iterator(self.kept.len(), self.kept.iter().map(|&i| theta[i]));
-        let dropped = DVector::from_iterator(self.dropped.len(), self.dropped.iter().map(|&i| theta[i]));
+        let dropped =
+            DVector::from_iterator(self.dropped.len(), self.dropped.iter().map(|&i| theta[i]));
         Ok(kept + &self.k * dropped)
     }
 
@@ -66,7 +67,12 @@ impl BaseParameters {
                 for (d, &dc) in self.dropped.iter().enumerate() {
                     let v = self.k[(i, d)];
                     if v.abs() > 1e-9 {
-                        s.push_str(&format!(" {} {:.4} {}", if v < 0.0 { '-' } else { '+' }, v.abs(), self.layout.names[dc]));
+                        s.push_str(&format!(
+                            " {} {:.4} {}",
+                            if v < 0.0 { '-' } else { '+' },
+                            v.abs(),
+                            self.layout.names[dc]
+                        ));
                     }
                 }
                 s
@@ -82,26 +88,58 @@ impl BaseParameters {
     /// Base parameters of `layout` for `model` from `samples` random states (uniform positions
     /// within the limits, or +-pi where unlimited; speeds and accelerations uniform in +-1 rad/s
     /// and +-1 rad/s^2 scaled to the limits when given), seeded; with or without `gravity`.
-    pub fn from_random_states(model: &Model, layout: &ParameterLayout, gravity: bool, samples: usize, tolerance: f64, seed: u64) -> Result<Self> {
+    pub fn from_random_states(
+        model: &Model,
+        layout: &ParameterLayout,
+        gravity: bool,
+        samples: usize,
+        tolerance: f64,
+        seed: u64,
+    ) -> Result<Self> {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let (mut q, mut qd, mut qdd) = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..samples {
             for lim in &model.limits {
-                let (lo, hi) = if lim.lower.is_finite() && lim.upper.is_finite() { (lim.lower, lim.upper) } else { (-std::f64::consts::PI, std::f64::consts::PI) };
+                let (lo, hi) = if lim.lower.is_finite() && lim.upper.is_finite() {
+                    (lim.lower, lim.upper)
+                } else {
+                    (-std::f64::consts::PI, std::f64::consts::PI)
+                };
                 q.push(rng.random_range(lo..=hi));
-                let v = if lim.velocity.is_finite() { lim.velocity } else { 1.0 };
+                let v = if lim.velocity.is_finite() {
+                    lim.velocity
+                } else {
+                    1.0
+                };
                 qd.push(rng.random_range(-v..=v));
-                let a = if lim.acceleration.is_finite() { lim.acceleration } else { 1.0 };
+                let a = if lim.acceleration.is_finite() {
+                    lim.acceleration
+                } else {
+                    1.0
+                };
                 qdd.push(rng.random_range(-a..=a));
             }
         }
-        let phi = regressor_matrix(model, layout, &Batch { q: &q, qd: &qd, qdd: &qdd }, gravity)?;
+        let phi = regressor_matrix(
+            model,
+            layout,
+            &Batch {
+                q: &q,
+                qd: &qd,
+                qdd: &qdd,
+            },
+            gravity,
+        )?;
         Self::from_regressor(layout.clone(), &phi, tolerance)
     }
 
     /// Base parameters from a stacked regressor `phi` (rows >= columns) by a column-pivoted QR
     /// (faer): a column is kept when `|R_ii| > tolerance |R_00|`.
-    pub fn from_regressor(layout: ParameterLayout, phi: &DMatrix<f64>, tolerance: f64) -> Result<Self> {
+    pub fn from_regressor(
+        layout: ParameterLayout,
+        phi: &DMatrix<f64>,
+        tolerance: f64,
+    ) -> Result<Self> {
         let (m, p) = phi.shape();
         if p != layout.len() || m < p {
             return Err(Error::Shape {
@@ -115,22 +153,35 @@ impl BaseParameters {
         let r = qr.R();
         let perm: Vec<usize> = qr.P().arrays().0.to_vec();
         let r00 = r[(0, 0)].abs();
-        let rank = (0..p).take_while(|&i| r[(i, i)].abs() > tolerance * r00).count();
+        let rank = (0..p)
+            .take_while(|&i| r[(i, i)].abs() > tolerance * r00)
+            .count();
         if rank == 0 {
-            return Err(Error::Numerical { operation: "base parameters".into(), message: "the regressor is zero".into() });
+            return Err(Error::Numerical {
+                operation: "base parameters".into(),
+                message: "the regressor is zero".into(),
+            });
         }
         // K (pivot order) = R11^-1 R12
         let r11 = DMatrix::from_fn(rank, rank, |i, j| if j >= i { r[(i, j)] } else { 0.0 });
         let r12 = DMatrix::from_fn(rank, p - rank, |i, j| r[(i, rank + j)]);
-        let kp = r11.solve_upper_triangular(&r12).ok_or_else(|| Error::Numerical {
-            operation: "base parameters".into(),
-            message: "singular triangular factor".into(),
-        })?;
+        let kp = r11
+            .solve_upper_triangular(&r12)
+            .ok_or_else(|| Error::Numerical {
+                operation: "base parameters".into(),
+                message: "singular triangular factor".into(),
+            })?;
         let mut kept: Vec<(usize, usize)> = (0..rank).map(|i| (perm[i], i)).collect();
         let mut dropped: Vec<(usize, usize)> = (rank..p).map(|i| (perm[i], i - rank)).collect();
         kept.sort();
         dropped.sort();
         let k = DMatrix::from_fn(rank, p - rank, |i, d| kp[(kept[i].1, dropped[d].1)]);
-        Ok(Self { layout, kept: kept.iter().map(|x| x.0).collect(), dropped: dropped.iter().map(|x| x.0).collect(), k, tolerance })
+        Ok(Self {
+            layout,
+            kept: kept.iter().map(|x| x.0).collect(),
+            dropped: dropped.iter().map(|x| x.0).collect(),
+            k,
+            tolerance,
+        })
     }
 }

@@ -29,7 +29,10 @@ impl Criterion {
         match name {
             "cond" => Ok(Criterion::Cond),
             "logdet" | "log_det" => Ok(Criterion::LogDet),
-            other => Err(Error::InvalidArgument { argument: "criterion".into(), message: format!("'{other}'; expected 'cond' or 'logdet'") }),
+            other => Err(Error::InvalidArgument {
+                argument: "criterion".into(),
+                message: format!("'{other}'; expected 'cond' or 'logdet'"),
+            }),
         }
     }
 }
@@ -69,7 +72,11 @@ impl Default for ExcitationOptions {
             margin: 0.9,
             default_velocity: 1.0,
             default_acceleration: 4.0,
-            friction: FrictionTerms { viscous: true, coulomb: true, offset: false },
+            friction: FrictionTerms {
+                viscous: true,
+                coulomb: true,
+                offset: false,
+            },
             max_evaluations: 2000,
             seed: 0,
         }
@@ -108,7 +115,11 @@ struct Problem<'a> {
 impl Problem<'_> {
     fn free_per_joint(&self) -> usize {
         let l = self.o.harmonics;
-        if self.o.rest { 2 * (l - 1) + 1 } else { 2 * l + 1 }
+        if self.o.rest {
+            2 * (l - 1) + 1
+        } else {
+            2 * l + 1
+        }
     }
 
     /// The trajectory of a decision vector (rest constraints eliminated).
@@ -134,7 +145,12 @@ impl Problem<'_> {
             }
             q0[i] = xi[f - 1];
         }
-        FourierTrajectory { w_f: self.w_f, q0, a, b }
+        FourierTrajectory {
+            w_f: self.w_f,
+            q0,
+            a,
+            b,
+        }
     }
 
     /// Constraint values (>= 0 when satisfied): per joint, the normalised slack of position
@@ -158,7 +174,16 @@ impl Problem<'_> {
     /// (criterion, cond) of a trajectory.
     fn criterion(&self, traj: &FourierTrajectory) -> (f64, f64) {
         let s = traj.sample(&self.t_fit);
-        let phi = match regressor_matrix(self.model, &self.base.layout, &Batch { q: &s.q, qd: &s.qd, qdd: &s.qdd }, true) {
+        let phi = match regressor_matrix(
+            self.model,
+            &self.base.layout,
+            &Batch {
+                q: &s.q,
+                qd: &s.qd,
+                qdd: &s.qdd,
+            },
+            true,
+        ) {
             Ok(p) => self.base.select(&p),
             Err(_) => return (f64::INFINITY, f64::INFINITY),
         };
@@ -167,11 +192,15 @@ impl Problem<'_> {
             Ok(sv) => sv,
             Err(_) => return (f64::INFINITY, f64::INFINITY),
         };
-        let (max, min) = sv.iter().fold((0.0f64, f64::INFINITY), |(a, b), &v| (a.max(v), b.min(v)));
+        let (max, min) = sv
+            .iter()
+            .fold((0.0f64, f64::INFINITY), |(a, b), &v| (a.max(v), b.min(v)));
         let cond = if min > 0.0 { max / min } else { f64::INFINITY };
         let value = match self.o.criterion {
             Criterion::Cond => cond.log10(),
-            Criterion::LogDet => -sv.iter().map(|v| 2.0 * v.max(1e-300).ln()).sum::<f64>() / sv.len() as f64,
+            Criterion::LogDet => {
+                -sv.iter().map(|v| 2.0 * v.max(1e-300).ln()).sum::<f64>() / sv.len() as f64
+            }
         };
         (value, cond)
     }
@@ -181,24 +210,48 @@ impl Problem<'_> {
 /// criterion over the coefficients and offsets subject to the limits (times `margin`), from a
 /// seeded random feasible start. `progress` is called every 100 evaluations. The result is
 /// checked against the full limits at 1 kHz over one period.
-pub fn design_excitation(model: &Model, options: &ExcitationOptions, progress: Option<Progress<'_>>) -> Result<ExcitationDesign> {
+pub fn design_excitation(
+    model: &Model,
+    options: &ExcitationOptions,
+    progress: Option<Progress<'_>>,
+) -> Result<ExcitationDesign> {
     let o = options;
     if o.harmonics == 0 || (o.rest && o.harmonics < 2) {
-        return Err(Error::InvalidArgument { argument: "harmonics".into(), message: format!("{}; need at least 2 to start at rest", o.harmonics) });
+        return Err(Error::InvalidArgument {
+            argument: "harmonics".into(),
+            message: format!("{}; need at least 2 to start at rest", o.harmonics),
+        });
     }
     if !(o.base_frequency.is_finite() && o.base_frequency > 0.0) {
-        return Err(Error::InvalidArgument { argument: "base_frequency".into(), message: format!("{} Hz; expected a positive number", o.base_frequency) });
+        return Err(Error::InvalidArgument {
+            argument: "base_frequency".into(),
+            message: format!("{} Hz; expected a positive number", o.base_frequency),
+        });
     }
     if !(o.margin > 0.0 && o.margin <= 1.0) {
-        return Err(Error::InvalidArgument { argument: "margin".into(), message: format!("{}; expected a fraction in (0, 1]", o.margin) });
+        return Err(Error::InvalidArgument {
+            argument: "margin".into(),
+            message: format!("{}; expected a fraction in (0, 1]", o.margin),
+        });
     }
     let n = model.nv;
     let layout = ParameterLayout::new(model, o.friction);
-    let base = BaseParameters::from_random_states(model, &layout, true, 200.max(layout.len()), BASE_TOLERANCE, o.seed)?;
+    let base = BaseParameters::from_random_states(
+        model,
+        &layout,
+        true,
+        200.max(layout.len()),
+        BASE_TOLERANCE,
+        o.seed,
+    )?;
     if o.samples * n < base.len() {
         return Err(Error::InvalidArgument {
             argument: "samples".into(),
-            message: format!("{} samples x {n} joints cannot determine {} base parameters", o.samples, base.len()),
+            message: format!(
+                "{} samples x {n} joints cannot determine {} base parameters",
+                o.samples,
+                base.len()
+            ),
         });
     }
     let w_f = 2.0 * std::f64::consts::PI * o.base_frequency;
@@ -206,7 +259,11 @@ pub fn design_excitation(model: &Model, options: &ExcitationOptions, progress: O
     let m = o.margin;
     let (mut lower, mut upper) = (vec![0.0; n], vec![0.0; n]);
     for (i, lim) in model.limits.iter().enumerate() {
-        let (lo, hi) = if lim.lower.is_finite() && lim.upper.is_finite() { (lim.lower, lim.upper) } else { (-std::f64::consts::PI, std::f64::consts::PI) };
+        let (lo, hi) = if lim.lower.is_finite() && lim.upper.is_finite() {
+            (lim.lower, lim.upper)
+        } else {
+            (-std::f64::consts::PI, std::f64::consts::PI)
+        };
         let (c, h) = (0.5 * (lo + hi), 0.5 * (hi - lo) * m);
         (lower[i], upper[i]) = (c - h, c + h);
     }
@@ -215,11 +272,33 @@ pub fn design_excitation(model: &Model, options: &ExcitationOptions, progress: O
         base,
         o,
         w_f,
-        vel: model.limits.iter().map(|l| m * if l.velocity.is_finite() { l.velocity } else { o.default_velocity }).collect(),
-        acc: model.limits.iter().map(|l| m * if l.acceleration.is_finite() { l.acceleration } else { o.default_acceleration }).collect(),
+        vel: model
+            .limits
+            .iter()
+            .map(|l| {
+                m * if l.velocity.is_finite() {
+                    l.velocity
+                } else {
+                    o.default_velocity
+                }
+            })
+            .collect(),
+        acc: model
+            .limits
+            .iter()
+            .map(|l| {
+                m * if l.acceleration.is_finite() {
+                    l.acceleration
+                } else {
+                    o.default_acceleration
+                }
+            })
+            .collect(),
         lower,
         upper,
-        t_fit: (0..o.samples).map(|k| period * k as f64 / o.samples as f64).collect(),
+        t_fit: (0..o.samples)
+            .map(|k| period * k as f64 / o.samples as f64)
+            .collect(),
         t_check: (0..400).map(|k| period * k as f64 / 400.0).collect(),
     };
     // seeded random start, shrunk until feasible
@@ -271,7 +350,12 @@ pub fn design_excitation(model: &Model, options: &ExcitationOptions, progress: O
         }
         value
     };
-    let cons: Vec<_> = (0..4 * n).map(|c| { let cf = &constraints_of; move |x: &[f64], _: &mut ()| cf(x)[c] }).collect();
+    let cons: Vec<_> = (0..4 * n)
+        .map(|c| {
+            let cf = &constraints_of;
+            move |x: &[f64], _: &mut ()| cf(x)[c]
+        })
+        .collect();
     let rhobeg = p.vel.iter().cloned().fold(f64::INFINITY, f64::min) / (4.0 * o.harmonics as f64);
     let result = cobyla::minimize(
         objective,
@@ -281,7 +365,10 @@ pub fn design_excitation(model: &Model, options: &ExcitationOptions, progress: O
         (),
         o.max_evaluations,
         cobyla::RhoBeg::All(rhobeg),
-        Some(cobyla::StopTols { ftol_rel: 1e-6, ..cobyla::StopTols::default() }),
+        Some(cobyla::StopTols {
+            ftol_rel: 1e-6,
+            ..cobyla::StopTols::default()
+        }),
     );
     let x = match result {
         Ok((_, x, _)) | Err((_, x, _)) => x,
@@ -295,8 +382,18 @@ pub fn design_excitation(model: &Model, options: &ExcitationOptions, progress: O
         traj.a *= 0.99;
         traj.b *= 0.99;
     }
-    check_limits(model, &traj.sample_periods(1.0, 1000.0), "designed excitation", "; lower the margin")?;
+    check_limits(
+        model,
+        &traj.sample_periods(1.0, 1000.0),
+        "designed excitation",
+        "; lower the margin",
+    )?;
     let (value, cond) = p.criterion(&traj);
     let evaluations = *evaluations.borrow();
-    Ok(ExcitationDesign { trajectory: traj, value, cond, evaluations })
+    Ok(ExcitationDesign {
+        trajectory: traj,
+        value,
+        cond,
+        evaluations,
+    })
 }

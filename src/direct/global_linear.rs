@@ -31,11 +31,19 @@ pub struct GlobalLinearModel {
 
 /// Fits the globally linearised model at `op` to the samples of `batch` and `tau` (row-major
 /// `k x nv`; rad, rad/s, rad/s^2, N m): one least-squares solve, `nv` outputs.
-pub fn identify_global_linear(op: &OperatingPoint, batch: &Batch<'_>, tau: &[f64]) -> Result<GlobalLinearModel> {
+pub fn identify_global_linear(
+    op: &OperatingPoint,
+    batch: &Batch<'_>,
+    tau: &[f64],
+) -> Result<GlobalLinearModel> {
     let nv = op.n();
     let k = batch.samples(nv)?;
     if tau.len() != k * nv {
-        return Err(Error::Shape { argument: "tau".into(), expected: format!("{k} samples x {nv} joints like q"), got: format!("{} values", tau.len()) });
+        return Err(Error::Shape {
+            argument: "tau".into(),
+            expected: format!("{k} samples x {nv} joints like q"),
+            got: format!("{} values", tau.len()),
+        });
     }
     let x = DMatrix::from_fn(k, 1 + 3 * nv, |s, c| match c {
         0 => 1.0,

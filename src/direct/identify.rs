@@ -39,7 +39,14 @@ pub struct BaseOptions {
 
 impl Default for BaseOptions {
     fn default() -> Self {
-        Self { friction: FrictionTerms::ALL, weighting: Weighting::Wls, gravity: true, tolerance: BASE_TOLERANCE, states: 200, seed: 0 }
+        Self {
+            friction: FrictionTerms::ALL,
+            weighting: Weighting::Wls,
+            gravity: true,
+            tolerance: BASE_TOLERANCE,
+            states: 200,
+            seed: 0,
+        }
     }
 }
 
@@ -69,17 +76,37 @@ pub struct BaseModel {
 
 /// Identifies the base parameters of `model` from samples `q`, `qd`, `qdd`, `tau` (row-major,
 /// `k x nv` each; rad, rad/s, rad/s^2, N m).
-pub fn identify_base_parameters(model: &Model, batch: &Batch<'_>, tau: &[f64], options: &BaseOptions) -> Result<BaseModel> {
+pub fn identify_base_parameters(
+    model: &Model,
+    batch: &Batch<'_>,
+    tau: &[f64],
+    options: &BaseOptions,
+) -> Result<BaseModel> {
     let nv = model.nv;
     let k = batch.samples(nv)?;
     if tau.len() != k * nv {
-        return Err(Error::Shape { argument: "tau".into(), expected: format!("{k} samples x {nv} joints like q"), got: format!("{} values", tau.len()) });
+        return Err(Error::Shape {
+            argument: "tau".into(),
+            expected: format!("{k} samples x {nv} joints like q"),
+            got: format!("{} values", tau.len()),
+        });
     }
     if let Some(i) = tau.iter().position(|v| !v.is_finite()) {
-        return Err(Error::NonFiniteInput { argument: format!("tau[{}]", i / nv), index: i % nv, value: tau[i] });
+        return Err(Error::NonFiniteInput {
+            argument: format!("tau[{}]", i / nv),
+            index: i % nv,
+            value: tau[i],
+        });
     }
     let layout = ParameterLayout::new(model, options.friction);
-    let base = BaseParameters::from_random_states(model, &layout, options.gravity, options.states.max(layout.len() / nv + 1), options.tolerance, options.seed)?;
+    let base = BaseParameters::from_random_states(
+        model,
+        &layout,
+        options.gravity,
+        options.states.max(layout.len() / nv + 1),
+        options.tolerance,
+        options.seed,
+    )?;
     let names = base.names();
     let g = options.gravity;
     let mut sigma = vec![1.0; nv];
@@ -114,14 +141,27 @@ impl BaseModel {
 
     /// A model from [`BaseModel::to_json`] text; checks the format and the shapes.
     pub fn from_json(text: &str) -> Result<Self> {
-        let bad = |message: String| Error::Json { context: "base-parameter model".into(), message };
-        let m: BaseModel = serde_json::from_str(text).map_err(|e| bad(format!("line {}, column {}: {e}", e.line(), e.column())))?;
+        let bad = |message: String| Error::Json {
+            context: "base-parameter model".into(),
+            message,
+        };
+        let m: BaseModel = serde_json::from_str(text)
+            .map_err(|e| bad(format!("line {}, column {}: {e}", e.line(), e.column())))?;
         if m.format != BASE_MODEL_FORMAT {
-            return Err(bad(format!("format '{}', expected '{BASE_MODEL_FORMAT}'", m.format)));
+            return Err(bad(format!(
+                "format '{}', expected '{BASE_MODEL_FORMAT}'",
+                m.format
+            )));
         }
         let p = m.base.kept.len();
-        if m.theta.len() != p || m.stderr.len() != p || m.base.k.shape() != (p, m.base.dropped.len()) || p + m.base.dropped.len() != m.base.layout.len() {
-            return Err(bad("the base parameters, their map and the layout disagree in size".into()));
+        if m.theta.len() != p
+            || m.stderr.len() != p
+            || m.base.k.shape() != (p, m.base.dropped.len())
+            || p + m.base.dropped.len() != m.base.layout.len()
+        {
+            return Err(bad(
+                "the base parameters, their map and the layout disagree in size".into(),
+            ));
         }
         Ok(m)
     }
@@ -130,7 +170,11 @@ impl BaseModel {
         if model.joint_names != self.joint_names || model.nbodies() != self.base.layout.nbodies {
             return Err(Error::InvalidArgument {
                 argument: "robot".into(),
-                message: format!("the model was identified for '{}' with joints [{}]", self.robot, self.joint_names.join(", ")),
+                message: format!(
+                    "the model was identified for '{}' with joints [{}]",
+                    self.robot,
+                    self.joint_names.join(", ")
+                ),
             });
         }
         Ok(())
@@ -140,8 +184,15 @@ impl BaseModel {
     /// was identified for).
     pub fn predict(&self, model: &Model, batch: &Batch<'_>) -> Result<Vec<f64>> {
         self.check(model)?;
-        let phi = self.base.select(&regressor_matrix(model, &self.base.layout, batch, self.gravity)?);
-        Ok((phi * DVector::from_column_slice(&self.theta)).as_slice().to_vec())
+        let phi = self.base.select(&regressor_matrix(
+            model,
+            &self.base.layout,
+            batch,
+            self.gravity,
+        )?);
+        Ok((phi * DVector::from_column_slice(&self.theta))
+            .as_slice()
+            .to_vec())
     }
 
     /// The mass matrix `M(q)` (`nv x nv`) of the identified parameters at `q`: column `j` is
@@ -159,7 +210,16 @@ impl BaseModel {
             }
         }
         let zeros = vec![0.0; (nv + 1) * nv];
-        let tau = self.predict(model, &Batch { q: &qs, qd: &zeros, qdd: &qdd })?;
-        Ok(DMatrix::from_fn(nv, nv, |i, j| tau[(j + 1) * nv + i] - tau[i]))
+        let tau = self.predict(
+            model,
+            &Batch {
+                q: &qs,
+                qd: &zeros,
+                qdd: &qdd,
+            },
+        )?;
+        Ok(DMatrix::from_fn(nv, nv, |i, j| {
+            tau[(j + 1) * nv + i] - tau[i]
+        }))
     }
 }

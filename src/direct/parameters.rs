@@ -5,7 +5,9 @@
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
-use crate::algorithms::regressor::{joint_torque_regressor, model_parameters, PARAMETER_NAMES, PARAMS_PER_BODY};
+use crate::algorithms::regressor::{
+    joint_torque_regressor, model_parameters, PARAMETER_NAMES, PARAMS_PER_BODY,
+};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -22,15 +24,27 @@ pub struct FrictionTerms {
 }
 
 impl FrictionTerms {
-    pub const NONE: FrictionTerms = FrictionTerms { viscous: false, coulomb: false, offset: false };
-    pub const ALL: FrictionTerms = FrictionTerms { viscous: true, coulomb: true, offset: true };
+    pub const NONE: FrictionTerms = FrictionTerms {
+        viscous: false,
+        coulomb: false,
+        offset: false,
+    };
+    pub const ALL: FrictionTerms = FrictionTerms {
+        viscous: true,
+        coulomb: true,
+        offset: true,
+    };
 
     /// Names of the terms switched on, in column order (`viscous`, `coulomb`, `offset`).
     pub fn names(&self) -> Vec<&'static str> {
-        [("viscous", self.viscous), ("coulomb", self.coulomb), ("offset", self.offset)]
-            .into_iter()
-            .filter_map(|(n, on)| on.then_some(n))
-            .collect()
+        [
+            ("viscous", self.viscous),
+            ("coulomb", self.coulomb),
+            ("offset", self.offset),
+        ]
+        .into_iter()
+        .filter_map(|(n, on)| on.then_some(n))
+        .collect()
     }
 }
 
@@ -54,7 +68,12 @@ impl ParameterLayout {
         for j in &model.joint_names {
             names.extend(friction.names().iter().map(|t| format!("{j}.{t}")));
         }
-        Self { nv: model.nv, nbodies: model.nbodies(), friction, names }
+        Self {
+            nv: model.nv,
+            nbodies: model.nbodies(),
+            friction,
+            names,
+        }
     }
 
     /// Number of parameters.
@@ -115,7 +134,12 @@ impl<'a> Batch<'a> {
 
 /// The identification regressor of a batch: `(k nv) x layout.len()`, row `s * nv + j` the torque
 /// of joint `j` at sample `s` per unit of each parameter. `gravity` includes gravity.
-pub fn regressor_matrix(model: &Model, layout: &ParameterLayout, batch: &Batch<'_>, gravity: bool) -> Result<DMatrix<f64>> {
+pub fn regressor_matrix(
+    model: &Model,
+    layout: &ParameterLayout,
+    batch: &Batch<'_>,
+    gravity: bool,
+) -> Result<DMatrix<f64>> {
     let nv = model.nv;
     let k = batch.samples(nv)?;
     let mut out = DMatrix::zeros(k * nv, layout.len());
@@ -139,8 +163,13 @@ pub(crate) fn fill_regressor(
     let mut data = Data::new(model);
     let mut y = std::mem::take(&mut data.regressor);
     for (r, s) in range.enumerate() {
-        let (q, qd, qdd) = (Batch::row(batch.q, s, nv), Batch::row(batch.qd, s, nv), Batch::row(batch.qdd, s, nv));
-        joint_torque_regressor(model, &mut data, q, qd, qdd, gravity, &mut y).map_err(|e| in_sample(e, s))?;
+        let (q, qd, qdd) = (
+            Batch::row(batch.q, s, nv),
+            Batch::row(batch.qd, s, nv),
+            Batch::row(batch.qdd, s, nv),
+        );
+        joint_torque_regressor(model, &mut data, q, qd, qdd, gravity, &mut y)
+            .map_err(|e| in_sample(e, s))?;
         let base = row0 + r * nv;
         out.view_mut((base, 0), (nv, ni)).copy_from(&y);
         for j in 0..nv {
@@ -158,7 +187,15 @@ pub(crate) fn fill_regressor(
 
 fn in_sample(e: Error, s: usize) -> Error {
     match e {
-        Error::NonFiniteInput { argument, index, value } => Error::NonFiniteInput { argument: format!("{argument}[{s}]"), index, value },
+        Error::NonFiniteInput {
+            argument,
+            index,
+            value,
+        } => Error::NonFiniteInput {
+            argument: format!("{argument}[{s}]"),
+            index,
+            value,
+        },
         other => other,
     }
 }

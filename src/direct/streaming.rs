@@ -21,7 +21,15 @@ pub const CHUNK: usize = 2048;
 
 /// The regressor's base columns of samples `range`, rows weighted by `1 / sigma[joint]`, with
 /// the weighted torques as an extra last column.
-fn chunk_system(model: &Model, base: &BaseParameters, batch: &Batch<'_>, tau: &[f64], gravity: bool, sigma: &[f64], range: std::ops::Range<usize>) -> Result<DMatrix<f64>> {
+fn chunk_system(
+    model: &Model,
+    base: &BaseParameters,
+    batch: &Batch<'_>,
+    tau: &[f64],
+    gravity: bool,
+    sigma: &[f64],
+    range: std::ops::Range<usize>,
+) -> Result<DMatrix<f64>> {
     let nv = model.nv;
     let rows = range.len() * nv;
     let mut full = DMatrix::zeros(rows, base.layout.len());
@@ -51,7 +59,15 @@ fn triangular(a: &DMatrix<f64>) -> DMatrix<f64> {
 /// Solves the weighted base-parameter least squares over all samples; `names` label the base
 /// columns for a rank-deficiency error. Returns the solution with `stderr` for the weighted
 /// problem (`sigma_w^2 (W^T W)^-1`) and `residual_rms` left empty (see [`residual_rms`]).
-pub fn solve(model: &Model, base: &BaseParameters, batch: &Batch<'_>, tau: &[f64], gravity: bool, sigma: &[f64], names: &[String]) -> Result<LeastSquares> {
+pub fn solve(
+    model: &Model,
+    base: &BaseParameters,
+    batch: &Batch<'_>,
+    tau: &[f64],
+    gravity: bool,
+    sigma: &[f64],
+    names: &[String],
+) -> Result<LeastSquares> {
     let nv = model.nv;
     let k = batch.samples(nv)?;
     let p = base.len();
@@ -61,13 +77,20 @@ pub fn solve(model: &Model, base: &BaseParameters, batch: &Batch<'_>, tau: &[f64
             rows: k * nv,
             cols: p,
             rank: k * nv,
-            missing: format!("{k} samples x {nv} joints cannot determine {p} base parameters; add samples"),
+            missing: format!(
+                "{k} samples x {nv} joints cannot determine {p} base parameters; add samples"
+            ),
         });
     }
-    let chunks: Vec<std::ops::Range<usize>> = (0..k).step_by(CHUNK).map(|s| s..(s + CHUNK).min(k)).collect();
+    let chunks: Vec<std::ops::Range<usize>> = (0..k)
+        .step_by(CHUNK)
+        .map(|s| s..(s + CHUNK).min(k))
+        .collect();
     let factors: Vec<DMatrix<f64>> = chunks
         .into_par_iter()
-        .map(|range| chunk_system(model, base, batch, tau, gravity, sigma, range).map(|a| triangular(&a)))
+        .map(|range| {
+            chunk_system(model, base, batch, tau, gravity, sigma, range).map(|a| triangular(&a))
+        })
         .collect::<Result<_>>()?;
     let height: usize = factors.iter().map(|f| f.nrows()).sum();
     let mut stacked = DMatrix::zeros(height, p + 1);
@@ -76,7 +99,11 @@ pub fn solve(model: &Model, base: &BaseParameters, batch: &Batch<'_>, tau: &[f64
         stacked.view_mut((row, 0), f.shape()).copy_from(f);
         row += f.nrows();
     }
-    let r = if height > p + 1 { triangular(&stacked) } else { stacked };
+    let r = if height > p + 1 {
+        triangular(&stacked)
+    } else {
+        stacked
+    };
     // [R11 z; 0 rho]: min |W theta - y| solves R11 theta = z with residual norm |rho|
     let r11 = r.view((0, 0), (p, p)).into_owned();
     let z = r.view((0, p), (p, 1)).into_owned();
@@ -91,7 +118,14 @@ pub fn solve(model: &Model, base: &BaseParameters, batch: &Batch<'_>, tau: &[f64
 }
 
 /// Per-joint RMS of the unweighted residuals `tau - Phi_base theta` (N m), streamed.
-pub fn residual_rms(model: &Model, base: &BaseParameters, batch: &Batch<'_>, tau: &[f64], gravity: bool, theta: &[f64]) -> Result<Vec<f64>> {
+pub fn residual_rms(
+    model: &Model,
+    base: &BaseParameters,
+    batch: &Batch<'_>,
+    tau: &[f64],
+    gravity: bool,
+    theta: &[f64],
+) -> Result<Vec<f64>> {
     let nv = model.nv;
     let k = batch.samples(nv)?;
     let ones = vec![1.0; nv];
@@ -112,5 +146,7 @@ pub fn residual_rms(model: &Model, base: &BaseParameters, batch: &Batch<'_>, tau
             Ok(acc)
         })
         .collect::<Result<_>>()?;
-    Ok((0..nv).map(|j| (sums.iter().map(|s| s[j]).sum::<f64>() / k as f64).sqrt()).collect())
+    Ok((0..nv)
+        .map(|j| (sums.iter().map(|s| s[j]).sum::<f64>() / k as f64).sqrt())
+        .collect())
 }

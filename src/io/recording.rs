@@ -10,7 +10,9 @@ use crate::trajectory::Samples;
 /// The column of variable `var` (`q`, `qd`, `qdd`, `tau`) of joint `j`: `var{j+1}` or
 /// `var_<name>`.
 fn find(table: &Table, var: &str, j: usize, name: &str) -> Option<usize> {
-    table.index(&format!("{var}{}", j + 1)).or_else(|| table.index(&format!("{var}_{name}")))
+    table
+        .index(&format!("{var}{}", j + 1))
+        .or_else(|| table.index(&format!("{var}_{name}")))
 }
 
 /// Joint columns of a table, found by name, with a record of which columns were used.
@@ -22,14 +24,37 @@ struct Columns<'a> {
 
 impl<'a> Columns<'a> {
     fn new(table: &'a Table, joints: &'a [String]) -> Result<(Self, Vec<f64>)> {
-        let t_col = table.index("t").ok_or_else(|| bad(table, format!("no column 't' (time, s); the columns are: {}", table.columns.join(", "))))?;
+        let t_col = table.index("t").ok_or_else(|| {
+            bad(
+                table,
+                format!(
+                    "no column 't' (time, s); the columns are: {}",
+                    table.columns.join(", ")
+                ),
+            )
+        })?;
         let mut used = vec![false; table.columns.len()];
         used[t_col] = true;
         let t = table.column(t_col);
         if let Some(i) = (1..t.len()).find(|&i| t[i] <= t[i - 1]) {
-            return Err(bad(table, format!("time does not increase at data row {} (t = {} after {})", i + 1, t[i], t[i - 1])));
+            return Err(bad(
+                table,
+                format!(
+                    "time does not increase at data row {} (t = {} after {})",
+                    i + 1,
+                    t[i],
+                    t[i - 1]
+                ),
+            ));
         }
-        Ok((Self { table, joints, used }, t))
+        Ok((
+            Self {
+                table,
+                joints,
+                used,
+            },
+            t,
+        ))
     }
 
     /// Row-major values of variable `var` for every joint; `None` when absent and optional.
@@ -41,15 +66,29 @@ impl<'a> Columns<'a> {
             return Ok(None);
         }
         if found < n {
-            let missing: Vec<String> = (0..n).filter(|&j| cols[j].is_none()).map(|j| format!("{var}{} (or {var}_{})", j + 1, joints[j])).collect();
-            return Err(bad(table, format!("missing column(s) {}: the robot has {n} joints ({})", missing.join(", "), joints.join(", "))));
+            let missing: Vec<String> = (0..n)
+                .filter(|&j| cols[j].is_none())
+                .map(|j| format!("{var}{} (or {var}_{})", j + 1, joints[j]))
+                .collect();
+            return Err(bad(
+                table,
+                format!(
+                    "missing column(s) {}: the robot has {n} joints ({})",
+                    missing.join(", "),
+                    joints.join(", ")
+                ),
+            ));
         }
         let cols: Vec<usize> = cols.into_iter().map(|c| c.expect("checked")).collect();
         for &c in &cols {
             self.used[c] = true;
         }
         let w = table.columns.len();
-        Ok(Some((0..table.rows()).flat_map(|r| cols.iter().map(move |&c| table.values[r * w + c])).collect()))
+        Ok(Some(
+            (0..table.rows())
+                .flat_map(|r| cols.iter().map(move |&c| table.values[r * w + c]))
+                .collect(),
+        ))
     }
 
     /// Fails on a column no `get` used.
@@ -69,7 +108,10 @@ impl<'a> Columns<'a> {
 }
 
 fn bad(table: &Table, message: String) -> Error {
-    Error::Recording { recording: table.source.clone(), message }
+    Error::Recording {
+        recording: table.source.clone(),
+        message,
+    }
 }
 
 /// Reads a recording of the joints `joints` from a CSV table: `t`, positions and torques
@@ -140,7 +182,11 @@ pub fn recording_table(rec: &Recording, source: &str) -> Table {
 pub fn samples_table(s: &Samples, source: &str) -> Table {
     let n = s.n;
     let mut columns = vec!["t".to_string()];
-    columns.extend(header("q", n).chain(header("qd", n)).chain(header("qdd", n)));
+    columns.extend(
+        header("q", n)
+            .chain(header("qd", n))
+            .chain(header("qdd", n)),
+    );
     let mut t = Table::new(source, columns);
     for i in 0..s.len() {
         let mut row = vec![s.t[i]];

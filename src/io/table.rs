@@ -14,7 +14,11 @@ pub struct Table {
 
 impl Table {
     pub fn new(source: impl Into<String>, columns: Vec<String>) -> Self {
-        Self { source: source.into(), columns, values: Vec::new() }
+        Self {
+            source: source.into(),
+            columns,
+            values: Vec::new(),
+        }
     }
 
     pub fn rows(&self) -> usize {
@@ -22,31 +26,61 @@ impl Table {
     }
 
     fn error(&self, message: String) -> Error {
-        Error::Recording { recording: self.source.clone(), message }
+        Error::Recording {
+            recording: self.source.clone(),
+            message,
+        }
     }
 
     /// Parses CSV text (comma separated; blank lines and lines starting with `#` skipped). Every
     /// row must have one number per header column; a non-number, NaN or inf is an error naming
     /// the line (1-based) and the column.
     pub fn parse(source: &str, text: &str) -> Result<Self> {
-        let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
         let Some((_, header)) = lines.next() else {
-            return Err(Error::Recording { recording: source.into(), message: "empty file: expected a header line of column names".into() });
+            return Err(Error::Recording {
+                recording: source.into(),
+                message: "empty file: expected a header line of column names".into(),
+            });
         };
         let columns: Vec<String> = header.split(',').map(|c| c.trim().to_string()).collect();
         let mut t = Table::new(source, columns);
-        if let Some(dup) = t.columns.iter().enumerate().find(|(i, c)| t.columns[..*i].contains(c)) {
+        if let Some(dup) = t
+            .columns
+            .iter()
+            .enumerate()
+            .find(|(i, c)| t.columns[..*i].contains(c))
+        {
             return Err(t.error(format!("line 1: column '{}' appears twice", dup.1)));
         }
         for (i, line) in lines {
             let fields: Vec<&str> = line.split(',').collect();
             if fields.len() != t.columns.len() {
-                return Err(t.error(format!("line {}: {} fields, the header has {} columns", i + 1, fields.len(), t.columns.len())));
+                return Err(t.error(format!(
+                    "line {}: {} fields, the header has {} columns",
+                    i + 1,
+                    fields.len(),
+                    t.columns.len()
+                )));
             }
             for (c, f) in fields.iter().enumerate() {
-                let v: f64 = f.trim().parse().map_err(|_| t.error(format!("line {}, column '{}': '{}' is not a number", i + 1, t.columns[c], f.trim())))?;
+                let v: f64 = f.trim().parse().map_err(|_| {
+                    t.error(format!(
+                        "line {}, column '{}': '{}' is not a number",
+                        i + 1,
+                        t.columns[c],
+                        f.trim()
+                    ))
+                })?;
                 if !v.is_finite() {
-                    return Err(t.error(format!("line {}, column '{}': {v} is not a finite number", i + 1, t.columns[c])));
+                    return Err(t.error(format!(
+                        "line {}, column '{}': {v} is not a finite number",
+                        i + 1,
+                        t.columns[c]
+                    )));
                 }
                 t.values.push(v);
             }
@@ -80,7 +114,10 @@ impl Table {
         out.push('\n');
         let w = self.columns.len();
         for r in 0..self.rows() {
-            let row: Vec<String> = self.values[r * w..(r + 1) * w].iter().map(|v| format!("{v}")).collect();
+            let row: Vec<String> = self.values[r * w..(r + 1) * w]
+                .iter()
+                .map(|v| format!("{v}"))
+                .collect();
             out.push_str(&row.join(","));
             out.push('\n');
         }

@@ -39,25 +39,50 @@ pub struct FitOptions {
 
 impl Default for FitOptions {
     fn default() -> Self {
-        Self { window: None, torque_degree: 6, recorded_derivatives: false }
+        Self {
+            window: None,
+            torque_degree: 6,
+            recorded_derivatives: false,
+        }
     }
 }
 
 /// Least-squares weights of a polynomial fit of degree `degree` over the samples `t[lo..hi]`
 /// with `u = (t - tc) / half`: row `d` of the result maps the samples onto coefficient `d`.
 fn fit_weights(t: &[f64], tc: f64, half: f64, degree: usize) -> Result<DMatrix<f64>> {
-    let v = DMatrix::from_fn(t.len(), degree + 1, |i, d| ((t[i] - tc) / half).powi(d as i32));
-    v.pseudo_inverse(1e-12).map_err(|m| Error::Numerical { operation: "crossing fit".into(), message: m.into() })
+    let v = DMatrix::from_fn(t.len(), degree + 1, |i, d| {
+        ((t[i] - tc) / half).powi(d as i32)
+    });
+    v.pseudo_inverse(1e-12).map_err(|m| Error::Numerical {
+        operation: "crossing fit".into(),
+        message: m.into(),
+    })
 }
 
-fn apply(w: &DMatrix<f64>, row: usize, values: &[f64], lo: usize, count: usize, n: usize, j: usize) -> f64 {
-    (0..count).map(|i| w[(row, i)] * values[(lo + i) * n + j]).sum()
+fn apply(
+    w: &DMatrix<f64>,
+    row: usize,
+    values: &[f64],
+    lo: usize,
+    count: usize,
+    n: usize,
+    j: usize,
+) -> f64 {
+    (0..count)
+        .map(|i| w[(row, i)] * values[(lo + i) * n + j])
+        .sum()
 }
 
 /// Estimates the values at time `tc` (the recording's clock) from the samples within `+-half`
 /// s: a quadratic fit of q gives q, qd and qdd; a fit of degree `options.torque_degree` gives
 /// tau. Fails when the window is not inside the recording or holds too few samples.
-pub fn values_at(rec: &Recording, tc: f64, half: f64, options: &FitOptions, what: &str) -> Result<CrossingValues> {
+pub fn values_at(
+    rec: &Recording,
+    tc: f64,
+    half: f64,
+    options: &FitOptions,
+    what: &str,
+) -> Result<CrossingValues> {
     let n = rec.n;
     let (first, last) = (rec.t[0], rec.t[rec.len() - 1]);
     let eps = 1e-9 * half;
@@ -86,8 +111,18 @@ pub fn values_at(rec: &Recording, tc: f64, half: f64, options: &FitOptions, what
     }
     let t = &rec.t[lo..hi];
     let wq = fit_weights(t, tc, half, 2)?;
-    let wt = if options.torque_degree == 2 { wq.clone() } else { fit_weights(t, tc, half, options.torque_degree)? };
-    let mut out = CrossingValues { time: tc, q: vec![0.0; n], qd: vec![0.0; n], qdd: vec![0.0; n], tau: vec![0.0; n] };
+    let wt = if options.torque_degree == 2 {
+        wq.clone()
+    } else {
+        fit_weights(t, tc, half, options.torque_degree)?
+    };
+    let mut out = CrossingValues {
+        time: tc,
+        q: vec![0.0; n],
+        qd: vec![0.0; n],
+        qdd: vec![0.0; n],
+        tau: vec![0.0; n],
+    };
     for j in 0..n {
         out.q[j] = apply(&wq, 0, &rec.q, lo, count, n, j);
         out.qd[j] = apply(&wq, 1, &rec.q, lo, count, n, j) / half;

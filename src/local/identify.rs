@@ -32,7 +32,11 @@ pub struct IdentifyOptions {
 impl Default for IdentifyOptions {
     /// Planned times, the default fit, the separated estimator.
     fn default() -> Self {
-        Self { times: CrossingTimes::Planned, fit: FitOptions::default(), estimator: Estimator::Separated }
+        Self {
+            times: CrossingTimes::Planned,
+            fit: FitOptions::default(),
+            estimator: Estimator::Separated,
+        }
     }
 }
 
@@ -47,28 +51,56 @@ pub struct ExperimentValues {
 }
 
 /// Reads the values at every crossing of `experiment` from `rec`.
-pub fn experiment_values(experiment: &Experiment, rec: &Recording, options: &IdentifyOptions) -> Result<ExperimentValues> {
+pub fn experiment_values(
+    experiment: &Experiment,
+    rec: &Recording,
+    options: &IdentifyOptions,
+) -> Result<ExperimentValues> {
     let offset = match options.times {
         CrossingTimes::Planned => 0.0,
         CrossingTimes::Detected { max_shift } => detect_offset(experiment, rec, max_shift)?,
     };
     let half = options.fit.window.unwrap_or(experiment.window);
     if !(half.is_finite() && half > 0.0) {
-        return Err(Error::InvalidArgument { argument: "window".into(), message: format!("{half}; expected a positive number of seconds") });
+        return Err(Error::InvalidArgument {
+            argument: "window".into(),
+            message: format!("{half}; expected a positive number of seconds"),
+        });
     }
     let name = experiment.kind.name();
     let crossings = experiment
         .crossings
         .iter()
         .enumerate()
-        .map(|(k, c)| values_at(rec, c.time + offset, half, &options.fit, &format!("experiment '{name}', crossing {k}")))
+        .map(|(k, c)| {
+            values_at(
+                rec,
+                c.time + offset,
+                half,
+                &options.fit,
+                &format!("experiment '{name}', crossing {k}"),
+            )
+        })
         .collect::<Result<Vec<_>>>()?;
     let reference = experiment
         .reference
         .as_ref()
-        .map(|c| values_at(rec, c.time + offset, half, &options.fit, &format!("experiment '{name}', reference posture")))
+        .map(|c| {
+            values_at(
+                rec,
+                c.time + offset,
+                half,
+                &options.fit,
+                &format!("experiment '{name}', reference posture"),
+            )
+        })
         .transpose()?;
-    Ok(ExperimentValues { kind: experiment.kind, offset, crossings, reference })
+    Ok(ExperimentValues {
+        kind: experiment.kind,
+        offset,
+        crossings,
+        reference,
+    })
 }
 
 fn state(c: &CrossingValues, v: usize) -> &[f64] {
@@ -97,7 +129,11 @@ fn estimate(ls: LeastSquares) -> Estimate {
 /// perturbed variable from that point; G-static: `tau_k - tau_ref` against `q_k - q_ref` at the
 /// reference posture. One least-squares solve each (faer SVD). The combined estimate stacks the
 /// nominal, G, H and D crossings against `[dqdd dqd dq]`.
-pub fn identify_local(plan: &Plan, recordings: &[Recording], options: &IdentifyOptions) -> Result<LocalModel> {
+pub fn identify_local(
+    plan: &Plan,
+    recordings: &[Recording],
+    options: &IdentifyOptions,
+) -> Result<LocalModel> {
     let n = plan.n();
     if recordings.len() != plan.experiments.len() {
         return Err(Error::InvalidArgument {
@@ -115,39 +151,67 @@ pub fn identify_local(plan: &Plan, recordings: &[Recording], options: &IdentifyO
         if r.n != n {
             return Err(Error::Recording {
                 recording: r.name.clone(),
-                message: format!("{} joints; the plan (experiment '{}') has {n}", r.n, e.kind.name()),
+                message: format!(
+                    "{} joints; the plan (experiment '{}') has {n}",
+                    r.n,
+                    e.kind.name()
+                ),
             });
         }
         values.push(experiment_values(e, r, options)?);
     }
     let find = |kind| values.iter().find(|v: &&ExperimentValues| v.kind == kind);
-    let names = |prefix: &str| -> Vec<String> { plan.joint_names.iter().map(|j| format!("{prefix}({j})")).collect() };
+    let names = |prefix: &str| -> Vec<String> {
+        plan.joint_names
+            .iter()
+            .map(|j| format!("{prefix}({j})"))
+            .collect()
+    };
 
     // T* and the measured operating point
     let nominal = find(ExperimentKind::Nominal);
-    let needs_nominal = values.iter().any(|v| matches!(v.kind, ExperimentKind::GDynamic | ExperimentKind::H | ExperimentKind::D));
+    let needs_nominal = values.iter().any(|v| {
+        matches!(
+            v.kind,
+            ExperimentKind::GDynamic | ExperimentKind::H | ExperimentKind::D
+        )
+    });
     let (torque, torque_stderr, op) = match nominal {
         Some(v) => {
             let k = v.crossings.len() as f64;
             let mean = |f: &dyn Fn(&CrossingValues) -> &[f64]| -> Vec<f64> {
-                (0..n).map(|j| v.crossings.iter().map(|c| f(c)[j]).sum::<f64>() / k).collect()
+                (0..n)
+                    .map(|j| v.crossings.iter().map(|c| f(c)[j]).sum::<f64>() / k)
+                    .collect()
             };
             let tau = mean(&|c| &c.tau);
             let se = (0..n)
                 .map(|j| {
-                    let ss: f64 = v.crossings.iter().map(|c| (c.tau[j] - tau[j]).powi(2)).sum();
-                    if k > 1.0 { (ss / (k - 1.0) / k).sqrt() } else { f64::NAN }
+                    let ss: f64 = v
+                        .crossings
+                        .iter()
+                        .map(|c| (c.tau[j] - tau[j]).powi(2))
+                        .sum();
+                    if k > 1.0 {
+                        (ss / (k - 1.0) / k).sqrt()
+                    } else {
+                        f64::NAN
+                    }
                 })
                 .collect();
-            let op = OperatingPoint { q: mean(&|c| &c.q), qd: mean(&|c| &c.qd), qdd: mean(&|c| &c.qdd) };
+            let op = OperatingPoint {
+                q: mean(&|c| &c.q),
+                qd: mean(&|c| &c.qd),
+                qdd: mean(&|c| &c.qdd),
+            };
             (tau, se, op)
         }
-        None if needs_nominal => {
-            return Err(Error::InvalidArgument {
-                argument: "plan".into(),
-                message: "the plan has no nominal experiment, which the G, H and D regressions need for T*".into(),
-            })
-        }
+        None if needs_nominal => return Err(Error::InvalidArgument {
+            argument: "plan".into(),
+            message:
+                "the plan has no nominal experiment, which the G, H and D regressions need for T*"
+                    .into(),
+        }),
         None => (vec![f64::NAN; n], vec![f64::NAN; n], plan.op.clone()),
     };
     let op_state = [op.q.clone(), op.qd.clone(), op.qdd.clone()];
@@ -162,7 +226,12 @@ pub fn identify_local(plan: &Plan, recordings: &[Recording], options: &IdentifyO
         };
         let x = DMatrix::from_fn(k, n, |i, j| state(&v.crossings[i], var)[j] - base_x[j]);
         let y = DMatrix::from_fn(k, n, |i, j| v.crossings[i].tau[j] - base_tau[j]);
-        let ls = least_squares(&x, &y, &format!("experiment '{}'", kind.name()), &names(prefix))?;
+        let ls = least_squares(
+            &x,
+            &y,
+            &format!("experiment '{}'", kind.name()),
+            &names(prefix),
+        )?;
         Ok(Some(estimate(ls)))
     };
     let d = separated(ExperimentKind::D, "dqdd")?;
@@ -182,7 +251,12 @@ pub fn identify_local(plan: &Plan, recordings: &[Recording], options: &IdentifyO
         });
         let y = DMatrix::from_fn(rows.len(), n, |i, j| rows[i].tau[j] - torque[j]);
         let columns: Vec<String> = [names("dqdd"), names("dqd"), names("dq")].concat();
-        Some(estimate(least_squares(&x, &y, "combined estimate (nominal, G, H, D)", &columns)?))
+        Some(estimate(least_squares(
+            &x,
+            &y,
+            "combined estimate (nominal, G, H, D)",
+            &columns,
+        )?))
     } else {
         None
     };

@@ -84,10 +84,12 @@ impl LocalModel {
     }
 
     fn part<'a>(e: &'a Option<Estimate>, name: &str) -> Result<&'a DMatrix<f64>> {
-        e.as_ref().map(|e| &e.matrix).ok_or_else(|| Error::InvalidArgument {
-            argument: "predict".into(),
-            message: format!("the model has no {name}: its plan had no {name} experiment"),
-        })
+        e.as_ref()
+            .map(|e| &e.matrix)
+            .ok_or_else(|| Error::InvalidArgument {
+                argument: "predict".into(),
+                message: format!("the model has no {name}: its plan had no {name} experiment"),
+            })
     }
 
     /// Predicted torque (N m, length N) at `(q, qd, qdd)` (length N each):
@@ -97,7 +99,11 @@ impl LocalModel {
         check_finite_vector("q", q, n)?;
         check_finite_vector("qd", qd, n)?;
         check_finite_vector("qdd", qdd, n)?;
-        let (d, h, g) = (Self::part(&self.d, "D")?, Self::part(&self.h, "H")?, Self::part(&self.g, "G")?);
+        let (d, h, g) = (
+            Self::part(&self.d, "D")?,
+            Self::part(&self.h, "H")?,
+            Self::part(&self.g, "G")?,
+        );
         let delta = |x: &[f64], x0: &[f64]| DVector::from_fn(n, |j, _| x[j] - x0[j]);
         let tau = DVector::from_column_slice(&self.torque)
             + d * delta(qdd, &self.op.qdd)
@@ -117,9 +123,15 @@ impl LocalModel {
             context: "local model".into(),
             message: format!("line {}, column {}: {e}", e.line(), e.column()),
         })?;
-        let bad = |message: String| Error::Json { context: "local model".into(), message };
+        let bad = |message: String| Error::Json {
+            context: "local model".into(),
+            message,
+        };
         if m.format != LOCAL_MODEL_FORMAT {
-            return Err(bad(format!("format '{}', expected '{LOCAL_MODEL_FORMAT}'", m.format)));
+            return Err(bad(format!(
+                "format '{}', expected '{LOCAL_MODEL_FORMAT}'",
+                m.format
+            )));
         }
         let n = m.n();
         for (what, len) in [
@@ -133,9 +145,18 @@ impl LocalModel {
                 return Err(bad(format!("{what} has {len} entries, torque has {n}")));
             }
         }
-        for (what, e, cols) in [("D", &m.d, n), ("H", &m.h, n), ("G", &m.g, n), ("G_static", &m.g_static, n), ("combined", &m.combined, 3 * n)] {
+        for (what, e, cols) in [
+            ("D", &m.d, n),
+            ("H", &m.h, n),
+            ("G", &m.g, n),
+            ("G_static", &m.g_static, n),
+            ("combined", &m.combined, 3 * n),
+        ] {
             if let Some(e) = e {
-                if e.matrix.shape() != (n, cols) || e.stderr.shape() != (n, cols) || e.residual_rms.len() != n {
+                if e.matrix.shape() != (n, cols)
+                    || e.stderr.shape() != (n, cols)
+                    || e.residual_rms.len() != n
+                {
                     return Err(bad(format!("{what} is not {n} x {cols}")));
                 }
             }

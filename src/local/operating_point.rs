@@ -48,13 +48,25 @@ impl OperatingPoint {
                 message: format!("{value} is outside {range}"),
             };
             if self.q[j] < lim.lower || self.q[j] > lim.upper {
-                return Err(bad("q", self.q[j], format!("the position limits [{}, {}]", lim.lower, lim.upper)));
+                return Err(bad(
+                    "q",
+                    self.q[j],
+                    format!("the position limits [{}, {}]", lim.lower, lim.upper),
+                ));
             }
             if self.qd[j].abs() > lim.velocity {
-                return Err(bad("qd", self.qd[j], format!("the velocity limit +-{}", lim.velocity)));
+                return Err(bad(
+                    "qd",
+                    self.qd[j],
+                    format!("the velocity limit +-{}", lim.velocity),
+                ));
             }
             if self.qdd[j].abs() > lim.acceleration {
-                return Err(bad("qdd", self.qdd[j], format!("the acceleration limit +-{}", lim.acceleration)));
+                return Err(bad(
+                    "qdd",
+                    self.qdd[j],
+                    format!("the acceleration limit +-{}", lim.acceleration),
+                ));
             }
         }
         Ok(())

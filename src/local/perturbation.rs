@@ -72,7 +72,11 @@ impl Size {
                 .map(|&l| if l.is_finite() { f * l } else { fallback })
                 .collect(),
         };
-        if let Some((j, s)) = sizes.iter().enumerate().find(|(_, s)| !(s.is_finite() && **s > 0.0)) {
+        if let Some((j, s)) = sizes
+            .iter()
+            .enumerate()
+            .find(|(_, s)| !(s.is_finite() && **s > 0.0))
+        {
             return Err(Error::InvalidArgument {
                 argument: format!("{argument}[{j}]"),
                 message: format!("perturbation size {s}; expected a positive finite number"),
@@ -107,7 +111,13 @@ pub const FALLBACK_SIZES: [f64; 3] = [0.02, 0.1, 0.5];
 /// `count x n` perturbations of `design`, joint `j` scaled by `size[j]`. With `symmetric`, rows
 /// come in pairs `(+delta, -delta)` (rows `2i` and `2i + 1`), which needs an even `count >= 2n`;
 /// otherwise `count >= n`. Seeded by `seed`.
-pub fn perturbations(design: Design, count: usize, size: &[f64], symmetric: bool, seed: u64) -> Result<DMatrix<f64>> {
+pub fn perturbations(
+    design: Design,
+    count: usize,
+    size: &[f64],
+    symmetric: bool,
+    seed: u64,
+) -> Result<DMatrix<f64>> {
     let n = size.len();
     let needed = if symmetric { 2 * n } else { n };
     if count < needed || (symmetric && count % 2 == 1) {
@@ -149,10 +159,23 @@ pub fn perturbations(design: Design, count: usize, size: &[f64], symmetric: bool
 /// scaled so the largest entry is 1.
 fn orthogonal_unit(m: usize, n: usize, rng: &mut ChaCha8Rng) -> DMatrix<f64> {
     let p = (n + 1).next_power_of_two();
-    let (p, skip) = if m % p == 0 { (p, 1) } else { (n.next_power_of_two(), usize::from(n.next_power_of_two() > n)) };
+    let (p, skip) = if m % p == 0 {
+        (p, 1)
+    } else {
+        (
+            n.next_power_of_two(),
+            usize::from(n.next_power_of_two() > n),
+        )
+    };
     if m % p == 0 && p >= n + skip {
         // Sylvester: H[i][j] = (-1)^popcount(i & j)
-        return DMatrix::from_fn(m, n, |i, j| if ((i % p) & (j + skip)).count_ones() % 2 == 0 { 1.0 } else { -1.0 });
+        return DMatrix::from_fn(m, n, |i, j| {
+            if ((i % p) & (j + skip)).count_ones() % 2 == 0 {
+                1.0
+            } else {
+                -1.0
+            }
+        });
     }
     let g = DMatrix::from_fn(m, n, |_, _| rng.sample::<f64, _>(StandardNormal));
     let q = g.qr().q();

@@ -9,7 +9,9 @@ use super::operating_point::OperatingPoint;
 use super::perturbation::{perturbations, Design, Sizes, FALLBACK_SIZES};
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::trajectory::{check_limits, transition, Segment, SegmentKind, Trajectory, TransitionLimits};
+use crate::trajectory::{
+    check_limits, transition, Segment, SegmentKind, Trajectory, TransitionLimits,
+};
 
 /// The kind of an experiment (METHOD.md section 3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -52,10 +54,15 @@ impl ExperimentKind {
     }
 
     pub fn parse(name: &str) -> Result<Self> {
-        Self::ALL.into_iter().find(|k| k.name() == name).ok_or_else(|| Error::InvalidArgument {
-            argument: "experiments".into(),
-            message: format!("'{name}' is not an experiment; expected one of nominal, G_static, G, H, D"),
-        })
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == name)
+            .ok_or_else(|| Error::InvalidArgument {
+                argument: "experiments".into(),
+                message: format!(
+                    "'{name}' is not an experiment; expected one of nominal, G_static, G, H, D"
+                ),
+            })
     }
 
     /// Which state variable the experiment perturbs: 0 = position, 1 = velocity,
@@ -176,7 +183,11 @@ impl Plan {
 
     /// The experiments' names in order, comma separated (for messages).
     pub fn kinds(&self) -> String {
-        self.experiments.iter().map(|e| e.kind.name()).collect::<Vec<_>>().join(", ")
+        self.experiments
+            .iter()
+            .map(|e| e.kind.name())
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 
     /// The experiment of `kind`, if planned.
@@ -196,16 +207,27 @@ impl Plan {
             message: format!("line {}, column {}: {e}", e.line(), e.column()),
         })?;
         let n = plan.n();
-        let bad = |m: String| Error::Json { context: "plan".into(), message: m };
+        let bad = |m: String| Error::Json {
+            context: "plan".into(),
+            message: m,
+        };
         if plan.joint_names.len() != n || plan.op.qd.len() != n || plan.op.qdd.len() != n {
-            return Err(bad(format!("the operating point and joint names disagree on the number of joints ({n})")));
+            return Err(bad(format!(
+                "the operating point and joint names disagree on the number of joints ({n})"
+            )));
         }
         for e in &plan.experiments {
             if e.trajectory.n != n || e.deltas.ncols() != n || e.trajectory.segments.is_empty() {
-                return Err(bad(format!("experiment '{}' is not for {n} joints", e.kind.name())));
+                return Err(bad(format!(
+                    "experiment '{}' is not for {n} joints",
+                    e.kind.name()
+                )));
             }
             if e.trajectory.segments.iter().any(|s| s.coeffs.len() != n) {
-                return Err(bad(format!("experiment '{}' has a segment that is not for {n} joints", e.kind.name())));
+                return Err(bad(format!(
+                    "experiment '{}' has a segment that is not for {n} joints",
+                    e.kind.name()
+                )));
             }
         }
         if !(plan.rate.is_finite() && plan.rate > 0.0) {
@@ -229,43 +251,84 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
     let n = model.nv;
     let o = options;
     if !(o.rate.is_finite() && o.rate > 0.0) {
-        return Err(Error::InvalidArgument { argument: "rate".into(), message: format!("{}; expected a positive number of Hz", o.rate) });
+        return Err(Error::InvalidArgument {
+            argument: "rate".into(),
+            message: format!("{}; expected a positive number of Hz", o.rate),
+        });
     }
     let window_samples = (o.window * o.rate).round() as usize;
     if window_samples < 2 {
         return Err(Error::InvalidArgument {
             argument: "window".into(),
-            message: format!("{} s holds fewer than 2 samples each side at {} Hz", o.window, o.rate),
+            message: format!(
+                "{} s holds fewer than 2 samples each side at {} Hz",
+                o.window, o.rate
+            ),
         });
     }
     let dwell_samples = (o.dwell * o.rate).round() as usize;
     if dwell_samples < 4 {
-        return Err(Error::InvalidArgument { argument: "dwell".into(), message: format!("{} s is too short at {} Hz", o.dwell, o.rate) });
+        return Err(Error::InvalidArgument {
+            argument: "dwell".into(),
+            message: format!("{} s is too short at {} Hz", o.dwell, o.rate),
+        });
     }
     if !(o.margin > 0.0 && o.margin <= 1.0) {
-        return Err(Error::InvalidArgument { argument: "margin".into(), message: format!("{}; expected a fraction in (0, 1]", o.margin) });
+        return Err(Error::InvalidArgument {
+            argument: "margin".into(),
+            message: format!("{}; expected a fraction in (0, 1]", o.margin),
+        });
     }
     let count = o.count.unwrap_or(2 * n);
     let range: Vec<f64> = model.limits.iter().map(|l| l.upper - l.lower).collect();
     let sizes = [
-        o.sizes.position.resolve("position size", &range, FALLBACK_SIZES[0])?,
-        o.sizes.velocity.resolve("velocity size", &model.velocity_limit(), FALLBACK_SIZES[1])?,
-        o.sizes.acceleration.resolve("acceleration size", &model.acceleration_limit(), FALLBACK_SIZES[2])?,
+        o.sizes
+            .position
+            .resolve("position size", &range, FALLBACK_SIZES[0])?,
+        o.sizes
+            .velocity
+            .resolve("velocity size", &model.velocity_limit(), FALLBACK_SIZES[1])?,
+        o.sizes.acceleration.resolve(
+            "acceleration size",
+            &model.acceleration_limit(),
+            FALLBACK_SIZES[2],
+        )?,
     ];
     let lim = TransitionLimits {
         lower: model.lower(),
         upper: model.upper(),
-        velocity: model.limits.iter().map(|l| o.margin * if l.velocity.is_finite() { l.velocity } else { o.default_velocity }).collect(),
+        velocity: model
+            .limits
+            .iter()
+            .map(|l| {
+                o.margin
+                    * if l.velocity.is_finite() {
+                        l.velocity
+                    } else {
+                        o.default_velocity
+                    }
+            })
+            .collect(),
         acceleration: model
             .limits
             .iter()
-            .map(|l| o.margin * if l.acceleration.is_finite() { l.acceleration } else { o.default_acceleration })
+            .map(|l| {
+                o.margin
+                    * if l.acceleration.is_finite() {
+                        l.acceleration
+                    } else {
+                        o.default_acceleration
+                    }
+            })
             .collect(),
     };
     let mut experiments = Vec::new();
     for (index, &kind) in o.experiments.iter().enumerate() {
         if o.experiments[..index].contains(&kind) {
-            return Err(Error::InvalidArgument { argument: "experiments".into(), message: format!("'{}' is listed twice", kind.name()) });
+            return Err(Error::InvalidArgument {
+                argument: "experiments".into(),
+                message: format!("'{}' is listed twice", kind.name()),
+            });
         }
         let seed = o.seed.wrapping_add(1000 * index as u64 + 1);
         let deltas = match kind.perturbed() {
@@ -273,7 +336,12 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
             Some(v) => perturbations(o.design, count, &sizes[v], o.symmetric, seed)?,
         };
         let mut b = Builder::new(n, o.rate, &lim, o.min_transition, &op.q);
-        let rest_at = |q: &[f64]| Crossing { time: 0.0, q: q.to_vec(), qd: vec![0.0; n], qdd: vec![0.0; n] };
+        let rest_at = |q: &[f64]| Crossing {
+            time: 0.0,
+            q: q.to_vec(),
+            qd: vec![0.0; n],
+            qdd: vec![0.0; n],
+        };
         let (crossings, reference, window) = if kind == ExperimentKind::GStatic {
             let reference = b.dwell(SegmentKind::Reference, rest_at(&op.q), dwell_samples);
             let crossings = (0..count)
@@ -283,11 +351,20 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
                 })
                 .collect();
             // Fit windows: the middle 80 % of each dwell.
-            (crossings, Some(reference), 0.4 * dwell_samples as f64 / o.rate)
+            (
+                crossings,
+                Some(reference),
+                0.4 * dwell_samples as f64 / o.rate,
+            )
         } else {
             let crossings = (0..count)
                 .map(|k| {
-                    let mut c = Crossing { time: 0.0, q: op.q.clone(), qd: op.qd.clone(), qdd: op.qdd.clone() };
+                    let mut c = Crossing {
+                        time: 0.0,
+                        q: op.q.clone(),
+                        qd: op.qd.clone(),
+                        qdd: op.qdd.clone(),
+                    };
                     let target = match kind.perturbed() {
                         Some(0) => &mut c.q,
                         Some(1) => &mut c.qd,
@@ -310,7 +387,14 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
             &context,
             "; reduce the perturbation sizes or move the operating point away from the limit",
         )?;
-        experiments.push(Experiment { kind, deltas, crossings, reference, window, trajectory });
+        experiments.push(Experiment {
+            kind,
+            deltas,
+            crossings,
+            reference,
+            window,
+            trajectory,
+        });
     }
     Ok(Plan {
         robot: model.name.clone(),
@@ -337,9 +421,23 @@ struct Builder<'a> {
 
 impl<'a> Builder<'a> {
     /// Starts at rest at `start`.
-    fn new(n: usize, rate: f64, lim: &'a TransitionLimits, min_transition: f64, start: &[f64]) -> Self {
+    fn new(
+        n: usize,
+        rate: f64,
+        lim: &'a TransitionLimits,
+        min_transition: f64,
+        start: &[f64],
+    ) -> Self {
         let state = Some(start.iter().map(|&q| [q, 0.0, 0.0]).collect());
-        Self { n, rate, lim, min_transition, now: 0, state, segments: Vec::new() }
+        Self {
+            n,
+            rate,
+            lim,
+            min_transition,
+            now: 0,
+            state,
+            segments: Vec::new(),
+        }
     }
 
     fn time(&self, samples: usize) -> f64 {
@@ -356,11 +454,21 @@ impl<'a> Builder<'a> {
         let samples = transition(&from, &to, self.lim, self.rate, self.min_transition, 30.0);
         let duration = samples as f64 / self.rate;
         let coeffs = (0..self.n)
-            .map(|j| crate::trajectory::quintic(from[j][0], from[j][1], from[j][2], to[j][0], to[j][1], to[j][2], duration))
+            .map(|j| {
+                crate::trajectory::quintic(
+                    from[j][0], from[j][1], from[j][2], to[j][0], to[j][1], to[j][2], duration,
+                )
+            })
             .collect();
         let t0 = self.time(self.now);
         self.now += samples;
-        self.segments.push(Segment { kind: SegmentKind::Transition, t0, t1: self.time(self.now), t_ref: t0, coeffs });
+        self.segments.push(Segment {
+            kind: SegmentKind::Transition,
+            t0,
+            t1: self.time(self.now),
+            t_ref: t0,
+            coeffs,
+        });
         self.state = Some(to);
     }
 
@@ -370,7 +478,8 @@ impl<'a> Builder<'a> {
         let (t0, t1) = (self.time(self.now), self.time(self.now + samples));
         c.time = self.time(self.now + samples / 2);
         let zero = vec![0.0; self.n];
-        self.segments.push(Segment::quadratic(kind, t0, t1, c.time, &c.q, &zero, &zero));
+        self.segments
+            .push(Segment::quadratic(kind, t0, t1, c.time, &c.q, &zero, &zero));
         self.now += samples;
         c
     }
@@ -379,17 +488,37 @@ impl<'a> Builder<'a> {
     fn crossing(&mut self, index: usize, mut c: Crossing, half: usize) -> Crossing {
         let h = self.time(half);
         let start = (0..self.n)
-            .map(|j| [c.q[j] - c.qd[j] * h + 0.5 * c.qdd[j] * h * h, c.qd[j] - c.qdd[j] * h, c.qdd[j]])
+            .map(|j| {
+                [
+                    c.q[j] - c.qd[j] * h + 0.5 * c.qdd[j] * h * h,
+                    c.qd[j] - c.qdd[j] * h,
+                    c.qdd[j],
+                ]
+            })
             .collect();
         self.go_to(start);
         let t0 = self.time(self.now);
         c.time = self.time(self.now + half);
         let t1 = self.time(self.now + 2 * half);
-        self.segments.push(Segment::quadratic(SegmentKind::Crossing { index }, t0, t1, c.time, &c.q, &c.qd, &c.qdd));
+        self.segments.push(Segment::quadratic(
+            SegmentKind::Crossing { index },
+            t0,
+            t1,
+            c.time,
+            &c.q,
+            &c.qd,
+            &c.qdd,
+        ));
         self.now += 2 * half;
         self.state = Some(
             (0..self.n)
-                .map(|j| [c.q[j] + c.qd[j] * h + 0.5 * c.qdd[j] * h * h, c.qd[j] + c.qdd[j] * h, c.qdd[j]])
+                .map(|j| {
+                    [
+                        c.q[j] + c.qd[j] * h + 0.5 * c.qdd[j] * h * h,
+                        c.qd[j] + c.qdd[j] * h,
+                        c.qdd[j],
+                    ]
+                })
                 .collect(),
         );
         c
@@ -398,6 +527,9 @@ impl<'a> Builder<'a> {
     /// Ends at rest at `q`.
     fn finish(mut self, q: &[f64]) -> Trajectory {
         self.go_to(q.iter().map(|&q| [q, 0.0, 0.0]).collect());
-        Trajectory { n: self.n, segments: self.segments }
+        Trajectory {
+            n: self.n,
+            segments: self.segments,
+        }
     }
 }

@@ -102,7 +102,10 @@ pub(crate) fn to_numpy<'py>(
 }
 
 /// A numpy array of shape `(rows, cols)` from a matrix (copied out row by row).
-pub(crate) fn matrix_to_numpy<'py>(py: Python<'py>, m: &nalgebra::DMatrix<f64>) -> PyResult<Bound<'py, PyAny>> {
+pub(crate) fn matrix_to_numpy<'py>(
+    py: Python<'py>,
+    m: &nalgebra::DMatrix<f64>,
+) -> PyResult<Bound<'py, PyAny>> {
     let values: Vec<f64> = m.transpose().iter().copied().collect(); // row-major
     to_numpy(py, values, m.nrows(), false, &[m.ncols()])
 }

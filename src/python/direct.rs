@@ -14,8 +14,9 @@ use super::local::{PyOperatingPoint, PyRecording};
 use super::robot::PyRobot;
 use crate::direct::excitation::ExcitationDesign;
 use crate::direct::{
-    design_excitation as design_rs, identify_base_parameters as base_rs, identify_global_linear as global_rs, BaseModel,
-    BaseOptions, Batch, Criterion, ExcitationOptions, FrictionTerms, GlobalLinearModel, Weighting,
+    design_excitation as design_rs, identify_base_parameters as base_rs,
+    identify_global_linear as global_rs, BaseModel, BaseOptions, Batch, Criterion,
+    ExcitationOptions, FrictionTerms, GlobalLinearModel, Weighting,
 };
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -27,8 +28,16 @@ type ArrayLike<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 
 fn matrix(name: &str, a: &ArrayLike<'_>) -> Result<DMatrix<f64>> {
     match a.shape() {
-        [r, c] => Ok(DMatrix::from_row_iterator(*r, *c, a.as_array().iter().copied())),
-        s => Err(Error::Shape { argument: name.into(), expected: "a 2-D array (joints x harmonics)".into(), got: format!("shape {s:?}") }),
+        [r, c] => Ok(DMatrix::from_row_iterator(
+            *r,
+            *c,
+            a.as_array().iter().copied(),
+        )),
+        s => Err(Error::Shape {
+            argument: name.into(),
+            expected: "a 2-D array (joints x harmonics)".into(),
+            got: format!("shape {s:?}"),
+        }),
     }
 }
 
@@ -45,20 +54,36 @@ pub(crate) struct PyFourier {
 impl PyFourier {
     #[new]
     #[pyo3(signature = (a, b, q0, *, w_f=None, base_frequency=None))]
-    fn new(a: ArrayLike<'_>, b: ArrayLike<'_>, q0: ArrayLike<'_>, w_f: Option<f64>, base_frequency: Option<f64>) -> PyResult<Self> {
+    fn new(
+        a: ArrayLike<'_>,
+        b: ArrayLike<'_>,
+        q0: ArrayLike<'_>,
+        w_f: Option<f64>,
+        base_frequency: Option<f64>,
+    ) -> PyResult<Self> {
         let w_f = match (w_f, base_frequency) {
             (Some(_), Some(_)) => {
-                return Err(Error::InvalidArgument { argument: "w_f".into(), message: "give w_f or base_frequency, not both".into() }.into())
+                return Err(Error::InvalidArgument {
+                    argument: "w_f".into(),
+                    message: "give w_f or base_frequency, not both".into(),
+                }
+                .into())
             }
             (Some(w), None) => w,
             (None, f) => 2.0 * std::f64::consts::PI * f.unwrap_or(0.1),
         };
         let q0: Vec<f64> = q0.as_array().iter().copied().collect();
-        Ok(Self { traj: FourierTrajectory::new(w_f, q0, matrix("a", &a)?, matrix("b", &b)?)? })
+        Ok(Self {
+            traj: FourierTrajectory::new(w_f, q0, matrix("a", &a)?, matrix("b", &b)?)?,
+        })
     }
     /// Positions, velocities and accelerations at times `t` (s): a tuple of three arrays of
     /// shape (k, n) for `t` of shape (k,), or (n,) for a scalar `t`.
-    fn sample<'py>(&self, py: Python<'py>, t: &Bound<'py, PyAny>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let (times, single) = match t.extract::<f64>() {
             Ok(x) => (vec![x], true),
             Err(_) => {
@@ -68,7 +93,11 @@ impl PyFourier {
         };
         let s = self.traj.sample(&times);
         let n = self.traj.n();
-        Ok((to_numpy(py, s.q, times.len(), single, &[n])?, to_numpy(py, s.qd, times.len(), single, &[n])?, to_numpy(py, s.qdd, times.len(), single, &[n])?))
+        Ok((
+            to_numpy(py, s.q, times.len(), single, &[n])?,
+            to_numpy(py, s.qd, times.len(), single, &[n])?,
+            to_numpy(py, s.qdd, times.len(), single, &[n])?,
+        ))
     }
     #[getter]
     fn a<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
@@ -99,11 +128,21 @@ impl PyFourier {
     }
     #[staticmethod]
     fn from_json(text: &str) -> PyResult<Self> {
-        let t: FourierTrajectory = serde_json::from_str(text).map_err(|e| Error::Json { context: "Fourier trajectory".into(), message: e.to_string() })?;
-        Ok(Self { traj: FourierTrajectory::new(t.w_f, t.q0, t.a, t.b)? })
+        let t: FourierTrajectory = serde_json::from_str(text).map_err(|e| Error::Json {
+            context: "Fourier trajectory".into(),
+            message: e.to_string(),
+        })?;
+        Ok(Self {
+            traj: FourierTrajectory::new(t.w_f, t.q0, t.a, t.b)?,
+        })
     }
     fn __repr__(&self) -> String {
-        format!("FourierTrajectory(n={}, harmonics={}, period={:.3} s)", self.traj.n(), self.traj.harmonics(), self.traj.period())
+        format!(
+            "FourierTrajectory(n={}, harmonics={}, period={:.3} s)",
+            self.traj.n(),
+            self.traj.harmonics(),
+            self.traj.period()
+        )
     }
 }
 
@@ -118,7 +157,9 @@ pub(crate) struct PyExcitationDesign {
 impl PyExcitationDesign {
     #[getter]
     fn trajectory(&self) -> PyFourier {
-        PyFourier { traj: self.design.trajectory.clone() }
+        PyFourier {
+            traj: self.design.trajectory.clone(),
+        }
     }
     #[getter]
     fn cond(&self) -> f64 {
@@ -133,17 +174,28 @@ impl PyExcitationDesign {
         self.design.evaluations
     }
     /// `trajectory.sample(t)`.
-    fn sample<'py>(&self, py: Python<'py>, t: &Bound<'py, PyAny>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         self.trajectory().sample(py, t)
     }
     fn __repr__(&self) -> String {
-        format!("ExcitationDesign(cond={:.4}, evaluations={})", self.design.cond, self.design.evaluations)
+        format!(
+            "ExcitationDesign(cond={:.4}, evaluations={})",
+            self.design.cond, self.design.evaluations
+        )
     }
 }
 
 fn friction_terms(value: &Bound<'_, PyAny>) -> PyResult<FrictionTerms> {
     if let Ok(b) = value.extract::<bool>() {
-        return Ok(if b { FrictionTerms::ALL } else { FrictionTerms::NONE });
+        return Ok(if b {
+            FrictionTerms::ALL
+        } else {
+            FrictionTerms::NONE
+        });
     }
     let names: Vec<String> = value.extract().map_err(|_| Error::InvalidArgument {
         argument: "friction".into(),
@@ -155,7 +207,13 @@ fn friction_terms(value: &Bound<'_, PyAny>) -> PyResult<FrictionTerms> {
             "viscous" => f.viscous = true,
             "coulomb" => f.coulomb = true,
             "offset" => f.offset = true,
-            other => return Err(Error::InvalidArgument { argument: "friction".into(), message: format!("'{other}' is not a friction term (viscous, coulomb, offset)") }.into()),
+            other => {
+                return Err(Error::InvalidArgument {
+                    argument: "friction".into(),
+                    message: format!("'{other}' is not a friction term (viscous, coulomb, offset)"),
+                }
+                .into())
+            }
         }
     }
     Ok(f)
@@ -181,19 +239,41 @@ pub(crate) fn design_excitation(
     friction: Option<Bound<'_, PyAny>>,
     progress: bool,
 ) -> PyResult<PyExcitationDesign> {
-    let mut o = ExcitationOptions { harmonics, base_frequency, criterion: Criterion::parse(criterion)?, seed, rest, samples, margin, max_evaluations, ..ExcitationOptions::default() };
+    let mut o = ExcitationOptions {
+        harmonics,
+        base_frequency,
+        criterion: Criterion::parse(criterion)?,
+        seed,
+        rest,
+        samples,
+        margin,
+        max_evaluations,
+        ..ExcitationOptions::default()
+    };
     if let Some(f) = friction {
         o.friction = friction_terms(&f)?;
     }
     let design = py.detach(|| {
-        let mut report = |e: usize, best: f64| eprintln!("excitation design: {e} evaluations, best criterion {best:.4}");
-        design_rs(&robot.model, &o, if progress { Some(&mut report) } else { None })
+        let mut report = |e: usize, best: f64| {
+            eprintln!("excitation design: {e} evaluations, best criterion {best:.4}")
+        };
+        design_rs(
+            &robot.model,
+            &o,
+            if progress { Some(&mut report) } else { None },
+        )
     })?;
     Ok(PyExcitationDesign { design })
 }
 
 /// Row-major (k, n) samples of three arrays and optionally a fourth.
-fn states(n: usize, q: &ArrayLike<'_>, qd: &ArrayLike<'_>, qdd: &ArrayLike<'_>, tau: Option<&ArrayLike<'_>>) -> Result<Vec<Vec<f64>>> {
+fn states(
+    n: usize,
+    q: &ArrayLike<'_>,
+    qd: &ArrayLike<'_>,
+    qdd: &ArrayLike<'_>,
+    tau: Option<&ArrayLike<'_>>,
+) -> Result<Vec<Vec<f64>>> {
     let mut args = vec![("q", q), ("qd", qd), ("qdd", qdd)];
     if let Some(t) = tau {
         args.push(("tau", t));
@@ -263,11 +343,26 @@ impl PyBaseModel {
         self.fit.samples
     }
     /// Predicted torques (N m) at `q`, `qd`, `qdd`: (n,) each or (k, n).
-    fn predict<'py>(&self, py: Python<'py>, q: ArrayLike<'py>, qd: ArrayLike<'py>, qdd: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
+    fn predict<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayLike<'py>,
+        qd: ArrayLike<'py>,
+        qdd: ArrayLike<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.model.nv;
         let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
         let c = &batch.columns;
-        let tau = py.detach(|| self.fit.predict(&self.model, &Batch { q: &c[0], qd: &c[1], qdd: &c[2] }))?;
+        let tau = py.detach(|| {
+            self.fit.predict(
+                &self.model,
+                &Batch {
+                    q: &c[0],
+                    qd: &c[1],
+                    qdd: &c[2],
+                },
+            )
+        })?;
         to_numpy(py, tau, batch.k, batch.single, &[n])
     }
     /// M(q) from the identified parameters: (n, n), or (k, n, n) for q of shape (k, n).
@@ -276,7 +371,10 @@ impl PyBaseModel {
         let batch = read_batch(n, &[("q", &q)])?;
         let mut out = Vec::with_capacity(batch.k * n * n);
         for s in 0..batch.k {
-            let m = self.fit.mass_matrix(&self.model, &batch.columns[0][s * n..(s + 1) * n]).map_err(|e| batch.in_sample(s, e))?;
+            let m = self
+                .fit
+                .mass_matrix(&self.model, &batch.columns[0][s * n..(s + 1) * n])
+                .map_err(|e| batch.in_sample(s, e))?;
             out.extend(m.transpose().iter());
         }
         to_numpy(py, out, batch.k, batch.single, &[n, n])
@@ -285,7 +383,13 @@ impl PyBaseModel {
         serde_json::to_string_pretty(&self.fit).expect("serialisable")
     }
     fn __repr__(&self) -> String {
-        format!("BaseParameterModel(robot='{}', base parameters={}, samples={}, cond={:.4})", self.fit.robot, self.fit.theta.len(), self.fit.samples, self.fit.cond)
+        format!(
+            "BaseParameterModel(robot='{}', base parameters={}, samples={}, cond={:.4})",
+            self.fit.robot,
+            self.fit.theta.len(),
+            self.fit.samples,
+            self.fit.cond
+        )
     }
 }
 
@@ -312,17 +416,44 @@ pub(crate) fn identify_base_parameters(
     let weighting = match weighting {
         "wls" => Weighting::Wls,
         "ols" => Weighting::Ols,
-        other => return Err(Error::InvalidArgument { argument: "weighting".into(), message: format!("'{other}'; expected 'ols' or 'wls'") }.into()),
+        other => {
+            return Err(Error::InvalidArgument {
+                argument: "weighting".into(),
+                message: format!("'{other}'; expected 'ols' or 'wls'"),
+            }
+            .into())
+        }
     };
     let friction = match friction {
         Some(f) => friction_terms(&f)?,
         None => FrictionTerms::ALL,
     };
-    let options = BaseOptions { friction, weighting, gravity, tolerance, seed, ..BaseOptions::default() };
+    let options = BaseOptions {
+        friction,
+        weighting,
+        gravity,
+        tolerance,
+        seed,
+        ..BaseOptions::default()
+    };
     let model = &robot.model;
     let c = states(model.nv, &q, &qd, &qdd, Some(&tau))?;
-    let fit = py.detach(|| base_rs(model, &Batch { q: &c[0], qd: &c[1], qdd: &c[2] }, &c[3], &options))?;
-    Ok(PyBaseModel { fit, model: Arc::new(model.clone()) })
+    let fit = py.detach(|| {
+        base_rs(
+            model,
+            &Batch {
+                q: &c[0],
+                qd: &c[1],
+                qdd: &c[2],
+            },
+            &c[3],
+            &options,
+        )
+    })?;
+    Ok(PyBaseModel {
+        fit,
+        model: Arc::new(model.clone()),
+    })
 }
 
 /// The globally linearised model: constant D, H, G and an offset about an operating point.
@@ -356,7 +487,10 @@ impl PyGlobalLinear {
         let n = self.fit.offset.len();
         let s = &self.fit.stderr;
         let d = PyDict::new(py);
-        d.set_item("torque", PyArray1::from_iter(py, s.column(0).iter().copied()))?;
+        d.set_item(
+            "torque",
+            PyArray1::from_iter(py, s.column(0).iter().copied()),
+        )?;
         for (k, name) in ["D", "H", "G"].iter().enumerate() {
             d.set_item(*name, mat(py, &s.columns(1 + k * n, n).into_owned())?)?;
         }
@@ -372,17 +506,30 @@ impl PyGlobalLinear {
     }
     #[getter]
     fn op(&self) -> PyOperatingPoint {
-        PyOperatingPoint { op: self.fit.op.clone() }
+        PyOperatingPoint {
+            op: self.fit.op.clone(),
+        }
     }
     /// `T + D (qdd - qdd*) + H (qd - qd*) + G (q - q*)`: (n,) each or (k, n).
-    fn predict<'py>(&self, py: Python<'py>, q: ArrayLike<'py>, qd: ArrayLike<'py>, qdd: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
+    fn predict<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayLike<'py>,
+        qd: ArrayLike<'py>,
+        qdd: ArrayLike<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let f = &self.fit;
         let n = f.offset.len();
         let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
         let mut out = Vec::with_capacity(batch.k * n);
         for s in 0..batch.k {
-            let x = |c: usize, o: &[f64]| nalgebra::DVector::from_fn(n, |j, _| batch.columns[c][s * n + j] - o[j]);
-            let tau = nalgebra::DVector::from_column_slice(&f.offset) + &f.d * x(2, &f.op.qdd) + &f.h * x(1, &f.op.qd) + &f.g * x(0, &f.op.q);
+            let x = |c: usize, o: &[f64]| {
+                nalgebra::DVector::from_fn(n, |j, _| batch.columns[c][s * n + j] - o[j])
+            };
+            let tau = nalgebra::DVector::from_column_slice(&f.offset)
+                + &f.d * x(2, &f.op.qdd)
+                + &f.h * x(1, &f.op.qd)
+                + &f.g * x(0, &f.op.q);
             out.extend(tau.iter());
         }
         to_numpy(py, out, batch.k, batch.single, &[n])
@@ -403,7 +550,17 @@ pub(crate) fn identify_global_linear(
     tau: ArrayLike<'_>,
 ) -> PyResult<PyGlobalLinear> {
     let c = states(op.op.n(), &q, &qd, &qdd, Some(&tau))?;
-    let fit = py.detach(|| global_rs(&op.op, &Batch { q: &c[0], qd: &c[1], qdd: &c[2] }, &c[3]))?;
+    let fit = py.detach(|| {
+        global_rs(
+            &op.op,
+            &Batch {
+                q: &c[0],
+                qd: &c[1],
+                qdd: &c[2],
+            },
+            &c[3],
+        )
+    })?;
     Ok(PyGlobalLinear { fit })
 }
 
@@ -430,7 +587,14 @@ pub(crate) fn preprocess(
     name: &str,
 ) -> PyResult<PyRecording> {
     let rec = PyRecording::build(t, q, tau, qd, None, name)?;
-    let options = PreprocessOptions { rate, cutoff, order, filter_position, trim, decimate };
+    let options = PreprocessOptions {
+        rate,
+        cutoff,
+        order,
+        filter_position,
+        trim,
+        decimate,
+    };
     let out: Recording = py.detach(|| preprocess_rs(&rec, &options))?;
     Ok(PyRecording { rec: Arc::new(out) })
 }

@@ -66,9 +66,7 @@ impl From<Error> for PyErr {
             | Error::LimitViolation { .. }
             | Error::PositionLimit { .. }
             | Error::Recording { .. }
-            | Error::Json { .. } => {
-                InputError::new_err(msg)
-            }
+            | Error::Json { .. } => InputError::new_err(msg),
             Error::Numerical { .. } | Error::RankDeficient { .. } => NumericalError::new_err(msg),
             Error::UrdfSyntax { .. }
             | Error::UnsupportedJoint { .. }

@@ -11,8 +11,9 @@ use super::arrays::{matrix_to_numpy as mat, read_batch, to_numpy};
 use super::robot::PyRobot;
 use crate::error::{Error, Result};
 use crate::local::{
-    identify_local as identify_rs, plan_experiments as plan_rs, CrossingTimes, Design, Estimate, Estimator,
-    ExperimentKind, FitOptions, IdentifyOptions, LocalModel, OperatingPoint, Plan, PlanOptions, Size,
+    identify_local as identify_rs, plan_experiments as plan_rs, CrossingTimes, Design, Estimate,
+    Estimator, ExperimentKind, FitOptions, IdentifyOptions, LocalModel, OperatingPoint, Plan,
+    PlanOptions, Size,
 };
 use crate::recording::Recording;
 use crate::simulation::{simulate_plan, Friction, SimulationOptions};
@@ -37,14 +38,23 @@ fn per_joint(name: &str, value: &Bound<'_, PyAny>, n: usize) -> PyResult<Vec<f64
         message: "expected a number or a sequence of numbers".into(),
     })?;
     if arr.shape() != [n] {
-        return Err(Error::Shape { argument: name.into(), expected: format!("a number or shape ({n},)"), got: format!("shape {:?}", arr.shape()) }.into());
+        return Err(Error::Shape {
+            argument: name.into(),
+            expected: format!("a number or shape ({n},)"),
+            got: format!("shape {:?}", arr.shape()),
+        }
+        .into());
     }
     Ok(arr.as_array().iter().copied().collect())
 }
 
 fn vector(name: &str, a: &ArrayLike<'_>) -> Result<Vec<f64>> {
     if a.ndim() != 1 {
-        return Err(Error::Shape { argument: name.into(), expected: "a 1-D array".into(), got: format!("shape {:?}", a.shape()) });
+        return Err(Error::Shape {
+            argument: name.into(),
+            expected: "a 1-D array".into(),
+            got: format!("shape {:?}", a.shape()),
+        });
     }
     Ok(a.as_array().iter().copied().collect())
 }
@@ -61,7 +71,9 @@ pub(crate) struct PyOperatingPoint {
 impl PyOperatingPoint {
     #[new]
     fn new(q: ArrayLike<'_>, qd: ArrayLike<'_>, qdd: ArrayLike<'_>) -> PyResult<Self> {
-        Ok(Self { op: OperatingPoint::new(vector("q", &q)?, vector("qd", &qd)?, vector("qdd", &qdd)?)? })
+        Ok(Self {
+            op: OperatingPoint::new(vector("q", &q)?, vector("qd", &qd)?, vector("qdd", &qdd)?)?,
+        })
     }
     #[getter]
     fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
@@ -81,7 +93,10 @@ impl PyOperatingPoint {
         self.op.n()
     }
     fn __repr__(&self) -> String {
-        format!("OperatingPoint(q={:?}, qd={:?}, qdd={:?})", self.op.q, self.op.qd, self.op.qdd)
+        format!(
+            "OperatingPoint(q={:?}, qd={:?}, qdd={:?})",
+            self.op.q, self.op.qd, self.op.qdd
+        )
     }
 }
 
@@ -96,7 +111,9 @@ pub(crate) struct PyPlan {
 impl PyPlan {
     #[getter]
     fn op(&self) -> PyOperatingPoint {
-        PyOperatingPoint { op: self.plan.op.clone() }
+        PyOperatingPoint {
+            op: self.plan.op.clone(),
+        }
     }
     /// Sampling rate of the trajectories (Hz).
     #[getter]
@@ -118,16 +135,29 @@ impl PyPlan {
     /// The experiments, in order.
     #[getter]
     fn experiments(&self) -> Vec<PyExperiment> {
-        (0..self.plan.experiments.len()).map(|index| PyExperiment { plan: self.plan.clone(), index }).collect()
+        (0..self.plan.experiments.len())
+            .map(|index| PyExperiment {
+                plan: self.plan.clone(),
+                index,
+            })
+            .collect()
     }
     /// The experiment named `kind` ('nominal', 'G_static', 'G', 'H' or 'D').
     fn experiment(&self, kind: &str) -> PyResult<PyExperiment> {
         let k = ExperimentKind::parse(kind)?;
-        let index = self.plan.experiments.iter().position(|e| e.kind == k).ok_or_else(|| Error::InvalidArgument {
-            argument: "kind".into(),
-            message: format!("the plan has no '{kind}' experiment"),
-        })?;
-        Ok(PyExperiment { plan: self.plan.clone(), index })
+        let index = self
+            .plan
+            .experiments
+            .iter()
+            .position(|e| e.kind == k)
+            .ok_or_else(|| Error::InvalidArgument {
+                argument: "kind".into(),
+                message: format!("the plan has no '{kind}' experiment"),
+            })?;
+        Ok(PyExperiment {
+            plan: self.plan.clone(),
+            index,
+        })
     }
     fn __len__(&self) -> usize {
         self.plan.experiments.len()
@@ -138,11 +168,23 @@ impl PyPlan {
     }
     #[staticmethod]
     fn from_json(text: &str) -> PyResult<Self> {
-        Ok(Self { plan: Arc::new(Plan::from_json(text)?) })
+        Ok(Self {
+            plan: Arc::new(Plan::from_json(text)?),
+        })
     }
     fn __repr__(&self) -> String {
-        let kinds: Vec<String> = self.plan.experiments.iter().map(|e| format!("{}: {:.1} s", e.kind.name(), e.duration())).collect();
-        format!("Plan(robot='{}', rate={} Hz, experiments=[{}])", self.plan.robot, self.plan.rate, kinds.join(", "))
+        let kinds: Vec<String> = self
+            .plan
+            .experiments
+            .iter()
+            .map(|e| format!("{}: {:.1} s", e.kind.name(), e.duration()))
+            .collect();
+        format!(
+            "Plan(robot='{}', rate={} Hz, experiments=[{}])",
+            self.plan.robot,
+            self.plan.rate,
+            kinds.join(", ")
+        )
     }
 }
 
@@ -191,7 +233,15 @@ impl PyExperiment {
     }
     #[getter]
     fn crossing_times<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        vec1(py, &self.exp().crossings.iter().map(|c| c.time).collect::<Vec<_>>())
+        vec1(
+            py,
+            &self
+                .exp()
+                .crossings
+                .iter()
+                .map(|c| c.time)
+                .collect::<Vec<_>>(),
+        )
     }
     /// G-static only: time (s) of the reference rest posture at `q*`; otherwise None.
     #[getter]
@@ -214,7 +264,12 @@ impl PyExperiment {
     }
     fn __repr__(&self) -> String {
         let e = self.exp();
-        format!("Experiment('{}', crossings={}, duration={:.2} s)", e.kind.name(), e.crossings.len(), e.duration())
+        format!(
+            "Experiment('{}', crossings={}, duration={:.2} s)",
+            e.kind.name(),
+            e.crossings.len(),
+            e.duration()
+        )
     }
 }
 
@@ -276,10 +331,15 @@ pub(crate) fn plan_experiments(
     options.sizes.velocity = size("dqd", &dqd, dqd_fraction)?;
     options.sizes.acceleration = size("dqdd", &dqdd, dqdd_fraction)?;
     if let Some(list) = experiments {
-        options.experiments = list.iter().map(|k| ExperimentKind::parse(k)).collect::<Result<_>>()?;
+        options.experiments = list
+            .iter()
+            .map(|k| ExperimentKind::parse(k))
+            .collect::<Result<_>>()?;
     }
     let plan = py.detach(|| plan_rs(&robot.model, &op.op, &options))?;
-    Ok(PyPlan { plan: Arc::new(plan) })
+    Ok(PyPlan {
+        plan: Arc::new(plan),
+    })
 }
 
 /// A recording of one run: `t` (s, `(m,)`, increasing), `q` (rad, `(m, n)`), `tau` (N m,
@@ -290,13 +350,23 @@ pub(crate) struct PyRecording {
     pub rec: Arc<Recording>,
 }
 
-fn matrix_rows(name: &str, a: &ArrayLike<'_>, m: usize, n: Option<usize>) -> Result<(usize, Vec<f64>)> {
+fn matrix_rows(
+    name: &str,
+    a: &ArrayLike<'_>,
+    m: usize,
+    n: Option<usize>,
+) -> Result<(usize, Vec<f64>)> {
     let shape = a.shape().to_vec();
     match shape.as_slice() {
-        [rows, cols] if *rows == m && n.is_none_or(|n| n == *cols) => Ok((*cols, a.as_array().iter().copied().collect())),
+        [rows, cols] if *rows == m && n.is_none_or(|n| n == *cols) => {
+            Ok((*cols, a.as_array().iter().copied().collect()))
+        }
         _ => Err(Error::Shape {
             argument: name.into(),
-            expected: format!("shape ({m}, {}) like t", n.map_or("n".to_string(), |n| n.to_string())),
+            expected: format!(
+                "shape ({m}, {}) like t",
+                n.map_or("n".to_string(), |n| n.to_string())
+            ),
             got: format!("shape {shape:?}"),
         }),
     }
@@ -304,13 +374,24 @@ fn matrix_rows(name: &str, a: &ArrayLike<'_>, m: usize, n: Option<usize>) -> Res
 
 impl PyRecording {
     /// A checked recording from numpy arrays.
-    pub(crate) fn build(t: ArrayLike<'_>, q: ArrayLike<'_>, tau: ArrayLike<'_>, qd: Option<ArrayLike<'_>>, qdd: Option<ArrayLike<'_>>, name: &str) -> Result<Recording> {
+    pub(crate) fn build(
+        t: ArrayLike<'_>,
+        q: ArrayLike<'_>,
+        tau: ArrayLike<'_>,
+        qd: Option<ArrayLike<'_>>,
+        qdd: Option<ArrayLike<'_>>,
+        name: &str,
+    ) -> Result<Recording> {
         let t = vector("t", &t)?;
         let m = t.len();
         let (n, q) = matrix_rows("q", &q, m, None)?;
         let (_, tau) = matrix_rows("tau", &tau, m, Some(n))?;
-        let qd = qd.map(|a| matrix_rows("qd", &a, m, Some(n)).map(|r| r.1)).transpose()?;
-        let qdd = qdd.map(|a| matrix_rows("qdd", &a, m, Some(n)).map(|r| r.1)).transpose()?;
+        let qd = qd
+            .map(|a| matrix_rows("qd", &a, m, Some(n)).map(|r| r.1))
+            .transpose()?;
+        let qdd = qdd
+            .map(|a| matrix_rows("qdd", &a, m, Some(n)).map(|r| r.1))
+            .transpose()?;
         Recording::new(name, n, t, q, tau, qd, qdd)
     }
 }
@@ -319,8 +400,17 @@ impl PyRecording {
 impl PyRecording {
     #[new]
     #[pyo3(signature = (t, q, tau, qd=None, qdd=None, name="recording"))]
-    fn new(t: ArrayLike<'_>, q: ArrayLike<'_>, tau: ArrayLike<'_>, qd: Option<ArrayLike<'_>>, qdd: Option<ArrayLike<'_>>, name: &str) -> PyResult<Self> {
-        Ok(Self { rec: Arc::new(Self::build(t, q, tau, qd, qdd, name)?) })
+    fn new(
+        t: ArrayLike<'_>,
+        q: ArrayLike<'_>,
+        tau: ArrayLike<'_>,
+        qd: Option<ArrayLike<'_>>,
+        qdd: Option<ArrayLike<'_>>,
+        name: &str,
+    ) -> PyResult<Self> {
+        Ok(Self {
+            rec: Arc::new(Self::build(t, q, tau, qd, qdd, name)?),
+        })
     }
     #[getter]
     fn name(&self) -> String {
@@ -344,17 +434,30 @@ impl PyRecording {
     }
     #[getter]
     fn qd<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
-        self.rec.qd.as_ref().map(|v| rows(py, v, self.rec.n)).transpose()
+        self.rec
+            .qd
+            .as_ref()
+            .map(|v| rows(py, v, self.rec.n))
+            .transpose()
     }
     #[getter]
     fn qdd<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
-        self.rec.qdd.as_ref().map(|v| rows(py, v, self.rec.n)).transpose()
+        self.rec
+            .qdd
+            .as_ref()
+            .map(|v| rows(py, v, self.rec.n))
+            .transpose()
     }
     fn __len__(&self) -> usize {
         self.rec.len()
     }
     fn __repr__(&self) -> String {
-        format!("Recording('{}', samples={}, joints={})", self.rec.name, self.rec.len(), self.rec.n)
+        format!(
+            "Recording('{}', samples={}, joints={})",
+            self.rec.name,
+            self.rec.len(),
+            self.rec.n
+        )
     }
 }
 
@@ -402,7 +505,10 @@ pub(crate) fn simulate(
                     None => Ok(vec![0.0; n]),
                 }
             };
-            Friction { viscous: get("viscous")?, coulomb: get("coulomb")? }
+            Friction {
+                viscous: get("viscous")?,
+                coulomb: get("coulomb")?,
+            }
         }
     };
     for (target, name, value) in [
@@ -416,7 +522,10 @@ pub(crate) fn simulate(
     }
     let plan = plan.plan.clone();
     let recs = py.detach(|| simulate_plan(model, &plan, &o))?;
-    Ok(recs.into_iter().map(|r| PyRecording { rec: Arc::new(r) }).collect())
+    Ok(recs
+        .into_iter()
+        .map(|r| PyRecording { rec: Arc::new(r) })
+        .collect())
 }
 
 /// Identifies the local model from `plan` and `recordings` (one per experiment, in order).
@@ -454,7 +563,11 @@ pub(crate) fn identify_local(
     };
     let options = IdentifyOptions {
         times,
-        fit: FitOptions { window, torque_degree, recorded_derivatives },
+        fit: FitOptions {
+            window,
+            torque_degree,
+            recorded_derivatives,
+        },
         estimator: Estimator::parse(estimator)?,
     };
     let recs: Vec<Recording> = recordings.iter().map(|r| (*r.get().rec).clone()).collect();
@@ -480,9 +593,18 @@ pub(crate) struct PyLocalModel {
 impl PyLocalModel {
     fn parts(&self) -> [(&'static str, &Option<Estimate>); 4] {
         let m = &self.model;
-        [("D", &m.d), ("H", &m.h), ("G", &m.g), ("G_static", &m.g_static)]
+        [
+            ("D", &m.d),
+            ("H", &m.h),
+            ("G", &m.g),
+            ("G_static", &m.g_static),
+        ]
     }
-    fn get<'py>(&self, py: Python<'py>, e: &Option<Estimate>) -> PyResult<Option<Bound<'py, PyAny>>> {
+    fn get<'py>(
+        &self,
+        py: Python<'py>,
+        e: &Option<Estimate>,
+    ) -> PyResult<Option<Bound<'py, PyAny>>> {
         e.as_ref().map(|e| mat(py, &e.matrix)).transpose()
     }
 }
@@ -547,11 +669,15 @@ impl PyLocalModel {
     }
     #[getter]
     fn op(&self) -> PyOperatingPoint {
-        PyOperatingPoint { op: self.model.op.clone() }
+        PyOperatingPoint {
+            op: self.model.op.clone(),
+        }
     }
     #[getter]
     fn planned_op(&self) -> PyOperatingPoint {
-        PyOperatingPoint { op: self.model.planned_op.clone() }
+        PyOperatingPoint {
+            op: self.model.planned_op.clone(),
+        }
     }
     #[getter]
     fn joint_names<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
@@ -565,13 +691,22 @@ impl PyLocalModel {
         }
     }
     /// Predicted torques (N m) at `q`, `qd`, `qdd`: shape `(n,)` each or a batch `(k, n)`.
-    fn predict<'py>(&self, py: Python<'py>, q: ArrayLike<'py>, qd: ArrayLike<'py>, qdd: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
+    fn predict<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayLike<'py>,
+        qd: ArrayLike<'py>,
+        qdd: ArrayLike<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.model.n();
         let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
         let mut out = Vec::with_capacity(batch.k * n);
         for s in 0..batch.k {
             let row = |c: usize| &batch.columns[c][s * n..(s + 1) * n];
-            let tau = self.model.predict(row(0), row(1), row(2)).map_err(|e| batch.in_sample(s, e))?;
+            let tau = self
+                .model
+                .predict(row(0), row(1), row(2))
+                .map_err(|e| batch.in_sample(s, e))?;
             out.extend(tau);
         }
         to_numpy(py, out, batch.k, batch.single, &[n])
@@ -582,10 +717,21 @@ impl PyLocalModel {
     }
     #[staticmethod]
     fn from_json(text: &str) -> PyResult<Self> {
-        Ok(Self { model: LocalModel::from_json(text)? })
+        Ok(Self {
+            model: LocalModel::from_json(text)?,
+        })
     }
     fn __repr__(&self) -> String {
-        let parts: Vec<String> = self.parts().iter().filter_map(|(k, e)| e.as_ref().map(|e| format!("{k}: cond {:.3}", e.cond))).collect();
-        format!("LocalModel(robot='{}', {} estimator, {})", self.model.robot, self.estimator(), parts.join(", "))
+        let parts: Vec<String> = self
+            .parts()
+            .iter()
+            .filter_map(|(k, e)| e.as_ref().map(|e| format!("{k}: cond {:.3}", e.cond)))
+            .collect();
+        format!(
+            "LocalModel(robot='{}', {} estimator, {})",
+            self.model.robot,
+            self.estimator(),
+            parts.join(", ")
+        )
     }
 }

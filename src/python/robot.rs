@@ -289,19 +289,31 @@ impl PyRobot {
         gravity: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (n, p) = (self.model.nv, 10 * self.model.nbodies());
-        self.map_samples(py, &[("q", &q), ("qd", &qd), ("qdd", &qdd)], &[n, p], move |m, d, x, out| {
-            let mut y = std::mem::take(&mut d.regressor);
-            let r = crate::algorithms::regressor::joint_torque_regressor(m, d, x[0], x[1], x[2], gravity, &mut y);
-            copy_matrix(&y, out);
-            d.regressor = y;
-            r
-        })
+        self.map_samples(
+            py,
+            &[("q", &q), ("qd", &qd), ("qdd", &qdd)],
+            &[n, p],
+            move |m, d, x, out| {
+                let mut y = std::mem::take(&mut d.regressor);
+                let r = crate::algorithms::regressor::joint_torque_regressor(
+                    m, d, x[0], x[1], x[2], gravity, &mut y,
+                );
+                copy_matrix(&y, out);
+                d.regressor = y;
+                r
+            },
+        )
     }
 
     /// The model's own inertial parameters, shape (10 b,), in the order of `regressor`.
     #[getter]
     fn parameters<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_vec(py, crate::algorithms::regressor::model_parameters(&self.model).as_slice().to_vec())
+        PyArray1::from_vec(
+            py,
+            crate::algorithms::regressor::model_parameters(&self.model)
+                .as_slice()
+                .to_vec(),
+        )
     }
 
     /// Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) [- g(q)]). Shapes as `rnea`.

@@ -25,20 +25,33 @@ impl FourierTrajectory {
     pub fn new(w_f: f64, q0: Vec<f64>, a: DMatrix<f64>, b: DMatrix<f64>) -> Result<Self> {
         let n = q0.len();
         if !(w_f.is_finite() && w_f > 0.0) {
-            return Err(Error::InvalidArgument { argument: "base pulsation".into(), message: format!("{w_f}; expected a positive number of rad/s") });
+            return Err(Error::InvalidArgument {
+                argument: "base pulsation".into(),
+                message: format!("{w_f}; expected a positive number of rad/s"),
+            });
         }
         for (name, m) in [("a", &a), ("b", &b)] {
             if m.nrows() != n || m.ncols() == 0 || m.ncols() != a.ncols() {
                 return Err(Error::Shape {
                     argument: name.into(),
-                    expected: format!("{n} x L (one row per joint, L >= 1 harmonics, a and b alike)"),
+                    expected: format!(
+                        "{n} x L (one row per joint, L >= 1 harmonics, a and b alike)"
+                    ),
                     got: format!("{} x {}", m.nrows(), m.ncols()),
                 });
             }
         }
-        for (name, v) in [("q0", &DMatrix::from_row_slice(1, n, &q0)), ("a", &a), ("b", &b)] {
+        for (name, v) in [
+            ("q0", &DMatrix::from_row_slice(1, n, &q0)),
+            ("a", &a),
+            ("b", &b),
+        ] {
             if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-                return Err(Error::NonFiniteInput { argument: name.into(), index: i, value: v[i] });
+                return Err(Error::NonFiniteInput {
+                    argument: name.into(),
+                    index: i,
+                    value: v[i],
+                });
             }
         }
         Ok(Self { w_f, q0, a, b })

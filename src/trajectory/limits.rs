@@ -24,7 +24,9 @@ pub fn check_limits(model: &Model, samples: &Samples, context: &str, hint: &str)
             let lim = &model.limits[j];
             let [_, vu, au] = units(model.joint_kinds[j]);
             let scale = 1.0 + tol;
-            if q[j] < lim.lower - tol * lim.lower.abs().max(1.0) || q[j] > lim.upper + tol * lim.upper.abs().max(1.0) {
+            if q[j] < lim.lower - tol * lim.lower.abs().max(1.0)
+                || q[j] > lim.upper + tol * lim.upper.abs().max(1.0)
+            {
                 return Err(Error::PositionLimit {
                     context: context.to_string(),
                     joint: model.joint_names[j].clone(),

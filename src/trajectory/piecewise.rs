@@ -36,11 +36,25 @@ pub struct Segment {
 
 impl Segment {
     /// A segment of constant acceleration through `(q, qd, qdd)` at `t_ref` (eq. 11).
-    pub fn quadratic(kind: SegmentKind, t0: f64, t1: f64, t_ref: f64, q: &[f64], qd: &[f64], qdd: &[f64]) -> Self {
+    pub fn quadratic(
+        kind: SegmentKind,
+        t0: f64,
+        t1: f64,
+        t_ref: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+    ) -> Self {
         let coeffs = (0..q.len())
             .map(|j| [q[j], qd[j], 0.5 * qdd[j], 0.0, 0.0, 0.0])
             .collect();
-        Self { kind, t0, t1, t_ref, coeffs }
+        Self {
+            kind,
+            t0,
+            t1,
+            t_ref,
+            coeffs,
+        }
     }
 
     /// Joint `j`'s position, velocity and acceleration at time `t`.

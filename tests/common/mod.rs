@@ -101,4 +101,3 @@ pub fn mimic_pair(mimic: bool) -> String {
 </robot>"#
     )
 }
-
