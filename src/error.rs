@@ -215,5 +215,28 @@ pub enum Error {
     },
 }
 
+impl Error {
+    /// The error as raised at sample `s` of a batch: a non-finite entry's argument becomes
+    /// `name[s]`, a numerical failure says `(sample s)`.
+    pub fn in_sample(self, s: usize) -> Error {
+        match self {
+            Error::NonFiniteInput {
+                argument,
+                index,
+                value,
+            } => Error::NonFiniteInput {
+                argument: format!("{argument}[{s}]"),
+                index,
+                value,
+            },
+            Error::Numerical { operation, message } => Error::Numerical {
+                operation: format!("{operation} (sample {s})"),
+                message,
+            },
+            other => other,
+        }
+    }
+}
+
 /// `Result` with the library's [`Error`].
 pub type Result<T> = std::result::Result<T, Error>;

@@ -169,7 +169,7 @@ pub(crate) fn fill_regressor(
             Batch::row(batch.qdd, s, nv),
         );
         joint_torque_regressor(model, &mut data, q, qd, qdd, gravity, &mut y)
-            .map_err(|e| in_sample(e, s))?;
+            .map_err(|e| e.in_sample(s))?;
         let base = row0 + r * nv;
         out.view_mut((base, 0), (nv, ni)).copy_from(&y);
         for j in 0..nv {
@@ -183,19 +183,4 @@ pub(crate) fn fill_regressor(
         }
     }
     Ok(())
-}
-
-fn in_sample(e: Error, s: usize) -> Error {
-    match e {
-        Error::NonFiniteInput {
-            argument,
-            index,
-            value,
-        } => Error::NonFiniteInput {
-            argument: format!("{argument}[{s}]"),
-            index,
-            value,
-        },
-        other => other,
-    }
 }

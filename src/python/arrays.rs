@@ -69,22 +69,7 @@ impl Batch {
         if self.single {
             return e;
         }
-        match e {
-            Error::NonFiniteInput {
-                argument,
-                index,
-                value,
-            } => Error::NonFiniteInput {
-                argument: format!("{argument}[{s}]"),
-                index,
-                value,
-            },
-            Error::Numerical { operation, message } => Error::Numerical {
-                operation: format!("{operation} (sample {s})"),
-                message,
-            },
-            other => other,
-        }
+        e.in_sample(s)
     }
 }
 
