@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use serde::Serialize;
 
 use crate::data::Data;
@@ -182,7 +182,6 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
     }
     let mut actual_tau = Vec::with_capacity(q.len());
     let mut local_tau = Vec::with_capacity(q.len());
-    let mut global_tau = Vec::with_capacity(q.len());
     for k in 0..ts.len() {
         let r = k * n..(k + 1) * n;
         rnea(
@@ -195,13 +194,12 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
         )?;
         actual_tau.extend(data.tau.iter());
         local_tau.extend(local.predict(&q[r.clone()], &qd[r.clone()], &qdd[r.clone()])?);
-        let x = |v: &[f64], o: &[f64]| DVector::from_fn(n, |j, _| v[j] - o[j]);
-        let g = DVector::from_column_slice(&global.offset)
-            + &global.d * x(&qdd[r.clone()], &op.qdd)
-            + &global.h * x(&qd[r.clone()], &op.qd)
-            + &global.g * x(&q[r.clone()], &op.q);
-        global_tau.extend(g.iter());
     }
+    let global_tau = global.predict(&Batch {
+        q: &q,
+        qd: &qd,
+        qdd: &qdd,
+    })?;
     let base_tau = base.predict(
         &model,
         &Batch {

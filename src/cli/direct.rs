@@ -129,25 +129,6 @@ pub(crate) struct IdentifyDirectArgs {
     validate: f64,
 }
 
-fn friction_terms(names: &[String]) -> Result<FrictionTerms> {
-    let mut f = FrictionTerms::NONE;
-    for n in names {
-        match n.trim() {
-            "viscous" => f.viscous = true,
-            "coulomb" => f.coulomb = true,
-            "offset" => f.offset = true,
-            "none" | "" => {}
-            other => {
-                return Err(Error::InvalidArgument {
-                    argument: "--friction".into(),
-                    message: format!("'{other}'; expected viscous, coulomb, offset or none"),
-                })
-            }
-        }
-    }
-    Ok(f)
-}
-
 pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     let model = load_robot(&a.robot)?;
     let progress = Progress::new();
@@ -190,7 +171,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         }
     };
     let options = BaseOptions {
-        friction: friction_terms(&a.friction)?,
+        friction: FrictionTerms::from_names(&a.friction)?,
         weighting,
         gravity: !a.no_gravity,
         ..BaseOptions::default()

@@ -2,7 +2,7 @@
 //! constant `D_g`, `H_g`, `G_g` and an offset fitted to all samples of an excitation in the form
 //! `tau = T + D_g (qdd - qdd*) + H_g (qd - qd*) + G_g (q - q*)`.
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 use super::parameters::Batch;
@@ -27,6 +27,25 @@ pub struct GlobalLinearModel {
     pub stderr: DMatrix<f64>,
     pub residual_rms: Vec<f64>,
     pub cond: f64,
+}
+
+impl GlobalLinearModel {
+    /// Predicted torques (N m, row-major `k x nv`) at a batch of states:
+    /// `T + D_g (qdd - qdd*) + H_g (qd - qd*) + G_g (q - q*)`.
+    pub fn predict(&self, batch: &Batch<'_>) -> Result<Vec<f64>> {
+        let nv = self.offset.len();
+        let k = batch.samples(nv)?;
+        let mut out = Vec::with_capacity(k * nv);
+        for s in 0..k {
+            let x = |v: &[f64], o: &[f64]| DVector::from_fn(nv, |j, _| v[s * nv + j] - o[j]);
+            let tau = DVector::from_column_slice(&self.offset)
+                + &self.d * x(batch.qdd, &self.op.qdd)
+                + &self.h * x(batch.qd, &self.op.qd)
+                + &self.g * x(batch.q, &self.op.q);
+            out.extend(tau.iter());
+        }
+        Ok(out)
+    }
 }
 
 /// Fits the globally linearised model at `op` to the samples of `batch` and `tau` (row-major

@@ -35,6 +35,26 @@ impl FrictionTerms {
         offset: true,
     };
 
+    /// The terms named in `names` (`viscous`, `coulomb`, `offset`; `none` or empty for none).
+    pub fn from_names<S: AsRef<str>>(names: &[S]) -> Result<Self> {
+        let mut f = FrictionTerms::NONE;
+        for n in names {
+            match n.as_ref().trim() {
+                "viscous" => f.viscous = true,
+                "coulomb" => f.coulomb = true,
+                "offset" => f.offset = true,
+                "none" | "" => {}
+                other => {
+                    return Err(Error::InvalidArgument {
+                        argument: "friction".into(),
+                        message: format!("'{other}' is not a friction term; expected viscous, coulomb, offset or none"),
+                    })
+                }
+            }
+        }
+        Ok(f)
+    }
+
     /// Names of the terms switched on, in column order (`viscous`, `coulomb`, `offset`).
     pub fn names(&self) -> Vec<&'static str> {
         [

@@ -201,22 +201,7 @@ fn friction_terms(value: &Bound<'_, PyAny>) -> PyResult<FrictionTerms> {
         argument: "friction".into(),
         message: "expected True, False or a list of 'viscous', 'coulomb', 'offset'".into(),
     })?;
-    let mut f = FrictionTerms::NONE;
-    for n in &names {
-        match n.as_str() {
-            "viscous" => f.viscous = true,
-            "coulomb" => f.coulomb = true,
-            "offset" => f.offset = true,
-            other => {
-                return Err(Error::InvalidArgument {
-                    argument: "friction".into(),
-                    message: format!("'{other}' is not a friction term (viscous, coulomb, offset)"),
-                }
-                .into())
-            }
-        }
-    }
-    Ok(f)
+    Ok(FrictionTerms::from_names(&names)?)
 }
 
 /// Designs a Fourier excitation for `robot` minimising `criterion` ('cond' or 'logdet') of the
@@ -518,20 +503,14 @@ impl PyGlobalLinear {
         qd: ArrayLike<'py>,
         qdd: ArrayLike<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let f = &self.fit;
-        let n = f.offset.len();
+        let n = self.fit.offset.len();
         let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
-        let mut out = Vec::with_capacity(batch.k * n);
-        for s in 0..batch.k {
-            let x = |c: usize, o: &[f64]| {
-                nalgebra::DVector::from_fn(n, |j, _| batch.columns[c][s * n + j] - o[j])
-            };
-            let tau = nalgebra::DVector::from_column_slice(&f.offset)
-                + &f.d * x(2, &f.op.qdd)
-                + &f.h * x(1, &f.op.qd)
-                + &f.g * x(0, &f.op.q);
-            out.extend(tau.iter());
-        }
+        let c = &batch.columns;
+        let out = self.fit.predict(&Batch {
+            q: &c[0],
+            qd: &c[1],
+            qdd: &c[2],
+        })?;
         to_numpy(py, out, batch.k, batch.single, &[n])
     }
     fn to_json(&self) -> String {
