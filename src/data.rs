@@ -5,7 +5,7 @@
 use nalgebra::{DMatrix, DVector, Matrix6, Vector6};
 
 use crate::model::Model;
-use crate::spatial::{Force, Inertia, Motion, Se3};
+use crate::spatial::{Force, Motion, OriginInertia, Se3};
 
 /// Buffers and results. Results are in degree-of-freedom coordinates (`nv`), in the units of the
 /// joints (rad, m, N m, N).
@@ -36,7 +36,8 @@ pub struct Data {
     pub(crate) v: Vec<Motion>,
     pub(crate) a: Vec<Motion>,
     pub(crate) f: Vec<Force>,
-    pub(crate) ic: Vec<Inertia>,
+    /// Composite inertias in the base frame (mass matrix).
+    pub(crate) ycrb: Vec<OriginInertia>,
     // World-frame recursion of the derivatives.
     pub(crate) o_mi: Vec<Se3>,
     pub(crate) ov: Vec<Motion>,
@@ -89,7 +90,7 @@ impl Data {
             v: vec![Motion::zeros(); nb],
             a: vec![Motion::zeros(); nb],
             f: vec![Force::zeros(); nb],
-            ic: vec![Inertia::zeros(); nb],
+            ycrb: vec![OriginInertia::default(); nb],
             o_mi: vec![Se3::identity(); nb],
             ov: vec![Motion::zeros(); nb],
             oa_gf: vec![Motion::zeros(); nb],

@@ -11,10 +11,10 @@
 //!   ordinary joint, the URDF `<mimic>` values for a coupled joint, which adds no degree of
 //!   freedom of its own.
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
 use crate::error::{Error, Location, Result};
-use crate::spatial::{Inertia, Motion, Se3};
+use crate::spatial::{skew, Inertia, Motion, OriginInertia, Se3};
 
 /// Standard gravity (m/s^2) along -z of the base frame.
 pub const STANDARD_GRAVITY: f64 = 9.81;
@@ -53,9 +53,43 @@ pub struct Body {
     /// Joint coordinate = `multiplier * q[dof] + offset` (mimic coupling).
     pub multiplier: f64,
     pub offset: f64,
+    /// `inertia` in the form the composite-body algorithms sum.
+    pub(crate) origin_inertia: OriginInertia,
+    /// `placement` and `axis` premultiplied for [`Body::pose_in_parent`].
+    pub(crate) pose_terms: PoseTerms,
+}
+
+/// A joint's pose in its parent as a function of its coordinate `x`, premultiplied once:
+/// revolute `R(x) = R0 + sin(x) R1 + (1 - cos(x)) R2` (Rodrigues' formula with the placement's
+/// rotation `R0` folded in: `R1 = R0 [a]x`, `R2 = R0 [a]x^2`), prismatic `p(x) = p0 + x t1`
+/// with `t1 = R0 a`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct PoseTerms {
+    r1: Matrix3<f64>,
+    r2: Matrix3<f64>,
+    t1: Vector3<f64>,
+}
+
+impl PoseTerms {
+    pub(crate) fn new(placement: &Se3, axis: &Vector3<f64>) -> Self {
+        let k = skew(axis);
+        let r1 = placement.rotation * k;
+        Self {
+            r2: r1 * k,
+            r1,
+            t1: placement.rotation * axis,
+        }
+    }
 }
 
 impl Body {
+    /// Recomputes the terms the algorithms cache from `placement`, `axis` and `inertia`. The
+    /// builders call it; call [`Model::refresh`] after editing those fields of a model.
+    pub fn refresh(&mut self) {
+        self.origin_inertia = OriginInertia::from(&self.inertia);
+        self.pose_terms = PoseTerms::new(&self.placement, &self.axis);
+    }
+
     /// The joint's motion subspace: the body's twist per unit joint velocity, in its own frame.
     #[inline]
     pub fn motion_subspace(&self) -> Motion {
@@ -68,7 +102,21 @@ impl Body {
     /// Pose of this body's frame in the parent's frame at joint coordinate `x` (rad or m).
     #[inline]
     pub fn pose_in_parent(&self, x: f64) -> Se3 {
-        joint_pose(self.kind, &self.placement, &self.axis, x)
+        let p = &self.placement;
+        let t = &self.pose_terms;
+        match self.kind {
+            JointKind::Revolute => {
+                let (s, c) = x.sin_cos();
+                Se3 {
+                    rotation: p.rotation + t.r1 * s + t.r2 * (1.0 - c),
+                    translation: p.translation,
+                }
+            }
+            JointKind::Prismatic => Se3 {
+                rotation: p.rotation,
+                translation: p.translation + t.t1 * x,
+            },
+        }
     }
 }
 
@@ -110,7 +158,8 @@ pub struct Model {
     pub name: String,
     /// Where the model came from (file path, `<string>` or a built-in name).
     pub source: String,
-    /// Moving bodies in depth-first order.
+    /// Moving bodies in depth-first order. After editing a body's `placement`, `axis` or
+    /// `inertia`, call [`Model::refresh`].
     pub bodies: Vec<Body>,
     /// Number of degrees of freedom.
     pub nv: usize,
@@ -134,6 +183,14 @@ pub struct Model {
 }
 
 impl Model {
+    /// Recomputes every body's cached terms (see [`Body::refresh`]): needed after editing
+    /// `placement`, `axis` or `inertia` of a body, e.g. to simulate other inertial parameters.
+    pub fn refresh(&mut self) {
+        for b in &mut self.bodies {
+            b.refresh();
+        }
+    }
+
     /// Number of moving bodies (>= `nv` when joints are coupled).
     pub fn nbodies(&self) -> usize {
         self.bodies.len()

@@ -372,6 +372,84 @@ impl Inertia {
     }
 }
 
+/// A spatial inertia in the form that adds and moves cheaply (Featherstone's): mass `mass`
+/// (kg), first mass moment `h = m c` (kg m) and rotational inertia `i` about the frame origin
+/// (kg m^2, symmetric), all in one frame. Composite-body algorithms sum these.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OriginInertia {
+    pub mass: f64,
+    pub h: Vector3<f64>,
+    pub i: Matrix3<f64>,
+}
+
+impl Default for OriginInertia {
+    fn default() -> Self {
+        Self {
+            mass: 0.0,
+            h: Vector3::zeros(),
+            i: Matrix3::zeros(),
+        }
+    }
+}
+
+impl From<&Inertia> for OriginInertia {
+    fn from(b: &Inertia) -> Self {
+        Self {
+            mass: b.mass,
+            h: b.com * b.mass,
+            i: b.inertia_origin(),
+        }
+    }
+}
+
+impl OriginInertia {
+    /// Momentum `I v` (in this frame) of a body moving with twist `v`.
+    #[inline]
+    pub fn apply(&self, v: &Motion) -> Force {
+        Force {
+            angular: self.i * v.angular + self.h.cross(&v.linear),
+            linear: v.linear * self.mass - self.h.cross(&v.angular),
+        }
+    }
+
+    /// This inertia (given in frame b) expressed in frame a, for `x = aXb`.
+    #[inline]
+    pub fn transformed(&self, x: &Se3) -> OriginInertia {
+        let r = &x.rotation;
+        let p = &x.translation;
+        let hr = r * self.h;
+        // about a's origin: R I R^T - S(p) S(hr) - S(hr) S(p) - m S(p) S(p)
+        //                 = R I R^T - (w p^T + p w^T) + 2 (p . w) 1,  w = hr + m p / 2
+        let w = hr + p * (0.5 * self.mass);
+        let d = 2.0 * p.dot(&w);
+        let ri = r * self.i;
+        // upper triangle of R I R^T (symmetric), then the shift
+        let mut i = Matrix3::zeros();
+        for c in 0..3 {
+            for l in 0..=c {
+                let v = ri.row(l).dot(&r.row(c)) - w[l] * p[c] - p[l] * w[c];
+                i[(l, c)] = v;
+                i[(c, l)] = v;
+            }
+            i[(c, c)] += d;
+        }
+        OriginInertia {
+            mass: self.mass,
+            h: hr + p * self.mass,
+            i,
+        }
+    }
+}
+
+impl std::ops::AddAssign for OriginInertia {
+    #[inline]
+    fn add_assign(&mut self, o: OriginInertia) {
+        self.mass += o.mass;
+        self.h += o.h;
+        self.i += o.i;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -426,6 +504,23 @@ mod tests {
             (f.cross_matrix_of_motion() * m.to_vector() - m.cross_force(&f).to_vector()).norm()
                 < 1e-12
         );
+    }
+
+    #[test]
+    fn origin_inertia_agrees_with_inertia() {
+        let b = sample_inertia();
+        let x = Se3::from_xyz_rpy([0.3, -0.4, 0.1], [0.5, 0.2, -0.7]);
+        let v = Motion::new(Vector3::new(0.3, -1.0, 2.0), Vector3::new(1.5, 0.2, -0.7));
+        let direct = x.act_inertia(&b).apply(&v).to_vector();
+        let moved = OriginInertia::from(&b)
+            .transformed(&x)
+            .apply(&v)
+            .to_vector();
+        assert!((direct - moved).norm() < 1e-12);
+        let mut sum = OriginInertia::from(&b);
+        sum += OriginInertia::from(&x.act_inertia(&b));
+        let parts = b.apply(&v) + x.act_inertia(&b).apply(&v);
+        assert!((sum.apply(&v).to_vector() - parts.to_vector()).norm() < 1e-12);
     }
 
     #[test]

@@ -287,6 +287,7 @@ impl<'a> Builder<'a> {
                         unreachable!("only moving joints start bodies")
                     };
                     let axis = Vector3::from(joint.axis.xyz.0);
+                    let axis = axis / axis.norm();
                     bodies.push(Body {
                         joint: joint.name.clone(),
                         link: joint.child.link.clone(),
@@ -294,11 +295,13 @@ impl<'a> Builder<'a> {
                         subtree_end: 0,
                         placement: v.pose,
                         kind: joint_kind(&joint.joint_type),
-                        axis: axis / axis.norm(),
+                        axis,
                         inertia: Inertia::zeros(),
                         dof: usize::MAX,
                         multiplier,
                         offset,
+                        origin_inertia: Default::default(),
+                        pose_terms: Default::default(),
                     });
                     body_joint.push(j);
                     (Some(bodies.len() - 1), Se3::identity())
@@ -380,8 +383,9 @@ impl<'a> Builder<'a> {
         }
         // Subtree ranges (children come after their parent in pre-order).
         let n = bodies.len();
-        for i in 0..n {
-            bodies[i].subtree_end = i + 1;
+        for (i, b) in bodies.iter_mut().enumerate() {
+            b.subtree_end = i + 1;
+            b.refresh();
         }
         for i in (0..n).rev() {
             if let Some(p) = bodies[i].parent {

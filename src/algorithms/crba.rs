@@ -1,4 +1,6 @@
-//! Composite rigid body algorithm for the mass matrix (Featherstone, RBDA Table 6.2).
+//! Composite rigid body algorithm for the mass matrix (Featherstone, RBDA Table 6.2), run in the
+//! base frame as Pinocchio does: composite inertias are summed there, and each column's
+//! momentum `Ic_i S_i` is projected on every ancestor's motion subspace by a dot product.
 
 use nalgebra::DMatrix;
 
@@ -27,24 +29,30 @@ pub fn mass_matrix(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
 
 /// CRBA over bodies with poses in `data.li_mi`; fills the body-level matrix `out`.
 fn crba_bodies(model: &Model, data: &mut Data, out: &mut DMatrix<f64>) {
+    // base-frame poses, motion subspaces and inertias
     for (i, b) in model.bodies.iter().enumerate() {
-        data.ic[i] = b.inertia;
+        let x = match b.parent {
+            Some(p) => data.o_mi[p].compose(&data.li_mi[i]),
+            None => data.li_mi[i],
+        };
+        data.s_world[i] = x.act_motion(&b.motion_subspace());
+        data.ycrb[i] = b.origin_inertia.transformed(&x);
+        data.o_mi[i] = x;
     }
-    for i in (0..model.nbodies()).rev() {
-        let b = &model.bodies[i];
-        let mut f = data.ic[i].apply(&b.motion_subspace());
-        out[(i, i)] = b.motion_subspace().dot(&f);
-        let mut j = i;
-        while let Some(p) = model.bodies[j].parent {
-            f = data.li_mi[j].act_force(&f);
-            j = p;
-            let mij = model.bodies[j].motion_subspace().dot(&f);
-            out[(i, j)] = mij;
-            out[(j, i)] = mij;
+    let n = model.nbodies();
+    let m = out.as_mut_slice(); // column-major n x n
+    for i in (0..n).rev() {
+        let f = data.ycrb[i].apply(&data.s_world[i]);
+        let mut j = Some(i);
+        while let Some(k) = j {
+            let mik = data.s_world[k].dot(&f);
+            m[i + k * n] = mik;
+            m[k + i * n] = mik;
+            j = model.bodies[k].parent;
         }
-        if let Some(p) = b.parent {
-            let child = data.li_mi[i].act_inertia(&data.ic[i]);
-            data.ic[p] = data.ic[p].add(&child);
+        if let Some(p) = model.bodies[i].parent {
+            let child = data.ycrb[i];
+            data.ycrb[p] += child;
         }
     }
 }

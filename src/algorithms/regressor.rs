@@ -8,7 +8,7 @@ use super::load_state;
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::spatial::{Force, Inertia, Motion};
+use crate::spatial::{Force, Inertia, Motion, Se3};
 
 /// Number of inertial parameters per body.
 pub const PARAMS_PER_BODY: usize = 10;
@@ -89,6 +89,48 @@ pub fn body_regressor(v: &Motion, a: &Motion) -> [Force; 10] {
     out
 }
 
+/// [`body_regressor`] expressed in the base frame, for a body at pose `x` (`oXi`): column `c`
+/// is `x.act_force(&body_regressor(v, a)[c])`. The six rotational-inertia columns have no force
+/// part (`linear == 0`) in any frame.
+#[inline]
+pub fn world_body_regressor(v: &Motion, a: &Motion, x: &Se3) -> [Force; 10] {
+    let (r, p) = (&x.rotation, &x.translation);
+    let (w, al) = (v.angular, a.angular);
+    let ac = r * (a.linear + w.cross(&v.linear)); // classical acceleration of the origin
+    let (ww, alw) = (r * w, r * al);
+    let w2 = w.norm_squared();
+    let mut out = [Force::zeros(); 10];
+    out[0] = Force {
+        angular: p.cross(&ac),
+        linear: ac,
+    };
+    for k in 0..3 {
+        // R (e_k x ac_local) = r_k x ac;  R (al x e_k + w x (w x e_k)) = alw x r_k + ww w_k - r_k |w|^2
+        let rk: Vector3<f64> = r.column(k).into();
+        let linear = alw.cross(&rk) + ww * w[k] - rk * w2;
+        out[1 + k] = Force {
+            angular: rk.cross(&ac) + p.cross(&linear),
+            linear,
+        };
+    }
+    // I_p x for the unit inertias of [Ixx, Ixy, Iyy, Ixz, Iyz, Izz], then rotated
+    let unit = |x: &Vector3<f64>| {
+        [
+            Vector3::new(x.x, 0.0, 0.0),
+            Vector3::new(x.y, x.x, 0.0),
+            Vector3::new(0.0, x.y, 0.0),
+            Vector3::new(x.z, 0.0, x.x),
+            Vector3::new(0.0, x.z, x.y),
+            Vector3::new(0.0, 0.0, x.z),
+        ]
+    };
+    let (ia, iw) = (unit(&al), unit(&w));
+    for q in 0..6 {
+        out[4 + q].angular = r * (ia[q] + w.cross(&iw[q]));
+    }
+    out
+}
+
 /// The joint-torque regressor at `(q, qd, qdd)` (length `model.nv` each; rad, rad/s, rad/s^2):
 /// writes `out` (`nv x 10 nbodies`, N m per parameter unit) such that
 /// `out * theta = rnea(q, qd, qdd)`, with `theta` from [`model_parameters`] ordering (body
@@ -123,19 +165,44 @@ pub fn joint_torque_regressor(
         data.s_world[i] = data.o_mi[i].act_motion(&b.motion_subspace());
     }
     out.fill(0.0);
+    let nv = model.nv;
+    let o = out.as_mut_slice(); // column-major nv x 10 nb
     for i in 0..nb {
-        let columns = body_regressor(&data.v[i], &data.a[i]);
-        let x = data.o_mi[i];
-        for (c, f) in columns.iter().enumerate() {
-            let fw = x.act_force(f);
-            let col = PARAMS_PER_BODY * i + c;
-            let mut j = Some(i);
-            while let Some(k) = j {
-                let b = &model.bodies[k];
-                out[(b.dof, col)] += b.multiplier * data.s_world[k].dot(&fw);
-                j = b.parent;
+        let columns = world_body_regressor(&data.v[i], &data.a[i], &data.o_mi[i]);
+        let first = PARAMS_PER_BODY * i * nv;
+        let mut j = Some(i);
+        while let Some(k) = j {
+            let b = &model.bodies[k];
+            let s = &data.s_world[k];
+            let (w, l) = (s.angular * b.multiplier, s.linear * b.multiplier);
+            let at = |c: usize| first + c * nv + b.dof;
+            // mass and first moments: full wrenches; rotational inertias: moments only
+            for (c, f) in columns[..4].iter().enumerate() {
+                o[at(c)] += w.dot(&f.angular) + l.dot(&f.linear);
             }
+            for (c, f) in columns[4..].iter().enumerate() {
+                o[at(4 + c)] += w.dot(&f.angular);
+            }
+            j = b.parent;
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn world_columns_are_the_moved_body_columns() {
+        let v = Motion::new(Vector3::new(0.3, -1.0, 2.0), Vector3::new(1.5, 0.2, -0.7));
+        let a = Motion::new(Vector3::new(-0.2, 0.4, 0.1), Vector3::new(0.5, -0.3, 9.9));
+        let x = Se3::from_xyz_rpy([0.1, 0.2, -0.3], [0.4, -0.5, 0.6]);
+        let local = body_regressor(&v, &a);
+        let world = world_body_regressor(&v, &a, &x);
+        for (l, w) in local.iter().zip(&world) {
+            let moved = x.act_force(l).to_vector();
+            assert!((moved - w.to_vector()).norm() < 1e-12, "{moved} vs {w:?}");
+        }
+    }
 }
