@@ -616,11 +616,11 @@ fn panda_real_data_matches_the_reference() {
     );
 }
 
-/// The chunked TSQR solve equals one dense least-squares solve over the whole regressor
+/// The per-joint TSQR solve equals one dense least-squares solve over the whole regressor
 /// (coefficients, standard errors, cond), across several chunks and with noise.
 #[test]
 fn streaming_solve_equals_the_dense_solve() {
-    use perturbid_rs::direct::streaming::{residual_rms, solve, CHUNK};
+    use perturbid_rs::direct::streaming::{JointFactors, CHUNK};
     use perturbid_rs::regression::least_squares;
     let model = a465::model("physical").unwrap();
     let layout = ParameterLayout::new(&model, FrictionTerms::ALL);
@@ -637,7 +637,8 @@ fn streaming_solve_equals_the_dense_solve() {
     };
     let sigma = [1.0, 2.0, 0.5, 1.0, 1.5, 0.7];
     let names = base.names();
-    let streamed = solve(&model, &base, &batch, &tau, true, &sigma, &names).unwrap();
+    let factors = JointFactors::new(&model, &base, &batch, &tau, true).unwrap();
+    let streamed = factors.solve(&sigma, &names).unwrap();
     let mut phi = base.select(&regressor_matrix(&model, &layout, &batch, true).unwrap());
     let mut y = DMatrix::from_column_slice(k * 6, 1, &tau);
     for r in 0..k * 6 {
@@ -652,6 +653,17 @@ fn streaming_solve_equals_the_dense_solve() {
     );
     assert!((&streamed.stderr - &dense.stderr).amax() < 1e-8 * dense.stderr.amax());
     assert!((streamed.cond - dense.cond).abs() < 1e-6 * dense.cond);
-    let rms = residual_rms(&model, &base, &batch, &tau, true, streamed.coef.as_slice()).unwrap();
+    // the per-joint residuals from the factors equal the ones computed directly
+    let rms = factors.residual_rms(streamed.coef.as_slice()).unwrap();
+    let full = base.select(&regressor_matrix(&model, &layout, &batch, true).unwrap());
+    let r = DMatrix::from_column_slice(k * 6, 1, &tau) - full * streamed.coef.transpose();
+    for j in 0..6 {
+        let direct = ((0..k).map(|s| r[s * 6 + j].powi(2)).sum::<f64>() / k as f64).sqrt();
+        assert!(
+            (rms[j] - direct).abs() < 1e-12 * direct,
+            "joint {j}: {} vs {direct}",
+            rms[j]
+        );
+    }
     assert!(rms.iter().all(|r| (0.05..0.07).contains(r)), "{rms:?}"); // uniform +-0.1: 0.0577
 }

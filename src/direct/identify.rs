@@ -110,12 +110,14 @@ pub fn identify_base_parameters(
     let names = base.names();
     let g = options.gravity;
     let mut sigma = vec![1.0; nv];
-    let mut ls = streaming::solve(model, &base, batch, tau, g, &sigma, &names)?;
-    let mut rms = streaming::residual_rms(model, &base, batch, tau, g, ls.coef.as_slice())?;
+    // one pass over the samples; OLS, the WLS weights and the WLS fit all come from it
+    let factors = streaming::JointFactors::new(model, &base, batch, tau, g)?;
+    let mut ls = factors.solve(&sigma, &names)?;
+    let mut rms = factors.residual_rms(ls.coef.as_slice())?;
     if options.weighting == Weighting::Wls {
         sigma = rms.iter().map(|&s| if s > 0.0 { s } else { 1.0 }).collect();
-        ls = streaming::solve(model, &base, batch, tau, g, &sigma, &names)?;
-        rms = streaming::residual_rms(model, &base, batch, tau, g, ls.coef.as_slice())?;
+        ls = factors.solve(&sigma, &names)?;
+        rms = factors.residual_rms(ls.coef.as_slice())?;
     }
     Ok(BaseModel {
         format: BASE_MODEL_FORMAT.into(),

@@ -1,152 +1,347 @@
-//! Base-parameter least squares that scale to 10^5-10^6 samples without the whole regressor
-//! in memory: the weighted system `[Phi_base | tau]` is reduced chunk by chunk (in parallel) to
-//! its `(p + 1) x (p + 1)` triangular factor by QR, and the factors are reduced again (TSQR).
-//! Memory: one chunk's regressor per thread (`CHUNK * nv * (P + 1)` values; about 9 MB for a
-//! 7-dof arm with friction) plus `(p + 1)^2` per chunk. QR keeps the conditioning of the
-//! regressor (normal equations would square it).
+//! Base-parameter least squares that scale to 10^5-10^6 samples in one pass over the data and
+//! without the whole regressor in memory.
+//!
+//! The system `[Phi_base | tau]` is split by joint: the rows of joint `j` (one per sample) are
+//! reduced, chunk by chunk and in parallel, to their `(p + 1) x (p + 1)` triangular QR factor
+//! `R_j` (a TSQR per joint). Those `nv` factors hold everything the fits need, exactly:
+//! - any per-joint weighting `1 / sigma_j`: the weighted system's factor is the QR of the
+//!   stacked `R_j / sigma_j`, so OLS and then WLS need no second pass over the samples;
+//! - the per-joint residuals of any `theta`: `|tau_j - Phi_j theta| = |R_j [theta; -1]|`.
+//!
+//! QR keeps the conditioning of the regressor (normal equations would square it).
+//! Memory: per worker (about two per core), one chunk of every joint, `nv * (CHUNK + p + 1) *
+//! (p + 1)` values (3.4 MB for a 6-dof arm with 36 base parameters, 7.8 MB for a 7-dof arm with
+//! friction), plus the `nv` factors; never the whole regressor.
 
-use faer::linalg::solvers::Qr;
-use faer::Mat;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::qr::no_pivoting::factor::{
+    qr_in_place, qr_in_place_scratch, recommended_block_size,
+};
+use faer::{Mat, MatMut, Par};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use super::base::BaseParameters;
-use super::parameters::{fill_regressor, Batch};
+use super::parameters::Batch;
+use crate::algorithms::regressor::{joint_torque_regressor, PARAMS_PER_BODY};
+use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::regression::{least_squares, LeastSquares};
 
 /// Samples per chunk.
-pub const CHUNK: usize = 2048;
+pub const CHUNK: usize = 1024;
 
-/// The regressor's base columns of samples `range`, rows weighted by `1 / sigma[joint]`, with
-/// the weighted torques as an extra last column.
-fn chunk_system(
-    model: &Model,
-    base: &BaseParameters,
-    batch: &Batch<'_>,
-    tau: &[f64],
-    gravity: bool,
-    sigma: &[f64],
-    range: std::ops::Range<usize>,
-) -> Result<DMatrix<f64>> {
-    let nv = model.nv;
-    let rows = range.len() * nv;
-    let mut full = DMatrix::zeros(rows, base.layout.len());
-    let start = range.start;
-    fill_regressor(model, &base.layout, batch, gravity, range, &mut full, 0)?;
-    let p = base.len();
-    let mut out = DMatrix::zeros(rows, p + 1);
-    for r in 0..rows {
-        let w = 1.0 / sigma[r % nv];
-        for (c, &col) in base.kept.iter().enumerate() {
-            out[(r, c)] = w * full[(r, col)];
-        }
-        out[(r, p)] = w * tau[start * nv + r];
-    }
-    Ok(out)
+/// A friction term of a joint: `qd`, `sign(qd)` or 1, on that joint's rows only.
+#[derive(Clone, Copy, Debug)]
+enum Term {
+    Viscous,
+    Coulomb,
+    Offset,
 }
 
-/// The upper-triangular factor (at most `cols` rows) of a QR of `a`.
+/// Where the base columns' values come from: `(base column, inertial regressor column)` and
+/// `(base column, joint, friction term)`.
+struct Columns {
+    inertial: Vec<(usize, usize)>,
+    friction: Vec<(usize, usize, Term)>,
+}
+
+impl Columns {
+    fn new(model: &Model, base: &BaseParameters) -> Self {
+        let ni = PARAMS_PER_BODY * model.nbodies();
+        let terms = base.layout.friction.names();
+        let mut out = Columns {
+            inertial: Vec::new(),
+            friction: Vec::new(),
+        };
+        for (c, &col) in base.kept.iter().enumerate() {
+            if col < ni {
+                out.inertial.push((c, col));
+                continue;
+            }
+            let (joint, t) = ((col - ni) / terms.len(), (col - ni) % terms.len());
+            let term = match terms[t] {
+                "viscous" => Term::Viscous,
+                "coulomb" => Term::Coulomb,
+                _ => Term::Offset,
+            };
+            out.friction.push((c, joint, term));
+        }
+        out
+    }
+
+    fn len(&self) -> usize {
+        self.inertial.len() + self.friction.len()
+    }
+}
+
+/// The per-joint triangular factors of `[Phi_base | tau]` over a batch (see the module docs).
+#[derive(Clone, Debug)]
+pub struct JointFactors {
+    /// Number of samples reduced.
+    pub samples: usize,
+    /// Number of base parameters `p`.
+    pub parameters: usize,
+    /// `R_j`, `(p + 1) x (p + 1)` upper triangular, one per joint: `R_j^T R_j = A_j^T A_j` for
+    /// the rows `A_j = [Phi_base | tau]` of joint `j`.
+    pub factors: Vec<DMatrix<f64>>,
+}
+
+/// One worker's buffers: a `Data`, the regressor of one sample, and per joint a column-major
+/// `(p + 1 + CHUNK) x (p + 1)` matrix whose top rows carry the factor so far (zeros at first)
+/// and whose other rows take the next chunk.
+struct Worker {
+    data: Data,
+    y: DMatrix<f64>,
+    stacks: Vec<Mat<f64>>,
+    q_coeff: Mat<f64>,
+    scratch: MemBuffer,
+}
+
+impl Worker {
+    fn new(model: &Model, p: usize) -> Self {
+        let (rows, cols) = (p + 1 + CHUNK, p + 1);
+        let block = recommended_block_size::<f64>(rows, cols);
+        Self {
+            data: Data::new(model),
+            y: DMatrix::zeros(model.nv, PARAMS_PER_BODY * model.nbodies()),
+            stacks: (0..model.nv).map(|_| Mat::zeros(rows, cols)).collect(),
+            q_coeff: Mat::zeros(block, cols),
+            scratch: MemBuffer::new(qr_in_place_scratch::<f64>(
+                rows,
+                cols,
+                block,
+                Par::Seq,
+                Default::default(),
+            )),
+        }
+    }
+
+    /// Reduces samples `range` into the factors.
+    fn absorb(
+        &mut self,
+        model: &Model,
+        columns: &Columns,
+        batch: &Batch<'_>,
+        tau: &[f64],
+        gravity: bool,
+        range: std::ops::Range<usize>,
+    ) -> Result<()> {
+        let nv = model.nv;
+        let p = columns.len();
+        let top = p + 1;
+        for (r, s) in range.clone().enumerate() {
+            let (q, qd, qdd) = (
+                Batch::row(batch.q, s, nv),
+                Batch::row(batch.qd, s, nv),
+                Batch::row(batch.qdd, s, nv),
+            );
+            joint_torque_regressor(model, &mut self.data, q, qd, qdd, gravity, &mut self.y)
+                .map_err(|e| e.in_sample(s))?;
+            let y = self.y.as_slice(); // column-major nv x 10 nbodies
+            let i = top + r;
+            for (j, a) in self.stacks.iter_mut().enumerate() {
+                for &(c, col) in &columns.inertial {
+                    a[(i, c)] = y[j + col * nv];
+                }
+                for &(c, joint, term) in &columns.friction {
+                    a[(i, c)] = if joint != j {
+                        0.0
+                    } else {
+                        match term {
+                            Term::Viscous => qd[j],
+                            Term::Coulomb => qd[j].signum() * f64::from(u8::from(qd[j] != 0.0)),
+                            Term::Offset => 1.0,
+                        }
+                    };
+                }
+                a[(i, p)] = tau[s * nv + j];
+            }
+        }
+        let rows = top + range.len();
+        for a in &mut self.stacks {
+            factor_top(
+                a.as_mut().get_mut(..rows, ..),
+                self.q_coeff.as_mut(),
+                &mut self.scratch,
+            );
+        }
+        Ok(())
+    }
+
+    fn factors(&self, p: usize) -> Vec<DMatrix<f64>> {
+        self.stacks
+            .iter()
+            .map(|a| DMatrix::from_fn(p + 1, p + 1, |i, j| a[(i, j)]))
+            .collect()
+    }
+}
+
+/// QR of `a` in place, leaving its `R` in the top `ncols` rows with zeros below the diagonal.
+fn factor_top(mut a: MatMut<'_, f64>, q_coeff: MatMut<'_, f64>, scratch: &mut MemBuffer) {
+    let n = a.ncols();
+    let block = q_coeff.nrows().min(a.nrows().min(n)).max(1);
+    let q_coeff = q_coeff.get_mut(..block, ..a.nrows().min(n));
+    qr_in_place(
+        a.as_mut(),
+        q_coeff,
+        Par::Seq,
+        MemStack::new(scratch),
+        Default::default(),
+    );
+    for j in 0..n {
+        for i in j + 1..n.min(a.nrows()) {
+            a[(i, j)] = 0.0;
+        }
+    }
+}
+
+/// The upper-triangular factor (`ncols x ncols`, zero rows added when `a` is short) of a QR of
+/// `a`.
 fn triangular(a: &DMatrix<f64>) -> DMatrix<f64> {
     let (m, n) = a.shape();
-    let f = Mat::<f64>::from_fn(m, n, |i, j| a[(i, j)]);
-    let qr = Qr::new(f.as_ref());
-    let r = qr.thin_R();
-    DMatrix::from_fn(r.nrows(), n, |i, j| if j >= i { r[(i, j)] } else { 0.0 })
+    let mut f = Mat::<f64>::from_fn(m.max(n), n, |i, j| if i < m { a[(i, j)] } else { 0.0 });
+    let block = recommended_block_size::<f64>(m.max(n), n);
+    let mut q_coeff = Mat::zeros(block, n);
+    let mut scratch = MemBuffer::new(qr_in_place_scratch::<f64>(
+        m.max(n),
+        n,
+        block,
+        Par::Seq,
+        Default::default(),
+    ));
+    factor_top(f.as_mut(), q_coeff.as_mut(), &mut scratch);
+    DMatrix::from_fn(n, n, |i, j| f[(i, j)])
 }
 
-/// Solves the weighted base-parameter least squares over all samples; `names` label the base
-/// columns for a rank-deficiency error. Returns the solution with `stderr` for the weighted
-/// problem (`sigma_w^2 (W^T W)^-1`) and `residual_rms` left empty (see [`residual_rms`]).
-pub fn solve(
-    model: &Model,
-    base: &BaseParameters,
-    batch: &Batch<'_>,
-    tau: &[f64],
-    gravity: bool,
-    sigma: &[f64],
-    names: &[String],
-) -> Result<LeastSquares> {
-    let nv = model.nv;
-    let k = batch.samples(nv)?;
-    let p = base.len();
-    if k * nv <= p {
-        return Err(Error::RankDeficient {
-            context: "base-parameter identification".into(),
-            rows: k * nv,
-            cols: p,
-            rank: k * nv,
-            missing: format!(
-                "{k} samples x {nv} joints cannot determine {p} base parameters; add samples"
-            ),
-        });
-    }
-    let chunks: Vec<std::ops::Range<usize>> = (0..k)
-        .step_by(CHUNK)
-        .map(|s| s..(s + CHUNK).min(k))
-        .collect();
-    let factors: Vec<DMatrix<f64>> = chunks
-        .into_par_iter()
-        .map(|range| {
-            chunk_system(model, base, batch, tau, gravity, sigma, range).map(|a| triangular(&a))
+/// Merges two sets of per-joint factors (QR of each stacked pair).
+fn merge(a: Vec<DMatrix<f64>>, b: Vec<DMatrix<f64>>) -> Vec<DMatrix<f64>> {
+    a.into_iter()
+        .zip(b)
+        .map(|(ra, rb)| {
+            let n = ra.ncols();
+            let mut s = DMatrix::zeros(2 * n, n);
+            s.rows_mut(0, n).copy_from(&ra);
+            s.rows_mut(n, n).copy_from(&rb);
+            triangular(&s)
         })
-        .collect::<Result<_>>()?;
-    let height: usize = factors.iter().map(|f| f.nrows()).sum();
-    let mut stacked = DMatrix::zeros(height, p + 1);
-    let mut row = 0;
-    for f in &factors {
-        stacked.view_mut((row, 0), f.shape()).copy_from(f);
-        row += f.nrows();
-    }
-    let r = if height > p + 1 {
-        triangular(&stacked)
-    } else {
-        stacked
-    };
-    // [R11 z; 0 rho]: min |W theta - y| solves R11 theta = z with residual norm |rho|
-    let r11 = r.view((0, 0), (p, p)).into_owned();
-    let z = r.view((0, p), (p, 1)).into_owned();
-    let rho = if r.nrows() > p { r[(p, p)] } else { 0.0 };
-    let mut ls = least_squares(&r11, &z, "base-parameter identification", names)?;
-    let dof = (k * nv - p) as f64;
-    let s = (rho * rho / dof).sqrt();
-    ls.stderr = DMatrix::from_fn(1, p, |_, j| s * ls.cov_diag[j].sqrt());
-    ls.rows = k * nv;
-    ls.residual_rms = DVector::zeros(0);
-    Ok(ls)
+        .collect()
 }
 
-/// Per-joint RMS of the unweighted residuals `tau - Phi_base theta` (N m), streamed.
-pub fn residual_rms(
-    model: &Model,
-    base: &BaseParameters,
-    batch: &Batch<'_>,
-    tau: &[f64],
-    gravity: bool,
-    theta: &[f64],
-) -> Result<Vec<f64>> {
-    let nv = model.nv;
-    let k = batch.samples(nv)?;
-    let ones = vec![1.0; nv];
-    let p = base.len();
-    let theta = DVector::from_column_slice(theta);
-    let sums: Vec<Vec<f64>> = (0..k)
-        .step_by(CHUNK)
-        .map(|s| s..(s + CHUNK).min(k))
-        .collect::<Vec<_>>()
-        .into_par_iter()
-        .map(|range| {
-            let a = chunk_system(model, base, batch, tau, gravity, &ones, range)?;
-            let r = a.column(p) - a.columns(0, p) * &theta;
-            let mut acc = vec![0.0; nv];
-            for (i, v) in r.iter().enumerate() {
-                acc[i % nv] += v * v;
-            }
-            Ok(acc)
+impl JointFactors {
+    /// Reduces the base regressor and torques of every sample of `batch` (row-major `k x nv`
+    /// states, rad, rad/s, rad/s^2) and `tau` (row-major `k x nv`, N m), in parallel chunks of
+    /// [`CHUNK`] samples. `gravity` includes gravity in the regressor.
+    pub fn new(
+        model: &Model,
+        base: &BaseParameters,
+        batch: &Batch<'_>,
+        tau: &[f64],
+        gravity: bool,
+    ) -> Result<Self> {
+        let nv = model.nv;
+        let k = batch.samples(nv)?;
+        if tau.len() != k * nv {
+            return Err(Error::Shape {
+                argument: "tau".into(),
+                expected: format!("{k} samples x {nv} joints like q"),
+                got: format!("{} values", tau.len()),
+            });
+        }
+        let p = base.len();
+        let columns = Columns::new(model, base);
+        let chunks: Vec<std::ops::Range<usize>> = (0..k)
+            .step_by(CHUNK)
+            .map(|s| s..(s + CHUNK).min(k))
+            .collect();
+        // a few workers per thread (for balance on a busy machine), each reducing a run of
+        // consecutive chunks into its own factors; then the workers' factors are merged
+        let groups = (2 * rayon::current_num_threads()).clamp(1, chunks.len().max(1));
+        let per = chunks.len().div_ceil(groups).max(1);
+        let factors = chunks
+            .par_chunks(per)
+            .map(|run| -> Result<Vec<DMatrix<f64>>> {
+                let mut w = Worker::new(model, p);
+                for range in run {
+                    w.absorb(model, &columns, batch, tau, gravity, range.clone())?;
+                }
+                Ok(w.factors(p))
+            })
+            .try_reduce_with(|a, b| Ok(merge(a, b)))
+            .transpose()?
+            .unwrap_or_else(|| vec![DMatrix::zeros(p + 1, p + 1); nv]);
+        Ok(Self {
+            samples: k,
+            parameters: p,
+            factors,
         })
-        .collect::<Result<_>>()?;
-    Ok((0..nv)
-        .map(|j| (sums.iter().map(|s| s[j]).sum::<f64>() / k as f64).sqrt())
-        .collect())
+    }
+
+    /// The least-squares fit of the base parameters with the rows of joint `j` weighted by
+    /// `1 / sigma[j]` (`sigma`: `nv` values, N m; all 1 for OLS). `names` label the `p` base
+    /// columns for a rank-deficiency error. Returns the coefficients (`1 x p`), `cond` of the
+    /// column-scaled weighted regressor, `stderr` for the weighted problem
+    /// (`sigma_w^2 (W^T W)^-1`, `sigma_w^2` = weighted residual sum of squares / (K nv - p)) and
+    /// `residual_rms` left empty (see [`JointFactors::residual_rms`]).
+    pub fn solve(&self, sigma: &[f64], names: &[String]) -> Result<LeastSquares> {
+        let nv = self.factors.len();
+        let p = self.parameters;
+        let rows = self.samples * nv;
+        if rows <= p {
+            return Err(Error::RankDeficient {
+                context: "base-parameter identification".into(),
+                rows,
+                cols: p,
+                rank: rows,
+                missing: format!(
+                    "{} samples x {nv} joints cannot determine {p} base parameters; add samples",
+                    self.samples
+                ),
+            });
+        }
+        if sigma.len() != nv || sigma.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+            return Err(Error::InvalidArgument {
+                argument: "sigma".into(),
+                message: format!("expected {nv} positive finite weights, got {sigma:?}"),
+            });
+        }
+        let mut stacked = DMatrix::zeros(nv * (p + 1), p + 1);
+        for (j, r) in self.factors.iter().enumerate() {
+            stacked
+                .rows_mut(j * (p + 1), p + 1)
+                .copy_from(&(r / sigma[j]));
+        }
+        let r = triangular(&stacked);
+        // [R11 z; 0 rho]: min |W theta - y| solves R11 theta = z with residual norm |rho|
+        let r11 = r.view((0, 0), (p, p)).into_owned();
+        let z = r.view((0, p), (p, 1)).into_owned();
+        let rho = r[(p, p)];
+        let mut ls = least_squares(&r11, &z, "base-parameter identification", names)?;
+        let s = (rho * rho / (rows - p) as f64).sqrt();
+        ls.stderr = DMatrix::from_fn(1, p, |_, j| s * ls.cov_diag[j].sqrt());
+        ls.rows = rows;
+        ls.residual_rms = DVector::zeros(0);
+        Ok(ls)
+    }
+
+    /// Per-joint RMS over the samples of the unweighted residuals `tau - Phi_base theta` (N m)
+    /// for base parameters `theta` (`p`): `|R_j [theta; -1]| / sqrt(K)`.
+    pub fn residual_rms(&self, theta: &[f64]) -> Result<Vec<f64>> {
+        let p = self.parameters;
+        if theta.len() != p {
+            return Err(Error::Shape {
+                argument: "theta".into(),
+                expected: format!("{p} base parameters"),
+                got: format!("{} values", theta.len()),
+            });
+        }
+        let x = DVector::from_column_slice(theta).push(-1.0);
+        let k = self.samples.max(1) as f64;
+        Ok(self
+            .factors
+            .iter()
+            .map(|r| (r * &x).norm() / k.sqrt())
+            .collect())
+    }
 }
