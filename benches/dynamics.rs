@@ -6,8 +6,8 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use perturbid_rs::algorithms::regressor::joint_torque_regressor;
 use perturbid_rs::robots::a465::{TABLE2_Q, TABLE2_QD, TABLE2_QDD};
 use perturbid_rs::{
-    forward_dynamics, gravity_torque, linearize, mass_matrix, rnea, rnea_derivatives, robots, Data,
-    Model,
+    forward_dynamics, gravity_torque, linearize, mass_matrix, rnea, rnea_derivatives, rnea_lanes,
+    robots, Data, LaneData, Model,
 };
 use std::hint::black_box;
 
@@ -92,6 +92,23 @@ fn dynamics(c: &mut Criterion) {
             })
         });
     }
+    // the same batch through the multi-sample kernel (LANES samples side by side)
+    let mut lanes = LaneData::new(&model);
+    let mut tau = vec![0.0; BATCH * n];
+    group.bench_function(format!("rnea_lanes/a465/{BATCH}"), |b| {
+        b.iter(|| {
+            rnea_lanes(
+                &model,
+                &mut lanes,
+                &bq,
+                Some(&bqd),
+                Some(&bqdd),
+                true,
+                &mut tau,
+            )
+            .unwrap()
+        })
+    });
     group.bench_function(format!("regressor/a465/{BATCH}"), |b| {
         b.iter(|| {
             for s in 0..BATCH {

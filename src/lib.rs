@@ -20,6 +20,7 @@ pub mod direct;
 pub mod error;
 pub mod io;
 pub mod json;
+mod lanes;
 pub mod linearization;
 pub mod local;
 pub mod model;
@@ -38,6 +39,7 @@ pub mod urdf;
 #[cfg(feature = "python")]
 mod python;
 
+pub use algorithms::batch::{rnea_lanes, LaneData, LANES};
 pub use algorithms::crba::mass_matrix;
 pub use algorithms::derivatives::rnea_derivatives;
 pub use algorithms::forward_dynamics::forward_dynamics;

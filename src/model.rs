@@ -65,9 +65,9 @@ pub struct Body {
 /// with `t1 = R0 a`.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub(crate) struct PoseTerms {
-    r1: Matrix3<f64>,
-    r2: Matrix3<f64>,
-    t1: Vector3<f64>,
+    pub(crate) r1: Matrix3<f64>,
+    pub(crate) r2: Matrix3<f64>,
+    pub(crate) t1: Vector3<f64>,
 }
 
 impl PoseTerms {

@@ -229,3 +229,80 @@ fn linearize_into_reuses_its_buffer_and_checks_its_size() {
         "{e}"
     );
 }
+
+/// The multi-sample kernel equals the one-sample RNEA on every sample, on random trees (with
+/// prismatic and continuous joints, angles beyond 2 pi) and on a mimic coupling, for batch
+/// lengths that fill the lanes and leave partial groups, with qd and qdd given or zero.
+fn check_lanes(model: &Model, rng: &mut Rng, k: usize) {
+    let n = model.nv;
+    let (q, qd, qdd) = (
+        rng.vector(k * n, 9.0),
+        rng.vector(k * n, 2.0),
+        rng.vector(k * n, 2.0),
+    );
+    let mut lanes = perturbid_rs::LaneData::new(model);
+    let mut out = vec![0.0; k * n];
+    let zeros = vec![0.0; n];
+    for (with_v, with_a, gravity) in [
+        (true, true, true),
+        (false, false, true),
+        (true, false, false),
+    ] {
+        let (v, a) = (with_v.then_some(&qd[..]), with_a.then_some(&qdd[..]));
+        perturbid_rs::rnea_lanes(model, &mut lanes, &q, v, a, gravity, &mut out).unwrap();
+        let mut data = Data::new(model);
+        for s in 0..k {
+            let r = s * n..(s + 1) * n;
+            let vs = if with_v { &qd[r.clone()] } else { &zeros[..] };
+            let as_ = if with_a { &qdd[r.clone()] } else { &zeros[..] };
+            rnea(model, &mut data, &q[r.clone()], vs, as_, gravity).unwrap();
+            let scale = 1.0 + data.tau.amax();
+            for j in 0..n {
+                assert!(
+                    (out[s * n + j] - data.tau[j]).abs() < 1e-12 * scale,
+                    "sample {s} joint {j}: {} vs {}",
+                    out[s * n + j],
+                    data.tau[j]
+                );
+            }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    #[test]
+    fn lanes_equal_one_sample_rnea_on_random_trees(seed in any::<u64>(), nlinks in 1usize..9, k in 1usize..11) {
+        let text = random_tree_urdf(seed, nlinks);
+        let model = model_from_urdf_str(&text, "random", &LoadOptions::default()).unwrap();
+        check_lanes(&model, &mut Rng(seed ^ 0x5A5A), k);
+    }
+}
+
+#[test]
+fn lanes_equal_one_sample_rnea_on_the_a465_and_a_mimic_pair() {
+    let mut rng = Rng(8);
+    for model in [
+        robots::builtin("a465").unwrap(),
+        model_from_urdf_str(&mimic_pair(true), "mimic", &LoadOptions::default()).unwrap(),
+    ] {
+        for k in [1, 3, 4, 5, 8, 13] {
+            check_lanes(&model, &mut rng, k);
+        }
+    }
+    // wrong lengths are errors
+    let model = robots::builtin("a465").unwrap();
+    let mut lanes = perturbid_rs::LaneData::new(&model);
+    let mut out = vec![0.0; 12];
+    let e = perturbid_rs::rnea_lanes(
+        &model,
+        &mut lanes,
+        &[0.0; 12],
+        Some(&[0.0; 6]),
+        None,
+        true,
+        &mut out,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("qd"), "{e}");
+}

@@ -9,6 +9,7 @@ use pyo3::prelude::*;
 
 use super::arrays::{read_batch, to_numpy};
 use super::linearization::PyLinearization;
+use crate::algorithms::batch::{rnea_lanes, LaneData, LANES};
 use crate::error::Result;
 use crate::{robots, urdf, Data, Model};
 
@@ -24,23 +25,107 @@ type ArrayLike<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 #[pyclass(name = "Robot", module = "perturbid_rs", frozen)]
 pub(crate) struct PyRobot {
     pub(crate) model: Model,
-    data: Mutex<Data>,
+    work: Mutex<Work>,
+}
+
+/// The work buffers of one thread: a [`Data`] for the one-sample algorithms and a [`LaneData`]
+/// for the multi-sample kernel.
+pub(crate) struct Work {
+    pub(crate) data: Data,
+    lanes: LaneData,
+}
+
+impl Work {
+    fn new(model: &Model) -> Self {
+        Self {
+            data: Data::new(model),
+            lanes: LaneData::new(model),
+        }
+    }
+}
+
+/// Samples `first..first + len` of a batch: one row-major `len x n` slice per argument.
+struct Chunk<'a> {
+    first: usize,
+    len: usize,
+    /// Missing arguments are empty.
+    columns: [&'a [f64]; 3],
+    /// Whether the call was given single samples (errors then name no sample).
+    single: bool,
+}
+
+impl Chunk<'_> {
+    /// An error raised at sample `i` of the chunk, renamed for its sample in the batch.
+    fn at(&self, i: usize, e: crate::error::Error) -> crate::error::Error {
+        if self.single {
+            e
+        } else {
+            e.in_sample(self.first + i)
+        }
+    }
 }
 
 impl PyRobot {
     fn new(model: Model) -> Self {
-        let data = Mutex::new(Data::new(&model));
-        Self { model, data }
+        let work = Mutex::new(Work::new(&model));
+        Self { model, work }
     }
 
-    fn data(&self) -> MutexGuard<'_, Data> {
-        self.data
+    pub(crate) fn work(&self) -> MutexGuard<'_, Work> {
+        self.work
             .lock()
             .unwrap_or_else(|poisoned| poisoned.into_inner())
     }
 
-    /// Evaluates `f` on every sample of `args` with the GIL released; `f` writes one sample's
-    /// result (`out_dims` values, row-major) into its output slice.
+    /// Evaluates `f` on the chunks of the batch `args` with the GIL released, in parallel
+    /// (rayon, one [`Work`] per chunk, so no per-sample allocation) for large batches; `f`
+    /// writes the chunk's results (`out_dims` values per sample, row-major) into its slice.
+    fn map_chunks<'py, F>(
+        &self,
+        py: Python<'py>,
+        args: &[(&str, &ArrayLike<'py>)],
+        out_dims: &[usize],
+        f: F,
+    ) -> PyResult<Bound<'py, PyAny>>
+    where
+        F: Fn(&Model, &mut Work, &Chunk<'_>, &mut [f64]) -> Result<()> + Send + Sync,
+    {
+        let n = self.model.nv;
+        let batch = read_batch(n, args)?;
+        let size: usize = out_dims.iter().product();
+        let mut out = vec![0.0; batch.k * size];
+        py.detach(|| -> Result<()> {
+            let run = |work: &mut Work, first: usize, out: &mut [f64]| -> Result<()> {
+                let len = out.len() / size.max(1);
+                let mut columns: [&[f64]; 3] = [&[]; 3];
+                for (c, column) in columns.iter_mut().zip(&batch.columns) {
+                    *c = &column[first * n..(first + len) * n];
+                }
+                f(
+                    &self.model,
+                    work,
+                    &Chunk {
+                        first,
+                        len,
+                        columns,
+                        single: batch.single,
+                    },
+                    out,
+                )
+            };
+            if batch.k < PARALLEL_BATCH || size == 0 {
+                return run(&mut self.work(), 0, &mut out);
+            }
+            use rayon::prelude::*;
+            out.par_chunks_mut(PARALLEL_CHUNK * size)
+                .enumerate()
+                .try_for_each(|(c, o)| run(&mut Work::new(&self.model), c * PARALLEL_CHUNK, o))
+        })?;
+        to_numpy(py, out, batch.k, batch.single, out_dims)
+    }
+
+    /// [`PyRobot::map_chunks`] one sample at a time: `f` gets the sample's arguments and
+    /// writes its `out_dims` values.
     fn map_samples<'py, F>(
         &self,
         py: Python<'py>,
@@ -52,31 +137,63 @@ impl PyRobot {
         F: Fn(&Model, &mut Data, [&[f64]; 3], &mut [f64]) -> Result<()> + Send + Sync,
     {
         let n = self.model.nv;
-        let batch = read_batch(n, args)?;
         let size: usize = out_dims.iter().product();
-        let mut out = vec![0.0; batch.k * size];
-        py.detach(|| -> Result<()> {
-            let run = |data: &mut Data, first: usize, out: &mut [f64]| -> Result<()> {
-                for (i, o) in out.chunks_mut(size.max(1)).enumerate() {
-                    let s = first + i;
-                    let mut rows: [&[f64]; 3] = [&[]; 3];
-                    for (row, column) in rows.iter_mut().zip(&batch.columns) {
-                        *row = &column[s * n..(s + 1) * n];
+        self.map_chunks(py, args, out_dims, |m, w, chunk, out| {
+            for (i, o) in out.chunks_mut(size.max(1)).enumerate() {
+                let mut rows: [&[f64]; 3] = [&[]; 3];
+                for (row, column) in rows.iter_mut().zip(&chunk.columns) {
+                    if !column.is_empty() {
+                        *row = &column[i * n..(i + 1) * n];
                     }
-                    f(&self.model, data, rows, o).map_err(|e| batch.in_sample(s, e))?;
                 }
-                Ok(())
-            };
-            if batch.k < PARALLEL_BATCH || size == 0 {
-                return run(&mut self.data(), 0, &mut out);
+                f(m, &mut w.data, rows, o).map_err(|e| chunk.at(i, e))?;
             }
-            // large batches: chunks in parallel, one Data per chunk (no per-sample allocation)
-            use rayon::prelude::*;
-            out.par_chunks_mut(PARALLEL_CHUNK * size)
-                .enumerate()
-                .try_for_each(|(c, o)| run(&mut Data::new(&self.model), c * PARALLEL_CHUNK, o))
-        })?;
-        to_numpy(py, out, batch.k, batch.single, out_dims)
+            Ok(())
+        })
+    }
+
+    /// Inverse dynamics of a batch with `qd` and `qdd` optional (zeros), by the multi-sample
+    /// kernel; the arguments' finiteness is checked first, sample by sample.
+    fn inverse_dynamics<'py>(
+        &self,
+        py: Python<'py>,
+        args: &[(&str, &ArrayLike<'py>)],
+        gravity: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.model.nv;
+        let names: Vec<&str> = args.iter().map(|a| a.0).collect();
+        self.map_chunks(py, args, &[n], |m, w, chunk, out| {
+            for i in 0..chunk.len {
+                for (name, column) in names.iter().zip(&chunk.columns) {
+                    m.check_vector(name, &column[i * n..(i + 1) * n])
+                        .map_err(|e| chunk.at(i, e))?;
+                }
+            }
+            let [q, qd, qdd] = chunk.columns;
+            fn opt(x: &[f64]) -> Option<&[f64]> {
+                (!x.is_empty()).then_some(x)
+            }
+            /// Sample `i` of `x`, or `zeros` for a missing argument.
+            fn row<'a>(x: &'a [f64], zeros: &'a [f64], i: usize) -> &'a [f64] {
+                let n = zeros.len();
+                if x.is_empty() {
+                    zeros
+                } else {
+                    &x[i * n..(i + 1) * n]
+                }
+            }
+            if chunk.len < LANES {
+                // too few samples to fill the lanes: one at a time
+                let zeros = vec![0.0; n];
+                for (i, o) in out.chunks_mut(n).enumerate() {
+                    let (a, b, c) = (row(q, &zeros, i), row(qd, &zeros, i), row(qdd, &zeros, i));
+                    crate::rnea(m, &mut w.data, a, b, c, gravity)?;
+                    o.copy_from_slice(w.data.tau.as_slice());
+                }
+                return Ok(());
+            }
+            rnea_lanes(m, &mut w.lanes, q, opt(qd), opt(qdd), gravity, out)
+        })
     }
 }
 
@@ -222,25 +339,12 @@ impl PyRobot {
         qdd: ArrayLike<'py>,
         gravity: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.map_samples(
-            py,
-            &[("q", &q), ("qd", &qd), ("qdd", &qdd)],
-            &[self.model.nv],
-            |m, d, x, out| {
-                crate::rnea(m, d, x[0], x[1], x[2], gravity)?;
-                out.copy_from_slice(d.tau.as_slice());
-                Ok(())
-            },
-        )
+        self.inverse_dynamics(py, &[("q", &q), ("qd", &qd), ("qdd", &qdd)], gravity)
     }
 
     /// Gravity torque g(q): the torque holding the robot at rest. q: (n,) or (k, n).
     fn gravity<'py>(&self, py: Python<'py>, q: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.map_samples(py, &[("q", &q)], &[self.model.nv], |m, d, x, out| {
-            crate::gravity_torque(m, d, x[0])?;
-            out.copy_from_slice(d.g.as_slice());
-            Ok(())
-        })
+        self.inverse_dynamics(py, &[("q", &q)], true)
     }
 
     /// Bias torque c(q, qd) [+ g(q)]: the inverse dynamics at zero acceleration.
@@ -252,16 +356,7 @@ impl PyRobot {
         qd: ArrayLike<'py>,
         gravity: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.map_samples(
-            py,
-            &[("q", &q), ("qd", &qd)],
-            &[self.model.nv],
-            |m, d, x, out| {
-                crate::bias_torque(m, d, x[0], x[1], gravity)?;
-                out.copy_from_slice(d.bias.as_slice());
-                Ok(())
-            },
-        )
+        self.inverse_dynamics(py, &[("q", &q), ("qd", &qd)], gravity)
     }
 
     /// Joint-space mass matrix M(q), symmetric positive definite. q: (n,) or (k, n); returns
@@ -361,14 +456,15 @@ impl PyRobot {
             vec![0.0; k * n * n],
         );
         py.detach(|| -> Result<()> {
-            let mut data = self.data();
+            let mut work = self.work();
+            let data = &mut work.data;
             let mut lin = crate::Linearization::zeros(n);
             let c = &batch.columns;
             for s in 0..k {
                 let r = s * n..(s + 1) * n;
                 crate::linearize_into(
                     &self.model,
-                    &mut data,
+                    data,
                     &c[0][r.clone()],
                     &c[1][r.clone()],
                     &c[2][r.clone()],

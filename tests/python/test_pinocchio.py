@@ -97,9 +97,27 @@ def test_batches_match_single_samples(pair: Pair):
     lin = pair.ours.linearize(Q, QD, QDD)
     assert lin.G.shape == (5, pair.ours.n, pair.ours.n) and lin.torque.shape == (5, pair.ours.n)
     for k in range(5):
-        np.testing.assert_array_equal(tau[k], pair.ours.rnea(Q[k], QD[k], QDD[k]))
+        # batches of 4 or more run the multi-sample kernel: equal up to rounding
+        single = pair.ours.rnea(Q[k], QD[k], QDD[k])
+        np.testing.assert_allclose(tau[k], single, rtol=0, atol=1e-12 * (1 + np.abs(single).max()))
         np.testing.assert_array_equal(M[k], pair.ours.mass_matrix(Q[k]))
         np.testing.assert_array_equal(lin.H[k], pair.ours.linearize(Q[k], QD[k], QDD[k]).H)
+
+
+def test_large_batches_match_pinocchio(pair: Pair):
+    """A batch large enough to run in parallel chunks through the multi-sample kernel, with a
+    length that leaves a partial group of lanes: rnea, gravity and bias against Pinocchio."""
+    rng = np.random.default_rng(2)
+    k = 4096 + 1024 + 3
+    states = [pair.random_state(rng) for _ in range(k)]
+    Q, QD, QDD = (np.array([s[i] for s in states]) for i in range(3))
+    tau, g, bias = pair.ours.rnea(Q, QD, QDD), pair.ours.gravity(Q), pair.ours.bias(Q, QD)
+    m, d = pair.model, pair.data
+    for i in list(range(0, k, 97)) + [k - 1]:
+        qp, vp, ap = pair.q(Q[i]), pair.v(QD[i]), pair.v(QDD[i])
+        assert relerr(tau[i], pair.vec(pin.rnea(m, d, qp, vp, ap))) < TOL
+        assert relerr(g[i], pair.vec(pin.computeGeneralizedGravity(m, d, qp))) < TOL
+        assert relerr(bias[i], pair.vec(pin.nonLinearEffects(m, d, qp, vp))) < TOL
 
 
 def test_gravity_switch_matches_pinocchio_with_zero_gravity():
