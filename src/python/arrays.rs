@@ -53,7 +53,10 @@ pub(crate) fn read_batch(
             _ => {}
         }
         // Finiteness is checked by the algorithms, sample by sample (see `in_sample`).
-        columns.push(arr.as_array().iter().copied().collect());
+        columns.push(match arr.as_slice() {
+            Ok(contiguous) => contiguous.to_vec(),
+            Err(_) => arr.as_array().iter().copied().collect(),
+        });
     }
     let (k, batched) = first.unwrap_or((0, false));
     Ok(Batch {

@@ -163,10 +163,14 @@ impl PyRobot {
         let n = self.model.nv;
         let names: Vec<&str> = args.iter().map(|a| a.0).collect();
         self.map_chunks(py, args, &[n], |m, w, chunk, out| {
-            for i in 0..chunk.len {
-                for (name, column) in names.iter().zip(&chunk.columns) {
-                    m.check_vector(name, &column[i * n..(i + 1) * n])
-                        .map_err(|e| chunk.at(i, e))?;
+            // a fast pass over the chunk; a sample at a time only to name a bad one
+            let bad = |c: &&[f64]| c.iter().fold(false, |bad, v| bad | !v.is_finite());
+            if chunk.columns.iter().any(bad) {
+                for i in 0..chunk.len {
+                    for (name, column) in names.iter().zip(&chunk.columns) {
+                        m.check_vector(name, &column[i * n..(i + 1) * n])
+                            .map_err(|e| chunk.at(i, e))?;
+                    }
                 }
             }
             let [q, qd, qdd] = chunk.columns;

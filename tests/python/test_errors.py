@@ -45,6 +45,13 @@ def test_non_finite_input(robot):
         robot.rnea(np.zeros((3, 6)), np.zeros((3, 6)), batch)
     with pytest.raises(pr.InputError, match=r"qd\[1\]: entry 4 is inf"):
         robot.linearize(np.zeros((3, 6)), batch, np.zeros((3, 6)))
+    # a large batch (parallel chunks, multi-sample kernel) names the sample too
+    big = np.zeros((5000, 6))
+    big[4321, 5] = -np.inf
+    with pytest.raises(pr.InputError, match=r"q\[4321\]: entry 5 is -inf"):
+        robot.gravity(big)
+    with pytest.raises(pr.InputError, match=r"qd\[4321\]: entry 5 is -inf"):
+        robot.bias(np.zeros((5000, 6)), big)
 
 
 def test_non_numeric_input(robot):
