@@ -3,15 +3,16 @@
 //!
 //! The system `[Phi_base | tau]` is split by joint: the rows of joint `j` (one per sample) are
 //! reduced, chunk by chunk and in parallel, to their `(p + 1) x (p + 1)` triangular QR factor
-//! `R_j` (a TSQR per joint). Those `nv` factors hold everything the fits need, exactly:
+//! `R_j` (a TSQR per joint), over only the columns those rows can have nonzero (the bodies the
+//! joint carries, its own friction). Those `nv` factors hold everything the fits need, exactly:
 //! - any per-joint weighting `1 / sigma_j`: the weighted system's factor is the QR of the
 //!   stacked `R_j / sigma_j`, so OLS and then WLS need no second pass over the samples;
 //! - the per-joint residuals of any `theta`: `|tau_j - Phi_j theta| = |R_j [theta; -1]|`.
 //!
 //! QR keeps the conditioning of the regressor (normal equations would square it).
-//! Memory: per worker (about two per core), one chunk of every joint, `nv * (CHUNK + p + 1) *
-//! (p + 1)` values (3.4 MB for a 6-dof arm with 36 base parameters, 7.8 MB for a 7-dof arm with
-//! friction), plus the `nv` factors; never the whole regressor.
+//! Memory: per worker (about two per core), one chunk of every joint, at most `nv * (CHUNK + p +
+//! 1) * (p + 1)` values (1.9 MB for a 6-dof arm with 36 base parameters, 3.9 MB for a 7-dof
+//! arm with friction), plus the `nv` factors; never the whole regressor.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::qr::no_pivoting::factor::{
@@ -40,39 +41,61 @@ enum Term {
     Offset,
 }
 
-/// Where the base columns' values come from: `(base column, inertial regressor column)` and
-/// `(base column, joint, friction term)`.
-struct Columns {
+/// The columns that joint `j`'s rows can have nonzero: the base columns of the bodies the
+/// joint carries (its subtree; a joint's torque does not depend on the bodies before it) and
+/// the joint's own friction terms. Reducing only those saves about half the QR work on a chain.
+#[derive(Clone, Debug)]
+struct JointColumns {
+    /// The base column of each active column, ascending.
+    base: Vec<usize>,
+    /// `(active column, inertial regressor column)`.
     inertial: Vec<(usize, usize)>,
-    friction: Vec<(usize, usize, Term)>,
+    /// `(active column, friction term)`.
+    friction: Vec<(usize, Term)>,
 }
 
-impl Columns {
-    fn new(model: &Model, base: &BaseParameters) -> Self {
+impl JointColumns {
+    /// One per degree of freedom.
+    fn new(model: &Model, base: &BaseParameters) -> Vec<Self> {
         let ni = PARAMS_PER_BODY * model.nbodies();
         let terms = base.layout.friction.names();
-        let mut out = Columns {
-            inertial: Vec::new(),
-            friction: Vec::new(),
-        };
-        for (c, &col) in base.kept.iter().enumerate() {
-            if col < ni {
-                out.inertial.push((c, col));
-                continue;
-            }
-            let (joint, t) = ((col - ni) / terms.len(), (col - ni) % terms.len());
-            let term = match terms[t] {
-                "viscous" => Term::Viscous,
-                "coulomb" => Term::Coulomb,
-                _ => Term::Offset,
-            };
-            out.friction.push((c, joint, term));
-        }
-        out
-    }
-
-    fn len(&self) -> usize {
-        self.inertial.len() + self.friction.len()
+        (0..model.nv)
+            .map(|j| {
+                let carried = |body: usize| {
+                    model
+                        .bodies
+                        .iter()
+                        .enumerate()
+                        .any(|(i, b)| b.dof == j && (i..b.subtree_end).contains(&body))
+                };
+                let mut out = JointColumns {
+                    base: Vec::new(),
+                    inertial: Vec::new(),
+                    friction: Vec::new(),
+                };
+                for (c, &col) in base.kept.iter().enumerate() {
+                    let a = out.base.len();
+                    if col < ni {
+                        if carried(col / PARAMS_PER_BODY) {
+                            out.inertial.push((a, col));
+                            out.base.push(c);
+                        }
+                        continue;
+                    }
+                    let (joint, t) = ((col - ni) / terms.len(), (col - ni) % terms.len());
+                    if joint == j {
+                        let term = match terms[t] {
+                            "viscous" => Term::Viscous,
+                            "coulomb" => Term::Coulomb,
+                            _ => Term::Offset,
+                        };
+                        out.friction.push((a, term));
+                        out.base.push(c);
+                    }
+                }
+                out
+            })
+            .collect()
     }
 }
 
@@ -83,14 +106,17 @@ pub struct JointFactors {
     pub samples: usize,
     /// Number of base parameters `p`.
     pub parameters: usize,
-    /// `R_j`, `(p + 1) x (p + 1)` upper triangular, one per joint: `R_j^T R_j = A_j^T A_j` for
-    /// the rows `A_j = [Phi_base | tau]` of joint `j`.
+    /// The base columns that joint `j`'s rows can have nonzero (`n_j` of them, ascending).
+    pub active: Vec<Vec<usize>>,
+    /// `R_j`, `(n_j + 1) x (n_j + 1)` upper triangular, one per joint, over the columns
+    /// `active[j]` and then the torque: `R_j^T R_j = A_j^T A_j` for the rows
+    /// `A_j = [Phi_base[:, active[j]] | tau]` of joint `j`.
     pub factors: Vec<DMatrix<f64>>,
 }
 
 /// One worker's buffers: a `Data`, the regressor of one sample, and per joint a column-major
-/// `(p + 1 + CHUNK) x (p + 1)` matrix whose top rows carry the factor so far (zeros at first)
-/// and whose other rows take the next chunk.
+/// `(n_j + 1 + CHUNK) x (n_j + 1)` matrix whose top rows carry the factor so far (zeros at
+/// first) and whose other rows take the next chunk.
 struct Worker {
     data: Data,
     y: DMatrix<f64>,
@@ -100,17 +126,20 @@ struct Worker {
 }
 
 impl Worker {
-    fn new(model: &Model, p: usize) -> Self {
-        let (rows, cols) = (p + 1 + CHUNK, p + 1);
-        let block = recommended_block_size::<f64>(rows, cols);
+    fn new(model: &Model, columns: &[JointColumns]) -> Self {
+        let widest = columns.iter().map(|c| c.base.len() + 1).max().unwrap_or(1);
+        let block = recommended_block_size::<f64>(widest + CHUNK, widest);
         Self {
             data: Data::new(model),
             y: DMatrix::zeros(model.nv, PARAMS_PER_BODY * model.nbodies()),
-            stacks: (0..model.nv).map(|_| Mat::zeros(rows, cols)).collect(),
-            q_coeff: Mat::zeros(block, cols),
+            stacks: columns
+                .iter()
+                .map(|c| Mat::zeros(c.base.len() + 1 + CHUNK, c.base.len() + 1))
+                .collect(),
+            q_coeff: Mat::zeros(block, widest),
             scratch: MemBuffer::new(qr_in_place_scratch::<f64>(
-                rows,
-                cols,
+                widest + CHUNK,
+                widest,
                 block,
                 Par::Seq,
                 Default::default(),
@@ -122,15 +151,13 @@ impl Worker {
     fn absorb(
         &mut self,
         model: &Model,
-        columns: &Columns,
+        columns: &[JointColumns],
         batch: &Batch<'_>,
         tau: &[f64],
         gravity: bool,
         range: std::ops::Range<usize>,
     ) -> Result<()> {
         let nv = model.nv;
-        let p = columns.len();
-        let top = p + 1;
         for (r, s) in range.clone().enumerate() {
             let (q, qd, qdd) = (
                 Batch::row(batch.q, s, nv),
@@ -140,27 +167,24 @@ impl Worker {
             joint_torque_regressor(model, &mut self.data, q, qd, qdd, gravity, &mut self.y)
                 .map_err(|e| e.in_sample(s))?;
             let y = self.y.as_slice(); // column-major nv x 10 nbodies
-            let i = top + r;
-            for (j, a) in self.stacks.iter_mut().enumerate() {
-                for &(c, col) in &columns.inertial {
+            for (j, (a, cols)) in self.stacks.iter_mut().zip(columns).enumerate() {
+                let nj = cols.base.len();
+                let i = nj + 1 + r;
+                for &(c, col) in &cols.inertial {
                     a[(i, c)] = y[j + col * nv];
                 }
-                for &(c, joint, term) in &columns.friction {
-                    a[(i, c)] = if joint != j {
-                        0.0
-                    } else {
-                        match term {
-                            Term::Viscous => qd[j],
-                            Term::Coulomb => qd[j].signum() * f64::from(u8::from(qd[j] != 0.0)),
-                            Term::Offset => 1.0,
-                        }
+                for &(c, term) in &cols.friction {
+                    a[(i, c)] = match term {
+                        Term::Viscous => qd[j],
+                        Term::Coulomb => qd[j].signum() * f64::from(u8::from(qd[j] != 0.0)),
+                        Term::Offset => 1.0,
                     };
                 }
-                a[(i, p)] = tau[s * nv + j];
+                a[(i, nj)] = tau[s * nv + j];
             }
         }
-        let rows = top + range.len();
         for a in &mut self.stacks {
+            let rows = a.ncols() + range.len();
             factor_top(
                 a.as_mut().get_mut(..rows, ..),
                 self.q_coeff.as_mut(),
@@ -170,10 +194,10 @@ impl Worker {
         Ok(())
     }
 
-    fn factors(&self, p: usize) -> Vec<DMatrix<f64>> {
+    fn factors(&self) -> Vec<DMatrix<f64>> {
         self.stacks
             .iter()
-            .map(|a| DMatrix::from_fn(p + 1, p + 1, |i, j| a[(i, j)]))
+            .map(|a| DMatrix::from_fn(a.ncols(), a.ncols(), |i, j| a[(i, j)]))
             .collect()
     }
 }
@@ -250,7 +274,7 @@ impl JointFactors {
             });
         }
         let p = base.len();
-        let columns = Columns::new(model, base);
+        let columns = JointColumns::new(model, base);
         let chunks: Vec<std::ops::Range<usize>> = (0..k)
             .step_by(CHUNK)
             .map(|s| s..(s + CHUNK).min(k))
@@ -262,18 +286,25 @@ impl JointFactors {
         let factors = chunks
             .par_chunks(per)
             .map(|run| -> Result<Vec<DMatrix<f64>>> {
-                let mut w = Worker::new(model, p);
+                let mut w = Worker::new(model, &columns);
                 for range in run {
                     w.absorb(model, &columns, batch, tau, gravity, range.clone())?;
                 }
-                Ok(w.factors(p))
+                Ok(w.factors())
             })
             .try_reduce_with(|a, b| Ok(merge(a, b)))
             .transpose()?
-            .unwrap_or_else(|| vec![DMatrix::zeros(p + 1, p + 1); nv]);
+            .unwrap_or_else(|| {
+                let size = |c: &JointColumns| c.base.len() + 1;
+                columns
+                    .iter()
+                    .map(|c| DMatrix::zeros(size(c), size(c)))
+                    .collect()
+            });
         Ok(Self {
             samples: k,
             parameters: p,
+            active: columns.into_iter().map(|c| c.base).collect(),
             factors,
         })
     }
@@ -306,11 +337,19 @@ impl JointFactors {
                 message: format!("expected {nv} positive finite weights, got {sigma:?}"),
             });
         }
-        let mut stacked = DMatrix::zeros(nv * (p + 1), p + 1);
-        for (j, r) in self.factors.iter().enumerate() {
-            stacked
-                .rows_mut(j * (p + 1), p + 1)
-                .copy_from(&(r / sigma[j]));
+        // every joint's factor, weighted and scattered onto the p base columns and the torque
+        let height: usize = self.factors.iter().map(|r| r.nrows()).sum();
+        let mut stacked = DMatrix::zeros(height, p + 1);
+        let mut row = 0;
+        for ((r, active), s) in self.factors.iter().zip(&self.active).zip(sigma) {
+            let nj = active.len();
+            for i in 0..=nj {
+                for (a, &c) in active.iter().enumerate() {
+                    stacked[(row + i, c)] = r[(i, a)] / s;
+                }
+                stacked[(row + i, p)] = r[(i, nj)] / s;
+            }
+            row += nj + 1;
         }
         let r = triangular(&stacked);
         // [R11 z; 0 rho]: min |W theta - y| solves R11 theta = z with residual norm |rho|
@@ -336,12 +375,18 @@ impl JointFactors {
                 got: format!("{} values", theta.len()),
             });
         }
-        let x = DVector::from_column_slice(theta).push(-1.0);
         let k = self.samples.max(1) as f64;
         Ok(self
             .factors
             .iter()
-            .map(|r| (r * &x).norm() / k.sqrt())
+            .zip(&self.active)
+            .map(|(r, active)| {
+                let x = DVector::from_iterator(
+                    active.len() + 1,
+                    active.iter().map(|&c| theta[c]).chain([-1.0]),
+                );
+                (r * x).norm() / k.sqrt()
+            })
             .collect())
     }
 }
