@@ -1,6 +1,7 @@
 //! Throughput of the dynamics core on the built-in A465: `cargo bench --bench dynamics`.
-//! Names give the size: `rnea/a465/1` is one call, `rnea/a465/100000` a batch of 10^5 samples
-//! (serial, one `Data`).
+//! Names give the size: `rnea/a465/1` is one call, `batch/rnea/a465/100000` a batch of 10^5
+//! samples one at a time (serial, one `Data`), `batch/rnea_lanes/a465/100000` the same batch
+//! through the multi-sample kernel (serial too: the Python API adds the threads).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use perturbid_rs::algorithms::regressor::joint_torque_regressor;
@@ -82,7 +83,7 @@ fn dynamics(c: &mut Criterion) {
     });
     let mut group = c.benchmark_group("batch");
     group.sample_size(10);
-    for (name, f) in kernels.iter().take(3) {
+    for (name, f) in kernels.iter() {
         group.bench_function(format!("{name}/a465/{BATCH}"), |b| {
             b.iter(|| {
                 for s in 0..BATCH {

@@ -90,9 +90,24 @@ impl PyRobot {
     where
         F: Fn(&Model, &mut Work, &Chunk<'_>, &mut [f64]) -> Result<()> + Send + Sync,
     {
+        let (out, k, single) = self.run_chunks(py, args, out_dims.iter().product(), f)?;
+        to_numpy(py, out, k, single, out_dims)
+    }
+
+    /// [`PyRobot::map_chunks`] returning the results as one row-major buffer of `size` values
+    /// per sample, with the number of samples and whether the call was given single samples.
+    fn run_chunks<'py, F>(
+        &self,
+        py: Python<'py>,
+        args: &[(&str, &ArrayLike<'py>)],
+        size: usize,
+        f: F,
+    ) -> PyResult<(Vec<f64>, usize, bool)>
+    where
+        F: Fn(&Model, &mut Work, &Chunk<'_>, &mut [f64]) -> Result<()> + Send + Sync,
+    {
         let n = self.model.nv;
         let batch = read_batch(n, args)?;
-        let size: usize = out_dims.iter().product();
         let mut out = vec![0.0; batch.k * size];
         py.detach(|| -> Result<()> {
             let run = |work: &mut Work, first: usize, out: &mut [f64]| -> Result<()> {
@@ -121,7 +136,7 @@ impl PyRobot {
                 .enumerate()
                 .try_for_each(|(c, o)| run(&mut Work::new(&self.model), c * PARALLEL_CHUNK, o))
         })?;
-        to_numpy(py, out, batch.k, batch.single, out_dims)
+        Ok((out, batch.k, batch.single))
     }
 
     /// [`PyRobot::map_chunks`] one sample at a time: `f` gets the sample's arguments and
@@ -450,48 +465,38 @@ impl PyRobot {
         gravity: bool,
     ) -> PyResult<PyLinearization> {
         let n = self.model.nv;
-        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
-        let k = batch.k;
-        let (mut torque, mut dm, mut hm, mut gm, mut gs) = (
-            vec![0.0; k * n],
-            vec![0.0; k * n * n],
-            vec![0.0; k * n * n],
-            vec![0.0; k * n * n],
-            vec![0.0; k * n * n],
-        );
-        py.detach(|| -> Result<()> {
-            let mut work = self.work();
-            let data = &mut work.data;
+        let nn = n * n;
+        // one record per sample: torque (n), then D, H, G, G_static (n x n each, row-major)
+        let size = n + 4 * nn;
+        let args = [("q", &q), ("qd", &qd), ("qdd", &qdd)];
+        let (packed, k, single) = self.run_chunks(py, &args, size, |m, w, chunk, out| {
             let mut lin = crate::Linearization::zeros(n);
-            let c = &batch.columns;
-            for s in 0..k {
-                let r = s * n..(s + 1) * n;
-                crate::linearize_into(
-                    &self.model,
-                    data,
-                    &c[0][r.clone()],
-                    &c[1][r.clone()],
-                    &c[2][r.clone()],
-                    gravity,
-                    &mut lin,
-                )
-                .map_err(|e| batch.in_sample(s, e))?;
-                torque[r].copy_from_slice(lin.torque.as_slice());
-                let rr = s * n * n..(s + 1) * n * n;
-                copy_matrix(&lin.d, &mut dm[rr.clone()]);
-                copy_matrix(&lin.h, &mut hm[rr.clone()]);
-                copy_matrix(&lin.g, &mut gm[rr.clone()]);
-                copy_matrix(&lin.g_static, &mut gs[rr]);
+            for (i, o) in out.chunks_mut(size).enumerate() {
+                let [q, qd, qdd] = chunk.columns.map(|c| &c[i * n..(i + 1) * n]);
+                crate::linearize_into(m, &mut w.data, q, qd, qdd, gravity, &mut lin)
+                    .map_err(|e| chunk.at(i, e))?;
+                o[..n].copy_from_slice(lin.torque.as_slice());
+                for (b, mat) in [&lin.d, &lin.h, &lin.g, &lin.g_static].iter().enumerate() {
+                    copy_matrix(mat, &mut o[n + b * nn..n + (b + 1) * nn]);
+                }
             }
             Ok(())
         })?;
-        let single = batch.single;
+        let part = |offset: usize, len: usize| -> Vec<f64> {
+            packed
+                .chunks(size.max(1))
+                .flat_map(|r| r[offset..offset + len].iter().copied())
+                .collect()
+        };
+        let matrix = |b: usize| -> PyResult<Py<PyAny>> {
+            Ok(to_numpy(py, part(n + b * nn, nn), k, single, &[n, n])?.unbind())
+        };
         Ok(PyLinearization {
-            torque: to_numpy(py, torque, k, single, &[n])?.unbind(),
-            d: to_numpy(py, dm, k, single, &[n, n])?.unbind(),
-            h: to_numpy(py, hm, k, single, &[n, n])?.unbind(),
-            g: to_numpy(py, gm, k, single, &[n, n])?.unbind(),
-            g_static: to_numpy(py, gs, k, single, &[n, n])?.unbind(),
+            torque: to_numpy(py, part(0, n), k, single, &[n])?.unbind(),
+            d: matrix(0)?,
+            h: matrix(1)?,
+            g: matrix(2)?,
+            g_static: matrix(3)?,
         })
     }
 
