@@ -92,7 +92,7 @@ pub fn body_regressor(v: &Motion, a: &Motion) -> [Force; 10] {
 /// [`body_regressor`] expressed in the base frame, for a body at pose `x` (`oXi`): column `c`
 /// is `x.act_force(&body_regressor(v, a)[c])`. The six rotational-inertia columns have no force
 /// part (`linear == 0`) in any frame.
-#[inline]
+#[inline(always)]
 pub fn world_body_regressor(v: &Motion, a: &Motion, x: &Se3) -> [Force; 10] {
     let (r, p) = (&x.rotation, &x.translation);
     let (w, al) = (v.angular, a.angular);
@@ -137,6 +137,21 @@ pub fn world_body_regressor(v: &Motion, a: &Motion, x: &Se3) -> [Force; 10] {
 /// after body, each in [`PARAMETER_NAMES`] order, about the body's joint frame). `gravity`
 /// includes gravity.
 pub fn joint_torque_regressor(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    gravity: bool,
+    out: &mut DMatrix<f64>,
+) -> Result<()> {
+    regressor_inlined(model, data, q, qd, qdd, gravity, out)
+}
+
+/// [`joint_torque_regressor`], inlined into its caller (for callers compiled for other
+/// instruction sets, e.g. the streaming identification).
+#[inline(always)]
+pub(crate) fn regressor_inlined(
     model: &Model,
     data: &mut Data,
     q: &[f64],

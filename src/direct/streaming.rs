@@ -24,7 +24,7 @@ use rayon::prelude::*;
 
 use super::base::BaseParameters;
 use super::parameters::Batch;
-use crate::algorithms::regressor::{joint_torque_regressor, PARAMS_PER_BODY};
+use crate::algorithms::regressor::{regressor_inlined, PARAMS_PER_BODY};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -157,6 +157,53 @@ impl Worker {
         gravity: bool,
         range: std::ops::Range<usize>,
     ) -> Result<()> {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+        {
+            // SAFETY: the processor supports the features `fill_avx2` is compiled for.
+            unsafe { self.fill_avx2(model, columns, batch, tau, gravity, range.clone()) }?;
+        } else {
+            self.fill(model, columns, batch, tau, gravity, range.clone())?;
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        self.fill(model, columns, batch, tau, gravity, range.clone())?;
+        for a in &mut self.stacks {
+            let rows = a.ncols() + range.len();
+            factor_top(
+                a.as_mut().get_mut(..rows, ..),
+                self.q_coeff.as_mut(),
+                &mut self.scratch,
+            );
+        }
+        Ok(())
+    }
+
+    /// [`Worker::fill`] compiled for AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn fill_avx2(
+        &mut self,
+        model: &Model,
+        columns: &[JointColumns],
+        batch: &Batch<'_>,
+        tau: &[f64],
+        gravity: bool,
+        range: std::ops::Range<usize>,
+    ) -> Result<()> {
+        self.fill(model, columns, batch, tau, gravity, range)
+    }
+
+    /// Writes the rows of samples `range` below the factors.
+    #[inline(always)]
+    fn fill(
+        &mut self,
+        model: &Model,
+        columns: &[JointColumns],
+        batch: &Batch<'_>,
+        tau: &[f64],
+        gravity: bool,
+        range: std::ops::Range<usize>,
+    ) -> Result<()> {
         let nv = model.nv;
         for (r, s) in range.clone().enumerate() {
             let (q, qd, qdd) = (
@@ -164,7 +211,7 @@ impl Worker {
                 Batch::row(batch.qd, s, nv),
                 Batch::row(batch.qdd, s, nv),
             );
-            joint_torque_regressor(model, &mut self.data, q, qd, qdd, gravity, &mut self.y)
+            regressor_inlined(model, &mut self.data, q, qd, qdd, gravity, &mut self.y)
                 .map_err(|e| e.in_sample(s))?;
             let y = self.y.as_slice(); // column-major nv x 10 nbodies
             for (j, (a, cols)) in self.stacks.iter_mut().zip(columns).enumerate() {
@@ -182,14 +229,6 @@ impl Worker {
                 }
                 a[(i, nj)] = tau[s * nv + j];
             }
-        }
-        for a in &mut self.stacks {
-            let rows = a.ncols() + range.len();
-            factor_top(
-                a.as_mut().get_mut(..rows, ..),
-                self.q_coeff.as_mut(),
-                &mut self.scratch,
-            );
         }
         Ok(())
     }

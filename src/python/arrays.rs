@@ -2,25 +2,27 @@
 
 use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
+use std::borrow::Cow;
 
 use crate::error::Error;
 
-/// Arguments of one call, copied into contiguous row-major buffers so that the Rust work can
-/// run without the GIL.
-pub(crate) struct Batch {
+/// Arguments of one call as contiguous row-major buffers that the Rust work reads without the
+/// GIL: the numpy arrays' own memory when they are C-contiguous float64 (no copy; numpy's
+/// own GIL-free loops read their buffers the same way), copies otherwise.
+pub(crate) struct Batch<'a> {
     /// Number of samples.
     pub k: usize,
     /// Whether the call was given single samples (shape `(n,)`).
     pub single: bool,
     /// One buffer per argument, `k * n` values each, sample after sample.
-    pub columns: Vec<Vec<f64>>,
+    pub columns: Vec<Cow<'a, [f64]>>,
 }
 
 /// Reads `args` (name, array-like), each of shape `(n,)` or `(k, n)`, all with the same `k`.
-pub(crate) fn read_batch(
+pub(crate) fn read_batch<'a>(
     n: usize,
-    args: &[(&str, &PyArrayLikeDyn<'_, f64, AllowTypeChange>)],
-) -> Result<Batch, Error> {
+    args: &[(&str, &'a PyArrayLikeDyn<'_, f64, AllowTypeChange>)],
+) -> Result<Batch<'a>, Error> {
     // (number of samples, whether given as a batch) of the first argument
     let mut first: Option<(usize, bool)> = None;
     let mut columns = Vec::with_capacity(args.len());
@@ -53,9 +55,15 @@ pub(crate) fn read_batch(
             _ => {}
         }
         // Finiteness is checked by the algorithms, sample by sample (see `in_sample`).
-        columns.push(match arr.as_slice() {
-            Ok(contiguous) => contiguous.to_vec(),
-            Err(_) => arr.as_array().iter().copied().collect(),
+        // `as_slice` also accepts Fortran order, whose memory order is not ours
+        let c_order = if arr.is_c_contiguous() {
+            arr.as_slice().ok()
+        } else {
+            None
+        };
+        columns.push(match c_order {
+            Some(contiguous) => Cow::Borrowed(contiguous),
+            None => Cow::Owned(arr.as_array().iter().copied().collect()),
         });
     }
     let (k, batched) = first.unwrap_or((0, false));
@@ -66,7 +74,7 @@ pub(crate) fn read_batch(
     })
 }
 
-impl Batch {
+impl Batch<'_> {
     /// An error raised at sample `s` of this batch, its argument renamed `name[s]` for a batch.
     pub fn in_sample(&self, s: usize, e: Error) -> Error {
         if self.single {

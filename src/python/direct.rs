@@ -263,7 +263,11 @@ fn states(
     if let Some(t) = tau {
         args.push(("tau", t));
     }
-    Ok(read_batch(n, &args)?.columns)
+    Ok(read_batch(n, &args)?
+        .columns
+        .into_iter()
+        .map(|c| c.into_owned())
+        .collect())
 }
 
 /// An identified base-parameter model (the direct method).

@@ -59,6 +59,18 @@ def test_non_numeric_input(robot):
         robot.rnea(["a"] * 6, np.zeros(6), np.zeros(6))
 
 
+def test_any_memory_layout_is_read_in_logical_order(robot):
+    rng = np.random.default_rng(5)
+    Q, QD, QDD = rng.uniform(-1, 1, (3, 9, 6))
+    expected = robot.rnea(Q, QD, QDD)
+    fortran = [np.asfortranarray(x) for x in (Q, QD, QDD)]
+    np.testing.assert_array_equal(robot.rnea(*fortran), expected)
+    strided = [np.repeat(x, 2, axis=0)[::2] for x in (Q, QD, QDD)]  # not contiguous
+    np.testing.assert_array_equal(robot.rnea(*strided), expected)
+    np.testing.assert_array_equal(robot.mass_matrix(np.asfortranarray(Q)), robot.mass_matrix(Q))
+    np.testing.assert_array_equal(robot.rnea(Q.T.copy().T, QD, QDD), expected)
+
+
 def test_lists_and_ints_are_accepted(robot):
     assert robot.rnea([0] * 6, [0] * 6, [0] * 6).dtype == np.float64
 
