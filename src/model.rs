@@ -99,6 +99,17 @@ impl Body {
         }
     }
 
+    /// The motion subspace expressed in another frame, for the body's pose `x` in it (the same
+    /// as `x.act_motion(&self.motion_subspace())`, without the products by zero).
+    #[inline]
+    pub fn motion_subspace_in(&self, x: &Se3) -> Motion {
+        let r = x.rotation * self.axis;
+        match self.kind {
+            JointKind::Revolute => Motion::new(r, x.translation.cross(&r)),
+            JointKind::Prismatic => Motion::new(Vector3::zeros(), r),
+        }
+    }
+
     /// Pose of this body's frame in the parent's frame at joint coordinate `x` (rad or m).
     #[inline]
     pub fn pose_in_parent(&self, x: f64) -> Se3 {

@@ -35,7 +35,7 @@ fn crba_bodies(model: &Model, data: &mut Data, out: &mut DMatrix<f64>) {
             Some(p) => data.o_mi[p].compose(&data.li_mi[i]),
             None => data.li_mi[i],
         };
-        data.s_world[i] = x.act_motion(&b.motion_subspace());
+        data.s_world[i] = b.motion_subspace_in(&x);
         data.ycrb[i] = b.origin_inertia.transformed(&x);
         data.o_mi[i] = x;
     }

@@ -78,7 +78,7 @@ fn derivatives_loaded(
             None => x,
         };
         data.o_mi[i] = o_mi;
-        let j = o_mi.act_motion(&b.motion_subspace());
+        let j = b.motion_subspace_in(&o_mi);
         let (ov_p, oa_gf_p) = match b.parent {
             Some(p) => (data.ov[p], data.oa_gf[p]),
             None => (Motion::zeros(), minus_g),

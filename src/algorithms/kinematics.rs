@@ -1,7 +1,7 @@
 //! Forward kinematics: the pose of every body in its parent.
 
 use crate::data::Data;
-use crate::model::Model;
+use crate::model::{JointKind, Model};
 use crate::spatial::Motion;
 
 /// Poses `data.li_mi[i]` of every body in its parent's frame for the body coordinates in
@@ -20,14 +20,27 @@ pub(crate) fn motion_pass(model: &Model, data: &mut Data, gravity: bool) {
     let a0 = model.base_acceleration(gravity);
     for (i, b) in model.bodies.iter().enumerate() {
         let x = b.pose_in_parent(data.qb[i]);
-        let s = b.motion_subspace();
-        let vj = s.scale(data.vb[i]);
         let (vp, ap) = match b.parent {
             Some(p) => (data.v[p], data.a[p]),
             None => (Motion::zeros(), a0),
         };
-        let v = x.act_inv_motion(&vp) + vj;
-        data.a[i] = x.act_inv_motion(&ap) + s.scale(data.ab[i]) + v.cross(&vj);
+        let mut v = x.act_inv_motion(&vp);
+        let mut a = x.act_inv_motion(&ap);
+        // joint twist vj = S qd and acceleration S qdd; a += v x vj (written out: S has one
+        // nonzero half)
+        let (vj, aj) = (b.axis * data.vb[i], b.axis * data.ab[i]);
+        match b.kind {
+            JointKind::Revolute => {
+                v.angular += vj;
+                a.angular += aj + v.angular.cross(&vj);
+                a.linear += v.linear.cross(&vj);
+            }
+            JointKind::Prismatic => {
+                v.linear += vj;
+                a.linear += aj + v.angular.cross(&vj);
+            }
+        }
+        data.a[i] = a;
         data.li_mi[i] = x;
         data.v[i] = v;
     }

@@ -177,7 +177,7 @@ pub(crate) fn regressor_inlined(
             Some(p) => data.o_mi[p].compose(&data.li_mi[i]),
             None => data.li_mi[i],
         };
-        data.s_world[i] = data.o_mi[i].act_motion(&b.motion_subspace());
+        data.s_world[i] = b.motion_subspace_in(&data.o_mi[i]);
     }
     out.fill(0.0);
     let nv = model.nv;

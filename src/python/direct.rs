@@ -23,6 +23,7 @@ use crate::model::Model;
 use crate::preprocess::{preprocess as preprocess_rs, PreprocessOptions};
 use crate::recording::Recording;
 use crate::trajectory::FourierTrajectory;
+use std::borrow::Cow;
 
 type ArrayLike<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 
@@ -252,22 +253,18 @@ pub(crate) fn design_excitation(
 }
 
 /// Row-major (k, n) samples of three arrays and optionally a fourth.
-fn states(
+fn states<'a>(
     n: usize,
-    q: &ArrayLike<'_>,
-    qd: &ArrayLike<'_>,
-    qdd: &ArrayLike<'_>,
-    tau: Option<&ArrayLike<'_>>,
-) -> Result<Vec<Vec<f64>>> {
+    q: &'a ArrayLike<'_>,
+    qd: &'a ArrayLike<'_>,
+    qdd: &'a ArrayLike<'_>,
+    tau: Option<&'a ArrayLike<'_>>,
+) -> Result<Vec<Cow<'a, [f64]>>> {
     let mut args = vec![("q", q), ("qd", qd), ("qdd", qdd)];
     if let Some(t) = tau {
         args.push(("tau", t));
     }
-    Ok(read_batch(n, &args)?
-        .columns
-        .into_iter()
-        .map(|c| c.into_owned())
-        .collect())
+    Ok(read_batch(n, &args)?.columns)
 }
 
 /// An identified base-parameter model (the direct method).
