@@ -97,6 +97,19 @@ impl V {
             z: s * a.z,
         }
     }
+    #[inline(always)]
+    pub(crate) fn dot(&self, o: &V) -> L {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+    /// `self * s` for a lane scalar `s`.
+    #[inline(always)]
+    pub(crate) fn mul_lanes(&self, s: L) -> V {
+        V {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
+    }
     /// `a . self` for a constant vector `a`.
     #[inline(always)]
     pub(crate) fn dot_const(&self, a: &nalgebra::Vector3<f64>) -> L {
@@ -118,6 +131,39 @@ impl V {
 pub(crate) struct R(pub(crate) [V; 3]);
 
 impl R {
+    /// `self * o`.
+    #[inline(always)]
+    pub(crate) fn compose(&self, o: &R) -> R {
+        let row = |a: &V| V {
+            x: a.x * o.0[0].x + a.y * o.0[1].x + a.z * o.0[2].x,
+            y: a.x * o.0[0].y + a.y * o.0[1].y + a.z * o.0[2].y,
+            z: a.x * o.0[0].z + a.y * o.0[1].z + a.z * o.0[2].z,
+        };
+        R([row(&self.0[0]), row(&self.0[1]), row(&self.0[2])])
+    }
+    /// Column `k`.
+    #[inline(always)]
+    pub(crate) fn column(&self, k: usize) -> V {
+        let pick = |r: &V| match k {
+            0 => r.x,
+            1 => r.y,
+            _ => r.z,
+        };
+        V {
+            x: pick(&self.0[0]),
+            y: pick(&self.0[1]),
+            z: pick(&self.0[2]),
+        }
+    }
+    /// `self * a` for a constant vector `a`.
+    #[inline(always)]
+    pub(crate) fn mul_const_vector(&self, a: &nalgebra::Vector3<f64>) -> V {
+        V {
+            x: self.0[0].dot_const(a),
+            y: self.0[1].dot_const(a),
+            z: self.0[2].dot_const(a),
+        }
+    }
     #[inline(always)]
     pub(crate) fn mul(&self, v: &V) -> V {
         let d = |r: &V| r.x * v.x + r.y * v.y + r.z * v.z;

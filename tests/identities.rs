@@ -306,3 +306,69 @@ fn lanes_equal_one_sample_rnea_on_the_a465_and_a_mimic_pair() {
     .unwrap_err();
     assert!(e.to_string().contains("qd"), "{e}");
 }
+
+/// The multi-sample regressor equals the one-sample regressor on every sample.
+fn check_regressor_batch(model: &Model, rng: &mut Rng, k: usize) {
+    use perturbid_rs::algorithms::regressor::joint_torque_regressor;
+    let n = model.nv;
+    let p = 10 * model.nbodies();
+    let (q, qd, qdd) = (
+        rng.vector(k * n, 9.0),
+        rng.vector(k * n, 2.0),
+        rng.vector(k * n, 2.0),
+    );
+    let mut lanes = perturbid_rs::LaneData::new(model);
+    for gravity in [true, false] {
+        let mut out = vec![f64::NAN; k * n * p];
+        perturbid_rs::regressor_batch(model, &mut lanes, &q, &qd, &qdd, gravity, &mut out).unwrap();
+        let mut data = Data::new(model);
+        let mut y = DMatrix::zeros(n, p);
+        for s in 0..k {
+            let r = s * n..(s + 1) * n;
+            joint_torque_regressor(
+                model,
+                &mut data,
+                &q[r.clone()],
+                &qd[r.clone()],
+                &qdd[r],
+                gravity,
+                &mut y,
+            )
+            .unwrap();
+            let scale = 1.0 + y.amax();
+            for i in 0..n {
+                for c in 0..p {
+                    let got = out[s * n * p + i * p + c];
+                    assert!(
+                        (got - y[(i, c)]).abs() < 1e-12 * scale,
+                        "sample {s} row {i} column {c}: {got} vs {}",
+                        y[(i, c)]
+                    );
+                }
+            }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    #[test]
+    fn regressor_batch_equals_one_sample_regressor_on_random_trees(seed in any::<u64>(), nlinks in 1usize..9, k in 1usize..11) {
+        let text = random_tree_urdf(seed, nlinks);
+        let model = model_from_urdf_str(&text, "random", &LoadOptions::default()).unwrap();
+        check_regressor_batch(&model, &mut Rng(seed ^ 0x7777), k);
+    }
+}
+
+#[test]
+fn regressor_batch_equals_one_sample_regressor_on_the_a465_and_a_mimic_pair() {
+    let mut rng = Rng(9);
+    for model in [
+        robots::builtin("a465:physical").unwrap(),
+        model_from_urdf_str(&mimic_pair(true), "mimic", &LoadOptions::default()).unwrap(),
+    ] {
+        for k in [1, 4, 7] {
+            check_regressor_batch(&model, &mut rng, k);
+        }
+    }
+}

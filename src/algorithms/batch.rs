@@ -4,6 +4,7 @@
 //! samples that the compiler maps onto SIMD registers; the model's constants (placements,
 //! axes, inertias) are shared by the lanes.
 
+use crate::algorithms::regressor::PARAMS_PER_BODY;
 use crate::error::Result;
 pub use crate::lanes::LANES;
 use crate::lanes::{sin_cos, L, R, S, V};
@@ -14,6 +15,9 @@ use crate::spatial::Se3;
 #[derive(Clone, Debug)]
 pub struct LaneData {
     rot: Vec<R>,
+    o_rot: Vec<R>,
+    o_pos: Vec<V>,
+    o_s: Vec<S>,
     pos: Vec<V>,
     v: Vec<S>,
     a: Vec<S>,
@@ -29,6 +33,9 @@ impl LaneData {
         let nb = model.nbodies();
         Self {
             rot: vec![R::default(); nb],
+            o_rot: vec![R::default(); nb],
+            o_pos: vec![V::default(); nb],
+            o_s: vec![S::default(); nb],
             pos: vec![V::default(); nb],
             v: vec![S::default(); nb],
             a: vec![S::default(); nb],
@@ -118,14 +125,12 @@ fn rnea_lanes_body(
     let g = model.base_acceleration(gravity);
     let mut first = 0;
     while first < k {
-        // the last group repeats its final sample in the unused lanes
-        let lane = |l: usize| (first + l).min(k - 1);
-        for (i, b) in model.bodies.iter().enumerate() {
-            let get = |x: &[f64], l: usize| b.multiplier * x[lane(l) * nv + b.dof];
-            data.qb[i] = L(std::array::from_fn(|l| get(q, l) + b.offset));
-            data.vb[i] = L(std::array::from_fn(|l| qd.map_or(0.0, |x| get(x, l))));
-            data.ab[i] = L(std::array::from_fn(|l| qdd.map_or(0.0, |x| get(x, l))));
-        }
+        load(
+            model,
+            data,
+            [q, qd.unwrap_or(&[]), qdd.unwrap_or(&[])],
+            first,
+        );
         group(model, data, &g);
         // contract body torques onto the dofs and write the lanes in use
         let used = (k - first).min(LANES);
@@ -147,10 +152,57 @@ fn rnea_lanes_body(
     Ok(())
 }
 
+/// Loads the body coordinates of samples `first..first + LANES` of the row-major `k x nv`
+/// arrays `[q, qd, qdd]` (empty for zeros) into the lanes; past the last sample the lanes repeat
+/// it.
+#[inline(always)]
+pub(crate) fn load(model: &Model, data: &mut LaneData, x: [&[f64]; 3], first: usize) {
+    let nv = model.nv;
+    let k = x[0].len() / nv.max(1);
+    let lane = |l: usize| (first + l).min(k.max(1) - 1);
+    for (i, b) in model.bodies.iter().enumerate() {
+        let get = |x: &[f64], l: usize| {
+            if x.is_empty() {
+                0.0
+            } else {
+                b.multiplier * x[lane(l) * nv + b.dof]
+            }
+        };
+        data.qb[i] = L(std::array::from_fn(|l| get(x[0], l) + b.offset));
+        data.vb[i] = L(std::array::from_fn(|l| get(x[1], l)));
+        data.ab[i] = L(std::array::from_fn(|l| get(x[2], l)));
+    }
+}
+
 /// One group of lanes: forward pass (poses, twists, accelerations, body wrenches) then the
 /// backward pass accumulating the wrenches in `data.f`.
 #[inline(always)]
 fn group(model: &Model, data: &mut LaneData, g: &crate::spatial::Motion) {
+    forward(model, data, g);
+    for (i, b) in model.bodies.iter().enumerate() {
+        // f = I a + v x* (I v)
+        let (v, a) = (&data.v[i], &data.a[i]);
+        let (ia, h) = (apply(&b.inertia, a), apply(&b.inertia, v));
+        data.f[i] = S {
+            ang: ia.ang.add(&v.ang.cross(&h.ang)).add(&v.lin.cross(&h.lin)),
+            lin: ia.lin.add(&v.ang.cross(&h.lin)),
+        };
+    }
+    for i in (0..model.nbodies()).rev() {
+        if let Some(p) = model.bodies[i].parent {
+            let (rot, pos, f) = (&data.rot[i], &data.pos[i], data.f[i]);
+            let lin = rot.mul(&f.lin);
+            let ang = rot.mul(&f.ang).add(&pos.cross(&lin));
+            data.f[p].ang = data.f[p].ang.add(&ang);
+            data.f[p].lin = data.f[p].lin.add(&lin);
+        }
+    }
+}
+
+/// The forward pass on the loaded coordinates: every body's pose in its parent (`rot`, `pos`),
+/// twist `v` and acceleration `a` (gravity included as a base acceleration `g`) in its frame.
+#[inline(always)]
+fn forward(model: &Model, data: &mut LaneData, g: &crate::spatial::Motion) {
     let base = S {
         ang: V::splat(&g.angular),
         lin: V::splat(&g.linear),
@@ -179,24 +231,190 @@ fn group(model: &Model, data: &mut LaneData, g: &crate::spatial::Motion) {
                 a.lin = a.lin.add(&v.ang.cross(&vj));
             }
         }
-        // f = I a + v x* (I v)
-        let (ia, h) = (apply(&b.inertia, &a), apply(&b.inertia, &v));
-        data.f[i] = S {
-            ang: ia.ang.add(&v.ang.cross(&h.ang)).add(&v.lin.cross(&h.lin)),
-            lin: ia.lin.add(&v.ang.cross(&h.lin)),
-        };
         data.rot[i] = rot;
         data.pos[i] = pos;
         data.v[i] = v;
         data.a[i] = a;
     }
-    for i in (0..model.nbodies()).rev() {
-        if let Some(p) = model.bodies[i].parent {
-            let (rot, pos, f) = (&data.rot[i], &data.pos[i], data.f[i]);
-            let lin = rot.mul(&f.lin);
-            let ang = rot.mul(&f.ang).add(&pos.cross(&lin));
-            data.f[p].ang = data.f[p].ang.add(&ang);
-            data.f[p].lin = data.f[p].lin.add(&lin);
+}
+
+/// The joint-torque regressor of a batch, [`LANES`] samples at a time: `out` (row-major
+/// `k x nv x 10 nbodies`, N m per parameter unit) holds for every sample the matrix that
+/// [`crate::algorithms::regressor::joint_torque_regressor`] gives, up to rounding.
+///
+/// `q`, `qd`, `qdd`: row-major `k x nv` (rad, rad/s, rad/s^2), finite (checked by the caller, as
+/// for [`rnea_lanes`]); `gravity` includes gravity. Uses AVX2 and FMA when the processor has
+/// them.
+pub fn regressor_batch(
+    model: &Model,
+    data: &mut LaneData,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    gravity: bool,
+    out: &mut [f64],
+) -> Result<()> {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the processor supports the features `regressor_batch_avx2` is compiled for.
+        return unsafe { regressor_batch_avx2(model, data, q, qd, qdd, gravity, out) };
+    }
+    regressor_batch_body(model, data, q, qd, qdd, gravity, out)
+}
+
+/// [`regressor_batch_body`] compiled for AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn regressor_batch_avx2(
+    model: &Model,
+    data: &mut LaneData,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    gravity: bool,
+    out: &mut [f64],
+) -> Result<()> {
+    regressor_batch_body(model, data, q, qd, qdd, gravity, out)
+}
+
+#[inline(always)]
+fn regressor_batch_body(
+    model: &Model,
+    data: &mut LaneData,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    gravity: bool,
+    out: &mut [f64],
+) -> Result<()> {
+    let nv = model.nv;
+    let p = PARAMS_PER_BODY * model.nbodies();
+    let k = q.len() / nv.max(1);
+    for (name, len, per) in [
+        ("q", q.len(), nv),
+        ("qd", qd.len(), nv),
+        ("qdd", qdd.len(), nv),
+        ("regressor output", out.len(), nv * p),
+    ] {
+        if len != k * per || q.len() % nv.max(1) != 0 {
+            return Err(crate::error::Error::Shape {
+                argument: name.into(),
+                expected: format!("{k} samples x {per} values"),
+                got: format!("{len} values"),
+            });
+        }
+    }
+    let mut y = vec![L::default(); nv * p];
+    let mut first = 0;
+    while first < k {
+        load(model, data, [q, qd, qdd], first);
+        regressor_lanes(model, data, gravity, &mut y);
+        for l in 0..(k - first).min(LANES) {
+            let o = &mut out[(first + l) * nv * p..(first + l + 1) * nv * p];
+            for r in 0..nv {
+                for c in 0..p {
+                    o[r * p + c] = y[r + c * nv].0[l];
+                }
+            }
+        }
+        first += LANES;
+    }
+    Ok(())
+}
+
+/// The joint-torque regressor (see [`crate::algorithms::regressor::joint_torque_regressor`]) of
+/// the loaded group of lanes (see [`load`]): `out` column-major `nv x 10 nbodies`, one lane per
+/// sample, every entry written. `gravity` includes gravity.
+#[inline(always)]
+pub(crate) fn regressor_lanes(model: &Model, data: &mut LaneData, gravity: bool, out: &mut [L]) {
+    let nv = model.nv;
+    forward(model, data, &model.base_acceleration(gravity));
+    out.fill(L::default());
+    for (i, b) in model.bodies.iter().enumerate() {
+        // pose in the base frame and the motion subspace there
+        let (r, p) = match b.parent {
+            Some(k) => {
+                let (rp, pp) = (data.o_rot[k], data.o_pos[k]);
+                (rp.compose(&data.rot[i]), pp.add(&rp.mul(&data.pos[i])))
+            }
+            None => (data.rot[i], data.pos[i]),
+        };
+        let axis = r.mul_const_vector(&b.axis);
+        data.o_s[i] = match b.kind {
+            JointKind::Revolute => S {
+                ang: axis,
+                lin: p.cross(&axis),
+            },
+            JointKind::Prismatic => S {
+                ang: V::default(),
+                lin: axis,
+            },
+        };
+        data.o_rot[i] = r;
+        data.o_pos[i] = p;
+        // the body's 10 columns in the base frame (see `world_body_regressor`)
+        let (v, a) = (&data.v[i], &data.a[i]);
+        let (w, al) = (v.ang, a.ang);
+        let ac = r.mul(&a.lin.add(&w.cross(&v.lin)));
+        let (ww, alw) = (r.mul(&w), r.mul(&al));
+        let w2 = w.x * w.x + w.y * w.y + w.z * w.z;
+        let mut cols = [S::default(); 10];
+        cols[0] = S {
+            ang: p.cross(&ac),
+            lin: ac,
+        };
+        let wk = [w.x, w.y, w.z];
+        for (k, &wkk) in wk.iter().enumerate() {
+            let rk = r.column(k);
+            let lin = alw
+                .cross(&rk)
+                .add(&ww.mul_lanes(wkk))
+                .sub(&rk.mul_lanes(w2));
+            cols[1 + k] = S {
+                ang: rk.cross(&ac).add(&p.cross(&lin)),
+                lin,
+            };
+        }
+        // I_q x for the unit inertias of [Ixx, Ixy, Iyy, Ixz, Iyz, Izz], then rotated
+        let z = L::default();
+        let unit = |x: &V| {
+            [
+                V { x: x.x, y: z, z },
+                V { x: x.y, y: x.x, z },
+                V { x: z, y: x.y, z },
+                V {
+                    x: x.z,
+                    y: z,
+                    z: x.x,
+                },
+                V {
+                    x: z,
+                    y: x.z,
+                    z: x.y,
+                },
+                V { x: z, y: z, z: x.z },
+            ]
+        };
+        let (ia, iw) = (unit(&al), unit(&w));
+        for q in 0..6 {
+            cols[4 + q].ang = r.mul(&ia[q].add(&w.cross(&iw[q])));
+        }
+        // project on the motion subspaces of the body and its ancestors
+        let first = PARAMS_PER_BODY * i * nv;
+        let mut j = Some(i);
+        while let Some(k) = j {
+            let bk = &model.bodies[k];
+            let sk = &data.o_s[k];
+            let at = |c: usize| first + c * nv + bk.dof;
+            for (c, f) in cols[..4].iter().enumerate() {
+                let t = sk.ang.dot(&f.ang) + sk.lin.dot(&f.lin);
+                out[at(c)] = out[at(c)] + t * bk.multiplier;
+            }
+            for (c, f) in cols[4..].iter().enumerate() {
+                let t = sk.ang.dot(&f.ang);
+                out[at(4 + c)] = out[at(4 + c)] + t * bk.multiplier;
+            }
+            j = bk.parent;
         }
     }
 }

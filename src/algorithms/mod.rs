@@ -20,7 +20,6 @@ use crate::error::Result;
 use crate::model::Model;
 
 /// Checks the state vectors and writes the body coordinates into `data`.
-#[inline(always)]
 pub(crate) fn load_state(
     model: &Model,
     data: &mut Data,

@@ -145,21 +145,6 @@ pub fn joint_torque_regressor(
     gravity: bool,
     out: &mut DMatrix<f64>,
 ) -> Result<()> {
-    regressor_inlined(model, data, q, qd, qdd, gravity, out)
-}
-
-/// [`joint_torque_regressor`], inlined into its caller (for callers compiled for other
-/// instruction sets, e.g. the streaming identification).
-#[inline(always)]
-pub(crate) fn regressor_inlined(
-    model: &Model,
-    data: &mut Data,
-    q: &[f64],
-    qd: &[f64],
-    qdd: &[f64],
-    gravity: bool,
-    out: &mut DMatrix<f64>,
-) -> Result<()> {
     let nb = model.nbodies();
     if out.shape() != (model.nv, PARAMS_PER_BODY * nb) {
         return Err(Error::Shape {

@@ -24,11 +24,13 @@ use rayon::prelude::*;
 
 use super::base::BaseParameters;
 use super::parameters::Batch;
-use crate::algorithms::regressor::{regressor_inlined, PARAMS_PER_BODY};
-use crate::data::Data;
+use crate::algorithms::batch::{load, regressor_lanes};
+use crate::algorithms::regressor::PARAMS_PER_BODY;
 use crate::error::{Error, Result};
+use crate::lanes::{L, LANES};
 use crate::model::Model;
 use crate::regression::{least_squares, LeastSquares};
+use crate::LaneData;
 
 /// Samples per chunk.
 pub const CHUNK: usize = 1024;
@@ -118,8 +120,9 @@ pub struct JointFactors {
 /// `(n_j + 1 + CHUNK) x (n_j + 1)` matrix whose top rows carry the factor so far (zeros at
 /// first) and whose other rows take the next chunk.
 struct Worker {
-    data: Data,
-    y: DMatrix<f64>,
+    lanes: LaneData,
+    /// The regressor of a group of samples, column-major `nv x 10 nbodies`, a lane per sample.
+    y: Vec<L>,
     stacks: Vec<Mat<f64>>,
     q_coeff: Mat<f64>,
     scratch: MemBuffer,
@@ -130,8 +133,8 @@ impl Worker {
         let widest = columns.iter().map(|c| c.base.len() + 1).max().unwrap_or(1);
         let block = recommended_block_size::<f64>(widest + CHUNK, widest);
         Self {
-            data: Data::new(model),
-            y: DMatrix::zeros(model.nv, PARAMS_PER_BODY * model.nbodies()),
+            lanes: LaneData::new(model),
+            y: vec![L::default(); model.nv * PARAMS_PER_BODY * model.nbodies()],
             stacks: columns
                 .iter()
                 .map(|c| Mat::zeros(c.base.len() + 1 + CHUNK, c.base.len() + 1))
@@ -205,30 +208,45 @@ impl Worker {
         range: std::ops::Range<usize>,
     ) -> Result<()> {
         let nv = model.nv;
-        for (r, s) in range.clone().enumerate() {
-            let (q, qd, qdd) = (
-                Batch::row(batch.q, s, nv),
-                Batch::row(batch.qd, s, nv),
-                Batch::row(batch.qdd, s, nv),
-            );
-            regressor_inlined(model, &mut self.data, q, qd, qdd, gravity, &mut self.y)
-                .map_err(|e| e.in_sample(s))?;
-            let y = self.y.as_slice(); // column-major nv x 10 nbodies
-            for (j, (a, cols)) in self.stacks.iter_mut().zip(columns).enumerate() {
-                let nj = cols.base.len();
-                let i = nj + 1 + r;
-                for &(c, col) in &cols.inertial {
-                    a[(i, c)] = y[j + col * nv];
+        let mut first = range.start;
+        while first < range.end {
+            // a group of LANES samples through the multi-sample regressor
+            let used = (range.end - first).min(LANES);
+            let rows = first * nv..(first + used) * nv;
+            let x = [
+                &batch.q[rows.clone()],
+                &batch.qd[rows.clone()],
+                &batch.qdd[rows],
+            ];
+            for l in 0..used {
+                for (name, column) in ["q", "qd", "qdd"].iter().zip(&x) {
+                    model
+                        .check_vector(name, &column[l * nv..(l + 1) * nv])
+                        .map_err(|e| e.in_sample(first + l))?;
                 }
-                for &(c, term) in &cols.friction {
-                    a[(i, c)] = match term {
-                        Term::Viscous => qd[j],
-                        Term::Coulomb => qd[j].signum() * f64::from(u8::from(qd[j] != 0.0)),
-                        Term::Offset => 1.0,
-                    };
-                }
-                a[(i, nj)] = tau[s * nv + j];
             }
+            load(model, &mut self.lanes, x, 0);
+            regressor_lanes(model, &mut self.lanes, gravity, &mut self.y);
+            for l in 0..used {
+                let s = first + l;
+                let qd = Batch::row(batch.qd, s, nv);
+                for (j, (a, cols)) in self.stacks.iter_mut().zip(columns).enumerate() {
+                    let nj = cols.base.len();
+                    let i = nj + 1 + s - range.start;
+                    for &(c, col) in &cols.inertial {
+                        a[(i, c)] = self.y[j + col * nv].0[l];
+                    }
+                    for &(c, term) in &cols.friction {
+                        a[(i, c)] = match term {
+                            Term::Viscous => qd[j],
+                            Term::Coulomb => qd[j].signum() * f64::from(u8::from(qd[j] != 0.0)),
+                            Term::Offset => 1.0,
+                        };
+                    }
+                    a[(i, nj)] = tau[s * nv + j];
+                }
+            }
+            first += used;
         }
         Ok(())
     }

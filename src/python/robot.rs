@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 
 use super::arrays::{read_batch, to_numpy};
 use super::linearization::PyLinearization;
-use crate::algorithms::batch::{rnea_lanes, LaneData, LANES};
+use crate::algorithms::batch::{regressor_batch, rnea_lanes, LaneData, LANES};
 use crate::error::Result;
 use crate::{robots, urdf, Data, Model};
 
@@ -55,6 +55,23 @@ struct Chunk<'a> {
 }
 
 impl Chunk<'_> {
+    /// Fails on the first non-finite argument value, naming the argument (`names`, in order)
+    /// and the sample: one fast pass over the chunk, a sample at a time only to find a bad one.
+    fn check_finite(&self, model: &Model, names: &[&str]) -> Result<()> {
+        let n = model.nv;
+        let bad = |c: &&[f64]| c.iter().fold(false, |bad, v| bad | !v.is_finite());
+        if self.columns.iter().any(bad) {
+            for i in 0..self.len {
+                for (name, column) in names.iter().zip(&self.columns) {
+                    model
+                        .check_vector(name, &column[i * n..(i + 1) * n])
+                        .map_err(|e| self.at(i, e))?;
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// An error raised at sample `i` of the chunk, renamed for its sample in the batch.
     fn at(&self, i: usize, e: crate::error::Error) -> crate::error::Error {
         if self.single {
@@ -178,16 +195,7 @@ impl PyRobot {
         let n = self.model.nv;
         let names: Vec<&str> = args.iter().map(|a| a.0).collect();
         self.map_chunks(py, args, &[n], |m, w, chunk, out| {
-            // a fast pass over the chunk; a sample at a time only to name a bad one
-            let bad = |c: &&[f64]| c.iter().fold(false, |bad, v| bad | !v.is_finite());
-            if chunk.columns.iter().any(bad) {
-                for i in 0..chunk.len {
-                    for (name, column) in names.iter().zip(&chunk.columns) {
-                        m.check_vector(name, &column[i * n..(i + 1) * n])
-                            .map_err(|e| chunk.at(i, e))?;
-                    }
-                }
-            }
+            chunk.check_finite(m, &names)?;
             let [q, qd, qdd] = chunk.columns;
             fn opt(x: &[f64]) -> Option<&[f64]> {
                 (!x.is_empty()).then_some(x)
@@ -403,20 +411,34 @@ impl PyRobot {
         gravity: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (n, p) = (self.model.nv, 10 * self.model.nbodies());
-        self.map_samples(
-            py,
-            &[("q", &q), ("qd", &qd), ("qdd", &qdd)],
-            &[n, p],
-            move |m, d, x, out| {
-                let mut y = std::mem::take(&mut d.regressor);
-                let r = crate::algorithms::regressor::joint_torque_regressor(
-                    m, d, x[0], x[1], x[2], gravity, &mut y,
-                );
-                copy_matrix(&y, out);
-                d.regressor = y;
-                r
-            },
-        )
+        let args = [("q", &q), ("qd", &qd), ("qdd", &qdd)];
+        self.map_chunks(py, &args, &[n, p], move |m, w, chunk, out| {
+            chunk.check_finite(m, &["q", "qd", "qdd"])?;
+            let [q, qd, qdd] = chunk.columns;
+            if chunk.len >= LANES {
+                return regressor_batch(m, &mut w.lanes, q, qd, qdd, gravity, out);
+            }
+            // too few samples to fill the lanes: one at a time
+            let d = &mut w.data;
+            let mut y = std::mem::take(&mut d.regressor);
+            let result = out.chunks_mut(n * p).enumerate().try_for_each(|(i, o)| {
+                let r = i * n..(i + 1) * n;
+                crate::algorithms::regressor::joint_torque_regressor(
+                    m,
+                    d,
+                    &q[r.clone()],
+                    &qd[r.clone()],
+                    &qdd[r],
+                    gravity,
+                    &mut y,
+                )
+                .map_err(|e| chunk.at(i, e))?;
+                copy_matrix(&y, o);
+                Ok(())
+            });
+            d.regressor = y; // back in place even after an error
+            result
+        })
     }
 
     /// The model's own inertial parameters, shape (10 b,), in the order of `regressor`.

@@ -52,6 +52,12 @@ def test_non_finite_input(robot):
         robot.gravity(big)
     with pytest.raises(pr.InputError, match=r"qd\[4321\]: entry 5 is -inf"):
         robot.bias(np.zeros((5000, 6)), big)
+    with pytest.raises(pr.InputError, match=r"qdd\[4321\]: entry 5 is -inf"):
+        robot.regressor(np.zeros((5000, 6)), np.zeros((5000, 6)), big)
+    with pytest.raises(pr.InputError, match=r"qd\[1\]: entry 4 is inf"):
+        robot.regressor(np.zeros((3, 6)), batch, np.zeros((3, 6)))
+    # the robot still works after errors
+    assert robot.regressor(z, z, z).shape == (6, 60)
 
 
 def test_non_numeric_input(robot):

@@ -96,11 +96,15 @@ def test_batches_match_single_samples(pair: Pair):
     assert M.shape == (5, pair.ours.n, pair.ours.n)
     lin = pair.ours.linearize(Q, QD, QDD)
     assert lin.G.shape == (5, pair.ours.n, pair.ours.n) and lin.torque.shape == (5, pair.ours.n)
+    Ys = pair.ours.regressor(Q, QD, QDD)  # 5 samples: the multi-sample kernel and one more
     for k in range(5):
         # batches of 4 or more run the multi-sample kernel: equal up to rounding
         single = pair.ours.rnea(Q[k], QD[k], QDD[k])
         np.testing.assert_allclose(tau[k], single, rtol=0, atol=1e-12 * (1 + np.abs(single).max()))
         np.testing.assert_array_equal(M[k], pair.ours.mass_matrix(Q[k]))
+        Y = pair.ours.regressor(Q[k], QD[k], QDD[k])
+        np.testing.assert_allclose(Ys[k], Y, rtol=0, atol=1e-12 * (1 + np.abs(Y).max()))
+        assert relerr(Ys[k] @ pair.ours.parameters, tau[k]) < TOL
         np.testing.assert_array_equal(lin.H[k], pair.ours.linearize(Q[k], QD[k], QDD[k]).H)
 
 
