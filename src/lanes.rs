@@ -3,6 +3,33 @@
 //! short loop over the lanes that the compiler maps onto SIMD registers; used by the
 //! multi-sample kernels ([`crate::algorithms::batch`]).
 
+/// Defines `$vis fn $name(args) -> ret` that runs `$body(args)` (an `#[inline(always)]`
+/// function) compiled for AVX2 and FMA when the processor has them (checked at run time, then
+/// cached by the standard library), and compiled for the baseline instruction set otherwise.
+/// The AVX2 copy is the private `$avx`.
+macro_rules! simd_dispatch {
+    ($(#[$meta:meta])* $vis:vis fn $name:ident, $avx:ident => $body:ident ($($arg:ident : $ty:ty),* $(,)?) -> $ret:ty) => {
+        $(#[$meta])*
+        $vis fn $name($($arg: $ty),*) -> $ret {
+            #[cfg(target_arch = "x86_64")]
+            if std::arch::is_x86_feature_detected!("avx2")
+                && std::arch::is_x86_feature_detected!("fma")
+            {
+                // SAFETY: the processor supports the features `$avx` is compiled for.
+                return unsafe { $avx($($arg),*) };
+            }
+            $body($($arg),*)
+        }
+
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2,fma")]
+        unsafe fn $avx($($arg: $ty),*) -> $ret {
+            $body($($arg),*)
+        }
+    };
+}
+pub(crate) use simd_dispatch;
+
 /// Samples processed together.
 pub const LANES: usize = 4;
 

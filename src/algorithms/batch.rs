@@ -7,7 +7,7 @@
 use crate::algorithms::regressor::PARAMS_PER_BODY;
 use crate::error::Result;
 pub use crate::lanes::LANES;
-use crate::lanes::{sin_cos, L, R, S, V};
+use crate::lanes::{simd_dispatch, sin_cos, L, R, S, V};
 use crate::model::{JointKind, Model};
 use crate::spatial::Se3;
 
@@ -47,6 +47,7 @@ impl LaneData {
     }
 }
 
+simd_dispatch! {
 /// Inverse dynamics `tau = M(q) qdd + c(q, qd) + g(q)` of a batch, [`LANES`] samples at a time.
 ///
 /// - `q` (rad or m), `qd` (rad/s or m/s), `qdd` (rad/s^2 or m/s^2): row-major `k x nv`
@@ -60,7 +61,7 @@ impl LaneData {
 ///
 /// On x86-64 processors with AVX2 and FMA (checked at run time) the kernel runs compiled for
 /// them; elsewhere with the baseline instruction set.
-pub fn rnea_lanes(
+pub fn rnea_lanes, rnea_lanes_avx2 => rnea_lanes_body(
     model: &Model,
     data: &mut LaneData,
     q: &[f64],
@@ -68,28 +69,7 @@ pub fn rnea_lanes(
     qdd: Option<&[f64]>,
     gravity: bool,
     tau: &mut [f64],
-) -> Result<()> {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-        // SAFETY: the processor supports the features `rnea_lanes_avx2` is compiled for.
-        return unsafe { rnea_lanes_avx2(model, data, q, qd, qdd, gravity, tau) };
-    }
-    rnea_lanes_body(model, data, q, qd, qdd, gravity, tau)
-}
-
-/// [`rnea_lanes_body`] compiled for AVX2 and FMA.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn rnea_lanes_avx2(
-    model: &Model,
-    data: &mut LaneData,
-    q: &[f64],
-    qd: Option<&[f64]>,
-    qdd: Option<&[f64]>,
-    gravity: bool,
-    tau: &mut [f64],
-) -> Result<()> {
-    rnea_lanes_body(model, data, q, qd, qdd, gravity, tau)
+) -> Result<()>
 }
 
 #[inline(always)]
@@ -238,6 +218,7 @@ fn forward(model: &Model, data: &mut LaneData, g: &crate::spatial::Motion) {
     }
 }
 
+simd_dispatch! {
 /// The joint-torque regressor of a batch, [`LANES`] samples at a time: `out` (row-major
 /// `k x nv x 10 nbodies`, N m per parameter unit) holds for every sample the matrix that
 /// [`crate::algorithms::regressor::joint_torque_regressor`] gives, up to rounding.
@@ -245,7 +226,7 @@ fn forward(model: &Model, data: &mut LaneData, g: &crate::spatial::Motion) {
 /// `q`, `qd`, `qdd`: row-major `k x nv` (rad, rad/s, rad/s^2), finite (checked by the caller, as
 /// for [`rnea_lanes`]); `gravity` includes gravity. Uses AVX2 and FMA when the processor has
 /// them.
-pub fn regressor_batch(
+pub fn regressor_batch, regressor_batch_avx2 => regressor_batch_body(
     model: &Model,
     data: &mut LaneData,
     q: &[f64],
@@ -253,28 +234,7 @@ pub fn regressor_batch(
     qdd: &[f64],
     gravity: bool,
     out: &mut [f64],
-) -> Result<()> {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-        // SAFETY: the processor supports the features `regressor_batch_avx2` is compiled for.
-        return unsafe { regressor_batch_avx2(model, data, q, qd, qdd, gravity, out) };
-    }
-    regressor_batch_body(model, data, q, qd, qdd, gravity, out)
-}
-
-/// [`regressor_batch_body`] compiled for AVX2 and FMA.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn regressor_batch_avx2(
-    model: &Model,
-    data: &mut LaneData,
-    q: &[f64],
-    qd: &[f64],
-    qdd: &[f64],
-    gravity: bool,
-    out: &mut [f64],
-) -> Result<()> {
-    regressor_batch_body(model, data, q, qd, qdd, gravity, out)
+) -> Result<()>
 }
 
 #[inline(always)]

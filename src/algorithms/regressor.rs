@@ -68,18 +68,7 @@ pub fn body_regressor(v: &Motion, a: &Motion) -> [Force; 10] {
             linear: al.cross(&e) + w.cross(&w.cross(&e)),
         };
     }
-    // I_p x for the unit inertias of [Ixx, Ixy, Iyy, Ixz, Iyz, Izz]
-    let unit = |x: &Vector3<f64>| {
-        [
-            Vector3::new(x.x, 0.0, 0.0),
-            Vector3::new(x.y, x.x, 0.0),
-            Vector3::new(0.0, x.y, 0.0),
-            Vector3::new(x.z, 0.0, x.x),
-            Vector3::new(0.0, x.z, x.y),
-            Vector3::new(0.0, 0.0, x.z),
-        ]
-    };
-    let (ia, iw) = (unit(&al), unit(&w));
+    let (ia, iw) = (unit_inertia_products(&al), unit_inertia_products(&w));
     for p in 0..6 {
         out[4 + p] = Force {
             angular: ia[p] + w.cross(&iw[p]),
@@ -113,22 +102,26 @@ pub fn world_body_regressor(v: &Motion, a: &Motion, x: &Se3) -> [Force; 10] {
             linear,
         };
     }
-    // I_p x for the unit inertias of [Ixx, Ixy, Iyy, Ixz, Iyz, Izz], then rotated
-    let unit = |x: &Vector3<f64>| {
-        [
-            Vector3::new(x.x, 0.0, 0.0),
-            Vector3::new(x.y, x.x, 0.0),
-            Vector3::new(0.0, x.y, 0.0),
-            Vector3::new(x.z, 0.0, x.x),
-            Vector3::new(0.0, x.z, x.y),
-            Vector3::new(0.0, 0.0, x.z),
-        ]
-    };
-    let (ia, iw) = (unit(&al), unit(&w));
+    // the rotational-inertia columns, rotated
+    let (ia, iw) = (unit_inertia_products(&al), unit_inertia_products(&w));
     for q in 0..6 {
         out[4 + q].angular = r * (ia[q] + w.cross(&iw[q]));
     }
     out
+}
+
+/// `I x` for the unit rotational inertias of `[Ixx, Ixy, Iyy, Ixz, Iyz, Izz]` (the symmetric
+/// matrices with ones at those entries).
+#[inline(always)]
+fn unit_inertia_products(x: &Vector3<f64>) -> [Vector3<f64>; 6] {
+    [
+        Vector3::new(x.x, 0.0, 0.0),
+        Vector3::new(x.y, x.x, 0.0),
+        Vector3::new(0.0, x.y, 0.0),
+        Vector3::new(x.z, 0.0, x.x),
+        Vector3::new(0.0, x.z, x.y),
+        Vector3::new(0.0, 0.0, x.z),
+    ]
 }
 
 /// The joint-torque regressor at `(q, qd, qdd)` (length `model.nv` each; rad, rad/s, rad/s^2):

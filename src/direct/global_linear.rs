@@ -6,7 +6,7 @@ use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 use super::parameters::Batch;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::local::OperatingPoint;
 use crate::regression::least_squares;
 
@@ -56,14 +56,7 @@ pub fn identify_global_linear(
     tau: &[f64],
 ) -> Result<GlobalLinearModel> {
     let nv = op.n();
-    let k = batch.samples(nv)?;
-    if tau.len() != k * nv {
-        return Err(Error::Shape {
-            argument: "tau".into(),
-            expected: format!("{k} samples x {nv} joints like q"),
-            got: format!("{} values", tau.len()),
-        });
-    }
+    let k = batch.samples_with_torques(nv, tau)?;
     let x = DMatrix::from_fn(k, 1 + 3 * nv, |s, c| match c {
         0 => 1.0,
         c if c <= nv => batch.qdd[s * nv + c - 1] - op.qdd[c - 1],

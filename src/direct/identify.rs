@@ -83,14 +83,7 @@ pub fn identify_base_parameters(
     options: &BaseOptions,
 ) -> Result<BaseModel> {
     let nv = model.nv;
-    let k = batch.samples(nv)?;
-    if tau.len() != k * nv {
-        return Err(Error::Shape {
-            argument: "tau".into(),
-            expected: format!("{k} samples x {nv} joints like q"),
-            got: format!("{} values", tau.len()),
-        });
-    }
+    let k = batch.samples_with_torques(nv, tau)?;
     if let Some(i) = tau.iter().position(|v| !v.is_finite()) {
         return Err(Error::NonFiniteInput {
             argument: format!("tau[{}]", i / nv),

@@ -147,6 +147,19 @@ impl<'a> Batch<'a> {
         Ok(k)
     }
 
+    /// [`Batch::samples`], also checking that `tau` holds `nv` torques for every sample.
+    pub fn samples_with_torques(&self, nv: usize, tau: &[f64]) -> Result<usize> {
+        let k = self.samples(nv)?;
+        if tau.len() != k * nv {
+            return Err(Error::Shape {
+                argument: "tau".into(),
+                expected: format!("{k} samples x {nv} joints like q"),
+                got: format!("{} values", tau.len()),
+            });
+        }
+        Ok(k)
+    }
+
     pub fn row(x: &'a [f64], s: usize, nv: usize) -> &'a [f64] {
         &x[s * nv..(s + 1) * nv]
     }

@@ -27,7 +27,7 @@ use super::parameters::Batch;
 use crate::algorithms::batch::{load, regressor_lanes};
 use crate::algorithms::regressor::PARAMS_PER_BODY;
 use crate::error::{Error, Result};
-use crate::lanes::{L, LANES};
+use crate::lanes::{simd_dispatch, L, LANES};
 use crate::model::Model;
 use crate::regression::{least_squares, LeastSquares};
 use crate::LaneData;
@@ -160,16 +160,7 @@ impl Worker {
         gravity: bool,
         range: std::ops::Range<usize>,
     ) -> Result<()> {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-        {
-            // SAFETY: the processor supports the features `fill_avx2` is compiled for.
-            unsafe { self.fill_avx2(model, columns, batch, tau, gravity, range.clone()) }?;
-        } else {
-            self.fill(model, columns, batch, tau, gravity, range.clone())?;
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        self.fill(model, columns, batch, tau, gravity, range.clone())?;
+        fill(self, model, columns, batch, tau, gravity, range.clone())?;
         for a in &mut self.stacks {
             let rows = a.ncols() + range.len();
             factor_top(
@@ -181,82 +172,80 @@ impl Worker {
         Ok(())
     }
 
-    /// [`Worker::fill`] compiled for AVX2 and FMA.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn fill_avx2(
-        &mut self,
-        model: &Model,
-        columns: &[JointColumns],
-        batch: &Batch<'_>,
-        tau: &[f64],
-        gravity: bool,
-        range: std::ops::Range<usize>,
-    ) -> Result<()> {
-        self.fill(model, columns, batch, tau, gravity, range)
-    }
-
-    /// Writes the rows of samples `range` below the factors.
-    #[inline(always)]
-    fn fill(
-        &mut self,
-        model: &Model,
-        columns: &[JointColumns],
-        batch: &Batch<'_>,
-        tau: &[f64],
-        gravity: bool,
-        range: std::ops::Range<usize>,
-    ) -> Result<()> {
-        let nv = model.nv;
-        let mut first = range.start;
-        while first < range.end {
-            // a group of LANES samples through the multi-sample regressor
-            let used = (range.end - first).min(LANES);
-            let rows = first * nv..(first + used) * nv;
-            let x = [
-                &batch.q[rows.clone()],
-                &batch.qd[rows.clone()],
-                &batch.qdd[rows],
-            ];
-            for l in 0..used {
-                for (name, column) in ["q", "qd", "qdd"].iter().zip(&x) {
-                    model
-                        .check_vector(name, &column[l * nv..(l + 1) * nv])
-                        .map_err(|e| e.in_sample(first + l))?;
-                }
-            }
-            load(model, &mut self.lanes, x, 0);
-            regressor_lanes(model, &mut self.lanes, gravity, &mut self.y);
-            for l in 0..used {
-                let s = first + l;
-                let qd = Batch::row(batch.qd, s, nv);
-                for (j, (a, cols)) in self.stacks.iter_mut().zip(columns).enumerate() {
-                    let nj = cols.base.len();
-                    let i = nj + 1 + s - range.start;
-                    for &(c, col) in &cols.inertial {
-                        a[(i, c)] = self.y[j + col * nv].0[l];
-                    }
-                    for &(c, term) in &cols.friction {
-                        a[(i, c)] = match term {
-                            Term::Viscous => qd[j],
-                            Term::Coulomb => qd[j].signum() * f64::from(u8::from(qd[j] != 0.0)),
-                            Term::Offset => 1.0,
-                        };
-                    }
-                    a[(i, nj)] = tau[s * nv + j];
-                }
-            }
-            first += used;
-        }
-        Ok(())
-    }
-
     fn factors(&self) -> Vec<DMatrix<f64>> {
         self.stacks
             .iter()
             .map(|a| DMatrix::from_fn(a.ncols(), a.ncols(), |i, j| a[(i, j)]))
             .collect()
     }
+}
+
+simd_dispatch! {
+/// Writes the rows of samples `range` below the factors of `w` (the regressor 4 samples at a
+/// time, with AVX2 and FMA when the processor has them).
+fn fill, fill_avx2 => fill_body(
+    w: &mut Worker,
+    model: &Model,
+    columns: &[JointColumns],
+    batch: &Batch<'_>,
+    tau: &[f64],
+    gravity: bool,
+    range: std::ops::Range<usize>,
+) -> Result<()>
+}
+
+#[inline(always)]
+fn fill_body(
+    w: &mut Worker,
+    model: &Model,
+    columns: &[JointColumns],
+    batch: &Batch<'_>,
+    tau: &[f64],
+    gravity: bool,
+    range: std::ops::Range<usize>,
+) -> Result<()> {
+    let nv = model.nv;
+    let mut first = range.start;
+    while first < range.end {
+        // a group of LANES samples through the multi-sample regressor
+        let used = (range.end - first).min(LANES);
+        let rows = first * nv..(first + used) * nv;
+        let x = [
+            &batch.q[rows.clone()],
+            &batch.qd[rows.clone()],
+            &batch.qdd[rows],
+        ];
+        for l in 0..used {
+            for (name, column) in ["q", "qd", "qdd"].iter().zip(&x) {
+                model
+                    .check_vector(name, &column[l * nv..(l + 1) * nv])
+                    .map_err(|e| e.in_sample(first + l))?;
+            }
+        }
+        load(model, &mut w.lanes, x, 0);
+        regressor_lanes(model, &mut w.lanes, gravity, &mut w.y);
+        for l in 0..used {
+            let s = first + l;
+            let qd = Batch::row(batch.qd, s, nv);
+            for (j, (a, cols)) in w.stacks.iter_mut().zip(columns).enumerate() {
+                let nj = cols.base.len();
+                let i = nj + 1 + s - range.start;
+                for &(c, col) in &cols.inertial {
+                    a[(i, c)] = w.y[j + col * nv].0[l];
+                }
+                for &(c, term) in &cols.friction {
+                    a[(i, c)] = match term {
+                        Term::Viscous => qd[j],
+                        Term::Coulomb => qd[j].signum() * f64::from(u8::from(qd[j] != 0.0)),
+                        Term::Offset => 1.0,
+                    };
+                }
+                a[(i, nj)] = tau[s * nv + j];
+            }
+        }
+        first += used;
+    }
+    Ok(())
 }
 
 /// QR of `a` in place, leaving its `R` in the top `ncols` rows with zeros below the diagonal.
@@ -322,14 +311,7 @@ impl JointFactors {
         gravity: bool,
     ) -> Result<Self> {
         let nv = model.nv;
-        let k = batch.samples(nv)?;
-        if tau.len() != k * nv {
-            return Err(Error::Shape {
-                argument: "tau".into(),
-                expected: format!("{k} samples x {nv} joints like q"),
-                got: format!("{} values", tau.len()),
-            });
-        }
+        let k = batch.samples_with_torques(nv, tau)?;
         let p = base.len();
         let columns = JointColumns::new(model, base);
         let chunks: Vec<std::ops::Range<usize>> = (0..k)
