@@ -22,8 +22,14 @@ D1_ACTUAL = np.array([9.956, 0.0, 0.0, -1.37, 0.0, -0.27])
 D1_PERTURBATION = np.array([9.95, 0.0, 0.0, -1.37, 0.0, -0.27])
 
 
+def num(x, fmt: str) -> str:
+    """`x` formatted; a number that rounds to zero prints without a sign (no `-0.000`)."""
+    s = f"{x:{fmt}}"
+    return s.replace("-", " ") if isinstance(x, (float, np.floating)) and float(s) == 0 else s
+
+
 def row(label: str, values, fmt: str = "8.3f") -> str:
-    return f"{label:<22}" + " ".join(f"{x:{fmt}}" for x in values)
+    return f"{label:<22}" + " ".join(num(x, fmt) for x in values)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -44,7 +50,8 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{'joint':>5} {'q*':>8} {'qd*':>8} {'qdd*':>8} {'T* identified':>14} {'Tn paper':>10} {'diff':>8}")
     for i in range(robot.n):
         t = model.torque[i]
-        print(f"{i + 1:>5} {Q[i]:>8.4f} {QD[i]:>8.4f} {QDD[i]:>8.4f} {t:>14.4f} {TN[i]:>10.4f} {t - TN[i]:>8.4f}")
+        cells = [num(Q[i], ">8.4f"), num(QD[i], ">8.4f"), num(QDD[i], ">8.4f"), num(t, ">14.4f"), num(TN[i], ">10.4f"), num(t - TN[i], ">8.4f")]
+        print(f"{i + 1:>5} " + " ".join(cells))
     print("\nTable 3, first column of D:")
     print(row("", [f"D{i + 1}1" for i in range(6)], ">8"))
     print(row("actual M(q*)", actual[:, 0]))
