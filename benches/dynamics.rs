@@ -7,8 +7,8 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use perturbid_rs::algorithms::regressor::joint_torque_regressor;
 use perturbid_rs::robots::a465::{TABLE2_Q, TABLE2_QD, TABLE2_QDD};
 use perturbid_rs::{
-    forward_dynamics, gravity_torque, linearize, mass_matrix, regressor_batch, rnea,
-    rnea_derivatives, rnea_lanes, robots, Data, LaneData, Model,
+    forward_dynamics, gravity_torque, linearize, mass_matrix, mass_matrix_batch, regressor_batch,
+    rnea, rnea_derivatives, rnea_lanes, robots, Data, LaneData, Model,
 };
 use std::hint::black_box;
 
@@ -109,6 +109,10 @@ fn dynamics(c: &mut Criterion) {
             )
             .unwrap()
         })
+    });
+    let mut ms = vec![0.0; BATCH * n * n];
+    group.bench_function(format!("mass_matrix_batch/a465/{BATCH}"), |b| {
+        b.iter(|| mass_matrix_batch(&model, &mut lanes, &bq, &mut ms).unwrap())
     });
     let mut ys = vec![0.0; BATCH * n * 10 * model.nbodies()];
     group.bench_function(format!("regressor_batch/a465/{BATCH}"), |b| {

@@ -39,7 +39,7 @@ pub mod urdf;
 #[cfg(feature = "python")]
 mod python;
 
-pub use algorithms::batch::{regressor_batch, rnea_lanes, LaneData, LANES};
+pub use algorithms::batch::{mass_matrix_batch, regressor_batch, rnea_lanes, LaneData, LANES};
 pub use algorithms::crba::mass_matrix;
 pub use algorithms::derivatives::rnea_derivatives;
 pub use algorithms::forward_dynamics::forward_dynamics;

@@ -372,3 +372,50 @@ fn regressor_batch_equals_one_sample_regressor_on_the_a465_and_a_mimic_pair() {
         }
     }
 }
+
+/// The multi-sample mass matrix equals the one-sample CRBA on every sample.
+fn check_mass_matrix_batch(model: &Model, rng: &mut Rng, k: usize) {
+    let n = model.nv;
+    let q = rng.vector(k * n, 9.0);
+    let mut lanes = perturbid_rs::LaneData::new(model);
+    let mut out = vec![f64::NAN; k * n * n];
+    perturbid_rs::mass_matrix_batch(model, &mut lanes, &q, &mut out).unwrap();
+    let mut data = Data::new(model);
+    for s in 0..k {
+        mass_matrix(model, &mut data, &q[s * n..(s + 1) * n]).unwrap();
+        let scale = data.m.amax();
+        for i in 0..n {
+            for j in 0..n {
+                let got = out[s * n * n + i * n + j];
+                assert!(
+                    (got - data.m[(i, j)]).abs() < 1e-12 * scale,
+                    "sample {s} M[{i}, {j}]: {got} vs {}",
+                    data.m[(i, j)]
+                );
+            }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    #[test]
+    fn mass_matrix_batch_equals_crba_on_random_trees(seed in any::<u64>(), nlinks in 1usize..9, k in 1usize..11) {
+        let text = random_tree_urdf(seed, nlinks);
+        let model = model_from_urdf_str(&text, "random", &LoadOptions::default()).unwrap();
+        check_mass_matrix_batch(&model, &mut Rng(seed ^ 0x3333), k);
+    }
+}
+
+#[test]
+fn mass_matrix_batch_equals_crba_on_the_a465_and_a_mimic_pair() {
+    let mut rng = Rng(10);
+    for model in [
+        robots::builtin("a465:physical").unwrap(),
+        model_from_urdf_str(&mimic_pair(true), "mimic", &LoadOptions::default()).unwrap(),
+    ] {
+        for k in [1, 4, 6] {
+            check_mass_matrix_batch(&model, &mut rng, k);
+        }
+    }
+}

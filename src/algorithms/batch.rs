@@ -282,6 +282,168 @@ fn regressor_batch_body(
     Ok(())
 }
 
+simd_dispatch! {
+/// Joint-space mass matrices `M(q)` of a batch, [`LANES`] samples at a time (the composite
+/// rigid body algorithm in the base frame, as [`crate::mass_matrix`]; equal to it up to
+/// rounding).
+///
+/// `q`: row-major `k x nv` (rad or m), finite (checked by the caller, as for [`rnea_lanes`]).
+/// `out`: row-major `k x nv x nv` (kg m^2, kg m or kg), both triangles written. Uses AVX2 and
+/// FMA when the processor has them.
+pub fn mass_matrix_batch, mass_matrix_batch_avx2 => mass_matrix_batch_body(
+    model: &Model,
+    data: &mut LaneData,
+    q: &[f64],
+    out: &mut [f64],
+) -> Result<()>
+}
+
+/// A composite inertia per lane in origin form (mass, first moment `h`, rotational inertia `i`
+/// about the origin, by rows); the mass is the same in every lane.
+#[derive(Clone, Copy, Debug, Default)]
+struct Composite {
+    mass: f64,
+    h: V,
+    i: R,
+}
+
+#[inline(always)]
+fn mass_matrix_batch_body(
+    model: &Model,
+    data: &mut LaneData,
+    q: &[f64],
+    out: &mut [f64],
+) -> Result<()> {
+    let nv = model.nv;
+    let nb = model.nbodies();
+    let k = q.len() / nv.max(1);
+    for (name, len, per) in [
+        ("q", q.len(), nv),
+        ("mass matrix output", out.len(), nv * nv),
+    ] {
+        if len != k * per || q.len() % nv.max(1) != 0 {
+            return Err(crate::error::Error::Shape {
+                argument: name.into(),
+                expected: format!("{k} samples x {per} values"),
+                got: format!("{len} values"),
+            });
+        }
+    }
+    let mut m = vec![L::default(); nb * nb]; // body-level, row-major
+    let mut ic = vec![Composite::default(); nb];
+    let mut first = 0;
+    while first < k {
+        load(model, data, [q, &[], &[]], first);
+        // base-frame poses, motion subspaces and body inertias
+        for (i, b) in model.bodies.iter().enumerate() {
+            let (rot, pos) = pose(b, data.qb[i]);
+            let (r, p) = match b.parent {
+                Some(k) => (
+                    data.o_rot[k].compose(&rot),
+                    data.o_pos[k].add(&data.o_rot[k].mul(&pos)),
+                ),
+                None => (rot, pos),
+            };
+            data.o_s[i] = subspace_in(b, &r, &p);
+            ic[i] = transformed(&b.origin_inertia, &r, &p);
+            data.o_rot[i] = r;
+            data.o_pos[i] = p;
+        }
+        m.fill(L::default());
+        for i in (0..nb).rev() {
+            let (c, s) = (&ic[i], &data.o_s[i]);
+            let f = S {
+                ang: c.i.mul(&s.ang).add(&c.h.cross(&s.lin)),
+                lin: s.lin.scale(c.mass).sub(&c.h.cross(&s.ang)),
+            };
+            let mut j = Some(i);
+            while let Some(k) = j {
+                let sk = &data.o_s[k];
+                let mik = sk.ang.dot(&f.ang) + sk.lin.dot(&f.lin);
+                m[i * nb + k] = mik;
+                m[k * nb + i] = mik;
+                j = model.bodies[k].parent;
+            }
+            if let Some(p) = model.bodies[i].parent {
+                let child = ic[i];
+                let parent = &mut ic[p];
+                parent.mass += child.mass;
+                parent.h = parent.h.add(&child.h);
+                for r in 0..3 {
+                    parent.i.0[r] = parent.i.0[r].add(&child.i.0[r]);
+                }
+            }
+        }
+        // onto the degrees of freedom (mimic couplings), for the lanes in use
+        for l in 0..(k - first).min(LANES) {
+            let o = &mut out[(first + l) * nv * nv..(first + l + 1) * nv * nv];
+            if !model.coupled {
+                for (x, v) in o.iter_mut().zip(&m) {
+                    *x = v.0[l];
+                }
+                continue;
+            }
+            o.fill(0.0);
+            for (i, bi) in model.bodies.iter().enumerate() {
+                for (j, bj) in model.bodies.iter().enumerate() {
+                    o[bi.dof * nv + bj.dof] += bi.multiplier * bj.multiplier * m[i * nb + j].0[l];
+                }
+            }
+        }
+        first += LANES;
+    }
+    Ok(())
+}
+
+/// Body `b`'s motion subspace in the base frame, for its base-frame pose `r`, `p`.
+#[inline(always)]
+fn subspace_in(b: &crate::model::Body, r: &R, p: &V) -> S {
+    let axis = r.mul_const_vector(&b.axis);
+    match b.kind {
+        JointKind::Revolute => S {
+            ang: axis,
+            lin: p.cross(&axis),
+        },
+        JointKind::Prismatic => S {
+            ang: V::default(),
+            lin: axis,
+        },
+    }
+}
+
+/// A body's (constant) origin-form inertia expressed in the base frame, for its pose `r`, `p`
+/// there (see `OriginInertia::transformed`).
+#[inline(always)]
+fn transformed(b: &crate::spatial::OriginInertia, r: &R, p: &V) -> Composite {
+    let hr = r.mul_const_vector(&b.h);
+    let w = hr.add(&p.scale(0.5 * b.mass));
+    let d = p.dot(&w) * 2.0;
+    let ri = [0, 1, 2].map(|row| r.0[row].mul_const(&b.i)); // rows of R I (I symmetric)
+    let pw = [p.x, p.y, p.z];
+    let ww = [w.x, w.y, w.z];
+    let mut i = R::default();
+    for row in 0..3 {
+        let e = |c: usize| {
+            let v = ri[row].dot(&r.0[c]) - ww[row] * pw[c] - pw[row] * ww[c];
+            if c == row {
+                v + d
+            } else {
+                v
+            }
+        };
+        i.0[row] = V {
+            x: e(0),
+            y: e(1),
+            z: e(2),
+        };
+    }
+    Composite {
+        mass: b.mass,
+        h: hr.add(&p.scale(b.mass)),
+        i,
+    }
+}
+
 /// The joint-torque regressor (see [`crate::algorithms::regressor::joint_torque_regressor`]) of
 /// the loaded group of lanes (see [`load`]): `out` column-major `nv x 10 nbodies`, one lane per
 /// sample, every entry written. `gravity` includes gravity.
@@ -299,17 +461,7 @@ pub(crate) fn regressor_lanes(model: &Model, data: &mut LaneData, gravity: bool,
             }
             None => (data.rot[i], data.pos[i]),
         };
-        let axis = r.mul_const_vector(&b.axis);
-        data.o_s[i] = match b.kind {
-            JointKind::Revolute => S {
-                ang: axis,
-                lin: p.cross(&axis),
-            },
-            JointKind::Prismatic => S {
-                ang: V::default(),
-                lin: axis,
-            },
-        };
+        data.o_s[i] = subspace_in(b, &r, &p);
         data.o_rot[i] = r;
         data.o_pos[i] = p;
         // the body's 10 columns in the base frame (see `world_body_regressor`)

@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 
 use super::arrays::{read_batch, to_numpy};
 use super::linearization::PyLinearization;
-use crate::algorithms::batch::{regressor_batch, rnea_lanes, LaneData, LANES};
+use crate::algorithms::batch::{mass_matrix_batch, regressor_batch, rnea_lanes, LaneData, LANES};
 use crate::error::Result;
 use crate::{robots, urdf, Data, Model};
 
@@ -390,9 +390,18 @@ impl PyRobot {
     /// (n, n) or (k, n, n).
     fn mass_matrix<'py>(&self, py: Python<'py>, q: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
         let n = self.model.nv;
-        self.map_samples(py, &[("q", &q)], &[n, n], |m, d, x, out| {
-            crate::mass_matrix(m, d, x[0])?;
-            copy_matrix(&d.m, out);
+        self.map_chunks(py, &[("q", &q)], &[n, n], |m, w, chunk, out| {
+            chunk.check_finite(m, &["q"])?;
+            let q = chunk.columns[0];
+            if chunk.len >= LANES {
+                return mass_matrix_batch(m, &mut w.lanes, q, out);
+            }
+            // too few samples to fill the lanes: one at a time
+            for (i, o) in out.chunks_mut(n * n).enumerate() {
+                crate::mass_matrix(m, &mut w.data, &q[i * n..(i + 1) * n])
+                    .map_err(|e| chunk.at(i, e))?;
+                copy_matrix(&w.data.m, o);
+            }
             Ok(())
         })
     }

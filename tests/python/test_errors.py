@@ -50,6 +50,8 @@ def test_non_finite_input(robot):
     big[4321, 5] = -np.inf
     with pytest.raises(pr.InputError, match=r"q\[4321\]: entry 5 is -inf"):
         robot.gravity(big)
+    with pytest.raises(pr.InputError, match=r"q\[4321\]: entry 5 is -inf"):
+        robot.mass_matrix(big)
     with pytest.raises(pr.InputError, match=r"qd\[4321\]: entry 5 is -inf"):
         robot.bias(np.zeros((5000, 6)), big)
     with pytest.raises(pr.InputError, match=r"qdd\[4321\]: entry 5 is -inf"):

@@ -101,7 +101,8 @@ def test_batches_match_single_samples(pair: Pair):
         # batches of 4 or more run the multi-sample kernel: equal up to rounding
         single = pair.ours.rnea(Q[k], QD[k], QDD[k])
         np.testing.assert_allclose(tau[k], single, rtol=0, atol=1e-12 * (1 + np.abs(single).max()))
-        np.testing.assert_array_equal(M[k], pair.ours.mass_matrix(Q[k]))
+        Mk = pair.ours.mass_matrix(Q[k])
+        np.testing.assert_allclose(M[k], Mk, rtol=0, atol=1e-12 * np.abs(Mk).max())
         Y = pair.ours.regressor(Q[k], QD[k], QDD[k])
         np.testing.assert_allclose(Ys[k], Y, rtol=0, atol=1e-12 * (1 + np.abs(Y).max()))
         assert relerr(Ys[k] @ pair.ours.parameters, tau[k]) < TOL
@@ -109,19 +110,22 @@ def test_batches_match_single_samples(pair: Pair):
 
 
 def test_large_batches_match_pinocchio(pair: Pair):
-    """A batch large enough to run in parallel chunks through the multi-sample kernel, with a
-    length that leaves a partial group of lanes: rnea, gravity and bias against Pinocchio."""
+    """A batch large enough to run in parallel chunks through the multi-sample kernels, with a
+    length that leaves a partial group of lanes: rnea, gravity, bias and M against Pinocchio."""
     rng = np.random.default_rng(2)
     k = 4096 + 1024 + 3
     states = [pair.random_state(rng) for _ in range(k)]
     Q, QD, QDD = (np.array([s[i] for s in states]) for i in range(3))
     tau, g, bias = pair.ours.rnea(Q, QD, QDD), pair.ours.gravity(Q), pair.ours.bias(Q, QD)
+    M = pair.ours.mass_matrix(Q)
     m, d = pair.model, pair.data
     for i in list(range(0, k, 97)) + [k - 1]:
         qp, vp, ap = pair.q(Q[i]), pair.v(QD[i]), pair.v(QDD[i])
         assert relerr(tau[i], pair.vec(pin.rnea(m, d, qp, vp, ap))) < TOL
         assert relerr(g[i], pair.vec(pin.computeGeneralizedGravity(m, d, qp))) < TOL
         assert relerr(bias[i], pair.vec(pin.nonLinearEffects(m, d, qp, vp))) < TOL
+        Mp = pin.crba(m, d, qp)
+        assert relerr(M[i], pair.mat(np.triu(Mp) + np.triu(Mp, 1).T)) < TOL
 
 
 def test_gravity_switch_matches_pinocchio_with_zero_gravity():
