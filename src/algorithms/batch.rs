@@ -83,25 +83,15 @@ fn rnea_lanes_body(
     tau: &mut [f64],
 ) -> Result<()> {
     let nv = model.nv;
-    let k = q.len() / nv.max(1);
-    let expect = |name: &str, len: usize| -> Result<()> {
-        if len != k * nv || q.len() % nv.max(1) != 0 {
-            return Err(crate::error::Error::Shape {
-                argument: name.into(),
-                expected: format!("{k} samples x {nv} values like q"),
-                got: format!("{len} values"),
-            });
-        }
-        Ok(())
-    };
-    expect("q", q.len())?;
-    expect("tau", tau.len())?;
-    if let Some(x) = qd {
-        expect("qd", x.len())?;
-    }
-    if let Some(x) = qdd {
-        expect("qdd", x.len())?;
-    }
+    let (v, a) = (
+        qd.map_or(q.len(), <[f64]>::len),
+        qdd.map_or(q.len(), <[f64]>::len),
+    );
+    let k = samples(
+        nv,
+        q.len(),
+        &[("qd", v, nv), ("qdd", a, nv), ("tau", tau.len(), nv)],
+    )?;
     let g = model.base_acceleration(gravity);
     let mut first = 0;
     while first < k {
@@ -130,6 +120,24 @@ fn rnea_lanes_body(
         first += LANES;
     }
     Ok(())
+}
+
+/// The number of samples `k` in `q` (`q_len` values, `k x nv`); checks that every other argument
+/// `(name, length, values per sample)` holds `k` samples too.
+fn samples(nv: usize, q_len: usize, others: &[(&str, usize, usize)]) -> Result<usize> {
+    let k = q_len / nv.max(1);
+    let shape = |name: &str, len: usize, per: usize| crate::error::Error::Shape {
+        argument: name.into(),
+        expected: format!("{k} samples x {per} values, like q"),
+        got: format!("{len} values"),
+    };
+    if k * nv != q_len {
+        return Err(shape("q", q_len, nv));
+    }
+    match others.iter().find(|(_, len, per)| *len != k * per) {
+        Some(&(name, len, per)) => Err(shape(name, len, per)),
+        None => Ok(k),
+    }
 }
 
 /// Loads the body coordinates of samples `first..first + LANES` of the row-major `k x nv`
@@ -249,21 +257,15 @@ fn regressor_batch_body(
 ) -> Result<()> {
     let nv = model.nv;
     let p = PARAMS_PER_BODY * model.nbodies();
-    let k = q.len() / nv.max(1);
-    for (name, len, per) in [
-        ("q", q.len(), nv),
-        ("qd", qd.len(), nv),
-        ("qdd", qdd.len(), nv),
-        ("regressor output", out.len(), nv * p),
-    ] {
-        if len != k * per || q.len() % nv.max(1) != 0 {
-            return Err(crate::error::Error::Shape {
-                argument: name.into(),
-                expected: format!("{k} samples x {per} values"),
-                got: format!("{len} values"),
-            });
-        }
-    }
+    let k = samples(
+        nv,
+        q.len(),
+        &[
+            ("qd", qd.len(), nv),
+            ("qdd", qdd.len(), nv),
+            ("regressor output", out.len(), nv * p),
+        ],
+    )?;
     let mut y = vec![L::default(); nv * p];
     let mut first = 0;
     while first < k {
@@ -316,19 +318,7 @@ fn mass_matrix_batch_body(
 ) -> Result<()> {
     let nv = model.nv;
     let nb = model.nbodies();
-    let k = q.len() / nv.max(1);
-    for (name, len, per) in [
-        ("q", q.len(), nv),
-        ("mass matrix output", out.len(), nv * nv),
-    ] {
-        if len != k * per || q.len() % nv.max(1) != 0 {
-            return Err(crate::error::Error::Shape {
-                argument: name.into(),
-                expected: format!("{k} samples x {per} values"),
-                got: format!("{len} values"),
-            });
-        }
-    }
+    let k = samples(nv, q.len(), &[("mass matrix output", out.len(), nv * nv)])?;
     let mut m = vec![L::default(); nb * nb]; // body-level, row-major
     let mut ic = vec![Composite::default(); nb];
     let mut first = 0;
