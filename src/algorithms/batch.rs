@@ -327,17 +327,8 @@ fn mass_matrix_batch_body(
         // base-frame poses, motion subspaces and body inertias
         for (i, b) in model.bodies.iter().enumerate() {
             let (rot, pos) = pose(b, data.qb[i]);
-            let (r, p) = match b.parent {
-                Some(k) => (
-                    data.o_rot[k].compose(&rot),
-                    data.o_pos[k].add(&data.o_rot[k].mul(&pos)),
-                ),
-                None => (rot, pos),
-            };
-            data.o_s[i] = subspace_in(b, &r, &p);
+            let (r, p) = place_in_base(model, data, i, &rot, &pos);
             ic[i] = transformed(&b.origin_inertia, &r, &p);
-            data.o_rot[i] = r;
-            data.o_pos[i] = p;
         }
         m.fill(L::default());
         for i in (0..nb).rev() {
@@ -383,6 +374,25 @@ fn mass_matrix_batch_body(
         first += LANES;
     }
     Ok(())
+}
+
+/// Body `i`'s pose in the base frame from its pose `rot`, `pos` in its parent (whose base-frame
+/// pose is already in `data`): stores it with the motion subspace there (`o_rot`, `o_pos`,
+/// `o_s`) and returns it.
+#[inline(always)]
+fn place_in_base(model: &Model, data: &mut LaneData, i: usize, rot: &R, pos: &V) -> (R, V) {
+    let b = &model.bodies[i];
+    let (r, p) = match b.parent {
+        Some(k) => {
+            let (rp, pp) = (&data.o_rot[k], &data.o_pos[k]);
+            (rp.compose(rot), pp.add(&rp.mul(pos)))
+        }
+        None => (*rot, *pos),
+    };
+    data.o_s[i] = subspace_in(b, &r, &p);
+    data.o_rot[i] = r;
+    data.o_pos[i] = p;
+    (r, p)
 }
 
 /// Body `b`'s motion subspace in the base frame, for its base-frame pose `r`, `p`.
@@ -442,18 +452,9 @@ pub(crate) fn regressor_lanes(model: &Model, data: &mut LaneData, gravity: bool,
     let nv = model.nv;
     forward(model, data, &model.base_acceleration(gravity));
     out.fill(L::default());
-    for (i, b) in model.bodies.iter().enumerate() {
-        // pose in the base frame and the motion subspace there
-        let (r, p) = match b.parent {
-            Some(k) => {
-                let (rp, pp) = (data.o_rot[k], data.o_pos[k]);
-                (rp.compose(&data.rot[i]), pp.add(&rp.mul(&data.pos[i])))
-            }
-            None => (data.rot[i], data.pos[i]),
-        };
-        data.o_s[i] = subspace_in(b, &r, &p);
-        data.o_rot[i] = r;
-        data.o_pos[i] = p;
+    for i in 0..model.nbodies() {
+        let (rot, pos) = (data.rot[i], data.pos[i]);
+        let (r, p) = place_in_base(model, data, i, &rot, &pos);
         // the body's 10 columns in the base frame (see `world_body_regressor`)
         let (v, a) = (&data.v[i], &data.a[i]);
         let (w, al) = (v.ang, a.ang);
