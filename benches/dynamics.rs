@@ -6,6 +6,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use perturbid_rs::algorithms::regressor::joint_torque_regressor;
 use perturbid_rs::robots::a465::{TABLE2_Q, TABLE2_QD, TABLE2_QDD};
+use perturbid_rs::Gravity;
 use perturbid_rs::{
     forward_dynamics, gravity_torque, linearize, mass_matrix, mass_matrix_batch, regressor_batch,
     rnea, rnea_derivatives, rnea_lanes, robots, Data, LaneData, Model,
@@ -39,18 +40,18 @@ fn dynamics(c: &mut Criterion) {
     let mut y = nalgebra::DMatrix::zeros(n, 10 * model.nbodies());
     let kernels: [(&str, Kernel); 6] = [
         ("rnea", |m, d, q, qd, qdd| {
-            rnea(m, d, q, qd, qdd, true).unwrap()
+            rnea(m, d, q, qd, qdd, Gravity::Included).unwrap()
         }),
         ("mass_matrix", |m, d, q, _, _| mass_matrix(m, d, q).unwrap()),
         ("gravity", |m, d, q, _, _| gravity_torque(m, d, q).unwrap()),
         ("forward_dynamics", |m, d, q, qd, tau| {
-            forward_dynamics(m, d, q, qd, tau, true).unwrap()
+            forward_dynamics(m, d, q, qd, tau, Gravity::Included).unwrap()
         }),
         ("rnea_derivatives", |m, d, q, qd, qdd| {
-            rnea_derivatives(m, d, q, qd, qdd, true).unwrap()
+            rnea_derivatives(m, d, q, qd, qdd, Gravity::Included).unwrap()
         }),
         ("linearize", |m, d, q, qd, qdd| {
-            linearize(m, d, q, qd, qdd, true).unwrap();
+            linearize(m, d, q, qd, qdd, Gravity::Included).unwrap();
         }),
     ];
     let (bq, bqd, bqdd) = states(&model);
@@ -75,7 +76,7 @@ fn dynamics(c: &mut Criterion) {
                 black_box(&TABLE2_Q),
                 black_box(&TABLE2_QD),
                 black_box(&TABLE2_QDD),
-                true,
+                Gravity::Included,
                 &mut y,
             )
             .unwrap()
@@ -104,7 +105,7 @@ fn dynamics(c: &mut Criterion) {
                 &bq,
                 Some(&bqd),
                 Some(&bqdd),
-                true,
+                Gravity::Included,
                 &mut tau,
             )
             .unwrap()
@@ -116,7 +117,18 @@ fn dynamics(c: &mut Criterion) {
     });
     let mut ys = vec![0.0; BATCH * n * 10 * model.nbodies()];
     group.bench_function(format!("regressor_batch/a465/{BATCH}"), |b| {
-        b.iter(|| regressor_batch(&model, &mut lanes, &bq, &bqd, &bqdd, true, &mut ys).unwrap())
+        b.iter(|| {
+            regressor_batch(
+                &model,
+                &mut lanes,
+                &bq,
+                &bqd,
+                &bqdd,
+                Gravity::Included,
+                &mut ys,
+            )
+            .unwrap()
+        })
     });
     group.bench_function(format!("regressor/a465/{BATCH}"), |b| {
         b.iter(|| {
@@ -128,7 +140,7 @@ fn dynamics(c: &mut Criterion) {
                     &bq[r.clone()],
                     &bqd[r.clone()],
                     &bqdd[r],
-                    true,
+                    Gravity::Included,
                     &mut y,
                 )
                 .unwrap();

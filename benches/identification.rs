@@ -8,6 +8,7 @@ use perturbid_rs::local::{
     identify_local, plan_experiments, IdentifyOptions, OperatingPoint, PlanOptions,
 };
 use perturbid_rs::robots::a465::{self, TABLE2_Q, TABLE2_QD, TABLE2_QDD};
+use perturbid_rs::Gravity;
 use perturbid_rs::{rnea, simulate_plan, Data, SimulationOptions};
 
 fn identification(c: &mut Criterion) {
@@ -46,7 +47,7 @@ fn identification(c: &mut Criterion) {
             &q[r.clone()],
             &qd[r.clone()],
             &qdd[r],
-            true,
+            Gravity::Included,
         )
         .unwrap();
         tau.extend(data.tau.iter());

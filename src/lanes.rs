@@ -1,6 +1,6 @@
-//! Arithmetic on a few samples side by side (structure of arrays): a scalar per lane [`L`],
-//! 3-vectors [`V`], rotations [`R`] and spatial vectors [`S`] of lanes. Each operation is a
-//! short loop over the lanes that the compiler maps onto SIMD registers; used by the
+//! Arithmetic on a few samples side by side (structure of arrays): a scalar per lane
+//! [`Lanes`], 3-vectors [`Vector3Lanes`], rotations [`Rotation3Lanes`] and spatial vectors
+//! [`SpatialLanes`] of lanes. Each operation is a short loop over the lanes that the compiler maps onto SIMD registers; used by the
 //! multi-sample kernels ([`crate::algorithms::batch`]).
 
 /// Defines `$vis fn $name(args) -> ret` that runs `$body(args)` (an `#[inline(always)]`
@@ -35,29 +35,29 @@ pub const LANES: usize = 4;
 
 /// One scalar per lane.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct L(pub(crate) [f64; LANES]);
+pub(crate) struct Lanes(pub(crate) [f64; LANES]);
 
-impl L {
+impl Lanes {
     #[inline(always)]
     pub(crate) fn splat(x: f64) -> Self {
-        L([x; LANES])
+        Lanes([x; LANES])
     }
 }
 
 macro_rules! lane_op {
     ($tr:ident, $f:ident, $op:tt) => {
-        impl std::ops::$tr for L {
-            type Output = L;
+        impl std::ops::$tr for Lanes {
+            type Output = Lanes;
             #[inline(always)]
-            fn $f(self, o: L) -> L {
-                L(std::array::from_fn(|l| self.0[l] $op o.0[l]))
+            fn $f(self, o: Lanes) -> Lanes {
+                Lanes(std::array::from_fn(|l| self.0[l] $op o.0[l]))
             }
         }
-        impl std::ops::$tr<f64> for L {
-            type Output = L;
+        impl std::ops::$tr<f64> for Lanes {
+            type Output = Lanes;
             #[inline(always)]
-            fn $f(self, o: f64) -> L {
-                L(self.0.map(|a| a $op o))
+            fn $f(self, o: f64) -> Lanes {
+                Lanes(self.0.map(|a| a $op o))
             }
         }
     };
@@ -68,48 +68,48 @@ lane_op!(Mul, mul, *);
 
 /// A 3-vector per lane.
 #[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct V {
-    pub(crate) x: L,
-    pub(crate) y: L,
-    pub(crate) z: L,
+pub(crate) struct Vector3Lanes {
+    pub(crate) x: Lanes,
+    pub(crate) y: Lanes,
+    pub(crate) z: Lanes,
 }
 
-impl V {
+impl Vector3Lanes {
     #[inline(always)]
     pub(crate) fn splat(v: &nalgebra::Vector3<f64>) -> Self {
-        V {
-            x: L::splat(v.x),
-            y: L::splat(v.y),
-            z: L::splat(v.z),
+        Vector3Lanes {
+            x: Lanes::splat(v.x),
+            y: Lanes::splat(v.y),
+            z: Lanes::splat(v.z),
         }
     }
     #[inline(always)]
-    pub(crate) fn cross(&self, o: &V) -> V {
-        V {
+    pub(crate) fn cross(&self, o: &Vector3Lanes) -> Vector3Lanes {
+        Vector3Lanes {
             x: self.y * o.z - self.z * o.y,
             y: self.z * o.x - self.x * o.z,
             z: self.x * o.y - self.y * o.x,
         }
     }
     #[inline(always)]
-    pub(crate) fn add(&self, o: &V) -> V {
-        V {
+    pub(crate) fn add(&self, o: &Vector3Lanes) -> Vector3Lanes {
+        Vector3Lanes {
             x: self.x + o.x,
             y: self.y + o.y,
             z: self.z + o.z,
         }
     }
     #[inline(always)]
-    pub(crate) fn sub(&self, o: &V) -> V {
-        V {
+    pub(crate) fn sub(&self, o: &Vector3Lanes) -> Vector3Lanes {
+        Vector3Lanes {
             x: self.x - o.x,
             y: self.y - o.y,
             z: self.z - o.z,
         }
     }
     #[inline(always)]
-    pub(crate) fn scale(&self, s: f64) -> V {
-        V {
+    pub(crate) fn scale(&self, s: f64) -> Vector3Lanes {
+        Vector3Lanes {
             x: self.x * s,
             y: self.y * s,
             z: self.z * s,
@@ -117,21 +117,21 @@ impl V {
     }
     /// `a * s` for a constant vector `a` and a lane scalar `s`.
     #[inline(always)]
-    pub(crate) fn of(a: &nalgebra::Vector3<f64>, s: L) -> V {
-        V {
+    pub(crate) fn of(a: &nalgebra::Vector3<f64>, s: Lanes) -> Vector3Lanes {
+        Vector3Lanes {
             x: s * a.x,
             y: s * a.y,
             z: s * a.z,
         }
     }
     #[inline(always)]
-    pub(crate) fn dot(&self, o: &V) -> L {
+    pub(crate) fn dot(&self, o: &Vector3Lanes) -> Lanes {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
     /// `self * s` for a lane scalar `s`.
     #[inline(always)]
-    pub(crate) fn mul_lanes(&self, s: L) -> V {
-        V {
+    pub(crate) fn mul_lanes(&self, s: Lanes) -> Vector3Lanes {
+        Vector3Lanes {
             x: self.x * s,
             y: self.y * s,
             z: self.z * s,
@@ -139,13 +139,13 @@ impl V {
     }
     /// `a . self` for a constant vector `a`.
     #[inline(always)]
-    pub(crate) fn dot_const(&self, a: &nalgebra::Vector3<f64>) -> L {
+    pub(crate) fn dot_const(&self, a: &nalgebra::Vector3<f64>) -> Lanes {
         self.x * a.x + self.y * a.y + self.z * a.z
     }
     /// `m * self` for a constant matrix `m`.
     #[inline(always)]
-    pub(crate) fn mul_const(&self, m: &nalgebra::Matrix3<f64>) -> V {
-        V {
+    pub(crate) fn mul_const(&self, m: &nalgebra::Matrix3<f64>) -> Vector3Lanes {
+        Vector3Lanes {
             x: self.x * m[(0, 0)] + self.y * m[(0, 1)] + self.z * m[(0, 2)],
             y: self.x * m[(1, 0)] + self.y * m[(1, 1)] + self.z * m[(1, 2)],
             z: self.x * m[(2, 0)] + self.y * m[(2, 1)] + self.z * m[(2, 2)],
@@ -155,28 +155,28 @@ impl V {
 
 /// A rotation per lane, by rows.
 #[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct R(pub(crate) [V; 3]);
+pub(crate) struct Rotation3Lanes(pub(crate) [Vector3Lanes; 3]);
 
-impl R {
+impl Rotation3Lanes {
     /// `self * o`.
     #[inline(always)]
-    pub(crate) fn compose(&self, o: &R) -> R {
-        let row = |a: &V| V {
+    pub(crate) fn compose(&self, o: &Rotation3Lanes) -> Rotation3Lanes {
+        let row = |a: &Vector3Lanes| Vector3Lanes {
             x: a.x * o.0[0].x + a.y * o.0[1].x + a.z * o.0[2].x,
             y: a.x * o.0[0].y + a.y * o.0[1].y + a.z * o.0[2].y,
             z: a.x * o.0[0].z + a.y * o.0[1].z + a.z * o.0[2].z,
         };
-        R([row(&self.0[0]), row(&self.0[1]), row(&self.0[2])])
+        Rotation3Lanes([row(&self.0[0]), row(&self.0[1]), row(&self.0[2])])
     }
     /// Column `k`.
     #[inline(always)]
-    pub(crate) fn column(&self, k: usize) -> V {
-        let pick = |r: &V| match k {
+    pub(crate) fn column(&self, k: usize) -> Vector3Lanes {
+        let pick = |r: &Vector3Lanes| match k {
             0 => r.x,
             1 => r.y,
             _ => r.z,
         };
-        V {
+        Vector3Lanes {
             x: pick(&self.0[0]),
             y: pick(&self.0[1]),
             z: pick(&self.0[2]),
@@ -184,26 +184,26 @@ impl R {
     }
     /// `self * a` for a constant vector `a`.
     #[inline(always)]
-    pub(crate) fn mul_const_vector(&self, a: &nalgebra::Vector3<f64>) -> V {
-        V {
+    pub(crate) fn mul_const_vector(&self, a: &nalgebra::Vector3<f64>) -> Vector3Lanes {
+        Vector3Lanes {
             x: self.0[0].dot_const(a),
             y: self.0[1].dot_const(a),
             z: self.0[2].dot_const(a),
         }
     }
     #[inline(always)]
-    pub(crate) fn mul(&self, v: &V) -> V {
-        let d = |r: &V| r.x * v.x + r.y * v.y + r.z * v.z;
-        V {
+    pub(crate) fn mul(&self, v: &Vector3Lanes) -> Vector3Lanes {
+        let d = |r: &Vector3Lanes| r.x * v.x + r.y * v.y + r.z * v.z;
+        Vector3Lanes {
             x: d(&self.0[0]),
             y: d(&self.0[1]),
             z: d(&self.0[2]),
         }
     }
     #[inline(always)]
-    pub(crate) fn tr_mul(&self, v: &V) -> V {
+    pub(crate) fn tr_mul(&self, v: &Vector3Lanes) -> Vector3Lanes {
         let [a, b, c] = &self.0;
-        V {
+        Vector3Lanes {
             x: a.x * v.x + b.x * v.y + c.x * v.z,
             y: a.y * v.x + b.y * v.y + c.y * v.z,
             z: a.z * v.x + b.z * v.y + c.z * v.z,
@@ -213,9 +213,9 @@ impl R {
 
 /// A spatial vector per lane (`angular`, `linear`).
 #[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct S {
-    pub(crate) ang: V,
-    pub(crate) lin: V,
+pub(crate) struct SpatialLanes {
+    pub(crate) ang: Vector3Lanes,
+    pub(crate) lin: Vector3Lanes,
 }
 
 /// `pi / 2` split in three: the first two with 33 significant bits (so `k * P1`, `k * P2` are
@@ -259,10 +259,10 @@ const COS: [f64; 10] = [
 /// reduced by multiples of `pi / 2` (Cody-Waite, three parts) to `[-pi/4, pi/4]`, where Taylor
 /// series to degree 17 (sin) and 18 (cos) are exact to below half an ulp.
 #[inline(always)]
-pub(crate) fn sin_cos(x: L) -> (L, L) {
+pub(crate) fn sin_cos(x: Lanes) -> (Lanes, Lanes) {
     if x.0.iter().any(|v| v.is_nan() || v.abs() > SINCOS_RANGE) {
         let sc = x.0.map(f64::sin_cos);
-        return (L(sc.map(|v| v.0)), L(sc.map(|v| v.1)));
+        return (Lanes(sc.map(|v| v.0)), Lanes(sc.map(|v| v.1)));
     }
     // k = round(x 2 / pi) by the 1.5 * 2^52 trick (exact for |k| < 2^51); the low bits of the
     // shifted value are k's, so the quadrant k mod 4 needs no float-to-integer conversion
@@ -272,11 +272,11 @@ pub(crate) fn sin_cos(x: L) -> (L, L) {
     let r = ((x - k * PIO2[0]) - k * PIO2[1]) - k * PIO2[2];
     let z = r * r;
     // sin r = r (1 - z/3! + z^2/5! - ...), cos r = 1 - z/2! + z^2/4! - ... (Horner, unrolled)
-    let mut ps = L::splat(SIN[SIN.len() - 1]);
+    let mut ps = Lanes::splat(SIN[SIN.len() - 1]);
     for &ci in SIN[..SIN.len() - 1].iter().rev() {
         ps = ps * z + ci;
     }
-    let mut pc = L::splat(COS[COS.len() - 1]);
+    let mut pc = Lanes::splat(COS[COS.len() - 1]);
     for &ci in COS[..COS.len() - 1].iter().rev() {
         pc = pc * z + ci;
     }
@@ -295,7 +295,7 @@ pub(crate) fn sin_cos(x: L) -> (L, L) {
         sin[l] = f64::from_bits(a.to_bits() ^ ((q & 2) << 62));
         cos[l] = f64::from_bits(b.to_bits() ^ (((q + 1) & 2) << 62));
     }
-    (L(sin), L(cos))
+    (Lanes(sin), Lanes(cos))
 }
 
 #[cfg(test)]
@@ -314,14 +314,14 @@ mod tests {
         xs.extend([0.0, -0.0, 1e-300, -1e-12, 123456.789, -999999.0, 2e6, -3e7]);
         let mut worst: f64 = 0.0;
         for group in xs.chunks_exact(LANES) {
-            let (s, c) = sin_cos(L(group.try_into().unwrap()));
+            let (s, c) = sin_cos(Lanes(group.try_into().unwrap()));
             for (l, x) in group.iter().enumerate() {
                 let (es, ec) = x.sin_cos();
                 worst = worst.max((s.0[l] - es).abs()).max((c.0[l] - ec).abs());
             }
         }
         assert!(worst <= 4.5e-16, "worst absolute difference {worst:e}");
-        let (s, c) = sin_cos(L([f64::NAN, 0.5, f64::INFINITY, -0.5]));
+        let (s, c) = sin_cos(Lanes([f64::NAN, 0.5, f64::INFINITY, -0.5]));
         assert!(s.0[0].is_nan() && c.0[2].is_nan() && s.0[1] == 0.5f64.sin());
         assert_eq!(c.0[3], (-0.5f64).cos());
     }

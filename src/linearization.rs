@@ -6,6 +6,7 @@ use nalgebra::{DMatrix, DVector};
 use crate::algorithms::derivatives::derivatives_at;
 use crate::data::Data;
 use crate::error::{Error, Result};
+use crate::gravity::Gravity;
 use crate::model::Model;
 
 /// The linearisation of the inverse dynamics at `P = (q*, qd*, qdd*)`. Torques in N m (or N),
@@ -46,7 +47,7 @@ pub fn linearize(
     q: &[f64],
     qd: &[f64],
     qdd: &[f64],
-    gravity: bool,
+    gravity: Gravity,
 ) -> Result<Linearization> {
     let mut out = Linearization::zeros(model.nv);
     linearize_into(model, data, q, qd, qdd, gravity, &mut out)?;
@@ -61,7 +62,7 @@ pub fn linearize_into(
     q: &[f64],
     qd: &[f64],
     qdd: &[f64],
-    gravity: bool,
+    gravity: Gravity,
     out: &mut Linearization,
 ) -> Result<()> {
     if out.torque.len() != model.nv || out.d.shape() != (model.nv, model.nv) {

@@ -14,10 +14,10 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::error::{Error, Location, Result};
+use crate::gravity::Gravity;
 use crate::spatial::{skew, Inertia, Motion, OriginInertia, Se3};
 
-/// Standard gravity (m/s^2) along -z of the base frame.
-pub const STANDARD_GRAVITY: f64 = 9.81;
+pub use crate::gravity::STANDARD_GRAVITY;
 
 /// The kind of a moving joint.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -240,8 +240,8 @@ impl Model {
     /// Spatial acceleration given to the fixed base in the Newton-Euler recursions: upwards at g
     /// when `gravity` is on (instead of applying gravity to every body), zero otherwise.
     #[inline]
-    pub fn base_acceleration(&self, gravity: bool) -> Motion {
-        if gravity {
+    pub fn base_acceleration(&self, gravity: Gravity) -> Motion {
+        if gravity.is_included() {
             Motion::new(Vector3::zeros(), -self.gravity)
         } else {
             Motion::zeros()

@@ -13,6 +13,7 @@ use crate::direct::{
     ExcitationOptions, FrictionTerms, Weighting,
 };
 use crate::error::Result;
+use crate::gravity::Gravity;
 use crate::io::{write_atomic, Table};
 use crate::local::{
     identify_local, plan_experiments, Design, IdentifyOptions, LocalModel, OperatingPoint,
@@ -115,7 +116,7 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
         a465::TABLE2_QDD.to_vec(),
     )?;
     let mut sim = SimulationOptions::new(&model);
-    sim.gravity = false; // the paper assumes gravity and friction compensated
+    sim.gravity = Gravity::Excluded; // the paper assumes gravity and friction compensated
     sim.friction = Friction::none(n);
     sim.torque_noise = vec![options.torque_noise; n];
     sim.seed = options.seed;
@@ -159,7 +160,7 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
         &BaseOptions {
             friction: FrictionTerms::NONE,
             weighting: Weighting::Ols,
-            gravity: false,
+            gravity: Gravity::Excluded,
             seed: options.seed,
             ..BaseOptions::default()
         },
@@ -190,7 +191,7 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
             &q[r.clone()],
             &qd[r.clone()],
             &qdd[r.clone()],
-            false,
+            Gravity::Excluded,
         )?;
         actual_tau.extend(data.tau.iter());
         local_tau.extend(local.predict(&q[r.clone()], &qd[r.clone()], &qdd[r.clone()])?);

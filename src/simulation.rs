@@ -8,6 +8,7 @@ use rand_distr::{Distribution, Normal};
 use crate::algorithms::rnea::rnea;
 use crate::data::Data;
 use crate::error::{Error, Result};
+use crate::gravity::Gravity;
 use crate::model::Model;
 use crate::recording::Recording;
 use crate::trajectory::Samples;
@@ -54,7 +55,7 @@ impl Friction {
 #[derive(Clone, Debug, PartialEq)]
 pub struct SimulationOptions {
     /// Gravity on (default) or off (as if compensated).
-    pub gravity: bool,
+    pub gravity: Gravity,
     pub friction: Friction,
     /// Gaussian noise on the logged torques (N m).
     pub torque_noise: Vec<f64>,
@@ -70,7 +71,7 @@ impl SimulationOptions {
     pub fn new(model: &Model) -> Self {
         let n = model.nv;
         Self {
-            gravity: true,
+            gravity: Gravity::Included,
             friction: Friction::from_model(model),
             torque_noise: vec![0.0; n],
             position_noise: vec![0.0; n],

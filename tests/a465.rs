@@ -6,6 +6,7 @@ use nalgebra::DMatrix;
 use perturbid_rs::robots::a465::{
     TABLE2_Q, TABLE2_QD, TABLE2_QDD, TABLE2_TORQUE, TABLE3_D_COLUMN1,
 };
+use perturbid_rs::Gravity;
 use perturbid_rs::{gravity_torque, mass_matrix, rnea, robots, Data};
 
 #[test]
@@ -28,7 +29,15 @@ fn first_column_of_d_matches_table3() {
 fn nominal_torque_matches_table2() {
     let model = robots::builtin("a465:kinsheel2010").unwrap();
     let mut data = Data::new(&model);
-    rnea(&model, &mut data, &TABLE2_Q, &TABLE2_QD, &TABLE2_QDD, false).unwrap();
+    rnea(
+        &model,
+        &mut data,
+        &TABLE2_Q,
+        &TABLE2_QD,
+        &TABLE2_QDD,
+        Gravity::Excluded,
+    )
+    .unwrap();
     for i in 0..6 {
         assert!(
             (data.tau[i] - TABLE2_TORQUE[i]).abs() < 0.01,

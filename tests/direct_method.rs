@@ -16,6 +16,7 @@ use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::robots::a465;
 use perturbid_rs::signal::{butterworth_lowpass, filtfilt};
 use perturbid_rs::trajectory::FourierTrajectory;
+use perturbid_rs::Gravity;
 use perturbid_rs::{mass_matrix, model_from_urdf_str, rnea, Data, LoadOptions, Model, Recording};
 
 fn random_states(model: &Model, k: usize, rng: &mut Rng) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
@@ -33,7 +34,7 @@ fn random_states(model: &Model, k: usize, rng: &mut Rng) -> (Vec<f64>, Vec<f64>,
     (q, rng.vector(k * n, 2.0), rng.vector(k * n, 5.0))
 }
 
-fn torques(model: &Model, q: &[f64], qd: &[f64], qdd: &[f64], gravity: bool) -> Vec<f64> {
+fn torques(model: &Model, q: &[f64], qd: &[f64], qdd: &[f64], gravity: Gravity) -> Vec<f64> {
     let n = model.nv;
     let mut data = Data::new(model);
     (0..q.len() / n)
@@ -72,7 +73,7 @@ fn regressor_times_parameters_is_rnea() {
         let theta = model_parameters(model);
         let mut data = Data::new(model);
         let mut y = DMatrix::zeros(model.nv, theta.len());
-        for gravity in [true, false] {
+        for gravity in [Gravity::Included, Gravity::Excluded] {
             let (q, qd, qdd) = random_states(model, 5, &mut rng);
             let expected = torques(model, &q, &qd, &qdd, gravity);
             let n = model.nv;
@@ -108,7 +109,8 @@ fn base_parameters_reproduce_the_full_regressor() {
     let layout = ParameterLayout::new(&model, FrictionTerms::ALL);
     assert_eq!(layout.len(), 60 + 18);
     assert_eq!(layout.names[1], "link1.mcx");
-    let base = BaseParameters::from_random_states(&model, &layout, true, 200, 1e-8, 1).unwrap();
+    let base = BaseParameters::from_random_states(&model, &layout, Gravity::Included, 200, 1e-8, 1)
+        .unwrap();
     let mut theta = layout.model_parameters(&model);
     let mut rng = Rng(9);
     for v in theta.iter_mut().skip(60) {
@@ -124,7 +126,7 @@ fn base_parameters_reproduce_the_full_regressor() {
             qd: &qd,
             qdd: &qdd,
         },
-        true,
+        Gravity::Included,
     )
     .unwrap();
     let full = &phi * &theta;
@@ -171,7 +173,7 @@ fn base_parameter_identification_is_exact_without_noise() {
         let s = traj.sample_periods(1.0, 100.0);
         let viscous = [0.5, 0.4, 0.3, 0.2, 0.1, 0.05];
         let coulomb = [1.0, 0.8, 0.6, 0.4, 0.2, 0.1];
-        let mut tau = torques(&model, &s.q, &s.qd, &s.qdd, true);
+        let mut tau = torques(&model, &s.q, &s.qd, &s.qdd, Gravity::Included);
         for (i, t) in tau.iter_mut().enumerate() {
             let (j, v) = (i % 6, s.qd[i]);
             *t += viscous[j] * v + coulomb[j] * v.signum();
@@ -201,7 +203,7 @@ fn base_parameter_identification_is_exact_without_noise() {
             // held-out states
             let mut rng = Rng(4);
             let (q, qd, qdd) = random_states(&model, 30, &mut rng);
-            let mut expected = torques(&model, &q, &qd, &qdd, true);
+            let mut expected = torques(&model, &q, &qd, &qdd, Gravity::Included);
             for (i, t) in expected.iter_mut().enumerate() {
                 *t += viscous[i % 6] * qd[i] + coulomb[i % 6] * qd[i].signum();
             }
@@ -279,7 +281,7 @@ fn global_linear_model() {
     // One period of L harmonics spans only 2L + 1 functions of time, and q, qd and qdd all live
     // in it: with 5 harmonics the 19 columns [1 dqdd dqd dq] have rank 11, and the error says so.
     let s = a465_excitation().sample_periods(1.0, 100.0);
-    let tau = torques(&model, &s.q, &s.qd, &s.qdd, false);
+    let tau = torques(&model, &s.q, &s.qd, &s.qdd, Gravity::Excluded);
     let e = identify_global_linear(
         &op,
         &Batch {
@@ -304,7 +306,7 @@ fn global_linear_model() {
     )
     .unwrap();
     let s = rich.sample_periods(1.0, 50.0);
-    let tau = torques(&model, &s.q, &s.qd, &s.qdd, false);
+    let tau = torques(&model, &s.q, &s.qd, &s.qdd, Gravity::Excluded);
     let lin = identify_global_linear(
         &op,
         &Batch {
@@ -624,11 +626,12 @@ fn streaming_solve_equals_the_dense_solve() {
     use perturbid_rs::regression::least_squares;
     let model = a465::model("physical").unwrap();
     let layout = ParameterLayout::new(&model, FrictionTerms::ALL);
-    let base = BaseParameters::from_random_states(&model, &layout, true, 200, 1e-8, 0).unwrap();
+    let base = BaseParameters::from_random_states(&model, &layout, Gravity::Included, 200, 1e-8, 0)
+        .unwrap();
     let mut rng = Rng(17);
     let k = 2 * CHUNK + 123;
     let (q, qd, qdd) = random_states(&model, k, &mut rng);
-    let mut tau = torques(&model, &q, &qd, &qdd, true);
+    let mut tau = torques(&model, &q, &qd, &qdd, Gravity::Included);
     tau.iter_mut().for_each(|t| *t += rng.uniform(-0.1, 0.1));
     let batch = Batch {
         q: &q,
@@ -637,9 +640,10 @@ fn streaming_solve_equals_the_dense_solve() {
     };
     let sigma = [1.0, 2.0, 0.5, 1.0, 1.5, 0.7];
     let names = base.names();
-    let factors = JointFactors::new(&model, &base, &batch, &tau, true).unwrap();
+    let factors = JointFactors::new(&model, &base, &batch, &tau, Gravity::Included).unwrap();
     let streamed = factors.solve(&sigma, &names).unwrap();
-    let mut phi = base.select(&regressor_matrix(&model, &layout, &batch, true).unwrap());
+    let mut phi =
+        base.select(&regressor_matrix(&model, &layout, &batch, Gravity::Included).unwrap());
     let mut y = DMatrix::from_column_slice(k * 6, 1, &tau);
     for r in 0..k * 6 {
         phi.row_mut(r).scale_mut(1.0 / sigma[r % 6]);
@@ -655,7 +659,7 @@ fn streaming_solve_equals_the_dense_solve() {
     assert!((streamed.cond - dense.cond).abs() < 1e-6 * dense.cond);
     // the per-joint residuals from the factors equal the ones computed directly
     let rms = factors.residual_rms(streamed.coef.as_slice()).unwrap();
-    let full = base.select(&regressor_matrix(&model, &layout, &batch, true).unwrap());
+    let full = base.select(&regressor_matrix(&model, &layout, &batch, Gravity::Included).unwrap());
     let r = DMatrix::from_column_slice(k * 6, 1, &tau) - full * streamed.coef.transpose();
     for j in 0..6 {
         let direct = ((0..k).map(|s| r[s * 6 + j].powi(2)).sum::<f64>() / k as f64).sqrt();

@@ -5,13 +5,14 @@ mod common;
 
 use common::{mimic_pair, random_tree_urdf, rel_err, Rng};
 use nalgebra::{DMatrix, DVector};
+use perturbid_rs::Gravity;
 use perturbid_rs::{
     bias_torque, forward_dynamics, gravity_torque, linearize, mass_matrix, model_from_urdf_str,
     rnea, rnea_derivatives, robots, Data, LoadOptions, Model,
 };
 use proptest::prelude::*;
 
-fn tau(model: &Model, q: &[f64], qd: &[f64], qdd: &[f64], gravity: bool) -> DVector<f64> {
+fn tau(model: &Model, q: &[f64], qd: &[f64], qdd: &[f64], gravity: Gravity) -> DVector<f64> {
     let mut data = Data::new(model);
     rnea(model, &mut data, q, qd, qdd, gravity).unwrap();
     data.tau.clone()
@@ -31,7 +32,9 @@ fn fd_jacobian(model: &Model, q: &[f64], qd: &[f64], qdd: &[f64], which: usize) 
             vp[j] += h;
             vm[j] -= h;
         }
-        let d = (tau(model, &qp, &vp, qdd, true) - tau(model, &qm, &vm, qdd, true)) / (2.0 * h);
+        let d = (tau(model, &qp, &vp, qdd, Gravity::Included)
+            - tau(model, &qm, &vm, qdd, Gravity::Included))
+            / (2.0 * h);
         jac.set_column(j, &d);
     }
     jac
@@ -49,22 +52,30 @@ fn check_all_identities(model: &Model, rng: &mut Rng) {
     assert!((&m - m.transpose()).amax() < 1e-12);
     gravity_torque(model, &mut data, &q).unwrap();
     let lhs = &m * DVector::from_column_slice(&qdd);
-    let rhs = tau(model, &q, &vec![0.0; n], &qdd, true) - &data.g;
+    let rhs = tau(model, &q, &vec![0.0; n], &qdd, Gravity::Included) - &data.g;
     assert!((lhs - &rhs).amax() < 1e-9 * rhs.amax().max(1.0));
     // rnea = M qdd + bias
-    bias_torque(model, &mut data, &q, &qd, true).unwrap();
-    let full = tau(model, &q, &qd, &qdd, true);
+    bias_torque(model, &mut data, &q, &qd, Gravity::Included).unwrap();
+    let full = tau(model, &q, &qd, &qdd, Gravity::Included);
     let recomposed = &m * DVector::from_column_slice(&qdd) + &data.bias;
     assert!((&full - recomposed).amax() < 1e-9 * full.amax().max(1.0));
     // forward_dynamics(rnea(q, qd, qdd)) = qdd
-    forward_dynamics(model, &mut data, &q, &qd, full.as_slice(), true).unwrap();
+    forward_dynamics(
+        model,
+        &mut data,
+        &q,
+        &qd,
+        full.as_slice(),
+        Gravity::Included,
+    )
+    .unwrap();
     let back = data.qdd.clone();
     assert!(
         (back - DVector::from_column_slice(&qdd)).amax() < 1e-8,
         "forward dynamics round trip"
     );
     // the derivatives: tau and M agree with rnea and crba, dq and dv with finite differences
-    rnea_derivatives(model, &mut data, &q, &qd, &qdd, true).unwrap();
+    rnea_derivatives(model, &mut data, &q, &qd, &qdd, Gravity::Included).unwrap();
     assert!((&data.tau - &full).amax() < 1e-10 * full.amax().max(1.0));
     assert!(rel_err(&data.m, &m) < 1e-12);
     let fd_q = fd_jacobian(model, &q, &qd, &qdd, 0);
@@ -82,7 +93,7 @@ fn check_all_identities(model: &Model, rng: &mut Rng) {
         fd_v
     );
     // the linearisation is made of those pieces; Gs is the gravity stiffness
-    let lin = linearize(model, &mut data, &q, &qd, &qdd, true).unwrap();
+    let lin = linearize(model, &mut data, &q, &qd, &qdd, Gravity::Included).unwrap();
     assert!(rel_err(&lin.h, &fd_v) < 1e-6);
     let zero = vec![0.0; n];
     assert!(rel_err(&lin.g_static, &fd_jacobian(model, &q, &zero, &zero, 0)) < 1e-6);
@@ -117,9 +128,10 @@ fn gravity_off_removes_exactly_g() {
     let mut data = Data::new(&model);
     let (q, qd, qdd) = (rng.vector(6, 1.0), rng.vector(6, 1.0), rng.vector(6, 1.0));
     gravity_torque(&model, &mut data, &q).unwrap();
-    let diff = tau(&model, &q, &qd, &qdd, true) - tau(&model, &q, &qd, &qdd, false);
+    let diff = tau(&model, &q, &qd, &qdd, Gravity::Included)
+        - tau(&model, &q, &qd, &qdd, Gravity::Excluded);
     assert!((diff - &data.g).amax() < 1e-12);
-    let lin = linearize(&model, &mut data, &q, &qd, &qdd, false).unwrap();
+    let lin = linearize(&model, &mut data, &q, &qd, &qdd, Gravity::Excluded).unwrap();
     assert!(lin.g_static.amax() == 0.0);
 }
 
@@ -127,7 +139,15 @@ fn gravity_off_removes_exactly_g() {
 fn wrong_lengths_and_nan_are_errors_not_panics() {
     let model = robots::builtin("a465").unwrap();
     let mut data = Data::new(&model);
-    let e = rnea(&model, &mut data, &[0.0; 5], &[0.0; 6], &[0.0; 6], true).unwrap_err();
+    let e = rnea(
+        &model,
+        &mut data,
+        &[0.0; 5],
+        &[0.0; 6],
+        &[0.0; 6],
+        Gravity::Included,
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("q: expected 6 values"), "{e}");
     let e = rnea(
         &model,
@@ -135,11 +155,19 @@ fn wrong_lengths_and_nan_are_errors_not_panics() {
         &[0.0; 6],
         &[0.0, f64::NAN, 0.0, 0.0, 0.0, 0.0],
         &[0.0; 6],
-        true,
+        Gravity::Included,
     )
     .unwrap_err();
     assert!(e.to_string().contains("qd: entry 1 is NaN"), "{e}");
-    let e = forward_dynamics(&model, &mut data, &[0.0; 6], &[0.0; 6], &[0.0; 7], true).unwrap_err();
+    let e = forward_dynamics(
+        &model,
+        &mut data,
+        &[0.0; 6],
+        &[0.0; 6],
+        &[0.0; 7],
+        Gravity::Included,
+    )
+    .unwrap_err();
     assert!(e.to_string().starts_with("tau:"), "{e}");
 }
 
@@ -157,15 +185,15 @@ fn mimic_joint_is_the_chain_rule_of_the_uncoupled_model() {
         let qf = [q[0], 2.0 * q[0] + 0.1, q[1]];
         let qdf = [qd[0], 2.0 * qd[0], qd[1]];
         let qddf = [qdd[0], 2.0 * qdd[0], qdd[1]];
-        let expected = c.transpose() * tau(&free, &qf, &qdf, &qddf, true);
-        let got = tau(&coupled, &q, &qd, &qdd, true);
+        let expected = c.transpose() * tau(&free, &qf, &qdf, &qddf, Gravity::Included);
+        let got = tau(&coupled, &q, &qd, &qdd, Gravity::Included);
         assert!((got - &expected).amax() < 1e-12);
         let (mut dc, mut df) = (Data::new(&coupled), Data::new(&free));
         mass_matrix(&coupled, &mut dc, &q).unwrap();
         mass_matrix(&free, &mut df, &qf).unwrap();
         assert!((&dc.m - c.transpose() * &df.m * &c).amax() < 1e-12);
         // derivatives of the coupled model against finite differences
-        rnea_derivatives(&coupled, &mut dc, &q, &qd, &qdd, true).unwrap();
+        rnea_derivatives(&coupled, &mut dc, &q, &qd, &qdd, Gravity::Included).unwrap();
         assert!(rel_err(&dc.dtau_dq, &fd_jacobian(&coupled, &q, &qd, &qdd, 0)) < 1e-6);
         assert!(rel_err(&dc.dtau_dv, &fd_jacobian(&coupled, &q, &qd, &qdd, 1)) < 1e-6);
         assert!((&dc.m - c.transpose() * &df.m * &c).amax() < 1e-12);
@@ -189,9 +217,9 @@ fn locked_joint_is_the_full_model_with_that_joint_held() {
             &[q[0], 0.7, q[1]],
             &[qd[0], 0.0, qd[1]],
             &[qdd[0], 0.0, qdd[1]],
-            true,
+            Gravity::Included,
         );
-        let got = tau(&locked, &q, &qd, &qdd, true);
+        let got = tau(&locked, &q, &qd, &qdd, Gravity::Included);
         assert!((got[0] - full[0]).abs() < 1e-12 && (got[1] - full[2]).abs() < 1e-12);
     }
     // locking the leader locks its follower too
@@ -215,14 +243,31 @@ fn linearize_into_reuses_its_buffer_and_checks_its_size() {
     let mut rng = Rng(21);
     let (q, qd, qdd) = (rng.vector(6, 1.0), rng.vector(6, 1.0), rng.vector(6, 1.0));
     let mut out = perturbid_rs::Linearization::zeros(6);
-    perturbid_rs::linearize_into(&model, &mut data, &q, &qd, &qdd, true, &mut out).unwrap();
+    perturbid_rs::linearize_into(
+        &model,
+        &mut data,
+        &q,
+        &qd,
+        &qdd,
+        Gravity::Included,
+        &mut out,
+    )
+    .unwrap();
     assert_eq!(
         out,
-        linearize(&model, &mut data, &q, &qd, &qdd, true).unwrap()
+        linearize(&model, &mut data, &q, &qd, &qdd, Gravity::Included).unwrap()
     );
     let mut wrong = perturbid_rs::Linearization::zeros(5);
-    let e = perturbid_rs::linearize_into(&model, &mut data, &q, &qd, &qdd, true, &mut wrong)
-        .unwrap_err();
+    let e = perturbid_rs::linearize_into(
+        &model,
+        &mut data,
+        &q,
+        &qd,
+        &qdd,
+        Gravity::Included,
+        &mut wrong,
+    )
+    .unwrap_err();
     assert!(
         e.to_string()
             .starts_with("out: expected a Linearization of 6 joints"),
@@ -244,9 +289,9 @@ fn check_lanes(model: &Model, rng: &mut Rng, k: usize) {
     let mut out = vec![0.0; k * n];
     let zeros = vec![0.0; n];
     for (with_v, with_a, gravity) in [
-        (true, true, true),
-        (false, false, true),
-        (true, false, false),
+        (true, true, Gravity::Included),
+        (false, false, Gravity::Included),
+        (true, false, Gravity::Excluded),
     ] {
         let (v, a) = (with_v.then_some(&qd[..]), with_a.then_some(&qdd[..]));
         perturbid_rs::rnea_lanes(model, &mut lanes, &q, v, a, gravity, &mut out).unwrap();
@@ -300,7 +345,7 @@ fn lanes_equal_one_sample_rnea_on_the_a465_and_a_mimic_pair() {
         &[0.0; 12],
         Some(&[0.0; 6]),
         None,
-        true,
+        Gravity::Included,
         &mut out,
     )
     .unwrap_err();
@@ -318,7 +363,7 @@ fn check_regressor_batch(model: &Model, rng: &mut Rng, k: usize) {
         rng.vector(k * n, 2.0),
     );
     let mut lanes = perturbid_rs::LaneData::new(model);
-    for gravity in [true, false] {
+    for gravity in [Gravity::Included, Gravity::Excluded] {
         let mut out = vec![f64::NAN; k * n * p];
         perturbid_rs::regressor_batch(model, &mut lanes, &q, &qd, &qdd, gravity, &mut out).unwrap();
         let mut data = Data::new(model);

@@ -11,6 +11,7 @@ use perturbid_rs::local::{
 };
 use perturbid_rs::regression::least_squares;
 use perturbid_rs::robots::a465;
+use perturbid_rs::Gravity;
 use perturbid_rs::{
     linearize, rnea, simulate_plan, Data, Error, Friction, Linearization, Model, Recording,
     SimulationOptions,
@@ -29,7 +30,7 @@ fn rel(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
     (a - b).norm() / b.norm()
 }
 
-fn noise_free(model: &Model, gravity: bool) -> SimulationOptions {
+fn noise_free(model: &Model, gravity: Gravity) -> SimulationOptions {
     let mut sim = SimulationOptions::new(model);
     sim.gravity = gravity;
     sim.friction = Friction::none(model.nv);
@@ -48,7 +49,7 @@ fn identify(
     (plan, m)
 }
 
-fn truth(model: &Model, op: &OperatingPoint, gravity: bool) -> Linearization {
+fn truth(model: &Model, op: &OperatingPoint, gravity: Gravity) -> Linearization {
     let mut data = Data::new(model);
     linearize(model, &mut data, &op.q, &op.qd, &op.qdd, gravity).unwrap()
 }
@@ -62,7 +63,7 @@ fn mat(e: &Option<perturbid_rs::local::Estimate>) -> &DMatrix<f64> {
 fn a465_table2_noise_free_d_h_exact() {
     let model = a465::model("kinsheel2010").unwrap();
     let op = table2();
-    let lin = truth(&model, &op, false);
+    let lin = truth(&model, &op, Gravity::Excluded);
     for design in [Design::Random, Design::Orthogonal] {
         let (_, m) = identify(
             &model,
@@ -71,7 +72,7 @@ fn a465_table2_noise_free_d_h_exact() {
                 design,
                 ..PlanOptions::default()
             },
-            &noise_free(&model, false),
+            &noise_free(&model, Gravity::Excluded),
         );
         assert!(
             rel(mat(&m.d), &lin.d) < 1e-9,
@@ -113,7 +114,7 @@ fn a465_table2_noise_free_d_h_exact() {
 fn g_within_the_taylor_bound() {
     let model = a465::model("kinsheel2010").unwrap();
     let op = table2();
-    let lin = truth(&model, &op, true);
+    let lin = truth(&model, &op, Gravity::Included);
     let mut data = Data::new(&model);
     let mut errors = vec![];
     for scale in [1.0, 0.5] {
@@ -124,7 +125,7 @@ fn g_within_the_taylor_bound() {
             },
             ..PlanOptions::default()
         };
-        let (plan, m) = identify(&model, &op, &opts, &noise_free(&model, true));
+        let (plan, m) = identify(&model, &op, &opts, &noise_free(&model, Gravity::Included));
         for (kind, est, exact, qd, qdd, t0) in [
             (
                 ExperimentKind::GDynamic,
@@ -150,7 +151,7 @@ fn g_within_the_taylor_bound() {
             let mut r = DMatrix::zeros(x.nrows(), 6);
             for k in 0..x.nrows() {
                 let q: Vec<f64> = (0..6).map(|j| op.q[j] + x[(k, j)]).collect();
-                rnea(&model, &mut data, &q, qd, qdd, true).unwrap();
+                rnea(&model, &mut data, &q, qd, qdd, Gravity::Included).unwrap();
                 let rem = &data.tau - &t0 - exact * x.row(k).transpose();
                 r.set_row(k, &rem.transpose());
             }
@@ -182,7 +183,7 @@ fn other_operating_points() {
                 .map(|j| 0.6 * rng.uniform(model.limits[j].lower, model.limits[j].upper))
                 .collect();
             let op = OperatingPoint::new(q, rng.vector(6, 0.5), rng.vector(6, 1.5)).unwrap();
-            let lin = truth(&model, &op, true);
+            let lin = truth(&model, &op, Gravity::Included);
             let (_, m) = identify(
                 &model,
                 &op,
@@ -190,7 +191,7 @@ fn other_operating_points() {
                     design: Design::Orthogonal,
                     ..PlanOptions::default()
                 },
-                &noise_free(&model, true),
+                &noise_free(&model, Gravity::Included),
             );
             assert!(
                 rel(mat(&m.d), &lin.d) < 1e-9,
@@ -229,8 +230,8 @@ fn common_mode_gravity_and_friction() {
         },
         ..PlanOptions::default()
     };
-    let (_, rigid) = identify(&model, &op, &opts, &noise_free(&model, false));
-    let mut sim = noise_free(&model, true);
+    let (_, rigid) = identify(&model, &op, &opts, &noise_free(&model, Gravity::Excluded));
+    let mut sim = noise_free(&model, Gravity::Included);
     let viscous = vec![2.0, 1.5, 1.0, 0.5, 0.4, 0.3];
     sim.friction = Friction {
         viscous: viscous.clone(),
@@ -252,7 +253,7 @@ fn common_mode_gravity_and_friction() {
 fn noise_error_falls_as_one_over_sqrt_k() {
     let model = a465::model("kinsheel2010").unwrap();
     let op = table2();
-    let lin = truth(&model, &op, true);
+    let lin = truth(&model, &op, Gravity::Included);
     let mut mean_err = vec![];
     for k in [16, 64, 256] {
         let mut acc = 0.0;
@@ -265,7 +266,7 @@ fn noise_error_falls_as_one_over_sqrt_k() {
                 seed,
                 ..PlanOptions::default()
             };
-            let mut sim = noise_free(&model, true);
+            let mut sim = noise_free(&model, Gravity::Included);
             sim.torque_noise = vec![0.05; 6];
             sim.seed = 100 + seed;
             let (_, m) = identify(&model, &op, &opts, &sim);
@@ -416,7 +417,7 @@ fn recordings_with_problems_get_clear_errors() {
 
     let model = a465::model("kinsheel2010").unwrap();
     let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
-    let mut recs = simulate_plan(&model, &plan, &noise_free(&model, true)).unwrap();
+    let mut recs = simulate_plan(&model, &plan, &noise_free(&model, Gravity::Included)).unwrap();
     // too short: cut the D recording in half
     let d = plan
         .experiments
@@ -442,7 +443,7 @@ fn recordings_with_problems_get_clear_errors() {
         "{e}"
     );
     // too few samples per window: decimate to 50 Hz
-    let r = simulate_plan(&model, &plan, &noise_free(&model, true))
+    let r = simulate_plan(&model, &plan, &noise_free(&model, Gravity::Included))
         .unwrap()
         .remove(d);
     let keep: Vec<usize> = (0..r.len()).step_by(20).collect();
@@ -503,7 +504,7 @@ fn detected_crossing_times_recover_a_shifted_log() {
     let model = a465::model("kinsheel2010").unwrap();
     let op = table2();
     let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
-    let recs: Vec<Recording> = simulate_plan(&model, &plan, &noise_free(&model, false))
+    let recs: Vec<Recording> = simulate_plan(&model, &plan, &noise_free(&model, Gravity::Excluded))
         .unwrap()
         .into_iter()
         .map(|mut r| {
@@ -516,7 +517,7 @@ fn detected_crossing_times_recover_a_shifted_log() {
         ..IdentifyOptions::default()
     };
     let m = identify_local(&plan, &recs, &opts).unwrap();
-    let lin = truth(&model, &op, false);
+    let lin = truth(&model, &op, Gravity::Excluded);
     assert!(
         rel(mat(&m.d), &lin.d) < 1e-8,
         "{:e}",
@@ -537,13 +538,13 @@ fn combined_estimator_and_json_round_trip() {
         },
     )
     .unwrap();
-    let recs = simulate_plan(&model, &plan, &noise_free(&model, true)).unwrap();
+    let recs = simulate_plan(&model, &plan, &noise_free(&model, Gravity::Included)).unwrap();
     let opts = IdentifyOptions {
         estimator: Estimator::Combined,
         ..IdentifyOptions::default()
     };
     let m = identify_local(&plan, &recs, &opts).unwrap();
-    let lin = truth(&model, &op, true);
+    let lin = truth(&model, &op, Gravity::Included);
     assert_eq!(m.combined.as_ref().unwrap().matrix.shape(), (6, 18));
     assert!(
         rel(mat(&m.d), &lin.d) < 1e-3,

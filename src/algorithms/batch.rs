@@ -6,25 +6,26 @@
 
 use crate::algorithms::regressor::PARAMS_PER_BODY;
 use crate::error::Result;
+use crate::gravity::Gravity;
 pub use crate::lanes::LANES;
-use crate::lanes::{simd_dispatch, sin_cos, L, R, S, V};
+use crate::lanes::{simd_dispatch, sin_cos, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
 use crate::model::{JointKind, Model};
 use crate::spatial::Se3;
 
 /// Work buffers of [`rnea_lanes`] for one model (allocate once, reuse).
 #[derive(Clone, Debug)]
 pub struct LaneData {
-    rot: Vec<R>,
-    o_rot: Vec<R>,
-    o_pos: Vec<V>,
-    o_s: Vec<S>,
-    pos: Vec<V>,
-    v: Vec<S>,
-    a: Vec<S>,
-    f: Vec<S>,
-    qb: Vec<L>,
-    vb: Vec<L>,
-    ab: Vec<L>,
+    rot: Vec<Rotation3Lanes>,
+    o_rot: Vec<Rotation3Lanes>,
+    o_pos: Vec<Vector3Lanes>,
+    o_s: Vec<SpatialLanes>,
+    pos: Vec<Vector3Lanes>,
+    v: Vec<SpatialLanes>,
+    a: Vec<SpatialLanes>,
+    f: Vec<SpatialLanes>,
+    qb: Vec<Lanes>,
+    vb: Vec<Lanes>,
+    ab: Vec<Lanes>,
 }
 
 impl LaneData {
@@ -32,17 +33,17 @@ impl LaneData {
     pub fn new(model: &Model) -> Self {
         let nb = model.nbodies();
         Self {
-            rot: vec![R::default(); nb],
-            o_rot: vec![R::default(); nb],
-            o_pos: vec![V::default(); nb],
-            o_s: vec![S::default(); nb],
-            pos: vec![V::default(); nb],
-            v: vec![S::default(); nb],
-            a: vec![S::default(); nb],
-            f: vec![S::default(); nb],
-            qb: vec![L::default(); nb],
-            vb: vec![L::default(); nb],
-            ab: vec![L::default(); nb],
+            rot: vec![Rotation3Lanes::default(); nb],
+            o_rot: vec![Rotation3Lanes::default(); nb],
+            o_pos: vec![Vector3Lanes::default(); nb],
+            o_s: vec![SpatialLanes::default(); nb],
+            pos: vec![Vector3Lanes::default(); nb],
+            v: vec![SpatialLanes::default(); nb],
+            a: vec![SpatialLanes::default(); nb],
+            f: vec![SpatialLanes::default(); nb],
+            qb: vec![Lanes::default(); nb],
+            vb: vec![Lanes::default(); nb],
+            ab: vec![Lanes::default(); nb],
         }
     }
 }
@@ -67,7 +68,7 @@ pub fn rnea_lanes, rnea_lanes_avx2 => rnea_lanes_body(
     q: &[f64],
     qd: Option<&[f64]>,
     qdd: Option<&[f64]>,
-    gravity: bool,
+    gravity: Gravity,
     tau: &mut [f64],
 ) -> Result<()>
 }
@@ -79,7 +80,7 @@ fn rnea_lanes_body(
     q: &[f64],
     qd: Option<&[f64]>,
     qdd: Option<&[f64]>,
-    gravity: bool,
+    gravity: Gravity,
     tau: &mut [f64],
 ) -> Result<()> {
     let nv = model.nv;
@@ -156,9 +157,9 @@ pub(crate) fn load(model: &Model, data: &mut LaneData, x: [&[f64]; 3], first: us
                 b.multiplier * x[lane(l) * nv + b.dof]
             }
         };
-        data.qb[i] = L(std::array::from_fn(|l| get(x[0], l) + b.offset));
-        data.vb[i] = L(std::array::from_fn(|l| get(x[1], l)));
-        data.ab[i] = L(std::array::from_fn(|l| get(x[2], l)));
+        data.qb[i] = Lanes(std::array::from_fn(|l| get(x[0], l) + b.offset));
+        data.vb[i] = Lanes(std::array::from_fn(|l| get(x[1], l)));
+        data.ab[i] = Lanes(std::array::from_fn(|l| get(x[2], l)));
     }
 }
 
@@ -171,7 +172,7 @@ fn group(model: &Model, data: &mut LaneData, g: &crate::spatial::Motion) {
         // f = I a + v x* (I v)
         let (v, a) = (&data.v[i], &data.a[i]);
         let (ia, h) = (apply(&b.inertia, a), apply(&b.inertia, v));
-        data.f[i] = S {
+        data.f[i] = SpatialLanes {
             ang: ia.ang.add(&v.ang.cross(&h.ang)).add(&v.lin.cross(&h.lin)),
             lin: ia.lin.add(&v.ang.cross(&h.lin)),
         };
@@ -191,19 +192,22 @@ fn group(model: &Model, data: &mut LaneData, g: &crate::spatial::Motion) {
 /// twist `v` and acceleration `a` (gravity included as a base acceleration `g`) in its frame.
 #[inline(always)]
 fn forward(model: &Model, data: &mut LaneData, g: &crate::spatial::Motion) {
-    let base = S {
-        ang: V::splat(&g.angular),
-        lin: V::splat(&g.linear),
+    let base = SpatialLanes {
+        ang: Vector3Lanes::splat(&g.angular),
+        lin: Vector3Lanes::splat(&g.linear),
     };
     for (i, b) in model.bodies.iter().enumerate() {
         let (rot, pos) = pose(b, data.qb[i]);
         let (vp, ap) = match b.parent {
             Some(p) => (data.v[p], data.a[p]),
-            None => (S::default(), base),
+            None => (SpatialLanes::default(), base),
         };
         let (mut v, mut a) = (act_inv(&rot, &pos, &vp), act_inv(&rot, &pos, &ap));
         // joint twist vj = S qd and acceleration S qdd
-        let (vj, aj) = (V::of(&b.axis, data.vb[i]), V::of(&b.axis, data.ab[i]));
+        let (vj, aj) = (
+            Vector3Lanes::of(&b.axis, data.vb[i]),
+            Vector3Lanes::of(&b.axis, data.ab[i]),
+        );
         match b.kind {
             JointKind::Revolute => {
                 v.ang = v.ang.add(&vj);
@@ -240,7 +244,7 @@ pub fn regressor_batch, regressor_batch_avx2 => regressor_batch_body(
     q: &[f64],
     qd: &[f64],
     qdd: &[f64],
-    gravity: bool,
+    gravity: Gravity,
     out: &mut [f64],
 ) -> Result<()>
 }
@@ -252,7 +256,7 @@ fn regressor_batch_body(
     q: &[f64],
     qd: &[f64],
     qdd: &[f64],
-    gravity: bool,
+    gravity: Gravity,
     out: &mut [f64],
 ) -> Result<()> {
     let nv = model.nv;
@@ -266,7 +270,7 @@ fn regressor_batch_body(
             ("regressor output", out.len(), nv * p),
         ],
     )?;
-    let mut y = vec![L::default(); nv * p];
+    let mut y = vec![Lanes::default(); nv * p];
     let mut first = 0;
     while first < k {
         load(model, data, [q, qd, qdd], first);
@@ -305,8 +309,8 @@ pub fn mass_matrix_batch, mass_matrix_batch_avx2 => mass_matrix_batch_body(
 #[derive(Clone, Copy, Debug, Default)]
 struct Composite {
     mass: f64,
-    h: V,
-    i: R,
+    h: Vector3Lanes,
+    i: Rotation3Lanes,
 }
 
 #[inline(always)]
@@ -319,7 +323,7 @@ fn mass_matrix_batch_body(
     let nv = model.nv;
     let nb = model.nbodies();
     let k = samples(nv, q.len(), &[("mass matrix output", out.len(), nv * nv)])?;
-    let mut m = vec![L::default(); nb * nb]; // body-level, row-major
+    let mut m = vec![Lanes::default(); nb * nb]; // body-level, row-major
     let mut ic = vec![Composite::default(); nb];
     let mut first = 0;
     while first < k {
@@ -330,10 +334,10 @@ fn mass_matrix_batch_body(
             let (r, p) = place_in_base(model, data, i, &rot, &pos);
             ic[i] = transformed(&b.origin_inertia, &r, &p);
         }
-        m.fill(L::default());
+        m.fill(Lanes::default());
         for i in (0..nb).rev() {
             let (c, s) = (&ic[i], &data.o_s[i]);
-            let f = S {
+            let f = SpatialLanes {
                 ang: c.i.mul(&s.ang).add(&c.h.cross(&s.lin)),
                 lin: s.lin.scale(c.mass).sub(&c.h.cross(&s.ang)),
             };
@@ -380,7 +384,13 @@ fn mass_matrix_batch_body(
 /// pose is already in `data`): stores it with the motion subspace there (`o_rot`, `o_pos`,
 /// `o_s`) and returns it.
 #[inline(always)]
-fn place_in_base(model: &Model, data: &mut LaneData, i: usize, rot: &R, pos: &V) -> (R, V) {
+fn place_in_base(
+    model: &Model,
+    data: &mut LaneData,
+    i: usize,
+    rot: &Rotation3Lanes,
+    pos: &Vector3Lanes,
+) -> (Rotation3Lanes, Vector3Lanes) {
     let b = &model.bodies[i];
     let (r, p) = match b.parent {
         Some(k) => {
@@ -397,15 +407,15 @@ fn place_in_base(model: &Model, data: &mut LaneData, i: usize, rot: &R, pos: &V)
 
 /// Body `b`'s motion subspace in the base frame, for its base-frame pose `r`, `p`.
 #[inline(always)]
-fn subspace_in(b: &crate::model::Body, r: &R, p: &V) -> S {
+fn subspace_in(b: &crate::model::Body, r: &Rotation3Lanes, p: &Vector3Lanes) -> SpatialLanes {
     let axis = r.mul_const_vector(&b.axis);
     match b.kind {
-        JointKind::Revolute => S {
+        JointKind::Revolute => SpatialLanes {
             ang: axis,
             lin: p.cross(&axis),
         },
-        JointKind::Prismatic => S {
-            ang: V::default(),
+        JointKind::Prismatic => SpatialLanes {
+            ang: Vector3Lanes::default(),
             lin: axis,
         },
     }
@@ -414,14 +424,18 @@ fn subspace_in(b: &crate::model::Body, r: &R, p: &V) -> S {
 /// A body's (constant) origin-form inertia expressed in the base frame, for its pose `r`, `p`
 /// there (see `OriginInertia::transformed`).
 #[inline(always)]
-fn transformed(b: &crate::spatial::OriginInertia, r: &R, p: &V) -> Composite {
+fn transformed(
+    b: &crate::spatial::OriginInertia,
+    r: &Rotation3Lanes,
+    p: &Vector3Lanes,
+) -> Composite {
     let hr = r.mul_const_vector(&b.h);
     let w = hr.add(&p.scale(0.5 * b.mass));
     let d = p.dot(&w) * 2.0;
     let ri = [0, 1, 2].map(|row| r.0[row].mul_const(&b.i)); // rows of R I (I symmetric)
     let pw = [p.x, p.y, p.z];
     let ww = [w.x, w.y, w.z];
-    let mut i = R::default();
+    let mut i = Rotation3Lanes::default();
     for row in 0..3 {
         let e = |c: usize| {
             let v = ri[row].dot(&r.0[c]) - ww[row] * pw[c] - pw[row] * ww[c];
@@ -431,7 +445,7 @@ fn transformed(b: &crate::spatial::OriginInertia, r: &R, p: &V) -> Composite {
                 v
             }
         };
-        i.0[row] = V {
+        i.0[row] = Vector3Lanes {
             x: e(0),
             y: e(1),
             z: e(2),
@@ -448,10 +462,15 @@ fn transformed(b: &crate::spatial::OriginInertia, r: &R, p: &V) -> Composite {
 /// the loaded group of lanes (see [`load`]): `out` column-major `nv x 10 nbodies`, one lane per
 /// sample, every entry written. `gravity` includes gravity.
 #[inline(always)]
-pub(crate) fn regressor_lanes(model: &Model, data: &mut LaneData, gravity: bool, out: &mut [L]) {
+pub(crate) fn regressor_lanes(
+    model: &Model,
+    data: &mut LaneData,
+    gravity: Gravity,
+    out: &mut [Lanes],
+) {
     let nv = model.nv;
     forward(model, data, &model.base_acceleration(gravity));
-    out.fill(L::default());
+    out.fill(Lanes::default());
     for i in 0..model.nbodies() {
         let (rot, pos) = (data.rot[i], data.pos[i]);
         let (r, p) = place_in_base(model, data, i, &rot, &pos);
@@ -461,8 +480,8 @@ pub(crate) fn regressor_lanes(model: &Model, data: &mut LaneData, gravity: bool,
         let ac = r.mul(&a.lin.add(&w.cross(&v.lin)));
         let (ww, alw) = (r.mul(&w), r.mul(&al));
         let w2 = w.x * w.x + w.y * w.y + w.z * w.z;
-        let mut cols = [S::default(); 10];
-        cols[0] = S {
+        let mut cols = [SpatialLanes::default(); 10];
+        cols[0] = SpatialLanes {
             ang: p.cross(&ac),
             lin: ac,
         };
@@ -473,29 +492,29 @@ pub(crate) fn regressor_lanes(model: &Model, data: &mut LaneData, gravity: bool,
                 .cross(&rk)
                 .add(&ww.mul_lanes(wkk))
                 .sub(&rk.mul_lanes(w2));
-            cols[1 + k] = S {
+            cols[1 + k] = SpatialLanes {
                 ang: rk.cross(&ac).add(&p.cross(&lin)),
                 lin,
             };
         }
         // I_q x for the unit inertias of [Ixx, Ixy, Iyy, Ixz, Iyz, Izz], then rotated
-        let z = L::default();
-        let unit = |x: &V| {
+        let z = Lanes::default();
+        let unit = |x: &Vector3Lanes| {
             [
-                V { x: x.x, y: z, z },
-                V { x: x.y, y: x.x, z },
-                V { x: z, y: x.y, z },
-                V {
+                Vector3Lanes { x: x.x, y: z, z },
+                Vector3Lanes { x: x.y, y: x.x, z },
+                Vector3Lanes { x: z, y: x.y, z },
+                Vector3Lanes {
                     x: x.z,
                     y: z,
                     z: x.x,
                 },
-                V {
+                Vector3Lanes {
                     x: z,
                     y: x.z,
                     z: x.y,
                 },
-                V { x: z, y: z, z: x.z },
+                Vector3Lanes { x: z, y: z, z: x.z },
             ]
         };
         let (ia, iw) = (unit(&al), unit(&w));
@@ -524,8 +543,8 @@ pub(crate) fn regressor_lanes(model: &Model, data: &mut LaneData, gravity: bool,
 
 /// A motion given in the parent's frame expressed in the child's (pose `rot`, `pos`).
 #[inline(always)]
-fn act_inv(rot: &R, pos: &V, m: &S) -> S {
-    S {
+fn act_inv(rot: &Rotation3Lanes, pos: &Vector3Lanes, m: &SpatialLanes) -> SpatialLanes {
+    SpatialLanes {
         ang: rot.tr_mul(&m.ang),
         lin: rot.tr_mul(&m.lin.sub(&pos.cross(&m.ang))),
     }
@@ -533,10 +552,10 @@ fn act_inv(rot: &R, pos: &V, m: &S) -> S {
 
 /// Momentum `I m` of a body of (constant) inertia `inertia` moving with twist `m`.
 #[inline(always)]
-fn apply(inertia: &crate::spatial::Inertia, m: &S) -> S {
-    let com = V::splat(&inertia.com);
+fn apply(inertia: &crate::spatial::Inertia, m: &SpatialLanes) -> SpatialLanes {
+    let com = Vector3Lanes::splat(&inertia.com);
     let lin = m.lin.sub(&com.cross(&m.ang)).scale(inertia.mass);
-    S {
+    SpatialLanes {
         ang: m.ang.mul_const(&inertia.inertia_com).add(&com.cross(&lin)),
         lin,
     }
@@ -544,33 +563,36 @@ fn apply(inertia: &crate::spatial::Inertia, m: &S) -> S {
 
 /// The pose of body `b` in its parent for the lane coordinates `x` (see `Body::pose_in_parent`).
 #[inline(always)]
-fn pose(b: &crate::model::Body, x: L) -> (R, V) {
+fn pose(b: &crate::model::Body, x: Lanes) -> (Rotation3Lanes, Vector3Lanes) {
     let p: &Se3 = &b.placement;
     match b.kind {
         JointKind::Revolute => {
             let (s, c) = sin_cos(x);
-            let c1 = L::splat(1.0) - c;
+            let c1 = Lanes::splat(1.0) - c;
             let t = &b.pose_terms;
             let row = |r: usize| {
                 let e = |c: usize| s * t.r1[(r, c)] + c1 * t.r2[(r, c)] + p.rotation[(r, c)];
-                V {
+                Vector3Lanes {
                     x: e(0),
                     y: e(1),
                     z: e(2),
                 }
             };
-            (R([row(0), row(1), row(2)]), V::splat(&p.translation))
+            (
+                Rotation3Lanes([row(0), row(1), row(2)]),
+                Vector3Lanes::splat(&p.translation),
+            )
         }
         JointKind::Prismatic => {
-            let row = |r: usize| V {
-                x: L::splat(p.rotation[(r, 0)]),
-                y: L::splat(p.rotation[(r, 1)]),
-                z: L::splat(p.rotation[(r, 2)]),
+            let row = |r: usize| Vector3Lanes {
+                x: Lanes::splat(p.rotation[(r, 0)]),
+                y: Lanes::splat(p.rotation[(r, 1)]),
+                z: Lanes::splat(p.rotation[(r, 2)]),
             };
             let t1 = &b.pose_terms.t1;
             (
-                R([row(0), row(1), row(2)]),
-                V::splat(&p.translation).add(&V::of(t1, x)),
+                Rotation3Lanes([row(0), row(1), row(2)]),
+                Vector3Lanes::splat(&p.translation).add(&Vector3Lanes::of(t1, x)),
             )
         }
     }

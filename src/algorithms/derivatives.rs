@@ -7,6 +7,7 @@ use nalgebra::{DMatrix, DVector};
 use super::{contract_matrix, contract_vector, load_state};
 use crate::data::Data;
 use crate::error::Result;
+use crate::gravity::Gravity;
 use crate::model::Model;
 use crate::spatial::Motion;
 
@@ -23,7 +24,7 @@ pub fn rnea_derivatives(
     q: &[f64],
     qd: &[f64],
     qdd: &[f64],
-    gravity: bool,
+    gravity: Gravity,
 ) -> Result<()> {
     derivatives_at(model, data, q, Some(qd), Some(qdd), gravity)
 }
@@ -35,7 +36,7 @@ pub(crate) fn derivatives_at(
     q: &[f64],
     qd: Option<&[f64]>,
     qdd: Option<&[f64]>,
-    gravity: bool,
+    gravity: Gravity,
 ) -> Result<()> {
     load_state(model, data, q, qd, qdd)?;
     let mut tau = std::mem::take(&mut data.tau);
@@ -64,7 +65,7 @@ pub(crate) fn derivatives_at(
 fn derivatives_loaded(
     model: &Model,
     data: &mut Data,
-    gravity: bool,
+    gravity: Gravity,
     tau: &mut DVector<f64>,
     m: &mut DMatrix<f64>,
     dq: &mut DMatrix<f64>,

@@ -4,6 +4,7 @@ use super::crba::mass_matrix;
 use super::rnea::bias_torque;
 use crate::data::Data;
 use crate::error::{Error, Result};
+use crate::gravity::Gravity;
 use crate::model::Model;
 
 /// Joint accelerations `qdd = M(q)^-1 (tau - c(q, qd) - g(q))` (rad/s^2 or m/s^2).
@@ -16,7 +17,7 @@ pub fn forward_dynamics(
     q: &[f64],
     qd: &[f64],
     tau: &[f64],
-    gravity: bool,
+    gravity: Gravity,
 ) -> Result<()> {
     model.check_vector("tau", tau)?;
     bias_torque(model, data, q, qd, gravity)?;

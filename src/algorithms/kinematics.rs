@@ -1,6 +1,7 @@
 //! Forward kinematics: the pose of every body in its parent.
 
 use crate::data::Data;
+use crate::gravity::Gravity;
 use crate::model::{JointKind, Model};
 use crate::spatial::Motion;
 
@@ -17,7 +18,7 @@ pub(crate) fn update_placements(model: &Model, data: &mut Data) {
 /// its own frame, the base accelerating upwards at `g` when `gravity` (so `a` includes gravity).
 // inlined into every algorithm: measured 5-10 % faster one-sample calls
 #[inline(always)]
-pub(crate) fn motion_pass(model: &Model, data: &mut Data, gravity: bool) {
+pub(crate) fn motion_pass(model: &Model, data: &mut Data, gravity: Gravity) {
     let a0 = model.base_acceleration(gravity);
     for (i, b) in model.bodies.iter().enumerate() {
         let x = b.pose_in_parent(data.qb[i]);

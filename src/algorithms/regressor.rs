@@ -7,6 +7,7 @@ use super::kinematics::motion_pass;
 use super::load_state;
 use crate::data::Data;
 use crate::error::{Error, Result};
+use crate::gravity::Gravity;
 use crate::model::Model;
 use crate::spatial::{Force, Inertia, Motion, Se3};
 
@@ -135,7 +136,7 @@ pub fn joint_torque_regressor(
     q: &[f64],
     qd: &[f64],
     qdd: &[f64],
-    gravity: bool,
+    gravity: Gravity,
     out: &mut DMatrix<f64>,
 ) -> Result<()> {
     let nb = model.nbodies();

@@ -6,6 +6,7 @@ use super::kinematics::motion_pass;
 use super::{contract_vector, load_state};
 use crate::data::Data;
 use crate::error::Result;
+use crate::gravity::Gravity;
 use crate::model::Model;
 
 /// Inverse dynamics `tau = M(q) qdd + c(q, qd) + g(q)` (rigid bodies only: no friction).
@@ -20,7 +21,7 @@ pub fn rnea(
     q: &[f64],
     qd: &[f64],
     qdd: &[f64],
-    gravity: bool,
+    gravity: Gravity,
 ) -> Result<()> {
     load_state(model, data, q, Some(qd), Some(qdd))?;
     let mut out = std::mem::take(&mut data.tau);
@@ -34,7 +35,7 @@ pub fn rnea(
 pub fn gravity_torque(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
     load_state(model, data, q, None, None)?;
     let mut out = std::mem::take(&mut data.g);
-    rnea_loaded(model, data, true, &mut out);
+    rnea_loaded(model, data, Gravity::Included, &mut out);
     data.g = out;
     Ok(())
 }
@@ -46,7 +47,7 @@ pub fn bias_torque(
     data: &mut Data,
     q: &[f64],
     qd: &[f64],
-    gravity: bool,
+    gravity: Gravity,
 ) -> Result<()> {
     load_state(model, data, q, Some(qd), None)?;
     let mut out = std::mem::take(&mut data.bias);
@@ -56,7 +57,12 @@ pub fn bias_torque(
 }
 
 /// RNEA on the body coordinates already in `data` (`qb`, `vb`, `ab`); torques into `out`.
-pub(crate) fn rnea_loaded(model: &Model, data: &mut Data, gravity: bool, out: &mut DVector<f64>) {
+pub(crate) fn rnea_loaded(
+    model: &Model,
+    data: &mut Data,
+    gravity: Gravity,
+    out: &mut DVector<f64>,
+) {
     motion_pass(model, data, gravity);
     for (i, b) in model.bodies.iter().enumerate() {
         let h = b.inertia.apply(&data.v[i]);

@@ -14,6 +14,7 @@ use crate::direct::{
     ExcitationOptions, FrictionTerms, Weighting,
 };
 use crate::error::{Error, Result};
+use crate::gravity::Gravity;
 use crate::io::{read_recording, read_states, samples_table, write_atomic, Table};
 use crate::local::LocalModel;
 use crate::preprocess::{preprocess, PreprocessOptions};
@@ -173,7 +174,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     let options = BaseOptions {
         friction: FrictionTerms::from_names(&a.friction)?,
         weighting,
-        gravity: !a.no_gravity,
+        gravity: Gravity::from(!a.no_gravity),
         ..BaseOptions::default()
     };
     progress.update(&format!("identifying on {split} samples"));

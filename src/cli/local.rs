@@ -9,6 +9,7 @@ use serde::Deserialize;
 use super::files::{load_json, load_robot, load_table};
 use super::out_dir;
 use crate::error::{Error, Result};
+use crate::gravity::Gravity;
 use crate::io::{read_recording, recording_table, samples_table, write_atomic};
 use crate::local::{
     identify_local, plan_experiments, CrossingTimes, Design, Estimator, ExperimentKind,
@@ -175,7 +176,7 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<String> {
     let plan = load_json(&a.plan, Plan::from_json)?;
     let n = model.nv;
     let mut o = SimulationOptions::new(&model);
-    o.gravity = !a.no_gravity;
+    o.gravity = Gravity::from(!a.no_gravity);
     if a.no_friction {
         o.friction = Friction::none(n);
     }

@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use super::parameters::{regressor_matrix, Batch, ParameterLayout};
 use crate::error::{Error, Result};
+use crate::gravity::Gravity;
 use crate::model::Model;
 
 /// The base parameters of a layout: `theta_base = theta[kept] + K theta[dropped]`, and
@@ -91,7 +92,7 @@ impl BaseParameters {
     pub fn from_random_states(
         model: &Model,
         layout: &ParameterLayout,
-        gravity: bool,
+        gravity: Gravity,
         samples: usize,
         tolerance: f64,
         seed: u64,

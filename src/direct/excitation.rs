@@ -12,6 +12,7 @@ use rand_chacha::ChaCha8Rng;
 use super::base::{BaseParameters, BASE_TOLERANCE};
 use super::parameters::{regressor_matrix, Batch, FrictionTerms, ParameterLayout};
 use crate::error::{Error, Result};
+use crate::gravity::Gravity;
 use crate::model::Model;
 use crate::trajectory::{check_limits, FourierTrajectory};
 
@@ -182,7 +183,7 @@ impl Problem<'_> {
                 qd: &s.qd,
                 qdd: &s.qdd,
             },
-            true,
+            Gravity::Included,
         ) {
             Ok(p) => self.base.select(&p),
             Err(_) => return (f64::INFINITY, f64::INFINITY),
@@ -239,7 +240,7 @@ pub fn design_excitation(
     let base = BaseParameters::from_random_states(
         model,
         &layout,
-        true,
+        Gravity::Included,
         200.max(layout.len()),
         BASE_TOLERANCE,
         o.seed,

@@ -8,6 +8,7 @@ use super::base::{BaseParameters, BASE_TOLERANCE};
 use super::parameters::{regressor_matrix, Batch, FrictionTerms, ParameterLayout};
 use super::streaming;
 use crate::error::{Error, Result};
+use crate::gravity::Gravity;
 use crate::model::Model;
 
 /// Version tag of the JSON format of [`BaseModel`].
@@ -29,7 +30,7 @@ pub struct BaseOptions {
     pub friction: FrictionTerms,
     pub weighting: Weighting,
     /// Whether the torques include gravity (default true).
-    pub gravity: bool,
+    pub gravity: Gravity,
     /// Relative rank tolerance of the pivoted QR (default 1e-8).
     pub tolerance: f64,
     /// Random states used to find the base parameters (default 200) and their seed.
@@ -42,7 +43,7 @@ impl Default for BaseOptions {
         Self {
             friction: FrictionTerms::ALL,
             weighting: Weighting::Wls,
-            gravity: true,
+            gravity: Gravity::Included,
             tolerance: BASE_TOLERANCE,
             states: 200,
             seed: 0,
@@ -58,7 +59,7 @@ pub struct BaseModel {
     pub robot: String,
     pub joint_names: Vec<String>,
     pub base: BaseParameters,
-    pub gravity: bool,
+    pub gravity: Gravity,
     pub weighting: Weighting,
     /// The identified base parameters (SI units of each combination).
     pub theta: Vec<f64>,

@@ -10,6 +10,7 @@ use crate::algorithms::regressor::{
 };
 use crate::data::Data;
 use crate::error::{Error, Result};
+use crate::gravity::Gravity;
 use crate::model::Model;
 
 /// Which per-joint friction parameters are identified with the inertial ones.
@@ -171,7 +172,7 @@ pub fn regressor_matrix(
     model: &Model,
     layout: &ParameterLayout,
     batch: &Batch<'_>,
-    gravity: bool,
+    gravity: Gravity,
 ) -> Result<DMatrix<f64>> {
     let nv = model.nv;
     let k = batch.samples(nv)?;
@@ -185,7 +186,7 @@ pub(crate) fn fill_regressor(
     model: &Model,
     layout: &ParameterLayout,
     batch: &Batch<'_>,
-    gravity: bool,
+    gravity: Gravity,
     range: std::ops::Range<usize>,
     out: &mut DMatrix<f64>,
     row0: usize,

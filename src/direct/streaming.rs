@@ -27,7 +27,8 @@ use super::parameters::Batch;
 use crate::algorithms::batch::{load, regressor_lanes};
 use crate::algorithms::regressor::PARAMS_PER_BODY;
 use crate::error::{Error, Result};
-use crate::lanes::{simd_dispatch, L, LANES};
+use crate::gravity::Gravity;
+use crate::lanes::{simd_dispatch, Lanes, LANES};
 use crate::model::Model;
 use crate::regression::{least_squares, LeastSquares};
 use crate::LaneData;
@@ -122,7 +123,7 @@ pub struct JointFactors {
 struct Worker {
     lanes: LaneData,
     /// The regressor of a group of samples, column-major `nv x 10 nbodies`, a lane per sample.
-    y: Vec<L>,
+    y: Vec<Lanes>,
     stacks: Vec<Mat<f64>>,
     q_coeff: Mat<f64>,
     scratch: MemBuffer,
@@ -134,7 +135,7 @@ impl Worker {
         let block = recommended_block_size::<f64>(widest + CHUNK, widest);
         Self {
             lanes: LaneData::new(model),
-            y: vec![L::default(); model.nv * PARAMS_PER_BODY * model.nbodies()],
+            y: vec![Lanes::default(); model.nv * PARAMS_PER_BODY * model.nbodies()],
             stacks: columns
                 .iter()
                 .map(|c| Mat::zeros(c.base.len() + 1 + CHUNK, c.base.len() + 1))
@@ -157,7 +158,7 @@ impl Worker {
         columns: &[JointColumns],
         batch: &Batch<'_>,
         tau: &[f64],
-        gravity: bool,
+        gravity: Gravity,
         range: std::ops::Range<usize>,
     ) -> Result<()> {
         fill(self, model, columns, batch, tau, gravity, range.clone())?;
@@ -189,7 +190,7 @@ fn fill, fill_avx2 => fill_body(
     columns: &[JointColumns],
     batch: &Batch<'_>,
     tau: &[f64],
-    gravity: bool,
+    gravity: Gravity,
     range: std::ops::Range<usize>,
 ) -> Result<()>
 }
@@ -201,7 +202,7 @@ fn fill_body(
     columns: &[JointColumns],
     batch: &Batch<'_>,
     tau: &[f64],
-    gravity: bool,
+    gravity: Gravity,
     range: std::ops::Range<usize>,
 ) -> Result<()> {
     let nv = model.nv;
@@ -308,7 +309,7 @@ impl JointFactors {
         base: &BaseParameters,
         batch: &Batch<'_>,
         tau: &[f64],
-        gravity: bool,
+        gravity: Gravity,
     ) -> Result<Self> {
         let nv = model.nv;
         let k = batch.samples_with_torques(nv, tau)?;

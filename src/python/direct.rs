@@ -417,7 +417,7 @@ pub(crate) fn identify_base_parameters(
     let options = BaseOptions {
         friction,
         weighting,
-        gravity,
+        gravity: gravity.into(),
         tolerance,
         seed,
         ..BaseOptions::default()

@@ -483,7 +483,7 @@ pub(crate) fn simulate(
     let model = &robot.model;
     let n = model.nv;
     let mut o = SimulationOptions::new(model);
-    o.gravity = gravity;
+    o.gravity = gravity.into();
     o.seed = seed;
     o.friction = match &friction {
         None => Friction::from_model(model),

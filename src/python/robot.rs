@@ -214,12 +214,12 @@ impl PyRobot {
                 let zeros = vec![0.0; n];
                 for (i, o) in out.chunks_mut(n).enumerate() {
                     let (a, b, c) = (row(q, &zeros, i), row(qd, &zeros, i), row(qdd, &zeros, i));
-                    crate::rnea(m, &mut w.data, a, b, c, gravity)?;
+                    crate::rnea(m, &mut w.data, a, b, c, gravity.into())?;
                     o.copy_from_slice(w.data.tau.as_slice());
                 }
                 return Ok(());
             }
-            rnea_lanes(m, &mut w.lanes, q, opt(qd), opt(qdd), gravity, out)
+            rnea_lanes(m, &mut w.lanes, q, opt(qd), opt(qdd), gravity.into(), out)
         })
     }
 }
@@ -425,7 +425,7 @@ impl PyRobot {
             chunk.check_finite(m, &["q", "qd", "qdd"])?;
             let [q, qd, qdd] = chunk.columns;
             if chunk.len >= LANES {
-                return regressor_batch(m, &mut w.lanes, q, qd, qdd, gravity, out);
+                return regressor_batch(m, &mut w.lanes, q, qd, qdd, gravity.into(), out);
             }
             // too few samples to fill the lanes: one at a time
             let d = &mut w.data;
@@ -438,7 +438,7 @@ impl PyRobot {
                     &q[r.clone()],
                     &qd[r.clone()],
                     &qdd[r],
-                    gravity,
+                    gravity.into(),
                     &mut y,
                 )
                 .map_err(|e| chunk.at(i, e))?;
@@ -476,7 +476,7 @@ impl PyRobot {
             &[("q", &q), ("qd", &qd), ("tau", &tau)],
             &[self.model.nv],
             |m, d, x, out| {
-                crate::forward_dynamics(m, d, x[0], x[1], x[2], gravity)?;
+                crate::forward_dynamics(m, d, x[0], x[1], x[2], gravity.into())?;
                 out.copy_from_slice(d.qdd.as_slice());
                 Ok(())
             },
@@ -504,7 +504,7 @@ impl PyRobot {
             let mut lin = crate::Linearization::zeros(n);
             for (i, o) in out.chunks_mut(size).enumerate() {
                 let [q, qd, qdd] = chunk.columns.map(|c| &c[i * n..(i + 1) * n]);
-                crate::linearize_into(m, &mut w.data, q, qd, qdd, gravity, &mut lin)
+                crate::linearize_into(m, &mut w.data, q, qd, qdd, gravity.into(), &mut lin)
                     .map_err(|e| chunk.at(i, e))?;
                 o[..n].copy_from_slice(lin.torque.as_slice());
                 for (b, mat) in [&lin.d, &lin.h, &lin.g, &lin.g_static].iter().enumerate() {
