@@ -2,13 +2,14 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use perturbid_rs::direct::{
-    design_excitation, identify_base_parameters, BaseOptions, Batch, ExcitationOptions, Weighting,
+    design_excitation, identify_base_parameters, BaseOptions, ExcitationOptions, Weighting,
 };
 use perturbid_rs::local::{
     identify_local, plan_experiments, IdentifyOptions, OperatingPoint, PlanOptions,
 };
 use perturbid_rs::robots::a465::{self, TABLE2_Q, TABLE2_QD, TABLE2_QDD};
 use perturbid_rs::Gravity;
+use perturbid_rs::States;
 use perturbid_rs::{rnea, simulate_plan, Data, SimulationOptions};
 
 fn identification(c: &mut Criterion) {
@@ -52,11 +53,7 @@ fn identification(c: &mut Criterion) {
         .unwrap();
         tau.extend(data.tau.iter());
     }
-    let batch = Batch {
-        q: &q,
-        qd: &qd,
-        qdd: &qdd,
-    };
+    let batch = States::new(model.nv, &q, Some(&qd), Some(&qdd)).unwrap();
     let ols = BaseOptions {
         weighting: Weighting::Ols,
         ..BaseOptions::default()

@@ -17,6 +17,7 @@ pub mod algorithms;
 pub mod cli;
 pub mod data;
 pub mod direct;
+pub mod document;
 pub mod error;
 pub mod gravity;
 pub mod io;
@@ -34,6 +35,8 @@ pub mod robots;
 pub mod signal;
 pub mod simulation;
 pub mod spatial;
+pub mod states;
+pub mod torque_model;
 pub mod trajectory;
 pub mod urdf;
 
@@ -44,8 +47,10 @@ pub use algorithms::batch::{mass_matrix_batch, regressor_batch, rnea_lanes, Lane
 pub use algorithms::crba::mass_matrix;
 pub use algorithms::derivatives::rnea_derivatives;
 pub use algorithms::forward_dynamics::forward_dynamics;
+pub use algorithms::parallel;
 pub use algorithms::rnea::{bias_torque, gravity_torque, rnea};
 pub use data::Data;
+pub use document::Document;
 pub use error::{Error, Result};
 pub use gravity::Gravity;
 pub use linearization::{linearize, linearize_into, Linearization};
@@ -53,4 +58,6 @@ pub use local::{identify_local, plan_experiments, LocalModel, OperatingPoint, Pl
 pub use model::{Body, JointKind, JointLimits, Model};
 pub use recording::Recording;
 pub use simulation::{simulate_plan, Friction, SimulationOptions};
+pub use states::{State, States};
+pub use torque_model::{ModelFile, TorqueModel};
 pub use urdf::{model_from_urdf_file, model_from_urdf_str, LoadOptions};

@@ -9,9 +9,10 @@ use serde::Serialize;
 
 use crate::data::Data;
 use crate::direct::{
-    design_excitation, identify_base_parameters, identify_global_linear, BaseOptions, Batch,
+    design_excitation, identify_base_parameters, identify_global_linear, BaseOptions,
     ExcitationOptions, FrictionTerms, Weighting,
 };
+use crate::document::Document;
 use crate::error::Result;
 use crate::gravity::Gravity;
 use crate::io::{write_atomic, Table};
@@ -22,6 +23,8 @@ use crate::local::{
 use crate::report::{markdown, svg};
 use crate::robots::a465;
 use crate::simulation::{simulate_plan, simulate_samples, Friction, SimulationOptions};
+use crate::states::States;
+use crate::torque_model::TorqueModel;
 use crate::{mass_matrix, rnea};
 
 /// The paper's Table 3 "direct method" row (first column of D).
@@ -147,11 +150,7 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
     progress("direct method: simulating the excitation and fitting both direct models");
     let samples = design.trajectory.sample_periods(1.0, 50.0);
     let rec = simulate_samples(&model, &samples, &sim, 99, "excitation")?;
-    let batch = Batch {
-        q: &samples.q,
-        qd: &samples.qd,
-        qdd: &samples.qdd,
-    };
+    let batch = States::new(model.nv, &samples.q, Some(&samples.qd), Some(&samples.qdd))?;
     let global = identify_global_linear(&op, &batch, &rec.tau)?;
     let base = identify_base_parameters(
         &model,
@@ -182,7 +181,7 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
         }
     }
     let mut actual_tau = Vec::with_capacity(q.len());
-    let mut local_tau = Vec::with_capacity(q.len());
+    let states = States::new(model.nv, &q, Some(&qd), Some(&qdd))?;
     for k in 0..ts.len() {
         let r = k * n..(k + 1) * n;
         rnea(
@@ -194,21 +193,10 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
             Gravity::Excluded,
         )?;
         actual_tau.extend(data.tau.iter());
-        local_tau.extend(local.predict(&q[r.clone()], &qd[r.clone()], &qdd[r.clone()])?);
     }
-    let global_tau = global.predict(&Batch {
-        q: &q,
-        qd: &qd,
-        qdd: &qdd,
-    })?;
-    let base_tau = base.predict(
-        &model,
-        &Batch {
-            q: &q,
-            qd: &qd,
-            qdd: &qdd,
-        },
-    )?;
+    let local_tau = local.predict(&states)?;
+    let global_tau = global.predict(&states)?;
+    let base_tau = base.on(&model)?.predict(&states)?;
     let pick = |v: &[f64], j: usize| -> Vec<f64> { (0..ts.len()).map(|k| v[k * n + j]).collect() };
     let rms = |a: &[f64], b: &[f64], mask: &dyn Fn(f64) -> bool| -> f64 {
         let e: Vec<f64> = ts
@@ -341,7 +329,7 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
             .as_bytes(),
     )?;
     if let Some(m) = &r.local_model {
-        put("local_model.json", m.to_json().as_bytes())?;
+        put("local_model.json", Document::to_json(m).as_bytes())?;
     }
     // figures
     let mut curves = Table::new("figures.csv", vec!["t".into()]);

@@ -8,6 +8,7 @@ use perturbid_rs::local::LocalModel;
 use perturbid_rs::robots::a465;
 use perturbid_rs::simulation::{simulate_samples, SimulationOptions};
 use perturbid_rs::trajectory::FourierTrajectory;
+use perturbid_rs::Document;
 use perturbid_rs::{mass_matrix, Data};
 
 fn bin() -> Command {

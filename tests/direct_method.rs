@@ -8,8 +8,8 @@ use nalgebra::{DMatrix, DVector};
 use perturbid_rs::algorithms::regressor::{joint_torque_regressor, model_parameters};
 use perturbid_rs::direct::{
     design_excitation, identify_base_parameters, identify_global_linear, regressor_matrix,
-    BaseOptions, BaseParameters, Batch, Criterion, ExcitationOptions, FrictionTerms,
-    ParameterLayout, Weighting,
+    BaseOptions, BaseParameters, Criterion, ExcitationOptions, FrictionTerms, ParameterLayout,
+    Weighting,
 };
 use perturbid_rs::local::OperatingPoint;
 use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
@@ -17,6 +17,7 @@ use perturbid_rs::robots::a465;
 use perturbid_rs::signal::{butterworth_lowpass, filtfilt};
 use perturbid_rs::trajectory::FourierTrajectory;
 use perturbid_rs::Gravity;
+use perturbid_rs::States;
 use perturbid_rs::{mass_matrix, model_from_urdf_str, rnea, Data, LoadOptions, Model, Recording};
 
 fn random_states(model: &Model, k: usize, rng: &mut Rng) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
@@ -121,11 +122,7 @@ fn base_parameters_reproduce_the_full_regressor() {
     let phi = regressor_matrix(
         &model,
         &layout,
-        &Batch {
-            q: &q,
-            qd: &qd,
-            qdd: &qdd,
-        },
+        &States::new(model.nv, &q, Some(&qd), Some(&qdd)).unwrap(),
         Gravity::Included,
     )
     .unwrap();
@@ -191,11 +188,7 @@ fn base_parameter_identification_is_exact_without_noise() {
             };
             let fit = identify_base_parameters(
                 &model,
-                &Batch {
-                    q: &s.q,
-                    qd: &s.qd,
-                    qdd: &s.qdd,
-                },
+                &States::new(model.nv, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap(),
                 &tau,
                 &opts,
             )
@@ -210,11 +203,7 @@ fn base_parameter_identification_is_exact_without_noise() {
             let predicted = fit
                 .predict(
                     &model,
-                    &Batch {
-                        q: &q,
-                        qd: &qd,
-                        qdd: &qdd,
-                    },
+                    &States::new(model.nv, &q, Some(&qd), Some(&qdd)).unwrap(),
                 )
                 .unwrap();
             let (e, p) = (DVector::from_vec(expected), DVector::from_vec(predicted));
@@ -263,11 +252,7 @@ fn global_linear_model() {
     }
     let lin = identify_global_linear(
         &op,
-        &Batch {
-            q: &q,
-            qd: &qd,
-            qdd: &qdd,
-        },
+        &States::new(model.nv, &q, Some(&qd), Some(&qdd)).unwrap(),
         &tau,
     )
     .unwrap();
@@ -284,11 +269,7 @@ fn global_linear_model() {
     let tau = torques(&model, &s.q, &s.qd, &s.qdd, Gravity::Excluded);
     let e = identify_global_linear(
         &op,
-        &Batch {
-            q: &s.q,
-            qd: &s.qd,
-            qdd: &s.qdd,
-        },
+        &States::new(model.nv, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap(),
         &tau,
     )
     .unwrap_err();
@@ -309,11 +290,7 @@ fn global_linear_model() {
     let tau = torques(&model, &s.q, &s.qd, &s.qdd, Gravity::Excluded);
     let lin = identify_global_linear(
         &op,
-        &Batch {
-            q: &s.q,
-            qd: &s.qd,
-            qdd: &s.qdd,
-        },
+        &States::new(model.nv, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap(),
         &tau,
     )
     .unwrap();
@@ -563,11 +540,13 @@ fn panda_real_data_matches_the_reference() {
     let reference = [5.8, 1.1, 2.1, 1.0, 6.6, 5.9, 19.6];
     let mut means = vec![];
     for weighting in [Weighting::Ols, Weighting::Wls] {
-        let fit_batch = Batch {
-            q: &rec.q[..split],
-            qd: &qd[..split],
-            qdd: &qdd[..split],
-        };
+        let fit_batch = States::new(
+            model.nv,
+            &rec.q[..split],
+            Some(&qd[..split]),
+            Some(&qdd[..split]),
+        )
+        .unwrap();
         let fit = identify_base_parameters(
             &model,
             &fit_batch,
@@ -582,11 +561,13 @@ fn panda_real_data_matches_the_reference() {
         let p = fit
             .predict(
                 &model,
-                &Batch {
-                    q: &rec.q[split..],
-                    qd: &qd[split..],
-                    qdd: &qdd[split..],
-                },
+                &States::new(
+                    model.nv,
+                    &rec.q[split..],
+                    Some(&qd[split..]),
+                    Some(&qdd[split..]),
+                )
+                .unwrap(),
             )
             .unwrap();
         let measured = &rec.tau[split..];
@@ -633,11 +614,7 @@ fn streaming_solve_equals_the_dense_solve() {
     let (q, qd, qdd) = random_states(&model, k, &mut rng);
     let mut tau = torques(&model, &q, &qd, &qdd, Gravity::Included);
     tau.iter_mut().for_each(|t| *t += rng.uniform(-0.1, 0.1));
-    let batch = Batch {
-        q: &q,
-        qd: &qd,
-        qdd: &qdd,
-    };
+    let batch = States::new(model.nv, &q, Some(&qd), Some(&qdd)).unwrap();
     let sigma = [1.0, 2.0, 0.5, 1.0, 1.5, 0.7];
     let names = base.names();
     let factors = JointFactors::new(&model, &base, &batch, &tau, Gravity::Included).unwrap();

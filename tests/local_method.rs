@@ -11,6 +11,7 @@ use perturbid_rs::local::{
 };
 use perturbid_rs::regression::least_squares;
 use perturbid_rs::robots::a465;
+use perturbid_rs::Document;
 use perturbid_rs::Gravity;
 use perturbid_rs::{
     linearize, rnea, simulate_plan, Data, Error, Friction, Linearization, Model, Recording,
@@ -557,7 +558,9 @@ fn combined_estimator_and_json_round_trip() {
         rel(mat(&m.g), &lin.g)
     );
     // predict: T* at P, and the local model's own linear law
-    let p = m.predict(&op.q, &op.qd, &op.qdd).unwrap();
+    let p = m
+        .predict(&perturbid_rs::States::single(op.n(), &op.q, Some(&op.qd), Some(&op.qdd)).unwrap())
+        .unwrap();
     assert!((DVector::from_vec(p) - &lin.torque).norm() < 1e-6);
     let back = LocalModel::from_json(&m.to_json()).unwrap();
     assert!(back == m, "the JSON round trip changed the model");

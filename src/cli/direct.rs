@@ -5,19 +5,20 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::files::{load_json, load_robot, load_table};
+use super::files::{load_robot, load_table};
 use super::out_dir;
 use super::progress::Progress;
-use crate::direct::identify::BASE_MODEL_FORMAT;
 use crate::direct::{
-    design_excitation, identify_base_parameters, BaseModel, BaseOptions, Batch, Criterion,
-    ExcitationOptions, FrictionTerms, Weighting,
+    design_excitation, identify_base_parameters, BaseOptions, Criterion, ExcitationOptions,
+    FrictionTerms, Weighting,
 };
+use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::io::{read_recording, read_states, samples_table, write_atomic, Table};
-use crate::local::LocalModel;
 use crate::preprocess::{preprocess, PreprocessOptions};
+use crate::states::States;
+use crate::torque_model::{ModelFile, TorqueModel};
 
 #[derive(Args)]
 pub(crate) struct ExciteArgs {
@@ -181,16 +182,17 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     let r = 0..split * n;
     let fit = identify_base_parameters(
         &model,
-        &Batch {
-            q: &rec.q[r.clone()],
-            qd: &qd[r.clone()],
-            qdd: &qdd[r.clone()],
-        },
+        &States::new(
+            model.nv,
+            &rec.q[r.clone()],
+            Some(&qd[r.clone()]),
+            Some(&qdd[r.clone()]),
+        )?,
         &rec.tau[r],
         &options,
     )?;
     progress.done();
-    write_atomic(&a.out, fit.to_json().as_bytes())?;
+    fit.save(&a.out)?;
     let _ = writeln!(
         out,
         "{} base parameters from {} samples, cond {:.3e} -> {}",
@@ -216,11 +218,12 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         let r = split * n..k * n;
         let p = fit.predict(
             &model,
-            &Batch {
-                q: &rec.q[r.clone()],
-                qd: &qd[r.clone()],
-                qdd: &qdd[r.clone()],
-            },
+            &States::new(
+                model.nv,
+                &rec.q[r.clone()],
+                Some(&qd[r.clone()]),
+                Some(&qdd[r.clone()]),
+            )?,
         )?;
         let _ = writeln!(
             out,
@@ -263,44 +266,25 @@ pub(crate) struct PredictArgs {
 }
 
 pub(crate) fn predict(a: PredictArgs) -> Result<String> {
-    let text = crate::io::read_text(&a.model)?;
-    let is_base = text.contains(BASE_MODEL_FORMAT);
-    let (joints, tau_of): (
-        Vec<String>,
-        Box<dyn Fn(&[f64], &[f64], &[f64]) -> Result<Vec<f64>>>,
-    ) = if is_base {
-        let fit = load_json(&a.model, BaseModel::from_json)?;
-        let robot = a.robot.as_deref().ok_or_else(|| Error::InvalidArgument {
-            argument: "--robot".into(),
-            message: format!(
-                "a base-parameter model needs its robot ('{}'): give --robot",
-                fit.robot
-            ),
-        })?;
-        let model = load_robot(robot)?;
-        let joints = fit.joint_names.clone();
-        (
-            joints,
-            Box::new(move |q, qd, qdd| fit.predict(&model, &Batch { q, qd, qdd })),
-        )
-    } else {
-        let m = load_json(&a.model, LocalModel::from_json)?;
-        let joints = m.joint_names.clone();
-        let n = joints.len();
-        (
-            joints,
-            Box::new(move |q, qd, qdd| {
-                let mut out = Vec::with_capacity(q.len());
-                for s in 0..q.len() / n {
-                    let r = s * n..(s + 1) * n;
-                    out.extend(m.predict(&q[r.clone()], &qd[r.clone()], &qdd[r])?);
-                }
-                Ok(out)
-            }),
-        )
+    let file = ModelFile::load(&a.model)?;
+    let joints = file.joint_names().to_vec();
+    let rows = read_states(&load_table(&a.data)?, &joints)?;
+    let states = States::new(joints.len(), &rows.q, Some(&rows.qd), Some(&rows.qdd))?;
+    let tau = match &file {
+        ModelFile::Base(fit) => {
+            let robot = a.robot.as_deref().ok_or_else(|| Error::InvalidArgument {
+                argument: "--robot".into(),
+                message: format!(
+                    "a base-parameter model needs its robot ('{}'): give --robot",
+                    fit.robot
+                ),
+            })?;
+            fit.on(&load_robot(robot)?)?.predict(&states)?
+        }
+        ModelFile::Local(m) => m.predict(&states)?,
+        ModelFile::GlobalLinear(m) => m.predict(&states)?,
     };
-    let states = read_states(&load_table(&a.data)?, &joints)?;
-    let tau = tau_of(&states.q, &states.qd, &states.qdd)?;
+    let states = rows;
     let n = joints.len();
     let mut columns = vec!["t".to_string()];
     columns.extend((1..=n).map(|j| format!("tau{j}")));

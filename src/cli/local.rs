@@ -8,6 +8,7 @@ use serde::Deserialize;
 
 use super::files::{load_json, load_robot, load_table};
 use super::out_dir;
+use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::io::{read_recording, recording_table, samples_table, write_atomic};
@@ -138,7 +139,7 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
         );
     }
     let path = dir.join("plan.json");
-    write_atomic(&path, plan.to_json().as_bytes())?;
+    plan.save(&path)?;
     let _ = writeln!(out, "plan -> {}", path.display());
     Ok(out)
 }
@@ -173,7 +174,7 @@ pub(crate) struct SimulateArgs {
 
 pub(crate) fn simulate(a: SimulateArgs) -> Result<String> {
     let model = load_robot(&a.robot)?;
-    let plan = load_json(&a.plan, Plan::from_json)?;
+    let plan = Plan::load(&a.plan)?;
     let n = model.nv;
     let mut o = SimulationOptions::new(&model);
     o.gravity = Gravity::from(!a.no_gravity);
@@ -242,7 +243,7 @@ fn fmt_matrix(
 }
 
 pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
-    let plan = load_json(&a.plan, Plan::from_json)?;
+    let plan = Plan::load(&a.plan)?;
     let files: Vec<PathBuf> = if a.recordings.len() == 1 && a.recordings[0].is_dir() {
         plan.experiments
             .iter()
@@ -281,7 +282,7 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
         estimator: Estimator::parse(&a.estimator)?,
     };
     let model: LocalModel = identify_local(&plan, &recs, &options)?;
-    write_atomic(&a.out, model.to_json().as_bytes())?;
+    model.save(&a.out)?;
     let mut out = String::new();
     let _ = writeln!(
         out,

@@ -8,10 +8,11 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use super::parameters::{regressor_matrix, Batch, ParameterLayout};
+use super::parameters::{regressor_matrix, ParameterLayout};
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
+use crate::states::States;
 
 /// The base parameters of a layout: `theta_base = theta[kept] + K theta[dropped]`, and
 /// `Phi theta = Phi[:, kept] theta_base` for every state.
@@ -124,11 +125,7 @@ impl BaseParameters {
         let phi = regressor_matrix(
             model,
             layout,
-            &Batch {
-                q: &q,
-                qd: &qd,
-                qdd: &qdd,
-            },
+            &States::new(model.nv, &q, Some(&qd), Some(&qdd))?,
             gravity,
         )?;
         Self::from_regressor(layout.clone(), &phi, tolerance)

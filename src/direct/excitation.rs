@@ -10,10 +10,11 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::base::{BaseParameters, BASE_TOLERANCE};
-use super::parameters::{regressor_matrix, Batch, FrictionTerms, ParameterLayout};
+use super::parameters::{regressor_matrix, FrictionTerms, ParameterLayout};
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
+use crate::states::States;
 use crate::trajectory::{check_limits, FourierTrajectory};
 
 /// What the design minimises.
@@ -175,16 +176,10 @@ impl Problem<'_> {
     /// (criterion, cond) of a trajectory.
     fn criterion(&self, traj: &FourierTrajectory) -> (f64, f64) {
         let s = traj.sample(&self.t_fit);
-        let phi = match regressor_matrix(
-            self.model,
-            &self.base.layout,
-            &Batch {
-                q: &s.q,
-                qd: &s.qd,
-                qdd: &s.qdd,
-            },
-            Gravity::Included,
-        ) {
+        let states = States::new(self.model.nv, &s.q, Some(&s.qd), Some(&s.qdd));
+        let phi = match states.and_then(|states| {
+            regressor_matrix(self.model, &self.base.layout, &states, Gravity::Included)
+        }) {
             Ok(p) => self.base.select(&p),
             Err(_) => return (f64::INFINITY, f64::INFINITY),
         };

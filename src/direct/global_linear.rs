@@ -2,17 +2,23 @@
 //! constant `D_g`, `H_g`, `G_g` and an offset fitted to all samples of an excitation in the form
 //! `tau = T + D_g (qdd - qdd*) + H_g (qd - qd*) + G_g (q - q*)`.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-use super::parameters::Batch;
+use crate::document::{invalid, Document};
 use crate::error::Result;
 use crate::local::OperatingPoint;
 use crate::regression::least_squares;
+use crate::states::States;
+use crate::torque_model::{check_joints, predict_linear};
 
 /// A globally linearised model about an operating point.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct GlobalLinearModel {
+    /// `perturbid-global-linear-model/1`.
+    pub format: String,
+    /// The joints of the robot, in coordinate order (`joint1`, ... when not known).
+    pub joint_names: Vec<String>,
     pub op: OperatingPoint,
     /// The fitted torque at the operating point `T` (N m).
     pub offset: Vec<f64>,
@@ -32,19 +38,8 @@ pub struct GlobalLinearModel {
 impl GlobalLinearModel {
     /// Predicted torques (N m, row-major `k x nv`) at a batch of states:
     /// `T + D_g (qdd - qdd*) + H_g (qd - qd*) + G_g (q - q*)`.
-    pub fn predict(&self, batch: &Batch<'_>) -> Result<Vec<f64>> {
-        let nv = self.offset.len();
-        let k = batch.samples(nv)?;
-        let mut out = Vec::with_capacity(k * nv);
-        for s in 0..k {
-            let x = |v: &[f64], o: &[f64]| DVector::from_fn(nv, |j, _| v[s * nv + j] - o[j]);
-            let tau = DVector::from_column_slice(&self.offset)
-                + &self.d * x(batch.qdd, &self.op.qdd)
-                + &self.h * x(batch.qd, &self.op.qd)
-                + &self.g * x(batch.q, &self.op.q);
-            out.extend(tau.iter());
-        }
-        Ok(out)
+    pub fn predict(&self, states: &States<'_>) -> Result<Vec<f64>> {
+        predict_linear(states, &self.offset, [&self.d, &self.h, &self.g], &self.op)
     }
 }
 
@@ -52,16 +47,19 @@ impl GlobalLinearModel {
 /// `k x nv`; rad, rad/s, rad/s^2, N m): one least-squares solve, `nv` outputs.
 pub fn identify_global_linear(
     op: &OperatingPoint,
-    batch: &Batch<'_>,
+    states: &States<'_>,
     tau: &[f64],
 ) -> Result<GlobalLinearModel> {
     let nv = op.n();
-    let k = batch.samples_with_torques(nv, tau)?;
+    check_joints(states, nv)?;
+    states.check_companion("tau", tau, nv)?;
+    let k = states.len();
+    let (q, qd, qdd) = (states.q(), states.qd_or_zeros(), states.qdd_or_zeros());
     let x = DMatrix::from_fn(k, 1 + 3 * nv, |s, c| match c {
         0 => 1.0,
-        c if c <= nv => batch.qdd[s * nv + c - 1] - op.qdd[c - 1],
-        c if c <= 2 * nv => batch.qd[s * nv + c - 1 - nv] - op.qd[c - 1 - nv],
-        c => batch.q[s * nv + c - 1 - 2 * nv] - op.q[c - 1 - 2 * nv],
+        c if c <= nv => qdd[s * nv + c - 1] - op.qdd[c - 1],
+        c if c <= 2 * nv => qd[s * nv + c - 1 - nv] - op.qd[c - 1 - nv],
+        c => q[s * nv + c - 1 - 2 * nv] - op.q[c - 1 - 2 * nv],
     });
     let y = DMatrix::from_fn(k, nv, |s, j| tau[s * nv + j]);
     let mut names = vec!["1".to_string()];
@@ -70,6 +68,8 @@ pub fn identify_global_linear(
     }
     let ls = least_squares(&x, &y, "globally linearised model", &names)?;
     Ok(GlobalLinearModel {
+        format: GlobalLinearModel::tag(),
+        joint_names: (1..=nv).map(|j| format!("joint{j}")).collect(),
         op: op.clone(),
         offset: ls.coef.column(0).iter().copied().collect(),
         d: ls.coef.columns(1, nv).into_owned(),
@@ -79,4 +79,32 @@ pub fn identify_global_linear(
         residual_rms: ls.residual_rms.iter().copied().collect(),
         cond: ls.cond,
     })
+}
+
+impl Document for GlobalLinearModel {
+    const FORMAT: &'static str = "perturbid-global-linear-model";
+    const VERSION: u32 = 1;
+    const WHAT: &'static str = "globally linearised model";
+
+    /// Checks every shape against the number of joints.
+    fn validate(&self) -> Result<()> {
+        let n = self.offset.len();
+        let square = [&self.d, &self.h, &self.g]
+            .iter()
+            .all(|m| m.shape() == (n, n));
+        if !square
+            || self.joint_names.len() != n
+            || self.op.q.len() != n
+            || self.op.qd.len() != n
+            || self.op.qdd.len() != n
+            || self.stderr.shape() != (n, 1 + 3 * n)
+            || self.residual_rms.len() != n
+        {
+            return Err(invalid(
+                Self::WHAT,
+                format!("its parts do not all have the {n} joints of the offset"),
+            ));
+        }
+        Ok(())
+    }
 }

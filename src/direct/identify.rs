@@ -5,14 +5,16 @@ use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 use super::base::{BaseParameters, BASE_TOLERANCE};
-use super::parameters::{regressor_matrix, Batch, FrictionTerms, ParameterLayout};
+use super::parameters::{regressor_matrix, FrictionTerms, ParameterLayout};
 use super::streaming;
+use crate::document::{invalid, Document};
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
+use crate::states::States;
+use crate::torque_model::BaseModelOn;
 
 /// Version tag of the JSON format of [`BaseModel`].
-pub const BASE_MODEL_FORMAT: &str = "perturbid-base-model/1";
 
 /// Ordinary or weighted least squares.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -79,19 +81,14 @@ pub struct BaseModel {
 /// `k x nv` each; rad, rad/s, rad/s^2, N m).
 pub fn identify_base_parameters(
     model: &Model,
-    batch: &Batch<'_>,
+    states: &States<'_>,
     tau: &[f64],
     options: &BaseOptions,
 ) -> Result<BaseModel> {
     let nv = model.nv;
-    let k = batch.samples_with_torques(nv, tau)?;
-    if let Some(i) = tau.iter().position(|v| !v.is_finite()) {
-        return Err(Error::NonFiniteInput {
-            argument: format!("tau[{}]", i / nv),
-            index: i % nv,
-            value: tau[i],
-        });
-    }
+    crate::torque_model::check_joints(states, nv)?;
+    states.check_companion("tau", tau, nv)?;
+    let k = states.len();
     let layout = ParameterLayout::new(model, options.friction);
     let base = BaseParameters::from_random_states(
         model,
@@ -105,7 +102,7 @@ pub fn identify_base_parameters(
     let g = options.gravity;
     let mut sigma = vec![1.0; nv];
     // one pass over the samples; OLS, the WLS weights and the WLS fit all come from it
-    let factors = streaming::JointFactors::new(model, &base, batch, tau, g)?;
+    let factors = streaming::JointFactors::new(model, &base, states, tau, g)?;
     let mut ls = factors.solve(&sigma, &names)?;
     let mut rms = factors.residual_rms(ls.coef.as_slice())?;
     if options.weighting == Weighting::Wls {
@@ -114,7 +111,7 @@ pub fn identify_base_parameters(
         rms = factors.residual_rms(ls.coef.as_slice())?;
     }
     Ok(BaseModel {
-        format: BASE_MODEL_FORMAT.into(),
+        format: BaseModel::tag(),
         robot: model.name.clone(),
         joint_names: model.joint_names.clone(),
         gravity: options.gravity,
@@ -129,37 +126,35 @@ pub fn identify_base_parameters(
     })
 }
 
-impl BaseModel {
-    /// The model as pretty-printed JSON.
-    pub fn to_json(&self) -> String {
-        serde_json::to_string_pretty(self).expect("a base model always serialises")
-    }
+impl Document for BaseModel {
+    const FORMAT: &'static str = "perturbid-base-model";
+    const VERSION: u32 = 1;
+    const WHAT: &'static str = "base-parameter model";
 
-    /// A model from [`BaseModel::to_json`] text; checks the format and the shapes.
-    pub fn from_json(text: &str) -> Result<Self> {
-        let bad = |message: String| Error::Json {
-            context: "base-parameter model".into(),
-            message,
-        };
-        let m: BaseModel = serde_json::from_str(text)
-            .map_err(|e| bad(format!("line {}, column {}: {e}", e.line(), e.column())))?;
-        if m.format != BASE_MODEL_FORMAT {
-            return Err(bad(format!(
-                "format '{}', expected '{BASE_MODEL_FORMAT}'",
-                m.format
-            )));
-        }
+    /// Checks that the base parameters, their map and the layout agree in size.
+    fn validate(&self) -> Result<()> {
+        let m = self;
         let p = m.base.kept.len();
         if m.theta.len() != p
             || m.stderr.len() != p
             || m.base.k.shape() != (p, m.base.dropped.len())
             || p + m.base.dropped.len() != m.base.layout.len()
         {
-            return Err(bad(
+            return Err(invalid(
+                Self::WHAT,
                 "the base parameters, their map and the layout disagree in size".into(),
             ));
         }
-        Ok(m)
+        Ok(())
+    }
+}
+
+impl BaseModel {
+    /// The model bound to the robot it was identified for, as a [`TorqueModel`]; fails when
+    /// `robot` has other joints.
+    pub fn on<'a>(&'a self, robot: &'a Model) -> Result<BaseModelOn<'a>> {
+        self.check(robot)?;
+        Ok(BaseModelOn { fit: self, robot })
     }
 
     fn check(&self, model: &Model) -> Result<()> {
@@ -178,12 +173,12 @@ impl BaseModel {
 
     /// Predicted torques (row-major `k x nv`, N m) at a batch of states of `model` (the robot it
     /// was identified for).
-    pub fn predict(&self, model: &Model, batch: &Batch<'_>) -> Result<Vec<f64>> {
+    pub fn predict(&self, model: &Model, states: &States<'_>) -> Result<Vec<f64>> {
         self.check(model)?;
         let phi = self.base.select(&regressor_matrix(
             model,
             &self.base.layout,
-            batch,
+            states,
             self.gravity,
         )?);
         Ok((phi * DVector::from_column_slice(&self.theta))
@@ -208,11 +203,7 @@ impl BaseModel {
         let zeros = vec![0.0; (nv + 1) * nv];
         let tau = self.predict(
             model,
-            &Batch {
-                q: &qs,
-                qd: &zeros,
-                qdd: &qdd,
-            },
+            &States::new(model.nv, &qs, Some(&zeros), Some(&qdd))?,
         )?;
         Ok(DMatrix::from_fn(nv, nv, |i, j| {
             tau[(j + 1) * nv + i] - tau[i]

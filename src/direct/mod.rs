@@ -14,4 +14,4 @@ pub use base::BaseParameters;
 pub use excitation::{design_excitation, Criterion, ExcitationDesign, ExcitationOptions};
 pub use global_linear::{identify_global_linear, GlobalLinearModel};
 pub use identify::{identify_base_parameters, BaseModel, BaseOptions, Weighting};
-pub use parameters::{regressor_matrix, Batch, FrictionTerms, ParameterLayout};
+pub use parameters::{regressor_matrix, FrictionTerms, ParameterLayout};

@@ -12,6 +12,7 @@ use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
+use crate::states::States;
 
 /// Which per-joint friction parameters are identified with the inertial ones.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -123,61 +124,18 @@ impl ParameterLayout {
     }
 }
 
-/// Row-major joint states of a batch: sample `s` of joint `j` at `[s * nv + j]`.
-#[derive(Clone, Copy, Debug)]
-pub struct Batch<'a> {
-    pub q: &'a [f64],
-    pub qd: &'a [f64],
-    pub qdd: &'a [f64],
-}
-
-impl<'a> Batch<'a> {
-    /// Checks that the three arrays hold the same whole number of samples of `nv` joints;
-    /// returns that number.
-    pub fn samples(&self, nv: usize) -> Result<usize> {
-        let k = self.q.len() / nv.max(1);
-        for (name, x) in [("q", self.q), ("qd", self.qd), ("qdd", self.qdd)] {
-            if x.len() != k * nv || x.len() % nv != 0 {
-                return Err(Error::Shape {
-                    argument: name.into(),
-                    expected: format!("{k} samples x {nv} joints like q"),
-                    got: format!("{} values", x.len()),
-                });
-            }
-        }
-        Ok(k)
-    }
-
-    /// [`Batch::samples`], also checking that `tau` holds `nv` torques for every sample.
-    pub fn samples_with_torques(&self, nv: usize, tau: &[f64]) -> Result<usize> {
-        let k = self.samples(nv)?;
-        if tau.len() != k * nv {
-            return Err(Error::Shape {
-                argument: "tau".into(),
-                expected: format!("{k} samples x {nv} joints like q"),
-                got: format!("{} values", tau.len()),
-            });
-        }
-        Ok(k)
-    }
-
-    pub fn row(x: &'a [f64], s: usize, nv: usize) -> &'a [f64] {
-        &x[s * nv..(s + 1) * nv]
-    }
-}
-
 /// The identification regressor of a batch: `(k nv) x layout.len()`, row `s * nv + j` the torque
 /// of joint `j` at sample `s` per unit of each parameter. `gravity` includes gravity.
 pub fn regressor_matrix(
     model: &Model,
     layout: &ParameterLayout,
-    batch: &Batch<'_>,
+    states: &States<'_>,
     gravity: Gravity,
 ) -> Result<DMatrix<f64>> {
     let nv = model.nv;
-    let k = batch.samples(nv)?;
+    let k = states.len();
     let mut out = DMatrix::zeros(k * nv, layout.len());
-    fill_regressor(model, layout, batch, gravity, 0..k, &mut out, 0)?;
+    fill_regressor(model, layout, states, gravity, 0..k, &mut out, 0)?;
     Ok(out)
 }
 
@@ -185,7 +143,7 @@ pub fn regressor_matrix(
 pub(crate) fn fill_regressor(
     model: &Model,
     layout: &ParameterLayout,
-    batch: &Batch<'_>,
+    states: &States<'_>,
     gravity: Gravity,
     range: std::ops::Range<usize>,
     out: &mut DMatrix<f64>,
@@ -196,14 +154,12 @@ pub(crate) fn fill_regressor(
     let terms = layout.friction.names();
     let mut data = Data::new(model);
     let mut y = std::mem::take(&mut data.regressor);
+    let zeros = vec![0.0; nv];
     for (r, s) in range.enumerate() {
-        let (q, qd, qdd) = (
-            Batch::row(batch.q, s, nv),
-            Batch::row(batch.qd, s, nv),
-            Batch::row(batch.qdd, s, nv),
-        );
+        let x = states.sample(s);
+        let (q, qd, qdd) = (x.q, x.qd.unwrap_or(&zeros), x.qdd.unwrap_or(&zeros));
         joint_torque_regressor(model, &mut data, q, qd, qdd, gravity, &mut y)
-            .map_err(|e| e.in_sample(s))?;
+            .map_err(|e| states.at(s, e))?;
         let base = row0 + r * nv;
         out.view_mut((base, 0), (nv, ni)).copy_from(&y);
         for j in 0..nv {

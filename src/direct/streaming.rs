@@ -23,15 +23,13 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use super::base::BaseParameters;
-use super::parameters::Batch;
-use crate::algorithms::batch::{load, regressor_lanes};
+use crate::algorithms::batch::{regressor_batch, LaneData, LANES};
 use crate::algorithms::regressor::PARAMS_PER_BODY;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
-use crate::lanes::{simd_dispatch, Lanes, LANES};
 use crate::model::Model;
 use crate::regression::{least_squares, LeastSquares};
-use crate::LaneData;
+use crate::states::States;
 
 /// Samples per chunk.
 pub const CHUNK: usize = 1024;
@@ -122,8 +120,8 @@ pub struct JointFactors {
 /// first) and whose other rows take the next chunk.
 struct Worker {
     lanes: LaneData,
-    /// The regressor of a group of samples, column-major `nv x 10 nbodies`, a lane per sample.
-    y: Vec<Lanes>,
+    /// The regressors of a group of [`LANES`] samples, row-major `LANES x nv x 10 nbodies`.
+    y: Vec<f64>,
     stacks: Vec<Mat<f64>>,
     q_coeff: Mat<f64>,
     scratch: MemBuffer,
@@ -135,7 +133,7 @@ impl Worker {
         let block = recommended_block_size::<f64>(widest + CHUNK, widest);
         Self {
             lanes: LaneData::new(model),
-            y: vec![Lanes::default(); model.nv * PARAMS_PER_BODY * model.nbodies()],
+            y: vec![0.0; LANES * model.nv * PARAMS_PER_BODY * model.nbodies()],
             stacks: columns
                 .iter()
                 .map(|c| Mat::zeros(c.base.len() + 1 + CHUNK, c.base.len() + 1))
@@ -156,12 +154,12 @@ impl Worker {
         &mut self,
         model: &Model,
         columns: &[JointColumns],
-        batch: &Batch<'_>,
+        states: &States<'_>,
         tau: &[f64],
         gravity: Gravity,
         range: std::ops::Range<usize>,
     ) -> Result<()> {
-        fill(self, model, columns, batch, tau, gravity, range.clone())?;
+        self.fill(model, columns, states, tau, gravity, range.clone())?;
         for a in &mut self.stacks {
             let rows = a.ncols() + range.len();
             factor_top(
@@ -181,72 +179,60 @@ impl Worker {
     }
 }
 
-simd_dispatch! {
-/// Writes the rows of samples `range` below the factors of `w` (the regressor 4 samples at a
-/// time, with AVX2 and FMA when the processor has them).
-fn fill, fill_avx2 => fill_body(
-    w: &mut Worker,
-    model: &Model,
-    columns: &[JointColumns],
-    batch: &Batch<'_>,
-    tau: &[f64],
-    gravity: Gravity,
-    range: std::ops::Range<usize>,
-) -> Result<()>
-}
-
-#[inline(always)]
-fn fill_body(
-    w: &mut Worker,
-    model: &Model,
-    columns: &[JointColumns],
-    batch: &Batch<'_>,
-    tau: &[f64],
-    gravity: Gravity,
-    range: std::ops::Range<usize>,
-) -> Result<()> {
-    let nv = model.nv;
-    let mut first = range.start;
-    while first < range.end {
-        // a group of LANES samples through the multi-sample regressor
-        let used = (range.end - first).min(LANES);
-        let rows = first * nv..(first + used) * nv;
-        let x = [
-            &batch.q[rows.clone()],
-            &batch.qd[rows.clone()],
-            &batch.qdd[rows],
-        ];
-        for l in 0..used {
-            for (name, column) in ["q", "qd", "qdd"].iter().zip(&x) {
-                model
-                    .check_vector(name, &column[l * nv..(l + 1) * nv])
-                    .map_err(|e| e.in_sample(first + l))?;
-            }
-        }
-        load(model, &mut w.lanes, x, 0);
-        regressor_lanes(model, &mut w.lanes, gravity, &mut w.y);
-        for l in 0..used {
-            let s = first + l;
-            let qd = Batch::row(batch.qd, s, nv);
-            for (j, (a, cols)) in w.stacks.iter_mut().zip(columns).enumerate() {
-                let nj = cols.base.len();
-                let i = nj + 1 + s - range.start;
-                for &(c, col) in &cols.inertial {
-                    a[(i, c)] = w.y[j + col * nv].0[l];
+impl Worker {
+    /// Writes the rows of samples `range` below the factors (the regressor [`LANES`] samples at
+    /// a time, through the multi-sample kernel).
+    fn fill(
+        &mut self,
+        model: &Model,
+        columns: &[JointColumns],
+        states: &States<'_>,
+        tau: &[f64],
+        gravity: Gravity,
+        range: std::ops::Range<usize>,
+    ) -> Result<()> {
+        let nv = model.nv;
+        let p = PARAMS_PER_BODY * model.nbodies();
+        let qd = states.qd_or_zeros();
+        let qdd = states.qdd_or_zeros();
+        let mut first = range.start;
+        while first < range.end {
+            let used = (range.end - first).min(LANES);
+            let rows = first * nv..(first + used) * nv;
+            let y = &mut self.y[..used * nv * p];
+            regressor_batch(
+                model,
+                &mut self.lanes,
+                &states.q()[rows.clone()],
+                &qd[rows.clone()],
+                &qdd[rows],
+                gravity,
+                y,
+            )?;
+            for l in 0..used {
+                let s = first + l;
+                let qd = &qd[s * nv..(s + 1) * nv];
+                let y = &y[l * nv * p..(l + 1) * nv * p];
+                for (j, (a, cols)) in self.stacks.iter_mut().zip(columns).enumerate() {
+                    let nj = cols.base.len();
+                    let i = nj + 1 + s - range.start;
+                    for &(c, col) in &cols.inertial {
+                        a[(i, c)] = y[j * p + col];
+                    }
+                    for &(c, term) in &cols.friction {
+                        a[(i, c)] = match term {
+                            Term::Viscous => qd[j],
+                            Term::Coulomb => qd[j].signum() * f64::from(u8::from(qd[j] != 0.0)),
+                            Term::Offset => 1.0,
+                        };
+                    }
+                    a[(i, nj)] = tau[s * nv + j];
                 }
-                for &(c, term) in &cols.friction {
-                    a[(i, c)] = match term {
-                        Term::Viscous => qd[j],
-                        Term::Coulomb => qd[j].signum() * f64::from(u8::from(qd[j] != 0.0)),
-                        Term::Offset => 1.0,
-                    };
-                }
-                a[(i, nj)] = tau[s * nv + j];
             }
+            first += used;
         }
-        first += used;
+        Ok(())
     }
-    Ok(())
 }
 
 /// QR of `a` in place, leaving its `R` in the top `ncols` rows with zeros below the diagonal.
@@ -301,18 +287,19 @@ fn merge(a: Vec<DMatrix<f64>>, b: Vec<DMatrix<f64>>) -> Vec<DMatrix<f64>> {
 }
 
 impl JointFactors {
-    /// Reduces the base regressor and torques of every sample of `batch` (row-major `k x nv`
-    /// states, rad, rad/s, rad/s^2) and `tau` (row-major `k x nv`, N m), in parallel chunks of
-    /// [`CHUNK`] samples. `gravity` includes gravity in the regressor.
+    /// Reduces the base regressor and torques of every sample of `states` (rad, rad/s,
+    /// rad/s^2) and `tau` (row-major `k x nv`, N m), in parallel chunks of [`CHUNK`] samples.
+    /// `gravity` includes gravity in the regressor.
     pub fn new(
         model: &Model,
         base: &BaseParameters,
-        batch: &Batch<'_>,
+        states: &States<'_>,
         tau: &[f64],
         gravity: Gravity,
     ) -> Result<Self> {
         let nv = model.nv;
-        let k = batch.samples_with_torques(nv, tau)?;
+        states.check_companion("tau", tau, nv)?;
+        let k = states.len();
         let p = base.len();
         let columns = JointColumns::new(model, base);
         let chunks: Vec<std::ops::Range<usize>> = (0..k)
@@ -328,7 +315,7 @@ impl JointFactors {
             .map(|run| -> Result<Vec<DMatrix<f64>>> {
                 let mut w = Worker::new(model, &columns);
                 for range in run {
-                    w.absorb(model, &columns, batch, tau, gravity, range.clone())?;
+                    w.absorb(model, &columns, states, tau, gravity, range.clone())?;
                 }
                 Ok(w.factors())
             })

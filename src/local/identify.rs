@@ -4,9 +4,10 @@
 use nalgebra::DMatrix;
 
 use super::crossing::{detect_offset, values_at, CrossingValues, FitOptions};
-use super::model::{Estimate, Estimator, LocalModel, LOCAL_MODEL_FORMAT};
+use super::model::{Estimate, Estimator, LocalModel};
 use super::operating_point::OperatingPoint;
 use super::plan::{Experiment, ExperimentKind, Plan};
+use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::recording::Recording;
 use crate::regression::{least_squares, LeastSquares};
@@ -281,7 +282,7 @@ pub fn identify_local(
         }
     };
     Ok(LocalModel {
-        format: LOCAL_MODEL_FORMAT.into(),
+        format: LocalModel::tag(),
         robot: plan.robot.clone(),
         joint_names: plan.joint_names.clone(),
         op,

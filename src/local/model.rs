@@ -1,15 +1,14 @@
 //! The identified local model `tau ~= T* + D* dqdd + H* dqd + G* dq` near the operating point,
 //! with its uncertainty; saved as JSON.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use super::operating_point::OperatingPoint;
+use crate::document::{invalid, Document};
 use crate::error::{Error, Result};
-use crate::model::check_finite_vector;
-
-/// Version tag of the JSON format.
-pub const LOCAL_MODEL_FORMAT: &str = "perturbid-local-model/1";
+use crate::states::States;
+use crate::torque_model::predict_linear;
 
 /// One identified matrix with its statistics.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -92,47 +91,28 @@ impl LocalModel {
             })
     }
 
-    /// Predicted torque (N m, length N) at `(q, qd, qdd)` (length N each):
-    /// `T* + D* (qdd - qdd*) + H* (qd - qd*) + G* (q - q*)`.
-    pub fn predict(&self, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<Vec<f64>> {
-        let n = self.n();
-        check_finite_vector("q", q, n)?;
-        check_finite_vector("qd", qd, n)?;
-        check_finite_vector("qdd", qdd, n)?;
-        let (d, h, g) = (
+    /// Predicted torques (row-major `k x N`, N m) at the `k` samples of `states`:
+    /// `T* + D* (qdd - qdd*) + H* (qd - qd*) + G* (q - q*)`, expanded about the operating point
+    /// measured at the nominal crossings (where `T*` holds).
+    pub fn predict(&self, states: &States<'_>) -> Result<Vec<f64>> {
+        let parts = [
             Self::part(&self.d, "D")?,
             Self::part(&self.h, "H")?,
             Self::part(&self.g, "G")?,
-        );
-        let delta = |x: &[f64], x0: &[f64]| DVector::from_fn(n, |j, _| x[j] - x0[j]);
-        let tau = DVector::from_column_slice(&self.torque)
-            + d * delta(qdd, &self.op.qdd)
-            + h * delta(qd, &self.op.qd)
-            + g * delta(q, &self.op.q);
-        Ok(tau.as_slice().to_vec())
+        ];
+        predict_linear(states, &self.torque, parts, &self.op)
     }
+}
 
-    /// The model as pretty-printed JSON (matrices as lists of rows).
-    pub fn to_json(&self) -> String {
-        serde_json::to_string_pretty(self).expect("a local model always serialises")
-    }
+impl Document for LocalModel {
+    const FORMAT: &'static str = "perturbid-local-model";
+    const VERSION: u32 = 1;
+    const WHAT: &'static str = "local model";
 
-    /// A model from [`LocalModel::to_json`] text; checks the format tag and every shape.
-    pub fn from_json(text: &str) -> Result<Self> {
-        let m: LocalModel = serde_json::from_str(text).map_err(|e| Error::Json {
-            context: "local model".into(),
-            message: format!("line {}, column {}: {e}", e.line(), e.column()),
-        })?;
-        let bad = |message: String| Error::Json {
-            context: "local model".into(),
-            message,
-        };
-        if m.format != LOCAL_MODEL_FORMAT {
-            return Err(bad(format!(
-                "format '{}', expected '{LOCAL_MODEL_FORMAT}'",
-                m.format
-            )));
-        }
+    /// Checks every shape against the number of joints.
+    fn validate(&self) -> Result<()> {
+        let m = self;
+        let bad = |message: String| invalid(Self::WHAT, message);
         let n = m.n();
         for (what, len) in [
             ("joint_names", m.joint_names.len()),
@@ -161,6 +141,6 @@ impl LocalModel {
                 }
             }
         }
-        Ok(m)
+        Ok(())
     }
 }

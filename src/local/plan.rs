@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::operating_point::OperatingPoint;
 use super::perturbation::{perturbations, Design, Sizes, FALLBACK_SIZES};
+use crate::document::{invalid, Document};
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::trajectory::{
@@ -164,6 +165,8 @@ impl Default for PlanOptions {
 /// A plan: the operating point and its experiments, for one robot.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Plan {
+    /// `perturbid-plan/1`.
+    pub format: String,
     /// Robot name and joint names (the plan is only valid for this robot).
     pub robot: String,
     pub joint_names: Vec<String>,
@@ -194,23 +197,18 @@ impl Plan {
     pub fn experiment(&self, kind: ExperimentKind) -> Option<&Experiment> {
         self.experiments.iter().find(|e| e.kind == kind)
     }
+}
 
-    /// The plan as pretty-printed JSON.
-    pub fn to_json(&self) -> String {
-        serde_json::to_string_pretty(self).expect("a plan always serialises")
-    }
+impl Document for Plan {
+    const FORMAT: &'static str = "perturbid-plan";
+    const VERSION: u32 = 1;
+    const WHAT: &'static str = "plan";
 
-    /// A plan from [`Plan::to_json`] text.
-    pub fn from_json(text: &str) -> Result<Self> {
-        let plan: Plan = serde_json::from_str(text).map_err(|e| Error::Json {
-            context: "plan".into(),
-            message: format!("line {}, column {}: {e}", e.line(), e.column()),
-        })?;
+    /// Checks that every experiment is for the plan's joints and the rate is positive.
+    fn validate(&self) -> Result<()> {
+        let plan = self;
         let n = plan.n();
-        let bad = |m: String| Error::Json {
-            context: "plan".into(),
-            message: m,
-        };
+        let bad = |m: String| invalid(Self::WHAT, m);
         if plan.joint_names.len() != n || plan.op.qd.len() != n || plan.op.qdd.len() != n {
             return Err(bad(format!(
                 "the operating point and joint names disagree on the number of joints ({n})"
@@ -233,7 +231,7 @@ impl Plan {
         if !(plan.rate.is_finite() && plan.rate > 0.0) {
             return Err(bad(format!("rate {} is not a positive number", plan.rate)));
         }
-        Ok(plan)
+        Ok(())
     }
 }
 
@@ -397,6 +395,7 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
         });
     }
     Ok(Plan {
+        format: Plan::tag(),
         robot: model.name.clone(),
         joint_names: model.joint_names.clone(),
         op: op.clone(),

@@ -5,6 +5,7 @@ use pyo3::prelude::*;
 use std::borrow::Cow;
 
 use crate::error::Error;
+use crate::states::States;
 
 /// Arguments of one call as contiguous row-major buffers that the Rust work reads without the
 /// GIL: the numpy arrays' own memory when they are C-contiguous float64 (no copy; numpy's
@@ -75,6 +76,18 @@ pub(crate) fn read_batch<'a>(
 }
 
 impl Batch<'_> {
+    /// The first three arguments as joint states (q, then qd and qdd when given) of `nv` joints,
+    /// checked: a single sample stays single (errors name no sample).
+    pub fn states(&self, nv: usize) -> Result<States<'_>, Error> {
+        let column = |i: usize| self.columns.get(i).map(|c| &c[..]);
+        let q = column(0).unwrap_or(&[]);
+        if self.single {
+            States::single(nv, q, column(1), column(2))
+        } else {
+            States::new(nv, q, column(1), column(2))
+        }
+    }
+
     /// An error raised at sample `s` of this batch, its argument renamed `name[s]` for a batch.
     pub fn in_sample(&self, s: usize, e: Error) -> Error {
         if self.single {

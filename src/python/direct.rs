@@ -15,13 +15,14 @@ use super::robot::PyRobot;
 use crate::direct::excitation::ExcitationDesign;
 use crate::direct::{
     design_excitation as design_rs, identify_base_parameters as base_rs,
-    identify_global_linear as global_rs, BaseModel, BaseOptions, Batch, Criterion,
-    ExcitationOptions, FrictionTerms, GlobalLinearModel, Weighting,
+    identify_global_linear as global_rs, BaseModel, BaseOptions, Criterion, ExcitationOptions,
+    FrictionTerms, GlobalLinearModel, Weighting,
 };
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::preprocess::{preprocess as preprocess_rs, PreprocessOptions};
 use crate::recording::Recording;
+use crate::states::States;
 use crate::trajectory::FourierTrajectory;
 use std::borrow::Cow;
 
@@ -342,11 +343,7 @@ impl PyBaseModel {
         let tau = py.detach(|| {
             self.fit.predict(
                 &self.model,
-                &Batch {
-                    q: &c[0],
-                    qd: &c[1],
-                    qdd: &c[2],
-                },
+                &States::new(self.model.nv, &c[0], Some(&c[1]), Some(&c[2]))?,
             )
         })?;
         to_numpy(py, tau, batch.k, batch.single, &[n])
@@ -427,11 +424,7 @@ pub(crate) fn identify_base_parameters(
     let fit = py.detach(|| {
         base_rs(
             model,
-            &Batch {
-                q: &c[0],
-                qd: &c[1],
-                qdd: &c[2],
-            },
+            &States::new(model.nv, &c[0], Some(&c[1]), Some(&c[2]))?,
             &c[3],
             &options,
         )
@@ -507,11 +500,9 @@ impl PyGlobalLinear {
         let n = self.fit.offset.len();
         let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
         let c = &batch.columns;
-        let out = self.fit.predict(&Batch {
-            q: &c[0],
-            qd: &c[1],
-            qdd: &c[2],
-        })?;
+        let out = self
+            .fit
+            .predict(&States::new(n, &c[0], Some(&c[1]), Some(&c[2]))?)?;
         to_numpy(py, out, batch.k, batch.single, &[n])
     }
     fn to_json(&self) -> String {
@@ -533,11 +524,7 @@ pub(crate) fn identify_global_linear(
     let fit = py.detach(|| {
         global_rs(
             &op.op,
-            &Batch {
-                q: &c[0],
-                qd: &c[1],
-                qdd: &c[2],
-            },
+            &States::new(op.op.n(), &c[0], Some(&c[1]), Some(&c[2]))?,
             &c[3],
         )
     })?;

@@ -9,6 +9,7 @@ use pyo3::types::{PyDict, PyList};
 
 use super::arrays::{matrix_to_numpy as mat, read_batch, to_numpy};
 use super::robot::PyRobot;
+use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::local::{
     identify_local as identify_rs, plan_experiments as plan_rs, CrossingTimes, Design, Estimate,
@@ -164,12 +165,12 @@ impl PyPlan {
     }
     /// The plan as JSON text.
     fn to_json(&self) -> String {
-        self.plan.to_json()
+        Document::to_json(&*self.plan)
     }
     #[staticmethod]
     fn from_json(text: &str) -> PyResult<Self> {
         Ok(Self {
-            plan: Arc::new(Plan::from_json(text)?),
+            plan: Arc::new(<Plan as Document>::from_json(text)?),
         })
     }
     fn __repr__(&self) -> String {
@@ -700,25 +701,17 @@ impl PyLocalModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.model.n();
         let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
-        let mut out = Vec::with_capacity(batch.k * n);
-        for s in 0..batch.k {
-            let row = |c: usize| &batch.columns[c][s * n..(s + 1) * n];
-            let tau = self
-                .model
-                .predict(row(0), row(1), row(2))
-                .map_err(|e| batch.in_sample(s, e))?;
-            out.extend(tau);
-        }
+        let out = self.model.predict(&batch.states(n)?)?;
         to_numpy(py, out, batch.k, batch.single, &[n])
     }
     /// The model as JSON text (matrices as lists of rows).
     fn to_json(&self) -> String {
-        self.model.to_json()
+        Document::to_json(&self.model)
     }
     #[staticmethod]
     fn from_json(text: &str) -> PyResult<Self> {
         Ok(Self {
-            model: LocalModel::from_json(text)?,
+            model: <LocalModel as Document>::from_json(text)?,
         })
     }
     fn __repr__(&self) -> String {

@@ -9,9 +9,11 @@ use pyo3::prelude::*;
 
 use super::arrays::{read_batch, to_numpy};
 use super::linearization::PyLinearization;
-use crate::algorithms::batch::{mass_matrix_batch, regressor_batch, rnea_lanes, LaneData, LANES};
+use crate::algorithms::parallel::{self, Workspace};
 use crate::error::Result;
-use crate::{robots, urdf, Data, Model};
+use crate::gravity::Gravity;
+use crate::states::States;
+use crate::{robots, urdf, Model};
 
 type ArrayLike<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 
@@ -25,79 +27,25 @@ type ArrayLike<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 #[pyclass(name = "Robot", module = "perturbid_rs", frozen)]
 pub(crate) struct PyRobot {
     pub(crate) model: Model,
-    work: Mutex<Work>,
-}
-
-/// The work buffers of one thread: a [`Data`] for the one-sample algorithms and a [`LaneData`]
-/// for the multi-sample kernel.
-pub(crate) struct Work {
-    pub(crate) data: Data,
-    lanes: LaneData,
-}
-
-impl Work {
-    fn new(model: &Model) -> Self {
-        Self {
-            data: Data::new(model),
-            lanes: LaneData::new(model),
-        }
-    }
-}
-
-/// Samples `first..first + len` of a batch: one row-major `len x n` slice per argument.
-struct Chunk<'a> {
-    first: usize,
-    len: usize,
-    /// Missing arguments are empty.
-    columns: [&'a [f64]; 3],
-    /// Whether the call was given single samples (errors then name no sample).
-    single: bool,
-}
-
-impl Chunk<'_> {
-    /// Fails on the first non-finite argument value, naming the argument (`names`, in order)
-    /// and the sample: one fast pass over the chunk, a sample at a time only to find a bad one.
-    fn check_finite(&self, model: &Model, names: &[&str]) -> Result<()> {
-        let n = model.nv;
-        let bad = |c: &&[f64]| c.iter().fold(false, |bad, v| bad | !v.is_finite());
-        if self.columns.iter().any(bad) {
-            for i in 0..self.len {
-                for (name, column) in names.iter().zip(&self.columns) {
-                    model
-                        .check_vector(name, &column[i * n..(i + 1) * n])
-                        .map_err(|e| self.at(i, e))?;
-                }
-            }
-        }
-        Ok(())
-    }
-
-    /// An error raised at sample `i` of the chunk, renamed for its sample in the batch.
-    fn at(&self, i: usize, e: crate::error::Error) -> crate::error::Error {
-        if self.single {
-            e
-        } else {
-            e.in_sample(self.first + i)
-        }
-    }
+    work: Mutex<Workspace>,
 }
 
 impl PyRobot {
     fn new(model: Model) -> Self {
-        let work = Mutex::new(Work::new(&model));
+        let work = Mutex::new(Workspace::new(&model));
         Self { model, work }
     }
 
-    pub(crate) fn work(&self) -> MutexGuard<'_, Work> {
+    fn workspace(&self) -> MutexGuard<'_, Workspace> {
         self.work
             .lock()
             .unwrap_or_else(|poisoned| poisoned.into_inner())
     }
 
-    /// Evaluates `f` on the chunks of the batch `args` with the GIL released, in parallel
-    /// (rayon, one [`Work`] per chunk, so no per-sample allocation) for large batches; `f`
-    /// writes the chunk's results (`out_dims` values per sample, row-major) into its slice.
-    fn map_chunks<'py, F>(
+    /// Runs the batch algorithm `f` of the library's engine ([`parallel`]) on the states
+    /// `args` (q, then qd and qdd when given) with the GIL released, into a new array of
+    /// `out_dims` values per sample.
+    fn batch<'py, F>(
         &self,
         py: Python<'py>,
         args: &[(&str, &ArrayLike<'py>)],
@@ -105,136 +53,16 @@ impl PyRobot {
         f: F,
     ) -> PyResult<Bound<'py, PyAny>>
     where
-        F: Fn(&Model, &mut Work, &Chunk<'_>, &mut [f64]) -> Result<()> + Send + Sync,
-    {
-        let (out, k, single) = self.run_chunks(py, args, out_dims.iter().product(), f)?;
-        to_numpy(py, out, k, single, out_dims)
-    }
-
-    /// [`PyRobot::map_chunks`] returning the results as one row-major buffer of `size` values
-    /// per sample, with the number of samples and whether the call was given single samples.
-    fn run_chunks<'py, F>(
-        &self,
-        py: Python<'py>,
-        args: &[(&str, &ArrayLike<'py>)],
-        size: usize,
-        f: F,
-    ) -> PyResult<(Vec<f64>, usize, bool)>
-    where
-        F: Fn(&Model, &mut Work, &Chunk<'_>, &mut [f64]) -> Result<()> + Send + Sync,
+        F: FnOnce(&Model, &mut Workspace, &States<'_>, &mut [f64]) -> Result<()> + Send,
     {
         let n = self.model.nv;
         let batch = read_batch(n, args)?;
-        let mut out = vec![0.0; batch.k * size];
+        let mut out = vec![0.0; batch.k * out_dims.iter().product::<usize>()];
         py.detach(|| -> Result<()> {
-            let run = |work: &mut Work, first: usize, out: &mut [f64]| -> Result<()> {
-                let len = out.len() / size.max(1);
-                let mut columns: [&[f64]; 3] = [&[]; 3];
-                for (c, column) in columns.iter_mut().zip(&batch.columns) {
-                    *c = &column[first * n..(first + len) * n];
-                }
-                f(
-                    &self.model,
-                    work,
-                    &Chunk {
-                        first,
-                        len,
-                        columns,
-                        single: batch.single,
-                    },
-                    out,
-                )
-            };
-            if batch.k < PARALLEL_BATCH || size == 0 {
-                return run(&mut self.work(), 0, &mut out);
-            }
-            use rayon::prelude::*;
-            out.par_chunks_mut(PARALLEL_CHUNK * size)
-                .enumerate()
-                .try_for_each(|(c, o)| run(&mut Work::new(&self.model), c * PARALLEL_CHUNK, o))
+            let states = batch.states(n)?;
+            f(&self.model, &mut self.workspace(), &states, &mut out)
         })?;
-        Ok((out, batch.k, batch.single))
-    }
-
-    /// [`PyRobot::map_chunks`] one sample at a time: `f` gets the sample's arguments and
-    /// writes its `out_dims` values.
-    fn map_samples<'py, F>(
-        &self,
-        py: Python<'py>,
-        args: &[(&str, &ArrayLike<'py>)],
-        out_dims: &[usize],
-        f: F,
-    ) -> PyResult<Bound<'py, PyAny>>
-    where
-        F: Fn(&Model, &mut Data, [&[f64]; 3], &mut [f64]) -> Result<()> + Send + Sync,
-    {
-        let n = self.model.nv;
-        let size: usize = out_dims.iter().product();
-        self.map_chunks(py, args, out_dims, |m, w, chunk, out| {
-            for (i, o) in out.chunks_mut(size.max(1)).enumerate() {
-                let mut rows: [&[f64]; 3] = [&[]; 3];
-                for (row, column) in rows.iter_mut().zip(&chunk.columns) {
-                    if !column.is_empty() {
-                        *row = &column[i * n..(i + 1) * n];
-                    }
-                }
-                f(m, &mut w.data, rows, o).map_err(|e| chunk.at(i, e))?;
-            }
-            Ok(())
-        })
-    }
-
-    /// Inverse dynamics of a batch with `qd` and `qdd` optional (zeros), by the multi-sample
-    /// kernel; the arguments' finiteness is checked first, sample by sample.
-    fn inverse_dynamics<'py>(
-        &self,
-        py: Python<'py>,
-        args: &[(&str, &ArrayLike<'py>)],
-        gravity: bool,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let n = self.model.nv;
-        let names: Vec<&str> = args.iter().map(|a| a.0).collect();
-        self.map_chunks(py, args, &[n], |m, w, chunk, out| {
-            chunk.check_finite(m, &names)?;
-            let [q, qd, qdd] = chunk.columns;
-            fn opt(x: &[f64]) -> Option<&[f64]> {
-                (!x.is_empty()).then_some(x)
-            }
-            /// Sample `i` of `x`, or `zeros` for a missing argument.
-            fn row<'a>(x: &'a [f64], zeros: &'a [f64], i: usize) -> &'a [f64] {
-                let n = zeros.len();
-                if x.is_empty() {
-                    zeros
-                } else {
-                    &x[i * n..(i + 1) * n]
-                }
-            }
-            if chunk.len < LANES {
-                // too few samples to fill the lanes: one at a time
-                let zeros = vec![0.0; n];
-                for (i, o) in out.chunks_mut(n).enumerate() {
-                    let (a, b, c) = (row(q, &zeros, i), row(qd, &zeros, i), row(qdd, &zeros, i));
-                    crate::rnea(m, &mut w.data, a, b, c, gravity.into())?;
-                    o.copy_from_slice(w.data.tau.as_slice());
-                }
-                return Ok(());
-            }
-            rnea_lanes(m, &mut w.lanes, q, opt(qd), opt(qdd), gravity.into(), out)
-        })
-    }
-}
-
-/// Batches of at least this many samples run in parallel (rayon), in chunks of
-/// `PARALLEL_CHUNK` samples.
-const PARALLEL_BATCH: usize = 4096;
-const PARALLEL_CHUNK: usize = 1024;
-
-fn copy_matrix(m: &nalgebra::DMatrix<f64>, out: &mut [f64]) {
-    let n = m.ncols();
-    for r in 0..m.nrows() {
-        for c in 0..n {
-            out[r * n + c] = m[(r, c)];
-        }
+        to_numpy(py, out, batch.k, batch.single, out_dims)
     }
 }
 
@@ -366,12 +194,18 @@ impl PyRobot {
         qdd: ArrayLike<'py>,
         gravity: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.inverse_dynamics(py, &[("q", &q), ("qd", &qd), ("qdd", &qdd)], gravity)
+        let n = self.model.nv;
+        let args = [("q", &q), ("qd", &qd), ("qdd", &qdd)];
+        self.batch(py, &args, &[n], |m, w, s, out| {
+            parallel::rnea(m, w, s, gravity.into(), out)
+        })
     }
 
     /// Gravity torque g(q): the torque holding the robot at rest. q: (n,) or (k, n).
     fn gravity<'py>(&self, py: Python<'py>, q: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.inverse_dynamics(py, &[("q", &q)], true)
+        self.batch(py, &[("q", &q)], &[self.model.nv], |m, w, s, out| {
+            parallel::rnea(m, w, s, Gravity::Included, out)
+        })
     }
 
     /// Bias torque c(q, qd) [+ g(q)]: the inverse dynamics at zero acceleration.
@@ -383,27 +217,17 @@ impl PyRobot {
         qd: ArrayLike<'py>,
         gravity: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.inverse_dynamics(py, &[("q", &q), ("qd", &qd)], gravity)
+        let n = self.model.nv;
+        self.batch(py, &[("q", &q), ("qd", &qd)], &[n], |m, w, s, out| {
+            parallel::rnea(m, w, s, gravity.into(), out)
+        })
     }
 
     /// Joint-space mass matrix M(q), symmetric positive definite. q: (n,) or (k, n); returns
     /// (n, n) or (k, n, n).
     fn mass_matrix<'py>(&self, py: Python<'py>, q: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
         let n = self.model.nv;
-        self.map_chunks(py, &[("q", &q)], &[n, n], |m, w, chunk, out| {
-            chunk.check_finite(m, &["q"])?;
-            let q = chunk.columns[0];
-            if chunk.len >= LANES {
-                return mass_matrix_batch(m, &mut w.lanes, q, out);
-            }
-            // too few samples to fill the lanes: one at a time
-            for (i, o) in out.chunks_mut(n * n).enumerate() {
-                crate::mass_matrix(m, &mut w.data, &q[i * n..(i + 1) * n])
-                    .map_err(|e| chunk.at(i, e))?;
-                copy_matrix(&w.data.m, o);
-            }
-            Ok(())
-        })
+        self.batch(py, &[("q", &q)], &[n, n], parallel::mass_matrix)
     }
 
     /// Joint-torque regressor Phi(q, qd, qdd): `Phi @ theta == rnea(q, qd, qdd)` with `theta`
@@ -421,32 +245,8 @@ impl PyRobot {
     ) -> PyResult<Bound<'py, PyAny>> {
         let (n, p) = (self.model.nv, 10 * self.model.nbodies());
         let args = [("q", &q), ("qd", &qd), ("qdd", &qdd)];
-        self.map_chunks(py, &args, &[n, p], move |m, w, chunk, out| {
-            chunk.check_finite(m, &["q", "qd", "qdd"])?;
-            let [q, qd, qdd] = chunk.columns;
-            if chunk.len >= LANES {
-                return regressor_batch(m, &mut w.lanes, q, qd, qdd, gravity.into(), out);
-            }
-            // too few samples to fill the lanes: one at a time
-            let d = &mut w.data;
-            let mut y = std::mem::take(&mut d.regressor);
-            let result = out.chunks_mut(n * p).enumerate().try_for_each(|(i, o)| {
-                let r = i * n..(i + 1) * n;
-                crate::algorithms::regressor::joint_torque_regressor(
-                    m,
-                    d,
-                    &q[r.clone()],
-                    &qd[r.clone()],
-                    &qdd[r],
-                    gravity.into(),
-                    &mut y,
-                )
-                .map_err(|e| chunk.at(i, e))?;
-                copy_matrix(&y, o);
-                Ok(())
-            });
-            d.regressor = y; // back in place even after an error
-            result
+        self.batch(py, &args, &[n, p], |m, w, s, out| {
+            parallel::regressor(m, w, s, gravity.into(), out)
         })
     }
 
@@ -471,16 +271,28 @@ impl PyRobot {
         tau: ArrayLike<'py>,
         gravity: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        self.map_samples(
-            py,
-            &[("q", &q), ("qd", &qd), ("tau", &tau)],
-            &[self.model.nv],
-            |m, d, x, out| {
-                crate::forward_dynamics(m, d, x[0], x[1], x[2], gravity.into())?;
-                out.copy_from_slice(d.qdd.as_slice());
-                Ok(())
-            },
-        )
+        let n = self.model.nv;
+        // tau rides as the third column; the states are q and qd only
+        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("tau", &tau)])?;
+        let mut out = vec![0.0; batch.k * n];
+        py.detach(|| -> Result<()> {
+            let c = &batch.columns;
+            let states = if batch.single {
+                States::single(n, &c[0], Some(&c[1]), None)?
+            } else {
+                States::new(n, &c[0], Some(&c[1]), None)?
+            };
+            let mut w = self.workspace();
+            parallel::forward_dynamics(
+                &self.model,
+                &mut w,
+                &states,
+                &c[2],
+                gravity.into(),
+                &mut out,
+            )
+        })?;
+        to_numpy(py, out, batch.k, batch.single, &[n])
     }
 
     /// The linearisation at the operating point (q, qd, qdd), computed analytically:
@@ -496,38 +308,37 @@ impl PyRobot {
         gravity: bool,
     ) -> PyResult<PyLinearization> {
         let n = self.model.nv;
-        let nn = n * n;
-        // one record per sample: torque (n), then D, H, G, G_static (n x n each, row-major)
-        let size = n + 4 * nn;
-        let args = [("q", &q), ("qd", &qd), ("qdd", &qdd)];
-        let (packed, k, single) = self.run_chunks(py, &args, size, |m, w, chunk, out| {
-            let mut lin = crate::Linearization::zeros(n);
-            for (i, o) in out.chunks_mut(size).enumerate() {
-                let [q, qd, qdd] = chunk.columns.map(|c| &c[i * n..(i + 1) * n]);
-                crate::linearize_into(m, &mut w.data, q, qd, qdd, gravity.into(), &mut lin)
-                    .map_err(|e| chunk.at(i, e))?;
-                o[..n].copy_from_slice(lin.torque.as_slice());
-                for (b, mat) in [&lin.d, &lin.h, &lin.g, &lin.g_static].iter().enumerate() {
-                    copy_matrix(mat, &mut o[n + b * nn..n + (b + 1) * nn]);
-                }
-            }
-            Ok(())
+        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
+        let k = batch.k;
+        let mut torque = vec![0.0; k * n];
+        let mut parts = [(); 4].map(|_| vec![0.0; k * n * n]);
+        py.detach(|| -> Result<()> {
+            let states = batch.states(n)?;
+            let [d, h, g, g_static] = &mut parts;
+            let out = parallel::LinearizationsOut {
+                torque: &mut torque,
+                d,
+                h,
+                g,
+                g_static,
+            };
+            parallel::linearize(
+                &self.model,
+                &mut self.workspace(),
+                &states,
+                gravity.into(),
+                out,
+            )
         })?;
-        let part = |offset: usize, len: usize| -> Vec<f64> {
-            packed
-                .chunks(size.max(1))
-                .flat_map(|r| r[offset..offset + len].iter().copied())
-                .collect()
-        };
-        let matrix = |b: usize| -> PyResult<Py<PyAny>> {
-            Ok(to_numpy(py, part(n + b * nn, nn), k, single, &[n, n])?.unbind())
-        };
+        let single = batch.single;
+        let [d, h, g, g_static] =
+            parts.map(|p| to_numpy(py, p, k, single, &[n, n]).map(Bound::unbind));
         Ok(PyLinearization {
-            torque: to_numpy(py, part(0, n), k, single, &[n])?.unbind(),
-            d: matrix(0)?,
-            h: matrix(1)?,
-            g: matrix(2)?,
-            g_static: matrix(3)?,
+            torque: to_numpy(py, torque, k, single, &[n])?.unbind(),
+            d: d?,
+            h: h?,
+            g: g?,
+            g_static: g_static?,
         })
     }
 

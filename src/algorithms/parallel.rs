@@ -1,0 +1,316 @@
+//! The batch engine: an algorithm over many samples, split over the cores.
+//!
+//! Every function takes the samples as a checked [`States`] view, writes its results into the
+//! caller's row-major buffers, and runs
+//! - on the multi-sample kernels of [`super::batch`] ([`LANES`] samples side by side, SIMD)
+//!   where one exists (inverse dynamics, mass matrix, regressor), one sample at a time
+//!   otherwise;
+//! - on the calling thread with the caller's [`Workspace`] below [`PARALLEL_BATCH`] samples,
+//!   and in chunks of [`PARALLEL_CHUNK`] samples over rayon's thread pool above it, each chunk
+//!   with its own buffers (no allocation per sample).
+//!
+//! Results equal the one-sample algorithms up to rounding. Errors name the sample of the batch.
+
+use nalgebra::DMatrix;
+use rayon::prelude::*;
+
+use super::batch::{mass_matrix_batch, regressor_batch, rnea_lanes, LaneData, LANES};
+use super::regressor::{joint_torque_regressor, PARAMS_PER_BODY};
+use crate::data::Data;
+use crate::error::{Error, Result};
+use crate::gravity::Gravity;
+use crate::linearization::{linearize_into, Linearization};
+use crate::model::Model;
+use crate::states::States;
+
+/// Batches of at least this many samples run in parallel.
+pub const PARALLEL_BATCH: usize = 4096;
+/// Samples per parallel chunk.
+pub const PARALLEL_CHUNK: usize = 1024;
+
+/// The buffers of one thread: a [`Data`] for the one-sample algorithms and a [`LaneData`] for
+/// the multi-sample kernels. Allocate once per model and reuse.
+#[derive(Clone, Debug)]
+pub struct Workspace {
+    pub data: Data,
+    pub lanes: LaneData,
+}
+
+impl Workspace {
+    /// Buffers sized for `model`.
+    pub fn new(model: &Model) -> Self {
+        Self {
+            data: Data::new(model),
+            lanes: LaneData::new(model),
+        }
+    }
+}
+
+/// Runs `f` over the samples of `states`, whose results fill `outs` (`per_sample[i]` values per
+/// sample in `outs[i]`): on `ws` for a small batch, in parallel chunks for a large one.
+fn run<F>(
+    model: &Model,
+    ws: &mut Workspace,
+    states: &States<'_>,
+    outs: &mut [(&str, &mut [f64], usize)],
+    f: F,
+) -> Result<()>
+where
+    F: Fn(&mut Workspace, &States<'_>, &mut [&mut [f64]]) -> Result<()> + Sync,
+{
+    if states.nv() != model.nv {
+        return Err(Error::Shape {
+            argument: "q".into(),
+            expected: format!("{} joints per sample (the model's)", model.nv),
+            got: format!("{} joints per sample", states.nv()),
+        });
+    }
+    let k = states.len();
+    for (name, out, per) in outs.iter() {
+        if out.len() != k * per {
+            return Err(Error::Shape {
+                argument: (*name).into(),
+                expected: format!("{k} samples x {per} values"),
+                got: format!("{} values", out.len()),
+            });
+        }
+    }
+    if k < PARALLEL_BATCH || outs.iter().any(|o| o.2 == 0) {
+        let mut whole: Vec<&mut [f64]> = outs.iter_mut().map(|o| &mut *o.1).collect();
+        return f(ws, states, &mut whole);
+    }
+    let chunks = k.div_ceil(PARALLEL_CHUNK);
+    let mut per_chunk: Vec<Vec<&mut [f64]>> = (0..chunks).map(|_| Vec::new()).collect();
+    for (_, out, per) in outs.iter_mut() {
+        for (c, part) in out.chunks_mut(PARALLEL_CHUNK * *per).enumerate() {
+            per_chunk[c].push(part);
+        }
+    }
+    per_chunk
+        .into_par_iter()
+        .enumerate()
+        .try_for_each(|(c, mut parts)| {
+            let first = c * PARALLEL_CHUNK;
+            let chunk = states.slice(first..(first + PARALLEL_CHUNK).min(k));
+            f(&mut Workspace::new(model), &chunk, &mut parts)
+        })
+}
+
+/// Inverse dynamics `tau = M(q) qdd + c(q, qd) [+ g(q)]` of every sample (rigid bodies, no
+/// friction); missing `qd` or `qdd` are zeros, so `States::new(nv, q, None, None)` gives the
+/// gravity torques and `qdd = None` the bias torques.
+///
+/// `tau`: row-major `k x nv` (N m or N).
+///
+/// ```
+/// use perturbid_rs::{parallel, robots, Gravity, States};
+/// let model = robots::builtin("a465").unwrap();
+/// let q = vec![0.3; 10 * model.nv];
+/// let states = States::new(model.nv, &q, None, None).unwrap();
+/// let mut ws = parallel::Workspace::new(&model);
+/// let mut tau = vec![0.0; q.len()];
+/// parallel::rnea(&model, &mut ws, &states, Gravity::Included, &mut tau).unwrap();
+/// ```
+pub fn rnea(
+    model: &Model,
+    ws: &mut Workspace,
+    states: &States<'_>,
+    gravity: Gravity,
+    tau: &mut [f64],
+) -> Result<()> {
+    let n = model.nv;
+    run(model, ws, states, &mut [("tau", tau, n)], |w, s, out| {
+        let out = &mut *out[0];
+        if s.len() >= LANES {
+            return rnea_lanes(model, &mut w.lanes, s.q(), s.qd(), s.qdd(), gravity, out);
+        }
+        let zeros = vec![0.0; n];
+        for (i, o) in out.chunks_mut(n).enumerate() {
+            let x = s.sample(i);
+            let (qd, qdd) = (x.qd.unwrap_or(&zeros), x.qdd.unwrap_or(&zeros));
+            crate::algorithms::rnea::rnea(model, &mut w.data, x.q, qd, qdd, gravity)
+                .map_err(|e| s.at(i, e))?;
+            o.copy_from_slice(w.data.tau.as_slice());
+        }
+        Ok(())
+    })
+}
+
+/// Joint-space mass matrices `M(q)` of every sample (velocities and accelerations ignored).
+///
+/// `out`: row-major `k x nv x nv` (kg m^2, kg m or kg), both triangles.
+pub fn mass_matrix(
+    model: &Model,
+    ws: &mut Workspace,
+    states: &States<'_>,
+    out: &mut [f64],
+) -> Result<()> {
+    let n = model.nv;
+    run(
+        model,
+        ws,
+        states,
+        &mut [("out", out, n * n)],
+        |w, s, out| {
+            let out = &mut *out[0];
+            if s.len() >= LANES {
+                return mass_matrix_batch(model, &mut w.lanes, s.q(), out);
+            }
+            for (i, o) in out.chunks_mut(n * n).enumerate() {
+                crate::algorithms::crba::mass_matrix(model, &mut w.data, s.sample(i).q)
+                    .map_err(|e| s.at(i, e))?;
+                copy_row_major(&w.data.m, o);
+            }
+            Ok(())
+        },
+    )
+}
+
+/// The joint-torque regressor `Phi(q, qd, qdd)` of every sample (see
+/// [`joint_torque_regressor`]): `Phi theta = rnea(q, qd, qdd)` for the inertial parameters
+/// `theta` of every body in Pinocchio's order.
+///
+/// `out`: row-major `k x nv x 10 nbodies` (N m per parameter unit).
+pub fn regressor(
+    model: &Model,
+    ws: &mut Workspace,
+    states: &States<'_>,
+    gravity: Gravity,
+    out: &mut [f64],
+) -> Result<()> {
+    let (n, p) = (model.nv, PARAMS_PER_BODY * model.nbodies());
+    run(
+        model,
+        ws,
+        states,
+        &mut [("out", out, n * p)],
+        |w, s, out| {
+            let out = &mut *out[0];
+            let (qd, qdd) = (s.qd_or_zeros(), s.qdd_or_zeros());
+            if s.len() >= LANES {
+                return regressor_batch(model, &mut w.lanes, s.q(), &qd, &qdd, gravity, out);
+            }
+            let mut y = std::mem::take(&mut w.data.regressor);
+            let result = out.chunks_mut(n * p).enumerate().try_for_each(|(i, o)| {
+                let r = i * n..(i + 1) * n;
+                joint_torque_regressor(
+                    model,
+                    &mut w.data,
+                    s.sample(i).q,
+                    &qd[r.clone()],
+                    &qdd[r],
+                    gravity,
+                    &mut y,
+                )
+                .map_err(|e| s.at(i, e))?;
+                copy_row_major(&y, o);
+                Ok(())
+            });
+            w.data.regressor = y; // back in place even after an error
+            result
+        },
+    )
+}
+
+/// Forward dynamics `qdd = M(q)^-1 (tau - c(q, qd) [- g(q)])` of every sample; the
+/// accelerations of `states` are ignored.
+///
+/// `tau`: row-major `k x nv` (N m or N), finite. `qdd`: row-major `k x nv` output.
+pub fn forward_dynamics(
+    model: &Model,
+    ws: &mut Workspace,
+    states: &States<'_>,
+    tau: &[f64],
+    gravity: Gravity,
+    qdd: &mut [f64],
+) -> Result<()> {
+    let n = model.nv;
+    states.check_companion("tau", tau, n)?;
+    run(model, ws, states, &mut [("qdd", qdd, n)], |w, s, out| {
+        let zeros = vec![0.0; n];
+        // the chunk's torques: its samples sit at the same offset in `tau` as in the batch
+        let offset = s.offset() - states.offset();
+        for (i, o) in out[0].chunks_mut(n).enumerate() {
+            let x = s.sample(i);
+            let t = &tau[(offset + i) * n..(offset + i + 1) * n];
+            crate::algorithms::forward_dynamics::forward_dynamics(
+                model,
+                &mut w.data,
+                x.q,
+                x.qd.unwrap_or(&zeros),
+                t,
+                gravity,
+            )
+            .map_err(|e| s.at(i, e))?;
+            o.copy_from_slice(w.data.qdd.as_slice());
+        }
+        Ok(())
+    })
+}
+
+/// Where the results of [`linearize`] go: row-major buffers of `k` samples.
+#[derive(Debug)]
+pub struct LinearizationsOut<'a> {
+    /// `T*`, `k x nv` (N m).
+    pub torque: &'a mut [f64],
+    /// `D* = M(q*)`, `k x nv x nv`.
+    pub d: &'a mut [f64],
+    /// `H* = d tau / d qd`, `k x nv x nv`.
+    pub h: &'a mut [f64],
+    /// `G* = d tau / d q`, `k x nv x nv`.
+    pub g: &'a mut [f64],
+    /// `Gs = d g / d q` at rest, `k x nv x nv`.
+    pub g_static: &'a mut [f64],
+}
+
+/// The analytic linearisation (see [`crate::linearize`]) at every sample taken as an operating
+/// point, written into `out`.
+pub fn linearize(
+    model: &Model,
+    ws: &mut Workspace,
+    states: &States<'_>,
+    gravity: Gravity,
+    out: LinearizationsOut<'_>,
+) -> Result<()> {
+    let (n, nn) = (model.nv, model.nv * model.nv);
+    let mut outs = [
+        ("torque", out.torque, n),
+        ("d", out.d, nn),
+        ("h", out.h, nn),
+        ("g", out.g, nn),
+        ("g_static", out.g_static, nn),
+    ];
+    run(model, ws, states, &mut outs, |w, s, out| {
+        let (qd, qdd) = (s.qd_or_zeros(), s.qdd_or_zeros());
+        let mut lin = Linearization::zeros(n);
+        for i in 0..s.len() {
+            let r = i * n..(i + 1) * n;
+            let q = s.sample(i).q;
+            linearize_into(
+                model,
+                &mut w.data,
+                q,
+                &qd[r.clone()],
+                &qdd[r.clone()],
+                gravity,
+                &mut lin,
+            )
+            .map_err(|e| s.at(i, e))?;
+            out[0][r].copy_from_slice(lin.torque.as_slice());
+            for (b, m) in [&lin.d, &lin.h, &lin.g, &lin.g_static].iter().enumerate() {
+                copy_row_major(m, &mut out[b + 1][i * nn..(i + 1) * nn]);
+            }
+        }
+        Ok(())
+    })
+}
+
+/// `m` written row by row into `out` (`nrows * ncols` values).
+pub(crate) fn copy_row_major(m: &DMatrix<f64>, out: &mut [f64]) {
+    let n = m.ncols();
+    for r in 0..m.nrows() {
+        for c in 0..n {
+            out[r * n + c] = m[(r, c)];
+        }
+    }
+}

@@ -1,0 +1,101 @@
+//! [`Document`]: the JSON files of the library (plans, models), each with a format tag and a
+//! version, loaded with checks and saved atomically.
+
+use std::path::Path;
+
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+
+/// A JSON document with a `format` field `"<FORMAT>/<VERSION>"`.
+///
+/// Loading checks the tag (a file of another kind or a newer version is refused by name), then
+/// the document's own consistency ([`Document::validate`]); errors name the source and the line
+/// and column or the field. Saving writes a temporary file and renames it into place.
+pub trait Document: Serialize + DeserializeOwned {
+    /// The kind, e.g. `perturbid-local-model`.
+    const FORMAT: &'static str;
+    /// The version this library writes and reads.
+    const VERSION: u32;
+    /// What the document is, for messages ("local model").
+    const WHAT: &'static str;
+
+    /// The full tag, `"<FORMAT>/<VERSION>"`.
+    fn tag() -> String {
+        format!("{}/{}", Self::FORMAT, Self::VERSION)
+    }
+
+    /// Checks the parsed document's consistency (shapes, ranges).
+    fn validate(&self) -> Result<()>;
+
+    /// Pretty-printed JSON.
+    fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("library documents always serialise")
+    }
+
+    /// Parses and checks a document; errors say "the <WHAT>" as the source.
+    fn from_json(text: &str) -> Result<Self> {
+        Self::from_json_in(text, Self::WHAT)
+    }
+
+    /// Parses and checks a document read from `source` (a path, named in errors).
+    fn from_json_in(text: &str, source: &str) -> Result<Self> {
+        let context = if source == Self::WHAT {
+            source.to_string()
+        } else {
+            format!("{source} ({})", Self::WHAT)
+        };
+        let tag = format_tag(text, &context)?;
+        if tag != Self::tag() {
+            return Err(Error::Json {
+                context,
+                message: format!("format '{tag}', expected '{}'", Self::tag()),
+            });
+        }
+        let doc: Self = serde_json::from_str(text).map_err(|e| Error::Json {
+            context: context.clone(),
+            message: format!("line {}, column {}: {e}", e.line(), e.column()),
+        })?;
+        doc.validate().map_err(|e| match e {
+            Error::Json { message, .. } => Error::Json { context, message },
+            other => other,
+        })?;
+        Ok(doc)
+    }
+
+    /// Reads and checks a document file.
+    fn load(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        Self::from_json_in(&crate::io::read_text(path)?, &path.display().to_string())
+    }
+
+    /// Writes the document to `path` atomically (a temporary file renamed into place).
+    fn save(&self, path: impl AsRef<Path>) -> Result<()> {
+        crate::io::write_atomic(path, self.to_json().as_bytes())
+    }
+}
+
+/// The `format` field of a JSON document (without parsing the rest into a type).
+pub(crate) fn format_tag(text: &str, context: &str) -> Result<String> {
+    #[derive(serde::Deserialize)]
+    struct Tagged {
+        format: Option<String>,
+    }
+    let t: Tagged = serde_json::from_str(text).map_err(|e| Error::Json {
+        context: context.into(),
+        message: format!("line {}, column {}: {e}", e.line(), e.column()),
+    })?;
+    t.format.ok_or_else(|| Error::Json {
+        context: context.into(),
+        message: "no 'format' field: not a document written by perturbid_rs".into(),
+    })
+}
+
+/// An error about a document's content (after parsing), for [`Document::validate`].
+pub(crate) fn invalid(what: &str, message: String) -> Error {
+    Error::Json {
+        context: what.into(),
+        message,
+    }
+}

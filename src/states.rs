@@ -1,0 +1,260 @@
+//! [`States`]: the joint states of many samples, a view checked once (shapes and finiteness)
+//! and then read by every batched algorithm without further checks.
+
+use std::borrow::Cow;
+use std::ops::Range;
+
+use crate::error::{Error, Result};
+
+/// The joint states of `k` samples of a robot with `nv` degrees of freedom, borrowed from
+/// row-major `k x nv` arrays: sample `s`, joint `j` at index `s * nv + j`.
+///
+/// - `q`: positions (rad or m), always present;
+/// - `qd`: velocities (rad/s or m/s), `None` for zeros;
+/// - `qdd`: accelerations (rad/s^2 or m/s^2), `None` for zeros.
+///
+/// Built by [`States::new`] (a batch) or [`States::single`] (one sample), which check the
+/// shapes and that every value is finite; algorithms taking a `States` rely on both. Errors
+/// about a sample of a batch name it as `q[s]`, those of a single sample as `q`.
+///
+/// ```
+/// use perturbid_rs::States;
+/// let q = [0.1, 0.2, 0.3, 0.4]; // two samples of a 2-dof robot
+/// let states = States::new(2, &q, None, None).unwrap();
+/// assert_eq!(states.len(), 2);
+/// assert_eq!(states.sample(1).q, &[0.3, 0.4]);
+/// assert!(States::new(2, &[0.0, f64::NAN], None, None).is_err());
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct States<'a> {
+    nv: usize,
+    k: usize,
+    /// Index of the first sample in the batch this view was cut from (for error messages).
+    first: usize,
+    single: bool,
+    q: &'a [f64],
+    qd: Option<&'a [f64]>,
+    qdd: Option<&'a [f64]>,
+}
+
+/// One sample of [`States`]: slices of `nv` values, `None` for zeros.
+#[derive(Clone, Copy, Debug)]
+pub struct State<'a> {
+    pub q: &'a [f64],
+    pub qd: Option<&'a [f64]>,
+    pub qdd: Option<&'a [f64]>,
+}
+
+impl<'a> States<'a> {
+    /// A batch of `q.len() / nv` samples; `qd` and `qdd` must hold as many (or be `None`).
+    ///
+    /// Fails with [`Error::Shape`] when `nv` is zero or an array does not hold a whole number
+    /// of samples like `q`, and with [`Error::NonFiniteInput`] naming the argument, sample and
+    /// joint of the first NaN or infinity.
+    pub fn new(
+        nv: usize,
+        q: &'a [f64],
+        qd: Option<&'a [f64]>,
+        qdd: Option<&'a [f64]>,
+    ) -> Result<Self> {
+        Self::build(nv, q, qd, qdd, false)
+    }
+
+    /// One sample: `q`, `qd`, `qdd` of `nv` values each (`None` for zeros).
+    pub fn single(
+        nv: usize,
+        q: &'a [f64],
+        qd: Option<&'a [f64]>,
+        qdd: Option<&'a [f64]>,
+    ) -> Result<Self> {
+        let states = Self::build(nv, q, qd, qdd, true)?;
+        if states.k != 1 {
+            return Err(Error::Shape {
+                argument: "q".into(),
+                expected: format!("{nv} values (one per degree of freedom)"),
+                got: format!("{} values", q.len()),
+            });
+        }
+        Ok(states)
+    }
+
+    fn build(
+        nv: usize,
+        q: &'a [f64],
+        qd: Option<&'a [f64]>,
+        qdd: Option<&'a [f64]>,
+        single: bool,
+    ) -> Result<Self> {
+        if nv == 0 {
+            return Err(Error::Shape {
+                argument: "q".into(),
+                expected: "a robot with at least one degree of freedom".into(),
+                got: "a robot with none".into(),
+            });
+        }
+        let k = q.len() / nv;
+        if k * nv != q.len() {
+            return Err(Error::Shape {
+                argument: "q".into(),
+                expected: format!("a whole number of samples of {nv} joints"),
+                got: format!("{} values", q.len()),
+            });
+        }
+        for (name, x) in [("qd", qd), ("qdd", qdd)] {
+            if let Some(x) = x {
+                if x.len() != q.len() {
+                    return Err(Error::Shape {
+                        argument: name.into(),
+                        expected: format!("{k} samples x {nv} joints, like q"),
+                        got: format!("{} values", x.len()),
+                    });
+                }
+            }
+        }
+        let states = Self {
+            nv,
+            k,
+            first: 0,
+            single,
+            q,
+            qd,
+            qdd,
+        };
+        states.check_finite()?;
+        Ok(states)
+    }
+
+    /// One fast pass over every value; a second one only to name a bad value.
+    fn check_finite(&self) -> Result<()> {
+        for (name, x) in self.arrays() {
+            if x.iter().fold(false, |bad, v| bad | !v.is_finite()) {
+                let (i, &value) = x
+                    .iter()
+                    .enumerate()
+                    .find(|(_, v)| !v.is_finite())
+                    .expect("a non-finite value was seen");
+                let e = Error::NonFiniteInput {
+                    argument: name.into(),
+                    index: i % self.nv,
+                    value,
+                };
+                return Err(self.at(i / self.nv, e));
+            }
+        }
+        Ok(())
+    }
+
+    fn arrays(&self) -> impl Iterator<Item = (&'static str, &'a [f64])> {
+        [("q", Some(self.q)), ("qd", self.qd), ("qdd", self.qdd)]
+            .into_iter()
+            .filter_map(|(n, x)| x.map(|x| (n, x)))
+    }
+
+    /// Degrees of freedom per sample.
+    pub fn nv(&self) -> usize {
+        self.nv
+    }
+
+    /// Number of samples `k`.
+    pub fn len(&self) -> usize {
+        self.k
+    }
+
+    /// No samples.
+    pub fn is_empty(&self) -> bool {
+        self.k == 0
+    }
+
+    /// The index of this view's first sample in the batch it was cut from (0 for a whole batch).
+    pub fn offset(&self) -> usize {
+        self.first
+    }
+
+    /// Whether this is one sample given as such (not a batch of one).
+    pub fn is_single(&self) -> bool {
+        self.single
+    }
+
+    /// Positions, row-major `k x nv`.
+    pub fn q(&self) -> &'a [f64] {
+        self.q
+    }
+
+    /// Velocities, row-major `k x nv`, or `None` for zeros.
+    pub fn qd(&self) -> Option<&'a [f64]> {
+        self.qd
+    }
+
+    /// Accelerations, row-major `k x nv`, or `None` for zeros.
+    pub fn qdd(&self) -> Option<&'a [f64]> {
+        self.qdd
+    }
+
+    /// Velocities with zeros filled in where none were given.
+    pub fn qd_or_zeros(&self) -> Cow<'a, [f64]> {
+        self.qd
+            .map_or_else(|| Cow::Owned(vec![0.0; self.q.len()]), Cow::Borrowed)
+    }
+
+    /// Accelerations with zeros filled in where none were given.
+    pub fn qdd_or_zeros(&self) -> Cow<'a, [f64]> {
+        self.qdd
+            .map_or_else(|| Cow::Owned(vec![0.0; self.q.len()]), Cow::Borrowed)
+    }
+
+    /// Sample `s` (panics past the end, like slice indexing).
+    pub fn sample(&self, s: usize) -> State<'a> {
+        let r = s * self.nv..(s + 1) * self.nv;
+        State {
+            q: &self.q[r.clone()],
+            qd: self.qd.map(|x| &x[r.clone()]),
+            qdd: self.qdd.map(|x| &x[r]),
+        }
+    }
+
+    /// The samples `range` (panics past the end, like slice indexing); errors raised on them
+    /// still name their index in the whole batch.
+    pub fn slice(&self, range: Range<usize>) -> States<'a> {
+        let r = range.start * self.nv..range.end * self.nv;
+        States {
+            nv: self.nv,
+            k: range.len(),
+            first: self.first + range.start,
+            single: self.single,
+            q: &self.q[r.clone()],
+            qd: self.qd.map(|x| &x[r.clone()]),
+            qdd: self.qdd.map(|x| &x[r]),
+        }
+    }
+
+    /// An error raised at sample `s` of this view, renamed for its sample in the batch (a
+    /// single sample keeps the plain argument names).
+    pub fn at(&self, s: usize, e: Error) -> Error {
+        if self.single {
+            e
+        } else {
+            e.in_sample(self.first + s)
+        }
+    }
+
+    /// Checks that `x` (named `name`, e.g. the torques) holds `per_sample` finite values for
+    /// each sample.
+    pub fn check_companion(&self, name: &str, x: &[f64], per_sample: usize) -> Result<()> {
+        if x.len() != self.k * per_sample {
+            return Err(Error::Shape {
+                argument: name.into(),
+                expected: format!("{} samples x {per_sample} values, like q", self.k),
+                got: format!("{} values", x.len()),
+            });
+        }
+        if let Some((i, &value)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            let e = Error::NonFiniteInput {
+                argument: name.into(),
+                index: i % per_sample.max(1),
+                value,
+            };
+            return Err(self.at(i / per_sample.max(1), e));
+        }
+        Ok(())
+    }
+}

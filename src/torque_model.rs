@@ -1,0 +1,147 @@
+//! One interface for every identified model: [`TorqueModel::predict`] gives the joint torques
+//! at a batch of states, whether the model is local (the paper's method), base-parameter or
+//! globally linearised (the direct method). [`ModelFile`] loads any of them from JSON, picking
+//! the model by its format tag.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::direct::{BaseModel, GlobalLinearModel};
+use crate::document::Document;
+use crate::error::{Error, Result};
+use crate::local::{LocalModel, OperatingPoint};
+use crate::model::Model;
+use crate::states::States;
+
+/// A model of the joint torques of a robot.
+pub trait TorqueModel {
+    /// The names of the joints the model is for, in coordinate order.
+    fn joint_names(&self) -> &[String];
+
+    /// Predicted joint torques (row-major `k x nv`, N m or N) at the `k` samples of `states`
+    /// (rad, rad/s, rad/s^2; missing velocities or accelerations are zeros).
+    fn predict(&self, states: &States<'_>) -> Result<Vec<f64>>;
+}
+
+/// Fails unless `states` has `nv` joints per sample.
+pub(crate) fn check_joints(states: &States<'_>, nv: usize) -> Result<()> {
+    if states.nv() != nv {
+        return Err(Error::Shape {
+            argument: "q".into(),
+            expected: format!("{nv} joints per sample (the model's)"),
+            got: format!("{} joints per sample", states.nv()),
+        });
+    }
+    Ok(())
+}
+
+/// The first-order expansion `T + D (qdd - qdd*) + H (qd - qd*) + G (q - q*)` about `op` at
+/// every sample of `states` (row-major `k x nv` out): the form of the local and the globally
+/// linearised models.
+pub(crate) fn predict_linear(
+    states: &States<'_>,
+    torque: &[f64],
+    [d, h, g]: [&DMatrix<f64>; 3],
+    op: &OperatingPoint,
+) -> Result<Vec<f64>> {
+    let nv = torque.len();
+    check_joints(states, nv)?;
+    let (qd, qdd) = (states.qd_or_zeros(), states.qdd_or_zeros());
+    let mut out = Vec::with_capacity(states.len() * nv);
+    for s in 0..states.len() {
+        let r = s * nv..(s + 1) * nv;
+        let delta = |x: &[f64], x0: &[f64]| DVector::from_fn(nv, |j, _| x[j] - x0[j]);
+        let tau = DVector::from_column_slice(torque)
+            + d * delta(&qdd[r.clone()], &op.qdd)
+            + h * delta(&qd[r.clone()], &op.qd)
+            + g * delta(&states.q()[r], &op.q);
+        out.extend(tau.iter());
+    }
+    Ok(out)
+}
+
+/// A base-parameter model together with the robot whose regressor it needs
+/// ([`BaseModel::on`]).
+#[derive(Clone, Copy, Debug)]
+pub struct BaseModelOn<'a> {
+    pub fit: &'a BaseModel,
+    pub robot: &'a Model,
+}
+
+impl TorqueModel for BaseModelOn<'_> {
+    fn joint_names(&self) -> &[String] {
+        &self.fit.joint_names
+    }
+
+    fn predict(&self, states: &States<'_>) -> Result<Vec<f64>> {
+        self.fit.predict(self.robot, states)
+    }
+}
+
+impl TorqueModel for LocalModel {
+    fn joint_names(&self) -> &[String] {
+        &self.joint_names
+    }
+
+    fn predict(&self, states: &States<'_>) -> Result<Vec<f64>> {
+        LocalModel::predict(self, states)
+    }
+}
+
+impl TorqueModel for GlobalLinearModel {
+    fn joint_names(&self) -> &[String] {
+        &self.joint_names
+    }
+
+    fn predict(&self, states: &States<'_>) -> Result<Vec<f64>> {
+        GlobalLinearModel::predict(self, states)
+    }
+}
+
+/// Any model file of this library, told apart by its `format` tag.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ModelFile {
+    Local(LocalModel),
+    Base(BaseModel),
+    GlobalLinear(GlobalLinearModel),
+}
+
+impl ModelFile {
+    /// Parses a model document: the `format` tag picks the kind, then the kind's own checks
+    /// run. `source` names the text in errors (a path).
+    pub fn from_json(text: &str, source: &str) -> Result<Self> {
+        let tag = crate::document::format_tag(text, source)?;
+        let kind = tag.split('/').next().unwrap_or_default();
+        Ok(if kind == LocalModel::FORMAT {
+            ModelFile::Local(LocalModel::from_json_in(text, source)?)
+        } else if kind == BaseModel::FORMAT {
+            ModelFile::Base(BaseModel::from_json_in(text, source)?)
+        } else if kind == GlobalLinearModel::FORMAT {
+            ModelFile::GlobalLinear(GlobalLinearModel::from_json_in(text, source)?)
+        } else {
+            return Err(Error::Json {
+                context: source.into(),
+                message: format!(
+                    "format '{tag}' is not a model; expected {}, {} or {}",
+                    LocalModel::FORMAT,
+                    BaseModel::FORMAT,
+                    GlobalLinearModel::FORMAT
+                ),
+            });
+        })
+    }
+
+    /// Reads and parses a model file.
+    pub fn load(path: impl AsRef<std::path::Path>) -> Result<Self> {
+        let path = path.as_ref();
+        Self::from_json(&crate::io::read_text(path)?, &path.display().to_string())
+    }
+
+    /// The names of the joints the model is for.
+    pub fn joint_names(&self) -> &[String] {
+        match self {
+            ModelFile::Local(m) => &m.joint_names,
+            ModelFile::Base(m) => &m.joint_names,
+            ModelFile::GlobalLinear(m) => &m.joint_names,
+        }
+    }
+}
