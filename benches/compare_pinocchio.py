@@ -93,7 +93,7 @@ def main() -> int:
         fits["pin"], *_ = np.linalg.lstsq(phi, tau.reshape(-1), rcond=None)
 
     def our_identify():
-        fits["ours"] = pr.identify_base_parameters(robot, Q, QD, QDD, tau, friction=False, weighting="ols")
+        fits["ours"] = pr.identify_base_parameters(robot, Q, QD, QDD, tau, friction=None, weighting="ols")
 
     t_pin, t_our = compare(pin_identify, our_identify, 3)
     fit, theta_pin = fits["ours"], fits["pin"]

@@ -14,6 +14,8 @@
 #![allow(clippy::result_large_err)]
 
 pub mod algorithms;
+mod choice;
+#[cfg(feature = "cli")]
 pub mod cli;
 pub mod data;
 pub mod direct;
@@ -26,11 +28,11 @@ mod lanes;
 pub mod linearization;
 pub mod local;
 pub mod model;
+#[cfg(feature = "cli")]
 pub mod paper;
 pub mod preprocess;
 pub mod recording;
 pub mod regression;
-pub mod report;
 pub mod robots;
 pub mod signal;
 pub mod simulation;

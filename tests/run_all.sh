@@ -11,7 +11,7 @@ PY=${PYTHON:-python3}
 deps=$("$PY" -c "import tomllib; print(' '.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies']['test']))")
 "$PY" -m pip install --quiet $deps
 
-PYTHON="$PY" cargo test --release
+PYTHON="$PY" cargo test --release --features cli
 cargo bench --no-run --quiet
 
 rm -rf target/wheels

@@ -40,8 +40,8 @@ def main(argv: list[str] | None = None) -> int:
     robot = robots.a465("kinsheel2010")
     op = OperatingPoint(Q, QD, QDD)
     plan = plan_experiments(robot, op, design="random", seed=0)
-    model = identify_local(plan, simulate(robot, plan, gravity=False, friction=False))
-    noisy = identify_local(plan, simulate(robot, plan, gravity=False, friction=False, torque_noise=0.05, seed=1))
+    model = identify_local(plan, simulate(robot, plan, gravity=False, friction=None))
+    noisy = identify_local(plan, simulate(robot, plan, gravity=False, friction=None, torque_noise=0.05, seed=1))
     actual = robot.mass_matrix(Q)
 
     print("CRS A465 (kinsheel2010) at the operating point of Kinsheel & Taha (2010), Table 2")

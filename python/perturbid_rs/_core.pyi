@@ -1,7 +1,7 @@
 """Type stubs of the extension module perturbid_rs._core (implemented in Rust)."""
 
 from os import PathLike
-from typing import Mapping, Optional, Union
+from typing import Literal, Mapping, Optional, Sequence, Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -275,7 +275,7 @@ def simulate(
     robot: Robot,
     plan: Plan,
     gravity: bool = True,
-    friction: Union[bool, Mapping[str, ArrayLike], None] = None,
+    friction: Union[Literal["urdf"], Mapping[str, ArrayLike], None] = "urdf",
     torque_noise: Optional[ArrayLike] = None,
     position_noise: Optional[ArrayLike] = None,
     quantization: Optional[ArrayLike] = None,
@@ -388,7 +388,7 @@ def design_excitation(
     samples: int = 100,
     margin: float = 0.9,
     max_evaluations: int = 2000,
-    friction: Union[bool, list[str], None] = None,
+    friction: Union[str, Sequence[str], None] = ("viscous", "coulomb"),
     progress: bool = False,
 ) -> ExcitationDesign: ...
 
@@ -398,7 +398,7 @@ def identify_base_parameters(
     qd: ArrayLike,
     qdd: ArrayLike,
     tau: ArrayLike,
-    friction: Union[bool, list[str], None] = None,
+    friction: Union[str, Sequence[str], None] = None,
     weighting: str = "wls",
     gravity: bool = True,
     tolerance: float = 1e-8,

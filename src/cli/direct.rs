@@ -34,8 +34,8 @@ pub(crate) struct ExciteArgs {
     #[arg(long, default_value_t = 0.1)]
     base_frequency: f64,
     /// cond (of the base regressor) or logdet (of its information matrix).
-    #[arg(long, default_value = "cond")]
-    criterion: String,
+    #[arg(long, value_enum, default_value_t = Criterion::Cond)]
+    criterion: Criterion,
     #[arg(long, default_value_t = 0)]
     seed: u64,
     /// Budget of criterion evaluations.
@@ -54,7 +54,7 @@ pub(crate) fn excite(a: ExciteArgs) -> Result<String> {
     let o = ExcitationOptions {
         harmonics: a.harmonics,
         base_frequency: a.base_frequency,
-        criterion: Criterion::parse(&a.criterion)?,
+        criterion: a.criterion,
         seed: a.seed,
         max_evaluations: a.max_evaluations,
         margin: a.margin,
@@ -106,11 +106,11 @@ pub(crate) struct IdentifyDirectArgs {
     #[arg(long, default_value = "base_model.json")]
     out: PathBuf,
     /// Friction terms per joint, comma separated from viscous, coulomb, offset; or none.
-    #[arg(long, value_delimiter = ',', default_value = "viscous,coulomb,offset")]
-    friction: Vec<String>,
+    #[arg(long, default_value = "viscous,coulomb,offset")]
+    friction: FrictionTerms,
     /// wls (weights from the per-joint residuals) or ols.
-    #[arg(long, default_value = "wls")]
-    weighting: String,
+    #[arg(long, value_enum, default_value_t = Weighting::Wls)]
+    weighting: Weighting,
     /// The torques exclude gravity.
     #[arg(long)]
     no_gravity: bool,
@@ -162,19 +162,9 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         rec.qd.clone().expect("preprocessed"),
         rec.qdd.clone().expect("preprocessed"),
     );
-    let weighting = match a.weighting.as_str() {
-        "wls" => Weighting::Wls,
-        "ols" => Weighting::Ols,
-        other => {
-            return Err(Error::InvalidArgument {
-                argument: "--weighting".into(),
-                message: format!("'{other}'; expected wls or ols"),
-            })
-        }
-    };
     let options = BaseOptions {
-        friction: FrictionTerms::from_names(&a.friction)?,
-        weighting,
+        friction: a.friction,
+        weighting: a.weighting,
         gravity: Gravity::from(!a.no_gravity),
         ..BaseOptions::default()
     };

@@ -30,8 +30,8 @@ pub(crate) struct PlanArgs {
     #[arg(long)]
     out: Option<PathBuf>,
     /// Perturbation design: random (the paper's draws) or orthogonal (cond(X) = 1).
-    #[arg(long, default_value = "random")]
-    design: String,
+    #[arg(long, value_enum, default_value_t = Design::Random)]
+    design: Design,
     /// Perturbations per experiment (default 2N, in +- pairs).
     #[arg(long)]
     n: Option<usize>,
@@ -41,8 +41,13 @@ pub(crate) struct PlanArgs {
     #[arg(long, default_value_t = 1000.0)]
     rate: f64,
     /// Experiments, comma separated, from nominal, G_static, G, H, D.
-    #[arg(long, value_delimiter = ',', default_value = "nominal,G_static,G,H,D")]
-    experiments: Vec<String>,
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "nominal,G_static,G,H,D"
+    )]
+    experiments: Vec<ExperimentKind>,
     /// Position perturbation: fraction of the joint range (default 0.01) ...
     #[arg(long, default_value_t = 0.01)]
     dq_fraction: f64,
@@ -102,17 +107,13 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
     let op = load_op(&a.op)?;
     let n = model.nv;
     let mut o = PlanOptions {
-        design: Design::parse(&a.design)?,
+        design: a.design,
         count: a.n,
         seed: a.seed,
         rate: a.rate,
         window: a.window,
         dwell: a.dwell,
-        experiments: a
-            .experiments
-            .iter()
-            .map(|k| ExperimentKind::parse(k.trim()))
-            .collect::<Result<_>>()?,
+        experiments: a.experiments,
         ..PlanOptions::default()
     };
     o.sizes.position = size(a.dq, a.dq_fraction, n);
@@ -223,8 +224,8 @@ pub(crate) struct IdentifyArgs {
     #[arg(long)]
     window: Option<f64>,
     /// separated (the paper) or combined (all crossings in one regression).
-    #[arg(long, default_value = "separated")]
-    estimator: String,
+    #[arg(long, value_enum, default_value_t = Estimator::Separated)]
+    estimator: Estimator,
 }
 
 fn fmt_matrix(
@@ -279,7 +280,7 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
             window: a.window,
             ..Default::default()
         },
-        estimator: Estimator::parse(&a.estimator)?,
+        estimator: a.estimator,
     };
     let model: LocalModel = identify_local(&plan, &recs, &options)?;
     model.save(&a.out)?;

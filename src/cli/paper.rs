@@ -62,7 +62,7 @@ pub(crate) fn run(a: PaperArgs) -> Result<String> {
             out,
             "{name:<30} {}",
             v.iter()
-                .map(|&x| format!("{:>7}", crate::report::markdown::number(x, 3)))
+                .map(|&x| format!("{:>7}", crate::paper::markdown::number(x, 3)))
                 .collect::<Vec<_>>()
                 .join(" ")
         );

@@ -11,31 +11,20 @@ use rand_chacha::ChaCha8Rng;
 
 use super::base::{BaseParameters, BASE_TOLERANCE};
 use super::parameters::{regressor_matrix, FrictionTerms, ParameterLayout};
+use crate::choice::choice;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
 use crate::states::States;
 use crate::trajectory::{check_limits, FourierTrajectory};
 
-/// What the design minimises.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Criterion {
-    /// `log10 cond(Phi_base)`, the 2-norm condition number of the stacked base regressor.
-    Cond,
-    /// `-log det(Phi_base^T Phi_base) / p` (D-optimality).
-    LogDet,
-}
-
-impl Criterion {
-    pub fn parse(name: &str) -> Result<Self> {
-        match name {
-            "cond" => Ok(Criterion::Cond),
-            "logdet" | "log_det" => Ok(Criterion::LogDet),
-            other => Err(Error::InvalidArgument {
-                argument: "criterion".into(),
-                message: format!("'{other}'; expected 'cond' or 'logdet'"),
-            }),
-        }
+choice! {
+    /// What the design minimises.
+    pub enum Criterion ("criterion") {
+        /// `log10 cond(Phi_base)`, the 2-norm condition number of the stacked base regressor.
+        Cond = "cond",
+        /// `-log det(Phi_base^T Phi_base) / p` (D-optimality).
+        LogDet = "logdet" | "log_det",
     }
 }
 

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::base::{BaseParameters, BASE_TOLERANCE};
 use super::parameters::{regressor_matrix, FrictionTerms, ParameterLayout};
 use super::streaming;
+use crate::choice::choice;
 use crate::document::{invalid, Document};
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
@@ -14,16 +15,17 @@ use crate::model::Model;
 use crate::states::States;
 use crate::torque_model::BaseModelOn;
 
-/// Version tag of the JSON format of [`BaseModel`].
-
-/// Ordinary or weighted least squares.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Weighting {
-    Ols,
-    /// Rows of joint `j` divided by `sigma_j`, the RMS of joint `j`'s OLS residuals (Swevers et
-    /// al.: the maximum-likelihood estimate for independent per-joint noise).
-    Wls,
+choice! {
+    /// Ordinary or weighted least squares.
+    #[derive(Serialize, Deserialize)]
+    #[serde(rename_all = "snake_case")]
+    pub enum Weighting ("weighting") {
+        /// Ordinary least squares: every row weighs the same.
+        Ols = "ols",
+        /// Rows of joint `j` divided by `sigma_j`, the RMS of joint `j`'s OLS residuals (Swevers
+        /// et al.: the maximum-likelihood estimate for independent per-joint noise).
+        Wls = "wls",
+    }
 }
 
 /// Options of [`identify_base_parameters`].

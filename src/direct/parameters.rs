@@ -37,7 +37,8 @@ impl FrictionTerms {
         offset: true,
     };
 
-    /// The terms named in `names` (`viscous`, `coulomb`, `offset`; `none` or empty for none).
+    /// The terms named in `names` (`viscous`, `coulomb`, `offset`; `all` for the three,
+    /// `none` or nothing for none).
     pub fn from_names<S: AsRef<str>>(names: &[S]) -> Result<Self> {
         let mut f = FrictionTerms::NONE;
         for n in names {
@@ -45,11 +46,14 @@ impl FrictionTerms {
                 "viscous" => f.viscous = true,
                 "coulomb" => f.coulomb = true,
                 "offset" => f.offset = true,
+                "all" => f = FrictionTerms::ALL,
                 "none" | "" => {}
                 other => {
                     return Err(Error::InvalidArgument {
                         argument: "friction".into(),
-                        message: format!("'{other}' is not a friction term; expected viscous, coulomb, offset or none"),
+                        message: format!(
+                            "'{other}' is not a friction term; expected viscous, coulomb, offset, all or none"
+                        ),
                     })
                 }
             }
@@ -67,6 +71,25 @@ impl FrictionTerms {
         .into_iter()
         .filter_map(|(n, on)| on.then_some(n))
         .collect()
+    }
+}
+
+/// Comma-separated names, as [`FrictionTerms::from_names`] reads them.
+impl std::str::FromStr for FrictionTerms {
+    type Err = Error;
+
+    fn from_str(text: &str) -> Result<Self> {
+        Self::from_names(&text.split(',').collect::<Vec<_>>())
+    }
+}
+
+/// The names of the terms switched on, comma separated; `none` for none.
+impl std::fmt::Display for FrictionTerms {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.names().join(",") {
+            names if names.is_empty() => f.write_str("none"),
+            names => f.write_str(&names),
+        }
     }
 }
 

@@ -5,6 +5,7 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use super::operating_point::OperatingPoint;
+use crate::choice::choice;
 use crate::document::{invalid, Document};
 use crate::error::{Error, Result};
 use crate::states::States;
@@ -27,27 +28,16 @@ pub struct Estimate {
     pub crossings: usize,
 }
 
-/// Which estimate fills `D`, `H` and `G`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Estimator {
-    /// One regression per experiment with its own perturbed variable (the paper).
-    Separated,
-    /// All crossings stacked, `Gamma = [D H G] [dqdd; dqd; dq]`, with the measured deltas of
-    /// every variable (absorbs tracking errors; METHOD.md section 4).
-    Combined,
-}
-
-impl Estimator {
-    pub fn parse(name: &str) -> Result<Self> {
-        match name {
-            "separated" => Ok(Estimator::Separated),
-            "combined" => Ok(Estimator::Combined),
-            other => Err(Error::InvalidArgument {
-                argument: "estimator".into(),
-                message: format!("'{other}'; expected 'separated' or 'combined'"),
-            }),
-        }
+choice! {
+    /// Which estimate fills `D`, `H` and `G`.
+    #[derive(Serialize, Deserialize)]
+    #[serde(rename_all = "snake_case")]
+    pub enum Estimator ("estimator") {
+        /// One regression per experiment with its own perturbed variable (the paper).
+        Separated = "separated",
+        /// All crossings stacked, `Gamma = [D H G] [dqdd; dqd; dq]`, with the measured deltas of
+        /// every variable (absorbs tracking errors; METHOD.md section 4).
+        Combined = "combined",
     }
 }
 

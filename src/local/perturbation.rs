@@ -7,38 +7,21 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 
+use crate::choice::choice;
 use crate::error::{Error, Result};
 
-/// How the K perturbations are chosen.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Design {
-    /// The paper's draws near the nominal (its Fig. 1): every joint uniform in `[-size, size]`,
-    /// seeded.
-    Random,
-    /// A designed set with `cond(X) = 1` once each column is divided by its joint's size:
-    /// Sylvester-Hadamard columns (every joint at full size in every crossing) when K/2 is a
-    /// multiple of the power of two above N, otherwise seeded random orthonormal columns.
-    Orthogonal,
-}
-
-impl Design {
-    pub fn parse(name: &str) -> Result<Self> {
-        match name {
-            "random" => Ok(Design::Random),
-            "orthogonal" | "designed" => Ok(Design::Orthogonal),
-            other => Err(Error::InvalidArgument {
-                argument: "design".into(),
-                message: format!("'{other}' is not a design; expected 'random' or 'orthogonal'"),
-            }),
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Design::Random => "random",
-            Design::Orthogonal => "orthogonal",
-        }
+choice! {
+    /// How the K perturbations are chosen.
+    #[derive(Serialize, Deserialize)]
+    #[serde(rename_all = "snake_case")]
+    pub enum Design ("design") {
+        /// The paper's draws near the nominal (its Fig. 1): every joint uniform in
+        /// `[-size, size]`, seeded.
+        Random = "random",
+        /// A designed set with `cond(X) = 1` once each column is divided by its joint's size:
+        /// Sylvester-Hadamard columns (every joint at full size in every crossing) when K/2 is a
+        /// multiple of the power of two above N, otherwise seeded random orthonormal columns.
+        Orthogonal = "orthogonal" | "designed",
     }
 }
 

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::operating_point::OperatingPoint;
 use super::perturbation::{perturbations, Design, Sizes, FALLBACK_SIZES};
+use crate::choice::choice;
 use crate::document::{invalid, Document};
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -14,58 +15,30 @@ use crate::trajectory::{
     check_limits, transition, Segment, SegmentKind, Trajectory, TransitionLimits,
 };
 
-/// The kind of an experiment (METHOD.md section 3).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-pub enum ExperimentKind {
-    /// Step 1: K crossings of P itself; `T*` is the mean torque.
-    #[serde(rename = "nominal")]
-    Nominal,
-    /// Step 2: at rest at `q* + dq_k`; `tau_k - tau_rest(q*) = Gs dq_k`.
-    #[serde(rename = "G_static")]
-    GStatic,
-    /// Extension: crossings of `(q* + dq_k, qd*, qdd*)`; `tau_k - T* = G* dq_k`.
-    #[serde(rename = "G")]
-    GDynamic,
-    /// Step 3: crossings of `(q*, qd* + dqd_k, qdd*)`; `tau_k - T* = H* dqd_k`.
-    #[serde(rename = "H")]
-    H,
-    /// Step 4: crossings of `(q*, qd*, qdd* + dqdd_k)`; `tau_k - T* = D* dqdd_k`.
-    #[serde(rename = "D")]
-    D,
+choice! {
+    /// The kind of an experiment (METHOD.md section 3); named `nominal`, `G_static`, `G`, `H`,
+    /// `D` in files and messages.
+    #[derive(PartialOrd, Ord, Serialize, Deserialize)]
+    pub enum ExperimentKind ("experiments") {
+        /// Step 1: K crossings of P itself; `T*` is the mean torque.
+        #[serde(rename = "nominal")]
+        Nominal = "nominal",
+        /// Step 2: at rest at `q* + dq_k`; `tau_k - tau_rest(q*) = Gs dq_k`.
+        #[serde(rename = "G_static")]
+        GStatic = "G_static",
+        /// Extension: crossings of `(q* + dq_k, qd*, qdd*)`; `tau_k - T* = G* dq_k`.
+        #[serde(rename = "G")]
+        GDynamic = "G",
+        /// Step 3: crossings of `(q*, qd* + dqd_k, qdd*)`; `tau_k - T* = H* dqd_k`.
+        #[serde(rename = "H")]
+        H = "H",
+        /// Step 4: crossings of `(q*, qd*, qdd* + dqdd_k)`; `tau_k - T* = D* dqdd_k`.
+        #[serde(rename = "D")]
+        D = "D",
+    }
 }
 
 impl ExperimentKind {
-    pub const ALL: [ExperimentKind; 5] = [
-        ExperimentKind::Nominal,
-        ExperimentKind::GStatic,
-        ExperimentKind::GDynamic,
-        ExperimentKind::H,
-        ExperimentKind::D,
-    ];
-
-    /// The name used in files and messages: `nominal`, `G_static`, `G`, `H`, `D`.
-    pub fn name(self) -> &'static str {
-        match self {
-            ExperimentKind::Nominal => "nominal",
-            ExperimentKind::GStatic => "G_static",
-            ExperimentKind::GDynamic => "G",
-            ExperimentKind::H => "H",
-            ExperimentKind::D => "D",
-        }
-    }
-
-    pub fn parse(name: &str) -> Result<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|k| k.name() == name)
-            .ok_or_else(|| Error::InvalidArgument {
-                argument: "experiments".into(),
-                message: format!(
-                    "'{name}' is not an experiment; expected one of nominal, G_static, G, H, D"
-                ),
-            })
-    }
-
     /// Which state variable the experiment perturbs: 0 = position, 1 = velocity,
     /// 2 = acceleration, `None` for the nominal experiment.
     pub fn perturbed(self) -> Option<usize> {

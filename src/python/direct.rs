@@ -191,26 +191,38 @@ impl PyExcitationDesign {
     }
 }
 
-fn friction_terms(value: &Bound<'_, PyAny>) -> PyResult<FrictionTerms> {
-    if let Ok(b) = value.extract::<bool>() {
-        return Ok(if b {
-            FrictionTerms::ALL
-        } else {
-            FrictionTerms::NONE
-        });
-    }
-    let names: Vec<String> = value.extract().map_err(|_| Error::InvalidArgument {
-        argument: "friction".into(),
-        message: "expected True, False or a list of 'viscous', 'coulomb', 'offset'".into(),
-    })?;
-    Ok(FrictionTerms::from_names(&names)?)
+/// The `friction` argument of the direct method: a name or a list of names from 'viscous',
+/// 'coulomb', 'offset' ('all' for the three, 'none' for none), or anything else (refused).
+#[derive(FromPyObject)]
+pub(crate) enum FrictionNames<'py> {
+    One(String),
+    Many(Vec<String>),
+    Other(Bound<'py, PyAny>),
+}
+
+/// The friction terms of a `friction` argument; `None` means none.
+fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<FrictionTerms> {
+    Ok(match value {
+        None => FrictionTerms::NONE,
+        Some(FrictionNames::One(name)) => FrictionTerms::from_names(&[name])?,
+        Some(FrictionNames::Many(names)) => FrictionTerms::from_names(&names)?,
+        Some(FrictionNames::Other(v)) => {
+            return Err(Error::InvalidArgument {
+                argument: "friction".into(),
+                message: format!(
+                    "{v}; expected None, 'all', or a list of 'viscous', 'coulomb', 'offset'"
+                ),
+            }
+            .into())
+        }
+    })
 }
 
 /// Designs a Fourier excitation for `robot` minimising `criterion` ('cond' or 'logdet') of the
 /// base regressor subject to the limits (times `margin`), starting and ending at rest when
 /// `rest`. COBYLA, seeded; `progress=True` prints the progress to stderr.
 #[pyfunction]
-#[pyo3(signature = (robot, harmonics=5, base_frequency=0.1, criterion="cond", seed=0, *, rest=true, samples=100, margin=0.9, max_evaluations=2000, friction=None, progress=false))]
+#[pyo3(signature = (robot, harmonics=5, base_frequency=0.1, criterion="cond", seed=0, *, rest=true, samples=100, margin=0.9, max_evaluations=2000, friction=Some(FrictionNames::Many(vec!["viscous".into(), "coulomb".into()])), progress=false))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn design_excitation(
     py: Python<'_>,
@@ -223,13 +235,13 @@ pub(crate) fn design_excitation(
     samples: usize,
     margin: f64,
     max_evaluations: usize,
-    friction: Option<Bound<'_, PyAny>>,
+    friction: Option<FrictionNames<'_>>,
     progress: bool,
 ) -> PyResult<PyExcitationDesign> {
     let mut o = ExcitationOptions {
         harmonics,
         base_frequency,
-        criterion: Criterion::parse(criterion)?,
+        criterion: criterion.parse::<Criterion>()?,
         seed,
         rest,
         samples,
@@ -237,9 +249,7 @@ pub(crate) fn design_excitation(
         max_evaluations,
         ..ExcitationOptions::default()
     };
-    if let Some(f) = friction {
-        o.friction = friction_terms(&f)?;
-    }
+    o.friction = friction_terms(friction)?;
     let design = py.detach(|| {
         let mut report = |e: usize, best: f64| {
             eprintln!("excitation design: {e} evaluations, best criterion {best:.4}")
@@ -390,27 +400,14 @@ pub(crate) fn identify_base_parameters(
     qd: ArrayLike<'_>,
     qdd: ArrayLike<'_>,
     tau: ArrayLike<'_>,
-    friction: Option<Bound<'_, PyAny>>,
+    friction: Option<FrictionNames<'_>>,
     weighting: &str,
     gravity: bool,
     tolerance: f64,
     seed: u64,
 ) -> PyResult<PyBaseModel> {
-    let weighting = match weighting {
-        "wls" => Weighting::Wls,
-        "ols" => Weighting::Ols,
-        other => {
-            return Err(Error::InvalidArgument {
-                argument: "weighting".into(),
-                message: format!("'{other}'; expected 'ols' or 'wls'"),
-            }
-            .into())
-        }
-    };
-    let friction = match friction {
-        Some(f) => friction_terms(&f)?,
-        None => FrictionTerms::ALL,
-    };
+    let weighting: Weighting = weighting.parse()?;
+    let friction = friction_terms(friction)?;
     let options = BaseOptions {
         friction,
         weighting,

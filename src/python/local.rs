@@ -145,7 +145,7 @@ impl PyPlan {
     }
     /// The experiment named `kind` ('nominal', 'G_static', 'G', 'H' or 'D').
     fn experiment(&self, kind: &str) -> PyResult<PyExperiment> {
-        let k = ExperimentKind::parse(kind)?;
+        let k = kind.parse::<ExperimentKind>()?;
         let index = self
             .plan
             .experiments
@@ -318,7 +318,7 @@ pub(crate) fn plan_experiments(
         })
     };
     let mut options = PlanOptions {
-        design: Design::parse(design)?,
+        design: design.parse::<Design>()?,
         count: n,
         seed,
         rate,
@@ -334,7 +334,7 @@ pub(crate) fn plan_experiments(
     if let Some(list) = experiments {
         options.experiments = list
             .iter()
-            .map(|k| ExperimentKind::parse(k))
+            .map(|k| k.parse::<ExperimentKind>())
             .collect::<Result<_>>()?;
     }
     let plan = py.detach(|| plan_rs(&robot.model, &op.op, &options))?;
@@ -462,20 +462,27 @@ impl PyRecording {
     }
 }
 
+/// The `friction` argument of `simulate`: a name ('urdf') or anything else (a dict).
+#[derive(FromPyObject)]
+pub(crate) enum FrictionArg<'py> {
+    Name(String),
+    Other(Bound<'py, PyAny>),
+}
+
 /// Simulates what the robot would log running every experiment of `plan`: torques from the
-/// dynamics with `gravity`, `friction` (True: the URDF's `<dynamics>`; False: none; or a dict
-/// with 'viscous' and 'coulomb', a number or one per joint), Gaussian `torque_noise` (N m) and
+/// dynamics with `gravity`, `friction` ('urdf', the default: the URDF's `<dynamics damping
+/// friction>`; None: none; or a dict with 'viscous' and 'coulomb', a number or one per joint), Gaussian `torque_noise` (N m) and
 /// `position_noise` (rad) standard deviations, encoder `quantization` (rad per count), seeded.
 /// Returns one Recording per experiment, in the plan's order.
 #[pyfunction]
-#[pyo3(signature = (robot, plan, gravity=true, friction=None, torque_noise=None, position_noise=None, quantization=None, seed=0))]
+#[pyo3(signature = (robot, plan, gravity=true, friction=Some(FrictionArg::Name("urdf".into())), torque_noise=None, position_noise=None, quantization=None, seed=0))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn simulate(
     py: Python<'_>,
     robot: &PyRobot,
     plan: &PyPlan,
     gravity: bool,
-    friction: Option<Bound<'_, PyAny>>,
+    friction: Option<FrictionArg<'_>>,
     torque_noise: Option<Bound<'_, PyAny>>,
     position_noise: Option<Bound<'_, PyAny>>,
     quantization: Option<Bound<'_, PyAny>>,
@@ -486,20 +493,16 @@ pub(crate) fn simulate(
     let mut o = SimulationOptions::new(model);
     o.gravity = gravity.into();
     o.seed = seed;
+    let refuse = |what: String| Error::InvalidArgument {
+        argument: "friction".into(),
+        message: format!("{what}; expected 'urdf', None or a dict with 'viscous' and 'coulomb'"),
+    };
     o.friction = match &friction {
-        None => Friction::from_model(model),
-        Some(f) if f.extract::<bool>().is_ok() => {
-            if f.extract::<bool>()? {
-                Friction::from_model(model)
-            } else {
-                Friction::none(n)
-            }
-        }
-        Some(f) => {
-            let d = f.cast::<PyDict>().map_err(|_| Error::InvalidArgument {
-                argument: "friction".into(),
-                message: "expected True, False or a dict with 'viscous' and 'coulomb'".into(),
-            })?;
+        None => Friction::none(n),
+        Some(FrictionArg::Name(name)) if name == "urdf" => Friction::from_model(model),
+        Some(FrictionArg::Name(name)) => return Err(refuse(format!("'{name}'")).into()),
+        Some(FrictionArg::Other(f)) => {
+            let d = f.cast::<PyDict>().map_err(|_| refuse(f.to_string()))?;
             let get = |k: &str| -> PyResult<Vec<f64>> {
                 match d.get_item(k)? {
                     Some(v) => per_joint(&format!("friction['{k}']"), &v, n),
@@ -569,7 +572,7 @@ pub(crate) fn identify_local(
             torque_degree,
             recorded_derivatives,
         },
-        estimator: Estimator::parse(estimator)?,
+        estimator: estimator.parse::<Estimator>()?,
     };
     let recs: Vec<Recording> = recordings.iter().map(|r| (*r.get().rec).clone()).collect();
     let plan = plan.plan.clone();

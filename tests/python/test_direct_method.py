@@ -72,7 +72,7 @@ def test_base_parameters_on_simulated_a465_are_exact():
     t = np.arange(0, traj.period, 0.01)
     q, qd, qdd = traj.sample(t)
     tau = robot.rnea(q, qd, qdd)
-    fit = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction=False, weighting="ols")
+    fit = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction=None, weighting="ols")
     assert len(fit.theta_base) == len(fit.names) == len(fit.kept) and len(fit.kept) + len(fit.dropped) == 60
     rng = np.random.default_rng(2)
     qh, qdh, qddh = rng.uniform(-1, 1, (3, 40, 6))
@@ -158,7 +158,7 @@ def test_panda_real_data_matches_or_beats_the_reference():
     Q, QD, QDD, T = rec.q, rec.qd, rec.qdd, rec.tau
     result = {}
     for weighting in ["ols", "wls"]:
-        fit = pr.identify_base_parameters(robot, Q[:split], QD[:split], QDD[:split], T[:split], weighting=weighting)
+        fit = pr.identify_base_parameters(robot, Q[:split], QD[:split], QDD[:split], T[:split], friction="all", weighting=weighting)
         assert len(fit.theta_base) == 64
         err = fit.predict(Q[split:], QD[split:], QDD[split:]) - T[split:]
         result[weighting] = 100 * np.sqrt((err**2).mean(0) / (T[split:] ** 2).mean(0))
@@ -167,3 +167,22 @@ def test_panda_real_data_matches_or_beats_the_reference():
     assert np.all(result["ols"] <= np.array(PANDA_REFERENCE) + 0.05), result["ols"]
     # WLS beats it overall
     assert result["wls"].mean() < np.mean(PANDA_REFERENCE)
+
+
+def test_friction_options_say_what_they_do():
+    """None (the default) identifies no friction, names pick terms, 'all' the three, and a bool,
+    which does not say which terms, is refused."""
+    robot = pr.robots.a465()
+    traj = excitation(robot, 5, 0.1, 0.12, 1)
+    q, qd, qdd = traj.sample(np.arange(0, traj.period, 0.01))
+    tau = robot.rnea(q, qd, qdd)
+    friction_columns = lambda fit: sorted({n.split(".")[-1] for n in fit.full_names} & {"viscous", "coulomb", "offset"})
+    assert friction_columns(pr.identify_base_parameters(robot, q, qd, qdd, tau)) == []
+    assert friction_columns(pr.identify_base_parameters(robot, q, qd, qdd, tau, friction="viscous")) == ["viscous"]
+    both = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction=["viscous", "coulomb"])
+    assert friction_columns(both) == ["coulomb", "viscous"]
+    every = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction="all")
+    assert friction_columns(every) == ["coulomb", "offset", "viscous"]
+    for bad in [True, False, 3, ["viscous", "stiction"]]:
+        with pytest.raises(pr.InputError, match="friction"):
+            pr.identify_base_parameters(robot, q, qd, qdd, tau, friction=bad)

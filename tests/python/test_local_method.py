@@ -55,7 +55,7 @@ def ur5():
 def test_a465_table2_matches_pinocchio(a465):
     op = pr.OperatingPoint(*TABLE2)
     plan = pr.plan_experiments(a465.ours, op, design="random", seed=3)
-    recs = pr.simulate(a465.ours, plan, gravity=False, friction=False)
+    recs = pr.simulate(a465.ours, plan, gravity=False, friction=None)
     model = pr.identify_local(plan, recs)
     t, d, h, _ = oracle(a465, op.q, op.qd, op.qdd, gravity=False)
     assert rel(model.D, d) < 1e-9
@@ -72,7 +72,7 @@ def test_ur5_matches_pinocchio(ur5, design):
     q = rng.uniform(-1.5, 1.5, 6)
     op = pr.OperatingPoint(q, rng.uniform(-0.4, 0.4, 6), rng.uniform(-1, 1, 6))
     plan = pr.plan_experiments(ur5.ours, op, design=design, seed=5)
-    recs = pr.simulate(ur5.ours, plan, friction=False)
+    recs = pr.simulate(ur5.ours, plan, friction=None)
     model = pr.identify_local(plan, recs)
     t, d, h, g = oracle(ur5, op.q, op.qd, op.qdd)
     assert rel(model.D, d) < 1e-9

@@ -1,4 +1,0 @@
-//! Human-readable outputs: SVG line plots and Markdown tables.
-
-pub mod markdown;
-pub mod svg;
