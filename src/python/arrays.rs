@@ -1,10 +1,13 @@
 //! numpy in and out: one sample as shape `(n,)` or a batch as `(k, n)`; results shaped to match.
 
+use nalgebra::DMatrix;
 use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use std::borrow::Cow;
 
-use crate::error::Error;
+pub(crate) type ArrayLike<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+
+use crate::error::{Error, Result};
 use crate::states::States;
 
 /// Arguments of one call as contiguous row-major buffers that the Rust work reads without the
@@ -23,7 +26,7 @@ pub(crate) struct Batch<'a> {
 pub(crate) fn read_batch<'a>(
     n: usize,
     args: &[(&str, &'a PyArrayLikeDyn<'_, f64, AllowTypeChange>)],
-) -> Result<Batch<'a>, Error> {
+) -> Result<Batch<'a>> {
     // (number of samples, whether given as a batch) of the first argument
     let mut first: Option<(usize, bool)> = None;
     let mut columns = Vec::with_capacity(args.len());
@@ -78,7 +81,7 @@ pub(crate) fn read_batch<'a>(
 impl Batch<'_> {
     /// The first three arguments as joint states (q, then qd and qdd when given) of `nv` joints,
     /// checked: a single sample stays single (errors name no sample).
-    pub fn states(&self, nv: usize) -> Result<States<'_>, Error> {
+    pub fn states(&self, nv: usize) -> Result<States<'_>> {
         let column = |i: usize| self.columns.get(i).map(|c| &c[..]);
         let q = column(0).unwrap_or(&[]);
         if self.single {
@@ -117,4 +120,59 @@ pub(crate) fn matrix_to_numpy<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let values: Vec<f64> = m.transpose().iter().copied().collect(); // row-major
     to_numpy(py, values, m.nrows(), false, &[m.ncols()])
+}
+
+pub(crate) fn vec1<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyAny> {
+    PyArray1::from_slice(py, v).into_any()
+}
+
+pub(crate) fn rows<'py>(py: Python<'py>, v: &[f64], n: usize) -> PyResult<Bound<'py, PyAny>> {
+    to_numpy(py, v.to_vec(), v.len() / n.max(1), false, &[n])
+}
+
+/// A 1-D array-like of length `n` (or a scalar broadcast to `n`).
+pub(crate) fn per_joint(name: &str, value: &Bound<'_, PyAny>, n: usize) -> PyResult<Vec<f64>> {
+    if let Ok(x) = value.extract::<f64>() {
+        return Ok(vec![x; n]);
+    }
+    let arr: ArrayLike<'_> = value.extract().map_err(|_| Error::InvalidArgument {
+        argument: name.into(),
+        message: "expected a number or a sequence of numbers".into(),
+    })?;
+    if arr.shape() != [n] {
+        return Err(Error::Shape {
+            argument: name.into(),
+            expected: format!("a number or shape ({n},)"),
+            got: format!("shape {:?}", arr.shape()),
+        }
+        .into());
+    }
+    Ok(arr.as_array().iter().copied().collect())
+}
+
+pub(crate) fn vector(name: &str, a: &ArrayLike<'_>) -> Result<Vec<f64>> {
+    if a.ndim() != 1 {
+        return Err(Error::Shape {
+            argument: name.into(),
+            expected: "a 1-D array".into(),
+            got: format!("shape {:?}", a.shape()),
+        });
+    }
+    Ok(a.as_array().iter().copied().collect())
+}
+
+/// A 2-D array-like as a matrix (rows x columns).
+pub(crate) fn matrix(name: &str, a: &ArrayLike<'_>) -> Result<DMatrix<f64>> {
+    match a.shape() {
+        [r, c] => Ok(DMatrix::from_row_iterator(
+            *r,
+            *c,
+            a.as_array().iter().copied(),
+        )),
+        s => Err(Error::Shape {
+            argument: name.into(),
+            expected: "a 2-D array (joints x harmonics)".into(),
+            got: format!("shape {s:?}"),
+        }),
+    }
 }

@@ -1,17 +1,18 @@
-//! The direct method in Python: `FourierTrajectory`, `design_excitation`,
-//! `identify_base_parameters` (`BaseParameterModel`), `identify_global_linear`
-//! (`GlobalLinearModel`) and `preprocess`.
+//! The direct method in Python: `design_excitation` (`ExcitationDesign`),
+//! `identify_base_parameters` (`BaseParameterModel`) and `identify_global_linear`
+//! (`GlobalLinearModel`) (mirrors `crate::direct`).
 
+use std::borrow::Cow;
 use std::sync::Arc;
 
-use nalgebra::DMatrix;
-use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyUntypedArrayMethods};
+use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::arrays::{matrix_to_numpy as mat, read_batch, to_numpy};
-use super::local::{PyOperatingPoint, PyRecording};
+use super::arrays::{matrix_to_numpy as mat, read_batch, to_numpy, ArrayLike};
+use super::local::PyOperatingPoint;
 use super::robot::PyRobot;
+use super::trajectory::PyFourier;
 use crate::direct::excitation::ExcitationDesign;
 use crate::direct::{
     design_excitation as design_rs, identify_base_parameters as base_rs,
@@ -20,133 +21,7 @@ use crate::direct::{
 };
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::preprocess::{preprocess as preprocess_rs, PreprocessOptions};
-use crate::recording::Recording;
 use crate::states::States;
-use crate::trajectory::FourierTrajectory;
-use std::borrow::Cow;
-
-type ArrayLike<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
-
-fn matrix(name: &str, a: &ArrayLike<'_>) -> Result<DMatrix<f64>> {
-    match a.shape() {
-        [r, c] => Ok(DMatrix::from_row_iterator(
-            *r,
-            *c,
-            a.as_array().iter().copied(),
-        )),
-        s => Err(Error::Shape {
-            argument: name.into(),
-            expected: "a 2-D array (joints x harmonics)".into(),
-            got: format!("shape {s:?}"),
-        }),
-    }
-}
-
-/// A Fourier excitation (eq. 16): `q_i(t) = q0_i + sum_l a_il/(w_f l) sin(w_f l t) -
-/// b_il/(w_f l) cos(w_f l t)`. `a`, `b`: (n, L) in rad/s; `q0`: (n,) in rad; the base
-/// pulsation `w_f` in rad/s, or `base_frequency` in Hz (default 0.1 Hz).
-#[pyclass(name = "FourierTrajectory", module = "perturbid_rs", frozen)]
-#[derive(Clone)]
-pub(crate) struct PyFourier {
-    pub traj: FourierTrajectory,
-}
-
-#[pymethods]
-impl PyFourier {
-    #[new]
-    #[pyo3(signature = (a, b, q0, *, w_f=None, base_frequency=None))]
-    fn new(
-        a: ArrayLike<'_>,
-        b: ArrayLike<'_>,
-        q0: ArrayLike<'_>,
-        w_f: Option<f64>,
-        base_frequency: Option<f64>,
-    ) -> PyResult<Self> {
-        let w_f = match (w_f, base_frequency) {
-            (Some(_), Some(_)) => {
-                return Err(Error::InvalidArgument {
-                    argument: "w_f".into(),
-                    message: "give w_f or base_frequency, not both".into(),
-                }
-                .into())
-            }
-            (Some(w), None) => w,
-            (None, f) => 2.0 * std::f64::consts::PI * f.unwrap_or(0.1),
-        };
-        let q0: Vec<f64> = q0.as_array().iter().copied().collect();
-        Ok(Self {
-            traj: FourierTrajectory::new(w_f, q0, matrix("a", &a)?, matrix("b", &b)?)?,
-        })
-    }
-    /// Positions, velocities and accelerations at times `t` (s): a tuple of three arrays of
-    /// shape (k, n) for `t` of shape (k,), or (n,) for a scalar `t`.
-    fn sample<'py>(
-        &self,
-        py: Python<'py>,
-        t: &Bound<'py, PyAny>,
-    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-        let (times, single) = match t.extract::<f64>() {
-            Ok(x) => (vec![x], true),
-            Err(_) => {
-                let a: ArrayLike<'_> = t.extract()?;
-                (a.as_array().iter().copied().collect(), false)
-            }
-        };
-        let s = self.traj.sample(&times);
-        let n = self.traj.n();
-        Ok((
-            to_numpy(py, s.q, times.len(), single, &[n])?,
-            to_numpy(py, s.qd, times.len(), single, &[n])?,
-            to_numpy(py, s.qdd, times.len(), single, &[n])?,
-        ))
-    }
-    #[getter]
-    fn a<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        mat(py, &self.traj.a)
-    }
-    #[getter]
-    fn b<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        mat(py, &self.traj.b)
-    }
-    #[getter]
-    fn q0<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_slice(py, &self.traj.q0)
-    }
-    #[getter]
-    fn w_f(&self) -> f64 {
-        self.traj.w_f
-    }
-    #[getter]
-    fn period(&self) -> f64 {
-        self.traj.period()
-    }
-    #[getter]
-    fn harmonics(&self) -> usize {
-        self.traj.harmonics()
-    }
-    fn to_json(&self) -> String {
-        serde_json::to_string_pretty(&self.traj).expect("serialisable")
-    }
-    #[staticmethod]
-    fn from_json(text: &str) -> PyResult<Self> {
-        let t: FourierTrajectory = serde_json::from_str(text).map_err(|e| Error::Json {
-            context: "Fourier trajectory".into(),
-            message: e.to_string(),
-        })?;
-        Ok(Self {
-            traj: FourierTrajectory::new(t.w_f, t.q0, t.a, t.b)?,
-        })
-    }
-    fn __repr__(&self) -> String {
-        format!(
-            "FourierTrajectory(n={}, harmonics={}, period={:.3} s)",
-            self.traj.n(),
-            self.traj.harmonics(),
-            self.traj.period()
-        )
-    }
-}
 
 /// A designed excitation: `trajectory` (a FourierTrajectory), `cond` (cond of the base
 /// regressor), `value` (the criterion) and `evaluations`.
@@ -526,39 +401,4 @@ pub(crate) fn identify_global_linear(
         )
     })?;
     Ok(PyGlobalLinear { fit })
-}
-
-/// Preprocesses a real recording: resample `t`, `q`, `tau` (and `qd` when logged) onto a
-/// uniform grid at `rate` Hz, zero-phase Butterworth low-pass (`order`, `cutoff` Hz; None = no
-/// filter) on qd and tau (and q with `filter_position`), qdd by differentiating the filtered
-/// qd, drop `trim` s at both ends and keep every `decimate`-th sample. Returns a Recording with
-/// qd and qdd.
-#[pyfunction]
-#[pyo3(signature = (t, q, tau, qd=None, *, rate=1000.0, cutoff=Some(10.0), order=4, decimate=10, trim=0.5, filter_position=false, name="recording"))]
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn preprocess(
-    py: Python<'_>,
-    t: ArrayLike<'_>,
-    q: ArrayLike<'_>,
-    tau: ArrayLike<'_>,
-    qd: Option<ArrayLike<'_>>,
-    rate: f64,
-    cutoff: Option<f64>,
-    order: usize,
-    decimate: usize,
-    trim: f64,
-    filter_position: bool,
-    name: &str,
-) -> PyResult<PyRecording> {
-    let rec = PyRecording::build(t, q, tau, qd, None, name)?;
-    let options = PreprocessOptions {
-        rate,
-        cutoff,
-        order,
-        filter_position,
-        trim,
-        decimate,
-    };
-    let out: Recording = py.detach(|| preprocess_rs(&rec, &options))?;
-    Ok(PyRecording { rec: Arc::new(out) })
 }

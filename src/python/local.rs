@@ -1,13 +1,15 @@
-//! The paper's method in Python: `OperatingPoint`, `Plan` and `Experiment`, `Recording`,
-//! `LocalModel`, and the functions `plan_experiments`, `simulate` and `identify_local`.
+//! The paper's method in Python: `OperatingPoint`, `Plan` and `Experiment`, `LocalModel`, and
+//! the functions `plan_experiments` and `identify_local` (mirrors `crate::local`).
 
 use std::sync::Arc;
 
-use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use super::arrays::{matrix_to_numpy as mat, read_batch, to_numpy};
+use super::arrays::{
+    matrix_to_numpy as mat, per_joint, read_batch, rows, to_numpy, vec1, vector, ArrayLike,
+};
+use super::recording::PyRecording;
 use super::robot::PyRobot;
 use crate::document::Document;
 use crate::error::{Error, Result};
@@ -17,48 +19,6 @@ use crate::local::{
     PlanOptions, Size,
 };
 use crate::recording::Recording;
-use crate::simulation::{simulate_plan, Friction, SimulationOptions};
-
-type ArrayLike<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
-
-fn vec1<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyAny> {
-    PyArray1::from_slice(py, v).into_any()
-}
-
-fn rows<'py>(py: Python<'py>, v: &[f64], n: usize) -> PyResult<Bound<'py, PyAny>> {
-    to_numpy(py, v.to_vec(), v.len() / n.max(1), false, &[n])
-}
-
-/// A 1-D array-like of length `n` (or a scalar broadcast to `n`).
-fn per_joint(name: &str, value: &Bound<'_, PyAny>, n: usize) -> PyResult<Vec<f64>> {
-    if let Ok(x) = value.extract::<f64>() {
-        return Ok(vec![x; n]);
-    }
-    let arr: ArrayLike<'_> = value.extract().map_err(|_| Error::InvalidArgument {
-        argument: name.into(),
-        message: "expected a number or a sequence of numbers".into(),
-    })?;
-    if arr.shape() != [n] {
-        return Err(Error::Shape {
-            argument: name.into(),
-            expected: format!("a number or shape ({n},)"),
-            got: format!("shape {:?}", arr.shape()),
-        }
-        .into());
-    }
-    Ok(arr.as_array().iter().copied().collect())
-}
-
-fn vector(name: &str, a: &ArrayLike<'_>) -> Result<Vec<f64>> {
-    if a.ndim() != 1 {
-        return Err(Error::Shape {
-            argument: name.into(),
-            expected: "a 1-D array".into(),
-            got: format!("shape {:?}", a.shape()),
-        });
-    }
-    Ok(a.as_array().iter().copied().collect())
-}
 
 /// An operating point `P = (q*, qd*, qdd*)`: joint positions (rad or m), velocities (rad/s or
 /// m/s) and accelerations (rad/s^2 or m/s^2), each of shape `(n,)`.
@@ -341,195 +301,6 @@ pub(crate) fn plan_experiments(
     Ok(PyPlan {
         plan: Arc::new(plan),
     })
-}
-
-/// A recording of one run: `t` (s, `(m,)`, increasing), `q` (rad, `(m, n)`), `tau` (N m,
-/// `(m, n)`), and optionally `qd`, `qdd` when the robot logs them.
-#[pyclass(name = "Recording", module = "perturbid_rs", frozen)]
-#[derive(Clone)]
-pub(crate) struct PyRecording {
-    pub rec: Arc<Recording>,
-}
-
-fn matrix_rows(
-    name: &str,
-    a: &ArrayLike<'_>,
-    m: usize,
-    n: Option<usize>,
-) -> Result<(usize, Vec<f64>)> {
-    let shape = a.shape().to_vec();
-    match shape.as_slice() {
-        [rows, cols] if *rows == m && n.is_none_or(|n| n == *cols) => {
-            Ok((*cols, a.as_array().iter().copied().collect()))
-        }
-        _ => Err(Error::Shape {
-            argument: name.into(),
-            expected: format!(
-                "shape ({m}, {}) like t",
-                n.map_or("n".to_string(), |n| n.to_string())
-            ),
-            got: format!("shape {shape:?}"),
-        }),
-    }
-}
-
-impl PyRecording {
-    /// A checked recording from numpy arrays.
-    pub(crate) fn build(
-        t: ArrayLike<'_>,
-        q: ArrayLike<'_>,
-        tau: ArrayLike<'_>,
-        qd: Option<ArrayLike<'_>>,
-        qdd: Option<ArrayLike<'_>>,
-        name: &str,
-    ) -> Result<Recording> {
-        let t = vector("t", &t)?;
-        let m = t.len();
-        let (n, q) = matrix_rows("q", &q, m, None)?;
-        let (_, tau) = matrix_rows("tau", &tau, m, Some(n))?;
-        let qd = qd
-            .map(|a| matrix_rows("qd", &a, m, Some(n)).map(|r| r.1))
-            .transpose()?;
-        let qdd = qdd
-            .map(|a| matrix_rows("qdd", &a, m, Some(n)).map(|r| r.1))
-            .transpose()?;
-        Recording::new(name, n, t, q, tau, qd, qdd)
-    }
-}
-
-#[pymethods]
-impl PyRecording {
-    #[new]
-    #[pyo3(signature = (t, q, tau, qd=None, qdd=None, name="recording"))]
-    fn new(
-        t: ArrayLike<'_>,
-        q: ArrayLike<'_>,
-        tau: ArrayLike<'_>,
-        qd: Option<ArrayLike<'_>>,
-        qdd: Option<ArrayLike<'_>>,
-        name: &str,
-    ) -> PyResult<Self> {
-        Ok(Self {
-            rec: Arc::new(Self::build(t, q, tau, qd, qdd, name)?),
-        })
-    }
-    #[getter]
-    fn name(&self) -> String {
-        self.rec.name.clone()
-    }
-    #[getter]
-    fn n(&self) -> usize {
-        self.rec.n
-    }
-    #[getter]
-    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        vec1(py, &self.rec.t)
-    }
-    #[getter]
-    fn q<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        rows(py, &self.rec.q, self.rec.n)
-    }
-    #[getter]
-    fn tau<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        rows(py, &self.rec.tau, self.rec.n)
-    }
-    #[getter]
-    fn qd<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
-        self.rec
-            .qd
-            .as_ref()
-            .map(|v| rows(py, v, self.rec.n))
-            .transpose()
-    }
-    #[getter]
-    fn qdd<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
-        self.rec
-            .qdd
-            .as_ref()
-            .map(|v| rows(py, v, self.rec.n))
-            .transpose()
-    }
-    fn __len__(&self) -> usize {
-        self.rec.len()
-    }
-    fn __repr__(&self) -> String {
-        format!(
-            "Recording('{}', samples={}, joints={})",
-            self.rec.name,
-            self.rec.len(),
-            self.rec.n
-        )
-    }
-}
-
-/// The `friction` argument of `simulate`: a name ('urdf') or anything else (a dict).
-#[derive(FromPyObject)]
-pub(crate) enum FrictionArg<'py> {
-    Name(String),
-    Other(Bound<'py, PyAny>),
-}
-
-/// Simulates what the robot would log running every experiment of `plan`: torques from the
-/// dynamics with `gravity`, `friction` ('urdf', the default: the URDF's `<dynamics damping
-/// friction>`; None: none; or a dict with 'viscous' and 'coulomb', a number or one per joint), Gaussian `torque_noise` (N m) and
-/// `position_noise` (rad) standard deviations, encoder `quantization` (rad per count), seeded.
-/// Returns one Recording per experiment, in the plan's order.
-#[pyfunction]
-#[pyo3(signature = (robot, plan, gravity=true, friction=Some(FrictionArg::Name("urdf".into())), torque_noise=None, position_noise=None, quantization=None, seed=0))]
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn simulate(
-    py: Python<'_>,
-    robot: &PyRobot,
-    plan: &PyPlan,
-    gravity: bool,
-    friction: Option<FrictionArg<'_>>,
-    torque_noise: Option<Bound<'_, PyAny>>,
-    position_noise: Option<Bound<'_, PyAny>>,
-    quantization: Option<Bound<'_, PyAny>>,
-    seed: u64,
-) -> PyResult<Vec<PyRecording>> {
-    let model = &robot.model;
-    let n = model.nv;
-    let mut o = SimulationOptions::new(model);
-    o.gravity = gravity.into();
-    o.seed = seed;
-    let refuse = |what: String| Error::InvalidArgument {
-        argument: "friction".into(),
-        message: format!("{what}; expected 'urdf', None or a dict with 'viscous' and 'coulomb'"),
-    };
-    o.friction = match &friction {
-        None => Friction::none(n),
-        Some(FrictionArg::Name(name)) if name == "urdf" => Friction::from_model(model),
-        Some(FrictionArg::Name(name)) => return Err(refuse(format!("'{name}'")).into()),
-        Some(FrictionArg::Other(f)) => {
-            let d = f.cast::<PyDict>().map_err(|_| refuse(f.to_string()))?;
-            let get = |k: &str| -> PyResult<Vec<f64>> {
-                match d.get_item(k)? {
-                    Some(v) => per_joint(&format!("friction['{k}']"), &v, n),
-                    None => Ok(vec![0.0; n]),
-                }
-            };
-            Friction {
-                viscous: get("viscous")?,
-                coulomb: get("coulomb")?,
-            }
-        }
-    };
-    for (target, name, value) in [
-        (&mut o.torque_noise, "torque_noise", &torque_noise),
-        (&mut o.position_noise, "position_noise", &position_noise),
-        (&mut o.quantization, "quantization", &quantization),
-    ] {
-        if let Some(v) = value {
-            *target = per_joint(name, v, n)?;
-        }
-    }
-    let plan = plan.plan.clone();
-    let recs = py.detach(|| simulate_plan(model, &plan, &o))?;
-    Ok(recs
-        .into_iter()
-        .map(|r| PyRecording { rec: Arc::new(r) })
-        .collect())
 }
 
 /// Identifies the local model from `plan` and `recordings` (one per experiment, in order).

@@ -8,7 +8,11 @@ mod direct;
 mod errors;
 mod linearization;
 mod local;
+mod preprocess;
+mod recording;
 mod robot;
+mod simulation;
+mod trajectory;
 
 use pyo3::prelude::*;
 
@@ -20,19 +24,19 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<local::PyOperatingPoint>()?;
     m.add_class::<local::PyPlan>()?;
     m.add_class::<local::PyExperiment>()?;
-    m.add_class::<local::PyRecording>()?;
+    m.add_class::<recording::PyRecording>()?;
     m.add_class::<local::PyLocalModel>()?;
     m.add_function(wrap_pyfunction!(local::plan_experiments, m)?)?;
-    m.add_function(wrap_pyfunction!(local::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(simulation::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(local::identify_local, m)?)?;
-    m.add_class::<direct::PyFourier>()?;
+    m.add_class::<trajectory::PyFourier>()?;
     m.add_class::<direct::PyExcitationDesign>()?;
     m.add_class::<direct::PyBaseModel>()?;
     m.add_class::<direct::PyGlobalLinear>()?;
     m.add_function(wrap_pyfunction!(direct::design_excitation, m)?)?;
     m.add_function(wrap_pyfunction!(direct::identify_base_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(direct::identify_global_linear, m)?)?;
-    m.add_function(wrap_pyfunction!(direct::preprocess, m)?)?;
+    m.add_function(wrap_pyfunction!(preprocess::preprocess, m)?)?;
     m.add_function(wrap_pyfunction!(cli::cli, m)?)?;
     errors::register(m)?;
     m.add_function(wrap_pyfunction!(robot::a465_urdf, m)?)?;

@@ -4,9 +4,10 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::{Mutex, MutexGuard};
 
-use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn};
+use numpy::PyArray1;
 use pyo3::prelude::*;
 
+use super::arrays::ArrayLike;
 use super::arrays::{read_batch, to_numpy};
 use super::linearization::PyLinearization;
 use crate::algorithms::parallel::{self, Workspace};
@@ -14,8 +15,6 @@ use crate::error::Result;
 use crate::gravity::Gravity;
 use crate::states::States;
 use crate::{robots, urdf, Model};
-
-type ArrayLike<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 
 /// A robot model (immutable) with the dynamics algorithms.
 ///

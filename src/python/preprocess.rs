@@ -1,0 +1,46 @@
+//! `preprocess` in Python: real logs to uniform, filtered, differentiated samples (mirrors
+//! `crate::preprocess`).
+
+use pyo3::prelude::*;
+
+use super::arrays::ArrayLike;
+use super::recording::PyRecording;
+use std::sync::Arc;
+
+use crate::preprocess::{preprocess as preprocess_rs, PreprocessOptions};
+use crate::recording::Recording;
+
+/// Preprocesses a real recording: resample `t`, `q`, `tau` (and `qd` when logged) onto a
+/// uniform grid at `rate` Hz, zero-phase Butterworth low-pass (`order`, `cutoff` Hz; None = no
+/// filter) on qd and tau (and q with `filter_position`), qdd by differentiating the filtered
+/// qd, drop `trim` s at both ends and keep every `decimate`-th sample. Returns a Recording with
+/// qd and qdd.
+#[pyfunction]
+#[pyo3(signature = (t, q, tau, qd=None, *, rate=1000.0, cutoff=Some(10.0), order=4, decimate=10, trim=0.5, filter_position=false, name="recording"))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn preprocess(
+    py: Python<'_>,
+    t: ArrayLike<'_>,
+    q: ArrayLike<'_>,
+    tau: ArrayLike<'_>,
+    qd: Option<ArrayLike<'_>>,
+    rate: f64,
+    cutoff: Option<f64>,
+    order: usize,
+    decimate: usize,
+    trim: f64,
+    filter_position: bool,
+    name: &str,
+) -> PyResult<PyRecording> {
+    let rec = PyRecording::build(t, q, tau, qd, None, name)?;
+    let options = PreprocessOptions {
+        rate,
+        cutoff,
+        order,
+        filter_position,
+        trim,
+        decimate,
+    };
+    let out: Recording = py.detach(|| preprocess_rs(&rec, &options))?;
+    Ok(PyRecording { rec: Arc::new(out) })
+}

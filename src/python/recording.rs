@@ -1,0 +1,129 @@
+//! `Recording` in Python: what a robot logs (mirrors `crate::recording`).
+
+use std::sync::Arc;
+
+use numpy::PyUntypedArrayMethods;
+use pyo3::prelude::*;
+
+use super::arrays::{rows, vec1, vector, ArrayLike};
+use crate::error::{Error, Result};
+use crate::recording::Recording;
+
+/// A recording of one run: `t` (s, `(m,)`, increasing), `q` (rad, `(m, n)`), `tau` (N m,
+/// `(m, n)`), and optionally `qd`, `qdd` when the robot logs them.
+#[pyclass(name = "Recording", module = "perturbid_rs", frozen)]
+#[derive(Clone)]
+pub(crate) struct PyRecording {
+    pub rec: Arc<Recording>,
+}
+
+fn matrix_rows(
+    name: &str,
+    a: &ArrayLike<'_>,
+    m: usize,
+    n: Option<usize>,
+) -> Result<(usize, Vec<f64>)> {
+    let shape = a.shape().to_vec();
+    match shape.as_slice() {
+        [rows, cols] if *rows == m && n.is_none_or(|n| n == *cols) => {
+            Ok((*cols, a.as_array().iter().copied().collect()))
+        }
+        _ => Err(Error::Shape {
+            argument: name.into(),
+            expected: format!(
+                "shape ({m}, {}) like t",
+                n.map_or("n".to_string(), |n| n.to_string())
+            ),
+            got: format!("shape {shape:?}"),
+        }),
+    }
+}
+
+impl PyRecording {
+    /// A checked recording from numpy arrays.
+    pub(crate) fn build(
+        t: ArrayLike<'_>,
+        q: ArrayLike<'_>,
+        tau: ArrayLike<'_>,
+        qd: Option<ArrayLike<'_>>,
+        qdd: Option<ArrayLike<'_>>,
+        name: &str,
+    ) -> Result<Recording> {
+        let t = vector("t", &t)?;
+        let m = t.len();
+        let (n, q) = matrix_rows("q", &q, m, None)?;
+        let (_, tau) = matrix_rows("tau", &tau, m, Some(n))?;
+        let qd = qd
+            .map(|a| matrix_rows("qd", &a, m, Some(n)).map(|r| r.1))
+            .transpose()?;
+        let qdd = qdd
+            .map(|a| matrix_rows("qdd", &a, m, Some(n)).map(|r| r.1))
+            .transpose()?;
+        Recording::new(name, n, t, q, tau, qd, qdd)
+    }
+}
+
+#[pymethods]
+impl PyRecording {
+    #[new]
+    #[pyo3(signature = (t, q, tau, qd=None, qdd=None, name="recording"))]
+    fn new(
+        t: ArrayLike<'_>,
+        q: ArrayLike<'_>,
+        tau: ArrayLike<'_>,
+        qd: Option<ArrayLike<'_>>,
+        qdd: Option<ArrayLike<'_>>,
+        name: &str,
+    ) -> PyResult<Self> {
+        Ok(Self {
+            rec: Arc::new(Self::build(t, q, tau, qd, qdd, name)?),
+        })
+    }
+    #[getter]
+    fn name(&self) -> String {
+        self.rec.name.clone()
+    }
+    #[getter]
+    fn n(&self) -> usize {
+        self.rec.n
+    }
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        vec1(py, &self.rec.t)
+    }
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        rows(py, &self.rec.q, self.rec.n)
+    }
+    #[getter]
+    fn tau<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        rows(py, &self.rec.tau, self.rec.n)
+    }
+    #[getter]
+    fn qd<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.rec
+            .qd
+            .as_ref()
+            .map(|v| rows(py, v, self.rec.n))
+            .transpose()
+    }
+    #[getter]
+    fn qdd<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.rec
+            .qdd
+            .as_ref()
+            .map(|v| rows(py, v, self.rec.n))
+            .transpose()
+    }
+    fn __len__(&self) -> usize {
+        self.rec.len()
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Recording('{}', samples={}, joints={})",
+            self.rec.name,
+            self.rec.len(),
+            self.rec.n
+        )
+    }
+}

@@ -1,0 +1,85 @@
+//! The [`Model`] from the bodies: degrees of freedom numbered (the independent moving joints in
+//! body order; mimic followers share their leader's), subtree ranges, caches, and the check
+//! that every degree of freedom moves some mass.
+
+use std::collections::HashMap;
+
+use nalgebra::Vector3;
+
+use super::bodies::Bodies;
+use super::convert::joint_limits;
+use super::graph::Graph;
+use super::roles::Role;
+use super::Builder;
+use crate::error::Result;
+use crate::model::{Model, STANDARD_GRAVITY};
+
+impl Builder<'_> {
+    pub(super) fn assemble(
+        &self,
+        graph: &Graph<'_>,
+        roles: &[Role],
+        walked: Bodies,
+    ) -> Result<Model> {
+        let robot = self.robot;
+        let Bodies {
+            mut bodies,
+            body_joint,
+            base_inertia,
+        } = walked;
+        let mut dof_of_joint: HashMap<usize, usize> = HashMap::new();
+        let mut joint_names = Vec::new();
+        let mut joint_kinds = Vec::new();
+        let mut limits = Vec::new();
+        for (b, &j) in body_joint.iter().enumerate() {
+            if let Role::Moving { leader, .. } = roles[j] {
+                if leader == j {
+                    dof_of_joint.insert(j, joint_names.len());
+                    joint_names.push(robot.joints[j].name.clone());
+                    joint_kinds.push(bodies[b].kind);
+                    limits.push(joint_limits(&robot.joints[j]));
+                }
+            }
+        }
+        for (b, &j) in body_joint.iter().enumerate() {
+            if let Role::Moving { leader, .. } = roles[j] {
+                bodies[b].dof = dof_of_joint[&leader];
+            }
+        }
+        // Subtree ranges (children come after their parent in pre-order).
+        let n = bodies.len();
+        for (i, b) in bodies.iter_mut().enumerate() {
+            b.subtree_end = i + 1;
+            b.refresh();
+        }
+        for i in (0..n).rev() {
+            if let Some(p) = bodies[i].parent {
+                bodies[p].subtree_end = bodies[p].subtree_end.max(bodies[i].subtree_end);
+            }
+        }
+        let coupled = bodies.len() != joint_names.len()
+            || bodies
+                .iter()
+                .any(|b| b.multiplier != 1.0 || b.offset != 0.0);
+        let joint_lines = bodies
+            .iter()
+            .map(|b| self.lines.joints.get(&b.joint).map(|j| j.0))
+            .collect();
+        let model = Model {
+            name: robot.name.clone(),
+            source: self.source.to_string(),
+            nv: joint_names.len(),
+            bodies,
+            joint_names,
+            joint_kinds,
+            limits,
+            gravity: Vector3::new(0.0, 0.0, -STANDARD_GRAVITY),
+            root_link: robot.links[graph.root].name.clone(),
+            base_mass: base_inertia.mass,
+            coupled,
+            joint_lines,
+        };
+        model.check_every_dof_moves_mass()?;
+        Ok(model)
+    }
+}

@@ -1,0 +1,129 @@
+//! What no robot can have: non-finite numbers, unusable axes, missing `<limit>` elements,
+//! inverted limits, and link inertias that no rigid body has.
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::convert::kind_name;
+use super::Builder;
+use crate::error::{Error, Result};
+
+impl Builder<'_> {
+    /// Finite numbers, a usable axis and a `<limit>` where the URDF requires one.
+    pub(super) fn check_joint_numbers(&self, joint: &urdf_rs::Joint) -> Result<()> {
+        let name = joint.name.as_str();
+        self.finite("joint", name, "origin xyz", &joint.origin.xyz.0)?;
+        self.finite("joint", name, "origin rpy", &joint.origin.rpy.0)?;
+        use urdf_rs::JointType::*;
+        if joint.joint_type == Fixed {
+            return Ok(());
+        }
+        let axis = joint.axis.xyz.0;
+        let norm = Vector3::from(axis).norm();
+        if !norm.is_finite() || norm < 1e-12 {
+            return Err(Error::InvalidAxis {
+                location: self.joint_location(name),
+                joint: name.to_string(),
+                axis,
+            });
+        }
+        if matches!(joint.joint_type, Revolute | Prismatic) {
+            let has_limit = self.lines.joints.get(name).map(|j| j.1).unwrap_or(true);
+            if !has_limit {
+                return Err(Error::MissingLimit {
+                    location: self.joint_location(name),
+                    joint: name.to_string(),
+                    kind: kind_name(&joint.joint_type),
+                });
+            }
+        }
+        let l = &joint.limit;
+        for (field, value) in [
+            ("limit lower", l.lower),
+            ("limit upper", l.upper),
+            ("limit effort", l.effort),
+            ("limit velocity", l.velocity),
+            ("limit acceleration", l.acceleration),
+        ] {
+            // Infinite limits mean "no limit" (URDF 1.2); NaN is never meaningful.
+            if value.is_nan() {
+                return Err(Error::NonFiniteUrdf {
+                    location: self.joint_location(name),
+                    element: "joint",
+                    name: name.to_string(),
+                    field,
+                    value,
+                });
+            }
+        }
+        if joint.joint_type != Continuous && l.lower > l.upper {
+            return Err(Error::InvalidArgument {
+                argument: format!("{}: joint '{name}' <limit>", self.joint_location(name)),
+                message: format!("lower ({}) is above upper ({})", l.lower, l.upper),
+            });
+        }
+        if let Some(d) = &joint.dynamics {
+            self.finite(
+                "joint",
+                name,
+                "dynamics damping/friction",
+                &[d.damping, d.friction],
+            )?;
+        }
+        if let Some(m) = &joint.mimic {
+            self.finite(
+                "joint",
+                name,
+                "mimic multiplier/offset",
+                &[m.multiplier.unwrap_or(1.0), m.offset.unwrap_or(0.0)],
+            )?;
+        }
+        Ok(())
+    }
+
+    /// A link inertia must be one a rigid body can have (beyond rounding).
+    pub(super) fn check_link_inertial(&self, link: &urdf_rs::Link) -> Result<()> {
+        let name = link.name.as_str();
+        let inertial = &link.inertial;
+        let i = &inertial.inertia;
+        self.finite("link", name, "inertial origin xyz", &inertial.origin.xyz.0)?;
+        self.finite("link", name, "inertial origin rpy", &inertial.origin.rpy.0)?;
+        self.finite("link", name, "mass", &[inertial.mass.value])?;
+        self.finite(
+            "link",
+            name,
+            "inertia",
+            &[i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz],
+        )?;
+        let invalid = |reason: String| Error::InvalidInertia {
+            location: self.link_location(name),
+            link: name.to_string(),
+            reason,
+        };
+        if inertial.mass.value < 0.0 {
+            return Err(invalid(format!(
+                "mass {} kg is negative",
+                inertial.mass.value
+            )));
+        }
+        let m = Matrix3::new(
+            i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz,
+        );
+        let mut eig: Vec<f64> = m.symmetric_eigenvalues().iter().copied().collect();
+        eig.sort_by(|a, b| a.total_cmp(b));
+        // "Rounding": URDFs print inertias to a few significant digits.
+        let tol = 1e-6 * eig.iter().map(|e| e.abs()).sum::<f64>() + 1e-12;
+        if eig[0] < -tol {
+            return Err(invalid(format!(
+                "the inertia tensor is not positive semi-definite (principal moments {:.6e}, {:.6e}, {:.6e} kg m^2)",
+                eig[0], eig[1], eig[2]
+            )));
+        }
+        if self.options.check_triangle_inequality && eig[0] + eig[1] < eig[2] - tol {
+            return Err(invalid(format!(
+                "principal moments {:.6e} + {:.6e} < {:.6e} kg m^2 break the triangle inequality (no rigid body has them; load with the triangle-inequality check off to accept lumped rotor inertias)",
+                eig[0], eig[1], eig[2]
+            )));
+        }
+        Ok(())
+    }
+}
