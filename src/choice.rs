@@ -4,7 +4,7 @@
 
 /// Declares a `Copy` enum of named choices:
 ///
-/// ```ignore
+/// ```text
 /// choice! {
 ///     /// What the design minimises.
 ///     pub enum Criterion ("criterion") {

@@ -13,6 +13,13 @@ use crate::error::{Error, Result};
 /// Loading checks the tag (a file of another kind or a newer version is refused by name), then
 /// the document's own consistency ([`Document::validate`]); errors name the source and the line
 /// and column or the field. Saving writes a temporary file and renames it into place.
+///
+/// ```
+/// use perturbid_rs::{Document, LocalModel, Plan};
+/// let err = Plan::from_json(r#"{"format": "perturbid-local-model/1"}"#).unwrap_err();
+/// assert!(err.to_string().contains("expected 'perturbid-plan/1'"));
+/// assert_eq!(LocalModel::tag(), "perturbid-local-model/1");
+/// ```
 pub trait Document: Serialize + DeserializeOwned {
     /// The kind, e.g. `perturbid-local-model`.
     const FORMAT: &'static str;
@@ -34,7 +41,7 @@ pub trait Document: Serialize + DeserializeOwned {
         serde_json::to_string_pretty(self).expect("library documents always serialise")
     }
 
-    /// Parses and checks a document; errors say "the <WHAT>" as the source.
+    /// Parses and checks a document; errors name the document by `WHAT`.
     fn from_json(text: &str) -> Result<Self> {
         Self::from_json_in(text, Self::WHAT)
     }

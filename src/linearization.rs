@@ -41,6 +41,17 @@ impl Linearization {
 
 /// Linearises the inverse dynamics at `(q, qd, qdd)` (length `model.nv` each), analytically.
 /// `gravity` switches gravity on in every term.
+///
+/// ```
+/// use perturbid_rs::{linearize, mass_matrix, robots, Data, Gravity};
+/// let model = robots::builtin("a465")?;
+/// let mut data = Data::new(&model);
+/// let (q, qd, qdd) = ([0.1; 6], [0.2; 6], [0.3; 6]);
+/// let lin = linearize(&model, &mut data, &q, &qd, &qdd, Gravity::Excluded)?;
+/// mass_matrix(&model, &mut data, &q)?;
+/// assert!((&lin.d - &data.m).norm() < 1e-12); // D* = M(q*)
+/// # Ok::<(), perturbid_rs::Error>(())
+/// ```
 pub fn linearize(
     model: &Model,
     data: &mut Data,

@@ -7,7 +7,7 @@ use crate::recording::Recording;
 use crate::signal::{butterworth_lowpass, differentiate, filtfilt, interpolate};
 
 /// Options of [`preprocess`]. The defaults follow the common protocol (and the reference
-/// result of `shared/data/panda-gaz2019`): 1 kHz, 4th-order Butterworth at 10 Hz applied
+/// result on the real Panda log, docs/data.md): 1 kHz, 4th-order Butterworth at 10 Hz applied
 /// zero-phase to qd and tau, qdd from the filtered qd, 0.5 s dropped at both ends, every 10th
 /// sample kept.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,7 +46,7 @@ impl Default for PreprocessOptions {
 /// decimates. The result is a recording with `qd` and `qdd`, named `<name> (preprocessed)`.
 pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Recording> {
     let o = options;
-    if !(o.rate.is_finite() && o.rate > 0.0) || o.decimate == 0 || !(o.trim >= 0.0) {
+    if !(o.rate.is_finite() && o.rate > 0.0) || o.decimate == 0 || o.trim.is_nan() || o.trim < 0.0 {
         return Err(Error::InvalidArgument {
             argument: "preprocess options".into(),
             message: format!(

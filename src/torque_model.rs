@@ -100,7 +100,7 @@ impl TorqueModel for GlobalLinearModel {
 /// Any model file of this library, told apart by its `format` tag.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ModelFile {
-    Local(LocalModel),
+    Local(Box<LocalModel>),
     Base(BaseModel),
     GlobalLinear(GlobalLinearModel),
 }
@@ -112,7 +112,7 @@ impl ModelFile {
         let tag = crate::document::format_tag(text, source)?;
         let kind = tag.split('/').next().unwrap_or_default();
         Ok(if kind == LocalModel::FORMAT {
-            ModelFile::Local(LocalModel::from_json_in(text, source)?)
+            ModelFile::Local(Box::new(LocalModel::from_json_in(text, source)?))
         } else if kind == BaseModel::FORMAT {
             ModelFile::Base(BaseModel::from_json_in(text, source)?)
         } else if kind == GlobalLinearModel::FORMAT {

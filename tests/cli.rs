@@ -257,7 +257,7 @@ fn bad_inputs_get_one_line_errors_and_no_output() {
     // a missing column
     let f = csv(
         "missing.csv",
-        &format!("t,q1,q2,q3,q4,q5,tau1,tau2,tau3,tau4,tau5,tau6\n0,0,0,0,0,0,0,0,0,0,0,0\n"),
+        "t,q1,q2,q3,q4,q5,tau1,tau2,tau3,tau4,tau5,tau6\n0,0,0,0,0,0,0,0,0,0,0,0\n",
     );
     fails(
         &["identify", s(&plan), &f, &f, "--out", s(&model)],
@@ -380,7 +380,7 @@ fn paper_reproduction() {
             .map(|x| x.parse().unwrap())
             .collect()
     };
-    // A465.md: the first column of M(q*) within 0.002 of the paper's "actual" row
+    // docs/a465.md: the first column of M(q*) within 0.002 of the paper's "actual" row
     for (a, p) in row("actual").iter().zip(a465::TABLE3_D_COLUMN1) {
         assert!((a - p).abs() < 0.002, "actual {a} vs {p}");
     }

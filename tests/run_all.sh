@@ -9,10 +9,13 @@ PY=${PYTHON:-python3}
 
 # test dependencies first: the Rust Panda test finds example-robot-data's URDF through Python
 deps=$("$PY" -c "import tomllib; print(' '.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies']['test']))")
-"$PY" -m pip install --quiet $deps
+"$PY" -m pip install --quiet "maturin>=1.7,<2" $deps
 
 PYTHON="$PY" cargo test --release --features cli
 cargo bench --no-run --quiet
+# lints and docs without warnings, over every feature (python includes cli)
+cargo clippy --release --all-targets --features python --quiet -- -D warnings
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --features python --quiet
 
 rm -rf target/wheels
 "$PY" -m maturin build --release --quiet -o target/wheels

@@ -43,6 +43,7 @@ def main(argv: list[str] | None = None) -> int:
     model = identify_local(plan, simulate(robot, plan, gravity=False, friction=None))
     noisy = identify_local(plan, simulate(robot, plan, gravity=False, friction=None, torque_noise=0.05, seed=1))
     actual = robot.mass_matrix(Q)
+    assert model.D is not None and noisy.D is not None, "the plan has a D experiment"
 
     print("CRS A465 (kinsheel2010) at the operating point of Kinsheel & Taha (2010), Table 2")
     print("local model identified from simulated perturbation experiments; gravity and friction")

@@ -1,12 +1,41 @@
 """Type stubs of the extension module perturbid_rs._core (implemented in Rust)."""
 
 from os import PathLike
-from typing import Literal, Mapping, Optional, Sequence, Union
+from typing import Literal, Mapping, Optional, Sequence, Union, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __version__: str
+
+__all__ = [
+    "BaseParameterModel",
+    "ExcitationDesign",
+    "Experiment",
+    "FileError",
+    "FourierTrajectory",
+    "GlobalLinearModel",
+    "InputError",
+    "Linearization",
+    "LocalModel",
+    "ModelError",
+    "NumericalError",
+    "OperatingPoint",
+    "PerturbidError",
+    "Plan",
+    "Recording",
+    "Robot",
+    "__version__",
+    "a465_urdf",
+    "cli",
+    "design_excitation",
+    "identify_base_parameters",
+    "identify_global_linear",
+    "identify_local",
+    "plan_experiments",
+    "preprocess",
+    "simulate",
+]
 
 class PerturbidError(Exception):
     """Base class of all perturbid_rs errors."""
@@ -23,6 +52,7 @@ class NumericalError(PerturbidError):
 class FileError(PerturbidError):
     """A file that cannot be read or written."""
 
+@final
 class Linearization:
     """The linearisation ``tau - T* ~= D dqdd + H dqd + G dq`` at an operating point.
 
@@ -46,6 +76,7 @@ class Linearization:
     def G_static(self) -> NDArray[np.float64]:
         """d tau / d q at rest at q* (gravity stiffness dg/dq), shape (n, n)."""
 
+@final
 class Robot:
     """A robot model with its dynamics algorithms.
 
@@ -125,9 +156,10 @@ def a465_urdf(variant: str = "kinsheel2010") -> str:
 
 # --- the paper's method -------------------------------------------------------------------
 
+@final
 class OperatingPoint:
     """P = (q*, qd*, qdd*): rad, rad/s, rad/s^2 (m for prismatic joints), each shape (n,)."""
-    def __init__(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> None: ...
+    def __new__(cls, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> "OperatingPoint": ...
     @property
     def q(self) -> NDArray[np.float64]: ...
     @property
@@ -137,6 +169,7 @@ class OperatingPoint:
     @property
     def n(self) -> int: ...
 
+@final
 class Experiment:
     """One experiment of a plan: a rest-to-rest trajectory through K crossings."""
     @property
@@ -167,6 +200,7 @@ class Experiment:
     @property
     def duration(self) -> float: ...
 
+@final
 class Plan:
     """The experiments at an operating point for one robot."""
     @property
@@ -187,17 +221,18 @@ class Plan:
     @staticmethod
     def from_json(text: str) -> "Plan": ...
 
+@final
 class Recording:
     """What a robot logs: t (s, (m,)), q (rad, (m, n)), tau (N m, (m, n)), optional qd, qdd."""
-    def __init__(
-        self,
+    def __new__(
+        cls,
         t: ArrayLike,
         q: ArrayLike,
         tau: ArrayLike,
         qd: Optional[ArrayLike] = None,
         qdd: Optional[ArrayLike] = None,
         name: str = "recording",
-    ) -> None: ...
+    ) -> "Recording": ...
     @property
     def name(self) -> str: ...
     @property
@@ -214,6 +249,7 @@ class Recording:
     def qdd(self) -> Optional[NDArray[np.float64]]: ...
     def __len__(self) -> int: ...
 
+@final
 class LocalModel:
     """tau ~= T* + D (qdd - qdd*) + H (qd - qd*) + G (q - q*), with its uncertainty."""
     @property
@@ -297,10 +333,11 @@ def identify_local(
 
 # --- the direct method ----------------------------------------------------------------------
 
+@final
 class FourierTrajectory:
     """Eq. 16: q_i(t) = q0_i + sum_l a_il/(w_f l) sin(w_f l t) - b_il/(w_f l) cos(w_f l t).
     a, b: (n, L) in rad/s; q0: (n,) rad; w_f rad/s or base_frequency Hz (default 0.1)."""
-    def __init__(self, a: ArrayLike, b: ArrayLike, q0: ArrayLike, *, w_f: Optional[float] = None, base_frequency: Optional[float] = None) -> None: ...
+    def __new__(cls, a: ArrayLike, b: ArrayLike, q0: ArrayLike, *, w_f: Optional[float] = None, base_frequency: Optional[float] = None) -> "FourierTrajectory": ...
     def sample(self, t: Union[float, ArrayLike]) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """(q, qd, qdd) at t: (k, n) each for t of shape (k,), (n,) for a scalar."""
     @property
@@ -319,6 +356,7 @@ class FourierTrajectory:
     @staticmethod
     def from_json(text: str) -> "FourierTrajectory": ...
 
+@final
 class ExcitationDesign:
     @property
     def trajectory(self) -> FourierTrajectory: ...
@@ -330,6 +368,7 @@ class ExcitationDesign:
     def evaluations(self) -> int: ...
     def sample(self, t: Union[float, ArrayLike]) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...
 
+@final
 class BaseParameterModel:
     @property
     def theta_base(self) -> NDArray[np.float64]: ...
@@ -357,6 +396,7 @@ class BaseParameterModel:
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]: ...
     def to_json(self) -> str: ...
 
+@final
 class GlobalLinearModel:
     @property
     def D(self) -> NDArray[np.float64]: ...

@@ -23,8 +23,8 @@ pub fn forward_dynamics(
     bias_torque(model, data, q, qd, gravity)?;
     mass_matrix(model, data, q)?;
     let n = model.nv;
-    for i in 0..n {
-        data.qdd[i] = tau[i] - data.bias[i];
+    for (qdd, (t, b)) in data.qdd.iter_mut().zip(tau.iter().zip(data.bias.iter())) {
+        *qdd = t - b;
     }
     // Cholesky M = L L^T into the lower triangle of `chol`.
     let l = &mut data.chol;
@@ -34,7 +34,8 @@ pub fn forward_dynamics(
         for k in 0..j {
             d -= l[(j, k)] * l[(j, k)];
         }
-        if !(d > 0.0) {
+        // NaN fails too
+        if d.is_nan() || d <= 0.0 {
             return Err(Error::Numerical {
                 operation: "forward_dynamics".to_string(),
                 message: format!(

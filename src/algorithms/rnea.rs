@@ -15,6 +15,18 @@ use crate::model::Model;
 /// - `gravity`: include `g(q)` (gravity `model.gravity`, along -z of the base frame).
 ///
 /// Writes `data.tau` (`nv`, N m or N). Fails on a wrong length or a non-finite entry.
+///
+/// ```
+/// use perturbid_rs::{rnea, robots, Data, Gravity};
+/// let model = robots::builtin("a465")?;
+/// let mut data = Data::new(&model);
+/// let q = [0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0];
+/// rnea(&model, &mut data, &q, &[0.0; 6], &[0.0; 6], Gravity::Included)?;
+/// let holding = data.tau.clone(); // at rest: the gravity torques
+/// perturbid_rs::gravity_torque(&model, &mut data, &q)?;
+/// assert!((&holding - &data.tau).norm() < 1e-12);
+/// # Ok::<(), perturbid_rs::Error>(())
+/// ```
 pub fn rnea(
     model: &Model,
     data: &mut Data,

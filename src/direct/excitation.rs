@@ -191,7 +191,7 @@ impl Problem<'_> {
     }
 }
 
-/// Designs a Fourier excitation for `model` (METHOD.md section 8): COBYLA minimises the
+/// Designs a Fourier excitation for `model` (docs/method.md, section 8): COBYLA minimises the
 /// criterion over the coefficients and offsets subject to the limits (times `margin`), from a
 /// seeded random feasible start. `progress` is called every 100 evaluations. The result is
 /// checked against the full limits at 1 kHz over one period.

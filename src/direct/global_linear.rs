@@ -1,4 +1,4 @@
-//! The globally linearised model (METHOD.md section 8a, the paper's "direct method" rows):
+//! The globally linearised model (docs/method.md, section 8a, the paper's "direct method" rows):
 //! constant `D_g`, `H_g`, `G_g` and an offset fitted to all samples of an excitation in the form
 //! `tau = T + D_g (qdd - qdd*) + H_g (qd - qd*) + G_g (q - q*)`.
 

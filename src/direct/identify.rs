@@ -1,5 +1,5 @@
-//! Base-parameter identification (the direct method, METHOD.md section 8b): ordinary or weighted
-//! least squares of `tau = Phi_base(q, qd, qdd) theta_base` over all samples.
+//! Base-parameter identification (the direct method, docs/method.md, section 8b): ordinary or
+//! weighted least squares of `tau = Phi_base(q, qd, qdd) theta_base` over all samples.
 
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -79,8 +79,29 @@ pub struct BaseModel {
     pub samples: usize,
 }
 
-/// Identifies the base parameters of `model` from samples `q`, `qd`, `qdd`, `tau` (row-major,
-/// `k x nv` each; rad, rad/s, rad/s^2, N m).
+/// Identifies the base parameters of `model` from the samples of `states` (rad, rad/s,
+/// rad/s^2) and the torques `tau` (row-major `k x nv`, N m).
+///
+/// ```
+/// use perturbid_rs::direct::{identify_base_parameters, BaseOptions, FrictionTerms, Weighting};
+/// use perturbid_rs::{parallel, robots, Gravity, States, TorqueModel};
+/// let model = robots::builtin("a465:physical")?;
+/// let n = model.nv;
+/// // 500 states spread over the joint space, and the model's own torques
+/// let x = |s: usize, j: usize, f: f64| ((s * 7 + j * 3) as f64 * f).sin();
+/// let q: Vec<f64> = (0..500 * n).map(|i| x(i / n, i % n, 0.37)).collect();
+/// let qd: Vec<f64> = (0..500 * n).map(|i| x(i / n, i % n, 0.53)).collect();
+/// let qdd: Vec<f64> = (0..500 * n).map(|i| x(i / n, i % n, 0.71)).collect();
+/// let states = States::new(n, &q, Some(&qd), Some(&qdd))?;
+/// let mut tau = vec![0.0; q.len()];
+/// parallel::rnea(&model, &mut parallel::Workspace::new(&model), &states, Gravity::Included, &mut tau)?;
+/// let options = BaseOptions { friction: FrictionTerms::NONE, weighting: Weighting::Ols, ..BaseOptions::default() };
+/// let fit = identify_base_parameters(&model, &states, &tau, &options)?;
+/// let predicted = fit.on(&model)?.predict(&states)?;
+/// let error: f64 = predicted.iter().zip(&tau).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+/// assert!(error < 1e-8);
+/// # Ok::<(), perturbid_rs::Error>(())
+/// ```
 pub fn identify_base_parameters(
     model: &Model,
     states: &States<'_>,
@@ -152,7 +173,7 @@ impl Document for BaseModel {
 }
 
 impl BaseModel {
-    /// The model bound to the robot it was identified for, as a [`TorqueModel`]; fails when
+    /// The model bound to the robot it was identified for, as a [`crate::TorqueModel`]; fails when
     /// `robot` has other joints.
     pub fn on<'a>(&'a self, robot: &'a Model) -> Result<BaseModelOn<'a>> {
         self.check(robot)?;
@@ -189,7 +210,7 @@ impl BaseModel {
     }
 
     /// The mass matrix `M(q)` (`nv x nv`) of the identified parameters at `q`: column `j` is
-    /// `Phi(q, 0, e_j) theta - Phi(q, 0, 0) theta` (METHOD.md section 8b).
+    /// `Phi(q, 0, e_j) theta - Phi(q, 0, 0) theta` (docs/method.md, section 8b).
     pub fn mass_matrix(&self, model: &Model, q: &[f64]) -> Result<DMatrix<f64>> {
         self.check(model)?;
         let nv = model.nv;

@@ -1,5 +1,5 @@
-//! The classical direct method the paper compares with (Swevers et al. 2007; METHOD.md section
-//! 8): Fourier excitation ([`crate::trajectory::fourier`]) designed by [`design_excitation`],
+//! The classical direct method the paper compares with (Swevers et al. 2007; docs/method.md,
+//! section 8): Fourier excitation ([`crate::trajectory::fourier`]) designed by [`design_excitation`],
 //! the regressor of the inertial and friction parameters, base parameters by pivoted QR,
 //! OLS/WLS identification, and the globally linearised model.
 

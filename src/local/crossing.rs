@@ -1,4 +1,4 @@
-//! Values at a crossing from sampled data (METHOD.md section 7): local polynomial fits over a
+//! Values at a crossing from sampled data (docs/method.md, section 7): local polynomial fits over a
 //! window around the crossing time, and detection of the time offset between a plan and a
 //! recording.
 

@@ -1,4 +1,4 @@
-//! The separated least-squares identification of the local model (METHOD.md section 4) from a
+//! The separated least-squares identification of the local model (docs/method.md, section 4) from a
 //! plan and one recording per experiment.
 
 use nalgebra::DMatrix;

@@ -1,10 +1,34 @@
-//! The paper's method (Kinsheel & Taha 2010; METHOD.md sections 2-7): experiments that pass a
+//! The paper's method (Kinsheel & Taha 2010; docs/method.md, sections 2-7): experiments that pass a
 //! perturbed operating point, and separated regressions of the torque changes that give the
 //! local model `tau - T* = D* dqdd + H* dqd + G* dq`.
 //!
 //! The workflow: an [`OperatingPoint`], a [`Plan`] from [`plan_experiments`], one
 //! [`crate::Recording`] per experiment (from the robot, or rehearsed with
 //! [`crate::simulation::simulate_plan`]), and the [`LocalModel`] from [`identify_local`].
+//!
+//! ```
+//! use perturbid_rs::local::{identify_local, plan_experiments, Design, IdentifyOptions};
+//! use perturbid_rs::{linearize, robots, simulate_plan, Data, Friction, Gravity};
+//! use perturbid_rs::{OperatingPoint, PlanOptions, SimulationOptions};
+//! let model = robots::builtin("a465")?;
+//! let op = OperatingPoint::new(
+//!     vec![0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0],
+//!     vec![0.089, -0.106, 0.022, 0.056, 0.011, 0.014],
+//!     vec![-0.155, -0.5, 0.034, -0.291, -0.008, 0.171],
+//! )?;
+//! let options = PlanOptions { design: Design::Orthogonal, ..PlanOptions::default() };
+//! let plan = plan_experiments(&model, &op, &options)?;
+//! // rehearse on the model itself: gravity compensated, no friction, no noise
+//! let mut sim = SimulationOptions::new(&model);
+//! sim.gravity = Gravity::Excluded;
+//! sim.friction = Friction::none(model.nv);
+//! let recordings = simulate_plan(&model, &plan, &sim)?;
+//! let local = identify_local(&plan, &recordings, &IdentifyOptions::default())?;
+//! let truth = linearize(&model, &mut Data::new(&model), &op.q, &op.qd, &op.qdd, Gravity::Excluded)?;
+//! let d = local.d.as_ref().expect("the plan has a D experiment");
+//! assert!((&d.matrix - &truth.d).norm() < 1e-6 * truth.d.norm());
+//! # Ok::<(), perturbid_rs::Error>(())
+//! ```
 
 pub mod crossing;
 pub mod identify;

@@ -36,7 +36,7 @@ choice! {
         /// One regression per experiment with its own perturbed variable (the paper).
         Separated = "separated",
         /// All crossings stacked, `Gamma = [D H G] [dqdd; dqd; dq]`, with the measured deltas of
-        /// every variable (absorbs tracking errors; METHOD.md section 4).
+        /// every variable (absorbs tracking errors; docs/method.md, section 4).
         Combined = "combined",
     }
 }

@@ -16,8 +16,8 @@ use crate::trajectory::{
 };
 
 choice! {
-    /// The kind of an experiment (METHOD.md section 3); named `nominal`, `G_static`, `G`, `H`,
-    /// `D` in files and messages.
+    /// The kind of an experiment (docs/method.md, section 3); named `nominal`, `G_static`, `G`,
+    /// `H`, `D` in files and messages.
     #[derive(PartialOrd, Ord, Serialize, Deserialize)]
     pub enum ExperimentKind ("experiments") {
         /// Step 1: K crossings of P itself; `T*` is the mean torque.

@@ -153,7 +153,7 @@ fn markdown_report(r: &PaperResult, figs: &[String]) -> String {
     let mut s =
         String::from("# Kinsheel & Taha (ICARCV 2010) reproduced on the built-in CRS A465\n\n");
     s.push_str(
-        "Robot: the `kinsheel2010` A465 model (see `shared/A465.md`). Gravity and friction are excluded from the simulated \
+        "Robot: the `kinsheel2010` A465 model (see `docs/a465.md` in the repository). Gravity and friction are excluded from the simulated \
          torques, as the paper assumes them compensated. Everything below is computed by `perturbid paper`; \
          the numbers are also in `table2.csv`, `table3.csv` and `results.json`.\n\n",
     );

@@ -97,7 +97,8 @@ fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<FrictionTerms> {
 /// base regressor subject to the limits (times `margin`), starting and ending at rest when
 /// `rest`. COBYLA, seeded; `progress=True` prints the progress to stderr.
 #[pyfunction]
-#[pyo3(signature = (robot, harmonics=5, base_frequency=0.1, criterion="cond", seed=0, *, rest=true, samples=100, margin=0.9, max_evaluations=2000, friction=Some(FrictionNames::Many(vec!["viscous".into(), "coulomb".into()])), progress=false))]
+#[pyo3(signature = (robot, harmonics=5, base_frequency=0.1, criterion="cond", seed=0, *, rest=true, samples=100, margin=0.9, max_evaluations=2000, friction=Some(FrictionNames::Many(vec!["viscous".into(), "coulomb".into()])), progress=false),
+    text_signature = "(robot, harmonics=5, base_frequency=0.1, criterion='cond', seed=0, *, rest=True, samples=100, margin=0.9, max_evaluations=2000, friction=('viscous', 'coulomb'), progress=False)")]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn design_excitation(
     py: Python<'_>,

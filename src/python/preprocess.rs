@@ -16,7 +16,8 @@ use crate::recording::Recording;
 /// qd, drop `trim` s at both ends and keep every `decimate`-th sample. Returns a Recording with
 /// qd and qdd.
 #[pyfunction]
-#[pyo3(signature = (t, q, tau, qd=None, *, rate=1000.0, cutoff=Some(10.0), order=4, decimate=10, trim=0.5, filter_position=false, name="recording"))]
+#[pyo3(signature = (t, q, tau, qd=None, *, rate=1000.0, cutoff=Some(10.0), order=4, decimate=10, trim=0.5, filter_position=false, name="recording"),
+    text_signature = "(t, q, tau, qd=None, *, rate=1000.0, cutoff=10.0, order=4, decimate=10, trim=0.5, filter_position=False, name='recording')")]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn preprocess(
     py: Python<'_>,

@@ -25,7 +25,8 @@ pub(crate) enum FrictionArg<'py> {
 /// `position_noise` (rad) standard deviations, encoder `quantization` (rad per count), seeded.
 /// Returns one Recording per experiment, in the plan's order.
 #[pyfunction]
-#[pyo3(signature = (robot, plan, gravity=true, friction=Some(FrictionArg::Name("urdf".into())), torque_noise=None, position_noise=None, quantization=None, seed=0))]
+#[pyo3(signature = (robot, plan, gravity=true, friction=Some(FrictionArg::Name("urdf".into())), torque_noise=None, position_noise=None, quantization=None, seed=0),
+    text_signature = "(robot, plan, gravity=True, friction='urdf', torque_noise=None, position_noise=None, quantization=None, seed=0)")]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn simulate(
     py: Python<'_>,

@@ -1,4 +1,4 @@
-//! The CRS A465 arm of Kinsheel & Taha (ICARCV 2010), as documented in the project's A465 notes:
+//! The CRS A465 arm of Kinsheel & Taha (ICARCV 2010), as documented in docs/a465.md:
 //! six revolute joints, frames parallel to the base at q = 0 (arm pointing up).
 //!
 //! Variants:

@@ -9,6 +9,13 @@ use crate::model::Model;
 pub const BUILTIN: &[&str] = &["a465", "a465:kinsheel2010", "a465:physical"];
 
 /// A built-in robot by name: `a465` (the `kinsheel2010` variant) or `a465:VARIANT`.
+///
+/// ```
+/// let model = perturbid_rs::robots::builtin("a465:physical")?;
+/// assert_eq!(model.nv, 6);
+/// assert!(perturbid_rs::robots::builtin("puma").is_err());
+/// # Ok::<(), perturbid_rs::Error>(())
+/// ```
 pub fn builtin(name: &str) -> Result<Model> {
     let (robot, variant) = name
         .split_once(':')

@@ -14,7 +14,7 @@
 //! numbers; revolute or prismatic joints without `<limit>`; moving joints that carry no mass.
 
 //!
-//! The reader is split by step: [`lines`] finds where each element stands in the file,
+//! The reader is split by step: `lines` finds where each element stands in the file,
 //! `checks` refuses what no robot can have, `graph` links joints and links into a tree,
 //! `roles` resolves mimic couplings and locks, `bodies` merges links into moving bodies and
 //! `assemble` numbers the degrees of freedom into a [`Model`]; `convert` turns urdf-rs values
