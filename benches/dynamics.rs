@@ -1,16 +1,17 @@
 //! Throughput of the dynamics core on the built-in A465: `cargo bench --bench dynamics`.
 //! Names give the size: `rnea/a465/1` is one call, `batch/rnea/a465/100000` a batch of 10^5
 //! samples one at a time (serial, one `Data`), `batch/rnea_lanes/a465/100000` the same batch
-//! through the multi-sample kernel (serial too: the Python API adds the threads).
+//! through the multi-sample kernel (serial too), `batch/parallel_rnea/a465/100000` the batch
+//! engine (`perturbid_rs::parallel`: the kernel in chunks over every core, as Python calls it).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use perturbid_rs::algorithms::regressor::joint_torque_regressor;
 use perturbid_rs::robots::a465::{TABLE2_Q, TABLE2_QD, TABLE2_QDD};
-use perturbid_rs::Gravity;
 use perturbid_rs::{
     forward_dynamics, gravity_torque, linearize, mass_matrix, mass_matrix_batch, regressor_batch,
     rnea, rnea_derivatives, rnea_lanes, robots, Data, LaneData, Model,
 };
+use perturbid_rs::{parallel, Gravity, States};
 use std::hint::black_box;
 
 const BATCH: usize = 100_000;
@@ -111,7 +112,18 @@ fn dynamics(c: &mut Criterion) {
             .unwrap()
         })
     });
+    // the batch engine: the same kernels in parallel chunks, states checked once
+    let mut workspace = parallel::Workspace::new(&model);
+    let states = States::new(n, &bq, Some(&bqd), Some(&bqdd)).unwrap();
+    group.bench_function(format!("parallel_rnea/a465/{BATCH}"), |b| {
+        b.iter(|| {
+            parallel::rnea(&model, &mut workspace, &states, Gravity::Included, &mut tau).unwrap()
+        })
+    });
     let mut ms = vec![0.0; BATCH * n * n];
+    group.bench_function(format!("parallel_mass_matrix/a465/{BATCH}"), |b| {
+        b.iter(|| parallel::mass_matrix(&model, &mut workspace, &states, &mut ms).unwrap())
+    });
     group.bench_function(format!("mass_matrix_batch/a465/{BATCH}"), |b| {
         b.iter(|| mass_matrix_batch(&model, &mut lanes, &bq, &mut ms).unwrap())
     });

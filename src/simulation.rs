@@ -5,12 +5,12 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
-use crate::algorithms::rnea::rnea;
-use crate::data::Data;
+use crate::algorithms::parallel;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
 use crate::recording::Recording;
+use crate::states::States;
 use crate::trajectory::Samples;
 
 /// Joint friction `tau_f = viscous * qd + coulomb * sign(qd)` (per joint; N m s/rad and N m),
@@ -126,21 +126,17 @@ pub fn simulate_samples(
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     rng.set_stream(stream);
     let gauss = Normal::new(0.0, 1.0).expect("unit normal");
-    let mut data = Data::new(model);
     let k = samples.len();
+    // the rigid-body torques of every sample at once, by the batch engine
+    let states = States::new(n, &samples.q, Some(&samples.qd), Some(&samples.qdd))?;
+    let mut rigid = vec![0.0; k * n];
+    let mut workspace = parallel::Workspace::new(model);
+    parallel::rnea(model, &mut workspace, &states, options.gravity, &mut rigid)?;
     let (mut q, mut tau) = (Vec::with_capacity(k * n), Vec::with_capacity(k * n));
     for i in 0..k {
         let (qi, qdi) = (samples.q_at(i), samples.qd_at(i));
-        rnea(
-            model,
-            &mut data,
-            qi,
-            qdi,
-            samples.qdd_at(i),
-            options.gravity,
-        )?;
         for j in 0..n {
-            let t = data.tau[j]
+            let t = rigid[i * n + j]
                 + options.friction.torque(j, qdi[j])
                 + options.torque_noise[j] * gauss.sample(&mut rng);
             tau.push(t);

@@ -15,11 +15,11 @@ use crate::local::{
     identify_local, plan_experiments, Design, IdentifyOptions, LocalModel, OperatingPoint,
     PlanOptions,
 };
+use crate::mass_matrix;
 use crate::robots::a465;
 use crate::simulation::{simulate_plan, simulate_samples, Friction, SimulationOptions};
 use crate::states::States;
 use crate::torque_model::TorqueModel;
-use crate::{mass_matrix, rnea};
 
 /// The paper's Table 3 "direct method" row (first column of D).
 pub const TABLE3_DIRECT: [f64; 6] = [4.73, -0.26, 1.68, -0.87, 0.39, -1.95];
@@ -174,20 +174,16 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
             qdd.push(op.qdd[j]);
         }
     }
-    let mut actual_tau = Vec::with_capacity(q.len());
     let states = States::new(model.nv, &q, Some(&qd), Some(&qdd))?;
-    for k in 0..ts.len() {
-        let r = k * n..(k + 1) * n;
-        rnea(
-            &model,
-            &mut data,
-            &q[r.clone()],
-            &qd[r.clone()],
-            &qdd[r.clone()],
-            Gravity::Excluded,
-        )?;
-        actual_tau.extend(data.tau.iter());
-    }
+    let mut actual_tau = vec![0.0; q.len()];
+    let mut workspace = crate::parallel::Workspace::new(&model);
+    crate::parallel::rnea(
+        &model,
+        &mut workspace,
+        &states,
+        Gravity::Excluded,
+        &mut actual_tau,
+    )?;
     let local_tau = local.predict(&states)?;
     let global_tau = global.predict(&states)?;
     let base_tau = base.on(&model)?.predict(&states)?;
