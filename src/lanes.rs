@@ -1,7 +1,7 @@
 //! Arithmetic on a few samples side by side (structure of arrays): a scalar per lane
 //! [`Lanes`], 3-vectors [`Vector3Lanes`], rotations [`Rotation3Lanes`] and spatial vectors
-//! [`SpatialLanes`] of lanes. Each operation is a short loop over the lanes that the compiler maps onto SIMD registers; used by the
-//! multi-sample kernels ([`crate::algorithms::batch`]).
+//! [`SpatialLanes`] of lanes. Each operation is a short loop over the lanes that the compiler
+//! maps onto SIMD registers; used by the multi-sample kernels ([`crate::algorithms::batch`]).
 
 /// Defines `$vis fn $name(args) -> ret` that runs `$body(args)` (an `#[inline(always)]`
 /// function) compiled for AVX2 and FMA when the processor has them (checked at run time, then

@@ -191,3 +191,38 @@ fn errors_name_the_sample_of_the_whole_batch() {
     .unwrap_err();
     assert!(e.to_string().contains("tau[4103]"), "{e}");
 }
+
+#[test]
+fn a_regressor_group_equals_the_one_sample_regressor() {
+    use perturbid_rs::algorithms::batch::{regressor_group, LaneData};
+    use perturbid_rs::algorithms::regressor::joint_torque_regressor;
+    for model in models() {
+        let n = model.nv;
+        let [q, qd, qdd] = random_states(&model, 3, 21);
+        let mut lanes = LaneData::new(&model);
+        let g = regressor_group(&model, &mut lanes, &q, &qd, &qdd, Gravity::Included).unwrap();
+        assert_eq!(g, 3);
+        let mut data = Data::new(&model);
+        let mut y = nalgebra::DMatrix::zeros(n, 10 * model.nbodies());
+        for s in 0..3 {
+            let r = s * n..(s + 1) * n;
+            joint_torque_regressor(
+                &model,
+                &mut data,
+                &q[r.clone()],
+                &qd[r.clone()],
+                &qdd[r],
+                Gravity::Included,
+                &mut y,
+            )
+            .unwrap();
+            let scale = y.amax().max(1.0);
+            for (j, p) in (0..n).flat_map(|j| (0..y.ncols()).map(move |p| (j, p))) {
+                assert!((lanes.regressor_entry(s, j, p) - y[(j, p)]).abs() <= 1e-12 * scale);
+            }
+        }
+        // more samples than lanes are refused, not truncated
+        let [q, qd, qdd] = random_states(&model, 5, 22);
+        assert!(regressor_group(&model, &mut lanes, &q, &qd, &qdd, Gravity::Included).is_err());
+    }
+}

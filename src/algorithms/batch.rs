@@ -26,6 +26,10 @@ pub struct LaneData {
     qb: Vec<Lanes>,
     vb: Vec<Lanes>,
     ab: Vec<Lanes>,
+    /// The regressor of the loaded lanes, column-major `nv x 10 nbodies` (see
+    /// [`regressor_batch`] and [`regressor_group`]), kept so that no call allocates.
+    regressor: Vec<Lanes>,
+    nv: usize,
 }
 
 impl LaneData {
@@ -44,7 +48,17 @@ impl LaneData {
             qb: vec![Lanes::default(); nb],
             vb: vec![Lanes::default(); nb],
             ab: vec![Lanes::default(); nb],
+            regressor: vec![Lanes::default(); model.nv * PARAMS_PER_BODY * nb],
+            nv: model.nv,
         }
+    }
+
+    /// Entry `(joint, parameter)` (N m per parameter unit) of the regressor of sample `sample`
+    /// of the group last given to [`regressor_group`]. Panics past the group's `LANES` samples
+    /// or the model's sizes, like slice indexing.
+    #[inline]
+    pub fn regressor_entry(&self, sample: usize, joint: usize, parameter: usize) -> f64 {
+        self.regressor[joint + parameter * self.nv].0[sample]
     }
 }
 
@@ -53,8 +67,8 @@ simd_dispatch! {
 ///
 /// - `q` (rad or m), `qd` (rad/s or m/s), `qdd` (rad/s^2 or m/s^2): row-major `k x nv`
 ///   (sample `s`, dof `j` at `s * nv + j`); `qd` or `qdd` `None` for zeros. All arguments
-///   must hold the same `k` samples and finite values: check them first (as the Python batch
-///   API does with [`Model::check_vector`]); this kernel does not.
+///   must hold the same `k` samples and finite values: check them first (a [`crate::States`]
+///   is checked once for all); this kernel does not.
 /// - `gravity`: include `g(q)`.
 /// - `tau`: row-major `k x nv` output (N m or N).
 ///
@@ -270,7 +284,8 @@ fn regressor_batch_body(
             ("regressor output", out.len(), nv * p),
         ],
     )?;
-    let mut y = vec![Lanes::default(); nv * p];
+    let mut y = std::mem::take(&mut data.regressor);
+    y.resize(nv * p, Lanes::default());
     let mut first = 0;
     while first < k {
         load(model, data, [q, qd, qdd], first);
@@ -285,7 +300,51 @@ fn regressor_batch_body(
         }
         first += LANES;
     }
+    data.regressor = y;
     Ok(())
+}
+
+simd_dispatch! {
+/// The joint-torque regressors of a group of 1 to [`LANES`] samples, left in `data` and read
+/// with [`LaneData::regressor_entry`]: the building block for work that reduces the regressor
+/// as it is made (the streaming identification), without the copy into a row-major array that
+/// [`regressor_batch`] makes.
+///
+/// `q`, `qd`, `qdd`: row-major `g x nv` (rad, rad/s, rad/s^2), finite (checked by the caller).
+/// Returns `g`. Uses AVX2 and FMA when the processor has them.
+pub fn regressor_group, regressor_group_avx2 => regressor_group_body(
+    model: &Model,
+    data: &mut LaneData,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    gravity: Gravity,
+) -> Result<usize>
+}
+
+#[inline(always)]
+fn regressor_group_body(
+    model: &Model,
+    data: &mut LaneData,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    gravity: Gravity,
+) -> Result<usize> {
+    let nv = model.nv;
+    let k = samples(nv, q.len(), &[("qd", qd.len(), nv), ("qdd", qdd.len(), nv)])?;
+    if k == 0 || k > LANES {
+        return Err(crate::error::Error::Shape {
+            argument: "q".into(),
+            expected: format!("1 to {LANES} samples of {nv} joints"),
+            got: format!("{k} samples"),
+        });
+    }
+    let mut y = std::mem::take(&mut data.regressor);
+    load(model, data, [q, qd, qdd], 0);
+    regressor_lanes(model, data, gravity, &mut y);
+    data.regressor = y;
+    Ok(k)
 }
 
 simd_dispatch! {

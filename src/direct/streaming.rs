@@ -23,7 +23,7 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use super::base::BaseParameters;
-use crate::algorithms::batch::{regressor_batch, LaneData, LANES};
+use crate::algorithms::batch::{regressor_group, LaneData, LANES};
 use crate::algorithms::regressor::PARAMS_PER_BODY;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
@@ -120,8 +120,6 @@ pub struct JointFactors {
 /// first) and whose other rows take the next chunk.
 struct Worker {
     lanes: LaneData,
-    /// The regressors of a group of [`LANES`] samples, row-major `LANES x nv x 10 nbodies`.
-    y: Vec<f64>,
     stacks: Vec<Mat<f64>>,
     q_coeff: Mat<f64>,
     scratch: MemBuffer,
@@ -133,7 +131,6 @@ impl Worker {
         let block = recommended_block_size::<f64>(widest + CHUNK, widest);
         Self {
             lanes: LaneData::new(model),
-            y: vec![0.0; LANES * model.nv * PARAMS_PER_BODY * model.nbodies()],
             stacks: columns
                 .iter()
                 .map(|c| Mat::zeros(c.base.len() + 1 + CHUNK, c.base.len() + 1))
@@ -154,12 +151,12 @@ impl Worker {
         &mut self,
         model: &Model,
         columns: &[JointColumns],
-        states: &States<'_>,
+        x: [&[f64]; 3],
         tau: &[f64],
         gravity: Gravity,
         range: std::ops::Range<usize>,
     ) -> Result<()> {
-        self.fill(model, columns, states, tau, gravity, range.clone())?;
+        self.fill(model, columns, x, tau, gravity, range.clone())?;
         for a in &mut self.stacks {
             let rows = a.ncols() + range.len();
             factor_top(
@@ -180,44 +177,39 @@ impl Worker {
 }
 
 impl Worker {
-    /// Writes the rows of samples `range` below the factors (the regressor [`LANES`] samples at
-    /// a time, through the multi-sample kernel).
+    /// Writes the rows of samples `range` of the states `[q, qd, qdd]` (row-major, the whole
+    /// batch) below the factors: the regressor [`LANES`] samples at a time by the multi-sample
+    /// kernel ([`regressor_group`]), read in place.
     fn fill(
         &mut self,
         model: &Model,
         columns: &[JointColumns],
-        states: &States<'_>,
+        [q, qd, qdd]: [&[f64]; 3],
         tau: &[f64],
         gravity: Gravity,
         range: std::ops::Range<usize>,
     ) -> Result<()> {
         let nv = model.nv;
-        let p = PARAMS_PER_BODY * model.nbodies();
-        let qd = states.qd_or_zeros();
-        let qdd = states.qdd_or_zeros();
         let mut first = range.start;
         while first < range.end {
             let used = (range.end - first).min(LANES);
             let rows = first * nv..(first + used) * nv;
-            let y = &mut self.y[..used * nv * p];
-            regressor_batch(
+            regressor_group(
                 model,
                 &mut self.lanes,
-                &states.q()[rows.clone()],
+                &q[rows.clone()],
                 &qd[rows.clone()],
                 &qdd[rows],
                 gravity,
-                y,
             )?;
             for l in 0..used {
                 let s = first + l;
                 let qd = &qd[s * nv..(s + 1) * nv];
-                let y = &y[l * nv * p..(l + 1) * nv * p];
                 for (j, (a, cols)) in self.stacks.iter_mut().zip(columns).enumerate() {
                     let nj = cols.base.len();
                     let i = nj + 1 + s - range.start;
                     for &(c, col) in &cols.inertial {
-                        a[(i, c)] = y[j * p + col];
+                        a[(i, c)] = self.lanes.regressor_entry(l, j, col);
                     }
                     for &(c, term) in &cols.friction {
                         a[(i, c)] = match term {
@@ -300,6 +292,8 @@ impl JointFactors {
         let nv = model.nv;
         states.check_companion("tau", tau, nv)?;
         let k = states.len();
+        let (qd, qdd) = (states.qd_or_zeros(), states.qdd_or_zeros());
+        let x = [states.q(), &qd[..], &qdd[..]];
         let p = base.len();
         let columns = JointColumns::new(model, base);
         let chunks: Vec<std::ops::Range<usize>> = (0..k)
@@ -315,7 +309,7 @@ impl JointFactors {
             .map(|run| -> Result<Vec<DMatrix<f64>>> {
                 let mut w = Worker::new(model, &columns);
                 for range in run {
-                    w.absorb(model, &columns, states, tau, gravity, range.clone())?;
+                    w.absorb(model, &columns, x, tau, gravity, range.clone())?;
                 }
                 Ok(w.factors())
             })
