@@ -124,10 +124,18 @@ impl<'a> States<'a> {
         Ok(states)
     }
 
-    /// One fast pass over every value; a second one only to name a bad value.
+    /// One fast pass over every value (over the cores for large batches); a second one only to
+    /// name a bad value.
     fn check_finite(&self) -> Result<()> {
+        use rayon::prelude::*;
+        let any_bad = |x: &[f64]| x.iter().fold(false, |bad, v| bad | !v.is_finite());
         for (name, x) in self.arrays() {
-            if x.iter().fold(false, |bad, v| bad | !v.is_finite()) {
+            let bad = if x.len() >= 1 << 16 {
+                x.par_chunks(1 << 14).any(any_bad)
+            } else {
+                any_bad(x)
+            };
+            if bad {
                 let (i, &value) = x
                     .iter()
                     .enumerate()
