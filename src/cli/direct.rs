@@ -169,16 +169,11 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         ..BaseOptions::default()
     };
     progress.update(&format!("identifying on {split} samples"));
-    let r = 0..split * n;
+    let states = States::new(n, &rec.q, Some(&qd), Some(&qdd))?;
     let fit = identify_base_parameters(
         &model,
-        &States::new(
-            model.nv,
-            &rec.q[r.clone()],
-            Some(&qd[r.clone()]),
-            Some(&qdd[r.clone()]),
-        )?,
-        &rec.tau[r],
+        &states.slice(0..split),
+        &rec.tau[..split * n],
         &options,
     )?;
     progress.done();
@@ -197,24 +192,16 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         "base parameter", "value", "std. error"
     );
     for ((name, v), s) in fit.base.names().iter().zip(&fit.theta).zip(&fit.stderr) {
-        let name = if name.len() > 48 {
-            format!("{}...", &name[..45])
+        let name = if name.chars().count() > 48 {
+            // by characters: a byte index could fall inside a UTF-8 link name
+            format!("{}...", name.chars().take(45).collect::<String>())
         } else {
             name.clone()
         };
         let _ = writeln!(out, "{name:<48} {v:>14.6} {s:>12.2e}");
     }
     if split < k {
-        let r = split * n..k * n;
-        let p = fit.predict(
-            &model,
-            &States::new(
-                model.nv,
-                &rec.q[r.clone()],
-                Some(&qd[r.clone()]),
-                Some(&qdd[r.clone()]),
-            )?,
-        )?;
+        let p = fit.on(&model)?.predict(&states.slice(split..k))?;
         let _ = writeln!(
             out,
             "validation on the last {} samples: per joint RMS (N m) and relative RMS (%)",
