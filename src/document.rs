@@ -60,7 +60,21 @@ pub trait Document: Serialize + DeserializeOwned {
                 message: format!("format '{tag}', expected '{}'", Self::tag()),
             });
         }
-        let doc: Self = serde_json::from_str(text).map_err(|e| Error::Json {
+        // the JSON path of the culprit (`experiments[2].trajectory.rate`) beside line and column
+        let mut reader = serde_json::Deserializer::from_str(text);
+        let doc: Self = serde_path_to_error::deserialize(&mut reader).map_err(|e| {
+            let path = e.path().to_string();
+            let inner = e.into_inner();
+            Error::Json {
+                context: context.clone(),
+                message: format!(
+                    "line {}, column {}, at {path}: {inner}",
+                    inner.line(),
+                    inner.column()
+                ),
+            }
+        })?;
+        reader.end().map_err(|e| Error::Json {
             context: context.clone(),
             message: format!("line {}, column {}: {e}", e.line(), e.column()),
         })?;

@@ -20,8 +20,29 @@ impl fmt::Display for Location {
     }
 }
 
+/// What kind of problem an [`Error`] is, for callers that handle errors by kind (the Python
+/// exception classes follow it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ErrorKind {
+    /// A URDF or robot model that cannot be built (Python `ModelError`).
+    Model,
+    /// An argument, a recording or a document that cannot be used (Python `InputError`, also a
+    /// `ValueError`).
+    Input,
+    /// A numerical failure (Python `NumericalError`, also an `ArithmeticError`).
+    Numerical,
+    /// A file that cannot be read or written (Python `FileError`, also an `OSError`).
+    File,
+    /// Long work stopped by the user (Ctrl-C; Python `KeyboardInterrupt`).
+    Interrupted,
+    /// A bug of this library caught at its boundary (Python `InternalError`).
+    Internal,
+}
+
 /// All errors of perturbid_rs.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// A file could not be read or written.
     #[error("{path}: {source}")]
@@ -207,6 +228,27 @@ pub enum Error {
     #[error("{context}: {message}")]
     Json { context: String, message: String },
 
+    /// A joint `<limit>` that no joint can have: lower above upper, a speed, effort or
+    /// acceleration limit that is zero or negative.
+    #[error("{location}: joint '{joint}' <limit>: {message}")]
+    InvalidLimit {
+        location: Location,
+        joint: String,
+        message: String,
+    },
+
+    /// A model with no degree of freedom: every joint is fixed or locked.
+    #[error("{source_name}: robot '{robot}' has no moving joint (every joint is fixed or locked); nothing can be identified")]
+    NoDegreeOfFreedom { source_name: String, robot: String },
+
+    /// Long work stopped by the user (Ctrl-C); nothing was written.
+    #[error("{context}: interrupted")]
+    Interrupted { context: String },
+
+    /// A bug of this library (a panic), caught at its boundary.
+    #[error("internal error in {context}: {message} (a bug in perturbid_rs: please report it)")]
+    Internal { context: String, message: String },
+
     /// A built-in robot or variant name that does not exist.
     #[error("unknown robot '{name}'; built-in robots: {}", available.join(", "))]
     UnknownRobot {
@@ -216,6 +258,52 @@ pub enum Error {
 }
 
 impl Error {
+    /// The kind of problem.
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            Error::Io { .. } => ErrorKind::File,
+            Error::Shape { .. }
+            | Error::NonFiniteInput { .. }
+            | Error::InvalidArgument { .. }
+            | Error::LimitViolation { .. }
+            | Error::PositionLimit { .. }
+            | Error::Recording { .. }
+            | Error::Json { .. } => ErrorKind::Input,
+            Error::Numerical { .. } | Error::RankDeficient { .. } => ErrorKind::Numerical,
+            Error::UrdfSyntax { .. }
+            | Error::UnsupportedJoint { .. }
+            | Error::RootCount { .. }
+            | Error::Cycle { .. }
+            | Error::DuplicateChild { .. }
+            | Error::DuplicateName { .. }
+            | Error::UnknownLink { .. }
+            | Error::JointReference { .. }
+            | Error::InvalidInertia { .. }
+            | Error::MasslessSubtree { .. }
+            | Error::InvalidAxis { .. }
+            | Error::MissingLimit { .. }
+            | Error::NonFiniteUrdf { .. }
+            | Error::InvalidLimit { .. }
+            | Error::NoDegreeOfFreedom { .. }
+            | Error::UnknownRobot { .. } => ErrorKind::Model,
+            Error::Interrupted { .. } => ErrorKind::Interrupted,
+            Error::Internal { .. } => ErrorKind::Internal,
+        }
+    }
+
+    /// The error for a panic caught in `context` (a function name), with the panic's message.
+    pub fn from_panic(context: &str, payload: &(dyn std::any::Any + Send)) -> Error {
+        let message = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "a panic without a message".into());
+        Error::Internal {
+            context: context.into(),
+            message,
+        }
+    }
+
     /// The error as raised at sample `s` of a batch: a non-finite entry's argument becomes
     /// `name[s]`, a numerical failure says `(sample s)`.
     pub fn in_sample(self, s: usize) -> Error {
@@ -236,6 +324,14 @@ impl Error {
             other => other,
         }
     }
+}
+
+/// Runs `f`, turning a panic into [`Error::Internal`] naming `context`: the last line of
+/// defence at the library's boundaries (Python, the command line), so that a bug reaches the
+/// user as an error, not as an abort.
+pub fn catch_panics<T>(context: &str, f: impl FnOnce() -> Result<T>) -> Result<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f))
+        .unwrap_or_else(|payload| Err(Error::from_panic(context, &*payload)))
 }
 
 /// `Result` with the library's [`Error`].

@@ -53,7 +53,7 @@ pub use algorithms::parallel;
 pub use algorithms::rnea::{bias_torque, gravity_torque, rnea};
 pub use data::Data;
 pub use document::Document;
-pub use error::{Error, Result};
+pub use error::{catch_panics, Error, ErrorKind, Result};
 pub use gravity::Gravity;
 pub use linearization::{linearize, linearize_into, Linearization};
 pub use local::{identify_local, plan_experiments, LocalModel, OperatingPoint, Plan, PlanOptions};

@@ -270,13 +270,16 @@ impl Model {
                 weight[p] += weight[i];
             }
         }
+        // per dof, what its bodies move, and its first body (one pass: linear in the bodies)
+        let mut moved = vec![0.0; self.nv];
+        let mut first = vec![usize::MAX; self.nv];
+        for (i, b) in self.bodies.iter().enumerate() {
+            moved[b.dof] += weight[i];
+            first[b.dof] = first[b.dof].min(i);
+        }
         for dof in 0..self.nv {
-            let moved: f64 = (0..n)
-                .filter(|&i| self.bodies[i].dof == dof)
-                .map(|i| weight[i])
-                .sum();
-            if moved <= 0.0 {
-                let i = (0..n).find(|&i| self.bodies[i].dof == dof).unwrap_or(0);
+            if moved[dof] <= 0.0 {
+                let i = first[dof].min(n.saturating_sub(1));
                 return Err(Error::MasslessSubtree {
                     location: Location {
                         source: self.source.clone(),

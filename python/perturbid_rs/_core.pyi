@@ -16,6 +16,7 @@ __all__ = [
     "FourierTrajectory",
     "GlobalLinearModel",
     "InputError",
+    "InternalError",
     "Linearization",
     "LocalModel",
     "ModelError",
@@ -43,14 +44,17 @@ class PerturbidError(Exception):
 class ModelError(PerturbidError):
     """A URDF or robot model that cannot be built."""
 
-class InputError(PerturbidError):
-    """An argument of the wrong shape, non-finite, or out of range."""
+class InputError(PerturbidError, ValueError):
+    """An argument, recording or document of the wrong shape, non-finite, or out of range."""
 
-class NumericalError(PerturbidError):
-    """A numerical failure (e.g. a mass matrix that is not positive definite)."""
+class NumericalError(PerturbidError, ArithmeticError):
+    """A numerical failure."""
 
-class FileError(PerturbidError):
+class FileError(PerturbidError, OSError):
     """A file that cannot be read or written."""
+
+class InternalError(PerturbidError, RuntimeError):
+    """A bug of perturbid_rs caught at its boundary: please report it."""
 
 @final
 class Linearization:

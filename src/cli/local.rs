@@ -75,6 +75,7 @@ pub(crate) struct PlanArgs {
 }
 
 #[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct OpFile {
     q: Vec<f64>,
     qd: Vec<f64>,

@@ -73,8 +73,28 @@ fn run(cli: Cli) -> Result<String> {
 
 /// Runs the command line with `args` (the program name first); prints results on stdout and
 /// a one-line error on stderr; returns the exit status (0 on success, 1 on an error, 2 on a
-/// usage error).
+/// usage error, [`EXIT_INTERNAL`] on a bug caught at the boundary).
 pub fn main_with_args<I, T>(args: I) -> i32
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString> + Clone,
+{
+    // A bug must still end in one line and a non-zero status: the panic is caught here and
+    // reported once (the default hook's message and backtrace are held back meanwhile).
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let result = crate::error::catch_panics("perturbid", || Ok(main_unguarded(args)));
+    std::panic::set_hook(hook);
+    result.unwrap_or_else(|e| {
+        eprintln!("perturbid: {e}");
+        EXIT_INTERNAL
+    })
+}
+
+/// Exit status of a bug caught at the boundary (`EX_SOFTWARE` of sysexits.h).
+pub const EXIT_INTERNAL: i32 = 70;
+
+fn main_unguarded<I, T>(args: I) -> i32
 where
     I: IntoIterator<Item = T>,
     T: Into<OsString> + Clone,

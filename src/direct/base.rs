@@ -17,6 +17,7 @@ use crate::states::States;
 /// The base parameters of a layout: `theta_base = theta[kept] + K theta[dropped]`, and
 /// `Phi theta = Phi[:, kept] theta_base` for every state.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct BaseParameters {
     pub layout: ParameterLayout,
     /// Indices (ascending) of the full parameters kept as base columns.

@@ -14,6 +14,7 @@ use crate::torque_model::{check_joints, predict_linear};
 
 /// A globally linearised model about an operating point.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct GlobalLinearModel {
     /// `perturbid-global-linear-model/1`.
     pub format: String,

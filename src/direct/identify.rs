@@ -57,6 +57,7 @@ impl Default for BaseOptions {
 
 /// An identified base-parameter model.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct BaseModel {
     /// `perturbid-base-model/1`.
     pub format: String,

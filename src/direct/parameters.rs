@@ -16,6 +16,7 @@ use crate::states::States;
 
 /// Which per-joint friction parameters are identified with the inertial ones.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FrictionTerms {
     /// Viscous friction `fv qd` (N m s/rad).
     pub viscous: bool,
@@ -96,6 +97,7 @@ impl std::fmt::Display for FrictionTerms {
 /// The full parameter layout for a model: `10 * nbodies` inertial parameters (body after body)
 /// and then, joint after joint, the friction terms switched on.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ParameterLayout {
     pub nv: usize,
     pub nbodies: usize,

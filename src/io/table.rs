@@ -40,7 +40,7 @@ impl Table {
             .lines()
             .enumerate()
             .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-        let Some((_, header)) = lines.next() else {
+        let Some((header_line, header)) = lines.next() else {
             return Err(Error::Recording {
                 recording: source.into(),
                 message: "empty file: expected a header line of column names".into(),
@@ -48,13 +48,13 @@ impl Table {
         };
         let columns: Vec<String> = header.split(',').map(|c| c.trim().to_string()).collect();
         let mut t = Table::new(source, columns);
-        if let Some(dup) = t
-            .columns
-            .iter()
-            .enumerate()
-            .find(|(i, c)| t.columns[..*i].contains(c))
-        {
-            return Err(t.error(format!("line 1: column '{}' appears twice", dup.1)));
+        // one pass with a set: a header of a million columns is read in linear time
+        let mut seen = std::collections::HashSet::with_capacity(t.columns.len());
+        if let Some(dup) = t.columns.iter().find(|c| !seen.insert(c.as_str())) {
+            return Err(t.error(format!(
+                "line {}: column '{dup}' appears twice",
+                header_line + 1
+            )));
         }
         for (i, line) in lines {
             let fields: Vec<&str> = line.split(',').collect();

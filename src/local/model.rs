@@ -13,6 +13,7 @@ use crate::torque_model::predict_linear;
 
 /// One identified matrix with its statistics.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Estimate {
     /// N x N (row = torque, column = joint); N x 3N `[D H G]` for the combined estimate.
     #[serde(with = "crate::json::rows")]
@@ -43,6 +44,7 @@ choice! {
 
 /// The local model at an operating point.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct LocalModel {
     pub format: String,
     pub robot: String,

@@ -8,6 +8,7 @@ use crate::model::{check_finite_vector, Model};
 /// An operating point: joint positions `q` (rad or m), velocities `qd` (rad/s or m/s) and
 /// accelerations `qdd` (rad/s^2 or m/s^2), each of length N (the robot's degrees of freedom).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct OperatingPoint {
     pub q: Vec<f64>,
     pub qd: Vec<f64>,

@@ -72,6 +72,7 @@ impl Size {
 /// Default perturbation sizes: 1 % of the position range, 5 % of the speed limit, 5 % of the
 /// acceleration limit; where a limit is infinite, 0.02 rad, 0.1 rad/s, 0.5 rad/s^2.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Sizes {
     pub position: Size,
     pub velocity: Size,

@@ -54,6 +54,7 @@ impl ExperimentKind {
 /// A planned crossing: the time (s from the start of the experiment) and the state the robot
 /// passes then.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Crossing {
     pub time: f64,
     pub q: Vec<f64>,
@@ -63,6 +64,7 @@ pub struct Crossing {
 
 /// One experiment: its perturbations, its crossings and its trajectory.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Experiment {
     pub kind: ExperimentKind,
     /// `K x N` planned perturbations of the perturbed variable (zeros for the nominal one).
@@ -137,6 +139,7 @@ impl Default for PlanOptions {
 
 /// A plan: the operating point and its experiments, for one robot.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Plan {
     /// `perturbid-plan/1`.
     pub format: String,

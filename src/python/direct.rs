@@ -7,6 +7,8 @@ use std::sync::Arc;
 
 use numpy::PyArray1;
 use pyo3::prelude::*;
+
+use super::detached;
 use pyo3::types::PyDict;
 
 use super::arrays::{matrix_to_numpy as mat, read_batch, to_numpy, ArrayLike};
@@ -126,7 +128,7 @@ pub(crate) fn design_excitation(
         ..ExcitationOptions::default()
     };
     o.friction = friction_terms(friction)?;
-    let design = py.detach(|| {
+    let design = detached(py, "design_excitation", || {
         let mut report = |e: usize, best: f64| {
             eprintln!("excitation design: {e} evaluations, best criterion {best:.4}")
         };
@@ -226,7 +228,7 @@ impl PyBaseModel {
         let n = self.model.nv;
         let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
         let c = &batch.columns;
-        let tau = py.detach(|| {
+        let tau = detached(py, "BaseParameterModel.predict", || {
             self.fit.predict(
                 &self.model,
                 &States::new(self.model.nv, &c[0], Some(&c[1]), Some(&c[2]))?,
@@ -294,7 +296,7 @@ pub(crate) fn identify_base_parameters(
     };
     let model = &robot.model;
     let c = states(model.nv, &q, &qd, &qdd, Some(&tau))?;
-    let fit = py.detach(|| {
+    let fit = detached(py, "identify_base_parameters", || {
         base_rs(
             model,
             &States::new(model.nv, &c[0], Some(&c[1]), Some(&c[2]))?,
@@ -394,7 +396,7 @@ pub(crate) fn identify_global_linear(
     tau: ArrayLike<'_>,
 ) -> PyResult<PyGlobalLinear> {
     let c = states(op.op.n(), &q, &qd, &qdd, Some(&tau))?;
-    let fit = py.detach(|| {
+    let fit = detached(py, "identify_global_linear", || {
         global_rs(
             &op.op,
             &States::new(op.op.n(), &c[0], Some(&c[1]), Some(&c[2]))?,

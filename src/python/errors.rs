@@ -1,87 +1,120 @@
-//! The Python exception hierarchy and the mapping of [`crate::Error`] onto it:
+//! The Python exception hierarchy and the mapping of [`crate::Error`] onto it, by its
+//! [`ErrorKind`]:
 //!
 //! - `PerturbidError(Exception)`: base of everything the library raises;
-//! - `ModelError`: a URDF or robot model that cannot be built;
-//! - `InputError`: an argument of the wrong shape, with NaN/inf, or out of range; a plan that
-//!   breaks the joint limits; a recording or JSON document that cannot be used;
-//! - `NumericalError`: a numerical failure (e.g. a mass matrix not positive definite, a
-//!   regression whose data do not excite every direction);
-//! - `FileError`: a file that cannot be read or written.
+//! - `ModelError`: a URDF or robot model that cannot be built (limits included);
+//! - `InputError`, also a `ValueError`: an argument of the wrong shape, with NaN/inf, or out of
+//!   range; a plan that breaks the joint limits; a recording or JSON document that cannot be
+//!   used;
+//! - `NumericalError`, also an `ArithmeticError`: a numerical failure (a mass matrix not
+//!   positive definite, a regression whose data do not excite every direction);
+//! - `FileError`, also an `OSError`: a file that cannot be read or written;
+//! - `InternalError`, also a `RuntimeError`: a bug of this library caught at its boundary
+//!   (never a bare `PanicException`).
+//!
+//! Ctrl-C during long work raises Python's own `KeyboardInterrupt`.
+//!
+//! The classes are made with Python's `type()`, so that they can have two bases.
 
-use pyo3::create_exception;
-use pyo3::exceptions::PyException;
+use pyo3::exceptions::{
+    PyArithmeticError, PyException, PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError,
+};
 use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyTuple, PyType};
 
-use crate::error::Error;
+use crate::error::{Error, ErrorKind};
 
-create_exception!(
-    perturbid_rs,
-    PerturbidError,
-    PyException,
-    "Base class of all perturbid_rs errors."
-);
-create_exception!(
-    perturbid_rs,
-    ModelError,
-    PerturbidError,
-    "A URDF or robot model that cannot be built."
-);
-create_exception!(
-    perturbid_rs,
-    InputError,
-    PerturbidError,
-    "An argument of the wrong shape, non-finite, or out of range."
-);
-create_exception!(
-    perturbid_rs,
-    NumericalError,
-    PerturbidError,
-    "A numerical failure."
-);
-create_exception!(
-    perturbid_rs,
-    FileError,
-    PerturbidError,
-    "A file that cannot be read or written."
-);
+/// One exception class: its name, docstring and the bases after `PerturbidError`.
+struct Class {
+    name: &'static str,
+    doc: &'static str,
+    cell: PyOnceLock<Py<PyType>>,
+}
+
+static BASE: Class = Class {
+    name: "PerturbidError",
+    doc: "Base class of all perturbid_rs errors.",
+    cell: PyOnceLock::new(),
+};
+static MODEL: Class = Class {
+    name: "ModelError",
+    doc: "A URDF or robot model that cannot be built.",
+    cell: PyOnceLock::new(),
+};
+static INPUT: Class = Class {
+    name: "InputError",
+    doc: "An argument, recording or document of the wrong shape, non-finite, or out of range.",
+    cell: PyOnceLock::new(),
+};
+static NUMERICAL: Class = Class {
+    name: "NumericalError",
+    doc: "A numerical failure.",
+    cell: PyOnceLock::new(),
+};
+static FILE: Class = Class {
+    name: "FileError",
+    doc: "A file that cannot be read or written.",
+    cell: PyOnceLock::new(),
+};
+static INTERNAL: Class = Class {
+    name: "InternalError",
+    doc: "A bug of perturbid_rs caught at its boundary: please report it.",
+    cell: PyOnceLock::new(),
+};
+
+impl Class {
+    /// The class, made on first use.
+    fn get<'py>(&'static self, py: Python<'py>) -> PyResult<&'py Bound<'py, PyType>> {
+        self.cell
+            .get_or_try_init(py, || {
+                let bases = if self.name == BASE.name {
+                    PyTuple::new(py, [py.get_type::<PyException>()])?
+                } else {
+                    let second = match self.name {
+                        "InputError" => Some(py.get_type::<PyValueError>()),
+                        "NumericalError" => Some(py.get_type::<PyArithmeticError>()),
+                        "FileError" => Some(py.get_type::<PyOSError>()),
+                        "InternalError" => Some(py.get_type::<PyRuntimeError>()),
+                        _ => None,
+                    };
+                    let base = BASE.get(py)?.clone();
+                    PyTuple::new(py, std::iter::once(base).chain(second).collect::<Vec<_>>())?
+                };
+                let namespace = PyDict::new(py);
+                namespace.set_item("__doc__", self.doc)?;
+                namespace.set_item("__module__", "perturbid_rs")?;
+                let class = py
+                    .get_type::<PyType>()
+                    .call1((self.name, bases, namespace))?
+                    .cast_into::<PyType>()?;
+                Ok(class.unbind())
+            })
+            .map(|c| c.bind(py))
+    }
+}
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
-    m.add("PerturbidError", py.get_type::<PerturbidError>())?;
-    m.add("ModelError", py.get_type::<ModelError>())?;
-    m.add("InputError", py.get_type::<InputError>())?;
-    m.add("NumericalError", py.get_type::<NumericalError>())?;
-    m.add("FileError", py.get_type::<FileError>())?;
+    for class in [&BASE, &MODEL, &INPUT, &NUMERICAL, &FILE, &INTERNAL] {
+        m.add(class.name, class.get(py)?)?;
+    }
     Ok(())
 }
 
 impl From<Error> for PyErr {
     fn from(e: Error) -> PyErr {
-        let msg = e.to_string();
-        match e {
-            Error::Io { .. } => FileError::new_err(msg),
-            Error::Shape { .. }
-            | Error::NonFiniteInput { .. }
-            | Error::InvalidArgument { .. }
-            | Error::LimitViolation { .. }
-            | Error::PositionLimit { .. }
-            | Error::Recording { .. }
-            | Error::Json { .. } => InputError::new_err(msg),
-            Error::Numerical { .. } | Error::RankDeficient { .. } => NumericalError::new_err(msg),
-            Error::UrdfSyntax { .. }
-            | Error::UnsupportedJoint { .. }
-            | Error::RootCount { .. }
-            | Error::Cycle { .. }
-            | Error::DuplicateChild { .. }
-            | Error::DuplicateName { .. }
-            | Error::UnknownLink { .. }
-            | Error::JointReference { .. }
-            | Error::InvalidInertia { .. }
-            | Error::MasslessSubtree { .. }
-            | Error::InvalidAxis { .. }
-            | Error::MissingLimit { .. }
-            | Error::NonFiniteUrdf { .. }
-            | Error::UnknownRobot { .. } => ModelError::new_err(msg),
-        }
+        let class = match e.kind() {
+            ErrorKind::Interrupted => return PyKeyboardInterrupt::new_err(e.to_string()),
+            ErrorKind::Model => &MODEL,
+            ErrorKind::Input => &INPUT,
+            ErrorKind::Numerical => &NUMERICAL,
+            ErrorKind::File => &FILE,
+            ErrorKind::Internal => &INTERNAL,
+        };
+        Python::attach(|py| match class.get(py) {
+            Ok(t) => PyErr::from_type(t.clone(), e.to_string()),
+            Err(failed) => failed,
+        })
     }
 }

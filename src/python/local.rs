@@ -4,6 +4,8 @@
 use std::sync::Arc;
 
 use pyo3::prelude::*;
+
+use super::detached;
 use pyo3::types::{PyDict, PyList};
 
 use super::arrays::{
@@ -297,7 +299,9 @@ pub(crate) fn plan_experiments(
             .map(|k| k.parse::<ExperimentKind>())
             .collect::<Result<_>>()?;
     }
-    let plan = py.detach(|| plan_rs(&robot.model, &op.op, &options))?;
+    let plan = detached(py, "plan_experiments", || {
+        plan_rs(&robot.model, &op.op, &options)
+    })?;
     Ok(PyPlan {
         plan: Arc::new(plan),
     })
@@ -347,7 +351,7 @@ pub(crate) fn identify_local(
     };
     let recs: Vec<Recording> = recordings.iter().map(|r| (*r.get().rec).clone()).collect();
     let plan = plan.plan.clone();
-    let model = py.detach(|| identify_rs(&plan, &recs, &options))?;
+    let model = detached(py, "identify_local", || identify_rs(&plan, &recs, &options))?;
     Ok(PyLocalModel { model })
 }
 

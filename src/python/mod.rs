@@ -16,6 +16,18 @@ mod trajectory;
 
 use pyo3::prelude::*;
 
+use crate::error::{catch_panics, Result};
+
+/// Runs the Rust work `f` of the Python entry point `name` with the GIL released, a panic
+/// turned into `InternalError` naming `name` (never a bare `PanicException`).
+pub(crate) fn detached<T: Send>(
+    py: Python<'_>,
+    name: &str,
+    f: impl FnOnce() -> Result<T> + Send,
+) -> Result<T> {
+    py.detach(|| catch_panics(name, f))
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -3,6 +3,8 @@
 
 use pyo3::prelude::*;
 
+use super::detached;
+
 use super::arrays::ArrayLike;
 use super::recording::PyRecording;
 use std::sync::Arc;
@@ -42,6 +44,6 @@ pub(crate) fn preprocess(
         trim,
         decimate,
     };
-    let out: Recording = py.detach(|| preprocess_rs(&rec, &options))?;
+    let out: Recording = detached(py, "preprocess", || preprocess_rs(&rec, &options))?;
     Ok(PyRecording { rec: Arc::new(out) })
 }

@@ -7,6 +7,8 @@ use std::sync::{Mutex, MutexGuard};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 
+use super::detached;
+
 use super::arrays::ArrayLike;
 use super::arrays::{read_batch, to_numpy};
 use super::linearization::PyLinearization;
@@ -41,12 +43,14 @@ impl PyRobot {
             .unwrap_or_else(|poisoned| poisoned.into_inner())
     }
 
-    /// Runs the batch algorithm `f` of the library's engine ([`parallel`]) on the states
+    /// Runs the batch algorithm `f` of the library's engine ([`parallel`]), for the method
+    /// `name` (in errors), on the states
     /// `args` (q, then qd and qdd when given) with the GIL released, into a new array of
     /// `out_dims` values per sample.
     fn batch<'py, F>(
         &self,
         py: Python<'py>,
+        name: &str,
         args: &[(&str, &ArrayLike<'py>)],
         out_dims: &[usize],
         f: F,
@@ -57,7 +61,7 @@ impl PyRobot {
         let n = self.model.nv;
         let batch = read_batch(n, args)?;
         let mut out = vec![0.0; batch.k * out_dims.iter().product::<usize>()];
-        py.detach(|| -> Result<()> {
+        detached(py, name, || -> Result<()> {
             let states = batch.states(n)?;
             f(&self.model, &mut self.workspace(), &states, &mut out)
         })?;
@@ -92,7 +96,9 @@ impl PyRobot {
         check_triangle_inequality: bool,
     ) -> PyResult<Self> {
         let options = load_options(lock, check_triangle_inequality);
-        let model = py.detach(|| urdf::model_from_urdf_file(&path, &options))?;
+        let model = detached(py, "Robot.from_urdf", || {
+            urdf::model_from_urdf_file(&path, &options)
+        })?;
         Ok(Self::new(model))
     }
 
@@ -106,7 +112,9 @@ impl PyRobot {
         check_triangle_inequality: bool,
     ) -> PyResult<Self> {
         let options = load_options(lock, check_triangle_inequality);
-        let model = py.detach(|| urdf::model_from_urdf_str(text, "<string>", &options))?;
+        let model = detached(py, "Robot.from_urdf_string", || {
+            urdf::model_from_urdf_str(text, "<string>", &options)
+        })?;
         Ok(Self::new(model))
     }
 
@@ -195,16 +203,20 @@ impl PyRobot {
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.model.nv;
         let args = [("q", &q), ("qd", &qd), ("qdd", &qdd)];
-        self.batch(py, &args, &[n], |m, w, s, out| {
+        self.batch(py, "Robot.rnea", &args, &[n], |m, w, s, out| {
             parallel::rnea(m, w, s, gravity.into(), out)
         })
     }
 
     /// Gravity torque g(q): the torque holding the robot at rest. q: (n,) or (k, n).
     fn gravity<'py>(&self, py: Python<'py>, q: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.batch(py, &[("q", &q)], &[self.model.nv], |m, w, s, out| {
-            parallel::rnea(m, w, s, Gravity::Included, out)
-        })
+        self.batch(
+            py,
+            "Robot.gravity",
+            &[("q", &q)],
+            &[self.model.nv],
+            |m, w, s, out| parallel::rnea(m, w, s, Gravity::Included, out),
+        )
     }
 
     /// Bias torque c(q, qd) [+ g(q)]: the inverse dynamics at zero acceleration.
@@ -217,16 +229,26 @@ impl PyRobot {
         gravity: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.model.nv;
-        self.batch(py, &[("q", &q), ("qd", &qd)], &[n], |m, w, s, out| {
-            parallel::rnea(m, w, s, gravity.into(), out)
-        })
+        self.batch(
+            py,
+            "Robot.bias",
+            &[("q", &q), ("qd", &qd)],
+            &[n],
+            |m, w, s, out| parallel::rnea(m, w, s, gravity.into(), out),
+        )
     }
 
     /// Joint-space mass matrix M(q), symmetric positive definite. q: (n,) or (k, n); returns
     /// (n, n) or (k, n, n).
     fn mass_matrix<'py>(&self, py: Python<'py>, q: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
         let n = self.model.nv;
-        self.batch(py, &[("q", &q)], &[n, n], parallel::mass_matrix)
+        self.batch(
+            py,
+            "Robot.mass_matrix",
+            &[("q", &q)],
+            &[n, n],
+            parallel::mass_matrix,
+        )
     }
 
     /// Joint-torque regressor Phi(q, qd, qdd): `Phi @ theta == rnea(q, qd, qdd)` with `theta`
@@ -244,7 +266,7 @@ impl PyRobot {
     ) -> PyResult<Bound<'py, PyAny>> {
         let (n, p) = (self.model.nv, 10 * self.model.nbodies());
         let args = [("q", &q), ("qd", &qd), ("qdd", &qdd)];
-        self.batch(py, &args, &[n, p], |m, w, s, out| {
+        self.batch(py, "Robot.regressor", &args, &[n, p], |m, w, s, out| {
             parallel::regressor(m, w, s, gravity.into(), out)
         })
     }
@@ -274,7 +296,7 @@ impl PyRobot {
         // tau rides as the third column; the states are q and qd only
         let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("tau", &tau)])?;
         let mut out = vec![0.0; batch.k * n];
-        py.detach(|| -> Result<()> {
+        detached(py, "Robot.forward_dynamics", || -> Result<()> {
             let c = &batch.columns;
             let states = if batch.single {
                 States::single(n, &c[0], Some(&c[1]), None)?
@@ -311,7 +333,7 @@ impl PyRobot {
         let k = batch.k;
         let mut torque = vec![0.0; k * n];
         let mut parts = [(); 4].map(|_| vec![0.0; k * n * n]);
-        py.detach(|| -> Result<()> {
+        detached(py, "Robot.linearize", || -> Result<()> {
             let states = batch.states(n)?;
             let [d, h, g, g_static] = &mut parts;
             let out = parallel::LinearizationsOut {

@@ -3,6 +3,8 @@
 use std::sync::Arc;
 
 use pyo3::prelude::*;
+
+use super::detached;
 use pyo3::types::PyDict;
 
 use super::arrays::per_joint;
@@ -76,7 +78,7 @@ pub(crate) fn simulate(
         }
     }
     let plan = plan.plan.clone();
-    let recs = py.detach(|| simulate_plan(model, &plan, &o))?;
+    let recs = detached(py, "simulate", || simulate_plan(model, &plan, &o))?;
     Ok(recs
         .into_iter()
         .map(|r| PyRecording { rec: Arc::new(r) })

@@ -11,6 +11,7 @@ use crate::error::{Error, Result};
 /// period `2 pi / w_f`). `a` and `b` are `n x L` (rad/s: they are velocity amplitudes), `q0`
 /// the offsets (rad).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FourierTrajectory {
     pub w_f: f64,
     pub q0: Vec<f64>,

@@ -97,6 +97,7 @@ pub fn quintic(p0: f64, v0: f64, a0: f64, p1: f64, v1: f64, a1: f64, duration: f
 /// A trajectory of `n` joints made of contiguous segments (`segments[i].t1 ==
 /// segments[i + 1].t0`), starting at `segments[0].t0`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Trajectory {
     pub n: usize,
     pub segments: Vec<Segment>,

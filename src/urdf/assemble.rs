@@ -11,7 +11,7 @@ use super::convert::joint_limits;
 use super::graph::Graph;
 use super::roles::Role;
 use super::Builder;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::{Model, STANDARD_GRAVITY};
 
 impl Builder<'_> {
@@ -65,6 +65,12 @@ impl Builder<'_> {
             .iter()
             .map(|b| self.lines.joints.get(&b.joint).map(|j| j.0))
             .collect();
+        if joint_names.is_empty() {
+            return Err(Error::NoDegreeOfFreedom {
+                source_name: self.source.to_string(),
+                robot: robot.name.clone(),
+            });
+        }
         let model = Model {
             name: robot.name.clone(),
             source: self.source.to_string(),

@@ -55,11 +55,41 @@ impl Builder<'_> {
                 });
             }
         }
-        if joint.joint_type != Continuous && l.lower > l.upper {
-            return Err(Error::InvalidArgument {
-                argument: format!("{}: joint '{name}' <limit>", self.joint_location(name)),
-                message: format!("lower ({}) is above upper ({})", l.lower, l.upper),
-            });
+        let invalid = |message: String| Error::InvalidLimit {
+            location: self.joint_location(name),
+            joint: name.to_string(),
+            message,
+        };
+        if joint.joint_type != Continuous {
+            if l.lower > l.upper {
+                return Err(invalid(format!(
+                    "lower ({}) is above upper ({})",
+                    l.lower, l.upper
+                )));
+            }
+            if l.lower == l.upper {
+                return Err(invalid(format!(
+                    "lower = upper = {}: the joint cannot move; make it fixed, or lock it when loading",
+                    l.lower
+                )));
+            }
+        }
+        // On a continuous joint zeros mean "not given" (see `convert::joint_limits`).
+        let given = |v: f64| !(joint.joint_type == Continuous && v == 0.0);
+        if l.velocity <= 0.0 && given(l.velocity) {
+            return Err(invalid(format!(
+                "velocity {} rad/s (or m/s) is not positive",
+                l.velocity
+            )));
+        }
+        if l.effort < 0.0 {
+            return Err(invalid(format!("effort {} is negative", l.effort)));
+        }
+        if l.acceleration <= 0.0 {
+            return Err(invalid(format!(
+                "acceleration {} is not positive",
+                l.acceleration
+            )));
         }
         if let Some(d) = &joint.dynamics {
             self.finite(

@@ -53,13 +53,19 @@ pub(super) fn joint_limits(joint: &urdf_rs::Joint) -> JointLimits {
         .map(|d| (d.damping, d.friction))
         .unwrap_or((0.0, 0.0));
     // A continuous joint's <limit> may be absent (urdf-rs then reports zeros) or give only
-    // effort and velocity: zeros there mean "not given".
+    // effort and velocity: zeros there mean "not given". An effort of 0 means the same on any
+    // joint (URDF writers put 0 for "unknown"; no joint moves with no effort at all).
     let given = |v: f64| {
         if continuous && v == 0.0 {
             f64::INFINITY
         } else {
             v
         }
+    };
+    let effort = if l.effort == 0.0 {
+        f64::INFINITY
+    } else {
+        l.effort
     };
     JointLimits {
         lower: if continuous {
@@ -69,7 +75,7 @@ pub(super) fn joint_limits(joint: &urdf_rs::Joint) -> JointLimits {
         },
         upper: if continuous { f64::INFINITY } else { l.upper },
         velocity: given(l.velocity),
-        effort: given(l.effort),
+        effort,
         acceleration: l.acceleration,
         damping,
         friction,

@@ -28,6 +28,8 @@ mod graph;
 mod lines;
 mod roles;
 
+pub use lines::MAX_XML_DEPTH;
+
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -68,6 +70,7 @@ pub fn model_from_urdf_file(path: impl AsRef<Path>, options: &LoadOptions) -> Re
 
 /// Builds a model from URDF text. `source_name` names the text in error messages.
 pub fn model_from_urdf_str(text: &str, source_name: &str, options: &LoadOptions) -> Result<Model> {
+    lines::check_depth(text, source_name)?;
     let lines = LineIndex::new(text);
     let robot = urdf_rs::read_from_string(text).map_err(|e| Error::UrdfSyntax {
         source_name: source_name.to_string(),

@@ -25,3 +25,11 @@ def test_python_m_paper(tmp_path):
     assert out.returncode == 0, out.stderr
     assert "Table 3" in out.stdout
     assert (tmp_path / "report.md").is_file() and (tmp_path / "fig4_joint3.svg").is_file()
+
+
+def test_a_file_name_that_is_not_utf8_gets_an_error_not_a_crash(tmp_path):
+    name = os.fsdecode(b"model-\xff.json")  # surrogate-escaped, as Python hands it over
+    out = subprocess.run([perturbid(), "predict", name, "data.csv"], cwd=tmp_path, capture_output=True, text=True, errors="replace")
+    assert out.returncode == 1, out.stderr
+    assert out.stderr.startswith("perturbid: model-") and out.stderr.count("\n") == 1, out.stderr
+    assert "Traceback" not in out.stderr

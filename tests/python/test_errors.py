@@ -14,9 +14,37 @@ def robot():
 
 
 def test_hierarchy():
-    for cls in (pr.ModelError, pr.InputError, pr.NumericalError, pr.FileError):
+    for cls in (pr.ModelError, pr.InputError, pr.NumericalError, pr.FileError, pr.InternalError):
         assert issubclass(cls, pr.PerturbidError)
     assert issubclass(pr.PerturbidError, Exception)
+    # caught as Python users expect
+    assert issubclass(pr.InputError, ValueError)
+    assert issubclass(pr.FileError, OSError)
+    assert issubclass(pr.NumericalError, ArithmeticError)
+    assert issubclass(pr.InternalError, RuntimeError)
+    assert not issubclass(pr.ModelError, ValueError)
+    with pytest.raises(ValueError, match="q: expected shape"):
+        pr.robots.a465().rnea([0.0] * 5, [0.0] * 6, [0.0] * 6)
+    with pytest.raises(OSError, match="no-such.urdf"):
+        pr.Robot.from_urdf("no-such.urdf")
+
+
+def test_unusable_limits_and_robots_are_model_errors():
+    urdf = """<robot name="r"><link name="a"/>
+<link name="b"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+<joint name="j1" type="{kind}"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>{limit}</joint></robot>"""
+    bad = urdf.format(kind="revolute", limit='<limit lower="-1" upper="1" effort="1" velocity="-3"/>')
+    with pytest.raises(pr.ModelError, match=r"<string>:3: joint 'j1' <limit>: velocity -3 .* is not positive"):
+        pr.Robot.from_urdf_string(bad)
+    bad = urdf.format(kind="revolute", limit='<limit lower="1" upper="-1" effort="1" velocity="1"/>')
+    with pytest.raises(pr.ModelError, match=r"lower \(1\) is above upper \(-1\)"):
+        pr.Robot.from_urdf_string(bad)
+    with pytest.raises(pr.ModelError, match="has no moving joint"):
+        pr.Robot.from_urdf_string(urdf.format(kind="fixed", limit=""))
+    robot = pr.Robot.from_urdf_string(urdf.format(kind="revolute", limit='<limit lower="-1" upper="1" effort="1" velocity="1"/>'))
+    with pytest.raises(pr.ModelError, match="has no moving joint"):
+        pr.Robot.from_urdf_string(urdf.format(kind="revolute", limit='<limit lower="-1" upper="1" effort="1" velocity="1"/>'), lock={"j1": 0.0})
+    assert robot.n == 1
 
 
 def test_wrong_shapes(robot):

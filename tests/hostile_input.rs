@@ -1,0 +1,200 @@
+//! Careless and hostile input gets one of our errors, of the right kind, naming what is wrong:
+//! never a panic, a stack overflow or a silent reinterpretation.
+
+mod common;
+
+use std::collections::BTreeMap;
+
+use common::mimic_pair;
+use perturbid_rs::io::Table;
+use perturbid_rs::local::{plan_experiments, OperatingPoint, PlanOptions};
+use perturbid_rs::urdf::MAX_XML_DEPTH;
+use perturbid_rs::{
+    catch_panics, model_from_urdf_str, robots, Document, Error, ErrorKind, LoadOptions, Plan,
+};
+
+fn load(urdf: &str) -> Result<perturbid_rs::Model, Error> {
+    model_from_urdf_str(urdf, "arm.urdf", &LoadOptions::default())
+}
+
+fn with_limit(limit: &str, kind: &str) -> String {
+    format!(
+        r#"<robot name="r"><link name="a"/>
+<link name="b"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+<joint name="j1" type="{kind}"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>{limit}</joint></robot>"#
+    )
+}
+
+#[test]
+fn unusable_limits_are_model_errors_naming_the_joint_and_line() {
+    for (limit, says) in [
+        (
+            r#"<limit lower="1" upper="-1" effort="1" velocity="1"/>"#,
+            "lower (1) is above upper (-1)",
+        ),
+        (
+            r#"<limit lower="0" upper="0" effort="1" velocity="1"/>"#,
+            "cannot move",
+        ),
+        (
+            r#"<limit lower="-1" upper="1" effort="1" velocity="-1"/>"#,
+            "velocity -1",
+        ),
+        (
+            r#"<limit lower="-1" upper="1" effort="1" velocity="0"/>"#,
+            "velocity 0",
+        ),
+        (
+            r#"<limit lower="-1" upper="1" effort="-2" velocity="1"/>"#,
+            "effort -2 is negative",
+        ),
+        (
+            r#"<limit lower="-1" upper="1" effort="1" velocity="1" acceleration="0"/>"#,
+            "acceleration 0",
+        ),
+    ] {
+        let mut urdf = with_limit(limit, "revolute");
+        if limit.contains("acceleration") {
+            // URDF 1.2 is the first version with acceleration limits
+            urdf = urdf.replace(r#"name="r">"#, r#"name="r" version="1.2">"#);
+        }
+        let e = load(&urdf).unwrap_err();
+        assert_eq!(e.kind(), ErrorKind::Model, "{e}");
+        let text = e.to_string();
+        assert!(
+            text.starts_with("arm.urdf:3: joint 'j1' <limit>: "),
+            "{text}"
+        );
+        assert!(text.contains(says), "{text}");
+    }
+    // a continuous joint may leave velocity and effort out (zeros from the parser): no limit
+    let m = load(&with_limit(
+        r#"<limit effort="0" velocity="0"/>"#,
+        "continuous",
+    ))
+    .unwrap();
+    assert!(m.limits[0].velocity.is_infinite() && m.limits[0].effort.is_infinite());
+    // effort 0 means "not given" on any joint
+    let m = load(&with_limit(
+        r#"<limit lower="-1" upper="1" effort="0" velocity="1"/>"#,
+        "revolute",
+    ))
+    .unwrap();
+    assert!(m.limits[0].effort.is_infinite());
+}
+
+#[test]
+fn a_robot_without_a_moving_joint_is_refused() {
+    let fixed = with_limit("", "fixed");
+    let e = load(&fixed).unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::Model);
+    assert!(e.to_string().contains("has no moving joint"), "{e}");
+    // every joint locked: the same
+    let mut lock = BTreeMap::new();
+    lock.insert("a".to_string(), 0.0);
+    lock.insert("c".to_string(), 0.0);
+    let options = LoadOptions {
+        lock,
+        ..LoadOptions::default()
+    };
+    let e = model_from_urdf_str(&mimic_pair(true), "m.urdf", &options).unwrap_err();
+    assert!(e.to_string().contains("has no moving joint"), "{e}");
+}
+
+#[test]
+fn deep_nesting_is_refused_before_parsing() {
+    // far deeper than any parser's recursion can take
+    let depth = 200_000;
+    let mut urdf = String::from(r#"<robot name="r"><link name="a">"#);
+    urdf.push_str(&"<x>".repeat(depth));
+    urdf.push_str(&"</x>".repeat(depth));
+    urdf.push_str("</link></robot>");
+    let e = load(&urdf).unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::Model);
+    let text = e.to_string();
+    assert!(
+        text.contains(&format!("at most {MAX_XML_DEPTH} levels")),
+        "{text}"
+    );
+    // comments, CDATA and quoted '>' do not count as elements
+    let ok = with_limit(
+        r#"<!-- <a><b><c> --><limit lower="-1" upper="1" effort="1" velocity="1"/><![CDATA[<<<]]>"#,
+        "revolute",
+    )
+    .replace(r#"<robot name="r">"#, r#"<robot name="r>s">"#);
+    load(&ok).unwrap();
+}
+
+#[test]
+fn a_long_chain_loads() {
+    // 5,000 links: the loader used to be quadratic (line numbers, the mass check)
+    let n = 5000;
+    let mut urdf = String::from(r#"<robot name="chain"><link name="l0"/>"#);
+    for i in 1..=n {
+        urdf.push_str(&format!(
+            r#"<link name="l{i}"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+<joint name="j{i}" type="revolute"><parent link="l{}"/><child link="l{i}"/><origin xyz="0 0 0.1"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>"#,
+            i - 1
+        ));
+    }
+    urdf.push_str("</robot>");
+    let m = load(&urdf).unwrap();
+    assert_eq!(m.nv, n);
+    // an error deep in the file names its line
+    let bad = urdf.replace(
+        r#"name="j4000" type="revolute""#,
+        r#"name="j4000" type="floating""#,
+    );
+    let e = load(&bad).unwrap_err().to_string();
+    assert!(e.starts_with("arm.urdf:4001: joint 'j4000'"), "{e}");
+}
+
+#[test]
+fn csv_headers_are_checked_in_one_pass() {
+    let e = Table::parse("log.csv", "# a comment\n\nt,q1,q1\n0,1,2\n").unwrap_err();
+    assert_eq!(e.to_string(), "log.csv: line 3: column 'q1' appears twice");
+    let wide: Vec<String> = (0..200_000).map(|i| format!("c{i}")).collect();
+    let zeros = vec!["0"; wide.len()].join(",");
+    let t = Table::parse("wide.csv", &format!("{}\n{zeros}\n", wide.join(","))).unwrap();
+    assert_eq!(t.columns.len(), 200_000);
+}
+
+#[test]
+fn documents_refuse_unknown_keys_with_their_path() {
+    let model = robots::builtin("a465").unwrap();
+    let op = OperatingPoint::new(
+        vec![0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0],
+        vec![0.089, -0.106, 0.022, 0.056, 0.011, 0.014],
+        vec![-0.155, -0.5, 0.034, -0.291, -0.008, 0.171],
+    )
+    .unwrap();
+    let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+    let text = plan.to_json();
+    // a misspelled top-level key
+    let e = Plan::from_json(&text.replacen("\"rate\"", "\"rat\"", 1)).unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::Input);
+    assert!(e.to_string().contains("unknown field `rat`"), "{e}");
+    // an extra key deep inside: the path says where
+    let deep = text.replacen("\"crossings\": [", "\"crosings\": 1, \"crossings\": [", 1);
+    let e = Plan::from_json(&deep).unwrap_err().to_string();
+    assert!(
+        e.contains("at experiments[0]") && e.contains("unknown field `crosings`"),
+        "{e}"
+    );
+    // trailing content is not ignored
+    assert!(Plan::from_json(&format!("{text} {{}}")).is_err());
+    Plan::from_json(&text).unwrap();
+}
+
+#[test]
+fn a_panic_at_the_boundary_becomes_an_internal_error() {
+    let e = catch_panics("Robot.rnea", || -> perturbid_rs::Result<()> {
+        panic!("boom")
+    })
+    .unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::Internal);
+    assert_eq!(
+        e.to_string(),
+        "internal error in Robot.rnea: boom (a bug in perturbid_rs: please report it)"
+    );
+}
