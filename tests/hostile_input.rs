@@ -1,5 +1,7 @@
 //! Careless and hostile input gets one of our errors, of the right kind, naming what is wrong:
 //! never a panic, a stack overflow or a silent reinterpretation.
+// Errors carry their context by value (the library allows the same).
+#![allow(clippy::result_large_err)]
 
 mod common;
 
@@ -8,12 +10,13 @@ use std::collections::BTreeMap;
 use common::mimic_pair;
 use perturbid_rs::io::Table;
 use perturbid_rs::local::{plan_experiments, OperatingPoint, PlanOptions};
+use perturbid_rs::robots::a465::{TABLE2_Q, TABLE2_QD, TABLE2_QDD};
 use perturbid_rs::urdf::MAX_XML_DEPTH;
 use perturbid_rs::{
-    catch_panics, model_from_urdf_str, robots, Document, Error, ErrorKind, LoadOptions, Plan,
+    catch_panics, model_from_urdf_str, robots, Document, ErrorKind, LoadOptions, Plan,
 };
 
-fn load(urdf: &str) -> Result<perturbid_rs::Model, Error> {
+fn load(urdf: &str) -> perturbid_rs::Result<perturbid_rs::Model> {
     model_from_urdf_str(urdf, "arm.urdf", &LoadOptions::default())
 }
 
@@ -162,12 +165,8 @@ fn csv_headers_are_checked_in_one_pass() {
 #[test]
 fn documents_refuse_unknown_keys_with_their_path() {
     let model = robots::builtin("a465").unwrap();
-    let op = OperatingPoint::new(
-        vec![0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0],
-        vec![0.089, -0.106, 0.022, 0.056, 0.011, 0.014],
-        vec![-0.155, -0.5, 0.034, -0.291, -0.008, 0.171],
-    )
-    .unwrap();
+    let op =
+        OperatingPoint::new(TABLE2_Q.to_vec(), TABLE2_QD.to_vec(), TABLE2_QDD.to_vec()).unwrap();
     let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
     let text = plan.to_json();
     // a misspelled top-level key
