@@ -25,6 +25,7 @@ pub mod gravity;
 pub mod io;
 pub mod json;
 mod lanes;
+pub mod limits;
 pub mod linearization;
 pub mod local;
 pub mod model;

@@ -57,7 +57,8 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     }
     let n = rec.n;
     let (t0, t1) = (rec.t[0], rec.t[rec.len() - 1]);
-    let count = ((t1 - t0) * o.rate).floor() as usize + 1;
+    let count = crate::limits::sample_count("preprocess", t1 - t0, o.rate)?;
+    check_gaps(rec)?;
     let grid: Vec<f64> = (0..count).map(|i| t0 + i as f64 / o.rate).collect();
     let dt = 1.0 / o.rate;
     let filter = o
@@ -114,4 +115,34 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
         Some(rows(&cols[1])),
         Some(rows(&cols[2])),
     )
+}
+
+/// Refuses a log with a gap longer than [`MAX_GAP_INTERVALS`] times its median sample
+/// interval: resampling would fill it with invented, interpolated values. The error names the
+/// gap's time.
+///
+/// [`MAX_GAP_INTERVALS`]: crate::limits::MAX_GAP_INTERVALS
+fn check_gaps(rec: &Recording) -> Result<()> {
+    let dt: Vec<f64> = rec.t.windows(2).map(|w| w[1] - w[0]).collect();
+    if dt.is_empty() {
+        return Ok(());
+    }
+    let mut sorted = dt.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2];
+    let limit = crate::limits::MAX_GAP_INTERVALS * median;
+    match dt.iter().position(|&d| d > limit) {
+        Some(i) => Err(Error::Recording {
+            recording: rec.name.clone(),
+            message: format!(
+                "a gap of {:.6} s after t = {:.6} s, {:.0} times the median sample interval ({:.3e} s); resampling would invent the values in it (at most {} intervals are bridged): split the log there",
+                dt[i],
+                rec.t[i],
+                dt[i] / median,
+                median,
+                crate::limits::MAX_GAP_INTERVALS
+            ),
+        }),
+        None => Ok(()),
+    }
 }

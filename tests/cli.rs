@@ -151,6 +151,20 @@ fn plan_simulate_identify_predict() {
         pred.columns,
         ["t", "tau1", "tau2", "tau3", "tau4", "tau5", "tau6"]
     );
+    // an output that is an input is refused, also spelled another way, and the input survives
+    let before = std::fs::read(d.join("plan/D.csv")).unwrap();
+    let other_spelling = d.join("plan/../plan/D.csv");
+    fails(
+        &[
+            "predict",
+            s(&d.join("model.json")),
+            s(&d.join("plan/D.csv")),
+            "--out",
+            s(&other_spelling),
+        ],
+        &["--out: ", "is also an input; writing it would destroy"],
+    );
+    assert_eq!(std::fs::read(d.join("plan/D.csv")).unwrap(), before);
 }
 
 #[test]

@@ -197,3 +197,149 @@ fn a_panic_at_the_boundary_becomes_an_internal_error() {
         "internal error in Robot.rnea: boom (a bug in perturbid_rs: please report it)"
     );
 }
+
+#[test]
+fn sizes_from_input_are_bounded_before_allocation() {
+    use perturbid_rs::direct::{design_excitation, ExcitationOptions};
+    use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+    use perturbid_rs::Recording;
+    let model = robots::builtin("a465").unwrap();
+    let op =
+        OperatingPoint::new(TABLE2_Q.to_vec(), TABLE2_QD.to_vec(), TABLE2_QDD.to_vec()).unwrap();
+    for (options, says) in [
+        (
+            PlanOptions {
+                rate: 1e12,
+                ..PlanOptions::default()
+            },
+            "rate: 1000000000000;",
+        ),
+        (
+            PlanOptions {
+                count: Some(1_000_000_000_000),
+                ..PlanOptions::default()
+            },
+            "count: 1000000000000; expected 2 to 100000",
+        ),
+        (
+            PlanOptions {
+                window: f64::INFINITY,
+                ..PlanOptions::default()
+            },
+            "window: inf",
+        ),
+        (
+            PlanOptions {
+                experiments: vec![],
+                ..PlanOptions::default()
+            },
+            "experiments: none asked for",
+        ),
+    ] {
+        let e = plan_experiments(&model, &op, &options).unwrap_err();
+        assert_eq!(e.kind(), ErrorKind::Input);
+        assert!(e.to_string().starts_with(says), "{e}");
+    }
+    for (options, says) in [
+        (
+            ExcitationOptions {
+                harmonics: 1_000_000_000,
+                ..ExcitationOptions::default()
+            },
+            "harmonics: 1000000000; expected 1 to 1000",
+        ),
+        (
+            ExcitationOptions {
+                max_evaluations: 0,
+                ..ExcitationOptions::default()
+            },
+            "max_evaluations: 0",
+        ),
+        (
+            ExcitationOptions {
+                base_frequency: f64::NAN,
+                ..ExcitationOptions::default()
+            },
+            "base_frequency: NaN",
+        ),
+    ] {
+        let e = design_excitation(&model, &options, None).unwrap_err();
+        assert!(e.to_string().starts_with(says), "{e}");
+    }
+    // a log resampled at an absurd rate is refused, not allocated
+    let t: Vec<f64> = (0..100).map(|i| i as f64 * 1e-3).collect();
+    let rec = Recording::new("log", 1, t, vec![0.0; 100], vec![0.0; 100], None, None).unwrap();
+    let options = PreprocessOptions {
+        rate: 1e15,
+        ..PreprocessOptions::default()
+    };
+    let e = preprocess(&rec, &options).unwrap_err().to_string();
+    assert!(e.starts_with("rate: 1000000000000000"), "{e}");
+}
+
+#[test]
+fn a_gap_in_a_log_is_not_filled_with_invented_values() {
+    use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+    use perturbid_rs::Recording;
+    // 1 kHz for 3 s, then nothing for 100 s, then 3 s more
+    let mut t: Vec<f64> = (0..3000).map(|i| i as f64 * 1e-3).collect();
+    t.extend((0..3000).map(|i| 103.0 + i as f64 * 1e-3));
+    let q: Vec<f64> = t.iter().map(|x| (0.3 * x).sin()).collect();
+    let rec = Recording::new("arm.csv", 1, t, q.clone(), q, None, None).unwrap();
+    let e = preprocess(&rec, &PreprocessOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("arm.csv: a gap of 100.001000 s after t = 2.999000 s"),
+        "{e}"
+    );
+    assert!(e.contains("split the log there"), "{e}");
+}
+
+#[test]
+fn a_hand_edited_plan_is_checked_on_load() {
+    let model = robots::builtin("a465").unwrap();
+    let op =
+        OperatingPoint::new(TABLE2_Q.to_vec(), TABLE2_QD.to_vec(), TABLE2_QDD.to_vec()).unwrap();
+    let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+    // segments reversed in time
+    let mut edited = plan.clone();
+    let seg = &mut edited.experiments[1].trajectory.segments[2];
+    std::mem::swap(&mut seg.t0, &mut seg.t1);
+    let e = Plan::from_json(&edited.to_json()).unwrap_err().to_string();
+    assert!(
+        e.contains("experiments[1] ('G_static'): trajectory.segments[2] runs from"),
+        "{e}"
+    );
+    // a duration that would need more samples than are ever made
+    let mut edited = plan.clone();
+    let last = edited.experiments[0]
+        .trajectory
+        .segments
+        .last_mut()
+        .unwrap();
+    last.t1 = 1e12;
+    let e = Plan::from_json(&edited.to_json()).unwrap_err().to_string();
+    assert!(e.contains("at most 1e8 are made"), "{e}");
+    // no experiment at all
+    let mut edited = plan;
+    edited.experiments.clear();
+    let e = Plan::from_json(&edited.to_json()).unwrap_err().to_string();
+    assert!(e.contains("the plan has no experiment"), "{e}");
+}
+
+#[test]
+fn an_absurd_speed_limit_does_not_stall_the_excitation_design() {
+    use perturbid_rs::direct::{design_excitation, ExcitationOptions, FrictionTerms};
+    let mut model = robots::builtin("a465").unwrap();
+    for l in &mut model.limits {
+        l.velocity = 1e300;
+    }
+    let options = ExcitationOptions {
+        max_evaluations: 200,
+        friction: FrictionTerms::NONE,
+        ..ExcitationOptions::default()
+    };
+    let design = design_excitation(&model, &options, None).unwrap();
+    assert!(design.cond.is_finite() && design.evaluations <= 201);
+}

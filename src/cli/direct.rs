@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::files::{load_robot, load_table};
+use super::files::{load_robot, load_table, refuse_overwriting_inputs};
 use super::out_dir;
 use super::progress::Progress;
 use crate::direct::{
@@ -132,6 +132,7 @@ pub(crate) struct IdentifyDirectArgs {
 }
 
 pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
+    refuse_overwriting_inputs(&a.out, &[&a.data, std::path::Path::new(&a.robot)])?;
     let model = load_robot(&a.robot)?;
     let progress = Progress::new();
     progress.update(&format!("reading {}", a.data.display()));
@@ -243,6 +244,7 @@ pub(crate) struct PredictArgs {
 }
 
 pub(crate) fn predict(a: PredictArgs) -> Result<String> {
+    refuse_overwriting_inputs(&a.out, &[&a.model, &a.data])?;
     let file = ModelFile::load(&a.model)?;
     let joints = file.joint_names().to_vec();
     let rows = read_states(&load_table(&a.data)?, &joints)?;

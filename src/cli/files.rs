@@ -33,3 +33,23 @@ pub(crate) fn load_json<T>(path: &Path, parse: impl Fn(&str) -> Result<T>) -> Re
         other => other,
     })
 }
+
+/// Refuses an output file that is one of the inputs (it would be destroyed before, or while,
+/// it is read): `--out` equal to an input, also through another spelling of the same path.
+pub(crate) fn refuse_overwriting_inputs(out: &Path, inputs: &[&Path]) -> Result<()> {
+    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => a == b,
+    };
+    match inputs.iter().find(|i| same(out, i)) {
+        Some(input) => Err(Error::InvalidArgument {
+            argument: "--out".into(),
+            message: format!(
+                "{} is also an input; writing it would destroy {}: choose another output",
+                out.display(),
+                input.display()
+            ),
+        }),
+        None => Ok(()),
+    }
+}

@@ -254,6 +254,10 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
     } else {
         a.recordings.clone()
     };
+    let inputs: Vec<&std::path::Path> = std::iter::once(a.plan.as_path())
+        .chain(files.iter().map(PathBuf::as_path))
+        .collect();
+    super::files::refuse_overwriting_inputs(&a.out, &inputs)?;
     if files.len() != plan.experiments.len() {
         return Err(Error::InvalidArgument {
             argument: "RECORDINGS".into(),

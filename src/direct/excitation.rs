@@ -201,6 +201,25 @@ pub fn design_excitation(
     progress: Option<Progress<'_>>,
 ) -> Result<ExcitationDesign> {
     let o = options;
+    use crate::limits::{
+        check_count, check_range, MAX_EVALUATIONS, MAX_FIT_SAMPLES, MAX_HARMONICS,
+    };
+    check_count("harmonics", o.harmonics, 1, MAX_HARMONICS)?;
+    check_count("samples", o.samples, 1, MAX_FIT_SAMPLES)?;
+    check_count("max_evaluations", o.max_evaluations, 1, MAX_EVALUATIONS)?;
+    check_range("base_frequency", o.base_frequency, f64::MIN_POSITIVE, 1e3)?;
+    check_range(
+        "default_velocity",
+        o.default_velocity,
+        f64::MIN_POSITIVE,
+        1e6,
+    )?;
+    check_range(
+        "default_acceleration",
+        o.default_acceleration,
+        f64::MIN_POSITIVE,
+        1e9,
+    )?;
     if o.harmonics == 0 || (o.rest && o.harmonics < 2) {
         return Err(Error::InvalidArgument {
             argument: "harmonics".into(),
@@ -252,33 +271,28 @@ pub fn design_excitation(
         let (c, h) = (0.5 * (lo + hi), 0.5 * (hi - lo) * m);
         (lower[i], upper[i]) = (c - h, c + h);
     }
+    // The speeds the excitation can use. A Fourier series of L harmonics that stays within a
+    // position half-range h moves at most h w_f L fast (Bernstein's inequality): a speed limit
+    // above that cannot be reached, and taken as it is (1e300 from a careless URDF) it would
+    // only scale the search (its bounds and first step) into overflow. Accelerations enter the
+    // constraints only, as ratios to their limits, where a huge limit does no harm.
+    let given = |limit: f64, default: f64| if limit.is_finite() { limit } else { default };
+    let vel: Vec<f64> = (0..n)
+        .map(|i| {
+            let reach = 0.5 * (upper[i] - lower[i]) * w_f * o.harmonics as f64;
+            (m * given(model.limits[i].velocity, o.default_velocity)).min(reach)
+        })
+        .collect();
+    let acc: Vec<f64> = (0..n)
+        .map(|i| m * given(model.limits[i].acceleration, o.default_acceleration))
+        .collect();
     let p = Problem {
         model,
         base,
         o,
         w_f,
-        vel: model
-            .limits
-            .iter()
-            .map(|l| {
-                m * if l.velocity.is_finite() {
-                    l.velocity
-                } else {
-                    o.default_velocity
-                }
-            })
-            .collect(),
-        acc: model
-            .limits
-            .iter()
-            .map(|l| {
-                m * if l.acceleration.is_finite() {
-                    l.acceleration
-                } else {
-                    o.default_acceleration
-                }
-            })
-            .collect(),
+        vel,
+        acc,
         lower,
         upper,
         t_fit: (0..o.samples)

@@ -204,8 +204,57 @@ impl Document for Plan {
                 )));
             }
         }
-        if !(plan.rate.is_finite() && plan.rate > 0.0) {
-            return Err(bad(format!("rate {} is not a positive number", plan.rate)));
+        if !(plan.rate.is_finite() && plan.rate > 0.0 && plan.rate <= crate::limits::MAX_RATE) {
+            return Err(bad(format!(
+                "rate {} Hz; expected a positive number up to {:e}",
+                plan.rate,
+                crate::limits::MAX_RATE
+            )));
+        }
+        if plan.experiments.is_empty() {
+            return Err(bad("the plan has no experiment".into()));
+        }
+        for (k, e) in plan.experiments.iter().enumerate() {
+            let at = |what: &str| format!("experiments[{k}] ('{}'): {what}", e.kind.name());
+            // segments in time order, end to end, finite: what sampling walks through
+            let mut previous: Option<f64> = None;
+            for (i, seg) in e.trajectory.segments.iter().enumerate() {
+                let ordered = seg.t0.is_finite() && seg.t1.is_finite() && seg.t0 <= seg.t1;
+                let joined = previous.is_none_or(|t| (seg.t0 - t).abs() <= 1e-9 * t.abs().max(1.0));
+                if !ordered || !joined {
+                    return Err(bad(at(&format!(
+                        "trajectory.segments[{i}] runs from {} to {} s; segments must be finite, in time order and end to end",
+                        seg.t0, seg.t1
+                    ))));
+                }
+                if seg.coeffs.iter().flatten().any(|c| !c.is_finite()) {
+                    return Err(bad(at(&format!(
+                        "trajectory.segments[{i}] has a coefficient that is not finite"
+                    ))));
+                }
+                previous = Some(seg.t1);
+            }
+            crate::limits::sample_count(&at("trajectory"), e.duration(), plan.rate)?;
+            if e.deltas.nrows() != e.crossings.len() && e.kind != ExperimentKind::Nominal {
+                return Err(bad(at(&format!(
+                    "{} perturbations for {} crossings",
+                    e.deltas.nrows(),
+                    e.crossings.len()
+                ))));
+            }
+            let (start, end) = (e.trajectory.start(), e.trajectory.end());
+            if let Some(c) = e.crossings.iter().find(|c| {
+                !(c.time >= start && c.time <= end)
+                    || [&c.q, &c.qd, &c.qdd].iter().any(|v| v.len() != n)
+            }) {
+                return Err(bad(at(&format!(
+                    "the crossing at t = {} s is outside the trajectory ({start} to {end} s) or not for {n} joints",
+                    c.time
+                ))));
+            }
+            if !(e.window.is_finite() && e.window > 0.0) {
+                return Err(bad(at(&format!("window {} s is not positive", e.window))));
+            }
         }
         Ok(())
     }
@@ -224,10 +273,18 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
     op.check(model)?;
     let n = model.nv;
     let o = options;
-    if !(o.rate.is_finite() && o.rate > 0.0) {
+    use crate::limits::{check_count, check_range, MAX_PERTURBATIONS, MAX_RATE};
+    check_range("rate", o.rate, f64::MIN_POSITIVE, MAX_RATE)?;
+    check_range("window", o.window, 0.0, 60.0)?;
+    check_range("dwell", o.dwell, 0.0, 3600.0)?;
+    check_range("min_transition", o.min_transition, 0.0, 3600.0)?;
+    if let Some(count) = o.count {
+        check_count("count", count, 2, MAX_PERTURBATIONS)?;
+    }
+    if o.experiments.is_empty() {
         return Err(Error::InvalidArgument {
-            argument: "rate".into(),
-            message: format!("{}; expected a positive number of Hz", o.rate),
+            argument: "experiments".into(),
+            message: "none asked for; expected some of nominal, G_static, G, H, D".into(),
         });
     }
     let window_samples = (o.window * o.rate).round() as usize;

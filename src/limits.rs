@@ -1,0 +1,60 @@
+//! The sizes this library accepts from its input, checked before anything is allocated from
+//! them, so that a typing slip (`rate=1e12`) or a hostile file gets an error naming the
+//! parameter, its value and the limit instead of an abort on allocation or a run of hours.
+//! docs/limits.md lists them with their reasons.
+
+use crate::error::{Error, Result};
+
+/// Samples in one trajectory, recording or resampled log: 10^8 (a day at 1 kHz).
+pub const MAX_SAMPLES: f64 = 1e8;
+/// Sampling rate (Hz): 10 MHz, far above any robot controller.
+pub const MAX_RATE: f64 = 1e7;
+/// Perturbations (crossings) per experiment.
+pub const MAX_PERTURBATIONS: usize = 100_000;
+/// Harmonics per joint of a Fourier excitation.
+pub const MAX_HARMONICS: usize = 1_000;
+/// Samples per period at which an excitation's criterion is evaluated.
+pub const MAX_FIT_SAMPLES: usize = 1_000_000;
+/// Criterion evaluations of one excitation design.
+pub const MAX_EVALUATIONS: usize = 10_000_000;
+/// A recording's longest gap between time stamps, in multiples of its median interval, before
+/// resampling refuses to fill it with interpolated values.
+pub const MAX_GAP_INTERVALS: f64 = 20.0;
+
+/// Fails unless `value` (the parameter `name`) is finite and in `[low, high]`.
+pub fn check_range(name: &str, value: f64, low: f64, high: f64) -> Result<()> {
+    if value.is_finite() && value >= low && value <= high {
+        return Ok(());
+    }
+    Err(Error::InvalidArgument {
+        argument: name.into(),
+        message: format!("{value}; expected a finite number in [{low}, {high}]"),
+    })
+}
+
+/// Fails unless the count `value` (the parameter `name`) is in `[low, high]`.
+pub fn check_count(name: &str, value: usize, low: usize, high: usize) -> Result<()> {
+    if (low..=high).contains(&value) {
+        return Ok(());
+    }
+    Err(Error::InvalidArgument {
+        argument: name.into(),
+        message: format!("{value}; expected {low} to {high}"),
+    })
+}
+
+/// The number of samples of `duration` seconds at `rate` Hz (both checked: finite, positive,
+/// the rate at most [`MAX_RATE`]), at most [`MAX_SAMPLES`]; `what` names the result in errors.
+pub fn sample_count(what: &str, duration: f64, rate: f64) -> Result<usize> {
+    check_range("rate", rate, f64::MIN_POSITIVE, MAX_RATE)?;
+    let count = duration * rate;
+    if !(count.is_finite() && count >= 0.0) || count + 1.0 > MAX_SAMPLES {
+        return Err(Error::InvalidArgument {
+            argument: what.into(),
+            message: format!(
+                "{duration} s at {rate} Hz is {count:.3e} samples; at most {MAX_SAMPLES:e} are made (docs/limits.md)"
+            ),
+        });
+    }
+    Ok(count as usize + 1)
+}
