@@ -115,6 +115,10 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
         Some(rows(&cols[1])),
         Some(rows(&cols[2])),
     )
+    .map(|out| Recording {
+        experiment: rec.experiment.clone(),
+        ..out
+    })
 }
 
 /// Refuses a log with a gap longer than [`MAX_GAP_INTERVALS`] times its median sample

@@ -16,6 +16,9 @@ pub struct Recording {
     pub tau: Vec<f64>,
     pub qd: Option<Vec<f64>>,
     pub qdd: Option<Vec<f64>>,
+    /// The experiment of a plan this recording is a run of (`nominal`, `G_static`, `G`, `H`,
+    /// `D`), when it says; see [`Recording::experiment`].
+    pub experiment: Option<String>,
 }
 
 impl Recording {
@@ -39,9 +42,30 @@ impl Recording {
             tau,
             qd,
             qdd,
+            experiment: None,
         };
         r.check()?;
         Ok(r)
+    }
+
+    /// The recording marked as a run of the experiment named `experiment`.
+    pub fn for_experiment(mut self, experiment: impl Into<String>) -> Self {
+        self.experiment = Some(experiment.into());
+        self
+    }
+
+    /// The experiment this recording is a run of: its mark ([`Recording::for_experiment`]),
+    /// or else its name when that names an experiment, as a file `D.csv` or `rec/G_static.csv`
+    /// does (the stem counts). `kinds` are the experiment names to recognise.
+    pub fn experiment<'a>(&'a self, kinds: &[&str]) -> Option<&'a str> {
+        if let Some(e) = &self.experiment {
+            return Some(e);
+        }
+        let stem = std::path::Path::new(&self.name)
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or(&self.name);
+        kinds.iter().find(|k| **k == stem).map(|_| stem)
     }
 
     fn error(&self, message: String) -> Error {

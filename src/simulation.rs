@@ -180,6 +180,7 @@ pub fn simulate_plan(
                 i as u64,
                 &format!("simulated experiment '{}'", e.kind.name()),
             )
+            .map(|r| r.for_experiment(e.kind.name()))
         })
         .collect()
 }

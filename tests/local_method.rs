@@ -436,7 +436,8 @@ fn recordings_with_problems_get_clear_errors() {
         None,
         None,
     )
-    .unwrap();
+    .unwrap()
+    .for_experiment("D");
     let e = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap_err();
     assert!(
         e.to_string().contains("cut: experiment 'D', crossing")
@@ -461,18 +462,66 @@ fn recordings_with_problems_get_clear_errors() {
         None,
         None,
     )
-    .unwrap();
+    .unwrap()
+    .for_experiment("D");
     let e = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap_err();
     assert!(
         e.to_string().contains("samples in the") && e.to_string().contains("need at least"),
         "{e}"
     );
-    // wrong number of recordings
+    // a missing recording is named
     recs.pop();
-    assert!(identify_local(&plan, &recs, &IdentifyOptions::default())
-        .unwrap_err()
-        .to_string()
-        .contains("one per experiment"));
+    let e = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "recordings: experiment 'D' of the plan has no recording"
+    );
+}
+
+/// Recordings are matched with experiments by identity, never by order: shuffled recordings
+/// give the same model; unmarked, unknown and doubled ones are refused by name.
+#[test]
+fn recordings_are_matched_by_experiment_not_order() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
+    let recs = simulate_plan(&model, &plan, &noise_free(&model, Gravity::Excluded)).unwrap();
+    let options = IdentifyOptions::default();
+    let model_in_order = identify_local(&plan, &recs, &options).unwrap();
+    let mut shuffled = recs.clone();
+    shuffled.reverse();
+    shuffled.swap(0, 2);
+    assert_eq!(
+        identify_local(&plan, &shuffled, &options).unwrap(),
+        model_in_order
+    );
+    // a file named after its experiment needs no mark
+    let mut named = recs.clone();
+    for r in &mut named {
+        r.name = format!("rec/{}.csv", r.experiment.take().unwrap());
+    }
+    named.reverse();
+    assert_eq!(
+        identify_local(&plan, &named, &options).unwrap(),
+        model_in_order
+    );
+    let refused = |recs: &[Recording], says: &str| {
+        let e = identify_local(&plan, recs, &options)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(says), "{e}");
+    };
+    let mut unmarked = recs.clone();
+    unmarked[1].experiment = None;
+    refused(&unmarked, "does not say which experiment it is a run of");
+    let mut unknown = recs.clone();
+    unknown[1].experiment = Some("E".into());
+    refused(
+        &unknown,
+        "a run of experiment 'E', which the plan does not have",
+    );
+    let mut doubled = recs.clone();
+    doubled[1].experiment = Some("D".into());
+    refused(&doubled, "are both runs of experiment 'D'");
 }
 
 #[test]

@@ -236,7 +236,11 @@ class Recording:
         qd: Optional[ArrayLike] = None,
         qdd: Optional[ArrayLike] = None,
         name: str = "recording",
+        experiment: Optional[str] = None,
     ) -> "Recording": ...
+    @property
+    def experiment(self) -> Optional[str]:
+        """The experiment of a plan this is a run of (nominal, G_static, G, H, D), or None."""
     @property
     def name(self) -> str: ...
     @property

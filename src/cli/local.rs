@@ -262,7 +262,7 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
         return Err(Error::InvalidArgument {
             argument: "RECORDINGS".into(),
             message: format!(
-                "{} files for {} experiments ({}); give one CSV per experiment in that order, or a folder",
+                "{} files for {} experiments ({}); give one CSV per experiment, named after it (D.csv), or a folder",
                 files.len(),
                 plan.experiments.len(),
                 plan.kinds()

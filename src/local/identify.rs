@@ -122,8 +122,51 @@ fn estimate(ls: LeastSquares) -> Estimate {
     }
 }
 
+/// Pairs each experiment of `plan` with its recording, by identity: each recording says which
+/// experiment it is a run of ([`Recording::experiment`]: its mark, or a name such as `D.csv`).
+/// A recording that names no experiment of the plan, two for one experiment, or an experiment
+/// without one is an error naming them: the order of `recordings` does not matter.
+fn match_recordings<'a>(plan: &Plan, recordings: &'a [Recording]) -> Result<Vec<&'a Recording>> {
+    let kinds: Vec<&str> = plan.experiments.iter().map(|e| e.kind.name()).collect();
+    let mut found: Vec<Option<&Recording>> = vec![None; kinds.len()];
+    let refuse = |message: String| Error::InvalidArgument {
+        argument: "recordings".into(),
+        message,
+    };
+    for r in recordings {
+        let Some(kind) = r.experiment(&kinds) else {
+            return Err(refuse(format!(
+                "recording '{}' does not say which experiment it is a run of (the plan has {}): mark it (Python: Recording(..., experiment='D')) or name its file after the experiment (D.csv)",
+                r.name,
+                plan.kinds()
+            )));
+        };
+        let Some(i) = kinds.iter().position(|k| *k == kind) else {
+            return Err(refuse(format!(
+                "recording '{}' is a run of experiment '{kind}', which the plan does not have (it has {})",
+                r.name,
+                plan.kinds()
+            )));
+        };
+        if let Some(first) = found[i] {
+            return Err(refuse(format!(
+                "recordings '{}' and '{}' are both runs of experiment '{kind}'; give one",
+                first.name, r.name
+            )));
+        }
+        found[i] = Some(r);
+    }
+    kinds
+        .iter()
+        .zip(found)
+        .map(|(kind, r)| {
+            r.ok_or_else(|| refuse(format!("experiment '{kind}' of the plan has no recording")))
+        })
+        .collect()
+}
+
 /// Identifies the local model from `plan` and `recordings` (one per experiment of the plan, in
-/// the plan's order, each with the plan's N joints).
+/// any order, each saying which experiment it is a run of, each with the plan's N joints).
 ///
 /// `T*` is the mean torque at the nominal crossings, and the model's operating point the mean
 /// state there. For G, H and D: `Y` rows `tau_k - T*`, `X` rows the measured deltas of the
@@ -136,19 +179,12 @@ pub fn identify_local(
     options: &IdentifyOptions,
 ) -> Result<LocalModel> {
     let n = plan.n();
-    if recordings.len() != plan.experiments.len() {
-        return Err(Error::InvalidArgument {
-            argument: "recordings".into(),
-            message: format!(
-                "{} recordings for {} experiments ({}); give one per experiment, in the plan's order",
-                recordings.len(),
-                plan.experiments.len(),
-                plan.kinds()
-            ),
-        });
-    }
     let mut values = Vec::new();
-    for (e, r) in plan.experiments.iter().zip(recordings) {
+    for (e, r) in plan
+        .experiments
+        .iter()
+        .zip(match_recordings(plan, recordings)?)
+    {
         if r.n != n {
             return Err(Error::Recording {
                 recording: r.name.clone(),

@@ -307,7 +307,9 @@ pub(crate) fn plan_experiments(
     })
 }
 
-/// Identifies the local model from `plan` and `recordings` (one per experiment, in order).
+/// Identifies the local model from `plan` and `recordings`: one per experiment, in any order,
+/// each saying which experiment it is a run of (`Recording.experiment`, set by `simulate`, or a
+/// name such as `D.csv`).
 ///
 /// - `crossing_times`: 'planned' (the recording's clock starts with the plan) or 'detected'
 ///   (the offset between plan and recording is found in the data, within `max_shift` s);

@@ -65,8 +65,12 @@ impl PyRecording {
 
 #[pymethods]
 impl PyRecording {
+    /// `experiment` says which experiment of a plan this is a run of (`nominal`, `G_static`,
+    /// `G`, `H`, `D`): `identify_local` pairs recordings with experiments by it (or by a `name`
+    /// that is such a name or a file named after one, `D.csv`), never by order.
     #[new]
-    #[pyo3(signature = (t, q, tau, qd=None, qdd=None, name="recording"))]
+    #[pyo3(signature = (t, q, tau, qd=None, qdd=None, name="recording", experiment=None))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         t: ArrayLike<'_>,
         q: ArrayLike<'_>,
@@ -74,14 +78,20 @@ impl PyRecording {
         qd: Option<ArrayLike<'_>>,
         qdd: Option<ArrayLike<'_>>,
         name: &str,
+        experiment: Option<String>,
     ) -> PyResult<Self> {
-        Ok(Self {
-            rec: Arc::new(Self::build(t, q, tau, qd, qdd, name)?),
-        })
+        let mut rec = Self::build(t, q, tau, qd, qdd, name)?;
+        rec.experiment = experiment;
+        Ok(Self { rec: Arc::new(rec) })
     }
     #[getter]
     fn name(&self) -> String {
         self.rec.name.clone()
+    }
+    /// The experiment this recording is marked as a run of, or None.
+    #[getter]
+    fn experiment(&self) -> Option<String> {
+        self.rec.experiment.clone()
     }
     #[getter]
     fn n(&self) -> usize {

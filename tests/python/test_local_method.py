@@ -133,7 +133,7 @@ def test_real_recording_from_arrays_and_shifted_clock():
     plan = pr.plan_experiments(robot, op, experiments=["nominal", "D"], seed=2)
     sims = pr.simulate(robot, plan)
     # as if logged by a robot whose clock started 0.25 s before the plan, with qd logged
-    recs = [pr.Recording(r.t + 0.25, r.q, r.tau, qd=np.gradient(r.q, r.t, axis=0), name=f"log{i}") for i, r in enumerate(sims)]
+    recs = [pr.Recording(r.t + 0.25, r.q, r.tau, qd=np.gradient(r.q, r.t, axis=0), name=f"log{i}", experiment=r.experiment) for i, r in enumerate(sims)]
     model = pr.identify_local(plan, recs, crossing_times="detected", max_shift=0.5)
     assert rel(model.D, robot.mass_matrix(op.q)) < 1e-8
     assert model.H is None and model.G is None
@@ -161,9 +161,14 @@ def test_errors():
         pr.Recording([0, 1, 2], [[0, 0], [0, np.nan], [0, 0]], np.zeros((3, 2)))
     plan = pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2), experiments=["nominal", "D"])
     recs = pr.simulate(robot, plan)
-    with pytest.raises(pr.InputError, match="one per experiment"):
+    with pytest.raises(pr.InputError, match="experiment 'D' of the plan has no recording"):
         pr.identify_local(plan, recs[:1])
-    short = pr.Recording(recs[1].t[:2000], recs[1].q[:2000], recs[1].tau[:2000], name="short.csv")
+    # matched by identity, not order
+    assert np.array_equal(pr.identify_local(plan, recs[::-1]).D, pr.identify_local(plan, recs).D)
+    unmarked = pr.Recording(recs[1].t, recs[1].q, recs[1].tau, name="run7.csv")
+    with pytest.raises(pr.InputError, match="recording 'run7.csv' does not say which experiment"):
+        pr.identify_local(plan, [recs[0], unmarked])
+    short = pr.Recording(recs[1].t[:2000], recs[1].q[:2000], recs[1].tau[:2000], name="short.csv", experiment="D")
     with pytest.raises(pr.InputError, match="short.csv: experiment 'D', crossing .*too short"):
         pr.identify_local(plan, [recs[0], short])
     with pytest.raises(pr.InputError, match="line 1"):
