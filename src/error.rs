@@ -144,7 +144,7 @@ pub enum Error {
     },
 
     /// A number in the URDF that is NaN or infinite where a finite value is required.
-    #[error("{location}: {element} '{name}': {field} is {value}, expected a finite number")]
+    #[error("{location}: {element} '{name}': {field} is {value}, expected a finite number below 1e12 in size")]
     NonFiniteUrdf {
         location: Location,
         element: &'static str,

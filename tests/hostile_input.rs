@@ -343,3 +343,113 @@ fn an_absurd_speed_limit_does_not_stall_the_excitation_design() {
     let design = design_excitation(&model, &options, None).unwrap();
     assert!(design.cond.is_finite() && design.evaluations <= 201);
 }
+
+#[test]
+fn finite_inputs_that_overflow_get_errors_not_inf() {
+    use perturbid_rs::{parallel, Gravity, States};
+    // inertias near the top of the floating-point range
+    for inertia in [
+        r#"ixx="0.1" ixy="-1e308" ixz="0" iyy="0.1" iyz="0" izz="0.1""#,
+        r#"ixx="1e308" ixy="0" ixz="0" iyy="1e308" iyz="0" izz="1e308""#,
+    ] {
+        let urdf = with_limit(
+            r#"<limit lower="-1" upper="1" effort="1" velocity="1"/>"#,
+            "revolute",
+        )
+        .replace(
+            r#"ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1""#,
+            inertia,
+        );
+        let e = load(&urdf).unwrap_err();
+        assert_eq!(e.kind(), ErrorKind::Model, "{e}");
+        assert!(e.to_string().contains("link 'b'"), "{e}");
+    }
+    let urdf = with_limit(
+        r#"<limit lower="-1" upper="1" effort="1" velocity="1"/>"#,
+        "revolute",
+    )
+    .replace(r#"<mass value="1"/>"#, r#"<mass value="1e300"/>"#);
+    assert!(load(&urdf).unwrap_err().to_string().contains("below 1e12"));
+    // a state so large that the dynamics overflow: an error naming the sample, not inf
+    let model = robots::builtin("a465").unwrap();
+    let mut qd = vec![0.1; 5 * 6];
+    qd[3 * 6 + 1] = 1e200;
+    let q = vec![0.2; 5 * 6];
+    let states = States::new(6, &q, Some(&qd), None).unwrap();
+    let mut tau = vec![0.0; 30];
+    let e = parallel::rnea(
+        &model,
+        &mut parallel::Workspace::new(&model),
+        &states,
+        Gravity::Included,
+        &mut tau,
+    )
+    .unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::Numerical);
+    assert!(e.to_string().starts_with("rnea (sample 3): tau is"), "{e}");
+}
+
+#[test]
+fn options_that_mean_nothing_are_refused() {
+    use perturbid_rs::direct::{identify_base_parameters, BaseOptions};
+    use perturbid_rs::States;
+    let model = robots::builtin("a465").unwrap();
+    let q = vec![0.1; 60];
+    let states = States::new(6, &q, Some(&q), Some(&q)).unwrap();
+    for tolerance in [f64::NAN, -1.0, 1.0] {
+        let options = BaseOptions {
+            tolerance,
+            ..BaseOptions::default()
+        };
+        let e = identify_base_parameters(&model, &states, &q, &options).unwrap_err();
+        assert!(e.to_string().starts_with("tolerance: "), "{e}");
+    }
+}
+
+mod fuzz {
+    //! Arbitrary and mutated text through every reader: a result or one of our errors, never a
+    //! panic. Bounded for CI (`PROPTEST_CASES` raises the count for a release run).
+    use super::*;
+    use perturbid_rs::local::LocalModel;
+    use proptest::prelude::*;
+
+    fn a_urdf() -> String {
+        mimic_pair(true)
+    }
+
+    /// `text` with the bytes in `cuts` removed and `insert` put at `at`.
+    fn mutate(text: &str, at: usize, cut: usize, insert: &str) -> String {
+        let mut chars: Vec<char> = text.chars().collect();
+        let at = at % (chars.len() + 1);
+        let end = (at + cut).min(chars.len());
+        chars.splice(at..end, insert.chars());
+        chars.into_iter().collect()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+
+        #[test]
+        fn urdf_reader(at in 0usize..4000, cut in 0usize..40, insert in ".{0,12}") {
+            let text = mutate(&a_urdf(), at, cut, &insert);
+            let _ = model_from_urdf_str(&text, "fuzz.urdf", &LoadOptions::default());
+        }
+
+        #[test]
+        fn csv_reader(text in "[a-z0-9,.\\-#eE\\n ]{0,200}") {
+            let _ = Table::parse("fuzz.csv", &text);
+        }
+
+        #[test]
+        fn json_documents(at in 0usize..3000, cut in 0usize..30, insert in "[\\[\\]{}\",:0-9a-z.eE-]{0,10}") {
+            let model = robots::builtin("a465").unwrap();
+            let op = OperatingPoint::new(TABLE2_Q.to_vec(), TABLE2_QD.to_vec(), TABLE2_QDD.to_vec()).unwrap();
+            let options = PlanOptions { experiments: vec![perturbid_rs::local::ExperimentKind::D], ..PlanOptions::default() };
+            let plan = plan_experiments(&model, &op, &options).unwrap();
+            let text = mutate(&plan.to_json(), at, cut, &insert);
+            let _ = Plan::from_json(&text);
+            let _ = LocalModel::from_json(&text);
+            let _ = perturbid_rs::ModelFile::from_json(&text, "fuzz.json");
+        }
+    }
+}

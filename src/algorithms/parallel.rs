@@ -49,6 +49,7 @@ impl Workspace {
 /// Runs `f` over the samples of `states`, whose results fill `outs` (`per_sample[i]` values per
 /// sample in `outs[i]`): on `ws` for a small batch, in parallel chunks for a large one.
 fn run<F>(
+    algorithm: &str,
     model: &Model,
     ws: &mut Workspace,
     states: &States<'_>,
@@ -77,7 +78,8 @@ where
     }
     if k < PARALLEL_BATCH || outs.iter().any(|o| o.2 == 0) {
         let mut whole: Vec<&mut [f64]> = outs.iter_mut().map(|o| &mut *o.1).collect();
-        return f(ws, states, &mut whole);
+        f(ws, states, &mut whole)?;
+        return check_finite(algorithm, states, outs);
     }
     let chunks = k.div_ceil(PARALLEL_CHUNK);
     let mut per_chunk: Vec<Vec<&mut [f64]>> = (0..chunks).map(|_| Vec::new()).collect();
@@ -93,7 +95,31 @@ where
             let first = c * PARALLEL_CHUNK;
             let chunk = states.slice(first..(first + PARALLEL_CHUNK).min(k));
             f(&mut Workspace::new(model), &chunk, &mut parts)
-        })
+        })?;
+    check_finite(algorithm, states, outs)
+}
+
+/// Fails on the first result that is not finite (finite inputs so large that the arithmetic
+/// overflows), naming the algorithm and the sample: no inf or NaN is handed back.
+fn check_finite(
+    algorithm: &str,
+    states: &States<'_>,
+    outs: &[(&str, &mut [f64], usize)],
+) -> Result<()> {
+    for (name, out, per) in outs {
+        if let Some(i) = out.iter().position(|v| !v.is_finite()) {
+            let e = Error::Numerical {
+                operation: algorithm.into(),
+                message: format!(
+                    "{name} is {} at entry {}: the state is too large to compute with",
+                    out[i],
+                    i % per.max(&1)
+                ),
+            };
+            return Err(states.at(i / per.max(&1), e));
+        }
+    }
+    Ok(())
 }
 
 /// Inverse dynamics `tau = M(q) qdd + c(q, qd) [+ g(q)]` of every sample (rigid bodies, no
@@ -119,21 +145,28 @@ pub fn rnea(
     tau: &mut [f64],
 ) -> Result<()> {
     let n = model.nv;
-    run(model, ws, states, &mut [("tau", tau, n)], |w, s, out| {
-        let out = &mut *out[0];
-        if s.len() >= LANES {
-            return rnea_lanes(model, &mut w.lanes, s.q(), s.qd(), s.qdd(), gravity, out);
-        }
-        let zeros = vec![0.0; n];
-        for (i, o) in out.chunks_mut(n).enumerate() {
-            let x = s.sample(i);
-            let (qd, qdd) = (x.qd.unwrap_or(&zeros), x.qdd.unwrap_or(&zeros));
-            crate::algorithms::rnea::rnea(model, &mut w.data, x.q, qd, qdd, gravity)
-                .map_err(|e| s.at(i, e))?;
-            o.copy_from_slice(w.data.tau.as_slice());
-        }
-        Ok(())
-    })
+    run(
+        "rnea",
+        model,
+        ws,
+        states,
+        &mut [("tau", tau, n)],
+        |w, s, out| {
+            let out = &mut *out[0];
+            if s.len() >= LANES {
+                return rnea_lanes(model, &mut w.lanes, s.q(), s.qd(), s.qdd(), gravity, out);
+            }
+            let zeros = vec![0.0; n];
+            for (i, o) in out.chunks_mut(n).enumerate() {
+                let x = s.sample(i);
+                let (qd, qdd) = (x.qd.unwrap_or(&zeros), x.qdd.unwrap_or(&zeros));
+                crate::algorithms::rnea::rnea(model, &mut w.data, x.q, qd, qdd, gravity)
+                    .map_err(|e| s.at(i, e))?;
+                o.copy_from_slice(w.data.tau.as_slice());
+            }
+            Ok(())
+        },
+    )
 }
 
 /// Joint-space mass matrices `M(q)` of every sample (velocities and accelerations ignored).
@@ -147,10 +180,11 @@ pub fn mass_matrix(
 ) -> Result<()> {
     let n = model.nv;
     run(
+        "mass_matrix",
         model,
         ws,
         states,
-        &mut [("out", out, n * n)],
+        &mut [("M", out, n * n)],
         |w, s, out| {
             let out = &mut *out[0];
             if s.len() >= LANES {
@@ -180,10 +214,11 @@ pub fn regressor(
 ) -> Result<()> {
     let (n, p) = (model.nv, PARAMS_PER_BODY * model.nbodies());
     run(
+        "regressor",
         model,
         ws,
         states,
-        &mut [("out", out, n * p)],
+        &mut [("the regressor", out, n * p)],
         |w, s, out| {
             let out = &mut *out[0];
             let (qd, qdd) = (s.qd_or_zeros(), s.qdd_or_zeros());
@@ -226,26 +261,33 @@ pub fn forward_dynamics(
 ) -> Result<()> {
     let n = model.nv;
     states.check_companion("tau", tau, n)?;
-    run(model, ws, states, &mut [("qdd", qdd, n)], |w, s, out| {
-        let zeros = vec![0.0; n];
-        // the chunk's torques: its samples sit at the same offset in `tau` as in the batch
-        let offset = s.offset() - states.offset();
-        for (i, o) in out[0].chunks_mut(n).enumerate() {
-            let x = s.sample(i);
-            let t = &tau[(offset + i) * n..(offset + i + 1) * n];
-            crate::algorithms::forward_dynamics::forward_dynamics(
-                model,
-                &mut w.data,
-                x.q,
-                x.qd.unwrap_or(&zeros),
-                t,
-                gravity,
-            )
-            .map_err(|e| s.at(i, e))?;
-            o.copy_from_slice(w.data.qdd.as_slice());
-        }
-        Ok(())
-    })
+    run(
+        "forward_dynamics",
+        model,
+        ws,
+        states,
+        &mut [("qdd", qdd, n)],
+        |w, s, out| {
+            let zeros = vec![0.0; n];
+            // the chunk's torques: its samples sit at the same offset in `tau` as in the batch
+            let offset = s.offset() - states.offset();
+            for (i, o) in out[0].chunks_mut(n).enumerate() {
+                let x = s.sample(i);
+                let t = &tau[(offset + i) * n..(offset + i + 1) * n];
+                crate::algorithms::forward_dynamics::forward_dynamics(
+                    model,
+                    &mut w.data,
+                    x.q,
+                    x.qd.unwrap_or(&zeros),
+                    t,
+                    gravity,
+                )
+                .map_err(|e| s.at(i, e))?;
+                o.copy_from_slice(w.data.qdd.as_slice());
+            }
+            Ok(())
+        },
+    )
 }
 
 /// Where the results of [`linearize`] go: row-major buffers of `k` samples.
@@ -280,7 +322,7 @@ pub fn linearize(
         ("g", out.g, nn),
         ("g_static", out.g_static, nn),
     ];
-    run(model, ws, states, &mut outs, |w, s, out| {
+    run("linearize", model, ws, states, &mut outs, |w, s, out| {
         let (qd, qdd) = (s.qd_or_zeros(), s.qdd_or_zeros());
         let mut lin = Linearization::zeros(n);
         for i in 0..s.len() {

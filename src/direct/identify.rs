@@ -112,6 +112,8 @@ pub fn identify_base_parameters(
     let nv = model.nv;
     crate::torque_model::check_joints(states, nv)?;
     states.check_companion("tau", tau, nv)?;
+    crate::limits::check_range("tolerance", options.tolerance, 1e-15, 0.1)?;
+    crate::limits::check_count("states", options.states, 1, 1_000_000)?;
     let k = states.len();
     let layout = ParameterLayout::new(model, options.friction);
     let base = BaseParameters::from_random_states(

@@ -62,6 +62,7 @@ pub fn experiment_values(
         CrossingTimes::Detected { max_shift } => detect_offset(experiment, rec, max_shift)?,
     };
     let half = options.fit.window.unwrap_or(experiment.window);
+    crate::limits::check_range("window", half, 0.0, 60.0)?;
     if !(half.is_finite() && half > 0.0) {
         return Err(Error::InvalidArgument {
             argument: "window".into(),

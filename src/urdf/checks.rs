@@ -7,11 +7,15 @@ use super::convert::kind_name;
 use super::Builder;
 use crate::error::{Error, Result};
 
+/// The largest mass (kg) or inertia (kg m^2) accepted in a link.
+pub const MAX_INERTIAL: f64 = 1e9;
+
 impl Builder<'_> {
     /// Finite numbers, a usable axis and a `<limit>` where the URDF requires one.
     pub(super) fn check_joint_numbers(&self, joint: &urdf_rs::Joint) -> Result<()> {
         let name = joint.name.as_str();
         self.finite("joint", name, "origin xyz", &joint.origin.xyz.0)?;
+
         self.finite("joint", name, "origin rpy", &joint.origin.rpy.0)?;
         use urdf_rs::JointType::*;
         if joint.joint_type == Fixed {
@@ -135,6 +139,18 @@ impl Builder<'_> {
                 inertial.mass.value
             )));
         }
+        // finite values whose products overflow (1e308) would turn every result into inf or
+        // NaN: no robot link is anywhere near these bounds
+        let too_large = |v: f64| v.abs() > MAX_INERTIAL;
+        if too_large(inertial.mass.value)
+            || [i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz]
+                .into_iter()
+                .any(too_large)
+        {
+            return Err(invalid(format!(
+                "a mass or inertia beyond {MAX_INERTIAL:e} (kg, kg m^2); no link has them"
+            )));
+        }
         let m = Matrix3::new(
             i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz,
         );
@@ -142,7 +158,7 @@ impl Builder<'_> {
         eig.sort_by(|a, b| a.total_cmp(b));
         // "Rounding": URDFs print inertias to a few significant digits.
         let tol = 1e-6 * eig.iter().map(|e| e.abs()).sum::<f64>() + 1e-12;
-        if eig[0] < -tol {
+        if eig.iter().any(|e| !e.is_finite()) || eig[0] < -tol {
             return Err(invalid(format!(
                 "the inertia tensor is not positive semi-definite (principal moments {:.6e}, {:.6e}, {:.6e} kg m^2)",
                 eig[0], eig[1], eig[2]

@@ -129,7 +129,8 @@ impl Builder<'_> {
         field: &'static str,
         values: &[f64],
     ) -> Result<()> {
-        if let Some(&value) = values.iter().find(|v| !v.is_finite()) {
+        // beyond 1e12 (m, kg, N m...) no robot number lies, and products would overflow
+        if let Some(&value) = values.iter().find(|v| !v.is_finite() || v.abs() > 1e12) {
             let location = if element == "link" {
                 self.link_location(name)
             } else {

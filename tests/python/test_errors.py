@@ -134,3 +134,27 @@ def test_bad_urdfs():
 def test_lock_removes_the_joint():
     r = pr.Robot.from_urdf_string(pr.robots.a465_urdf("physical"), lock={"joint6": 0.3})
     assert r.n == 5 and "joint6" not in r.joint_names
+
+
+from hypothesis import given, settings, strategies as st
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    shape=st.lists(st.integers(0, 7), min_size=0, max_size=3),
+    value=st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.sampled_from([1e300, -1e300, 0.0])),
+    method=st.sampled_from(["rnea", "mass_matrix", "regressor", "linearize", "forward_dynamics", "gravity"]),
+)
+def test_any_array_gets_a_result_or_our_error(shape, value, method):
+    """Arrays of any shape and any value through the dynamics: a finite result or one of the
+    library's errors; never a crash, a PanicException or an inf/NaN handed back."""
+    robot = pr.robots.a465()
+    x = np.full(shape, value)
+    args = {"gravity": (x,), "mass_matrix": (x,)}.get(method, (x, x, x))
+    try:
+        out = getattr(robot, method)(*args)
+    except pr.PerturbidError as e:
+        assert not isinstance(e, pr.InternalError), e
+        return
+    results = [out] if isinstance(out, np.ndarray) else [out.torque, out.D, out.H, out.G, out.G_static]
+    assert all(np.isfinite(r).all() for r in results)
