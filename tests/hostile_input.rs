@@ -453,3 +453,27 @@ mod fuzz {
         }
     }
 }
+
+#[test]
+fn urdf_messages_say_where_and_what() {
+    let urdf = with_limit(
+        r#"<limit lower="-1" upper="1" effort="1" velocity="1"/>"#,
+        "revolute",
+    );
+    let bad_number = urdf.replace(r#"ixx="0.1""#, r#"ixx="0,1""#);
+    assert_eq!(
+        load(&bad_number).unwrap_err().to_string(),
+        r#"arm.urdf: not a valid URDF: line 2: <inertia ixx="0,1">: '0,1' is not a number"#
+    );
+    let not_a_robot = "<model name=\"r\"><link name=\"a\"/></model>";
+    assert_eq!(
+        load(not_a_robot).unwrap_err().to_string(),
+        "arm.urdf: not a valid URDF: the document's root element is <model>, expected <robot>"
+    );
+    let broken = urdf.replace("</joint>", "</jiont>");
+    let e = load(&broken).unwrap_err().to_string();
+    assert!(
+        e.starts_with("arm.urdf: not a valid URDF: XML: ") && e.contains("3:"),
+        "{e}"
+    );
+}

@@ -17,17 +17,95 @@ pub(super) struct LineIndex {
     pub(super) links: HashMap<String, u32>,
 }
 
-impl LineIndex {
+/// Byte offset of every line start, for a binary search per element (roxmltree's own
+/// `text_pos_at` scans from the start: quadratic over a long file).
+pub(super) struct Lines(Vec<usize>);
+
+impl Lines {
     pub(super) fn new(text: &str) -> Self {
+        Lines(
+            std::iter::once(0)
+                .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+                .collect(),
+        )
+    }
+
+    /// The 1-based line of byte `offset`.
+    pub(super) fn of(&self, offset: usize) -> u32 {
+        self.0.partition_point(|&s| s <= offset) as u32
+    }
+}
+
+/// Parses the text as XML (errors with line and column), checks that its root is `<robot>`,
+/// and that every attribute URDF reads as numbers holds numbers, naming the line, element,
+/// attribute and value: urdf-rs reports such problems without saying where.
+pub(super) fn parse_xml<'a>(text: &'a str, source: &str) -> Result<roxmltree::Document<'a>> {
+    let syntax = |message: String| Error::UrdfSyntax {
+        source_name: source.to_string(),
+        message,
+    };
+    let doc = roxmltree::Document::parse(text).map_err(|e| syntax(format!("XML: {e}")))?;
+    let root = doc.root_element();
+    if root.tag_name().name() != "robot" {
+        return Err(syntax(format!(
+            "the document's root element is <{}>, expected <robot>",
+            root.tag_name().name()
+        )));
+    }
+    const NUMERIC: &[&str] = &[
+        "xyz",
+        "rpy",
+        "value",
+        "ixx",
+        "ixy",
+        "ixz",
+        "iyy",
+        "iyz",
+        "izz",
+        "lower",
+        "upper",
+        "effort",
+        "velocity",
+        "acceleration",
+        "damping",
+        "friction",
+        "multiplier",
+        "offset",
+    ];
+    let lines = Lines::new(text);
+    for node in doc.descendants().filter(|n| n.is_element()) {
+        if !matches!(
+            node.tag_name().name(),
+            "origin" | "axis" | "mass" | "inertia" | "limit" | "dynamics" | "mimic"
+        ) {
+            continue;
+        }
+        for attr in node.attributes().filter(|a| NUMERIC.contains(&a.name())) {
+            let bad = attr
+                .value()
+                .split_whitespace()
+                .find(|token| token.parse::<f64>().is_err());
+            if let Some(token) = bad {
+                return Err(syntax(format!(
+                    "line {}: <{} {}=\"{}\">: '{token}' is not a number",
+                    lines.of(node.range().start),
+                    node.tag_name().name(),
+                    attr.name(),
+                    attr.value()
+                )));
+            }
+        }
+    }
+    Ok(doc)
+}
+
+impl LineIndex {
+    pub(super) fn new(text: &str, doc: &roxmltree::Document<'_>) -> Self {
         let mut joints = HashMap::new();
         let mut links = HashMap::new();
-        // byte offset of every line start, for a binary search per element (roxmltree's own
-        // `text_pos_at` scans from the start: quadratic over a long file)
-        let starts: Vec<usize> = std::iter::once(0)
-            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
-            .collect();
-        let line_of = |offset: usize| starts.partition_point(|&s| s <= offset) as u32;
-        if let Ok(doc) = roxmltree::Document::parse(text) {
+        let lines = Lines::new(text);
+        let line_of = |offset: usize| lines.of(offset);
+        {
             for node in doc.root_element().children().filter(|n| n.is_element()) {
                 let Some(name) = node.attribute("name") else {
                     continue;

@@ -71,7 +71,8 @@ pub fn model_from_urdf_file(path: impl AsRef<Path>, options: &LoadOptions) -> Re
 /// Builds a model from URDF text. `source_name` names the text in error messages.
 pub fn model_from_urdf_str(text: &str, source_name: &str, options: &LoadOptions) -> Result<Model> {
     lines::check_depth(text, source_name)?;
-    let lines = LineIndex::new(text);
+    let doc = lines::parse_xml(text, source_name)?;
+    let lines = LineIndex::new(text, &doc);
     let robot = urdf_rs::read_from_string(text).map_err(|e| Error::UrdfSyntax {
         source_name: source_name.to_string(),
         message: e.to_string(),
