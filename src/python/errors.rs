@@ -32,36 +32,29 @@ struct Class {
     cell: PyOnceLock<Py<PyType>>,
 }
 
-static BASE: Class = Class {
-    name: "PerturbidError",
-    doc: "Base class of all perturbid_rs errors.",
-    cell: PyOnceLock::new(),
-};
-static MODEL: Class = Class {
-    name: "ModelError",
-    doc: "A URDF or robot model that cannot be built.",
-    cell: PyOnceLock::new(),
-};
-static INPUT: Class = Class {
-    name: "InputError",
-    doc: "An argument, recording or document of the wrong shape, non-finite, or out of range.",
-    cell: PyOnceLock::new(),
-};
-static NUMERICAL: Class = Class {
-    name: "NumericalError",
-    doc: "A numerical failure.",
-    cell: PyOnceLock::new(),
-};
-static FILE: Class = Class {
-    name: "FileError",
-    doc: "A file that cannot be read or written.",
-    cell: PyOnceLock::new(),
-};
-static INTERNAL: Class = Class {
-    name: "InternalError",
-    doc: "A bug of perturbid_rs caught at its boundary: please report it.",
-    cell: PyOnceLock::new(),
-};
+/// A class definition with an empty cell, made on first use.
+macro_rules! class {
+    ($name:literal, $doc:literal) => {
+        Class {
+            name: $name,
+            doc: $doc,
+            cell: PyOnceLock::new(),
+        }
+    };
+}
+
+static BASE: Class = class!("PerturbidError", "Base class of all perturbid_rs errors.");
+static MODEL: Class = class!("ModelError", "A URDF or robot model that cannot be built.");
+static INPUT: Class = class!(
+    "InputError",
+    "An argument, recording or document of the wrong shape, non-finite, or out of range."
+);
+static NUMERICAL: Class = class!("NumericalError", "A numerical failure.");
+static FILE: Class = class!("FileError", "A file that cannot be read or written.");
+static INTERNAL: Class = class!(
+    "InternalError",
+    "A bug of perturbid_rs caught at its boundary: please report it."
+);
 
 impl Class {
     /// The class, made on first use.
