@@ -22,6 +22,7 @@ pub mod direct;
 pub mod document;
 pub mod error;
 pub mod gravity;
+pub mod interrupt;
 pub mod io;
 pub mod json;
 mod lanes;

@@ -78,6 +78,7 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     };
     let mut cols: [Vec<Vec<f64>>; 4] = Default::default(); // q, qd, qdd, tau per joint
     for j in 0..n {
+        crate::interrupt::check("preprocessing")?;
         let q = interpolate(&rec.t, &column(&rec.q, j), &grid);
         let qd = match &rec.qd {
             Some(v) => interpolate(&rec.t, &column(v, j), &grid),

@@ -173,6 +173,7 @@ pub fn simulate_plan(
         .iter()
         .enumerate()
         .map(|(i, e)| {
+            crate::interrupt::check("simulation")?;
             simulate_samples(
                 model,
                 &e.trajectory.sample(plan.rate),

@@ -419,3 +419,44 @@ fn paper_reproduction() {
     ok(&["paper", "--out", s(&d2)]);
     assert_eq!(t3, std::fs::read_to_string(d2.join("table3.csv")).unwrap());
 }
+
+/// Ctrl-C stops long work within a second, with status 130, one line, and nothing written.
+#[cfg(unix)]
+#[test]
+fn ctrl_c_stops_long_work_and_writes_nothing() {
+    let d = tmp("ctrl-c");
+    let out = d.join("excitation");
+    let child = bin()
+        .args([
+            "excite",
+            "a465",
+            "--max-evaluations",
+            "1000000",
+            "--out",
+            s(&out),
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let sent = std::time::Instant::now();
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let result = child.wait_with_output().unwrap();
+    assert!(
+        sent.elapsed() < std::time::Duration::from_secs(5),
+        "took {:?}",
+        sent.elapsed()
+    );
+    assert_eq!(result.status.code(), Some(130));
+    let se = String::from_utf8_lossy(&result.stderr);
+    let last = se.trim_end().lines().last().unwrap_or_default();
+    assert_eq!(
+        last, "perturbid: excitation design: interrupted; nothing was written",
+        "{se}"
+    );
+    assert!(!out.exists(), "an interrupted run wrote {}", out.display());
+}

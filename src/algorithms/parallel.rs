@@ -92,6 +92,7 @@ where
         .into_par_iter()
         .enumerate()
         .try_for_each(|(c, mut parts)| {
+            crate::interrupt::check(algorithm)?;
             let first = c * PARALLEL_CHUNK;
             let chunk = states.slice(first..(first + PARALLEL_CHUNK).min(k));
             f(&mut Workspace::new(model), &chunk, &mut parts)

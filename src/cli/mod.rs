@@ -81,6 +81,7 @@ where
 {
     // A bug must still end in one line and a non-zero status: the panic is caught here and
     // reported once (the default hook's message and backtrace are held back meanwhile).
+    crate::interrupt::reset();
     let hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(|_| {}));
     let result = crate::error::catch_panics("perturbid", || Ok(main_unguarded(args)));
@@ -93,6 +94,8 @@ where
 
 /// Exit status of a bug caught at the boundary (`EX_SOFTWARE` of sysexits.h).
 pub const EXIT_INTERNAL: i32 = 70;
+/// Exit status after Ctrl-C (128 + SIGINT, as shells report it).
+pub const EXIT_INTERRUPTED: i32 = 130;
 
 fn main_unguarded<I, T>(args: I) -> i32
 where
@@ -112,6 +115,10 @@ where
             // A closed pipe (`perturbid info a465 | head`) is not an error worth a panic.
             let _ = std::io::Write::write_all(&mut std::io::stdout().lock(), text.as_bytes());
             0
+        }
+        Err(e) if e.kind() == crate::error::ErrorKind::Interrupted => {
+            eprintln!("perturbid: {e}; nothing was written");
+            EXIT_INTERRUPTED
         }
         Err(e) => {
             eprintln!("perturbid: {e}");

@@ -191,6 +191,9 @@ impl Problem<'_> {
     }
 }
 
+/// The payload that carries a Ctrl-C out of COBYLA's loop.
+struct Interrupted;
+
 /// Designs a Fourier excitation for `model` (docs/method.md, section 8): COBYLA minimises the
 /// criterion over the coefficients and offsets subject to the limits (times `margin`), from a
 /// seeded random feasible start. `progress` is called every 100 evaluations. The result is
@@ -336,6 +339,11 @@ pub fn design_excitation(
         c.1.clone()
     };
     let objective = |x: &[f64], _: &mut ()| -> f64 {
+        // Ctrl-C: unwind out of COBYLA (pure Rust, nothing of it is kept), caught below;
+        // `resume_unwind` skips the panic hook, so nothing is printed
+        if crate::interrupt::requested() {
+            std::panic::resume_unwind(Box::new(Interrupted));
+        }
         let (value, _) = p.criterion(&p.trajectory(x));
         let mut e = evaluations.borrow_mut();
         *e += 1;
@@ -356,19 +364,30 @@ pub fn design_excitation(
         })
         .collect();
     let rhobeg = p.vel.iter().cloned().fold(f64::INFINITY, f64::min) / (4.0 * o.harmonics as f64);
-    let result = cobyla::minimize(
-        objective,
-        &x,
-        &bounds,
-        &cons,
-        (),
-        o.max_evaluations,
-        cobyla::RhoBeg::All(rhobeg),
-        Some(cobyla::StopTols {
-            ftol_rel: 1e-6,
-            ..cobyla::StopTols::default()
-        }),
-    );
+    let run = || {
+        cobyla::minimize(
+            objective,
+            &x,
+            &bounds,
+            &cons,
+            (),
+            o.max_evaluations,
+            cobyla::RhoBeg::All(rhobeg),
+            Some(cobyla::StopTols {
+                ftol_rel: 1e-6,
+                ..cobyla::StopTols::default()
+            }),
+        )
+    };
+    let result = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)) {
+        Ok(result) => result,
+        Err(payload) if payload.is::<Interrupted>() => {
+            return Err(Error::Interrupted {
+                context: "excitation design".into(),
+            })
+        }
+        Err(payload) => std::panic::resume_unwind(payload),
+    };
     let x = match result {
         Ok((_, x, _)) | Err((_, x, _)) => x,
     };

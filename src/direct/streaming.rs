@@ -309,6 +309,7 @@ impl JointFactors {
             .map(|run| -> Result<Vec<DMatrix<f64>>> {
                 let mut w = Worker::new(model, &columns);
                 for range in run {
+                    crate::interrupt::check("identification")?;
                     w.absorb(model, &columns, x, tau, gravity, range.clone())?;
                 }
                 Ok(w.factors())

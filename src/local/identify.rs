@@ -186,6 +186,7 @@ pub fn identify_local(
         .iter()
         .zip(match_recordings(plan, recordings)?)
     {
+        crate::interrupt::check("identification")?;
         if r.n != n {
             return Err(Error::Recording {
                 recording: r.name.clone(),

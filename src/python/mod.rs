@@ -25,11 +25,19 @@ pub(crate) fn detached<T: Send>(
     name: &str,
     f: impl FnOnce() -> Result<T> + Send,
 ) -> Result<T> {
+    crate::interrupt::reset();
     py.detach(|| catch_panics(name, f))
+}
+
+/// Python's own signal check, for [`crate::interrupt`]: a Ctrl-C in the session is seen while
+/// Rust works with the GIL released (its `KeyboardInterrupt` is raised by the work's error).
+fn python_interrupted() -> bool {
+    Python::attach(|py| py.check_signals().is_err())
 }
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    crate::interrupt::set_checker(python_interrupted);
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<robot::PyRobot>()?;
     m.add_class::<linearization::PyLinearization>()?;
