@@ -387,6 +387,28 @@ fn finite_inputs_that_overflow_get_errors_not_inf() {
     .unwrap_err();
     assert_eq!(e.kind(), ErrorKind::Numerical);
     assert!(e.to_string().starts_with("rnea (sample 3): tau is"), "{e}");
+    // one sample through the one-sample API: the same
+    let mut data = perturbid_rs::Data::new(&model);
+    let e = perturbid_rs::rnea(
+        &model,
+        &mut data,
+        &q[18..24],
+        &qd[18..24],
+        &[0.0; 6],
+        Gravity::Included,
+    )
+    .unwrap_err();
+    assert!(e.to_string().starts_with("rnea: tau is"), "{e}");
+    let e = perturbid_rs::linearize(
+        &model,
+        &mut data,
+        &q[18..24],
+        &qd[18..24],
+        &[0.0; 6],
+        Gravity::Included,
+    )
+    .unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::Numerical, "{e}");
 }
 
 #[test]

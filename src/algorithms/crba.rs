@@ -4,7 +4,7 @@
 
 use nalgebra::DMatrix;
 
-use super::{contract_matrix, kinematics::update_placements, load_state};
+use super::{check_result, contract_matrix, kinematics::update_placements, load_state};
 use crate::data::Data;
 use crate::error::Result;
 use crate::model::Model;
@@ -24,7 +24,7 @@ pub fn mass_matrix(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
         crba_bodies(model, data, &mut out);
     }
     data.m = out;
-    Ok(())
+    check_result("mass_matrix", "M", data.m.as_slice())
 }
 
 /// CRBA over bodies with poses in `data.li_mi`; fills the body-level matrix `out`.

@@ -4,7 +4,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::{contract_matrix, contract_vector, load_state};
+use super::{check_result, contract_matrix, contract_vector, load_state};
 use crate::data::Data;
 use crate::error::Result;
 use crate::gravity::Gravity;
@@ -58,7 +58,9 @@ pub(crate) fn derivatives_at(
         derivatives_loaded(model, data, gravity, &mut tau, &mut m, &mut dq, &mut dv);
     }
     (data.tau, data.m, data.dtau_dq, data.dtau_dv) = (tau, m, dq, dv);
-    Ok(())
+    check_result("rnea_derivatives", "tau", data.tau.as_slice())?;
+    check_result("rnea_derivatives", "d tau / d q", data.dtau_dq.as_slice())?;
+    check_result("rnea_derivatives", "d tau / d qd", data.dtau_dv.as_slice())
 }
 
 /// The recursion over bodies, for the body coordinates already in `data`.

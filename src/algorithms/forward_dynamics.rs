@@ -69,5 +69,5 @@ pub fn forward_dynamics(
         }
         x[i] = s / l[(i, i)];
     }
-    Ok(())
+    super::check_result("forward_dynamics", "qdd", data.qdd.as_slice())
 }

@@ -7,7 +7,6 @@ use crate::spatial::Motion;
 
 /// Poses `data.li_mi[i]` of every body in its parent's frame for the body coordinates in
 /// `data.qb` (set by the caller from `q`).
-#[inline]
 pub(crate) fn update_placements(model: &Model, data: &mut Data) {
     for (i, b) in model.bodies.iter().enumerate() {
         data.li_mi[i] = b.pose_in_parent(data.qb[i]);

@@ -62,3 +62,21 @@ pub(crate) fn contract_matrix(model: &Model, body: &DMatrix<f64>, out: &mut DMat
         }
     }
 }
+
+/// Fails when a result of `algorithm` is not finite: finite inputs so large that the arithmetic
+/// overflowed. No inf or NaN is handed back.
+#[inline]
+pub(crate) fn check_result(algorithm: &str, name: &str, values: &[f64]) -> Result<()> {
+    // one branch-free pass; the position is only looked for on failure
+    if values.iter().fold(false, |bad, v| bad | !v.is_finite()) {
+        let i = values.iter().position(|v| !v.is_finite()).unwrap_or(0);
+        return Err(crate::error::Error::Numerical {
+            operation: algorithm.into(),
+            message: format!(
+                "{name} is {} at entry {i}: the state is too large to compute with",
+                values[i]
+            ),
+        });
+    }
+    Ok(())
+}

@@ -3,7 +3,7 @@
 use nalgebra::DVector;
 
 use super::kinematics::motion_pass;
-use super::{contract_vector, load_state};
+use super::{check_result, contract_vector, load_state};
 use crate::data::Data;
 use crate::error::Result;
 use crate::gravity::Gravity;
@@ -39,7 +39,7 @@ pub fn rnea(
     let mut out = std::mem::take(&mut data.tau);
     rnea_loaded(model, data, gravity, &mut out);
     data.tau = out;
-    Ok(())
+    check_result("rnea", "tau", data.tau.as_slice())
 }
 
 /// Gravity torque `g(q)` (N m or N): the torque that holds the robot at rest at `q`.
@@ -49,7 +49,7 @@ pub fn gravity_torque(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
     let mut out = std::mem::take(&mut data.g);
     rnea_loaded(model, data, Gravity::Included, &mut out);
     data.g = out;
-    Ok(())
+    check_result("gravity_torque", "g", data.g.as_slice())
 }
 
 /// Bias torque `c(q, qd) + g(q)` (Coriolis, centrifugal and, with `gravity`, gravity terms):
@@ -65,7 +65,7 @@ pub fn bias_torque(
     let mut out = std::mem::take(&mut data.bias);
     rnea_loaded(model, data, gravity, &mut out);
     data.bias = out;
-    Ok(())
+    check_result("bias_torque", "the bias torque", data.bias.as_slice())
 }
 
 /// RNEA on the body coordinates already in `data` (`qb`, `vb`, `ab`); torques into `out`.
