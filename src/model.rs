@@ -111,7 +111,7 @@ impl Body {
     }
 
     /// Pose of this body's frame in the parent's frame at joint coordinate `x` (rad or m).
-    #[inline]
+    #[inline(always)] // in every recursion's loop: a call per body costs 8 % of a CRBA
     pub fn pose_in_parent(&self, x: f64) -> Se3 {
         let p = &self.placement;
         let t = &self.pose_terms;
