@@ -460,3 +460,24 @@ fn ctrl_c_stops_long_work_and_writes_nothing() {
     );
     assert!(!out.exists(), "an interrupted run wrote {}", out.display());
 }
+
+/// Usage errors are one line too, with clap's message and where to read more (status 2).
+#[test]
+fn usage_errors_are_one_line() {
+    for (args, says) in [
+        (
+            &["plan", "a465", "--op", "op.json", "--design", "latin"][..],
+            "invalid value 'latin' for '--design <DESIGN>' [possible values: random, orthogonal]",
+        ),
+        (&["bogus"][..], "unrecognized subcommand 'bogus'"),
+        (
+            &["plan"][..],
+            "the following required arguments were not provided: --op <OP> <ROBOT>",
+        ),
+    ] {
+        let out = bin().args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let se = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(se, format!("perturbid: {says} (see perturbid --help)\n"));
+    }
+}

@@ -105,8 +105,25 @@ where
     let cli = match Cli::try_parse_from(args) {
         Ok(c) => c,
         Err(e) => {
+            use clap::error::ErrorKind as Kind;
             let code = e.exit_code();
-            let _ = e.print();
+            if matches!(e.kind(), Kind::DisplayHelp | Kind::DisplayVersion)
+                || matches!(e.kind(), Kind::DisplayHelpOnMissingArgumentOrSubcommand)
+            {
+                let _ = e.print();
+                return code;
+            }
+            // a usage error in one line, like every other error: clap's first line, without
+            // its "error: " prefix, and where to read more
+            let text = e.render().to_string();
+            let message: Vec<&str> = text
+                .lines()
+                .take_while(|l| !l.trim().is_empty())
+                .map(str::trim)
+                .collect();
+            let message = message.join(" ");
+            let message = message.strip_prefix("error: ").unwrap_or(&message);
+            eprintln!("perturbid: {message} (see perturbid --help)");
             return code;
         }
     };
