@@ -302,12 +302,12 @@ pub(crate) fn check_finite_vector(argument: &str, x: &[f64], n: usize) -> Result
             got: format!("{} values", x.len()),
         });
     }
-    if let Some((index, &value)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-        return Err(Error::NonFiniteInput {
+    match crate::states::first_non_finite(x) {
+        Some(index) => Err(Error::NonFiniteInput {
             argument: argument.to_string(),
             index,
-            value,
-        });
+            value: x[index],
+        }),
+        None => Ok(()),
     }
-    Ok(())
 }

@@ -124,32 +124,25 @@ impl<'a> States<'a> {
         Ok(states)
     }
 
-    /// One fast pass over every value (over the cores for large batches); a second one only to
-    /// name a bad value.
     fn check_finite(&self) -> Result<()> {
-        use rayon::prelude::*;
-        let any_bad = |x: &[f64]| x.iter().fold(false, |bad, v| bad | !v.is_finite());
-        for (name, x) in self.arrays() {
-            let bad = if x.len() >= 1 << 16 {
-                x.par_chunks(1 << 14).any(any_bad)
-            } else {
-                any_bad(x)
-            };
-            if bad {
-                let (i, &value) = x
-                    .iter()
-                    .enumerate()
-                    .find(|(_, v)| !v.is_finite())
-                    .expect("a non-finite value was seen");
-                let e = Error::NonFiniteInput {
+        self.arrays()
+            .try_for_each(|(name, x)| self.check_values(name, x, self.nv))
+    }
+
+    /// Fails on the first value of `x` (`per_sample` values per sample, named `name`) that is
+    /// not finite, naming the sample and the entry.
+    fn check_values(&self, name: &str, x: &[f64], per_sample: usize) -> Result<()> {
+        match first_non_finite(x) {
+            Some(i) => Err(self.at(
+                i / per_sample.max(1),
+                Error::NonFiniteInput {
                     argument: name.into(),
-                    index: i % self.nv,
-                    value,
-                };
-                return Err(self.at(i / self.nv, e));
-            }
+                    index: i % per_sample.max(1),
+                    value: x[i],
+                },
+            )),
+            None => Ok(()),
         }
-        Ok(())
     }
 
     fn arrays(&self) -> impl Iterator<Item = (&'static str, &'a [f64])> {
@@ -255,14 +248,23 @@ impl<'a> States<'a> {
                 got: format!("{} values", x.len()),
             });
         }
-        if let Some((i, &value)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            let e = Error::NonFiniteInput {
-                argument: name.into(),
-                index: i % per_sample.max(1),
-                value,
-            };
-            return Err(self.at(i / per_sample.max(1), e));
-        }
-        Ok(())
+        self.check_values(name, x, per_sample)
+    }
+}
+
+/// The index of the first value of `x` that is NaN or infinite: one branch-free pass (over the
+/// cores for large arrays), a second one only to find a bad value.
+pub(crate) fn first_non_finite(x: &[f64]) -> Option<usize> {
+    use rayon::prelude::*;
+    let any_bad = |x: &[f64]| x.iter().fold(false, |bad, v| bad | !v.is_finite());
+    let bad = if x.len() >= 1 << 16 {
+        x.par_chunks(1 << 14).any(any_bad)
+    } else {
+        any_bad(x)
+    };
+    if bad {
+        x.iter().position(|v| !v.is_finite())
+    } else {
+        None
     }
 }

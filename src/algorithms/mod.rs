@@ -67,16 +67,18 @@ pub(crate) fn contract_matrix(model: &Model, body: &DMatrix<f64>, out: &mut DMat
 /// overflowed. No inf or NaN is handed back.
 #[inline]
 pub(crate) fn check_result(algorithm: &str, name: &str, values: &[f64]) -> Result<()> {
-    // one branch-free pass; the position is only looked for on failure
-    if values.iter().fold(false, |bad, v| bad | !v.is_finite()) {
-        let i = values.iter().position(|v| !v.is_finite()).unwrap_or(0);
-        return Err(crate::error::Error::Numerical {
-            operation: algorithm.into(),
-            message: format!(
-                "{name} is {} at entry {i}: the state is too large to compute with",
-                values[i]
-            ),
-        });
+    match crate::states::first_non_finite(values) {
+        Some(i) => Err(overflow(algorithm, name, values[i], i)),
+        None => Ok(()),
     }
-    Ok(())
+}
+
+/// The error for a result `name` of `algorithm` that came out as `value` (inf or NaN) at `entry`.
+pub(crate) fn overflow(algorithm: &str, name: &str, value: f64, entry: usize) -> crate::Error {
+    crate::error::Error::Numerical {
+        operation: algorithm.into(),
+        message: format!(
+            "{name} is {value} at entry {entry}: the state is too large to compute with"
+        ),
+    }
 }

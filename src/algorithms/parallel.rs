@@ -108,16 +108,9 @@ fn check_finite(
     outs: &[(&str, &mut [f64], usize)],
 ) -> Result<()> {
     for (name, out, per) in outs {
-        if let Some(i) = out.iter().position(|v| !v.is_finite()) {
-            let e = Error::Numerical {
-                operation: algorithm.into(),
-                message: format!(
-                    "{name} is {} at entry {}: the state is too large to compute with",
-                    out[i],
-                    i % per.max(&1)
-                ),
-            };
-            return Err(states.at(i / per.max(&1), e));
+        if let Some(i) = crate::states::first_non_finite(out) {
+            let per = (*per).max(1);
+            return Err(states.at(i / per, super::overflow(algorithm, name, out[i], i % per)));
         }
     }
     Ok(())
