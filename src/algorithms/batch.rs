@@ -284,24 +284,36 @@ fn regressor_batch_body(
             ("regressor output", out.len(), nv * p),
         ],
     )?;
-    let mut y = std::mem::take(&mut data.regressor);
-    y.resize(nv * p, Lanes::default());
     let mut first = 0;
     while first < k {
-        load(model, data, [q, qd, qdd], first);
-        regressor_lanes(model, data, gravity, &mut y);
+        group_regressor(model, data, [q, qd, qdd], first, gravity);
         for l in 0..(k - first).min(LANES) {
             let o = &mut out[(first + l) * nv * p..(first + l + 1) * nv * p];
             for r in 0..nv {
                 for c in 0..p {
-                    o[r * p + c] = y[r + c * nv].0[l];
+                    o[r * p + c] = data.regressor_entry(l, r, c);
                 }
             }
         }
         first += LANES;
     }
-    data.regressor = y;
     Ok(())
+}
+
+/// Loads the samples `first..first + LANES` of `[q, qd, qdd]` (see [`load`]) and leaves their
+/// regressors in `data.regressor`.
+#[inline(always)]
+fn group_regressor(
+    model: &Model,
+    data: &mut LaneData,
+    x: [&[f64]; 3],
+    first: usize,
+    gravity: Gravity,
+) {
+    let mut y = std::mem::take(&mut data.regressor);
+    load(model, data, x, first);
+    regressor_lanes(model, data, gravity, &mut y);
+    data.regressor = y;
 }
 
 simd_dispatch! {
@@ -340,10 +352,7 @@ fn regressor_group_body(
             got: format!("{k} samples"),
         });
     }
-    let mut y = std::mem::take(&mut data.regressor);
-    load(model, data, [q, qd, qdd], 0);
-    regressor_lanes(model, data, gravity, &mut y);
-    data.regressor = y;
+    group_regressor(model, data, [q, qd, qdd], 0, gravity);
     Ok(k)
 }
 
