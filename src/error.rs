@@ -249,6 +249,11 @@ pub enum Error {
     #[error("internal error in {context}: {message} (a bug in perturbid_rs: please report it)")]
     Internal { context: String, message: String },
 
+    /// A file of an output set whose writing was interrupted (its manifest is still in state
+    /// `"writing"`): the set may mix old and new files.
+    #[error("{path} belongs to an output set whose writing was interrupted (see {manifest}): it may mix old and new files; run the command that wrote it again")]
+    PartialOutput { path: String, manifest: String },
+
     /// A built-in robot or variant name that does not exist.
     #[error("unknown robot '{name}'; built-in robots: {}", available.join(", "))]
     UnknownRobot {
@@ -261,7 +266,7 @@ impl Error {
     /// The kind of problem.
     pub fn kind(&self) -> ErrorKind {
         match self {
-            Error::Io { .. } => ErrorKind::File,
+            Error::Io { .. } | Error::PartialOutput { .. } => ErrorKind::File,
             Error::Shape { .. }
             | Error::NonFiniteInput { .. }
             | Error::InvalidArgument { .. }

@@ -165,6 +165,42 @@ fn plan_simulate_identify_predict() {
         &["--out: ", "is also an input; writing it would destroy"],
     );
     assert_eq!(std::fs::read(d.join("plan/D.csv")).unwrap(), before);
+    // recordings written over the plan's trajectories are refused, the plan survives
+    fails(
+        &[
+            "simulate",
+            "a465",
+            s(&d.join("plan/plan.json")),
+            "--out",
+            s(&d.join("plan")),
+        ],
+        &[
+            "nominal.csv belongs to the output set 'plan'",
+            "plan.manifest.json",
+            "choose another output folder",
+        ],
+    );
+    assert_eq!(std::fs::read(d.join("plan/D.csv")).unwrap(), before);
+    // a set whose writing was killed between its renames is refused by every reader
+    let manifest = d.join("rec/recordings.manifest.json");
+    let complete = std::fs::read_to_string(&manifest).unwrap();
+    assert!(complete.contains("\"state\": \"complete\""), "{complete}");
+    write(&manifest, &complete.replace("\"complete\"", "\"writing\""));
+    fails(
+        &[
+            "identify",
+            s(&d.join("plan/plan.json")),
+            s(&d.join("rec")),
+            "--out",
+            s(&d.join("model3.json")),
+        ],
+        &[
+            ".csv belongs to an output set whose writing was interrupted (see ",
+            "recordings.manifest.json",
+            "run the command that wrote it again",
+        ],
+    );
+    assert!(!d.join("model3.json").exists());
 }
 
 #[test]

@@ -15,7 +15,7 @@ use crate::direct::{
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
-use crate::io::{read_recording, read_states, samples_table, write_atomic, Table};
+use crate::io::{read_recording, read_states, samples_table, write_atomic, OutputSet, Table};
 use crate::preprocess::{preprocess, PreprocessOptions};
 use crate::states::States;
 use crate::torque_model::{ModelFile, TorqueModel};
@@ -71,18 +71,16 @@ pub(crate) fn excite(a: ExciteArgs) -> Result<String> {
     progress.done();
     let dir = out_dir(&a.out);
     let traj = &design.trajectory;
-    write_atomic(
-        dir.join("excitation.json"),
-        serde_json::to_string_pretty(traj)
-            .expect("serialisable")
-            .as_bytes(),
+    let mut set = OutputSet::new(&dir, "excitation");
+    set.add(
+        "excitation.json",
+        serde_json::to_string_pretty(traj).expect("serialisable"),
     )?;
-    write_atomic(
-        dir.join("excitation.csv"),
-        samples_table(&traj.sample_periods(1.0, a.rate), "")
-            .to_csv()
-            .as_bytes(),
+    set.add(
+        "excitation.csv",
+        samples_table(&traj.sample_periods(1.0, a.rate), "").to_csv(),
     )?;
+    set.commit()?;
     Ok(format!(
         "excitation: {} harmonics of {} Hz (period {:.1} s), cond(Phi_base) {:.2} after {} evaluations\n-> {} and {}\n",
         a.harmonics,

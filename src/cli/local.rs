@@ -11,7 +11,7 @@ use super::out_dir;
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
-use crate::io::{read_recording, recording_table, samples_table, write_atomic};
+use crate::io::{read_recording, recording_table, samples_table, write_atomic, OutputSet};
 use crate::local::{
     identify_local, plan_experiments, CrossingTimes, Design, Estimator, ExperimentKind,
     IdentifyOptions, LocalModel, OperatingPoint, Plan, PlanOptions, Size,
@@ -122,14 +122,13 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
     o.sizes.acceleration = size(a.dqdd, a.dqdd_fraction, n);
     let plan = plan_experiments(&model, &op, &o)?;
     let dir = out_dir(&a.out);
+    let mut set = OutputSet::new(&dir, "plan");
     let mut out = String::new();
     for e in &plan.experiments {
-        let path = dir.join(format!("{}.csv", e.kind.name()));
-        write_atomic(
-            &path,
-            samples_table(&e.trajectory.sample(plan.rate), "")
-                .to_csv()
-                .as_bytes(),
+        let name = format!("{}.csv", e.kind.name());
+        set.add(
+            &name,
+            samples_table(&e.trajectory.sample(plan.rate), "").to_csv(),
         )?;
         let _ = writeln!(
             out,
@@ -137,12 +136,12 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
             e.kind.name(),
             e.crossings.len(),
             e.duration(),
-            path.display()
+            set.path_of(&name).display()
         );
     }
-    let path = dir.join("plan.json");
-    plan.save(&path)?;
-    let _ = writeln!(out, "plan -> {}", path.display());
+    set.add("plan.json", plan.to_json())?;
+    let _ = writeln!(out, "plan -> {}", set.path_of("plan.json").display());
+    set.commit()?;
     Ok(out)
 }
 
@@ -189,18 +188,20 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<String> {
     o.seed = a.seed;
     let recs = simulate_plan(&model, &plan, &o)?;
     let dir = out_dir(&a.out);
+    let mut set = OutputSet::new(&dir, "recordings");
     let mut out = String::new();
     for (e, r) in plan.experiments.iter().zip(&recs) {
-        let path = dir.join(format!("{}.csv", e.kind.name()));
-        write_atomic(&path, recording_table(r, "").to_csv().as_bytes())?;
+        let name = format!("{}.csv", e.kind.name());
+        set.add(&name, recording_table(r, "").to_csv())?;
         let _ = writeln!(
             out,
             "{:<9} {:>7} samples -> {}",
             e.kind.name(),
             r.len(),
-            path.display()
+            set.path_of(&name).display()
         );
     }
+    set.commit()?;
     Ok(out)
 }
 

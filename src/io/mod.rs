@@ -1,11 +1,14 @@
 //! Files: numeric CSV tables with a header, recordings and trajectories as CSV, JSON documents,
 //! all written atomically (a temporary file renamed into place), so no half-written output is
-//! ever left behind.
+//! ever left behind; files that belong together are written as one [`OutputSet`], which a
+//! reader sees whole or not at all.
 
 pub mod atomic;
+pub mod output_set;
 pub mod recording;
 pub mod table;
 
 pub use atomic::{read_text, write_atomic};
+pub use output_set::{check_not_partial, OutputSet};
 pub use recording::{read_recording, read_states, recording_table, samples_table, States};
 pub use table::Table;

@@ -7,7 +7,7 @@ use super::reproduce::PaperResult;
 use super::{markdown, svg};
 use crate::document::Document;
 use crate::error::Result;
-use crate::io::{write_atomic, Table};
+use crate::io::{OutputSet, Table};
 
 fn fmt_row(label: &str, v: &[f64], decimals: usize) -> Vec<String> {
     let mut r = vec![label.to_string()];
@@ -17,13 +17,12 @@ fn fmt_row(label: &str, v: &[f64], decimals: usize) -> Vec<String> {
 
 /// Writes the report into `dir`: `report.md`, `table2.csv`, `table3.csv`, `results.json`,
 /// `local_model.json`, `fig3_joint2.svg`, `fig4_joint3.svg`, `fig5_joint4.svg` and
-/// `figures.csv`. Every file is written atomically. Returns the paths.
+/// `figures.csv`, as one output set (`report.manifest.json`): a reader sees the whole old report
+/// or the whole new one. Returns the paths.
 pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
-    let mut written = vec![];
+    let mut set = OutputSet::new(dir, "report");
     let mut put = |name: &str, bytes: &[u8]| -> Result<()> {
-        let p = dir.join(name);
-        write_atomic(&p, bytes)?;
-        written.push(p);
+        set.add(name, bytes)?;
         Ok(())
     };
     let n = r.op.q.len();
@@ -145,7 +144,7 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
         fig_names.push(name);
     }
     put("report.md", markdown_report(r, &fig_names).as_bytes())?;
-    Ok(written)
+    set.commit()
 }
 
 fn markdown_report(r: &PaperResult, figs: &[String]) -> String {
