@@ -20,6 +20,69 @@ impl fmt::Display for Location {
     }
 }
 
+/// Which limit a planned trajectory breaks, with the limit's values.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Limit {
+    /// A position outside `[lower, upper]` (rad or m).
+    Position { lower: f64, upper: f64 },
+    /// A speed above the limit (rad/s or m/s).
+    Velocity(f64),
+    /// An acceleration above the limit (rad/s^2 or m/s^2).
+    Acceleration(f64),
+}
+
+/// A planned trajectory that breaks a joint limit: the payload of [`Error::LimitViolation`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct LimitViolation {
+    /// What was being planned, e.g. `experiment 'D' of the plan`.
+    pub context: String,
+    pub joint: String,
+    /// Time from the start of the trajectory (s).
+    pub time: f64,
+    /// The position, velocity or acceleration found (SI units of the joint).
+    pub value: f64,
+    pub limit: Limit,
+    /// `rad` or `m` for the joint's kind (the rate suffixes are added).
+    pub unit: &'static str,
+    /// A suggestion, starting with "; " (or empty).
+    pub hint: String,
+}
+
+impl fmt::Display for LimitViolation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let LimitViolation {
+            context,
+            joint,
+            time,
+            value,
+            unit,
+            hint,
+            ..
+        } = self;
+        write!(f, "{context}: joint '{joint}' at t = {time:.4} s: ")?;
+        match self.limit {
+            Limit::Position { lower, upper } => {
+                let by = (lower - value).max(value - upper);
+                write!(
+                    f,
+                    "position {value:.6} {unit} is outside [{lower:.6}, {upper:.6}] {unit} by {by:.6} {unit}"
+                )?
+            }
+            Limit::Velocity(l) => write!(
+                f,
+                "velocity {value:.6} {unit}/s is outside the limit +-{l:.6} {unit}/s by {:.6} {unit}/s",
+                value.abs() - l
+            )?,
+            Limit::Acceleration(l) => write!(
+                f,
+                "acceleration {value:.6} {unit}/s^2 is outside the limit +-{l:.6} {unit}/s^2 by {:.6} {unit}/s^2",
+                value.abs() - l
+            )?,
+        }
+        write!(f, "{hint}")
+    }
+}
+
 /// What kind of problem an [`Error`] is, for callers that handle errors by kind (the Python
 /// exception classes follow it).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,7 +125,7 @@ pub enum Error {
     /// A joint type the library does not model (floating, planar, spherical).
     #[error("{location}: joint '{joint}' is of type {kind}; only revolute, continuous, prismatic and fixed joints are supported (a floating base is not modelled)")]
     UnsupportedJoint {
-        location: Location,
+        location: Box<Location>,
         joint: String,
         kind: String,
     },
@@ -86,7 +149,7 @@ pub enum Error {
         "{location}: link '{link}' is the child of joint '{first}' and again of joint '{second}'"
     )]
     DuplicateChild {
-        location: Location,
+        location: Box<Location>,
         link: String,
         first: String,
         second: String,
@@ -95,7 +158,7 @@ pub enum Error {
     /// Two elements share a name.
     #[error("{location}: {element} name '{name}' is used twice")]
     DuplicateName {
-        location: Location,
+        location: Box<Location>,
         element: &'static str,
         name: String,
     },
@@ -103,7 +166,7 @@ pub enum Error {
     /// A joint names a link that does not exist.
     #[error("{location}: joint '{joint}' names {role} link '{link}', which does not exist")]
     UnknownLink {
-        location: Location,
+        location: Box<Location>,
         joint: String,
         role: &'static str,
         link: String,
@@ -116,21 +179,24 @@ pub enum Error {
     /// A link inertia that no rigid body can have.
     #[error("{location}: link '{link}' has a physically invalid inertia: {reason}")]
     InvalidInertia {
-        location: Location,
+        location: Box<Location>,
         link: String,
         reason: String,
     },
 
     /// A moving joint whose subtree carries no mass and no inertia: M(q) would be singular.
     #[error("{location}: joint '{joint}' moves nothing: the links behind it have no mass and no inertia, so the mass matrix would be singular")]
-    MasslessSubtree { location: Location, joint: String },
+    MasslessSubtree {
+        location: Box<Location>,
+        joint: String,
+    },
 
     /// A joint axis of zero length or with non-finite components.
     #[error(
         "{location}: joint '{joint}' has axis {axis:?}, which is not a finite non-zero vector"
     )]
     InvalidAxis {
-        location: Location,
+        location: Box<Location>,
         joint: String,
         axis: [f64; 3],
     },
@@ -138,7 +204,7 @@ pub enum Error {
     /// A revolute or prismatic joint without a `<limit>` element (required by the URDF spec).
     #[error("{location}: {kind} joint '{joint}' has no <limit> element (the URDF specification requires one; use type=\"continuous\" for an unlimited revolute joint)")]
     MissingLimit {
-        location: Location,
+        location: Box<Location>,
         joint: String,
         kind: &'static str,
     },
@@ -146,7 +212,7 @@ pub enum Error {
     /// A number in the URDF that is NaN or infinite where a finite value is required.
     #[error("{location}: {element} '{name}': {field} is {value}, expected a finite number below 1e12 in size")]
     NonFiniteUrdf {
-        location: Location,
+        location: Box<Location>,
         element: &'static str,
         name: String,
         field: &'static str,
@@ -177,36 +243,9 @@ pub enum Error {
     #[error("{operation}: {message}")]
     Numerical { operation: String, message: String },
 
-    /// A planned trajectory breaks a joint limit.
-    #[error("{context}: joint '{joint}' at t = {time:.4} s: {quantity} {value:.6} {unit} is outside the limit +-{limit:.6} {unit}{hint}")]
-    LimitViolation {
-        /// What was being planned, e.g. `experiment 'D' of the plan`.
-        context: String,
-        joint: String,
-        /// Time from the start of the trajectory (s).
-        time: f64,
-        /// `position`, `velocity` or `acceleration`.
-        quantity: &'static str,
-        value: f64,
-        /// For positions the limit is printed as the violated bound.
-        limit: f64,
-        unit: &'static str,
-        /// A suggestion, starting with "; " (or empty).
-        hint: String,
-    },
-
-    /// A position outside `[lower, upper]` (kept apart from [`Error::LimitViolation`] because the
-    /// range is not symmetric).
-    #[error("{context}: joint '{joint}' at t = {time:.4} s: position {value:.6} is outside [{lower:.6}, {upper:.6}]{hint}")]
-    PositionLimit {
-        context: String,
-        joint: String,
-        time: f64,
-        value: f64,
-        lower: f64,
-        upper: f64,
-        hint: String,
-    },
+    /// A planned trajectory breaks a joint limit (position, velocity or acceleration).
+    #[error("{0}")]
+    LimitViolation(Box<LimitViolation>),
 
     /// A least-squares design matrix without full column rank: the data do not excite some
     /// directions.
@@ -232,7 +271,7 @@ pub enum Error {
     /// acceleration limit that is zero or negative.
     #[error("{location}: joint '{joint}' <limit>: {message}")]
     InvalidLimit {
-        location: Location,
+        location: Box<Location>,
         joint: String,
         message: String,
     },
@@ -270,8 +309,7 @@ impl Error {
             Error::Shape { .. }
             | Error::NonFiniteInput { .. }
             | Error::InvalidArgument { .. }
-            | Error::LimitViolation { .. }
-            | Error::PositionLimit { .. }
+            | Error::LimitViolation(_)
             | Error::Recording { .. }
             | Error::Json { .. } => ErrorKind::Input,
             Error::Numerical { .. } | Error::RankDeficient { .. } => ErrorKind::Numerical,
@@ -341,3 +379,16 @@ pub fn catch_panics<T>(context: &str, f: impl FnOnce() -> Result<T>) -> Result<T
 
 /// `Result` with the library's [`Error`].
 pub type Result<T> = std::result::Result<T, Error>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_error_stays_small() {
+        // large context is boxed (locations, limit violations): a `Result<T>` costs little more
+        // than its `T` on the happy path
+        let size = std::mem::size_of::<Error>();
+        assert!(size <= 80, "Error is {size} bytes (128 before the boxing)");
+    }
+}

@@ -281,10 +281,10 @@ impl Model {
             if moved[dof] <= 0.0 {
                 let i = first[dof].min(n.saturating_sub(1));
                 return Err(Error::MasslessSubtree {
-                    location: Location {
+                    location: Box::new(Location {
                         source: self.source.clone(),
                         line: self.joint_lines.get(i).copied().flatten(),
-                    },
+                    }),
                     joint: self.joint_names[dof].clone(),
                 });
             }

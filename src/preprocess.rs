@@ -25,6 +25,13 @@ pub struct PreprocessOptions {
     pub trim: f64,
     /// Keep every `decimate`-th sample (1 keeps all).
     pub decimate: usize,
+    /// At a gap longer than [`MAX_GAP_INTERVALS`] median sample intervals, split the log and
+    /// preprocess each part on its own (filtered, differentiated and trimmed separately, then
+    /// concatenated with the gap kept in `t`) instead of refusing it. Nothing is interpolated
+    /// across a gap either way.
+    ///
+    /// [`MAX_GAP_INTERVALS`]: crate::limits::MAX_GAP_INTERVALS
+    pub split_at_gaps: bool,
 }
 
 impl Default for PreprocessOptions {
@@ -36,6 +43,7 @@ impl Default for PreprocessOptions {
             filter_position: false,
             trim: 0.5,
             decimate: 10,
+            split_at_gaps: false,
         }
     }
 }
@@ -44,7 +52,104 @@ impl Default for PreprocessOptions {
 /// derivative of q) onto a uniform grid at `rate`, filters qd and tau (and q if asked) with a
 /// zero-phase Butterworth low-pass, differentiates the filtered qd into qdd, trims and
 /// decimates. The result is a recording with `qd` and `qdd`, named `<name> (preprocessed)`.
+///
+/// A gap in `t` longer than [`MAX_GAP_INTERVALS`] median sample intervals is an error naming
+/// its time, unless `options.split_at_gaps`: then each part between gaps is preprocessed on its
+/// own and the parts are concatenated (`t` keeps the gaps); a part too short to filter and trim
+/// is an error naming its time span.
+///
+/// [`MAX_GAP_INTERVALS`]: crate::limits::MAX_GAP_INTERVALS
 pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Recording> {
+    if !options.split_at_gaps {
+        return preprocess_part(rec, options);
+    }
+    let parts = split_at_gaps(rec)?;
+    if parts.len() == 1 {
+        return preprocess_part(rec, options);
+    }
+    let mut done = Vec::with_capacity(parts.len());
+    for (k, part) in parts.iter().enumerate() {
+        let p = preprocess_part(part, options).map_err(|e| match e {
+            Error::Recording { message, .. } => Error::Recording {
+                recording: rec.name.clone(),
+                message: format!(
+                    "part {} of {} (t = {:.6} s to {:.6} s, between gaps): {message}",
+                    k + 1,
+                    parts.len(),
+                    part.t[0],
+                    part.t[part.len() - 1]
+                ),
+            },
+            other => other,
+        })?;
+        done.push(p);
+    }
+    let cat = |f: fn(&Recording) -> &[f64]| -> Vec<f64> {
+        done.iter().flat_map(|r| f(r).iter().copied()).collect()
+    };
+    Recording::new(
+        format!("{} (preprocessed, {} parts)", rec.name, done.len()),
+        rec.n,
+        cat(|r| &r.t),
+        cat(|r| &r.q),
+        cat(|r| &r.tau),
+        Some(cat(|r| r.qd.as_deref().unwrap_or(&[]))),
+        Some(cat(|r| r.qdd.as_deref().unwrap_or(&[]))),
+    )
+    .map(|out| Recording {
+        experiment: rec.experiment.clone(),
+        ..out
+    })
+}
+
+/// The parts of a recording between its gaps (intervals longer than [`MAX_GAP_INTERVALS`]
+/// median sample intervals), in order; the whole recording if it has none. Each part keeps the
+/// recording's name with ` [t0-t1 s]` appended.
+///
+/// Errors: a part of fewer than 2 samples (an isolated sample between two gaps), naming its
+/// time.
+///
+/// [`MAX_GAP_INTERVALS`]: crate::limits::MAX_GAP_INTERVALS
+pub fn split_at_gaps(rec: &Recording) -> Result<Vec<Recording>> {
+    let gaps = gap_positions(rec);
+    if gaps.is_empty() {
+        return Ok(vec![rec.clone()]);
+    }
+    let n = rec.n;
+    let mut bounds = vec![0];
+    bounds.extend(gaps.iter().map(|&i| i + 1));
+    bounds.push(rec.len());
+    let mut parts = Vec::with_capacity(bounds.len() - 1);
+    for w in bounds.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if b - a < 2 {
+            return Err(Error::Recording {
+                recording: rec.name.clone(),
+                message: format!(
+                    "the sample at t = {:.6} s stands alone between two gaps; remove it or the gaps",
+                    rec.t[a]
+                ),
+            });
+        }
+        let rows = |x: &[f64]| x[a * n..b * n].to_vec();
+        let part = Recording::new(
+            format!("{} [{:.3}-{:.3} s]", rec.name, rec.t[a], rec.t[b - 1]),
+            n,
+            rec.t[a..b].to_vec(),
+            rows(&rec.q),
+            rows(&rec.tau),
+            rec.qd.as_deref().map(rows),
+            rec.qdd.as_deref().map(rows),
+        )?;
+        parts.push(Recording {
+            experiment: rec.experiment.clone(),
+            ..part
+        });
+    }
+    Ok(parts)
+}
+
+fn preprocess_part(rec: &Recording, options: &PreprocessOptions) -> Result<Recording> {
     let o = options;
     if !(o.rate.is_finite() && o.rate > 0.0) || o.decimate == 0 || o.trim.is_nan() || o.trim < 0.0 {
         return Err(Error::InvalidArgument {
@@ -122,32 +227,49 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     })
 }
 
+/// The median sample interval of `rec` and the indices `i` after which `t[i + 1] - t[i]` is
+/// longer than [`MAX_GAP_INTERVALS`] medians.
+///
+/// [`MAX_GAP_INTERVALS`]: crate::limits::MAX_GAP_INTERVALS
+fn gaps(rec: &Recording) -> (f64, Vec<usize>) {
+    let dt: Vec<f64> = rec.t.windows(2).map(|w| w[1] - w[0]).collect();
+    if dt.is_empty() {
+        return (0.0, vec![]);
+    }
+    let mut sorted = dt.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2];
+    let limit = crate::limits::MAX_GAP_INTERVALS * median;
+    let at = (0..dt.len()).filter(|&i| dt[i] > limit).collect();
+    (median, at)
+}
+
+fn gap_positions(rec: &Recording) -> Vec<usize> {
+    gaps(rec).1
+}
+
 /// Refuses a log with a gap longer than [`MAX_GAP_INTERVALS`] times its median sample
 /// interval: resampling would fill it with invented, interpolated values. The error names the
 /// gap's time.
 ///
 /// [`MAX_GAP_INTERVALS`]: crate::limits::MAX_GAP_INTERVALS
 fn check_gaps(rec: &Recording) -> Result<()> {
-    let dt: Vec<f64> = rec.t.windows(2).map(|w| w[1] - w[0]).collect();
-    if dt.is_empty() {
-        return Ok(());
-    }
-    let mut sorted = dt.clone();
-    sorted.sort_by(f64::total_cmp);
-    let median = sorted[sorted.len() / 2];
-    let limit = crate::limits::MAX_GAP_INTERVALS * median;
-    match dt.iter().position(|&d| d > limit) {
-        Some(i) => Err(Error::Recording {
-            recording: rec.name.clone(),
-            message: format!(
-                "a gap of {:.6} s after t = {:.6} s, {:.0} times the median sample interval ({:.3e} s); resampling would invent the values in it (at most {} intervals are bridged): split the log there",
-                dt[i],
-                rec.t[i],
-                dt[i] / median,
-                median,
-                crate::limits::MAX_GAP_INTERVALS
-            ),
-        }),
+    let (median, at) = gaps(rec);
+    match at.first() {
+        Some(&i) => {
+            let d = rec.t[i + 1] - rec.t[i];
+            Err(Error::Recording {
+                recording: rec.name.clone(),
+                message: format!(
+                    "a gap of {:.6} s after t = {:.6} s, {:.0} times the median sample interval ({:.3e} s); resampling would invent the values in it (at most {} intervals are bridged): split the log there (split_at_gaps, --split-at-gaps) or remove the gap",
+                    d,
+                    rec.t[i],
+                    d / median,
+                    median,
+                    crate::limits::MAX_GAP_INTERVALS
+                ),
+            })
+        }
         None => Ok(()),
     }
 }

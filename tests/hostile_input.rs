@@ -49,7 +49,7 @@ fn unusable_limits_are_model_errors_naming_the_joint_and_line() {
         ),
         (
             r#"<limit lower="-1" upper="1" effort="-2" velocity="1"/>"#,
-            "effort -2 is negative",
+            "effort -2 N m is negative",
         ),
         (
             r#"<limit lower="-1" upper="1" effort="1" velocity="1" acceleration="0"/>"#,
@@ -293,7 +293,33 @@ fn a_gap_in_a_log_is_not_filled_with_invented_values() {
         e.starts_with("arm.csv: a gap of 100.001000 s after t = 2.999000 s"),
         "{e}"
     );
-    assert!(e.contains("split the log there"), "{e}");
+    assert!(e.contains("split the log there (split_at_gaps"), "{e}");
+    // with the explicit option, each side is preprocessed on its own; the gap stays a gap
+    let options = PreprocessOptions {
+        split_at_gaps: true,
+        ..PreprocessOptions::default()
+    };
+    let out = preprocess(&rec, &options).unwrap();
+    assert_eq!(out.name, "arm.csv (preprocessed, 2 parts)");
+    let largest_step = out.t.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+    assert!(largest_step > 100.0, "the gap was bridged: {largest_step}");
+    assert!(out.t.iter().all(|&t| t < 3.0 || t > 103.0), "invented samples in the gap");
+    // each part: 3 s at 1 kHz, 0.5 s trimmed at both ends, every 10th sample
+    assert_eq!(out.len(), 2 * 200);
+    for (i, &t) in out.t.iter().enumerate() {
+        let qd = out.qd.as_ref().unwrap()[i];
+        assert!((qd - 0.3 * (0.3 * t).cos()).abs() < 1e-3, "qd at t = {t}: {qd}");
+    }
+    // a part too short to trim is refused, naming it
+    let mut t2 = rec.t[..3000].to_vec();
+    t2.extend((0..50).map(|i| 200.0 + i as f64 * 1e-3));
+    let q2: Vec<f64> = t2.iter().map(|x| (0.3 * x).sin()).collect();
+    let short = Recording::new("arm.csv", 1, t2, q2.clone(), q2, None, None).unwrap();
+    let e = preprocess(&short, &options).unwrap_err().to_string();
+    assert!(
+        e.starts_with("arm.csv: part 2 of 2 (t = 200.000000 s to 200.049000 s, between gaps): "),
+        "{e}"
+    );
 }
 
 #[test]
@@ -497,5 +523,60 @@ fn urdf_messages_say_where_and_what() {
     assert!(
         e.starts_with("arm.urdf: not a valid URDF: XML: ") && e.contains("3:"),
         "{e}"
+    );
+}
+
+/// The messages users act on most, word for word: a change to any of them is deliberate.
+#[test]
+fn key_messages_word_for_word() {
+    let says = |e: perturbid_rs::Error| e.to_string();
+    // a URDF limit no joint can have
+    let e = load(&with_limit(
+        r#"<limit lower="-1" upper="1" effort="1" velocity="-1"/>"#,
+        "revolute",
+    ))
+    .unwrap_err();
+    assert_eq!(
+        says(e),
+        "arm.urdf:3: joint 'j1' <limit>: velocity -1 rad/s is not positive; a moving joint needs a positive speed limit"
+    );
+    // a robot that cannot move
+    assert_eq!(
+        says(load(&with_limit("", "fixed")).unwrap_err()),
+        "arm.urdf: robot 'r' has no moving joint (every joint is fixed or locked); nothing can be identified"
+    );
+    // a plan that leaves the joint's range, and one too fast
+    let model = robots::builtin("a465").unwrap();
+    let mut q = TABLE2_Q.to_vec();
+    q[1] = model.limits[1].upper - 0.01;
+    let op = OperatingPoint::new(q, TABLE2_QD.to_vec(), TABLE2_QDD.to_vec()).unwrap();
+    let e = plan_experiments(&model, &op, &PlanOptions::default()).unwrap_err();
+    assert_eq!(
+        says(e),
+        "experiment 'G_static' of the plan: joint 'joint2' at t = 1.0900 s: position 1.571010 rad is outside [-1.570796, 1.570796] rad by 0.000213 rad; reduce the perturbation sizes or move the operating point away from the limit"
+    );
+    let mut qd = TABLE2_QD.to_vec();
+    qd[0] = 0.99 * model.limits[0].velocity;
+    let op = OperatingPoint::new(TABLE2_Q.to_vec(), qd, TABLE2_QDD.to_vec()).unwrap();
+    let e = plan_experiments(&model, &op, &PlanOptions::default()).unwrap_err();
+    assert_eq!(
+        says(e),
+        "experiment 'H' of the plan: joint 'joint1' at t = 3.1640 s: velocity 3.143438 rad/s is outside the limit +-3.141600 rad/s by 0.001838 rad/s; reduce the perturbation sizes or move the operating point away from the limit"
+    );
+    // a file of an output set whose writing was killed
+    let d = std::env::temp_dir().join(format!("perturbid-words-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    std::fs::write(d.join("x.csv"), "t,q1,tau1\n0,0,0\n").unwrap();
+    std::fs::write(
+        d.join("run.manifest.json"),
+        r#"{"format": "perturbid.manifest", "version": 1, "set": "run", "state": "writing", "files": ["x.csv"], "replacing": []}"#,
+    )
+    .unwrap();
+    let e = perturbid_rs::io::read_text(d.join("x.csv")).unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::File);
+    assert_eq!(
+        says(e).replace(&d.display().to_string(), "DIR"),
+        "DIR/x.csv belongs to an output set whose writing was interrupted (see DIR/run.manifest.json): it may mix old and new files; run the command that wrote it again"
     );
 }

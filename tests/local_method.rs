@@ -13,6 +13,7 @@ use perturbid_rs::regression::least_squares;
 use perturbid_rs::robots::a465;
 use perturbid_rs::Document;
 use perturbid_rs::Gravity;
+use perturbid_rs::error::Limit;
 use perturbid_rs::{
     linearize, rnea, simulate_plan, Data, Error, Friction, Linearization, Model, Recording,
     SimulationOptions,
@@ -343,7 +344,10 @@ fn plans_breaking_limits_are_refused_with_joint_and_time() {
     let op = OperatingPoint::new(q, a465::TABLE2_QD.to_vec(), a465::TABLE2_QDD.to_vec()).unwrap();
     let err = plan_experiments(&model, &op, &PlanOptions::default()).unwrap_err();
     let msg = err.to_string();
-    assert!(matches!(err, Error::PositionLimit { .. }), "{msg}");
+    assert!(
+        matches!(&err, Error::LimitViolation(v) if matches!(v.limit, Limit::Position { .. })),
+        "{msg}"
+    );
     assert!(
         msg.contains("shoulder") || msg.contains("joint2") || msg.contains(&model.joint_names[1]),
         "{msg}"
@@ -355,13 +359,7 @@ fn plans_breaking_limits_are_refused_with_joint_and_time() {
     let op = OperatingPoint::new(a465::TABLE2_Q.to_vec(), qd, a465::TABLE2_QDD.to_vec()).unwrap();
     let err = plan_experiments(&model, &op, &PlanOptions::default()).unwrap_err();
     assert!(
-        matches!(
-            err,
-            Error::LimitViolation {
-                quantity: "velocity",
-                ..
-            }
-        ),
+        matches!(&err, Error::LimitViolation(v) if matches!(v.limit, Limit::Velocity(_))),
         "{err}"
     );
     assert!(err.to_string().contains(&model.joint_names[0]));

@@ -467,6 +467,7 @@ def preprocess(
     decimate: int = 10,
     trim: float = 0.5,
     filter_position: bool = False,
+    split_at_gaps: bool = False,
     name: str = "recording",
 ) -> Recording: ...
 

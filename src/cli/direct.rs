@@ -124,6 +124,10 @@ pub(crate) struct IdentifyDirectArgs {
     decimate: usize,
     #[arg(long, default_value_t = 0.5)]
     trim: f64,
+    /// At a gap in the log (longer than 20 median sample intervals), preprocess the parts on
+    /// either side separately instead of refusing the log; nothing is interpolated across it.
+    #[arg(long)]
+    split_at_gaps: bool,
     /// Fit on the first (1 - FRACTION) of the samples and report the errors on the rest.
     #[arg(long, default_value_t = 0.3)]
     validate: f64,
@@ -143,6 +147,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
             cutoff: Some(a.cutoff),
             decimate: a.decimate,
             trim: a.trim,
+            split_at_gaps: a.split_at_gaps,
             ..PreprocessOptions::default()
         };
         rec = preprocess(&rec, &o)?;

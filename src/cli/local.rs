@@ -11,7 +11,7 @@ use super::out_dir;
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
-use crate::io::{read_recording, recording_table, samples_table, write_atomic, OutputSet};
+use crate::io::{read_recording, recording_table, samples_table, OutputSet};
 use crate::local::{
     identify_local, plan_experiments, CrossingTimes, Design, Estimator, ExperimentKind,
     IdentifyOptions, LocalModel, OperatingPoint, Plan, PlanOptions, Size,

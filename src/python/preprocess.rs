@@ -16,10 +16,12 @@ use crate::recording::Recording;
 /// uniform grid at `rate` Hz, zero-phase Butterworth low-pass (`order`, `cutoff` Hz; None = no
 /// filter) on qd and tau (and q with `filter_position`), qdd by differentiating the filtered
 /// qd, drop `trim` s at both ends and keep every `decimate`-th sample. Returns a Recording with
-/// qd and qdd.
+/// qd and qdd. A gap in `t` longer than 20 median sample intervals is an InputError naming its
+/// time, unless `split_at_gaps`: then each part between gaps is preprocessed on its own and the
+/// parts are concatenated (the gaps stay in `t`; nothing is interpolated across them).
 #[pyfunction]
-#[pyo3(signature = (t, q, tau, qd=None, *, rate=1000.0, cutoff=Some(10.0), order=4, decimate=10, trim=0.5, filter_position=false, name="recording"),
-    text_signature = "(t, q, tau, qd=None, *, rate=1000.0, cutoff=10.0, order=4, decimate=10, trim=0.5, filter_position=False, name='recording')")]
+#[pyo3(signature = (t, q, tau, qd=None, *, rate=1000.0, cutoff=Some(10.0), order=4, decimate=10, trim=0.5, filter_position=false, split_at_gaps=false, name="recording"),
+    text_signature = "(t, q, tau, qd=None, *, rate=1000.0, cutoff=10.0, order=4, decimate=10, trim=0.5, filter_position=False, split_at_gaps=False, name='recording')")]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn preprocess(
     py: Python<'_>,
@@ -33,6 +35,7 @@ pub(crate) fn preprocess(
     decimate: usize,
     trim: f64,
     filter_position: bool,
+    split_at_gaps: bool,
     name: &str,
 ) -> PyResult<PyRecording> {
     let rec = PyRecording::build(t, q, tau, qd, None, name)?;
@@ -43,6 +46,7 @@ pub(crate) fn preprocess(
         filter_position,
         trim,
         decimate,
+        split_at_gaps,
     };
     let out: Recording = detached(py, "preprocess", || preprocess_rs(&rec, &options))?;
     Ok(PyRecording { rec: Arc::new(out) })

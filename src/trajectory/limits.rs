@@ -1,14 +1,14 @@
 //! Joint-limit checks of sampled trajectories.
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Limit, LimitViolation, Result};
 use crate::model::{JointKind, Model};
 
 use super::samples::Samples;
 
-fn units(kind: JointKind) -> [&'static str; 3] {
+fn unit(kind: JointKind) -> &'static str {
     match kind {
-        JointKind::Revolute => ["rad", "rad/s", "rad/s^2"],
-        JointKind::Prismatic => ["m", "m/s", "m/s^2"],
+        JointKind::Revolute => "rad",
+        JointKind::Prismatic => "m",
     }
 }
 
@@ -18,41 +18,37 @@ fn units(kind: JointKind) -> [&'static str; 3] {
 pub fn check_limits(model: &Model, samples: &Samples, context: &str, hint: &str) -> Result<()> {
     let n = model.nv;
     let tol = 1e-9;
+    let violation = |j: usize, i: usize, value: f64, limit: Limit| {
+        Error::LimitViolation(Box::new(LimitViolation {
+            context: context.to_string(),
+            joint: model.joint_names[j].clone(),
+            time: samples.t[i],
+            value,
+            limit,
+            unit: unit(model.joint_kinds[j]),
+            hint: hint.to_string(),
+        }))
+    };
     for i in 0..samples.len() {
         let (q, qd, qdd) = (samples.q_at(i), samples.qd_at(i), samples.qdd_at(i));
         for j in 0..n {
             let lim = &model.limits[j];
-            let [_, vu, au] = units(model.joint_kinds[j]);
             let scale = 1.0 + tol;
             if q[j] < lim.lower - tol * lim.lower.abs().max(1.0)
                 || q[j] > lim.upper + tol * lim.upper.abs().max(1.0)
             {
-                return Err(Error::PositionLimit {
-                    context: context.to_string(),
-                    joint: model.joint_names[j].clone(),
-                    time: samples.t[i],
-                    value: q[j],
+                let range = Limit::Position {
                     lower: lim.lower,
                     upper: lim.upper,
-                    hint: hint.to_string(),
-                });
+                };
+                return Err(violation(j, i, q[j], range));
             }
-            for (quantity, value, limit, unit) in [
-                ("velocity", qd[j], lim.velocity, vu),
-                ("acceleration", qdd[j], lim.acceleration, au),
-            ] {
-                if value.abs() > limit * scale {
-                    return Err(Error::LimitViolation {
-                        context: context.to_string(),
-                        joint: model.joint_names[j].clone(),
-                        time: samples.t[i],
-                        quantity,
-                        value,
-                        limit,
-                        unit,
-                        hint: hint.to_string(),
-                    });
-                }
+            if qd[j].abs() > lim.velocity * scale {
+                return Err(violation(j, i, qd[j], Limit::Velocity(lim.velocity)));
+            }
+            if qdd[j].abs() > lim.acceleration * scale {
+                let l = Limit::Acceleration(lim.acceleration);
+                return Err(violation(j, i, qdd[j], l));
             }
         }
     }

@@ -80,18 +80,27 @@ impl Builder<'_> {
         }
         // On a continuous joint zeros mean "not given" (see `convert::joint_limits`).
         let given = |v: f64| !(joint.joint_type == Continuous && v == 0.0);
+        let unit = if joint.joint_type == urdf_rs::JointType::Prismatic {
+            "m"
+        } else {
+            "rad"
+        };
         if l.velocity <= 0.0 && given(l.velocity) {
             return Err(invalid(format!(
-                "velocity {} rad/s (or m/s) is not positive",
+                "velocity {} {unit}/s is not positive; a moving joint needs a positive speed limit",
                 l.velocity
             )));
         }
         if l.effort < 0.0 {
-            return Err(invalid(format!("effort {} is negative", l.effort)));
+            let effort_unit = if unit == "m" { "N" } else { "N m" };
+            return Err(invalid(format!(
+                "effort {} {effort_unit} is negative; give a positive limit, or 0 for none",
+                l.effort
+            )));
         }
         if l.acceleration <= 0.0 {
             return Err(invalid(format!(
-                "acceleration {} is not positive",
+                "acceleration {} {unit}/s^2 is not positive; leave it out for none",
                 l.acceleration
             )));
         }

@@ -107,19 +107,19 @@ impl Builder<'_> {
     }
 
     /// Where joint `name` stands in the file.
-    fn joint_location(&self, name: &str) -> Location {
-        Location {
+    fn joint_location(&self, name: &str) -> Box<Location> {
+        Box::new(Location {
             source: self.source.to_string(),
             line: self.lines.joints.get(name).map(|j| j.0),
-        }
+        })
     }
 
     /// Where link `name` stands in the file.
-    fn link_location(&self, name: &str) -> Location {
-        Location {
+    fn link_location(&self, name: &str) -> Box<Location> {
+        Box::new(Location {
             source: self.source.to_string(),
             line: self.lines.links.get(name).copied(),
-        }
+        })
     }
 
     /// Fails on the first non-finite value of `field` of element `name`.

@@ -158,3 +158,13 @@ def test_any_array_gets_a_result_or_our_error(shape, value, method):
         return
     results = [out] if isinstance(out, np.ndarray) else [out.torque, out.D, out.H, out.G, out.G_static]
     assert all(np.isfinite(r).all() for r in results)
+
+
+def test_a_gap_in_a_log_is_refused_or_split_never_filled():
+    t = np.concatenate([np.arange(3000) * 1e-3, 103.0 + np.arange(3000) * 1e-3])
+    q = np.sin(0.3 * t)[:, None]
+    with pytest.raises(pr.InputError, match=r"a gap of 100\.001000 s after t = 2\.999000 s"):
+        pr.preprocess(t, q, q)
+    out = pr.preprocess(t, q, q, split_at_gaps=True)
+    assert not np.any((out.t > 3.0) & (out.t < 103.0)), "samples invented in the gap"
+    np.testing.assert_allclose(out.qd[:, 0], 0.3 * np.cos(0.3 * out.t), atol=1e-3)
