@@ -5,6 +5,7 @@ mod common;
 
 use common::Rng;
 use nalgebra::{DMatrix, DVector};
+use perturbid_rs::error::Limit;
 use perturbid_rs::local::{
     identify_local, plan_experiments, CrossingTimes, Design, Estimator, ExperimentKind,
     IdentifyOptions, LocalModel, OperatingPoint, Plan, PlanOptions, Size, Sizes,
@@ -13,7 +14,6 @@ use perturbid_rs::regression::least_squares;
 use perturbid_rs::robots::a465;
 use perturbid_rs::Document;
 use perturbid_rs::Gravity;
-use perturbid_rs::error::Limit;
 use perturbid_rs::{
     linearize, rnea, simulate_plan, Data, Error, Friction, Linearization, Model, Recording,
     SimulationOptions,

@@ -320,10 +320,8 @@ mod tests {
     use super::*;
 
     fn tmpdir(tag: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!(
-            "perturbid-output-set-{tag}-{}",
-            std::process::id()
-        ));
+        let d =
+            std::env::temp_dir().join(format!("perturbid-output-set-{tag}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&d);
         std::fs::create_dir_all(&d).unwrap();
         d
@@ -415,7 +413,10 @@ mod tests {
         s.add("D.csv", "recording").unwrap();
         let e = s.commit().unwrap_err().to_string();
         assert!(e.contains("belongs to the output set 'plan'"), "{e}");
-        assert_eq!(std::fs::read_to_string(d.join("D.csv")).unwrap(), "trajectory");
+        assert_eq!(
+            std::fs::read_to_string(d.join("D.csv")).unwrap(),
+            "trajectory"
+        );
     }
 
     #[test]
