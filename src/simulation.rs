@@ -13,41 +13,111 @@ use crate::recording::Recording;
 use crate::states::States;
 use crate::trajectory::Samples;
 
-/// Joint friction `tau_f = viscous * qd + coulomb * sign(qd)` (per joint; N m s/rad and N m),
-/// with `sign(0) = 0`.
+/// Joint friction as a function of the joint speed alone, per joint (SI: N m for revolute
+/// joints, N for prismatic ones; speeds in rad/s or m/s):
+///
+/// ```text
+/// qd > 0:  tau_f =  viscous qd + coulomb          + stribeck exp(-(qd / stribeck_velocity)^2)
+/// qd < 0:  tau_f =  viscous qd - coulomb_negative - stribeck exp(-(qd / stribeck_velocity)^2)
+/// qd = 0:  tau_f = 0
+/// ```
+///
+/// `coulomb_negative` differs from `coulomb` for asymmetric Coulomb friction; `stribeck` is the
+/// breakaway excess (static minus Coulomb level), 0 for none. At exactly zero speed the friction
+/// carries no torque: a rehearsal defines it rather than leaving it to the sign of a rounding
+/// error (a real joint at rest holds anything up to its breakaway level).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Friction {
+    /// N m s/rad.
     pub viscous: Vec<f64>,
+    /// Coulomb level for positive speeds (N m, >= 0).
     pub coulomb: Vec<f64>,
+    /// Coulomb level for negative speeds (N m, >= 0; the torque is `-coulomb_negative`).
+    pub coulomb_negative: Vec<f64>,
+    /// Stribeck excess at zero speed (N m, >= 0).
+    pub stribeck: Vec<f64>,
+    /// Stribeck speed (rad/s, > 0 where `stribeck` is not 0).
+    pub stribeck_velocity: Vec<f64>,
 }
 
 impl Friction {
     /// No friction.
     pub fn none(n: usize) -> Self {
+        Self::viscous_coulomb(vec![0.0; n], vec![0.0; n])
+    }
+
+    /// Viscous and symmetric Coulomb friction (`coulomb_negative = coulomb`, no Stribeck).
+    pub fn viscous_coulomb(viscous: Vec<f64>, coulomb: Vec<f64>) -> Self {
+        let n = viscous.len();
         Self {
-            viscous: vec![0.0; n],
-            coulomb: vec![0.0; n],
+            viscous,
+            coulomb_negative: coulomb.clone(),
+            coulomb,
+            stribeck: vec![0.0; n],
+            stribeck_velocity: vec![1.0; n],
         }
     }
 
-    /// The URDF's `<dynamics damping friction>` of every joint.
+    /// The URDF's `<dynamics damping friction>` of every joint (viscous and symmetric Coulomb).
     pub fn from_model(model: &Model) -> Self {
-        Self {
-            viscous: model.limits.iter().map(|l| l.damping).collect(),
-            coulomb: model.limits.iter().map(|l| l.friction).collect(),
-        }
+        Self::viscous_coulomb(
+            model.limits.iter().map(|l| l.damping).collect(),
+            model.limits.iter().map(|l| l.friction).collect(),
+        )
     }
 
-    /// Friction torque of joint `j` at speed `qd`.
+    /// Friction torque of joint `j` at speed `qd`; see the type's documentation.
     pub fn torque(&self, j: usize, qd: f64) -> f64 {
-        let sign = if qd > 0.0 {
-            1.0
+        let stribeck = |level: f64| {
+            if self.stribeck[j] == 0.0 {
+                level
+            } else {
+                level + self.stribeck[j] * (-(qd / self.stribeck_velocity[j]).powi(2)).exp()
+            }
+        };
+        if qd > 0.0 {
+            self.viscous[j] * qd + stribeck(self.coulomb[j])
         } else if qd < 0.0 {
-            -1.0
+            self.viscous[j] * qd - stribeck(self.coulomb_negative[j])
         } else {
             0.0
-        };
-        self.viscous[j] * qd + self.coulomb[j] * sign
+        }
+    }
+
+    /// Checks the lengths (`n` each), finiteness and signs.
+    pub fn check(&self, n: usize) -> Result<()> {
+        for (what, v) in [
+            ("friction viscous", &self.viscous),
+            ("friction coulomb", &self.coulomb),
+            ("friction coulomb_negative", &self.coulomb_negative),
+            ("friction stribeck", &self.stribeck),
+            ("friction stribeck_velocity", &self.stribeck_velocity),
+        ] {
+            crate::model::check_finite_vector(what, v, n)?;
+            if what != "friction viscous" {
+                if let Some(j) = v.iter().position(|&x| x < 0.0) {
+                    return Err(Error::InvalidArgument {
+                        argument: format!("{what}[{j}]"),
+                        message: format!(
+                            "{}; expected a level >= 0 (the sign follows the speed)",
+                            v[j]
+                        ),
+                    });
+                }
+            }
+        }
+        if let Some(j) =
+            (0..n).find(|&j| self.stribeck[j] != 0.0 && self.stribeck_velocity[j] <= 0.0)
+        {
+            return Err(Error::InvalidArgument {
+                argument: format!("friction stribeck_velocity[{j}]"),
+                message: format!(
+                    "{}; expected a positive speed where stribeck[{j}] = {} is not 0",
+                    self.stribeck_velocity[j], self.stribeck[j]
+                ),
+            });
+        }
+        Ok(())
     }
 }
 
@@ -81,21 +151,18 @@ impl SimulationOptions {
     }
 
     fn check(&self, n: usize) -> Result<()> {
+        self.friction.check(n)?;
         for (what, v) in [
-            ("friction viscous", &self.friction.viscous),
-            ("friction coulomb", &self.friction.coulomb),
             ("torque_noise", &self.torque_noise),
             ("position_noise", &self.position_noise),
             ("quantization", &self.quantization),
         ] {
             crate::model::check_finite_vector(what, v, n)?;
-            if what != "friction viscous" && what != "friction coulomb" {
-                if let Some(j) = v.iter().position(|&x| x < 0.0) {
-                    return Err(Error::InvalidArgument {
-                        argument: format!("{what}[{j}]"),
-                        message: format!("{}; expected a value >= 0", v[j]),
-                    });
-                }
+            if let Some(j) = v.iter().position(|&x| x < 0.0) {
+                return Err(Error::InvalidArgument {
+                    argument: format!("{what}[{j}]"),
+                    message: format!("{}; expected a value >= 0", v[j]),
+                });
             }
         }
         Ok(())

@@ -235,10 +235,7 @@ fn common_mode_gravity_and_friction() {
     let (_, rigid) = identify(&model, &op, &opts, &noise_free(&model, Gravity::Excluded));
     let mut sim = noise_free(&model, Gravity::Included);
     let viscous = vec![2.0, 1.5, 1.0, 0.5, 0.4, 0.3];
-    sim.friction = Friction {
-        viscous: viscous.clone(),
-        coulomb: vec![3.0, 2.5, 2.0, 1.0, 0.8, 0.5],
-    };
+    sim.friction = Friction::viscous_coulomb(viscous.clone(), vec![3.0, 2.5, 2.0, 1.0, 0.8, 0.5]);
     let (_, full) = identify(&model, &op, &opts, &sim);
     assert!(rel(mat(&full.d), mat(&rigid.d)) < 1e-9);
     let h_expected = mat(&rigid.h) + DMatrix::from_diagonal(&DVector::from_vec(viscous));

@@ -1,7 +1,7 @@
 """Type stubs of the extension module perturbid_rs._core (implemented in Rust)."""
 
 from os import PathLike
-from typing import Literal, Mapping, Optional, Sequence, Union, final
+from typing import Any, Literal, Mapping, Optional, Sequence, Union, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -52,6 +52,9 @@ class NumericalError(PerturbidError, ArithmeticError):
 
 class FileError(PerturbidError, OSError):
     """A file that cannot be read or written."""
+
+class PerturbidWarning(UserWarning):
+    """A result the library computed but cannot fully vouch for (also in its diagnostics)."""
 
 class InternalError(PerturbidError, RuntimeError):
     """A bug of perturbid_rs caught at its boundary: please report it."""
@@ -287,6 +290,9 @@ class LocalModel:
     def joint_names(self) -> list[str]: ...
     @property
     def estimator(self) -> str: ...
+    @property
+    def diagnostics(self) -> dict[str, Any]:
+        """offsets (experiment -> clock offset, s), reversals (list of dicts), warnings."""
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:
         """Predicted torques (N m), shape (n,) or (k, n)."""
     def to_json(self) -> str: ...
@@ -330,8 +336,8 @@ def simulate(
 def identify_local(
     plan: Plan,
     recordings: list[Recording],
-    crossing_times: str = "planned",
-    max_shift: float = 1.0,
+    crossing_times: str = "detected",
+    max_shift: float = 0.5,
     window: Optional[float] = None,
     torque_degree: int = 6,
     recorded_derivatives: bool = False,

@@ -216,11 +216,12 @@ pub(crate) struct IdentifyArgs {
     /// Where to write the local model (JSON).
     #[arg(long, default_value = "local_model.json")]
     out: PathBuf,
-    /// Find the offset between the plan and the recordings' clock in the data.
+    /// Take the plan's crossing times as they are (the recordings' clocks start with the
+    /// plan) instead of aligning each recording with the plan from its positions (the default).
     #[arg(long)]
-    detect_times: bool,
-    /// Largest offset searched by --detect-times (s).
-    #[arg(long, default_value_t = 1.0)]
+    planned_times: bool,
+    /// Largest clock offset between a recording and the plan accepted by the alignment (s).
+    #[arg(long, default_value_t = 0.5)]
     max_shift: f64,
     /// Half-width of the fits around each crossing (s; default: the plan's window).
     #[arg(long)]
@@ -275,12 +276,12 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
         .map(|f| read_recording(&load_table(f)?, &plan.joint_names))
         .collect::<Result<_>>()?;
     let options = IdentifyOptions {
-        times: if a.detect_times {
+        times: if a.planned_times {
+            CrossingTimes::Planned
+        } else {
             CrossingTimes::Detected {
                 max_shift: a.max_shift,
             }
-        } else {
-            CrossingTimes::Planned
         },
         fit: crate::local::FitOptions {
             window: a.window,
@@ -290,6 +291,9 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
     };
     let model: LocalModel = identify_local(&plan, &recs, &options)?;
     model.save(&a.out)?;
+    for w in &model.diagnostics.warnings {
+        eprintln!("perturbid: warning: {w}");
+    }
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -298,6 +302,26 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
         a.estimator,
         a.out.display()
     );
+    let offsets: Vec<String> = model
+        .diagnostics
+        .offsets
+        .iter()
+        .map(|o| format!("{} {:+.2} ms", o.experiment, 1e3 * o.offset))
+        .collect();
+    let _ = writeln!(out, "clock offsets: {}", offsets.join(", "));
+    let reversals = &model.diagnostics.reversals;
+    if !reversals.is_empty() {
+        let stepped = reversals
+            .iter()
+            .filter(|r| r.handling == crate::local::ReversalHandling::Step)
+            .count();
+        let _ = writeln!(
+            out,
+            "velocity reversals near crossings: {} torque fit(s) narrowed to leave the friction step out, {stepped} with the step modelled; see \"diagnostics\" in {}",
+            reversals.len() - stepped,
+            a.out.display()
+        );
+    }
     let t: Vec<String> = model
         .torque
         .iter()

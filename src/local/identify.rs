@@ -3,7 +3,11 @@
 
 use nalgebra::DMatrix;
 
-use super::crossing::{detect_offset, values_at, CrossingValues, FitOptions};
+use super::crossing::{
+    detect_offset, samples_needed, values_at_with, velocity_reversals, CrossingValues, FitOptions,
+    TorqueFit,
+};
+use super::diagnostics::{ClockOffset, Diagnostics, Reversal, ReversalHandling};
 use super::model::{Estimate, Estimator, LocalModel};
 use super::operating_point::OperatingPoint;
 use super::plan::{Experiment, ExperimentKind, Plan};
@@ -15,11 +19,21 @@ use crate::regression::{least_squares, LeastSquares};
 /// Where the crossing times come from.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum CrossingTimes {
-    /// The plan's times, the recording starting with the plan (t = 0 at the plan's start).
+    /// The plan's times, the recording's clock starting with the plan (t = 0 at the plan's
+    /// start). A recording whose clock is offset reads every crossing at the wrong time: 1 ms
+    /// makes H* wrong by far more than its noise.
     Planned,
-    /// The plan's times shifted by the offset between plan and recording found in the data
-    /// (searched within `+-max_shift` s).
+    /// The plan's times shifted by the offset between plan and recording found in the
+    /// recorded positions (least squares against the planned trajectory, sub-sample). An
+    /// offset larger than `max_shift` s is refused: the recording is then likely not a run of
+    /// the experiment, or its clock needs to be fixed first. The offsets are in the model's
+    /// diagnostics.
     Detected { max_shift: f64 },
+}
+
+impl CrossingTimes {
+    /// The default tolerance of [`CrossingTimes::Detected`] (s).
+    pub const DEFAULT_MAX_SHIFT: f64 = 0.5;
 }
 
 /// Options of [`identify_local`].
@@ -31,10 +45,13 @@ pub struct IdentifyOptions {
 }
 
 impl Default for IdentifyOptions {
-    /// Planned times, the default fit, the separated estimator.
+    /// Crossing times aligned with each recording's clock (offsets up to 0.5 s), the default
+    /// fit, the separated estimator.
     fn default() -> Self {
         Self {
-            times: CrossingTimes::Planned,
+            times: CrossingTimes::Detected {
+                max_shift: CrossingTimes::DEFAULT_MAX_SHIFT,
+            },
             fit: FitOptions::default(),
             estimator: Estimator::Separated,
         }
@@ -49,17 +66,90 @@ pub struct ExperimentValues {
     pub offset: f64,
     pub crossings: Vec<CrossingValues>,
     pub reference: Option<CrossingValues>,
+    /// The crossings at which a joint's velocity reverses within the fit window, and how its
+    /// torque was read there.
+    pub reversals: Vec<Reversal>,
 }
 
-/// Reads the values at every crossing of `experiment` from `rec`.
+/// How to read the torque of each joint at the crossing at plan time `tp` (the recording's
+/// clock: `tp + offset`) so that no velocity reversal enters the fit: the full window where no
+/// joint reverses within it; a window narrowed to 0.9 of the distance to the reversal where
+/// that still holds `min_half` s; else a step at the reversal (see [`TorqueFit`]). The
+/// reversals are appended to `found`.
+#[allow(clippy::too_many_arguments)]
+fn torque_fits(
+    experiment: &Experiment,
+    joint_names: &[String],
+    tp: f64,
+    offset: f64,
+    half: f64,
+    min_half: f64,
+    crossing: Option<usize>,
+    found: &mut Vec<Reversal>,
+) -> Vec<TorqueFit> {
+    let traj = &experiment.trajectory;
+    (0..traj.n)
+        .map(|j| {
+            let nearest = velocity_reversals(traj, j, tp - half, tp + half)
+                .into_iter()
+                .min_by(|a, b| (a - tp).abs().total_cmp(&(b - tp).abs()));
+            let Some(tr) = nearest else {
+                return TorqueFit::Window(half);
+            };
+            let narrowed = 0.9 * (tr - tp).abs();
+            let (fit, handling, window) = if narrowed >= min_half {
+                (
+                    TorqueFit::Window(narrowed),
+                    ReversalHandling::Narrowed,
+                    narrowed,
+                )
+            } else {
+                let slope = traj.segment_at(tr).eval(j, tr).2.signum();
+                let fit = TorqueFit::Step {
+                    reversal: tr + offset,
+                    slope,
+                };
+                (fit, ReversalHandling::Step, half)
+            };
+            found.push(Reversal {
+                experiment: experiment.kind.name().to_string(),
+                crossing,
+                joint: joint_names
+                    .get(j)
+                    .cloned()
+                    .unwrap_or_else(|| format!("{}", j + 1)),
+                at: tr - tp,
+                handling,
+                window,
+            });
+            fit
+        })
+        .collect()
+}
+
+/// Reads the values at every crossing of `experiment` from `rec`. `joint_names` name the
+/// joints in diagnostics.
 pub fn experiment_values(
     experiment: &Experiment,
     rec: &Recording,
+    joint_names: &[String],
     options: &IdentifyOptions,
 ) -> Result<ExperimentValues> {
     let offset = match options.times {
         CrossingTimes::Planned => 0.0,
-        CrossingTimes::Detected { max_shift } => detect_offset(experiment, rec, max_shift)?,
+        CrossingTimes::Detected { max_shift } => {
+            let offset = detect_offset(experiment, rec, 1.25 * max_shift)?;
+            if offset.abs() > max_shift {
+                return Err(Error::Recording {
+                    recording: rec.name.clone(),
+                    message: format!(
+                        "its clock is {offset:+.4} s off the plan of experiment '{}' (found in its positions), more than the {max_shift} s accepted: check that it is a run of this experiment, or raise max_shift (--max-shift)",
+                        experiment.kind.name()
+                    ),
+                });
+            }
+            offset
+        }
     };
     let half = options.fit.window.unwrap_or(experiment.window);
     crate::limits::check_range("window", half, 0.0, 60.0)?;
@@ -69,18 +159,33 @@ pub fn experiment_values(
             message: format!("{half}; expected a positive number of seconds"),
         });
     }
+    // the narrowest torque window that still holds enough samples at the recording's rate
+    let dt = (rec.t[rec.len() - 1] - rec.t[0]) / (rec.len() - 1) as f64;
+    let min_half = 0.5 * samples_needed(&options.fit) as f64 * dt;
     let name = experiment.kind.name();
+    let mut reversals = vec![];
+    let mut read = |tp: f64, crossing: Option<usize>, what: String| {
+        let fits = torque_fits(
+            experiment,
+            joint_names,
+            tp,
+            offset,
+            half,
+            min_half,
+            crossing,
+            &mut reversals,
+        );
+        values_at_with(rec, tp + offset, half, &fits, &options.fit, &what)
+    };
     let crossings = experiment
         .crossings
         .iter()
         .enumerate()
         .map(|(k, c)| {
-            values_at(
-                rec,
-                c.time + offset,
-                half,
-                &options.fit,
-                &format!("experiment '{name}', crossing {k}"),
+            read(
+                c.time,
+                Some(k),
+                format!("experiment '{name}', crossing {k}"),
             )
         })
         .collect::<Result<Vec<_>>>()?;
@@ -88,12 +193,10 @@ pub fn experiment_values(
         .reference
         .as_ref()
         .map(|c| {
-            values_at(
-                rec,
-                c.time + offset,
-                half,
-                &options.fit,
-                &format!("experiment '{name}', reference posture"),
+            read(
+                c.time,
+                None,
+                format!("experiment '{name}', reference posture"),
             )
         })
         .transpose()?;
@@ -102,6 +205,7 @@ pub fn experiment_values(
         offset,
         crossings,
         reference,
+        reversals,
     })
 }
 
@@ -197,7 +301,7 @@ pub fn identify_local(
                 ),
             });
         }
-        values.push(experiment_values(e, r, options)?);
+        values.push(experiment_values(e, r, &plan.joint_names, options)?);
     }
     let find = |kind| values.iter().find(|v: &&ExperimentValues| v.kind == kind);
     let names = |prefix: &str| -> Vec<String> {
@@ -319,6 +423,7 @@ pub fn identify_local(
             })
         }
     };
+    let diagnostics = diagnose(&values);
     Ok(LocalModel {
         format: LocalModel::tag(),
         robot: plan.robot.clone(),
@@ -333,5 +438,49 @@ pub fn identify_local(
         g,
         g_static,
         combined,
+        diagnostics,
     })
+}
+
+/// The diagnostics of an identification from the values read: the offsets, the reversals
+/// and a warning per experiment for the crossings whose friction step had to be modelled.
+fn diagnose(values: &[ExperimentValues]) -> Diagnostics {
+    let mut d = Diagnostics::default();
+    for v in values {
+        d.offsets.push(ClockOffset {
+            experiment: v.kind.name().to_string(),
+            offset: v.offset,
+        });
+        let steps: Vec<&Reversal> = v
+            .reversals
+            .iter()
+            .filter(|r| r.handling == ReversalHandling::Step)
+            .collect();
+        if !steps.is_empty() {
+            let list: Vec<String> = steps
+                .iter()
+                .take(5)
+                .map(|r| {
+                    let at = match r.crossing {
+                        Some(k) => format!("crossing {k}"),
+                        None => "reference posture".into(),
+                    };
+                    format!("{at} joint '{}' ({:+.4} s)", r.joint, r.at)
+                })
+                .collect();
+            let more = if steps.len() > 5 {
+                format!(" and {} more", steps.len() - 5)
+            } else {
+                String::new()
+            };
+            d.warnings.push(format!(
+                "experiment '{}': the velocity reverses too close to {} crossing(s) to be left out of the torque fit: {}{more}; a Coulomb step was fitted there, exact for Coulomb friction only (Stribeck or other friction that is steep near zero speed biases these values): move the operating point's speeds away from zero or use smaller perturbations",
+                v.kind.name(),
+                steps.len(),
+                list.join(", ")
+            ));
+        }
+        d.reversals.extend(v.reversals.iter().cloned());
+    }
+    d
 }

@@ -31,13 +31,15 @@
 //! ```
 
 pub mod crossing;
+pub mod diagnostics;
 pub mod identify;
 pub mod model;
 pub mod operating_point;
 pub mod perturbation;
 pub mod plan;
 
-pub use crossing::{values_at, CrossingValues, FitOptions};
+pub use crossing::{values_at, values_at_with, CrossingValues, FitOptions, TorqueFit};
+pub use diagnostics::{ClockOffset, Diagnostics, Reversal, ReversalHandling};
 pub use identify::{identify_local, CrossingTimes, IdentifyOptions};
 pub use model::{Estimate, Estimator, LocalModel};
 pub use operating_point::OperatingPoint;

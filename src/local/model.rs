@@ -4,6 +4,7 @@
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
+use super::diagnostics::Diagnostics;
 use super::operating_point::OperatingPoint;
 use crate::choice::choice;
 use crate::document::{invalid, Document};
@@ -66,6 +67,10 @@ pub struct LocalModel {
     pub g_static: Option<Estimate>,
     /// The combined estimate `[D H G]` (N x 3N), when the G, H and D experiments were run.
     pub combined: Option<Estimate>,
+    /// What happened during the identification: clock offsets, velocity reversals near
+    /// crossings, warnings (see [`Diagnostics`]).
+    #[serde(default)]
+    pub diagnostics: Diagnostics,
 }
 
 impl LocalModel {

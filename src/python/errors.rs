@@ -12,12 +12,15 @@
 //! - `InternalError`, also a `RuntimeError`: a bug of this library caught at its boundary
 //!   (never a bare `PanicException`).
 //!
-//! Ctrl-C during long work raises Python's own `KeyboardInterrupt`.
+//! Ctrl-C during long work raises Python's own `KeyboardInterrupt`. Results the library cannot
+//! fully vouch for come with a `PerturbidWarning` (a `UserWarning`), also recorded in their
+//! diagnostics.
 //!
 //! The classes are made with Python's `type()`, so that they can have two bases.
 
 use pyo3::exceptions::{
-    PyArithmeticError, PyException, PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError,
+    PyArithmeticError, PyException, PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyUserWarning,
+    PyValueError,
 };
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
@@ -55,6 +58,10 @@ static INTERNAL: Class = class!(
     "InternalError",
     "A bug of perturbid_rs caught at its boundary: please report it."
 );
+static WARNING: Class = class!(
+    "PerturbidWarning",
+    "A result the library computed but cannot fully vouch for (also in the result's diagnostics)."
+);
 
 impl Class {
     /// The class, made on first use.
@@ -63,6 +70,8 @@ impl Class {
             .get_or_try_init(py, || {
                 let bases = if self.name == BASE.name {
                     PyTuple::new(py, [py.get_type::<PyException>()])?
+                } else if self.name == WARNING.name {
+                    PyTuple::new(py, [py.get_type::<PyUserWarning>()])?
                 } else {
                     let second = match self.name {
                         "InputError" => Some(py.get_type::<PyValueError>()),
@@ -89,7 +98,9 @@ impl Class {
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
-    for class in [&BASE, &MODEL, &INPUT, &NUMERICAL, &FILE, &INTERNAL] {
+    for class in [
+        &BASE, &MODEL, &INPUT, &NUMERICAL, &FILE, &INTERNAL, &WARNING,
+    ] {
         m.add(class.name, class.get(py)?)?;
     }
     Ok(())
@@ -110,4 +121,15 @@ impl From<Error> for PyErr {
             Err(failed) => failed,
         })
     }
+}
+
+/// Issues each of `messages` as a `perturbid_rs.PerturbidWarning` (a `UserWarning`) pointing
+/// at the caller's line.
+pub(crate) fn warn_all(py: Python<'_>, messages: &[String]) -> PyResult<()> {
+    let class = WARNING.get(py)?;
+    for m in messages {
+        let text = std::ffi::CString::new(m.replace('\0', " ")).expect("no NUL left");
+        PyErr::warn(py, class, &text, 1)?;
+    }
+    Ok(())
 }

@@ -18,7 +18,7 @@ use crate::error::{Error, Result};
 use crate::local::{
     identify_local as identify_rs, plan_experiments as plan_rs, CrossingTimes, Design, Estimate,
     Estimator, ExperimentKind, FitOptions, IdentifyOptions, LocalModel, OperatingPoint, Plan,
-    PlanOptions, Size,
+    PlanOptions, ReversalHandling, Size,
 };
 use crate::recording::Recording;
 
@@ -311,14 +311,15 @@ pub(crate) fn plan_experiments(
 /// each saying which experiment it is a run of (`Recording.experiment`, set by `simulate`, or a
 /// name such as `D.csv`).
 ///
-/// - `crossing_times`: 'planned' (the recording's clock starts with the plan) or 'detected'
-///   (the offset between plan and recording is found in the data, within `max_shift` s);
+/// - `crossing_times`: 'detected' (default: each recording's clock offset from the plan is
+///   found in its positions, sub-sample, and refused above `max_shift` s; the offsets are in
+///   `diagnostics['offsets']`) or 'planned' (the recording's clock starts with the plan);
 /// - `window`: half-width (s) of the fits around each crossing (default: the plan's);
 /// - `torque_degree`: degree of the torque fit (default 6);
 /// - `recorded_derivatives`: use the recordings' qd/qdd columns instead of differentiating q;
 /// - `estimator`: 'separated' (the paper) or 'combined' (all crossings in one regression).
 #[pyfunction]
-#[pyo3(signature = (plan, recordings, crossing_times="planned", max_shift=1.0, window=None, torque_degree=6, recorded_derivatives=false, estimator="separated"))]
+#[pyo3(signature = (plan, recordings, crossing_times="detected", max_shift=0.5, window=None, torque_degree=6, recorded_derivatives=false, estimator="separated"))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_local(
     py: Python<'_>,
@@ -354,6 +355,7 @@ pub(crate) fn identify_local(
     let recs: Vec<Recording> = recordings.iter().map(|r| (*r.get().rec).clone()).collect();
     let plan = plan.plan.clone();
     let model = detached(py, "identify_local", || identify_rs(&plan, &recs, &options))?;
+    super::errors::warn_all(py, &model.diagnostics.warnings)?;
     Ok(PyLocalModel { model })
 }
 
@@ -392,6 +394,42 @@ impl PyLocalModel {
 
 #[pymethods]
 impl PyLocalModel {
+    /// What happened during the identification: `offsets` (dict experiment -> clock offset
+    /// in s found between the recording and the plan), `reversals` (list of dicts:
+    /// `experiment`, `crossing` (None for the reference posture), `joint`, `at` (s from the
+    /// crossing), `handling` ('narrowed' or 'step'), `window` (s)), `warnings` (list of str).
+    #[getter]
+    fn diagnostics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = &self.model.diagnostics;
+        let out = PyDict::new(py);
+        let offsets = PyDict::new(py);
+        for o in &d.offsets {
+            offsets.set_item(&o.experiment, o.offset)?;
+        }
+        out.set_item("offsets", offsets)?;
+        let reversals = d
+            .reversals
+            .iter()
+            .map(|r| {
+                let e = PyDict::new(py);
+                e.set_item("experiment", &r.experiment)?;
+                e.set_item("crossing", r.crossing)?;
+                e.set_item("joint", &r.joint)?;
+                e.set_item("at", r.at)?;
+                let handling = match r.handling {
+                    ReversalHandling::Narrowed => "narrowed",
+                    ReversalHandling::Step => "step",
+                };
+                e.set_item("handling", handling)?;
+                e.set_item("window", r.window)?;
+                Ok(e)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        out.set_item("reversals", reversals)?;
+        out.set_item("warnings", d.warnings.clone())?;
+        Ok(out)
+    }
+
     #[getter]
     fn torque<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
         vec1(py, &self.model.torque)

@@ -46,9 +46,11 @@ pub(crate) fn simulate(
     let mut o = SimulationOptions::new(model);
     o.gravity = gravity.into();
     o.seed = seed;
-    let refuse = |what: String| Error::InvalidArgument {
+    let refuse = |what: String| {
+        Error::InvalidArgument {
         argument: "friction".into(),
-        message: format!("{what}; expected 'urdf', None or a dict with 'viscous' and 'coulomb'"),
+        message: format!("{what}; expected 'urdf', None or a dict with 'viscous', 'coulomb' and optionally 'coulomb_negative', 'stribeck', 'stribeck_velocity'"),
+    }
     };
     o.friction = match &friction {
         None => Friction::none(n),
@@ -62,10 +64,31 @@ pub(crate) fn simulate(
                     None => Ok(vec![0.0; n]),
                 }
             };
-            Friction {
-                viscous: get("viscous")?,
-                coulomb: get("coulomb")?,
+            let known = [
+                "viscous",
+                "coulomb",
+                "coulomb_negative",
+                "stribeck",
+                "stribeck_velocity",
+            ];
+            for k in d.keys() {
+                let k: String = k.extract().map_err(|_| refuse(format!("key {k}")))?;
+                if !known.contains(&k.as_str()) {
+                    return Err(
+                        refuse(format!("unknown key '{k}' (known: {})", known.join(", "))).into(),
+                    );
+                }
             }
+            let coulomb = get("coulomb")?;
+            let mut f = Friction::viscous_coulomb(get("viscous")?, coulomb.clone());
+            if d.contains("coulomb_negative")? {
+                f.coulomb_negative = get("coulomb_negative")?;
+            }
+            f.stribeck = get("stribeck")?;
+            if d.contains("stribeck_velocity")? {
+                f.stribeck_velocity = get("stribeck_velocity")?;
+            }
+            f
         }
     };
     for (target, name, value) in [

@@ -175,3 +175,30 @@ def test_errors():
         pr.LocalModel.from_json("{")
     with pytest.raises(pr.InputError, match="friction"):
         pr.simulate(robot, plan, friction="lots")
+
+
+def test_friction_steps_near_crossings_and_clock_offsets_in_the_diagnostics():
+    robot = pr.robots.a465()
+    q, qd, qdd = (np.array(v, dtype=float) for v in TABLE2)
+    plan = pr.plan_experiments(robot, pr.OperatingPoint(q, qd, qdd), experiments=["nominal", "D"])
+    clean = pr.identify_local(plan, pr.simulate(robot, plan, friction=None))
+    friction = {"coulomb": [0.3] * 6, "coulomb_negative": [0.5] * 6, "stribeck": [0.2] * 6, "stribeck_velocity": [0.05] * 6}
+    recs = pr.simulate(robot, plan, friction=friction)
+    shifted = [pr.Recording(r.t + 0.01, r.q, r.tau, experiment=r.experiment) for r in recs]
+    model = pr.identify_local(plan, shifted)
+    assert rel(model.D, clean.D) < 1e-6
+    d = model.diagnostics
+    assert d["offsets"].keys() == {"nominal", "D"}
+    assert all(abs(o - 0.01) < 1e-6 for o in d["offsets"].values())
+    assert any(r["joint"] == robot.joint_names[4] and r["handling"] == "narrowed" for r in d["reversals"])
+    assert d["warnings"] == []
+    with pytest.raises(pr.InputError, match="unknown key 'coulomb_neg'"):
+        pr.simulate(robot, plan, friction={"coulomb_neg": [0.1] * 6})
+    # a joint at rest at the operating point reverses at every D crossing: modelled, and warned
+    qd0 = qd.copy()
+    qd0[4] = 0.0
+    plan0 = pr.plan_experiments(robot, pr.OperatingPoint(q, qd0, qdd), experiments=["nominal", "D"])
+    recs0 = pr.simulate(robot, plan0, friction={"coulomb": [0.3] * 6})
+    with pytest.warns(pr.PerturbidWarning, match="velocity reverses too close"):
+        m0 = pr.identify_local(plan0, recs0)
+    assert m0.diagnostics["warnings"] and issubclass(pr.PerturbidWarning, UserWarning)

@@ -1,0 +1,68 @@
+//! What happened while a local model was identified: the clock offset found for each
+//! recording, the crossings whose torque fit had to avoid a velocity reversal, and warnings
+//! about values the model cannot fully vouch for. Saved with the model.
+
+use serde::{Deserialize, Serialize};
+
+/// The clock offset found between a recording and the plan.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClockOffset {
+    /// The experiment (`nominal`, `G_static`, `G`, `H`, `D`).
+    pub experiment: String,
+    /// Seconds added to the plan's crossing times to read the recording (the recording runs
+    /// `offset` s behind the plan); 0 with planned times.
+    pub offset: f64,
+}
+
+/// How the torque of one joint at one crossing was read because its velocity reverses near
+/// the crossing (Coulomb friction steps there).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ReversalHandling {
+    /// The fit window was narrowed so that the reversal lies outside it: exact for any
+    /// friction that depends on the velocity alone.
+    Narrowed,
+    /// The reversal is too close to the crossing to be left out: the fit models a step at it
+    /// (exact for Coulomb friction, asymmetric or not; not for Stribeck or other friction that
+    /// varies steeply near zero speed). Also a warning.
+    Step,
+}
+
+/// A crossing at which a joint's velocity reverses within the fit window.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Reversal {
+    pub experiment: String,
+    /// Index of the crossing in the experiment (0-based); `None` for the reference posture.
+    pub crossing: Option<usize>,
+    pub joint: String,
+    /// Time of the planned reversal minus the crossing time (s).
+    pub at: f64,
+    pub handling: ReversalHandling,
+    /// Half-width (s) of the torque fit window used for this joint at this crossing.
+    pub window: f64,
+}
+
+/// Diagnostics of a local identification; see the module documentation.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Diagnostics {
+    /// One per experiment, in the plan's order.
+    #[serde(default)]
+    pub offsets: Vec<ClockOffset>,
+    /// Crossings whose torque fit avoided or modelled a velocity reversal.
+    #[serde(default)]
+    pub reversals: Vec<Reversal>,
+    /// What the user should know: each is also given as a Python warning and printed by the
+    /// command line.
+    #[serde(default)]
+    pub warnings: Vec<String>,
+}
+
+impl Diagnostics {
+    /// True when nothing needs the user's attention.
+    pub fn is_clean(&self) -> bool {
+        self.warnings.is_empty()
+    }
+}

@@ -1,0 +1,202 @@
+//! The method on what a real robot records: friction that steps where a joint's velocity
+//! reverses near a crossing, clocks offset from the plan's. Each effect is checked against the
+//! model identified without it.
+
+use nalgebra::DMatrix;
+use perturbid_rs::local::{
+    identify_local, plan_experiments, CrossingTimes, IdentifyOptions, LocalModel, PlanOptions,
+    ReversalHandling,
+};
+use perturbid_rs::robots::a465;
+use perturbid_rs::{simulate_plan, Friction, Gravity, Model, OperatingPoint, SimulationOptions};
+
+fn table2() -> OperatingPoint {
+    OperatingPoint::new(
+        a465::TABLE2_Q.to_vec(),
+        a465::TABLE2_QD.to_vec(),
+        a465::TABLE2_QDD.to_vec(),
+    )
+    .unwrap()
+}
+
+fn rel(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+    (a - b).norm() / b.norm()
+}
+
+fn mat(e: &Option<perturbid_rs::local::Estimate>) -> &DMatrix<f64> {
+    &e.as_ref().unwrap().matrix
+}
+
+fn rehearse(model: &Model, friction: Friction, options: &IdentifyOptions) -> LocalModel {
+    let plan = plan_experiments(model, &table2(), &PlanOptions::default()).unwrap();
+    let mut sim = SimulationOptions::new(model);
+    sim.gravity = Gravity::Included;
+    sim.friction = friction;
+    let recs = simulate_plan(model, &plan, &sim).unwrap();
+    identify_local(&plan, &recs, options).unwrap()
+}
+
+/// At the paper's operating point joints 5 and 6 move slowly (0.011 and 0.014 rad/s) and the
+/// D perturbations reverse them within the plan's fit window: Coulomb, asymmetric Coulomb and
+/// Stribeck friction must still cancel from D* and G* (to 1e-6 of the friction-free model).
+#[test]
+fn friction_steps_near_crossings_do_not_reach_d_and_g() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let options = IdentifyOptions::default();
+    let clean = rehearse(&model, Friction::none(n), &options);
+    assert!(
+        clean.diagnostics.warnings.is_empty(),
+        "{:?}",
+        clean.diagnostics
+    );
+    let coulomb = Friction::viscous_coulomb(vec![0.0; n], vec![0.3; n]);
+    let mut asymmetric = coulomb.clone();
+    asymmetric.coulomb_negative = vec![0.5, 0.1, 0.4, 0.2, 0.45, 0.15];
+    let mut stribeck = Friction::viscous_coulomb(vec![0.8; n], vec![0.3; n]);
+    stribeck.stribeck = vec![0.2; n];
+    stribeck.stribeck_velocity = vec![0.05; n];
+    for (what, friction) in [
+        ("Coulomb", coulomb),
+        ("asymmetric Coulomb", asymmetric),
+        ("Stribeck", stribeck),
+    ] {
+        let m = rehearse(&model, friction, &options);
+        let (d, g) = (rel(mat(&m.d), mat(&clean.d)), rel(mat(&m.g), mat(&clean.g)));
+        assert!(d < 1e-6, "{what}: D* moved by {d:.2e} relative");
+        assert!(g < 1e-6, "{what}: G* moved by {g:.2e} relative");
+        // the reversals were seen and avoided, not modelled
+        let r = &m.diagnostics.reversals;
+        assert!(
+            r.iter()
+                .any(|r| r.experiment == "D" && r.joint == model.joint_names[4]),
+            "{what}: joint 5's reversals in D not found: {r:?}"
+        );
+        assert!(r.iter().all(|r| r.handling == ReversalHandling::Narrowed));
+        assert!(
+            m.diagnostics.warnings.is_empty(),
+            "{:?}",
+            m.diagnostics.warnings
+        );
+    }
+}
+
+/// A joint at rest at the operating point reverses exactly at every D crossing: no window can
+/// leave the step out, so it is fitted (exact for Coulomb friction) and the user is warned.
+#[test]
+fn a_reversal_at_the_crossing_is_modelled_and_warned() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let mut qd = a465::TABLE2_QD.to_vec();
+    qd[4] = 0.0;
+    let op = OperatingPoint::new(a465::TABLE2_Q.to_vec(), qd, a465::TABLE2_QDD.to_vec()).unwrap();
+    let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+    let mut sim = SimulationOptions::new(&model);
+    sim.friction = Friction::none(n);
+    let clean = identify_local(
+        &plan,
+        &simulate_plan(&model, &plan, &sim).unwrap(),
+        &IdentifyOptions::default(),
+    )
+    .unwrap();
+    let mut asymmetric = Friction::viscous_coulomb(vec![0.0; n], vec![0.3; n]);
+    asymmetric.coulomb_negative = vec![0.5; n];
+    sim.friction = asymmetric;
+    let m = identify_local(
+        &plan,
+        &simulate_plan(&model, &plan, &sim).unwrap(),
+        &IdentifyOptions::default(),
+    )
+    .unwrap();
+    let d = rel(mat(&m.d), mat(&clean.d));
+    assert!(d < 1e-6, "D* moved by {d:.2e} relative");
+    let w = &m.diagnostics.warnings;
+    assert!(
+        w.iter().any(
+            |w| w.starts_with("experiment 'D': the velocity reverses too close to")
+                && w.contains(&format!("joint '{}'", model.joint_names[4]))
+        ),
+        "{w:?}"
+    );
+    assert!(m
+        .diagnostics
+        .reversals
+        .iter()
+        .any(|r| r.handling == ReversalHandling::Step));
+}
+
+/// A recording whose clock is offset from the plan's: the offset is found in the positions and
+/// corrected by default (1, 10 and 100 ms give the offset-free model to noise level), reported
+/// in the diagnostics, and refused beyond the tolerance.
+#[test]
+fn clock_offsets_are_found_and_corrected() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
+    let mut sim = SimulationOptions::new(&model);
+    sim.torque_noise = vec![0.002; model.nv];
+    sim.position_noise = vec![1e-5; model.nv];
+    sim.seed = 7;
+    let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    let planned = IdentifyOptions {
+        times: CrossingTimes::Planned,
+        ..IdentifyOptions::default()
+    };
+    let reference = identify_local(&plan, &recs, &planned).unwrap();
+    for offset in [1e-3, 1e-2, 1e-1] {
+        let shifted: Vec<_> = recs
+            .iter()
+            .cloned()
+            .map(|mut r| {
+                r.t.iter_mut().for_each(|t| *t += offset);
+                r
+            })
+            .collect();
+        let m = identify_local(&plan, &shifted, &IdentifyOptions::default()).unwrap();
+        for o in &m.diagnostics.offsets {
+            assert!(
+                (o.offset - offset).abs() < 2e-5,
+                "{}: found {} for {offset}",
+                o.experiment,
+                o.offset
+            );
+        }
+        for (what, a, b) in [
+            ("D", &m.d, &reference.d),
+            ("H", &m.h, &reference.h),
+            ("G", &m.g, &reference.g),
+        ] {
+            let worst = (mat(a) - mat(b)).abs().max();
+            let se = b.as_ref().unwrap().stderr.max();
+            assert!(
+                worst < 0.5 * se,
+                "{what} at {offset} s: {worst:.2e} vs stderr {se:.2e}"
+            );
+        }
+        // the same recordings read at the planned times: H* far outside its noise
+        let naive = identify_local(&plan, &shifted, &planned).unwrap();
+        let (wrong, right) = (
+            rel(mat(&naive.h), mat(&reference.h)),
+            rel(mat(&m.h), mat(&reference.h)),
+        );
+        assert!(
+            wrong > 100.0 * right && wrong > 0.05,
+            "{offset}: H* {wrong:.2e} off at planned times, {right:.2e} aligned"
+        );
+    }
+    // beyond the tolerance: refused, naming the recording and the offset
+    let far: Vec<_> = recs
+        .iter()
+        .cloned()
+        .map(|mut r| {
+            r.t.iter_mut().for_each(|t| *t += 0.6);
+            r
+        })
+        .collect();
+    let e = identify_local(&plan, &far, &IdentifyOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("simulated experiment 'nominal': its clock is +0.6000 s off the plan of experiment 'nominal'"),
+        "{e}"
+    );
+}
