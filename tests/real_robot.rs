@@ -200,3 +200,84 @@ fn clock_offsets_are_found_and_corrected() {
         "{e}"
     );
 }
+
+/// Velocity perturbations larger than |qd*| reverse joints between the H passes: the planner
+/// warns, can keep them below, and the friction-aware H regression recovers H* and each
+/// reversed joint's Coulomb step exactly from noise-free data, where the plain one cannot.
+#[test]
+fn friction_aware_h_recovers_h_and_the_coulomb_steps() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let op = table2();
+    let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+    let w = &plan.warnings;
+    assert!(
+        w.len() == 1
+            && w[0].starts_with(
+                "experiment 'H': the velocity perturbations reverse joint(s) 'joint1'"
+            ),
+        "{w:?}"
+    );
+    // keep_velocity_sign: no reversal, no warning, and friction cancels from the plain H*
+    let keep = PlanOptions {
+        keep_velocity_sign: true,
+        ..PlanOptions::default()
+    };
+    let kept = plan_experiments(&model, &op, &keep).unwrap();
+    assert!(kept.warnings.is_empty(), "{:?}", kept.warnings);
+    let h = kept
+        .experiment(perturbid_rs::local::ExperimentKind::H)
+        .unwrap();
+    for j in 0..n {
+        assert!(h.deltas.column(j).amax() < op.qd[j].abs(), "joint {j}");
+    }
+    // the friction-aware regression on a plan made for it
+    let aware = PlanOptions {
+        friction_aware_h: true,
+        ..PlanOptions::default()
+    };
+    let plan = plan_experiments(&model, &op, &aware).unwrap();
+    assert!(plan.warnings.is_empty());
+    let h_plan = plan
+        .experiment(perturbid_rs::local::ExperimentKind::H)
+        .unwrap();
+    assert_eq!(h_plan.crossings.len(), 2 * (n + 1));
+    let mut sim = SimulationOptions::new(&model);
+    sim.friction = Friction::none(n);
+    let options = IdentifyOptions {
+        friction_aware_h: true,
+        ..IdentifyOptions::default()
+    };
+    let clean = identify_local(
+        &plan,
+        &simulate_plan(&model, &plan, &sim).unwrap(),
+        &options,
+    )
+    .unwrap();
+    let viscous = vec![0.5, 0.4, 0.3, 0.2, 0.1, 0.05];
+    let mut friction = Friction::viscous_coulomb(viscous.clone(), vec![0.3; n]);
+    friction.coulomb_negative = vec![0.5, 0.2, 0.4, 0.1, 0.45, 0.15];
+    sim.friction = friction.clone();
+    let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    let m = identify_local(&plan, &recs, &options).unwrap();
+    let expected = mat(&clean.h) + DMatrix::from_diagonal(&nalgebra::DVector::from_vec(viscous));
+    let err = rel(mat(&m.h), &expected);
+    assert!(err < 1e-6, "friction-aware H* off by {err:.2e}");
+    let steps = m.coulomb.as_ref().unwrap();
+    let mut reversed = 0;
+    for j in 0..n {
+        let reverses = h_plan.deltas.column(j).amax() > op.qd[j].abs();
+        match steps.step[j] {
+            Some(s) => {
+                let truth = friction.coulomb[j] + friction.coulomb_negative[j];
+                assert!((s - truth).abs() < 1e-6, "joint {j}: step {s} vs {truth}");
+                reversed += 1;
+            }
+            None => assert!(!reverses, "joint {j} reverses but has no step"),
+        }
+    }
+    assert!(reversed >= 1);
+    // the plain regression on the same data is far off
+    let plain = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    assert!(rel(mat(&plain.h), &expected) > 1e-2);
+}

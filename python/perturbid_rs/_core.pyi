@@ -23,6 +23,7 @@ __all__ = [
     "NumericalError",
     "OperatingPoint",
     "PerturbidError",
+    "PerturbidWarning",
     "Plan",
     "Recording",
     "Robot",
@@ -213,6 +214,8 @@ class Plan:
     @property
     def op(self) -> OperatingPoint: ...
     @property
+    def warnings(self) -> list[str]: ...
+    @property
     def rate(self) -> float: ...
     @property
     def robot(self) -> str: ...
@@ -291,6 +294,9 @@ class LocalModel:
     @property
     def estimator(self) -> str: ...
     @property
+    def coulomb(self) -> Optional[dict[str, Optional[float]]]:
+        """Coulomb steps (N m) from the friction-aware H regression, per joint."""
+    @property
     def diagnostics(self) -> dict[str, Any]:
         """offsets (experiment -> clock offset, s), reversals (list of dicts), warnings."""
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:
@@ -318,6 +324,8 @@ def plan_experiments(
     dwell: float = 1.0,
     margin: float = 0.8,
     symmetric: bool = True,
+    keep_velocity_sign: bool = False,
+    friction_aware_h: bool = False,
 ) -> Plan:
     """Plans the nominal, G_static, G, H and D experiments at op; refuses plans breaking limits."""
 
@@ -342,6 +350,7 @@ def identify_local(
     torque_degree: int = 6,
     recorded_derivatives: bool = False,
     estimator: str = "separated",
+    friction_aware_h: bool = False,
 ) -> LocalModel:
     """The local model from a plan and one recording per experiment."""
 

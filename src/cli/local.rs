@@ -72,6 +72,13 @@ pub(crate) struct PlanArgs {
     /// How long each static posture is held (s).
     #[arg(long, default_value_t = 1.0)]
     dwell: f64,
+    /// Keep the velocity perturbations below 0.9 |qd*| of each joint, so that no joint
+    /// reverses between H passes and friction cancels from H*.
+    #[arg(long)]
+    keep_velocity_sign: bool,
+    /// Plan enough H passes (2 (N + 1), in +- pairs) for `identify --friction-aware-h`.
+    #[arg(long)]
+    friction_aware_h: bool,
 }
 
 #[derive(Deserialize)]
@@ -115,12 +122,17 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
         window: a.window,
         dwell: a.dwell,
         experiments: a.experiments,
+        keep_velocity_sign: a.keep_velocity_sign,
+        friction_aware_h: a.friction_aware_h,
         ..PlanOptions::default()
     };
     o.sizes.position = size(a.dq, a.dq_fraction, n);
     o.sizes.velocity = size(a.dqd, a.dqd_fraction, n);
     o.sizes.acceleration = size(a.dqdd, a.dqdd_fraction, n);
     let plan = plan_experiments(&model, &op, &o)?;
+    for w in &plan.warnings {
+        eprintln!("perturbid: warning: {w}");
+    }
     let dir = out_dir(&a.out);
     let mut set = OutputSet::new(&dir, "plan");
     let mut out = String::new();
@@ -229,6 +241,11 @@ pub(crate) struct IdentifyArgs {
     /// separated (the paper) or combined (all crossings in one regression).
     #[arg(long, value_enum, default_value_t = Estimator::Separated)]
     estimator: Estimator,
+    /// Identify H* with the friction-aware regression (differences of the +- pairs with each
+    /// joint's Coulomb step as its own column); the plan needs 2 (N + 1) H passes
+    /// (`plan --friction-aware-h`).
+    #[arg(long)]
+    friction_aware_h: bool,
 }
 
 fn fmt_matrix(
@@ -288,6 +305,7 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
             ..Default::default()
         },
         estimator: a.estimator,
+        friction_aware_h: a.friction_aware_h,
     };
     let model: LocalModel = identify_local(&plan, &recs, &options)?;
     model.save(&a.out)?;

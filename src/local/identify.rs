@@ -8,7 +8,7 @@ use super::crossing::{
     TorqueFit,
 };
 use super::diagnostics::{ClockOffset, Diagnostics, Reversal, ReversalHandling};
-use super::model::{Estimate, Estimator, LocalModel};
+use super::model::{CoulombSteps, Estimate, Estimator, LocalModel};
 use super::operating_point::OperatingPoint;
 use super::plan::{Experiment, ExperimentKind, Plan};
 use crate::document::Document;
@@ -42,6 +42,14 @@ pub struct IdentifyOptions {
     pub times: CrossingTimes,
     pub fit: FitOptions,
     pub estimator: Estimator,
+    /// Identify H* with the friction-aware regression (default false): the differences of
+    /// the +- pairs of the H experiment, `tau(qd* + d) - tau(qd* - d) = 2 H* d + c_j s_j`,
+    /// where the rigid-body terms even in `d` cancel exactly and `s_j = sign(d_j)` marks the
+    /// pairs that reverse joint j (its Coulomb step, `c_j` = the sum of its two Coulomb levels).
+    /// Exact for viscous and (asymmetric) Coulomb friction; needs the plan's H perturbations in
+    /// pairs, at least N + 1 of them (`PlanOptions::friction_aware_h`). The Coulomb levels are
+    /// in [`LocalModel::coulomb`].
+    pub friction_aware_h: bool,
 }
 
 impl Default for IdentifyOptions {
@@ -54,6 +62,7 @@ impl Default for IdentifyOptions {
             },
             fit: FitOptions::default(),
             estimator: Estimator::Separated,
+            friction_aware_h: false,
         }
     }
 }
@@ -378,7 +387,22 @@ pub fn identify_local(
         Ok(Some(estimate(ls)))
     };
     let d = separated(ExperimentKind::D, "dqdd")?;
-    let h = separated(ExperimentKind::H, "dqd")?;
+    let (h, coulomb) = match (options.friction_aware_h, find(ExperimentKind::H)) {
+        (true, Some(v)) => {
+            let e = plan
+                .experiment(ExperimentKind::H)
+                .expect("values of a planned experiment");
+            let (h, c) = friction_aware_h(plan, e, v)?;
+            (Some(h), Some(c))
+        }
+        (true, None) => {
+            return Err(Error::InvalidArgument {
+                argument: "friction_aware_h".into(),
+                message: "the plan has no H experiment".into(),
+            })
+        }
+        (false, _) => (separated(ExperimentKind::H, "dqd")?, None),
+    };
     let g = separated(ExperimentKind::GDynamic, "dq")?;
     let g_static = separated(ExperimentKind::GStatic, "dq")?;
 
@@ -438,8 +462,119 @@ pub fn identify_local(
         g,
         g_static,
         combined,
+        coulomb,
         diagnostics,
     })
+}
+
+/// H* and the Coulomb steps from the differences of the H experiment's +- pairs; see
+/// [`IdentifyOptions::friction_aware_h`]. One least-squares solve per torque row: the columns
+/// are the measured velocity differences and, where some pair reverses that row's joint, its
+/// step `sign(d_j)`.
+fn friction_aware_h(
+    plan: &Plan,
+    e: &Experiment,
+    v: &ExperimentValues,
+) -> Result<(Estimate, CoulombSteps)> {
+    let n = plan.n();
+    let k = v.crossings.len();
+    let refuse = |message: String| Error::InvalidArgument {
+        argument: "friction_aware_h".into(),
+        message,
+    };
+    let paired = k % 2 == 0
+        && (0..k / 2).all(|i| {
+            (0..n).all(|j| {
+                let (a, b) = (e.deltas[(2 * i, j)], e.deltas[(2 * i + 1, j)]);
+                (a + b).abs() <= 1e-12 * a.abs().max(1e-300)
+            })
+        });
+    if !paired {
+        return Err(refuse(
+            "the H perturbations are not in +- pairs (plan with symmetric pairs)".into(),
+        ));
+    }
+    let m = k / 2;
+    let qd0 = &plan.op.qd;
+    let step = |i: usize, j: usize| {
+        let d = e.deltas[(2 * i, j)];
+        0.5 * (sign0(qd0[j] + d) - sign0(qd0[j] - d))
+    };
+    let reverses: Vec<bool> = (0..n).map(|j| (0..m).any(|i| step(i, j) != 0.0)).collect();
+    let needed = n + usize::from(reverses.iter().any(|&r| r));
+    if m < needed {
+        return Err(refuse(format!(
+            "{m} +- pairs of H passes for {needed} unknowns per joint; plan at least {} H passes (PlanOptions::friction_aware_h, --friction-aware-h)",
+            2 * needed
+        )));
+    }
+    let mut matrix = DMatrix::zeros(n, n);
+    let mut stderr = DMatrix::zeros(n, n);
+    let (mut cond, mut residual_rms) = (1.0f64, vec![0.0; n]);
+    let mut steps = CoulombSteps {
+        joint_names: plan.joint_names.clone(),
+        step: vec![None; n],
+        stderr: vec![None; n],
+    };
+    for j in 0..n {
+        let p = n + usize::from(reverses[j]);
+        let x = DMatrix::from_fn(m, p, |i, c| {
+            if c < n {
+                v.crossings[2 * i].qd[c] - v.crossings[2 * i + 1].qd[c]
+            } else {
+                step(i, j)
+            }
+        });
+        let y = DMatrix::from_fn(m, 1, |i, _| {
+            v.crossings[2 * i].tau[j] - v.crossings[2 * i + 1].tau[j]
+        });
+        let mut columns: Vec<String> = plan
+            .joint_names
+            .iter()
+            .map(|q| format!("dqd({q})"))
+            .collect();
+        if reverses[j] {
+            columns.push(format!("coulomb_step({})", plan.joint_names[j]));
+        }
+        let ls = least_squares(
+            &x,
+            &y,
+            &format!(
+                "friction-aware H regression, torque of joint '{}'",
+                plan.joint_names[j]
+            ),
+            &columns,
+        )?;
+        for c in 0..n {
+            matrix[(j, c)] = ls.coef[(0, c)];
+            stderr[(j, c)] = ls.stderr[(0, c)];
+        }
+        if reverses[j] {
+            steps.step[j] = Some(ls.coef[(0, n)]);
+            steps.stderr[j] = Some(ls.stderr[(0, n)]);
+        }
+        cond = cond.max(ls.cond);
+        residual_rms[j] = ls.residual_rms[0];
+    }
+    let estimate = Estimate {
+        matrix,
+        cond,
+        residual_rms,
+        stderr,
+        crossings: k,
+    };
+    Ok((estimate, steps))
+}
+
+/// `sign(x)` with `sign(0) = 0`.
+fn sign0(x: f64) -> f64 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
 }
 
 /// The diagnostics of an identification from the values read: the offsets, the reversals

@@ -43,6 +43,19 @@ choice! {
     }
 }
 
+/// The Coulomb friction steps of the joints, from the friction-aware H regression: for joint
+/// `j`, the jump of its friction torque where its velocity changes sign (N m: the Coulomb level
+/// for positive speeds plus the one for negative speeds, twice the level when symmetric).
+/// `None` for a joint that no pair of H passes reversed (not identifiable from the data).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoulombSteps {
+    pub joint_names: Vec<String>,
+    pub step: Vec<Option<f64>>,
+    /// Standard error of each step (N m).
+    pub stderr: Vec<Option<f64>>,
+}
+
 /// The local model at an operating point.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -67,6 +80,10 @@ pub struct LocalModel {
     pub g_static: Option<Estimate>,
     /// The combined estimate `[D H G]` (N x 3N), when the G, H and D experiments were run.
     pub combined: Option<Estimate>,
+    /// The Coulomb steps found by the friction-aware H regression
+    /// ([`crate::local::IdentifyOptions::friction_aware_h`]), when it was used.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coulomb: Option<CoulombSteps>,
     /// What happened during the identification: clock offsets, velocity reversals near
     /// crossings, warnings (see [`Diagnostics`]).
     #[serde(default)]

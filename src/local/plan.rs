@@ -115,6 +115,14 @@ pub struct PlanOptions {
     pub default_acceleration: f64,
     /// Shortest transition (s, default 0.2); the longest tried is 30 s.
     pub min_transition: f64,
+    /// Keep every velocity perturbation of the H experiment below `0.9 |qd*|` of its joint, so
+    /// that no joint's velocity changes sign between passes and friction cancels from H*
+    /// (default false: a joint whose perturbations exceed `|qd*|` gets a warning instead). A
+    /// joint with `qd* = 0` cannot be perturbed so: refused, use `friction_aware_h`.
+    pub keep_velocity_sign: bool,
+    /// Plan enough H passes for the friction-aware H regression
+    /// ([`crate::local::IdentifyOptions::friction_aware_h`]): at least `2 (N + 1)`, in +- pairs.
+    pub friction_aware_h: bool,
 }
 
 impl Default for PlanOptions {
@@ -133,6 +141,8 @@ impl Default for PlanOptions {
             default_velocity: 1.0,
             default_acceleration: 4.0,
             min_transition: 0.2,
+            keep_velocity_sign: false,
+            friction_aware_h: false,
         }
     }
 }
@@ -152,6 +162,10 @@ pub struct Plan {
     pub design: Design,
     pub seed: u64,
     pub experiments: Vec<Experiment>,
+    /// What the planner found the user should know (each also given as a Python warning and
+    /// printed by the command line), e.g. velocity perturbations that reverse a joint.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 impl Plan {
@@ -312,7 +326,7 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
     }
     let count = o.count.unwrap_or(2 * n);
     let range: Vec<f64> = model.limits.iter().map(|l| l.upper - l.lower).collect();
-    let sizes = [
+    let mut sizes = [
         o.sizes
             .position
             .resolve("position size", &range, FALLBACK_SIZES[0])?,
@@ -325,6 +339,21 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
             FALLBACK_SIZES[2],
         )?,
     ];
+    if o.keep_velocity_sign {
+        for (j, size) in sizes[1].iter_mut().enumerate() {
+            let limit = 0.9 * op.qd[j].abs();
+            if limit == 0.0 {
+                return Err(Error::InvalidArgument {
+                    argument: "keep_velocity_sign".into(),
+                    message: format!(
+                        "joint '{}' has qd* = 0: every velocity perturbation reverses it; identify H with the friction-aware regression (friction_aware_h) instead",
+                        model.joint_names[j]
+                    ),
+                });
+            }
+            *size = size.min(limit);
+        }
+    }
     let lim = TransitionLimits {
         lower: model.lower(),
         upper: model.upper(),
@@ -354,6 +383,7 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
             .collect(),
     };
     let mut experiments = Vec::new();
+    let mut warnings = Vec::new();
     for (index, &kind) in o.experiments.iter().enumerate() {
         if o.experiments[..index].contains(&kind) {
             return Err(Error::InvalidArgument {
@@ -362,10 +392,24 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
             });
         }
         let seed = o.seed.wrapping_add(1000 * index as u64 + 1);
+        let count = if kind == ExperimentKind::H && o.friction_aware_h {
+            if !o.symmetric {
+                return Err(Error::InvalidArgument {
+                    argument: "friction_aware_h".into(),
+                    message: "the friction-aware H regression needs the perturbations in +- pairs (symmetric)".into(),
+                });
+            }
+            count.max(2 * (n + 1))
+        } else {
+            count
+        };
         let deltas = match kind.perturbed() {
             None => DMatrix::zeros(count, n),
             Some(v) => perturbations(o.design, count, &sizes[v], o.symmetric, seed)?,
         };
+        if kind == ExperimentKind::H {
+            warnings.extend(velocity_reversal_warning(model, op, &deltas, o));
+        }
         let mut b = Builder::new(n, o.rate, &lim, o.min_transition, &op.q);
         let rest_at = |q: &[f64]| Crossing {
             time: 0.0,
@@ -436,6 +480,39 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
         design: o.design,
         seed: o.seed,
         experiments,
+        warnings,
+    })
+}
+
+/// The warning for H perturbations that reverse a joint's velocity between passes (`|delta| >
+/// |qd*|`): friction then changes sign and enters H*. None if there are none, or if the plan
+/// is made for the friction-aware regression.
+fn velocity_reversal_warning(
+    model: &Model,
+    op: &OperatingPoint,
+    deltas: &DMatrix<f64>,
+    o: &PlanOptions,
+) -> Option<String> {
+    if o.friction_aware_h {
+        return None;
+    }
+    let reversed: Vec<String> = (0..deltas.ncols())
+        .filter_map(|j| {
+            let largest = deltas.column(j).amax();
+            (largest > op.qd[j].abs()).then(|| {
+                format!(
+                    "'{}' (up to {largest:.3} against |qd*| = {:.3})",
+                    model.joint_names[j],
+                    op.qd[j].abs()
+                )
+            })
+        })
+        .collect();
+    (!reversed.is_empty()).then(|| {
+        format!(
+            "experiment 'H': the velocity perturbations reverse joint(s) {} between passes, so their friction changes sign and enters H* unless it is modelled: plan with keep_velocity_sign (--keep-velocity-sign) to keep them below 0.9 |qd*|, or with friction_aware_h (--friction-aware-h) and identify with the friction-aware H regression",
+            reversed.join(", ")
+        )
     })
 }
 

@@ -79,6 +79,11 @@ impl PyPlan {
         }
     }
     /// Sampling rate of the trajectories (Hz).
+    /// What the planner found the user should know (also issued as PerturbidWarning).
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.plan.warnings.clone()
+    }
     #[getter]
     fn rate(&self) -> f64 {
         self.plan.rate
@@ -245,12 +250,16 @@ impl PyExperiment {
 ///   limit (0.05), `dqdd_fraction` of the acceleration limit (0.05);
 /// - `rate` (Hz), `window` (crossing half-width, s), `dwell` (static hold, s), `margin`
 ///   (fraction of speed/acceleration limits transitions may use);
-/// - `experiments`: a subset of ['nominal', 'G_static', 'G', 'H', 'D'].
+/// - `experiments`: a subset of ['nominal', 'G_static', 'G', 'H', 'D'];
+/// - `keep_velocity_sign`: keep the velocity perturbations below 0.9 |qd*| of each joint, so
+///   that friction cancels from H* (otherwise a joint they reverse gets a PerturbidWarning);
+/// - `friction_aware_h`: plan 2 (N + 1) H passes for `identify_local(friction_aware_h=True)`.
 ///
 /// Raises InputError when the plan would break a joint limit (naming joint, time and limit).
+/// The planner's warnings are issued as `PerturbidWarning` and kept in `Plan.warnings`.
 #[pyfunction]
 #[pyo3(signature = (robot, op, design="random", n=None, seed=0, rate=1000.0, *, experiments=None, dq=None, dqd=None, dqdd=None,
-    dq_fraction=0.01, dqd_fraction=0.05, dqdd_fraction=0.05, window=0.05, dwell=1.0, margin=0.8, symmetric=true))]
+    dq_fraction=0.01, dqd_fraction=0.05, dqdd_fraction=0.05, window=0.05, dwell=1.0, margin=0.8, symmetric=true, keep_velocity_sign=false, friction_aware_h=false))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn plan_experiments(
     py: Python<'_>,
@@ -271,6 +280,8 @@ pub(crate) fn plan_experiments(
     dwell: f64,
     margin: f64,
     symmetric: bool,
+    keep_velocity_sign: bool,
+    friction_aware_h: bool,
 ) -> PyResult<PyPlan> {
     let nv = robot.model.nv;
     let size = |name: &str, abs: &Option<Bound<'_, PyAny>>, frac: f64| -> PyResult<Size> {
@@ -288,6 +299,8 @@ pub(crate) fn plan_experiments(
         dwell,
         margin,
         symmetric,
+        keep_velocity_sign,
+        friction_aware_h,
         ..PlanOptions::default()
     };
     options.sizes.position = size("dq", &dq, dq_fraction)?;
@@ -302,6 +315,7 @@ pub(crate) fn plan_experiments(
     let plan = detached(py, "plan_experiments", || {
         plan_rs(&robot.model, &op.op, &options)
     })?;
+    super::errors::warn_all(py, &plan.warnings)?;
     Ok(PyPlan {
         plan: Arc::new(plan),
     })
@@ -317,9 +331,13 @@ pub(crate) fn plan_experiments(
 /// - `window`: half-width (s) of the fits around each crossing (default: the plan's);
 /// - `torque_degree`: degree of the torque fit (default 6);
 /// - `recorded_derivatives`: use the recordings' qd/qdd columns instead of differentiating q;
-/// - `estimator`: 'separated' (the paper) or 'combined' (all crossings in one regression).
+/// - `estimator`: 'separated' (the paper) or 'combined' (all crossings in one regression);
+/// - `friction_aware_h`: H* from the differences of the H passes' +- pairs with each joint's
+///   Coulomb step as its own column (exact for viscous and Coulomb friction that reverses
+///   between passes; the plan needs `friction_aware_h=True`); the steps are in
+///   `LocalModel.coulomb`.
 #[pyfunction]
-#[pyo3(signature = (plan, recordings, crossing_times="detected", max_shift=0.5, window=None, torque_degree=6, recorded_derivatives=false, estimator="separated"))]
+#[pyo3(signature = (plan, recordings, crossing_times="detected", max_shift=0.5, window=None, torque_degree=6, recorded_derivatives=false, estimator="separated", friction_aware_h=false))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_local(
     py: Python<'_>,
@@ -331,6 +349,7 @@ pub(crate) fn identify_local(
     torque_degree: usize,
     recorded_derivatives: bool,
     estimator: &str,
+    friction_aware_h: bool,
 ) -> PyResult<PyLocalModel> {
     let times = match crossing_times {
         "planned" => CrossingTimes::Planned,
@@ -351,6 +370,7 @@ pub(crate) fn identify_local(
             recorded_derivatives,
         },
         estimator: estimator.parse::<Estimator>()?,
+        friction_aware_h,
     };
     let recs: Vec<Recording> = recordings.iter().map(|r| (*r.get().rec).clone()).collect();
     let plan = plan.plan.clone();
@@ -428,6 +448,21 @@ impl PyLocalModel {
         out.set_item("reversals", reversals)?;
         out.set_item("warnings", d.warnings.clone())?;
         Ok(out)
+    }
+
+    /// The Coulomb steps from the friction-aware H regression (None when it was not used):
+    /// dict joint name -> step (N m; the two Coulomb levels summed) or None where no pair of H
+    /// passes reversed the joint.
+    #[getter]
+    fn coulomb<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(c) = &self.model.coulomb else {
+            return Ok(None);
+        };
+        let out = PyDict::new(py);
+        for (name, step) in c.joint_names.iter().zip(&c.step) {
+            out.set_item(name, *step)?;
+        }
+        Ok(Some(out))
     }
 
     #[getter]

@@ -202,3 +202,21 @@ def test_friction_steps_near_crossings_and_clock_offsets_in_the_diagnostics():
     with pytest.warns(pr.PerturbidWarning, match="velocity reverses too close"):
         m0 = pr.identify_local(plan0, recs0)
     assert m0.diagnostics["warnings"] and issubclass(pr.PerturbidWarning, UserWarning)
+
+
+def test_velocity_reversals_between_h_passes():
+    robot = pr.robots.a465()
+    op = pr.OperatingPoint(*TABLE2)
+    with pytest.warns(pr.PerturbidWarning, match=r"experiment 'H': the velocity perturbations reverse joint\(s\) 'joint1'"):
+        plan = pr.plan_experiments(robot, op, experiments=["nominal", "H"])
+    assert len(plan.warnings) == 1
+    kept = pr.plan_experiments(robot, op, experiments=["nominal", "H"], keep_velocity_sign=True)
+    assert kept.warnings == []
+    aware = pr.plan_experiments(robot, op, experiments=["nominal", "H"], friction_aware_h=True)
+    friction = {"viscous": [0.2] * 6, "coulomb": [0.3] * 6, "coulomb_negative": [0.4] * 6}
+    clean = pr.identify_local(aware, pr.simulate(robot, aware, friction=None), friction_aware_h=True)
+    model = pr.identify_local(aware, pr.simulate(robot, aware, friction=friction), friction_aware_h=True)
+    assert rel(model.H, clean.H + 0.2 * np.eye(6)) < 1e-6
+    steps = model.coulomb
+    assert steps is not None and steps["joint1"] == pytest.approx(0.7, abs=1e-6)
+    assert pr.identify_local(aware, pr.simulate(robot, aware, friction=None)).coulomb is None
