@@ -281,3 +281,58 @@ fn friction_aware_h_recovers_h_and_the_coulomb_steps() {
     let plain = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
     assert!(rel(mat(&plain.h), &expected) > 1e-2);
 }
+
+/// `predict` expands about the planned operating point, which every nominal pass crossed and
+/// where T* holds; with coarse encoders the point measured at the crossings is a noisy
+/// estimate of it (qdd through two derivatives of quantised positions) that would bias every
+/// prediction.
+#[test]
+fn predict_expands_about_the_planned_operating_point() {
+    use perturbid_rs::{linearize, Data, States, TorqueModel};
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let op = table2();
+    let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+    let mut sim = SimulationOptions::new(&model);
+    sim.friction = Friction::none(n);
+    sim.gravity = Gravity::Excluded;
+    sim.quantization = vec![2e-3; n];
+    let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    let m = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    let moved = (0..n)
+        .map(|j| (m.op.qdd[j] - op.qdd[j]).abs())
+        .fold(0.0, f64::max);
+    assert!(moved > 1e-2, "the measured point should differ: {moved:e}");
+    let at = |o: &OperatingPoint| {
+        let s = States::new(n, &o.q, Some(&o.qd), Some(&o.qdd)).unwrap();
+        m.predict(&s).unwrap()
+    };
+    let truth = |o: &OperatingPoint| {
+        linearize(
+            &model,
+            &mut Data::new(&model),
+            &o.q,
+            &o.qd,
+            &o.qdd,
+            Gravity::Excluded,
+        )
+        .unwrap()
+        .torque
+        .as_slice()
+        .to_vec()
+    };
+    let err = |a: &[f64], b: &[f64]| (0..n).map(|j| (a[j] - b[j]).abs()).fold(0.0, f64::max);
+    // at the planned point: T* itself, and the true torque there to quantisation level
+    let here = at(&op);
+    assert!(err(&here, &m.torque) < 1e-12);
+    assert!(
+        err(&here, &truth(&op)) < 1e-3,
+        "{:.2e}",
+        err(&here, &truth(&op))
+    );
+    // about the measured point instead, the same model would be off by the D*, H*, G* times
+    // the measurement error of the point
+    let d = mat(&m.d);
+    let dqdd = nalgebra::DVector::from_iterator(n, (0..n).map(|j| op.qdd[j] - m.op.qdd[j]));
+    assert!((d * dqdd).amax() > 100.0 * err(&here, &truth(&op)));
+}

@@ -63,10 +63,11 @@ pub struct LocalModel {
     pub format: String,
     pub robot: String,
     pub joint_names: Vec<String>,
-    /// The operating point as measured at the nominal crossings (mean), where `torque` holds;
-    /// predictions are deltas from it.
+    /// The operating point as measured at the nominal crossings (mean): how closely the
+    /// robot followed the plan (a diagnostic; noisier than the plan it estimates).
     pub op: OperatingPoint,
-    /// The operating point the plan asked for.
+    /// The operating point the plan asked for, which the nominal passes crossed: `torque`
+    /// holds there and predictions are deltas from it.
     pub planned_op: OperatingPoint,
     pub estimator: Estimator,
     /// `T*` (N m): mean torque at the nominal crossings.
@@ -106,15 +107,18 @@ impl LocalModel {
     }
 
     /// Predicted torques (row-major `k x N`, N m) at the `k` samples of `states`:
-    /// `T* + D* (qdd - qdd*) + H* (qd - qd*) + G* (q - q*)`, expanded about the operating point
-    /// measured at the nominal crossings (where `T*` holds).
+    /// `T* + D* (qdd - qdd*) + H* (qd - qd*) + G* (q - q*)`, expanded about the planned
+    /// operating point: the robot passed it at every nominal crossing and T* is the torque
+    /// there. The point measured at the nominal crossings (`op`) is an estimate of it whose
+    /// noise (encoder quantisation reaches qdd through two derivatives) would enter every
+    /// prediction; it is kept as a diagnostic.
     pub fn predict(&self, states: &States<'_>) -> Result<Vec<f64>> {
         let parts = [
             Self::part(&self.d, "D")?,
             Self::part(&self.h, "H")?,
             Self::part(&self.g, "G")?,
         ];
-        predict_linear(states, &self.torque, parts, &self.op)
+        predict_linear(states, &self.torque, parts, &self.planned_op)
     }
 }
 

@@ -387,7 +387,11 @@ pub(crate) fn identify_local(
 /// - `cond`: dict of cond(X) per estimate (columns scaled to unit norm);
 /// - `stderr`: dict of standard errors, same shapes ('torque', 'D', 'H', 'G', 'G_static');
 /// - `residual_rms`: dict of per-joint regression residual RMS (N m);
-/// - `op`: the operating point measured at the nominal crossings; `planned_op` the planned one.
+/// - `planned_op`: the operating point of the plan, which the nominal passes crossed: T* holds
+///   there and `predict` expands about it; `op`: the point as measured at the nominal crossings
+///   (a diagnostic of the tracking; noisier than the plan);
+/// - `diagnostics`: clock offsets, velocity reversals met at crossings, warnings;
+/// - `coulomb`: the Coulomb steps of the friction-aware H regression, when used.
 #[pyclass(name = "LocalModel", module = "perturbid_rs", frozen)]
 pub(crate) struct PyLocalModel {
     pub model: LocalModel,
@@ -544,7 +548,8 @@ impl PyLocalModel {
             Estimator::Combined => "combined",
         }
     }
-    /// Predicted torques (N m) at `q`, `qd`, `qdd`: shape `(n,)` each or a batch `(k, n)`.
+    /// Predicted torques (N m) at `q`, `qd`, `qdd`: shape `(n,)` each or a batch `(k, n)`;
+    /// `T* + D (qdd - qdd*) + H (qd - qd*) + G (q - q*)` about the planned operating point.
     fn predict<'py>(
         &self,
         py: Python<'py>,

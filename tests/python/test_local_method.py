@@ -113,9 +113,9 @@ def test_workflow_shapes_uncertainty_and_json():
     assert all(1 <= c < 1.1 for c in model.cond.values()), model.cond  # measured deltas: near 1
     assert model.stderr["torque"].shape == (6,) and model.residual_rms["H"].shape == (6,)
     # predict: one sample and a batch
-    m = model.op  # the operating point as measured at the nominal crossings, where T* holds
+    m = model.planned_op  # the nominal passes crossed it: T* holds there
     np.testing.assert_allclose(model.predict(m.q, m.qd, m.qdd), model.torque, atol=1e-12)
-    assert np.abs(m.q - op.q).max() < 1e-4
+    assert np.abs(model.op.q - op.q).max() < 1e-4  # measured at the nominal crossings
     batch = model.predict(np.tile(m.q, (3, 1)), np.tile(m.qd, (3, 1)), np.tile(m.qdd, (3, 1)) + [[0.0], [0.1], [0.2]])
     np.testing.assert_allclose(batch[2], model.torque + model.D @ np.full(6, 0.2), atol=1e-9)
     back = pr.LocalModel.from_json(model.to_json())
