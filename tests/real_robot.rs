@@ -288,7 +288,7 @@ fn friction_aware_h_recovers_h_and_the_coulomb_steps() {
 /// prediction.
 #[test]
 fn predict_expands_about_the_planned_operating_point() {
-    use perturbid_rs::{linearize, Data, States, TorqueModel};
+    use perturbid_rs::{linearize, Data, States};
     let model = a465::model("kinsheel2010").unwrap();
     let n = model.nv;
     let op = table2();
