@@ -35,6 +35,7 @@ pub mod paper;
 pub mod preprocess;
 pub mod recording;
 pub mod regression;
+pub mod rehearsal;
 pub mod robots;
 pub mod signal;
 pub mod simulation;

@@ -217,13 +217,8 @@ pub fn simulate_samples(
     Recording::new(name, n, samples.t.clone(), q, tau, None, None)
 }
 
-/// Simulates one recording per experiment of `plan` (in the plan's order) for `model`, which
-/// must have the plan's joints. Each experiment gets its own random stream of `options.seed`.
-pub fn simulate_plan(
-    model: &Model,
-    plan: &crate::local::Plan,
-    options: &SimulationOptions,
-) -> Result<Vec<Recording>> {
+/// Refuses a plan made for other joints than `model`'s.
+pub(crate) fn check_plan_robot(model: &Model, plan: &crate::local::Plan) -> Result<()> {
     if plan.joint_names != model.joint_names {
         return Err(Error::InvalidArgument {
             argument: "plan".into(),
@@ -236,6 +231,17 @@ pub fn simulate_plan(
             ),
         });
     }
+    Ok(())
+}
+
+/// Simulates one recording per experiment of `plan` (in the plan's order) for `model`, which
+/// must have the plan's joints. Each experiment gets its own random stream of `options.seed`.
+pub fn simulate_plan(
+    model: &Model,
+    plan: &crate::local::Plan,
+    options: &SimulationOptions,
+) -> Result<Vec<Recording>> {
+    check_plan_robot(model, plan)?;
     plan.experiments
         .iter()
         .enumerate()

@@ -1,0 +1,118 @@
+//! Rehearsal on a true robot: what a real robot would record along a reference, when it
+//! differs from the model the experiments were planned with (payload, parameter errors, joint
+//! zero offsets), its joints add friction, ripple and cogging, its sensors quantise, delay and
+//! add noise, and it tracks the reference under a controller. The true robot is one JSON
+//! document ([`TrueRobot`], `docs/rehearsal.md`); [`rehearse`] turns a reference (a plan's
+//! trajectory, a Fourier excitation, any sampled states) into the [`Recording`] the robot
+//! would log, which the identifications read like a real one.
+//!
+//! The simpler [`crate::simulation`] (friction, white noise, quantisation, exact tracking of
+//! the planned model) stays for quick rehearsals.
+
+pub mod joint_effects;
+pub mod sensors;
+pub mod tracking;
+pub mod true_robot;
+
+pub use joint_effects::JointEffects;
+pub use true_robot::{Controller, FrictionSpec, Harmonic, LinkError, Payload, Sensors, TrueRobot};
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+use crate::error::{Error, Result};
+use crate::gravity::Gravity;
+use crate::local::Plan;
+use crate::model::Model;
+use crate::recording::Recording;
+use crate::trajectory::Samples;
+
+/// What `robot` (the true robot built on `nominal`) logs while it follows `reference` (states
+/// in the nominal model's joint coordinates, rad, rad/s, rad/s^2; `t` in s): positions as its
+/// encoders read them and the torques it commands, through its sensors. `stream` separates the
+/// random streams of several recordings made with one seed; `name` names the recording.
+///
+/// Errors: a reference for another number of joints, a true-robot document that does not fit
+/// `nominal` (naming the field), an unstable controller (naming the time).
+pub fn rehearse(
+    nominal: &Model,
+    robot: &TrueRobot,
+    reference: &Samples,
+    stream: u64,
+    name: &str,
+) -> Result<Recording> {
+    let n = nominal.nv;
+    if reference.n != n {
+        return Err(Error::Shape {
+            argument: "reference".into(),
+            expected: format!("{n} joints"),
+            got: format!("{} joints", reference.n),
+        });
+    }
+    if reference.len() < 2 {
+        return Err(Error::InvalidArgument {
+            argument: "reference".into(),
+            message: format!("{} samples; expected at least 2", reference.len()),
+        });
+    }
+    let true_model = robot.rigid_body_model(nominal)?;
+    let effects = JointEffects::new(robot, n)?;
+    let offsets = true_robot::per_joint("joint_offsets", &robot.joint_offsets, n, 0.0)?;
+    let gravity = Gravity::from(robot.gravity);
+    let motion = match &robot.controller {
+        None => tracking::follow_exactly(&true_model, &effects, gravity, reference, &offsets)?,
+        Some(c) => tracking::follow_closed_loop(
+            nominal,
+            &true_model,
+            &effects,
+            gravity,
+            c,
+            reference,
+            &offsets,
+        )?,
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(robot.seed);
+    rng.set_stream(stream);
+    let signals = sensors::TrueSignals {
+        n,
+        t: &reference.t,
+        q: &motion.encoder,
+        qd: &motion.qd,
+        tau: &motion.command,
+    };
+    let (q, tau) = sensors::measure(&robot.sensors, &signals, &mut rng)?;
+    if let Some(i) = crate::states::first_non_finite(&tau) {
+        return Err(Error::Numerical {
+            operation: format!("rehearsal '{name}'"),
+            message: format!(
+                "the torque of joint {} at t = {} s is {}: the true robot's numbers overflow",
+                i % n + 1,
+                reference.t[i / n],
+                tau[i]
+            ),
+        });
+    }
+    Recording::new(name, n, reference.t.clone(), q, tau, None, None)
+}
+
+/// One rehearsed recording per experiment of `plan` (in the plan's order, each marked with
+/// its experiment), the plan's trajectories sampled at its rate. Each experiment gets its own
+/// random stream of the robot's seed.
+pub fn rehearse_plan(nominal: &Model, robot: &TrueRobot, plan: &Plan) -> Result<Vec<Recording>> {
+    crate::simulation::check_plan_robot(nominal, plan)?;
+    plan.experiments
+        .iter()
+        .enumerate()
+        .map(|(i, e)| {
+            crate::interrupt::check("rehearsal")?;
+            rehearse(
+                nominal,
+                robot,
+                &e.trajectory.sample(plan.rate),
+                i as u64,
+                &format!("rehearsed experiment '{}'", e.kind.name()),
+            )
+            .map(|r| r.for_experiment(e.kind.name()))
+        })
+        .collect()
+}

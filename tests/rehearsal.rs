@@ -1,0 +1,332 @@
+//! The true robot of a rehearsal: every effect against an independent computation (its
+//! formula, rounding, the URDF loader, a statistic of the noise), and closed-loop tracking.
+
+use perturbid_rs::rehearsal::{rehearse, Controller, Harmonic, Payload, TrueRobot};
+use perturbid_rs::robots::a465;
+use perturbid_rs::trajectory::Samples;
+use perturbid_rs::{model_from_urdf_str, rnea, Data, Document, Gravity, LoadOptions, Model};
+
+/// A smooth reference for every joint over `duration` s at `rate` Hz: `q = q0 + a sin(w t)`.
+fn reference(n: usize, duration: f64, rate: f64) -> Samples {
+    let k = (duration * rate) as usize + 1;
+    let mut s = Samples::with_capacity(n, k);
+    for i in 0..k {
+        let t = i as f64 / rate;
+        s.t.push(t);
+        for j in 0..n {
+            let (a, w, q0) = (0.3 + 0.05 * j as f64, 1.0 + 0.3 * j as f64, 0.1 * j as f64);
+            s.q.push(q0 + a * (w * t).sin());
+            s.qd.push(a * w * (w * t).cos());
+            s.qdd.push(-a * w * w * (w * t).sin());
+        }
+    }
+    s
+}
+
+fn rigid(model: &Model, q: &[f64], qd: &[f64], qdd: &[f64], gravity: Gravity) -> Vec<f64> {
+    let mut data = Data::new(model);
+    rnea(model, &mut data, q, qd, qdd, gravity).unwrap();
+    data.tau.as_slice().to_vec()
+}
+
+fn doc(json: &str) -> TrueRobot {
+    TrueRobot::from_json(json).unwrap()
+}
+
+/// Friction (asymmetric Coulomb, Stribeck, position harmonics, drift), ripple and cogging:
+/// the logged torque is the command that applies the rigid-body torque plus the friction of
+/// their formulas; joint offsets move the true joints, not the log.
+#[test]
+fn joint_effects_follow_their_formulas() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let robot = doc(r#"{
+        "format": "perturbid-true-robot/1",
+        "joint_offsets": [0.01, -0.02, 0.0, 0.005, 0.0, 0.03],
+        "friction": {
+            "viscous": [0.5, 0.4, 0.3, 0.2, 0.1, 0.05],
+            "coulomb": [0.3, 0.3, 0.2, 0.1, 0.1, 0.05],
+            "coulomb_negative": [0.4, 0.2, 0.25, 0.12, 0.08, 0.06],
+            "stribeck": [0.2, 0.1, 0.1, 0.05, 0.05, 0.02],
+            "stribeck_velocity": [0.05, 0.05, 0.05, 0.1, 0.1, 0.1],
+            "position": [[{"order": 2, "amplitude": 0.05}], [], [], [], [], [{"order": 1, "amplitude": 0.01, "phase": 0.5}]],
+            "drift": [0.01, 0.0, 0.0, 0.0, 0.0, -0.02]
+        },
+        "ripple": [[{"order": 6, "amplitude": 0.02}], [], [], [], [], []],
+        "cogging": [[], [{"order": 12, "amplitude": 0.03, "phase": 1.0}], [], [], [], []]
+    }"#);
+    let r = reference(n, 2.0, 200.0);
+    let rec = rehearse(&model, &robot, &r, 0, "log").unwrap();
+    assert_eq!(
+        rec.q, r.q,
+        "exact tracking logs the reference (the encoders read it)"
+    );
+    let off = robot.joint_offsets.clone().unwrap();
+    let f = &robot.friction;
+    let (v, c, cn, s, vs, d) = (
+        f.viscous.clone().unwrap(),
+        f.coulomb.clone().unwrap(),
+        f.coulomb_negative.clone().unwrap(),
+        f.stribeck.clone().unwrap(),
+        f.stribeck_velocity.clone().unwrap(),
+        f.drift.clone().unwrap(),
+    );
+    for i in (0..r.len()).step_by(7) {
+        let t = r.t[i];
+        let q: Vec<f64> = (0..n).map(|j| r.q_at(i)[j] - off[j]).collect();
+        let tau = rigid(&model, &q, r.qd_at(i), r.qdd_at(i), Gravity::Included);
+        for j in 0..n {
+            let w = r.qd_at(i)[j];
+            let position = match j {
+                0 => 0.05 * (2.0 * q[0]).sin(),
+                5 => 0.01 * (q[5] + 0.5).sin(),
+                _ => 0.0,
+            };
+            let level = if w > 0.0 { c[j] } else { cn[j] } + position;
+            let stribeck = s[j] * (-(w / vs[j]).powi(2)).exp();
+            let friction = (1.0 + d[j] * t) * (v[j] * w + w.signum() * (level + stribeck));
+            let ripple = if j == 0 {
+                0.02 * (6.0 * q[0]).sin()
+            } else {
+                0.0
+            };
+            let cogging = if j == 1 {
+                0.03 * (12.0 * q[1] + 1.0).sin()
+            } else {
+                0.0
+            };
+            let expected = (tau[j] + friction - cogging) / (1.0 + ripple);
+            let got = rec.tau[i * n + j];
+            assert!(
+                (got - expected).abs() < 1e-9 * (1.0 + expected.abs()),
+                "joint {j} at t = {t}: {got} vs {expected}"
+            );
+        }
+    }
+}
+
+/// A payload on a link is the same robot as the URDF with that payload attached to the link
+/// by a fixed joint (merged by the loader).
+#[test]
+fn a_payload_is_the_urdf_with_the_payload_attached() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let payload = Payload {
+        link: "link6".into(),
+        mass: 1.5,
+        com: [0.02, -0.01, 0.08],
+        inertia: [0.004, 0.0001, 0.0, 0.005, 0.0002, 0.003],
+    };
+    let robot = TrueRobot {
+        payload: Some(payload),
+        ..TrueRobot::default()
+    };
+    let truth = robot.rigid_body_model(&model).unwrap();
+    let urdf = a465::urdf("kinsheel2010").unwrap().replace(
+        "</robot>",
+        r#"<link name="tool"><inertial><origin xyz="0.02 -0.01 0.08"/><mass value="1.5"/>
+           <inertia ixx="0.004" ixy="0.0001" ixz="0" iyy="0.005" iyz="0.0002" izz="0.003"/></inertial></link>
+           <joint name="tool_mount" type="fixed"><parent link="link6"/><child link="tool"/></joint></robot>"#,
+    );
+    // the A465's lumped rotor inertias break the triangle inequality, as the built-in model does
+    let options = LoadOptions {
+        check_triangle_inequality: false,
+        ..LoadOptions::default()
+    };
+    let attached = model_from_urdf_str(&urdf, "a465+tool", &options).unwrap();
+    let r = reference(model.nv, 0.5, 20.0);
+    for i in 0..r.len() {
+        let (q, qd, qdd) = (r.q_at(i), r.qd_at(i), r.qdd_at(i));
+        let a = rigid(&truth, q, qd, qdd, Gravity::Included);
+        let b = rigid(&attached, q, qd, qdd, Gravity::Included);
+        for j in 0..model.nv {
+            assert!((a[j] - b[j]).abs() < 1e-10, "{j}: {} vs {}", a[j], b[j]);
+        }
+    }
+    // and a link that does not exist is named with the ones that do
+    let wrong = TrueRobot {
+        payload: Some(Payload {
+            link: "gripper".into(),
+            mass: 1.0,
+            com: [0.0; 3],
+            inertia: [0.0; 6],
+        }),
+        ..TrueRobot::default()
+    };
+    let e = wrong.rigid_body_model(&model).unwrap_err().to_string();
+    assert!(
+        e.contains("'gripper' is not a moving link") && e.contains("link6"),
+        "{e}"
+    );
+}
+
+/// Encoders round to whole counts; torques to whole resolution steps; the torque noise has
+/// its standard deviation and correlation; a delay of two samples shifts the torque by two
+/// samples; jitter moves the position by the speed times the jitter.
+#[test]
+fn sensors_quantise_delay_and_add_noise_as_specified() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let r = reference(n, 20.0, 500.0);
+    let clean = rehearse(&model, &TrueRobot::default(), &r, 0, "clean").unwrap();
+    let counts = 4096.0 * 100.0;
+    let robot = doc(&format!(
+        r#"{{"format": "perturbid-true-robot/1", "seed": 3,
+            "sensors": {{"encoder_counts": [{counts}, {counts}, {counts}, {counts}, {counts}, {counts}],
+                         "torque_resolution": [0.01, 0.01, 0.01, 0.01, 0.01, 0.01]}}}}"#
+    ));
+    let rec = rehearse(&model, &robot, &r, 0, "quantised").unwrap();
+    let step = std::f64::consts::TAU / counts;
+    for i in 0..rec.q.len() {
+        assert_eq!(rec.q[i], (r.q[i] / step).round() * step);
+        assert_eq!(rec.tau[i], (clean.tau[i] / 0.01).round() * 0.01);
+    }
+    // coloured noise: standard deviation 0.05, lag-1 correlation 0.9
+    let robot = doc(r#"{"format": "perturbid-true-robot/1", "seed": 5,
+        "sensors": {"torque_noise": [0.05, 0.05, 0.05, 0.05, 0.05, 0.05],
+                    "torque_noise_correlation": [0.9, 0.9, 0.9, 0.0, 0.0, 0.0]}}"#);
+    let rec = rehearse(&model, &robot, &r, 0, "noisy").unwrap();
+    for j in [0, 3] {
+        let e: Vec<f64> = (0..rec.len())
+            .map(|i| rec.tau[i * n + j] - clean.tau[i * n + j])
+            .collect();
+        let var = e.iter().map(|x| x * x).sum::<f64>() / e.len() as f64;
+        let lag1 = e.windows(2).map(|w| w[0] * w[1]).sum::<f64>() / (e.len() - 1) as f64 / var;
+        assert!(
+            (var.sqrt() - 0.05).abs() < 0.005,
+            "joint {j}: std {}",
+            var.sqrt()
+        );
+        let rho = if j == 0 { 0.9 } else { 0.0 };
+        assert!(
+            (lag1 - rho).abs() < 0.03,
+            "joint {j}: lag-1 correlation {lag1}"
+        );
+    }
+    // a torque delay of exactly two samples
+    let robot = doc(r#"{"format": "perturbid-true-robot/1", "sensors": {"delay": 0.004}}"#);
+    let rec = rehearse(&model, &robot, &r, 0, "delayed").unwrap();
+    for i in 2..rec.len() {
+        for j in 0..n {
+            let (a, b) = (rec.tau[i * n + j], clean.tau[(i - 2) * n + j]);
+            assert!(
+                (a - b).abs() < 1e-9 * (1.0 + b.abs()),
+                "{i} {j}: {a} vs {b}"
+            );
+        }
+        assert_eq!(
+            rec.q[i * n..(i + 1) * n],
+            clean.q[i * n..(i + 1) * n],
+            "positions are not delayed"
+        );
+    }
+    // jitter of 0.1 ms: (q_log - q_ref) / qd estimates the sampling-time error
+    let robot =
+        doc(r#"{"format": "perturbid-true-robot/1", "seed": 9, "sensors": {"jitter": 1e-4}}"#);
+    let rec = rehearse(&model, &robot, &r, 0, "jittered").unwrap();
+    let eps: Vec<f64> = (1..rec.len() - 1)
+        .filter(|&i| r.qd[i * n].abs() > 0.1)
+        .map(|i| (rec.q[i * n] - r.q[i * n]) / r.qd[i * n])
+        .collect();
+    let sd = (eps.iter().map(|x| x * x).sum::<f64>() / eps.len() as f64).sqrt();
+    assert!((sd - 1e-4).abs() < 1e-5, "jitter estimated at {sd:e} s");
+}
+
+/// Closed loop: with the true robot equal to the model and the computed-torque feed-forward,
+/// the robot tracks almost exactly; with a payload the model does not know, the tracking error
+/// shrinks as the gains grow, and the log shows it.
+#[test]
+fn tracking_error_shrinks_as_gains_grow() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let r = reference(n, 2.0, 500.0);
+    let rms_error = |kp: f64, payload: f64| -> f64 {
+        let robot = TrueRobot {
+            payload: (payload > 0.0).then(|| Payload {
+                link: "link6".into(),
+                mass: payload,
+                com: [0.0, 0.0, 0.05],
+                inertia: [0.001, 0.0, 0.0, 0.001, 0.0, 0.001],
+            }),
+            controller: Some(Controller {
+                kp: vec![kp; n],
+                kd: vec![2.0 * kp.sqrt(); n],
+                substeps: 4,
+                feedforward: true,
+            }),
+            ..TrueRobot::default()
+        };
+        let rec = rehearse(&model, &robot, &r, 0, "tracked").unwrap();
+        let ss: f64 = rec.q.iter().zip(&r.q).map(|(a, b)| (a - b).powi(2)).sum();
+        (ss / rec.q.len() as f64).sqrt()
+    };
+    let exact = rms_error(100.0, 0.0);
+    let errors: Vec<f64> = [25.0, 100.0, 400.0]
+        .iter()
+        .map(|&kp| rms_error(kp, 2.0))
+        .collect();
+    // its own feed-forward, held over each sample: only the hold lags
+    assert!(exact < 0.05 * errors[1], "{exact:e} vs {errors:?}");
+    assert!(
+        errors[0] > 1e-4,
+        "a payload the model does not know: {errors:?}"
+    );
+    assert!(
+        errors[1] < 0.5 * errors[0] && errors[2] < 0.5 * errors[1],
+        "the error should shrink as the gains grow: {errors:?}"
+    );
+}
+
+/// Hand-edited documents: unknown keys, negative levels, lengths that do not fit the robot.
+#[test]
+fn bad_true_robot_documents_are_refused_by_name() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let e = TrueRobot::from_json(r#"{"format": "perturbid-true-robot/1", "frictoin": {}}"#)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("unknown field `frictoin`"), "{e}");
+    let e = TrueRobot::from_json(
+        r#"{"format": "perturbid-true-robot/1", "friction": {"coulomb": [0.1, -0.2]}}"#,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("friction.coulomb[1] is -0.2, expected >= 0"),
+        "{e}"
+    );
+    let short = doc(r#"{"format": "perturbid-true-robot/1", "friction": {"viscous": [0.1, 0.2]}}"#);
+    let e = rehearse(&model, &short, &reference(6, 0.1, 100.0), 0, "x")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("friction.viscous") && e.contains("6 values"),
+        "{e}"
+    );
+    let h = Harmonic {
+        order: 0.0,
+        amplitude: 1.0,
+        phase: 0.0,
+    };
+    let bad = TrueRobot {
+        cogging: Some(vec![vec![h]; 6]),
+        ..TrueRobot::default()
+    };
+    assert!(bad
+        .check(&model)
+        .unwrap_err()
+        .to_string()
+        .contains("cogging[0][0]"));
+    // an unstable controller: the divergence is named with its time
+    let wild = TrueRobot {
+        controller: Some(Controller {
+            kp: vec![1e9; 6],
+            kd: vec![0.0; 6],
+            substeps: 1,
+            feedforward: true,
+        }),
+        ..TrueRobot::default()
+    };
+    let e = rehearse(&model, &wild, &reference(6, 1.0, 100.0), 0, "x")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("diverges at t = "), "{e}");
+}
