@@ -517,3 +517,92 @@ fn usage_errors_are_one_line() {
         assert_eq!(se, format!("perturbid: {says} (see perturbid --help)\n"));
     }
 }
+
+/// The direct method rehearsed from the command line: excite, simulate the excitation on a true
+/// robot, identify-direct from the log it wrote.
+#[test]
+fn excite_simulate_on_a_true_robot_identify_direct() {
+    let d = tmp("true-robot");
+    ok(&[
+        "excite",
+        "a465",
+        "--out",
+        s(&d),
+        "--max-evaluations",
+        "100",
+        "--rate",
+        "100",
+    ]);
+    let true_robot = d.join("true.json");
+    write(
+        &true_robot,
+        r#"{"format": "perturbid-true-robot/1",
+            "payload": {"link": "link6", "mass": 1.0, "com": [0, 0, 0.05]},
+            "friction": {"viscous": [0.5, 0.4, 0.3, 0.2, 0.1, 0.05]}}"#,
+    );
+    let out = ok(&[
+        "simulate",
+        "a465",
+        s(&d.join("excitation.json")),
+        "--true-robot",
+        s(&true_robot),
+        "--periods",
+        "2",
+        "--out",
+        s(&d.join("log.csv")),
+    ]);
+    assert!(
+        out.contains("excitation: ") && out.contains("log.csv"),
+        "{out}"
+    );
+    let out = ok(&[
+        "identify-direct",
+        "a465",
+        s(&d.join("log.csv")),
+        "--friction",
+        "viscous",
+        "--out",
+        s(&d.join("base.json")),
+    ]);
+    assert!(out.contains("base parameters from"), "{out}");
+    // the identified mass matrix is the true robot's (to the preprocessing's accuracy), not
+    // the nominal model's
+    let fit = perturbid_rs::direct::BaseModel::load(d.join("base.json")).unwrap();
+    let model = a465::model("kinsheel2010").unwrap();
+    let truth = perturbid_rs::rehearsal::TrueRobot::load(&true_robot)
+        .unwrap()
+        .rigid_body_model(&model)
+        .unwrap();
+    let q = a465::TABLE2_Q;
+    let m = fit.mass_matrix(&model, &q).unwrap();
+    let (mut dt, mut dn) = (Data::new(&truth), Data::new(&model));
+    mass_matrix(&truth, &mut dt, &q).unwrap();
+    mass_matrix(&model, &mut dn, &q).unwrap();
+    let err = (&m - &dt.m).norm() / dt.m.norm();
+    let nominal = (&dn.m - &dt.m).norm() / dt.m.norm();
+    assert!(
+        err < 0.2 * nominal,
+        "fit {err:.2e} vs nominal {nominal:.2e} off the truth"
+    );
+    // the noise options belong in the document
+    fails(
+        &[
+            "simulate",
+            "a465",
+            s(&d.join("excitation.json")),
+            "--true-robot",
+            s(&true_robot),
+            "--torque-noise",
+            "0.1",
+        ],
+        &["--true-robot: ", "come from the true-robot document"],
+    );
+    // a document that is neither a plan nor an excitation
+    fails(
+        &["simulate", "a465", s(&true_robot)],
+        &[
+            "true.json",
+            "a 'perturbid-true-robot/1' document; expected a plan",
+        ],
+    );
+}

@@ -330,3 +330,55 @@ fn bad_true_robot_documents_are_refused_by_name() {
         .to_string();
     assert!(e.contains("diverges at t = "), "{e}");
 }
+
+/// The direct method rehearsed end to end on the true robot: a Fourier excitation run by a
+/// robot with a payload and viscous and Coulomb friction (all of which the method models)
+/// gives back the true robot's base parameters: its torques and mass matrix, exactly.
+#[test]
+fn the_direct_method_recovers_the_true_robot_from_a_rehearsed_excitation() {
+    use perturbid_rs::direct::{identify_base_parameters, BaseOptions, FrictionTerms};
+    use perturbid_rs::trajectory::FourierTrajectory;
+    use perturbid_rs::{mass_matrix, States};
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let a = nalgebra::DMatrix::from_fn(n, 5, |i, l| 0.1 * ((3 * i + 5 * l) as f64).sin());
+    let b = nalgebra::DMatrix::from_fn(n, 5, |i, l| 0.1 * ((7 * i + 2 * l) as f64).cos());
+    let traj = FourierTrajectory::new(
+        2.0 * std::f64::consts::PI * 0.1,
+        vec![0.2, 0.3, -0.4, 0.1, 0.5, -0.2],
+        a,
+        b,
+    )
+    .unwrap();
+    let s = traj.sample_periods(1.0, 100.0);
+    let robot = doc(r#"{"format": "perturbid-true-robot/1",
+        "payload": {"link": "link6", "mass": 1.2, "com": [0.01, 0.0, 0.06], "inertia": [0.002, 0, 0, 0.002, 0, 0.001]},
+        "link_errors": [{"link": "link3", "mass": 0.1, "com": [0.01, 0.0, 0.0], "inertia": -0.2}],
+        "friction": {"viscous": [0.5, 0.4, 0.3, 0.2, 0.1, 0.05], "coulomb": [1.0, 0.8, 0.6, 0.4, 0.2, 0.1]}}"#);
+    let rec = rehearse(&model, &robot, &s, 0, "excitation").unwrap();
+    let fit = identify_base_parameters(
+        &model,
+        &States::new(n, &rec.q, Some(&s.qd), Some(&s.qdd)).unwrap(),
+        &rec.tau,
+        &BaseOptions {
+            friction: FrictionTerms {
+                viscous: true,
+                coulomb: true,
+                offset: false,
+            },
+            ..BaseOptions::default()
+        },
+    )
+    .unwrap();
+    let truth = robot.rigid_body_model(&model).unwrap();
+    let q = a465::TABLE2_Q;
+    let mut data = Data::new(&truth);
+    mass_matrix(&truth, &mut data, &q).unwrap();
+    let m = fit.mass_matrix(&model, &q).unwrap();
+    let err = (&m - &data.m).norm() / data.m.norm();
+    assert!(err < 1e-8, "M(q*) of the fit vs the true robot: {err:e}");
+    // and the nominal model is not what was identified
+    let mut nominal = Data::new(&model);
+    mass_matrix(&model, &mut nominal, &q).unwrap();
+    assert!((&m - &nominal.m).norm() > 1e-3 * nominal.m.norm());
+}

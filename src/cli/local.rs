@@ -11,13 +11,15 @@ use super::out_dir;
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
-use crate::io::{read_recording, recording_table, samples_table, OutputSet};
+use crate::io::{read_recording, recording_table, samples_table, write_atomic, OutputSet};
 use crate::local::{
     identify_local, plan_experiments, CrossingTimes, Design, Estimator, ExperimentKind,
     IdentifyOptions, LocalModel, OperatingPoint, Plan, PlanOptions, Size,
 };
 use crate::recording::Recording;
-use crate::simulation::{simulate_plan, Friction, SimulationOptions};
+use crate::rehearsal::{rehearse, rehearse_plan, TrueRobot};
+use crate::simulation::{simulate_plan, simulate_samples, Friction, SimulationOptions};
+use crate::trajectory::FourierTrajectory;
 
 #[derive(Args)]
 pub(crate) struct PlanArgs {
@@ -159,13 +161,26 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
 
 #[derive(Args)]
 pub(crate) struct SimulateArgs {
-    /// The robot (URDF file or built-in name).
+    /// The robot (URDF file or built-in name): the model the plan or excitation was made for.
     robot: String,
-    /// The plan (plan.json from `perturbid plan`).
-    plan: PathBuf,
-    /// Output folder: one <experiment>.csv per experiment (t, q1..qN, tau1..tauN).
+    /// What the robot runs: a plan (plan.json from `perturbid plan`) or a Fourier excitation
+    /// (excitation.json from `perturbid excite`).
+    input: PathBuf,
+    /// A plan: the output folder, one <experiment>.csv per experiment (t, q1..qN,
+    /// tau1..tauN). An excitation: the log file (default log.csv), which `perturbid
+    /// identify-direct` reads.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// The true robot (JSON, docs/rehearsal.md): parameter errors, friction, ripple, sensors,
+    /// closed-loop tracking. Replaces the options below.
+    #[arg(long)]
+    true_robot: Option<PathBuf>,
+    /// An excitation: periods to run.
+    #[arg(long, default_value_t = 1.0)]
+    periods: f64,
+    /// An excitation: sampling rate of the log (Hz).
+    #[arg(long, default_value_t = 1000.0)]
+    rate: f64,
     /// Leave gravity out of the torques (as if compensated).
     #[arg(long)]
     no_gravity: bool,
@@ -185,10 +200,67 @@ pub(crate) struct SimulateArgs {
     seed: u64,
 }
 
+/// What `simulate` runs.
+enum Reference {
+    Plan(Box<Plan>),
+    Excitation(FourierTrajectory),
+}
+
+fn load_reference(path: &Path) -> Result<Reference> {
+    let text = crate::io::read_text(path)?;
+    let context = path.display().to_string();
+    if let Ok(tag) = crate::document::format_tag(&text, &context) {
+        if tag.starts_with(Plan::FORMAT) {
+            return Ok(Reference::Plan(Box::new(Plan::from_json_in(
+                &text, &context,
+            )?)));
+        }
+        return Err(Error::Json {
+            context,
+            message: format!(
+                "a '{tag}' document; expected a plan (perturbid plan) or an excitation (perturbid excite)"
+            ),
+        });
+    }
+    let t: FourierTrajectory = serde_json::from_str(&text).map_err(|e| Error::Json {
+        context: context.clone(),
+        message: format!(
+            "neither a plan nor an excitation (line {}, column {}: {e})",
+            e.line(),
+            e.column()
+        ),
+    })?;
+    let t = FourierTrajectory::new(t.w_f, t.q0, t.a, t.b).map_err(|e| Error::Json {
+        context,
+        message: e.to_string(),
+    })?;
+    Ok(Reference::Excitation(t))
+}
+
 pub(crate) fn simulate(a: SimulateArgs) -> Result<String> {
     let model = load_robot(&a.robot)?;
-    let plan = Plan::load(&a.plan)?;
+    let reference = load_reference(&a.input)?;
     let n = model.nv;
+    let true_robot = match &a.true_robot {
+        None => None,
+        Some(path) => {
+            if a.no_gravity
+                || a.no_friction
+                || a.torque_noise != 0.0
+                || a.position_noise != 0.0
+                || a.quantization != 0.0
+                || a.seed != 0
+            {
+                return Err(Error::InvalidArgument {
+                    argument: "--true-robot".into(),
+                    message: "gravity, friction, noise, quantisation and seed come from the true-robot document; leave --no-gravity, --no-friction, --torque-noise, --position-noise, --quantization and --seed out".into(),
+                });
+            }
+            let t = TrueRobot::load(path)?;
+            t.check(&model)?;
+            Some(t)
+        }
+    };
     let mut o = SimulationOptions::new(&model);
     o.gravity = Gravity::from(!a.no_gravity);
     if a.no_friction {
@@ -198,7 +270,44 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<String> {
     o.position_noise = vec![a.position_noise; n];
     o.quantization = vec![a.quantization; n];
     o.seed = a.seed;
-    let recs = simulate_plan(&model, &plan, &o)?;
+    let plan = match reference {
+        Reference::Plan(plan) => plan,
+        Reference::Excitation(traj) => {
+            if traj.n() != n {
+                return Err(Error::InvalidArgument {
+                    argument: "excitation".into(),
+                    message: format!(
+                        "{} is for {} joints; robot '{}' has {n}",
+                        a.input.display(),
+                        traj.n(),
+                        model.name
+                    ),
+                });
+            }
+            crate::limits::check_range("--periods", a.periods, 1e-9, 1e6)?;
+            let count =
+                crate::limits::sample_count("--periods", a.periods * traj.period(), a.rate)?;
+            let t: Vec<f64> = (0..count).map(|i| i as f64 / a.rate).collect();
+            let samples = traj.sample(&t);
+            let rec = match &true_robot {
+                Some(t) => rehearse(&model, t, &samples, 0, "excitation")?,
+                None => simulate_samples(&model, &samples, &o, 0, "excitation")?,
+            };
+            let path = a.out.clone().unwrap_or_else(|| PathBuf::from("log.csv"));
+            super::files::refuse_overwriting_inputs(&path, &[a.input.as_path()])?;
+            write_atomic(&path, recording_table(&rec, "").to_csv().as_bytes())?;
+            return Ok(format!(
+                "excitation: {} samples, {:.2} s -> {}\n",
+                rec.len(),
+                rec.t[rec.len() - 1] - rec.t[0],
+                path.display()
+            ));
+        }
+    };
+    let recs = match &true_robot {
+        Some(t) => rehearse_plan(&model, t, &plan)?,
+        None => simulate_plan(&model, &plan, &o)?,
+    };
     let dir = out_dir(&a.out);
     let mut set = OutputSet::new(&dir, "recordings");
     let mut out = String::new();
