@@ -1,7 +1,7 @@
 """Type stubs of the extension module perturbid_rs._core (implemented in Rust)."""
 
 from os import PathLike
-from typing import Any, Literal, Mapping, Optional, Sequence, Union, final
+from typing import Any, Literal, overload, Mapping, Optional, Sequence, Union, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -27,6 +27,7 @@ __all__ = [
     "Plan",
     "Recording",
     "Robot",
+    "TrueRobot",
     "__version__",
     "a465_urdf",
     "cli",
@@ -329,6 +330,7 @@ def plan_experiments(
 ) -> Plan:
     """Plans the nominal, G_static, G, H and D experiments at op; refuses plans breaking limits."""
 
+@overload
 def simulate(
     robot: Robot,
     plan: Plan,
@@ -338,8 +340,38 @@ def simulate(
     position_noise: Optional[ArrayLike] = None,
     quantization: Optional[ArrayLike] = None,
     seed: int = 0,
-) -> list[Recording]:
-    """One simulated Recording per experiment of the plan."""
+    *,
+    true_robot: Optional["TrueRobot"] = None,
+    rate: float = 1000.0,
+    periods: float = 1.0,
+) -> list[Recording]: ...
+@overload
+def simulate(
+    robot: Robot,
+    plan: Union[FourierTrajectory, ExcitationDesign, tuple[ArrayLike, ArrayLike, ArrayLike, ArrayLike]],
+    gravity: bool = True,
+    friction: Union[Literal["urdf"], Mapping[str, ArrayLike], None] = "urdf",
+    torque_noise: Optional[ArrayLike] = None,
+    position_noise: Optional[ArrayLike] = None,
+    quantization: Optional[ArrayLike] = None,
+    seed: int = 0,
+    *,
+    true_robot: Optional["TrueRobot"] = None,
+    rate: float = 1000.0,
+    periods: float = 1.0,
+) -> Recording: ...
+
+@final
+class TrueRobot:
+    """The true robot of a rehearsal (docs/rehearsal.md): parameter errors, friction, ripple,
+    cogging, sensors and closed-loop tracking, from a dict of the JSON document's keys."""
+    def __new__(cls, spec: Optional[Mapping[str, Any]] = None) -> "TrueRobot": ...
+    def to_json(self) -> str: ...
+    @staticmethod
+    def from_json(text: str) -> "TrueRobot": ...
+    @staticmethod
+    def load(path: Union[str, PathLike[str]]) -> "TrueRobot": ...
+    def save(self, path: Union[str, PathLike[str]]) -> None: ...
 
 def identify_local(
     plan: Plan,

@@ -24,12 +24,20 @@ use crate::direct::{
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::states::States;
+use crate::trajectory::FourierTrajectory;
 
 /// A designed excitation: `trajectory` (a FourierTrajectory), `cond` (cond of the base
 /// regressor), `value` (the criterion) and `evaluations`.
 #[pyclass(name = "ExcitationDesign", module = "perturbid_rs", frozen)]
 pub(crate) struct PyExcitationDesign {
     design: ExcitationDesign,
+}
+
+impl PyExcitationDesign {
+    /// The designed trajectory.
+    pub(crate) fn trajectory_ref(&self) -> &FourierTrajectory {
+        &self.design.trajectory
+    }
 }
 
 #[pymethods]

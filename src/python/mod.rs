@@ -10,6 +10,7 @@ mod linearization;
 mod local;
 mod preprocess;
 mod recording;
+mod rehearsal;
 mod robot;
 mod simulation;
 mod trajectory;
@@ -48,6 +49,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<local::PyLocalModel>()?;
     m.add_function(wrap_pyfunction!(local::plan_experiments, m)?)?;
     m.add_function(wrap_pyfunction!(simulation::simulate, m)?)?;
+    m.add_class::<rehearsal::PyTrueRobot>()?;
     m.add_function(wrap_pyfunction!(local::identify_local, m)?)?;
     m.add_class::<trajectory::PyFourier>()?;
     m.add_class::<direct::PyExcitationDesign>()?;

@@ -17,7 +17,7 @@ pub(crate) struct PyRecording {
     pub rec: Arc<Recording>,
 }
 
-fn matrix_rows(
+pub(crate) fn matrix_rows(
     name: &str,
     a: &ArrayLike<'_>,
     m: usize,

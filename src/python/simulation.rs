@@ -7,12 +7,18 @@ use pyo3::prelude::*;
 use super::detached;
 use pyo3::types::PyDict;
 
-use super::arrays::per_joint;
+use super::arrays::{per_joint, vector, ArrayLike};
+use super::direct::PyExcitationDesign;
 use super::local::PyPlan;
-use super::recording::PyRecording;
+use super::recording::{matrix_rows, PyRecording};
+use super::rehearsal::PyTrueRobot;
 use super::robot::PyRobot;
-use crate::error::Error;
-use crate::simulation::{simulate_plan, Friction, SimulationOptions};
+use super::trajectory::PyFourier;
+use crate::error::{Error, Result};
+use crate::recording::Recording;
+use crate::rehearsal::{rehearse, rehearse_plan};
+use crate::simulation::{simulate_plan, simulate_samples, Friction, SimulationOptions};
+use crate::trajectory::{FourierTrajectory, Samples};
 
 /// The `friction` argument of `simulate`: a name ('urdf') or anything else (a dict).
 #[derive(FromPyObject)]
@@ -21,26 +27,118 @@ pub(crate) enum FrictionArg<'py> {
     Other(Bound<'py, PyAny>),
 }
 
-/// Simulates what the robot would log running every experiment of `plan`: torques from the
-/// dynamics with `gravity`, `friction` ('urdf', the default: the URDF's `<dynamics damping
-/// friction>`; None: none; or a dict with 'viscous' and 'coulomb', a number or one per joint), Gaussian `torque_noise` (N m) and
-/// `position_noise` (rad) standard deviations, encoder `quantization` (rad per count), seeded.
-/// Returns one Recording per experiment, in the plan's order.
+/// What `simulate` runs: a plan, a Fourier excitation, a designed excitation or sampled
+/// arrays `(t, q, qd, qdd)`.
+#[derive(FromPyObject)]
+pub(crate) enum ReferenceArg<'py> {
+    Plan(PyRef<'py, PyPlan>),
+    Fourier(PyRef<'py, PyFourier>),
+    Design(PyRef<'py, PyExcitationDesign>),
+    Arrays(
+        (
+            ArrayLike<'py>,
+            ArrayLike<'py>,
+            ArrayLike<'py>,
+            ArrayLike<'py>,
+        ),
+    ),
+}
+
+/// Simulates what the robot would log running `plan`: a Plan (one Recording per experiment,
+/// in the plan's order, returned as a list), or a FourierTrajectory / ExcitationDesign
+/// (`periods` periods sampled at `rate` Hz) or a tuple of arrays `(t, q, qd, qdd)` (shapes
+/// (k,), (k, n) x 3; s, rad, rad/s, rad/s^2), each returned as one Recording.
+///
+/// On the model itself: torques from the dynamics with `gravity`, `friction` ('urdf', the
+/// default: the URDF's `<dynamics damping friction>`; None: none; or a dict with 'viscous',
+/// 'coulomb' and optionally 'coulomb_negative', 'stribeck', 'stribeck_velocity', a number or
+/// one per joint), Gaussian `torque_noise` (N m) and `position_noise` (rad) standard
+/// deviations, encoder `quantization` (rad per count), seeded; the joints follow the reference
+/// exactly.
+///
+/// With `true_robot` (a TrueRobot): everything comes from it (parameter errors, friction,
+/// ripple, sensors, closed-loop tracking; docs/rehearsal.md); `gravity=False`, a `friction`
+/// other than the default, noise, quantisation or a seed are then refused.
 #[pyfunction]
-#[pyo3(signature = (robot, plan, gravity=true, friction=Some(FrictionArg::Name("urdf".into())), torque_noise=None, position_noise=None, quantization=None, seed=0),
-    text_signature = "(robot, plan, gravity=True, friction='urdf', torque_noise=None, position_noise=None, quantization=None, seed=0)")]
+#[pyo3(signature = (robot, plan, gravity=true, friction=Some(FrictionArg::Name("urdf".into())), torque_noise=None, position_noise=None, quantization=None, seed=0, *, true_robot=None, rate=1000.0, periods=1.0),
+    text_signature = "(robot, plan, gravity=True, friction='urdf', torque_noise=None, position_noise=None, quantization=None, seed=0, *, true_robot=None, rate=1000.0, periods=1.0)")]
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn simulate(
-    py: Python<'_>,
+pub(crate) fn simulate<'py>(
+    py: Python<'py>,
     robot: &PyRobot,
-    plan: &PyPlan,
+    plan: ReferenceArg<'py>,
     gravity: bool,
     friction: Option<FrictionArg<'_>>,
     torque_noise: Option<Bound<'_, PyAny>>,
     position_noise: Option<Bound<'_, PyAny>>,
     quantization: Option<Bound<'_, PyAny>>,
     seed: u64,
-) -> PyResult<Vec<PyRecording>> {
+    true_robot: Option<PyRef<'py, PyTrueRobot>>,
+    rate: f64,
+    periods: f64,
+) -> PyResult<Bound<'py, PyAny>> {
+    let default_friction = matches!(&friction, Some(FrictionArg::Name(n)) if n == "urdf");
+    if true_robot.is_some()
+        && (!gravity
+            || !default_friction
+            || torque_noise.is_some()
+            || position_noise.is_some()
+            || quantization.is_some()
+            || seed != 0)
+    {
+        return Err(Error::InvalidArgument {
+            argument: "true_robot".into(),
+            message: "gravity, friction, noise, quantization and seed come from the true robot; leave them out".into(),
+        }
+        .into());
+    }
+    let model = &robot.model;
+    let (plan, samples) = match plan {
+        ReferenceArg::Plan(p) => (Some(p.plan.clone()), None),
+        ReferenceArg::Fourier(f) => (None, Some(excitation_samples(&f.traj, periods, rate)?)),
+        ReferenceArg::Design(d) => (
+            None,
+            Some(excitation_samples(d.trajectory_ref(), periods, rate)?),
+        ),
+        ReferenceArg::Arrays((t, q, qd, qdd)) => {
+            let t = vector("t", &t)?;
+            let k = t.len();
+            let (n, q) = matrix_rows("q", &q, k, Some(model.nv))?;
+            let (_, qd) = matrix_rows("qd", &qd, k, Some(n))?;
+            let (_, qdd) = matrix_rows("qdd", &qdd, k, Some(n))?;
+            // the checks of a recording: t strictly increasing, everything finite
+            Recording::new(
+                "reference",
+                n,
+                t.clone(),
+                q.clone(),
+                qd.clone(),
+                Some(qdd.clone()),
+                None,
+            )?;
+            (None, Some(Samples { n, t, q, qd, qdd }))
+        }
+    };
+    let one = |rec: Recording| -> PyResult<Bound<'py, PyAny>> {
+        Ok(Bound::new(py, PyRecording { rec: Arc::new(rec) })?.into_any())
+    };
+    let many = |recs: Vec<Recording>| -> PyResult<Bound<'py, PyAny>> {
+        let list: Vec<PyRecording> = recs
+            .into_iter()
+            .map(|r| PyRecording { rec: Arc::new(r) })
+            .collect();
+        Ok(list.into_pyobject(py)?.into_any())
+    };
+    if let Some(t) = &true_robot {
+        let t = t.robot.clone();
+        return match (plan, samples) {
+            (Some(p), _) => many(detached(py, "simulate", || rehearse_plan(model, &t, &p))?),
+            (_, Some(s)) => one(detached(py, "simulate", || {
+                rehearse(model, &t, &s, 0, "rehearsal")
+            })?),
+            _ => unreachable!("samples exist for every reference but a plan"),
+        };
+    }
     let model = &robot.model;
     let n = model.nv;
     let mut o = SimulationOptions::new(model);
@@ -100,10 +198,19 @@ pub(crate) fn simulate(
             *target = per_joint(name, v, n)?;
         }
     }
-    let plan = plan.plan.clone();
-    let recs = detached(py, "simulate", || simulate_plan(model, &plan, &o))?;
-    Ok(recs
-        .into_iter()
-        .map(|r| PyRecording { rec: Arc::new(r) })
-        .collect())
+    match (plan, samples) {
+        (Some(p), _) => many(detached(py, "simulate", || simulate_plan(model, &p, &o))?),
+        (_, Some(s)) => one(detached(py, "simulate", || {
+            simulate_samples(model, &s, &o, 0, "simulation")
+        })?),
+        _ => unreachable!("samples exist for every reference but a plan"),
+    }
+}
+
+/// `periods` periods of `traj` sampled at `rate` Hz (bounded by the sample limit).
+fn excitation_samples(traj: &FourierTrajectory, periods: f64, rate: f64) -> Result<Samples> {
+    crate::limits::check_range("periods", periods, 1e-9, 1e6)?;
+    let count = crate::limits::sample_count("periods", periods * traj.period(), rate)?;
+    let t: Vec<f64> = (0..count).map(|i| i as f64 / rate).collect();
+    Ok(traj.sample(&t))
 }
