@@ -336,3 +336,66 @@ fn predict_expands_about_the_planned_operating_point() {
     let dqdd = nalgebra::DVector::from_iterator(n, (0..n).map(|j| op.qdd[j] - m.op.qdd[j]));
     assert!((d * dqdd).amax() > 100.0 * err(&here, &truth(&op)));
 }
+
+/// Under encoder quantisation the combined estimator's H* and G* are far off (the measured
+/// deviations of the variables an experiment did not perturb leak the large D* into them)
+/// while the separated ones hold: the model says so, in a warning and in its diagnostics.
+#[test]
+fn the_combined_estimate_reports_when_it_is_not_to_be_trusted() {
+    use perturbid_rs::local::Estimator;
+    use perturbid_rs::{linearize, Data};
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let op = table2();
+    let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+    let truth = linearize(
+        &model,
+        &mut Data::new(&model),
+        &op.q,
+        &op.qd,
+        &op.qdd,
+        Gravity::Included,
+    )
+    .unwrap();
+    let mut sim = SimulationOptions::new(&model);
+    sim.friction = Friction::none(n);
+    let combined = IdentifyOptions {
+        estimator: Estimator::Combined,
+        ..IdentifyOptions::default()
+    };
+    // noise-free: the two agree, no warning
+    let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    let m = identify_local(&plan, &recs, &combined).unwrap();
+    assert!(
+        m.diagnostics.warnings.is_empty(),
+        "{:?}",
+        m.diagnostics.warnings
+    );
+    assert!(m.diagnostics.combined.iter().all(|b| b.relative < 1e-6));
+    // 100,000 counts per revolution
+    sim.quantization = vec![std::f64::consts::TAU / 1e5; n];
+    let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    let separated = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    let m = identify_local(&plan, &recs, &combined).unwrap();
+    assert!(rel(mat(&separated.h), &truth.h) < 0.05);
+    assert!(rel(mat(&m.h), &truth.h) > 1.0, "the combined H* is far off");
+    let w = &m.diagnostics.warnings;
+    assert!(
+        w.iter().any(|w| w.starts_with("the model's D, H, G (estimator 'combined') disagrees with the separated regressions in H by 670 %")
+            && w.contains("trust the separated estimate")),
+        "{w:?}"
+    );
+    let h = m
+        .diagnostics
+        .combined
+        .iter()
+        .find(|b| b.block == "H")
+        .unwrap();
+    assert!(h.relative > 1.0, "{h:?}");
+    // the separated model keeps the combined estimate too, and says so
+    assert!(separated
+        .diagnostics
+        .warnings
+        .iter()
+        .any(|w| w.starts_with("the combined estimate kept in the model disagrees")));
+}

@@ -44,6 +44,17 @@ pub struct Reversal {
     pub window: f64,
 }
 
+/// How one block (`D`, `H` or `G`) of the combined estimate compares with the separated one.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlockAgreement {
+    pub block: String,
+    /// `|combined - separated| / |separated|` (Frobenius norms).
+    pub relative: f64,
+    /// The largest entry of the difference in standard errors of the separated estimate.
+    pub standard_errors: f64,
+}
+
 /// Diagnostics of a local identification; see the module documentation.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -54,6 +65,9 @@ pub struct Diagnostics {
     /// Crossings whose torque fit avoided or modelled a velocity reversal.
     #[serde(default)]
     pub reversals: Vec<Reversal>,
+    /// The combined estimate against the separated one, block by block (when both exist).
+    #[serde(default)]
+    pub combined: Vec<BlockAgreement>,
     /// What the user should know: each is also given as a Python warning and printed by the
     /// command line.
     #[serde(default)]

@@ -7,7 +7,7 @@ use super::crossing::{
     detect_offset, samples_needed, values_at_with, velocity_reversals, CrossingValues, FitOptions,
     TorqueFit,
 };
-use super::diagnostics::{ClockOffset, Diagnostics, Reversal, ReversalHandling};
+use super::diagnostics::{BlockAgreement, ClockOffset, Diagnostics, Reversal, ReversalHandling};
 use super::model::{CoulombSteps, Estimate, Estimator, LocalModel};
 use super::operating_point::OperatingPoint;
 use super::plan::{Experiment, ExperimentKind, Plan};
@@ -428,6 +428,9 @@ pub fn identify_local(
         None
     };
 
+    let disagreement = combined
+        .as_ref()
+        .map_or_else(Vec::new, |c| compare_combined(c, [&d, &h, &g], n));
     let (d, h, g) = match (options.estimator, &combined) {
         (Estimator::Separated, _) => (d, h, g),
         (Estimator::Combined, Some(c)) => {
@@ -447,7 +450,11 @@ pub fn identify_local(
             })
         }
     };
-    let diagnostics = diagnose(&values);
+    let mut diagnostics = diagnose(&values);
+    if let Some(w) = disagreement_warning(&disagreement, options.estimator) {
+        diagnostics.warnings.push(w);
+    }
+    diagnostics.combined = disagreement;
     Ok(LocalModel {
         format: LocalModel::tag(),
         robot: plan.robot.clone(),
@@ -465,6 +472,69 @@ pub fn identify_local(
         coulomb,
         diagnostics,
     })
+}
+
+/// Each block (D, H, G) of the combined estimate against the separated one: the relative
+/// difference and the largest difference in standard errors of the separated estimate. The separated
+/// regressions read each matrix from its own experiment; the combined one also uses the
+/// measured deviations of the variables an experiment did not perturb, where measurement noise
+/// (encoder quantisation reaches qdd through two derivatives) leaks the large D* into the
+/// small H* and G*.
+fn compare_combined(
+    combined: &Estimate,
+    separated: [&Option<Estimate>; 3],
+    n: usize,
+) -> Vec<BlockAgreement> {
+    let mut out = vec![];
+    for (b, (name, s)) in ["D", "H", "G"].into_iter().zip(separated).enumerate() {
+        let Some(s) = s else { continue };
+        let c = combined.matrix.columns(b * n, n);
+        let diff = &c - &s.matrix;
+        let relative = diff.norm() / s.matrix.norm().max(f64::MIN_POSITIVE);
+        let mut worst: f64 = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                let se = s.stderr[(i, j)];
+                if se.is_finite() && se > 0.0 {
+                    worst = worst.max(diff[(i, j)].abs() / se);
+                }
+            }
+        }
+        out.push(BlockAgreement {
+            block: name.to_string(),
+            relative,
+            standard_errors: worst,
+        });
+    }
+    out
+}
+
+/// A warning when the combined estimate disagrees with the separated one beyond its noise in
+/// some block: by more than half, or by more than 5 % and more than 10 standard errors.
+fn disagreement_warning(blocks: &[BlockAgreement], estimator: Estimator) -> Option<String> {
+    let bad: Vec<String> = blocks
+        .iter()
+        .filter(|b| b.relative > 0.5 || (b.relative > 0.05 && b.standard_errors > 10.0))
+        .map(|b| {
+            format!(
+                "{} by {:.0} % ({:.0} standard errors)",
+                b.block,
+                100.0 * b.relative,
+                b.standard_errors
+            )
+        })
+        .collect();
+    if bad.is_empty() {
+        return None;
+    }
+    let which = match estimator {
+        Estimator::Combined => "the model's D, H, G (estimator 'combined')",
+        Estimator::Separated => "the combined estimate kept in the model",
+    };
+    Some(format!(
+        "{which} disagrees with the separated regressions in {}: the measured deviations of the variables an experiment did not perturb carry measurement noise (encoder quantisation reaches qdd through two derivatives) that leaks D* into the smaller H* and G*; trust the separated estimate",
+        bad.join(", ")
+    ))
 }
 
 /// H* and the Coulomb steps from the differences of the H experiment's +- pairs; see

@@ -39,7 +39,7 @@ pub mod perturbation;
 pub mod plan;
 
 pub use crossing::{values_at, values_at_with, CrossingValues, FitOptions, TorqueFit};
-pub use diagnostics::{ClockOffset, Diagnostics, Reversal, ReversalHandling};
+pub use diagnostics::{BlockAgreement, ClockOffset, Diagnostics, Reversal, ReversalHandling};
 pub use identify::{identify_local, CrossingTimes, IdentifyOptions};
 pub use model::{Estimate, Estimator, LocalModel};
 pub use operating_point::OperatingPoint;

@@ -421,7 +421,9 @@ impl PyLocalModel {
     /// What happened during the identification: `offsets` (dict experiment -> clock offset
     /// in s found between the recording and the plan), `reversals` (list of dicts:
     /// `experiment`, `crossing` (None for the reference posture), `joint`, `at` (s from the
-    /// crossing), `handling` ('narrowed' or 'step'), `window` (s)), `warnings` (list of str).
+    /// crossing), `handling` ('narrowed' or 'step'), `window` (s)), `combined` (dict block ->
+    /// (relative difference, largest difference in standard errors) of the combined estimate
+    /// against the separated one), `warnings` (list of str).
     #[getter]
     fn diagnostics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = &self.model.diagnostics;
@@ -450,6 +452,11 @@ impl PyLocalModel {
             })
             .collect::<PyResult<Vec<_>>>()?;
         out.set_item("reversals", reversals)?;
+        let combined = PyDict::new(py);
+        for b in &d.combined {
+            combined.set_item(&b.block, (b.relative, b.standard_errors))?;
+        }
+        out.set_item("combined", combined)?;
         out.set_item("warnings", d.warnings.clone())?;
         Ok(out)
     }
