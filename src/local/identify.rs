@@ -489,7 +489,7 @@ fn compare_combined(
     for (b, (name, s)) in ["D", "H", "G"].into_iter().zip(separated).enumerate() {
         let Some(s) = s else { continue };
         let c = combined.matrix.columns(b * n, n);
-        let diff = &c - &s.matrix;
+        let diff = c - &s.matrix;
         let relative = diff.norm() / s.matrix.norm().max(f64::MIN_POSITIVE);
         let mut worst: f64 = 0.0;
         for i in 0..n {
