@@ -19,6 +19,9 @@ pub struct CrossingValues {
     pub qd: Vec<f64>,
     pub qdd: Vec<f64>,
     pub tau: Vec<f64>,
+    /// Standard errors of `q`, `qd`, `qdd` from the scatter of the positions about their
+    /// quadratic fit (measurement noise, quantisation; NaN with no residual degree of freedom).
+    pub state_stderr: [Vec<f64>; 3],
 }
 
 /// How to read crossing values from a recording.
@@ -191,11 +194,35 @@ pub fn values_at_with(
         qd: vec![0.0; n],
         qdd: vec![0.0; n],
         tau: vec![0.0; n],
+        state_stderr: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
     };
+    // sum of squared weights per coefficient: the variance factor of each estimate
+    let gain: Vec<f64> = (0..3)
+        .map(|d| (0..count).map(|i| wq[(d, i)].powi(2)).sum::<f64>().sqrt())
+        .collect();
     for (j, fit) in torque.iter().enumerate() {
-        out.q[j] = apply(&wq, 0, &rec.q, lo, count, n, j);
-        out.qd[j] = apply(&wq, 1, &rec.q, lo, count, n, j) / half;
-        out.qdd[j] = 2.0 * apply(&wq, 2, &rec.q, lo, count, n, j) / (half * half);
+        let c = [
+            apply(&wq, 0, &rec.q, lo, count, n, j),
+            apply(&wq, 1, &rec.q, lo, count, n, j),
+            apply(&wq, 2, &rec.q, lo, count, n, j),
+        ];
+        out.q[j] = c[0];
+        out.qd[j] = c[1] / half;
+        out.qdd[j] = 2.0 * c[2] / (half * half);
+        let ss: f64 = (0..count)
+            .map(|i| {
+                let u = (t[i] - tc) / half;
+                (rec.q[(lo + i) * n + j] - (c[0] + u * (c[1] + u * c[2]))).powi(2)
+            })
+            .sum();
+        let sigma = if count > 3 {
+            (ss / (count - 3) as f64).sqrt()
+        } else {
+            f64::NAN
+        };
+        out.state_stderr[0][j] = sigma * gain[0];
+        out.state_stderr[1][j] = sigma * gain[1] / half;
+        out.state_stderr[2][j] = 2.0 * sigma * gain[2] / (half * half);
         out.tau[j] = match *fit {
             TorqueFit::Window(h) if h >= half => apply(&wt, 0, &rec.tau, lo, count, n, j),
             TorqueFit::Window(h) => {

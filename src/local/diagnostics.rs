@@ -65,6 +65,11 @@ pub struct Diagnostics {
     /// Crossings whose torque fit avoided or modelled a velocity reversal.
     #[serde(default)]
     pub reversals: Vec<Reversal>,
+    /// How far the variables an experiment did not perturb stray from the operating point at
+    /// the crossings, in standard errors of their measurement (RMS): about 1 when that is
+    /// measurement noise, far above when the robot did not follow its plan.
+    #[serde(default)]
+    pub unperturbed_deviation: Option<f64>,
     /// The combined estimate against the separated one, block by block (when both exist).
     #[serde(default)]
     pub combined: Vec<BlockAgreement>,

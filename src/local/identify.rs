@@ -451,10 +451,12 @@ pub fn identify_local(
         }
     };
     let mut diagnostics = diagnose(&values);
-    if let Some(w) = disagreement_warning(&disagreement, options.estimator) {
+    let deviation = unperturbed_deviation(&values, &op_state);
+    if let Some(w) = disagreement_warning(&disagreement, options.estimator, deviation) {
         diagnostics.warnings.push(w);
     }
     diagnostics.combined = disagreement;
+    diagnostics.unperturbed_deviation = deviation;
     Ok(LocalModel {
         format: LocalModel::tag(),
         robot: plan.robot.clone(),
@@ -509,9 +511,41 @@ fn compare_combined(
     out
 }
 
+/// How far the variables an experiment did not perturb stray from the operating point at the
+/// crossings of nominal, G, H and D, in standard errors of their measurement (RMS over
+/// crossings, joints and variables): about 1 when the deviations are measurement noise, far
+/// above when the robot did not follow its plan (tracking errors). `None` without such values.
+fn unperturbed_deviation(values: &[ExperimentValues], op_state: &[Vec<f64>; 3]) -> Option<f64> {
+    let (mut ss, mut count) = (0.0, 0usize);
+    for v in values.iter().filter(|v| v.kind != ExperimentKind::GStatic) {
+        let perturbed = v.kind.perturbed();
+        for c in &v.crossings {
+            for var in (0..3).filter(|&var| Some(var) != perturbed) {
+                for (j, x) in state(c, var).iter().enumerate() {
+                    let se = c.state_stderr[var][j];
+                    let dev = x - op_state[var][j];
+                    // a floor against noise-free data, where both are rounding errors
+                    let se = se.max(1e-9 * (x.abs() + 1e-3));
+                    if se.is_finite() {
+                        ss += (dev / se).powi(2);
+                        count += 1;
+                    }
+                }
+            }
+        }
+    }
+    (count > 0).then(|| (ss / count as f64).sqrt())
+}
+
 /// A warning when the combined estimate disagrees with the separated one beyond its noise in
-/// some block: by more than half, or by more than 5 % and more than 10 standard errors.
-fn disagreement_warning(blocks: &[BlockAgreement], estimator: Estimator) -> Option<String> {
+/// some block (by more than half, or by more than 5 % and 10 standard errors), saying which to
+/// trust: the separated one when the deviations of the unperturbed variables are measurement
+/// noise (`deviation` about 1), the combined one when they are tracking errors.
+fn disagreement_warning(
+    blocks: &[BlockAgreement],
+    estimator: Estimator,
+    deviation: Option<f64>,
+) -> Option<String> {
     let bad: Vec<String> = blocks
         .iter()
         .filter(|b| b.relative > 0.5 || (b.relative > 0.05 && b.standard_errors > 10.0))
@@ -527,12 +561,29 @@ fn disagreement_warning(blocks: &[BlockAgreement], estimator: Estimator) -> Opti
     if bad.is_empty() {
         return None;
     }
-    let which = match estimator {
-        Estimator::Combined => "the model's D, H, G (estimator 'combined')",
-        Estimator::Separated => "the combined estimate kept in the model",
+    let deviation = deviation.unwrap_or(f64::NAN);
+    let tracking = deviation > 3.0;
+    let subject = match (estimator, tracking) {
+        (Estimator::Combined, _) => "the model's D, H, G (estimator 'combined') disagree",
+        (Estimator::Separated, true) => "the model's D, H, G (estimator 'separated') disagree",
+        (Estimator::Separated, false) => "the combined estimate kept in the model disagrees",
+    };
+    let cause = if tracking {
+        format!(
+            "the robot did not follow its plan: the variables an experiment did not perturb stray from the operating point by {deviation:.0} times their measurement noise (tracking errors), which the separated regressions ignore and the combined one accounts for; trust the combined estimate (estimator 'combined')"
+        )
+    } else {
+        format!(
+            "the variables an experiment did not perturb deviate only by their measurement noise ({deviation:.1} standard errors RMS), which the combined regression takes for motion (encoder quantisation reaches qdd through two derivatives and leaks D* into the smaller H* and G*); trust the separated estimate"
+        )
     };
     Some(format!(
-        "{which} disagrees with the separated regressions in {}: the measured deviations of the variables an experiment did not perturb carry measurement noise (encoder quantisation reaches qdd through two derivatives) that leaks D* into the smaller H* and G*; trust the separated estimate",
+        "{subject} with the {} regressions in {}: {cause}",
+        if estimator == Estimator::Combined || !tracking {
+            "separated"
+        } else {
+            "combined"
+        },
         bad.join(", ")
     ))
 }

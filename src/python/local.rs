@@ -423,7 +423,9 @@ impl PyLocalModel {
     /// `experiment`, `crossing` (None for the reference posture), `joint`, `at` (s from the
     /// crossing), `handling` ('narrowed' or 'step'), `window` (s)), `combined` (dict block ->
     /// (relative difference, largest difference in standard errors) of the combined estimate
-    /// against the separated one), `warnings` (list of str).
+    /// against the separated one), `unperturbed_deviation` (how far the variables an experiment
+    /// did not perturb stray, in standard errors of their measurement: ~1 for noise, far above
+    /// for tracking errors), `warnings` (list of str).
     #[getter]
     fn diagnostics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = &self.model.diagnostics;
@@ -457,6 +459,7 @@ impl PyLocalModel {
             combined.set_item(&b.block, (b.relative, b.standard_errors))?;
         }
         out.set_item("combined", combined)?;
+        out.set_item("unperturbed_deviation", d.unperturbed_deviation)?;
         out.set_item("warnings", d.warnings.clone())?;
         Ok(out)
     }
