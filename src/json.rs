@@ -49,3 +49,44 @@ pub mod option_rows {
             .transpose()
     }
 }
+
+/// Serde adapter for matrices of standard errors as lists of rows, where an unknown standard
+/// error (NaN: no residual degree of freedom) is `null`; `null` reads back as NaN. Only for
+/// standard errors: a `null` anywhere else is refused.
+pub mod stderr_rows {
+    use nalgebra::DMatrix;
+    use serde::{de::Error as _, Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(m: &DMatrix<f64>, s: S) -> Result<S::Ok, S::Error> {
+        let rows: Vec<Vec<Option<f64>>> = m
+            .row_iter()
+            .map(|r| r.iter().map(|v| v.is_finite().then_some(*v)).collect())
+            .collect();
+        rows.serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<DMatrix<f64>, D::Error> {
+        let rows = Vec::<Vec<Option<f64>>>::deserialize(d)?;
+        let rows: Vec<Vec<f64>> = rows
+            .into_iter()
+            .map(|r| r.into_iter().map(|v| v.unwrap_or(f64::NAN)).collect())
+            .collect();
+        super::rows::from_rows(&rows).map_err(D::Error::custom)
+    }
+}
+
+/// Serde adapter for vectors of standard errors, `null` for an unknown one (see
+/// [`stderr_rows`]).
+pub mod stderr_vec {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &[f64], s: S) -> Result<S::Ok, S::Error> {
+        let v: Vec<Option<f64>> = v.iter().map(|x| x.is_finite().then_some(*x)).collect();
+        v.serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
+        let v = Vec::<Option<f64>>::deserialize(d)?;
+        Ok(v.into_iter().map(|x| x.unwrap_or(f64::NAN)).collect())
+    }
+}

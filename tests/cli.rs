@@ -606,3 +606,67 @@ fn excite_simulate_on_a_true_robot_identify_direct() {
         ],
     );
 }
+
+/// The planner's warning on stderr, and the friction-aware H regression from the command line.
+#[test]
+fn plan_warns_and_identify_friction_aware_h() {
+    let d = tmp("friction-aware");
+    let op = d.join("op.json");
+    write(
+        &op,
+        r#"{"q": [0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0], "qd": [0.089, -0.106, 0.022, 0.056, 0.011, 0.014], "qdd": [-0.155, -0.5, 0.034, -0.291, -0.008, 0.171]}"#,
+    );
+    let plain = bin()
+        .args([
+            "plan",
+            "a465",
+            "--op",
+            s(&op),
+            "--out",
+            s(&d.join("plain")),
+            "--experiments",
+            "nominal,H",
+        ])
+        .output()
+        .unwrap();
+    assert!(plain.status.success());
+    let err = String::from_utf8_lossy(&plain.stderr);
+    assert!(
+        err.starts_with(
+            "perturbid: warning: experiment 'H': the velocity perturbations reverse joint(s)"
+        ),
+        "{err}"
+    );
+    ok(&[
+        "plan",
+        "a465",
+        "--op",
+        s(&op),
+        "--out",
+        s(&d.join("plan")),
+        "--experiments",
+        "nominal,H",
+        "--friction-aware-h",
+    ]);
+    ok(&[
+        "simulate",
+        "a465",
+        s(&d.join("plan/plan.json")),
+        "--out",
+        s(&d.join("rec")),
+    ]);
+    let out = ok(&[
+        "identify",
+        s(&d.join("plan/plan.json")),
+        s(&d.join("rec")),
+        "--friction-aware-h",
+        "--out",
+        s(&d.join("model.json")),
+    ]);
+    assert!(
+        out.contains("H*: cond(X)") && out.contains("clock offsets: nominal"),
+        "{out}"
+    );
+    let model = LocalModel::load(d.join("model.json")).unwrap();
+    assert!(model.coulomb.is_some());
+}

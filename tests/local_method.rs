@@ -620,3 +620,24 @@ fn combined_estimator_and_json_round_trip() {
 }
 
 const LOCAL_FORMAT: &str = "perturbid-local-model/1";
+
+/// A regression without residual degrees of freedom (K = N) has unknown standard errors: NaN
+/// in Rust, `null` in the saved model, NaN again when loaded.
+#[test]
+fn unknown_standard_errors_survive_a_json_round_trip() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let opts = PlanOptions {
+        experiments: vec![ExperimentKind::Nominal, ExperimentKind::D],
+        symmetric: false,
+        count: Some(6),
+        ..PlanOptions::default()
+    };
+    let (_, m) = identify(&model, &table2(), &opts, &noise_free(&model, Gravity::Excluded));
+    let d = m.d.as_ref().unwrap();
+    assert!(d.stderr.iter().all(|s| s.is_nan()), "{}", d.stderr);
+    let text = m.to_json();
+    assert!(text.contains("null"));
+    let back = LocalModel::from_json(&text).unwrap();
+    assert!(back.d.as_ref().unwrap().stderr.iter().all(|s| s.is_nan()));
+    assert_eq!(back.d.as_ref().unwrap().matrix, d.matrix);
+}

@@ -241,7 +241,7 @@ fn friction_aware_h_recovers_h_and_the_coulomb_steps() {
     let h_plan = plan
         .experiment(perturbid_rs::local::ExperimentKind::H)
         .unwrap();
-    assert_eq!(h_plan.crossings.len(), 2 * (n + 1));
+    assert_eq!(h_plan.crossings.len(), 2 * (n + 2));
     let mut sim = SimulationOptions::new(&model);
     sim.friction = Friction::none(n);
     let options = IdentifyOptions {

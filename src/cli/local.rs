@@ -78,7 +78,7 @@ pub(crate) struct PlanArgs {
     /// reverses between H passes and friction cancels from H*.
     #[arg(long)]
     keep_velocity_sign: bool,
-    /// Plan enough H passes (2 (N + 1), in +- pairs) for `identify --friction-aware-h`.
+    /// Plan enough H passes (2 (N + 2), in +- pairs) for `identify --friction-aware-h`.
     #[arg(long)]
     friction_aware_h: bool,
 }
@@ -351,7 +351,7 @@ pub(crate) struct IdentifyArgs {
     #[arg(long, value_enum, default_value_t = Estimator::Separated)]
     estimator: Estimator,
     /// Identify H* with the friction-aware regression (differences of the +- pairs with each
-    /// joint's Coulomb step as its own column); the plan needs 2 (N + 1) H passes
+    /// joint's Coulomb step as its own column); the plan needs at least 2 (N + 1) H passes
     /// (`plan --friction-aware-h`).
     #[arg(long)]
     friction_aware_h: bool,

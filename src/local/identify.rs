@@ -672,7 +672,8 @@ fn friction_aware_h(
         }
         if reverses[j] {
             steps.step[j] = Some(ls.coef[(0, n)]);
-            steps.stderr[j] = Some(ls.stderr[(0, n)]);
+            let se = ls.stderr[(0, n)];
+            steps.stderr[j] = se.is_finite().then_some(se);
         }
         cond = cond.max(ls.cond);
         residual_rms[j] = ls.residual_rms[0];

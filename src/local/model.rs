@@ -23,8 +23,9 @@ pub struct Estimate {
     pub cond: f64,
     /// Per-joint RMS of the regression residuals (N m).
     pub residual_rms: Vec<f64>,
-    /// Standard error of every entry of `matrix` (same shape).
-    #[serde(with = "crate::json::rows")]
+    /// Standard error of every entry of `matrix` (same shape); NaN (`null` in JSON) where the
+    /// regression had no residual degree of freedom.
+    #[serde(with = "crate::json::stderr_rows")]
     pub stderr: DMatrix<f64>,
     /// Crossings (rows) used.
     pub crossings: usize,
@@ -72,7 +73,9 @@ pub struct LocalModel {
     pub estimator: Estimator,
     /// `T*` (N m): mean torque at the nominal crossings.
     pub torque: Vec<f64>,
-    /// Standard error of `T*` (sample standard deviation / sqrt(K)).
+    /// Standard error of `T*` (sample standard deviation / sqrt(K)); NaN (`null` in JSON) with
+    /// one nominal crossing.
+    #[serde(with = "crate::json::stderr_vec")]
     pub torque_stderr: Vec<f64>,
     /// `D*`, `H*`, `G*` (dynamic) and `Gs` (static), when their experiment was run.
     pub d: Option<Estimate>,

@@ -121,7 +121,8 @@ pub struct PlanOptions {
     /// joint with `qd* = 0` cannot be perturbed so: refused, use `friction_aware_h`.
     pub keep_velocity_sign: bool,
     /// Plan enough H passes for the friction-aware H regression
-    /// ([`crate::local::IdentifyOptions::friction_aware_h`]): at least `2 (N + 1)`, in +- pairs.
+    /// ([`crate::local::IdentifyOptions::friction_aware_h`]): at least `2 (N + 2)`, in +- pairs
+    /// (`N + 1` pairs determine it, one more gives its standard errors).
     pub friction_aware_h: bool,
 }
 
@@ -399,7 +400,8 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
                     message: "the friction-aware H regression needs the perturbations in +- pairs (symmetric)".into(),
                 });
             }
-            count.max(2 * (n + 1))
+            // N + 1 unknowns per torque row, and one pair more for its standard errors
+            count.max(2 * (n + 2))
         } else {
             count
         };

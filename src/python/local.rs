@@ -253,7 +253,7 @@ impl PyExperiment {
 /// - `experiments`: a subset of ['nominal', 'G_static', 'G', 'H', 'D'];
 /// - `keep_velocity_sign`: keep the velocity perturbations below 0.9 |qd*| of each joint, so
 ///   that friction cancels from H* (otherwise a joint they reverse gets a PerturbidWarning);
-/// - `friction_aware_h`: plan 2 (N + 1) H passes for `identify_local(friction_aware_h=True)`.
+/// - `friction_aware_h`: plan 2 (N + 2) H passes (N + 1 pairs determine it, one more gives its standard errors) for `identify_local(friction_aware_h=True)`.
 ///
 /// Raises InputError when the plan would break a joint limit (naming joint, time and limit).
 /// The planner's warnings are issued as `PerturbidWarning` and kept in `Plan.warnings`.
