@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::Rng;
+use common::{mat, rel, table2, Rng};
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::error::Limit;
 use perturbid_rs::local::{
@@ -18,19 +18,6 @@ use perturbid_rs::{
     linearize, rnea, simulate_plan, Data, Error, Friction, Linearization, Model, Recording,
     SimulationOptions,
 };
-
-fn table2() -> OperatingPoint {
-    OperatingPoint::new(
-        a465::TABLE2_Q.to_vec(),
-        a465::TABLE2_QD.to_vec(),
-        a465::TABLE2_QDD.to_vec(),
-    )
-    .unwrap()
-}
-
-fn rel(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
-    (a - b).norm() / b.norm()
-}
 
 fn noise_free(model: &Model, gravity: Gravity) -> SimulationOptions {
     let mut sim = SimulationOptions::new(model);
@@ -54,10 +41,6 @@ fn identify(
 fn truth(model: &Model, op: &OperatingPoint, gravity: Gravity) -> Linearization {
     let mut data = Data::new(model);
     linearize(model, &mut data, &op.q, &op.qd, &op.qdd, gravity).unwrap()
-}
-
-fn mat(e: &Option<perturbid_rs::local::Estimate>) -> &DMatrix<f64> {
-    &e.as_ref().unwrap().matrix
 }
 
 /// The paper's experiment: D* = M(q*) and H* = d tau/d qd to 1e-9, T* = tau(P), Table 3's row.
@@ -632,7 +615,12 @@ fn unknown_standard_errors_survive_a_json_round_trip() {
         count: Some(6),
         ..PlanOptions::default()
     };
-    let (_, m) = identify(&model, &table2(), &opts, &noise_free(&model, Gravity::Excluded));
+    let (_, m) = identify(
+        &model,
+        &table2(),
+        &opts,
+        &noise_free(&model, Gravity::Excluded),
+    );
     let d = m.d.as_ref().unwrap();
     assert!(d.stderr.iter().all(|s| s.is_nan()), "{}", d.stderr);
     let text = m.to_json();

@@ -2,6 +2,9 @@
 //! reverses near a crossing, clocks offset from the plan's. Each effect is checked against the
 //! model identified without it.
 
+mod common;
+
+use common::{mat, rel, table2};
 use nalgebra::DMatrix;
 use perturbid_rs::local::{
     identify_local, plan_experiments, CrossingTimes, IdentifyOptions, LocalModel, PlanOptions,
@@ -9,23 +12,6 @@ use perturbid_rs::local::{
 };
 use perturbid_rs::robots::a465;
 use perturbid_rs::{simulate_plan, Friction, Gravity, Model, OperatingPoint, SimulationOptions};
-
-fn table2() -> OperatingPoint {
-    OperatingPoint::new(
-        a465::TABLE2_Q.to_vec(),
-        a465::TABLE2_QD.to_vec(),
-        a465::TABLE2_QDD.to_vec(),
-    )
-    .unwrap()
-}
-
-fn rel(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
-    (a - b).norm() / b.norm()
-}
-
-fn mat(e: &Option<perturbid_rs::local::Estimate>) -> &DMatrix<f64> {
-    &e.as_ref().unwrap().matrix
-}
 
 fn rehearse(model: &Model, friction: Friction, options: &IdentifyOptions) -> LocalModel {
     let plan = plan_experiments(model, &table2(), &PlanOptions::default()).unwrap();

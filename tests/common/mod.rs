@@ -75,6 +75,27 @@ pub fn random_tree_urdf(seed: u64, nlinks: usize) -> String {
     s + "</robot>\n"
 }
 
+/// The paper's operating point (Table 2).
+pub fn table2() -> perturbid_rs::OperatingPoint {
+    use perturbid_rs::robots::a465;
+    perturbid_rs::OperatingPoint::new(
+        a465::TABLE2_Q.to_vec(),
+        a465::TABLE2_QD.to_vec(),
+        a465::TABLE2_QDD.to_vec(),
+    )
+    .unwrap()
+}
+
+/// |a - b| / |b| (Frobenius norms).
+pub fn rel(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+    (a - b).norm() / b.norm()
+}
+
+/// The matrix of an identified estimate that must exist.
+pub fn mat(e: &Option<perturbid_rs::local::Estimate>) -> &DMatrix<f64> {
+    &e.as_ref().unwrap().matrix
+}
+
 /// max |a - b| / max(1, max |b|).
 pub fn rel_err(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
     assert_eq!(a.shape(), b.shape());
