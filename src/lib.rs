@@ -64,5 +64,5 @@ pub use model::{Body, JointKind, JointLimits, Model};
 pub use recording::Recording;
 pub use simulation::{simulate_plan, Friction, SimulationOptions};
 pub use states::{State, States};
-pub use torque_model::{ModelFile, TorqueModel};
+pub use torque_model::{Expansion, ModelFile, TorqueModel};
 pub use urdf::{model_from_urdf_file, model_from_urdf_str, LoadOptions};

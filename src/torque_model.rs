@@ -20,6 +20,31 @@ pub trait TorqueModel {
     /// Predicted joint torques (row-major `k x nv`, N m or N) at the `k` samples of `states`
     /// (rad, rad/s, rad/s^2; missing velocities or accelerations are zeros).
     fn predict(&self, states: &States<'_>) -> Result<Vec<f64>>;
+
+    /// The model's first-order expansion at `op`: the torque there and `D = d tau / d qdd`,
+    /// `H = d tau / d qd`, `G = d tau / d q` (`nv x nv`, row = torque, column = joint). A local
+    /// or globally linearised model is linear: its D, H, G are the same everywhere and its
+    /// torque is its prediction at `op`; a base-parameter model is linearised exactly at `op`.
+    fn linearize(&self, op: &OperatingPoint) -> Result<Expansion>;
+}
+
+/// A model's first-order expansion at an operating point ([`TorqueModel::linearize`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Expansion {
+    /// The torque at the point (N m).
+    pub torque: DVector<f64>,
+    pub d: DMatrix<f64>,
+    pub h: DMatrix<f64>,
+    pub g: DMatrix<f64>,
+    /// `d g / d q` at rest at the point's q, where the model knows it (a base-parameter model;
+    /// a local model whose plan had the G_static experiment).
+    pub g_static: Option<DMatrix<f64>>,
+}
+
+/// The torque of a linear model at `op`.
+fn torque_at(model: &dyn TorqueModel, op: &OperatingPoint) -> Result<DVector<f64>> {
+    let states = States::new(op.n(), &op.q, Some(&op.qd), Some(&op.qdd))?;
+    Ok(DVector::from_vec(model.predict(&states)?))
 }
 
 /// Fails unless `states` has `nv` joints per sample.
@@ -75,6 +100,17 @@ impl TorqueModel for BaseModelOn<'_> {
     fn predict(&self, states: &States<'_>) -> Result<Vec<f64>> {
         self.fit.predict(self.robot, states)
     }
+
+    fn linearize(&self, op: &OperatingPoint) -> Result<Expansion> {
+        let l = self.fit.linearize(self.robot, &op.q, &op.qd, &op.qdd)?;
+        Ok(Expansion {
+            torque: l.torque,
+            d: l.d,
+            h: l.h,
+            g: l.g,
+            g_static: Some(l.g_static),
+        })
+    }
 }
 
 impl TorqueModel for LocalModel {
@@ -85,6 +121,18 @@ impl TorqueModel for LocalModel {
     fn predict(&self, states: &States<'_>) -> Result<Vec<f64>> {
         LocalModel::predict(self, states)
     }
+
+    fn linearize(&self, op: &OperatingPoint) -> Result<Expansion> {
+        let torque = torque_at(self, op)?;
+        let part = |e: &Option<crate::local::Estimate>| e.as_ref().map(|e| e.matrix.clone());
+        Ok(Expansion {
+            torque,
+            d: part(&self.d).expect("predict needs D"),
+            h: part(&self.h).expect("predict needs H"),
+            g: part(&self.g).expect("predict needs G"),
+            g_static: part(&self.g_static),
+        })
+    }
 }
 
 impl TorqueModel for GlobalLinearModel {
@@ -94,6 +142,16 @@ impl TorqueModel for GlobalLinearModel {
 
     fn predict(&self, states: &States<'_>) -> Result<Vec<f64>> {
         GlobalLinearModel::predict(self, states)
+    }
+
+    fn linearize(&self, op: &OperatingPoint) -> Result<Expansion> {
+        Ok(Expansion {
+            torque: torque_at(self, op)?,
+            d: self.d.clone(),
+            h: self.h.clone(),
+            g: self.g.clone(),
+            g_static: None,
+        })
     }
 }
 

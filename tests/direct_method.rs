@@ -654,3 +654,83 @@ fn streaming_solve_equals_the_dense_solve() {
     }
     assert!(rms.iter().all(|r| (0.05..0.07).contains(r)), "{rms:?}"); // uniform +-0.1: 0.0577
 }
+
+/// The base-parameter model linearised at a point: on noise-free data it is the robot's own
+/// linearisation (plus the viscous slope); on noisy data (parameters no rigid body has) it
+/// matches central finite differences of its own predictions.
+#[test]
+fn base_model_linearisation_is_exact() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let traj = a465_excitation();
+    let s = traj.sample_periods(1.0, 100.0);
+    let viscous = [0.5, 0.4, 0.3, 0.2, 0.1, 0.05];
+    let coulomb = [1.0, 0.8, 0.6, 0.4, 0.2, 0.1];
+    let mut tau = torques(&model, &s.q, &s.qd, &s.qdd, Gravity::Included);
+    for (i, t) in tau.iter_mut().enumerate() {
+        let (j, v) = (i % 6, s.qd[i]);
+        *t += viscous[j] * v + coulomb[j] * v.signum();
+    }
+    let states = States::new(n, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
+    let options = BaseOptions {
+        friction: FrictionTerms {
+            viscous: true,
+            coulomb: true,
+            offset: true,
+        },
+        ..BaseOptions::default()
+    };
+    let fit = identify_base_parameters(&model, &states, &tau, &options).unwrap();
+    let op = OperatingPoint::new(
+        a465::TABLE2_Q.to_vec(),
+        a465::TABLE2_QD.to_vec(),
+        a465::TABLE2_QDD.to_vec(),
+    )
+    .unwrap();
+    let lin = fit.linearize(&model, &op.q, &op.qd, &op.qdd).unwrap();
+    let truth = perturbid_rs::linearize(
+        &model,
+        &mut Data::new(&model),
+        &op.q,
+        &op.qd,
+        &op.qdd,
+        Gravity::Included,
+    )
+    .unwrap();
+    let h = &truth.h + DMatrix::from_diagonal(&DVector::from_row_slice(&viscous));
+    for (what, a, b) in [
+        ("D", &lin.d, &truth.d),
+        ("H", &lin.h, &h),
+        ("G", &lin.g, &truth.g),
+        ("G_static", &lin.g_static, &truth.g_static),
+    ] {
+        let e = (a - b).norm() / b.norm();
+        assert!(e < 1e-8, "{what}: {e:e}");
+    }
+    // noisy torques: parameters no rigid body has; against finite differences of predict
+    let mut rng = Rng(8);
+    let noisy: Vec<f64> = tau.iter().map(|t| t + rng.uniform(-0.5, 0.5)).collect();
+    let fit = identify_base_parameters(&model, &states, &noisy, &options).unwrap();
+    let lin = fit.linearize(&model, &op.q, &op.qd, &op.qdd).unwrap();
+    let predict = |q: &[f64], qd: &[f64], qdd: &[f64]| -> DVector<f64> {
+        DVector::from_vec(
+            fit.predict(&model, &States::new(n, q, Some(qd), Some(qdd)).unwrap())
+                .unwrap(),
+        )
+    };
+    let t0 = predict(&op.q, &op.qd, &op.qdd);
+    assert!((&t0 - &lin.torque).norm() < 1e-10 * t0.norm());
+    let eps = 1e-6;
+    for j in 0..n {
+        for (what, var, jac) in [("D", 2, &lin.d), ("H", 1, &lin.h), ("G", 0, &lin.g)] {
+            let mut x = [op.q.clone(), op.qd.clone(), op.qdd.clone()];
+            x[var][j] += eps;
+            let up = predict(&x[0], &x[1], &x[2]);
+            x[var][j] -= 2.0 * eps;
+            let down = predict(&x[0], &x[1], &x[2]);
+            let fd = (up - down) / (2.0 * eps);
+            let e = (&fd - jac.column(j)).norm();
+            assert!(e < 1e-6 * (1.0 + fd.norm()), "{what} column {j}: {e:e}");
+        }
+    }
+}

@@ -150,7 +150,7 @@ class Robot:
         """Bias torque c(q, qd) + g(q), shape (n,) or (k, n)."""
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]:
         """Mass matrix M(q), shape (n, n) or (k, n, n)."""
-    def regressor(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, gravity: bool = True) -> NDArray[np.float64]:
+    def regressor(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, gravity: bool = True, friction: Union[str, Sequence[str], None] = None) -> NDArray[np.float64]:
         """Joint-torque regressor, shape (n, 10 b) or (k, n, 10 b): regressor @ parameters == rnea."""
     @property
     def parameters(self) -> NDArray[np.float64]:
@@ -300,6 +300,8 @@ class LocalModel:
     @property
     def diagnostics(self) -> dict[str, Any]:
         """offsets (experiment -> clock offset, s), reversals (list of dicts), warnings."""
+    def linearize(self, op: OperatingPoint) -> dict[str, Any]:
+        """torque (n,), D, H, G (n, n) and G_static (n, n) or None at op."""
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:
         """Predicted torques (N m), shape (n,) or (k, n)."""
     def to_json(self) -> str: ...
@@ -447,6 +449,8 @@ class BaseParameterModel:
     def cond(self) -> float: ...
     @property
     def samples(self) -> int: ...
+    def linearize(self, op: OperatingPoint) -> dict[str, Any]:
+        """torque (n,), D, H, G (n, n) and G_static (n, n) or None at op."""
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]: ...
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]: ...
     def to_json(self) -> str: ...
@@ -469,6 +473,8 @@ class GlobalLinearModel:
     def cond(self) -> float: ...
     @property
     def op(self) -> OperatingPoint: ...
+    def linearize(self, op: OperatingPoint) -> dict[str, Any]:
+        """torque (n,), D, H, G (n, n) and G_static (n, n) or None at op."""
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]: ...
     def to_json(self) -> str: ...
 

@@ -39,6 +39,20 @@ pub fn dynamic_parameters(inertia: &Inertia) -> [f64; 10] {
     ]
 }
 
+/// The inertia with the 10 parameters `p` (the inverse of [`dynamic_parameters`]); `None` when
+/// the mass is not positive (the centre of mass `h / m` is then undefined). The rotational
+/// inertia need not be one a rigid body can have: the algorithms are linear in it.
+pub fn inertia_from_parameters(p: &[f64; 10]) -> Option<Inertia> {
+    let m = p[0];
+    if !(m > 0.0 && m.is_finite()) {
+        return None;
+    }
+    let com = nalgebra::Vector3::new(p[1], p[2], p[3]) / m;
+    let origin = nalgebra::Matrix3::new(p[4], p[5], p[7], p[5], p[6], p[8], p[7], p[8], p[9]);
+    let shift = (nalgebra::Matrix3::identity() * com.norm_squared() - com * com.transpose()) * m;
+    Some(Inertia::new(m, com, origin - shift))
+}
+
 /// The inertial parameters of every moving body, stacked (`10 * nbodies`), so that
 /// `Phi theta = rnea` for the model's own inertias.
 pub fn model_parameters(model: &Model) -> DVector<f64> {

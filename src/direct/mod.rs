@@ -4,6 +4,7 @@
 //! OLS/WLS identification, and the globally linearised model.
 
 pub mod base;
+pub mod base_linearization;
 pub mod excitation;
 pub mod global_linear;
 pub mod identify;

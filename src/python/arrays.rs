@@ -176,3 +176,21 @@ pub(crate) fn matrix(name: &str, a: &ArrayLike<'_>) -> Result<DMatrix<f64>> {
         }),
     }
 }
+
+/// A model's expansion at a point as a dict: `torque` (n,), `D`, `H`, `G` (n, n), `G_static`
+/// (n, n) or None.
+pub(crate) fn expansion_dict<'py>(
+    py: Python<'py>,
+    e: &crate::torque_model::Expansion,
+) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    let out = pyo3::types::PyDict::new(py);
+    out.set_item("torque", vec1(py, e.torque.as_slice()))?;
+    out.set_item("D", matrix_to_numpy(py, &e.d)?)?;
+    out.set_item("H", matrix_to_numpy(py, &e.h)?)?;
+    out.set_item("G", matrix_to_numpy(py, &e.g)?)?;
+    match &e.g_static {
+        Some(g) => out.set_item("G_static", matrix_to_numpy(py, g)?)?,
+        None => out.set_item("G_static", py.None())?,
+    }
+    Ok(out)
+}

@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use super::detached;
 use pyo3::types::PyDict;
 
-use super::arrays::{matrix_to_numpy as mat, read_batch, to_numpy, ArrayLike};
+use super::arrays::{expansion_dict, matrix_to_numpy as mat, read_batch, to_numpy, ArrayLike};
 use super::local::PyOperatingPoint;
 use super::robot::PyRobot;
 use super::trajectory::PyFourier;
@@ -24,6 +24,7 @@ use crate::direct::{
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::states::States;
+use crate::torque_model::TorqueModel;
 use crate::trajectory::FourierTrajectory;
 
 /// A designed excitation: `trajectory` (a FourierTrajectory), `cond` (cond of the base
@@ -244,6 +245,16 @@ impl PyBaseModel {
         })?;
         to_numpy(py, tau, batch.k, batch.single, &[n])
     }
+    /// The model linearised exactly at `op` (an OperatingPoint): dict `torque` (n,), `D`, `H`,
+    /// `G`, `G_static` (n, n; row = torque, column = joint), as a LocalModel answers it.
+    fn linearize<'py>(
+        &self,
+        py: Python<'py>,
+        op: &PyOperatingPoint,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let e = self.fit.on(&self.model)?.linearize(&op.op)?;
+        expansion_dict(py, &e)
+    }
     /// M(q) from the identified parameters: (n, n), or (k, n, n) for q of shape (k, n).
     fn mass_matrix<'py>(&self, py: Python<'py>, q: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
         let n = self.model.nv;
@@ -371,6 +382,15 @@ impl PyGlobalLinear {
         PyOperatingPoint {
             op: self.fit.op.clone(),
         }
+    }
+    /// The model at `op`: dict `torque` (n,), `D`, `H`, `G` (n, n; the same everywhere),
+    /// `G_static` None, as a LocalModel answers it.
+    fn linearize<'py>(
+        &self,
+        py: Python<'py>,
+        op: &PyOperatingPoint,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        expansion_dict(py, &TorqueModel::linearize(&self.fit, &op.op)?)
     }
     /// `T + D (qdd - qdd*) + H (qd - qd*) + G (q - q*)`: (n,) each or (k, n).
     fn predict<'py>(

@@ -558,6 +558,17 @@ impl PyLocalModel {
             Estimator::Combined => "combined",
         }
     }
+    /// The model at `op` (an OperatingPoint): dict `torque` (n,, its prediction there), `D`,
+    /// `H`, `G` (n, n; the same everywhere), `G_static` (n, n, or None without that
+    /// experiment): the question every identified model answers the same way.
+    fn linearize<'py>(
+        &self,
+        py: Python<'py>,
+        op: &PyOperatingPoint,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let e = crate::torque_model::TorqueModel::linearize(&self.model, &op.op)?;
+        super::arrays::expansion_dict(py, &e)
+    }
     /// Predicted torques (N m) at `q`, `qd`, `qdd`: shape `(n,)` each or a batch `(k, n)`;
     /// `T* + D (qdd - qdd*) + H (qd - qd*) + G (q - q*)` about the planned operating point.
     fn predict<'py>(

@@ -254,8 +254,11 @@ impl PyRobot {
     /// Joint-torque regressor Phi(q, qd, qdd): `Phi @ theta == rnea(q, qd, qdd)` with `theta`
     /// the 10 inertial parameters of every moving body in Pinocchio's order
     /// `[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]` (kg, kg m, kg m^2; about the body's
-    /// joint frame), body after body (see `parameters`). Returns (n, 10 b) or (k, n, 10 b).
-    #[pyo3(signature = (q, qd, qdd, gravity=true))]
+    /// joint frame), body after body (see `parameters`). With `friction` (a comma-separated
+    /// string or list from 'viscous', 'coulomb', 'offset'), those columns follow, joint after
+    /// joint: `qd_j`, `sign(qd_j)` (0 at rest), `1` in the rows of joint j (N m s/rad, N m, N m).
+    /// Returns (n, p) or (k, n, p), p = 10 b + (number of terms) n.
+    #[pyo3(signature = (q, qd, qdd, gravity=true, friction=None))]
     fn regressor<'py>(
         &self,
         py: Python<'py>,
@@ -263,12 +266,31 @@ impl PyRobot {
         qd: ArrayLike<'py>,
         qdd: ArrayLike<'py>,
         gravity: bool,
+        friction: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (n, p) = (self.model.nv, 10 * self.model.nbodies());
         let args = [("q", &q), ("qd", &qd), ("qdd", &qdd)];
-        self.batch(py, "Robot.regressor", &args, &[n, p], |m, w, s, out| {
-            parallel::regressor(m, w, s, gravity.into(), out)
-        })
+        let Some(friction) = friction else {
+            return self.batch(py, "Robot.regressor", &args, &[n, p], |m, w, s, out| {
+                parallel::regressor(m, w, s, gravity.into(), out)
+            });
+        };
+        let names: Vec<String> = match friction.extract::<String>() {
+            Ok(text) => text.split(',').map(|t| t.trim().to_string()).collect(),
+            Err(_) => friction.extract()?,
+        };
+        let terms = crate::direct::FrictionTerms::from_names(&names)?;
+        let layout = crate::direct::ParameterLayout::new(&self.model, terms);
+        let total = layout.len();
+        let batch = read_batch(n, &args)?;
+        let phi = detached(py, "Robot.regressor", || {
+            crate::direct::regressor_matrix(&self.model, &layout, &batch.states(n)?, gravity.into())
+        })?;
+        let rows: Vec<f64> = (0..phi.nrows())
+            .flat_map(|r| (0..total).map(move |c| (r, c)))
+            .map(|(r, c)| phi[(r, c)])
+            .collect();
+        to_numpy(py, rows, batch.k, batch.single, &[n, total])
     }
 
     /// The model's own inertial parameters, shape (10 b,), in the order of `regressor`.

@@ -186,3 +186,49 @@ def test_friction_options_say_what_they_do():
     for bad in [True, False, 3, ["viscous", "stiction"]]:
         with pytest.raises(pr.InputError, match="friction"):
             pr.identify_base_parameters(robot, q, qd, qdd, tau, friction=bad)
+
+
+def test_every_model_answers_linearize_the_same_way():
+    robot = pr.robots.a465()
+    op = pr.OperatingPoint(TABLE2_Q, [0.089, -0.106, 0.022, 0.056, 0.011, 0.014], [-0.155, -0.5, 0.034, -0.291, -0.008, 0.171])
+    traj = excitation(robot, 10, 0.05, 0.06, 3)
+    t = np.arange(0, traj.period, 0.02)
+    q, qd, qdd = traj.sample(t)
+    viscous = np.array([0.5, 0.4, 0.3, 0.2, 0.1, 0.05])
+    tau = robot.rnea(q, qd, qdd) + viscous * qd
+    truth = robot.linearize(op.q, op.qd, op.qdd)
+    base = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction="viscous", weighting="ols")
+    global_linear = pr.identify_global_linear(op, q, qd, qdd, tau)
+    plan = pr.plan_experiments(robot, op, design="orthogonal")
+    local = pr.identify_local(plan, pr.simulate(robot, plan, friction={"viscous": viscous}))
+    for name, model in [("base", base), ("global", global_linear), ("local", local)]:
+        e = model.linearize(op)
+        assert set(e) == {"torque", "D", "H", "G", "G_static"}, name
+        np.testing.assert_allclose(e["torque"], model.predict(op.q, op.qd, op.qdd), atol=1e-9)
+        assert e["D"].shape == e["H"].shape == e["G"].shape == (6, 6)
+    # the base-parameter model is the robot, exactly; the local one to its fit
+    e = base.linearize(op)
+    np.testing.assert_allclose(e["D"], truth.D, atol=1e-8)
+    np.testing.assert_allclose(e["H"], truth.H + np.diag(viscous), atol=1e-8)
+    np.testing.assert_allclose(e["G"], truth.G, atol=1e-7)
+    np.testing.assert_allclose(local.linearize(op)["D"], truth.D, atol=1e-6)
+    assert global_linear.linearize(op)["G_static"] is None
+
+
+def test_regressor_with_friction_columns():
+    robot = pr.robots.a465()
+    rng = np.random.default_rng(5)
+    q, qd, qdd = rng.uniform(-1, 1, (3, 4, 6))
+    rigid = robot.regressor(q, qd, qdd)
+    full = robot.regressor(q, qd, qdd, friction="viscous,coulomb,offset")
+    assert full.shape == (4, 6, 60 + 18)
+    np.testing.assert_allclose(full[:, :, :60], rigid, rtol=1e-12, atol=1e-12)
+    for j in range(6):
+        cols = full[:, :, 60 + 3 * j: 63 + 3 * j]
+        np.testing.assert_array_equal(cols[:, j, 0], qd[:, j])
+        np.testing.assert_array_equal(cols[:, j, 1], np.sign(qd[:, j]))
+        np.testing.assert_array_equal(cols[:, j, 2], 1.0)
+        others = [i for i in range(6) if i != j]
+        assert not cols[:, others, :].any()
+    with pytest.raises(pr.InputError, match="visous"):
+        robot.regressor(q, qd, qdd, friction="visous")
