@@ -152,6 +152,8 @@ class Robot:
         """Mass matrix M(q), shape (n, n) or (k, n, n)."""
     def regressor(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, gravity: bool = True, friction: Union[str, Sequence[str], None] = None) -> NDArray[np.float64]:
         """Joint-torque regressor, shape (n, 10 b) or (k, n, 10 b): regressor @ parameters == rnea."""
+    def physical_consistency(self, theta: Optional[ArrayLike] = None, friction: Union[str, Sequence[str], None] = None) -> tuple[bool, list[dict[str, Any]], list[tuple[str, float]]]:
+        """Per-body pseudo-inertia check of a full parameter vector (default: the model's)."""
     @property
     def parameters(self) -> NDArray[np.float64]:
         """The model's inertial parameters (10 per moving body, Pinocchio's order), shape (10 b,)."""

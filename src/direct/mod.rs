@@ -5,6 +5,7 @@
 
 pub mod base;
 pub mod base_linearization;
+pub mod consistency;
 pub mod excitation;
 pub mod global_linear;
 pub mod identify;
@@ -12,6 +13,7 @@ pub mod parameters;
 pub mod streaming;
 
 pub use base::BaseParameters;
+pub use consistency::{check_physical_consistency, BodyConsistency, ConsistencyReport};
 pub use excitation::{design_excitation, Criterion, ExcitationDesign, ExcitationOptions};
 pub use global_linear::{identify_global_linear, GlobalLinearModel};
 pub use identify::{identify_base_parameters, BaseModel, BaseOptions, Weighting};

@@ -69,6 +69,13 @@ impl PyRobot {
     }
 }
 
+/// `physical_consistency`'s answer: consistent, per-body dicts, negative friction terms.
+type Consistency<'py> = (
+    bool,
+    Vec<Bound<'py, pyo3::types::PyDict>>,
+    Vec<(String, f64)>,
+);
+
 fn load_options(
     lock: Option<BTreeMap<String, f64>>,
     check_triangle_inequality: bool,
@@ -291,6 +298,57 @@ impl PyRobot {
             .map(|(r, c)| phi[(r, c)])
             .collect();
         to_numpy(py, rows, batch.k, batch.single, &[n, total])
+    }
+
+    /// Physical consistency of a full parameter vector `theta` (default: the model's own
+    /// inertial parameters; with `friction` terms, as `regressor(..., friction=...)` orders
+    /// them): per body a dict `link`, `mass`, `eigenvalues` of the pseudo-inertia (ascending),
+    /// `relative_min` (smallest over largest; below -1e-9 is inconsistent) and `problem` (None
+    /// when consistent); returns `(consistent, bodies, negative_friction)` with
+    /// `negative_friction` a list of (name, value).
+    #[pyo3(signature = (theta=None, friction=None))]
+    fn physical_consistency<'py>(
+        &self,
+        py: Python<'py>,
+        theta: Option<ArrayLike<'py>>,
+        friction: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Consistency<'py>> {
+        let names: Vec<String> = match &friction {
+            None => vec![],
+            Some(f) => match f.extract::<String>() {
+                Ok(text) => text.split(',').map(|t| t.trim().to_string()).collect(),
+                Err(_) => f.extract()?,
+            },
+        };
+        let terms = if names.is_empty() {
+            crate::direct::FrictionTerms::NONE
+        } else {
+            crate::direct::FrictionTerms::from_names(&names)?
+        };
+        let layout = crate::direct::ParameterLayout::new(&self.model, terms);
+        let theta: Vec<f64> = match theta {
+            Some(t) => super::arrays::vector("theta", &t)?,
+            None => layout.model_parameters(&self.model).as_slice().to_vec(),
+        };
+        let report = crate::direct::check_physical_consistency(&layout, &theta)?;
+        let bodies = report
+            .bodies
+            .iter()
+            .map(|b| {
+                let d = pyo3::types::PyDict::new(py);
+                d.set_item("link", &b.link)?;
+                d.set_item("mass", b.mass)?;
+                d.set_item("eigenvalues", b.eigenvalues.to_vec())?;
+                d.set_item("relative_min", b.relative_min)?;
+                d.set_item("problem", b.problem.clone())?;
+                Ok(d)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        Ok((
+            report.is_consistent(),
+            bodies,
+            report.negative_friction.clone(),
+        ))
     }
 
     /// The model's own inertial parameters, shape (10 b,), in the order of `regressor`.

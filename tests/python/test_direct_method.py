@@ -232,3 +232,24 @@ def test_regressor_with_friction_columns():
         assert not cols[:, others, :].any()
     with pytest.raises(pr.InputError, match="visous"):
         robot.regressor(q, qd, qdd, friction="visous")
+
+
+def test_physical_consistency_against_pinocchio_pseudo_inertia():
+    import pinocchio as pin
+
+    physical = pr.robots.a465("physical")
+    ok, bodies, friction = physical.physical_consistency()
+    assert ok and friction == [] and len(bodies) == 6
+    fitted = pr.robots.a465()
+    ok, bodies, _ = fitted.physical_consistency()
+    assert not ok and any("pseudo-inertia" in (b["problem"] or "") for b in bodies)
+    # the eigenvalues are those of Pinocchio's pseudo-inertia of the same parameters
+    theta = fitted.parameters
+    for b, body in enumerate(bodies):
+        pi = pin.Inertia.FromDynamicParameters(theta[10 * b: 10 * b + 10])
+        expected = np.sort(np.linalg.eigvalsh(pi.toPseudoInertia().toMatrix()))
+        np.testing.assert_allclose(body["eigenvalues"], expected, atol=1e-12)
+    theta = physical.parameters.copy()
+    theta[0] = -1.0
+    ok, bodies, _ = physical.physical_consistency(theta)
+    assert not ok and bodies[0]["problem"] == "mass -1 kg is negative"
