@@ -10,6 +10,7 @@ pub mod crba;
 pub mod derivatives;
 pub mod forward_dynamics;
 pub mod kinematics;
+pub mod linearization_regressor;
 pub mod parallel;
 pub mod regressor;
 pub mod rnea;

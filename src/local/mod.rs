@@ -35,6 +35,7 @@ pub mod diagnostics;
 pub mod identify;
 pub mod model;
 pub mod operating_point;
+pub mod parameters;
 pub mod perturbation;
 pub mod plan;
 
@@ -43,5 +44,6 @@ pub use diagnostics::{BlockAgreement, ClockOffset, Diagnostics, Reversal, Revers
 pub use identify::{identify_local, CrossingTimes, IdentifyOptions};
 pub use model::{Estimate, Estimator, LocalModel};
 pub use operating_point::OperatingPoint;
+pub use parameters::{identify_parameters_from_local, FromLocalOptions, ParametersFromLocal};
 pub use perturbation::{Design, Size, Sizes};
 pub use plan::{plan_experiments, Crossing, Experiment, ExperimentKind, Plan, PlanOptions};

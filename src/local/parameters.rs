@@ -1,0 +1,255 @@
+//! The robot's parameters from local models (the paper's claim, section 9 of docs/method.md):
+//! T* (the whole torque at the point), D* = M(q*), and H*, G*, Gs where identified are all
+//! linear in the inertial and friction parameters, so local models at one or more operating
+//! points stack into one linear system ([`crate::algorithms::linearization_regressor`]),
+//! solved by weighted least squares with the models' standard errors.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::model::{Estimate, LocalModel};
+use crate::algorithms::linearization_regressor::linearization_regressor;
+use crate::direct::base::{BaseParameters, BASE_TOLERANCE};
+use crate::direct::{BaseModel, FrictionTerms, ParameterLayout, Weighting};
+use crate::document::Document;
+use crate::error::{Error, Result};
+use crate::gravity::Gravity;
+use crate::model::Model;
+use crate::regression::least_squares;
+
+/// Options of [`identify_parameters_from_local`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct FromLocalOptions {
+    /// Friction terms to identify with the inertial parameters (default none).
+    pub friction: FrictionTerms,
+    /// Whether the local models' torques include gravity (default true).
+    pub gravity: Gravity,
+    /// Which parts of the local models to use (default all: T*, D*, H*, G*, Gs).
+    pub use_torque: bool,
+    pub use_h: bool,
+    pub use_g: bool,
+    pub use_g_static: bool,
+}
+
+impl Default for FromLocalOptions {
+    fn default() -> Self {
+        Self {
+            friction: FrictionTerms::NONE,
+            gravity: Gravity::Included,
+            use_torque: true,
+            use_h: true,
+            use_g: true,
+            use_g_static: true,
+        }
+    }
+}
+
+/// The result: the identified parameters as a base-parameter model (predict, linearize, save
+/// like any), and what these points could identify.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParametersFromLocal {
+    /// The combinations the points identify, their values and standard errors.
+    pub model: BaseModel,
+    /// How many independent combinations the points identify.
+    pub rank: usize,
+    /// How many base parameters the robot has (identified from states spread over its
+    /// workspace): `rank == robot_rank` means every one was reached.
+    pub robot_rank: usize,
+    /// The robot's base parameters that these points cannot separate from the others (by the
+    /// name of the robot's base column); empty when `rank == robot_rank`.
+    pub unidentified: Vec<String>,
+    /// Rows of the stacked system used.
+    pub rows: usize,
+}
+
+/// Weight floor: standard errors below this fraction of the block's largest entry (noise-free
+/// models) are raised to it, so that no row gets an infinite weight.
+const WEIGHT_FLOOR: f64 = 1e-9;
+
+#[allow(clippy::too_many_arguments)]
+fn push_block(
+    x: &mut Vec<Vec<f64>>,
+    y: &mut Vec<f64>,
+    w: &mut Vec<f64>,
+    joint_of_row: &mut Vec<usize>,
+    regressor: &DMatrix<f64>,
+    values: &[f64],
+    stderr: &[f64],
+    nv: usize,
+) {
+    let scale = values.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let floor = WEIGHT_FLOOR * scale + 1e-12;
+    for (r, (&v, &se)) in values.iter().zip(stderr).enumerate() {
+        let se = if se.is_finite() {
+            se.max(floor)
+        } else {
+            floor.max(scale)
+        };
+        x.push(regressor.row(r).iter().map(|a| a / se).collect());
+        y.push(v / se);
+        w.push(se);
+        joint_of_row.push(if values.len() == nv { r } else { r / nv });
+    }
+}
+
+/// Row-major entries of a matrix (entry `(i, j)` at `i * n + j`).
+fn entries(m: &DMatrix<f64>) -> Vec<f64> {
+    (0..m.nrows())
+        .flat_map(|i| (0..m.ncols()).map(move |j| m[(i, j)]))
+        .collect()
+}
+
+/// The robot's inertial (and friction) parameters from local models at one or more operating
+/// points: see the module documentation. Each model's T*, D*, H*, G*, Gs (as `options` says,
+/// where identified) is a block of rows, each row divided by its standard error; the
+/// combinations the rows determine are found by a column-pivoted QR, and solved by least
+/// squares. The operating points are the models' planned ones (where T* holds).
+///
+/// Errors: no model, a model for other joints than `robot`'s.
+pub fn identify_parameters_from_local(
+    robot: &Model,
+    models: &[LocalModel],
+    options: &FromLocalOptions,
+) -> Result<ParametersFromLocal> {
+    let nv = robot.nv;
+    if models.is_empty() {
+        return Err(Error::InvalidArgument {
+            argument: "models".into(),
+            message: "no local model given".into(),
+        });
+    }
+    let layout = ParameterLayout::new(robot, options.friction);
+    let (mut x, mut y, mut w, mut joint) = (vec![], vec![], vec![], vec![]);
+    for (i, m) in models.iter().enumerate() {
+        crate::interrupt::check("parameters from local models")?;
+        if m.joint_names != robot.joint_names {
+            return Err(Error::InvalidArgument {
+                argument: format!("models[{i}]"),
+                message: format!(
+                    "identified for joints [{}]; the robot '{}' has [{}]",
+                    m.joint_names.join(", "),
+                    robot.name,
+                    robot.joint_names.join(", ")
+                ),
+            });
+        }
+        let op = &m.planned_op;
+        let reg = linearization_regressor(robot, &layout, &op.q, &op.qd, &op.qdd, options.gravity)?;
+        if options.use_torque {
+            push_block(
+                &mut x,
+                &mut y,
+                &mut w,
+                &mut joint,
+                &reg.torque,
+                &m.torque,
+                &m.torque_stderr,
+                nv,
+            );
+        }
+        let mut block = |e: &Option<Estimate>, r: &DMatrix<f64>| {
+            if let Some(e) = e {
+                push_block(
+                    &mut x,
+                    &mut y,
+                    &mut w,
+                    &mut joint,
+                    r,
+                    &entries(&e.matrix),
+                    &entries(&e.stderr),
+                    nv,
+                );
+            }
+        };
+        block(&m.d, &reg.d);
+        if options.use_h {
+            block(&m.h, &reg.h);
+        }
+        if options.use_g {
+            block(&m.g, &reg.g);
+        }
+        if options.use_g_static && options.gravity == Gravity::Included {
+            block(&m.g_static, &reg.g_static);
+        }
+    }
+    let rows = x.len();
+    let p = layout.len();
+    let phi = DMatrix::from_fn(rows, p, |r, c| x[r][c]);
+    // the pivoted QR wants at least as many rows as columns: zero rows change nothing
+    let padded = if rows < p {
+        phi.clone().resize_vertically(p, 0.0)
+    } else {
+        phi.clone()
+    };
+    let base = BaseParameters::from_regressor(layout.clone(), &padded, BASE_TOLERANCE)?;
+    let columns = base.names();
+    let ls = least_squares(
+        &base.select(&phi),
+        &DMatrix::from_column_slice(rows, 1, &y),
+        "parameters from local models",
+        &columns,
+    )?;
+    let theta: Vec<f64> = ls.coef.row(0).iter().copied().collect();
+    let stderr: Vec<f64> = ls.stderr.row(0).iter().copied().collect();
+    // residuals in N m (unweighted), by the torque row they belong to
+    let fitted = base.select(&phi) * DVector::from_column_slice(&theta);
+    let mut ss = vec![0.0; nv];
+    let mut count = vec![0usize; nv];
+    for r in 0..rows {
+        ss[joint[r]] += ((y[r] - fitted[r]) * w[r]).powi(2);
+        count[joint[r]] += 1;
+    }
+    let residual_rms = (0..nv)
+        .map(|j| (ss[j] / count[j].max(1) as f64).sqrt())
+        .collect();
+    let robot_base = BaseParameters::from_random_states(
+        robot,
+        &layout,
+        options.gravity,
+        20 * p,
+        BASE_TOLERANCE,
+        1,
+    )?;
+    // which of the robot's base columns the data cannot separate: the pivoted QR of the data
+    // restricted to those columns drops exactly them
+    let unidentified = if base.len() < robot_base.len() {
+        let mut masked = padded.clone();
+        for c in 0..p {
+            if !robot_base.kept.contains(&c) {
+                masked.column_mut(c).fill(0.0);
+            }
+        }
+        let within = BaseParameters::from_regressor(layout.clone(), &masked, BASE_TOLERANCE)?;
+        let names = robot_base.names();
+        robot_base
+            .kept
+            .iter()
+            .zip(names)
+            .filter(|(k, _)| within.dropped.contains(k))
+            .map(|(_, n)| n)
+            .collect()
+    } else {
+        vec![]
+    };
+    let rank = base.len();
+    let model = BaseModel {
+        format: BaseModel::tag(),
+        robot: robot.name.clone(),
+        joint_names: robot.joint_names.clone(),
+        base,
+        gravity: options.gravity,
+        weighting: Weighting::Wls,
+        theta,
+        stderr,
+        residual_rms,
+        sigma: vec![1.0; nv],
+        cond: ls.cond,
+        samples: rows,
+    };
+    Ok(ParametersFromLocal {
+        model,
+        rank,
+        robot_rank: robot_base.len(),
+        unidentified,
+        rows,
+    })
+}

@@ -1,0 +1,203 @@
+//! The robot's parameters from local models: the regressor of the linearisation against the
+//! robot's own linearisation and finite differences of the torque regressor, and the recovery
+//! of the base parameters from exact local models at a few operating points.
+
+mod common;
+
+use common::Rng;
+use nalgebra::{DMatrix, DVector};
+use perturbid_rs::algorithms::linearization_regressor::linearization_regressor;
+use perturbid_rs::direct::{regressor_matrix, FrictionTerms, ParameterLayout};
+use perturbid_rs::local::{
+    identify_parameters_from_local, Estimate, Estimator, FromLocalOptions, LocalModel,
+};
+use perturbid_rs::robots::a465;
+use perturbid_rs::{
+    linearize, mass_matrix, Data, Document, Gravity, Model, OperatingPoint, States,
+};
+
+fn random_op(model: &Model, rng: &mut Rng) -> OperatingPoint {
+    let n = model.nv;
+    let q = (0..n)
+        .map(|j| {
+            let l = &model.limits[j];
+            rng.uniform(0.8 * l.lower, 0.8 * l.upper)
+        })
+        .collect();
+    OperatingPoint::new(q, rng.vector(n, 0.5), rng.vector(n, 1.0)).unwrap()
+}
+
+#[test]
+fn the_linearisation_regressor_is_exact() {
+    let model = a465::model("physical").unwrap();
+    let n = model.nv;
+    let terms = FrictionTerms {
+        viscous: true,
+        coulomb: true,
+        offset: true,
+    };
+    let layout = ParameterLayout::new(&model, terms);
+    let theta = layout.model_parameters(&model);
+    let mut rng = Rng(11);
+    let op = random_op(&model, &mut rng);
+    let reg = linearization_regressor(&model, &layout, &op.q, &op.qd, &op.qdd, Gravity::Included)
+        .unwrap();
+    // Y theta == the robot's own linearisation (friction zero in the URDF)
+    let lin = linearize(
+        &model,
+        &mut Data::new(&model),
+        &op.q,
+        &op.qd,
+        &op.qdd,
+        Gravity::Included,
+    )
+    .unwrap();
+    let vec = |m: &DMatrix<f64>| {
+        DVector::from_iterator(n * n, (0..n).flat_map(|i| (0..n).map(move |j| m[(i, j)])))
+    };
+    let close = |a: DVector<f64>, b: DVector<f64>, what: &str| {
+        assert!(
+            (&a - &b).norm() < 1e-10 * (1.0 + b.norm()),
+            "{what}: {:e}",
+            (&a - &b).norm()
+        );
+    };
+    close(&reg.torque * &theta, lin.torque.clone(), "torque");
+    close(&reg.d * &theta, vec(&lin.d), "D");
+    close(&reg.h * &theta, vec(&lin.h), "H");
+    close(&reg.g * &theta, vec(&lin.g), "G");
+    close(&reg.g_static * &theta, vec(&lin.g_static), "G_static");
+    // column by column against central differences of the torque regressor
+    let phi = |q: &[f64], qd: &[f64], qdd: &[f64]| {
+        regressor_matrix(
+            &model,
+            &layout,
+            &States::new(n, q, Some(qd), Some(qdd)).unwrap(),
+            Gravity::Included,
+        )
+        .unwrap()
+    };
+    let eps = 1e-6;
+    for j in 0..n {
+        for (what, var, block) in [("G", 0, &reg.g), ("H", 1, &reg.h), ("D", 2, &reg.d)] {
+            let mut x = [op.q.clone(), op.qd.clone(), op.qdd.clone()];
+            if var == 1 && x[1][j].abs() < 2.0 * eps {
+                continue; // the Coulomb column steps at zero speed
+            }
+            x[var][j] += eps;
+            let up = phi(&x[0], &x[1], &x[2]);
+            x[var][j] -= 2.0 * eps;
+            let down = phi(&x[0], &x[1], &x[2]);
+            let fd = (up - down) / (2.0 * eps);
+            for i in 0..n {
+                let e = (fd.row(i) - block.row(i * n + j)).amax();
+                assert!(
+                    e < 1e-6 * (1.0 + fd.row(i).amax()),
+                    "{what}({i},{j}): {e:e}"
+                );
+            }
+        }
+    }
+}
+
+/// An exact local model at `op` (what noise-free data give for T*, D*, H*).
+fn exact_local(model: &Model, op: &OperatingPoint) -> LocalModel {
+    let n = model.nv;
+    let lin = linearize(
+        model,
+        &mut Data::new(model),
+        &op.q,
+        &op.qd,
+        &op.qdd,
+        Gravity::Included,
+    )
+    .unwrap();
+    let est = |m: &DMatrix<f64>| {
+        Some(Estimate {
+            matrix: m.clone(),
+            cond: 1.0,
+            residual_rms: vec![0.0; n],
+            stderr: DMatrix::from_element(n, n, 1e-9),
+            crossings: 2 * n,
+        })
+    };
+    LocalModel {
+        format: LocalModel::tag(),
+        robot: model.name.clone(),
+        joint_names: model.joint_names.clone(),
+        op: op.clone(),
+        planned_op: op.clone(),
+        estimator: Estimator::Separated,
+        torque: lin.torque.as_slice().to_vec(),
+        torque_stderr: vec![1e-9; n],
+        d: est(&lin.d),
+        h: est(&lin.h),
+        g: None,
+        g_static: None,
+        combined: None,
+        coulomb: None,
+        diagnostics: Default::default(),
+    }
+}
+
+#[test]
+fn exact_local_models_at_a_few_points_recover_the_base_parameters() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let mut rng = Rng(5);
+    let ops: Vec<OperatingPoint> = (0..4).map(|_| random_op(&model, &mut rng)).collect();
+    let models: Vec<LocalModel> = ops.iter().map(|op| exact_local(&model, op)).collect();
+    // D* alone at one point leaves base parameters unidentified, and says which
+    let d_only = FromLocalOptions {
+        use_torque: false,
+        use_h: false,
+        ..FromLocalOptions::default()
+    };
+    let one = identify_parameters_from_local(&model, &models[..1], &d_only).unwrap();
+    assert!(
+        one.rank < one.robot_rank && !one.unidentified.is_empty(),
+        "{} of {}",
+        one.rank,
+        one.robot_rank
+    );
+    assert_eq!(
+        one.unidentified.len(),
+        one.robot_rank - one.rank,
+        "{:?}",
+        one.unidentified
+    );
+    // T*, D*, H* at four points: every base parameter, to 1e-8
+    let fit =
+        identify_parameters_from_local(&model, &models, &FromLocalOptions::default()).unwrap();
+    assert_eq!(
+        fit.rank, fit.robot_rank,
+        "unidentified: {:?}",
+        fit.unidentified
+    );
+    let q = a465::TABLE2_Q;
+    let mut data = Data::new(&model);
+    mass_matrix(&model, &mut data, &q).unwrap();
+    let m = fit.model.mass_matrix(&model, &q).unwrap();
+    let e = (&m - &data.m).norm() / data.m.norm();
+    assert!(e < 1e-8, "M(q*) {e:e}");
+    let held_out = random_op(&model, &mut rng);
+    let lin = linearize(
+        &model,
+        &mut Data::new(&model),
+        &held_out.q,
+        &held_out.qd,
+        &held_out.qdd,
+        Gravity::Included,
+    )
+    .unwrap();
+    let states = States::new(n, &held_out.q, Some(&held_out.qd), Some(&held_out.qdd)).unwrap();
+    let tau = DVector::from_vec(fit.model.predict(&model, &states).unwrap());
+    assert!((&tau - &lin.torque).norm() < 1e-8 * lin.torque.norm());
+    // a model for another robot is refused by name
+    let other = a465::model("physical").unwrap();
+    let mut wrong = models[0].clone();
+    wrong.joint_names[0] = "shoulder".into();
+    let e =
+        identify_parameters_from_local(&other, &[wrong], &FromLocalOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("models[0]"), "{e}");
+}
