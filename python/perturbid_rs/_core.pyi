@@ -35,6 +35,7 @@ __all__ = [
     "identify_base_parameters",
     "identify_global_linear",
     "identify_local",
+    "identify_parameters_from_local",
     "plan_experiments",
     "preprocess",
     "simulate",
@@ -389,6 +390,16 @@ def identify_local(
     friction_aware_h: bool = False,
 ) -> LocalModel:
     """The local model from a plan and one recording per experiment."""
+
+def identify_parameters_from_local(
+    robot: Robot,
+    models: list[LocalModel],
+    *,
+    friction: Union[str, Sequence[str], None] = None,
+    gravity: bool = True,
+    use: Optional[Sequence[str]] = None,
+) -> tuple["BaseParameterModel", dict[str, Any]]:
+    """The robot's base parameters from local models at one or more operating points."""
 
 # --- the direct method ----------------------------------------------------------------------
 

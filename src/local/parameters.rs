@@ -25,6 +25,7 @@ pub struct FromLocalOptions {
     pub gravity: Gravity,
     /// Which parts of the local models to use (default all: T*, D*, H*, G*, Gs).
     pub use_torque: bool,
+    pub use_d: bool,
     pub use_h: bool,
     pub use_g: bool,
     pub use_g_static: bool,
@@ -36,6 +37,7 @@ impl Default for FromLocalOptions {
             friction: FrictionTerms::NONE,
             gravity: Gravity::Included,
             use_torque: true,
+            use_d: true,
             use_h: true,
             use_g: true,
             use_g_static: true,
@@ -160,7 +162,9 @@ pub fn identify_parameters_from_local(
                 );
             }
         };
-        block(&m.d, &reg.d);
+        if options.use_d {
+            block(&m.d, &reg.d);
+        }
         if options.use_h {
             block(&m.h, &reg.h);
         }

@@ -176,8 +176,8 @@ fn states<'a>(
 /// - `predict(q, qd, qdd)` torques; `mass_matrix(q)` M(q) from the identified parameters.
 #[pyclass(name = "BaseParameterModel", module = "perturbid_rs", frozen)]
 pub(crate) struct PyBaseModel {
-    fit: BaseModel,
-    model: Arc<Model>,
+    pub(crate) fit: BaseModel,
+    pub(crate) model: Arc<Model>,
 }
 
 #[pymethods]

@@ -607,3 +607,71 @@ impl PyLocalModel {
         )
     }
 }
+
+/// The robot's parameters from local models at one or more operating points: T*, D*, H*, G*,
+/// Gs (those identified, and switched on by `use`, a subset of ['torque', 'D', 'H', 'G',
+/// 'G_static']) stacked into one linear system in the inertial parameters (and the
+/// `friction` terms: a comma-separated string or list from 'viscous', 'coulomb', 'offset'),
+/// weighted by the models' standard errors. `gravity`: whether the models' torques include
+/// gravity. Returns `(model, info)`: a BaseParameterModel of the combinations the points
+/// identify, and a dict `rank`, `robot_rank` (the robot's base parameters), `unidentified`
+/// (the robot's base parameters these points cannot separate) and `rows`.
+#[pyfunction]
+#[pyo3(signature = (robot, models, *, friction=None, gravity=true, r#use=None))]
+pub(crate) fn identify_parameters_from_local<'py>(
+    py: Python<'py>,
+    robot: &PyRobot,
+    models: Vec<PyRef<'py, PyLocalModel>>,
+    friction: Option<Bound<'py, PyAny>>,
+    gravity: bool,
+    r#use: Option<Vec<String>>,
+) -> PyResult<(super::direct::PyBaseModel, Bound<'py, PyDict>)> {
+    use crate::local::{identify_parameters_from_local as from_local, FromLocalOptions};
+    let names: Vec<String> = match &friction {
+        None => vec![],
+        Some(f) => match f.extract::<String>() {
+            Ok(text) => text.split(',').map(|t| t.trim().to_string()).collect(),
+            Err(_) => f.extract()?,
+        },
+    };
+    let mut options = FromLocalOptions {
+        gravity: gravity.into(),
+        ..FromLocalOptions::default()
+    };
+    if !names.is_empty() {
+        options.friction = crate::direct::FrictionTerms::from_names(&names)?;
+    }
+    if let Some(parts) = r#use {
+        const KNOWN: [&str; 5] = ["torque", "D", "H", "G", "G_static"];
+        if let Some(bad) = parts.iter().find(|p| !KNOWN.contains(&p.as_str())) {
+            return Err(Error::InvalidArgument {
+                argument: "use".into(),
+                message: format!("'{bad}'; expected some of {}", KNOWN.join(", ")),
+            }
+            .into());
+        }
+        let on = |k: &str| parts.iter().any(|p| p == k);
+        options.use_torque = on("torque");
+        options.use_d = on("D");
+        options.use_h = on("H");
+        options.use_g = on("G");
+        options.use_g_static = on("G_static");
+    }
+    let local: Vec<LocalModel> = models.iter().map(|m| m.model.clone()).collect();
+    let model = &robot.model;
+    let out = detached(py, "identify_parameters_from_local", || {
+        from_local(model, &local, &options)
+    })?;
+    let info = PyDict::new(py);
+    info.set_item("rank", out.rank)?;
+    info.set_item("robot_rank", out.robot_rank)?;
+    info.set_item("unidentified", out.unidentified.clone())?;
+    info.set_item("rows", out.rows)?;
+    Ok((
+        super::direct::PyBaseModel {
+            fit: out.model,
+            model: Arc::new(model.clone()),
+        },
+        info,
+    ))
+}

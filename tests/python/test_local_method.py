@@ -220,3 +220,23 @@ def test_velocity_reversals_between_h_passes():
     steps = model.coulomb
     assert steps is not None and steps["joint1"] == pytest.approx(0.7, abs=1e-6)
     assert pr.identify_local(aware, pr.simulate(robot, aware, friction=None)).coulomb is None
+
+
+def test_parameters_from_identified_local_models():
+    robot = pr.robots.a465()
+    q, qd, qdd = (np.array(v, dtype=float) for v in TABLE2)
+    models = []
+    for k, shift in enumerate([0.0, 0.3, -0.3]):
+        op = pr.OperatingPoint(q + shift * np.array([1, 0.5, 0.5, 1, 0.3, 1]), qd, qdd)
+        plan = pr.plan_experiments(robot, op, experiments=["nominal", "H", "D"], design="orthogonal", seed=k)
+        models.append(pr.identify_local(plan, pr.simulate(robot, plan, friction=None)))
+    fit, info = pr.identify_parameters_from_local(robot, models, use=["torque", "D", "H"])
+    assert info["rank"] <= info["robot_rank"] and info["rows"] == 3 * (6 + 72)
+    assert len(info["unidentified"]) == info["robot_rank"] - info["rank"]
+    # whatever these three points identify, they predict the torques there
+    for m in models:
+        op = m.planned_op
+        np.testing.assert_allclose(fit.predict(op.q, op.qd, op.qdd), m.torque, atol=1e-6)
+        np.testing.assert_allclose(fit.mass_matrix(op.q), m.D, atol=1e-6)
+    with pytest.raises(pr.InputError, match="'Q'"):
+        pr.identify_parameters_from_local(robot, models, use=["Q"])
