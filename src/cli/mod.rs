@@ -6,6 +6,7 @@ mod files;
 mod info;
 mod local;
 mod paper;
+mod parameters;
 mod progress;
 
 use std::ffi::OsString;
@@ -48,6 +49,9 @@ enum Command {
     IdentifyDirect(direct::IdentifyDirectArgs),
     /// Torques predicted by a saved model (local or base-parameter) at the states of a CSV.
     Predict(direct::PredictArgs),
+    /// The robot's base parameters from local models at one or more operating points: writes
+    /// a base-parameter model (JSON) and says which parameters the points leave unidentified.
+    Parameters(parameters::ParametersArgs),
     /// Reproduce the paper (Tables 2 and 3, Figs. 3-5) on the built-in A465: report.md, CSV,
     /// JSON and SVG figures in --out.
     Paper(paper::PaperArgs),
@@ -67,6 +71,7 @@ fn run(cli: Cli) -> Result<String> {
         Command::Excite(a) => direct::excite(a),
         Command::IdentifyDirect(a) => direct::identify_direct(a),
         Command::Predict(a) => direct::predict(a),
+        Command::Parameters(a) => parameters::run(a),
         Command::Paper(a) => paper::run(a),
     }
 }

@@ -1,0 +1,70 @@
+//! `perturbid parameters`: the robot's base parameters from local models.
+
+use std::fmt::Write;
+use std::path::PathBuf;
+
+use clap::Args;
+
+use super::files::{load_robot, refuse_overwriting_inputs};
+use crate::direct::FrictionTerms;
+use crate::document::Document;
+use crate::error::Result;
+use crate::gravity::Gravity;
+use crate::local::{identify_parameters_from_local, FromLocalOptions, LocalModel};
+
+#[derive(Args)]
+pub(crate) struct ParametersArgs {
+    /// The robot (URDF file or built-in name).
+    robot: String,
+    /// Local models (local_model.json from `perturbid identify`), at one or more operating
+    /// points.
+    #[arg(required = true)]
+    models: Vec<PathBuf>,
+    /// Where to write the identified base parameters (a base-parameter model, JSON).
+    #[arg(long, default_value = "parameters.json")]
+    out: PathBuf,
+    /// Friction terms to identify too, comma separated from viscous, coulomb, offset; or none.
+    #[arg(long, default_value = "none")]
+    friction: FrictionTerms,
+    /// The models' torques exclude gravity.
+    #[arg(long)]
+    no_gravity: bool,
+}
+
+pub(crate) fn run(a: ParametersArgs) -> Result<String> {
+    let mut inputs: Vec<&std::path::Path> = a.models.iter().map(PathBuf::as_path).collect();
+    inputs.push(std::path::Path::new(&a.robot));
+    refuse_overwriting_inputs(&a.out, &inputs)?;
+    let robot = load_robot(&a.robot)?;
+    let models: Vec<LocalModel> = a
+        .models
+        .iter()
+        .map(LocalModel::load)
+        .collect::<Result<_>>()?;
+    let options = FromLocalOptions {
+        friction: a.friction,
+        gravity: Gravity::from(!a.no_gravity),
+        ..FromLocalOptions::default()
+    };
+    let fit = identify_parameters_from_local(&robot, &models, &options)?;
+    fit.model.save(&a.out)?;
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{} of the robot's {} base parameters identified from {} operating point(s), {} equations, cond {:.3e} -> {}",
+        fit.rank,
+        fit.robot_rank,
+        models.len(),
+        fit.rows,
+        fit.model.cond,
+        a.out.display()
+    );
+    if !fit.unidentified.is_empty() {
+        let _ = writeln!(
+            out,
+            "not separated by these points (add operating points): {}",
+            fit.unidentified.join("; ")
+        );
+    }
+    Ok(out)
+}
