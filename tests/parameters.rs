@@ -201,3 +201,47 @@ fn exact_local_models_at_a_few_points_recover_the_base_parameters() {
         identify_parameters_from_local(&other, &[wrong], &FromLocalOptions::default()).unwrap_err();
     assert!(e.to_string().contains("models[0]"), "{e}");
 }
+
+/// From one point whose D* leaves base parameters unidentified, the suggested points reach
+/// every one, and exact local models there recover them.
+#[test]
+fn suggested_operating_points_reach_full_rank() {
+    use perturbid_rs::local::suggest_operating_points;
+    let model = a465::model("kinsheel2010").unwrap();
+    let start = OperatingPoint::new(
+        a465::TABLE2_Q.to_vec(),
+        a465::TABLE2_QD.to_vec(),
+        a465::TABLE2_QDD.to_vec(),
+    )
+    .unwrap();
+    let options = FromLocalOptions {
+        use_g: false,
+        use_g_static: false,
+        ..FromLocalOptions::default()
+    };
+    let first =
+        identify_parameters_from_local(&model, &[exact_local(&model, &start)], &options).unwrap();
+    assert!(first.rank < first.robot_rank);
+    let picks =
+        suggest_operating_points(&model, std::slice::from_ref(&start), &options, 60, 3, 7).unwrap();
+    assert_eq!(picks.len(), 3);
+    assert!(picks.windows(2).all(|w| w[1].log_det >= w[0].log_det));
+    let last = picks.last().unwrap();
+    assert_eq!(
+        last.rank,
+        first.robot_rank,
+        "{:?}",
+        picks.iter().map(|p| p.rank).collect::<Vec<_>>()
+    );
+    for p in &picks {
+        for j in 0..model.nv {
+            let l = &model.limits[j];
+            assert!(p.op.q[j] >= l.lower && p.op.q[j] <= l.upper);
+        }
+    }
+    let mut models = vec![exact_local(&model, &start)];
+    models.extend(picks.iter().map(|p| exact_local(&model, &p.op)));
+    let fit = identify_parameters_from_local(&model, &models, &options).unwrap();
+    assert_eq!(fit.rank, fit.robot_rank);
+    assert!(fit.unidentified.is_empty());
+}

@@ -36,6 +36,7 @@ __all__ = [
     "identify_global_linear",
     "identify_local",
     "identify_parameters_from_local",
+    "suggest_operating_points",
     "plan_experiments",
     "preprocess",
     "simulate",
@@ -400,6 +401,17 @@ def identify_parameters_from_local(
     use: Optional[Sequence[str]] = None,
 ) -> tuple["BaseParameterModel", dict[str, Any]]:
     """The robot's base parameters from local models at one or more operating points."""
+
+def suggest_operating_points(
+    robot: Robot,
+    existing: Sequence[OperatingPoint] = ...,
+    *,
+    candidates: int = 200,
+    count: int = 3,
+    seed: int = 0,
+    use: Optional[Sequence[str]] = None,
+) -> list[tuple[OperatingPoint, int]]:
+    """Operating points to add (greedy D-optimal), each with the base rank reached."""
 
 # --- the direct method ----------------------------------------------------------------------
 

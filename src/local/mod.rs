@@ -38,6 +38,7 @@ pub mod operating_point;
 pub mod parameters;
 pub mod perturbation;
 pub mod plan;
+pub mod point_design;
 
 pub use crossing::{values_at, values_at_with, CrossingValues, FitOptions, TorqueFit};
 pub use diagnostics::{BlockAgreement, ClockOffset, Diagnostics, Reversal, ReversalHandling};
@@ -47,3 +48,4 @@ pub use operating_point::OperatingPoint;
 pub use parameters::{identify_parameters_from_local, FromLocalOptions, ParametersFromLocal};
 pub use perturbation::{Design, Size, Sizes};
 pub use plan::{plan_experiments, Crossing, Experiment, ExperimentKind, Plan, PlanOptions};
+pub use point_design::{suggest_operating_points, SuggestedPoint};

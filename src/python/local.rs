@@ -675,3 +675,48 @@ pub(crate) fn identify_parameters_from_local<'py>(
         info,
     ))
 }
+
+/// Operating points to add so that local models there identify every base parameter: greedy
+/// D-optimal choice of `count` points among `candidates` random ones within the limits
+/// (seeded), given the points already used (`existing`, OperatingPoints). `use` and `friction`
+/// as in `identify_parameters_from_local`. Returns a list of `(OperatingPoint, rank)`: the
+/// base parameters identified once that point is added.
+#[pyfunction]
+#[pyo3(signature = (robot, existing=Vec::new(), *, candidates=200, count=3, seed=0, r#use=None))]
+pub(crate) fn suggest_operating_points(
+    py: Python<'_>,
+    robot: &PyRobot,
+    existing: Vec<PyRef<'_, PyOperatingPoint>>,
+    candidates: usize,
+    count: usize,
+    seed: u64,
+    r#use: Option<Vec<String>>,
+) -> PyResult<Vec<(PyOperatingPoint, usize)>> {
+    use crate::local::{suggest_operating_points as suggest, FromLocalOptions};
+    let mut options = FromLocalOptions::default();
+    if let Some(parts) = r#use {
+        const KNOWN: [&str; 5] = ["torque", "D", "H", "G", "G_static"];
+        if let Some(bad) = parts.iter().find(|p| !KNOWN.contains(&p.as_str())) {
+            return Err(Error::InvalidArgument {
+                argument: "use".into(),
+                message: format!("'{bad}'; expected some of {}", KNOWN.join(", ")),
+            }
+            .into());
+        }
+        let on = |k: &str| parts.iter().any(|p| p == k);
+        options.use_torque = on("torque");
+        options.use_d = on("D");
+        options.use_h = on("H");
+        options.use_g = on("G");
+        options.use_g_static = on("G_static");
+    }
+    let existing: Vec<OperatingPoint> = existing.iter().map(|o| o.op.clone()).collect();
+    let model = &robot.model;
+    let picks = detached(py, "suggest_operating_points", || {
+        suggest(model, &existing, &options, candidates, count, seed)
+    })?;
+    Ok(picks
+        .into_iter()
+        .map(|p| (PyOperatingPoint { op: p.op }, p.rank))
+        .collect())
+}

@@ -52,6 +52,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<rehearsal::PyTrueRobot>()?;
     m.add_function(wrap_pyfunction!(local::identify_local, m)?)?;
     m.add_function(wrap_pyfunction!(local::identify_parameters_from_local, m)?)?;
+    m.add_function(wrap_pyfunction!(local::suggest_operating_points, m)?)?;
     m.add_class::<trajectory::PyFourier>()?;
     m.add_class::<direct::PyExcitationDesign>()?;
     m.add_class::<direct::PyBaseModel>()?;

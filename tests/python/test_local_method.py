@@ -240,3 +240,13 @@ def test_parameters_from_identified_local_models():
         np.testing.assert_allclose(fit.mass_matrix(op.q), m.D, atol=1e-6)
     with pytest.raises(pr.InputError, match="'Q'"):
         pr.identify_parameters_from_local(robot, models, use=["Q"])
+
+
+def test_suggested_operating_points_reach_every_base_parameter():
+    robot = pr.robots.a465()
+    start = pr.OperatingPoint(*TABLE2)
+    picks = pr.suggest_operating_points(robot, [start], candidates=40, count=3, use=["torque", "D", "H"])
+    assert len(picks) == 3 and picks[-1][1] == 36
+    assert all(isinstance(op, pr.OperatingPoint) for op, _ in picks)
+    with pytest.raises(pr.InputError, match="candidates"):
+        pr.suggest_operating_points(robot, candidates=0)
