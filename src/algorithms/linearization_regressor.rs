@@ -120,15 +120,7 @@ pub fn linearization_regressor(
                     out.torque[(j, col)] = v;
                     out.h[(j * nv + j, col)] = 1.0;
                 }
-                "coulomb" => {
-                    out.torque[(j, col)] = if v > 0.0 {
-                        1.0
-                    } else if v < 0.0 {
-                        -1.0
-                    } else {
-                        0.0
-                    }
-                }
+                "coulomb" => out.torque[(j, col)] = crate::direct::parameters::sign0(v),
                 _ => out.torque[(j, col)] = 1.0,
             }
             col += 1;

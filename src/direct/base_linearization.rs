@@ -13,6 +13,7 @@
 use nalgebra::DMatrix;
 
 use super::identify::BaseModel;
+use super::parameters::sign0;
 use crate::algorithms::regressor::inertia_from_parameters;
 use crate::data::Data;
 use crate::error::{Error, Result};
@@ -109,15 +110,5 @@ impl BaseModel {
             });
         }
         Ok(out)
-    }
-}
-
-fn sign0(x: f64) -> f64 {
-    if x > 0.0 {
-        1.0
-    } else if x < 0.0 {
-        -1.0
-    } else {
-        0.0
     }
 }

@@ -199,3 +199,15 @@ pub(crate) fn fill_regressor(
     }
     Ok(())
 }
+
+/// `sign(x)` with `sign(0) = 0`: the Coulomb column of the friction terms (no torque at
+/// exactly zero speed).
+pub fn sign0(x: f64) -> f64 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}

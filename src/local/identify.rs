@@ -11,6 +11,7 @@ use super::diagnostics::{BlockAgreement, ClockOffset, Diagnostics, Reversal, Rev
 use super::model::{CoulombSteps, Estimate, Estimator, LocalModel};
 use super::operating_point::OperatingPoint;
 use super::plan::{Experiment, ExperimentKind, Plan};
+use crate::direct::parameters::sign0;
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::recording::Recording;
@@ -686,17 +687,6 @@ fn friction_aware_h(
         crossings: k,
     };
     Ok((estimate, steps))
-}
-
-/// `sign(x)` with `sign(0) = 0`.
-fn sign0(x: f64) -> f64 {
-    if x > 0.0 {
-        1.0
-    } else if x < 0.0 {
-        -1.0
-    } else {
-        0.0
-    }
 }
 
 /// The diagnostics of an identification from the values read: the offsets, the reversals

@@ -194,3 +194,41 @@ pub(crate) fn expansion_dict<'py>(
     }
     Ok(out)
 }
+
+/// Friction terms from Python: None (none), a comma-separated string or a list of names from
+/// 'viscous', 'coulomb', 'offset' (or 'all', 'none').
+pub(crate) fn friction_terms(
+    value: Option<&Bound<'_, PyAny>>,
+) -> PyResult<crate::direct::FrictionTerms> {
+    let Some(value) = value else {
+        return Ok(crate::direct::FrictionTerms::NONE);
+    };
+    let names: Vec<String> = match value.extract::<String>() {
+        Ok(text) => text.split(',').map(|t| t.trim().to_string()).collect(),
+        Err(_) => value.extract()?,
+    };
+    Ok(crate::direct::FrictionTerms::from_names(&names)?)
+}
+
+/// The parts of local models to use, from Python's `use` (a subset of 'torque', 'D', 'H',
+/// 'G', 'G_static'; None: all), into `options`.
+pub(crate) fn local_parts(
+    parts: Option<Vec<String>>,
+    options: &mut crate::local::FromLocalOptions,
+) -> crate::error::Result<()> {
+    let Some(parts) = parts else { return Ok(()) };
+    const KNOWN: [&str; 5] = ["torque", "D", "H", "G", "G_static"];
+    if let Some(bad) = parts.iter().find(|p| !KNOWN.contains(&p.as_str())) {
+        return Err(crate::error::Error::InvalidArgument {
+            argument: "use".into(),
+            message: format!("'{bad}'; expected some of {}", KNOWN.join(", ")),
+        });
+    }
+    let on = |k: &str| parts.iter().any(|p| p == k);
+    options.use_torque = on("torque");
+    options.use_d = on("D");
+    options.use_h = on("H");
+    options.use_g = on("G");
+    options.use_g_static = on("G_static");
+    Ok(())
+}

@@ -627,36 +627,12 @@ pub(crate) fn identify_parameters_from_local<'py>(
     r#use: Option<Vec<String>>,
 ) -> PyResult<(super::direct::PyBaseModel, Bound<'py, PyDict>)> {
     use crate::local::{identify_parameters_from_local as from_local, FromLocalOptions};
-    let names: Vec<String> = match &friction {
-        None => vec![],
-        Some(f) => match f.extract::<String>() {
-            Ok(text) => text.split(',').map(|t| t.trim().to_string()).collect(),
-            Err(_) => f.extract()?,
-        },
-    };
     let mut options = FromLocalOptions {
         gravity: gravity.into(),
+        friction: super::arrays::friction_terms(friction.as_ref())?,
         ..FromLocalOptions::default()
     };
-    if !names.is_empty() {
-        options.friction = crate::direct::FrictionTerms::from_names(&names)?;
-    }
-    if let Some(parts) = r#use {
-        const KNOWN: [&str; 5] = ["torque", "D", "H", "G", "G_static"];
-        if let Some(bad) = parts.iter().find(|p| !KNOWN.contains(&p.as_str())) {
-            return Err(Error::InvalidArgument {
-                argument: "use".into(),
-                message: format!("'{bad}'; expected some of {}", KNOWN.join(", ")),
-            }
-            .into());
-        }
-        let on = |k: &str| parts.iter().any(|p| p == k);
-        options.use_torque = on("torque");
-        options.use_d = on("D");
-        options.use_h = on("H");
-        options.use_g = on("G");
-        options.use_g_static = on("G_static");
-    }
+    super::arrays::local_parts(r#use, &mut options)?;
     let local: Vec<LocalModel> = models.iter().map(|m| m.model.clone()).collect();
     let model = &robot.model;
     let out = detached(py, "identify_parameters_from_local", || {
@@ -694,22 +670,7 @@ pub(crate) fn suggest_operating_points(
 ) -> PyResult<Vec<(PyOperatingPoint, usize)>> {
     use crate::local::{suggest_operating_points as suggest, FromLocalOptions};
     let mut options = FromLocalOptions::default();
-    if let Some(parts) = r#use {
-        const KNOWN: [&str; 5] = ["torque", "D", "H", "G", "G_static"];
-        if let Some(bad) = parts.iter().find(|p| !KNOWN.contains(&p.as_str())) {
-            return Err(Error::InvalidArgument {
-                argument: "use".into(),
-                message: format!("'{bad}'; expected some of {}", KNOWN.join(", ")),
-            }
-            .into());
-        }
-        let on = |k: &str| parts.iter().any(|p| p == k);
-        options.use_torque = on("torque");
-        options.use_d = on("D");
-        options.use_h = on("H");
-        options.use_g = on("G");
-        options.use_g_static = on("G_static");
-    }
+    super::arrays::local_parts(r#use, &mut options)?;
     let existing: Vec<OperatingPoint> = existing.iter().map(|o| o.op.clone()).collect();
     let model = &robot.model;
     let picks = detached(py, "suggest_operating_points", || {

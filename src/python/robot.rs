@@ -282,11 +282,7 @@ impl PyRobot {
                 parallel::regressor(m, w, s, gravity.into(), out)
             });
         };
-        let names: Vec<String> = match friction.extract::<String>() {
-            Ok(text) => text.split(',').map(|t| t.trim().to_string()).collect(),
-            Err(_) => friction.extract()?,
-        };
-        let terms = crate::direct::FrictionTerms::from_names(&names)?;
+        let terms = super::arrays::friction_terms(Some(&friction))?;
         let layout = crate::direct::ParameterLayout::new(&self.model, terms);
         let total = layout.len();
         let batch = read_batch(n, &args)?;
@@ -313,18 +309,7 @@ impl PyRobot {
         theta: Option<ArrayLike<'py>>,
         friction: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Consistency<'py>> {
-        let names: Vec<String> = match &friction {
-            None => vec![],
-            Some(f) => match f.extract::<String>() {
-                Ok(text) => text.split(',').map(|t| t.trim().to_string()).collect(),
-                Err(_) => f.extract()?,
-            },
-        };
-        let terms = if names.is_empty() {
-            crate::direct::FrictionTerms::NONE
-        } else {
-            crate::direct::FrictionTerms::from_names(&names)?
-        };
+        let terms = super::arrays::friction_terms(friction.as_ref())?;
         let layout = crate::direct::ParameterLayout::new(&self.model, terms);
         let theta: Vec<f64> = match theta {
             Some(t) => super::arrays::vector("theta", &t)?,
