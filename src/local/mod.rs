@@ -31,7 +31,9 @@
 //! ```
 
 pub mod crossing;
+mod diagnose;
 pub mod diagnostics;
+mod friction_aware;
 pub mod identify;
 pub mod model;
 pub mod operating_point;

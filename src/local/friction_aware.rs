@@ -1,0 +1,112 @@
+//! The friction-aware H regression ([`super::IdentifyOptions::friction_aware_h`]): H* and each
+//! joint's Coulomb step from the differences of the H experiment's +- pairs, where the even
+//! rigid-body terms cancel and a reversed joint's step is its own column.
+
+use nalgebra::DMatrix;
+
+use super::identify::ExperimentValues;
+use super::model::{CoulombSteps, Estimate};
+use super::plan::{Experiment, Plan};
+use crate::direct::parameters::sign0;
+use crate::error::{Error, Result};
+use crate::regression::least_squares;
+
+/// H* and the Coulomb steps from the differences of the H experiment's +- pairs; see
+/// [`IdentifyOptions::friction_aware_h`]. One least-squares solve per torque row: the columns
+/// are the measured velocity differences and, where some pair reverses that row's joint, its
+/// step `sign(d_j)`.
+pub(super) fn friction_aware_h(
+    plan: &Plan,
+    e: &Experiment,
+    v: &ExperimentValues,
+) -> Result<(Estimate, CoulombSteps)> {
+    let n = plan.n();
+    let k = v.crossings.len();
+    let refuse = |message: String| Error::InvalidArgument {
+        argument: "friction_aware_h".into(),
+        message,
+    };
+    let paired = k % 2 == 0
+        && (0..k / 2).all(|i| {
+            (0..n).all(|j| {
+                let (a, b) = (e.deltas[(2 * i, j)], e.deltas[(2 * i + 1, j)]);
+                (a + b).abs() <= 1e-12 * a.abs().max(1e-300)
+            })
+        });
+    if !paired {
+        return Err(refuse(
+            "the H perturbations are not in +- pairs (plan with symmetric pairs)".into(),
+        ));
+    }
+    let m = k / 2;
+    let qd0 = &plan.op.qd;
+    let step = |i: usize, j: usize| {
+        let d = e.deltas[(2 * i, j)];
+        0.5 * (sign0(qd0[j] + d) - sign0(qd0[j] - d))
+    };
+    let reverses: Vec<bool> = (0..n).map(|j| (0..m).any(|i| step(i, j) != 0.0)).collect();
+    let needed = n + usize::from(reverses.iter().any(|&r| r));
+    if m < needed {
+        return Err(refuse(format!(
+            "{m} +- pairs of H passes for {needed} unknowns per joint; plan at least {} H passes (PlanOptions::friction_aware_h, --friction-aware-h)",
+            2 * needed
+        )));
+    }
+    let mut matrix = DMatrix::zeros(n, n);
+    let mut stderr = DMatrix::zeros(n, n);
+    let (mut cond, mut residual_rms) = (1.0f64, vec![0.0; n]);
+    let mut steps = CoulombSteps {
+        joint_names: plan.joint_names.clone(),
+        step: vec![None; n],
+        stderr: vec![None; n],
+    };
+    for j in 0..n {
+        let p = n + usize::from(reverses[j]);
+        let x = DMatrix::from_fn(m, p, |i, c| {
+            if c < n {
+                v.crossings[2 * i].qd[c] - v.crossings[2 * i + 1].qd[c]
+            } else {
+                step(i, j)
+            }
+        });
+        let y = DMatrix::from_fn(m, 1, |i, _| {
+            v.crossings[2 * i].tau[j] - v.crossings[2 * i + 1].tau[j]
+        });
+        let mut columns: Vec<String> = plan
+            .joint_names
+            .iter()
+            .map(|q| format!("dqd({q})"))
+            .collect();
+        if reverses[j] {
+            columns.push(format!("coulomb_step({})", plan.joint_names[j]));
+        }
+        let ls = least_squares(
+            &x,
+            &y,
+            &format!(
+                "friction-aware H regression, torque of joint '{}'",
+                plan.joint_names[j]
+            ),
+            &columns,
+        )?;
+        for c in 0..n {
+            matrix[(j, c)] = ls.coef[(0, c)];
+            stderr[(j, c)] = ls.stderr[(0, c)];
+        }
+        if reverses[j] {
+            steps.step[j] = Some(ls.coef[(0, n)]);
+            let se = ls.stderr[(0, n)];
+            steps.stderr[j] = se.is_finite().then_some(se);
+        }
+        cond = cond.max(ls.cond);
+        residual_rms[j] = ls.residual_rms[0];
+    }
+    let estimate = Estimate {
+        matrix,
+        cond,
+        residual_rms,
+        stderr,
+        crossings: k,
+    };
+    Ok((estimate, steps))
+}
