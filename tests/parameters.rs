@@ -245,3 +245,36 @@ fn suggested_operating_points_reach_full_rank() {
     assert_eq!(fit.rank, fit.robot_rank);
     assert!(fit.unidentified.is_empty());
 }
+
+/// A fit with as many equations as unknowns has unknown standard errors: the saved
+/// base-parameter model says `null` and loads back with NaN.
+#[test]
+fn a_base_model_without_residual_freedom_round_trips() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let start = OperatingPoint::new(
+        a465::TABLE2_Q.to_vec(),
+        a465::TABLE2_QD.to_vec(),
+        a465::TABLE2_QDD.to_vec(),
+    )
+    .unwrap();
+    let d_only = FromLocalOptions {
+        use_torque: false,
+        use_h: false,
+        use_g: false,
+        use_g_static: false,
+        ..FromLocalOptions::default()
+    };
+    let fit =
+        identify_parameters_from_local(&model, &[exact_local(&model, &start)], &d_only).unwrap();
+    let text = fit.model.to_json();
+    let back = perturbid_rs::direct::BaseModel::from_json(&text).unwrap();
+    assert_eq!(back.theta, fit.model.theta);
+    assert_eq!(
+        back.stderr.iter().map(|s| s.is_nan()).collect::<Vec<_>>(),
+        fit.model
+            .stderr
+            .iter()
+            .map(|s| s.is_nan())
+            .collect::<Vec<_>>()
+    );
+}

@@ -29,8 +29,9 @@ pub struct GlobalLinearModel {
     pub h: DMatrix<f64>,
     #[serde(with = "crate::json::rows")]
     pub g: DMatrix<f64>,
-    /// Standard errors of `[T D H G]` (`nv x (1 + 3 nv)`).
-    #[serde(with = "crate::json::rows")]
+    /// Standard errors of `[T D H G]` (`nv x (1 + 3 nv)`); NaN (`null` in JSON) without a
+    /// residual degree of freedom.
+    #[serde(with = "crate::json::stderr_rows")]
     pub stderr: DMatrix<f64>,
     pub residual_rms: Vec<f64>,
     pub cond: f64,

@@ -68,7 +68,8 @@ pub struct BaseModel {
     pub weighting: Weighting,
     /// The identified base parameters (SI units of each combination).
     pub theta: Vec<f64>,
-    /// Their standard errors.
+    /// Their standard errors; NaN (`null` in JSON) without a residual degree of freedom.
+    #[serde(with = "crate::json::stderr_vec")]
     pub stderr: Vec<f64>,
     /// Per joint, the RMS of the torque residuals of the fit (N m).
     pub residual_rms: Vec<f64>,
