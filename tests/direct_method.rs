@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{mimic_pair, random_tree_urdf, Rng};
+use common::{linearized, mimic_pair, random_tree_urdf, Rng};
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::algorithms::regressor::{joint_torque_regressor, model_parameters};
 use perturbid_rs::direct::{
@@ -688,15 +688,7 @@ fn base_model_linearisation_is_exact() {
     )
     .unwrap();
     let lin = fit.linearize(&model, &op.q, &op.qd, &op.qdd).unwrap();
-    let truth = perturbid_rs::linearize(
-        &model,
-        &mut Data::new(&model),
-        &op.q,
-        &op.qd,
-        &op.qdd,
-        Gravity::Included,
-    )
-    .unwrap();
+    let truth = linearized(&model, &op);
     let h = &truth.h + DMatrix::from_diagonal(&DVector::from_row_slice(&viscous));
     for (what, a, b) in [
         ("D", &lin.d, &truth.d),

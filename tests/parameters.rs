@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::Rng;
+use common::{linearized, table2, Rng};
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::algorithms::linearization_regressor::linearization_regressor;
 use perturbid_rs::direct::{regressor_matrix, FrictionTerms, ParameterLayout};
@@ -43,15 +43,7 @@ fn the_linearisation_regressor_is_exact() {
     let reg = linearization_regressor(&model, &layout, &op.q, &op.qd, &op.qdd, Gravity::Included)
         .unwrap();
     // Y theta == the robot's own linearisation (friction zero in the URDF)
-    let lin = linearize(
-        &model,
-        &mut Data::new(&model),
-        &op.q,
-        &op.qd,
-        &op.qdd,
-        Gravity::Included,
-    )
-    .unwrap();
+    let lin = linearized(&model, &op);
     let vec = |m: &DMatrix<f64>| {
         DVector::from_iterator(n * n, (0..n).flat_map(|i| (0..n).map(move |j| m[(i, j)])))
     };
@@ -208,12 +200,7 @@ fn exact_local_models_at_a_few_points_recover_the_base_parameters() {
 fn suggested_operating_points_reach_full_rank() {
     use perturbid_rs::local::suggest_operating_points;
     let model = a465::model("kinsheel2010").unwrap();
-    let start = OperatingPoint::new(
-        a465::TABLE2_Q.to_vec(),
-        a465::TABLE2_QD.to_vec(),
-        a465::TABLE2_QDD.to_vec(),
-    )
-    .unwrap();
+    let start = table2();
     let options = FromLocalOptions {
         use_g: false,
         use_g_static: false,
@@ -251,12 +238,7 @@ fn suggested_operating_points_reach_full_rank() {
 #[test]
 fn a_base_model_without_residual_freedom_round_trips() {
     let model = a465::model("kinsheel2010").unwrap();
-    let start = OperatingPoint::new(
-        a465::TABLE2_Q.to_vec(),
-        a465::TABLE2_QD.to_vec(),
-        a465::TABLE2_QDD.to_vec(),
-    )
-    .unwrap();
+    let start = table2();
     let d_only = FromLocalOptions {
         use_torque: false,
         use_h: false,

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{mat, rel, table2};
+use common::{linearized, mat, rel, table2};
 use nalgebra::DMatrix;
 use perturbid_rs::local::{
     identify_local, plan_experiments, CrossingTimes, IdentifyOptions, LocalModel, PlanOptions,
@@ -329,20 +329,11 @@ fn predict_expands_about_the_planned_operating_point() {
 #[test]
 fn the_combined_estimate_reports_when_it_is_not_to_be_trusted() {
     use perturbid_rs::local::Estimator;
-    use perturbid_rs::{linearize, Data};
     let model = a465::model("kinsheel2010").unwrap();
     let n = model.nv;
     let op = table2();
     let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
-    let truth = linearize(
-        &model,
-        &mut Data::new(&model),
-        &op.q,
-        &op.qd,
-        &op.qdd,
-        Gravity::Included,
-    )
-    .unwrap();
+    let truth = linearized(&model, &op);
     let mut sim = SimulationOptions::new(&model);
     sim.friction = Friction::none(n);
     let combined = IdentifyOptions {

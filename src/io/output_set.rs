@@ -96,7 +96,7 @@ impl OutputSet {
             argument: "output file name".into(),
             message: format!("'{name}' {why}"),
         };
-        if name.is_empty() || name.starts_with('.') || name.contains(['/', '\\', '\0']) {
+        if !is_plain_name(name) {
             return Err(bad(
                 "must be a plain, visible file name (no folder, not hidden)",
             ));

@@ -86,6 +86,23 @@ pub fn table2() -> perturbid_rs::OperatingPoint {
     .unwrap()
 }
 
+/// The robot's own linearisation at `op`, gravity included.
+pub fn linearized(
+    model: &perturbid_rs::Model,
+    op: &perturbid_rs::OperatingPoint,
+) -> perturbid_rs::Linearization {
+    let mut data = perturbid_rs::Data::new(model);
+    perturbid_rs::linearize(
+        model,
+        &mut data,
+        &op.q,
+        &op.qd,
+        &op.qdd,
+        perturbid_rs::Gravity::Included,
+    )
+    .unwrap()
+}
+
 /// |a - b| / |b| (Frobenius norms).
 pub fn rel(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
     (a - b).norm() / b.norm()
