@@ -26,10 +26,24 @@ pub fn check_range(name: &str, value: f64, low: f64, high: f64) -> Result<()> {
     if value.is_finite() && value >= low && value <= high {
         return Ok(());
     }
+    let expected = if low == f64::MIN_POSITIVE {
+        format!("a positive finite number up to {}", bound(high))
+    } else {
+        format!("a finite number in [{}, {}]", bound(low), bound(high))
+    };
     Err(Error::InvalidArgument {
         argument: name.into(),
-        message: format!("{value}; expected a finite number in [{low}, {high}]"),
+        message: format!("{value}; expected {expected}"),
     })
+}
+
+/// A range bound as a person reads it: `1e-9`, `0.5`, `1e7`.
+fn bound(x: f64) -> String {
+    if x != 0.0 && (x.abs() < 1e-3 || x.abs() >= 1e7) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
 }
 
 /// Fails unless the count `value` (the parameter `name`) is in `[low, high]`.
@@ -57,4 +71,23 @@ pub fn sample_count(what: &str, duration: f64, rate: f64) -> Result<usize> {
         });
     }
     Ok(count as usize + 1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn range_errors_print_their_bounds_readably() {
+        let e = check_range("rate", -1.0, f64::MIN_POSITIVE, MAX_RATE).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "rate: -1; expected a positive finite number up to 1e7"
+        );
+        let e = check_range("--periods", f64::NAN, 1e-9, 1e6).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "--periods: NaN; expected a finite number in [1e-9, 1000000]"
+        );
+    }
 }
