@@ -276,6 +276,15 @@ pub enum Error {
         message: String,
     },
 
+    /// A joint's armature (reflected rotor inertia) that cannot be used: not a number, negative,
+    /// given twice, or on a joint that does not drive its own degree of freedom.
+    #[error("{location}: joint '{joint}' armature: {message}")]
+    InvalidArmature {
+        location: Box<Location>,
+        joint: String,
+        message: String,
+    },
+
     /// A model with no degree of freedom: every joint is fixed or locked.
     #[error("{source_name}: robot '{robot}' has no moving joint (every joint is fixed or locked); nothing can be identified")]
     NoDegreeOfFreedom { source_name: String, robot: String },
@@ -327,6 +336,7 @@ impl Error {
             | Error::MissingLimit { .. }
             | Error::NonFiniteUrdf { .. }
             | Error::InvalidLimit { .. }
+            | Error::InvalidArmature { .. }
             | Error::NoDegreeOfFreedom { .. }
             | Error::UnknownRobot { .. } => ErrorKind::Model,
             Error::Interrupted { .. } => ErrorKind::Interrupted,

@@ -180,6 +180,10 @@ pub struct Model {
     pub joint_kinds: Vec<JointKind>,
     /// Limits and friction of every degree of freedom.
     pub limits: Vec<JointLimits>,
+    /// Armature of every degree of freedom: the motor's rotor inertia reflected to the joint
+    /// (kg m^2 or kg), as Pinocchio's `armature`; it adds `armature[i] * qdd[i]` to `tau[i]`
+    /// and `armature[i]` to `M[i, i]`. Zero unless the URDF gives it (see [`crate::urdf`]).
+    pub armature: Vec<f64>,
     /// Gravity acceleration in the base frame (m/s^2); `(0, 0, -9.81)`.
     pub gravity: Vector3<f64>,
     /// Name of the root (base) link.
@@ -245,6 +249,31 @@ impl Model {
             Motion::new(Vector3::zeros(), -self.gravity)
         } else {
             Motion::zeros()
+        }
+    }
+
+    /// Whether some degree of freedom has a non-zero armature.
+    #[inline]
+    pub fn has_armature(&self) -> bool {
+        self.armature.iter().any(|&a| a != 0.0)
+    }
+
+    /// Adds the armature torques `armature[i] * qdd[i]` to `tau` (both `nv`).
+    #[inline]
+    pub(crate) fn add_armature_torque(&self, qdd: &[f64], tau: &mut [f64]) {
+        if self.has_armature() {
+            for ((t, a), x) in tau.iter_mut().zip(&self.armature).zip(qdd) {
+                *t += a * x;
+            }
+        }
+    }
+
+    /// Adds the armature to the diagonal of the column-major `nv x nv` matrix `m`.
+    #[inline]
+    pub(crate) fn add_armature_inertia(&self, m: &mut [f64]) {
+        let n = self.nv;
+        for (i, a) in self.armature.iter().enumerate() {
+            m[i * n + i] += a;
         }
     }
 

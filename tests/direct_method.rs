@@ -179,6 +179,7 @@ fn base_parameter_identification_is_exact_without_noise() {
             viscous: true,
             coulomb: true,
             offset: false,
+            armature: false,
         };
         for weighting in [Weighting::Ols, Weighting::Wls] {
             let opts = BaseOptions {
@@ -677,6 +678,7 @@ fn base_model_linearisation_is_exact() {
             viscous: true,
             coulomb: true,
             offset: true,
+            armature: false,
         },
         ..BaseOptions::default()
     };
@@ -738,6 +740,7 @@ fn physical_consistency_is_checked_per_link() {
         viscous: true,
         coulomb: true,
         offset: true,
+        armature: false,
     };
     let physical = a465::model("physical").unwrap();
     let layout = ParameterLayout::new(&physical, friction);

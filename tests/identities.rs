@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{mimic_pair, random_tree_urdf, rel_err, Rng};
+use common::{a465_with_armature, mimic_pair, random_tree_urdf, rel_err, Rng};
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::Gravity;
 use perturbid_rs::{
@@ -462,5 +462,46 @@ fn mass_matrix_batch_equals_crba_on_the_a465_and_a_mimic_pair() {
         for k in [1, 4, 6] {
             check_mass_matrix_batch(&model, &mut rng, k);
         }
+    }
+}
+
+#[test]
+fn armature_adds_to_the_diagonal_and_every_algorithm_agrees() {
+    let model = a465_with_armature();
+    let expected = [
+        0.8,
+        0.5,
+        0.3,
+        1e-5 * 101.0f64.powi(2),
+        2e-5 * 1e4,
+        1e-5 * 101.0f64.powi(2),
+    ];
+    for (a, e) in model.armature.iter().zip(expected) {
+        assert!((a - e).abs() < 1e-12 * e, "{:?}", model.armature);
+    }
+    let bare = robots::a465::model("physical").unwrap();
+    let mut rng = Rng(21);
+    let n = model.nv;
+    for _ in 0..10 {
+        let (q, qd, qdd) = (rng.vector(n, 1.5), rng.vector(n, 2.0), rng.vector(n, 3.0));
+        // tau(armature) - tau(bare) = armature * qdd, M differs by the diagonal
+        let d = tau(&model, &q, &qd, &qdd, Gravity::Included)
+            - tau(&bare, &q, &qd, &qdd, Gravity::Included);
+        for j in 0..n {
+            assert!((d[j] - model.armature[j] * qdd[j]).abs() < 1e-10);
+        }
+        let (mut a, mut b) = (Data::new(&model), Data::new(&bare));
+        mass_matrix(&model, &mut a, &q).unwrap();
+        mass_matrix(&bare, &mut b, &q).unwrap();
+        let dm = &a.m - &b.m;
+        assert!(
+            (dm - DMatrix::from_diagonal(&DVector::from_column_slice(&model.armature))).amax()
+                < 1e-12
+        );
+        check_all_identities(&model, &mut rng);
+    }
+    for k in [1, 4, 5, 13] {
+        check_lanes(&model, &mut rng, k);
+        check_mass_matrix_batch(&model, &mut rng, k);
     }
 }

@@ -35,6 +35,7 @@ fn the_linearisation_regressor_is_exact() {
         viscous: true,
         coulomb: true,
         offset: true,
+        armature: false,
     };
     let layout = ParameterLayout::new(&model, terms);
     let theta = layout.model_parameters(&model);

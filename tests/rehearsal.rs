@@ -365,6 +365,7 @@ fn the_direct_method_recovers_the_true_robot_from_a_rehearsed_excitation() {
                 viscous: true,
                 coulomb: true,
                 offset: false,
+                armature: false,
             },
             ..BaseOptions::default()
         },

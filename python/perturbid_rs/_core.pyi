@@ -136,6 +136,9 @@ class Robot:
     def acceleration_limit(self) -> NDArray[np.float64]:
         """Acceleration limits (URDF 1.2), shape (n,); inf where not given."""
     @property
+    def armature(self) -> NDArray[np.float64]:
+        """Reflected rotor inertia per joint (kg m^2 or kg), shape (n,): adds armature * qdd to tau."""
+    @property
     def damping(self) -> NDArray[np.float64]:
         """Viscous friction coefficients from <dynamics damping>, shape (n,)."""
     @property

@@ -132,6 +132,12 @@ fn rnea_lanes_body(
                 tau[(first + l) * nv + b.dof] += b.multiplier * t.0[l];
             }
         }
+        if let Some(qdd) = qdd {
+            let r = first * nv..(first + used) * nv;
+            for (t, a) in tau[r.clone()].chunks_mut(nv).zip(qdd[r].chunks(nv)) {
+                model.add_armature_torque(a, t);
+            }
+        }
         first += LANES;
     }
     Ok(())
@@ -430,18 +436,20 @@ fn mass_matrix_batch_body(
         // onto the degrees of freedom (mimic couplings), for the lanes in use
         for l in 0..(k - first).min(LANES) {
             let o = &mut out[(first + l) * nv * nv..(first + l + 1) * nv * nv];
-            if !model.coupled {
+            if model.coupled {
+                o.fill(0.0);
+                for (i, bi) in model.bodies.iter().enumerate() {
+                    for (j, bj) in model.bodies.iter().enumerate() {
+                        o[bi.dof * nv + bj.dof] +=
+                            bi.multiplier * bj.multiplier * m[i * nb + j].0[l];
+                    }
+                }
+            } else {
                 for (x, v) in o.iter_mut().zip(&m) {
                     *x = v.0[l];
                 }
-                continue;
             }
-            o.fill(0.0);
-            for (i, bi) in model.bodies.iter().enumerate() {
-                for (j, bj) in model.bodies.iter().enumerate() {
-                    o[bi.dof * nv + bj.dof] += bi.multiplier * bj.multiplier * m[i * nb + j].0[l];
-                }
-            }
+            model.add_armature_inertia(o);
         }
         first += LANES;
     }

@@ -23,6 +23,7 @@ pub fn mass_matrix(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
     } else {
         crba_bodies(model, data, &mut out);
     }
+    model.add_armature_inertia(out.as_mut_slice());
     data.m = out;
     // M is positive semi-definite, so |M_ij| <= sqrt(M_ii M_jj): a finite diagonal bounds every
     // entry, and checking the nv diagonal entries is enough (the whole matrix costs 6 % of a call)

@@ -57,6 +57,10 @@ pub(crate) fn derivatives_at(
     } else {
         derivatives_loaded(model, data, gravity, &mut tau, &mut m, &mut dq, &mut dv);
     }
+    if let Some(qdd) = qdd {
+        model.add_armature_torque(qdd, tau.as_mut_slice());
+    }
+    model.add_armature_inertia(m.as_mut_slice());
     (data.tau, data.m, data.dtau_dq, data.dtau_dv) = (tau, m, dq, dv);
     check_result("rnea_derivatives", "tau", data.tau.as_slice())?;
     check_result("rnea_derivatives", "d tau / d q", data.dtau_dq.as_slice())?;

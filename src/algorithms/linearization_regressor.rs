@@ -121,6 +121,10 @@ pub fn linearization_regressor(
                     out.h[(j * nv + j, col)] = 1.0;
                 }
                 "coulomb" => out.torque[(j, col)] = crate::direct::parameters::sign0(v),
+                "armature" => {
+                    out.torque[(j, col)] = qdd[j];
+                    out.d[(j * nv + j, col)] = 1.0;
+                }
                 _ => out.torque[(j, col)] = 1.0,
             }
             col += 1;

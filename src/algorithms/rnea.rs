@@ -9,7 +9,8 @@ use crate::error::Result;
 use crate::gravity::Gravity;
 use crate::model::Model;
 
-/// Inverse dynamics `tau = M(q) qdd + c(q, qd) + g(q)` (rigid bodies only: no friction).
+/// Inverse dynamics `tau = M(q) qdd + c(q, qd) + g(q)` (rigid bodies and the joints'
+/// armature, [`Model::armature`]; no friction).
 ///
 /// - `q` (rad or m), `qd` (rad/s or m/s), `qdd` (rad/s^2 or m/s^2): length `model.nv` each.
 /// - `gravity`: include `g(q)` (gravity `model.gravity`, along -z of the base frame).
@@ -38,6 +39,7 @@ pub fn rnea(
     load_state(model, data, q, Some(qd), Some(qdd))?;
     let mut out = std::mem::take(&mut data.tau);
     rnea_loaded(model, data, gravity, &mut out);
+    model.add_armature_torque(qdd, out.as_mut_slice());
     data.tau = out;
     check_result("rnea", "tau", data.tau.as_slice())
 }

@@ -92,6 +92,10 @@ impl BaseModel {
                         out.h[(j, j)] += c;
                     }
                     "coulomb" => out.torque[j] += c * sign0(v),
+                    "armature" => {
+                        out.torque[j] += c * qdd[j];
+                        out.d[(j, j)] += c;
+                    }
                     _ => out.torque[j] += c,
                 }
                 at += 1;

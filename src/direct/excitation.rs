@@ -67,6 +67,7 @@ impl Default for ExcitationOptions {
                 viscous: true,
                 coulomb: true,
                 offset: false,
+                armature: false,
             },
             max_evaluations: 2000,
             seed: 0,

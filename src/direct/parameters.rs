@@ -24,6 +24,10 @@ pub struct FrictionTerms {
     pub coulomb: bool,
     /// A constant torque offset (N m), e.g. a sensor bias.
     pub offset: bool,
+    /// The armature `Ia qdd` (kg m^2): the motor's rotor inertia reflected to the joint, a
+    /// parameter of its own per joint (Pinocchio's `armature`) rather than lumped into a link.
+    #[serde(default)]
+    pub armature: bool,
 }
 
 impl FrictionTerms {
@@ -31,15 +35,18 @@ impl FrictionTerms {
         viscous: false,
         coulomb: false,
         offset: false,
+        armature: false,
     };
+    /// Viscous, Coulomb and offset (the friction terms; the armature is asked for by name).
     pub const ALL: FrictionTerms = FrictionTerms {
         viscous: true,
         coulomb: true,
         offset: true,
+        armature: false,
     };
 
-    /// The terms named in `names` (`viscous`, `coulomb`, `offset`; `all` for the three,
-    /// `none` or nothing for none).
+    /// The terms named in `names` (`viscous`, `coulomb`, `offset`, `armature`; `all` for the
+    /// three friction terms, `none` or nothing for none).
     pub fn from_names<S: AsRef<str>>(names: &[S]) -> Result<Self> {
         let mut f = FrictionTerms::NONE;
         for n in names {
@@ -47,13 +54,18 @@ impl FrictionTerms {
                 "viscous" => f.viscous = true,
                 "coulomb" => f.coulomb = true,
                 "offset" => f.offset = true,
-                "all" => f = FrictionTerms::ALL,
+                "armature" => f.armature = true,
+                "all" => {
+                    f.viscous = true;
+                    f.coulomb = true;
+                    f.offset = true;
+                }
                 "none" | "" => {}
                 other => {
                     return Err(Error::InvalidArgument {
                         argument: "friction".into(),
                         message: format!(
-                            "'{other}' is not a friction term; expected viscous, coulomb, offset, all or none"
+                            "'{other}' is not a joint term; expected viscous, coulomb, offset, armature, all (the three friction terms) or none"
                         ),
                     })
                 }
@@ -62,12 +74,14 @@ impl FrictionTerms {
         Ok(f)
     }
 
-    /// Names of the terms switched on, in column order (`viscous`, `coulomb`, `offset`).
+    /// Names of the terms switched on, in column order (`viscous`, `coulomb`, `offset`,
+    /// `armature`).
     pub fn names(&self) -> Vec<&'static str> {
         [
             ("viscous", self.viscous),
             ("coulomb", self.coulomb),
             ("offset", self.offset),
+            ("armature", self.armature),
         ]
         .into_iter()
         .filter_map(|(n, on)| on.then_some(n))
@@ -132,15 +146,16 @@ impl ParameterLayout {
         self.names.is_empty()
     }
 
-    /// The full parameter vector of `model` itself: its URDF inertias and friction
-    /// (`<dynamics damping friction>`; offsets 0).
+    /// The full parameter vector of `model` itself: its URDF inertias, friction
+    /// (`<dynamics damping friction>`; offsets 0) and armature.
     pub fn model_parameters(&self, model: &Model) -> DVector<f64> {
         let mut theta = model_parameters(model).as_slice().to_vec();
-        for lim in &model.limits {
+        for (j, lim) in model.limits.iter().enumerate() {
             for t in self.friction.names() {
                 theta.push(match t {
                     "viscous" => lim.damping,
                     "coulomb" => lim.friction,
+                    "armature" => model.armature[j],
                     _ => 0.0,
                 });
             }
@@ -191,7 +206,8 @@ pub(crate) fn fill_regressor(
             for (t, name) in terms.iter().enumerate() {
                 out[(base + j, ni + j * terms.len() + t)] = match *name {
                     "viscous" => qd[j],
-                    "coulomb" => qd[j].signum() * f64::from(u8::from(qd[j] != 0.0)),
+                    "coulomb" => sign0(qd[j]),
+                    "armature" => qdd[j],
                     _ => 1.0,
                 };
             }

@@ -40,6 +40,7 @@ enum Term {
     Viscous,
     Coulomb,
     Offset,
+    Armature,
 }
 
 /// The columns that joint `j`'s rows can have nonzero: the base columns of the bodies the
@@ -88,6 +89,7 @@ impl JointColumns {
                         let term = match terms[t] {
                             "viscous" => Term::Viscous,
                             "coulomb" => Term::Coulomb,
+                            "armature" => Term::Armature,
                             _ => Term::Offset,
                         };
                         out.friction.push((a, term));
@@ -204,7 +206,7 @@ impl Worker {
             )?;
             for l in 0..used {
                 let s = first + l;
-                let qd = &qd[s * nv..(s + 1) * nv];
+                let (qd, qdd) = (&qd[s * nv..(s + 1) * nv], &qdd[s * nv..(s + 1) * nv]);
                 for (j, (a, cols)) in self.stacks.iter_mut().zip(columns).enumerate() {
                     let nj = cols.base.len();
                     let i = nj + 1 + s - range.start;
@@ -214,8 +216,9 @@ impl Worker {
                     for &(c, term) in &cols.friction {
                         a[(i, c)] = match term {
                             Term::Viscous => qd[j],
-                            Term::Coulomb => qd[j].signum() * f64::from(u8::from(qd[j] != 0.0)),
+                            Term::Coulomb => crate::direct::parameters::sign0(qd[j]),
                             Term::Offset => 1.0,
+                            Term::Armature => qdd[j],
                         };
                     }
                     a[(i, nj)] = tau[s * nv + j];

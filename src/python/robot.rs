@@ -191,6 +191,15 @@ impl PyRobot {
         PyArray1::from_vec(py, self.model.limits.iter().map(|l| l.friction).collect())
     }
 
+    /// Armature (the motor's rotor inertia reflected to the joint), shape (n,), kg m^2 or kg:
+    /// from `<dynamics armature>` or a Drake `<transmission>` (`rotor_inertia * gear_ratio^2`);
+    /// adds `armature * qdd` to every torque and `armature` to the diagonal of M, as
+    /// Pinocchio's `model.armature`.
+    #[getter]
+    fn armature<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.model.armature.clone())
+    }
+
     /// Total mass of the moving links (kg).
     #[getter]
     fn mass(&self) -> f64 {
@@ -262,8 +271,10 @@ impl PyRobot {
     /// the 10 inertial parameters of every moving body in Pinocchio's order
     /// `[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]` (kg, kg m, kg m^2; about the body's
     /// joint frame), body after body (see `parameters`). With `friction` (a comma-separated
-    /// string or list from 'viscous', 'coulomb', 'offset'), those columns follow, joint after
-    /// joint: `qd_j`, `sign(qd_j)` (0 at rest), `1` in the rows of joint j (N m s/rad, N m, N m).
+    /// string or list from 'viscous', 'coulomb', 'offset', 'armature'), those columns follow,
+    /// joint after joint: `qd_j`, `sign(qd_j)` (0 at rest), `1`, `qdd_j` in the rows of joint j
+    /// (N m s/rad, N m, N m, kg m^2). `Phi @ theta == rnea` needs the 'armature' column when
+    /// the robot has an armature.
     /// Returns (n, p) or (k, n, p), p = 10 b + (number of terms) n.
     #[pyo3(signature = (q, qd, qdd, gravity=true, friction=None))]
     fn regressor<'py>(

@@ -46,6 +46,7 @@ impl Builder<'_> {
                 bodies[b].dof = dof_of_joint[&leader];
             }
         }
+        let armature = self.armature_per_dof(roles, &dof_of_joint, joint_names.len())?;
         // Subtree ranges (children come after their parent in pre-order).
         let n = bodies.len();
         for (i, b) in bodies.iter_mut().enumerate() {
@@ -79,6 +80,7 @@ impl Builder<'_> {
             joint_names,
             joint_kinds,
             limits,
+            armature,
             gravity: Vector3::new(0.0, 0.0, -STANDARD_GRAVITY),
             root_link: robot.links[graph.root].name.clone(),
             base_mass: base_inertia.mass,
@@ -87,5 +89,49 @@ impl Builder<'_> {
         };
         model.check_every_dof_moves_mass()?;
         Ok(model)
+    }
+}
+
+impl Builder<'_> {
+    /// The armature of every degree of freedom (zero where none is given); fails on an
+    /// armature for a joint that does not exist, is fixed in the URDF or follows another
+    /// through `<mimic>`. A joint locked by the caller keeps its rotor still: its armature is
+    /// dropped with the joint.
+    fn armature_per_dof(
+        &self,
+        roles: &[Role],
+        dof_of_joint: &HashMap<usize, usize>,
+        nv: usize,
+    ) -> Result<Vec<f64>> {
+        let mut out = vec![0.0; nv];
+        let mut given: Vec<_> = self.armature.iter().collect();
+        given.sort_by_key(|(_, e)| e.line);
+        for (name, entry) in given {
+            let error = |message: String| Error::InvalidArmature {
+                location: Box::new(crate::error::Location {
+                    source: self.source.to_string(),
+                    line: Some(entry.line),
+                }),
+                joint: name.clone(),
+                message,
+            };
+            let Some(j) = self.robot.joints.iter().position(|x| &x.name == name) else {
+                return Err(error("no joint of this name in the URDF".into()));
+            };
+            match roles[j] {
+                Role::Moving { leader, .. } if leader == j => out[dof_of_joint[&j]] = entry.value,
+                Role::Moving { leader, .. } => {
+                    return Err(error(format!(
+                        "the joint follows '{}' through <mimic>; give the armature of the driving joint",
+                        self.robot.joints[leader].name
+                    )))
+                }
+                Role::Rigid { .. } if self.robot.joints[j].joint_type != urdf_rs::JointType::Fixed => {}
+                Role::Rigid { .. } => {
+                    return Err(error("the joint is fixed: a rotor that never turns has no armature".into()))
+                }
+            }
+        }
+        Ok(out)
     }
 }

@@ -3,7 +3,8 @@
 //! What is read: the kinematic tree (any tree, not only chains) of revolute, continuous,
 //! prismatic and fixed joints; joint origins (xyz, rpy); axes (normalised); link inertials with
 //! their origin and rpy (the inertia is rotated into the link frame); `<limit>` (URDF 1.2
-//! `acceleration` included) and `<dynamics damping friction>`; `<mimic>` couplings. Links behind
+//! `acceleration` included) and `<dynamics damping friction>`; the armature (reflected rotor
+//! inertia, see `armature`); `<mimic>` couplings. Links behind
 //! fixed joints are merged into their parent body. Joints can be locked at a position when the
 //! model is built, which turns them into fixed joints.
 //!
@@ -20,6 +21,7 @@
 //! `assemble` numbers the degrees of freedom into a [`Model`]; `convert` turns urdf-rs values
 //! into ours.
 
+mod armature;
 mod assemble;
 mod bodies;
 mod checks;
@@ -30,7 +32,7 @@ mod roles;
 
 pub use lines::MAX_XML_DEPTH;
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
 use crate::error::{Error, Location, Result};
@@ -73,6 +75,7 @@ pub fn model_from_urdf_str(text: &str, source_name: &str, options: &LoadOptions)
     lines::check_depth(text, source_name)?;
     let doc = lines::parse_xml(text, source_name)?;
     let lines = LineIndex::new(text, &doc);
+    let armature = armature::read(text, &doc, source_name)?;
     let robot = urdf_rs::read_from_string(text).map_err(|e| Error::UrdfSyntax {
         source_name: source_name.to_string(),
         message: e.to_string(),
@@ -81,6 +84,7 @@ pub fn model_from_urdf_str(text: &str, source_name: &str, options: &LoadOptions)
         robot: &robot,
         source: source_name,
         lines: &lines,
+        armature: &armature,
         options,
     }
     .build()
@@ -91,6 +95,7 @@ struct Builder<'a> {
     robot: &'a urdf_rs::Robot,
     source: &'a str,
     lines: &'a LineIndex,
+    armature: &'a HashMap<String, armature::ArmatureEntry>,
     options: &'a LoadOptions,
 }
 

@@ -139,3 +139,30 @@ pub fn mimic_pair(mimic: bool) -> String {
 </robot>"#
     )
 }
+
+/// The A465 (physical) with an armature on every joint: joints 1-3 through `<dynamics
+/// armature>`, joints 4-6 through Drake `<transmission>` elements.
+pub fn a465_with_armature() -> perturbid_rs::Model {
+    let text = perturbid_rs::robots::a465::urdf("physical").unwrap();
+    let mut text = text.replace(
+        "<robot name=\"a465_physical\"",
+        "<robot xmlns:drake=\"http://drake.mit.edu\" name=\"a465_physical\"",
+    );
+    for (j, a) in [(1, 0.8), (2, 0.5), (3, 0.3)] {
+        let tag = format!("<joint name=\"joint{j}\" type=\"revolute\">");
+        text = text.replace(&tag, &format!("{tag}\n    <dynamics armature=\"{a}\"/>"));
+    }
+    let mut transmissions = String::new();
+    for (j, rotor, ratio) in [(4, 1e-5, 101.0), (5, 2e-5, 100.0), (6, 1e-5, 101.0)] {
+        transmissions.push_str(&format!(
+            "  <transmission type=\"SimpleTransmission\" name=\"t{j}\">\n    <joint name=\"joint{j}\"/>\n    <actuator name=\"m{j}\"><drake:rotor_inertia value=\"{rotor}\"/><drake:gear_ratio value=\"{ratio}\"/></actuator>\n  </transmission>\n"
+        ));
+    }
+    text = text.replace("</robot>", &format!("{transmissions}</robot>"));
+    perturbid_rs::model_from_urdf_str(
+        &text,
+        "a465+armature",
+        &perturbid_rs::LoadOptions::default(),
+    )
+    .unwrap()
+}

@@ -161,3 +161,24 @@ def test_locked_joints_match_pinocchio_reduced_model():
         q, qd, qdd = p.random_state(rng)
         check_dynamics(p, q, qd, qdd)
         check_derivatives(p, q, qd, qdd)
+
+
+def test_armature_matches_pinocchio_armature():
+    """`<dynamics armature>` and a Drake transmission against Pinocchio's `model.armature`."""
+    text = pr.robots.a465_urdf("physical")
+    text = text.replace('<joint name="joint2" type="revolute">', '<joint name="joint2" type="revolute"><dynamics damping="0" armature="0.7"/>')
+    text = text.replace(
+        "</robot>",
+        '<transmission name="t5"><joint name="joint5"/><actuator name="m5">'
+        '<rotor_inertia value="3e-5"/><gear_ratio value="100"/></actuator></transmission></robot>',
+    )
+    ours = pr.Robot.from_urdf_string(text)
+    np.testing.assert_allclose(ours.armature, [0, 0.7, 0, 0, 0.3, 0], rtol=1e-12)
+    model = pin.buildModelFromXML(text)
+    model.armature = np.asarray(ours.armature)
+    p = Pair(ours, model)
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        q, qd, qdd = p.random_state(rng, scale=2.0)
+        check_dynamics(p, q, qd, qdd)
+        check_derivatives(p, q, qd, qdd)
