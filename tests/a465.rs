@@ -106,10 +106,52 @@ fn gravity_of_the_physical_set_matches_reference() {
 }
 
 #[test]
-fn kinsheel2010_breaks_the_triangle_inequality_so_strict_loading_refuses_it() {
-    let text = robots::a465::urdf("kinsheel2010").unwrap();
+fn the_lumped_fit_breaks_the_triangle_inequality_so_strict_loading_refuses_it() {
+    let text = robots::a465::urdf("kinsheel2010_lumped").unwrap();
     let err = perturbid_rs::model_from_urdf_str(text, "k.urdf", &Default::default()).unwrap_err();
     assert!(err.to_string().contains("triangle inequality"), "{err}");
     assert!(robots::builtin("a465:nope").is_err());
     assert!(robots::builtin("ur5").is_err());
+}
+
+/// The default A465 is the lumped fit refitted as a consistent robot with an armature: it loads
+/// with every check on, every body is consistent, and its torques are the lumped model's.
+#[test]
+fn kinsheel2010_is_consistent_and_has_the_lumped_fits_torques() {
+    use perturbid_rs::direct::{check_physical_consistency, FrictionTerms, ParameterLayout};
+    let text = robots::a465::urdf("kinsheel2010").unwrap();
+    let model = perturbid_rs::model_from_urdf_str(text, "k.urdf", &Default::default()).unwrap();
+    let terms = FrictionTerms {
+        armature: true,
+        ..FrictionTerms::NONE
+    };
+    let layout = ParameterLayout::new(&model, terms);
+    let theta = layout.model_parameters(&model);
+    let report = check_physical_consistency(&layout, theta.as_slice()).unwrap();
+    assert!(report.is_consistent(), "{report:?}");
+    assert!(
+        model.armature[0] > 5.0 && model.armature[1] > 2.0,
+        "{:?}",
+        model.armature
+    );
+    let lumped = robots::a465::model("kinsheel2010_lumped").unwrap();
+    let lumped_layout = ParameterLayout::new(&lumped, FrictionTerms::NONE);
+    let lumped_theta = lumped_layout.model_parameters(&lumped);
+    let bad = check_physical_consistency(&lumped_layout, lumped_theta.as_slice()).unwrap();
+    assert_eq!(bad.bodies.iter().filter(|b| b.problem.is_some()).count(), 6);
+    let mut rng = common::Rng(77);
+    let (mut a, mut b) = (Data::new(&model), Data::new(&lumped));
+    let mut worst = 0.0f64;
+    for _ in 0..200 {
+        let q: Vec<f64> = model
+            .limits
+            .iter()
+            .map(|l| rng.uniform(l.lower, l.upper))
+            .collect();
+        let (qd, qdd) = (rng.vector(6, 2.0), rng.vector(6, 8.0));
+        rnea(&model, &mut a, &q, &qd, &qdd, Gravity::Included).unwrap();
+        rnea(&lumped, &mut b, &q, &qd, &qdd, Gravity::Included).unwrap();
+        worst = worst.max((&a.tau - &b.tau).amax());
+    }
+    assert!(worst < 1e-3, "torques differ by {worst} N m");
 }

@@ -727,7 +727,7 @@ fn parameters_from_local_models() {
         s(&d.join("parameters.json")),
     ]);
     assert!(
-        out.contains("of the robot's 36 base parameters identified from 2 operating point(s)"),
+        out.contains("of the robot's 40 base parameters identified from 2 operating point(s)"),
         "{out}"
     );
     let fit = perturbid_rs::direct::BaseModel::load(d.join("parameters.json")).unwrap();

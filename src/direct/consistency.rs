@@ -56,6 +56,24 @@ pub fn pseudo_inertia(p: &[f64]) -> Matrix4<f64> {
     j
 }
 
+/// The 10 parameters of a pseudo-inertia `J = [[Sigma, h], [h^T, m]]` (the inverse of
+/// [`pseudo_inertia`] on symmetric matrices): `I = tr(Sigma) 1 - Sigma`.
+pub fn parameters_of_pseudo_inertia(j: &Matrix4<f64>) -> [f64; 10] {
+    let (sxx, syy, szz) = (j[(0, 0)], j[(1, 1)], j[(2, 2)]);
+    [
+        j[(3, 3)],
+        j[(0, 3)],
+        j[(1, 3)],
+        j[(2, 3)],
+        syy + szz,
+        -j[(0, 1)],
+        sxx + szz,
+        -j[(0, 2)],
+        -j[(1, 2)],
+        sxx + syy,
+    ]
+}
+
 /// Checks the full parameter vector `theta` of `layout` (10 per body, then friction): see the
 /// module documentation. Errors: `theta` of the wrong length or non-finite.
 pub fn check_physical_consistency(

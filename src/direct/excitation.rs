@@ -45,7 +45,8 @@ pub struct ExcitationOptions {
     /// Bounds for joints whose URDF gives none (default 1 rad/s, 4 rad/s^2).
     pub default_velocity: f64,
     pub default_acceleration: f64,
-    /// Friction terms in the regressor (default viscous and Coulomb).
+    /// Joint terms in the regressor (default viscous and Coulomb; the armature is added when
+    /// the robot model has one).
     pub friction: FrictionTerms,
     /// COBYLA's budget of criterion evaluations (default 2000).
     pub max_evaluations: usize,
@@ -243,7 +244,7 @@ pub fn design_excitation(
         });
     }
     let n = model.nv;
-    let layout = ParameterLayout::new(model, o.friction);
+    let layout = ParameterLayout::new(model, o.friction.for_model(model));
     let base = BaseParameters::from_random_states(
         model,
         &layout,

@@ -31,6 +31,9 @@ choice! {
 /// Options of [`identify_base_parameters`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct BaseOptions {
+    /// Joint terms identified with the inertial parameters (default viscous, Coulomb and
+    /// offset); the armature is added when the robot model has one
+    /// ([`FrictionTerms::for_model`]).
     pub friction: FrictionTerms,
     pub weighting: Weighting,
     /// Whether the torques include gravity (default true).
@@ -110,13 +113,73 @@ pub fn identify_base_parameters(
     tau: &[f64],
     options: &BaseOptions,
 ) -> Result<BaseModel> {
+    Ok(fit_with_factors(model, states, tau, options)?.0)
+}
+
+/// Identifies physically consistent parameters of `model` from the same data as
+/// [`identify_base_parameters`] (same arguments, same weighting): the weighted least squares
+/// over parameter sets whose every body has a positive definite pseudo-inertia and whose
+/// friction and armature coefficients are non-negative (see [`super::consistent`]). The
+/// robot's own parameters serve as the weak prior that decides what the data do not.
+///
+/// Returns the consistent fit with the unconstrained one beside it.
+pub fn identify_consistent_parameters(
+    model: &Model,
+    states: &States<'_>,
+    tau: &[f64],
+    options: &BaseOptions,
+    consistent: &super::consistent::ConsistentOptions,
+) -> Result<super::consistent::ConsistentFit> {
+    let (fit, factors) = fit_with_factors(model, states, tau, options)?;
+    let (r11, z, rho) = factors.reduced(&fit.sigma)?;
+    let base = &fit.base;
+    let layout = &base.layout;
+    // theta_base = B theta: B[i, kept[i]] = 1, B[i, dropped[d]] = K[i, d]
+    let mut b = DMatrix::zeros(base.len(), layout.len());
+    for (i, &c) in base.kept.iter().enumerate() {
+        b[(i, c)] = 1.0;
+        for (d, &dc) in base.dropped.iter().enumerate() {
+            b[(i, dc)] = base.k[(i, d)];
+        }
+    }
+    let prior = layout.model_parameters(model);
+    let solution = super::consistent::consistent_least_squares(
+        layout,
+        &(r11 * b),
+        &DVector::from_column_slice(z.as_slice()),
+        rho * rho,
+        prior.as_slice(),
+        consistent,
+    )?;
+    let theta = base.from_full(&DVector::from_column_slice(&solution.theta))?;
+    let theta: Vec<f64> = theta.iter().copied().collect();
+    let consistent_model = BaseModel {
+        residual_rms: factors.residual_rms(&theta)?,
+        theta,
+        ..fit.clone()
+    };
+    Ok(super::consistent::ConsistentFit {
+        layout: layout.clone(),
+        solution,
+        model: consistent_model,
+        unconstrained: fit,
+    })
+}
+
+/// [`identify_base_parameters`] with the reduced data it was computed from.
+fn fit_with_factors(
+    model: &Model,
+    states: &States<'_>,
+    tau: &[f64],
+    options: &BaseOptions,
+) -> Result<(BaseModel, streaming::JointFactors)> {
     let nv = model.nv;
     crate::torque_model::check_joints(states, nv)?;
     states.check_companion("tau", tau, nv)?;
     crate::limits::check_range("tolerance", options.tolerance, 1e-15, 0.1)?;
     crate::limits::check_count("states", options.states, 1, 1_000_000)?;
     let k = states.len();
-    let layout = ParameterLayout::new(model, options.friction);
+    let layout = ParameterLayout::new(model, options.friction.for_model(model));
     let base = BaseParameters::from_random_states(
         model,
         &layout,
@@ -137,7 +200,7 @@ pub fn identify_base_parameters(
         ls = factors.solve(&sigma, &names)?;
         rms = factors.residual_rms(ls.coef.as_slice())?;
     }
-    Ok(BaseModel {
+    let fit = BaseModel {
         format: BaseModel::tag(),
         robot: model.name.clone(),
         joint_names: model.joint_names.clone(),
@@ -150,7 +213,8 @@ pub fn identify_base_parameters(
         cond: ls.cond,
         samples: k,
         base,
-    })
+    };
+    Ok((fit, factors))
 }
 
 impl Document for BaseModel {

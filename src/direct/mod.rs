@@ -6,6 +6,7 @@
 pub mod base;
 pub mod base_linearization;
 pub mod consistency;
+pub mod consistent;
 pub mod excitation;
 pub mod global_linear;
 pub mod identify;
@@ -14,7 +15,12 @@ pub mod streaming;
 
 pub use base::BaseParameters;
 pub use consistency::{check_physical_consistency, BodyConsistency, ConsistencyReport};
+pub use consistent::{
+    consistent_least_squares, ConsistentFit, ConsistentOptions, ConsistentSolution,
+};
 pub use excitation::{design_excitation, Criterion, ExcitationDesign, ExcitationOptions};
 pub use global_linear::{identify_global_linear, GlobalLinearModel};
-pub use identify::{identify_base_parameters, BaseModel, BaseOptions, Weighting};
+pub use identify::{
+    identify_base_parameters, identify_consistent_parameters, BaseModel, BaseOptions, Weighting,
+};
 pub use parameters::{regressor_matrix, FrictionTerms, ParameterLayout};

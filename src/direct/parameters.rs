@@ -74,6 +74,16 @@ impl FrictionTerms {
         Ok(f)
     }
 
+    /// These terms, with the armature added when `model` has one: a robot model with rotor
+    /// inertia needs the armature column for `Phi theta = tau`, so every identification takes
+    /// it.
+    pub fn for_model(self, model: &Model) -> Self {
+        Self {
+            armature: self.armature || model.has_armature(),
+            ..self
+        }
+    }
+
     /// Names of the terms switched on, in column order (`viscous`, `coulomb`, `offset`,
     /// `armature`).
     pub fn names(&self) -> Vec<&'static str> {

@@ -356,6 +356,21 @@ impl JointFactors {
                 ),
             });
         }
+        let (r11, z, rho) = self.reduced(sigma)?;
+        let mut ls = least_squares(&r11, &z, "base-parameter identification", names)?;
+        let s = (rho * rho / (rows - p) as f64).sqrt();
+        ls.stderr = DMatrix::from_fn(1, p, |_, j| s * ls.cov_diag[j].sqrt());
+        ls.rows = rows;
+        ls.residual_rms = DVector::zeros(0);
+        Ok(ls)
+    }
+
+    /// The weighted problem reduced to `p` rows: `|W (Phi_base theta - tau)|^2 = |R11 theta -
+    /// z|^2 + rho^2` for every `theta`, rows of joint `j` divided by `sigma[j]`. Returns
+    /// `(R11 (p x p, upper triangular), z (p x 1), rho)`.
+    pub fn reduced(&self, sigma: &[f64]) -> Result<(DMatrix<f64>, DMatrix<f64>, f64)> {
+        let nv = self.factors.len();
+        let p = self.parameters;
         if sigma.len() != nv || sigma.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
             return Err(Error::InvalidArgument {
                 argument: "sigma".into(),
@@ -380,13 +395,7 @@ impl JointFactors {
         // [R11 z; 0 rho]: min |W theta - y| solves R11 theta = z with residual norm |rho|
         let r11 = r.view((0, 0), (p, p)).into_owned();
         let z = r.view((0, p), (p, 1)).into_owned();
-        let rho = r[(p, p)];
-        let mut ls = least_squares(&r11, &z, "base-parameter identification", names)?;
-        let s = (rho * rho / (rows - p) as f64).sqrt();
-        ls.stderr = DMatrix::from_fn(1, p, |_, j| s * ls.cov_diag[j].sqrt());
-        ls.rows = rows;
-        ls.residual_rms = DVector::zeros(0);
-        Ok(ls)
+        Ok((r11, z, r[(p, p)]))
     }
 
     /// Per-joint RMS over the samples of the unweighted residuals `tau - Phi_base theta` (N m)

@@ -9,7 +9,10 @@ use nalgebra::{DMatrix, DVector};
 use super::model::{Estimate, LocalModel};
 use crate::algorithms::linearization_regressor::linearization_regressor;
 use crate::direct::base::{BaseParameters, BASE_TOLERANCE};
-use crate::direct::{BaseModel, FrictionTerms, ParameterLayout, Weighting};
+use crate::direct::{
+    consistent_least_squares, BaseModel, ConsistentFit, ConsistentOptions, FrictionTerms,
+    ParameterLayout, Weighting,
+};
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
@@ -19,7 +22,8 @@ use crate::regression::least_squares;
 /// Options of [`identify_parameters_from_local`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct FromLocalOptions {
-    /// Friction terms to identify with the inertial parameters (default none).
+    /// Joint terms to identify with the inertial parameters (default none; the armature is
+    /// added when the robot model has one, [`FrictionTerms::for_model`]).
     pub friction: FrictionTerms,
     /// Whether the local models' torques include gravity (default true).
     pub gravity: Gravity,
@@ -29,6 +33,9 @@ pub struct FromLocalOptions {
     pub use_h: bool,
     pub use_g: bool,
     pub use_g_static: bool,
+    /// Also fit physically consistent parameters (see [`crate::direct::consistent`]), with
+    /// these options; `None` (default) for the unconstrained fit only.
+    pub consistent: Option<ConsistentOptions>,
 }
 
 impl Default for FromLocalOptions {
@@ -41,6 +48,7 @@ impl Default for FromLocalOptions {
             use_h: true,
             use_g: true,
             use_g_static: true,
+            consistent: None,
         }
     }
 }
@@ -61,6 +69,9 @@ pub struct ParametersFromLocal {
     pub unidentified: Vec<String>,
     /// Rows of the stacked system used.
     pub rows: usize,
+    /// The consistent fit of the same rows, when asked for; the robot's own parameters are
+    /// its prior (they decide what the points do not).
+    pub consistent: Option<ConsistentFit>,
 }
 
 /// Weight floor: standard errors below this fraction of the block's largest entry (noise-free
@@ -119,7 +130,7 @@ pub fn identify_parameters_from_local(
             message: "no local model given".into(),
         });
     }
-    let layout = ParameterLayout::new(robot, options.friction);
+    let layout = ParameterLayout::new(robot, options.friction.for_model(robot));
     let (mut x, mut y, mut w, mut joint) = (vec![], vec![], vec![], vec![]);
     for (i, m) in models.iter().enumerate() {
         crate::interrupt::check("parameters from local models")?;
@@ -195,16 +206,19 @@ pub fn identify_parameters_from_local(
     let theta: Vec<f64> = ls.coef.row(0).iter().copied().collect();
     let stderr: Vec<f64> = ls.stderr.row(0).iter().copied().collect();
     // residuals in N m (unweighted), by the torque row they belong to
-    let fitted = base.select(&phi) * DVector::from_column_slice(&theta);
-    let mut ss = vec![0.0; nv];
-    let mut count = vec![0usize; nv];
-    for r in 0..rows {
-        ss[joint[r]] += ((y[r] - fitted[r]) * w[r]).powi(2);
-        count[joint[r]] += 1;
-    }
-    let residual_rms = (0..nv)
-        .map(|j| (ss[j] / count[j].max(1) as f64).sqrt())
-        .collect();
+    let phi_base = base.select(&phi);
+    let residual_rms = |theta_base: &[f64]| {
+        let fitted = &phi_base * DVector::from_column_slice(theta_base);
+        let mut ss = vec![0.0; nv];
+        let mut count = vec![0usize; nv];
+        for r in 0..rows {
+            ss[joint[r]] += ((y[r] - fitted[r]) * w[r]).powi(2);
+            count[joint[r]] += 1;
+        }
+        (0..nv)
+            .map(|j| (ss[j] / count[j].max(1) as f64).sqrt())
+            .collect::<Vec<f64>>()
+    };
     let robot_base = BaseParameters::from_random_states(
         robot,
         &layout,
@@ -242,12 +256,42 @@ pub fn identify_parameters_from_local(
         base,
         gravity: options.gravity,
         weighting: Weighting::Wls,
+        residual_rms: residual_rms(&theta),
         theta,
         stderr,
-        residual_rms,
         sigma: vec![1.0; nv],
         cond: ls.cond,
         samples: rows,
+    };
+    let consistent = match &options.consistent {
+        None => None,
+        Some(c) => {
+            let solution = consistent_least_squares(
+                &layout,
+                &phi,
+                &DVector::from_column_slice(&y),
+                0.0,
+                layout.model_parameters(robot).as_slice(),
+                c,
+            )?;
+            let theta_c: Vec<f64> = model
+                .base
+                .from_full(&DVector::from_column_slice(&solution.theta))?
+                .iter()
+                .copied()
+                .collect();
+            let consistent_model = BaseModel {
+                residual_rms: residual_rms(&theta_c),
+                theta: theta_c,
+                ..model.clone()
+            };
+            Some(ConsistentFit {
+                layout: layout.clone(),
+                solution,
+                model: consistent_model,
+                unconstrained: model.clone(),
+            })
+        }
     };
     Ok(ParametersFromLocal {
         model,
@@ -255,5 +299,6 @@ pub fn identify_parameters_from_local(
         robot_rank: robot_base.len(),
         unidentified,
         rows,
+        consistent,
     })
 }

@@ -92,7 +92,7 @@ pub fn suggest_operating_points(
 ) -> Result<Vec<SuggestedPoint>> {
     crate::limits::check_count("candidates", candidates, 1, 10_000)?;
     crate::limits::check_count("count", count, 1, 10_000)?;
-    let layout = ParameterLayout::new(robot, options.friction);
+    let layout = ParameterLayout::new(robot, options.friction.for_model(robot));
     let base = BaseParameters::from_random_states(
         robot,
         &layout,
