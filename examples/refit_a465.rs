@@ -75,7 +75,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let s = &fit.solution;
     let robot = fit.robot(&prior)?;
     eprintln!(
-        "ADMM: {} iterations, converged {}; torque RMS against the lumped model {:.3e} N m; consistent {}",
+        "interior point: {} Newton steps, converged {}; torque RMS against the lumped model {:.3e} N m; consistent {}",
         s.iterations,
         s.converged,
         (s.cost / tau.len() as f64).sqrt(),

@@ -61,9 +61,11 @@ fn a_consistent_truth_is_found_again_with_no_growth() {
     assert!(err < 1e-6, "torque error {err}");
 }
 
+/// The lumped fit's links are inconsistent; a consistent robot (with or without an armature)
+/// reproduces its torques: the inconsistency lies in directions the torques cannot see.
 #[test]
-fn the_lumped_a465_needs_the_armature_to_be_consistent() {
-    let lumped = robots::a465::model("kinsheel2010").unwrap();
+fn the_lumped_a465_has_a_consistent_twin() {
+    let lumped = robots::a465::model("kinsheel2010_lumped").unwrap();
     let (q, qd, qdd, tau) = data(&lumped, 400, 2);
     let states = States::new(6, &q, Some(&qd), Some(&qdd)).unwrap();
     for terms in ["none", "armature"] {
@@ -82,12 +84,127 @@ fn the_lumped_a465_needs_the_armature_to_be_consistent() {
         .unwrap();
         let s = &fit.solution;
         let rms = (s.cost / tau.len() as f64).sqrt();
-        println!(
-            "{terms}: iterations {} converged {} rms {rms} N m, active {:?}",
-            s.iterations, s.converged, s.active
-        );
-        assert!(s.report.is_consistent());
+        assert!(s.report.is_consistent(), "{terms}: {:?}", s.report);
+        assert!(rms < 1e-4, "{terms}: {rms} N m");
+        // the robot rebuilt from the parameters has the fit's torques
         let robot = fit.robot(&lumped).unwrap();
-        println!("armature {:?}", robot.armature);
+        let mut again = vec![0.0; tau.len()];
+        parallel::rnea(
+            &robot,
+            &mut parallel::Workspace::new(&robot),
+            &states,
+            Gravity::Included,
+            &mut again,
+        )
+        .unwrap();
+        let predicted = fit.model.on(&lumped).unwrap().predict(&states).unwrap();
+        let e = again
+            .iter()
+            .zip(&predicted)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(e < 1e-8, "{terms}: rebuilt robot vs base model {e}");
     }
+}
+
+/// Noisy torques from a consistent robot with few samples: the unconstrained fit is not a
+/// robot, the consistent one is, and its residual is no larger than the truth's (which is
+/// feasible), nor smaller than the unconstrained minimum.
+#[test]
+fn a_consistent_fit_is_consistent_and_no_worse_than_needed() {
+    use perturbid_rs::direct::{consistent_least_squares, regressor_matrix, ParameterLayout};
+    let truth = robots::a465::model("physical").unwrap();
+    let (q, qd, qdd, mut tau) = data(&truth, 40, 9);
+    let mut rng = Rng(10);
+    for t in tau.iter_mut() {
+        *t += rng.uniform(-2.0, 2.0);
+    }
+    let states = States::new(6, &q, Some(&qd), Some(&qdd)).unwrap();
+    let terms: FrictionTerms = "viscous,coulomb".parse().unwrap();
+    let layout = ParameterLayout::new(&truth, terms);
+    let phi = regressor_matrix(&truth, &layout, &states, Gravity::Included).unwrap();
+    let y = nalgebra::DVector::from_column_slice(&tau);
+    // a prior far from the truth: the data must do the work
+    let mut prior = layout.model_parameters(&truth);
+    prior.iter_mut().for_each(|v| *v *= 1.3);
+    let sol = consistent_least_squares(
+        &layout,
+        &phi,
+        &y,
+        0.0,
+        prior.as_slice(),
+        &ConsistentOptions::default(),
+    )
+    .unwrap();
+    assert!(sol.report.is_consistent(), "{:?}", sol.report);
+    let truth_cost = (&phi * layout.model_parameters(&truth) - &y).norm_squared();
+    let ridge_cost =
+        (&phi * nalgebra::DVector::from_column_slice(&sol.unconstrained_theta) - &y).norm_squared();
+    let unconstrained_report =
+        perturbid_rs::direct::check_physical_consistency(&layout, &sol.unconstrained_theta)
+            .unwrap();
+    assert!(
+        !unconstrained_report.is_consistent(),
+        "the noise should make it inconsistent"
+    );
+    assert!(!sol.active.is_empty());
+    assert!(sol.cost >= sol.unconstrained_cost * (1.0 - 1e-9));
+    assert!(sol.unconstrained_cost <= ridge_cost * (1.0 + 1e-9));
+    assert!(
+        sol.cost <= truth_cost * (1.0 + 1e-4),
+        "consistent {} vs the truth's {truth_cost}",
+        sol.cost
+    );
+    // more than a projection of the unconstrained solution: strictly better than clipping it
+    let mut clipped = sol.unconstrained_theta.clone();
+    for b in 0..layout.nbodies {
+        let p: [f64; 10] = clipped[10 * b..10 * b + 10].try_into().unwrap();
+        let eig = perturbid_rs::direct::consistency::pseudo_inertia(&p).symmetric_eigen();
+        let j = eig.eigenvectors
+            * nalgebra::Matrix4::from_diagonal(&eig.eigenvalues.map(|v| v.max(0.0)))
+            * eig.eigenvectors.transpose();
+        clipped[10 * b..10 * b + 10]
+            .copy_from_slice(&perturbid_rs::direct::consistency::parameters_of_pseudo_inertia(&j));
+    }
+    let clipped_cost = (&phi * nalgebra::DVector::from_column_slice(&clipped) - &y).norm_squared();
+    assert!(
+        sol.cost < clipped_cost,
+        "{} vs clipping {clipped_cost}",
+        sol.cost
+    );
+    println!(
+        "unconstrained {:.4} consistent {:.4} truth {truth_cost:.4} clipped {clipped_cost:.4}, {} iterations",
+        sol.unconstrained_cost, sol.cost, sol.iterations
+    );
+}
+
+/// Consistent parameters from local models: exact local models of a consistent robot give a
+/// consistent fit that reproduces M(q) at a held-out point.
+#[test]
+fn consistent_parameters_from_local_models() {
+    use perturbid_rs::local::{identify_parameters_from_local, FromLocalOptions};
+    let model = robots::a465::model("kinsheel2010").unwrap();
+    let mut rng = Rng(5);
+    let ops: Vec<_> = (0..4)
+        .map(|_| common::random_op(&model, &mut rng))
+        .collect();
+    let models: Vec<_> = ops
+        .iter()
+        .map(|op| common::exact_local(&model, op))
+        .collect();
+    let options = FromLocalOptions {
+        use_g: false,
+        use_g_static: false,
+        consistent: Some(ConsistentOptions::default()),
+        ..FromLocalOptions::default()
+    };
+    let out = identify_parameters_from_local(&model, &models, &options).unwrap();
+    let fit = out.consistent.unwrap();
+    assert!(fit.solution.report.is_consistent());
+    let q = [0.3, -0.4, 0.9, 0.2, -0.7, 1.1];
+    let m = fit.model.mass_matrix(&model, &q).unwrap();
+    let mut data = perturbid_rs::Data::new(&model);
+    perturbid_rs::mass_matrix(&model, &mut data, &q).unwrap();
+    let e = (&m - &data.m).norm() / data.m.norm();
+    assert!(e < 1e-6, "M(q) of the consistent fit: {e:e}");
 }

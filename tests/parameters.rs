@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{linearized, table2, Rng};
+use common::{exact_local, linearized, random_op, table2, Rng};
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::algorithms::linearization_regressor::linearization_regressor;
 use perturbid_rs::direct::{regressor_matrix, FrictionTerms, ParameterLayout};
@@ -15,17 +15,6 @@ use perturbid_rs::robots::a465;
 use perturbid_rs::{
     linearize, mass_matrix, Data, Document, Gravity, Model, OperatingPoint, States,
 };
-
-fn random_op(model: &Model, rng: &mut Rng) -> OperatingPoint {
-    let n = model.nv;
-    let q = (0..n)
-        .map(|j| {
-            let l = &model.limits[j];
-            rng.uniform(0.8 * l.lower, 0.8 * l.upper)
-        })
-        .collect();
-    OperatingPoint::new(q, rng.vector(n, 0.5), rng.vector(n, 1.0)).unwrap()
-}
 
 #[test]
 fn the_linearisation_regressor_is_exact() {
@@ -90,46 +79,6 @@ fn the_linearisation_regressor_is_exact() {
                 );
             }
         }
-    }
-}
-
-/// An exact local model at `op` (what noise-free data give for T*, D*, H*).
-fn exact_local(model: &Model, op: &OperatingPoint) -> LocalModel {
-    let n = model.nv;
-    let lin = linearize(
-        model,
-        &mut Data::new(model),
-        &op.q,
-        &op.qd,
-        &op.qdd,
-        Gravity::Included,
-    )
-    .unwrap();
-    let est = |m: &DMatrix<f64>| {
-        Some(Estimate {
-            matrix: m.clone(),
-            cond: 1.0,
-            residual_rms: vec![0.0; n],
-            stderr: DMatrix::from_element(n, n, 1e-9),
-            crossings: 2 * n,
-        })
-    };
-    LocalModel {
-        format: LocalModel::tag(),
-        robot: model.name.clone(),
-        joint_names: model.joint_names.clone(),
-        op: op.clone(),
-        planned_op: op.clone(),
-        estimator: Estimator::Separated,
-        torque: lin.torque.as_slice().to_vec(),
-        torque_stderr: vec![1e-9; n],
-        d: est(&lin.d),
-        h: est(&lin.h),
-        g: None,
-        g_static: None,
-        combined: None,
-        coulomb: None,
-        diagnostics: Default::default(),
     }
 }
 

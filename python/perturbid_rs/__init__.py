@@ -26,6 +26,7 @@ Quick start::
 
 from ._core import (
     BaseParameterModel,
+    ConsistentFit,
     ExcitationDesign,
     Experiment,
     FileError,
@@ -46,6 +47,7 @@ from ._core import (
     TrueRobot,
     design_excitation,
     identify_base_parameters,
+    identify_consistent_parameters,
     identify_global_linear,
     identify_local,
     identify_parameters_from_local,
@@ -59,6 +61,7 @@ from . import robots
 
 __all__ = [
     "BaseParameterModel",
+    "ConsistentFit",
     "ExcitationDesign",
     "Experiment",
     "FileError",
@@ -79,6 +82,7 @@ __all__ = [
     "TrueRobot",
     "design_excitation",
     "identify_base_parameters",
+    "identify_consistent_parameters",
     "identify_global_linear",
     "identify_local",
     "identify_parameters_from_local",

@@ -10,6 +10,7 @@ __version__: str
 
 __all__ = [
     "BaseParameterModel",
+    "ConsistentFit",
     "ExcitationDesign",
     "Experiment",
     "FileError",
@@ -33,6 +34,7 @@ __all__ = [
     "cli",
     "design_excitation",
     "identify_base_parameters",
+    "identify_consistent_parameters",
     "identify_global_linear",
     "identify_local",
     "identify_parameters_from_local",
@@ -402,6 +404,7 @@ def identify_parameters_from_local(
     friction: Union[str, Sequence[str], None] = None,
     gravity: bool = True,
     use: Optional[Sequence[str]] = None,
+    consistent: bool = False,
 ) -> tuple["BaseParameterModel", dict[str, Any]]:
     """The robot's base parameters from local models at one or more operating points."""
 
@@ -533,6 +536,45 @@ def identify_base_parameters(
     tolerance: float = 1e-8,
     seed: int = 0,
 ) -> BaseParameterModel: ...
+
+class ConsistentFit:
+    """Physically consistent parameters: every pseudo-inertia PSD, friction and armature >= 0."""
+    @property
+    def model(self) -> BaseParameterModel: ...
+    @property
+    def unconstrained(self) -> BaseParameterModel: ...
+    @property
+    def theta(self) -> NDArray[np.float64]: ...
+    @property
+    def names(self) -> list[str]: ...
+    @property
+    def cost(self) -> float: ...
+    @property
+    def unconstrained_cost(self) -> float: ...
+    @property
+    def residual_growth(self) -> float: ...
+    @property
+    def active(self) -> list[str]: ...
+    @property
+    def iterations(self) -> int: ...
+    @property
+    def converged(self) -> bool: ...
+    def robot(self) -> Robot:
+        """The robot with the consistent parameters (inertias, armature, damping, friction)."""
+
+def identify_consistent_parameters(
+    robot: Robot,
+    q: ArrayLike,
+    qd: ArrayLike,
+    qdd: ArrayLike,
+    tau: ArrayLike,
+    friction: Union[str, Sequence[str], None] = None,
+    weighting: str = "wls",
+    gravity: bool = True,
+    prior_weight: float = 1e-6,
+    max_iterations: int = 2000,
+) -> ConsistentFit:
+    """Physically consistent least squares over the direct method's data (interior point)."""
 
 def identify_global_linear(op: OperatingPoint, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, tau: ArrayLike) -> GlobalLinearModel: ...
 

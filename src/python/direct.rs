@@ -78,7 +78,8 @@ impl PyExcitationDesign {
 }
 
 /// The `friction` argument of the direct method: a name or a list of names from 'viscous',
-/// 'coulomb', 'offset' ('all' for the three, 'none' for none), or anything else (refused).
+/// 'coulomb', 'offset', 'armature' ('all' for the three friction terms, 'none' for none), or
+/// anything else (refused).
 #[derive(FromPyObject)]
 pub(crate) enum FrictionNames<'py> {
     One(String),
@@ -87,7 +88,7 @@ pub(crate) enum FrictionNames<'py> {
 }
 
 /// The friction terms of a `friction` argument; `None` means none.
-fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<FrictionTerms> {
+pub(crate) fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<FrictionTerms> {
     Ok(match value {
         None => FrictionTerms::NONE,
         Some(FrictionNames::One(name)) => FrictionTerms::from_names(&[name])?,
@@ -96,7 +97,7 @@ fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<FrictionTerms> {
             return Err(Error::InvalidArgument {
                 argument: "friction".into(),
                 message: format!(
-                    "{v}; expected None, 'all', or a list of 'viscous', 'coulomb', 'offset'"
+                    "{v}; expected None, 'all', or a list of 'viscous', 'coulomb', 'offset', 'armature'"
                 ),
             }
             .into())
@@ -151,7 +152,7 @@ pub(crate) fn design_excitation(
 }
 
 /// Row-major (k, n) samples of three arrays and optionally a fourth.
-fn states<'a>(
+pub(crate) fn states<'a>(
     n: usize,
     q: &'a ArrayLike<'_>,
     qd: &'a ArrayLike<'_>,

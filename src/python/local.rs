@@ -615,9 +615,11 @@ impl PyLocalModel {
 /// weighted by the models' standard errors. `gravity`: whether the models' torques include
 /// gravity. Returns `(model, info)`: a BaseParameterModel of the combinations the points
 /// identify, and a dict `rank`, `robot_rank` (the robot's base parameters), `unidentified`
-/// (the robot's base parameters these points cannot separate) and `rows`.
+/// (the robot's base parameters these points cannot separate) and `rows`. With
+/// `consistent=True` the dict also holds `consistent`: a ConsistentFit of the same rows (the
+/// robot's own parameters as the weak prior).
 #[pyfunction]
-#[pyo3(signature = (robot, models, *, friction=None, gravity=true, r#use=None))]
+#[pyo3(signature = (robot, models, *, friction=None, gravity=true, r#use=None, consistent=false))]
 pub(crate) fn identify_parameters_from_local<'py>(
     py: Python<'py>,
     robot: &PyRobot,
@@ -625,11 +627,13 @@ pub(crate) fn identify_parameters_from_local<'py>(
     friction: Option<Bound<'py, PyAny>>,
     gravity: bool,
     r#use: Option<Vec<String>>,
+    consistent: bool,
 ) -> PyResult<(super::direct::PyBaseModel, Bound<'py, PyDict>)> {
     use crate::local::{identify_parameters_from_local as from_local, FromLocalOptions};
     let mut options = FromLocalOptions {
         gravity: gravity.into(),
         friction: super::arrays::friction_terms(friction.as_ref())?,
+        consistent: consistent.then(crate::direct::ConsistentOptions::default),
         ..FromLocalOptions::default()
     };
     super::arrays::local_parts(r#use, &mut options)?;
@@ -643,6 +647,15 @@ pub(crate) fn identify_parameters_from_local<'py>(
     info.set_item("robot_rank", out.robot_rank)?;
     info.set_item("unidentified", out.unidentified.clone())?;
     info.set_item("rows", out.rows)?;
+    if let Some(fit) = out.consistent {
+        info.set_item(
+            "consistent",
+            super::consistent::PyConsistentFit {
+                fit,
+                model: Arc::new(model.clone()),
+            },
+        )?;
+    }
     Ok((
         super::direct::PyBaseModel {
             fit: out.model,

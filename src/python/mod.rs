@@ -4,6 +4,7 @@
 
 mod arrays;
 mod cli;
+mod consistent;
 mod direct;
 mod errors;
 mod linearization;
@@ -60,6 +61,11 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(direct::design_excitation, m)?)?;
     m.add_function(wrap_pyfunction!(direct::identify_base_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(direct::identify_global_linear, m)?)?;
+    m.add_class::<consistent::PyConsistentFit>()?;
+    m.add_function(wrap_pyfunction!(
+        consistent::identify_consistent_parameters,
+        m
+    )?)?;
     m.add_function(wrap_pyfunction!(preprocess::preprocess, m)?)?;
     m.add_function(wrap_pyfunction!(cli::cli, m)?)?;
     errors::register(m)?;

@@ -32,7 +32,7 @@ pub(crate) struct PyRobot {
 }
 
 impl PyRobot {
-    fn new(model: Model) -> Self {
+    pub(crate) fn new(model: Model) -> Self {
         let work = Mutex::new(Workspace::new(&model));
         Self { model, work }
     }

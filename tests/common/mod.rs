@@ -166,3 +166,58 @@ pub fn a465_with_armature() -> perturbid_rs::Model {
     )
     .unwrap()
 }
+
+/// A random operating point within 0.8 of the position limits.
+pub fn random_op(model: &perturbid_rs::Model, rng: &mut Rng) -> perturbid_rs::OperatingPoint {
+    let n = model.nv;
+    let q = (0..n)
+        .map(|j| {
+            let l = &model.limits[j];
+            rng.uniform(0.8 * l.lower, 0.8 * l.upper)
+        })
+        .collect();
+    perturbid_rs::OperatingPoint::new(q, rng.vector(n, 0.5), rng.vector(n, 1.0)).unwrap()
+}
+
+/// An exact local model at `op` (what noise-free data give for T*, D*, H*).
+pub fn exact_local(
+    model: &perturbid_rs::Model,
+    op: &perturbid_rs::OperatingPoint,
+) -> perturbid_rs::local::LocalModel {
+    let n = model.nv;
+    let lin = perturbid_rs::linearize(
+        model,
+        &mut perturbid_rs::Data::new(model),
+        &op.q,
+        &op.qd,
+        &op.qdd,
+        perturbid_rs::Gravity::Included,
+    )
+    .unwrap();
+    let est = |m: &DMatrix<f64>| {
+        Some(perturbid_rs::local::Estimate {
+            matrix: m.clone(),
+            cond: 1.0,
+            residual_rms: vec![0.0; n],
+            stderr: DMatrix::from_element(n, n, 1e-9),
+            crossings: 2 * n,
+        })
+    };
+    perturbid_rs::local::LocalModel {
+        format: <perturbid_rs::local::LocalModel as perturbid_rs::Document>::tag(),
+        robot: model.name.clone(),
+        joint_names: model.joint_names.clone(),
+        op: op.clone(),
+        planned_op: op.clone(),
+        estimator: perturbid_rs::local::Estimator::Separated,
+        torque: lin.torque.as_slice().to_vec(),
+        torque_stderr: vec![1e-9; n],
+        d: est(&lin.d),
+        h: est(&lin.h),
+        g: None,
+        g_static: None,
+        combined: None,
+        coulomb: None,
+        diagnostics: Default::default(),
+    }
+}

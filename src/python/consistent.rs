@@ -1,0 +1,153 @@
+//! Python: physically consistent identification (`identify_consistent_parameters`) and its
+//! result, `ConsistentFit`.
+
+use std::sync::Arc;
+
+use numpy::PyArray1;
+use pyo3::prelude::*;
+
+use super::arrays::ArrayLike;
+use super::detached;
+use super::direct::{friction_terms, states, FrictionNames, PyBaseModel};
+use super::robot::PyRobot;
+use crate::direct::{
+    identify_consistent_parameters as consistent_rs, BaseOptions, ConsistentFit, ConsistentOptions,
+    Weighting,
+};
+use crate::model::Model;
+use crate::states::States;
+
+/// Physically consistent parameters: every body's pseudo-inertia positive semi-definite (a
+/// rigid body with a non-negative density can have them), viscous, Coulomb and armature
+/// coefficients >= 0. Attributes:
+/// - `model`: a BaseParameterModel of the consistent parameters (predict, linearize, save);
+///   its standard errors are the unconstrained fit's (valid where no constraint is active);
+/// - `unconstrained`: the BaseParameterModel of the same data without constraints;
+/// - `theta` (p,), `names` (p,): the full consistent parameters (10 per body in
+///   `Robot.regressor` order, kg, kg m, kg m^2 about the body frame, then the joint terms);
+/// - `cost`, `unconstrained_cost`: the weighted residual sums of squares; `residual_growth`
+///   their ratio (1 = the constraints cost nothing);
+/// - `active`: the constraints the solution presses against, as sentences;
+/// - `iterations`, `converged`; `robot()`: the robot with these parameters.
+#[pyclass(name = "ConsistentFit", module = "perturbid_rs", frozen)]
+pub(crate) struct PyConsistentFit {
+    pub(crate) fit: ConsistentFit,
+    pub(crate) model: Arc<Model>,
+}
+
+#[pymethods]
+impl PyConsistentFit {
+    #[getter]
+    fn model(&self) -> PyBaseModel {
+        PyBaseModel {
+            fit: self.fit.model.clone(),
+            model: self.model.clone(),
+        }
+    }
+    #[getter]
+    fn unconstrained(&self) -> PyBaseModel {
+        PyBaseModel {
+            fit: self.fit.unconstrained.clone(),
+            model: self.model.clone(),
+        }
+    }
+    #[getter]
+    fn theta<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.fit.solution.theta)
+    }
+    #[getter]
+    fn names(&self) -> Vec<String> {
+        self.fit.layout.names.clone()
+    }
+    #[getter]
+    fn cost(&self) -> f64 {
+        self.fit.solution.cost
+    }
+    #[getter]
+    fn unconstrained_cost(&self) -> f64 {
+        self.fit.solution.unconstrained_cost
+    }
+    #[getter]
+    fn residual_growth(&self) -> f64 {
+        self.fit.residual_growth()
+    }
+    #[getter]
+    fn active(&self) -> Vec<String> {
+        self.fit.solution.active.clone()
+    }
+    #[getter]
+    fn iterations(&self) -> usize {
+        self.fit.solution.iterations
+    }
+    #[getter]
+    fn converged(&self) -> bool {
+        self.fit.solution.converged
+    }
+    /// The robot with the consistent parameters (inertias, armature, viscous and Coulomb
+    /// friction as `damping` and `friction`; offsets stay in `model`).
+    fn robot(&self) -> PyResult<PyRobot> {
+        Ok(PyRobot::new(self.fit.robot(&self.model)?))
+    }
+    fn __repr__(&self) -> String {
+        let s = &self.fit.solution;
+        format!(
+            "ConsistentFit(robot='{}', parameters={}, residual_growth={:.6}, active={}, iterations={})",
+            self.fit.model.robot,
+            s.theta.len(),
+            self.fit.residual_growth(),
+            s.active.len(),
+            s.iterations
+        )
+    }
+}
+
+/// Identifies physically consistent parameters of `robot` from samples `q`, `qd`, `qdd`, `tau`
+/// (each (k, n); rad, rad/s, rad/s^2, N m): the weighted least squares of
+/// `identify_base_parameters` (same `friction`, `weighting`, `gravity`) over the parameter sets
+/// a real robot can have, solved by an interior-point (log-barrier Newton) method. The robot's own
+/// parameters are a weak prior (`prior_weight` relative to each column's norm) that decides
+/// what the data do not. Returns a ConsistentFit.
+#[pyfunction]
+#[pyo3(signature = (robot, q, qd, qdd, tau, friction=None, weighting="wls", gravity=true, prior_weight=1e-6, max_iterations=2000))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn identify_consistent_parameters(
+    py: Python<'_>,
+    robot: &PyRobot,
+    q: ArrayLike<'_>,
+    qd: ArrayLike<'_>,
+    qdd: ArrayLike<'_>,
+    tau: ArrayLike<'_>,
+    friction: Option<FrictionNames<'_>>,
+    weighting: &str,
+    gravity: bool,
+    prior_weight: f64,
+    max_iterations: usize,
+) -> PyResult<PyConsistentFit> {
+    let weighting: Weighting = weighting.parse()?;
+    let options = BaseOptions {
+        friction: friction_terms(friction)?,
+        weighting,
+        gravity: gravity.into(),
+        ..BaseOptions::default()
+    };
+    let consistent = ConsistentOptions {
+        prior_weight,
+        max_iterations,
+        ..ConsistentOptions::default()
+    };
+    let model = &robot.model;
+    let c = states(model.nv, &q, &qd, &qdd, Some(&tau))?;
+    let fit = detached(py, "identify_consistent_parameters", || {
+        consistent_rs(
+            model,
+            &States::new(model.nv, &c[0], Some(&c[1]), Some(&c[2]))?,
+            &c[3],
+            &options,
+            &consistent,
+        )
+    })?;
+    Ok(PyConsistentFit {
+        fit,
+        model: Arc::new(model.clone()),
+    })
+}
