@@ -584,6 +584,24 @@ fn excite_simulate_on_a_true_robot_identify_direct() {
         err < 0.2 * nominal,
         "fit {err:.2e} vs nominal {nominal:.2e} off the truth"
     );
+    // physically consistent: every link of the saved model's parameters a possible body
+    let out = ok(&[
+        "identify-direct",
+        "a465",
+        s(&d.join("log.csv")),
+        "--friction",
+        "viscous",
+        "--consistent",
+        "--out",
+        s(&d.join("consistent.json")),
+    ]);
+    assert!(
+        out.contains("physically consistent: the weighted residual grows by a factor"),
+        "{out}"
+    );
+    let c = perturbid_rs::direct::BaseModel::load(d.join("consistent.json")).unwrap();
+    let mc = c.mass_matrix(&model, &q).unwrap();
+    assert!((&mc - &dt.m).norm() / dt.m.norm() < 0.2 * nominal);
     // the noise options belong in the document
     fails(
         &[
@@ -736,6 +754,20 @@ fn parameters_from_local_models() {
     let mut data = Data::new(&model);
     mass_matrix(&model, &mut data, &a465::TABLE2_Q).unwrap();
     assert!((&m - &data.m).norm() < 1e-6 * data.m.norm());
+    let out = ok(&[
+        "parameters",
+        "a465",
+        s(&models[0]),
+        s(&models[1]),
+        "--consistent",
+        "--out",
+        s(&d.join("consistent.json")),
+    ]);
+    assert!(
+        out.contains("physically consistent: the weighted residual grows by a factor"),
+        "{out}"
+    );
+    assert!(perturbid_rs::direct::BaseModel::load(d.join("consistent.json")).is_ok());
     fails(
         &["parameters", "a465", s(&d.join("nope.json"))],
         &["nope.json"],

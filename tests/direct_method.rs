@@ -607,6 +607,58 @@ fn panda_real_data_matches_the_reference() {
         "WLS mean {:.2} %",
         means[1]
     );
+    // physically consistent: every link a possible body, and the held-out error within half a
+    // point of the unconstrained fit's on every joint (docs/parameters.md)
+    let fit_batch = States::new(
+        model.nv,
+        &rec.q[..split],
+        Some(&qd[..split]),
+        Some(&qdd[..split]),
+    )
+    .unwrap();
+    let val_batch = States::new(
+        model.nv,
+        &rec.q[split..],
+        Some(&qd[split..]),
+        Some(&qdd[split..]),
+    )
+    .unwrap();
+    let fit = perturbid_rs::direct::identify_consistent_parameters(
+        &model,
+        &fit_batch,
+        &rec.tau[..split],
+        &BaseOptions::default(),
+        &perturbid_rs::direct::ConsistentOptions::default(),
+    )
+    .unwrap();
+    assert!(fit.solution.report.is_consistent() && fit.solution.converged);
+    assert!(
+        fit.residual_growth() < 1.15,
+        "growth {}",
+        fit.residual_growth()
+    );
+    let measured = &rec.tau[split..];
+    let relative = |m: &perturbid_rs::direct::BaseModel| -> Vec<f64> {
+        let p = m.predict(&model, &val_batch).unwrap();
+        (0..7)
+            .map(|j| {
+                let idx = (j..p.len()).step_by(7);
+                let e: f64 = idx.clone().map(|i| (p[i] - measured[i]).powi(2)).sum();
+                let m: f64 = idx.map(|i| measured[i].powi(2)).sum();
+                100.0 * (e / m).sqrt()
+            })
+            .collect()
+    };
+    let (u, c) = (relative(&fit.unconstrained), relative(&fit.model));
+    for j in 0..7 {
+        assert!(
+            c[j] <= u[j] + 0.5,
+            "joint {}: consistent {:.2} % vs {:.2} %",
+            j + 1,
+            c[j],
+            u[j]
+        );
+    }
 }
 
 /// The per-joint TSQR solve equals one dense least-squares solve over the whole regressor

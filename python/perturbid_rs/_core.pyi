@@ -537,6 +537,7 @@ def identify_base_parameters(
     seed: int = 0,
 ) -> BaseParameterModel: ...
 
+@final
 class ConsistentFit:
     """Physically consistent parameters: every pseudo-inertia PSD, friction and armature >= 0."""
     @property

@@ -15,8 +15,10 @@ def a465(variant: str = "kinsheel2010") -> Robot:
     """The CRS A465 arm of Kinsheel & Taha (2010): 6 revolute joints, frames parallel to the
     base at q = 0 (arm pointing up), gravity along -z.
 
-    ``variant="kinsheel2010"`` adds a rotor inertia to each link about its joint axis, fitted to
-    the paper's tables (its link inertias break the triangle inequality on purpose);
-    ``variant="physical"`` is the CAD estimate. Raises ``ModelError`` for another name.
+    ``variant="kinsheel2010"`` is fitted to the paper's tables, physically consistent, with the
+    motors' rotor inertia as each joint's armature; ``variant="kinsheel2010_lumped"`` is the
+    first fit, with the rotor inertia lumped into each link (its links break the triangle
+    inequality); ``variant="physical"`` is the CAD estimate. Raises ``ModelError`` for another
+    name.
     """
     return Robot.builtin(f"a465:{variant}")

@@ -103,7 +103,8 @@ pub(crate) struct IdentifyDirectArgs {
     /// Where to write the base-parameter model (JSON).
     #[arg(long, default_value = "base_model.json")]
     out: PathBuf,
-    /// Friction terms per joint, comma separated from viscous, coulomb, offset; or none.
+    /// Joint terms, comma separated from viscous, coulomb, offset, armature; or none (the
+    /// armature is added when the robot has one).
     #[arg(long, default_value = "viscous,coulomb,offset")]
     friction: FrictionTerms,
     /// wls (weights from the per-joint residuals) or ols.
@@ -131,6 +132,11 @@ pub(crate) struct IdentifyDirectArgs {
     /// Fit on the first (1 - FRACTION) of the samples and report the errors on the rest.
     #[arg(long, default_value_t = 0.3)]
     validate: f64,
+    /// Physically consistent parameters (every link a possible rigid body, friction and
+    /// armature >= 0; the URDF's own parameters decide what the data do not): the consistent
+    /// model is saved, and the residual growth over the unconstrained fit is reported.
+    #[arg(long)]
+    consistent: bool,
 }
 
 pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
@@ -174,12 +180,33 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     };
     progress.update(&format!("identifying on {split} samples"));
     let states = States::new(n, &rec.q, Some(&qd), Some(&qdd))?;
-    let fit = identify_base_parameters(
-        &model,
-        &states.slice(0..split),
-        &rec.tau[..split * n],
-        &options,
-    )?;
+    let fit = if a.consistent {
+        let c = crate::direct::identify_consistent_parameters(
+            &model,
+            &states.slice(0..split),
+            &rec.tau[..split * n],
+            &options,
+            &crate::direct::ConsistentOptions::default(),
+        )?;
+        let s = &c.solution;
+        let _ = writeln!(
+            out,
+            "physically consistent: the weighted residual grows by a factor {:.4} over the unconstrained fit ({} Newton steps{}); {} constraint(s) active{}",
+            c.residual_growth(),
+            s.iterations,
+            if s.converged { "" } else { ", stopped at the limit before converging" },
+            s.active.len(),
+            if s.active.is_empty() { String::new() } else { format!(": {}", s.active.join("; ")) }
+        );
+        c.model
+    } else {
+        identify_base_parameters(
+            &model,
+            &states.slice(0..split),
+            &rec.tau[..split * n],
+            &options,
+        )?
+    };
     progress.done();
     fit.save(&a.out)?;
     let _ = writeln!(

@@ -23,12 +23,17 @@ pub(crate) struct ParametersArgs {
     /// Where to write the identified base parameters (a base-parameter model, JSON).
     #[arg(long, default_value = "parameters.json")]
     out: PathBuf,
-    /// Friction terms to identify too, comma separated from viscous, coulomb, offset; or none.
+    /// Joint terms to identify too, comma separated from viscous, coulomb, offset, armature;
+    /// or none (the armature is added when the robot has one).
     #[arg(long, default_value = "none")]
     friction: FrictionTerms,
     /// The models' torques exclude gravity.
     #[arg(long)]
     no_gravity: bool,
+    /// Save physically consistent parameters instead (every link a possible rigid body,
+    /// friction and armature >= 0; the URDF's own parameters decide what the points do not).
+    #[arg(long)]
+    consistent: bool,
 }
 
 pub(crate) fn run(a: ParametersArgs) -> Result<String> {
@@ -44,11 +49,24 @@ pub(crate) fn run(a: ParametersArgs) -> Result<String> {
     let options = FromLocalOptions {
         friction: a.friction,
         gravity: Gravity::from(!a.no_gravity),
+        consistent: a.consistent.then(crate::direct::ConsistentOptions::default),
         ..FromLocalOptions::default()
     };
     let fit = identify_parameters_from_local(&robot, &models, &options)?;
-    fit.model.save(&a.out)?;
     let mut out = String::new();
+    match &fit.consistent {
+        Some(c) => {
+            c.model.save(&a.out)?;
+            let _ = writeln!(
+                out,
+                "physically consistent: the weighted residual grows by a factor {:.4} over the unconstrained fit; {} constraint(s) active{}",
+                c.residual_growth(),
+                c.solution.active.len(),
+                if c.solution.active.is_empty() { String::new() } else { format!(": {}", c.solution.active.join("; ")) }
+            );
+        }
+        None => fit.model.save(&a.out)?,
+    }
     let _ = writeln!(
         out,
         "{} of the robot's {} base parameters identified from {} operating point(s), {} equations, cond {:.3e} -> {}",

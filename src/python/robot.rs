@@ -125,7 +125,8 @@ impl PyRobot {
         Ok(Self::new(model))
     }
 
-    /// A built-in robot by name: "a465", "a465:kinsheel2010", "a465:physical".
+    /// A built-in robot by name: "a465", "a465:kinsheel2010", "a465:physical",
+    /// "a465:kinsheel2010_lumped".
     #[staticmethod]
     fn builtin(name: &str) -> PyResult<Self> {
         Ok(Self::new(robots::builtin(name)?))
@@ -447,7 +448,8 @@ impl PyRobot {
     }
 }
 
-/// The URDF text of a built-in A465 variant ("kinsheel2010" or "physical").
+/// The URDF text of a built-in A465 variant ("kinsheel2010", "physical" or
+/// "kinsheel2010_lumped").
 #[pyfunction]
 #[pyo3(signature = (variant="kinsheel2010"))]
 pub(crate) fn a465_urdf(variant: &str) -> PyResult<&'static str> {

@@ -90,4 +90,7 @@ def pair_from_urdf(path, lock=None, pin_lock=None, mimic=False) -> Pair:
 
 def pair_from_text(text, **kw) -> Pair:
     ours = pr.Robot.from_urdf_string(text, **kw)
-    return Pair(ours, pin.buildModelFromXML(text))
+    model = pin.buildModelFromXML(text)
+    # URDF has no armature element: Pinocchio takes ours (joints in the same order here)
+    model.armature = np.asarray(ours.armature)
+    return Pair(ours, model)

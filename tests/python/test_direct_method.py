@@ -25,7 +25,7 @@ def pin_parameters(pair):
 @pytest.mark.parametrize(
     "make",
     [
-        lambda: pair_from_text(pr.robots.a465_urdf("kinsheel2010"), check_triangle_inequality=False),
+        lambda: pair_from_text(pr.robots.a465_urdf("kinsheel2010")),
         lambda: pair_from_urdf(erd_dir() / "ur_description/urdf/ur5_robot.urdf"),
         lambda: pair_from_urdf(
             erd_dir() / "panda_description/urdf/panda.urdf",
@@ -47,7 +47,12 @@ def test_regressor_matches_pinocchio(make):
         theirs = pin.computeJointTorqueRegressor(pair.model, pair.data, pair.q(q), pair.v(qd), pair.v(qdd))
         theirs = theirs[np.ix_(pair.idx_v, cols)]
         np.testing.assert_allclose(ours, theirs, rtol=1e-9, atol=1e-9 * np.abs(theirs).max())
-        np.testing.assert_allclose(ours @ pair.ours.parameters, pair.ours.rnea(q, qd, qdd), atol=1e-9)
+        # the rigid bodies' regressor; the armature (the A465's rotors) adds its own term
+        rigid = ours @ pair.ours.parameters + pair.ours.armature * qdd
+        np.testing.assert_allclose(rigid, pair.ours.rnea(q, qd, qdd), atol=1e-9)
+        full = pair.ours.regressor(q, qd, qdd, friction="armature")
+        theta = np.concatenate([pair.ours.parameters, pair.ours.armature])
+        np.testing.assert_allclose(full @ theta, pair.ours.rnea(q, qd, qdd), atol=1e-9)
     # a batch
     qs = np.array([pair.random_state(rng)[0] for _ in range(4)])
     assert pair.ours.regressor(qs, 0 * qs, 0 * qs).shape == (4, pair.ours.n, 10 * pair.ours.n)
@@ -73,7 +78,8 @@ def test_base_parameters_on_simulated_a465_are_exact():
     q, qd, qdd = traj.sample(t)
     tau = robot.rnea(q, qd, qdd)
     fit = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction=None, weighting="ols")
-    assert len(fit.theta_base) == len(fit.names) == len(fit.kept) and len(fit.kept) + len(fit.dropped) == 60
+    # 10 per body and the armature per joint: the robot has rotors, so the fit takes them
+    assert len(fit.theta_base) == len(fit.names) == len(fit.kept) and len(fit.kept) + len(fit.dropped) == 66
     rng = np.random.default_rng(2)
     qh, qdh, qddh = rng.uniform(-1, 1, (3, 40, 6))
     expected = robot.rnea(qh, qdh, qddh)
@@ -81,7 +87,7 @@ def test_base_parameters_on_simulated_a465_are_exact():
     m_true = robot.mass_matrix(TABLE2_Q)
     assert np.linalg.norm(fit.mass_matrix(TABLE2_Q) - m_true) < 1e-8 * np.linalg.norm(m_true)
     # theta_base = theta[kept] + K theta[dropped] for the true parameters
-    theta = robot.parameters
+    theta = np.concatenate([robot.parameters, robot.armature])
     np.testing.assert_allclose(fit.theta_base, theta[fit.kept] + fit.K @ theta[fit.dropped], rtol=1e-7, atol=1e-9)
     assert fit.mass_matrix(np.tile(TABLE2_Q, (2, 1))).shape == (2, 6, 6)
 
@@ -240,8 +246,9 @@ def test_physical_consistency_against_pinocchio_pseudo_inertia():
     physical = pr.robots.a465("physical")
     ok, bodies, friction = physical.physical_consistency()
     assert ok and friction == [] and len(bodies) == 6
-    fitted = pr.robots.a465()
+    fitted = pr.robots.a465("kinsheel2010_lumped")
     ok, bodies, _ = fitted.physical_consistency()
+    assert pr.robots.a465().physical_consistency(friction="armature")[0]
     assert not ok and any("pseudo-inertia" in (b["problem"] or "") for b in bodies)
     # the eigenvalues are those of Pinocchio's pseudo-inertia of the same parameters
     theta = fitted.parameters
@@ -253,3 +260,34 @@ def test_physical_consistency_against_pinocchio_pseudo_inertia():
     theta[0] = -1.0
     ok, bodies, _ = physical.physical_consistency(theta)
     assert not ok and bodies[0]["problem"] == "mass -1 kg is negative"
+
+
+def test_consistent_parameters_make_a_robot_pinocchio_agrees_with():
+    """Noisy torques from few samples: the consistent fit is a robot (every pseudo-inertia PSD),
+    costs at least the unconstrained minimum, and the robot built from it has, in Pinocchio,
+    the torques the fit predicts."""
+    import pinocchio as pin
+
+    robot = pr.robots.a465("physical")
+    rng = np.random.default_rng(11)
+    q, qd, qdd = rng.uniform(-1.2, 1.2, (3, 60, 6))
+    viscous = np.array([0.5, 0.4, 0.3, 0.2, 0.1, 0.05])
+    tau = robot.rnea(q, qd, qdd) + viscous * qd + rng.normal(0, 0.5, (60, 6))
+    fit = pr.identify_consistent_parameters(robot, q, qd, qdd, tau, friction="viscous", weighting="ols")
+    assert isinstance(fit, pr.ConsistentFit) and fit.converged
+    assert fit.residual_growth >= 1.0 - 1e-9 and fit.cost >= fit.unconstrained_cost * (1 - 1e-9)
+    assert len(fit.theta) == len(fit.names) == 60 + 6 and fit.names[60] == "joint1.viscous"
+    ok, bodies, negative = robot.physical_consistency(fit.theta, friction="viscous")
+    assert ok and negative == [], bodies
+    built = fit.robot()
+    np.testing.assert_allclose(built.damping, fit.theta[60:], rtol=1e-12)
+    # Pinocchio, with the fitted inertias
+    model = pin.buildModelFromXML(pr.robots.a465_urdf("physical"))
+    data = model.createData()
+    for j in range(6):
+        model.inertias[j + 1] = pin.Inertia.FromDynamicParameters(fit.theta[10 * j: 10 * j + 10])
+    qh, qdh, qddh = rng.uniform(-1, 1, (3, 6))
+    expected = pin.rnea(model, data, qh, qdh, qddh) + fit.theta[60:] * qdh
+    np.testing.assert_allclose(fit.model.predict(qh, qdh, qddh), expected, atol=1e-8)
+    np.testing.assert_allclose(built.rnea(qh, qdh, qddh) + built.damping * qdh, expected, atol=1e-8)
+    assert "ConsistentFit(" in repr(fit)

@@ -122,8 +122,8 @@ def test_bad_urdfs():
             "<parent link='a'/><child link='b'/></joint></robot>"
         )
     with pytest.raises(pr.ModelError, match="triangle inequality"):
-        pr.Robot.from_urdf_string(pr.robots.a465_urdf("kinsheel2010"))
-    relaxed = pr.Robot.from_urdf_string(pr.robots.a465_urdf("kinsheel2010"), check_triangle_inequality=False)
+        pr.Robot.from_urdf_string(pr.robots.a465_urdf("kinsheel2010_lumped"))
+    relaxed = pr.Robot.from_urdf_string(pr.robots.a465_urdf("kinsheel2010_lumped"), check_triangle_inequality=False)
     assert relaxed.n == 6
     with pytest.raises(pr.ModelError, match="lock 'nope'"):
         pr.Robot.from_urdf_string(pr.robots.a465_urdf("physical"), lock={"nope": 0.0})

@@ -44,7 +44,7 @@ def taylor_bound(pair, op, deltas, g_true, qd, qdd, t0):
 
 @pytest.fixture(scope="module")
 def a465():
-    return pair_from_text(pr.robots.a465_urdf("kinsheel2010"), check_triangle_inequality=False)
+    return pair_from_text(pr.robots.a465_urdf("kinsheel2010"))
 
 
 @pytest.fixture(scope="module")
@@ -238,6 +238,14 @@ def test_parameters_from_identified_local_models():
         op = m.planned_op
         np.testing.assert_allclose(fit.predict(op.q, op.qd, op.qdd), m.torque, atol=1e-6)
         np.testing.assert_allclose(fit.mass_matrix(op.q), m.D, atol=1e-6)
+    # and physically consistent: the same torques there, from a robot that can exist
+    _, info = pr.identify_parameters_from_local(robot, models, use=["torque", "D", "H"], consistent=True)
+    c = info["consistent"]
+    assert isinstance(c, pr.ConsistentFit) and c.residual_growth >= 1.0 - 1e-9
+    assert robot.physical_consistency(c.theta, friction="armature")[0]
+    for m in models:
+        op = m.planned_op
+        np.testing.assert_allclose(c.model.predict(op.q, op.qd, op.qdd), m.torque, atol=1e-3)
     with pytest.raises(pr.InputError, match="'Q'"):
         pr.identify_parameters_from_local(robot, models, use=["Q"])
 
@@ -246,7 +254,7 @@ def test_suggested_operating_points_reach_every_base_parameter():
     robot = pr.robots.a465()
     start = pr.OperatingPoint(*TABLE2)
     picks = pr.suggest_operating_points(robot, [start], candidates=40, count=3, use=["torque", "D", "H"])
-    assert len(picks) == 3 and picks[-1][1] == 36
+    assert len(picks) == 3 and picks[-1][1] == 40  # 36 rigid-body ones and 4 the armatures add
     assert all(isinstance(op, pr.OperatingPoint) for op, _ in picks)
     with pytest.raises(pr.InputError, match="candidates"):
         pr.suggest_operating_points(robot, candidates=0)

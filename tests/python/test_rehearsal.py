@@ -27,6 +27,7 @@ def test_stribeck_friction_and_offsets_on_sampled_arrays_against_pinocchio(tmp_p
     urdf = tmp_path / "a465.urdf"
     urdf.write_text(pr.robots.a465_urdf())
     pm = pin.buildModelFromUrdf(str(urdf))
+    pm.armature = np.asarray(robot.armature)  # URDF has no armature element
     pd = pm.createData()
     spec = {
         "joint_offsets": [0.01, -0.02, 0.0, 0.0, 0.03, 0.0],
