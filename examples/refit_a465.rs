@@ -61,10 +61,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         weighting: Weighting::Ols,
         ..BaseOptions::default()
     };
-    let tight = ConsistentOptions {
-        tolerance: 1e-16,
-        ..ConsistentOptions::default()
-    };
     let fit = identify_consistent_parameters(
         &prior,
         &states,

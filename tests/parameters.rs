@@ -8,13 +8,9 @@ use common::{exact_local, linearized, random_op, table2, Rng};
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::algorithms::linearization_regressor::linearization_regressor;
 use perturbid_rs::direct::{regressor_matrix, FrictionTerms, ParameterLayout};
-use perturbid_rs::local::{
-    identify_parameters_from_local, Estimate, Estimator, FromLocalOptions, LocalModel,
-};
+use perturbid_rs::local::{identify_parameters_from_local, FromLocalOptions, LocalModel};
 use perturbid_rs::robots::a465;
-use perturbid_rs::{
-    linearize, mass_matrix, Data, Document, Gravity, Model, OperatingPoint, States,
-};
+use perturbid_rs::{linearize, mass_matrix, Data, Document, Gravity, OperatingPoint, States};
 
 #[test]
 fn the_linearisation_regressor_is_exact() {
