@@ -8,11 +8,10 @@ use pyo3::prelude::*;
 
 use super::arrays::ArrayLike;
 use super::detached;
-use super::direct::{friction_terms, states, FrictionNames, PyBaseModel};
+use super::direct::{base_options, states, FrictionNames, PyBaseModel};
 use super::robot::PyRobot;
 use crate::direct::{
-    identify_consistent_parameters as consistent_rs, BaseOptions, ConsistentFit, ConsistentOptions,
-    Weighting,
+    identify_consistent_parameters as consistent_rs, ConsistentFit, ConsistentOptions,
 };
 use crate::model::Model;
 use crate::states::States;
@@ -123,13 +122,7 @@ pub(crate) fn identify_consistent_parameters(
     prior_weight: f64,
     max_iterations: usize,
 ) -> PyResult<PyConsistentFit> {
-    let weighting: Weighting = weighting.parse()?;
-    let options = BaseOptions {
-        friction: friction_terms(friction)?,
-        weighting,
-        gravity: gravity.into(),
-        ..BaseOptions::default()
-    };
+    let options = base_options(friction, weighting, gravity)?;
     let consistent = ConsistentOptions {
         prior_weight,
         max_iterations,

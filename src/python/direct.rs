@@ -88,7 +88,7 @@ pub(crate) enum FrictionNames<'py> {
 }
 
 /// The friction terms of a `friction` argument; `None` means none.
-pub(crate) fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<FrictionTerms> {
+fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<FrictionTerms> {
     Ok(match value {
         None => FrictionTerms::NONE,
         Some(FrictionNames::One(name)) => FrictionTerms::from_names(&[name])?,
@@ -164,6 +164,21 @@ pub(crate) fn states<'a>(
         args.push(("tau", t));
     }
     Ok(read_batch(n, &args)?.columns)
+}
+
+/// The options of the direct method from its Python arguments (`friction`, `weighting`,
+/// `gravity`; the rest default).
+pub(crate) fn base_options(
+    friction: Option<FrictionNames<'_>>,
+    weighting: &str,
+    gravity: bool,
+) -> PyResult<BaseOptions> {
+    Ok(BaseOptions {
+        friction: friction_terms(friction)?,
+        weighting: weighting.parse::<Weighting>()?,
+        gravity: gravity.into(),
+        ..BaseOptions::default()
+    })
 }
 
 /// An identified base-parameter model (the direct method).
@@ -304,15 +319,10 @@ pub(crate) fn identify_base_parameters(
     tolerance: f64,
     seed: u64,
 ) -> PyResult<PyBaseModel> {
-    let weighting: Weighting = weighting.parse()?;
-    let friction = friction_terms(friction)?;
     let options = BaseOptions {
-        friction,
-        weighting,
-        gravity: gravity.into(),
         tolerance,
         seed,
-        ..BaseOptions::default()
+        ..base_options(friction, weighting, gravity)?
     };
     let model = &robot.model;
     let c = states(model.nv, &q, &qd, &qdd, Some(&tau))?;
