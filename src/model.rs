@@ -252,6 +252,50 @@ impl Model {
         }
     }
 
+    /// The degrees of freedom that look like a gripper's fingers: prismatic, or named
+    /// `finger`/`gripper`, and moving less than 1 % of the robot's moving mass. Their torque is
+    /// seldom measured and their parameters are noise in an identification: lock them.
+    /// Returns (joint name, mass it moves in kg).
+    pub fn light_joints(&self) -> Vec<(String, f64)> {
+        let n = self.nbodies();
+        let mut subtree = vec![0.0; n];
+        for i in (0..n).rev() {
+            subtree[i] += self.bodies[i].inertia.mass;
+            if let Some(p) = self.bodies[i].parent {
+                subtree[p] += subtree[i];
+            }
+        }
+        let total = self.moving_mass();
+        let mut moved = vec![0.0; self.nv];
+        for (i, b) in self.bodies.iter().enumerate() {
+            moved[b.dof] += subtree[i];
+        }
+        (0..self.nv)
+            .filter(|&j| {
+                let name = self.joint_names[j].to_lowercase();
+                (self.joint_kinds[j] == JointKind::Prismatic
+                    || name.contains("finger")
+                    || name.contains("gripper"))
+                    && moved[j] < 0.01 * total
+                    && self.nv > 1
+            })
+            .map(|j| (self.joint_names[j].clone(), moved[j]))
+            .collect()
+    }
+
+    /// One warning per [`Model::light_joints`] joint, saying how to lock it.
+    pub fn light_joint_warnings(&self) -> Vec<String> {
+        self.light_joints()
+            .into_iter()
+            .map(|(joint, mass)| {
+                format!(
+                    "joint '{joint}' moves {mass:.3} kg of the robot's {:.2} kg (a gripper finger?): its torque is seldom measured and its fit is noise; lock it (--lock {joint}=VALUE on the command line, lock={{'{joint}': VALUE}} in Python)",
+                    self.moving_mass()
+                )
+            })
+            .collect()
+    }
+
     /// Whether some degree of freedom has a non-zero armature.
     #[inline]
     pub fn has_armature(&self) -> bool {

@@ -8,7 +8,8 @@ cd "$(dirname "$0")/.."
 PY=${PYTHON:-python3}
 
 # test dependencies first: the Rust Panda test finds example-robot-data's URDF through Python
-deps=$("$PY" -c "import tomllib; print(' '.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies']['test']))")
+# (read without tomllib, which Python 3.9 and 3.10 lack: the list is one line of pyproject.toml)
+deps=$("$PY" -c "import re, ast; print(' '.join(ast.literal_eval(re.search(r'^test = (\[.*\])$', open('pyproject.toml').read(), re.M).group(1))))")
 "$PY" -m pip install --quiet "maturin>=1.7,<2" $deps
 
 PYTHON="$PY" cargo test --release --features cli

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::files::{load_robot, load_table, refuse_overwriting_inputs};
+use super::files::{load_robot, load_table, refuse_overwriting_inputs, RobotArg};
 use super::out_dir;
 use super::progress::Progress;
 use crate::direct::{
@@ -22,8 +22,8 @@ use crate::torque_model::{ModelFile, TorqueModel};
 
 #[derive(Args)]
 pub(crate) struct ExciteArgs {
-    /// The robot (URDF file or built-in name).
-    robot: String,
+    #[command(flatten)]
+    robot: RobotArg,
     /// Output folder: excitation.json (the coefficients) and excitation.csv (one period, t, q, qd, qdd).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -50,7 +50,7 @@ pub(crate) struct ExciteArgs {
 }
 
 pub(crate) fn excite(a: ExciteArgs) -> Result<String> {
-    let model = load_robot(&a.robot)?;
+    let model = a.robot.load()?;
     let o = ExcitationOptions {
         harmonics: a.harmonics,
         base_frequency: a.base_frequency,
@@ -95,8 +95,8 @@ pub(crate) fn excite(a: ExciteArgs) -> Result<String> {
 
 #[derive(Args)]
 pub(crate) struct IdentifyDirectArgs {
-    /// The robot (URDF file or built-in name).
-    robot: String,
+    #[command(flatten)]
+    robot: RobotArg,
     /// The recording CSV: t, q1..qN, tau1..tauN, optional qd1..qN (and qdd1..qN, which skips
     /// preprocessing unless --preprocess is given).
     data: PathBuf,
@@ -140,8 +140,8 @@ pub(crate) struct IdentifyDirectArgs {
 }
 
 pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
-    refuse_overwriting_inputs(&a.out, &[&a.data, std::path::Path::new(&a.robot)])?;
-    let model = load_robot(&a.robot)?;
+    refuse_overwriting_inputs(&a.out, &[&a.data, a.robot.path()])?;
+    let model = a.robot.load()?;
     let progress = Progress::new();
     progress.update(&format!("reading {}", a.data.display()));
     let mut rec = read_recording(&load_table(&a.data)?, &model.joint_names)?;
@@ -271,6 +271,9 @@ pub(crate) struct PredictArgs {
     /// The robot, for a base-parameter model (URDF file or built-in name).
     #[arg(long)]
     robot: Option<String>,
+    /// Joints of --robot held still, as when the model was identified (JOINT=VALUE, repeat).
+    #[arg(long = "lock", value_name = "JOINT=VALUE", value_parser = super::files::parse_lock)]
+    lock: Vec<(String, f64)>,
 }
 
 pub(crate) fn predict(a: PredictArgs) -> Result<String> {
@@ -288,7 +291,7 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
                     fit.robot
                 ),
             })?;
-            fit.on(&load_robot(robot)?)?.predict(&states)?
+            fit.on(&load_robot(robot, &a.lock)?)?.predict(&states)?
         }
         ModelFile::Local(m) => m.predict(&states)?,
         ModelFile::GlobalLinear(m) => m.predict(&states)?,

@@ -7,14 +7,64 @@ use crate::io::{read_text, Table};
 use crate::model::Model;
 use crate::{robots, urdf};
 
-/// A URDF path or a built-in robot name.
-pub(crate) fn load_robot(robot: &str) -> Result<Model> {
-    let p = Path::new(robot);
-    if p.exists() || robot.ends_with(".urdf") || robot.contains('/') {
-        urdf::model_from_urdf_file(p, &urdf::LoadOptions::default())
-    } else {
-        robots::builtin(robot)
+/// The robot of a subcommand: a URDF file or a built-in name, and the joints to hold still.
+#[derive(clap::Args)]
+pub(crate) struct RobotArg {
+    /// The robot: a URDF file, or a built-in robot (a465, a465:physical, ...).
+    pub(crate) robot: String,
+    /// Hold a joint at a position (rad or m) and leave it out of the model, e.g. a gripper's
+    /// finger: --lock panda_finger_joint1=0.02. Repeat for several joints; a joint that mimics
+    /// a locked one is locked with it.
+    #[arg(long = "lock", value_name = "JOINT=VALUE", value_parser = parse_lock)]
+    pub(crate) lock: Vec<(String, f64)>,
+}
+
+impl RobotArg {
+    /// The robot, with the joints locked, warning on stderr about light joints left free.
+    pub(crate) fn load(&self) -> Result<Model> {
+        load_robot(&self.robot, &self.lock)
     }
+
+    /// The robot's file (for the check that no output overwrites an input).
+    pub(crate) fn path(&self) -> &Path {
+        Path::new(&self.robot)
+    }
+}
+
+/// `JOINT=VALUE` of `--lock`.
+pub(crate) fn parse_lock(text: &str) -> std::result::Result<(String, f64), String> {
+    let (joint, value) = text
+        .split_once('=')
+        .ok_or_else(|| format!("'{text}': expected JOINT=VALUE, e.g. panda_finger_joint1=0.02"))?;
+    let v: f64 = value
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{value}' in '{text}' is not a number (rad or m)"))?;
+    if !v.is_finite() || joint.trim().is_empty() {
+        return Err(format!(
+            "'{text}': expected a joint name and a finite value"
+        ));
+    }
+    Ok((joint.trim().to_string(), v))
+}
+
+/// A URDF path or a built-in robot name, with joints locked; warns on stderr about the light
+/// joints left free ([`Model::light_joints`]).
+pub(crate) fn load_robot(robot: &str, lock: &[(String, f64)]) -> Result<Model> {
+    let p = Path::new(robot);
+    let options = urdf::LoadOptions {
+        lock: lock.iter().cloned().collect(),
+        ..urdf::LoadOptions::default()
+    };
+    let model = if p.exists() || robot.ends_with(".urdf") || robot.contains('/') {
+        urdf::model_from_urdf_file(p, &options)?
+    } else {
+        robots::builtin_with(robot, &options)?
+    };
+    for w in model.light_joint_warnings() {
+        eprintln!("perturbid: warning: {w}");
+    }
+    Ok(model)
 }
 
 /// A CSV table from a file.

@@ -4,13 +4,13 @@ use std::fmt::Write;
 
 use clap::Args;
 
-use super::files::load_robot;
+use super::files::RobotArg;
 use crate::error::Result;
 
 #[derive(Args)]
 pub(crate) struct InfoArgs {
-    /// A URDF file, or a built-in robot: a465, a465:kinsheel2010, a465:physical.
-    robot: String,
+    #[command(flatten)]
+    robot: RobotArg,
 }
 
 fn fmt_limit(x: f64) -> String {
@@ -22,7 +22,7 @@ fn fmt_limit(x: f64) -> String {
 }
 
 pub(crate) fn run(a: InfoArgs) -> Result<String> {
-    let model = load_robot(&a.robot)?;
+    let model = a.robot.load()?;
     let mut out = String::new();
     let _ = writeln!(
         out,

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use serde::Deserialize;
 
-use super::files::{load_json, load_robot, load_table};
+use super::files::{load_json, load_table, RobotArg};
 use super::out_dir;
 use crate::document::Document;
 use crate::error::{Error, Result};
@@ -23,8 +23,8 @@ use crate::trajectory::FourierTrajectory;
 
 #[derive(Args)]
 pub(crate) struct PlanArgs {
-    /// The robot (URDF file or built-in name).
-    robot: String,
+    #[command(flatten)]
+    robot: RobotArg,
     /// The operating point: JSON {"q": [...], "qd": [...], "qdd": [...]} (rad, rad/s, rad/s^2).
     #[arg(long)]
     op: PathBuf,
@@ -113,7 +113,7 @@ fn size(abs: Option<f64>, fraction: f64, n: usize) -> Size {
 }
 
 pub(crate) fn plan(a: PlanArgs) -> Result<String> {
-    let model = load_robot(&a.robot)?;
+    let model = a.robot.load()?;
     let op = load_op(&a.op)?;
     let n = model.nv;
     let mut o = PlanOptions {
@@ -161,8 +161,8 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
 
 #[derive(Args)]
 pub(crate) struct SimulateArgs {
-    /// The robot (URDF file or built-in name): the model the plan or excitation was made for.
-    robot: String,
+    #[command(flatten)]
+    robot: RobotArg,
     /// What the robot runs: a plan (plan.json from `perturbid plan`) or a Fourier excitation
     /// (excitation.json from `perturbid excite`).
     input: PathBuf,
@@ -238,7 +238,7 @@ fn load_reference(path: &Path) -> Result<Reference> {
 }
 
 pub(crate) fn simulate(a: SimulateArgs) -> Result<String> {
-    let model = load_robot(&a.robot)?;
+    let model = a.robot.load()?;
     let reference = load_reference(&a.input)?;
     let n = model.nv;
     let true_robot = match &a.true_robot {

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::files::{load_robot, refuse_overwriting_inputs};
+use super::files::{refuse_overwriting_inputs, RobotArg};
 use crate::direct::FrictionTerms;
 use crate::document::Document;
 use crate::error::Result;
@@ -14,8 +14,8 @@ use crate::local::{identify_parameters_from_local, FromLocalOptions, LocalModel}
 
 #[derive(Args)]
 pub(crate) struct ParametersArgs {
-    /// The robot (URDF file or built-in name).
-    robot: String,
+    #[command(flatten)]
+    robot: RobotArg,
     /// Local models (local_model.json from `perturbid identify`), at one or more operating
     /// points.
     #[arg(required = true)]
@@ -38,9 +38,9 @@ pub(crate) struct ParametersArgs {
 
 pub(crate) fn run(a: ParametersArgs) -> Result<String> {
     let mut inputs: Vec<&std::path::Path> = a.models.iter().map(PathBuf::as_path).collect();
-    inputs.push(std::path::Path::new(&a.robot));
+    inputs.push(a.robot.path());
     refuse_overwriting_inputs(&a.out, &inputs)?;
-    let robot = load_robot(&a.robot)?;
+    let robot = a.robot.load()?;
     let models: Vec<LocalModel> = a
         .models
         .iter()

@@ -106,6 +106,7 @@ impl PyRobot {
         let model = detached(py, "Robot.from_urdf", || {
             urdf::model_from_urdf_file(&path, &options)
         })?;
+        super::errors::warn_all(py, &model.light_joint_warnings())?;
         Ok(Self::new(model))
     }
 
@@ -122,6 +123,7 @@ impl PyRobot {
         let model = detached(py, "Robot.from_urdf_string", || {
             urdf::model_from_urdf_str(text, "<string>", &options)
         })?;
+        super::errors::warn_all(py, &model.light_joint_warnings())?;
         Ok(Self::new(model))
     }
 

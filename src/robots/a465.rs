@@ -51,10 +51,17 @@ pub fn urdf(variant: &str) -> Result<&'static str> {
 
 /// The A465 model of a variant (`"kinsheel2010"` or `"physical"`).
 pub fn model(variant: &str) -> Result<Model> {
+    model_with(variant, &LoadOptions::default())
+}
+
+/// [`model`] with load options (joints to lock); the lumped variant is loaded with the
+/// triangle-inequality check off whatever `options` say.
+pub fn model_with(variant: &str, options: &LoadOptions) -> Result<Model> {
     let text = urdf(variant)?;
     let options = LoadOptions {
-        check_triangle_inequality: variant != "kinsheel2010_lumped",
-        ..LoadOptions::default()
+        check_triangle_inequality: options.check_triangle_inequality
+            && variant != "kinsheel2010_lumped",
+        ..options.clone()
     };
     model_from_urdf_str(text, &format!("a465:{variant}"), &options)
 }

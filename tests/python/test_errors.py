@@ -168,3 +168,17 @@ def test_a_gap_in_a_log_is_refused_or_split_never_filled():
     out = pr.preprocess(t, q, q, split_at_gaps=True)
     assert not np.any((out.t > 3.0) & (out.t < 103.0)), "samples invented in the gap"
     np.testing.assert_allclose(out.qd[:, 0], 0.3 * np.cos(0.3 * out.t), atol=1e-3)
+
+
+def test_a_free_gripper_finger_is_warned_about():
+    import warnings
+
+    from conftest import erd_dir
+
+    path = erd_dir() / "panda_description/urdf/panda.urdf"
+    with pytest.warns(pr.PerturbidWarning, match=r"joint 'panda_finger_joint1' moves 0\.0\d\d kg .*lock=\{'panda_finger_joint1': VALUE\}"):
+        robot = pr.Robot.from_urdf(path)
+    assert robot.n == 8
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert pr.Robot.from_urdf(path, lock={"panda_finger_joint1": 0.02}).n == 7
