@@ -44,6 +44,7 @@ pub mod states;
 pub mod torque_model;
 pub mod trajectory;
 pub mod urdf;
+pub mod validation;
 
 #[cfg(feature = "python")]
 mod python;

@@ -262,6 +262,56 @@ fn excite_identify_direct_predict() {
         &["predict", s(&d.join("base.json")), s(&d.join("log.csv"))],
         &["--robot"],
     );
+    // validation on the log with qdd: exact; on a raw log (positions and torques at 1 kHz,
+    // five periods): preprocessed as for identification, close
+    let out = ok(&[
+        "validate",
+        s(&d.join("base.json")),
+        s(&d.join("log.csv")),
+        "--robot",
+        "a465",
+        "--out",
+        s(&d.join("validation")),
+    ]);
+    assert!(out.contains("rel. RMS") && out.contains("joint6"), "{out}");
+    let v: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(d.join("validation/validation.json")).unwrap(),
+    )
+    .unwrap();
+    for j in v["joints"].as_array().unwrap() {
+        assert!(j["rms"].as_f64().unwrap() < 1e-6, "{j}");
+    }
+    let residuals = std::fs::read_to_string(d.join("validation/residuals.csv")).unwrap();
+    assert!(residuals.starts_with("t,residual_joint1,"), "{residuals:.80}");
+    assert_eq!(residuals.lines().count(), samples.t.len() + 1);
+    let svg = std::fs::read_to_string(d.join("validation/validation.svg")).unwrap();
+    assert_eq!(svg.matches("measured and predicted torque").count(), 6);
+    let raw_samples = traj.sample_periods(5.0, 1000.0);
+    let raw =
+        simulate_samples(&model, &raw_samples, &SimulationOptions::new(&model), 0, "raw").unwrap();
+    assert!(raw.qdd.is_none());
+    write(&d.join("raw.csv"), &recording_table(&raw, "").to_csv());
+    let out = ok(&[
+        "validate",
+        s(&d.join("base.json")),
+        s(&d.join("raw.csv")),
+        "--robot",
+        "a465",
+        "--out",
+        s(&d.join("raw_validation")),
+    ]);
+    assert!(out.contains("preprocessed: 1000 Hz"), "{out}");
+    let v: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(d.join("raw_validation/validation.json")).unwrap(),
+    )
+    .unwrap();
+    for j in v["joints"].as_array().unwrap() {
+        assert!(j["relative_rms"].as_f64().unwrap() < 0.02, "{j}");
+    }
+    fails(
+        &["validate", s(&d.join("base.json")), s(&d.join("raw.csv"))],
+        &["--robot", "base-parameter model"],
+    );
 }
 
 #[test]

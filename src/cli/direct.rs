@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::files::{load_robot, load_table, refuse_overwriting_inputs, RobotArg};
+use super::files::{load_robot, load_table, refuse_overwriting_inputs, PreprocessArgs, RobotArg};
 use super::out_dir;
 use super::progress::Progress;
 use crate::direct::{
@@ -15,8 +15,7 @@ use crate::direct::{
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
-use crate::io::{read_recording, read_states, samples_table, write_atomic, OutputSet, Table};
-use crate::preprocess::{preprocess, PreprocessOptions};
+use crate::io::{read_states, samples_table, write_atomic, OutputSet, Table};
 use crate::states::States;
 use crate::torque_model::{ModelFile, TorqueModel};
 
@@ -113,22 +112,8 @@ pub(crate) struct IdentifyDirectArgs {
     /// The torques exclude gravity.
     #[arg(long)]
     no_gravity: bool,
-    /// Preprocess even when the file has qdd columns.
-    #[arg(long)]
-    preprocess: bool,
-    /// Preprocessing: uniform rate (Hz), low-pass cutoff (Hz), decimation, trim (s).
-    #[arg(long, default_value_t = 1000.0)]
-    rate: f64,
-    #[arg(long, default_value_t = 10.0)]
-    cutoff: f64,
-    #[arg(long, default_value_t = 10)]
-    decimate: usize,
-    #[arg(long, default_value_t = 0.5)]
-    trim: f64,
-    /// At a gap in the log (longer than 20 median sample intervals), preprocess the parts on
-    /// either side separately instead of refusing the log; nothing is interpolated across it.
-    #[arg(long)]
-    split_at_gaps: bool,
+    #[command(flatten)]
+    preprocessing: PreprocessArgs,
     /// Fit on the first (1 - FRACTION) of the samples and report the errors on the rest.
     #[arg(long, default_value_t = 0.3)]
     validate: f64,
@@ -143,22 +128,10 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     refuse_overwriting_inputs(&a.out, &[&a.data, a.robot.path()])?;
     let model = a.robot.load()?;
     let progress = Progress::new();
-    progress.update(&format!("reading {}", a.data.display()));
-    let mut rec = read_recording(&load_table(&a.data)?, &model.joint_names)?;
     let mut out = String::new();
-    if rec.qdd.is_none() || a.preprocess {
-        progress.update("preprocessing");
-        let o = PreprocessOptions {
-            rate: a.rate,
-            cutoff: Some(a.cutoff),
-            decimate: a.decimate,
-            trim: a.trim,
-            split_at_gaps: a.split_at_gaps,
-            ..PreprocessOptions::default()
-        };
-        rec = preprocess(&rec, &o)?;
-        let _ = writeln!(out, "preprocessed: {} Hz, {} Hz zero-phase low-pass, every {}th sample, {} s trimmed: {} samples", a.rate, a.cutoff, a.decimate, a.trim, rec.len());
-    }
+    let rec = a
+        .preprocessing
+        .read(&a.data, &model.joint_names, &progress, &mut out)?;
     if !(0.0..1.0).contains(&a.validate) {
         return Err(Error::InvalidArgument {
             argument: "--validate".into(),

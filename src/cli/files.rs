@@ -103,3 +103,59 @@ pub(crate) fn refuse_overwriting_inputs(out: &Path, inputs: &[&Path]) -> Result<
         None => Ok(()),
     }
 }
+
+/// How a recording is preprocessed (the same for identification and validation).
+#[derive(clap::Args)]
+pub(crate) struct PreprocessArgs {
+    /// Preprocess even when the file has qdd columns.
+    #[arg(long)]
+    preprocess: bool,
+    /// Preprocessing: uniform rate (Hz), low-pass cutoff (Hz), decimation, trim (s).
+    #[arg(long, default_value_t = 1000.0)]
+    rate: f64,
+    #[arg(long, default_value_t = 10.0)]
+    cutoff: f64,
+    #[arg(long, default_value_t = 10)]
+    decimate: usize,
+    #[arg(long, default_value_t = 0.5)]
+    trim: f64,
+    /// At a gap in the log (longer than 20 median sample intervals), preprocess the parts on
+    /// either side separately instead of refusing the log; nothing is interpolated across it.
+    #[arg(long)]
+    split_at_gaps: bool,
+}
+
+impl PreprocessArgs {
+    /// The recording of `path` for the joints `joints`, preprocessed when it has no qdd
+    /// columns (or `--preprocess` asks); says so in `out`.
+    pub(crate) fn read(
+        &self,
+        path: &Path,
+        joints: &[String],
+        progress: &super::progress::Progress,
+        out: &mut String,
+    ) -> Result<crate::recording::Recording> {
+        use std::fmt::Write;
+        progress.update(&format!("reading {}", path.display()));
+        let rec = crate::io::read_recording(&load_table(path)?, joints)?;
+        if rec.qdd.is_some() && !self.preprocess {
+            return Ok(rec);
+        }
+        progress.update("preprocessing");
+        let o = crate::preprocess::PreprocessOptions {
+            rate: self.rate,
+            cutoff: Some(self.cutoff),
+            decimate: self.decimate,
+            trim: self.trim,
+            split_at_gaps: self.split_at_gaps,
+            ..crate::preprocess::PreprocessOptions::default()
+        };
+        let rec = crate::preprocess::preprocess(&rec, &o)?;
+        let _ = writeln!(
+            out,
+            "preprocessed: {} Hz, {} Hz zero-phase low-pass, every {}th sample, {} s trimmed: {} samples",
+            self.rate, self.cutoff, self.decimate, self.trim, rec.len()
+        );
+        Ok(rec)
+    }
+}

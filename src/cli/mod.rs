@@ -8,6 +8,7 @@ mod local;
 mod paper;
 mod parameters;
 mod progress;
+mod validate;
 
 use std::ffi::OsString;
 use std::path::PathBuf;
@@ -49,6 +50,10 @@ enum Command {
     IdentifyDirect(direct::IdentifyDirectArgs),
     /// Torques predicted by a saved model (local or base-parameter) at the states of a CSV.
     Predict(direct::PredictArgs),
+    /// A saved model against a log (positions and torques; preprocessed as for
+    /// identification): writes residuals.csv, validation.json and validation.svg, and prints
+    /// per joint the RMS, relative RMS and largest error.
+    Validate(validate::ValidateArgs),
     /// The robot's base parameters from local models at one or more operating points: writes
     /// a base-parameter model (JSON) and says which parameters the points leave unidentified.
     Parameters(parameters::ParametersArgs),
@@ -72,6 +77,7 @@ fn run(cli: Cli) -> Result<String> {
         Command::IdentifyDirect(a) => direct::identify_direct(a),
         Command::Predict(a) => direct::predict(a),
         Command::Parameters(a) => parameters::run(a),
+        Command::Validate(a) => validate::run(a),
         Command::Paper(a) => paper::run(a),
     }
 }

@@ -30,3 +30,11 @@ impl Progress {
         }
     }
 }
+
+/// The progress line goes when the work ends, also on an error (the message then starts on a
+/// clean line).
+impl Drop for Progress {
+    fn drop(&mut self) {
+        self.done();
+    }
+}

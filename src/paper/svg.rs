@@ -35,10 +35,11 @@ fn escape(s: &str) -> String {
         .replace('>', "&gt;")
 }
 
-/// An SVG document (800 x 480 px) plotting `series` with the given title and axis labels.
+/// An SVG document (960 x 480 px) plotting `series` with the given title and axis labels; the
+/// legend stands right of the plot, off the data.
 pub fn line_plot(title: &str, xlabel: &str, ylabel: &str, series: &[Series<'_>]) -> String {
-    let (w, h) = (800.0, 480.0);
-    let (left, right, top, bottom) = (80.0, 20.0, 40.0, 60.0);
+    let (w, h) = (960.0, 480.0);
+    let (left, right, top, bottom) = (80.0, 180.0, 40.0, 60.0);
     let finite = |v: &&f64| v.is_finite();
     let xs = series.iter().flat_map(|s| s.x.iter()).filter(finite);
     let (x0, x1) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
@@ -133,7 +134,7 @@ pub fn line_plot(title: &str, xlabel: &str, ylabel: &str, series: &[Series<'_>])
             pts.join(" ")
         );
         let ly = top + 16.0 + 18.0 * k as f64;
-        let lx = left + 12.0;
+        let lx = w - right + 12.0;
         let _ = writeln!(
             s,
             r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{}" stroke-width="2"{dash}/>"#,
@@ -147,6 +148,23 @@ pub fn line_plot(title: &str, xlabel: &str, ylabel: &str, series: &[Series<'_>])
             ly + 4.0,
             escape(se.name)
         );
+    }
+    s.push_str("</svg>\n");
+    s
+}
+
+/// SVG documents of [`line_plot`] stacked into one, top to bottom.
+pub fn stack(panels: &[String]) -> String {
+    let (w, h) = (960.0, 480.0);
+    let total = h * panels.len() as f64;
+    let mut s = format!(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{total}" viewBox="0 0 {w} {total}">"#
+    );
+    s.push('\n');
+    for (i, p) in panels.iter().enumerate() {
+        // each panel is a complete <svg>: nested, it is placed by its y
+        let inner = p.replacen("<svg ", &format!(r#"<svg y="{}" "#, h * i as f64), 1);
+        s.push_str(&inner);
     }
     s.push_str("</svg>\n");
     s

@@ -1,0 +1,169 @@
+//! `perturbid validate`: a saved model against a recorded log (positions and torques are
+//! enough; the log is preprocessed as for identification).
+
+use std::fmt::Write;
+use std::path::PathBuf;
+
+use clap::Args;
+
+use super::files::{load_robot, refuse_overwriting_inputs, PreprocessArgs};
+use super::progress::Progress;
+use crate::error::{Error, Result};
+use crate::io::{OutputSet, Table};
+use crate::paper::svg::{line_plot, Series};
+use crate::states::States;
+use crate::torque_model::{ModelFile, TorqueModel};
+use crate::validation::validate;
+
+#[derive(Args)]
+pub(crate) struct ValidateArgs {
+    /// A saved model: local (perturbid identify), base-parameter (perturbid identify-direct,
+    /// perturbid parameters) or globally linearised.
+    model: PathBuf,
+    /// The log CSV: t, q1..qN, tau1..tauN (qd, qdd optional: without qdd the log is
+    /// preprocessed as for identification).
+    data: PathBuf,
+    /// The robot, for a base-parameter model (URDF file or built-in name).
+    #[arg(long)]
+    robot: Option<String>,
+    /// Joints of --robot held still, as when the model was identified (JOINT=VALUE, repeat).
+    #[arg(long = "lock", value_name = "JOINT=VALUE", value_parser = super::files::parse_lock)]
+    lock: Vec<(String, f64)>,
+    #[command(flatten)]
+    preprocessing: PreprocessArgs,
+    /// Output folder: residuals.csv (t, measured - predicted per joint), validation.json (the
+    /// per-joint table) and validation.svg (measured and predicted torques, and residuals).
+    #[arg(long, default_value = "validation")]
+    out: PathBuf,
+}
+
+pub(crate) fn run(a: ValidateArgs) -> Result<String> {
+    refuse_overwriting_inputs(&a.out, &[&a.model, &a.data])?;
+    let file = ModelFile::load(&a.model)?;
+    let joints = file.joint_names().to_vec();
+    let robot = match (&file, &a.robot) {
+        (ModelFile::Base(_), None) => {
+            return Err(Error::InvalidArgument {
+                argument: "--robot".into(),
+                message: format!(
+                    "{} is a base-parameter model: give the robot it was identified for",
+                    a.model.display()
+                ),
+            })
+        }
+        (_, Some(r)) => Some(load_robot(r, &a.lock)?),
+        (_, None) => None,
+    };
+    let progress = Progress::new();
+    let mut out = String::new();
+    let rec = a
+        .preprocessing
+        .read(&a.data, &joints, &progress, &mut out)?;
+    let n = joints.len();
+    let (qd, qdd) = match (&rec.qd, &rec.qdd) {
+        (Some(v), Some(a)) => (v, a),
+        _ => unreachable!("read() preprocesses a log without qdd"),
+    };
+    let states = States::new(n, &rec.q, Some(qd), Some(qdd))?;
+    progress.update("predicting");
+    let predicted = match &file {
+        ModelFile::Base(fit) => fit
+            .on(robot.as_ref().expect("checked above"))?
+            .predict(&states)?,
+        ModelFile::Local(m) => m.predict(&states)?,
+        ModelFile::GlobalLinear(m) => m.predict(&states)?,
+    };
+    let v = validate(&joints, &predicted, &rec.tau)?;
+    progress.done();
+    // the residuals, the table and the figure, as one output set
+    let mut columns = vec!["t".to_string()];
+    columns.extend(joints.iter().map(|j| format!("residual_{j}")));
+    let mut table = Table::new("", columns);
+    for s in 0..v.samples {
+        let mut row = vec![rec.t[s]];
+        row.extend_from_slice(&v.residuals[s * n..(s + 1) * n]);
+        table.push(&row);
+    }
+    let mut set = OutputSet::new(&a.out, "validation");
+    set.add("residuals.csv", table.to_csv())?;
+    set.add(
+        "validation.json",
+        serde_json::to_string_pretty(&v).expect("serialisable"),
+    )?;
+    set.add(
+        "validation.svg",
+        figure(&joints, &rec.t, &rec.tau, &predicted),
+    )?;
+    set.commit()?;
+    let _ = writeln!(
+        out,
+        "{} against {} samples of {}:",
+        a.model.display(),
+        v.samples,
+        a.data.display()
+    );
+    let _ = writeln!(
+        out,
+        "  {:<20} {:>12} {:>10} {:>12}",
+        "joint", "RMS (N m)", "rel. RMS", "max (N m)"
+    );
+    for j in &v.joints {
+        let rel = j
+            .relative_rms
+            .map_or("-".to_string(), |r| format!("{:.2} %", 100.0 * r));
+        let _ = writeln!(
+            out,
+            "  {:<20} {:>12.4} {:>10} {:>12.4}",
+            j.joint, j.rms, rel, j.max
+        );
+    }
+    let _ = writeln!(
+        out,
+        "wrote residuals.csv, validation.json, validation.svg to {}",
+        a.out.display()
+    );
+    Ok(out)
+}
+
+/// Measured and predicted torques per joint, one panel each (measured solid, predicted
+/// dashed over it), with the residual.
+fn figure(joints: &[String], t: &[f64], measured: &[f64], predicted: &[f64]) -> String {
+    let n = joints.len();
+    let column =
+        |v: &[f64], j: usize| -> Vec<f64> { v.iter().skip(j).step_by(n).copied().collect() };
+    let panels: Vec<String> = (0..n)
+        .map(|j| {
+            let (m, p) = (column(measured, j), column(predicted, j));
+            let r: Vec<f64> = m.iter().zip(&p).map(|(a, b)| a - b).collect();
+            line_plot(
+                &format!("{}: measured and predicted torque", joints[j]),
+                "t (s)",
+                "N m",
+                &[
+                    Series {
+                        name: "measured",
+                        color: "#444444",
+                        dash: "",
+                        x: t,
+                        y: &m,
+                    },
+                    Series {
+                        name: "predicted",
+                        color: "#d62728",
+                        dash: "6 4",
+                        x: t,
+                        y: &p,
+                    },
+                    Series {
+                        name: "residual",
+                        color: "#1f77b4",
+                        dash: "2 2",
+                        x: t,
+                        y: &r,
+                    },
+                ],
+            )
+        })
+        .collect();
+    crate::paper::svg::stack(&panels)
+}
