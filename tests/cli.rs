@@ -243,6 +243,31 @@ fn excite_identify_direct_predict() {
         out.contains("base parameters from") && out.contains("validation"),
         "{out}"
     );
+    // the parameter table, in full, as CSV and JSON beside the model
+    assert!(
+        out.contains("rel. std") && out.contains("parameter table -> "),
+        "{out}"
+    );
+    let fit = perturbid_rs::direct::BaseModel::load(d.join("base.json")).unwrap();
+    let csv = std::fs::read_to_string(d.join("base.parameters.csv")).unwrap();
+    assert!(csv.starts_with("parameter,value,std,relative_std,combination\n"));
+    assert_eq!(csv.lines().count(), fit.theta.len() + 1);
+    let names = fit.base.names();
+    assert!(csv.contains(&format!("\"{}\",", names[0])), "{csv:.300}");
+    assert!(out.contains(&names[0]), "full names printed");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("base.parameters.json")).unwrap())
+            .unwrap();
+    let rows = json.as_array().unwrap();
+    assert_eq!(rows.len(), fit.theta.len());
+    assert!(
+        rows.iter().any(|r| r["combination"] == true)
+            && rows.iter().any(|r| r["combination"] == false)
+    );
+    let r0 = &rows[0];
+    let (value, std) = (r0["value"].as_f64().unwrap(), r0["std"].as_f64().unwrap());
+    let relative = std / value.abs();
+    assert!((r0["relative_std"].as_f64().unwrap() - relative).abs() < 1e-12 * (1.0 + relative));
     let out = ok(&[
         "predict",
         s(&d.join("base.json")),
@@ -282,13 +307,22 @@ fn excite_identify_direct_predict() {
         assert!(j["rms"].as_f64().unwrap() < 1e-6, "{j}");
     }
     let residuals = std::fs::read_to_string(d.join("validation/residuals.csv")).unwrap();
-    assert!(residuals.starts_with("t,residual_joint1,"), "{residuals:.80}");
+    assert!(
+        residuals.starts_with("t,residual_joint1,"),
+        "{residuals:.80}"
+    );
     assert_eq!(residuals.lines().count(), samples.t.len() + 1);
     let svg = std::fs::read_to_string(d.join("validation/validation.svg")).unwrap();
     assert_eq!(svg.matches("measured and predicted torque").count(), 6);
     let raw_samples = traj.sample_periods(5.0, 1000.0);
-    let raw =
-        simulate_samples(&model, &raw_samples, &SimulationOptions::new(&model), 0, "raw").unwrap();
+    let raw = simulate_samples(
+        &model,
+        &raw_samples,
+        &SimulationOptions::new(&model),
+        0,
+        "raw",
+    )
+    .unwrap();
     assert!(raw.qdd.is_none());
     write(&d.join("raw.csv"), &recording_table(&raw, "").to_csv());
     let out = ok(&[

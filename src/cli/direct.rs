@@ -190,20 +190,41 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         fit.cond,
         a.out.display()
     );
+    // the parameter table: printed in full and saved as CSV and JSON beside the model
+    let rows = fit.parameter_table();
+    let width = rows
+        .iter()
+        .map(|r| r.name.chars().count())
+        .max()
+        .unwrap_or(0)
+        .max(14);
     let _ = writeln!(
         out,
-        "{:<48} {:>14} {:>12}",
-        "base parameter", "value", "std. error"
+        "{:<width$} {:>14} {:>12} {:>10}",
+        "base parameter", "value", "std. error", "rel. std"
     );
-    for ((name, v), s) in fit.base.names().iter().zip(&fit.theta).zip(&fit.stderr) {
-        let name = if name.chars().count() > 48 {
-            // by characters: a byte index could fall inside a UTF-8 link name
-            format!("{}...", name.chars().take(45).collect::<String>())
-        } else {
-            name.clone()
-        };
-        let _ = writeln!(out, "{name:<48} {v:>14.6} {s:>12.2e}");
+    let fmt_opt = |v: Option<f64>, percent: bool| match v {
+        None => "-".to_string(),
+        Some(x) if percent => format!("{:.1} %", 100.0 * x),
+        Some(x) => format!("{x:.2e}"),
+    };
+    for r in &rows {
+        let _ = writeln!(
+            out,
+            "{:<width$} {:>14.6} {:>12} {:>10}",
+            r.name,
+            r.value,
+            fmt_opt(r.std, false),
+            fmt_opt(r.relative_std, true)
+        );
     }
+    let (csv, json) = write_parameter_table(&a.out, &rows)?;
+    let _ = writeln!(
+        out,
+        "parameter table -> {}, {}",
+        csv.display(),
+        json.display()
+    );
     if split < k {
         let p = fit.on(&model)?.predict(&states.slice(split..k))?;
         let _ = writeln!(
@@ -299,4 +320,45 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
         }
     }
     Ok(out)
+}
+
+/// The parameter table beside the model file `out` (`<stem>.parameters.csv` and `.json`), as
+/// one output set. Returns the two paths.
+fn write_parameter_table(
+    out: &std::path::Path,
+    rows: &[crate::direct::ParameterRow],
+) -> Result<(PathBuf, PathBuf)> {
+    let dir = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    let stem = out.file_stem().map_or("base_model".to_string(), |s| {
+        s.to_string_lossy().into_owned()
+    });
+    let (csv_name, json_name) = (
+        format!("{stem}.parameters.csv"),
+        format!("{stem}.parameters.json"),
+    );
+    let mut csv = String::from("parameter,value,std,relative_std,combination\n");
+    let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:e}"));
+    for r in rows {
+        // names hold spaces, '+' and '.', never a comma or a quote; quoted all the same
+        let _ = writeln!(
+            csv,
+            "\"{}\",{:e},{},{},{}",
+            r.name.replace('"', "\"\""),
+            r.value,
+            opt(r.std),
+            opt(r.relative_std),
+            r.combination
+        );
+    }
+    let mut set = OutputSet::new(dir, &format!("{stem}.parameters"));
+    set.add(&csv_name, csv)?;
+    set.add(
+        &json_name,
+        serde_json::to_string_pretty(rows).expect("serialisable"),
+    )?;
+    set.commit()?;
+    Ok((dir.join(csv_name), dir.join(json_name)))
 }

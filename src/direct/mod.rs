@@ -10,6 +10,7 @@ pub mod consistent;
 pub mod excitation;
 pub mod global_linear;
 pub mod identify;
+pub mod parameter_table;
 pub mod parameters;
 pub mod streaming;
 
@@ -23,4 +24,5 @@ pub use global_linear::{identify_global_linear, GlobalLinearModel};
 pub use identify::{
     identify_base_parameters, identify_consistent_parameters, BaseModel, BaseOptions, Weighting,
 };
+pub use parameter_table::ParameterRow;
 pub use parameters::{regressor_matrix, FrictionTerms, ParameterLayout};
