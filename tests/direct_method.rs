@@ -847,3 +847,65 @@ fn physical_consistency_is_checked_per_link() {
     }
     assert!(check_physical_consistency(&layout, &theta.as_slice()[1..]).is_err());
 }
+
+/// Warnings that protect: a friction coefficient negative beyond its standard errors, a joint
+/// the excitation leaves still; none on sound data and a sound excitation.
+#[test]
+fn negative_friction_and_still_joints_are_warned_about() {
+    use perturbid_rs::direct::ExcitationDesign;
+    let model = a465::model("kinsheel2010").unwrap();
+    let traj = a465_excitation();
+    let s = traj.sample_periods(1.0, 100.0);
+    let states = States::new(6, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
+    let mut rng = Rng(3);
+    let clean: Vec<f64> = torques(&model, &s.q, &s.qd, &s.qdd, Gravity::Included)
+        .iter()
+        .enumerate()
+        .map(|(i, t)| t + 0.3 * s.qd[i] + rng.uniform(-0.05, 0.05))
+        .collect();
+    let options = BaseOptions {
+        friction: "viscous".parse().unwrap(),
+        ..BaseOptions::default()
+    };
+    let fit = identify_base_parameters(&model, &states, &clean, &options).unwrap();
+    assert!(fit.warnings().is_empty(), "{:?}", fit.warnings());
+    // joint 3 pushed forward by its own speed: a negative viscous coefficient
+    let pushed: Vec<f64> = clean
+        .iter()
+        .enumerate()
+        .map(|(i, t)| if i % 6 == 2 { t - 0.8 * s.qd[i] } else { *t })
+        .collect();
+    let fit = identify_base_parameters(&model, &states, &pushed, &options).unwrap();
+    let w = fit.warnings();
+    assert!(
+        w.len() == 1
+            && w[0].starts_with("joint3.viscous = -0.5")
+            && w[0].contains("negative beyond 3 standard errors"),
+        "{w:?}"
+    );
+    // the excitation: joint 2 held still
+    let sound = ExcitationDesign {
+        trajectory: traj.clone(),
+        value: 1.0,
+        cond: 1.0,
+        evaluations: 1,
+    };
+    assert!(
+        sound.warnings(&model).is_empty(),
+        "{:?}",
+        sound.warnings(&model)
+    );
+    let mut a = traj.a.clone();
+    let mut b = traj.b.clone();
+    a.row_mut(1).fill(0.0);
+    b.row_mut(1).fill(0.0);
+    let still = ExcitationDesign {
+        trajectory: FourierTrajectory::new(traj.w_f, traj.q0.clone(), a, b).unwrap(),
+        ..sound
+    };
+    let w = still.warnings(&model);
+    assert!(
+        w.len() == 1 && w[0].starts_with("joint joint2 moves over 0.0 % of its range"),
+        "{w:?}"
+    );
+}

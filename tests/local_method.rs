@@ -629,3 +629,25 @@ fn unknown_standard_errors_survive_a_json_round_trip() {
     assert!(back.d.as_ref().unwrap().stderr.iter().all(|s| s.is_nan()));
     assert_eq!(back.d.as_ref().unwrap().matrix, d.matrix);
 }
+
+/// The warning about a D* no mass matrix has (tested on constructed estimates in
+/// `src/local/diagnose.rs`) stays silent on a sound identification with noise.
+#[test]
+fn a_sound_d_star_raises_no_mass_matrix_warning() {
+    use perturbid_rs::local::IdentifyOptions;
+    use perturbid_rs::{simulate_plan, SimulationOptions};
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let plan = plan_experiments(&model, &common::table2(), &PlanOptions::default()).unwrap();
+    for noise in [0.0, 0.01, 0.1] {
+        let mut sim = SimulationOptions::new(&model);
+        sim.torque_noise = vec![noise; n];
+        let recs = simulate_plan(&model, &plan, &sim).unwrap();
+        let m = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+        assert!(
+            !m.diagnostics.warnings.iter().any(|w| w.contains("D* is")),
+            "noise {noise}: {:?}",
+            m.diagnostics.warnings
+        );
+    }
+}

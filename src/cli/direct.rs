@@ -80,6 +80,9 @@ pub(crate) fn excite(a: ExciteArgs) -> Result<String> {
         samples_table(&traj.sample_periods(1.0, a.rate), "").to_csv(),
     )?;
     set.commit()?;
+    for w in design.warnings(&model) {
+        eprintln!("perturbid: warning: {w}");
+    }
     Ok(format!(
         "excitation: {} harmonics of {} Hz (period {:.1} s), cond(Phi_base) {:.2} after {} evaluations\n-> {} and {}\n",
         a.harmonics,
@@ -181,6 +184,9 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         )?
     };
     progress.done();
+    for w in fit.warnings() {
+        eprintln!("perturbid: warning: {w}");
+    }
     fit.save(&a.out)?;
     let _ = writeln!(
         out,

@@ -417,3 +417,34 @@ pub fn design_excitation(
         evaluations,
     })
 }
+
+impl ExcitationDesign {
+    /// Joints with position limits that the excitation leaves almost still: moving over less
+    /// than 2 % of their range in a period, so that their parameters are barely excited. One
+    /// warning per joint.
+    pub fn warnings(&self, model: &Model) -> Vec<String> {
+        let s = self.trajectory.sample_periods(1.0, 200.0);
+        let n = model.nv;
+        (0..n)
+            .filter_map(|j| {
+                let l = &model.limits[j];
+                let range = l.upper - l.lower;
+                if !range.is_finite() || range <= 0.0 {
+                    return None;
+                }
+                let (lo, hi) = s.q.iter().skip(j).step_by(n).fold(
+                    (f64::INFINITY, f64::NEG_INFINITY),
+                    |(a, b), &v| (a.min(v), b.max(v)),
+                );
+                let used = (hi - lo) / range;
+                (used < 0.02).then(|| {
+                    format!(
+                        "joint {} moves over {:.1} % of its range in the excitation: the parameters it alone excites are barely identified; raise its amplitude or lock the joint",
+                        model.joint_names[j],
+                        100.0 * used
+                    )
+                })
+            })
+            .collect()
+    }
+}

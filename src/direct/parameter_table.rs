@@ -42,3 +42,30 @@ impl BaseModel {
             .collect()
     }
 }
+
+impl BaseModel {
+    /// What a person should know before trusting the fit: friction or armature coefficients
+    /// identified on their own (not in a combination) and negative beyond three standard
+    /// errors. No joint has them; the data hold an effect the model lacks, or are not what it
+    /// assumes. A consistent fit keeps them at zero.
+    pub fn warnings(&self) -> Vec<String> {
+        self.parameter_table()
+            .into_iter()
+            .filter(|r| {
+                !r.combination
+                    && [".viscous", ".coulomb", ".armature"]
+                        .iter()
+                        .any(|t| r.name.ends_with(t))
+            })
+            .filter_map(|r| {
+                let std = r.std?;
+                (r.value + 3.0 * std < 0.0).then(|| {
+                    format!(
+                        "{} = {:.4} +- {:.4} is negative beyond 3 standard errors: no joint has that; the data hold an effect the model lacks or are not what it assumes (fit physically consistent parameters to keep it at zero)",
+                        r.name, r.value, std
+                    )
+                })
+            })
+            .collect()
+    }
+}

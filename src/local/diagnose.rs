@@ -165,3 +165,117 @@ pub(super) fn diagnose(values: &[ExperimentValues]) -> Diagnostics {
     }
     d
 }
+
+/// How many standard errors a departure must exceed to be warned about.
+const SIGNIFICANT: f64 = 3.0;
+
+/// D* is a mass matrix: symmetric and positive definite. A warning when it departs from either
+/// by more than [`SIGNIFICANT`] standard errors: pairs `D_ij`, `D_ji` that differ beyond their
+/// combined standard error, and a negative eigenvalue of the symmetric part beyond the
+/// Frobenius norm of the standard errors (which bounds how far noise moves an eigenvalue).
+pub(super) fn mass_matrix_warning(d: &Estimate, joints: &[String]) -> Option<String> {
+    let n = joints.len();
+    let (m, se) = (&d.matrix, &d.stderr);
+    if !se.iter().all(|s| s.is_finite()) {
+        return None; // no standard errors: nothing to judge by
+    }
+    let mut asymmetric = vec![];
+    for i in 0..n {
+        for j in (i + 1)..n {
+            let diff = (m[(i, j)] - m[(j, i)]).abs();
+            let bound = SIGNIFICANT * (se[(i, j)].powi(2) + se[(j, i)].powi(2)).sqrt();
+            if diff > bound {
+                asymmetric.push(format!(
+                    "D({},{}) = {:.4} vs D({},{}) = {:.4}",
+                    joints[i],
+                    joints[j],
+                    m[(i, j)],
+                    joints[j],
+                    joints[i],
+                    m[(j, i)]
+                ));
+            }
+        }
+    }
+    let symmetric = (m + m.transpose()) * 0.5;
+    let smallest = symmetric
+        .symmetric_eigenvalues()
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let noise = se.norm();
+    let mut parts = vec![];
+    if !asymmetric.is_empty() {
+        parts.push(format!(
+            "not symmetric beyond {SIGNIFICANT} standard errors ({})",
+            asymmetric.join("; ")
+        ));
+    }
+    if smallest < -SIGNIFICANT * noise {
+        parts.push(format!(
+            "not positive definite: smallest eigenvalue {smallest:.4} where the standard errors allow {:.4}",
+            -SIGNIFICANT * noise
+        ));
+    }
+    (!parts.is_empty()).then(|| {
+        format!(
+            "D* is {}: no mass matrix is; the D experiment did not measure what the model assumes (tracking errors, a joint that slipped, unmodelled compliance), so do not trust D*",
+            parts.join(" and ")
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::DMatrix;
+
+    use super::*;
+
+    fn estimate(m: DMatrix<f64>, se: f64) -> Estimate {
+        let n = m.nrows();
+        Estimate {
+            matrix: m,
+            stderr: DMatrix::from_element(n, n, se),
+            cond: 1.0,
+            residual_rms: vec![0.0; n],
+            crossings: 2 * n,
+        }
+    }
+
+    #[test]
+    fn a_d_star_no_mass_matrix_has_is_named() {
+        let joints: Vec<String> = (1..=3).map(|j| format!("j{j}")).collect();
+        let m = DMatrix::from_row_slice(3, 3, &[2.0, 0.3, 0.0, 0.3, 1.0, 0.1, 0.0, 0.1, 0.5]);
+        // sound, and within the noise either way
+        assert_eq!(
+            mass_matrix_warning(&estimate(m.clone(), 0.01), &joints),
+            None
+        );
+        let mut skew = m.clone();
+        skew[(0, 2)] += 0.05; // 0.05 apart with standard errors 0.01: 3.5 sigma
+        let w = mass_matrix_warning(&estimate(skew.clone(), 0.01), &joints).unwrap();
+        assert!(
+            w.contains(
+                "not symmetric beyond 3 standard errors (D(j1,j3) = 0.0500 vs D(j3,j1) = 0.0000)"
+            ),
+            "{w}"
+        );
+        assert_eq!(mass_matrix_warning(&estimate(skew, 0.02), &joints), None);
+        // an indefinite one, beyond its noise
+        let mut indefinite = m.clone();
+        indefinite[(2, 2)] = -0.4;
+        let w = mass_matrix_warning(&estimate(indefinite.clone(), 0.01), &joints).unwrap();
+        assert!(
+            w.contains("not positive definite: smallest eigenvalue -0.4073"),
+            "{w}"
+        );
+        assert_eq!(
+            mass_matrix_warning(&estimate(indefinite, 0.2), &joints),
+            None
+        );
+        // without standard errors nothing is judged
+        let mut unknown = estimate(m, 0.01);
+        unknown.stderr[(0, 0)] = f64::NAN;
+        assert_eq!(mass_matrix_warning(&unknown, &joints), None);
+    }
+}

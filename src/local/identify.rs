@@ -7,7 +7,9 @@ use super::crossing::{
     detect_offset, samples_needed, values_at_with, velocity_reversals, CrossingValues, FitOptions,
     TorqueFit,
 };
-use super::diagnose::{compare_combined, diagnose, disagreement_warning, unperturbed_deviation};
+use super::diagnose::{
+    compare_combined, diagnose, disagreement_warning, mass_matrix_warning, unperturbed_deviation,
+};
 use super::diagnostics::{Reversal, ReversalHandling};
 use super::friction_aware::friction_aware_h;
 use super::model::{Estimate, Estimator, LocalModel};
@@ -455,6 +457,12 @@ pub fn identify_local(
     let mut diagnostics = diagnose(&values);
     let deviation = unperturbed_deviation(&values, &op_state);
     if let Some(w) = disagreement_warning(&disagreement, options.estimator, deviation) {
+        diagnostics.warnings.push(w);
+    }
+    if let Some(w) = d
+        .as_ref()
+        .and_then(|d| mass_matrix_warning(d, &plan.joint_names))
+    {
         diagnostics.warnings.push(w);
     }
     diagnostics.combined = disagreement;

@@ -148,6 +148,7 @@ pub(crate) fn design_excitation(
             if progress { Some(&mut report) } else { None },
         )
     })?;
+    super::errors::warn_all(py, &design.warnings(&robot.model))?;
     Ok(PyExcitationDesign { design })
 }
 
@@ -334,6 +335,7 @@ pub(crate) fn identify_base_parameters(
             &options,
         )
     })?;
+    super::errors::warn_all(py, &fit.warnings())?;
     Ok(PyBaseModel {
         fit,
         model: Arc::new(model.clone()),
