@@ -14,6 +14,9 @@ deps=$("$PY" -c "import re, ast; print(' '.join(ast.literal_eval(re.search(r'^te
 
 PYTHON="$PY" cargo test --release --features cli
 cargo bench --no-run --quiet
+# the Rust examples run (docs/parameters.md and docs/a465.md quote what they print)
+cargo run --release --quiet --example refit_a465 -- target/refit_a465.urdf
+cargo run --release --quiet --example parameters_evidence > target/parameters_evidence.md
 # lints and docs without warnings, over every feature (python includes cli)
 cargo clippy --release --all-targets --features python --quiet -- -D warnings
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --features python --quiet
