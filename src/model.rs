@@ -144,6 +144,15 @@ pub fn joint_pose(kind: JointKind, placement: &Se3, axis: &Vector3<f64>, x: f64)
     }
 }
 
+/// A link's frame: the body it moves with (`None`: fixed to the base) and its pose in that
+/// body's frame (links behind fixed or locked joints share their parent's body).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    pub link: String,
+    pub body: Option<usize>,
+    pub pose: Se3,
+}
+
 /// Per-degree-of-freedom data from the URDF: limits and `<dynamics>`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct JointLimits {
@@ -184,6 +193,8 @@ pub struct Model {
     /// (kg m^2 or kg), as Pinocchio's `armature`; it adds `armature[i] * qdd[i]` to `tau[i]`
     /// and `armature[i]` to `M[i, i]`. Zero unless the URDF gives it (see [`crate::urdf`]).
     pub armature: Vec<f64>,
+    /// Every link's frame (URDF links, the root's included), for poses of named links.
+    pub frames: Vec<Frame>,
     /// Gravity acceleration in the base frame (m/s^2); `(0, 0, -9.81)`.
     pub gravity: Vector3<f64>,
     /// Name of the root (base) link.
@@ -209,6 +220,11 @@ impl Model {
     /// Number of moving bodies (>= `nv` when joints are coupled).
     pub fn nbodies(&self) -> usize {
         self.bodies.len()
+    }
+
+    /// The frame of the link named `name`, if any.
+    pub fn frame(&self, name: &str) -> Option<&Frame> {
+        self.frames.iter().find(|f| f.link == name)
     }
 
     /// Index of the degree of freedom named `name`, if any.

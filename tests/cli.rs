@@ -902,3 +902,43 @@ fn lock_joints_and_warn_about_free_fingers() {
     );
     fails(&["info", "a465", "--lock", "elbow=0"], &["elbow"]);
 }
+
+/// `excite --workspace`: the constraints' slack printed; a bad document is a one-line error
+/// with the JSON path of the culprit.
+#[test]
+fn excite_within_a_workspace() {
+    let d = tmp("workspace");
+    let ws = d.join("ws.json");
+    write(
+        &ws,
+        r#"[{"frame": "link6", "region": {"above": {"normal": [0, 0, 1], "offset": 0.3}}, "margin": 0.02}]"#,
+    );
+    let out = ok(&[
+        "excite",
+        "a465",
+        "--workspace",
+        s(&ws),
+        "--max-evaluations",
+        "60",
+        "--out",
+        s(&d.join("x")),
+    ]);
+    let line = out
+        .lines()
+        .find(|l| l.contains("link6 above the plane (m)"))
+        .unwrap_or_else(|| panic!("{out}"));
+    let slack: f64 = line.split_whitespace().last().unwrap().parse().unwrap();
+    assert!(slack >= 0.0, "{out}");
+    write(&ws, r#"[{"frame": "link6", "region": {"under": {}}}]"#);
+    fails(
+        &[
+            "excite",
+            "a465",
+            "--workspace",
+            s(&ws),
+            "--out",
+            s(&d.join("y")),
+        ],
+        &["ws.json", "[0].region", "unknown variant `under`"],
+    );
+}

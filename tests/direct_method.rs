@@ -889,6 +889,7 @@ fn negative_friction_and_still_joints_are_warned_about() {
         value: 1.0,
         cond: 1.0,
         evaluations: 1,
+        margins: vec![],
     };
     assert!(
         sound.warnings(&model).is_empty(),

@@ -453,6 +453,9 @@ class ExcitationDesign:
     @property
     def value(self) -> float: ...
     @property
+    def margins(self) -> dict[str, float]:
+        """Workspace and effort constraints with their smallest slack over a period."""
+    @property
     def evaluations(self) -> int: ...
     def sample(self, t: Union[float, ArrayLike]) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...
 
@@ -522,6 +525,8 @@ def design_excitation(
     max_evaluations: int = 2000,
     friction: Union[str, Sequence[str], None] = ("viscous", "coulomb"),
     progress: bool = False,
+    workspace: Union[str, Sequence[Mapping[str, Any]], None] = None,
+    effort_limits: bool = True,
 ) -> ExcitationDesign: ...
 
 def identify_base_parameters(

@@ -13,6 +13,33 @@ pub(crate) fn update_placements(model: &Model, data: &mut Data) {
     }
 }
 
+/// Forward kinematics: every body's pose in the base frame at `q` (length `model.nv`, rad or
+/// m) into `data.o_mi`. Fails on a wrong length or a non-finite entry.
+pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) -> crate::error::Result<()> {
+    super::load_state(model, data, q, None, None)?;
+    update_placements(model, data);
+    for (i, b) in model.bodies.iter().enumerate() {
+        data.o_mi[i] = match b.parent {
+            Some(p) => data.o_mi[p].compose(&data.li_mi[i]),
+            None => data.li_mi[i],
+        };
+    }
+    Ok(())
+}
+
+/// The position in the base frame (m) of `point` (m, in the frame of `body`, `None` for the
+/// base) after [`forward_kinematics`] filled `data`.
+pub fn point_in_base(
+    data: &Data,
+    body: Option<usize>,
+    point: &nalgebra::Vector3<f64>,
+) -> nalgebra::Vector3<f64> {
+    match body {
+        Some(b) => data.o_mi[b].rotation * point + data.o_mi[b].translation,
+        None => *point,
+    }
+}
+
 /// The forward pass of the Newton-Euler recursion on the body coordinates in `data` (`qb`, `vb`,
 /// `ab`): every body's pose in its parent `li_mi`, twist `v` and spatial acceleration `a` in
 /// its own frame, the base accelerating upwards at `g` when `gravity` (so `a` includes gravity).

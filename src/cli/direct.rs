@@ -46,6 +46,14 @@ pub(crate) struct ExciteArgs {
     /// Fraction of the limits the excitation may use.
     #[arg(long, default_value_t = 0.9)]
     margin: f64,
+    /// Workspace constraints (JSON): points on named links kept above a plane (the floor, a
+    /// table) or inside a box, e.g. [{"frame": "panda_hand", "point": [0, 0, 0.1], "region":
+    /// {"above": {"normal": [0, 0, 1], "offset": 0}}, "margin": 0.05}].
+    #[arg(long)]
+    workspace: Option<PathBuf>,
+    /// Do not hold the joint torques within the URDF's effort limits (times --margin).
+    #[arg(long)]
+    no_effort_limits: bool,
 }
 
 pub(crate) fn excite(a: ExciteArgs) -> Result<String> {
@@ -57,6 +65,14 @@ pub(crate) fn excite(a: ExciteArgs) -> Result<String> {
         seed: a.seed,
         max_evaluations: a.max_evaluations,
         margin: a.margin,
+        workspace: match &a.workspace {
+            Some(path) => crate::direct::workspace_from_json(
+                &crate::io::read_text(path)?,
+                &path.display().to_string(),
+            )?,
+            None => vec![],
+        },
+        effort: !a.no_effort_limits,
         ..ExcitationOptions::default()
     };
     let progress = Progress::new();
@@ -83,7 +99,7 @@ pub(crate) fn excite(a: ExciteArgs) -> Result<String> {
     for w in design.warnings(&model) {
         eprintln!("perturbid: warning: {w}");
     }
-    Ok(format!(
+    let mut out = format!(
         "excitation: {} harmonics of {} Hz (period {:.1} s), cond(Phi_base) {:.2} after {} evaluations\n-> {} and {}\n",
         a.harmonics,
         a.base_frequency,
@@ -92,7 +108,14 @@ pub(crate) fn excite(a: ExciteArgs) -> Result<String> {
         design.evaluations,
         dir.join("excitation.json").display(),
         dir.join("excitation.csv").display()
-    ))
+    );
+    if !design.margins.is_empty() {
+        out.push_str("smallest slack over a period (beyond each margin):\n");
+        for (what, slack) in &design.margins {
+            out.push_str(&format!("  {what:<48} {slack:>10.4}\n"));
+        }
+    }
+    Ok(out)
 }
 
 #[derive(Args)]

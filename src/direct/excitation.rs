@@ -11,6 +11,8 @@ use rand_chacha::ChaCha8Rng;
 
 use super::base::{BaseParameters, BASE_TOLERANCE};
 use super::parameters::{regressor_matrix, FrictionTerms, ParameterLayout};
+use super::workspace::{CartesianConstraint, Region};
+use crate::algorithms::kinematics::{forward_kinematics, point_in_base};
 use crate::choice::choice;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
@@ -51,6 +53,11 @@ pub struct ExcitationOptions {
     /// COBYLA's budget of criterion evaluations (default 2000).
     pub max_evaluations: usize,
     pub seed: u64,
+    /// Points on named links kept above a plane or inside a box (default none).
+    pub workspace: Vec<CartesianConstraint>,
+    /// Keep every joint's torque (the model's, gravity included) within `margin` of the
+    /// URDF's effort limit where it gives one (default true).
+    pub effort: bool,
 }
 
 impl Default for ExcitationOptions {
@@ -72,6 +79,8 @@ impl Default for ExcitationOptions {
             },
             max_evaluations: 2000,
             seed: 0,
+            workspace: Vec::new(),
+            effort: true,
         }
     }
 }
@@ -86,6 +95,10 @@ pub struct ExcitationDesign {
     pub cond: f64,
     /// Criterion evaluations used.
     pub evaluations: usize,
+    /// The workspace and effort constraints with their smallest slack over a period (checked
+    /// at 1 kHz): metres kept beyond each workspace constraint's margin, and `1 - |tau| /
+    /// (margin effort)` per joint with an effort limit.
+    pub margins: Vec<(String, f64)>,
 }
 
 /// Progress of the design: evaluations so far and the best feasible criterion value.
@@ -103,6 +116,10 @@ struct Problem<'a> {
     /// Criterion sample times and (finer) limit check times.
     t_fit: Vec<f64>,
     t_check: Vec<f64>,
+    /// The workspace constraints' points: (body, point in its frame).
+    points: Vec<(Option<usize>, nalgebra::Vector3<f64>)>,
+    /// `margin * effort` of the joints whose effort limit binds.
+    effort: Vec<Option<f64>>,
 }
 
 impl Problem<'_> {
@@ -148,17 +165,81 @@ impl Problem<'_> {
 
     /// Constraint values (>= 0 when satisfied): per joint, the normalised slack of position
     /// (both sides), speed and acceleration over the check grid.
+    /// Every constraint's smallest slack over a period (>= 0 where met): per joint position
+    /// (upper, lower), speed and acceleration as fractions of their ranges; then per workspace
+    /// constraint the distance kept (m); then per joint with a binding effort limit
+    /// `1 - |tau| / (margin effort)`.
     fn constraints(&self, traj: &FourierTrajectory) -> Vec<f64> {
         let n = self.model.nv;
-        let mut out = vec![f64::INFINITY; 4 * n];
+        let extra = self.points.len() + self.effort.iter().flatten().count();
+        let mut out = vec![f64::INFINITY; 4 * n + extra];
+        let cartesian = !self.points.is_empty();
+        let torque = self.effort.iter().any(Option::is_some);
+        let mut data = (cartesian || torque).then(|| crate::data::Data::new(self.model));
+        let (mut q, mut v, mut a) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         for &t in &self.t_check {
             for i in 0..n {
-                let (q, v, a) = traj.eval(i, t);
+                let (qi, vi, ai) = traj.eval(i, t);
+                (q[i], v[i], a[i]) = (qi, vi, ai);
                 let span = (self.upper[i] - self.lower[i]).max(1e-9);
-                out[4 * i] = out[4 * i].min((self.upper[i] - q) / span);
-                out[4 * i + 1] = out[4 * i + 1].min((q - self.lower[i]) / span);
-                out[4 * i + 2] = out[4 * i + 2].min(1.0 - v.abs() / self.vel[i]);
-                out[4 * i + 3] = out[4 * i + 3].min(1.0 - a.abs() / self.acc[i]);
+                out[4 * i] = out[4 * i].min((self.upper[i] - qi) / span);
+                out[4 * i + 1] = out[4 * i + 1].min((qi - self.lower[i]) / span);
+                out[4 * i + 2] = out[4 * i + 2].min(1.0 - vi.abs() / self.vel[i]);
+                out[4 * i + 3] = out[4 * i + 3].min(1.0 - ai.abs() / self.acc[i]);
+            }
+            let Some(data) = data.as_mut() else { continue };
+            let mut c = 4 * n;
+            if cartesian {
+                if forward_kinematics(self.model, data, &q).is_err() {
+                    return vec![-1.0; out.len()];
+                }
+                for (k, (body, point)) in self.points.iter().enumerate() {
+                    let p = point_in_base(data, *body, point);
+                    out[c] = out[c].min(self.o.workspace[k].slack(&p));
+                    c += 1;
+                }
+            }
+            if torque {
+                if crate::algorithms::rnea::rnea(self.model, data, &q, &v, &a, Gravity::Included)
+                    .is_err()
+                {
+                    return vec![-1.0; out.len()];
+                }
+                for (i, e) in self.effort.iter().enumerate() {
+                    if let Some(e) = e {
+                        out[c] = out[c].min(1.0 - data.tau[i].abs() / e);
+                        c += 1;
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Names of the constraints in [`Problem::constraints`]'s order, with their unit.
+    fn constraint_names(&self) -> Vec<String> {
+        let names = &self.model.joint_names;
+        let mut out = vec![];
+        for j in names {
+            for what in [
+                "upper position limit",
+                "lower position limit",
+                "speed limit",
+                "acceleration limit",
+            ] {
+                out.push(format!("{j} {what} (fraction)"));
+            }
+        }
+        for w in &self.o.workspace {
+            let region = match &w.region {
+                Region::Above { .. } => "above the plane",
+                Region::Inside { .. } => "inside the box",
+            };
+            out.push(format!("{} {region} (m)", w.frame));
+        }
+        for (j, e) in names.iter().zip(&self.effort) {
+            if e.is_some() {
+                out.push(format!("{j} effort limit (fraction)"));
             }
         }
         out
@@ -304,6 +385,16 @@ pub fn design_excitation(
             .map(|k| period * k as f64 / o.samples as f64)
             .collect(),
         t_check: (0..400).map(|k| period * k as f64 / 400.0).collect(),
+        points: o
+            .workspace
+            .iter()
+            .map(|w| w.resolve(model))
+            .collect::<Result<_>>()?,
+        effort: model
+            .limits
+            .iter()
+            .map(|l| (o.effort && l.effort.is_finite()).then_some(m * l.effort))
+            .collect(),
     };
     // seeded random start, shrunk until feasible
     let f = p.free_per_joint();
@@ -359,7 +450,7 @@ pub fn design_excitation(
         }
         value
     };
-    let cons: Vec<_> = (0..4 * n)
+    let cons: Vec<_> = (0..p.constraint_names().len())
         .map(|c| {
             let cf = &constraints_of;
             move |x: &[f64], _: &mut ()| cf(x)[c]
@@ -408,13 +499,34 @@ pub fn design_excitation(
         "designed excitation",
         "; lower the margin",
     )?;
-    let (value, cond) = p.criterion(&traj);
+    // the workspace and effort constraints, at 1 kHz over a period (the search checked 400
+    // times a period), reported with their slack
+    let fine = Problem {
+        t_check: (0..(1000.0 * period).ceil() as usize)
+            .map(|k| k as f64 / 1000.0)
+            .collect(),
+        ..p
+    };
+    let slack = fine.constraints(&traj);
+    let names = fine.constraint_names();
+    let margins: Vec<(String, f64)> = names.into_iter().zip(slack).skip(4 * n).collect();
+    if let Some((what, s)) = margins.iter().find(|(_, s)| *s < 0.0) {
+        return Err(Error::InvalidArgument {
+            argument: "workspace".into(),
+            message: format!(
+                "the designed excitation breaks '{what}' by {:.4}: no excitation within the other limits keeps it; move the constraint, lower its margin, or give the design more evaluations",
+                -s
+            ),
+        });
+    }
+    let (value, cond) = fine.criterion(&traj);
     let evaluations = *evaluations.borrow();
     Ok(ExcitationDesign {
         trajectory: traj,
         value,
         cond,
         evaluations,
+        margins,
     })
 }
 

@@ -13,6 +13,7 @@ pub mod identify;
 pub mod parameter_table;
 pub mod parameters;
 pub mod streaming;
+pub mod workspace;
 
 pub use base::BaseParameters;
 pub use consistency::{check_physical_consistency, BodyConsistency, ConsistencyReport};
@@ -26,3 +27,4 @@ pub use identify::{
 };
 pub use parameter_table::ParameterRow;
 pub use parameters::{regressor_matrix, FrictionTerms, ParameterLayout};
+pub use workspace::{workspace_from_json, CartesianConstraint, Region};

@@ -57,6 +57,12 @@ impl PyExcitationDesign {
     fn value(&self) -> f64 {
         self.design.value
     }
+    /// The workspace and effort constraints with their smallest slack over a period (m beyond
+    /// each workspace margin; `1 - |tau| / (margin effort)` per joint), as a dict.
+    #[getter]
+    fn margins(&self) -> std::collections::BTreeMap<String, f64> {
+        self.design.margins.iter().cloned().collect()
+    }
     #[getter]
     fn evaluations(&self) -> usize {
         self.design.evaluations
@@ -109,8 +115,8 @@ fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<FrictionTerms> {
 /// base regressor subject to the limits (times `margin`), starting and ending at rest when
 /// `rest`. COBYLA, seeded; `progress=True` prints the progress to stderr.
 #[pyfunction]
-#[pyo3(signature = (robot, harmonics=5, base_frequency=0.1, criterion="cond", seed=0, *, rest=true, samples=100, margin=0.9, max_evaluations=2000, friction=Some(FrictionNames::Many(vec!["viscous".into(), "coulomb".into()])), progress=false),
-    text_signature = "(robot, harmonics=5, base_frequency=0.1, criterion='cond', seed=0, *, rest=True, samples=100, margin=0.9, max_evaluations=2000, friction=('viscous', 'coulomb'), progress=False)")]
+#[pyo3(signature = (robot, harmonics=5, base_frequency=0.1, criterion="cond", seed=0, *, rest=true, samples=100, margin=0.9, max_evaluations=2000, friction=Some(FrictionNames::Many(vec!["viscous".into(), "coulomb".into()])), progress=false, workspace=None, effort_limits=true),
+    text_signature = "(robot, harmonics=5, base_frequency=0.1, criterion='cond', seed=0, *, rest=True, samples=100, margin=0.9, max_evaluations=2000, friction=('viscous', 'coulomb'), progress=False, workspace=None, effort_limits=True)")]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn design_excitation(
     py: Python<'_>,
@@ -125,7 +131,20 @@ pub(crate) fn design_excitation(
     max_evaluations: usize,
     friction: Option<FrictionNames<'_>>,
     progress: bool,
+    workspace: Option<Bound<'_, PyAny>>,
+    effort_limits: bool,
 ) -> PyResult<PyExcitationDesign> {
+    // workspace constraints: a list of dicts (or a JSON string), read as the JSON file is
+    let workspace = match workspace {
+        None => vec![],
+        Some(w) => {
+            let text: String = match w.extract::<String>() {
+                Ok(s) => s,
+                Err(_) => py.import("json")?.call_method1("dumps", (w,))?.extract()?,
+            };
+            crate::direct::workspace_from_json(&text, "workspace")?
+        }
+    };
     let mut o = ExcitationOptions {
         harmonics,
         base_frequency,
@@ -135,6 +154,8 @@ pub(crate) fn design_excitation(
         samples,
         margin,
         max_evaluations,
+        workspace,
+        effort: effort_limits,
         ..ExcitationOptions::default()
     };
     o.friction = friction_terms(friction)?;

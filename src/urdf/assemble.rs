@@ -26,6 +26,7 @@ impl Builder<'_> {
             mut bodies,
             body_joint,
             base_inertia,
+            frames,
         } = walked;
         let mut dof_of_joint: HashMap<usize, usize> = HashMap::new();
         let mut joint_names = Vec::new();
@@ -81,6 +82,7 @@ impl Builder<'_> {
             joint_kinds,
             limits,
             armature,
+            frames,
             gravity: Vector3::new(0.0, 0.0, -STANDARD_GRAVITY),
             root_link: robot.links[graph.root].name.clone(),
             base_mass: base_inertia.mass,

@@ -9,7 +9,7 @@ use super::graph::Graph;
 use super::roles::Role;
 use super::Builder;
 use crate::error::{Error, Result};
-use crate::model::{joint_pose, Body};
+use crate::model::{joint_pose, Body, Frame};
 use crate::spatial::{Inertia, Se3};
 
 /// The bodies in pre-order, the URDF joint of each, and the inertia fixed to the base.
@@ -17,6 +17,8 @@ pub(super) struct Bodies {
     pub(super) bodies: Vec<Body>,
     pub(super) body_joint: Vec<usize>,
     pub(super) base_inertia: Inertia,
+    /// Every link's frame: the body it moves with and its pose there.
+    pub(super) frames: Vec<Frame>,
 }
 
 /// A link to visit.
@@ -40,6 +42,7 @@ impl Builder<'_> {
         let mut body_joint: Vec<usize> = Vec::new();
         let mut base_inertia = Inertia::zeros();
         let mut visited = vec![false; robot.links.len()];
+        let mut frames = Vec::with_capacity(robot.links.len());
         let mut stack = vec![Visit {
             link: graph.root,
             body: None,
@@ -72,6 +75,11 @@ impl Builder<'_> {
                 }
                 None => (v.body, v.pose),
             };
+            frames.push(Frame {
+                link: robot.links[v.link].name.clone(),
+                body,
+                pose,
+            });
             let inertia = pose.act_inertia(&link_inertia(&robot.links[v.link]));
             match body {
                 Some(b) => bodies[b].inertia = bodies[b].inertia.add(&inertia),
@@ -128,6 +136,7 @@ impl Builder<'_> {
             bodies,
             body_joint,
             base_inertia,
+            frames,
         })
     }
 }

@@ -291,3 +291,49 @@ def test_consistent_parameters_make_a_robot_pinocchio_agrees_with():
     np.testing.assert_allclose(fit.model.predict(qh, qdh, qddh), expected, atol=1e-8)
     np.testing.assert_allclose(built.rnea(qh, qdh, qddh) + built.damping * qdh, expected, atol=1e-8)
     assert "ConsistentFit(" in repr(fit)
+
+
+def test_excitation_within_the_workspace_and_effort_limits():
+    """The Panda's excitation without a floor takes its hand below the plane it stands on;
+    with the floor as a workspace constraint (and the URDF's effort limits) it stays above it
+    by the margin, which Pinocchio's frame kinematics and inverse dynamics confirm at 1 kHz."""
+    import pinocchio as pin
+
+    from conftest import erd_dir
+
+    path = erd_dir() / "panda_description/urdf/panda.urdf"
+    robot = pr.Robot.from_urdf(path, lock={"panda_finger_joint1": 0.02})
+    model = pin.buildModelFromUrdf(str(path))
+    q_ref = pin.neutral(model)
+    fingers = [model.getJointId(n) for n in ("panda_finger_joint1", "panda_finger_joint2")]
+    for j in fingers:
+        q_ref[model.joints[j].idx_q] = 0.02
+    model = pin.buildReducedModel(model, fingers, q_ref)
+    data = model.createData()
+    hand = model.getFrameId("panda_hand")
+    floor = [{"frame": "panda_hand", "point": [0, 0, 0.1], "region": {"above": {"normal": [0, 0, 1], "offset": 0.0}}, "margin": 0.05}]
+
+    def lowest_and_effort(design):
+        t = np.arange(0, design.trajectory.period, 1e-3)
+        q, qd, qdd = design.sample(t)
+        z, use = [], []
+        for k in range(len(t)):
+            pin.framesForwardKinematics(model, data, q[k])
+            z.append((data.oMf[hand].act(np.array([0, 0, 0.1])))[2])
+            use.append(np.abs(pin.rnea(model, data, q[k], qd[k], qdd[k])) / model.effortLimit)
+        return min(z), np.max(use)
+
+    free = pr.design_excitation(robot, seed=1, max_evaluations=300, effort_limits=False)
+    z_free, _ = lowest_and_effort(free)
+    kept = pr.design_excitation(robot, seed=1, max_evaluations=300, workspace=floor)
+    z_kept, effort_use = lowest_and_effort(kept)
+    assert z_kept >= 0.05 - 1e-6, z_kept
+    assert effort_use <= 0.9 + 1e-6, effort_use
+    m = kept.margins
+    assert set(m) == {"panda_hand above the plane (m)"} | {f"panda_joint{j} effort limit (fraction)" for j in range(1, 8)}
+    assert abs(m["panda_hand above the plane (m)"] - (z_kept - 0.05)) < 1e-3
+    print(f"lowest point of the hand: {z_free:.3f} m free, {z_kept:.3f} m with the floor")
+    with pytest.raises(pr.InputError, match="no link of this name"):
+        pr.design_excitation(robot, max_evaluations=10, workspace=[{**floor[0], "frame": "panda_elbow"}])
+    with pytest.raises(pr.InputError, match=r"at \[0\]\.region"):
+        pr.design_excitation(robot, max_evaluations=10, workspace=[{**floor[0], "region": {"below": {}}}])

@@ -45,6 +45,6 @@ def test_panda_direct_example(tmp_path):
 
 def test_every_input_the_readme_names_is_in_examples():
     readme = (EXAMPLES.parent / "README.md").read_text()
-    for name in ["op.json", "panda_drilling_op.json", "panda_true_robot.json"]:
+    for name in ["op.json", "panda_drilling_op.json", "panda_true_robot.json", "panda_workspace.json", "a465_true_robot.json"]:
         assert (EXAMPLES / name).is_file()
         assert f"examples/{name}" in readme, name
