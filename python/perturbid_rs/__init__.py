@@ -45,6 +45,7 @@ from ._core import (
     Recording,
     Robot,
     TrueRobot,
+    Validation,
     design_excitation,
     identify_base_parameters,
     identify_consistent_parameters,
@@ -55,6 +56,7 @@ from ._core import (
     plan_experiments,
     preprocess,
     simulate,
+    validate,
     __version__,
 )
 from . import robots
@@ -80,6 +82,7 @@ __all__ = [
     "Recording",
     "Robot",
     "TrueRobot",
+    "Validation",
     "design_excitation",
     "identify_base_parameters",
     "identify_consistent_parameters",
@@ -91,5 +94,6 @@ __all__ = [
     "preprocess",
     "robots",
     "simulate",
+    "validate",
     "__version__",
 ]

@@ -29,6 +29,7 @@ __all__ = [
     "Recording",
     "Robot",
     "TrueRobot",
+    "Validation",
     "__version__",
     "a465_urdf",
     "cli",
@@ -42,6 +43,7 @@ __all__ = [
     "plan_experiments",
     "preprocess",
     "simulate",
+    "validate",
 ]
 
 class PerturbidError(Exception):
@@ -485,6 +487,8 @@ class BaseParameterModel:
     def samples(self) -> int: ...
     def linearize(self, op: OperatingPoint) -> dict[str, Any]:
         """torque (n,), D, H, G (n, n) and G_static (n, n) or None at op."""
+    def to_dataframe(self) -> Any:
+        """The parameter table as a pandas DataFrame (index parameter; value, std, relative_std, combination)."""
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]: ...
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]: ...
     def to_json(self) -> str: ...
@@ -581,6 +585,27 @@ def identify_consistent_parameters(
     max_iterations: int = 2000,
 ) -> ConsistentFit:
     """Physically consistent least squares over the direct method's data (interior point)."""
+
+@final
+class Validation:
+    """A model's torques against measured ones, per joint."""
+    @property
+    def joints(self) -> list[str]: ...
+    @property
+    def rms(self) -> NDArray[np.float64]: ...
+    @property
+    def relative_rms(self) -> NDArray[np.float64]: ...
+    @property
+    def max(self) -> NDArray[np.float64]: ...
+    @property
+    def residuals(self) -> NDArray[np.float64]: ...
+    @property
+    def samples(self) -> int: ...
+    def to_dataframe(self) -> Any:
+        """The per-joint table as a pandas DataFrame (index joint; rms, relative_rms, max)."""
+
+def validate(model: Any, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, tau: ArrayLike) -> Validation:
+    """Validates any model with predict(q, qd, qdd) on measured states and torques."""
 
 def identify_global_linear(op: OperatingPoint, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, tau: ArrayLike) -> GlobalLinearModel: ...
 

@@ -47,7 +47,7 @@ impl CartesianConstraint {
             message,
         };
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite() && x.abs() < 1e6);
-        if !finite(&self.point) || !(self.margin.is_finite() && (0.0..1e3).contains(&self.margin)) {
+        if !(finite(&self.point) && (0.0..1e3).contains(&self.margin)) {
             return Err(bad(format!(
                 "point {:?} and margin {} must be finite (m), the margin >= 0",
                 self.point, self.margin

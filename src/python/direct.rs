@@ -264,6 +264,29 @@ impl PyBaseModel {
     fn samples(&self) -> usize {
         self.fit.samples
     }
+    /// The parameter table (pandas): index `parameter` (full base-parameter names), columns
+    /// `value`, `std`, `relative_std` (NaN where unknown) and `combination` (other parameters
+    /// merged into it: only the combination is identifiable).
+    fn to_dataframe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let rows = self.fit.parameter_table();
+        let column = |f: &dyn Fn(&crate::direct::ParameterRow) -> f64| {
+            PyArray1::from_iter(py, rows.iter().map(f)).into_any()
+        };
+        let combination = pyo3::types::PyList::new(py, rows.iter().map(|r| r.combination))?;
+        super::tables::dataframe(
+            py,
+            vec![
+                ("value", column(&|r| r.value)),
+                ("std", column(&|r| r.std.unwrap_or(f64::NAN))),
+                (
+                    "relative_std",
+                    column(&|r| r.relative_std.unwrap_or(f64::NAN)),
+                ),
+                ("combination", combination.into_any()),
+            ],
+            Some(("parameter", rows.iter().map(|r| r.name.clone()).collect())),
+        )
+    }
     /// Predicted torques (N m) at `q`, `qd`, `qdd`: (n,) each or (k, n).
     fn predict<'py>(
         &self,

@@ -14,7 +14,9 @@ mod recording;
 mod rehearsal;
 mod robot;
 mod simulation;
+mod tables;
 mod trajectory;
+mod validation;
 
 use pyo3::prelude::*;
 
@@ -62,6 +64,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(direct::identify_base_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(direct::identify_global_linear, m)?)?;
     m.add_class::<consistent::PyConsistentFit>()?;
+    m.add_class::<validation::PyValidation>()?;
+    m.add_function(wrap_pyfunction!(validation::validate, m)?)?;
     m.add_function(wrap_pyfunction!(
         consistent::identify_consistent_parameters,
         m

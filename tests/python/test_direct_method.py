@@ -337,3 +337,43 @@ def test_excitation_within_the_workspace_and_effort_limits():
         pr.design_excitation(robot, max_evaluations=10, workspace=[{**floor[0], "frame": "panda_elbow"}])
     with pytest.raises(pr.InputError, match=r"at \[0\]\.region"):
         pr.design_excitation(robot, max_evaluations=10, workspace=[{**floor[0], "region": {"below": {}}}])
+
+
+def test_validation_tables_and_figures():
+    """validate() against numpy, the tables as pandas DataFrames, the figures with matplotlib."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import pandas as pd
+
+    from perturbid_rs import plot
+
+    robot = pr.robots.a465()
+    traj = excitation(robot, 5, 0.1, 0.12, 1)
+    t = np.arange(0, traj.period, 0.01)
+    q, qd, qdd = traj.sample(t)
+    rng = np.random.default_rng(0)
+    tau = robot.rnea(q, qd, qdd) + rng.normal(0, 0.05, q.shape)
+    fit = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction=None)
+    v = pr.validate(fit, q, qd, qdd, tau)
+    r = tau - fit.predict(q, qd, qdd)
+    np.testing.assert_allclose(v.residuals, r, atol=1e-12)
+    np.testing.assert_allclose(v.rms, np.sqrt(np.mean(r**2, axis=0)), rtol=1e-12)
+    np.testing.assert_allclose(v.relative_rms, np.sqrt(np.sum(r**2, axis=0) / np.sum(tau**2, axis=0)), rtol=1e-12)
+    np.testing.assert_allclose(v.max, np.abs(r).max(axis=0), rtol=1e-12)
+    df = v.to_dataframe()
+    assert isinstance(df, pd.DataFrame) and list(df.index) == robot.joint_names and df.index.name == "joint"
+    np.testing.assert_allclose(df["rms"].to_numpy(), v.rms)
+    table = fit.to_dataframe()
+    assert table.index.name == "parameter" and list(table.index) == fit.names
+    np.testing.assert_allclose(table["value"].to_numpy(), fit.theta_base)
+    np.testing.assert_allclose(table["relative_std"].to_numpy(), fit.stderr / np.abs(fit.theta_base))
+    assert table["combination"].dtype == bool and table["combination"].any() and not table["combination"].all()
+    fig = plot.measured_and_predicted(t, tau, fit.predict(q, qd, qdd), robot.joint_names)
+    assert len(fig.axes) == 6 and fig.axes[0].get_legend() is not None
+    assert [line.get_linestyle() for line in fig.axes[0].lines] == ["-", "--", ":"]
+    assert len(plot.residuals(v, t).axes) == 6
+    with pytest.raises(ValueError, match="disagree"):
+        plot.measured_and_predicted(t[:-1], tau, tau)
+    with pytest.raises(pr.InputError):
+        pr.validate(fit, q, qd, qdd, tau[:-1])

@@ -1,0 +1,69 @@
+"""Figures for notebooks (matplotlib, an optional dependency: ``pip install perturbid_rs[plot]``).
+
+Each function draws on new axes and returns the matplotlib Figure; legends stand outside the
+data, and curves that may coincide (measured and predicted) get distinct line styles.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Optional, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+__all__ = ["measured_and_predicted", "residuals"]
+
+
+def _pyplot() -> Any:
+    try:
+        import matplotlib.pyplot as plt
+    except ImportError as e:  # pragma: no cover - exercised without matplotlib only
+        raise ImportError("perturbid_rs.plot needs matplotlib: pip install 'perturbid_rs[plot]'") from e
+    return plt
+
+
+def measured_and_predicted(
+    t: ArrayLike,
+    measured: ArrayLike,
+    predicted: ArrayLike,
+    joints: Optional[Sequence[str]] = None,
+) -> Any:
+    """One panel per joint: the measured torque (solid, grey), the predicted one (dashed, red)
+    and their difference (dotted, blue). ``t`` (k,) in s; ``measured``, ``predicted`` (k, n) in
+    N m; ``joints`` names the panels."""
+    plt = _pyplot()
+    t = np.asarray(t, dtype=float)
+    m = np.atleast_2d(np.asarray(measured, dtype=float))
+    p = np.atleast_2d(np.asarray(predicted, dtype=float))
+    if m.shape != p.shape or m.shape[0] != t.shape[0]:
+        raise ValueError(f"t {t.shape}, measured {m.shape} and predicted {p.shape} disagree: expected (k,), (k, n), (k, n)")
+    n = m.shape[1]
+    names = list(joints) if joints is not None else [f"joint {j + 1}" for j in range(n)]
+    fig, axes = plt.subplots(n, 1, figsize=(9, 2.0 * n), sharex=True, squeeze=False)
+    for j, ax in enumerate(axes[:, 0]):
+        ax.plot(t, m[:, j], "-", color="0.35", lw=1.5, label="measured")
+        ax.plot(t, p[:, j], "--", color="tab:red", lw=1.2, label="predicted")
+        ax.plot(t, m[:, j] - p[:, j], ":", color="tab:blue", lw=1.0, label="residual")
+        ax.set_ylabel(f"{names[j]}\n(N m)")
+    axes[0, 0].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    axes[-1, 0].set_xlabel("t (s)")
+    fig.tight_layout()
+    return fig
+
+
+def residuals(validation: Any, t: Optional[ArrayLike] = None) -> Any:
+    """The residuals of a ``perturbid_rs.Validation`` per joint (one panel each), with their RMS
+    as a band; ``t`` (k,) in s, sample index when omitted."""
+    plt = _pyplot()
+    r = np.asarray(validation.residuals, dtype=float)
+    x = np.arange(r.shape[0]) if t is None else np.asarray(t, dtype=float)
+    fig, axes = plt.subplots(r.shape[1], 1, figsize=(9, 1.8 * r.shape[1]), sharex=True, squeeze=False)
+    for j, ax in enumerate(axes[:, 0]):
+        rms = float(validation.rms[j])
+        ax.axhspan(-rms, rms, color="tab:blue", alpha=0.12, label="+- RMS")
+        ax.plot(x, r[:, j], "-", color="tab:blue", lw=0.8, label="measured - predicted")
+        ax.set_ylabel(f"{validation.joints[j]}\n(N m)")
+    axes[0, 0].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    axes[-1, 0].set_xlabel("t (s)" if t is not None else "sample")
+    fig.tight_layout()
+    return fig
