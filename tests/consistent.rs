@@ -1,11 +1,12 @@
-//! Physically consistent identification: the log-Cholesky parametrisation against finite
-//! differences, and consistent fits that are consistent and no worse than needed.
+//! Physical consistency: the check of a parameter set, and consistent fits that are consistent
+//! and no worse than needed.
 
 mod common;
 
 use common::Rng;
 use perturbid_rs::direct::{
-    identify_consistent_parameters, BaseOptions, ConsistentOptions, FrictionTerms, Weighting,
+    identify_consistent_parameters, BaseOptions, ConsistentOptions, FrictionTerms, ParameterLayout,
+    Weighting,
 };
 use perturbid_rs::{parallel, robots, Gravity, Model, States, TorqueModel};
 
@@ -207,4 +208,68 @@ fn consistent_parameters_from_local_models() {
     perturbid_rs::mass_matrix(&model, &mut data, &q).unwrap();
     let e = (&m - &data.m).norm() / data.m.norm();
     assert!(e < 1e-6, "M(q) of the consistent fit: {e:e}");
+}
+
+/// Physical consistency: the CAD-estimated A465 is consistent, the first paper fit (rotor
+/// inertias lumped into each link's Izz) is not; a negative mass, a negative friction and an
+/// inertia breaking the triangle inequality are named; the pseudo-inertia test agrees with the
+/// triangle inequalities on random diagonal inertias.
+#[test]
+fn physical_consistency_is_checked_per_link() {
+    use perturbid_rs::direct::check_physical_consistency;
+    let friction = FrictionTerms {
+        viscous: true,
+        coulomb: true,
+        offset: true,
+        armature: false,
+    };
+    let physical = robots::a465::model("physical").unwrap();
+    let layout = ParameterLayout::new(&physical, friction);
+    let theta = layout.model_parameters(&physical);
+    let report = check_physical_consistency(&layout, theta.as_slice()).unwrap();
+    assert!(report.is_consistent(), "{report:?}");
+    let fitted = robots::a465::model("kinsheel2010_lumped").unwrap();
+    let theta_fitted = layout.model_parameters(&fitted);
+    let report = check_physical_consistency(&layout, theta_fitted.as_slice()).unwrap();
+    assert!(!report.is_consistent());
+    let worst = report
+        .bodies
+        .iter()
+        .map(|b| b.relative_min)
+        .fold(0.0, f64::min);
+    assert!(worst < -0.5, "the lumped rotor inertias: {worst}");
+    // a negative mass and a negative Coulomb coefficient, named
+    let mut bad = theta.clone();
+    bad[10] = -1.0;
+    let c = layout
+        .names
+        .iter()
+        .position(|n| n == "joint2.coulomb")
+        .unwrap();
+    bad[c] = -0.1;
+    let report = check_physical_consistency(&layout, bad.as_slice()).unwrap();
+    assert_eq!(
+        report.bodies[1].problem.as_deref(),
+        Some("mass -1 kg is negative")
+    );
+    assert_eq!(
+        report.negative_friction,
+        vec![("joint2.coulomb".to_string(), -0.1)]
+    );
+    // against the triangle inequalities: a point mass at the origin plus a diagonal inertia
+    let mut rng = Rng(3);
+    for _ in 0..200 {
+        let d = [
+            rng.uniform(0.0, 1.0),
+            rng.uniform(0.0, 1.0),
+            rng.uniform(0.0, 1.0),
+        ];
+        let triangle = d[0] + d[1] >= d[2] && d[1] + d[2] >= d[0] && d[0] + d[2] >= d[1];
+        let mut t = theta.clone();
+        t.as_mut_slice()[..10]
+            .copy_from_slice(&[1.0, 0.0, 0.0, 0.0, d[0], 0.0, d[1], 0.0, 0.0, d[2]]);
+        let r = check_physical_consistency(&layout, t.as_slice()).unwrap();
+        assert_eq!(r.bodies[0].problem.is_none(), triangle, "{d:?}");
+    }
+    assert!(check_physical_consistency(&layout, &theta.as_slice()[1..]).is_err());
 }

@@ -1,0 +1,64 @@
+//! What the command-line tests share: running the binary and checking its output.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+pub fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_perturbid"))
+}
+
+pub fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("perturbid-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Runs and expects success; returns stdout.
+pub fn ok(args: &[&str]) -> String {
+    let out = bin().args(args).output().unwrap();
+    let (so, se) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert!(out.status.success(), "perturbid {args:?} failed: {se}");
+    so.into_owned()
+}
+
+/// Runs and expects a one-line error containing every `needles`, no panic; returns stderr.
+pub fn fails(args: &[&str], needles: &[&str]) -> String {
+    let out = bin().args(args).output().unwrap();
+    let se = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success(), "perturbid {args:?} should fail");
+    assert!(
+        !se.contains("panicked") && !se.contains("RUST_BACKTRACE"),
+        "panic: {se}"
+    );
+    assert!(
+        se.starts_with("perturbid: ") && se.trim_end().lines().count() == 1,
+        "not one line: {se}"
+    );
+    for n in needles {
+        assert!(se.contains(n), "'{n}' not in: {se}");
+    }
+    se
+}
+
+pub fn write(path: &Path, text: &str) {
+    std::fs::write(path, text).unwrap();
+}
+
+pub fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// No file named `name` and no temporary file in `dir`.
+pub fn nothing_written(dir: &Path, name: &str) {
+    assert!(!dir.join(name).exists(), "{name} was written");
+    let tmp = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .any(|e| e.file_name().to_string_lossy().ends_with(".tmp"));
+    assert!(!tmp, "a temporary file was left in {}", dir.display());
+}
