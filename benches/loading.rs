@@ -1,6 +1,6 @@
 //! Loading hostile sizes in linear time: `cargo bench --bench loading`. A chain of 20,000 and
 //! 100,000 links (the URDF loader was quadratic) and a CSV header of 1,000,000 columns (the
-//! duplicate check was quadratic). Each case runs 10 times: the 100,000-link chain takes
+//! duplicate check was quadratic), and a 60 s log at 1 kHz of a 7-joint arm. Each case runs 10 times: the 100,000-link chain takes
 //! seconds per run.
 
 use std::hint::black_box;
@@ -43,6 +43,27 @@ fn loading(c: &mut Criterion) {
     );
     g.bench_function("csv_header/1000000", |b| {
         b.iter(|| Table::parse("wide.csv", black_box(&csv)).unwrap())
+    });
+    // a realistic log: 60 s at 1 kHz of a 7-joint arm (t, q, qd, qdd, tau)
+    let mut log = String::from("t");
+    for p in ["q", "qd", "qdd", "tau"] {
+        for j in 1..=7 {
+            log.push_str(&format!(",{p}{j}"));
+        }
+    }
+    log.push('\n');
+    for k in 0..60_000 {
+        log.push_str(&format!("{}", k as f64 * 1e-3));
+        for c in 0..28 {
+            log.push_str(&format!(
+                ",{}",
+                ((k * 31 + c * 7) % 1000) as f64 * 0.001_234_567
+            ));
+        }
+        log.push('\n');
+    }
+    g.bench_function("csv_log/60000x29", |b| {
+        b.iter(|| Table::parse("log.csv", black_box(&log)).unwrap())
     });
     g.finish();
 }

@@ -302,6 +302,11 @@ pub enum Error {
     #[error("{path} belongs to an output set whose writing was interrupted (see {manifest}): it may mix old and new files; run the command that wrote it again")]
     PartialOutput { path: String, manifest: String },
 
+    /// A configuration file (TOML: a pipeline, a study) that does not say what is expected;
+    /// `location` is `file:line:column` or `file, step K`.
+    #[error("{location}: {message}")]
+    Config { location: String, message: String },
+
     /// A built-in robot or variant name that does not exist.
     #[error("unknown robot '{name}'; built-in robots: {}", available.join(", "))]
     UnknownRobot {
@@ -320,7 +325,8 @@ impl Error {
             | Error::InvalidArgument { .. }
             | Error::LimitViolation(_)
             | Error::Recording { .. }
-            | Error::Json { .. } => ErrorKind::Input,
+            | Error::Json { .. }
+            | Error::Config { .. } => ErrorKind::Input,
             Error::Numerical { .. } | Error::RankDeficient { .. } => ErrorKind::Numerical,
             Error::UrdfSyntax { .. }
             | Error::UnsupportedJoint { .. }

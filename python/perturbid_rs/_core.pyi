@@ -278,6 +278,9 @@ class Recording:
 @final
 class LocalModel:
     """tau ~= T* + D (qdd - qdd*) + H (qd - qd*) + G (q - q*), with its uncertainty."""
+    def to_dataframe(self) -> Any:
+        """Tidy table (pandas): term, torque, joint, value, std; one row per entry."""
+        ...
     @property
     def torque(self) -> NDArray[np.float64]: ...
     @property
@@ -549,6 +552,9 @@ def identify_base_parameters(
 @final
 class ConsistentFit:
     """Physically consistent parameters: every pseudo-inertia PSD, friction and armature >= 0."""
+    def to_dataframe(self) -> Any:
+        """Table (pandas) indexed by parameter: body, quantity, value."""
+        ...
     @property
     def model(self) -> BaseParameterModel: ...
     @property

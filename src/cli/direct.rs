@@ -368,20 +368,19 @@ fn write_parameter_table(
         format!("{stem}.parameters.csv"),
         format!("{stem}.parameters.json"),
     );
-    let mut csv = String::from("parameter,value,std,relative_std,combination\n");
     let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:e}"));
-    for r in rows {
-        // names hold spaces, '+' and '.', never a comma or a quote; quoted all the same
-        let _ = writeln!(
-            csv,
-            "\"{}\",{:e},{},{},{}",
-            r.name.replace('"', "\"\""),
-            r.value,
-            opt(r.std),
-            opt(r.relative_std),
-            r.combination
-        );
-    }
+    let csv = crate::io::csv_text(
+        &["parameter", "value", "std", "relative_std", "combination"],
+        rows.iter().map(|r| {
+            [
+                r.name.clone(),
+                format!("{:e}", r.value),
+                opt(r.std),
+                opt(r.relative_std),
+                r.combination.to_string(),
+            ]
+        }),
+    );
     let mut set = OutputSet::new(dir, &format!("{stem}.parameters"));
     set.add(&csv_name, csv)?;
     set.add(

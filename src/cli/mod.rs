@@ -7,6 +7,7 @@ mod info;
 mod local;
 mod paper;
 mod parameters;
+mod pipeline;
 mod progress;
 mod validate;
 
@@ -60,6 +61,10 @@ enum Command {
     /// Reproduce the paper (Tables 2 and 3, Figs. 3-5) on the built-in A465: report.md, CSV,
     /// JSON and SVG figures in --out.
     Paper(paper::PaperArgs),
+    /// Run a whole pipeline from one TOML file: its steps are the commands above, their
+    /// arguments written as keys (docs/pipeline.md); every step is checked before the first
+    /// runs.
+    Run(pipeline::RunArgs),
 }
 
 /// Where a subcommand writes: a folder or a file.
@@ -79,7 +84,20 @@ fn run(cli: Cli) -> Result<String> {
         Command::Parameters(a) => parameters::run(a),
         Command::Validate(a) => validate::run(a),
         Command::Paper(a) => paper::run(a),
+        Command::Run(a) => pipeline::run(a),
     }
+}
+
+/// clap's error in one line: its first paragraph, without the "error: " prefix.
+fn clap_message(e: &clap::Error) -> String {
+    let text = e.render().to_string();
+    let lines: Vec<&str> = text
+        .lines()
+        .take_while(|l| !l.trim().is_empty())
+        .map(str::trim)
+        .collect();
+    let line = lines.join(" ");
+    line.strip_prefix("error: ").unwrap_or(&line).to_string()
 }
 
 /// Runs the command line with `args` (the program name first); prints results on stdout and
@@ -124,17 +142,8 @@ where
                 let _ = e.print();
                 return code;
             }
-            // a usage error in one line, like every other error: clap's first line, without
-            // its "error: " prefix, and where to read more
-            let text = e.render().to_string();
-            let message: Vec<&str> = text
-                .lines()
-                .take_while(|l| !l.trim().is_empty())
-                .map(str::trim)
-                .collect();
-            let message = message.join(" ");
-            let message = message.strip_prefix("error: ").unwrap_or(&message);
-            eprintln!("perturbid: {message} (see perturbid --help)");
+            // a usage error in one line, like every other error, and where to read more
+            eprintln!("perturbid: {} (see perturbid --help)", clap_message(&e));
             return code;
         }
     };

@@ -1,33 +1,45 @@
-//! Progress on a terminal (stderr), silence otherwise.
+//! Progress on a terminal (stderr, through `indicatif`), silence otherwise: a spinner with a
+//! message.
 
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
+use std::time::Duration;
 
-/// Prints progress lines on stderr when it is a terminal.
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+/// A progress line on stderr, drawn only when stderr is a terminal (a log file or a pipe gets
+/// nothing), at most 10 times a second.
 pub(crate) struct Progress {
-    on: bool,
+    bar: ProgressBar,
+}
+
+fn target() -> ProgressDrawTarget {
+    if std::io::stderr().is_terminal() {
+        ProgressDrawTarget::stderr_with_hz(10)
+    } else {
+        ProgressDrawTarget::hidden()
+    }
 }
 
 impl Progress {
+    /// A spinner with a message ([`Progress::update`]).
     pub fn new() -> Self {
-        Self {
-            on: std::io::stderr().is_terminal(),
-        }
+        let bar = ProgressBar::with_draw_target(None, target());
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} {elapsed} {wide_msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+        );
+        bar.enable_steady_tick(Duration::from_millis(200));
+        Self { bar }
     }
 
-    /// Replaces the current progress line with `msg`.
+    /// Replaces the message with `msg`.
     pub fn update(&self, msg: &str) {
-        if self.on {
-            let mut e = std::io::stderr().lock();
-            let _ = write!(e, "\r\x1b[2K{msg}");
-            let _ = e.flush();
-        }
+        self.bar.set_message(msg.to_string());
     }
 
     /// Clears the progress line.
     pub fn done(&self) {
-        if self.on {
-            let _ = write!(std::io::stderr().lock(), "\r\x1b[2K");
-        }
+        self.bar.finish_and_clear();
     }
 }
 

@@ -4,6 +4,7 @@
 //! reader sees whole or not at all.
 
 pub mod atomic;
+pub mod config;
 pub mod output_set;
 pub mod recording;
 pub mod table;
@@ -11,4 +12,4 @@ pub mod table;
 pub use atomic::{read_text, write_atomic};
 pub use output_set::{check_not_partial, OutputSet};
 pub use recording::{read_recording, read_states, recording_table, samples_table, States};
-pub use table::Table;
+pub use table::{csv_text, Table};

@@ -32,53 +32,92 @@ impl Table {
         }
     }
 
-    /// Parses CSV text (comma separated; blank lines and lines starting with `#` skipped). Every
-    /// row must have one number per header column; a non-number, NaN or inf is an error naming
-    /// the line (1-based) and the column.
+    /// Parses CSV text (RFC 4180 through the `csv` crate: quoted fields such as `"q1"` or
+    /// `"a,b"` as other tools write them; a UTF-8 byte-order mark, blank lines and lines
+    /// starting with `#` skipped). Every row must have one number per header column; a
+    /// non-number, NaN or inf is an error naming the line (1-based) and the column.
     pub fn parse(source: &str, text: &str) -> Result<Self> {
-        let mut lines = text
-            .lines()
-            .enumerate()
-            .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-        let Some((header_line, header)) = lines.next() else {
-            return Err(Error::Recording {
-                recording: source.into(),
-                message: "empty file: expected a header line of column names".into(),
-            });
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let mut reader = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .trim(csv::Trim::All)
+            .from_reader(text.as_bytes());
+        let bad = |message: String| Error::Recording {
+            recording: source.into(),
+            message,
         };
-        let columns: Vec<String> = header.split(',').map(|c| c.trim().to_string()).collect();
+        // Line numbers from byte offsets (the csv crate does not count the blank lines it
+        // skips), counted incrementally: linear in the file. Records come in order.
+        let lines = std::cell::Cell::new((0usize, 1usize));
+        let line_at = |byte: u64| {
+            let (from, line) = lines.get();
+            let bytes = text.as_bytes();
+            let mut to = (byte as usize).clamp(from, text.len());
+            // a record's position is where the reader stood, before the blank lines it skipped
+            while to < bytes.len() && matches!(bytes[to], b'\n' | b'\r') {
+                to += 1;
+            }
+            let line = line + bytes[from..to].iter().filter(|&&b| b == b'\n').count();
+            lines.set((to, line));
+            line
+        };
+        let mut records = reader.records().filter_map(|r| match r {
+            // blank (also whitespace only) and comment lines carry nothing
+            Ok(rec) if rec.len() == 1 && rec[0].is_empty() => None,
+            Ok(rec) if rec.get(0).is_some_and(|f| f.starts_with('#')) => None,
+            Ok(rec) => {
+                let line = rec.position().map_or(0, |p| line_at(p.byte()));
+                Some(Ok((line, rec)))
+            }
+            Err(e) => Some(Err(e)),
+        });
+        let csv_error = |e: csv::Error| {
+            let at = e
+                .position()
+                .map_or(String::new(), |p| format!("line {}: ", line_at(p.byte())));
+            let what = match e.kind() {
+                csv::ErrorKind::Utf8 { .. } => "not UTF-8 text".to_string(),
+                csv::ErrorKind::Io(io) => io.to_string(),
+                _ => e.to_string(),
+            };
+            bad(format!("{at}{what}"))
+        };
+        let Some(first) = records.next() else {
+            return Err(bad(
+                "empty file: expected a header line of column names".into()
+            ));
+        };
+        let (header_line, header) = first.map_err(csv_error)?;
+        let columns: Vec<String> = header.iter().map(str::to_string).collect();
         let mut t = Table::new(source, columns);
         // one pass with a set: a header of a million columns is read in linear time
         let mut seen = std::collections::HashSet::with_capacity(t.columns.len());
         if let Some(dup) = t.columns.iter().find(|c| !seen.insert(c.as_str())) {
-            return Err(t.error(format!(
-                "line {}: column '{dup}' appears twice",
-                header_line + 1
-            )));
+            return Err(t.error(format!("line {header_line}: column '{dup}' appears twice")));
         }
-        for (i, line) in lines {
-            let fields: Vec<&str> = line.split(',').collect();
+        if let Some(c) = t.columns.iter().position(String::is_empty) {
+            return Err(t.error(format!("line {header_line}: column {} has no name", c + 1)));
+        }
+        for record in records {
+            let (line, fields) = record.map_err(csv_error)?;
             if fields.len() != t.columns.len() {
                 return Err(t.error(format!(
-                    "line {}: {} fields, the header has {} columns",
-                    i + 1,
+                    "line {line}: {} fields, the header has {} columns",
                     fields.len(),
                     t.columns.len()
                 )));
             }
             for (c, f) in fields.iter().enumerate() {
-                let v: f64 = f.trim().parse().map_err(|_| {
+                let v: f64 = f.parse().map_err(|_| {
                     t.error(format!(
-                        "line {}, column '{}': '{}' is not a number",
-                        i + 1,
-                        t.columns[c],
-                        f.trim()
+                        "line {line}, column '{}': '{f}' is not a number",
+                        t.columns[c]
                     ))
                 })?;
                 if !v.is_finite() {
                     return Err(t.error(format!(
-                        "line {}, column '{}': {v} is not a finite number",
-                        i + 1,
+                        "line {line}, column '{}': {v} is not a finite number",
                         t.columns[c]
                     )));
                 }
@@ -110,17 +149,67 @@ impl Table {
 
     /// CSV text: the header, then the rows with full precision (shortest round-trip form).
     pub fn to_csv(&self) -> String {
-        let mut out = self.columns.join(",");
-        out.push('\n');
         let w = self.columns.len();
-        for r in 0..self.rows() {
-            let row: Vec<String> = self.values[r * w..(r + 1) * w]
-                .iter()
-                .map(|v| format!("{v}"))
-                .collect();
-            out.push_str(&row.join(","));
-            out.push('\n');
+        csv_text(
+            &self.columns,
+            (0..self.rows()).map(|r| {
+                self.values[r * w..(r + 1) * w]
+                    .iter()
+                    .map(|v| format!("{v}"))
+            }),
+        )
+    }
+}
+
+/// CSV text (RFC 4180, through the `csv` crate: a field holding a comma, a quote or a line
+/// break is quoted) of a header and rows of already formatted fields.
+pub fn csv_text<H, R, F>(header: &[H], rows: impl IntoIterator<Item = R>) -> String
+where
+    H: AsRef<str>,
+    R: IntoIterator<Item = F>,
+    F: AsRef<str>,
+{
+    let mut w = csv::WriterBuilder::new()
+        .flexible(true)
+        .from_writer(Vec::new());
+    // writing into memory cannot fail
+    let _ = w.write_record(header.iter().map(|h| h.as_ref()));
+    for row in rows {
+        for f in row {
+            let _ = w.write_field(f.as_ref());
         }
-        out
+        let _ = w.write_record(None::<&[u8]>);
+    }
+    let bytes = w.into_inner().unwrap_or_default();
+    String::from_utf8(bytes).unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_what_other_tools_write() {
+        // quoted names (pandas, spreadsheets), a byte-order mark, CRLF, comments and blanks
+        let text =
+            "\u{feff}\"t\",\"q,1\"\r\n# a comment\r\n\r\n  # indented comment\n0,1.5\n \n1,\"2\"\n";
+        let t = Table::parse("x.csv", text).unwrap();
+        assert_eq!(t.columns, ["t", "q,1"]);
+        assert_eq!(t.values, [0.0, 1.5, 1.0, 2.0]);
+        // and writes it back so that it reads the same
+        assert_eq!(Table::parse("y.csv", &t.to_csv()).unwrap().values, t.values);
+        assert!(t.to_csv().starts_with("t,\"q,1\"\n"));
+    }
+
+    #[test]
+    fn errors_name_line_and_column() {
+        let e = Table::parse("x.csv", "t,q1\n0,1\n\n1,abc\n").unwrap_err();
+        assert!(e.to_string().contains("line 4, column 'q1': 'abc'"), "{e}");
+        let e = Table::parse("x.csv", "t,q1\n0,1,2\n").unwrap_err();
+        assert!(e.to_string().contains("line 2: 3 fields"), "{e}");
+        let e = Table::parse("x.csv", "t,\"q1\n0,1\n").unwrap_err();
+        assert!(e.to_string().contains("x.csv"), "{e}");
+        let e = Table::parse("x.csv", "t,,q\n0,1,2\n").unwrap_err();
+        assert!(e.to_string().contains("column 2 has no name"), "{e}");
     }
 }

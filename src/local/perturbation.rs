@@ -79,6 +79,26 @@ pub struct Sizes {
     pub acceleration: Size,
 }
 
+impl Sizes {
+    /// The sizes per joint for `model`, `[position, velocity, acceleration]` (rad, rad/s,
+    /// rad/s^2; m for prismatic joints): fractions of the position range and of the speed and
+    /// acceleration limits, [`FALLBACK_SIZES`] where a limit is infinite.
+    pub fn resolve_for(&self, model: &crate::model::Model) -> Result<[Vec<f64>; 3]> {
+        let range: Vec<f64> = model.limits.iter().map(|l| l.upper - l.lower).collect();
+        Ok([
+            self.position
+                .resolve("position size", &range, FALLBACK_SIZES[0])?,
+            self.velocity
+                .resolve("velocity size", &model.velocity_limit(), FALLBACK_SIZES[1])?,
+            self.acceleration.resolve(
+                "acceleration size",
+                &model.acceleration_limit(),
+                FALLBACK_SIZES[2],
+            )?,
+        ])
+    }
+}
+
 impl Default for Sizes {
     fn default() -> Self {
         Self {

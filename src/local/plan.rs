@@ -6,7 +6,7 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use super::operating_point::OperatingPoint;
-use super::perturbation::{perturbations, Design, Sizes, FALLBACK_SIZES};
+use super::perturbation::{perturbations, Design, Sizes};
 use crate::choice::choice;
 use crate::document::{invalid, Document};
 use crate::error::{Error, Result};
@@ -326,20 +326,7 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
         });
     }
     let count = o.count.unwrap_or(2 * n);
-    let range: Vec<f64> = model.limits.iter().map(|l| l.upper - l.lower).collect();
-    let mut sizes = [
-        o.sizes
-            .position
-            .resolve("position size", &range, FALLBACK_SIZES[0])?,
-        o.sizes
-            .velocity
-            .resolve("velocity size", &model.velocity_limit(), FALLBACK_SIZES[1])?,
-        o.sizes.acceleration.resolve(
-            "acceleration size",
-            &model.acceleration_limit(),
-            FALLBACK_SIZES[2],
-        )?,
-    ];
+    let mut sizes = o.sizes.resolve_for(model)?;
     if o.keep_velocity_sign {
         for (j, size) in sizes[1].iter_mut().enumerate() {
             let limit = 0.9 * op.qd[j].abs();

@@ -53,16 +53,12 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
         ("direct_base_parameters", &r.d_base_parameters),
         ("direct_paper", &r.d_direct_paper),
     ];
-    let mut t3 = String::from("row,D11,D21,D31,D41,D51,D61\n");
-    for (name, v) in &rows3 {
-        t3.push_str(&format!(
-            "{name},{}\n",
-            v.iter()
-                .map(|x| format!("{x}"))
-                .collect::<Vec<_>>()
-                .join(",")
-        ));
-    }
+    let t3 = crate::io::csv_text(
+        &["row", "D11", "D21", "D31", "D41", "D51", "D61"],
+        rows3.iter().map(|(name, v)| {
+            std::iter::once(name.to_string()).chain(v.iter().map(|x| format!("{x}")))
+        }),
+    );
     put("table3.csv", t3.as_bytes())?;
     put(
         "results.json",

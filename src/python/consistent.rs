@@ -50,6 +50,35 @@ impl PyConsistentFit {
             model: self.model.clone(),
         }
     }
+    /// The consistent parameters as a table (pandas): index `parameter` (full names as in
+    /// `names`), columns `body` (the link or joint), `quantity` ('m', 'mcx', ..., 'Izz',
+    /// 'viscous', 'coulomb', 'armature', 'offset') and `value` (kg, kg m, kg m^2 about the
+    /// body frame; N m s/rad, N m, kg m^2, N m for the joint terms of a revolute joint).
+    fn to_dataframe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let names = &self.fit.layout.names;
+        let split = |n: &String| -> (String, String) {
+            match n.rsplit_once('.') {
+                Some((b, q)) => (b.to_string(), q.to_string()),
+                None => (String::new(), n.clone()),
+            }
+        };
+        let (body, quantity): (Vec<String>, Vec<String>) = names.iter().map(split).unzip();
+        super::tables::dataframe(
+            py,
+            vec![
+                ("body", pyo3::types::PyList::new(py, body)?.into_any()),
+                (
+                    "quantity",
+                    pyo3::types::PyList::new(py, quantity)?.into_any(),
+                ),
+                (
+                    "value",
+                    PyArray1::from_slice(py, &self.fit.solution.theta).into_any(),
+                ),
+            ],
+            Some(("parameter", names.clone())),
+        )
+    }
     #[getter]
     fn theta<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_slice(py, &self.fit.solution.theta)

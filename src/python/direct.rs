@@ -113,7 +113,8 @@ fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<FrictionTerms> {
 
 /// Designs a Fourier excitation for `robot` minimising `criterion` ('cond' or 'logdet') of the
 /// base regressor subject to the limits (times `margin`), starting and ending at rest when
-/// `rest`. COBYLA, seeded; `progress=True` prints the progress to stderr.
+/// `rest`. COBYLA, seeded; `progress=True` logs the progress every 100 evaluations to Python's
+/// `logging` (logger `perturbid_rs.excitation`, level INFO).
 #[pyfunction]
 #[pyo3(signature = (robot, harmonics=5, base_frequency=0.1, criterion="cond", seed=0, *, rest=true, samples=100, margin=0.9, max_evaluations=2000, friction=Some(FrictionNames::Many(vec!["viscous".into(), "coulomb".into()])), progress=false, workspace=None, effort_limits=true),
     text_signature = "(robot, harmonics=5, base_frequency=0.1, criterion='cond', seed=0, *, rest=True, samples=100, margin=0.9, max_evaluations=2000, friction=('viscous', 'coulomb'), progress=False, workspace=None, effort_limits=True)")]
@@ -161,7 +162,12 @@ pub(crate) fn design_excitation(
     o.friction = friction_terms(friction)?;
     let design = detached(py, "design_excitation", || {
         let mut report = |e: usize, best: f64| {
-            eprintln!("excitation design: {e} evaluations, best criterion {best:.4}")
+            if e % 100 == 0 {
+                log::info!(
+                    target: "perturbid_rs::excitation",
+                    "excitation design: {e} evaluations, best criterion {best:.4}"
+                )
+            }
         };
         design_rs(
             &robot.model,

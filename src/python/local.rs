@@ -479,6 +479,47 @@ impl PyLocalModel {
         Ok(Some(out))
     }
 
+    /// The model as a tidy table (pandas): one row per entry, columns `term` ('T', 'D', 'H',
+    /// 'G', 'G_static'), `torque` (the joint whose torque the row is), `joint` (the joint
+    /// whose change multiplies the entry; empty for T*), `value` and `std` (NaN where
+    /// unknown). Units: N m for T*; N m s^2/rad, N m s/rad, N m/rad for D*, H*, G* (m in
+    /// place of rad for prismatic joints).
+    fn to_dataframe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let m = &self.model;
+        let names = &m.joint_names;
+        let (mut term, mut torque, mut joint) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut value, mut std) = (Vec::new(), Vec::new());
+        for (i, name) in names.iter().enumerate() {
+            term.push("T");
+            torque.push(name.clone());
+            joint.push(String::new());
+            value.push(m.torque[i]);
+            std.push(m.torque_stderr.get(i).copied().unwrap_or(f64::NAN));
+        }
+        for (k, e) in self.parts() {
+            let Some(e) = e else { continue };
+            for i in 0..e.matrix.nrows() {
+                for j in 0..e.matrix.ncols() {
+                    term.push(k);
+                    torque.push(names[i].clone());
+                    joint.push(names[j].clone());
+                    value.push(e.matrix[(i, j)]);
+                    std.push(e.stderr[(i, j)]);
+                }
+            }
+        }
+        super::tables::dataframe(
+            py,
+            vec![
+                ("term", pyo3::types::PyList::new(py, term)?.into_any()),
+                ("torque", pyo3::types::PyList::new(py, torque)?.into_any()),
+                ("joint", pyo3::types::PyList::new(py, joint)?.into_any()),
+                ("value", numpy::PyArray1::from_vec(py, value).into_any()),
+                ("std", numpy::PyArray1::from_vec(py, std).into_any()),
+            ],
+            None,
+        )
+    }
     #[getter]
     fn torque<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
         vec1(py, &self.model.torque)

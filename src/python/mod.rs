@@ -42,6 +42,9 @@ fn python_interrupted() -> bool {
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     crate::interrupt::set_checker(python_interrupted);
+    // Rust's `log` records go to Python's `logging` (logger names follow the targets:
+    // `perturbid_rs.excitation`, `perturbid_rs.study`, ...); already installed is fine.
+    let _ = pyo3_log::try_init();
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<robot::PyRobot>()?;
     m.add_class::<linearization::PyLinearization>()?;

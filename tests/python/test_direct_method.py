@@ -291,6 +291,28 @@ def test_consistent_parameters_make_a_robot_pinocchio_agrees_with():
     np.testing.assert_allclose(fit.model.predict(qh, qdh, qddh), expected, atol=1e-8)
     np.testing.assert_allclose(built.rnea(qh, qdh, qddh) + built.damping * qdh, expected, atol=1e-8)
     assert "ConsistentFit(" in repr(fit)
+    table = fit.to_dataframe()
+    assert table.index.name == "parameter" and list(table.index) == fit.names
+    np.testing.assert_array_equal(table["value"].to_numpy(), fit.theta)
+    assert list(table.loc["joint1.viscous", ["body", "quantity"]]) == ["joint1", "viscous"]
+    assert list(table["quantity"][:10]) == ["m", "mcx", "mcy", "mcz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz"]
+
+
+def test_progress_reaches_python_logging(caplog):
+    """Messages of the Rust side go to Python's logging (pyo3-log), under the library's name."""
+    import logging
+
+    robot = pr.robots.a465()
+    with caplog.at_level(logging.INFO, logger="perturbid_rs"):
+        pr.design_excitation(robot, seed=2, max_evaluations=300, progress=True)
+    records = [r for r in caplog.records if r.name == "perturbid_rs.excitation"]
+    assert len(records) >= 2, caplog.records
+    assert all(r.levelno == logging.INFO for r in records)
+    assert "excitation design: 100 evaluations" in records[0].getMessage()
+    caplog.clear()
+    with caplog.at_level(logging.WARNING, logger="perturbid_rs"):
+        pr.design_excitation(robot, seed=2, max_evaluations=300, progress=True)
+    assert not [r for r in caplog.records if r.name.startswith("perturbid_rs")]
 
 
 def test_excitation_within_the_workspace_and_effort_limits():

@@ -125,6 +125,20 @@ def test_workflow_shapes_uncertainty_and_json():
     assert doc["format"] == "perturbid-local-model/1" and len(doc["d"]["matrix"]) == 6
     combined = pr.identify_local(plan, recs, estimator="combined")
     assert combined.combined.shape == (6, 18) and combined.estimator == "combined"
+    # the model as a tidy table: every entry once, where the arrays have it
+    df = model.to_dataframe()
+    assert list(df.columns) == ["term", "torque", "joint", "value", "std"]
+    assert len(df) == 6 + 4 * 36
+    t_rows = df[df.term == "T"]
+    np.testing.assert_array_equal(t_rows["value"].to_numpy(), model.torque)
+    assert (t_rows["joint"] == "").all() and list(t_rows["torque"]) == robot.joint_names
+    names = robot.joint_names
+    for term, matrix in [("D", model.D), ("H", model.H), ("G", model.G), ("G_static", model.G_static)]:
+        part = df[df.term == term]
+        i = [names.index(n) for n in part["torque"]]
+        j = [names.index(n) for n in part["joint"]]
+        np.testing.assert_array_equal(part["value"].to_numpy(), matrix[i, j])
+        np.testing.assert_array_equal(part["std"].to_numpy(), model.stderr[term][i, j])
 
 
 def test_real_recording_from_arrays_and_shifted_clock():

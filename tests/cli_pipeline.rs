@@ -1,0 +1,201 @@
+//! `perturbid run PIPELINE.toml`: the example pipeline gives what the same commands typed by
+//! hand give; mistakes are found before anything runs and named by line and column.
+
+mod cli_support;
+use cli_support::*;
+
+use std::path::Path;
+
+fn example(name: &str) -> String {
+    std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("examples")
+            .join(name),
+    )
+    .unwrap()
+}
+
+#[test]
+fn the_example_pipeline_equals_the_commands_by_hand() {
+    let d = tmp("pipeline-example");
+    // the example and its input, in a folder of their own (relative paths follow the file)
+    write(&d.join("p.toml"), &example("a465_direct_pipeline.toml"));
+    write(
+        &d.join("a465_true_robot.json"),
+        &example("a465_true_robot.json"),
+    );
+    let out = ok(&["run", s(&d.join("p.toml"))]);
+    for k in 1..=6 {
+        assert!(out.contains(&format!("== step {k}/6: ")), "{out}");
+    }
+    let o = d.join("out/a465_direct");
+    for f in [
+        "excitation.json",
+        "log.csv",
+        "base.json",
+        "base.parameters.csv",
+        "held_out/log.csv",
+        "validation/residuals.csv",
+        "validation/validation.svg",
+    ] {
+        assert!(o.join(f).is_file(), "{f} missing");
+    }
+    // the commands it prints with --dry-run, run by hand from the same folder
+    let dry = ok(&["run", s(&d.join("p.toml")), "--dry-run"]);
+    let lines: Vec<&str> = dry.lines().collect();
+    assert_eq!(lines.len(), 6, "{dry}");
+    assert!(lines[0].starts_with("perturbid excite "), "{dry}");
+    let h = tmp("pipeline-by-hand");
+    std::fs::create_dir_all(h.join("out/a465_direct")).unwrap();
+    write(
+        &h.join("a465_true_robot.json"),
+        &example("a465_true_robot.json"),
+    );
+    let dir = s(&d).to_string() + "/";
+    for line in &lines {
+        // the same arguments, with the other folder's paths: no word holds a space here
+        let args: Vec<String> = line
+            .split(' ')
+            .skip(1)
+            .map(|w| w.replace(&dir, &(s(&h).to_string() + "/")))
+            .collect();
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        ok(&args);
+    }
+    for f in ["base.json", "validation/residuals.csv"] {
+        assert_eq!(
+            std::fs::read(o.join(f)).unwrap(),
+            std::fs::read(h.join("out/a465_direct").join(f)).unwrap(),
+            "{f} differs from the commands by hand"
+        );
+    }
+}
+
+#[test]
+fn mistakes_are_found_before_anything_runs() {
+    let d = tmp("pipeline-mistakes");
+    let p = d.join("p.toml");
+    let first = "[defaults]\nrobot = \"a465\"\n\n[[step]]\nrun = \"excite\"\nmax_evaluations = 20\nout = \"x\"\n\n";
+    let cases: &[(&str, &[&str])] = &[
+        // a wrong key in step 2: step 1 must not have run
+        (
+            "[[step]]\nrun = \"identify-direct\"\ndata = \"x/log.csv\"\nweigting = \"ols\"\n",
+            &[
+                "p.toml:12:12",
+                "'weigting' is not an argument of 'identify-direct'",
+                "weighting",
+            ],
+        ),
+        (
+            "[[step]]\nrun = \"fly\"\n",
+            &["p.toml:10:7", "'fly' is not a command", "identify-direct"],
+        ),
+        (
+            "[[step]]\nrun = \"run\"\n",
+            &["'run' is not a command a pipeline can run"],
+        ),
+        ("[[step]]\nout = \"y\"\n", &["step 2", "no 'run' key"]),
+        (
+            "[[step]]\nrun = \"identify-direct\"\ndata = \"x/log.csv\"\nconsistent = \"yes\"\n",
+            &[
+                "p.toml:12:14",
+                "'consistent' is a switch: write consistent = true",
+            ],
+        ),
+        (
+            "[[step]]\nrun = \"identify-direct\"\ndata = \"x/log.csv\"\nrate = true\n",
+            &["p.toml:12:8", "'rate' takes a value, not true/false"],
+        ),
+        (
+            "[[step]]\nrun = \"identify-direct\"\ndata = \"x/log.csv\"\nrate = \"fast\"\n",
+            &["step 2", "invalid value 'fast' for '--rate <RATE>'"],
+        ),
+        (
+            "[[step]]\nrun = \"identify-direct\"\n",
+            &["step 2", "<DATA>"],
+        ),
+        (
+            "[[step]]\nrun = \"identify-direct\"\ndata = \"x/log.csv\"\nrate = nan\n",
+            &["p.toml:12:8", "expected a finite number"],
+        ),
+        (
+            "[[step]]\nrun = \"info\"\nextra = [1, {a = 2}]\n",
+            &["p.toml:11:9", "'extra' is not an argument"],
+        ),
+        (
+            "[[step]]\nrun = \"info\"\n[oops]\n",
+            &["p.toml:11:2", "unknown field `oops`"],
+        ),
+        ("[[step]\n", &["p.toml:9:"]),
+    ];
+    for (second, needles) in cases {
+        write(&p, &format!("{first}{second}"));
+        fails(&["run", s(&p)], needles);
+        nothing_written(&d, "x");
+    }
+    write(
+        &p,
+        "[defaults]\nrobot = \"a465\"\nperiods = 3\n\n[[step]]\nrun = \"info\"\n",
+    );
+    fails(
+        &["run", s(&p)],
+        &["p.toml:3:11", "default 'periods' is taken by no step"],
+    );
+    write(&p, "[defaults]\nrobot = \"a465\"\n");
+    fails(&["run", s(&p)], &["p.toml", "step"]);
+    write(&p, "step = []\n");
+    fails(&["run", s(&p)], &["no [[step]]: nothing to run"]);
+}
+
+#[test]
+fn a_failing_step_names_itself_and_keeps_what_came_before() {
+    let d = tmp("pipeline-failing");
+    let p = d.join("p.toml");
+    write(
+        &p,
+        "[defaults]\nrobot = \"a465\"\n\n[[step]]\nrun = \"excite\"\nmax_evaluations = 20\nout = \"x\"\n\n[[step]]\nrun = \"identify-direct\"\ndata = \"missing.csv\"\n",
+    );
+    fails(
+        &["run", s(&p)],
+        &[
+            "p.toml:9:1, step 2 (identify-direct)",
+            "missing.csv",
+            "steps 1-1 finished and their outputs stand",
+        ],
+    );
+    assert!(d.join("x/excitation.json").is_file());
+}
+
+#[test]
+fn locks_and_robot_files_follow_the_pipeline() {
+    let d = tmp("pipeline-lock");
+    write(
+        &d.join("arm.urdf"),
+        r#"<robot name="arm">
+  <link name="base"/>
+  <link name="upper"><inertial><mass value="5"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <link name="finger"><inertial><mass value="0.02"/><inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-5" iyz="0" izz="1e-5"/></inertial></link>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
+    <limit lower="-2" upper="2" velocity="2" effort="50"/></joint>
+  <joint name="finger_joint" type="prismatic"><parent link="upper"/><child link="finger"/><origin xyz="0.3 0 0"/><axis xyz="0 1 0"/>
+    <limit lower="0" upper="0.04" velocity="0.2" effort="20"/></joint>
+</robot>"#,
+    );
+    // the robot file beside the pipeline, the lock as a table: the finger held still
+    write(
+        &d.join("p.toml"),
+        "[defaults]\nrobot = \"arm.urdf\"\nlock = { finger_joint = 0.01 }\n\n[[step]]\nrun = \"info\"\n",
+    );
+    let dry = ok(&["run", s(&d.join("p.toml")), "--dry-run"]);
+    assert!(dry.contains("--lock=finger_joint=0.01"), "{dry}");
+    assert!(dry.contains(&format!("{}/arm.urdf", s(&d))), "{dry}");
+    let out = bin().args(["run", s(&d.join("p.toml"))]).output().unwrap();
+    assert!(out.status.success() && out.stderr.is_empty(), "{out:?}");
+    assert!(String::from_utf8_lossy(&out.stdout).contains("1 degrees of freedom"));
+    // the list form means the same
+    write(
+        &d.join("p.toml"),
+        "[[step]]\nrun = \"info\"\nrobot = \"arm.urdf\"\nlock = [\"finger_joint=0.01\"]\n",
+    );
+    assert!(ok(&["run", s(&d.join("p.toml"))]).contains("1 degrees of freedom"));
+}
