@@ -41,6 +41,8 @@ pub mod signal;
 pub mod simulation;
 pub mod spatial;
 pub mod states;
+pub mod study;
+pub mod svg;
 pub mod torque_model;
 pub mod trajectory;
 pub mod urdf;

@@ -17,6 +17,9 @@ cargo bench --no-run --quiet
 # the Rust examples run (docs/parameters.md and docs/a465.md quote what they print)
 cargo run --release --quiet --example refit_a465 -- target/refit_a465.urdf
 cargo run --release --quiet --example parameters_evidence > target/parameters_evidence.md
+# the example study and pipeline through the command line (docs/study.md, docs/pipeline.md)
+rm -rf target/study_small
+cargo run --release --quiet --features cli --bin perturbid -- study examples/study_small.toml --out target/study_small > /dev/null
 # lints and docs without warnings, over every feature (python includes cli)
 cargo clippy --release --all-targets --features python --quiet -- -D warnings
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --features python --quiet

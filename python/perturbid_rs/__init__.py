@@ -60,6 +60,7 @@ from ._core import (
     __version__,
 )
 from . import robots
+from ._study import StudyResult, study
 
 __all__ = [
     "BaseParameterModel",
@@ -94,6 +95,8 @@ __all__ = [
     "preprocess",
     "robots",
     "simulate",
+    "study",
+    "StudyResult",
     "validate",
     "__version__",
 ]

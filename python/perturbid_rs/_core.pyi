@@ -43,6 +43,13 @@ __all__ = [
     "plan_experiments",
     "preprocess",
     "simulate",
+    "study_case",
+    "study_finish",
+    "study_len",
+    "study_pending",
+    "study_record",
+    "study_resolve",
+    "study_run",
     "validate",
 ]
 
@@ -633,3 +640,24 @@ def preprocess(
 
 def cli(argv: list[str]) -> int:
     """Runs the perturbid command line (argv[0] is the program name); returns the exit status."""
+
+def study_resolve(text: str, format: str, base: str, source: str) -> str:
+    """A study configuration (TOML or JSON text) resolved into its cases, as JSON."""
+
+def study_len(study: str) -> int:
+    """The number of cases of a resolved study."""
+
+def study_pending(study: str, out: str) -> list[int]:
+    """Indices of the cases the journal in `out` does not hold yet."""
+
+def study_case(study: str, index: int) -> str:
+    """Runs one case of a resolved study; its result as JSON."""
+
+def study_record(out: str, results: list[str]) -> None:
+    """Appends case results to the journal in `out`."""
+
+def study_finish(study: str, out: str) -> str:
+    """Writes the report of a finished study from its journal; the Markdown summary."""
+
+def study_run(study: str, out: str, progress: bool = True) -> str:
+    """Runs the pending cases on every core here, then writes the report."""

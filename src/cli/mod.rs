@@ -9,6 +9,7 @@ mod paper;
 mod parameters;
 mod pipeline;
 mod progress;
+mod study;
 mod validate;
 
 use std::ffi::OsString;
@@ -65,6 +66,10 @@ enum Command {
     /// arguments written as keys (docs/pipeline.md); every step is checked before the first
     /// runs.
     Run(pipeline::RunArgs),
+    /// A study of when the local model beats the global one, over robots, operating points,
+    /// true robots, noise, designs and seeds (docs/study.md): tidy results, summaries with
+    /// intervals and a figure in --out; resumable; every core.
+    Study(study::StudyArgs),
 }
 
 /// Where a subcommand writes: a folder or a file.
@@ -85,6 +90,7 @@ fn run(cli: Cli) -> Result<String> {
         Command::Validate(a) => validate::run(a),
         Command::Paper(a) => paper::run(a),
         Command::Run(a) => pipeline::run(a),
+        Command::Study(a) => study::run(a),
     }
 }
 

@@ -1,5 +1,5 @@
 //! Progress on a terminal (stderr, through `indicatif`), silence otherwise: a spinner with a
-//! message.
+//! message for open-ended work, a bar with counts and time left for counted work.
 
 use std::io::IsTerminal;
 use std::time::Duration;
@@ -32,9 +32,28 @@ impl Progress {
         Self { bar }
     }
 
+    /// A bar over `total` steps ([`Progress::set_position`]) labelled `what`.
+    pub fn counted(total: u64, what: &str) -> Self {
+        let bar = ProgressBar::with_draw_target(Some(total), target());
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{prefix} [{bar:30}] {pos}/{len} {elapsed} (left {eta}) {wide_msg}",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+        );
+        bar.set_prefix(what.to_string());
+        Self { bar }
+    }
+
     /// Replaces the message with `msg`.
     pub fn update(&self, msg: &str) {
         self.bar.set_message(msg.to_string());
+    }
+
+    /// Sets the number of steps done.
+    pub fn set_position(&self, done: u64) {
+        self.bar.set_position(done);
     }
 
     /// Clears the progress line.

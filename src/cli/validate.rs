@@ -10,8 +10,8 @@ use super::files::{load_robot, refuse_overwriting_inputs, PreprocessArgs};
 use super::progress::Progress;
 use crate::error::{Error, Result};
 use crate::io::{OutputSet, Table};
-use crate::paper::svg::{line_plot, Series};
 use crate::states::States;
+use crate::svg::{line_plot, Series};
 use crate::torque_model::{ModelFile, TorqueModel};
 use crate::validation::validate;
 
@@ -165,5 +165,5 @@ fn figure(joints: &[String], t: &[f64], measured: &[f64], predicted: &[f64]) -> 
             )
         })
         .collect();
-    crate::paper::svg::stack(&panels)
+    crate::svg::stack(&panels)
 }

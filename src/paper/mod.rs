@@ -6,7 +6,6 @@
 pub mod markdown;
 mod report;
 mod reproduce;
-pub mod svg;
 
 pub use report::write_report;
 pub use reproduce::*;

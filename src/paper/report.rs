@@ -3,11 +3,12 @@
 
 use std::path::{Path, PathBuf};
 
+use super::markdown;
 use super::reproduce::PaperResult;
-use super::{markdown, svg};
 use crate::document::Document;
 use crate::error::Result;
 use crate::io::{OutputSet, Table};
+use crate::svg;
 
 fn fmt_row(label: &str, v: &[f64], decimals: usize) -> Vec<String> {
     let mut r = vec![label.to_string()];

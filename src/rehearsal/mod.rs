@@ -116,3 +116,43 @@ pub fn rehearse_plan(nominal: &Model, robot: &TrueRobot, plan: &Plan) -> Result<
         })
         .collect()
 }
+
+/// The torques (row-major `k x nv`, N m or N) the true robot `robot` commands to hold the
+/// states `states` (the nominal model's joint coordinates as its encoders read them: rad,
+/// rad/s, rad/s^2), at the start of its life (friction drift at t = 0), without sensor noise:
+/// the plant a study measures every identified model against. Friction at exactly zero speed
+/// is zero (see [`JointEffects::friction`]).
+pub fn true_torques(
+    nominal: &Model,
+    robot: &TrueRobot,
+    states: &crate::states::States<'_>,
+) -> Result<Vec<f64>> {
+    let n = nominal.nv;
+    if states.nv() != n {
+        return Err(Error::Shape {
+            argument: "states".into(),
+            expected: format!("{n} joints"),
+            got: format!("{} joints", states.nv()),
+        });
+    }
+    robot.check(nominal)?;
+    let true_model = robot.rigid_body_model(nominal)?;
+    let effects = JointEffects::new(robot, n)?;
+    let offsets = true_robot::per_joint("joint_offsets", &robot.joint_offsets, n, 0.0)?;
+    let k = states.len();
+    let reference = Samples {
+        n,
+        t: vec![0.0; k],
+        q: states.q().to_vec(),
+        qd: states.qd_or_zeros().to_vec(),
+        qdd: states.qdd_or_zeros().to_vec(),
+    };
+    let motion = tracking::follow_exactly(
+        &true_model,
+        &effects,
+        Gravity::from(robot.gravity),
+        &reference,
+        &offsets,
+    )?;
+    Ok(motion.command)
+}

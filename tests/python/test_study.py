@@ -1,0 +1,52 @@
+"""Studies from Python: on every core here, and on a Dask LocalCluster with the same files."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import perturbid_rs as pr
+
+STUDY = {
+    "name": "dask test",
+    "seeds": 2,
+    "methods": ["local_separated", "direct_ols"],
+    "robots": [{"name": "a465"}],
+    "sample_points": {"count": 1, "speed_classes": ["fast"]},
+    "direct": {"max_evaluations": 30, "periods": 1},
+    "evaluation": {"distances": [1, 2], "samples": 4},
+}
+
+
+def test_study_locally_and_on_a_dask_cluster_give_the_same_files(tmp_path: Path):
+    distributed = pytest.importorskip("dask.distributed")
+    here = pr.study(STUDY, tmp_path / "here")
+    assert isinstance(here, pr.StudyResult) and "| local_separated |" in here.summary
+    df = here.to_dataframe()
+    assert set(df["method"]) == {"local_separated", "direct_ols"} and set(df["seed"]) == {0, 1}
+    assert here.parquet is not None and here.parquet.exists()
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        with distributed.Client(cluster) as client:
+            there = pr.study(STUDY, tmp_path / "there", client=client)
+    for name in ["results.csv", "summary.csv", "summary.md"]:
+        assert (here.out / name).read_text() == (there.out / name).read_text(), name
+
+
+def test_study_errors_and_resume(tmp_path: Path):
+    with pytest.raises(pr.InputError, match="seeds"):
+        pr.study({**STUDY, "seeds": 0}, tmp_path / "x")
+    with pytest.raises(pr.InputError, match="unknown field"):
+        pr.study({**STUDY, "sedes": 1}, tmp_path / "x")
+    toml = tmp_path / "s.toml"
+    toml.write_text('name = "t"\n[[robots]]\nname = "a465"\n[sample_points]\ncount = 1\nspeed_classes = ["fast"]\n'
+                    '[direct]\nmax_evaluations = 30\nperiods = 1\n[evaluation]\ndistances = [1]\nsamples = 2\n'
+                    'methods = ["local_separated"]\n')
+    with pytest.raises(pr.InputError, match=r"s\.toml:13:1: unknown field `methods`"):
+        pr.study(toml, tmp_path / "y")  # methods after [evaluation] belongs to that table
+    toml.write_text(toml.read_text().replace('methods = ["local_separated"]\n', ""))
+    first = pr.study(toml, tmp_path / "y")
+    journal = (tmp_path / "y" / "cases.jsonl").read_text()
+    again = pr.study(toml, tmp_path / "y")
+    assert (tmp_path / "y" / "cases.jsonl").read_text() == journal  # nothing rerun
+    assert first.results_csv.read_text() == again.results_csv.read_text()
