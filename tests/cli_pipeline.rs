@@ -169,18 +169,7 @@ fn a_failing_step_names_itself_and_keeps_what_came_before() {
 #[test]
 fn locks_and_robot_files_follow_the_pipeline() {
     let d = tmp("pipeline-lock");
-    write(
-        &d.join("arm.urdf"),
-        r#"<robot name="arm">
-  <link name="base"/>
-  <link name="upper"><inertial><mass value="5"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
-  <link name="finger"><inertial><mass value="0.02"/><inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-5" iyz="0" izz="1e-5"/></inertial></link>
-  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
-    <limit lower="-2" upper="2" velocity="2" effort="50"/></joint>
-  <joint name="finger_joint" type="prismatic"><parent link="upper"/><child link="finger"/><origin xyz="0.3 0 0"/><axis xyz="0 1 0"/>
-    <limit lower="0" upper="0.04" velocity="0.2" effort="20"/></joint>
-</robot>"#,
-    );
+    write(&d.join("arm.urdf"), ARM_WITH_FINGER);
     // the robot file beside the pipeline, the lock as a table: the finger held still
     write(
         &d.join("p.toml"),

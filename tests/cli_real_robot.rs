@@ -3,25 +3,14 @@
 
 mod cli_support;
 
-use cli_support::{bin, fails, ok, s, tmp, write};
+use cli_support::{bin, fails, ok, s, tmp, write, ARM_WITH_FINGER};
 
 /// `--lock JOINT=VALUE` wherever a robot is loaded; a free gripper finger is warned about.
 #[test]
 fn lock_joints_and_warn_about_free_fingers() {
     let d = tmp("lock");
     let urdf = d.join("arm.urdf");
-    write(
-        &urdf,
-        r#"<robot name="arm">
-  <link name="base"/>
-  <link name="upper"><inertial><mass value="5"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
-  <link name="finger"><inertial><mass value="0.02"/><inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-5" iyz="0" izz="1e-5"/></inertial></link>
-  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
-    <limit lower="-2" upper="2" velocity="2" effort="50"/></joint>
-  <joint name="finger_joint" type="prismatic"><parent link="upper"/><child link="finger"/><origin xyz="0.3 0 0"/><axis xyz="0 1 0"/>
-    <limit lower="0" upper="0.04" velocity="0.2" effort="20"/></joint>
-</robot>"#,
-    );
+    write(&urdf, ARM_WITH_FINGER);
     let out = bin().args(["info", s(&urdf)]).output().unwrap();
     let se = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success());

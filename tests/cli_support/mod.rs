@@ -62,3 +62,14 @@ pub fn nothing_written(dir: &Path, name: &str) {
         .any(|e| e.file_name().to_string_lossy().ends_with(".tmp"));
     assert!(!tmp, "a temporary file was left in {}", dir.display());
 }
+
+/// A one-joint arm with a light prismatic finger (0.02 kg): the case of `--lock`.
+pub const ARM_WITH_FINGER: &str = r#"<robot name="arm">
+  <link name="base"/>
+  <link name="upper"><inertial><mass value="5"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <link name="finger"><inertial><mass value="0.02"/><inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-5" iyz="0" izz="1e-5"/></inertial></link>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
+    <limit lower="-2" upper="2" velocity="2" effort="50"/></joint>
+  <joint name="finger_joint" type="prismatic"><parent link="upper"/><child link="finger"/><origin xyz="0.3 0 0"/><axis xyz="0 1 0"/>
+    <limit lower="0" upper="0.04" velocity="0.2" effort="20"/></joint>
+</robot>"#;
