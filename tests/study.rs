@@ -217,3 +217,52 @@ fn bad_configurations_name_the_place() {
         "{e}"
     );
 }
+
+#[test]
+fn true_robots_sweep_over_their_parameters() {
+    let text = format!(
+        "{STUDY}\n[[true_robots]]\nname = \"payload\"\ndocument = {{ gravity = false, payload = {{ link = \"link6\", mass = 1.0, com = [0, 0, 0.06], inertia = [0.002, 0, 0, 0.002, 0, 0.001] }} }}\nsweep = {{ \"payload.mass\" = [0.5, 2.0], \"friction.viscous\" = [[0.1, 0.1, 0.1, 0.1, 0.1, 0.1]] }}\n"
+    );
+    let config: StudyConfig = perturbid_rs::io::config::parse_toml("s.toml", &text).unwrap();
+    let s = Study::resolve(config, Path::new("."), "s.toml").unwrap();
+    let names: Vec<&str> = s.true_robots.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "payload[friction.viscous=[0.1,0.1,0.1,0.1,0.1,0.1],payload.mass=0.5]",
+            "payload[friction.viscous=[0.1,0.1,0.1,0.1,0.1,0.1],payload.mass=2.0]"
+        ]
+    );
+    assert_eq!(s.true_robots[1].1.payload.as_ref().unwrap().mass, 2.0);
+    assert_eq!(
+        s.true_robots[0].1.friction.viscous.as_deref(),
+        Some(&[0.1; 6][..])
+    );
+    assert_eq!(s.len(), 4); // 1 point x 2 true robots x 2 seeds
+                            // a path that does not fit the document is named
+    let bad = |sweep: &str| -> String {
+        let t = format!("{STUDY}\n[[true_robots]]\nname = \"p\"\nsweep = {sweep}\n");
+        let c: StudyConfig = perturbid_rs::io::config::parse_toml("s.toml", &t).unwrap();
+        Study::resolve(c, Path::new("."), "s.toml")
+            .unwrap_err()
+            .to_string()
+    };
+    let e = bad("{ \"friction.viscous.7\" = [1.0] }");
+    assert!(
+        e.contains("true_robots 'p[friction.viscous.7=1.0]'") && e.contains("friction.viscous"),
+        "{e}"
+    );
+    let e = bad("{ \"seed.x\" = [1.0] }");
+    assert!(
+        e.contains("s.toml, true_robots 'p', sweep: 'seed.x'")
+            && e.contains("neither a table nor a list"),
+        "{e}"
+    );
+    let e = bad("{ \"payload.weight\" = [1.0] }");
+    assert!(
+        e.contains("true_robots 'p[payload.weight=1.0]'") && e.contains("weight"),
+        "{e}"
+    );
+    let e = bad("{ \"seed\" = [] }");
+    assert!(e.contains("'seed' has no values"), "{e}");
+}

@@ -505,6 +505,9 @@ class BaseParameterModel:
 
 @final
 class GlobalLinearModel:
+    def to_dataframe(self) -> Any:
+        """Tidy table (pandas): term, torque, joint, value, std; one row per entry."""
+        ...
     @property
     def D(self) -> NDArray[np.float64]: ...
     @property

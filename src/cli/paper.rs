@@ -19,6 +19,13 @@ pub(crate) struct PaperArgs {
     /// Torque noise of the simulated measurements (N m; the paper's simulation has none).
     #[arg(long, default_value_t = 0.0)]
     noise: f64,
+    /// Excitation seeds of the direct method: Table 3's direct rows and Figs. 3-5 give the
+    /// median and the range over them.
+    #[arg(long, default_value_t = 10)]
+    excitation_seeds: usize,
+    /// Leave out the built-in study ("when to use which method", about a minute on 2 cores).
+    #[arg(long)]
+    no_study: bool,
 }
 
 pub(crate) fn run(a: PaperArgs) -> Result<String> {
@@ -28,6 +35,8 @@ pub(crate) fn run(a: PaperArgs) -> Result<String> {
         &PaperOptions {
             seed: a.seed,
             torque_noise: a.noise,
+            excitation_seeds: a.excitation_seeds,
+            study: !a.no_study,
             ..PaperOptions::default()
         },
         &mut step,
@@ -54,8 +63,8 @@ pub(crate) fn run(a: PaperArgs) -> Result<String> {
         ("actual M(q*)", &r.d_actual),
         ("perturbation, identified", &r.d_perturbation),
         ("perturbation, paper", &r.d_perturbation_paper),
-        ("direct, globally linearised", &r.d_global_linear),
-        ("direct, base parameters", &r.d_base_parameters),
+        ("direct, glob. lin. (median)", &r.d_global_linear),
+        ("direct, base param. (median)", &r.d_base_parameters),
         ("direct, paper", &r.d_direct_paper),
     ] {
         let _ = writeln!(
@@ -65,6 +74,26 @@ pub(crate) fn run(a: PaperArgs) -> Result<String> {
                 .map(|&x| format!("{:>7}", crate::paper::markdown::number(x, 3)))
                 .collect::<Vec<_>>()
                 .join(" ")
+        );
+    }
+    for d in &r.direct {
+        let _ = writeln!(
+            out,
+            "D11 globally linearised over {} excitations {}: {:.2} to {:.2}",
+            d.seeds.len(),
+            if d.excitation == "default" {
+                "within the joint limits"
+            } else {
+                "within q* +- 0.5 rad"
+            },
+            d.d_global_linear.min[0],
+            d.d_global_linear.max[0]
+        );
+    }
+    if r.study.is_some() {
+        let _ = writeln!(
+            out,
+            "report.md ends with 'When to use which method', from a built-in study (study.toml)"
         );
     }
     let _ = writeln!(

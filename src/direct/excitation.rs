@@ -427,7 +427,13 @@ pub fn design_excitation(
     let constraints_of = |x: &[f64]| -> Vec<f64> {
         let mut c = cache.borrow_mut();
         if c.0 != x {
-            *c = (x.to_vec(), p.constraints(&p.trajectory(x)));
+            // COBYLA loops forever on a NaN: a non-finite constraint counts as badly broken
+            let values = p
+                .constraints(&p.trajectory(x))
+                .into_iter()
+                .map(|v| if v.is_finite() { v } else { -1e30 })
+                .collect();
+            *c = (x.to_vec(), values);
         }
         c.1.clone()
     };
@@ -438,6 +444,8 @@ pub fn design_excitation(
             std::panic::resume_unwind(Box::new(Interrupted));
         }
         let (value, _) = p.criterion(&p.trajectory(x));
+        // a singular design (inf) or a failed evaluation (NaN) is the worst value, finite
+        let value = if value.is_finite() { value } else { 1e30 };
         let mut e = evaluations.borrow_mut();
         *e += 1;
         if constraints_of(x).iter().all(|&c| c >= 0.0) && value < *best.borrow() {
@@ -484,9 +492,14 @@ pub fn design_excitation(
     let x = match result {
         Ok((_, x, _)) | Err((_, x, _)) => x,
     };
-    // make sure of the limits: shrink the amplitudes about q0 until the full check passes
+    // make sure of the limits: COBYLA may end with an offset outside its bounds (narrow
+    // ranges), so the offsets go back within the limits; then the amplitudes shrink about q0
+    // until the full check passes
     let mut traj = p.trajectory(&x);
-    for _ in 0..200 {
+    for i in 0..n {
+        traj.q0[i] = traj.q0[i].clamp(p.lower[i], p.upper[i]);
+    }
+    for _ in 0..2000 {
         if p.constraints(&traj).iter().all(|&c| c >= 0.0) {
             break;
         }

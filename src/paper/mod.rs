@@ -6,6 +6,7 @@
 pub mod markdown;
 mod report;
 mod reproduce;
+pub mod study;
 
 pub use report::write_report;
 pub use reproduce::*;

@@ -32,8 +32,14 @@ pub struct PaperOptions {
     pub seed: u64,
     /// Torque noise (N m) of the simulated measurements (default 0: the paper's simulation).
     pub torque_noise: f64,
-    /// Budget of the excitation design (default 800 evaluations).
+    /// Budget of each excitation design (default 800 evaluations).
     pub design_evaluations: usize,
+    /// Excitation seeds of the direct method (`seed`, `seed + 1`, ...; default 10): Table 3's
+    /// direct rows and the figures give the median and the range over them.
+    pub excitation_seeds: usize,
+    /// Run the built-in study for the section "when to use which method" (about a minute on
+    /// 2 cores; default true).
+    pub study: bool,
 }
 
 impl Default for PaperOptions {
@@ -42,6 +48,8 @@ impl Default for PaperOptions {
             seed: 0,
             torque_noise: 0.0,
             design_evaluations: 800,
+            excitation_seeds: 10,
+            study: true,
         }
     }
 }
@@ -50,10 +58,16 @@ impl Default for PaperOptions {
 #[derive(Clone, Debug, Serialize)]
 pub struct Figure {
     pub joint: usize,
+    /// The direct method's excitation: `default` or `around_op`.
+    pub excitation: String,
     pub t: Vec<f64>,
     pub actual: Vec<f64>,
     pub local: Vec<f64>,
+    /// Median over the excitation seeds, and the lowest and highest.
     pub global_linear: Vec<f64>,
+    pub global_linear_min: Vec<f64>,
+    pub global_linear_max: Vec<f64>,
+    /// Median over the excitation seeds.
     pub base_parameters: Vec<f64>,
 }
 
@@ -62,6 +76,7 @@ pub struct Figure {
 #[derive(Clone, Debug, Serialize)]
 pub struct FigureErrors {
     pub joint: usize,
+    pub excitation: String,
     pub near: f64,
     pub local_near: f64,
     pub global_linear_near: f64,
@@ -69,6 +84,51 @@ pub struct FigureErrors {
     pub local_all: f64,
     pub global_linear_all: f64,
     pub base_parameters_all: f64,
+}
+
+/// Median, lowest and highest of a vector quantity over the excitation seeds.
+#[derive(Clone, Debug, Serialize)]
+pub struct OverSeeds {
+    pub median: Vec<f64>,
+    pub min: Vec<f64>,
+    pub max: Vec<f64>,
+}
+
+impl OverSeeds {
+    /// Entry-wise statistics of `runs` (each of the same length, at least one).
+    pub fn of(runs: &[Vec<f64>]) -> OverSeeds {
+        let n = runs[0].len();
+        let mut out = OverSeeds {
+            median: vec![0.0; n],
+            min: vec![0.0; n],
+            max: vec![0.0; n],
+        };
+        let mut column = vec![0.0; runs.len()];
+        for j in 0..n {
+            for (c, r) in column.iter_mut().zip(runs) {
+                *c = r[j];
+            }
+            column.sort_by(f64::total_cmp);
+            out.median[j] = crate::study::quantile(&column, 0.5);
+            out.min[j] = column[0];
+            out.max[j] = column[column.len() - 1];
+        }
+        out
+    }
+}
+
+/// The direct method over the excitation seeds, for one kind of excitation.
+#[derive(Clone, Debug, Serialize)]
+pub struct DirectOverSeeds {
+    /// `default` (the design within the joint limits) or `around_op` (limits narrowed to
+    /// q* +- 0.5 rad, like the paper's excitation, which stays near the point).
+    pub excitation: String,
+    pub seeds: Vec<u64>,
+    /// cond(Phi_base) of each seed's design.
+    pub cond: Vec<f64>,
+    /// First column of D: globally linearised D_g and the base-parameter model's M(q*).
+    pub d_global_linear: OverSeeds,
+    pub d_base_parameters: OverSeeds,
 }
 
 /// Everything the reproduction computes.
@@ -95,6 +155,12 @@ pub struct PaperResult {
     pub base_parameters: usize,
     pub figures: Vec<Figure>,
     pub errors: Vec<FigureErrors>,
+    /// The direct method over the excitation seeds: the default excitation, then the one
+    /// around the point. `d_global_linear` and `d_base_parameters` above are the default
+    /// excitation's medians.
+    pub direct: Vec<DirectOverSeeds>,
+    /// The built-in study ("when to use which method"), when run.
+    pub study: Option<Vec<super::study::StudyLine>>,
     #[serde(skip)]
     pub local_model: Option<LocalModel>,
 }
@@ -105,6 +171,12 @@ fn column0(m: &DMatrix<f64>) -> Vec<f64> {
 
 /// Runs the reproduction. `progress` hears each step's name.
 pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Result<PaperResult> {
+    if !(1..=1000).contains(&options.excitation_seeds) {
+        return Err(crate::error::Error::InvalidArgument {
+            argument: "excitation_seeds".into(),
+            message: format!("{}; expected 1..=1000", options.excitation_seeds),
+        });
+    }
     let model = a465::model("kinsheel2010")?;
     let n = model.nv;
     let op = OperatingPoint::new(
@@ -132,39 +204,11 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
     let local = identify_local(&plan, &recordings, &IdentifyOptions::default())?;
     let d_local = &local.d.as_ref().expect("planned").matrix;
 
-    progress("direct method: designing the Fourier excitation (10 harmonics of 0.05 Hz)");
-    let ex = ExcitationOptions {
-        harmonics: 10,
-        base_frequency: 0.05,
-        max_evaluations: options.design_evaluations,
-        seed: options.seed,
-        ..ExcitationOptions::default()
-    };
-    let design = design_excitation(&model, &ex, None)?;
-    progress("direct method: simulating the excitation and fitting both direct models");
-    let samples = design.trajectory.sample_periods(1.0, 50.0);
-    let rec = simulate_samples(&model, &samples, &sim, 99, "excitation")?;
-    let batch = States::new(model.nv, &samples.q, Some(&samples.qd), Some(&samples.qdd))?;
-    let global = identify_global_linear(&op, &batch, &rec.tau)?;
-    let base = identify_base_parameters(
-        &model,
-        &batch,
-        &rec.tau,
-        &BaseOptions {
-            friction: FrictionTerms::NONE,
-            weighting: Weighting::Ols,
-            gravity: Gravity::Excluded,
-            seed: options.seed,
-            ..BaseOptions::default()
-        },
-    )?;
     let mut data = Data::new(&model);
     mass_matrix(&model, &mut data, &op.q)?;
     let actual = data.m.clone();
-    let m_base = base.mass_matrix(&model, &op.q)?;
 
-    progress("figures: torques along a trajectory through the operating point");
-    // q(s) = q* + qd* s + qdd* s^2 / 2 for s in [-3, 3] s: passes P at s = 0
+    // Figs. 3-5: q(s) = q* + qd* s + qdd* s^2 / 2 for s in [-3, 3] s, passing P at s = 0
     let ts: Vec<f64> = (0..=600).map(|i| -3.0 + 0.01 * i as f64).collect();
     let (mut q, mut qd, mut qdd) = (vec![], vec![], vec![]);
     for &s in &ts {
@@ -185,8 +229,34 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
         &mut actual_tau,
     )?;
     let local_tau = local.predict(&states)?;
-    let global_tau = global.predict(&states)?;
-    let base_tau = base.on(&model)?.predict(&states)?;
+
+    let seeds = options.excitation_seeds;
+    progress(&format!(
+        "direct method: {seeds} excitations (10 harmonics of 0.05 Hz) within the limits and {seeds} around the point, designed, simulated and fitted"
+    ));
+    let around = around_op(&model, &op, 0.5);
+    let jobs: Vec<(usize, u64)> = (0..2)
+        .flat_map(|v| (0..seeds as u64).map(move |s| (v, options.seed + s)))
+        .collect();
+    use rayon::prelude::*;
+    let runs: Vec<DirectRun> = jobs
+        .par_iter()
+        .map(|&(v, seed)| {
+            crate::error::catch_panics("paper direct method", || {
+                direct_run(
+                    &model,
+                    (v, if v == 0 { &model } else { &around }),
+                    &sim,
+                    &op,
+                    seed,
+                    options.design_evaluations,
+                    &states,
+                )
+            })
+        })
+        .collect::<Result<_>>()?;
+    crate::interrupt::check("paper")?;
+
     let pick = |v: &[f64], j: usize| -> Vec<f64> { (0..ts.len()).map(|k| v[k * n + j]).collect() };
     let rms = |a: &[f64], b: &[f64], mask: &dyn Fn(f64) -> bool| -> f64 {
         let e: Vec<f64> = ts
@@ -200,30 +270,58 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
     let near = 0.5;
     let mut figures = vec![];
     let mut errors = vec![];
-    for joint in [2usize, 3, 4] {
-        let j = joint - 1;
-        let f = Figure {
-            joint,
-            t: ts.clone(),
-            actual: pick(&actual_tau, j),
-            local: pick(&local_tau, j),
-            global_linear: pick(&global_tau, j),
-            base_parameters: pick(&base_tau, j),
+    let mut direct = vec![];
+    for (v, name) in ["default", "around_op"].iter().enumerate() {
+        let these: Vec<&DirectRun> = runs.iter().filter(|r| r.variant == v).collect();
+        let column = |f: &dyn Fn(&DirectRun) -> &Vec<f64>| -> Vec<Vec<f64>> {
+            these.iter().map(|r| f(r).clone()).collect()
         };
-        let is_near = |t: f64| t.abs() <= near;
-        let all = |_: f64| true;
-        errors.push(FigureErrors {
-            joint,
-            near,
-            local_near: rms(&f.local, &f.actual, &is_near),
-            global_linear_near: rms(&f.global_linear, &f.actual, &is_near),
-            base_parameters_near: rms(&f.base_parameters, &f.actual, &is_near),
-            local_all: rms(&f.local, &f.actual, &all),
-            global_linear_all: rms(&f.global_linear, &f.actual, &all),
-            base_parameters_all: rms(&f.base_parameters, &f.actual, &all),
+        direct.push(DirectOverSeeds {
+            excitation: name.to_string(),
+            seeds: these.iter().map(|r| r.seed).collect(),
+            cond: these.iter().map(|r| r.cond).collect(),
+            d_global_linear: OverSeeds::of(&column(&|r| &r.d_global_linear)),
+            d_base_parameters: OverSeeds::of(&column(&|r| &r.d_base_parameters)),
         });
-        figures.push(f);
+        let global = OverSeeds::of(&column(&|r| &r.global_tau));
+        let base = OverSeeds::of(&column(&|r| &r.base_tau));
+        for joint in [2usize, 3, 4] {
+            let j = joint - 1;
+            let f = Figure {
+                joint,
+                excitation: name.to_string(),
+                t: ts.clone(),
+                actual: pick(&actual_tau, j),
+                local: pick(&local_tau, j),
+                global_linear: pick(&global.median, j),
+                global_linear_min: pick(&global.min, j),
+                global_linear_max: pick(&global.max, j),
+                base_parameters: pick(&base.median, j),
+            };
+            let is_near = |t: f64| t.abs() <= near;
+            let all = |_: f64| true;
+            errors.push(FigureErrors {
+                joint,
+                excitation: name.to_string(),
+                near,
+                local_near: rms(&f.local, &f.actual, &is_near),
+                global_linear_near: rms(&f.global_linear, &f.actual, &is_near),
+                base_parameters_near: rms(&f.base_parameters, &f.actual, &is_near),
+                local_all: rms(&f.local, &f.actual, &all),
+                global_linear_all: rms(&f.global_linear, &f.actual, &all),
+                base_parameters_all: rms(&f.base_parameters, &f.actual, &all),
+            });
+            figures.push(f);
+        }
     }
+    let study = if options.study {
+        progress("the built-in study: when to use which method");
+        Some(super::study::when_to_use(&mut |done, total| {
+            progress(&format!("the built-in study: {done} of {total} cases"))
+        })?)
+    } else {
+        None
+    };
     let d_stderr = &local.d.as_ref().expect("planned").stderr;
     Ok(PaperResult {
         torque_identified: local.torque.clone(),
@@ -233,8 +331,8 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
         d_perturbation: column0(d_local),
         d_perturbation_stderr: column0(d_stderr),
         d_perturbation_paper: TABLE3_PERTURBATION.to_vec(),
-        d_global_linear: column0(&global.d),
-        d_base_parameters: column0(&m_base),
+        d_global_linear: direct[0].d_global_linear.median.clone(),
+        d_base_parameters: direct[0].d_base_parameters.median.clone(),
         d_direct_paper: TABLE3_DIRECT.to_vec(),
         cond_local: [
             ("D", &local.d),
@@ -245,13 +343,98 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
         .iter()
         .filter_map(|(k, e)| e.as_ref().map(|e| (k.to_string(), e.cond)))
         .collect(),
-        excitation_cond: design.cond,
-        excitation_harmonics: ex.harmonics,
-        excitation_frequency: ex.base_frequency,
-        base_parameters: base.theta.len(),
+        excitation_cond: crate::study::quantile(&sorted(&direct[0].cond), 0.5),
+        excitation_harmonics: 10,
+        excitation_frequency: 0.05,
+        base_parameters: runs[0].base_parameters,
         figures,
         errors,
+        direct,
+        study,
         op,
         local_model: Some(local),
+    })
+}
+
+fn sorted(v: &[f64]) -> Vec<f64> {
+    let mut v = v.to_vec();
+    v.sort_by(f64::total_cmp);
+    v
+}
+
+/// The model with its position limits narrowed to `op.q +- half_width` (within its own): an
+/// excitation designed on it stays near the point, as the paper's does.
+fn around_op(
+    model: &crate::model::Model,
+    op: &OperatingPoint,
+    half_width: f64,
+) -> crate::model::Model {
+    let mut m = model.clone();
+    for (l, q) in m.limits.iter_mut().zip(&op.q) {
+        l.lower = l.lower.max(q - half_width);
+        l.upper = l.upper.min(q + half_width);
+    }
+    m
+}
+
+/// One excitation seed of the direct method.
+struct DirectRun {
+    variant: usize,
+    seed: u64,
+    cond: f64,
+    base_parameters: usize,
+    d_global_linear: Vec<f64>,
+    d_base_parameters: Vec<f64>,
+    /// Row-major torques along the figure trajectory.
+    global_tau: Vec<f64>,
+    base_tau: Vec<f64>,
+}
+
+/// Designs the excitation (`variant` 0: default, 1: around the point) on `design_model` (the robot, or its limits narrowed), simulates
+/// one period at 50 Hz on `model`, fits the globally linearised and the base-parameter models
+/// and predicts along `figure` (the figure trajectory).
+fn direct_run(
+    model: &crate::model::Model,
+    (variant, design_model): (usize, &crate::model::Model),
+    sim: &SimulationOptions,
+    op: &OperatingPoint,
+    seed: u64,
+    evaluations: usize,
+    figure: &States<'_>,
+) -> Result<DirectRun> {
+    let ex = ExcitationOptions {
+        harmonics: 10,
+        base_frequency: 0.05,
+        max_evaluations: evaluations,
+        seed,
+        ..ExcitationOptions::default()
+    };
+    let design = design_excitation(design_model, &ex, None)?;
+    let samples = design.trajectory.sample_periods(1.0, 50.0);
+    let rec = simulate_samples(model, &samples, sim, 99, "excitation")?;
+    let batch = States::new(model.nv, &samples.q, Some(&samples.qd), Some(&samples.qdd))?;
+    let global = identify_global_linear(op, &batch, &rec.tau)?;
+    let base = identify_base_parameters(
+        model,
+        &batch,
+        &rec.tau,
+        &BaseOptions {
+            friction: FrictionTerms::NONE,
+            weighting: Weighting::Ols,
+            gravity: Gravity::Excluded,
+            seed,
+            ..BaseOptions::default()
+        },
+    )?;
+    let m_base = base.mass_matrix(model, &op.q)?;
+    Ok(DirectRun {
+        variant,
+        seed,
+        cond: design.cond,
+        base_parameters: base.theta.len(),
+        d_global_linear: column0(&global.d),
+        d_base_parameters: column0(&m_base),
+        global_tau: global.predict(figure)?,
+        base_tau: base.on(model)?.predict(figure)?,
     })
 }

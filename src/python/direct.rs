@@ -436,6 +436,26 @@ impl PyGlobalLinear {
     fn residual_rms<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_slice(py, &self.fit.residual_rms)
     }
+    /// The model as a tidy table (pandas), as `LocalModel.to_dataframe()`: columns `term`
+    /// ('T', 'D', 'H', 'G'), `torque`, `joint`, `value`, `std`.
+    fn to_dataframe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.fit.offset.len();
+        let s = &self.fit.stderr;
+        let std_of = |k: usize| s.columns(1 + k * n, n).into_owned();
+        let (sd, sh, sg) = (std_of(0), std_of(1), std_of(2));
+        let torque_std: Vec<f64> = s.column(0).iter().copied().collect();
+        super::tables::linear_model_frame(
+            py,
+            &self.fit.joint_names,
+            &self.fit.offset,
+            &torque_std,
+            &[
+                ("D", &self.fit.d, &sd),
+                ("H", &self.fit.h, &sh),
+                ("G", &self.fit.g, &sg),
+            ],
+        )
+    }
     #[getter]
     fn cond(&self) -> f64 {
         self.fit.cond

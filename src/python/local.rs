@@ -486,39 +486,17 @@ impl PyLocalModel {
     /// place of rad for prismatic joints).
     fn to_dataframe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let m = &self.model;
-        let names = &m.joint_names;
-        let (mut term, mut torque, mut joint) = (Vec::new(), Vec::new(), Vec::new());
-        let (mut value, mut std) = (Vec::new(), Vec::new());
-        for (i, name) in names.iter().enumerate() {
-            term.push("T");
-            torque.push(name.clone());
-            joint.push(String::new());
-            value.push(m.torque[i]);
-            std.push(m.torque_stderr.get(i).copied().unwrap_or(f64::NAN));
-        }
-        for (k, e) in self.parts() {
-            let Some(e) = e else { continue };
-            for i in 0..e.matrix.nrows() {
-                for j in 0..e.matrix.ncols() {
-                    term.push(k);
-                    torque.push(names[i].clone());
-                    joint.push(names[j].clone());
-                    value.push(e.matrix[(i, j)]);
-                    std.push(e.stderr[(i, j)]);
-                }
-            }
-        }
-        super::tables::dataframe(
-            py,
-            vec![
-                ("term", pyo3::types::PyList::new(py, term)?.into_any()),
-                ("torque", pyo3::types::PyList::new(py, torque)?.into_any()),
-                ("joint", pyo3::types::PyList::new(py, joint)?.into_any()),
-                ("value", numpy::PyArray1::from_vec(py, value).into_any()),
-                ("std", numpy::PyArray1::from_vec(py, std).into_any()),
-            ],
-            None,
-        )
+        type Part<'a> = (
+            &'a str,
+            &'a nalgebra::DMatrix<f64>,
+            &'a nalgebra::DMatrix<f64>,
+        );
+        let parts: Vec<Part<'_>> = self
+            .parts()
+            .iter()
+            .filter_map(|(k, e)| e.as_ref().map(|e| (*k, &e.matrix, &e.stderr)))
+            .collect();
+        super::tables::linear_model_frame(py, &m.joint_names, &m.torque, &m.torque_stderr, &parts)
     }
     #[getter]
     fn torque<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {

@@ -30,3 +30,46 @@ pub(crate) fn dataframe<'py>(
         None => Ok(frame),
     }
 }
+
+/// The tidy table of a linear model (local or globally linearised): one row per entry, columns
+/// `term` ('T', then the names of `parts`), `torque` (the joint whose torque the row is),
+/// `joint` (the joint whose change multiplies the entry; empty for T), `value`, `std`.
+pub(crate) fn linear_model_frame<'py>(
+    py: Python<'py>,
+    names: &[String],
+    torque: &[f64],
+    torque_std: &[f64],
+    parts: &[(&str, &nalgebra::DMatrix<f64>, &nalgebra::DMatrix<f64>)],
+) -> PyResult<Bound<'py, PyAny>> {
+    let (mut term, mut tq, mut joint) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut value, mut std) = (Vec::new(), Vec::new());
+    for (i, name) in names.iter().enumerate() {
+        term.push("T");
+        tq.push(name.clone());
+        joint.push(String::new());
+        value.push(torque[i]);
+        std.push(torque_std.get(i).copied().unwrap_or(f64::NAN));
+    }
+    for (k, m, e) in parts {
+        for i in 0..m.nrows() {
+            for j in 0..m.ncols() {
+                term.push(k);
+                tq.push(names[i].clone());
+                joint.push(names[j].clone());
+                value.push(m[(i, j)]);
+                std.push(e[(i, j)]);
+            }
+        }
+    }
+    dataframe(
+        py,
+        vec![
+            ("term", pyo3::types::PyList::new(py, term)?.into_any()),
+            ("torque", pyo3::types::PyList::new(py, tq)?.into_any()),
+            ("joint", pyo3::types::PyList::new(py, joint)?.into_any()),
+            ("value", numpy::PyArray1::from_vec(py, value).into_any()),
+            ("std", numpy::PyArray1::from_vec(py, std).into_any()),
+        ],
+        None,
+    )
+}

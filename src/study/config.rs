@@ -119,6 +119,12 @@ pub struct TrueRobotSpec {
     pub file: Option<String>,
     #[serde(default)]
     pub document: Option<serde_json::Value>,
+    /// Values to sweep: `{ "payload.mass" = [0.5, 1.0, 2.0] }` makes one true robot per value
+    /// (per combination when several keys are given), named `NAME[payload.mass=0.5]`; a key
+    /// is a path into the document (fields by name, list entries by number:
+    /// `friction.coulomb.0`).
+    #[serde(default)]
+    pub sweep: std::collections::BTreeMap<String, Vec<serde_json::Value>>,
 }
 
 /// The local method's experiments.

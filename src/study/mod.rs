@@ -59,7 +59,27 @@ pub fn collected(study: &Study, out: &Path) -> Result<(Vec<CaseResult>, usize)> 
     Ok((results, missing))
 }
 
-/// Runs the cases of `study` that the journal in `out` does not hold, on every core (rayon),
+/// Runs the cases `indices` of `study` on every core (rayon), in batches of four per thread;
+/// `on_batch` hears each batch's results in index order on the calling thread (and may stop
+/// the run with an error). Stops on Ctrl-C between batches.
+pub fn run_cases(
+    study: &Study,
+    indices: &[usize],
+    on_batch: &mut dyn FnMut(Vec<CaseResult>) -> Result<()>,
+) -> Result<()> {
+    let batch = 4 * rayon::current_num_threads().max(1);
+    for chunk in indices.chunks(batch) {
+        crate::interrupt::check("study")?;
+        let results: Vec<CaseResult> = chunk
+            .par_iter()
+            .map(|&i| crate::error::catch_panics("study case", || run_case(study, i)))
+            .collect::<Result<_>>()?;
+        on_batch(results)?;
+    }
+    Ok(())
+}
+
+/// Runs the cases of `study` that the journal in `out` does not hold, on every core,
 /// appending each batch of finished cases to the journal; then writes the report into `out`
 /// and returns its Markdown summary. `progress` hears (cases done, cases in the study) on the
 /// calling thread. Stops on Ctrl-C between batches (what finished is kept in the journal).
@@ -72,17 +92,12 @@ pub fn run_study(
     let total = study.len();
     let mut done = total - todo.len();
     progress(done, total);
-    let batch = 4 * rayon::current_num_threads().max(1);
-    for chunk in todo.chunks(batch) {
-        crate::interrupt::check("study")?;
-        let results: Vec<CaseResult> = chunk
-            .par_iter()
-            .map(|&i| crate::error::catch_panics("study case", || run_case(study, i)))
-            .collect::<Result<_>>()?;
+    run_cases(study, &todo, &mut |results| {
         journal::append(out, &results)?;
         done += results.len();
         progress(done, total);
-    }
+        Ok(())
+    })?;
     let (results, missing) = collected(study, out)?;
     debug_assert_eq!(missing, 0);
     write_report(study, &results, out)

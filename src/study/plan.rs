@@ -125,30 +125,36 @@ impl Study {
         }
         for t in &config.true_robots {
             let at = format!("{source}, true_robots '{}'", t.name);
-            let doc = match (&t.file, &t.document) {
+            let doc: serde_json::Value = match (&t.file, &t.document) {
                 (Some(f), None) => {
                     let path = base.join(f);
-                    TrueRobot::from_json_in(
-                        &crate::io::read_text(&path)?,
-                        &path.display().to_string(),
-                    )?
+                    let text = crate::io::read_text(&path)?;
+                    // checked as a document first, so that its errors name the file
+                    TrueRobot::from_json_in(&text, &path.display().to_string())?;
+                    serde_json::from_str(&text).expect("parsed above")
                 }
                 (None, Some(v)) => {
                     let mut v = v.clone();
                     if let Some(o) = v.as_object_mut() {
                         o.entry("format").or_insert(TrueRobot::tag().into());
                     }
-                    TrueRobot::from_json_in(&v.to_string(), &at)?
+                    v
                 }
-                _ => ideal(),
+                _ => serde_json::to_value(ideal()).expect("serialisable"),
             };
-            for r in &robots {
-                doc.check(&r.model()?).map_err(|e| Error::Config {
-                    location: at.clone(),
-                    message: format!("for robot '{}': {e}", r.name),
-                })?;
+            for (name, value) in sweep(&t.name, &doc, &t.sweep, &at)? {
+                let robot = TrueRobot::from_json_in(
+                    &value.to_string(),
+                    &format!("{source}, true_robots '{name}'"),
+                )?;
+                for r in &robots {
+                    robot.check(&r.model()?).map_err(|e| Error::Config {
+                        location: format!("{source}, true_robots '{name}'"),
+                        message: format!("for robot '{}': {e}", r.name),
+                    })?;
+                }
+                true_robots.push((name, robot));
             }
-            true_robots.push((t.name.clone(), doc));
         }
         let study = Study {
             config,
@@ -343,4 +349,100 @@ fn fnv1a(bytes: &[u8]) -> u64 {
         h = h.wrapping_mul(0x0100_0000_01b3);
     }
     h
+}
+
+/// At most this many true robots from one sweep.
+const MAX_SWEEP: usize = 1000;
+
+/// The documents of a sweep: `doc` with every combination of the values of `keys` set, each
+/// named `name[key=value,...]`; `doc` itself, named `name`, without keys.
+fn sweep(
+    name: &str,
+    doc: &serde_json::Value,
+    keys: &std::collections::BTreeMap<String, Vec<serde_json::Value>>,
+    at: &str,
+) -> Result<Vec<(String, serde_json::Value)>> {
+    let bad = |message: String| Error::Config {
+        location: format!("{at}, sweep"),
+        message,
+    };
+    let mut out = vec![(Vec::<String>::new(), doc.clone())];
+    for (key, values) in keys {
+        if values.is_empty() {
+            return Err(bad(format!("'{key}' has no values")));
+        }
+        if out.len().saturating_mul(values.len()) > MAX_SWEEP {
+            return Err(bad(format!("more than {MAX_SWEEP} combinations")));
+        }
+        let mut next = Vec::new();
+        for (labels, d) in &out {
+            for v in values {
+                let mut d = d.clone();
+                set_path(&mut d, key, v.clone()).map_err(|m| bad(format!("'{key}': {m}")))?;
+                let mut labels = labels.clone();
+                labels.push(format!("{key}={v}"));
+                next.push((labels, d));
+            }
+        }
+        out = next;
+    }
+    Ok(out
+        .into_iter()
+        .map(|(labels, d)| {
+            let n = if labels.is_empty() {
+                name.to_string()
+            } else {
+                format!("{name}[{}]", labels.join(","))
+            };
+            (n, d)
+        })
+        .collect())
+}
+
+/// Sets the value at the dotted `path` of `doc` (objects are created where a field is
+/// missing; list entries must exist).
+fn set_path(
+    doc: &mut serde_json::Value,
+    path: &str,
+    value: serde_json::Value,
+) -> std::result::Result<(), String> {
+    let mut here = doc;
+    let parts: Vec<&str> = path.split('.').collect();
+    for (i, part) in parts.iter().enumerate() {
+        let last = i + 1 == parts.len();
+        if here.is_null() {
+            // an absent section (`payload: null`) is created by the path
+            *here = serde_json::Value::Object(Default::default());
+        }
+        here = match here {
+            serde_json::Value::Object(o) => {
+                if last {
+                    o.insert(part.to_string(), value);
+                    return Ok(());
+                }
+                o.entry(part.to_string())
+                    .or_insert_with(|| serde_json::Value::Object(Default::default()))
+            }
+            serde_json::Value::Array(a) => {
+                let k: usize = part
+                    .parse()
+                    .map_err(|_| format!("'{part}' is not a list index"))?;
+                let len = a.len();
+                let slot = a
+                    .get_mut(k)
+                    .ok_or_else(|| format!("index {k} beyond the list's {len} entries"))?;
+                if last {
+                    *slot = value;
+                    return Ok(());
+                }
+                slot
+            }
+            _ => {
+                return Err(format!(
+                    "'{part}' is inside a value that is neither a table nor a list"
+                ))
+            }
+        };
+    }
+    Err("an empty path".into())
 }

@@ -21,7 +21,7 @@ def test_console_script_info_and_errors():
 
 
 def test_python_m_paper(tmp_path):
-    out = subprocess.run([sys.executable, "-m", "perturbid_rs", "paper", "--out", str(tmp_path)], capture_output=True, text=True)
+    out = subprocess.run([sys.executable, "-m", "perturbid_rs", "paper", "--out", str(tmp_path), "--excitation-seeds", "2", "--no-study"], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     assert "Table 3" in out.stdout
     assert (tmp_path / "report.md").is_file() and (tmp_path / "fig4_joint3.svg").is_file()

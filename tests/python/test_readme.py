@@ -17,7 +17,7 @@ def test_readme_python_example_runs():
 def test_readme_main_command_prints_what_it_shows(tmp_path):
     text = (Path(__file__).parents[2] / "README.md").read_text()
     assert "pip install . && perturbid paper --out paper" in text
-    shown = re.search(r"prints \(in about 5 s\):\n\n```\n(.*?)```", text, re.S).group(1)
+    shown = re.search(r"prints \(in\nabout 80 s on 2 cores\):\n\n```\n(.*?)```", text, re.S).group(1)
     exe = Path(sysconfig.get_path("scripts")) / "perturbid"
     out = subprocess.run([str(exe), "paper", "--out", "paper"], cwd=tmp_path, capture_output=True, text=True, check=True)
     assert out.stdout == shown
