@@ -192,6 +192,15 @@ fn bad_configurations_name_the_place() {
         e.starts_with("s.toml:4:1: ") && e.contains("unknown field `seed`"),
         "{e}"
     );
+    let e = parse(&format!(
+        "{STUDY}\n[sample_points]\ncount = 1000000000000\n"
+    ));
+    assert!(
+        e.contains("sample_points.count: 1000000000000; at most 10000"),
+        "{e}"
+    );
+    let e = parse(&format!("{STUDY}\n[local]\nk = [4, 99999999]\n"));
+    assert!(e.contains("local.k: 99999999; at most 10000"), "{e}");
     let e = parse(&STUDY.replace("seeds = 2", "seeds = 0"));
     assert!(e.contains("s.toml, seeds: 0; expected 1..="), "{e}");
     let e = parse(&STUDY.replace("distances = [1, 4]", "distances = [1, -4]"));

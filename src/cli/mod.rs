@@ -160,7 +160,12 @@ where
             0
         }
         Err(e) if e.kind() == crate::error::ErrorKind::Interrupted => {
-            eprintln!("perturbid: {e}; nothing was written");
+            // a study keeps what finished (it says so); other work writes nothing on Ctrl-C
+            if e.to_string().contains("the same command resumes") {
+                eprintln!("perturbid: {e}");
+            } else {
+                eprintln!("perturbid: {e}; nothing was written");
+            }
             EXIT_INTERRUPTED
         }
         Err(e) => {

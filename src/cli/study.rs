@@ -35,6 +35,15 @@ pub(crate) fn run(a: StudyArgs) -> Result<String> {
     let total = study.len();
     let progress = Progress::counted(total as u64, "cases");
     let mut report = |done: usize, _: usize| progress.set_position(done as u64);
+    let resumable = |e: Error| match e {
+        Error::Interrupted { .. } => Error::Interrupted {
+            context: format!(
+                "study (the finished cases are in {}; the same command resumes)",
+                crate::study::journal::path(&a.out).display()
+            ),
+        },
+        e => e,
+    };
     let md = match a.threads {
         Some(0) => {
             return Err(Error::InvalidArgument {
@@ -49,8 +58,9 @@ pub(crate) fn run(a: StudyArgs) -> Result<String> {
                 argument: "--threads".into(),
                 message: e.to_string(),
             })?
-            .install(|| run_study(&study, &a.out, &mut report))?,
-        None => run_study(&study, &a.out, &mut report)?,
+            .install(|| run_study(&study, &a.out, &mut report))
+            .map_err(resumable)?,
+        None => run_study(&study, &a.out, &mut report).map_err(resumable)?,
     };
     progress.done();
     Ok(format!(

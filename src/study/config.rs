@@ -267,6 +267,9 @@ pub const MAX_CASES: usize = 1_000_000;
 pub const MAX_SAMPLES: usize = 10_000;
 pub const MAX_DISTANCES: usize = 100;
 pub const MAX_SEEDS: u64 = 1_000_000;
+/// Sampled points per speed class, and perturbations per experiment.
+pub const MAX_POINTS: usize = 10_000;
+pub const MAX_K: usize = 10_000;
 
 impl StudyConfig {
     /// Checks what serde cannot: non-empty lists, positive finite numbers, bounds.
@@ -283,6 +286,17 @@ impl StudyConfig {
                 "points",
                 "no operating point: give [[points]] or sample_points = { count = ... }".into(),
             ));
+        }
+        if let Some(s) = &self.sample_points {
+            if s.count > MAX_POINTS {
+                return Err(bad(
+                    "sample_points.count",
+                    format!("{}; at most {MAX_POINTS}", s.count),
+                ));
+            }
+        }
+        if let Some(k) = self.local.k.iter().find(|k| **k > MAX_K) {
+            return Err(bad("local.k", format!("{k}; at most {MAX_K}")));
         }
         if self.seeds == 0 || self.seeds > MAX_SEEDS {
             return Err(bad(
