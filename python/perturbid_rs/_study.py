@@ -113,21 +113,24 @@ def _run_on_dask(resolved: str, out: Path, client: Any, progress: bool) -> str:
     pending = _core.study_pending(resolved, str(out))
     total = _core.study_len(resolved)
     done = total - len(pending)
+    batch: list[str] = []
+
+    def record() -> None:
+        # finished cases go into the journal in batches, so an interrupted run resumes
+        nonlocal done
+        _core.study_record(str(out), batch)
+        done += len(batch)
+        batch.clear()
+        if progress:
+            log.info("study: %d of %d cases", done, total)
+
     if pending:
         shipped = client.scatter(resolved, broadcast=True)
         futures = client.map(run_case, [shipped] * len(pending), pending, pure=False)
-        batch: list[str] = []
         for future in as_completed(futures):
             batch.append(future.result())
             if len(batch) >= 8:
-                _core.study_record(str(out), batch)
-                done += len(batch)
-                batch = []
-                if progress:
-                    log.info("study: %d of %d cases", done, total)
+                record()
         if batch:
-            _core.study_record(str(out), batch)
-            done += len(batch)
-            if progress:
-                log.info("study: %d of %d cases", done, total)
+            record()
     return _core.study_finish(resolved, str(out))

@@ -195,9 +195,8 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
         )?;
         fig_names.push(name);
     }
-    if let Some(study) = &r.study {
+    if r.study.is_some() {
         put("study.toml", super::study::PAPER_STUDY.as_bytes())?;
-        let _ = study;
     }
     put("report.md", markdown_report(r, &fig_names).as_bytes())?;
     set.commit()
