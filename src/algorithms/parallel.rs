@@ -2,7 +2,7 @@
 //!
 //! Every function takes the samples as a checked [`States`] view, writes its results into the
 //! caller's row-major buffers, and runs
-//! - on the multi-sample kernels of [`super::batch`] ([`LANES`] samples side by side, SIMD)
+//! - on the multi-sample kernels of [`super::batch`] ([`LaneData::width`] samples side by side, SIMD)
 //!   where one exists (inverse dynamics, mass matrix, regressor), one sample at a time
 //!   otherwise;
 //! - on the calling thread with the caller's [`Workspace`] below [`PARALLEL_BATCH`] samples,
@@ -14,12 +14,12 @@
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 
-use super::batch::{mass_matrix_batch, regressor_batch, rnea_lanes, LaneData, LANES};
+pub use super::batch::LinearizationsOut;
+use super::batch::{linearize_batch, mass_matrix_batch, regressor_batch, rnea_lanes, LaneData};
 use super::regressor::{joint_torque_regressor, PARAMS_PER_BODY};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
-use crate::linearization::{linearize_into, Linearization};
 use crate::model::Model;
 use crate::states::States;
 
@@ -147,7 +147,7 @@ pub fn rnea(
         &mut [("tau", tau, n)],
         |w, s, out| {
             let out = &mut *out[0];
-            if s.len() >= LANES {
+            if s.len() >= w.lanes.width() {
                 return rnea_lanes(model, &mut w.lanes, s.q(), s.qd(), s.qdd(), gravity, out);
             }
             let zeros = vec![0.0; n];
@@ -181,7 +181,7 @@ pub fn mass_matrix(
         &mut [("M", out, n * n)],
         |w, s, out| {
             let out = &mut *out[0];
-            if s.len() >= LANES {
+            if s.len() >= w.lanes.width() {
                 return mass_matrix_batch(model, &mut w.lanes, s.q(), out);
             }
             for (i, o) in out.chunks_mut(n * n).enumerate() {
@@ -216,7 +216,7 @@ pub fn regressor(
         |w, s, out| {
             let out = &mut *out[0];
             let (qd, qdd) = (s.qd_or_zeros(), s.qdd_or_zeros());
-            if s.len() >= LANES {
+            if s.len() >= w.lanes.width() {
                 return regressor_batch(model, &mut w.lanes, s.q(), &qd, &qdd, gravity, out);
             }
             let mut y = std::mem::take(&mut w.data.regressor);
@@ -284,21 +284,6 @@ pub fn forward_dynamics(
     )
 }
 
-/// Where the results of [`linearize`] go: row-major buffers of `k` samples.
-#[derive(Debug)]
-pub struct LinearizationsOut<'a> {
-    /// `T*`, `k x nv` (N m).
-    pub torque: &'a mut [f64],
-    /// `D* = M(q*)`, `k x nv x nv`.
-    pub d: &'a mut [f64],
-    /// `H* = d tau / d qd`, `k x nv x nv`.
-    pub h: &'a mut [f64],
-    /// `G* = d tau / d q`, `k x nv x nv`.
-    pub g: &'a mut [f64],
-    /// `Gs = d g / d q` at rest, `k x nv x nv`.
-    pub g_static: &'a mut [f64],
-}
-
 /// The analytic linearisation (see [`crate::linearize`]) at every sample taken as an operating
 /// point, written into `out`.
 pub fn linearize(
@@ -318,26 +303,17 @@ pub fn linearize(
     ];
     run("linearize", model, ws, states, &mut outs, |w, s, out| {
         let (qd, qdd) = (s.qd_or_zeros(), s.qdd_or_zeros());
-        let mut lin = Linearization::zeros(n);
-        for i in 0..s.len() {
-            let r = i * n..(i + 1) * n;
-            let q = s.sample(i).q;
-            linearize_into(
-                model,
-                &mut w.data,
-                q,
-                &qd[r.clone()],
-                &qdd[r.clone()],
-                gravity,
-                &mut lin,
-            )
-            .map_err(|e| s.at(i, e))?;
-            out[0][r].copy_from_slice(lin.torque.as_slice());
-            for (b, m) in [&lin.d, &lin.h, &lin.g, &lin.g_static].iter().enumerate() {
-                copy_row_major(m, &mut out[b + 1][i * nn..(i + 1) * nn]);
-            }
+        if let [torque, d, h, g, g_static] = out {
+            let out = LinearizationsOut {
+                torque,
+                d,
+                h,
+                g,
+                g_static,
+            };
+            return linearize_batch(model, &mut w.lanes, s.q(), &qd, &qdd, gravity, out);
         }
-        Ok(())
+        unreachable!("five outputs")
     })
 }
 

@@ -23,7 +23,7 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use super::base::BaseParameters;
-use crate::algorithms::batch::{regressor_group, LaneData, LANES};
+use crate::algorithms::batch::{regressor_group, LaneData};
 use crate::algorithms::regressor::PARAMS_PER_BODY;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
@@ -180,7 +180,7 @@ impl Worker {
 
 impl Worker {
     /// Writes the rows of samples `range` of the states `[q, qd, qdd]` (row-major, the whole
-    /// batch) below the factors: the regressor [`LANES`] samples at a time by the multi-sample
+    /// batch) below the factors: the regressor [`LaneData::width`] samples at a time by the multi-sample
     /// kernel ([`regressor_group`]), read in place.
     fn fill(
         &mut self,
@@ -194,7 +194,7 @@ impl Worker {
         let nv = model.nv;
         let mut first = range.start;
         while first < range.end {
-            let used = (range.end - first).min(LANES);
+            let used = (range.end - first).min(self.lanes.width());
             let rows = first * nv..(first + used) * nv;
             regressor_group(
                 model,

@@ -1,0 +1,472 @@
+//! The analytic derivatives of the inverse dynamics and the local model `T*, D*, H*, G*, Gs`
+//! of many samples on the lanes: the base-frame recursion of [`crate::rnea_derivatives`]
+//! (Carpentier & Mansard, RSS 2018), one sample per lane.
+
+use super::kinematics::{place_in_base, pose};
+use super::mass_matrix::{transformed, Composite};
+use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
+use crate::data::Data;
+use crate::error::Result;
+use crate::gravity::Gravity;
+use crate::linearization::{linearize_into, Linearization};
+use crate::model::Model;
+use crate::simd::{Lanes, SpatialLanes, Vector3Lanes};
+
+/// Where [`derivatives_batch`] writes, row-major over `k` samples.
+#[derive(Debug)]
+pub struct DerivativesOut<'a> {
+    /// `tau`, `k x nv` (N m or N).
+    pub tau: &'a mut [f64],
+    /// `d tau / d q`, `k x nv x nv` (entry `(i, j)` of a sample is `d tau_i / d q_j`).
+    pub dtau_dq: &'a mut [f64],
+    /// `d tau / d qd`, `k x nv x nv`.
+    pub dtau_dv: &'a mut [f64],
+    /// `d tau / d qdd = M(q)`, `k x nv x nv`.
+    pub m: &'a mut [f64],
+}
+
+/// Where [`linearize_batch`] (and [`crate::parallel::linearize`]) write: row-major buffers of
+/// `k` samples.
+#[derive(Debug)]
+pub struct LinearizationsOut<'a> {
+    /// `T*`, `k x nv` (N m).
+    pub torque: &'a mut [f64],
+    /// `D* = M(q*)`, `k x nv x nv`.
+    pub d: &'a mut [f64],
+    /// `H* = d tau / d qd`, `k x nv x nv`.
+    pub h: &'a mut [f64],
+    /// `G* = d tau / d q`, `k x nv x nv`.
+    pub g: &'a mut [f64],
+    /// `Gs = d g / d q` at rest, `k x nv x nv`.
+    pub g_static: &'a mut [f64],
+}
+
+/// Inverse dynamics and its partial derivatives (see [`crate::rnea_derivatives`]) of a batch,
+/// [`LaneData::width`] samples at a time, equal to the one-sample algorithm up to rounding.
+///
+/// `q`, `qd`, `qdd`: row-major `k x nv` (rad, rad/s, rad/s^2 or m, m/s, m/s^2), finite (checked
+/// by the caller). `gravity` includes gravity in `tau` and `d tau / d q`. Runs on the
+/// instruction set of `data`.
+pub fn derivatives_batch(
+    model: &Model,
+    data: &mut LaneData,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    gravity: Gravity,
+    out: DerivativesOut<'_>,
+) -> Result<()> {
+    let (n, nn) = (model.nv, model.nv * model.nv);
+    let k = samples(
+        n,
+        q.len(),
+        &[
+            ("qd", qd.len(), n),
+            ("qdd", qdd.len(), n),
+            ("tau", out.tau.len(), n),
+            ("d tau / d q", out.dtau_dq.len(), nn),
+            ("d tau / d qd", out.dtau_dv.len(), nn),
+            ("M", out.m.len(), nn),
+        ],
+    )?;
+    let kernel = Derivatives {
+        k,
+        x: [q, qd, qdd],
+        gravity,
+        out: [out.tau, out.m, out.dtau_dq, out.dtau_dv],
+        g_static: None,
+    };
+    dispatch(model, data, kernel)
+}
+
+/// The local model (see [`crate::linearize`]) at every sample of a batch taken as an operating
+/// point, [`LaneData::width`] samples at a time: `T*`, `D*`, `H*`, `G*` from the derivatives at
+/// `(q, qd, qdd)` and `Gs` from those at `(q, 0, 0)`.
+///
+/// `q`, `qd`, `qdd`: row-major `k x nv`, finite (checked by the caller). Runs on the
+/// instruction set of `data`.
+pub fn linearize_batch(
+    model: &Model,
+    data: &mut LaneData,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    gravity: Gravity,
+    out: LinearizationsOut<'_>,
+) -> Result<()> {
+    let (n, nn) = (model.nv, model.nv * model.nv);
+    let k = samples(
+        n,
+        q.len(),
+        &[
+            ("qd", qd.len(), n),
+            ("qdd", qdd.len(), n),
+            ("torque", out.torque.len(), n),
+            ("d", out.d.len(), nn),
+            ("h", out.h.len(), nn),
+            ("g", out.g.len(), nn),
+            ("g_static", out.g_static.len(), nn),
+        ],
+    )?;
+    let kernel = Derivatives {
+        k,
+        x: [q, qd, qdd],
+        gravity,
+        out: [out.torque, out.d, out.g, out.h],
+        g_static: Some(out.g_static),
+    };
+    dispatch(model, data, kernel)
+}
+
+/// The derivatives of `k` samples into `out = [tau, M, d tau / d q, d tau / d qd]`, and with
+/// `g_static` the derivative along `q` at rest too.
+struct Derivatives<'a> {
+    k: usize,
+    x: [&'a [f64]; 3],
+    gravity: Gravity,
+    out: [&'a mut [f64]; 4],
+    g_static: Option<&'a mut [f64]>,
+}
+
+/// A 6x6 matrix per lane, by columns (each a spatial vector `[angular; linear]`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Matrix6Lanes<const W: usize>([SpatialLanes<W>; 6]);
+
+impl<const W: usize> Default for Matrix6Lanes<W> {
+    fn default() -> Self {
+        Matrix6Lanes([SpatialLanes::default(); 6])
+    }
+}
+
+impl<const W: usize> Matrix6Lanes<W> {
+    /// `self * x`.
+    #[inline(always)]
+    fn mul(&self, x: &SpatialLanes<W>) -> SpatialLanes<W> {
+        let c = [x.ang.x, x.ang.y, x.ang.z, x.lin.x, x.lin.y, x.lin.z];
+        let mut ang = self.0[0].ang.mul_lanes(c[0]);
+        let mut lin = self.0[0].lin.mul_lanes(c[0]);
+        for k in 1..6 {
+            ang = self.0[k].ang.mul_lanes_add(c[k], &ang);
+            lin = self.0[k].lin.mul_lanes_add(c[k], &lin);
+        }
+        SpatialLanes { ang, lin }
+    }
+    /// `self^T * x`.
+    #[inline(always)]
+    fn tr_mul(&self, x: &SpatialLanes<W>) -> SpatialLanes<W> {
+        let e = |k: usize| self.0[k].dot(x);
+        SpatialLanes {
+            ang: Vector3Lanes {
+                x: e(0),
+                y: e(1),
+                z: e(2),
+            },
+            lin: Vector3Lanes {
+                x: e(3),
+                y: e(4),
+                z: e(5),
+            },
+        }
+    }
+    #[inline(always)]
+    fn add_assign(&mut self, o: &Self) {
+        for k in 0..6 {
+            self.0[k] = self.0[k].add(&o.0[k]);
+        }
+    }
+}
+
+/// The unit spatial vector along coordinate `k` (0-2 angular, 3-5 linear).
+#[inline(always)]
+fn unit<const W: usize>(k: usize) -> SpatialLanes<W> {
+    let mut e = [Lanes::default(); 6];
+    e[k] = Lanes::splat(1.0);
+    SpatialLanes {
+        ang: Vector3Lanes {
+            x: e[0],
+            y: e[1],
+            z: e[2],
+        },
+        lin: Vector3Lanes {
+            x: e[3],
+            y: e[4],
+            z: e[5],
+        },
+    }
+}
+
+impl<const W: usize> Composite<W> {
+    /// The momentum `Y m` of this inertia (origin form, base frame) moving with twist `m`.
+    #[inline(always)]
+    fn apply(&self, m: &SpatialLanes<W>) -> SpatialLanes<W> {
+        SpatialLanes {
+            ang: self.i.mul(&m.ang).add(&self.h.cross(&m.lin)),
+            lin: m.lin.scale_add(self.mass, &m.ang.cross(&self.h)),
+        }
+    }
+    #[inline(always)]
+    fn add_assign(&mut self, o: &Self) {
+        self.mass += o.mass;
+        self.h = self.h.add(&o.h);
+        self.i = self.i.add(&o.i);
+    }
+}
+
+/// The per-body quantities of the recursion, all in the base frame.
+#[derive(Clone, Debug)]
+pub(crate) struct Buffers<const W: usize> {
+    ycrb: Vec<Composite<W>>,
+    dycrb: Vec<Matrix6Lanes<W>>,
+    j: Vec<SpatialLanes<W>>,
+    ov: Vec<SpatialLanes<W>>,
+    oa: Vec<SpatialLanes<W>>,
+    of: Vec<SpatialLanes<W>>,
+    dvdq: Vec<SpatialLanes<W>>,
+    dadq: Vec<SpatialLanes<W>>,
+    dadv: Vec<SpatialLanes<W>>,
+    dfda: Vec<SpatialLanes<W>>,
+    dfdq: Vec<SpatialLanes<W>>,
+    dfdv: Vec<SpatialLanes<W>>,
+    dytj: Vec<SpatialLanes<W>>,
+    /// Body-level results: torques and row-major `nbodies x nbodies` matrices.
+    tau: Vec<Lanes<W>>,
+    m: Vec<Lanes<W>>,
+    dq: Vec<Lanes<W>>,
+    dv: Vec<Lanes<W>>,
+}
+
+impl<const W: usize> Buffers<W> {
+    fn new(nb: usize) -> Self {
+        let s = vec![SpatialLanes::default(); nb];
+        Self {
+            ycrb: vec![Composite::default(); nb],
+            dycrb: vec![Matrix6Lanes::default(); nb],
+            j: s.clone(),
+            ov: s.clone(),
+            oa: s.clone(),
+            of: s.clone(),
+            dvdq: s.clone(),
+            dadq: s.clone(),
+            dadv: s.clone(),
+            dfda: s.clone(),
+            dfdq: s.clone(),
+            dfdv: s.clone(),
+            dytj: s,
+            tau: vec![Lanes::default(); nb],
+            m: vec![Lanes::default(); nb * nb],
+            dq: vec![Lanes::default(); nb * nb],
+            dv: vec![Lanes::default(); nb * nb],
+        }
+    }
+}
+
+impl LaneKernel for Derivatives<'_> {
+    type Output = Result<()>;
+
+    #[inline(always)]
+    fn wide<const W: usize>(mut self, model: &Model, data: &mut LaneBuffers<W>) -> Result<()> {
+        let mut d = data
+            .derivatives
+            .take()
+            .unwrap_or_else(|| Box::new(Buffers::new(model.nbodies())));
+        let (n, nn) = (model.nv, model.nv * model.nv);
+        let minus_g = model.base_acceleration(self.gravity);
+        let mut first = 0;
+        while first < self.k {
+            let used = (self.k - first).min(W);
+            data.load(model, self.x, first);
+            recursion(model, data, &mut d, &minus_g);
+            let [tau, m, dq, dv] = &mut self.out;
+            for l in 0..used {
+                let s = first + l;
+                write_vector(model, &d.tau, l, &mut tau[s * n..(s + 1) * n]);
+                write_matrix(model, &d.m, l, &mut m[s * nn..(s + 1) * nn]);
+                write_matrix(model, &d.dq, l, &mut dq[s * nn..(s + 1) * nn]);
+                write_matrix(model, &d.dv, l, &mut dv[s * nn..(s + 1) * nn]);
+                model.add_armature_torque(&self.x[2][s * n..(s + 1) * n], &mut tau[s * n..][..n]);
+                model.add_armature_inertia(&mut m[s * nn..(s + 1) * nn]);
+            }
+            if let Some(gs) = self.g_static.as_deref_mut() {
+                // at rest: the same poses, zero velocities and accelerations
+                data.vb.fill(Lanes::default());
+                data.ab.fill(Lanes::default());
+                recursion(model, data, &mut d, &minus_g);
+                for l in 0..used {
+                    let s = first + l;
+                    write_matrix(model, &d.dq, l, &mut gs[s * nn..(s + 1) * nn]);
+                }
+            }
+            first += W;
+        }
+        data.derivatives = Some(d);
+        Ok(())
+    }
+
+    fn scalar(self, model: &Model, data: &mut Data) -> Result<()> {
+        let (n, nn) = (model.nv, model.nv * model.nv);
+        let [tau, m, dq, dv] = self.out;
+        let copy = crate::algorithms::parallel::copy_row_major;
+        let mut lin = Linearization::zeros(n);
+        let mut gs = self.g_static;
+        for s in 0..self.k {
+            let r = s * n..(s + 1) * n;
+            let [q, qd, qdd] = self.x.map(|x| &x[r.clone()]);
+            let mr = s * nn..(s + 1) * nn;
+            if let Some(gs) = gs.as_deref_mut() {
+                linearize_into(model, data, q, qd, qdd, self.gravity, &mut lin)?;
+                tau[r].copy_from_slice(lin.torque.as_slice());
+                copy(&lin.d, &mut m[mr.clone()]);
+                copy(&lin.g, &mut dq[mr.clone()]);
+                copy(&lin.h, &mut dv[mr.clone()]);
+                copy(&lin.g_static, &mut gs[mr]);
+            } else {
+                crate::rnea_derivatives(model, data, q, qd, qdd, self.gravity)?;
+                tau[r].copy_from_slice(data.tau.as_slice());
+                copy(&data.m, &mut m[mr.clone()]);
+                copy(&data.dtau_dq, &mut dq[mr.clone()]);
+                copy(&data.dtau_dv, &mut dv[mr]);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Lane `l` of the body torques `body` summed onto the degrees of freedom into `out` (`nv`).
+#[inline(always)]
+fn write_vector<const W: usize>(model: &Model, body: &[Lanes<W>], l: usize, out: &mut [f64]) {
+    if model.coupled {
+        out.fill(0.0);
+        for (i, b) in model.bodies.iter().enumerate() {
+            out[b.dof] += b.multiplier * body[i].0[l];
+        }
+    } else {
+        for (o, b) in out.iter_mut().zip(body) {
+            *o = b.0[l];
+        }
+    }
+}
+
+/// Lane `l` of the body-level row-major matrix `body` as `C^T body C` (the degrees of freedom)
+/// into the row-major `out` (`nv x nv`).
+#[inline(always)]
+fn write_matrix<const W: usize>(model: &Model, body: &[Lanes<W>], l: usize, out: &mut [f64]) {
+    let nb = model.nbodies();
+    if model.coupled {
+        let nv = model.nv;
+        out.fill(0.0);
+        for (i, bi) in model.bodies.iter().enumerate() {
+            for (j, bj) in model.bodies.iter().enumerate() {
+                out[bi.dof * nv + bj.dof] += bi.multiplier * bj.multiplier * body[i * nb + j].0[l];
+            }
+        }
+    } else {
+        for (o, b) in out.iter_mut().zip(body) {
+            *o = b.0[l];
+        }
+    }
+}
+
+/// The recursion for the loaded lanes: body-level `tau`, `M`, `d tau / d q` and
+/// `d tau / d qd` into `d`.
+#[inline(always)]
+fn recursion<const W: usize>(
+    model: &Model,
+    data: &mut LaneBuffers<W>,
+    d: &mut Buffers<W>,
+    minus_g: &crate::spatial::Motion,
+) {
+    let nb = model.nbodies();
+    let base_a = SpatialLanes {
+        ang: Vector3Lanes::splat(&minus_g.angular),
+        lin: Vector3Lanes::splat(&minus_g.linear),
+    };
+    for (i, b) in model.bodies.iter().enumerate() {
+        let (rot, pos) = pose(b, data.qb[i]);
+        let (r, p) = place_in_base(model, data, i, &rot, &pos);
+        let j = data.o_s[i];
+        let (ov_p, oa_p) = match b.parent {
+            Some(k) => (d.ov[k], d.oa[k]),
+            None => (SpatialLanes::default(), base_a),
+        };
+        let vj = j.mul_lanes(data.vb[i]);
+        let ov = ov_p.add(&vj);
+        let oa = oa_p.add(&j.mul_lanes(data.ab[i])).add(&ov.cross(&vj));
+        let y = transformed(&b.origin_inertia, &r, &p);
+        let oh = y.apply(&ov);
+        d.of[i] = y.apply(&oa).add(&ov.cross_force(&oh));
+        d.ov[i] = ov;
+        d.oa[i] = oa;
+        d.ycrb[i] = y;
+        // dY = v x* Y - Y (v x) + (Y v) x-bar, column by column: column c is
+        // v x* (Y e_c) - Y (v x e_c) + e_c x* (Y v)
+        let mut dy = Matrix6Lanes::default();
+        for (c, col) in dy.0.iter_mut().enumerate() {
+            let e = unit::<W>(c);
+            *col = ov
+                .cross_force(&y.apply(&e))
+                .sub(&y.apply(&ov.cross(&e)))
+                .add(&e.cross_force(&oh));
+        }
+        d.dycrb[i] = dy;
+        d.j[i] = j;
+        let mut dadq = oa_p.cross(&j);
+        let mut dadv = ov.cross(&j);
+        if b.parent.is_some() {
+            let dvdq = ov_p.cross(&j);
+            dadq = dadq.add(&ov_p.cross(&dvdq));
+            dadv = dadv.add(&dvdq);
+            d.dvdq[i] = dvdq;
+        } else {
+            d.dvdq[i] = SpatialLanes::default();
+        }
+        d.dadq[i] = dadq;
+        d.dadv[i] = dadv;
+    }
+
+    for x in [&mut d.m, &mut d.dq, &mut d.dv] {
+        x.fill(Lanes::default());
+    }
+    for i in (0..nb).rev() {
+        let b = &model.bodies[i];
+        let end = b.subtree_end;
+        let j = d.j[i];
+        d.tau[i] = j.dot(&d.of[i]);
+
+        // d tau / d qdd (the mass matrix)
+        d.dfda[i] = d.ycrb[i].apply(&j);
+        for k in i..end {
+            let v = j.dot(&d.dfda[k]);
+            d.m[i * nb + k] = v;
+            d.m[k * nb + i] = v;
+        }
+
+        // d tau / d q
+        d.dfdq[i] = d.dycrb[i].mul(&d.dvdq[i]).add(&d.ycrb[i].apply(&d.dadq[i]));
+        d.dytj[i] = d.dycrb[i].tr_mul(&j);
+        let (dadq, dvdq) = (d.dadq[i], d.dvdq[i]);
+        for k in (i + 1)..end {
+            d.dq[k * nb + i] = d.dfda[k].dot(&dadq) + d.dytj[k].dot(&dvdq);
+        }
+        for k in i..end {
+            d.dq[i * nb + k] = j.dot(&d.dfdq[k]);
+        }
+        d.dfdq[i] = d.dfdq[i].add(&j.cross_force(&d.of[i]));
+
+        // d tau / d qd
+        d.dfdv[i] = d.dycrb[i].mul(&j).add(&d.ycrb[i].apply(&d.dadv[i]));
+        let dadv = d.dadv[i];
+        for k in (i + 1)..end {
+            d.dv[k * nb + i] = d.dfda[k].dot(&dadv) + d.dytj[k].dot(&j);
+        }
+        for k in i..end {
+            d.dv[i * nb + k] = j.dot(&d.dfdv[k]);
+        }
+
+        if let Some(p) = b.parent {
+            let (yi, dyi, fi) = (d.ycrb[i], d.dycrb[i], d.of[i]);
+            d.ycrb[p].add_assign(&yi);
+            d.dycrb[p].add_assign(&dyi);
+            d.of[p] = d.of[p].add(&fi);
+        }
+    }
+}

@@ -1,0 +1,199 @@
+//! The pieces the multi-sample kernels share: joint poses, the forward pass of twists and
+//! accelerations, base-frame poses and motion subspaces, on `W` lanes.
+
+use super::LaneBuffers;
+use crate::model::{Body, JointKind, Model};
+use crate::simd::{sin_cos, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
+use crate::spatial::{Inertia, Motion, Se3};
+
+/// The pose of body `b` in its parent (rotation by rows, translation) for the lane coordinates
+/// `x` (see `Body::pose_in_parent`).
+#[inline(always)]
+pub(crate) fn pose<const W: usize>(b: &Body, x: Lanes<W>) -> (Rotation3Lanes<W>, Vector3Lanes<W>) {
+    let p: &Se3 = &b.placement;
+    match b.kind {
+        JointKind::Revolute => {
+            let (s, c) = sin_cos(x);
+            let c1 = Lanes::splat(1.0) - c;
+            let t = &b.pose_terms;
+            let row = |r: usize| {
+                let e = |k: usize| {
+                    s.mul_add_s(
+                        t.r1[(r, k)],
+                        c1.mul_add_s(t.r2[(r, k)], Lanes::splat(p.rotation[(r, k)])),
+                    )
+                };
+                Vector3Lanes {
+                    x: e(0),
+                    y: e(1),
+                    z: e(2),
+                }
+            };
+            (
+                Rotation3Lanes([row(0), row(1), row(2)]),
+                Vector3Lanes::splat(&p.translation),
+            )
+        }
+        JointKind::Prismatic => {
+            let row = |r: usize| Vector3Lanes {
+                x: Lanes::splat(p.rotation[(r, 0)]),
+                y: Lanes::splat(p.rotation[(r, 1)]),
+                z: Lanes::splat(p.rotation[(r, 2)]),
+            };
+            let t1 = &b.pose_terms.t1;
+            (
+                Rotation3Lanes([row(0), row(1), row(2)]),
+                Vector3Lanes::of(t1, x).add(&Vector3Lanes::splat(&p.translation)),
+            )
+        }
+    }
+}
+
+/// A motion given in the parent's frame expressed in the child's (pose `rot`, `pos`).
+#[inline(always)]
+pub(crate) fn act_inv<const W: usize>(
+    rot: &Rotation3Lanes<W>,
+    pos: &Vector3Lanes<W>,
+    m: &SpatialLanes<W>,
+) -> SpatialLanes<W> {
+    SpatialLanes {
+        ang: rot.tr_mul(&m.ang),
+        lin: rot.tr_mul(&m.lin.sub(&pos.cross(&m.ang))),
+    }
+}
+
+/// Momentum `I m` of a body of (constant) inertia `inertia` moving with twist `m`.
+#[inline(always)]
+pub(crate) fn apply<const W: usize>(inertia: &Inertia, m: &SpatialLanes<W>) -> SpatialLanes<W> {
+    // lin = mass (v - c x w) = mass (v + w x c)
+    let lin = m
+        .ang
+        .cross_const(&inertia.com)
+        .add(&m.lin)
+        .scale(inertia.mass);
+    // ang = I_c w + c x lin
+    let c = &inertia.com;
+    let cx = Vector3Lanes {
+        x: lin.z.mul_add_s(c.y, lin.y * -c.z),
+        y: lin.x.mul_add_s(c.z, lin.z * -c.x),
+        z: lin.y.mul_add_s(c.x, lin.x * -c.y),
+    };
+    SpatialLanes {
+        ang: m.ang.mul_const(&inertia.inertia_com).add(&cx),
+        lin,
+    }
+}
+
+/// The forward pass on the loaded coordinates: every body's pose in its parent (`rot`, `pos`),
+/// twist `v` and acceleration `a` (gravity included as a base acceleration `g`) in its frame.
+#[inline(always)]
+pub(crate) fn forward<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, g: &Motion) {
+    let base = SpatialLanes {
+        ang: Vector3Lanes::splat(&g.angular),
+        lin: Vector3Lanes::splat(&g.linear),
+    };
+    for (i, b) in model.bodies.iter().enumerate() {
+        let (rot, pos) = pose(b, data.qb[i]);
+        let (mut v, mut a) = match b.parent {
+            Some(p) => (
+                act_inv(&rot, &pos, &data.v[p]),
+                act_inv(&rot, &pos, &data.a[p]),
+            ),
+            None => (SpatialLanes::default(), act_inv(&rot, &pos, &base)),
+        };
+        // joint twist vj = S qd and acceleration S qdd
+        let (vj, aj) = (
+            Vector3Lanes::of(&b.axis, data.vb[i]),
+            Vector3Lanes::of(&b.axis, data.ab[i]),
+        );
+        match b.kind {
+            JointKind::Revolute => {
+                v.ang = v.ang.add(&vj);
+                // a += S qdd + v x (vj, 0) = (w x vj, vlin x vj)
+                a.ang = a.ang.add(&aj).add(&v.ang.cross(&vj));
+                a.lin = a.lin.add(&v.lin.cross(&vj));
+            }
+            JointKind::Prismatic => {
+                v.lin = v.lin.add(&vj);
+                // v x (0, vj) = (0, w x vj)
+                a.lin = a.lin.add(&aj).add(&v.ang.cross(&vj));
+            }
+        }
+        data.rot[i] = rot;
+        data.pos[i] = pos;
+        data.v[i] = v;
+        data.a[i] = a;
+    }
+}
+
+/// Body `i`'s pose in the base frame from its pose `rot`, `pos` in its parent (whose base-frame
+/// pose is already in `data`): stores it with the motion subspace there (`o_rot`, `o_pos`,
+/// `o_s`) and returns it.
+#[inline(always)]
+pub(crate) fn place_in_base<const W: usize>(
+    model: &Model,
+    data: &mut LaneBuffers<W>,
+    i: usize,
+    rot: &Rotation3Lanes<W>,
+    pos: &Vector3Lanes<W>,
+) -> (Rotation3Lanes<W>, Vector3Lanes<W>) {
+    let b = &model.bodies[i];
+    let (r, p) = match b.parent {
+        Some(k) => {
+            let (rp, pp) = (&data.o_rot[k], &data.o_pos[k]);
+            (rp.compose(rot), pp.add(&rp.mul(pos)))
+        }
+        None => (*rot, *pos),
+    };
+    data.o_s[i] = subspace_in(b, &r, &p);
+    data.o_rot[i] = r;
+    data.o_pos[i] = p;
+    (r, p)
+}
+
+/// Body `b`'s motion subspace in the base frame, for its base-frame pose `r`, `p`.
+#[inline(always)]
+pub(crate) fn subspace_in<const W: usize>(
+    b: &Body,
+    r: &Rotation3Lanes<W>,
+    p: &Vector3Lanes<W>,
+) -> SpatialLanes<W> {
+    let axis = r.mul_const_vector(&b.axis);
+    match b.kind {
+        JointKind::Revolute => SpatialLanes {
+            ang: axis,
+            lin: p.cross(&axis),
+        },
+        JointKind::Prismatic => SpatialLanes {
+            ang: Vector3Lanes::default(),
+            lin: axis,
+        },
+    }
+}
+
+/// Writes the joint torques of lanes `0..used` (samples `first..first + used`) into the
+/// row-major `tau` from the body wrenches `f` (in the body frames): `tau_dof += multiplier *
+/// S^T f`.
+#[inline(always)]
+pub(crate) fn contract_torques<const W: usize>(
+    model: &Model,
+    f: &[SpatialLanes<W>],
+    first: usize,
+    used: usize,
+    tau: &mut [f64],
+) {
+    let nv = model.nv;
+    for s in first..first + used {
+        tau[s * nv..(s + 1) * nv].fill(0.0);
+    }
+    for (i, b) in model.bodies.iter().enumerate() {
+        let t = if b.kind == JointKind::Revolute {
+            f[i].ang.dot_const(&b.axis)
+        } else {
+            f[i].lin.dot_const(&b.axis)
+        };
+        for l in 0..used {
+            tau[(first + l) * nv + b.dof] += b.multiplier * t.0[l];
+        }
+    }
+}

@@ -1,0 +1,162 @@
+//! Joint-space mass matrices of many samples on the lanes (the composite rigid body algorithm
+//! in the base frame).
+
+use super::kinematics::{place_in_base, pose};
+use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
+use crate::data::Data;
+use crate::error::Result;
+use crate::model::Model;
+use crate::simd::{Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
+use crate::spatial::OriginInertia;
+
+/// Joint-space mass matrices `M(q)` of a batch, [`LaneData::width`] samples at a time (the
+/// composite rigid body algorithm in the base frame, as [`crate::mass_matrix`]; equal to it up
+/// to rounding).
+///
+/// `q`: row-major `k x nv` (rad or m), finite (checked by the caller, as for
+/// [`super::rnea_lanes`]). `out`: row-major `k x nv x nv` (kg m^2, kg m or kg), both triangles
+/// written. Runs on the instruction set of `data`.
+pub fn mass_matrix_batch(
+    model: &Model,
+    data: &mut LaneData,
+    q: &[f64],
+    out: &mut [f64],
+) -> Result<()> {
+    let nv = model.nv;
+    let k = samples(nv, q.len(), &[("mass matrix output", out.len(), nv * nv)])?;
+    dispatch(model, data, MassMatrix { k, q, out })
+}
+
+struct MassMatrix<'a> {
+    k: usize,
+    q: &'a [f64],
+    out: &'a mut [f64],
+}
+
+/// A composite inertia per lane in origin form (mass, first moment `h`, rotational inertia `i`
+/// about the origin, by rows); the mass is the same in every lane.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Composite<const W: usize> {
+    pub(crate) mass: f64,
+    pub(crate) h: Vector3Lanes<W>,
+    pub(crate) i: Rotation3Lanes<W>,
+}
+
+impl<const W: usize> Default for Composite<W> {
+    fn default() -> Self {
+        Self {
+            mass: 0.0,
+            h: Vector3Lanes::default(),
+            i: Rotation3Lanes::default(),
+        }
+    }
+}
+
+impl LaneKernel for MassMatrix<'_> {
+    type Output = Result<()>;
+
+    #[inline(always)]
+    fn wide<const W: usize>(self, model: &Model, data: &mut LaneBuffers<W>) -> Result<()> {
+        let (nv, nb) = (model.nv, model.nbodies());
+        let mut first = 0;
+        while first < self.k {
+            data.load(model, [self.q, &[], &[]], first);
+            // base-frame poses, motion subspaces and body inertias
+            for (i, b) in model.bodies.iter().enumerate() {
+                let (rot, pos) = pose(b, data.qb[i]);
+                let (r, p) = place_in_base(model, data, i, &rot, &pos);
+                data.composite[i] = transformed(&b.origin_inertia, &r, &p);
+            }
+            let m = &mut data.m;
+            m.fill(Lanes::default());
+            for i in (0..nb).rev() {
+                let (c, s) = (&data.composite[i], &data.o_s[i]);
+                let f = SpatialLanes {
+                    ang: c.i.mul(&s.ang).add(&c.h.cross(&s.lin)),
+                    lin: s.lin.scale_add(c.mass, &s.ang.cross(&c.h)),
+                };
+                let mut j = Some(i);
+                while let Some(k) = j {
+                    let mik = data.o_s[k].dot(&f);
+                    m[i * nb + k] = mik;
+                    m[k * nb + i] = mik;
+                    j = model.bodies[k].parent;
+                }
+                if let Some(p) = model.bodies[i].parent {
+                    let child = data.composite[i];
+                    let parent = &mut data.composite[p];
+                    parent.mass += child.mass;
+                    parent.h = parent.h.add(&child.h);
+                    parent.i = parent.i.add(&child.i);
+                }
+            }
+            // onto the degrees of freedom (mimic couplings), for the lanes in use
+            for l in 0..(self.k - first).min(W) {
+                let o = &mut self.out[(first + l) * nv * nv..(first + l + 1) * nv * nv];
+                if model.coupled {
+                    o.fill(0.0);
+                    for (i, bi) in model.bodies.iter().enumerate() {
+                        for (j, bj) in model.bodies.iter().enumerate() {
+                            o[bi.dof * nv + bj.dof] +=
+                                bi.multiplier * bj.multiplier * m[i * nb + j].0[l];
+                        }
+                    }
+                } else {
+                    for (x, v) in o.iter_mut().zip(m.iter()) {
+                        *x = v.0[l];
+                    }
+                }
+                model.add_armature_inertia(o);
+            }
+            first += W;
+        }
+        Ok(())
+    }
+
+    fn scalar(self, model: &Model, data: &mut Data) -> Result<()> {
+        let nv = model.nv;
+        for (s, o) in self.out.chunks_mut(nv * nv).enumerate() {
+            crate::algorithms::crba::mass_matrix(model, data, &self.q[s * nv..(s + 1) * nv])?;
+            crate::algorithms::parallel::copy_row_major(&data.m, o);
+        }
+        Ok(())
+    }
+}
+
+/// A body's (constant) origin-form inertia expressed in the base frame, for its pose `r`, `p`
+/// there (see `OriginInertia::transformed`).
+#[inline(always)]
+pub(crate) fn transformed<const W: usize>(
+    b: &OriginInertia,
+    r: &Rotation3Lanes<W>,
+    p: &Vector3Lanes<W>,
+) -> Composite<W> {
+    let hr = r.mul_const_vector(&b.h);
+    let w = p.scale_add(0.5 * b.mass, &hr);
+    let d = p.dot(&w) * 2.0;
+    let ri = [0, 1, 2].map(|row| r.0[row].mul_const(&b.i)); // rows of R I (I symmetric)
+    let mut i = Rotation3Lanes::default();
+    for row in 0..3 {
+        let e = |c: usize| {
+            let v = ri[row].dot(&r.0[c]);
+            let v = w
+                .get(row)
+                .neg_mul_add(p.get(c), p.get(row).neg_mul_add(w.get(c), v));
+            if c == row {
+                v + d
+            } else {
+                v
+            }
+        };
+        i.0[row] = Vector3Lanes {
+            x: e(0),
+            y: e(1),
+            z: e(2),
+        };
+    }
+    Composite {
+        mass: b.mass,
+        h: p.scale_add(b.mass, &hr),
+        i,
+    }
+}

@@ -1,0 +1,277 @@
+//! Dynamics of many samples at once: the algorithms run on several samples side by side, one
+//! sample per SIMD lane (8 with AVX-512, 4 with AVX2 and FMA; see [`Isa`]), chosen at run time
+//! by the processor. Every quantity is stored as a structure of arrays (one `[f64; W]` per
+//! scalar), so each operation of a recursion acts on one vector register of samples; the
+//! model's constants (placements, axes, inertias) are shared by the lanes. Without a vector
+//! instruction set the kernels run the one-sample algorithms in a loop.
+//!
+//! Kernels: [`rnea_lanes`] (inverse dynamics), [`mass_matrix_batch`], [`regressor_batch`] and
+//! [`regressor_group`] (the joint-torque regressor), [`derivatives_batch`] (the RNEA
+//! derivatives) and [`linearize_batch`] (`T*, D*, H*, G*, Gs`). Each takes a [`LaneData`] of
+//! buffers made once per model and thread.
+//!
+//! Inputs are row-major `k x nv` arrays (sample `s`, dof `j` at `s * nv + j`) of finite values:
+//! the kernels check shapes, not values (a [`crate::States`] is checked once for all).
+
+mod derivatives;
+mod kinematics;
+mod mass_matrix;
+mod regressor;
+mod rnea;
+
+pub use derivatives::{derivatives_batch, linearize_batch, DerivativesOut, LinearizationsOut};
+pub use mass_matrix::mass_matrix_batch;
+pub use regressor::{regressor_batch, regressor_group};
+pub use rnea::rnea_lanes;
+
+use crate::algorithms::regressor::PARAMS_PER_BODY;
+use crate::data::Data;
+use crate::error::{Error, Result};
+use crate::model::Model;
+pub use crate::simd::Isa;
+use crate::simd::{Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
+
+/// The most samples any instruction set processes side by side (AVX-512's 8); a given
+/// [`LaneData`] uses [`LaneData::width`] of them.
+pub const LANES: usize = 8;
+
+/// Work buffers of the multi-sample kernels for one model, sized for one instruction set
+/// (allocate once per model and thread, reuse).
+#[derive(Clone, Debug)]
+pub struct LaneData {
+    isa: Isa,
+    nv: usize,
+    nbodies: usize,
+    buffers: Buffers,
+}
+
+#[derive(Clone, Debug)]
+enum Buffers {
+    #[cfg(target_arch = "x86_64")]
+    W8(Box<LaneBuffers<8>>),
+    #[cfg(target_arch = "x86_64")]
+    W4(Box<LaneBuffers<4>>),
+    Scalar(Box<Data>),
+}
+
+/// The buffers of the kernels on `W` lanes.
+#[derive(Clone, Debug)]
+pub(crate) struct LaneBuffers<const W: usize> {
+    /// Body coordinates of the loaded lanes (joint units, after mimic couplings).
+    pub(crate) qb: Vec<Lanes<W>>,
+    pub(crate) vb: Vec<Lanes<W>>,
+    pub(crate) ab: Vec<Lanes<W>>,
+    /// Each body's pose in its parent (rotation by rows, translation).
+    pub(crate) rot: Vec<Rotation3Lanes<W>>,
+    pub(crate) pos: Vec<Vector3Lanes<W>>,
+    /// Each body's pose in the base frame and its motion subspace there.
+    pub(crate) o_rot: Vec<Rotation3Lanes<W>>,
+    pub(crate) o_pos: Vec<Vector3Lanes<W>>,
+    pub(crate) o_s: Vec<SpatialLanes<W>>,
+    /// Twists, accelerations and wrenches in the body frames (inverse dynamics).
+    pub(crate) v: Vec<SpatialLanes<W>>,
+    pub(crate) a: Vec<SpatialLanes<W>>,
+    pub(crate) f: Vec<SpatialLanes<W>>,
+    /// The regressor of the loaded lanes, column-major `nv x 10 nbodies`.
+    pub(crate) regressor: Vec<Lanes<W>>,
+    /// Body-level mass matrix (row-major `nbodies x nbodies`) and composite inertias.
+    pub(crate) m: Vec<Lanes<W>>,
+    pub(crate) composite: Vec<mass_matrix::Composite<W>>,
+    /// The derivatives' buffers, made on first use.
+    pub(crate) derivatives: Option<Box<derivatives::Buffers<W>>>,
+}
+
+impl<const W: usize> LaneBuffers<W> {
+    fn new(model: &Model) -> Self {
+        let nb = model.nbodies();
+        Self {
+            qb: vec![Lanes::default(); nb],
+            vb: vec![Lanes::default(); nb],
+            ab: vec![Lanes::default(); nb],
+            rot: vec![Rotation3Lanes::default(); nb],
+            pos: vec![Vector3Lanes::default(); nb],
+            o_rot: vec![Rotation3Lanes::default(); nb],
+            o_pos: vec![Vector3Lanes::default(); nb],
+            o_s: vec![SpatialLanes::default(); nb],
+            v: vec![SpatialLanes::default(); nb],
+            a: vec![SpatialLanes::default(); nb],
+            f: vec![SpatialLanes::default(); nb],
+            regressor: vec![Lanes::default(); model.nv * PARAMS_PER_BODY * nb],
+            m: vec![Lanes::default(); nb * nb],
+            composite: vec![mass_matrix::Composite::default(); nb],
+            derivatives: None,
+        }
+    }
+
+    /// Loads the body coordinates of samples `first..first + W` of the row-major `k x nv`
+    /// arrays `[q, qd, qdd]` (empty for zeros) into the lanes; past the last sample the lanes
+    /// repeat it.
+    #[inline(always)]
+    pub(crate) fn load(&mut self, model: &Model, x: [&[f64]; 3], first: usize) {
+        let nv = model.nv;
+        let k = x[0].len() / nv.max(1);
+        let lane = |l: usize| (first + l).min(k.max(1) - 1);
+        for (i, b) in model.bodies.iter().enumerate() {
+            let get = |x: &[f64], l: usize| {
+                if x.is_empty() {
+                    0.0
+                } else {
+                    b.multiplier * x[lane(l) * nv + b.dof]
+                }
+            };
+            self.qb[i] = Lanes(std::array::from_fn(|l| get(x[0], l) + b.offset));
+            self.vb[i] = Lanes(std::array::from_fn(|l| get(x[1], l)));
+            self.ab[i] = Lanes(std::array::from_fn(|l| get(x[2], l)));
+        }
+    }
+}
+
+impl LaneData {
+    /// Buffers sized for `model`, for the widest instruction set of this processor
+    /// ([`Isa::detect`]).
+    pub fn new(model: &Model) -> Self {
+        Self::for_isa(model, Isa::detect())
+    }
+
+    /// Buffers sized for `model` that run the kernels on `isa`; fails if this processor does
+    /// not have it (to compare the paths, or to pin one).
+    pub fn with_isa(model: &Model, isa: Isa) -> Result<Self> {
+        if !isa.is_available() {
+            return Err(Error::Numerical {
+                operation: "LaneData::with_isa".into(),
+                message: format!(
+                    "this processor has no {isa} (it has: {})",
+                    Isa::available()
+                        .iter()
+                        .map(|i| i.name())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            });
+        }
+        Ok(Self::for_isa(model, isa))
+    }
+
+    fn for_isa(model: &Model, isa: Isa) -> Self {
+        let buffers = match isa {
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => Buffers::W8(Box::new(LaneBuffers::new(model))),
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2Fma => Buffers::W4(Box::new(LaneBuffers::new(model))),
+            _ => Buffers::Scalar(Box::new(Data::new(model))),
+        };
+        Self {
+            isa: if matches!(buffers, Buffers::Scalar(_)) {
+                Isa::Scalar
+            } else {
+                isa
+            },
+            nv: model.nv,
+            nbodies: model.nbodies(),
+            buffers,
+        }
+    }
+
+    /// The instruction set these buffers run the kernels on.
+    pub fn isa(&self) -> Isa {
+        self.isa
+    }
+
+    /// Samples processed side by side (`self.isa().lanes()`).
+    pub fn width(&self) -> usize {
+        self.isa.lanes()
+    }
+
+    /// Entry `(joint, parameter)` (N m per parameter unit) of the regressor of sample `sample`
+    /// of the group last given to [`regressor_group`]. Panics past the group's samples or the
+    /// model's sizes, like slice indexing.
+    #[inline]
+    pub fn regressor_entry(&self, sample: usize, joint: usize, parameter: usize) -> f64 {
+        match &self.buffers {
+            #[cfg(target_arch = "x86_64")]
+            Buffers::W8(b) => b.regressor[joint + parameter * self.nv].0[sample],
+            #[cfg(target_arch = "x86_64")]
+            Buffers::W4(b) => b.regressor[joint + parameter * self.nv].0[sample],
+            Buffers::Scalar(d) => {
+                assert!(sample == 0, "sample {sample} of a one-sample group");
+                d.regressor[(joint, parameter)]
+            }
+        }
+    }
+
+    /// Fails unless these buffers were made for a model of `model`'s sizes.
+    fn check(&self, model: &Model) -> Result<()> {
+        if (self.nv, self.nbodies) == (model.nv, model.nbodies()) {
+            return Ok(());
+        }
+        Err(Error::Shape {
+            argument: "lane data".into(),
+            expected: format!(
+                "buffers for this model ({} dofs, {} bodies): LaneData::new(&model)",
+                model.nv,
+                model.nbodies()
+            ),
+            got: format!("buffers for {} dofs and {} bodies", self.nv, self.nbodies),
+        })
+    }
+}
+
+/// A kernel over a batch, written once for any lane width `W` and once for the one-sample
+/// algorithms; [`dispatch`] runs the version for the buffers' instruction set.
+pub(crate) trait LaneKernel {
+    type Output;
+    /// The kernel on `W` lanes. Implementations are `#[inline(always)]`, so that they are
+    /// compiled inside the instruction set's function.
+    fn wide<const W: usize>(self, model: &Model, buffers: &mut LaneBuffers<W>) -> Self::Output;
+    /// The kernel by the one-sample algorithms.
+    fn scalar(self, model: &Model, data: &mut Data) -> Self::Output;
+}
+
+/// Runs `kernel` on `lanes` (checked to be `model`'s) compiled for the buffers' instruction
+/// set.
+pub(crate) fn dispatch<K: LaneKernel<Output = Result<T>>, T>(
+    model: &Model,
+    lanes: &mut LaneData,
+    kernel: K,
+) -> Result<T> {
+    lanes.check(model)?;
+    match &mut lanes.buffers {
+        // SAFETY: `W8` and `W4` buffers are made only when the processor has the instruction
+        // set (`LaneData::with_isa`, `Isa::detect`).
+        #[cfg(target_arch = "x86_64")]
+        Buffers::W8(b) => unsafe { run_avx512(kernel, model, b) },
+        #[cfg(target_arch = "x86_64")]
+        Buffers::W4(b) => unsafe { run_avx2(kernel, model, b) },
+        Buffers::Scalar(d) => kernel.scalar(model, d),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
+unsafe fn run_avx512<K: LaneKernel>(kernel: K, model: &Model, b: &mut LaneBuffers<8>) -> K::Output {
+    kernel.wide::<8>(model, b)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn run_avx2<K: LaneKernel>(kernel: K, model: &Model, b: &mut LaneBuffers<4>) -> K::Output {
+    kernel.wide::<4>(model, b)
+}
+
+/// The number of samples `k` in `q` (`q_len` values, `k x nv`); checks that every other argument
+/// `(name, length, values per sample)` holds `k` samples too.
+pub(crate) fn samples(nv: usize, q_len: usize, others: &[(&str, usize, usize)]) -> Result<usize> {
+    let k = q_len / nv.max(1);
+    let shape = |name: &str, len: usize, per: usize| Error::Shape {
+        argument: name.into(),
+        expected: format!("{k} samples x {per} values, like q"),
+        got: format!("{len} values"),
+    };
+    if k * nv != q_len {
+        return Err(shape("q", q_len, nv));
+    }
+    match others.iter().find(|(_, len, per)| *len != k * per) {
+        Some(&(name, len, per)) => Err(shape(name, len, per)),
+        None => Ok(k),
+    }
+}

@@ -1,0 +1,209 @@
+//! The joint-torque regressor of many samples on the lanes.
+
+use super::kinematics::{forward, place_in_base};
+use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
+use crate::algorithms::regressor::{joint_torque_regressor, PARAMS_PER_BODY};
+use crate::data::Data;
+use crate::error::{Error, Result};
+use crate::gravity::Gravity;
+use crate::model::Model;
+use crate::simd::{Lanes, SpatialLanes, Vector3Lanes};
+
+/// The joint-torque regressor of a batch, [`LaneData::width`] samples at a time: `out`
+/// (row-major `k x nv x 10 nbodies`, N m per parameter unit) holds for every sample the matrix
+/// that [`crate::algorithms::regressor::joint_torque_regressor`] gives, up to rounding.
+///
+/// `q`, `qd`, `qdd`: row-major `k x nv` (rad, rad/s, rad/s^2), finite (checked by the caller, as
+/// for [`super::rnea_lanes`]); `gravity` includes gravity. Runs on the instruction set of
+/// `data`.
+pub fn regressor_batch(
+    model: &Model,
+    data: &mut LaneData,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    gravity: Gravity,
+    out: &mut [f64],
+) -> Result<()> {
+    let nv = model.nv;
+    let p = PARAMS_PER_BODY * model.nbodies();
+    let k = samples(
+        nv,
+        q.len(),
+        &[
+            ("qd", qd.len(), nv),
+            ("qdd", qdd.len(), nv),
+            ("regressor output", out.len(), nv * p),
+        ],
+    )?;
+    let kernel = Regressor {
+        k,
+        x: [q, qd, qdd],
+        gravity,
+        out: Some(out),
+    };
+    dispatch(model, data, kernel)
+}
+
+/// The joint-torque regressors of a group of 1 to [`LaneData::width`] samples, left in `data`
+/// and read with [`LaneData::regressor_entry`]: the building block for work that reduces the
+/// regressor as it is made (the streaming identification), without the copy into a row-major
+/// array that [`regressor_batch`] makes.
+///
+/// `q`, `qd`, `qdd`: row-major `g x nv` (rad, rad/s, rad/s^2), finite (checked by the caller).
+/// Returns `g`.
+pub fn regressor_group(
+    model: &Model,
+    data: &mut LaneData,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    gravity: Gravity,
+) -> Result<usize> {
+    let nv = model.nv;
+    let k = samples(nv, q.len(), &[("qd", qd.len(), nv), ("qdd", qdd.len(), nv)])?;
+    if k == 0 || k > data.width() {
+        return Err(Error::Shape {
+            argument: "q".into(),
+            expected: format!("1 to {} samples of {nv} joints", data.width()),
+            got: format!("{k} samples"),
+        });
+    }
+    let kernel = Regressor {
+        k,
+        x: [q, qd, qdd],
+        gravity,
+        out: None,
+    };
+    dispatch(model, data, kernel)?;
+    Ok(k)
+}
+
+/// The regressors of `k` samples, into `out` (row-major) or, with `out` `None` and at most one
+/// group of samples, left in the buffers.
+struct Regressor<'a> {
+    k: usize,
+    x: [&'a [f64]; 3],
+    gravity: Gravity,
+    out: Option<&'a mut [f64]>,
+}
+
+impl LaneKernel for Regressor<'_> {
+    type Output = Result<()>;
+
+    #[inline(always)]
+    fn wide<const W: usize>(mut self, model: &Model, data: &mut LaneBuffers<W>) -> Result<()> {
+        let nv = model.nv;
+        let p = PARAMS_PER_BODY * model.nbodies();
+        let mut first = 0;
+        while first < self.k {
+            data.load(model, self.x, first);
+            regressor_lanes(model, data, self.gravity);
+            if let Some(out) = self.out.as_deref_mut() {
+                for l in 0..(self.k - first).min(W) {
+                    let o = &mut out[(first + l) * nv * p..(first + l + 1) * nv * p];
+                    for r in 0..nv {
+                        for (c, x) in o[r * p..(r + 1) * p].iter_mut().enumerate() {
+                            *x = data.regressor[r + c * nv].0[l];
+                        }
+                    }
+                }
+            }
+            first += W;
+        }
+        Ok(())
+    }
+
+    fn scalar(mut self, model: &Model, data: &mut Data) -> Result<()> {
+        let nv = model.nv;
+        let p = PARAMS_PER_BODY * model.nbodies();
+        let mut y = std::mem::take(&mut data.regressor);
+        let result = (0..self.k).try_for_each(|s| {
+            let r = s * nv..(s + 1) * nv;
+            let [q, qd, qdd] = self.x.map(|x| &x[r.clone()]);
+            joint_torque_regressor(model, data, q, qd, qdd, self.gravity, &mut y)?;
+            if let Some(out) = self.out.as_deref_mut() {
+                crate::algorithms::parallel::copy_row_major(&y, &mut out[s * nv * p..][..nv * p]);
+            }
+            Ok(())
+        });
+        data.regressor = y; // back in place even after an error
+        result
+    }
+}
+
+/// The joint-torque regressor (see [`crate::algorithms::regressor::joint_torque_regressor`]) of
+/// the loaded group of lanes: `data.regressor` column-major `nv x 10 nbodies`, one lane per
+/// sample, every entry written. `gravity` includes gravity.
+#[inline(always)]
+fn regressor_lanes<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, gravity: Gravity) {
+    let nv = model.nv;
+    forward(model, data, &model.base_acceleration(gravity));
+    let mut out = std::mem::take(&mut data.regressor);
+    out.fill(Lanes::default());
+    for i in 0..model.nbodies() {
+        let (rot, pos) = (data.rot[i], data.pos[i]);
+        let (r, p) = place_in_base(model, data, i, &rot, &pos);
+        // the body's 10 columns in the base frame (see `world_body_regressor`)
+        let (v, a) = (&data.v[i], &data.a[i]);
+        let (w, al) = (v.ang, a.ang);
+        let ac = r.mul(&a.lin.add(&w.cross(&v.lin)));
+        let (ww, alw) = (r.mul(&w), r.mul(&al));
+        let w2 = w.dot(&w);
+        let mut cols = [SpatialLanes::default(); 10];
+        cols[0] = SpatialLanes {
+            ang: p.cross(&ac),
+            lin: ac,
+        };
+        for k in 0..3 {
+            let rk = r.column(k);
+            let lin = ww
+                .mul_lanes_add(w.get(k), &alw.cross(&rk))
+                .sub(&rk.mul_lanes(w2));
+            cols[1 + k] = SpatialLanes {
+                ang: rk.cross(&ac).add(&p.cross(&lin)),
+                lin,
+            };
+        }
+        // I_q x for the unit inertias of [Ixx, Ixy, Iyy, Ixz, Iyz, Izz], then rotated
+        let z = Lanes::default();
+        let unit = |x: &Vector3Lanes<W>| {
+            [
+                Vector3Lanes { x: x.x, y: z, z },
+                Vector3Lanes { x: x.y, y: x.x, z },
+                Vector3Lanes { x: z, y: x.y, z },
+                Vector3Lanes {
+                    x: x.z,
+                    y: z,
+                    z: x.x,
+                },
+                Vector3Lanes {
+                    x: z,
+                    y: x.z,
+                    z: x.y,
+                },
+                Vector3Lanes { x: z, y: z, z: x.z },
+            ]
+        };
+        let (ia, iw) = (unit(&al), unit(&w));
+        for q in 0..6 {
+            cols[4 + q].ang = r.mul(&ia[q].add(&w.cross(&iw[q])));
+        }
+        // project on the motion subspaces of the body and its ancestors
+        let first = PARAMS_PER_BODY * i * nv;
+        let mut j = Some(i);
+        while let Some(k) = j {
+            let bk = &model.bodies[k];
+            let sk = &data.o_s[k];
+            let at = |c: usize| first + c * nv + bk.dof;
+            for (c, f) in cols[..4].iter().enumerate() {
+                out[at(c)] = sk.dot(f).mul_add_s(bk.multiplier, out[at(c)]);
+            }
+            for (c, f) in cols[4..].iter().enumerate() {
+                out[at(4 + c)] = sk.ang.dot(&f.ang).mul_add_s(bk.multiplier, out[at(4 + c)]);
+            }
+            j = bk.parent;
+        }
+    }
+    data.regressor = out;
+}

@@ -1,0 +1,127 @@
+//! Inverse dynamics of many samples on the lanes.
+
+use super::kinematics::{apply, contract_torques, forward};
+use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
+use crate::data::Data;
+use crate::error::Result;
+use crate::gravity::Gravity;
+use crate::model::Model;
+use crate::simd::SpatialLanes;
+
+/// Inverse dynamics `tau = M(q) qdd + c(q, qd) + g(q)` of a batch, [`LaneData::width`] samples
+/// at a time.
+///
+/// - `q` (rad or m), `qd` (rad/s or m/s), `qdd` (rad/s^2 or m/s^2): row-major `k x nv`
+///   (sample `s`, dof `j` at `s * nv + j`); `qd` or `qdd` `None` for zeros. All arguments
+///   must hold the same `k` samples and finite values: check them first (a [`crate::States`]
+///   is checked once for all); this kernel does not.
+/// - `gravity`: include `g(q)`.
+/// - `tau`: row-major `k x nv` output (N m or N).
+///
+/// Equal to [`crate::rnea`] sample by sample up to rounding. Runs on the instruction set of
+/// `data` ([`LaneData::isa`]).
+pub fn rnea_lanes(
+    model: &Model,
+    data: &mut LaneData,
+    q: &[f64],
+    qd: Option<&[f64]>,
+    qdd: Option<&[f64]>,
+    gravity: Gravity,
+    tau: &mut [f64],
+) -> Result<()> {
+    let nv = model.nv;
+    let (v, a) = (
+        qd.map_or(q.len(), <[f64]>::len),
+        qdd.map_or(q.len(), <[f64]>::len),
+    );
+    let k = samples(
+        nv,
+        q.len(),
+        &[("qd", v, nv), ("qdd", a, nv), ("tau", tau.len(), nv)],
+    )?;
+    let kernel = Rnea {
+        k,
+        x: [q, qd.unwrap_or(&[]), qdd.unwrap_or(&[])],
+        gravity,
+        tau,
+    };
+    dispatch(model, data, kernel)
+}
+
+struct Rnea<'a> {
+    k: usize,
+    x: [&'a [f64]; 3],
+    gravity: Gravity,
+    tau: &'a mut [f64],
+}
+
+impl LaneKernel for Rnea<'_> {
+    type Output = Result<()>;
+
+    #[inline(always)]
+    fn wide<const W: usize>(self, model: &Model, data: &mut LaneBuffers<W>) -> Result<()> {
+        let g = model.base_acceleration(self.gravity);
+        let mut first = 0;
+        while first < self.k {
+            data.load(model, self.x, first);
+            forward(model, data, &g);
+            wrenches(model, data);
+            let used = (self.k - first).min(W);
+            contract_torques(model, &data.f, first, used, self.tau);
+            first += W;
+        }
+        let qdd = self.x[2];
+        if !qdd.is_empty() {
+            let nv = model.nv;
+            for (t, a) in self.tau.chunks_mut(nv).zip(qdd.chunks(nv)) {
+                model.add_armature_torque(a, t);
+            }
+        }
+        Ok(())
+    }
+
+    fn scalar(self, model: &Model, data: &mut Data) -> Result<()> {
+        let nv = model.nv;
+        let zeros = vec![0.0; nv];
+        for (s, t) in self.tau.chunks_mut(nv).enumerate() {
+            let r = s * nv..(s + 1) * nv;
+            crate::algorithms::rnea::rnea(
+                model,
+                data,
+                &self.x[0][r.clone()],
+                if self.x[1].is_empty() {
+                    &zeros
+                } else {
+                    &self.x[1][r.clone()]
+                },
+                if self.x[2].is_empty() {
+                    &zeros
+                } else {
+                    &self.x[2][r.clone()]
+                },
+                self.gravity,
+            )?;
+            t.copy_from_slice(data.tau.as_slice());
+        }
+        Ok(())
+    }
+}
+
+/// The backward pass: body wrenches `f = I a + v x* (I v)`, accumulated from the leaves into
+/// `data.f` (each in its body's frame).
+#[inline(always)]
+pub(crate) fn wrenches<const W: usize>(model: &Model, data: &mut LaneBuffers<W>) {
+    for (i, b) in model.bodies.iter().enumerate() {
+        let (v, a) = (&data.v[i], &data.a[i]);
+        let (ia, h) = (apply(&b.inertia, a), apply(&b.inertia, v));
+        data.f[i] = ia.add(&v.cross_force(&h));
+    }
+    for i in (0..model.nbodies()).rev() {
+        if let Some(p) = model.bodies[i].parent {
+            let (rot, pos, f) = (&data.rot[i], &data.pos[i], data.f[i]);
+            let lin = rot.mul(&f.lin);
+            let ang = rot.mul(&f.ang).add(&pos.cross(&lin));
+            data.f[p] = data.f[p].add(&SpatialLanes { ang, lin });
+        }
+    }
+}

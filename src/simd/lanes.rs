@@ -1,0 +1,360 @@
+//! Arithmetic on `W` samples side by side (structure of arrays): a scalar per lane
+//! [`Lanes`], 3-vectors [`Vector3Lanes`], 3x3 matrices [`Rotation3Lanes`] (by rows) and spatial
+//! vectors [`SpatialLanes`] of lanes. Each operation is a short loop over the lanes that the
+//! compiler maps onto one SIMD register per scalar when the caller is compiled for a vector
+//! instruction set (see [`super::Isa`]); products are summed with fused multiply-adds
+//! ([`f64::mul_add`]), which those sets do in one instruction. Only call these from code compiled
+//! for such a set: elsewhere `mul_add` is a library call.
+
+use nalgebra::{Matrix3, Vector3};
+
+/// One scalar per lane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Lanes<const W: usize>(pub(crate) [f64; W]);
+
+impl<const W: usize> Default for Lanes<W> {
+    #[inline(always)]
+    fn default() -> Self {
+        Lanes([0.0; W])
+    }
+}
+
+impl<const W: usize> Lanes<W> {
+    #[inline(always)]
+    pub(crate) fn splat(x: f64) -> Self {
+        Lanes([x; W])
+    }
+    /// `self * b + c`, fused.
+    #[inline(always)]
+    pub(crate) fn mul_add(self, b: Lanes<W>, c: Lanes<W>) -> Lanes<W> {
+        Lanes(std::array::from_fn(|l| self.0[l].mul_add(b.0[l], c.0[l])))
+    }
+    /// `self * b + c` for a constant `b`, fused.
+    #[inline(always)]
+    pub(crate) fn mul_add_s(self, b: f64, c: Lanes<W>) -> Lanes<W> {
+        Lanes(std::array::from_fn(|l| self.0[l].mul_add(b, c.0[l])))
+    }
+    /// `self * b - c`, fused.
+    #[inline(always)]
+    pub(crate) fn mul_sub(self, b: Lanes<W>, c: Lanes<W>) -> Lanes<W> {
+        Lanes(std::array::from_fn(|l| self.0[l].mul_add(b.0[l], -c.0[l])))
+    }
+    /// `c - self * b`, fused.
+    #[inline(always)]
+    pub(crate) fn neg_mul_add(self, b: Lanes<W>, c: Lanes<W>) -> Lanes<W> {
+        Lanes(std::array::from_fn(|l| {
+            (-self.0[l]).mul_add(b.0[l], c.0[l])
+        }))
+    }
+    /// Whether any lane is NaN or larger than `bound` in magnitude.
+    #[inline(always)]
+    pub(crate) fn any_nan_or_beyond(self, bound: f64) -> bool {
+        // `!(|x| <= bound)` is true for NaN too; reduced without branches per lane
+        self.0
+            .iter()
+            .fold(false, |acc, x| acc | !(x.abs() <= bound))
+    }
+}
+
+macro_rules! lane_op {
+    ($tr:ident, $f:ident, $op:tt) => {
+        impl<const W: usize> std::ops::$tr for Lanes<W> {
+            type Output = Lanes<W>;
+            #[inline(always)]
+            fn $f(self, o: Lanes<W>) -> Lanes<W> {
+                Lanes(std::array::from_fn(|l| self.0[l] $op o.0[l]))
+            }
+        }
+        impl<const W: usize> std::ops::$tr<f64> for Lanes<W> {
+            type Output = Lanes<W>;
+            #[inline(always)]
+            fn $f(self, o: f64) -> Lanes<W> {
+                Lanes(self.0.map(|a| a $op o))
+            }
+        }
+    };
+}
+lane_op!(Add, add, +);
+lane_op!(Sub, sub, -);
+lane_op!(Mul, mul, *);
+lane_op!(Div, div, /);
+
+impl<const W: usize> std::ops::Neg for Lanes<W> {
+    type Output = Lanes<W>;
+    #[inline(always)]
+    fn neg(self) -> Lanes<W> {
+        Lanes(self.0.map(|a| -a))
+    }
+}
+
+/// A 3-vector per lane.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Vector3Lanes<const W: usize> {
+    pub(crate) x: Lanes<W>,
+    pub(crate) y: Lanes<W>,
+    pub(crate) z: Lanes<W>,
+}
+
+impl<const W: usize> Default for Vector3Lanes<W> {
+    #[inline(always)]
+    fn default() -> Self {
+        let z = Lanes::default();
+        Vector3Lanes { x: z, y: z, z }
+    }
+}
+
+impl<const W: usize> Vector3Lanes<W> {
+    #[inline(always)]
+    pub(crate) fn splat(v: &Vector3<f64>) -> Self {
+        Vector3Lanes {
+            x: Lanes::splat(v.x),
+            y: Lanes::splat(v.y),
+            z: Lanes::splat(v.z),
+        }
+    }
+    #[inline(always)]
+    pub(crate) fn cross(&self, o: &Self) -> Self {
+        Vector3Lanes {
+            x: self.y.mul_sub(o.z, self.z * o.y),
+            y: self.z.mul_sub(o.x, self.x * o.z),
+            z: self.x.mul_sub(o.y, self.y * o.x),
+        }
+    }
+    /// `self x o` for a constant vector `o`.
+    #[inline(always)]
+    pub(crate) fn cross_const(&self, o: &Vector3<f64>) -> Self {
+        Vector3Lanes {
+            x: self.y.mul_add_s(o.z, self.z * -o.y),
+            y: self.z.mul_add_s(o.x, self.x * -o.z),
+            z: self.x.mul_add_s(o.y, self.y * -o.x),
+        }
+    }
+    #[inline(always)]
+    pub(crate) fn add(&self, o: &Self) -> Self {
+        Vector3Lanes {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
+    }
+    #[inline(always)]
+    pub(crate) fn sub(&self, o: &Self) -> Self {
+        Vector3Lanes {
+            x: self.x - o.x,
+            y: self.y - o.y,
+            z: self.z - o.z,
+        }
+    }
+    #[inline(always)]
+    pub(crate) fn scale(&self, s: f64) -> Self {
+        Vector3Lanes {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
+    }
+    /// `self * s + o`, fused.
+    #[inline(always)]
+    pub(crate) fn scale_add(&self, s: f64, o: &Self) -> Self {
+        Vector3Lanes {
+            x: self.x.mul_add_s(s, o.x),
+            y: self.y.mul_add_s(s, o.y),
+            z: self.z.mul_add_s(s, o.z),
+        }
+    }
+    /// `a * s` for a constant vector `a` and a lane scalar `s`.
+    #[inline(always)]
+    pub(crate) fn of(a: &Vector3<f64>, s: Lanes<W>) -> Self {
+        Vector3Lanes {
+            x: s * a.x,
+            y: s * a.y,
+            z: s * a.z,
+        }
+    }
+    #[inline(always)]
+    pub(crate) fn dot(&self, o: &Self) -> Lanes<W> {
+        self.x.mul_add(o.x, self.y.mul_add(o.y, self.z * o.z))
+    }
+    /// `self . o + c`, fused.
+    #[inline(always)]
+    pub(crate) fn dot_add(&self, o: &Self, c: Lanes<W>) -> Lanes<W> {
+        self.x
+            .mul_add(o.x, self.y.mul_add(o.y, self.z.mul_add(o.z, c)))
+    }
+    /// `self * s` for a lane scalar `s`.
+    #[inline(always)]
+    pub(crate) fn mul_lanes(&self, s: Lanes<W>) -> Self {
+        Vector3Lanes {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
+    }
+    /// `self * s + o` for a lane scalar `s`, fused.
+    #[inline(always)]
+    pub(crate) fn mul_lanes_add(&self, s: Lanes<W>, o: &Self) -> Self {
+        Vector3Lanes {
+            x: self.x.mul_add(s, o.x),
+            y: self.y.mul_add(s, o.y),
+            z: self.z.mul_add(s, o.z),
+        }
+    }
+    /// `a . self` for a constant vector `a`.
+    #[inline(always)]
+    pub(crate) fn dot_const(&self, a: &Vector3<f64>) -> Lanes<W> {
+        self.x.mul_add_s(a.x, self.y.mul_add_s(a.y, self.z * a.z))
+    }
+    /// `m * self` for a constant matrix `m`.
+    #[inline(always)]
+    pub(crate) fn mul_const(&self, m: &Matrix3<f64>) -> Self {
+        let row = |r: usize| {
+            self.x
+                .mul_add_s(m[(r, 0)], self.y.mul_add_s(m[(r, 1)], self.z * m[(r, 2)]))
+        };
+        Vector3Lanes {
+            x: row(0),
+            y: row(1),
+            z: row(2),
+        }
+    }
+    /// Component `k` (0, 1, 2).
+    #[inline(always)]
+    pub(crate) fn get(&self, k: usize) -> Lanes<W> {
+        match k {
+            0 => self.x,
+            1 => self.y,
+            _ => self.z,
+        }
+    }
+}
+
+/// A 3x3 matrix (a rotation, or a rotational inertia) per lane, by rows.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Rotation3Lanes<const W: usize>(pub(crate) [Vector3Lanes<W>; 3]);
+
+impl<const W: usize> Default for Rotation3Lanes<W> {
+    #[inline(always)]
+    fn default() -> Self {
+        Rotation3Lanes([Vector3Lanes::default(); 3])
+    }
+}
+
+impl<const W: usize> Rotation3Lanes<W> {
+    /// `self * o`.
+    #[inline(always)]
+    pub(crate) fn compose(&self, o: &Self) -> Self {
+        let row = |a: &Vector3Lanes<W>| Vector3Lanes {
+            x: a.x.mul_add(o.0[0].x, a.y.mul_add(o.0[1].x, a.z * o.0[2].x)),
+            y: a.x.mul_add(o.0[0].y, a.y.mul_add(o.0[1].y, a.z * o.0[2].y)),
+            z: a.x.mul_add(o.0[0].z, a.y.mul_add(o.0[1].z, a.z * o.0[2].z)),
+        };
+        Rotation3Lanes([row(&self.0[0]), row(&self.0[1]), row(&self.0[2])])
+    }
+    /// Column `k`.
+    #[inline(always)]
+    pub(crate) fn column(&self, k: usize) -> Vector3Lanes<W> {
+        Vector3Lanes {
+            x: self.0[0].get(k),
+            y: self.0[1].get(k),
+            z: self.0[2].get(k),
+        }
+    }
+    /// `self * a` for a constant vector `a`.
+    #[inline(always)]
+    pub(crate) fn mul_const_vector(&self, a: &Vector3<f64>) -> Vector3Lanes<W> {
+        Vector3Lanes {
+            x: self.0[0].dot_const(a),
+            y: self.0[1].dot_const(a),
+            z: self.0[2].dot_const(a),
+        }
+    }
+    #[inline(always)]
+    pub(crate) fn mul(&self, v: &Vector3Lanes<W>) -> Vector3Lanes<W> {
+        Vector3Lanes {
+            x: self.0[0].dot(v),
+            y: self.0[1].dot(v),
+            z: self.0[2].dot(v),
+        }
+    }
+    /// `self^T v`.
+    #[inline(always)]
+    pub(crate) fn tr_mul(&self, v: &Vector3Lanes<W>) -> Vector3Lanes<W> {
+        let [a, b, c] = &self.0;
+        Vector3Lanes {
+            x: a.x.mul_add(v.x, b.x.mul_add(v.y, c.x * v.z)),
+            y: a.y.mul_add(v.x, b.y.mul_add(v.y, c.y * v.z)),
+            z: a.z.mul_add(v.x, b.z.mul_add(v.y, c.z * v.z)),
+        }
+    }
+    #[inline(always)]
+    pub(crate) fn add(&self, o: &Self) -> Self {
+        Rotation3Lanes([
+            self.0[0].add(&o.0[0]),
+            self.0[1].add(&o.0[1]),
+            self.0[2].add(&o.0[2]),
+        ])
+    }
+}
+
+/// A spatial vector per lane (`angular`, `linear`): a motion or a force.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SpatialLanes<const W: usize> {
+    pub(crate) ang: Vector3Lanes<W>,
+    pub(crate) lin: Vector3Lanes<W>,
+}
+
+impl<const W: usize> Default for SpatialLanes<W> {
+    #[inline(always)]
+    fn default() -> Self {
+        SpatialLanes {
+            ang: Vector3Lanes::default(),
+            lin: Vector3Lanes::default(),
+        }
+    }
+}
+
+impl<const W: usize> SpatialLanes<W> {
+    #[inline(always)]
+    pub(crate) fn add(&self, o: &Self) -> Self {
+        SpatialLanes {
+            ang: self.ang.add(&o.ang),
+            lin: self.lin.add(&o.lin),
+        }
+    }
+    #[inline(always)]
+    pub(crate) fn sub(&self, o: &Self) -> Self {
+        SpatialLanes {
+            ang: self.ang.sub(&o.ang),
+            lin: self.lin.sub(&o.lin),
+        }
+    }
+    /// The pairing `<self, o>` of a motion and a force (or the 6-vector dot product).
+    #[inline(always)]
+    pub(crate) fn dot(&self, o: &Self) -> Lanes<W> {
+        self.ang.dot_add(&o.ang, self.lin.dot(&o.lin))
+    }
+    /// `self * s` for a lane scalar.
+    #[inline(always)]
+    pub(crate) fn mul_lanes(&self, s: Lanes<W>) -> Self {
+        SpatialLanes {
+            ang: self.ang.mul_lanes(s),
+            lin: self.lin.mul_lanes(s),
+        }
+    }
+    /// Motion cross product `self x m` (both motions).
+    #[inline(always)]
+    pub(crate) fn cross(&self, m: &Self) -> Self {
+        SpatialLanes {
+            ang: self.ang.cross(&m.ang),
+            lin: self.ang.cross(&m.lin).add(&self.lin.cross(&m.ang)),
+        }
+    }
+    /// Dual cross product `self x* f` (a motion acting on a force).
+    #[inline(always)]
+    pub(crate) fn cross_force(&self, f: &Self) -> Self {
+        SpatialLanes {
+            ang: self.ang.cross(&f.ang).add(&self.lin.cross(&f.lin)),
+            lin: self.ang.cross(&f.lin),
+        }
+    }
+}

@@ -1,0 +1,327 @@
+//! Every instruction-set path of the multi-sample kernels ([`Isa`]: AVX-512 with 8 lanes,
+//! AVX2+FMA with 4, scalar) against the one-sample algorithms to 1e-12 (relative to the
+//! largest entry), on random trees with prismatic and continuous joints, on the A465 and on a
+//! mimic coupling, for batch lengths that fill the lanes and leave partial groups. A path the
+//! processor lacks cannot run here: its tests say so on stderr and check the refusal instead.
+
+mod common;
+
+use common::{mimic_pair, random_tree_urdf, Rng};
+use nalgebra::DMatrix;
+use perturbid_rs::algorithms::batch::{
+    derivatives_batch, linearize_batch, regressor_group, DerivativesOut, LinearizationsOut,
+};
+use perturbid_rs::algorithms::regressor::joint_torque_regressor;
+use perturbid_rs::{
+    linearize, mass_matrix, mass_matrix_batch, model_from_urdf_str, regressor_batch, rnea,
+    rnea_derivatives, rnea_lanes, robots, Data, Gravity, Isa, LaneData, LoadOptions, Model,
+};
+use proptest::prelude::*;
+
+const TOL: f64 = 1e-12;
+
+/// The lane buffers of `isa` for `model`, or `None` (with a note) when the processor lacks it.
+fn lanes_for(model: &Model, isa: Isa) -> Option<LaneData> {
+    match LaneData::with_isa(model, isa) {
+        Ok(l) => {
+            assert_eq!((l.isa(), l.width()), (isa, isa.lanes()));
+            Some(l)
+        }
+        Err(e) => {
+            assert!(!isa.is_available());
+            assert!(e.to_string().contains(isa.name()), "{e}");
+            eprintln!("skipped: the {isa} path needs a processor with it ({e})");
+            None
+        }
+    }
+}
+
+fn close(got: f64, want: f64, scale: f64) -> bool {
+    (got - want).abs() <= TOL * scale
+}
+
+fn check_rnea(model: &Model, isa: Isa, rng: &mut Rng, k: usize) {
+    let Some(mut lanes) = lanes_for(model, isa) else {
+        return;
+    };
+    let n = model.nv;
+    let (q, qd, qdd) = (
+        rng.vector(k * n, 9.0),
+        rng.vector(k * n, 2.0),
+        rng.vector(k * n, 2.0),
+    );
+    let zeros = vec![0.0; n];
+    let mut data = Data::new(model);
+    for (with_v, with_a, gravity) in [
+        (true, true, Gravity::Included),
+        (false, false, Gravity::Included),
+        (true, false, Gravity::Excluded),
+    ] {
+        let mut out = vec![f64::NAN; k * n];
+        let (v, a) = (with_v.then_some(&qd[..]), with_a.then_some(&qdd[..]));
+        rnea_lanes(model, &mut lanes, &q, v, a, gravity, &mut out).unwrap();
+        for s in 0..k {
+            let r = s * n..(s + 1) * n;
+            let vs = if with_v { &qd[r.clone()] } else { &zeros[..] };
+            let as_ = if with_a { &qdd[r.clone()] } else { &zeros[..] };
+            rnea(model, &mut data, &q[r.clone()], vs, as_, gravity).unwrap();
+            let scale = 1.0 + data.tau.amax();
+            for j in 0..n {
+                assert!(
+                    close(out[s * n + j], data.tau[j], scale),
+                    "{isa} sample {s} joint {j}: {} vs {}",
+                    out[s * n + j],
+                    data.tau[j]
+                );
+            }
+        }
+    }
+}
+
+fn check_mass_matrix(model: &Model, isa: Isa, rng: &mut Rng, k: usize) {
+    let Some(mut lanes) = lanes_for(model, isa) else {
+        return;
+    };
+    let n = model.nv;
+    let q = rng.vector(k * n, 9.0);
+    let mut out = vec![f64::NAN; k * n * n];
+    mass_matrix_batch(model, &mut lanes, &q, &mut out).unwrap();
+    let mut data = Data::new(model);
+    for s in 0..k {
+        mass_matrix(model, &mut data, &q[s * n..(s + 1) * n]).unwrap();
+        let scale = data.m.amax();
+        for i in 0..n {
+            for j in 0..n {
+                let got = out[s * n * n + i * n + j];
+                assert!(
+                    close(got, data.m[(i, j)], scale),
+                    "{isa} sample {s} M[{i}, {j}]: {got} vs {}",
+                    data.m[(i, j)]
+                );
+            }
+        }
+    }
+}
+
+fn check_regressor(model: &Model, isa: Isa, rng: &mut Rng, k: usize) {
+    let Some(mut lanes) = lanes_for(model, isa) else {
+        return;
+    };
+    let (n, p) = (model.nv, 10 * model.nbodies());
+    let (q, qd, qdd) = (
+        rng.vector(k * n, 9.0),
+        rng.vector(k * n, 2.0),
+        rng.vector(k * n, 2.0),
+    );
+    let mut data = Data::new(model);
+    let mut y = DMatrix::zeros(n, p);
+    for gravity in [Gravity::Included, Gravity::Excluded] {
+        let mut out = vec![f64::NAN; k * n * p];
+        regressor_batch(model, &mut lanes, &q, &qd, &qdd, gravity, &mut out).unwrap();
+        let w = lanes.width();
+        for s in 0..k {
+            let r = s * n..(s + 1) * n;
+            joint_torque_regressor(
+                model,
+                &mut data,
+                &q[r.clone()],
+                &qd[r.clone()],
+                &qdd[r.clone()],
+                gravity,
+                &mut y,
+            )
+            .unwrap();
+            // the group kernel, read in place, for the group that starts at this sample
+            let g = if s % w == 0 {
+                let rows = s * n..(s + w).min(k) * n;
+                let g = regressor_group(
+                    model,
+                    &mut lanes,
+                    &q[rows.clone()],
+                    &qd[rows.clone()],
+                    &qdd[rows],
+                    gravity,
+                )
+                .unwrap();
+                assert_eq!(g, (k - s).min(w));
+                g
+            } else {
+                0
+            };
+            let scale = 1.0 + y.amax();
+            for i in 0..n {
+                for c in 0..p {
+                    let got = out[s * n * p + i * p + c];
+                    assert!(
+                        close(got, y[(i, c)], scale),
+                        "{isa} sample {s} row {i} column {c}: {got} vs {}",
+                        y[(i, c)]
+                    );
+                    if g > 0 {
+                        let e = lanes.regressor_entry(0, i, c);
+                        assert!(close(e, y[(i, c)], scale), "{isa} group: {e}");
+                    }
+                }
+            }
+        }
+    }
+    // a group larger than the lanes is refused
+    let rows = (w_plus_one(&lanes) * n).min(q.len());
+    if rows == w_plus_one(&lanes) * n {
+        let e = regressor_group(
+            model,
+            &mut lanes,
+            &q[..rows],
+            &qd[..rows],
+            &qdd[..rows],
+            Gravity::Included,
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("samples"), "{e}");
+    }
+}
+
+/// `got` (row-major `k x rows x cols`) against the one-sample `want(s)` of every sample.
+fn agree(isa: Isa, what: &str, got: &[f64], want: &DMatrix<f64>, s: usize) {
+    let (r, c) = want.shape();
+    let scale = 1.0 + want.amax();
+    for i in 0..r {
+        for j in 0..c {
+            let g = got[s * r * c + i * c + j];
+            assert!(
+                close(g, want[(i, j)], scale),
+                "{isa} {what} sample {s} [{i}, {j}]: {g} vs {}",
+                want[(i, j)]
+            );
+        }
+    }
+}
+
+fn check_derivatives(model: &Model, isa: Isa, rng: &mut Rng, k: usize) {
+    let Some(mut lanes) = lanes_for(model, isa) else {
+        return;
+    };
+    let n = model.nv;
+    let (q, qd, qdd) = (
+        rng.vector(k * n, 9.0),
+        rng.vector(k * n, 2.0),
+        rng.vector(k * n, 2.0),
+    );
+    let mut data = Data::new(model);
+    for gravity in [Gravity::Included, Gravity::Excluded] {
+        let mut b = vec![vec![f64::NAN; k * n * n]; 8];
+        let mut tau = vec![f64::NAN; k * n];
+        let mut torque = vec![f64::NAN; k * n];
+        let [dq, dv, m, d, h, g, gs, _] = &mut b[..] else {
+            unreachable!()
+        };
+        let out = DerivativesOut {
+            tau: &mut tau,
+            dtau_dq: dq,
+            dtau_dv: dv,
+            m,
+        };
+        derivatives_batch(model, &mut lanes, &q, &qd, &qdd, gravity, out).unwrap();
+        let out = LinearizationsOut {
+            torque: &mut torque,
+            d,
+            h,
+            g,
+            g_static: gs,
+        };
+        linearize_batch(model, &mut lanes, &q, &qd, &qdd, gravity, out).unwrap();
+        for s in 0..k {
+            let r = s * n..(s + 1) * n;
+            let x = [&q[r.clone()], &qd[r.clone()], &qdd[r]];
+            rnea_derivatives(model, &mut data, x[0], x[1], x[2], gravity).unwrap();
+            let t = DMatrix::from_column_slice(1, n, data.tau.as_slice());
+            agree(isa, "tau", &tau, &t, s);
+            agree(isa, "d tau / d q", &b[0], &data.dtau_dq, s);
+            agree(isa, "d tau / d qd", &b[1], &data.dtau_dv, s);
+            agree(isa, "M", &b[2], &data.m, s);
+            let lin = linearize(model, &mut data, x[0], x[1], x[2], gravity).unwrap();
+            let t = DMatrix::from_column_slice(1, n, lin.torque.as_slice());
+            agree(isa, "T*", &torque, &t, s);
+            agree(isa, "D*", &b[3], &lin.d, s);
+            agree(isa, "H*", &b[4], &lin.h, s);
+            agree(isa, "G*", &b[5], &lin.g, s);
+            agree(isa, "Gs", &b[6], &lin.g_static, s);
+        }
+    }
+}
+
+fn w_plus_one(lanes: &LaneData) -> usize {
+    lanes.width() + 1
+}
+
+fn models() -> Vec<Model> {
+    vec![
+        robots::builtin("a465").unwrap(),
+        robots::builtin("a465:physical").unwrap(),
+        model_from_urdf_str(&mimic_pair(true), "mimic", &LoadOptions::default()).unwrap(),
+        model_from_urdf_str(&random_tree_urdf(60, 60), "tree60", &LoadOptions::default()).unwrap(),
+    ]
+}
+
+#[test]
+fn every_path_equals_the_one_sample_algorithms_on_fixed_robots() {
+    let mut rng = Rng(17);
+    for model in models() {
+        for isa in Isa::ALL {
+            for k in [1, 3, 4, 5, 8, 9, 17] {
+                check_rnea(&model, isa, &mut rng, k);
+                check_mass_matrix(&model, isa, &mut rng, k);
+                check_regressor(&model, isa, &mut rng, k);
+                check_derivatives(&model, isa, &mut rng, k);
+            }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(16))]
+    #[test]
+    fn every_path_equals_the_one_sample_algorithms_on_random_trees(
+        seed in any::<u64>(), nlinks in 1usize..9, k in 1usize..19,
+    ) {
+        let text = random_tree_urdf(seed, nlinks);
+        let model = model_from_urdf_str(&text, "random", &LoadOptions::default()).unwrap();
+        let mut rng = Rng(seed ^ 0xA5A5);
+        for isa in Isa::ALL {
+            check_rnea(&model, isa, &mut rng, k);
+            check_mass_matrix(&model, isa, &mut rng, k);
+            check_regressor(&model, isa, &mut rng, k);
+            check_derivatives(&model, isa, &mut rng, k);
+        }
+    }
+}
+
+#[test]
+fn buffers_of_another_model_are_refused() {
+    let a465 = robots::builtin("a465").unwrap();
+    let mimic = model_from_urdf_str(&mimic_pair(true), "mimic", &LoadOptions::default()).unwrap();
+    let mut lanes = LaneData::new(&mimic);
+    let mut out = vec![0.0; 6];
+    let e = rnea_lanes(
+        &a465,
+        &mut lanes,
+        &[0.0; 6],
+        None,
+        None,
+        Gravity::Included,
+        &mut out,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("buffers for this model"), "{e}");
+}
+
+#[test]
+fn the_detected_path_is_the_widest_available() {
+    let best = Isa::detect();
+    assert_eq!(Some(&best), Isa::available().first());
+    assert_eq!(LaneData::new(&robots::builtin("a465").unwrap()).isa(), best);
+    eprintln!(
+        "this processor runs the {best} path ({} lanes)",
+        best.lanes()
+    );
+}
