@@ -1,165 +1,254 @@
-//! Throughput of the dynamics core on the built-in A465: `cargo bench --bench dynamics`.
-//! Names give the size: `rnea/a465/1` is one call, `batch/rnea/a465/100000` a batch of 10^5
-//! samples one at a time (serial, one `Data`), `batch/rnea_lanes/a465/100000` the same batch
-//! through the multi-sample kernel (serial too), `batch/parallel_rnea/a465/100000` the batch
-//! engine (`perturbid_rs::parallel`: the kernel in chunks over every core, as Python calls it).
+//! Throughput of every dynamics kernel on the A465, the Panda (when example-robot-data's URDF
+//! is installed: `pip install example-robot-data`) and a 60-dof tree:
+//! `cargo bench --bench dynamics`. Names are `KERNEL/ROBOT/PATH` with PATH
+//! - `one_call`: the one-sample algorithm, one call per sample (the peer of Pinocchio's calls);
+//! - `avx512`, `avx2+fma`, `scalar`: the multi-sample kernel of that instruction set (each the
+//!   processor has) over a batch, serial;
+//! - `parallel`: the batch engine (`perturbid_rs::parallel`) over every core.
+//!
+//! Every figure is a throughput per sample (criterion's `elem/s`). Forward dynamics compares
+//! the articulated-body algorithm (`aba`) with the mass matrix and Cholesky (`crba`).
+//! benches/README.md has the numbers and how they compare with Pinocchio.
 
-use criterion::{criterion_group, criterion_main, Criterion};
-use perturbid_rs::algorithms::regressor::joint_torque_regressor;
-use perturbid_rs::robots::a465::{TABLE2_Q, TABLE2_QD, TABLE2_QDD};
-use perturbid_rs::{
-    forward_dynamics, gravity_torque, linearize, mass_matrix, mass_matrix_batch, regressor_batch,
-    rnea, rnea_derivatives, rnea_lanes, robots, Data, LaneData, Model,
+#[path = "../tests/common/mod.rs"]
+#[allow(dead_code)]
+mod common;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use perturbid_rs::algorithms::batch::{
+    derivatives_batch, linearize_batch, DerivativesOut, LinearizationsOut,
 };
-use perturbid_rs::{parallel, Gravity, States};
+use perturbid_rs::algorithms::regressor::joint_torque_regressor;
+use perturbid_rs::{
+    aba, forward_dynamics_crba, linearize_into, mass_matrix, mass_matrix_batch, parallel,
+    regressor_batch, rnea, rnea_derivatives, rnea_lanes, robots, Data, Gravity, Isa, LaneData,
+    Linearization, LoadOptions, Model, States,
+};
 use std::hint::black_box;
+use std::time::Duration;
 
-const BATCH: usize = 100_000;
+/// Samples per batch.
+const BATCH: usize = 1024;
 
-/// `BATCH` states spread around the Table 2 operating point, row-major.
-pub fn states(model: &Model) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    let n = model.nv;
-    let wave = |i: usize, j: usize, f: f64| (f * (i as f64) * 1e-3 + j as f64).sin();
-    let q = (0..BATCH * n)
-        .map(|x| TABLE2_Q[x % n] + 0.5 * wave(x / n, x % n, 1.0))
-        .collect();
-    let qd = (0..BATCH * n)
-        .map(|x| TABLE2_QD[x % n] + wave(x / n, x % n, 2.0))
-        .collect();
-    let qdd = (0..BATCH * n)
-        .map(|x| TABLE2_QDD[x % n] + wave(x / n, x % n, 3.0))
-        .collect();
-    (q, qd, qdd)
+/// The robots: A465, Panda (fingers locked) when its URDF is installed, a 60-dof tree.
+fn robots() -> Vec<(&'static str, Model)> {
+    let mut out = vec![("a465", robots::builtin("a465").expect("built-in A465"))];
+    match panda() {
+        Some(m) => out.push(("panda", m)),
+        None => eprintln!(
+            "skipped the Panda: example-robot-data's panda.urdf is not installed \
+             (pip install example-robot-data)"
+        ),
+    }
+    let tree = common::random_tree_urdf(60, 60);
+    let tree = perturbid_rs::model_from_urdf_str(&tree, "tree60", &LoadOptions::default())
+        .expect("60-link tree");
+    out.push(("tree60", tree));
+    out
 }
 
-type Kernel = fn(&Model, &mut Data, &[f64], &[f64], &[f64]);
+/// example-robot-data's Panda under the running Python's site-packages, fingers locked.
+pub fn panda() -> Option<Model> {
+    let out = std::process::Command::new("python3")
+        .args([
+            "-c",
+            "import sysconfig; print(sysconfig.get_paths()['purelib'])",
+        ])
+        .output()
+        .ok()?;
+    let site = String::from_utf8(out.stdout).ok()?;
+    let path = std::path::Path::new(site.trim())
+        .join("cmeel.prefix/share/example-robot-data/robots/panda_description/urdf/panda.urdf");
+    let mut options = LoadOptions::default();
+    for j in ["panda_finger_joint1", "panda_finger_joint2"] {
+        options.lock.insert(j.to_string(), 0.0);
+    }
+    perturbid_rs::model_from_urdf_file(&path, &options).ok()
+}
+
+/// `BATCH` random states (rad, rad/s, rad/s^2), row-major.
+fn states(model: &Model) -> [Vec<f64>; 3] {
+    let mut rng = common::Rng(7);
+    let k = BATCH * model.nv;
+    [rng.vector(k, 3.0), rng.vector(k, 2.0), rng.vector(k, 2.0)]
+}
 
 fn dynamics(c: &mut Criterion) {
-    let model = robots::builtin("a465").expect("built-in A465");
-    let mut data = Data::new(&model);
-    let n = model.nv;
-    let mut y = nalgebra::DMatrix::zeros(n, 10 * model.nbodies());
-    let kernels: [(&str, Kernel); 6] = [
-        ("rnea", |m, d, q, qd, qdd| {
-            rnea(m, d, q, qd, qdd, Gravity::Included).unwrap()
-        }),
-        ("mass_matrix", |m, d, q, _, _| mass_matrix(m, d, q).unwrap()),
-        ("gravity", |m, d, q, _, _| gravity_torque(m, d, q).unwrap()),
-        ("forward_dynamics", |m, d, q, qd, tau| {
-            forward_dynamics(m, d, q, qd, tau, Gravity::Included).unwrap()
-        }),
-        ("rnea_derivatives", |m, d, q, qd, qdd| {
-            rnea_derivatives(m, d, q, qd, qdd, Gravity::Included).unwrap()
-        }),
-        ("linearize", |m, d, q, qd, qdd| {
-            linearize(m, d, q, qd, qdd, Gravity::Included).unwrap();
-        }),
-    ];
-    let (bq, bqd, bqdd) = states(&model);
-    for (name, f) in kernels {
-        c.bench_function(&format!("{name}/a465/1"), |b| {
-            b.iter(|| {
-                f(
-                    &model,
-                    &mut data,
-                    black_box(&TABLE2_Q),
-                    black_box(&TABLE2_QD),
-                    black_box(&TABLE2_QDD),
-                )
-            })
-        });
-    }
-    c.bench_function("regressor/a465/1", |b| {
-        b.iter(|| {
-            joint_torque_regressor(
-                &model,
-                &mut data,
-                black_box(&TABLE2_Q),
-                black_box(&TABLE2_QD),
-                black_box(&TABLE2_QDD),
-                Gravity::Included,
-                &mut y,
-            )
-            .unwrap()
-        })
-    });
-    let mut group = c.benchmark_group("batch");
-    group.sample_size(10);
-    for (name, f) in kernels.iter() {
-        group.bench_function(format!("{name}/a465/{BATCH}"), |b| {
+    for (robot, model) in robots() {
+        let (n, p) = (model.nv, 10 * model.nbodies());
+        let [q, qd, qdd] = states(&model);
+        let mut data = Data::new(&model);
+        let mut group = c.benchmark_group(format!("{robot}"));
+        group
+            .throughput(Throughput::Elements(BATCH as u64))
+            .sample_size(20)
+            .warm_up_time(Duration::from_millis(500))
+            .measurement_time(Duration::from_secs(2));
+        let sample = |s: usize| {
+            let r = s * n..(s + 1) * n;
+            (&q[r.clone()], &qd[r.clone()], &qdd[r])
+        };
+        // one call per sample, as Pinocchio is called
+        group.bench_function("rnea/one_call", |b| {
             b.iter(|| {
                 for s in 0..BATCH {
-                    let r = s * n..(s + 1) * n;
-                    f(&model, &mut data, &bq[r.clone()], &bqd[r.clone()], &bqdd[r]);
+                    let (q, qd, qdd) = sample(s);
+                    rnea(&model, &mut data, q, qd, qdd, Gravity::Included).unwrap();
+                    black_box(&data.tau);
                 }
             })
         });
+        group.bench_function("mass_matrix/one_call", |b| {
+            b.iter(|| {
+                for s in 0..BATCH {
+                    mass_matrix(&model, &mut data, sample(s).0).unwrap();
+                    black_box(&data.m);
+                }
+            })
+        });
+        let mut y = nalgebra::DMatrix::zeros(n, p);
+        group.bench_function("regressor/one_call", |b| {
+            b.iter(|| {
+                for s in 0..BATCH {
+                    let (q, qd, qdd) = sample(s);
+                    joint_torque_regressor(
+                        &model,
+                        &mut data,
+                        q,
+                        qd,
+                        qdd,
+                        Gravity::Included,
+                        &mut y,
+                    )
+                    .unwrap();
+                    black_box(&y);
+                }
+            })
+        });
+        group.bench_function("rnea_derivatives/one_call", |b| {
+            b.iter(|| {
+                for s in 0..BATCH {
+                    let (q, qd, qdd) = sample(s);
+                    rnea_derivatives(&model, &mut data, q, qd, qdd, Gravity::Included).unwrap();
+                    black_box(&data.dtau_dq);
+                }
+            })
+        });
+        let mut lin = Linearization::zeros(n);
+        group.bench_function("linearize/one_call", |b| {
+            b.iter(|| {
+                for s in 0..BATCH {
+                    let (q, qd, qdd) = sample(s);
+                    linearize_into(&model, &mut data, q, qd, qdd, Gravity::Included, &mut lin)
+                        .unwrap();
+                    black_box(&lin);
+                }
+            })
+        });
+        // forward dynamics: qdd as the torques (any torques do)
+        group.bench_function("forward_dynamics/aba", |b| {
+            b.iter(|| {
+                for s in 0..BATCH {
+                    let (q, qd, tau) = sample(s);
+                    aba(&model, &mut data, q, qd, tau, Gravity::Included).unwrap();
+                    black_box(&data.qdd);
+                }
+            })
+        });
+        group.bench_function("forward_dynamics/crba", |b| {
+            b.iter(|| {
+                for s in 0..BATCH {
+                    let (q, qd, tau) = sample(s);
+                    forward_dynamics_crba(&model, &mut data, q, qd, tau, Gravity::Included)
+                        .unwrap();
+                    black_box(&data.qdd);
+                }
+            })
+        });
+
+        // the multi-sample kernels, on every instruction set the processor has
+        let mut tau = vec![0.0; BATCH * n];
+        let mut mats = vec![vec![0.0; BATCH * n * n]; 5];
+        let mut ys = vec![0.0; BATCH * n * p];
+        for isa in Isa::available() {
+            let mut lanes = LaneData::with_isa(&model, isa).unwrap();
+            group.bench_function(format!("rnea/{isa}"), |b| {
+                b.iter(|| {
+                    rnea_lanes(
+                        &model,
+                        &mut lanes,
+                        &q,
+                        Some(&qd),
+                        Some(&qdd),
+                        Gravity::Included,
+                        &mut tau,
+                    )
+                    .unwrap()
+                })
+            });
+            group.bench_function(format!("mass_matrix/{isa}"), |b| {
+                b.iter(|| mass_matrix_batch(&model, &mut lanes, &q, &mut mats[0]).unwrap())
+            });
+            group.bench_function(format!("regressor/{isa}"), |b| {
+                b.iter(|| {
+                    regressor_batch(
+                        &model,
+                        &mut lanes,
+                        &q,
+                        &qd,
+                        &qdd,
+                        Gravity::Included,
+                        &mut ys,
+                    )
+                    .unwrap()
+                })
+            });
+            group.bench_function(format!("rnea_derivatives/{isa}"), |b| {
+                b.iter(|| {
+                    let [dq, dv, m, ..] = &mut mats[..] else {
+                        unreachable!()
+                    };
+                    let out = DerivativesOut {
+                        tau: &mut tau,
+                        dtau_dq: dq,
+                        dtau_dv: dv,
+                        m,
+                    };
+                    derivatives_batch(&model, &mut lanes, &q, &qd, &qdd, Gravity::Included, out)
+                        .unwrap()
+                })
+            });
+            group.bench_function(format!("linearize/{isa}"), |b| {
+                b.iter(|| {
+                    let [d, h, g, g_static, _] = &mut mats[..] else {
+                        unreachable!()
+                    };
+                    let out = LinearizationsOut {
+                        torque: &mut tau,
+                        d,
+                        h,
+                        g,
+                        g_static,
+                    };
+                    linearize_batch(&model, &mut lanes, &q, &qd, &qdd, Gravity::Included, out)
+                        .unwrap()
+                })
+            });
+        }
+        // the batch engine over every core
+        let mut ws = parallel::Workspace::new(&model);
+        let big = 8 * BATCH;
+        let [bq, bqd, bqdd] = [&q, &qd, &qdd].map(|x| x.repeat(8));
+        let states = States::new(n, &bq, Some(&bqd), Some(&bqdd)).unwrap();
+        let mut btau = vec![0.0; big * n];
+        group.throughput(Throughput::Elements(big as u64));
+        group.bench_function("rnea/parallel", |b| {
+            b.iter(|| {
+                parallel::rnea(&model, &mut ws, &states, Gravity::Included, &mut btau).unwrap()
+            })
+        });
+        group.finish();
     }
-    // the same batch through the multi-sample kernel (LANES samples side by side)
-    let mut lanes = LaneData::new(&model);
-    let mut tau = vec![0.0; BATCH * n];
-    group.bench_function(format!("rnea_lanes/a465/{BATCH}"), |b| {
-        b.iter(|| {
-            rnea_lanes(
-                &model,
-                &mut lanes,
-                &bq,
-                Some(&bqd),
-                Some(&bqdd),
-                Gravity::Included,
-                &mut tau,
-            )
-            .unwrap()
-        })
-    });
-    // the batch engine: the same kernels in parallel chunks, states checked once
-    let mut workspace = parallel::Workspace::new(&model);
-    let states = States::new(n, &bq, Some(&bqd), Some(&bqdd)).unwrap();
-    group.bench_function(format!("parallel_rnea/a465/{BATCH}"), |b| {
-        b.iter(|| {
-            parallel::rnea(&model, &mut workspace, &states, Gravity::Included, &mut tau).unwrap()
-        })
-    });
-    let mut ms = vec![0.0; BATCH * n * n];
-    group.bench_function(format!("parallel_mass_matrix/a465/{BATCH}"), |b| {
-        b.iter(|| parallel::mass_matrix(&model, &mut workspace, &states, &mut ms).unwrap())
-    });
-    group.bench_function(format!("mass_matrix_batch/a465/{BATCH}"), |b| {
-        b.iter(|| mass_matrix_batch(&model, &mut lanes, &bq, &mut ms).unwrap())
-    });
-    let mut ys = vec![0.0; BATCH * n * 10 * model.nbodies()];
-    group.bench_function(format!("regressor_batch/a465/{BATCH}"), |b| {
-        b.iter(|| {
-            regressor_batch(
-                &model,
-                &mut lanes,
-                &bq,
-                &bqd,
-                &bqdd,
-                Gravity::Included,
-                &mut ys,
-            )
-            .unwrap()
-        })
-    });
-    group.bench_function(format!("regressor/a465/{BATCH}"), |b| {
-        b.iter(|| {
-            for s in 0..BATCH {
-                let r = s * n..(s + 1) * n;
-                joint_torque_regressor(
-                    &model,
-                    &mut data,
-                    &bq[r.clone()],
-                    &bqd[r.clone()],
-                    &bqdd[r],
-                    Gravity::Included,
-                    &mut y,
-                )
-                .unwrap();
-            }
-        })
-    });
-    group.finish();
 }
 
 criterion_group!(benches, dynamics);

@@ -64,6 +64,13 @@ pub struct Data {
     pub(crate) s_world: Vec<Motion>,
     /// Scratch for the joint-torque regressor (`nv x 10 nbodies`).
     pub(crate) regressor: DMatrix<f64>,
+    /// Articulated-body inertias and bias forces, `U = IA S` and `1 / D` of [`crate::aba`]
+    /// (body frames).
+    pub(crate) aba_ia: Vec<Matrix6<f64>>,
+    pub(crate) aba_pa: Vec<Vector6<f64>>,
+    pub(crate) aba_u: Vec<Vector6<f64>>,
+    pub(crate) aba_dinv: Vec<f64>,
+    pub(crate) aba_c: Vec<Motion>,
 }
 
 impl Data {
@@ -112,6 +119,11 @@ impl Data {
             chol: DMatrix::zeros(n, n),
             regressor: DMatrix::zeros(n, 10 * model.nbodies()),
             s_world: vec![Motion::zeros(); model.nbodies()],
+            aba_ia: vec![Matrix6::zeros(); nb],
+            aba_pa: vec![Vector6::zeros(); nb],
+            aba_u: vec![Vector6::zeros(); nb],
+            aba_dinv: vec![0.0; nb],
+            aba_c: vec![Motion::zeros(); nb],
         }
     }
 }

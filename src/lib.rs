@@ -51,10 +51,11 @@ pub mod validation;
 #[cfg(feature = "python")]
 mod python;
 
+pub use algorithms::aba::aba;
 pub use algorithms::batch::{mass_matrix_batch, regressor_batch, rnea_lanes, LaneData, LANES};
 pub use algorithms::crba::mass_matrix;
 pub use algorithms::derivatives::rnea_derivatives;
-pub use algorithms::forward_dynamics::forward_dynamics;
+pub use algorithms::forward_dynamics::{forward_dynamics, forward_dynamics_crba};
 pub use algorithms::parallel;
 pub use algorithms::rnea::{bias_torque, gravity_torque, rnea};
 pub use data::Data;

@@ -1,4 +1,6 @@
-//! Forward dynamics by the mass matrix and an in-place Cholesky factorisation.
+//! Forward dynamics: the articulated-body algorithm ([`super::aba::aba`]) from
+//! [`super::aba::ABA_FROM_DOF`] degrees of freedom on, the mass matrix and an in-place Cholesky
+//! factorisation ([`forward_dynamics_crba`]) below.
 
 use super::crba::mass_matrix;
 use super::rnea::bias_torque;
@@ -7,11 +9,29 @@ use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
 
-/// Joint accelerations `qdd = M(q)^-1 (tau - c(q, qd) - g(q))` (rad/s^2 or m/s^2).
+/// Joint accelerations `qdd = M(q)^-1 (tau - c(q, qd) - g(q))` (rad/s^2 or m/s^2), by whichever
+/// of the two algorithms is faster for the model's size (equal up to rounding).
 ///
-/// `q`, `qd`, `tau` (N m or N): length `model.nv`. `gravity`: include `g(q)`. Writes `data.qdd`
-/// (and `data.m`, `data.bias`). Fails if `M(q)` is not positive definite.
+/// `q`, `qd`, `tau` (N m or N): length `model.nv`. `gravity`: include `g(q)`. Writes `data.qdd`.
+/// Fails if the model's inertia is singular at `q`.
 pub fn forward_dynamics(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    qd: &[f64],
+    tau: &[f64],
+    gravity: Gravity,
+) -> Result<()> {
+    if model.nv >= super::aba::ABA_FROM_DOF {
+        super::aba::aba(model, data, q, qd, tau, gravity)
+    } else {
+        forward_dynamics_crba(model, data, q, qd, tau, gravity)
+    }
+}
+
+/// [`forward_dynamics`] by the mass matrix and a Cholesky factorisation, whatever the size.
+/// Writes `data.qdd` (and `data.m`, `data.bias`). Fails if `M(q)` is not positive definite.
+pub fn forward_dynamics_crba(
     model: &Model,
     data: &mut Data,
     q: &[f64],

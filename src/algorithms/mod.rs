@@ -5,6 +5,7 @@
 //! Internally every algorithm runs over bodies; for models with mimic couplings the body
 //! coordinates are mapped from and to the degrees of freedom here.
 
+pub mod aba;
 pub mod batch;
 pub mod crba;
 pub mod derivatives;

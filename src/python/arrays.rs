@@ -1,7 +1,9 @@
 //! numpy in and out: one sample as shape `(n,)` or a batch as `(k, n)`; results shaped to match.
 
 use nalgebra::DMatrix;
-use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{
+    AllowTypeChange, PyArray1, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods,
+};
 use pyo3::prelude::*;
 use std::borrow::Cow;
 
@@ -98,6 +100,72 @@ impl Batch<'_> {
         }
         e.in_sample(s)
     }
+}
+
+/// Where a batched method writes: the caller's `out` array when given (checked: a float64
+/// numpy array of exactly the result's shape, C-contiguous, writeable, sharing no memory with
+/// the inputs), a new numpy array otherwise. Either way the Rust work writes the array's own
+/// memory: nothing is copied afterwards.
+pub(crate) fn output_array<'py>(
+    py: Python<'py>,
+    out: Option<Bound<'py, PyAny>>,
+    k: usize,
+    single: bool,
+    dims: &[usize],
+) -> Result<Bound<'py, PyArrayDyn<f64>>> {
+    let mut shape: Vec<usize> = if single { Vec::new() } else { vec![k] };
+    shape.extend_from_slice(dims);
+    let Some(out) = out else {
+        // SAFETY: every element is written before the array reaches Python (the algorithms
+        // write every entry of their output, and on an error the array is dropped)
+        return Ok(unsafe { PyArrayDyn::<f64>::new(py, shape, false) });
+    };
+    let wrong = |got: String| Error::Shape {
+        argument: "out".into(),
+        expected: format!(
+            "a C-contiguous, writeable float64 numpy array of shape {shape:?} (the result's)"
+        ),
+        got,
+    };
+    let arr = match out.cast::<PyArrayDyn<f64>>() {
+        Ok(a) => a.clone(),
+        Err(_) => {
+            let kind = match out.cast::<numpy::PyUntypedArray>() {
+                Ok(a) => format!("a numpy array of dtype {}", a.dtype()),
+                Err(_) => format!(
+                    "a {}",
+                    out.get_type().name().map_or("?".into(), |n| n.to_string())
+                ),
+            };
+            return Err(wrong(kind));
+        }
+    };
+    if arr.shape() != shape.as_slice() {
+        return Err(wrong(format!("shape {:?}", arr.shape())));
+    }
+    if !arr.is_c_contiguous() {
+        return Err(wrong("an array that is not C-contiguous".into()));
+    }
+    Ok(arr)
+}
+
+/// Runs `f` on the memory of `out` (from [`output_array`]); fails, naming `out`, when that memory
+/// is borrowed elsewhere (an input of the same call, say).
+pub(crate) fn write_into<T>(
+    out: &Bound<'_, PyArrayDyn<f64>>,
+    f: impl FnOnce(&mut [f64]) -> Result<T>,
+) -> Result<T> {
+    let mut rw = out.try_readwrite().map_err(|e| Error::Shape {
+        argument: "out".into(),
+        expected: "a writeable array that shares no memory with the inputs".into(),
+        got: format!("an array numpy refuses to lend for writing: {e}"),
+    })?;
+    let slice = rw.as_slice_mut().map_err(|e| Error::Shape {
+        argument: "out".into(),
+        expected: "a C-contiguous array".into(),
+        got: e.to_string(),
+    })?;
+    f(slice)
 }
 
 /// A numpy array of `values` with shape `dims` prefixed by `k` unless `single`.

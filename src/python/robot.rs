@@ -10,7 +10,7 @@ use pyo3::prelude::*;
 use super::detached;
 
 use super::arrays::ArrayLike;
-use super::arrays::{read_batch, to_numpy};
+use super::arrays::{output_array, read_batch, to_numpy, write_into};
 use super::linearization::PyLinearization;
 use crate::algorithms::parallel::{self, Workspace};
 use crate::error::Result;
@@ -44,15 +44,18 @@ impl PyRobot {
     }
 
     /// Runs the batch algorithm `f` of the library's engine ([`parallel`]), for the method
-    /// `name` (in errors), on the states
-    /// `args` (q, then qd and qdd when given) with the GIL released, into a new array of
-    /// `out_dims` values per sample.
+    /// `name` (in errors), on the states `args` (q, then qd and qdd when given), writing
+    /// `out_dims` values per sample into `out` (checked, see [`output_array`]) or a new array.
+    /// Large batches run with the GIL released; a few samples keep it (releasing costs more
+    /// than the work).
+    #[allow(clippy::too_many_arguments)]
     fn batch<'py, F>(
         &self,
         py: Python<'py>,
         name: &str,
         args: &[(&str, &ArrayLike<'py>)],
         out_dims: &[usize],
+        out: Option<Bound<'py, PyAny>>,
         f: F,
     ) -> PyResult<Bound<'py, PyAny>>
     where
@@ -60,14 +63,24 @@ impl PyRobot {
     {
         let n = self.model.nv;
         let batch = read_batch(n, args)?;
-        let mut out = vec![0.0; batch.k * out_dims.iter().product::<usize>()];
-        detached(py, name, || -> Result<()> {
+        let out = output_array(py, out, batch.k, batch.single, out_dims)?;
+        let work = |values: &mut [f64]| {
             let states = batch.states(n)?;
-            f(&self.model, &mut self.workspace(), &states, &mut out)
+            f(&self.model, &mut self.workspace(), &states, values)
+        };
+        write_into(&out, |values| {
+            if batch.k * (n + 1) < DETACH_FROM {
+                crate::error::catch_panics(name, || work(values))
+            } else {
+                detached(py, name, || work(values))
+            }
         })?;
-        to_numpy(py, out, batch.k, batch.single, out_dims)
+        Ok(out.into_any())
     }
 }
+
+/// Calls with at least this many samples times joints release the GIL.
+const DETACH_FROM: usize = 256;
 
 /// `physical_consistency`'s answer: consistent, per-body dicts, negative friction terms.
 type Consistency<'py> = (
@@ -211,7 +224,7 @@ impl PyRobot {
 
     /// Inverse dynamics `tau = M(q) qdd + c(q, qd) [+ g(q)]` (rigid bodies, no friction).
     /// q, qd, qdd: (n,) or (k, n). Returns tau with the same shape.
-    #[pyo3(signature = (q, qd, qdd, gravity=true))]
+    #[pyo3(signature = (q, qd, qdd, gravity=true, out=None))]
     fn rnea<'py>(
         &self,
         py: Python<'py>,
@@ -219,33 +232,42 @@ impl PyRobot {
         qd: ArrayLike<'py>,
         qdd: ArrayLike<'py>,
         gravity: bool,
+        out: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.model.nv;
         let args = [("q", &q), ("qd", &qd), ("qdd", &qdd)];
-        self.batch(py, "Robot.rnea", &args, &[n], |m, w, s, out| {
+        self.batch(py, "Robot.rnea", &args, &[n], out, |m, w, s, out| {
             parallel::rnea(m, w, s, gravity.into(), out)
         })
     }
 
     /// Gravity torque g(q): the torque holding the robot at rest. q: (n,) or (k, n).
-    fn gravity<'py>(&self, py: Python<'py>, q: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
+    #[pyo3(signature = (q, out=None))]
+    fn gravity<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayLike<'py>,
+        out: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         self.batch(
             py,
             "Robot.gravity",
             &[("q", &q)],
             &[self.model.nv],
+            out,
             |m, w, s, out| parallel::rnea(m, w, s, Gravity::Included, out),
         )
     }
 
     /// Bias torque c(q, qd) [+ g(q)]: the inverse dynamics at zero acceleration.
-    #[pyo3(signature = (q, qd, gravity=true))]
+    #[pyo3(signature = (q, qd, gravity=true, out=None))]
     fn bias<'py>(
         &self,
         py: Python<'py>,
         q: ArrayLike<'py>,
         qd: ArrayLike<'py>,
         gravity: bool,
+        out: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.model.nv;
         self.batch(
@@ -253,19 +275,27 @@ impl PyRobot {
             "Robot.bias",
             &[("q", &q), ("qd", &qd)],
             &[n],
+            out,
             |m, w, s, out| parallel::rnea(m, w, s, gravity.into(), out),
         )
     }
 
     /// Joint-space mass matrix M(q), symmetric positive definite. q: (n,) or (k, n); returns
     /// (n, n) or (k, n, n).
-    fn mass_matrix<'py>(&self, py: Python<'py>, q: ArrayLike<'py>) -> PyResult<Bound<'py, PyAny>> {
+    #[pyo3(signature = (q, out=None))]
+    fn mass_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayLike<'py>,
+        out: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.model.nv;
         self.batch(
             py,
             "Robot.mass_matrix",
             &[("q", &q)],
             &[n, n],
+            out,
             parallel::mass_matrix,
         )
     }
@@ -279,7 +309,8 @@ impl PyRobot {
     /// (N m s/rad, N m, N m, kg m^2). `Phi @ theta == rnea` needs the 'armature' column when
     /// the robot has an armature.
     /// Returns (n, p) or (k, n, p), p = 10 b + (number of terms) n.
-    #[pyo3(signature = (q, qd, qdd, gravity=true, friction=None))]
+    #[pyo3(signature = (q, qd, qdd, gravity=true, friction=None, out=None))]
+    #[allow(clippy::too_many_arguments)]
     fn regressor<'py>(
         &self,
         py: Python<'py>,
@@ -288,13 +319,19 @@ impl PyRobot {
         qdd: ArrayLike<'py>,
         gravity: bool,
         friction: Option<Bound<'py, PyAny>>,
+        out: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (n, p) = (self.model.nv, 10 * self.model.nbodies());
         let args = [("q", &q), ("qd", &qd), ("qdd", &qdd)];
         let Some(friction) = friction else {
-            return self.batch(py, "Robot.regressor", &args, &[n, p], |m, w, s, out| {
-                parallel::regressor(m, w, s, gravity.into(), out)
-            });
+            return self.batch(
+                py,
+                "Robot.regressor",
+                &args,
+                &[n, p],
+                out,
+                |m, w, s, out| parallel::regressor(m, w, s, gravity.into(), out),
+            );
         };
         let terms = super::arrays::friction_terms(Some(&friction))?;
         let layout = crate::direct::ParameterLayout::new(&self.model, terms);
@@ -303,11 +340,16 @@ impl PyRobot {
         let phi = detached(py, "Robot.regressor", || {
             crate::direct::regressor_matrix(&self.model, &layout, &batch.states(n)?, gravity.into())
         })?;
-        let rows: Vec<f64> = (0..phi.nrows())
-            .flat_map(|r| (0..total).map(move |c| (r, c)))
-            .map(|(r, c)| phi[(r, c)])
-            .collect();
-        to_numpy(py, rows, batch.k, batch.single, &[n, total])
+        let out = output_array(py, out, batch.k, batch.single, &[n, total])?;
+        write_into(&out, |values| {
+            for (r, row) in values.chunks_mut(total).enumerate() {
+                for (c, x) in row.iter_mut().enumerate() {
+                    *x = phi[(r, c)];
+                }
+            }
+            Ok(())
+        })?;
+        Ok(out.into_any())
     }
 
     /// Physical consistency of a full parameter vector `theta` (default: the model's own
@@ -362,7 +404,7 @@ impl PyRobot {
     }
 
     /// Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) [- g(q)]). Shapes as `rnea`.
-    #[pyo3(signature = (q, qd, tau, gravity=true))]
+    #[pyo3(signature = (q, qd, tau, gravity=true, out=None))]
     fn forward_dynamics<'py>(
         &self,
         py: Python<'py>,
@@ -370,29 +412,25 @@ impl PyRobot {
         qd: ArrayLike<'py>,
         tau: ArrayLike<'py>,
         gravity: bool,
+        out: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.model.nv;
         // tau rides as the third column; the states are q and qd only
         let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("tau", &tau)])?;
-        let mut out = vec![0.0; batch.k * n];
-        detached(py, "Robot.forward_dynamics", || -> Result<()> {
-            let c = &batch.columns;
-            let states = if batch.single {
-                States::single(n, &c[0], Some(&c[1]), None)?
-            } else {
-                States::new(n, &c[0], Some(&c[1]), None)?
-            };
-            let mut w = self.workspace();
-            parallel::forward_dynamics(
-                &self.model,
-                &mut w,
-                &states,
-                &c[2],
-                gravity.into(),
-                &mut out,
-            )
+        let array = output_array(py, out, batch.k, batch.single, &[n])?;
+        write_into(&array, |out| {
+            detached(py, "Robot.forward_dynamics", || -> Result<()> {
+                let c = &batch.columns;
+                let states = if batch.single {
+                    States::single(n, &c[0], Some(&c[1]), None)?
+                } else {
+                    States::new(n, &c[0], Some(&c[1]), None)?
+                };
+                let mut w = self.workspace();
+                parallel::forward_dynamics(&self.model, &mut w, &states, &c[2], gravity.into(), out)
+            })
         })?;
-        to_numpy(py, out, batch.k, batch.single, &[n])
+        Ok(array.into_any())
     }
 
     /// The linearisation at the operating point (q, qd, qdd), computed analytically:

@@ -49,10 +49,8 @@ impl<const W: usize> Lanes<W> {
     /// Whether any lane is NaN or larger than `bound` in magnitude.
     #[inline(always)]
     pub(crate) fn any_nan_or_beyond(self, bound: f64) -> bool {
-        // `!(|x| <= bound)` is true for NaN too; reduced without branches per lane
-        self.0
-            .iter()
-            .fold(false, |acc, x| acc | !(x.abs() <= bound))
+        // NaN fails `<=` too; reduced without a branch per lane
+        !self.0.iter().fold(true, |acc, x| acc & (x.abs() <= bound))
     }
 }
 

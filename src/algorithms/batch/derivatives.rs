@@ -145,9 +145,9 @@ impl<const W: usize> Matrix6Lanes<W> {
         let c = [x.ang.x, x.ang.y, x.ang.z, x.lin.x, x.lin.y, x.lin.z];
         let mut ang = self.0[0].ang.mul_lanes(c[0]);
         let mut lin = self.0[0].lin.mul_lanes(c[0]);
-        for k in 1..6 {
-            ang = self.0[k].ang.mul_lanes_add(c[k], &ang);
-            lin = self.0[k].lin.mul_lanes_add(c[k], &lin);
+        for (col, ck) in self.0.iter().zip(c).skip(1) {
+            ang = col.ang.mul_lanes_add(ck, &ang);
+            lin = col.lin.mul_lanes_add(ck, &lin);
         }
         SpatialLanes { ang, lin }
     }

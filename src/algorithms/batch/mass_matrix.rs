@@ -136,9 +136,9 @@ pub(crate) fn transformed<const W: usize>(
     let d = p.dot(&w) * 2.0;
     let ri = [0, 1, 2].map(|row| r.0[row].mul_const(&b.i)); // rows of R I (I symmetric)
     let mut i = Rotation3Lanes::default();
-    for row in 0..3 {
+    for (row, ri_row) in ri.iter().enumerate() {
         let e = |c: usize| {
-            let v = ri[row].dot(&r.0[c]);
+            let v = ri_row.dot(&r.0[c]);
             let v = w
                 .get(row)
                 .neg_mul_add(p.get(c), p.get(row).neg_mul_add(w.get(c), v));

@@ -1,0 +1,151 @@
+// The Pinocchio side of benches/compare_pinocchio.py: Pinocchio's C++ algorithms one call at a
+// time over the samples the script wrote, timed in this process. Built by the script against
+// the headers and libraries of the `pin` wheel (and Eigen); not part of the library.
+//
+//   pinocchio_peer MODEL.bin DIR K REPEATS
+//
+// MODEL.bin: the model saved by pinocchio.Model.saveToBinary. DIR holds q.bin, qd.bin, qdd.bin
+// and tau.bin (K x nv float64, row-major). Writes DIR/pin_<kernel>.bin (the results of every
+// sample, row-major) and prints one JSON line per kernel: {"kernel", "ns_per_call" (median over
+// REPEATS passes), "passes_ns"}.
+#include <pinocchio/multibody.hpp>
+#include <pinocchio/algorithm/aba.hpp>
+#include <pinocchio/algorithm/crba.hpp>
+#include <pinocchio/algorithm/regressor.hpp>
+#include <pinocchio/algorithm/rnea-derivatives.hpp>
+#include <pinocchio/algorithm/rnea.hpp>
+#include <pinocchio/serialization.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <string>
+#include <vector>
+
+using Clock = std::chrono::steady_clock;
+
+static std::vector<double> read_all(const std::string& path, size_t count) {
+  std::vector<double> v(count);
+  FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f || std::fread(v.data(), sizeof(double), count, f) != count) {
+    std::fprintf(stderr, "cannot read %zu values from %s\n", count, path.c_str());
+    std::exit(2);
+  }
+  std::fclose(f);
+  return v;
+}
+
+static void write_all(const std::string& path, const std::vector<double>& v) {
+  FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f || std::fwrite(v.data(), sizeof(double), v.size(), f) != v.size()) {
+    std::fprintf(stderr, "cannot write %s\n", path.c_str());
+    std::exit(2);
+  }
+  std::fclose(f);
+}
+
+int main(int argc, char** argv) {
+  if (argc != 5) {
+    std::fprintf(stderr, "usage: pinocchio_peer MODEL.bin DIR K REPEATS\n");
+    return 2;
+  }
+  pinocchio::Model model;
+  model.loadFromBinary(argv[1]);
+  pinocchio::Data data(model);
+  const std::string dir = argv[2];
+  const long k = std::atol(argv[3]);
+  const int repeats = std::atoi(argv[4]);
+  const long n = model.nv;
+  if (model.nq != model.nv || k <= 0 || repeats <= 0) {
+    std::fprintf(stderr, "needs nq == nv, K > 0, REPEATS > 0\n");
+    return 2;
+  }
+  auto q = read_all(dir + "/q.bin", k * n), qd = read_all(dir + "/qd.bin", k * n),
+       qdd = read_all(dir + "/qdd.bin", k * n), tau = read_all(dir + "/tau.bin", k * n);
+  using Map = Eigen::Map<const Eigen::VectorXd>;
+  auto at = [&](const std::vector<double>& x, long s) { return Map(x.data() + s * n, n); };
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+
+  // each kernel: compute sample s (timed), then store sample s's results (untimed pass)
+  struct Kernel {
+    std::string name;
+    long per_sample;
+    std::function<void(long)> compute;
+    std::function<void(long, double*)> store;
+  };
+  auto copy = [](const Eigen::MatrixXd& m, double* out) {  // row-major
+    for (long r = 0; r < m.rows(); ++r)
+      for (long c = 0; c < m.cols(); ++c) out[r * m.cols() + c] = m(r, c);
+  };
+  Eigen::MatrixXd gs(n, n);
+  std::vector<Kernel> kernels = {
+      {"rnea", n, [&](long s) { pinocchio::rnea(model, data, at(q, s), at(qd, s), at(qdd, s)); },
+       [&](long, double* o) { Eigen::Map<Eigen::VectorXd>(o, n) = data.tau; }},
+      {"mass_matrix", n * n,
+       [&](long s) { pinocchio::crba(model, data, at(q, s), pinocchio::Convention::WORLD); },
+       [&](long, double* o) {
+         Eigen::MatrixXd m = data.M;
+         m.triangularView<Eigen::StrictlyLower>() = m.transpose().triangularView<Eigen::StrictlyLower>();
+         copy(m, o);
+       }},
+      {"regressor", n * 10 * (model.njoints - 1),
+       [&](long s) {
+         pinocchio::computeJointTorqueRegressor(model, data, at(q, s), at(qd, s), at(qdd, s));
+       },
+       [&](long, double* o) { copy(data.jointTorqueRegressor, o); }},
+      {"forward_dynamics", n,
+       [&](long s) { pinocchio::aba(model, data, at(q, s), at(qd, s), at(tau, s), pinocchio::Convention::WORLD); },
+       [&](long, double* o) { Eigen::Map<Eigen::VectorXd>(o, n) = data.ddq; }},
+      {"rnea_derivatives", n + 3 * n * n,
+       [&](long s) { pinocchio::computeRNEADerivatives(model, data, at(q, s), at(qd, s), at(qdd, s)); },
+       [&](long, double* o) {
+         Eigen::Map<Eigen::VectorXd>(o, n) = data.tau;
+         copy(data.dtau_dq, o + n);
+         copy(data.dtau_dv, o + n + n * n);
+         Eigen::MatrixXd m = data.M;
+         m.triangularView<Eigen::StrictlyLower>() = m.transpose().triangularView<Eigen::StrictlyLower>();
+         copy(m, o + n + 2 * n * n);
+       }},
+      // the local model: the derivatives at the point and the gravity derivative at rest
+      {"linearize", n + 4 * n * n,
+       [&](long s) {
+         pinocchio::computeRNEADerivatives(model, data, at(q, s), at(qd, s), at(qdd, s));
+         pinocchio::computeGeneralizedGravityDerivatives(model, data, at(q, s), gs);
+       },
+       [&](long, double* o) {
+         Eigen::Map<Eigen::VectorXd>(o, n) = data.tau;
+         Eigen::MatrixXd m = data.M;
+         m.triangularView<Eigen::StrictlyLower>() = m.transpose().triangularView<Eigen::StrictlyLower>();
+         copy(m, o + n);
+         copy(data.dtau_dv, o + n + n * n);
+         copy(data.dtau_dq, o + n + 2 * n * n);
+         copy(gs, o + n + 3 * n * n);
+       }},
+  };
+  const char* only = std::getenv("PEER_KERNELS");
+  for (auto& kern : kernels) {
+    if (only && std::string(only).find(kern.name) == std::string::npos) continue;
+    std::vector<double> passes;
+    for (int r = 0; r < repeats; ++r) {
+      auto t0 = Clock::now();
+      for (long s = 0; s < k; ++s) kern.compute(s);
+      passes.push_back(std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / k);
+    }
+    std::vector<double> out(k * kern.per_sample);
+    for (long s = 0; s < k; ++s) {
+      kern.compute(s);
+      kern.store(s, out.data() + s * kern.per_sample);
+    }
+    write_all(dir + "/pin_" + kern.name + ".bin", out);
+    std::vector<double> sorted = passes;
+    std::sort(sorted.begin(), sorted.end());
+    std::printf("{\"kernel\": \"%s\", \"ns_per_call\": %.3f, \"passes_ns\": [", kern.name.c_str(),
+                sorted[sorted.size() / 2]);
+    for (size_t i = 0; i < passes.size(); ++i) std::printf("%s%.3f", i ? ", " : "", passes[i]);
+    std::printf("]}\n");
+    std::fflush(stdout);
+  }
+  return 0;
+}
