@@ -27,30 +27,48 @@ impl<const W: usize> Lanes<W> {
     /// `self * b + c`, fused.
     #[inline(always)]
     pub(crate) fn mul_add(self, b: Lanes<W>, c: Lanes<W>) -> Lanes<W> {
-        Lanes(std::array::from_fn(|l| self.0[l].mul_add(b.0[l], c.0[l])))
+        let mut r = c.0;
+        for l in 0..W {
+            r[l] = self.0[l].mul_add(b.0[l], r[l]);
+        }
+        Lanes(r)
     }
     /// `self * b + c` for a constant `b`, fused.
     #[inline(always)]
     pub(crate) fn mul_add_s(self, b: f64, c: Lanes<W>) -> Lanes<W> {
-        Lanes(std::array::from_fn(|l| self.0[l].mul_add(b, c.0[l])))
+        let mut r = c.0;
+        for l in 0..W {
+            r[l] = self.0[l].mul_add(b, r[l]);
+        }
+        Lanes(r)
     }
     /// `self * b - c`, fused.
     #[inline(always)]
     pub(crate) fn mul_sub(self, b: Lanes<W>, c: Lanes<W>) -> Lanes<W> {
-        Lanes(std::array::from_fn(|l| self.0[l].mul_add(b.0[l], -c.0[l])))
+        let mut r = c.0;
+        for l in 0..W {
+            r[l] = self.0[l].mul_add(b.0[l], -r[l]);
+        }
+        Lanes(r)
     }
     /// `c - self * b`, fused.
     #[inline(always)]
     pub(crate) fn neg_mul_add(self, b: Lanes<W>, c: Lanes<W>) -> Lanes<W> {
-        Lanes(std::array::from_fn(|l| {
-            (-self.0[l]).mul_add(b.0[l], c.0[l])
-        }))
+        let mut r = c.0;
+        for l in 0..W {
+            r[l] = (-self.0[l]).mul_add(b.0[l], r[l]);
+        }
+        Lanes(r)
     }
     /// Whether any lane is NaN or larger than `bound` in magnitude.
     #[inline(always)]
     pub(crate) fn any_nan_or_beyond(self, bound: f64) -> bool {
         // NaN fails `<=` too; reduced without a branch per lane
-        !self.0.iter().fold(true, |acc, x| acc & (x.abs() <= bound))
+        let mut inside = true;
+        for x in self.0 {
+            inside &= x.abs() <= bound;
+        }
+        !inside
     }
 }
 
@@ -60,14 +78,22 @@ macro_rules! lane_op {
             type Output = Lanes<W>;
             #[inline(always)]
             fn $f(self, o: Lanes<W>) -> Lanes<W> {
-                Lanes(std::array::from_fn(|l| self.0[l] $op o.0[l]))
+                let mut r = self.0;
+                for l in 0..W {
+                    r[l] = r[l] $op o.0[l];
+                }
+                Lanes(r)
             }
         }
         impl<const W: usize> std::ops::$tr<f64> for Lanes<W> {
             type Output = Lanes<W>;
             #[inline(always)]
             fn $f(self, o: f64) -> Lanes<W> {
-                Lanes(self.0.map(|a| a $op o))
+                let mut r = self.0;
+                for x in &mut r {
+                    *x = *x $op o;
+                }
+                Lanes(r)
             }
         }
     };
@@ -81,7 +107,11 @@ impl<const W: usize> std::ops::Neg for Lanes<W> {
     type Output = Lanes<W>;
     #[inline(always)]
     fn neg(self) -> Lanes<W> {
-        Lanes(self.0.map(|a| -a))
+        let mut r = self.0;
+        for x in &mut r {
+            *x = -*x;
+        }
+        Lanes(r)
     }
 }
 
@@ -205,14 +235,10 @@ impl<const W: usize> Vector3Lanes<W> {
     /// `m * self` for a constant matrix `m`.
     #[inline(always)]
     pub(crate) fn mul_const(&self, m: &Matrix3<f64>) -> Self {
-        let row = |r: usize| {
-            self.x
-                .mul_add_s(m[(r, 0)], self.y.mul_add_s(m[(r, 1)], self.z * m[(r, 2)]))
-        };
         Vector3Lanes {
-            x: row(0),
-            y: row(1),
-            z: row(2),
+            x: self.dot_const(&m.row(0).transpose()),
+            y: self.dot_const(&m.row(1).transpose()),
+            z: self.dot_const(&m.row(2).transpose()),
         }
     }
     /// Component `k` (0, 1, 2).
@@ -241,12 +267,12 @@ impl<const W: usize> Rotation3Lanes<W> {
     /// `self * o`.
     #[inline(always)]
     pub(crate) fn compose(&self, o: &Self) -> Self {
-        let row = |a: &Vector3Lanes<W>| Vector3Lanes {
-            x: a.x.mul_add(o.0[0].x, a.y.mul_add(o.0[1].x, a.z * o.0[2].x)),
-            y: a.x.mul_add(o.0[0].y, a.y.mul_add(o.0[1].y, a.z * o.0[2].y)),
-            z: a.x.mul_add(o.0[0].z, a.y.mul_add(o.0[1].z, a.z * o.0[2].z)),
-        };
-        Rotation3Lanes([row(&self.0[0]), row(&self.0[1]), row(&self.0[2])])
+        // row r of the product is row r of self times o: o^T applied to that row
+        Rotation3Lanes([
+            o.tr_mul(&self.0[0]),
+            o.tr_mul(&self.0[1]),
+            o.tr_mul(&self.0[2]),
+        ])
     }
     /// Column `k`.
     #[inline(always)]

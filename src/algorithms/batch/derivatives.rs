@@ -154,17 +154,17 @@ impl<const W: usize> Matrix6Lanes<W> {
     /// `self^T * x`.
     #[inline(always)]
     fn tr_mul(&self, x: &SpatialLanes<W>) -> SpatialLanes<W> {
-        let e = |k: usize| self.0[k].dot(x);
+        let c = &self.0;
         SpatialLanes {
             ang: Vector3Lanes {
-                x: e(0),
-                y: e(1),
-                z: e(2),
+                x: c[0].dot(x),
+                y: c[1].dot(x),
+                z: c[2].dot(x),
             },
             lin: Vector3Lanes {
-                x: e(3),
-                y: e(4),
-                z: e(5),
+                x: c[3].dot(x),
+                y: c[4].dot(x),
+                z: c[5].dot(x),
             },
         }
     }

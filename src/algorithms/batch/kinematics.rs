@@ -16,33 +16,28 @@ pub(crate) fn pose<const W: usize>(b: &Body, x: Lanes<W>) -> (Rotation3Lanes<W>,
             let (s, c) = sin_cos(x);
             let c1 = Lanes::splat(1.0) - c;
             let t = &b.pose_terms;
-            let row = |r: usize| {
-                let e = |k: usize| {
-                    s.mul_add_s(
-                        t.r1[(r, k)],
-                        c1.mul_add_s(t.r2[(r, k)], Lanes::splat(p.rotation[(r, k)])),
-                    )
-                };
-                Vector3Lanes {
-                    x: e(0),
-                    y: e(1),
-                    z: e(2),
+            let mut rot = Rotation3Lanes::default();
+            for (r, row) in rot.0.iter_mut().enumerate() {
+                let mut e = [Lanes::default(); 3];
+                for (k, ek) in e.iter_mut().enumerate() {
+                    let r0 = Lanes::splat(p.rotation[(r, k)]);
+                    *ek = s.mul_add_s(t.r1[(r, k)], c1.mul_add_s(t.r2[(r, k)], r0));
                 }
-            };
-            (
-                Rotation3Lanes([row(0), row(1), row(2)]),
-                Vector3Lanes::splat(&p.translation),
-            )
+                *row = Vector3Lanes {
+                    x: e[0],
+                    y: e[1],
+                    z: e[2],
+                };
+            }
+            (rot, Vector3Lanes::splat(&p.translation))
         }
         JointKind::Prismatic => {
-            let row = |r: usize| Vector3Lanes {
-                x: Lanes::splat(p.rotation[(r, 0)]),
-                y: Lanes::splat(p.rotation[(r, 1)]),
-                z: Lanes::splat(p.rotation[(r, 2)]),
-            };
+            let rot = Rotation3Lanes(
+                [0, 1, 2].map(|r| Vector3Lanes::splat(&p.rotation.row(r).transpose().into_owned())),
+            );
             let t1 = &b.pose_terms.t1;
             (
-                Rotation3Lanes([row(0), row(1), row(2)]),
+                rot,
                 Vector3Lanes::of(t1, x).add(&Vector3Lanes::splat(&p.translation)),
             )
         }

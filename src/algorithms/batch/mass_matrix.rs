@@ -134,24 +134,26 @@ pub(crate) fn transformed<const W: usize>(
     let hr = r.mul_const_vector(&b.h);
     let w = p.scale_add(0.5 * b.mass, &hr);
     let d = p.dot(&w) * 2.0;
-    let ri = [0, 1, 2].map(|row| r.0[row].mul_const(&b.i)); // rows of R I (I symmetric)
+    // rows of R I (I symmetric), then R I R^T - w p^T - p w^T + d 1
+    let ri = [
+        r.0[0].mul_const(&b.i),
+        r.0[1].mul_const(&b.i),
+        r.0[2].mul_const(&b.i),
+    ];
     let mut i = Rotation3Lanes::default();
     for (row, ri_row) in ri.iter().enumerate() {
-        let e = |c: usize| {
+        let mut e = [Lanes::default(); 3];
+        for (c, ec) in e.iter_mut().enumerate() {
             let v = ri_row.dot(&r.0[c]);
             let v = w
                 .get(row)
                 .neg_mul_add(p.get(c), p.get(row).neg_mul_add(w.get(c), v));
-            if c == row {
-                v + d
-            } else {
-                v
-            }
-        };
+            *ec = if c == row { v + d } else { v };
+        }
         i.0[row] = Vector3Lanes {
-            x: e(0),
-            y: e(1),
-            z: e(2),
+            x: e[0],
+            y: e[1],
+            z: e[2],
         };
     }
     Composite {

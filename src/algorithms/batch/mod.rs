@@ -110,18 +110,26 @@ impl<const W: usize> LaneBuffers<W> {
     pub(crate) fn load(&mut self, model: &Model, x: [&[f64]; 3], first: usize) {
         let nv = model.nv;
         let k = x[0].len() / nv.max(1);
-        let lane = |l: usize| (first + l).min(k.max(1) - 1);
+        // the sample of each lane: past the last sample, the last again
+        let mut rows = [0usize; W];
+        for (l, r) in rows.iter_mut().enumerate() {
+            *r = (first + l).min(k.max(1) - 1) * nv;
+        }
         for (i, b) in model.bodies.iter().enumerate() {
-            let get = |x: &[f64], l: usize| {
-                if x.is_empty() {
-                    0.0
-                } else {
-                    b.multiplier * x[lane(l) * nv + b.dof]
+            let mut lanes = [[0.0; W]; 3];
+            for (x, out) in x.iter().zip(&mut lanes) {
+                if !x.is_empty() {
+                    for (o, r) in out.iter_mut().zip(&rows) {
+                        *o = b.multiplier * x[r + b.dof];
+                    }
                 }
-            };
-            self.qb[i] = Lanes(std::array::from_fn(|l| get(x[0], l) + b.offset));
-            self.vb[i] = Lanes(std::array::from_fn(|l| get(x[1], l)));
-            self.ab[i] = Lanes(std::array::from_fn(|l| get(x[2], l)));
+            }
+            for o in &mut lanes[0] {
+                *o += b.offset;
+            }
+            self.qb[i] = Lanes(lanes[0]);
+            self.vb[i] = Lanes(lanes[1]);
+            self.ab[i] = Lanes(lanes[2]);
         }
     }
 }
