@@ -22,49 +22,13 @@ use perturbid_rs::algorithms::regressor::joint_torque_regressor;
 use perturbid_rs::{
     aba, forward_dynamics_crba, linearize_into, mass_matrix, mass_matrix_batch, parallel,
     regressor_batch, rnea, rnea_derivatives, rnea_lanes, robots, Data, Gravity, Isa, LaneData,
-    Linearization, LoadOptions, Model, States,
+    Linearization, Model, States,
 };
 use std::hint::black_box;
 use std::time::Duration;
 
 /// Samples per batch.
 const BATCH: usize = 1024;
-
-/// The robots: A465, Panda (fingers locked) when its URDF is installed, a 60-dof tree.
-fn robots() -> Vec<(&'static str, Model)> {
-    let mut out = vec![("a465", robots::builtin("a465").expect("built-in A465"))];
-    match panda() {
-        Some(m) => out.push(("panda", m)),
-        None => eprintln!(
-            "skipped the Panda: example-robot-data's panda.urdf is not installed \
-             (pip install example-robot-data)"
-        ),
-    }
-    let tree = common::random_tree_urdf(60, 60);
-    let tree = perturbid_rs::model_from_urdf_str(&tree, "tree60", &LoadOptions::default())
-        .expect("60-link tree");
-    out.push(("tree60", tree));
-    out
-}
-
-/// example-robot-data's Panda under the running Python's site-packages, fingers locked.
-pub fn panda() -> Option<Model> {
-    let out = std::process::Command::new("python3")
-        .args([
-            "-c",
-            "import sysconfig; print(sysconfig.get_paths()['purelib'])",
-        ])
-        .output()
-        .ok()?;
-    let site = String::from_utf8(out.stdout).ok()?;
-    let path = std::path::Path::new(site.trim())
-        .join("cmeel.prefix/share/example-robot-data/robots/panda_description/urdf/panda.urdf");
-    let mut options = LoadOptions::default();
-    for j in ["panda_finger_joint1", "panda_finger_joint2"] {
-        options.lock.insert(j.to_string(), 0.0);
-    }
-    perturbid_rs::model_from_urdf_file(&path, &options).ok()
-}
 
 /// `BATCH` random states (rad, rad/s, rad/s^2), row-major.
 fn states(model: &Model) -> [Vec<f64>; 3] {
@@ -74,7 +38,7 @@ fn states(model: &Model) -> [Vec<f64>; 3] {
 }
 
 fn dynamics(c: &mut Criterion) {
-    for (robot, model) in robots() {
+    for (robot, model) in common::speed_robots() {
         let (n, p) = (model.nv, 10 * model.nbodies());
         let [q, qd, qdd] = states(&model);
         let mut data = Data::new(&model);

@@ -2,26 +2,12 @@
 //! lies beside the repository (docs/data.md), against the reference protocol's errors, and
 //! physically consistent.
 
+mod common;
+
+use common::panda_urdf;
 use perturbid_rs::direct::{identify_base_parameters, BaseOptions, Weighting};
 use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::{LoadOptions, Recording, States};
-
-/// The example-robot-data Panda URDF, found through the Python installation that the test
-/// script sets up (`pip install example-robot-data`); `None` when it is not installed.
-fn panda_urdf() -> Option<std::path::PathBuf> {
-    let out =
-        std::process::Command::new(std::env::var("PYTHON").unwrap_or_else(|_| "python3".into()))
-            .args([
-                "-c",
-                "import sysconfig; print(sysconfig.get_paths()['purelib'])",
-            ])
-            .output()
-            .ok()?;
-    let purelib = String::from_utf8(out.stdout).unwrap();
-    let path = std::path::Path::new(purelib.trim())
-        .join("cmeel.prefix/share/example-robot-data/robots/panda_description/urdf/panda.urdf");
-    path.is_file().then_some(path)
-}
 
 /// Real data (the Panda log of Gaz et al. 2019, which lies beside the repository in
 /// `../shared/data/panda-gaz2019`; see docs/data.md): the reference protocol reaches the

@@ -14,8 +14,10 @@
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 
-pub use super::batch::LinearizationsOut;
-use super::batch::{linearize_batch, mass_matrix_batch, regressor_batch, rnea_lanes, LaneData};
+use super::batch::{
+    derivatives_batch, linearize_batch, mass_matrix_batch, regressor_batch, rnea_lanes, LaneData,
+};
+pub use super::batch::{DerivativesOut, LinearizationsOut};
 use super::regressor::{joint_torque_regressor, PARAMS_PER_BODY};
 use crate::data::Data;
 use crate::error::{Error, Result};
@@ -280,6 +282,44 @@ pub fn forward_dynamics(
                 o.copy_from_slice(w.data.qdd.as_slice());
             }
             Ok(())
+        },
+    )
+}
+
+/// Inverse dynamics and its analytic partial derivatives (see [`crate::rnea_derivatives`]) at
+/// every sample, written into `out` (row-major: `tau` `k x nv`, the matrices `k x nv x nv`).
+pub fn rnea_derivatives(
+    model: &Model,
+    ws: &mut Workspace,
+    states: &States<'_>,
+    gravity: Gravity,
+    out: DerivativesOut<'_>,
+) -> Result<()> {
+    let (n, nn) = (model.nv, model.nv * model.nv);
+    let mut outs = [
+        ("tau", out.tau, n),
+        ("d tau / d q", out.dtau_dq, nn),
+        ("d tau / d qd", out.dtau_dv, nn),
+        ("M", out.m, nn),
+    ];
+    run(
+        "rnea_derivatives",
+        model,
+        ws,
+        states,
+        &mut outs,
+        |w, s, out| {
+            let (qd, qdd) = (s.qd_or_zeros(), s.qdd_or_zeros());
+            if let [tau, dtau_dq, dtau_dv, m] = out {
+                let out = DerivativesOut {
+                    tau,
+                    dtau_dq,
+                    dtau_dv,
+                    m,
+                };
+                return derivatives_batch(model, &mut w.lanes, s.q(), &qd, &qdd, gravity, out);
+            }
+            unreachable!("four outputs")
         },
     )
 }

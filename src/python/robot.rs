@@ -433,6 +433,75 @@ impl PyRobot {
         Ok(array.into_any())
     }
 
+    /// Inverse dynamics and its analytic partial derivatives at (q, qd, qdd): returns
+    /// `(tau, dtau_dq, dtau_dv, M)` with `tau` shaped like `q` and the matrices `(n, n)` or
+    /// `(k, n, n)` (entry `[i, j]` is `d tau_i / d q_j`, `d tau_i / d qd_j`, `M[i, j]`).
+    /// Pinocchio's `computeRNEADerivatives`. With `out`, a tuple of four arrays of those shapes
+    /// (float64, C-contiguous, writeable) that are written and returned instead of new ones.
+    #[pyo3(signature = (q, qd, qdd, gravity=true, out=None))]
+    #[allow(clippy::type_complexity)]
+    fn rnea_derivatives<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayLike<'py>,
+        qd: ArrayLike<'py>,
+        qdd: ArrayLike<'py>,
+        gravity: bool,
+        out: Option<(
+            Bound<'py, PyAny>,
+            Bound<'py, PyAny>,
+            Bound<'py, PyAny>,
+            Bound<'py, PyAny>,
+        )>,
+    ) -> PyResult<(
+        Bound<'py, PyAny>,
+        Bound<'py, PyAny>,
+        Bound<'py, PyAny>,
+        Bound<'py, PyAny>,
+    )> {
+        let n = self.model.nv;
+        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
+        let (k, single) = (batch.k, batch.single);
+        let (o0, o1, o2, o3) = match out {
+            Some((a, b, c, d)) => (Some(a), Some(b), Some(c), Some(d)),
+            None => (None, None, None, None),
+        };
+        let tau = output_array(py, o0, k, single, &[n])?;
+        let dq = output_array(py, o1, k, single, &[n, n])?;
+        let dv = output_array(py, o2, k, single, &[n, n])?;
+        let m = output_array(py, o3, k, single, &[n, n])?;
+        write_into(&tau, |tau| {
+            write_into(&dq, |dtau_dq| {
+                write_into(&dv, |dtau_dv| {
+                    write_into(&m, |m| {
+                        let work = || {
+                            let states = batch.states(n)?;
+                            let out = parallel::DerivativesOut {
+                                tau,
+                                dtau_dq,
+                                dtau_dv,
+                                m,
+                            };
+                            parallel::rnea_derivatives(
+                                &self.model,
+                                &mut self.workspace(),
+                                &states,
+                                gravity.into(),
+                                out,
+                            )
+                        };
+                        if k * (n + 1) < DETACH_FROM {
+                            crate::error::catch_panics("Robot.rnea_derivatives", work)
+                        } else {
+                            detached(py, "Robot.rnea_derivatives", work)
+                        }
+                    })
+                })
+            })
+        })?;
+        Ok((tau.into_any(), dq.into_any(), dv.into_any(), m.into_any()))
+    }
+
     /// The linearisation at the operating point (q, qd, qdd), computed analytically:
     /// `tau - T* ~= D dqdd + H dqd + G dq`. Returns a `Linearization` (see its attributes);
     /// with a batch (k, n) every attribute gains a leading axis k.

@@ -6,7 +6,19 @@
 //! ([`f64::mul_add`]), which those sets do in one instruction. Only call these from code compiled
 //! for such a set: elsewhere `mul_add` is a library call.
 
+// index loops over the lanes: the form the compiler turns into one vector instruction
+#![allow(clippy::needless_range_loop)]
+
 use nalgebra::{Matrix3, Vector3};
+
+/// Counts `n` floating-point operations (with the `count-flops` feature; nothing otherwise).
+#[inline(always)]
+fn flops(n: usize) {
+    #[cfg(feature = "count-flops")]
+    super::flops::add(n);
+    #[cfg(not(feature = "count-flops"))]
+    let _ = n;
+}
 
 /// One scalar per lane.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,6 +39,7 @@ impl<const W: usize> Lanes<W> {
     /// `self * b + c`, fused.
     #[inline(always)]
     pub(crate) fn mul_add(self, b: Lanes<W>, c: Lanes<W>) -> Lanes<W> {
+        flops(2 * W);
         let mut r = c.0;
         for l in 0..W {
             r[l] = self.0[l].mul_add(b.0[l], r[l]);
@@ -36,6 +49,7 @@ impl<const W: usize> Lanes<W> {
     /// `self * b + c` for a constant `b`, fused.
     #[inline(always)]
     pub(crate) fn mul_add_s(self, b: f64, c: Lanes<W>) -> Lanes<W> {
+        flops(2 * W);
         let mut r = c.0;
         for l in 0..W {
             r[l] = self.0[l].mul_add(b, r[l]);
@@ -45,6 +59,7 @@ impl<const W: usize> Lanes<W> {
     /// `self * b - c`, fused.
     #[inline(always)]
     pub(crate) fn mul_sub(self, b: Lanes<W>, c: Lanes<W>) -> Lanes<W> {
+        flops(2 * W);
         let mut r = c.0;
         for l in 0..W {
             r[l] = self.0[l].mul_add(b.0[l], -r[l]);
@@ -54,6 +69,7 @@ impl<const W: usize> Lanes<W> {
     /// `c - self * b`, fused.
     #[inline(always)]
     pub(crate) fn neg_mul_add(self, b: Lanes<W>, c: Lanes<W>) -> Lanes<W> {
+        flops(2 * W);
         let mut r = c.0;
         for l in 0..W {
             r[l] = (-self.0[l]).mul_add(b.0[l], r[l]);
@@ -78,6 +94,7 @@ macro_rules! lane_op {
             type Output = Lanes<W>;
             #[inline(always)]
             fn $f(self, o: Lanes<W>) -> Lanes<W> {
+                flops(W);
                 let mut r = self.0;
                 for l in 0..W {
                     r[l] = r[l] $op o.0[l];
@@ -89,6 +106,7 @@ macro_rules! lane_op {
             type Output = Lanes<W>;
             #[inline(always)]
             fn $f(self, o: f64) -> Lanes<W> {
+                flops(W);
                 let mut r = self.0;
                 for x in &mut r {
                     *x = *x $op o;
@@ -343,13 +361,6 @@ impl<const W: usize> SpatialLanes<W> {
         SpatialLanes {
             ang: self.ang.add(&o.ang),
             lin: self.lin.add(&o.lin),
-        }
-    }
-    #[inline(always)]
-    pub(crate) fn sub(&self, o: &Self) -> Self {
-        SpatialLanes {
-            ang: self.ang.sub(&o.ang),
-            lin: self.lin.sub(&o.lin),
         }
     }
     /// The pairing `<self, o>` of a motion and a force (or the 6-vector dot product).

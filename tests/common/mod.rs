@@ -221,3 +221,48 @@ pub fn exact_local(
         diagnostics: Default::default(),
     }
 }
+
+/// The example-robot-data Panda URDF, found through the Python installation that the test
+/// script sets up (`pip install example-robot-data`); `None` when it is not installed.
+pub fn panda_urdf() -> Option<std::path::PathBuf> {
+    let out =
+        std::process::Command::new(std::env::var("PYTHON").unwrap_or_else(|_| "python3".into()))
+            .args([
+                "-c",
+                "import sysconfig; print(sysconfig.get_paths()['purelib'])",
+            ])
+            .output()
+            .ok()?;
+    let purelib = String::from_utf8(out.stdout).ok()?;
+    let path = std::path::Path::new(purelib.trim())
+        .join("cmeel.prefix/share/example-robot-data/robots/panda_description/urdf/panda.urdf");
+    path.is_file().then_some(path)
+}
+
+/// That Panda with its fingers locked (7 dofs); `None` when the URDF is not installed.
+pub fn panda_model() -> Option<perturbid_rs::Model> {
+    let mut options = perturbid_rs::LoadOptions::default();
+    for j in ["panda_finger_joint1", "panda_finger_joint2"] {
+        options.lock.insert(j.to_string(), 0.0);
+    }
+    perturbid_rs::model_from_urdf_file(&panda_urdf()?, &options).ok()
+}
+
+/// The robots of the speed comparisons: the A465, the Panda when installed, a 60-dof tree.
+pub fn speed_robots() -> Vec<(&'static str, perturbid_rs::Model)> {
+    let mut out = vec![("a465", perturbid_rs::robots::builtin("a465").unwrap())];
+    match panda_model() {
+        Some(m) => out.push(("panda", m)),
+        None => eprintln!(
+            "skipped the Panda: example-robot-data's panda.urdf is not installed \
+             (pip install example-robot-data)"
+        ),
+    }
+    let tree = random_tree_urdf(60, 60);
+    let options = perturbid_rs::LoadOptions::default();
+    out.push((
+        "tree60",
+        perturbid_rs::model_from_urdf_str(&tree, "tree60", &options).unwrap(),
+    ));
+    out
+}

@@ -10,7 +10,7 @@ use crate::error::Result;
 use crate::gravity::Gravity;
 use crate::linearization::{linearize_into, Linearization};
 use crate::model::Model;
-use crate::simd::{Lanes, SpatialLanes, Vector3Lanes};
+use crate::simd::{Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
 
 /// Where [`derivatives_batch`] writes, row-major over `k` samples.
 #[derive(Debug)]
@@ -128,70 +128,96 @@ struct Derivatives<'a> {
     g_static: Option<&'a mut [f64]>,
 }
 
-/// A 6x6 matrix per lane, by columns (each a spatial vector `[angular; linear]`).
+/// The time derivative of a body's (composite) inertia in the base frame moving with twist
+/// `v = (w, u)`, `dY = v x* Y - Y (v x) + (Y v) x-bar` (the 6x6 matrix of the recursion, per
+/// lane). For `Y` in origin form (mass `m`, first moment `h`, rotational inertia `I`) it has
+/// only two non-zero blocks: with `A = [w]x I`, `Y v = (hA, hL)`,
+///
+/// `dY = [[T, 0], [-2 [hL]x, 0]]`, `T = A + A^T - (h u^T + u h^T) + 2 (u . h) 1 - [hA]x`,
+///
+/// so it is kept as `T` (by rows) and `hL`; both add over composite bodies.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Matrix6Lanes<const W: usize>([SpatialLanes<W>; 6]);
+pub(crate) struct InertiaRate<const W: usize> {
+    t: Rotation3Lanes<W>,
+    hl: Vector3Lanes<W>,
+}
 
-impl<const W: usize> Default for Matrix6Lanes<W> {
+impl<const W: usize> Default for InertiaRate<W> {
     fn default() -> Self {
-        Matrix6Lanes([SpatialLanes::default(); 6])
+        Self {
+            t: Rotation3Lanes::default(),
+            hl: Vector3Lanes::default(),
+        }
     }
 }
 
-impl<const W: usize> Matrix6Lanes<W> {
-    /// `self * x`.
+impl<const W: usize> InertiaRate<W> {
+    /// `dY` of the inertia `y` moving with twist `v`; `yv = Y v`.
+    #[inline(always)]
+    fn new(y: &Composite<W>, v: &SpatialLanes<W>, yv: &SpatialLanes<W>) -> Self {
+        let (w, u, h) = (&v.ang, &v.lin, &y.h);
+        let ir = &y.i.0; // rows of I
+                         // rows of A = [w]x I: row r is sum_k [w]x[r][k] I_k
+        let a = [
+            ir[2].mul_lanes(w.y).sub(&ir[1].mul_lanes(w.z)),
+            ir[0].mul_lanes(w.z).sub(&ir[2].mul_lanes(w.x)),
+            ir[1].mul_lanes(w.x).sub(&ir[0].mul_lanes(w.y)),
+        ];
+        let uh2 = u.dot(h) * 2.0;
+        let ha = &yv.ang;
+        let mut t = Rotation3Lanes::default();
+        for r in 0..3 {
+            let mut e = [Lanes::default(); 3];
+            for (c, ec) in e.iter_mut().enumerate() {
+                let v = a[r].get(c) + a[c].get(r);
+                let v = h
+                    .get(r)
+                    .neg_mul_add(u.get(c), u.get(r).neg_mul_add(h.get(c), v));
+                *ec = if r == c { v + uh2 } else { v };
+            }
+            // - [hA]x: (0, hz, -hy; -hz, 0, hx; hy, -hx, 0)
+            match r {
+                0 => {
+                    e[1] = e[1] + ha.z;
+                    e[2] = e[2] - ha.y;
+                }
+                1 => {
+                    e[0] = e[0] - ha.z;
+                    e[2] = e[2] + ha.x;
+                }
+                _ => {
+                    e[0] = e[0] + ha.y;
+                    e[1] = e[1] - ha.x;
+                }
+            }
+            t.0[r] = Vector3Lanes {
+                x: e[0],
+                y: e[1],
+                z: e[2],
+            };
+        }
+        Self { t, hl: yv.lin }
+    }
+    /// `dY x`.
     #[inline(always)]
     fn mul(&self, x: &SpatialLanes<W>) -> SpatialLanes<W> {
-        let c = [x.ang.x, x.ang.y, x.ang.z, x.lin.x, x.lin.y, x.lin.z];
-        let mut ang = self.0[0].ang.mul_lanes(c[0]);
-        let mut lin = self.0[0].lin.mul_lanes(c[0]);
-        for (col, ck) in self.0.iter().zip(c).skip(1) {
-            ang = col.ang.mul_lanes_add(ck, &ang);
-            lin = col.lin.mul_lanes_add(ck, &lin);
+        SpatialLanes {
+            ang: self.t.mul(&x.ang),
+            lin: x.ang.cross(&self.hl).scale(2.0),
         }
-        SpatialLanes { ang, lin }
     }
-    /// `self^T * x`.
+    /// `dY^T x`.
     #[inline(always)]
     fn tr_mul(&self, x: &SpatialLanes<W>) -> SpatialLanes<W> {
-        let c = &self.0;
         SpatialLanes {
-            ang: Vector3Lanes {
-                x: c[0].dot(x),
-                y: c[1].dot(x),
-                z: c[2].dot(x),
-            },
-            lin: Vector3Lanes {
-                x: c[3].dot(x),
-                y: c[4].dot(x),
-                z: c[5].dot(x),
-            },
+            ang: self.hl.cross(&x.lin).scale(2.0).add(&self.t.tr_mul(&x.ang)),
+            lin: Vector3Lanes::default(),
         }
     }
     #[inline(always)]
     fn add_assign(&mut self, o: &Self) {
-        for k in 0..6 {
-            self.0[k] = self.0[k].add(&o.0[k]);
-        }
-    }
-}
-
-/// The unit spatial vector along coordinate `k` (0-2 angular, 3-5 linear).
-#[inline(always)]
-fn unit<const W: usize>(k: usize) -> SpatialLanes<W> {
-    let mut e = [Lanes::default(); 6];
-    e[k] = Lanes::splat(1.0);
-    SpatialLanes {
-        ang: Vector3Lanes {
-            x: e[0],
-            y: e[1],
-            z: e[2],
-        },
-        lin: Vector3Lanes {
-            x: e[3],
-            y: e[4],
-            z: e[5],
-        },
+        self.t = self.t.add(&o.t);
+        self.hl = self.hl.add(&o.hl);
     }
 }
 
@@ -216,7 +242,7 @@ impl<const W: usize> Composite<W> {
 #[derive(Clone, Debug)]
 pub(crate) struct Buffers<const W: usize> {
     ycrb: Vec<Composite<W>>,
-    dycrb: Vec<Matrix6Lanes<W>>,
+    dycrb: Vec<InertiaRate<W>>,
     j: Vec<SpatialLanes<W>>,
     ov: Vec<SpatialLanes<W>>,
     oa: Vec<SpatialLanes<W>>,
@@ -228,11 +254,16 @@ pub(crate) struct Buffers<const W: usize> {
     dfdq: Vec<SpatialLanes<W>>,
     dfdv: Vec<SpatialLanes<W>>,
     dytj: Vec<SpatialLanes<W>>,
+    /// The same at rest (for `Gs`).
+    of_rest: Vec<SpatialLanes<W>>,
+    dadq_rest: Vec<SpatialLanes<W>>,
+    dfdq_rest: Vec<SpatialLanes<W>>,
     /// Body-level results: torques and row-major `nbodies x nbodies` matrices.
     tau: Vec<Lanes<W>>,
     m: Vec<Lanes<W>>,
     dq: Vec<Lanes<W>>,
     dv: Vec<Lanes<W>>,
+    gs: Vec<Lanes<W>>,
 }
 
 impl<const W: usize> Buffers<W> {
@@ -240,7 +271,7 @@ impl<const W: usize> Buffers<W> {
         let s = vec![SpatialLanes::default(); nb];
         Self {
             ycrb: vec![Composite::default(); nb],
-            dycrb: vec![Matrix6Lanes::default(); nb],
+            dycrb: vec![InertiaRate::default(); nb],
             j: s.clone(),
             ov: s.clone(),
             oa: s.clone(),
@@ -251,11 +282,15 @@ impl<const W: usize> Buffers<W> {
             dfda: s.clone(),
             dfdq: s.clone(),
             dfdv: s.clone(),
-            dytj: s,
+            dytj: s.clone(),
+            of_rest: s.clone(),
+            dadq_rest: s.clone(),
+            dfdq_rest: s,
             tau: vec![Lanes::default(); nb],
             m: vec![Lanes::default(); nb * nb],
             dq: vec![Lanes::default(); nb * nb],
             dv: vec![Lanes::default(); nb * nb],
+            gs: vec![Lanes::default(); nb * nb],
         }
     }
 }
@@ -275,7 +310,7 @@ impl LaneKernel for Derivatives<'_> {
         while first < self.k {
             let used = (self.k - first).min(W);
             data.load(model, self.x, first);
-            recursion(model, data, &mut d, &minus_g);
+            recursion(model, data, &mut d, &minus_g, self.g_static.is_some());
             let [tau, m, dq, dv] = &mut self.out;
             for l in 0..used {
                 let s = first + l;
@@ -287,13 +322,9 @@ impl LaneKernel for Derivatives<'_> {
                 model.add_armature_inertia(&mut m[s * nn..(s + 1) * nn]);
             }
             if let Some(gs) = self.g_static.as_deref_mut() {
-                // at rest: the same poses, zero velocities and accelerations
-                data.vb.fill(Lanes::default());
-                data.ab.fill(Lanes::default());
-                recursion(model, data, &mut d, &minus_g);
                 for l in 0..used {
                     let s = first + l;
-                    write_matrix(model, &d.dq, l, &mut gs[s * nn..(s + 1) * nn]);
+                    write_matrix(model, &d.gs, l, &mut gs[s * nn..(s + 1) * nn]);
                 }
             }
             first += W;
@@ -374,6 +405,7 @@ fn recursion<const W: usize>(
     data: &mut LaneBuffers<W>,
     d: &mut Buffers<W>,
     minus_g: &crate::spatial::Motion,
+    at_rest: bool,
 ) {
     let nb = model.nbodies();
     let base_a = SpatialLanes {
@@ -397,16 +429,7 @@ fn recursion<const W: usize>(
         d.ov[i] = ov;
         d.oa[i] = oa;
         d.ycrb[i] = y;
-        // dY = v x* Y - Y (v x) + (Y v) x-bar, column by column: column c is
-        // v x* (Y e_c) - Y (v x e_c) + e_c x* (Y v)
-        let mut dy = Matrix6Lanes::default();
-        for (c, col) in dy.0.iter_mut().enumerate() {
-            let e = unit::<W>(c);
-            *col = ov
-                .cross_force(&y.apply(&e))
-                .sub(&y.apply(&ov.cross(&e)))
-                .add(&e.cross_force(&oh));
-        }
+        let dy = InertiaRate::new(&y, &ov, &oh);
         d.dycrb[i] = dy;
         d.j[i] = j;
         let mut dadq = oa_p.cross(&j);
@@ -421,9 +444,14 @@ fn recursion<const W: usize>(
         }
         d.dadq[i] = dadq;
         d.dadv[i] = dadv;
+        if at_rest {
+            // at rest every body accelerates with the base (gravity only): no velocity terms
+            d.of_rest[i] = y.apply(&base_a);
+            d.dadq_rest[i] = base_a.cross(&j);
+        }
     }
 
-    for x in [&mut d.m, &mut d.dq, &mut d.dv] {
+    for x in [&mut d.m, &mut d.dq, &mut d.dv, &mut d.gs] {
         x.fill(Lanes::default());
     }
     for i in (0..nb).rev() {
@@ -460,6 +488,24 @@ fn recursion<const W: usize>(
         }
         for k in i..end {
             d.dv[i * nb + k] = j.dot(&d.dfdv[k]);
+        }
+
+        // d g / d q at rest: the same recursion with v = 0 (so dY = 0, dv/dq = 0) and every
+        // body accelerating with the base
+        if at_rest {
+            d.dfdq_rest[i] = d.ycrb[i].apply(&d.dadq_rest[i]);
+            let dadq = d.dadq_rest[i];
+            for k in (i + 1)..end {
+                d.gs[k * nb + i] = d.dfda[k].dot(&dadq);
+            }
+            for k in i..end {
+                d.gs[i * nb + k] = j.dot(&d.dfdq_rest[k]);
+            }
+            d.dfdq_rest[i] = d.dfdq_rest[i].add(&j.cross_force(&d.of_rest[i]));
+            if let Some(p) = b.parent {
+                let fi = d.of_rest[i];
+                d.of_rest[p] = d.of_rest[p].add(&fi);
+            }
         }
 
         if let Some(p) = b.parent {
