@@ -1,113 +1,417 @@
-"""Side by side with Pinocchio, in one process: per-call latency from Python, batch
-throughput, and a 100,000-sample identification end to end.
+"""perturbid_rs side by side with Pinocchio on the A465, the Panda and a 60-dof tree.
 
-    python benches/compare_pinocchio.py            (needs: pip install pin)
+    python benches/compare_pinocchio.py [--rounds 5] [--samples 2048] [--no-write]
 
-Prints a Markdown table. Every figure is the median of several runs, and the two libraries take
-turns (Pinocchio, then perturbid_rs, then Pinocchio again, ...), each after a short idle gap, so
-that a slow spell of a shared machine or numpy's BLAS threads still spinning after
-`numpy.linalg.lstsq` do not fall on one side only."""
+Needs `pip install pin` (and example-robot-data for the Panda). Pinocchio runs in C++ one
+call per sample (benches/pinocchio_peer.cpp, built here with g++ against the `pin` wheel's
+headers and libraries and Debian's Eigen, `-O3 -march=native`); without a compiler or Eigen it
+runs from Python one call at a time (its figures then include Python's call overhead, and
+the table says so). perturbid_rs runs its batched kernels through the Python API on the same
+samples, writing into preallocated arrays (`out=`).
+
+For each robot and kernel: `rounds` rounds, each a Pinocchio pass and a perturbid_rs pass over
+the same samples in turn, so that a slow spell of the shared machine falls on both sides;
+figures are medians over the rounds, the noise the spread of the per-round ratios. One core:
+batches below the library's parallel threshold run on the calling thread, and one Pinocchio
+process. All cores: a batch large enough for the parallel engine against one Pinocchio process
+per core. Results are checked to agree (torques and matrices to 1e-10 relative, the
+parameters identified from either library's regressor to 1e-8 relative) before any time is
+reported. The Markdown table goes to stdout, benches/README.md and README.md (between the
+`speed-table` markers).
+"""
 
 from __future__ import annotations
 
+import argparse
+import hashlib
+import json
 import os
+import re
+import shutil
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
 import perturbid_rs as pr
 
-K = 100_000
-IDLE = 0.3  # s between timed runs
+ROOT = Path(__file__).resolve().parent.parent
+PEER = ROOT / "benches" / "pinocchio_peer.cpp"
+KERNELS = ["rnea", "mass_matrix", "regressor", "rnea_derivatives", "linearize", "forward_dynamics"]
+FLAGS = ["-O3", "-march=native", "-DNDEBUG", "-std=c++17", "-DBOOST_MPL_LIMIT_LIST_SIZE=30",
+         "-DBOOST_MPL_LIMIT_VECTOR_SIZE=30", "-DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS",
+         "-DBOOST_FUSION_INVOKE_MAX_ARITY=12"]
 
 
-def compare(pin_run, our_run, rounds):
-    """Median times (s) of `pin_run` and `our_run`, timed in alternation."""
+def tree_urdf(nlinks: int = 60, seed: int = 60) -> str:
+    """A random tree of revolute joints (each link on a random earlier one), valid inertias."""
+    rng = np.random.default_rng(seed)
+    parts = ['<robot name="tree60">', '<link name="base"/>']
+    for k in range(1, nlinks + 1):
+        a, b, c = rng.uniform(0.01, 0.2, 3)
+        x = rng.uniform(-0.2, 0.2, 3)
+        parts.append(
+            f'<link name="l{k}"><inertial><origin xyz="{x[0]} {x[1]} {x[2]}"/>'
+            f'<mass value="{rng.uniform(0.2, 3.0)}"/><inertia ixx="{b + c}" ixy="0" ixz="0" '
+            f'iyy="{a + c}" iyz="0" izz="{a + b}"/></inertial></link>')
+    for k in range(1, nlinks + 1):
+        parent = "base" if k == 1 or (p := int(rng.integers(0, k))) == 0 else f"l{p}"
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        o, r = rng.uniform(-0.3, 0.3, 3), rng.uniform(-1, 1, 3)
+        parts.append(
+            f'<joint name="j{k}" type="revolute"><parent link="{parent}"/><child link="l{k}"/>'
+            f'<origin xyz="{o[0]} {o[1]} {o[2]}" rpy="{r[0]} {r[1]} {r[2]}"/>'
+            f'<axis xyz="{axis[0]} {axis[1]} {axis[2]}"/>'
+            '<limit lower="-3" upper="3" effort="100" velocity="5"/></joint>')
+    parts.append("</robot>")
+    return "\n".join(parts)
+
+
+def robots():
+    """(name, perturbid_rs Robot, Pinocchio model) of the A465, the Panda and the tree."""
+    text = pr.robots.a465_urdf("kinsheel2010")
+    out = [("a465", pr.Robot.from_urdf_string(text, check_triangle_inequality=False),
+            pin.buildModelFromXML(text))]
+    try:
+        import example_robot_data as erd  # type: ignore[import-untyped]
+
+        path = Path(erd.getModelPath("panda_description/urdf/panda.urdf")) / \
+            "panda_description/urdf/panda.urdf"
+        fingers = ["panda_finger_joint1", "panda_finger_joint2"]
+        full = pin.buildModelFromUrdf(str(path))
+        panda = pin.buildReducedModel(full, [full.getJointId(j) for j in fingers],
+                                      pin.neutral(full))
+        ours = pr.Robot.from_urdf(str(path), lock={j: 0.0 for j in fingers})
+        out.append(("panda", ours, panda))
+    except Exception as e:  # noqa: BLE001 - any reason to leave the Panda out is reported
+        print(f"skipped the Panda ({e}); pip install example-robot-data", file=sys.stderr)
+    text = tree_urdf()
+    out.append(("tree60", pr.Robot.from_urdf_string(text), pin.buildModelFromXML(text)))
+    return out
+
+
+def build_peer() -> Path | None:
+    """The compiled C++ peer (cached by source, wheel and flags), or None when it cannot be."""
+    prefix = Path(pin.__file__).resolve()
+    while prefix.name != "cmeel.prefix" and prefix != prefix.parent:
+        prefix = prefix.parent
+    eigen = next((p for p in [Path("/usr/include/eigen3"), prefix / "include/eigen3"]
+                  if (p / "Eigen/Core").exists()), None)
+    if prefix.name != "cmeel.prefix" or eigen is None or shutil.which("g++") is None:
+        print("no C++ peer (needs g++, Eigen and the pin wheel's headers): Pinocchio runs "
+              "from Python", file=sys.stderr)
+        return None
+    key = hashlib.sha256(PEER.read_bytes() + pin.__version__.encode()
+                         + " ".join(FLAGS).encode()).hexdigest()[:16]
+    exe = Path.home() / ".cache" / "perturbid_rs" / f"pinocchio_peer-{key}"
+    if exe.exists():
+        return exe
+    exe.parent.mkdir(parents=True, exist_ok=True)
+    print("building the Pinocchio C++ peer (about 2 minutes, once)...", file=sys.stderr)
+    tmp = exe.with_suffix(".tmp")
+    cmd = ["g++", *FLAGS, f"-I{prefix / 'include'}", f"-I{eigen}", str(PEER), "-o", str(tmp),
+           f"-L{prefix / 'lib'}", f"-Wl,-rpath,{prefix / 'lib'}", "-lpinocchio_default",
+           "-lboost_serialization"]
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    if done.returncode != 0:
+        print("the C++ peer did not build; Pinocchio runs from Python:\n"
+              + done.stderr[-2000:], file=sys.stderr)
+        return None
+    tmp.rename(exe)
+    return exe
+
+
+class Side:
+    """The samples of one robot and both libraries' runs on them."""
+
+    def __init__(self, name, robot, model, k, workdir, peer):
+        self.name, self.robot, self.model, self.k, self.peer = name, robot, model, k, peer
+        self.dir = Path(workdir) / name
+        self.dir.mkdir(parents=True, exist_ok=True)
+        n = robot.n
+        if model.nv != n:
+            raise SystemExit(f"{name}: Pinocchio has {model.nv} dofs, perturbid_rs {n}")
+        # Pinocchio's joint order (depth first) against ours, by name
+        names = [model.names[j] for j in range(1, model.njoints)]
+        self.perm = np.array([names.index(j) for j in robot.joint_names])  # ours j -> pin
+        rng = np.random.default_rng(0)
+        self.x = {"q": rng.uniform(-3, 3, (k, n)), "qd": rng.uniform(-2, 2, (k, n)),
+                  "qdd": rng.uniform(-2, 2, (k, n)), "tau": rng.uniform(-2, 2, (k, n))}
+        inv = np.argsort(self.perm)
+        for key, v in self.x.items():  # pin's column p is our joint inv[p]
+            np.ascontiguousarray(v[:, inv]).tofile(self.dir / f"{key}.bin")
+        model.saveToBinary(str(self.dir / "model.bin"))
+        self.out = self.outputs(k)
+
+    def outputs(self, k):
+        n, p = self.robot.n, self.robot.parameters.size
+        e = np.empty
+        return {"rnea": e((k, n)), "mass_matrix": e((k, n, n)), "regressor": e((k, n, p)),
+                "rnea_derivatives": (e((k, n)), e((k, n, n)), e((k, n, n)), e((k, n, n))),
+                "forward_dynamics": e((k, n))}
+
+    def ours(self, kernel, x=None, out=None):
+        """Our batched call of `kernel` on the samples `x` (default: this side's)."""
+        x, out, r = x or self.x, out or self.out, self.robot
+        q, qd, qdd = x["q"], x["qd"], x["qdd"]
+        if kernel == "rnea":
+            return r.rnea(q, qd, qdd, out=out["rnea"])
+        if kernel == "mass_matrix":
+            return r.mass_matrix(q, out=out["mass_matrix"])
+        if kernel == "regressor":
+            return r.regressor(q, qd, qdd, out=out["regressor"])
+        if kernel == "rnea_derivatives":
+            return r.rnea_derivatives(q, qd, qdd, out=out["rnea_derivatives"])
+        if kernel == "linearize":
+            return r.linearize(q, qd, qdd)
+        return r.forward_dynamics(q, qd, x["tau"], out=out["forward_dynamics"])
+
+    def peer_pass(self, kernel, passes):
+        """ns per call of `kernel` by Pinocchio, one entry per pass."""
+        if self.peer is None:
+            return [self.python_pass(kernel) for _ in range(passes)]
+        done = subprocess.run([str(self.peer), str(self.dir / "model.bin"), str(self.dir),
+                               str(self.k), str(passes)], capture_output=True, text=True,
+                              env={**os.environ, "PEER_KERNELS": kernel}, check=True)
+        line = next(json.loads(x) for x in done.stdout.splitlines()
+                    if json.loads(x)["kernel"] == kernel)
+        return line["passes_ns"]
+
+    def python_pass(self, kernel):
+        m, d = self.model, self.model.createData()
+        inv = np.argsort(self.perm)
+        q, qd, qdd, tau = (self.x[k][:, inv] for k in ("q", "qd", "qdd", "tau"))
+        f = {"rnea": lambda i: pin.rnea(m, d, q[i], qd[i], qdd[i]),
+             "mass_matrix": lambda i: pin.crba(m, d, q[i]),
+             "regressor": lambda i: pin.computeJointTorqueRegressor(m, d, q[i], qd[i], qdd[i]),
+             "rnea_derivatives": lambda i: pin.computeRNEADerivatives(m, d, q[i], qd[i], qdd[i]),
+             "linearize": lambda i: (pin.computeRNEADerivatives(m, d, q[i], qd[i], qdd[i]),
+                                     pin.computeGeneralizedGravityDerivatives(m, d, q[i])),
+             "forward_dynamics": lambda i: pin.aba(m, d, q[i], qd[i], tau[i])}[kernel]
+        t = time.perf_counter()
+        for i in range(self.k):
+            f(i)
+        return (time.perf_counter() - t) / self.k * 1e9
+
+    def our_pass(self, kernel):
+        t = time.perf_counter()
+        self.ours(kernel)
+        return (time.perf_counter() - t) / self.k * 1e9
+
+
+def agree(side: Side) -> list[str]:
+    """Checks every kernel's results against Pinocchio's (the C++ peer's files, or pin's Python
+    calls), and the parameters identified from either regressor; returns the failures."""
+    n, k, perm = side.robot.n, min(side.k, 256), side.perm
+    m, d = side.model, side.model.createData()
+    inv = np.argsort(perm)
+    x = {key: v[:k] for key, v in side.x.items()}
+    px = {key: v[:, inv] for key, v in x.items()}
+    bad = []
+
+    def check(what, ours, theirs, tol):
+        scale = max(1.0, float(np.max(np.abs(theirs))))
+        err = float(np.max(np.abs(ours - theirs))) / scale
+        if not err <= tol:
+            bad.append(f"{side.name} {what}: differs by {err:.2e} (relative), tolerance {tol:g}")
+
+    def mat(a):  # pin's joint order -> ours, on both axes
+        return np.asarray(a)[np.ix_(perm, perm)]
+
+    tau = side.robot.rnea(x["q"], x["qd"], x["qdd"])
+    lin = side.robot.linearize(x["q"], x["qd"], x["qdd"])
+    der = side.robot.rnea_derivatives(x["q"], x["qd"], x["qdd"])
+    mm = side.robot.mass_matrix(x["q"])
+    fd = side.robot.forward_dynamics(x["q"], x["qd"], x["tau"])
+    phi = side.robot.regressor(x["q"], x["qd"], x["qdd"])
+    cols = np.concatenate([np.arange(10 * p, 10 * p + 10) for p in perm])
+    pin_phi = np.empty_like(phi)
+    for i in range(k):
+        q, qd, qdd, t = px["q"][i], px["qd"][i], px["qdd"][i], px["tau"][i]
+        check("rnea", tau[i], pin.rnea(m, d, q, qd, qdd)[perm], 1e-10)
+        check("mass matrix", mm[i], mat(pin.crba(m, d, q, pin.Convention.WORLD)), 1e-10)
+        pin.computeRNEADerivatives(m, d, q, qd, qdd)
+        check("d tau / d q", der[1][i], mat(d.dtau_dq), 1e-10)
+        check("d tau / d qd", der[2][i], mat(d.dtau_dv), 1e-10)
+        check("linearize H*", lin.H[i], mat(d.dtau_dv), 1e-10)
+        check("linearize G*", lin.G[i], mat(d.dtau_dq), 1e-10)
+        gs = pin.computeGeneralizedGravityDerivatives(m, d, q)
+        check("linearize Gs", lin.G_static[i], mat(gs), 1e-10)
+        check("forward dynamics", fd[i], pin.aba(m, d, q, qd, t)[perm], 1e-8)
+        pin_phi[i] = pin.computeJointTorqueRegressor(m, d, q, qd, qdd)[perm][:, cols]
+    check("regressor", phi, pin_phi, 1e-10)
+    # the same identification (minimum-norm least squares) on either library's regressor
+    theta_ours = np.linalg.lstsq(phi.reshape(-1, phi.shape[2]), tau.reshape(-1), rcond=None)[0]
+    theta_pin = np.linalg.lstsq(pin_phi.reshape(-1, phi.shape[2]), tau.reshape(-1), rcond=None)[0]
+    check("identified parameters", theta_ours, theta_pin, 1e-8)
+    return bad
+
+
+def run_kernel(side: Side, kernel: str, rounds: int, passes: int):
+    """Medians (ns per sample) of Pinocchio and of ours, and the per-round ratios."""
+    t_pin, t_our, ratios = [], [], []
+    for _ in range(rounds):
+        p = statistics.median(side.peer_pass(kernel, passes))
+        o = statistics.median(side.our_pass(kernel) for _ in range(passes))
+        t_pin.append(p)
+        t_our.append(o)
+        ratios.append(p / o)
+    return statistics.median(t_pin), statistics.median(t_our), ratios
+
+
+def all_cores(side: Side, kernel: str, rounds: int):
+    """Throughput ratio on every core: our parallel engine on a large batch against one
+    Pinocchio process per core."""
+    cores = os.cpu_count() or 1
+    big = {key: np.tile(v, (16, 1)) for key, v in side.x.items()}
+    out = side.outputs(big["q"].shape[0])
+    ratios = []
+    for _ in range(rounds):
+        if side.peer is None:
+            pin_rate = cores * 1e9 / side.python_pass(kernel)
+        else:
+            procs = [subprocess.Popen([str(side.peer), str(side.dir / "model.bin"),
+                                       str(side.dir), str(side.k), "3"], stdout=subprocess.PIPE,
+                                      text=True, env={**os.environ, "PEER_KERNELS": kernel})
+                     for _ in range(cores)]
+            pin_rate = 0.0
+            for pr_ in procs:
+                line = json.loads(pr_.communicate()[0].splitlines()[0])
+                pin_rate += 1e9 / line["ns_per_call"]
+        t = time.perf_counter()
+        side.ours(kernel, big, out)
+        our_rate = big["q"].shape[0] / (time.perf_counter() - t)
+        ratios.append(our_rate / pin_rate)
+    return statistics.median(ratios)
+
+
+def flop_counts() -> dict:
+    """Flops per sample of our kernels (examples/flop_count.rs), when cargo can build it."""
+    if shutil.which("cargo") is None:
+        return {}
+    done = subprocess.run(["cargo", "run", "--quiet", "--release", "--features", "count-flops",
+                           "--example", "flop_count"], cwd=ROOT, capture_output=True, text=True)
+    if done.returncode != 0:
+        print("no flop counts:\n" + done.stderr[-1000:], file=sys.stderr)
+        return {}
+    rows = [json.loads(x) for x in done.stdout.splitlines() if x.startswith("{")]
+    return {(r["robot"], r["kernel"]): r["flops_per_sample"] for r in rows}
+
+
+def cpu_ghz() -> float | None:
+    try:
+        mhz = [float(x.split(":")[1]) for x in Path("/proc/cpuinfo").read_text().splitlines()
+               if x.startswith("cpu MHz")]
+        return max(mhz) / 1e3 if mhz else None
+    except OSError:
+        return None
+
+
+def python_call(side: Side, calls: int = 20000, rounds: int = 5):
+    """Time of one single-sample call from Python, ours against pin's (rnea), in turns."""
+    inv = np.argsort(side.perm)
+    q, qd, qdd = (side.x[k][0] for k in ("q", "qd", "qdd"))
+    pq, pqd, pqdd = q[inv], qd[inv], qdd[inv]
+    m, d, r = side.model, side.model.createData(), side.robot
     t_pin, t_our = [], []
     for _ in range(rounds):
-        for f, times in ((pin_run, t_pin), (our_run, t_our)):
-            time.sleep(IDLE)
-            t = time.perf_counter()
-            f()
-            times.append(time.perf_counter() - t)
+        t = time.perf_counter()
+        for _ in range(calls):
+            pin.rnea(m, d, pq, pqd, pqdd)
+        t_pin.append((time.perf_counter() - t) / calls * 1e9)
+        t = time.perf_counter()
+        for _ in range(calls):
+            r.rnea(q, qd, qdd)
+        t_our.append((time.perf_counter() - t) / calls * 1e9)
     return statistics.median(t_pin), statistics.median(t_our)
 
 
+def write_between(path: Path, text: str):
+    """Replaces the text between the speed-table markers of `path` (atomically)."""
+    body = path.read_text()
+    start, end = "<!-- speed-table:start -->", "<!-- speed-table:end -->"
+    if start not in body or end not in body:
+        print(f"{path} has no speed-table markers: not written", file=sys.stderr)
+        return
+    new = re.sub(re.escape(start) + ".*?" + re.escape(end), lambda _: f"{start}\n{text}\n{end}",
+                 body, flags=re.S)
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp.write_text(new)
+    tmp.replace(path)
+
+
 def main() -> int:
-    urdf = pr.robots.a465_urdf("kinsheel2010")
-    robot = pr.Robot.from_urdf_string(urdf, check_triangle_inequality=False)
-    model = pin.buildModelFromXML(urdf)
-    data = model.createData()
-    n = robot.n
-    rng = np.random.default_rng(0)
-    Q, QD, QDD = rng.uniform(-1, 1, (3, K, n))
-    rows = []
-
-    # per-call latency from Python (one sample)
-    q, qd, qdd = Q[0], QD[0], QDD[0]
-    calls = 20_000
-    t_pin, t_our = compare(
-        lambda: [pin.rnea(model, data, q, qd, qdd) for _ in range(calls)],
-        lambda: [robot.rnea(q, qd, qdd) for _ in range(calls)],
-        5,
-    )
-    rows.append(("RNEA, one call from Python", t_pin / calls * 1e6, t_our / calls * 1e6, "us"))
-    calls //= 4
-    t_pin, t_our = compare(
-        lambda: [pin.computeJointTorqueRegressor(model, data, q, qd, qdd) for _ in range(calls)],
-        lambda: [robot.regressor(q, qd, qdd) for _ in range(calls)],
-        5,
-    )
-    rows.append(("regressor, one call from Python", t_pin / calls * 1e6, t_our / calls * 1e6, "us"))
-
-    # batch throughput: a Python loop over Pinocchio against one batched call
-    def pin_rnea():
-        out = np.empty((K, n))
-        for i in range(K):
-            out[i] = pin.rnea(model, data, Q[i], QD[i], QDD[i])
-        return out
-
-    def pin_crba():
-        out = np.empty((K, n, n))
-        for i in range(K):
-            out[i] = pin.crba(model, data, Q[i])
-        return out
-
-    np.testing.assert_allclose(robot.rnea(Q[:100], QD[:100], QDD[:100]), pin_rnea()[:100], atol=1e-9)
-    t_pin, t_our = compare(pin_rnea, lambda: robot.rnea(Q, QD, QDD), 5)
-    rows.append((f"RNEA, {K:,} samples (Pinocchio: Python loop)", t_pin * 1e3, t_our * 1e3, "ms"))
-    t_pin, t_our = compare(pin_crba, lambda: robot.mass_matrix(Q), 5)
-    rows.append((f"mass matrix, {K:,} samples", t_pin * 1e3, t_our * 1e3, "ms"))
-
-    # identification: 10^5 samples, 60 inertial parameters
-    tau = robot.rnea(Q, QD, QDD) + rng.normal(0, 0.01, (K, n))
-    fits = {}
-
-    def pin_identify():
-        phi = np.empty((K * n, 10 * n))
-        for i in range(K):
-            phi[i * n : (i + 1) * n] = pin.computeJointTorqueRegressor(model, data, Q[i], QD[i], QDD[i])
-        fits["pin"], *_ = np.linalg.lstsq(phi, tau.reshape(-1), rcond=None)
-
-    def our_identify():
-        fits["ours"] = pr.identify_base_parameters(robot, Q, QD, QDD, tau, friction=None, weighting="ols")
-
-    t_pin, t_our = compare(pin_identify, our_identify, 3)
-    fit, theta_pin = fits["ours"], fits["pin"]
-    base_pin = theta_pin[fit.kept] + fit.K @ theta_pin[fit.dropped]
-    agreement = np.abs(base_pin - fit.theta_base).max() / np.abs(fit.theta_base).max()
-    rows.append((f"identification, {K:,} samples (regressor + least squares)", t_pin, t_our, "s"))
-
-    print(f"machine: {os.cpu_count()} cores, Python {sys.version.split()[0]}, Pinocchio {pin.__version__}, perturbid_rs {pr.__version__}\n")
-    print("| workload | Pinocchio | perturbid_rs | speed-up |")
-    print("|---|---|---|---|")
-    for name, a, b, unit in rows:
-        print(f"| {name} | {a:.3g} {unit} | {b:.3g} {unit} | {a / b:.1f}x |")
-    print(f"\nbase parameters of the two identifications agree to {agreement:.1e} (relative)")
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--passes", type=int, default=3)
+    ap.add_argument("--samples", type=int, default=2048, help="per one-core batch (< 4096)")
+    ap.add_argument("--no-write", action="store_true", help="print only")
+    ap.add_argument("--robots", default="a465,panda,tree60")
+    args = ap.parse_args()
+    peer = build_peer()
+    flops = flop_counts()
+    ghz = cpu_ghz()
+    peak = 16 * ghz if ghz else None  # double flops per cycle: two 256-bit FMA pipes
+    rows, failures, first = [], [], None
+    with tempfile.TemporaryDirectory() as work:
+        for name, robot, model in robots():
+            if name not in args.robots.split(","):
+                continue
+            side = Side(name, robot, model, args.samples, work, peer)
+            first = first or side
+            failures += agree(side)
+            for kernel in KERNELS:
+                t_pin, t_our, ratios = run_kernel(side, kernel, args.rounds, args.passes)
+                many = all_cores(side, kernel, max(2, args.rounds // 2))
+                f = flops.get((name, kernel))
+                rate = f / t_our if f else None
+                rows.append((name, kernel, t_pin, t_our, statistics.median(ratios),
+                             min(ratios), max(ratios), many, rate))
+                print(f"{name:7s} {kernel:17s} pin {t_pin:9.1f} ns  ours {t_our:9.1f} ns  "
+                      f"x{statistics.median(ratios):5.2f} [{min(ratios):.2f}-{max(ratios):.2f}]"
+                      f"  all cores x{many:5.2f}", file=sys.stderr)
+        call = python_call(first)
+    if failures:
+        print("RESULTS DIFFER:\n" + "\n".join(failures), file=sys.stderr)
+        return 1
+    isa = pr.simd_isa()
+    who = "Pinocchio C++ (one call per sample)" if peer else \
+        "Pinocchio from Python (one call per sample, Python's overhead included)"
+    lines = [
+        f"Measured {time.strftime('%Y-%m-%d')} on {os.cpu_count()} cores "
+        f"({pr.simd_isa()} path, {isa_lanes(isa)} lanes), against {who}, "
+        f"`python benches/compare_pinocchio.py` (medians of {args.rounds} rounds taken in turns;"
+        " the brackets are the lowest and highest per-round ratio: the machine's noise).",
+        "",
+        "| robot | kernel | Pinocchio ns/sample | perturbid_rs ns/sample | speed-up, one core "
+        "| speed-up, all cores | GFlop/s (% of peak) |",
+        "|---|---|---:|---:|---:|---:|---:|",
+    ]
+    for name, kernel, t_pin, t_our, r, lo, hi, many, rate in rows:
+        fl = f"{rate:.1f} ({100 * rate / peak:.0f} %)" if rate and peak else "n/a"
+        lines.append(f"| {name} | {kernel} | {t_pin:.0f} | {t_our:.0f} | {r:.2f}x "
+                     f"[{lo:.2f}-{hi:.2f}] | {many:.2f}x | {fl} |")
+    lines += ["", f"One `Robot.rnea` call from Python (A465, one sample): {call[1]:.0f} ns against "
+              f"{call[0]:.0f} ns for `pinocchio.rnea` ({call[1] / call[0]:.2f}x its time)."]
+    if peak:
+        lines.append(f"Peak: 16 double flops per cycle per core at {ghz:.2f} GHz "
+                     f"({peak:.0f} GFlop/s; two 256-bit FMA pipes as on AMD Zen 3 and 4).")
+    table = "\n".join(lines)
+    print(table)
+    if not args.no_write:
+        for path in (ROOT / "benches" / "README.md", ROOT / "README.md"):
+            write_between(path, table)
     return 0
+
+
+def isa_lanes(isa: str) -> int:
+    return {"avx512": 8, "avx2+fma": 4}.get(isa, 1)
 
 
 if __name__ == "__main__":

@@ -5,9 +5,10 @@
 //   pinocchio_peer MODEL.bin DIR K REPEATS
 //
 // MODEL.bin: the model saved by pinocchio.Model.saveToBinary. DIR holds q.bin, qd.bin, qdd.bin
-// and tau.bin (K x nv float64, row-major). Writes DIR/pin_<kernel>.bin (the results of every
-// sample, row-major) and prints one JSON line per kernel: {"kernel", "ns_per_call" (median over
-// REPEATS passes), "passes_ns"}.
+// and tau.bin (K x nv float64, row-major). Each pass computes every sample with one call and
+// stores its results in a row-major K-sample output (both timed: what a batch costs), which is
+// written to DIR/pin_<kernel>.bin; prints one JSON line per kernel: {"kernel", "ns_per_call"
+// (median over REPEATS passes), "passes_ns"}. PEER_KERNELS (a list of names) limits the kernels.
 #include <pinocchio/multibody.hpp>
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/crba.hpp>
@@ -127,16 +128,16 @@ int main(int argc, char** argv) {
   const char* only = std::getenv("PEER_KERNELS");
   for (auto& kern : kernels) {
     if (only && std::string(only).find(kern.name) == std::string::npos) continue;
-    std::vector<double> passes;
+    // timed: every sample computed and its results stored in the batch's output, as a user
+    // of a batch gets them (and as perturbid_rs's batched kernels deliver them)
+    std::vector<double> passes, out(k * kern.per_sample);
     for (int r = 0; r < repeats; ++r) {
       auto t0 = Clock::now();
-      for (long s = 0; s < k; ++s) kern.compute(s);
+      for (long s = 0; s < k; ++s) {
+        kern.compute(s);
+        kern.store(s, out.data() + s * kern.per_sample);
+      }
       passes.push_back(std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / k);
-    }
-    std::vector<double> out(k * kern.per_sample);
-    for (long s = 0; s < k; ++s) {
-      kern.compute(s);
-      kern.store(s, out.data() + s * kern.per_sample);
     }
     write_all(dir + "/pin_" + kern.name + ".bin", out);
     std::vector<double> sorted = passes;

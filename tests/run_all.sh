@@ -20,8 +20,9 @@ cargo run --release --quiet --example parameters_evidence > target/parameters_ev
 # the example study and pipeline through the command line (docs/study.md, docs/pipeline.md)
 rm -rf target/study_small
 cargo run --release --quiet --features cli --bin perturbid -- study examples/study_small.toml --out target/study_small > /dev/null
-# lints and docs without warnings, over every feature (python includes cli)
-cargo clippy --release --all-targets --features python --quiet -- -D warnings
+# lints and docs without warnings, over every feature (python includes cli; count-flops builds
+# examples/flop_count.rs)
+cargo clippy --release --all-targets --features python,count-flops --quiet -- -D warnings
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --features python --quiet
 
 rm -rf target/wheels

@@ -42,6 +42,7 @@ __all__ = [
     "suggest_operating_points",
     "plan_experiments",
     "preprocess",
+    "simd_isa",
     "simulate",
     "study_case",
     "study_finish",
@@ -158,25 +159,32 @@ class Robot:
     @property
     def mass(self) -> float:
         """Total moving mass (kg)."""
-    def rnea(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, gravity: bool = True) -> NDArray[np.float64]:
-        """Inverse dynamics tau, shape (n,) or (k, n)."""
-    def gravity(self, q: ArrayLike) -> NDArray[np.float64]:
-        """Gravity torque g(q), shape (n,) or (k, n)."""
-    def bias(self, q: ArrayLike, qd: ArrayLike, gravity: bool = True) -> NDArray[np.float64]:
-        """Bias torque c(q, qd) + g(q), shape (n,) or (k, n)."""
-    def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]:
-        """Mass matrix M(q), shape (n, n) or (k, n, n)."""
-    def regressor(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, gravity: bool = True, friction: Union[str, Sequence[str], None] = None) -> NDArray[np.float64]:
-        """Joint-torque regressor, shape (n, 10 b) or (k, n, 10 b): regressor @ parameters == rnea."""
+    def rnea(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, gravity: bool = True, out: Optional[NDArray[np.float64]] = None) -> NDArray[np.float64]:
+        """Inverse dynamics tau, shape (n,) or (k, n). With `out` (float64, C-contiguous,
+        writeable, exactly that shape) the result is written there and `out` returned."""
+    def gravity(self, q: ArrayLike, out: Optional[NDArray[np.float64]] = None) -> NDArray[np.float64]:
+        """Gravity torque g(q), shape (n,) or (k, n); `out` as for `rnea`."""
+    def bias(self, q: ArrayLike, qd: ArrayLike, gravity: bool = True, out: Optional[NDArray[np.float64]] = None) -> NDArray[np.float64]:
+        """Bias torque c(q, qd) + g(q), shape (n,) or (k, n); `out` as for `rnea`."""
+    def mass_matrix(self, q: ArrayLike, out: Optional[NDArray[np.float64]] = None) -> NDArray[np.float64]:
+        """Mass matrix M(q), shape (n, n) or (k, n, n); `out` as for `rnea`."""
+    def regressor(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, gravity: bool = True, friction: Union[str, Sequence[str], None] = None, out: Optional[NDArray[np.float64]] = None) -> NDArray[np.float64]:
+        """Joint-torque regressor, shape (n, 10 b) or (k, n, 10 b): regressor @ parameters == rnea; `out` as for `rnea`."""
+    def rnea_derivatives(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, gravity: bool = True, out: Optional[tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]] = None) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """(tau, dtau_dq, dtau_dv, M): inverse dynamics and its analytic derivatives, shapes (n,) and (n, n) or with a leading k; `out` a tuple of four such arrays."""
     def physical_consistency(self, theta: Optional[ArrayLike] = None, friction: Union[str, Sequence[str], None] = None) -> tuple[bool, list[dict[str, Any]], list[tuple[str, float]]]:
         """Per-body pseudo-inertia check of a full parameter vector (default: the model's)."""
     @property
     def parameters(self) -> NDArray[np.float64]:
         """The model's inertial parameters (10 per moving body, Pinocchio's order), shape (10 b,)."""
-    def forward_dynamics(self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, gravity: bool = True) -> NDArray[np.float64]:
+    def forward_dynamics(self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, gravity: bool = True, out: Optional[NDArray[np.float64]] = None) -> NDArray[np.float64]:
         """Accelerations qdd, shape (n,) or (k, n)."""
     def linearize(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, gravity: bool = True) -> Linearization:
         """The local model at the operating point (analytic derivatives)."""
+
+def simd_isa() -> str:
+    """The instruction set the batched kernels run on here: "avx512" (8 samples side by side),
+    "avx2+fma" (4) or "scalar" (one at a time), detected at import."""
 
 def a465_urdf(variant: str = "kinsheel2010") -> str:
     """The URDF text of a built-in A465 variant."""

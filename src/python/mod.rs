@@ -34,6 +34,13 @@ pub(crate) fn detached<T: Send>(
     py.detach(|| catch_panics(name, f))
 }
 
+/// The instruction set the batched kernels run on here: "avx512" (8 samples side by side),
+/// "avx2+fma" (4) or "scalar" (one at a time).
+#[pyfunction]
+fn simd_isa() -> &'static str {
+    crate::simd::Isa::detect().name()
+}
+
 /// Python's own signal check, for [`crate::interrupt`]: a Ctrl-C in the session is seen while
 /// Rust works with the GIL released (its `KeyboardInterrupt` is raised by the work's error).
 fn python_interrupted() -> bool {
@@ -47,6 +54,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // `perturbid_rs.excitation`, `perturbid_rs.study`, ...); already installed is fine.
     let _ = pyo3_log::try_init();
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_function(wrap_pyfunction!(simd_isa, m)?)?;
     m.add_class::<robot::PyRobot>()?;
     m.add_function(wrap_pyfunction!(study::study_resolve, m)?)?;
     m.add_function(wrap_pyfunction!(study::study_len, m)?)?;

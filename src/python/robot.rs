@@ -69,11 +69,7 @@ impl PyRobot {
             f(&self.model, &mut self.workspace(), &states, values)
         };
         write_into(&out, |values| {
-            if batch.k * (n + 1) < DETACH_FROM {
-                crate::error::catch_panics(name, || work(values))
-            } else {
-                detached(py, name, || work(values))
-            }
+            compute(py, name, batch.k, n, || work(values))
         })?;
         Ok(out.into_any())
     }
@@ -81,6 +77,23 @@ impl PyRobot {
 
 /// Calls with at least this many samples times joints release the GIL.
 const DETACH_FROM: usize = 256;
+
+/// Runs `work` (for the method `name`, on `k` samples of `n` joints) with the GIL released when
+/// the call is large enough to pay for it, with the GIL held otherwise; panics become errors
+/// either way.
+fn compute<T: Send>(
+    py: Python<'_>,
+    name: &str,
+    k: usize,
+    n: usize,
+    work: impl FnOnce() -> Result<T> + Send,
+) -> Result<T> {
+    if k * (n + 1) < DETACH_FROM {
+        crate::error::catch_panics(name, work)
+    } else {
+        detached(py, name, work)
+    }
+}
 
 /// `physical_consistency`'s answer: consistent, per-body dicts, negative friction terms.
 type Consistency<'py> = (
@@ -490,11 +503,7 @@ impl PyRobot {
                                 out,
                             )
                         };
-                        if k * (n + 1) < DETACH_FROM {
-                            crate::error::catch_panics("Robot.rnea_derivatives", work)
-                        } else {
-                            detached(py, "Robot.rnea_derivatives", work)
-                        }
+                        compute(py, "Robot.rnea_derivatives", k, n, work)
                     })
                 })
             })

@@ -1,0 +1,84 @@
+"""The batched methods without waste: results written into the caller's arrays (`out=`),
+checked strictly, and the same numbers as without; the instruction set reported."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import perturbid_rs as pr
+
+
+@pytest.fixture(scope="module")
+def robot() -> pr.Robot:
+    return pr.Robot.builtin("a465")
+
+
+def states(k: int, n: int = 6, seed: int = 0):
+    rng = np.random.default_rng(seed)
+    return rng.uniform(-2, 2, (3, k, n))
+
+
+@pytest.mark.parametrize("k", [None, 1, 5, 4097])
+def test_out_is_written_and_returned_and_equals_a_new_result(robot, k):
+    q, qd, qdd = states(k or 1)
+    if k is None:
+        q, qd, qdd = q[0], qd[0], qdd[0]
+    lead = () if k is None else (k,)
+    n, p = robot.n, robot.parameters.size
+    calls = [
+        ("rnea", (q, qd, qdd), lead + (n,)),
+        ("gravity", (q,), lead + (n,)),
+        ("bias", (q, qd), lead + (n,)),
+        ("mass_matrix", (q,), lead + (n, n)),
+        ("regressor", (q, qd, qdd), lead + (n, p)),
+        ("forward_dynamics", (q, qd, qdd), lead + (n,)),
+    ]
+    for name, args, shape in calls:
+        out = np.full(shape, np.nan)
+        got = getattr(robot, name)(*args, out=out)
+        assert got is out, name
+        np.testing.assert_array_equal(out, getattr(robot, name)(*args), err_msg=name)
+    outs = tuple(np.full(lead + s, np.nan) for s in [(n,), (n, n), (n, n), (n, n)])
+    got = robot.rnea_derivatives(q, qd, qdd, out=outs)
+    assert all(a is b for a, b in zip(got, outs))
+    for a, b in zip(outs, robot.rnea_derivatives(q, qd, qdd)):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_friction_columns_go_into_out_too(robot):
+    q, qd, qdd = states(3)
+    want = robot.regressor(q, qd, qdd, friction="viscous,coulomb")
+    out = np.empty_like(want)
+    assert robot.regressor(q, qd, qdd, friction="viscous,coulomb", out=out) is out
+    np.testing.assert_array_equal(out, want)
+
+
+def test_a_wrong_out_is_refused_with_what_was_expected(robot):
+    q, qd, qdd = states(4)
+    cases = [
+        (np.zeros((4, 5)), "shape [4, 6]"),  # wrong shape
+        (np.zeros((6,)), "shape [4, 6]"),  # a single sample's shape for a batch
+        (np.zeros((4, 6), dtype=np.float32), "dtype float32"),
+        (np.zeros((6, 4)).T, "not C-contiguous"),
+        ([[0.0] * 6] * 4, "a list"),
+    ]
+    for out, words in cases:
+        with pytest.raises(pr.InputError, match="out") as e:
+            robot.rnea(q, qd, qdd, out=out)
+        assert words in str(e.value), str(e.value)
+    ro = np.zeros((4, 6))
+    ro.flags.writeable = False
+    with pytest.raises(pr.InputError, match="out"):
+        robot.rnea(q, qd, qdd, out=ro)
+    # the input's own memory: numpy refuses to lend it for writing while it is read
+    q = np.ascontiguousarray(q)
+    with pytest.raises(pr.InputError, match="shares no memory"):
+        robot.rnea(q, qd, qdd, out=q)
+    # rnea_derivatives wants all four (pyo3's own message names `out`)
+    with pytest.raises(ValueError, match="out"):
+        robot.rnea_derivatives(q, qd, qdd, out=(np.zeros((4, 6)),))
+
+
+def test_the_instruction_set_is_reported():
+    assert pr.simd_isa() in {"avx512", "avx2+fma", "scalar"}
