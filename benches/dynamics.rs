@@ -11,7 +11,6 @@
 //! benches/README.md has the numbers and how they compare with Pinocchio.
 
 #[path = "../tests/common/mod.rs"]
-#[allow(dead_code)]
 mod common;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
@@ -21,7 +20,7 @@ use perturbid_rs::algorithms::batch::{
 use perturbid_rs::algorithms::regressor::joint_torque_regressor;
 use perturbid_rs::{
     aba, forward_dynamics_crba, linearize_into, mass_matrix, mass_matrix_batch, parallel,
-    regressor_batch, rnea, rnea_derivatives, rnea_lanes, robots, Data, Gravity, Isa, LaneData,
+    regressor_batch, rnea, rnea_derivatives, rnea_lanes, Data, Gravity, Isa, LaneData,
     Linearization, Model, States,
 };
 use std::hint::black_box;
@@ -42,7 +41,7 @@ fn dynamics(c: &mut Criterion) {
         let (n, p) = (model.nv, 10 * model.nbodies());
         let [q, qd, qdd] = states(&model);
         let mut data = Data::new(&model);
-        let mut group = c.benchmark_group(format!("{robot}"));
+        let mut group = c.benchmark_group(robot.to_string());
         group
             .throughput(Throughput::Elements(BATCH as u64))
             .sample_size(20)

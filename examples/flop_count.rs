@@ -7,7 +7,6 @@
 //! divides these by the measured time per sample for the achieved rate.
 
 #[path = "../tests/common/mod.rs"]
-#[allow(dead_code)]
 mod common;
 
 use perturbid_rs::algorithms::batch::{
@@ -36,7 +35,7 @@ fn main() -> perturbid_rs::Result<()> {
         let mut mats = vec![vec![0.0; k * n * n]; 5];
         let mut y = vec![0.0; k * n * p];
         let g = Gravity::Included;
-        let mut report = |kernel: &str| {
+        let report = |kernel: &str| {
             let per = flops::take() as f64 / k as f64;
             println!("{{\"robot\": \"{robot}\", \"kernel\": \"{kernel}\", \"flops_per_sample\": {per:.1}}}");
         };

@@ -32,7 +32,10 @@ pub struct Validation {
 /// samples, no sample, a non-finite value (named by sample and joint).
 pub fn validate(joint_names: &[String], predicted: &[f64], measured: &[f64]) -> Result<Validation> {
     let n = joint_names.len();
-    if n == 0 || predicted.len() != measured.len() || measured.len() % n != 0 || measured.is_empty()
+    if n == 0
+        || predicted.len() != measured.len()
+        || !measured.len().is_multiple_of(n)
+        || measured.is_empty()
     {
         return Err(Error::Shape {
             argument: "validation".into(),

@@ -179,7 +179,7 @@ class Robot:
         """The model's inertial parameters (10 per moving body, Pinocchio's order), shape (10 b,)."""
     def forward_dynamics(self, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, gravity: bool = True, out: Optional[NDArray[np.float64]] = None) -> NDArray[np.float64]:
         """Accelerations qdd, shape (n,) or (k, n)."""
-    def linearize(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, gravity: bool = True) -> Linearization:
+    def linearize(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, gravity: bool = True, out: Optional[tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]] = None) -> Linearization:
         """The local model at the operating point (analytic derivatives)."""
 
 def simd_isa() -> str:

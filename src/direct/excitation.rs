@@ -451,7 +451,7 @@ pub fn design_excitation(
         if constraints_of(x).iter().all(|&c| c >= 0.0) && value < *best.borrow() {
             *best.borrow_mut() = value;
         }
-        if *e % 100 == 0 {
+        if (*e).is_multiple_of(100) {
             if let Some(cb) = progress.borrow_mut().as_mut() {
                 cb(*e, *best.borrow());
             }

@@ -26,7 +26,7 @@ pub(super) fn friction_aware_h(
         argument: "friction_aware_h".into(),
         message,
     };
-    let paired = k % 2 == 0
+    let paired = k.is_multiple_of(2)
         && (0..k / 2).all(|i| {
             (0..n).all(|j| {
                 let (a, b) = (e.deltas[(2 * i, j)], e.deltas[(2 * i + 1, j)]);

@@ -163,7 +163,7 @@ pub fn perturbations(
 /// scaled so the largest entry is 1.
 fn orthogonal_unit(m: usize, n: usize, rng: &mut ChaCha8Rng) -> DMatrix<f64> {
     let p = (n + 1).next_power_of_two();
-    let (p, skip) = if m % p == 0 {
+    let (p, skip) = if m.is_multiple_of(p) {
         (p, 1)
     } else {
         (
@@ -171,7 +171,7 @@ fn orthogonal_unit(m: usize, n: usize, rng: &mut ChaCha8Rng) -> DMatrix<f64> {
             usize::from(n.next_power_of_two() > n),
         )
     };
-    if m % p == 0 && p >= n + skip {
+    if m.is_multiple_of(p) && p >= n + skip {
         // Sylvester: H[i][j] = (-1)^popcount(i & j)
         return DMatrix::from_fn(m, n, |i, j| {
             if ((i % p) & (j + skip)).count_ones() % 2 == 0 {

@@ -162,7 +162,7 @@ pub(crate) fn design_excitation(
     o.friction = friction_terms(friction)?;
     let design = detached(py, "design_excitation", || {
         let mut report = |e: usize, best: f64| {
-            if e % 100 == 0 {
+            if e.is_multiple_of(100) {
                 log::info!(
                     target: "perturbid_rs::excitation",
                     "excitation design: {e} evaluations, best criterion {best:.4}"

@@ -10,7 +10,7 @@ use pyo3::prelude::*;
 use super::detached;
 
 use super::arrays::ArrayLike;
-use super::arrays::{output_array, read_batch, to_numpy, write_into};
+use super::arrays::{output_array, read_batch, write_into};
 use super::linearization::PyLinearization;
 use crate::algorithms::parallel::{self, Workspace};
 use crate::error::Result;
@@ -514,7 +514,8 @@ impl PyRobot {
     /// The linearisation at the operating point (q, qd, qdd), computed analytically:
     /// `tau - T* ~= D dqdd + H dqd + G dq`. Returns a `Linearization` (see its attributes);
     /// with a batch (k, n) every attribute gains a leading axis k.
-    #[pyo3(signature = (q, qd, qdd, gravity=true))]
+    #[pyo3(signature = (q, qd, qdd, gravity=true, out=None))]
+    #[allow(clippy::type_complexity)]
     fn linearize<'py>(
         &self,
         py: Python<'py>,
@@ -522,39 +523,61 @@ impl PyRobot {
         qd: ArrayLike<'py>,
         qdd: ArrayLike<'py>,
         gravity: bool,
+        out: Option<(
+            Bound<'py, PyAny>,
+            Bound<'py, PyAny>,
+            Bound<'py, PyAny>,
+            Bound<'py, PyAny>,
+            Bound<'py, PyAny>,
+        )>,
     ) -> PyResult<PyLinearization> {
         let n = self.model.nv;
         let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
-        let k = batch.k;
-        let mut torque = vec![0.0; k * n];
-        let mut parts = [(); 4].map(|_| vec![0.0; k * n * n]);
-        detached(py, "Robot.linearize", || -> Result<()> {
-            let states = batch.states(n)?;
-            let [d, h, g, g_static] = &mut parts;
-            let out = parallel::LinearizationsOut {
-                torque: &mut torque,
-                d,
-                h,
-                g,
-                g_static,
-            };
-            parallel::linearize(
-                &self.model,
-                &mut self.workspace(),
-                &states,
-                gravity.into(),
-                out,
-            )
+        let (k, single) = (batch.k, batch.single);
+        let outs: [Option<Bound<'py, PyAny>>; 5] = match out {
+            Some((a, b, c, d, e)) => [Some(a), Some(b), Some(c), Some(d), Some(e)],
+            None => [None, None, None, None, None],
+        };
+        let [o_t, o_d, o_h, o_g, o_gs] = outs;
+        let torque = output_array(py, o_t, k, single, &[n])?;
+        let d = output_array(py, o_d, k, single, &[n, n])?;
+        let h = output_array(py, o_h, k, single, &[n, n])?;
+        let g = output_array(py, o_g, k, single, &[n, n])?;
+        let g_static = output_array(py, o_gs, k, single, &[n, n])?;
+        write_into(&torque, |torque| {
+            write_into(&d, |d| {
+                write_into(&h, |h| {
+                    write_into(&g, |g| {
+                        write_into(&g_static, |g_static| {
+                            let work = || {
+                                let states = batch.states(n)?;
+                                let out = parallel::LinearizationsOut {
+                                    torque,
+                                    d,
+                                    h,
+                                    g,
+                                    g_static,
+                                };
+                                parallel::linearize(
+                                    &self.model,
+                                    &mut self.workspace(),
+                                    &states,
+                                    gravity.into(),
+                                    out,
+                                )
+                            };
+                            compute(py, "Robot.linearize", k, n, work)
+                        })
+                    })
+                })
+            })
         })?;
-        let single = batch.single;
-        let [d, h, g, g_static] =
-            parts.map(|p| to_numpy(py, p, k, single, &[n, n]).map(Bound::unbind));
         Ok(PyLinearization {
-            torque: to_numpy(py, torque, k, single, &[n])?.unbind(),
-            d: d?,
-            h: h?,
-            g: g?,
-            g_static: g_static?,
+            torque: torque.into_any().unbind(),
+            d: d.into_any().unbind(),
+            h: h.into_any().unbind(),
+            g: g.into_any().unbind(),
+            g_static: g_static.into_any().unbind(),
         })
     }
 

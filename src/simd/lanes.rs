@@ -88,11 +88,14 @@ impl<const W: usize> Lanes<W> {
     }
 }
 
+// `x = x op y` rather than `x op= y`: one macro for the four operators (clippy's assign-op
+// rewrite would take one operator for all)
 macro_rules! lane_op {
     ($tr:ident, $f:ident, $op:tt) => {
         impl<const W: usize> std::ops::$tr for Lanes<W> {
             type Output = Lanes<W>;
             #[inline(always)]
+            #[allow(clippy::assign_op_pattern)]
             fn $f(self, o: Lanes<W>) -> Lanes<W> {
                 flops(W);
                 let mut r = self.0;
@@ -105,6 +108,7 @@ macro_rules! lane_op {
         impl<const W: usize> std::ops::$tr<f64> for Lanes<W> {
             type Output = Lanes<W>;
             #[inline(always)]
+            #[allow(clippy::assign_op_pattern)]
             fn $f(self, o: f64) -> Lanes<W> {
                 flops(W);
                 let mut r = self.0;

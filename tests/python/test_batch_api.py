@@ -44,6 +44,12 @@ def test_out_is_written_and_returned_and_equals_a_new_result(robot, k):
     assert all(a is b for a, b in zip(got, outs))
     for a, b in zip(outs, robot.rnea_derivatives(q, qd, qdd)):
         np.testing.assert_array_equal(a, b)
+    outs = tuple(np.full(lead + s, np.nan) for s in [(n,), (n, n), (n, n), (n, n), (n, n)])
+    lin = robot.linearize(q, qd, qdd, out=outs)
+    assert all(a is b for a, b in zip((lin.torque, lin.D, lin.H, lin.G, lin.G_static), outs))
+    new = robot.linearize(q, qd, qdd)
+    for a, b in zip(outs, (new.torque, new.D, new.H, new.G, new.G_static)):
+        np.testing.assert_array_equal(a, b)
 
 
 def test_friction_columns_go_into_out_too(robot):
