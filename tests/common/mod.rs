@@ -239,12 +239,11 @@ pub fn panda_urdf() -> Option<std::path::PathBuf> {
     path.is_file().then_some(path)
 }
 
-/// That Panda with its fingers locked (7 dofs); `None` when the URDF is not installed.
+/// That Panda with its fingers locked (7 dofs; the second finger mimics the first and is held
+/// with it); `None` when the URDF is not installed.
 pub fn panda_model() -> Option<perturbid_rs::Model> {
     let mut options = perturbid_rs::LoadOptions::default();
-    for j in ["panda_finger_joint1", "panda_finger_joint2"] {
-        options.lock.insert(j.to_string(), 0.0);
-    }
+    options.lock.insert("panda_finger_joint1".to_string(), 0.0);
     perturbid_rs::model_from_urdf_file(&panda_urdf()?, &options).ok()
 }
 

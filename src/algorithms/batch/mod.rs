@@ -160,6 +160,19 @@ impl LaneData {
         Ok(Self::for_isa(model, isa))
     }
 
+    /// Buffers of 8 lanes run with AVX2 and FMA (two registers per lane vector): the AVX-512
+    /// path's 8-lane code on a processor without AVX-512, for tests (tests/simd_paths.rs).
+    /// Fails without AVX2 and FMA. [`LaneData::isa`] says `Avx2Fma`, [`LaneData::width`] 8.
+    #[doc(hidden)]
+    pub fn eight_lanes_on_avx2(model: &Model) -> Result<Self> {
+        let mut lanes = Self::with_isa(model, Isa::Avx2Fma)?;
+        #[cfg(target_arch = "x86_64")]
+        {
+            lanes.buffers = Buffers::W8(Box::new(LaneBuffers::new(model)));
+        }
+        Ok(lanes)
+    }
+
     fn for_isa(model: &Model, isa: Isa) -> Self {
         let buffers = match isa {
             #[cfg(target_arch = "x86_64")]
@@ -187,7 +200,13 @@ impl LaneData {
 
     /// Samples processed side by side (`self.isa().lanes()`).
     pub fn width(&self) -> usize {
-        self.isa.lanes()
+        match &self.buffers {
+            #[cfg(target_arch = "x86_64")]
+            Buffers::W8(_) => 8,
+            #[cfg(target_arch = "x86_64")]
+            Buffers::W4(_) => 4,
+            Buffers::Scalar(_) => 1,
+        }
     }
 
     /// Entry `(joint, parameter)` (N m per parameter unit) of the regressor of sample `sample`
@@ -247,9 +266,13 @@ pub(crate) fn dispatch<K: LaneKernel<Output = Result<T>>, T>(
         // SAFETY: `W8` and `W4` buffers are made only when the processor has the instruction
         // set (`LaneData::with_isa`, `Isa::detect`).
         #[cfg(target_arch = "x86_64")]
-        Buffers::W8(b) => unsafe { run_avx512(kernel, model, b) },
+        Buffers::W8(b) if lanes.isa == Isa::Avx512 => unsafe { run_avx512(kernel, model, b) },
+        // 8 lanes in pairs of AVX2 registers: the 8-lane code tested where AVX-512 is missing
+        // (`LaneData::eight_lanes_on_avx2`)
         #[cfg(target_arch = "x86_64")]
-        Buffers::W4(b) => unsafe { run_avx2(kernel, model, b) },
+        Buffers::W8(b) => unsafe { run_avx2(kernel, model, b.as_mut()) },
+        #[cfg(target_arch = "x86_64")]
+        Buffers::W4(b) => unsafe { run_avx2(kernel, model, b.as_mut()) },
         Buffers::Scalar(d) => kernel.scalar(model, d),
     }
 }
@@ -262,8 +285,12 @@ unsafe fn run_avx512<K: LaneKernel>(kernel: K, model: &Model, b: &mut LaneBuffer
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn run_avx2<K: LaneKernel>(kernel: K, model: &Model, b: &mut LaneBuffers<4>) -> K::Output {
-    kernel.wide::<4>(model, b)
+unsafe fn run_avx2<K: LaneKernel, const W: usize>(
+    kernel: K,
+    model: &Model,
+    b: &mut LaneBuffers<W>,
+) -> K::Output {
+    kernel.wide::<W>(model, b)
 }
 
 /// The number of samples `k` in `q` (`q_len` values, `k x nv`); checks that every other argument
