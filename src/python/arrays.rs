@@ -155,17 +155,35 @@ pub(crate) fn write_into<T>(
     out: &Bound<'_, PyArrayDyn<f64>>,
     f: impl FnOnce(&mut [f64]) -> Result<T>,
 ) -> Result<T> {
-    let mut rw = out.try_readwrite().map_err(|e| Error::Shape {
-        argument: "out".into(),
-        expected: "a writeable array that shares no memory with the inputs".into(),
-        got: format!("an array numpy refuses to lend for writing: {e}"),
-    })?;
-    let slice = rw.as_slice_mut().map_err(|e| Error::Shape {
-        argument: "out".into(),
-        expected: "a C-contiguous array".into(),
-        got: e.to_string(),
-    })?;
-    f(slice)
+    write_into_all([out], |[values]| f(values))
+}
+
+/// [`write_into`] for several arrays at once (the outputs of one call): each must be distinct
+/// and share no memory with the inputs.
+pub(crate) fn write_into_all<T, const N: usize>(
+    outs: [&Bound<'_, PyArrayDyn<f64>>; N],
+    f: impl FnOnce([&mut [f64]; N]) -> Result<T>,
+) -> Result<T> {
+    let mut guards = Vec::with_capacity(N);
+    for out in outs {
+        guards.push(out.try_readwrite().map_err(|e| Error::Shape {
+            argument: "out".into(),
+            expected: "writeable arrays that share no memory with the inputs or each other".into(),
+            got: format!("an array numpy refuses to lend for writing: {e}"),
+        })?);
+    }
+    let mut slices = Vec::with_capacity(N);
+    for guard in &mut guards {
+        slices.push(guard.as_slice_mut().map_err(|e| Error::Shape {
+            argument: "out".into(),
+            expected: "C-contiguous arrays".into(),
+            got: e.to_string(),
+        })?);
+    }
+    let Ok(slices) = <[&mut [f64]; N]>::try_from(slices) else {
+        unreachable!("one slice per array")
+    };
+    f(slices)
 }
 
 /// A numpy array of `values` with shape `dims` prefixed by `k` unless `single`.

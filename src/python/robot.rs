@@ -10,7 +10,7 @@ use pyo3::prelude::*;
 use super::detached;
 
 use super::arrays::ArrayLike;
-use super::arrays::{output_array, read_batch, write_into};
+use super::arrays::{output_array, read_batch, write_into, write_into_all};
 use super::linearization::PyLinearization;
 use crate::algorithms::parallel::{self, Workspace};
 use crate::error::Result;
@@ -483,30 +483,24 @@ impl PyRobot {
         let dq = output_array(py, o1, k, single, &[n, n])?;
         let dv = output_array(py, o2, k, single, &[n, n])?;
         let m = output_array(py, o3, k, single, &[n, n])?;
-        write_into(&tau, |tau| {
-            write_into(&dq, |dtau_dq| {
-                write_into(&dv, |dtau_dv| {
-                    write_into(&m, |m| {
-                        let work = || {
-                            let states = batch.states(n)?;
-                            let out = parallel::DerivativesOut {
-                                tau,
-                                dtau_dq,
-                                dtau_dv,
-                                m,
-                            };
-                            parallel::rnea_derivatives(
-                                &self.model,
-                                &mut self.workspace(),
-                                &states,
-                                gravity.into(),
-                                out,
-                            )
-                        };
-                        compute(py, "Robot.rnea_derivatives", k, n, work)
-                    })
-                })
-            })
+        write_into_all([&tau, &dq, &dv, &m], |[tau, dtau_dq, dtau_dv, m]| {
+            let work = || {
+                let states = batch.states(n)?;
+                let out = parallel::DerivativesOut {
+                    tau,
+                    dtau_dq,
+                    dtau_dv,
+                    m,
+                };
+                parallel::rnea_derivatives(
+                    &self.model,
+                    &mut self.workspace(),
+                    &states,
+                    gravity.into(),
+                    out,
+                )
+            };
+            compute(py, "Robot.rnea_derivatives", k, n, work)
         })?;
         Ok((tau.into_any(), dq.into_any(), dv.into_any(), m.into_any()))
     }
@@ -544,33 +538,26 @@ impl PyRobot {
         let h = output_array(py, o_h, k, single, &[n, n])?;
         let g = output_array(py, o_g, k, single, &[n, n])?;
         let g_static = output_array(py, o_gs, k, single, &[n, n])?;
-        write_into(&torque, |torque| {
-            write_into(&d, |d| {
-                write_into(&h, |h| {
-                    write_into(&g, |g| {
-                        write_into(&g_static, |g_static| {
-                            let work = || {
-                                let states = batch.states(n)?;
-                                let out = parallel::LinearizationsOut {
-                                    torque,
-                                    d,
-                                    h,
-                                    g,
-                                    g_static,
-                                };
-                                parallel::linearize(
-                                    &self.model,
-                                    &mut self.workspace(),
-                                    &states,
-                                    gravity.into(),
-                                    out,
-                                )
-                            };
-                            compute(py, "Robot.linearize", k, n, work)
-                        })
-                    })
-                })
-            })
+        let arrays = [&torque, &d, &h, &g, &g_static];
+        write_into_all(arrays, |[torque, d, h, g, g_static]| {
+            let work = || {
+                let states = batch.states(n)?;
+                let out = parallel::LinearizationsOut {
+                    torque,
+                    d,
+                    h,
+                    g,
+                    g_static,
+                };
+                parallel::linearize(
+                    &self.model,
+                    &mut self.workspace(),
+                    &states,
+                    gravity.into(),
+                    out,
+                )
+            };
+            compute(py, "Robot.linearize", k, n, work)
         })?;
         Ok(PyLinearization {
             torque: torque.into_any().unbind(),

@@ -79,8 +79,12 @@ def test_a_wrong_out_is_refused_with_what_was_expected(robot):
         robot.rnea(q, qd, qdd, out=ro)
     # the input's own memory: numpy refuses to lend it for writing while it is read
     q = np.ascontiguousarray(q)
-    with pytest.raises(pr.InputError, match="shares no memory"):
+    with pytest.raises(pr.InputError, match="share no memory with the inputs"):
         robot.rnea(q, qd, qdd, out=q)
+    # one array for two outputs is refused too
+    m = np.zeros((4, 6, 6))
+    with pytest.raises(pr.InputError, match="each other"):
+        robot.rnea_derivatives(q, qd, qdd, out=(np.zeros((4, 6)), m, m, np.zeros((4, 6, 6))))
     # rnea_derivatives wants all four (pyo3's own message names `out`)
     with pytest.raises(ValueError, match="out"):
         robot.rnea_derivatives(q, qd, qdd, out=(np.zeros((4, 6)),))
