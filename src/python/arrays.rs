@@ -102,6 +102,10 @@ impl Batch<'_> {
     }
 }
 
+/// Results up to this many values (1 GiB) are allocated directly; larger ones by numpy, which
+/// raises `MemoryError` when the memory is not there.
+const DIRECT_ALLOCATION: usize = 1 << 27;
+
 /// Where a batched method writes: the caller's `out` array when given (checked: a float64
 /// numpy array of exactly the result's shape, C-contiguous, writeable, sharing no memory with
 /// the inputs), a new numpy array otherwise. Either way the Rust work writes the array's own
@@ -112,13 +116,30 @@ pub(crate) fn output_array<'py>(
     k: usize,
     single: bool,
     dims: &[usize],
-) -> Result<Bound<'py, PyArrayDyn<f64>>> {
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let mut shape: Vec<usize> = if single { Vec::new() } else { vec![k] };
     shape.extend_from_slice(dims);
     let Some(out) = out else {
-        // SAFETY: every element is written before the array reaches Python (the algorithms
-        // write every entry of their output, and on an error the array is dropped)
-        return Ok(unsafe { PyArrayDyn::<f64>::new(py, shape, false) });
+        let values = shape.iter().try_fold(1usize, |a, &d| a.checked_mul(d));
+        return match values {
+            // SAFETY: every element is written before the array reaches Python (the algorithms
+            // write every entry of their output, and on an error the array is dropped)
+            Some(v) if v <= DIRECT_ALLOCATION => {
+                Ok(unsafe { PyArrayDyn::<f64>::new(py, shape, false) })
+            }
+            // numpy's own allocation: a MemoryError when the memory is not there (rust-numpy's
+            // direct allocation would panic)
+            Some(v) if v <= isize::MAX as usize / 8 => {
+                let empty = py.import("numpy")?.call_method1("empty", (shape,))?;
+                Ok(empty.cast_into::<PyArrayDyn<f64>>()?)
+            }
+            _ => Err(Error::Shape {
+                argument: "the result".into(),
+                expected: "an array that fits in memory".into(),
+                got: format!("shape {shape:?}"),
+            }
+            .into()),
+        };
     };
     let wrong = |got: String| Error::Shape {
         argument: "out".into(),
@@ -137,14 +158,14 @@ pub(crate) fn output_array<'py>(
                     out.get_type().name().map_or("?".into(), |n| n.to_string())
                 ),
             };
-            return Err(wrong(kind));
+            return Err(wrong(kind).into());
         }
     };
     if arr.shape() != shape.as_slice() {
-        return Err(wrong(format!("shape {:?}", arr.shape())));
+        return Err(wrong(format!("shape {:?}", arr.shape())).into());
     }
     if !arr.is_c_contiguous() {
-        return Err(wrong("an array that is not C-contiguous".into()));
+        return Err(wrong("an array that is not C-contiguous".into()).into());
     }
     Ok(arr)
 }

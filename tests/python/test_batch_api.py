@@ -92,3 +92,15 @@ def test_a_wrong_out_is_refused_with_what_was_expected(robot):
 
 def test_the_instruction_set_is_reported():
     assert pr.simd_isa() in {"avx512", "avx2+fma", "scalar"}
+
+
+def test_a_result_past_a_gibibyte_is_allocated_by_numpy_and_equal(robot):
+    """Results past 1 GiB come from numpy's allocator (a MemoryError, not a crash, when the
+    memory is not there): the A465 regressor of 380,000 samples is 1.1 GB."""
+    k = 380_000
+    q, qd, qdd = states(k)
+    y = robot.regressor(q, qd, qdd)
+    assert y.shape == (k, 6, robot.parameters.size) and y.flags.c_contiguous
+    for s in [0, k // 2, k - 1]:
+        np.testing.assert_allclose(y[s], robot.regressor(q[s], qd[s], qdd[s]), rtol=0, atol=1e-12 * (1 + np.abs(y[s]).max()))
+    del y
