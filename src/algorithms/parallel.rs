@@ -3,8 +3,8 @@
 //! Every function takes the samples as a checked [`States`] view, writes its results into the
 //! caller's row-major buffers, and runs
 //! - on the multi-sample kernels of [`super::batch`] ([`LaneData::width`] samples side by side, SIMD)
-//!   where one exists (inverse dynamics, mass matrix, regressor), one sample at a time
-//!   otherwise;
+//!   where one exists (inverse dynamics, mass matrix, regressor, derivatives, linearisation),
+//!   one sample at a time otherwise (forward dynamics);
 //! - on the calling thread with the caller's [`Workspace`] below [`PARALLEL_BATCH`] samples,
 //!   and in chunks of [`PARALLEL_CHUNK`] samples over rayon's thread pool above it, each chunk
 //!   with its own buffers (no allocation per sample).

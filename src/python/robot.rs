@@ -432,7 +432,7 @@ impl PyRobot {
         let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("tau", &tau)])?;
         let array = output_array(py, out, batch.k, batch.single, &[n])?;
         write_into(&array, |out| {
-            detached(py, "Robot.forward_dynamics", || -> Result<()> {
+            let work = || -> Result<()> {
                 let c = &batch.columns;
                 let states = if batch.single {
                     States::single(n, &c[0], Some(&c[1]), None)?
@@ -441,7 +441,8 @@ impl PyRobot {
                 };
                 let mut w = self.workspace();
                 parallel::forward_dynamics(&self.model, &mut w, &states, &c[2], gravity.into(), out)
-            })
+            };
+            compute(py, "Robot.forward_dynamics", batch.k, n, work)
         })?;
         Ok(array.into_any())
     }

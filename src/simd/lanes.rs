@@ -88,7 +88,7 @@ impl<const W: usize> Lanes<W> {
     }
 }
 
-// `x = x op y` rather than `x op= y`: one macro for the four operators (clippy's assign-op
+// `x = x op y` rather than `x op= y`: one macro for the three operators (clippy's assign-op
 // rewrite would take one operator for all)
 macro_rules! lane_op {
     ($tr:ident, $f:ident, $op:tt) => {
@@ -123,7 +123,6 @@ macro_rules! lane_op {
 lane_op!(Add, add, +);
 lane_op!(Sub, sub, -);
 lane_op!(Mul, mul, *);
-lane_op!(Div, div, /);
 
 impl<const W: usize> std::ops::Neg for Lanes<W> {
     type Output = Lanes<W>;

@@ -10,7 +10,7 @@ pub(crate) use lanes::{Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
 pub(crate) use sin_cos::sin_cos;
 
 /// Counting the floating-point operations of the lane kernels (build with the `count-flops`
-/// feature): every add, subtract, multiply and divide of a lane counts 1, a fused multiply-add
+/// feature): every add, subtract and multiply of a lane counts 1, a fused multiply-add
 /// 2, per lane in use or not. For the flop counts behind the fraction of peak in
 /// benches/README.md (`cargo run --release --features count-flops --example flop_count`).
 #[cfg(feature = "count-flops")]
