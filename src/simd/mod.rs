@@ -1,12 +1,17 @@
 //! SIMD arithmetic for the multi-sample kernels: the lane types (several samples side by side,
-//! one per vector lane), `sin`/`cos` of every lane, and the run-time choice of instruction set.
+//! one per vector lane), `sin`/`cos` of every lane, the transpose of lanes into the rows of an
+//! output, loops kept from a second vectorisation, and the run-time choice of instruction set.
 
 mod isa;
 mod lanes;
+mod rows;
+mod serial;
 mod sin_cos;
 
 pub use isa::Isa;
 pub(crate) use lanes::{Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
+pub(crate) use rows::write_rows;
+pub(crate) use serial::serial;
 pub(crate) use sin_cos::sin_cos;
 
 /// Counting the floating-point operations of the lane kernels (build with the `count-flops`

@@ -10,7 +10,7 @@ use crate::error::Result;
 use crate::gravity::Gravity;
 use crate::linearization::{linearize_into, Linearization};
 use crate::model::Model;
-use crate::simd::{Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
+use crate::simd::{serial, write_rows, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
 
 /// Where [`derivatives_batch`] writes, row-major over `k` samples.
 #[derive(Debug)]
@@ -166,9 +166,9 @@ impl<const W: usize> InertiaRate<W> {
         let uh2 = u.dot(h) * 2.0;
         let ha = &yv.ang;
         let mut t = Rotation3Lanes::default();
-        for r in 0..3 {
+        for r in serial(0..3) {
             let mut e = [Lanes::default(); 3];
-            for (c, ec) in e.iter_mut().enumerate() {
+            for (c, ec) in serial(e.iter_mut().enumerate()) {
                 let v = a[r].get(c) + a[c].get(r);
                 let v = h
                     .get(r)
@@ -312,20 +312,16 @@ impl LaneKernel for Derivatives<'_> {
             data.load(model, self.x, first);
             recursion(model, data, &mut d, &minus_g, self.g_static.is_some());
             let [tau, m, dq, dv] = &mut self.out;
-            for l in 0..used {
-                let s = first + l;
-                write_vector(model, &d.tau, l, &mut tau[s * n..(s + 1) * n]);
-                write_matrix(model, &d.m, l, &mut m[s * nn..(s + 1) * nn]);
-                write_matrix(model, &d.dq, l, &mut dq[s * nn..(s + 1) * nn]);
-                write_matrix(model, &d.dv, l, &mut dv[s * nn..(s + 1) * nn]);
+            write_vectors(model, &d.tau, used, &mut tau[first * n..]);
+            write_matrices(model, &d.m, used, &mut m[first * nn..]);
+            write_matrices(model, &d.dq, used, &mut dq[first * nn..]);
+            write_matrices(model, &d.dv, used, &mut dv[first * nn..]);
+            for s in first..first + used {
                 model.add_armature_torque(&self.x[2][s * n..(s + 1) * n], &mut tau[s * n..][..n]);
                 model.add_armature_inertia(&mut m[s * nn..(s + 1) * nn]);
             }
             if let Some(gs) = self.g_static.as_deref_mut() {
-                for l in 0..used {
-                    let s = first + l;
-                    write_matrix(model, &d.gs, l, &mut gs[s * nn..(s + 1) * nn]);
-                }
+                write_matrices(model, &d.gs, used, &mut gs[first * nn..]);
             }
             first += W;
         }
@@ -362,38 +358,40 @@ impl LaneKernel for Derivatives<'_> {
     }
 }
 
-/// Lane `l` of the body torques `body` summed onto the degrees of freedom into `out` (`nv`).
+/// Lanes `0..used` of the body torques `body` summed onto the degrees of freedom into the
+/// row-major `out` (`used x nv`).
 #[inline(always)]
-fn write_vector<const W: usize>(model: &Model, body: &[Lanes<W>], l: usize, out: &mut [f64]) {
+fn write_vectors<const W: usize>(model: &Model, body: &[Lanes<W>], used: usize, out: &mut [f64]) {
+    let nv = model.nv;
     if model.coupled {
-        out.fill(0.0);
-        for (i, b) in model.bodies.iter().enumerate() {
-            out[b.dof] += b.multiplier * body[i].0[l];
-        }
-    } else {
-        for (o, b) in out.iter_mut().zip(body) {
-            *o = b.0[l];
-        }
-    }
-}
-
-/// Lane `l` of the body-level row-major matrix `body` as `C^T body C` (the degrees of freedom)
-/// into the row-major `out` (`nv x nv`).
-#[inline(always)]
-fn write_matrix<const W: usize>(model: &Model, body: &[Lanes<W>], l: usize, out: &mut [f64]) {
-    let nb = model.nbodies();
-    if model.coupled {
-        let nv = model.nv;
-        out.fill(0.0);
-        for (i, bi) in model.bodies.iter().enumerate() {
-            for (j, bj) in model.bodies.iter().enumerate() {
-                out[bi.dof * nv + bj.dof] += bi.multiplier * bj.multiplier * body[i * nb + j].0[l];
+        for (l, out) in out.chunks_mut(nv).take(used).enumerate() {
+            out.fill(0.0);
+            for (i, b) in model.bodies.iter().enumerate() {
+                out[b.dof] += b.multiplier * body[i].0[l];
             }
         }
     } else {
-        for (o, b) in out.iter_mut().zip(body) {
-            *o = b.0[l];
+        write_rows(body, used, out, nv);
+    }
+}
+
+/// Lanes `0..used` of the body-level row-major matrix `body` as `C^T body C` (the degrees of
+/// freedom) into the row-major `out` (`used x nv x nv`).
+#[inline(always)]
+fn write_matrices<const W: usize>(model: &Model, body: &[Lanes<W>], used: usize, out: &mut [f64]) {
+    let (nb, nv) = (model.nbodies(), model.nv);
+    if model.coupled {
+        for (l, out) in out.chunks_mut(nv * nv).take(used).enumerate() {
+            out.fill(0.0);
+            for (i, bi) in model.bodies.iter().enumerate() {
+                for (j, bj) in model.bodies.iter().enumerate() {
+                    out[bi.dof * nv + bj.dof] +=
+                        bi.multiplier * bj.multiplier * body[i * nb + j].0[l];
+                }
+            }
         }
+    } else {
+        write_rows(body, used, out, nv * nv);
     }
 }
 
@@ -412,7 +410,7 @@ fn recursion<const W: usize>(
         ang: Vector3Lanes::splat(&minus_g.angular),
         lin: Vector3Lanes::splat(&minus_g.linear),
     };
-    for (i, b) in model.bodies.iter().enumerate() {
+    for (i, b) in serial(model.bodies.iter().enumerate()) {
         let (rot, pos) = pose(b, data.qb[i]);
         let (r, p) = place_in_base(model, data, i, &rot, &pos);
         let j = data.o_s[i];
@@ -454,7 +452,7 @@ fn recursion<const W: usize>(
     for x in [&mut d.m, &mut d.dq, &mut d.dv, &mut d.gs] {
         x.fill(Lanes::default());
     }
-    for i in (0..nb).rev() {
+    for i in serial((0..nb).rev()) {
         let b = &model.bodies[i];
         let end = b.subtree_end;
         let j = d.j[i];
@@ -462,7 +460,7 @@ fn recursion<const W: usize>(
 
         // d tau / d qdd (the mass matrix)
         d.dfda[i] = d.ycrb[i].apply(&j);
-        for k in i..end {
+        for k in serial(i..end) {
             let v = j.dot(&d.dfda[k]);
             d.m[i * nb + k] = v;
             d.m[k * nb + i] = v;
@@ -472,10 +470,10 @@ fn recursion<const W: usize>(
         d.dfdq[i] = d.dycrb[i].mul(&d.dvdq[i]).add(&d.ycrb[i].apply(&d.dadq[i]));
         d.dytj[i] = d.dycrb[i].tr_mul(&j);
         let (dadq, dvdq) = (d.dadq[i], d.dvdq[i]);
-        for k in (i + 1)..end {
+        for k in serial((i + 1)..end) {
             d.dq[k * nb + i] = d.dfda[k].dot(&dadq) + d.dytj[k].dot(&dvdq);
         }
-        for k in i..end {
+        for k in serial(i..end) {
             d.dq[i * nb + k] = j.dot(&d.dfdq[k]);
         }
         d.dfdq[i] = d.dfdq[i].add(&j.cross_force(&d.of[i]));
@@ -483,10 +481,10 @@ fn recursion<const W: usize>(
         // d tau / d qd
         d.dfdv[i] = d.dycrb[i].mul(&j).add(&d.ycrb[i].apply(&d.dadv[i]));
         let dadv = d.dadv[i];
-        for k in (i + 1)..end {
+        for k in serial((i + 1)..end) {
             d.dv[k * nb + i] = d.dfda[k].dot(&dadv) + d.dytj[k].dot(&j);
         }
-        for k in i..end {
+        for k in serial(i..end) {
             d.dv[i * nb + k] = j.dot(&d.dfdv[k]);
         }
 
@@ -495,10 +493,10 @@ fn recursion<const W: usize>(
         if at_rest {
             d.dfdq_rest[i] = d.ycrb[i].apply(&d.dadq_rest[i]);
             let dadq = d.dadq_rest[i];
-            for k in (i + 1)..end {
+            for k in serial((i + 1)..end) {
                 d.gs[k * nb + i] = d.dfda[k].dot(&dadq);
             }
-            for k in i..end {
+            for k in serial(i..end) {
                 d.gs[i * nb + k] = j.dot(&d.dfdq_rest[k]);
             }
             d.dfdq_rest[i] = d.dfdq_rest[i].add(&j.cross_force(&d.of_rest[i]));

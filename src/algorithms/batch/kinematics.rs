@@ -3,7 +3,7 @@
 
 use super::LaneBuffers;
 use crate::model::{Body, JointKind, Model};
-use crate::simd::{sin_cos, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
+use crate::simd::{serial, sin_cos, write_rows, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
 use crate::spatial::{Inertia, Motion, Se3};
 
 /// The pose of body `b` in its parent (rotation by rows, translation) for the lane coordinates
@@ -17,9 +17,9 @@ pub(crate) fn pose<const W: usize>(b: &Body, x: Lanes<W>) -> (Rotation3Lanes<W>,
             let c1 = Lanes::splat(1.0) - c;
             let t = &b.pose_terms;
             let mut rot = Rotation3Lanes::default();
-            for (r, row) in rot.0.iter_mut().enumerate() {
+            for (r, row) in serial(rot.0.iter_mut().enumerate()) {
                 let mut e = [Lanes::default(); 3];
-                for (k, ek) in e.iter_mut().enumerate() {
+                for (k, ek) in serial(e.iter_mut().enumerate()) {
                     let r0 = Lanes::splat(p.rotation[(r, k)]);
                     *ek = s.mul_add_s(t.r1[(r, k)], c1.mul_add_s(t.r2[(r, k)], r0));
                 }
@@ -87,7 +87,7 @@ pub(crate) fn forward<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, 
         ang: Vector3Lanes::splat(&g.angular),
         lin: Vector3Lanes::splat(&g.linear),
     };
-    for (i, b) in model.bodies.iter().enumerate() {
+    for (i, b) in serial(model.bodies.iter().enumerate()) {
         let (rot, pos) = pose(b, data.qb[i]);
         let (mut v, mut a) = match b.parent {
             Some(p) => (
@@ -168,25 +168,32 @@ pub(crate) fn subspace_in<const W: usize>(
 
 /// Writes the joint torques of lanes `0..used` (samples `first..first + used`) into the
 /// row-major `tau` from the body wrenches `f` (in the body frames): `tau_dof += multiplier *
-/// S^T f`.
+/// S^T f`. `body_tau` (one per body) is work space.
 #[inline(always)]
 pub(crate) fn contract_torques<const W: usize>(
     model: &Model,
     f: &[SpatialLanes<W>],
+    body_tau: &mut [Lanes<W>],
     first: usize,
     used: usize,
     tau: &mut [f64],
 ) {
     let nv = model.nv;
+    for ((t, b), f) in serial(body_tau.iter_mut().zip(&model.bodies).zip(f)) {
+        *t = if b.kind == JointKind::Revolute {
+            f.ang.dot_const(&b.axis)
+        } else {
+            f.lin.dot_const(&b.axis)
+        };
+    }
+    if !model.coupled {
+        write_rows(body_tau, used, &mut tau[first * nv..], nv);
+        return;
+    }
     for s in first..first + used {
         tau[s * nv..(s + 1) * nv].fill(0.0);
     }
-    for (i, b) in model.bodies.iter().enumerate() {
-        let t = if b.kind == JointKind::Revolute {
-            f[i].ang.dot_const(&b.axis)
-        } else {
-            f[i].lin.dot_const(&b.axis)
-        };
+    for (b, t) in model.bodies.iter().zip(body_tau.iter()) {
         for l in 0..used {
             tau[(first + l) * nv + b.dof] += b.multiplier * t.0[l];
         }

@@ -6,7 +6,7 @@ use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
 use crate::data::Data;
 use crate::error::Result;
 use crate::model::Model;
-use crate::simd::{Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
+use crate::simd::{serial, write_rows, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
 use crate::spatial::OriginInertia;
 
 /// Joint-space mass matrices `M(q)` of a batch, [`LaneData::width`] samples at a time (the
@@ -62,14 +62,14 @@ impl LaneKernel for MassMatrix<'_> {
         while first < self.k {
             data.load(model, [self.q, &[], &[]], first);
             // base-frame poses, motion subspaces and body inertias
-            for (i, b) in model.bodies.iter().enumerate() {
+            for (i, b) in serial(model.bodies.iter().enumerate()) {
                 let (rot, pos) = pose(b, data.qb[i]);
                 let (r, p) = place_in_base(model, data, i, &rot, &pos);
                 data.composite[i] = transformed(&b.origin_inertia, &r, &p);
             }
             let m = &mut data.m;
             m.fill(Lanes::default());
-            for i in (0..nb).rev() {
+            for i in serial((0..nb).rev()) {
                 let (c, s) = (&data.composite[i], &data.o_s[i]);
                 let f = SpatialLanes {
                     ang: c.i.mul(&s.ang).add(&c.h.cross(&s.lin)),
@@ -91,9 +91,11 @@ impl LaneKernel for MassMatrix<'_> {
                 }
             }
             // onto the degrees of freedom (mimic couplings), for the lanes in use
-            for l in 0..(self.k - first).min(W) {
-                let o = &mut self.out[(first + l) * nv * nv..(first + l + 1) * nv * nv];
-                if model.coupled {
+            let used = (self.k - first).min(W);
+            let out = &mut self.out[first * nv * nv..];
+            if model.coupled {
+                for l in 0..used {
+                    let o = &mut out[l * nv * nv..(l + 1) * nv * nv];
                     o.fill(0.0);
                     for (i, bi) in model.bodies.iter().enumerate() {
                         for (j, bj) in model.bodies.iter().enumerate() {
@@ -101,11 +103,11 @@ impl LaneKernel for MassMatrix<'_> {
                                 bi.multiplier * bj.multiplier * m[i * nb + j].0[l];
                         }
                     }
-                } else {
-                    for (x, v) in o.iter_mut().zip(m.iter()) {
-                        *x = v.0[l];
-                    }
                 }
+            } else {
+                write_rows(m, used, out, nv * nv);
+            }
+            for o in out.chunks_mut(nv * nv).take(used) {
                 model.add_armature_inertia(o);
             }
             first += W;
@@ -141,9 +143,9 @@ pub(crate) fn transformed<const W: usize>(
         r.0[2].mul_const(&b.i),
     ];
     let mut i = Rotation3Lanes::default();
-    for (row, ri_row) in ri.iter().enumerate() {
+    for (row, ri_row) in serial(ri.iter().enumerate()) {
         let mut e = [Lanes::default(); 3];
-        for (c, ec) in e.iter_mut().enumerate() {
+        for (c, ec) in serial(e.iter_mut().enumerate()) {
             let v = ri_row.dot(&r.0[c]);
             let v = w
                 .get(row)

@@ -72,7 +72,9 @@ pub(crate) struct LaneBuffers<const W: usize> {
     pub(crate) v: Vec<SpatialLanes<W>>,
     pub(crate) a: Vec<SpatialLanes<W>>,
     pub(crate) f: Vec<SpatialLanes<W>>,
-    /// The regressor of the loaded lanes, column-major `nv x 10 nbodies`.
+    /// Joint torques by body (inverse dynamics).
+    pub(crate) tau: Vec<Lanes<W>>,
+    /// The regressor of the loaded lanes, row-major `nv x 10 nbodies`.
     pub(crate) regressor: Vec<Lanes<W>>,
     /// Body-level mass matrix (row-major `nbodies x nbodies`) and composite inertias.
     pub(crate) m: Vec<Lanes<W>>,
@@ -96,6 +98,7 @@ impl<const W: usize> LaneBuffers<W> {
             v: vec![SpatialLanes::default(); nb],
             a: vec![SpatialLanes::default(); nb],
             f: vec![SpatialLanes::default(); nb],
+            tau: vec![Lanes::default(); nb],
             regressor: vec![Lanes::default(); model.nv * PARAMS_PER_BODY * nb],
             m: vec![Lanes::default(); nb * nb],
             composite: vec![mass_matrix::Composite::default(); nb],
@@ -214,11 +217,17 @@ impl LaneData {
     /// model's sizes, like slice indexing.
     #[inline]
     pub fn regressor_entry(&self, sample: usize, joint: usize, parameter: usize) -> f64 {
+        let p = PARAMS_PER_BODY * self.nbodies;
+        assert!(
+            joint < self.nv && parameter < p,
+            "regressor entry ({joint}, {parameter}) of a {} x {p} regressor",
+            self.nv
+        );
         match &self.buffers {
             #[cfg(target_arch = "x86_64")]
-            Buffers::W8(b) => b.regressor[joint + parameter * self.nv].0[sample],
+            Buffers::W8(b) => b.regressor[joint * p + parameter].0[sample],
             #[cfg(target_arch = "x86_64")]
-            Buffers::W4(b) => b.regressor[joint + parameter * self.nv].0[sample],
+            Buffers::W4(b) => b.regressor[joint * p + parameter].0[sample],
             Buffers::Scalar(d) => {
                 assert!(sample == 0, "sample {sample} of a one-sample group");
                 d.regressor[(joint, parameter)]

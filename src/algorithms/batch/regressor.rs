@@ -7,7 +7,7 @@ use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
-use crate::simd::{Lanes, SpatialLanes, Vector3Lanes};
+use crate::simd::{serial, write_rows, Lanes, SpatialLanes, Vector3Lanes};
 
 /// The joint-torque regressor of a batch, [`LaneData::width`] samples at a time: `out`
 /// (row-major `k x nv x 10 nbodies`, N m per parameter unit) holds for every sample the matrix
@@ -98,16 +98,11 @@ impl LaneKernel for Regressor<'_> {
         let mut first = 0;
         while first < self.k {
             data.load(model, self.x, first);
-            regressor_lanes(model, data, self.gravity);
+            // the entries left zero are the same for every group: cleared once per call
+            regressor_lanes(model, data, self.gravity, first == 0);
             if let Some(out) = self.out.as_deref_mut() {
-                for l in 0..(self.k - first).min(W) {
-                    let o = &mut out[(first + l) * nv * p..(first + l + 1) * nv * p];
-                    for r in 0..nv {
-                        for (c, x) in o[r * p..(r + 1) * p].iter_mut().enumerate() {
-                            *x = data.regressor[r + c * nv].0[l];
-                        }
-                    }
-                }
+                let used = (self.k - first).min(W);
+                write_rows(&data.regressor, used, &mut out[first * nv * p..], nv * p);
             }
             first += W;
         }
@@ -133,15 +128,24 @@ impl LaneKernel for Regressor<'_> {
 }
 
 /// The joint-torque regressor (see [`crate::algorithms::regressor::joint_torque_regressor`]) of
-/// the loaded group of lanes: `data.regressor` column-major `nv x 10 nbodies`, one lane per
-/// sample, every entry written. `gravity` includes gravity.
+/// the loaded group of lanes: `data.regressor` row-major `nv x 10 nbodies`, one lane per
+/// sample. `gravity` includes gravity. The entries of a degree of freedom that does not move
+/// the body of the column stay as they were: `clear` zeroes them first (needed on the first
+/// group of a call; a coupled model, whose entries accumulate, clears every time).
 #[inline(always)]
-fn regressor_lanes<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, gravity: Gravity) {
-    let nv = model.nv;
+fn regressor_lanes<const W: usize>(
+    model: &Model,
+    data: &mut LaneBuffers<W>,
+    gravity: Gravity,
+    clear: bool,
+) {
+    let cols_all = PARAMS_PER_BODY * model.nbodies();
     forward(model, data, &model.base_acceleration(gravity));
     let mut out = std::mem::take(&mut data.regressor);
-    out.fill(Lanes::default());
-    for i in 0..model.nbodies() {
+    if clear || model.coupled {
+        out.fill(Lanes::default());
+    }
+    for i in serial(0..model.nbodies()) {
         let (rot, pos) = (data.rot[i], data.pos[i]);
         let (r, p) = place_in_base(model, data, i, &rot, &pos);
         // the body's 10 columns in the base frame (see `world_body_regressor`)
@@ -155,7 +159,7 @@ fn regressor_lanes<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, gra
             ang: p.cross(&ac),
             lin: ac,
         };
-        for k in 0..3 {
+        for k in serial(0..3) {
             let rk = r.column(k);
             let lin = ww
                 .mul_lanes_add(w.get(k), &alw.cross(&rk))
@@ -186,21 +190,30 @@ fn regressor_lanes<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, gra
             ]
         };
         let (ia, iw) = (unit(&al), unit(&w));
-        for q in 0..6 {
+        for q in serial(0..6) {
             cols[4 + q].ang = r.mul(&ia[q].add(&w.cross(&iw[q])));
         }
         // project on the motion subspaces of the body and its ancestors
-        let first = PARAMS_PER_BODY * i * nv;
+        let first = PARAMS_PER_BODY * i;
         let mut j = Some(i);
         while let Some(k) = j {
             let bk = &model.bodies[k];
             let sk = &data.o_s[k];
-            let at = |c: usize| first + c * nv + bk.dof;
-            for (c, f) in cols[..4].iter().enumerate() {
-                out[at(c)] = sk.dot(f).mul_add_s(bk.multiplier, out[at(c)]);
+            let at = bk.dof * cols_all + first;
+            let row = &mut out[at..at + PARAMS_PER_BODY];
+            let mut y = [Lanes::default(); PARAMS_PER_BODY];
+            for (c, f) in serial(cols[..4].iter().enumerate()) {
+                y[c] = sk.dot(f);
             }
-            for (c, f) in cols[4..].iter().enumerate() {
-                out[at(4 + c)] = sk.ang.dot(&f.ang).mul_add_s(bk.multiplier, out[at(4 + c)]);
+            for (c, f) in serial(cols[4..].iter().enumerate()) {
+                y[4 + c] = sk.ang.dot(&f.ang);
+            }
+            if model.coupled {
+                for (o, y) in row.iter_mut().zip(&y) {
+                    *o = y.mul_add_s(bk.multiplier, *o);
+                }
+            } else {
+                row.copy_from_slice(&y);
             }
             j = bk.parent;
         }

@@ -6,7 +6,7 @@ use crate::data::Data;
 use crate::error::Result;
 use crate::gravity::Gravity;
 use crate::model::Model;
-use crate::simd::SpatialLanes;
+use crate::simd::{serial, SpatialLanes};
 
 /// Inverse dynamics `tau = M(q) qdd + c(q, qd) + g(q)` of a batch, [`LaneData::width`] samples
 /// at a time.
@@ -67,7 +67,7 @@ impl LaneKernel for Rnea<'_> {
             forward(model, data, &g);
             wrenches(model, data);
             let used = (self.k - first).min(W);
-            contract_torques(model, &data.f, first, used, self.tau);
+            contract_torques(model, &data.f, &mut data.tau, first, used, self.tau);
             first += W;
         }
         let qdd = self.x[2];
@@ -111,12 +111,12 @@ impl LaneKernel for Rnea<'_> {
 /// `data.f` (each in its body's frame).
 #[inline(always)]
 pub(crate) fn wrenches<const W: usize>(model: &Model, data: &mut LaneBuffers<W>) {
-    for (i, b) in model.bodies.iter().enumerate() {
+    for (i, b) in serial(model.bodies.iter().enumerate()) {
         let (v, a) = (&data.v[i], &data.a[i]);
         let (ia, h) = (apply(&b.inertia, a), apply(&b.inertia, v));
         data.f[i] = ia.add(&v.cross_force(&h));
     }
-    for i in (0..model.nbodies()).rev() {
+    for i in serial((0..model.nbodies()).rev()) {
         if let Some(p) = model.bodies[i].parent {
             let (rot, pos, f) = (&data.rot[i], &data.pos[i], data.f[i]);
             let lin = rot.mul(&f.lin);

@@ -1,0 +1,113 @@
+//! Lanes to rows: quantities held one sample per lane, written out sample by sample (the
+//! transpose every multi-sample kernel makes to fill a row-major output).
+
+use super::Lanes;
+
+/// Writes lanes `0..used` of `src` (`n` quantities, one value per lane each) into `dst` as rows:
+/// lane `l`'s `n` values at `dst[l * stride..l * stride + n]`, in the order of `src`.
+///
+/// `used <= W`, and `dst` must hold `(used - 1) * stride + n` values (slice indexing panics
+/// otherwise: the callers size `dst` from the same shapes). With AVX2, blocks of 4 quantities by
+/// 4 lanes are transposed in registers (4 loads, 8 shuffles, 4 stores) instead of being copied
+/// one value at a time.
+#[inline(always)]
+pub(crate) fn write_rows<const W: usize>(
+    src: &[Lanes<W>],
+    used: usize,
+    dst: &mut [f64],
+    stride: usize,
+) {
+    let n = src.len();
+    let mut done = 0;
+    #[cfg(target_arch = "x86_64")]
+    if W % 4 == 0 && std::arch::is_x86_feature_detected!("avx") {
+        done = n - n % 4;
+        for c in (0..done).step_by(4) {
+            for lb in (0..used).step_by(4) {
+                // SAFETY: the processor has AVX (checked above); every pointer comes from a
+                // bounds-checked slice of 4 values.
+                unsafe { transpose4(&src[c..c + 4], lb, used - lb, dst, stride, c) };
+            }
+        }
+    }
+    for l in 0..used {
+        let row = &mut dst[l * stride..l * stride + n];
+        for c in super::serial(done..n) {
+            row[c] = src[c].0[l];
+        }
+    }
+}
+
+/// Lanes `lb..lb + rows.min(4)` of the 4 quantities `src` into columns `c..c + 4` of those
+/// rows of `dst` (row `l` at `l * stride`).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+#[inline]
+unsafe fn transpose4<const W: usize>(
+    src: &[Lanes<W>],
+    lb: usize,
+    rows: usize,
+    dst: &mut [f64],
+    stride: usize,
+    c: usize,
+) {
+    use std::arch::x86_64::{
+        _mm256_loadu_pd, _mm256_permute2f128_pd, _mm256_storeu_pd, _mm256_unpackhi_pd,
+        _mm256_unpacklo_pd,
+    };
+    // no closures here: one compiled out of line would lose the target feature
+    let a = _mm256_loadu_pd(src[0].0[lb..lb + 4].as_ptr());
+    let b = _mm256_loadu_pd(src[1].0[lb..lb + 4].as_ptr());
+    let x = _mm256_loadu_pd(src[2].0[lb..lb + 4].as_ptr());
+    let y = _mm256_loadu_pd(src[3].0[lb..lb + 4].as_ptr());
+    // [a0 b0 a2 b2], [a1 b1 a3 b3], [x0 y0 x2 y2], [x1 y1 x3 y3]
+    let (t0, t1) = (_mm256_unpacklo_pd(a, b), _mm256_unpackhi_pd(a, b));
+    let (t2, t3) = (_mm256_unpacklo_pd(x, y), _mm256_unpackhi_pd(x, y));
+    let out = [
+        _mm256_permute2f128_pd::<0x20>(t0, t2),
+        _mm256_permute2f128_pd::<0x20>(t1, t3),
+        _mm256_permute2f128_pd::<0x31>(t0, t2),
+        _mm256_permute2f128_pd::<0x31>(t1, t3),
+    ];
+    for (l, v) in out.iter().enumerate().take(rows) {
+        let at = (lb + l) * stride + c;
+        _mm256_storeu_pd(dst[at..at + 4].as_mut_ptr(), *v);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check<const W: usize>() {
+        for n in [0, 1, 3, 4, 5, 8, 13] {
+            let src: Vec<Lanes<W>> = (0..n)
+                .map(|c| {
+                    let mut x = Lanes::<W>::default();
+                    for l in 0..W {
+                        x.0[l] = (100 * c + l) as f64;
+                    }
+                    x
+                })
+                .collect();
+            for used in 1..=W {
+                let stride = n + 2;
+                let mut dst = vec![-1.0; used * stride];
+                write_rows(&src, used, &mut dst, stride);
+                for l in 0..used {
+                    for c in 0..stride {
+                        let want = if c < n { (100 * c + l) as f64 } else { -1.0 };
+                        assert_eq!(dst[l * stride + c], want, "W {W} n {n} used {used}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rows_are_the_lanes_transposed() {
+        check::<1>();
+        check::<4>();
+        check::<8>();
+    }
+}
