@@ -35,10 +35,13 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
-import pinocchio as pin
+# numpy's BLAS threads would spin beside our one-core runs (nothing here calls BLAS)
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import perturbid_rs as pr
+import numpy as np  # noqa: E402
+import pinocchio as pin  # noqa: E402
+
+import perturbid_rs as pr  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 PEER = ROOT / "benches" / "pinocchio_peer.cpp"

@@ -586,3 +586,47 @@ fn key_messages_word_for_word() {
         "DIR/x.csv belongs to an output set whose writing was interrupted (see DIR/run.manifest.json): it may mix old and new files; run the command that wrote it again"
     );
 }
+
+#[test]
+fn overflow_deep_in_a_batch_names_its_sample() {
+    // the batch engine checks its results block by block as it writes them (and, over
+    // PARALLEL_BATCH samples, chunk by chunk on the threads): the failing sample is named
+    // wherever it falls, on the calling thread and in parallel
+    use perturbid_rs::{parallel, Gravity, States};
+    let model = robots::builtin("a465").unwrap();
+    let (n, p) = (model.nv, 10 * model.nbodies());
+    for (k, bad) in [
+        (300, 250),
+        (
+            parallel::PARALLEL_BATCH + 700,
+            parallel::PARALLEL_BATCH + 613,
+        ),
+    ] {
+        let q = vec![0.2; k * n];
+        let mut qd = vec![0.1; k * n];
+        qd[bad * n + 1] = 1e200;
+        let qdd = vec![0.0; k * n];
+        let states = States::new(n, &q, Some(&qd), Some(&qdd)).unwrap();
+        let mut ws = parallel::Workspace::new(&model);
+        let mut y = vec![0.0; k * n * p];
+        let e =
+            parallel::regressor(&model, &mut ws, &states, Gravity::Included, &mut y).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with(&format!("regressor (sample {bad}): ")),
+            "{e}"
+        );
+        let mut tau = vec![0.0; k * n];
+        let e = parallel::rnea(&model, &mut ws, &states, Gravity::Included, &mut tau).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with(&format!("rnea (sample {bad}): tau is")),
+            "{e}"
+        );
+        // the same batch without the bad sample passes, every value finite
+        qd[bad * n + 1] = 0.1;
+        let states = States::new(n, &q, Some(&qd), Some(&qdd)).unwrap();
+        parallel::regressor(&model, &mut ws, &states, Gravity::Included, &mut y).unwrap();
+        assert!(y.iter().all(|v| v.is_finite()));
+    }
+}

@@ -48,8 +48,15 @@ impl Workspace {
     }
 }
 
+/// Output values written per block before they are checked for finite values (while they
+/// are still in the core's cache: a second pass over a large batch would read it all back
+/// from memory).
+const CHECK_BLOCK_VALUES: usize = 1 << 14;
+
 /// Runs `f` over the samples of `states`, whose results fill `outs` (`per_sample[i]` values per
-/// sample in `outs[i]`): on `ws` for a small batch, in parallel chunks for a large one.
+/// sample in `outs[i]`): on `ws` for a small batch, in parallel chunks for a large one. Each
+/// thread runs its samples in blocks of a few kilobytes of output and checks each block's
+/// results to be finite as soon as it is written.
 fn run<F>(
     algorithm: &str,
     model: &Model,
@@ -78,10 +85,10 @@ where
             });
         }
     }
+    let layout: Vec<(&str, usize)> = outs.iter().map(|o| (o.0, o.2)).collect();
     if k < PARALLEL_BATCH || outs.iter().any(|o| o.2 == 0) {
         let mut whole: Vec<&mut [f64]> = outs.iter_mut().map(|o| &mut *o.1).collect();
-        f(ws, states, &mut whole)?;
-        return check_finite(algorithm, states, outs);
+        return in_blocks(algorithm, ws, states, &layout, &mut whole, &f);
     }
     let chunks = k.div_ceil(PARALLEL_CHUNK);
     let mut per_chunk: Vec<Vec<&mut [f64]>> = (0..chunks).map(|_| Vec::new()).collect();
@@ -97,25 +104,52 @@ where
             crate::interrupt::check(algorithm)?;
             let first = c * PARALLEL_CHUNK;
             let chunk = states.slice(first..(first + PARALLEL_CHUNK).min(k));
-            f(&mut Workspace::new(model), &chunk, &mut parts)
-        })?;
-    check_finite(algorithm, states, outs)
+            let mut ws = Workspace::new(model);
+            in_blocks(algorithm, &mut ws, &chunk, &layout, &mut parts, &f)
+        })
 }
 
-/// Fails on the first result that is not finite (finite inputs so large that the arithmetic
-/// overflows), naming the algorithm and the sample: no inf or NaN is handed back.
-fn check_finite(
+/// `f` over the samples of `states` on one thread, block by block (a multiple of 8 samples,
+/// about [`CHECK_BLOCK_VALUES`] output values), each block's results checked as soon as they
+/// are written: the first that is not finite (finite inputs so large that the arithmetic
+/// overflows) fails, naming the algorithm and the sample, so no inf or NaN is handed back.
+/// `layout`: each output's name and values per sample; `outs`: the outputs of `states`.
+fn in_blocks<F>(
     algorithm: &str,
+    ws: &mut Workspace,
     states: &States<'_>,
-    outs: &[(&str, &mut [f64], usize)],
-) -> Result<()> {
-    for (name, out, per) in outs {
-        if let Some(i) = crate::states::first_non_finite(out) {
-            let per = (*per).max(1);
-            return Err(states.at(i / per, super::overflow(algorithm, name, out[i], i % per)));
+    layout: &[(&str, usize)],
+    outs: &mut [&mut [f64]],
+    f: &F,
+) -> Result<()>
+where
+    F: Fn(&mut Workspace, &States<'_>, &mut [&mut [f64]]) -> Result<()>,
+{
+    let per_sample: usize = layout.iter().map(|o| o.1).sum();
+    let block = (CHECK_BLOCK_VALUES / per_sample.max(1)) / 8 * 8;
+    let block = block.max(8);
+    let k = states.len();
+    let mut first = 0;
+    loop {
+        let end = (first + block).min(k);
+        let samples = states.slice(first..end);
+        let mut parts: Vec<&mut [f64]> = outs
+            .iter_mut()
+            .zip(layout)
+            .map(|(o, (_, per))| &mut o[first * per..end * per])
+            .collect();
+        f(ws, &samples, &mut parts)?;
+        for (out, (name, per)) in parts.iter().zip(layout) {
+            if let Some(i) = crate::states::first_non_finite_here(out) {
+                let per = (*per).max(1);
+                return Err(samples.at(i / per, super::overflow(algorithm, name, out[i], i % per)));
+            }
+        }
+        first = end;
+        if first >= k {
+            return Ok(());
         }
     }
-    Ok(())
 }
 
 /// Inverse dynamics `tau = M(q) qdd + c(q, qd) [+ g(q)]` of every sample (rigid bodies, no

@@ -20,7 +20,7 @@ pub(crate) fn write_rows<const W: usize>(
     let n = src.len();
     let mut done = 0;
     #[cfg(target_arch = "x86_64")]
-    if W % 4 == 0 && std::arch::is_x86_feature_detected!("avx") {
+    if W.is_multiple_of(4) && std::arch::is_x86_feature_detected!("avx") {
         done = n - n % 4;
         for c in (0..done).step_by(4) {
             for lb in (0..used).step_by(4) {
