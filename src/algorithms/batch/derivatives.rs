@@ -165,37 +165,31 @@ impl<const W: usize> InertiaRate<W> {
         ];
         let uh2 = u.dot(h) * 2.0;
         let ha = &yv.ang;
-        let mut t = Rotation3Lanes::default();
-        for r in serial(0..3) {
-            let mut e = [Lanes::default(); 3];
-            for (c, ec) in serial(e.iter_mut().enumerate()) {
-                let v = a[r].get(c) + a[c].get(r);
-                let v = h
-                    .get(r)
-                    .neg_mul_add(u.get(c), u.get(r).neg_mul_add(h.get(c), v));
-                *ec = if r == c { v + uh2 } else { v };
-            }
-            // - [hA]x: (0, hz, -hy; -hz, 0, hx; hy, -hx, 0)
-            match r {
-                0 => {
-                    e[1] = e[1] + ha.z;
-                    e[2] = e[2] - ha.y;
-                }
-                1 => {
-                    e[0] = e[0] - ha.z;
-                    e[2] = e[2] + ha.x;
-                }
-                _ => {
-                    e[0] = e[0] + ha.y;
-                    e[1] = e[1] - ha.x;
-                }
-            }
-            t.0[r] = Vector3Lanes {
-                x: e[0],
-                y: e[1],
-                z: e[2],
-            };
-        }
+        // the symmetric part A + A^T - h u^T - u h^T + 2 (u . h) 1, each pair once
+        let sym = |r: usize, c: usize| {
+            let v = a[r].get(c) + a[c].get(r);
+            h.get(r)
+                .neg_mul_add(u.get(c), u.get(r).neg_mul_add(h.get(c), v))
+        };
+        let (xy, xz, yz) = (sym(0, 1), sym(0, 2), sym(1, 2));
+        // then - [hA]x: (0, hz, -hy; -hz, 0, hx; hy, -hx, 0)
+        let t = Rotation3Lanes([
+            Vector3Lanes {
+                x: sym(0, 0) + uh2,
+                y: xy + ha.z,
+                z: xz - ha.y,
+            },
+            Vector3Lanes {
+                x: xy - ha.z,
+                y: sym(1, 1) + uh2,
+                z: yz + ha.x,
+            },
+            Vector3Lanes {
+                x: xz + ha.y,
+                y: yz - ha.x,
+                z: sym(2, 2) + uh2,
+            },
+        ]);
         Self { t, hl: yv.lin }
     }
     /// `dY x`.

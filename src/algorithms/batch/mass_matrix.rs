@@ -136,31 +136,51 @@ pub(crate) fn transformed<const W: usize>(
     let hr = r.mul_const_vector(&b.h);
     let w = p.scale_add(0.5 * b.mass, &hr);
     let d = p.dot(&w) * 2.0;
-    // rows of R I (I symmetric), then R I R^T - w p^T - p w^T + d 1
+    // rows of R I (I symmetric), then R I R^T - w p^T - p w^T + d 1: symmetric, so each
+    // entry above the diagonal is computed once
     let ri = [
         r.0[0].mul_const(&b.i),
         r.0[1].mul_const(&b.i),
         r.0[2].mul_const(&b.i),
     ];
-    let mut i = Rotation3Lanes::default();
-    for (row, ri_row) in serial(ri.iter().enumerate()) {
-        let mut e = [Lanes::default(); 3];
-        for (c, ec) in serial(e.iter_mut().enumerate()) {
-            let v = ri_row.dot(&r.0[c]);
-            let v = w
-                .get(row)
-                .neg_mul_add(p.get(c), p.get(row).neg_mul_add(w.get(c), v));
-            *ec = if c == row { v + d } else { v };
-        }
-        i.0[row] = Vector3Lanes {
-            x: e[0],
-            y: e[1],
-            z: e[2],
-        };
-    }
+    let entry = |row: usize, c: usize| {
+        let v = ri[row].dot(&r.0[c]);
+        w.get(row)
+            .neg_mul_add(p.get(c), p.get(row).neg_mul_add(w.get(c), v))
+    };
+    let i = symmetric(
+        [entry(0, 0) + d, entry(1, 1) + d, entry(2, 2) + d],
+        [entry(0, 1), entry(0, 2), entry(1, 2)],
+    );
     Composite {
         mass: b.mass,
         h: p.scale_add(b.mass, &hr),
         i,
     }
+}
+
+/// The symmetric 3x3 matrix of diagonal `[xx, yy, zz]` and upper entries `[xy, xz, yz]`.
+#[inline(always)]
+pub(crate) fn symmetric<const W: usize>(
+    diag: [Lanes<W>; 3],
+    upper: [Lanes<W>; 3],
+) -> Rotation3Lanes<W> {
+    let ([xx, yy, zz], [xy, xz, yz]) = (diag, upper);
+    Rotation3Lanes([
+        Vector3Lanes {
+            x: xx,
+            y: xy,
+            z: xz,
+        },
+        Vector3Lanes {
+            x: xy,
+            y: yy,
+            z: yz,
+        },
+        Vector3Lanes {
+            x: xz,
+            y: yz,
+            z: zz,
+        },
+    ])
 }
