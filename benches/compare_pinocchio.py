@@ -253,17 +253,22 @@ class Side:
             f(i)
         return (time.perf_counter() - t) / k * 1e9
 
-    def our_pass(self, kernel, min_seconds=0.02):
-        """ns per sample of our batched call: one call untimed (right after the peer's process
-        the caches and the clock are cold), then calls for at least `min_seconds`."""
-        self.ours(kernel)
-        calls, t = 0, time.perf_counter()
-        while True:
-            self.ours(kernel)
-            calls += 1
-            elapsed = time.perf_counter() - t
-            if elapsed >= min_seconds:
-                return elapsed / (calls * self.samples_for(kernel)) * 1e9
+    def our_pass(self, kernel):
+        """ns per sample of our batched call of `kernel` on this side's samples."""
+        return warm_ns(lambda: self.ours(kernel), self.samples_for(kernel))
+
+
+def warm_ns(call, samples, min_seconds=0.02):
+    """ns per sample of `call` (which computes `samples` samples): one call untimed (right after
+    the peer's processes the caches and the clock are cold), then calls for `min_seconds`."""
+    call()
+    calls, t = 0, time.perf_counter()
+    while True:
+        call()
+        calls += 1
+        elapsed = time.perf_counter() - t
+        if elapsed >= min_seconds:
+            return elapsed / (calls * samples) * 1e9
 
 
 def agree(side: Side) -> list[str]:
@@ -350,11 +355,11 @@ def all_cores(side: Side, kernel: str, rounds: int):
                      for _ in range(cores)]
             pin_rate = 0.0
             for proc in procs:
-                line = json.loads(proc.communicate()[0].splitlines()[0])
+                # the peer's filter matches substrings ("rnea" in "rnea_derivatives"): by name
+                line = next(x for x in map(json.loads, proc.communicate()[0].splitlines())
+                            if x["kernel"] == kernel)
                 pin_rate += 1e9 / line["ns_per_call"]
-        t = time.perf_counter()
-        side.ours(kernel, big, out)
-        our_rate = big_k / (time.perf_counter() - t)
+        our_rate = 1e9 / warm_ns(lambda: side.ours(kernel, big, out), big_k)
         ratios.append(our_rate / pin_rate)
     return statistics.median(ratios)
 

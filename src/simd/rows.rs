@@ -69,9 +69,20 @@ unsafe fn transpose4<const W: usize>(
         _mm256_permute2f128_pd::<0x31>(t0, t2),
         _mm256_permute2f128_pd::<0x31>(t1, t3),
     ];
-    for (l, v) in out.iter().enumerate().take(rows) {
-        let at = (lb + l) * stride + c;
-        _mm256_storeu_pd(dst[at..at + 4].as_mut_ptr(), *v);
+    let first = lb * stride + c;
+    if rows >= 4 {
+        // the usual case: one bounds check for the 4 rows, then 4 plain stores
+        let block = &mut dst[first..first + 3 * stride + 4];
+        let at = block.as_mut_ptr();
+        for (l, v) in out.into_iter().enumerate() {
+            // SAFETY: `block` holds `3 * stride + 4` values, so `l * stride + 4` fit for l <= 3
+            _mm256_storeu_pd(at.add(l * stride), v);
+        }
+    } else {
+        for (l, v) in out.iter().enumerate().take(rows) {
+            let at = first + l * stride;
+            _mm256_storeu_pd(dst[at..at + 4].as_mut_ptr(), *v);
+        }
     }
 }
 
