@@ -9,6 +9,116 @@ use std::borrow::Cow;
 
 pub(crate) type ArrayLike<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 
+/// Values a [`Samples`] copies instead of borrowing (a few samples of a robot's joints).
+const COPY_UP_TO: usize = 64;
+
+/// A states argument of the `Robot` methods: anything [`ArrayLike`] takes. A small
+/// C-contiguous float64 array of one or two dimensions (a single sample, a few samples) is
+/// copied while the GIL is held, which costs less than numpy's borrow bookkeeping (a third of
+/// a one-sample call); anything else is lent as an [`ArrayLike`].
+pub(crate) enum Samples<'py> {
+    Copied {
+        shape: [usize; 2],
+        ndim: usize,
+        len: usize,
+        values: [f64; COPY_UP_TO],
+        /// The address range the values were copied from (to refuse it as an output).
+        memory: std::ops::Range<usize>,
+    },
+    Lent(ArrayLike<'py>),
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Samples<'py> {
+    type Error = PyErr;
+
+    fn extract(ob: pyo3::Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if let Ok(a) = ob.cast::<PyArrayDyn<f64>>() {
+            let (shape, len) = (a.shape(), a.len());
+            if shape.len() <= 2 && len <= COPY_UP_TO && a.is_c_contiguous() {
+                // SAFETY: the GIL is held from here to the copy's end, and no Rust reference
+                // to the array's memory is alive (writes into it go through numpy's borrow
+                // checks, which this copy does not need)
+                if let Ok(from) = unsafe { a.as_slice() } {
+                    let mut values = [0.0; COPY_UP_TO];
+                    values[..len].copy_from_slice(from);
+                    let mut dims = [0; 2];
+                    dims[..shape.len()].copy_from_slice(shape);
+                    let start = from.as_ptr() as usize;
+                    return Ok(Samples::Copied {
+                        shape: dims,
+                        ndim: shape.len(),
+                        len,
+                        values,
+                        memory: start..start + 8 * len,
+                    });
+                }
+            }
+        }
+        Ok(Samples::Lent(ob.extract()?))
+    }
+}
+
+impl Samples<'_> {
+    /// Refuses `out` when it shares memory with this argument, as numpy's borrow checks refuse
+    /// an output that is also an input (a copied argument is not borrowed, so this checks it).
+    pub(crate) fn check_apart_from(&self, out: &Bound<'_, PyArrayDyn<f64>>) -> Result<()> {
+        let Samples::Copied { memory, .. } = self else {
+            return Ok(());
+        };
+        let start = out.data() as usize;
+        let end = start + 8 * out.len();
+        if start < memory.end && memory.start < end {
+            return Err(Error::Shape {
+                argument: "out".into(),
+                expected: "writeable arrays that share no memory with the inputs or each other"
+                    .into(),
+                got: "an array that is also an input".into(),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// An array argument read by [`read_batch`]: its shape and its values in C order.
+pub(crate) trait ArrayArg {
+    fn dims(&self) -> &[usize];
+    /// The values in C (row-major) order: the array's own memory when it is C-contiguous,
+    /// a copy otherwise (`as_slice` also accepts Fortran order, whose memory order is not
+    /// ours).
+    fn values(&self) -> Cow<'_, [f64]>;
+}
+
+impl ArrayArg for ArrayLike<'_> {
+    fn dims(&self) -> &[usize] {
+        self.shape()
+    }
+    fn values(&self) -> Cow<'_, [f64]> {
+        match self
+            .is_c_contiguous()
+            .then(|| self.as_slice().ok())
+            .flatten()
+        {
+            Some(contiguous) => Cow::Borrowed(contiguous),
+            None => Cow::Owned(self.as_array().iter().copied().collect()),
+        }
+    }
+}
+
+impl ArrayArg for Samples<'_> {
+    fn dims(&self) -> &[usize] {
+        match self {
+            Samples::Copied { shape, ndim, .. } => &shape[..*ndim],
+            Samples::Lent(a) => a.dims(),
+        }
+    }
+    fn values(&self) -> Cow<'_, [f64]> {
+        match self {
+            Samples::Copied { values, len, .. } => Cow::Borrowed(&values[..*len]),
+            Samples::Lent(a) => a.values(),
+        }
+    }
+}
+
 use crate::error::{Error, Result};
 use crate::states::States;
 
@@ -25,16 +135,13 @@ pub(crate) struct Batch<'a> {
 }
 
 /// Reads `args` (name, array-like), each of shape `(n,)` or `(k, n)`, all with the same `k`.
-pub(crate) fn read_batch<'a>(
-    n: usize,
-    args: &[(&str, &'a PyArrayLikeDyn<'_, f64, AllowTypeChange>)],
-) -> Result<Batch<'a>> {
+pub(crate) fn read_batch<'a, A: ArrayArg>(n: usize, args: &[(&str, &'a A)]) -> Result<Batch<'a>> {
     // (number of samples, whether given as a batch) of the first argument
     let mut first: Option<(usize, bool)> = None;
     let mut columns = Vec::with_capacity(args.len());
     for (name, arr) in args {
-        let shape = arr.shape().to_vec();
-        let this = match shape.as_slice() {
+        let shape = arr.dims();
+        let this = match shape {
             [len] if *len == n => (1, false),
             [rows, len] if *len == n => (*rows, true),
             _ => {
@@ -61,16 +168,7 @@ pub(crate) fn read_batch<'a>(
             _ => {}
         }
         // Finiteness is checked by the algorithms, sample by sample (see `in_sample`).
-        // `as_slice` also accepts Fortran order, whose memory order is not ours
-        let c_order = if arr.is_c_contiguous() {
-            arr.as_slice().ok()
-        } else {
-            None
-        };
-        columns.push(match c_order {
-            Some(contiguous) => Cow::Borrowed(contiguous),
-            None => Cow::Owned(arr.as_array().iter().copied().collect()),
-        });
+        columns.push(arr.values());
     }
     let (k, batched) = first.unwrap_or((0, false));
     Ok(Batch {
@@ -170,21 +268,29 @@ pub(crate) fn output_array<'py>(
     Ok(arr)
 }
 
-/// Runs `f` on the memory of `out` (from [`output_array`]); fails, naming `out`, when that memory
-/// is borrowed elsewhere (an input of the same call, say).
+/// Lends the memory of `out` for writing to `f` (numpy's borrow checks refuse an array that
+/// is being read, or not writeable); `inputs` are the call's arguments, refused as outputs
+/// too when they were copied rather than borrowed.
 pub(crate) fn write_into<T>(
     out: &Bound<'_, PyArrayDyn<f64>>,
+    inputs: &[&Samples<'_>],
     f: impl FnOnce(&mut [f64]) -> Result<T>,
 ) -> Result<T> {
-    write_into_all([out], |[values]| f(values))
+    write_into_all([out], inputs, |[values]| f(values))
 }
 
 /// [`write_into`] for several arrays at once (the outputs of one call): each must be distinct
 /// and share no memory with the inputs.
 pub(crate) fn write_into_all<T, const N: usize>(
     outs: [&Bound<'_, PyArrayDyn<f64>>; N],
+    inputs: &[&Samples<'_>],
     f: impl FnOnce([&mut [f64]; N]) -> Result<T>,
 ) -> Result<T> {
+    for out in outs {
+        for input in inputs {
+            input.check_apart_from(out)?;
+        }
+    }
     let mut guards = Vec::with_capacity(N);
     for out in outs {
         guards.push(out.try_readwrite().map_err(|e| Error::Shape {

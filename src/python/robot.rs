@@ -4,13 +4,13 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::{Mutex, MutexGuard};
 
-use numpy::PyArray1;
+use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 
 use super::detached;
 
-use super::arrays::ArrayLike;
 use super::arrays::{output_array, read_batch, write_into, write_into_all};
+use super::arrays::{ArrayLike, Samples};
 use super::linearization::PyLinearization;
 use crate::algorithms::parallel::{self, Workspace};
 use crate::error::Result;
@@ -53,7 +53,7 @@ impl PyRobot {
         &self,
         py: Python<'py>,
         name: &str,
-        args: &[(&str, &ArrayLike<'py>)],
+        args: &[(&str, &Samples<'py>)],
         out_dims: &[usize],
         out: Option<Bound<'py, PyAny>>,
         f: F,
@@ -63,14 +63,27 @@ impl PyRobot {
     {
         let n = self.model.nv;
         let batch = read_batch(n, args)?;
+        let fresh = out.is_none();
         let out = output_array(py, out, batch.k, batch.single, out_dims)?;
         let work = |values: &mut [f64]| {
             let states = batch.states(n)?;
             f(&self.model, &mut self.workspace(), &states, values)
         };
-        write_into(&out, |values| {
-            compute(py, name, batch.k, n, || work(values))
-        })?;
+        if fresh {
+            // SAFETY: the array was made above and nothing else refers to it until it is
+            // returned (no borrow bookkeeping needed for it, with or without the GIL)
+            let values = unsafe { out.as_slice_mut() }.map_err(|e| crate::Error::Shape {
+                argument: "the result".into(),
+                expected: "a C-contiguous array".into(),
+                got: e.to_string(),
+            })?;
+            compute(py, name, batch.k, n, || work(values))?;
+        } else {
+            let inputs: Vec<&Samples> = args.iter().map(|a| a.1).collect();
+            write_into(&out, &inputs, |values| {
+                compute(py, name, batch.k, n, || work(values))
+            })?;
+        }
         Ok(out.into_any())
     }
 }
@@ -241,9 +254,9 @@ impl PyRobot {
     fn rnea<'py>(
         &self,
         py: Python<'py>,
-        q: ArrayLike<'py>,
-        qd: ArrayLike<'py>,
-        qdd: ArrayLike<'py>,
+        q: Samples<'py>,
+        qd: Samples<'py>,
+        qdd: Samples<'py>,
         gravity: bool,
         out: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
@@ -259,7 +272,7 @@ impl PyRobot {
     fn gravity<'py>(
         &self,
         py: Python<'py>,
-        q: ArrayLike<'py>,
+        q: Samples<'py>,
         out: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         self.batch(
@@ -277,8 +290,8 @@ impl PyRobot {
     fn bias<'py>(
         &self,
         py: Python<'py>,
-        q: ArrayLike<'py>,
-        qd: ArrayLike<'py>,
+        q: Samples<'py>,
+        qd: Samples<'py>,
         gravity: bool,
         out: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
@@ -299,7 +312,7 @@ impl PyRobot {
     fn mass_matrix<'py>(
         &self,
         py: Python<'py>,
-        q: ArrayLike<'py>,
+        q: Samples<'py>,
         out: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.model.nv;
@@ -327,9 +340,9 @@ impl PyRobot {
     fn regressor<'py>(
         &self,
         py: Python<'py>,
-        q: ArrayLike<'py>,
-        qd: ArrayLike<'py>,
-        qdd: ArrayLike<'py>,
+        q: Samples<'py>,
+        qd: Samples<'py>,
+        qdd: Samples<'py>,
         gravity: bool,
         friction: Option<Bound<'py, PyAny>>,
         out: Option<Bound<'py, PyAny>>,
@@ -354,7 +367,7 @@ impl PyRobot {
             crate::direct::regressor_matrix(&self.model, &layout, &batch.states(n)?, gravity.into())
         })?;
         let out = output_array(py, out, batch.k, batch.single, &[n, total])?;
-        write_into(&out, |values| {
+        write_into(&out, &[&q, &qd, &qdd], |values| {
             for (r, row) in values.chunks_mut(total).enumerate() {
                 for (c, x) in row.iter_mut().enumerate() {
                     *x = phi[(r, c)];
@@ -421,9 +434,9 @@ impl PyRobot {
     fn forward_dynamics<'py>(
         &self,
         py: Python<'py>,
-        q: ArrayLike<'py>,
-        qd: ArrayLike<'py>,
-        tau: ArrayLike<'py>,
+        q: Samples<'py>,
+        qd: Samples<'py>,
+        tau: Samples<'py>,
         gravity: bool,
         out: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
@@ -431,7 +444,7 @@ impl PyRobot {
         // tau rides as the third column; the states are q and qd only
         let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("tau", &tau)])?;
         let array = output_array(py, out, batch.k, batch.single, &[n])?;
-        write_into(&array, |out| {
+        write_into(&array, &[&q, &qd, &tau], |out| {
             let work = || -> Result<()> {
                 let c = &batch.columns;
                 let states = if batch.single {
@@ -457,9 +470,9 @@ impl PyRobot {
     fn rnea_derivatives<'py>(
         &self,
         py: Python<'py>,
-        q: ArrayLike<'py>,
-        qd: ArrayLike<'py>,
-        qdd: ArrayLike<'py>,
+        q: Samples<'py>,
+        qd: Samples<'py>,
+        qdd: Samples<'py>,
         gravity: bool,
         out: Option<(
             Bound<'py, PyAny>,
@@ -484,25 +497,29 @@ impl PyRobot {
         let dq = output_array(py, o1, k, single, &[n, n])?;
         let dv = output_array(py, o2, k, single, &[n, n])?;
         let m = output_array(py, o3, k, single, &[n, n])?;
-        write_into_all([&tau, &dq, &dv, &m], |[tau, dtau_dq, dtau_dv, m]| {
-            let work = || {
-                let states = batch.states(n)?;
-                let out = parallel::DerivativesOut {
-                    tau,
-                    dtau_dq,
-                    dtau_dv,
-                    m,
+        write_into_all(
+            [&tau, &dq, &dv, &m],
+            &[&q, &qd, &qdd],
+            |[tau, dtau_dq, dtau_dv, m]| {
+                let work = || {
+                    let states = batch.states(n)?;
+                    let out = parallel::DerivativesOut {
+                        tau,
+                        dtau_dq,
+                        dtau_dv,
+                        m,
+                    };
+                    parallel::rnea_derivatives(
+                        &self.model,
+                        &mut self.workspace(),
+                        &states,
+                        gravity.into(),
+                        out,
+                    )
                 };
-                parallel::rnea_derivatives(
-                    &self.model,
-                    &mut self.workspace(),
-                    &states,
-                    gravity.into(),
-                    out,
-                )
-            };
-            compute(py, "Robot.rnea_derivatives", k, n, work)
-        })?;
+                compute(py, "Robot.rnea_derivatives", k, n, work)
+            },
+        )?;
         Ok((tau.into_any(), dq.into_any(), dv.into_any(), m.into_any()))
     }
 
@@ -514,9 +531,9 @@ impl PyRobot {
     fn linearize<'py>(
         &self,
         py: Python<'py>,
-        q: ArrayLike<'py>,
-        qd: ArrayLike<'py>,
-        qdd: ArrayLike<'py>,
+        q: Samples<'py>,
+        qd: Samples<'py>,
+        qdd: Samples<'py>,
         gravity: bool,
         out: Option<(
             Bound<'py, PyAny>,
@@ -540,7 +557,7 @@ impl PyRobot {
         let g = output_array(py, o_g, k, single, &[n, n])?;
         let g_static = output_array(py, o_gs, k, single, &[n, n])?;
         let arrays = [&torque, &d, &h, &g, &g_static];
-        write_into_all(arrays, |[torque, d, h, g, g_static]| {
+        write_into_all(arrays, &[&q, &qd, &qdd], |[torque, d, h, g, g_static]| {
             let work = || {
                 let states = batch.states(n)?;
                 let out = parallel::LinearizationsOut {

@@ -81,6 +81,15 @@ def test_a_wrong_out_is_refused_with_what_was_expected(robot):
     q = np.ascontiguousarray(q)
     with pytest.raises(pr.InputError, match="share no memory with the inputs"):
         robot.rnea(q, qd, qdd, out=q)
+    # small arguments are copied rather than borrowed: an output that is one of them is still
+    # refused, in every method and for a single sample too
+    with pytest.raises(pr.InputError, match="share no memory with the inputs"):
+        robot.forward_dynamics(q[0], qd[0], np.zeros(6), out=q[0])
+    with pytest.raises(pr.InputError, match="share no memory with the inputs"):
+        robot.rnea_derivatives(q, qd, qdd, out=(qd, np.zeros((4, 6, 6)),
+                                                np.zeros((4, 6, 6)), np.zeros((4, 6, 6))))
+    with pytest.raises(pr.InputError, match="share no memory with the inputs"):
+        robot.linearize(q[1], qd[1], qdd[1], out=(qdd[1], *(np.zeros((6, 6)) for _ in range(4))))
     # one array for two outputs is refused too
     m = np.zeros((4, 6, 6))
     with pytest.raises(pr.InputError, match="each other"):
