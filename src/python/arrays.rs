@@ -16,6 +16,7 @@ const COPY_UP_TO: usize = 64;
 /// C-contiguous float64 array of one or two dimensions (a single sample, a few samples) is
 /// copied while the GIL is held, which costs less than numpy's borrow bookkeeping (a third of
 /// a one-sample call); anything else is lent as an [`ArrayLike`].
+#[allow(clippy::large_enum_variant)] // on the stack for one call: no allocation is the point
 pub(crate) enum Samples<'py> {
     Copied {
         shape: [usize; 2],
