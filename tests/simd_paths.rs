@@ -357,3 +357,35 @@ fn the_detected_path_is_the_widest_available() {
         best.lanes()
     );
 }
+
+#[test]
+fn a_kernel_vouches_for_its_output_only_when_every_value_is_finite() {
+    // the batch engine skips reading back what a kernel checked in registers: the flag must be
+    // true on finite output and false as soon as one value is not (or the path cannot tell)
+    let model = robots::builtin("a465").unwrap();
+    let (n, p) = (model.nv, 10 * model.nbodies());
+    let k = 13;
+    let q = vec![0.3; k * n];
+    let mut qd = vec![0.2; k * n];
+    let qdd = vec![0.1; k * n];
+    for path in PATHS {
+        let Some(mut lanes) = lanes_for(&model, path) else {
+            continue;
+        };
+        let vector_path = lanes.isa() != Isa::Scalar;
+        let mut y = vec![0.0; k * n * p];
+        regressor_batch(&model, &mut lanes, &q, &qd, &qdd, Gravity::Included, &mut y).unwrap();
+        assert_eq!(lanes.wrote_finite(), vector_path, "{}", describe(path));
+        assert!(y.iter().all(|v| v.is_finite()));
+        // one overflowing sample, in the last (partial) group and in a full one
+        for bad in [k - 1, 2] {
+            qd[bad * n + 1] = 1e200;
+            regressor_batch(&model, &mut lanes, &q, &qd, &qdd, Gravity::Included, &mut y).unwrap();
+            assert!(!lanes.wrote_finite(), "{} sample {bad}", describe(path));
+            assert!(y.iter().any(|v| !v.is_finite()));
+            qd[bad * n + 1] = 0.2;
+        }
+        lanes.forget_finite();
+        assert!(!lanes.wrote_finite());
+    }
+}

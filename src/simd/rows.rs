@@ -10,15 +10,20 @@ use super::Lanes;
 /// otherwise: the callers size `dst` from the same shapes). With AVX2, blocks of 4 quantities by
 /// 4 lanes are transposed in registers (4 loads, 8 shuffles, 4 stores) instead of being copied
 /// one value at a time.
+///
+/// Returns whether every value written is finite, tested on the way in registers (`v - v` is
+/// +0 for a finite `v`, NaN otherwise; the differences' bits or-ed together), so that a caller
+/// need not read its output back to vouch for it.
 #[inline(always)]
 pub(crate) fn write_rows<const W: usize>(
     src: &[Lanes<W>],
     used: usize,
     dst: &mut [f64],
     stride: usize,
-) {
+) -> bool {
     let n = src.len();
     let mut done = 0;
+    let mut bits = 0u64;
     #[cfg(target_arch = "x86_64")]
     if W.is_multiple_of(4) && std::arch::is_x86_feature_detected!("avx") {
         done = n - n % 4;
@@ -26,20 +31,24 @@ pub(crate) fn write_rows<const W: usize>(
             for lb in (0..used).step_by(4) {
                 // SAFETY: the processor has AVX (checked above); every pointer comes from a
                 // bounds-checked slice of 4 values.
-                unsafe { transpose4(&src[c..c + 4], lb, used - lb, dst, stride, c) };
+                bits |= unsafe { transpose4(&src[c..c + 4], lb, used - lb, dst, stride, c) };
             }
         }
     }
     for l in 0..used {
         let row = &mut dst[l * stride..l * stride + n];
         for c in super::serial(done..n) {
-            row[c] = src[c].0[l];
+            let v = src[c].0[l];
+            row[c] = v;
+            bits |= (v - v).to_bits();
         }
     }
+    bits == 0
 }
 
 /// Lanes `lb..lb + rows.min(4)` of the 4 quantities `src` into columns `c..c + 4` of those
-/// rows of `dst` (row `l` at `l * stride`).
+/// rows of `dst` (row `l` at `l * stride`); returns the bits of `v - v` of the values written,
+/// or-ed together (zero when all are finite).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
 #[inline]
@@ -50,10 +59,10 @@ unsafe fn transpose4<const W: usize>(
     dst: &mut [f64],
     stride: usize,
     c: usize,
-) {
+) -> u64 {
     use std::arch::x86_64::{
-        _mm256_loadu_pd, _mm256_permute2f128_pd, _mm256_storeu_pd, _mm256_unpackhi_pd,
-        _mm256_unpacklo_pd,
+        _mm256_loadu_pd, _mm256_or_pd, _mm256_permute2f128_pd, _mm256_setzero_pd, _mm256_storeu_pd,
+        _mm256_sub_pd, _mm256_unpackhi_pd, _mm256_unpacklo_pd,
     };
     // no closures here: one compiled out of line would lose the target feature
     let a = _mm256_loadu_pd(src[0].0[lb..lb + 4].as_ptr());
@@ -70,6 +79,13 @@ unsafe fn transpose4<const W: usize>(
         _mm256_permute2f128_pd::<0x31>(t1, t3),
     ];
     let first = lb * stride + c;
+    let mut bad = _mm256_setzero_pd();
+    for v in out.iter().take(rows) {
+        bad = _mm256_or_pd(bad, _mm256_sub_pd(*v, *v));
+    }
+    let mut lanes = [0.0f64; 4];
+    _mm256_storeu_pd(lanes.as_mut_ptr(), bad);
+    let bits = lanes.iter().fold(0u64, |b, x| b | x.to_bits());
     if rows >= 4 {
         // the usual case: one bounds check for the 4 rows, then 4 plain stores
         let block = &mut dst[first..first + 3 * stride + 4];
@@ -84,6 +100,7 @@ unsafe fn transpose4<const W: usize>(
             _mm256_storeu_pd(dst[at..at + 4].as_mut_ptr(), *v);
         }
     }
+    bits
 }
 
 #[cfg(test)]
@@ -104,7 +121,7 @@ mod tests {
             for used in 1..=W {
                 let stride = n + 2;
                 let mut dst = vec![-1.0; used * stride];
-                write_rows(&src, used, &mut dst, stride);
+                assert!(write_rows(&src, used, &mut dst, stride));
                 for l in 0..used {
                     for c in 0..stride {
                         let want = if c < n { (100 * c + l) as f64 } else { -1.0 };
@@ -113,6 +130,31 @@ mod tests {
                 }
             }
         }
+    }
+
+    fn finiteness<const W: usize>() {
+        // a non-finite value is reported wherever it sits among the lanes written, and not
+        // when it sits in a lane past `used`
+        for n in [1, 4, 7] {
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                for (c, l) in [(0, 0), (n - 1, W - 1), (n / 2, W / 2)] {
+                    let mut src = vec![Lanes::<W>::splat(1.5); n];
+                    src[c].0[l] = bad;
+                    for used in 1..=W {
+                        let mut dst = vec![0.0; used * n];
+                        let finite = write_rows(&src, used, &mut dst, n);
+                        assert_eq!(finite, l >= used, "W {W} n {n} c {c} l {l} used {used}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rows_report_whether_the_values_written_are_finite() {
+        finiteness::<1>();
+        finiteness::<4>();
+        finiteness::<8>();
     }
 
     #[test]

@@ -301,25 +301,28 @@ impl LaneKernel for Derivatives<'_> {
         let (n, nn) = (model.nv, model.nv * model.nv);
         let minus_g = model.base_acceleration(self.gravity);
         let mut first = 0;
+        // the armature is added after the rows are written: not vouched for then
+        let mut finite = !model.coupled && !model.has_armature();
         while first < self.k {
             let used = (self.k - first).min(W);
             data.load(model, self.x, first);
             recursion(model, data, &mut d, &minus_g, self.g_static.is_some());
             let [tau, m, dq, dv] = &mut self.out;
-            write_vectors(model, &d.tau, used, &mut tau[first * n..]);
-            write_matrices(model, &d.m, used, &mut m[first * nn..]);
-            write_matrices(model, &d.dq, used, &mut dq[first * nn..]);
-            write_matrices(model, &d.dv, used, &mut dv[first * nn..]);
+            finite &= write_vectors(model, &d.tau, used, &mut tau[first * n..]);
+            finite &= write_matrices(model, &d.m, used, &mut m[first * nn..]);
+            finite &= write_matrices(model, &d.dq, used, &mut dq[first * nn..]);
+            finite &= write_matrices(model, &d.dv, used, &mut dv[first * nn..]);
             for s in first..first + used {
                 model.add_armature_torque(&self.x[2][s * n..(s + 1) * n], &mut tau[s * n..][..n]);
                 model.add_armature_inertia(&mut m[s * nn..(s + 1) * nn]);
             }
             if let Some(gs) = self.g_static.as_deref_mut() {
-                write_matrices(model, &d.gs, used, &mut gs[first * nn..]);
+                finite &= write_matrices(model, &d.gs, used, &mut gs[first * nn..]);
             }
             first += W;
         }
         data.derivatives = Some(d);
+        data.finite = finite;
         Ok(())
     }
 
@@ -353,9 +356,14 @@ impl LaneKernel for Derivatives<'_> {
 }
 
 /// Lanes `0..used` of the body torques `body` summed onto the degrees of freedom into the
-/// row-major `out` (`used x nv`).
+/// row-major `out` (`used x nv`); whether every value was checked finite (see `write_rows`).
 #[inline(always)]
-fn write_vectors<const W: usize>(model: &Model, body: &[Lanes<W>], used: usize, out: &mut [f64]) {
+fn write_vectors<const W: usize>(
+    model: &Model,
+    body: &[Lanes<W>],
+    used: usize,
+    out: &mut [f64],
+) -> bool {
     let nv = model.nv;
     if model.coupled {
         for (l, out) in out.chunks_mut(nv).take(used).enumerate() {
@@ -364,15 +372,21 @@ fn write_vectors<const W: usize>(model: &Model, body: &[Lanes<W>], used: usize, 
                 out[b.dof] += b.multiplier * body[i].0[l];
             }
         }
+        false
     } else {
-        write_rows(body, used, out, nv);
+        write_rows(body, used, out, nv)
     }
 }
 
 /// Lanes `0..used` of the body-level row-major matrix `body` as `C^T body C` (the degrees of
-/// freedom) into the row-major `out` (`used x nv x nv`).
+/// freedom) into the row-major `out` (`used x nv x nv`); whether every value was checked finite.
 #[inline(always)]
-fn write_matrices<const W: usize>(model: &Model, body: &[Lanes<W>], used: usize, out: &mut [f64]) {
+fn write_matrices<const W: usize>(
+    model: &Model,
+    body: &[Lanes<W>],
+    used: usize,
+    out: &mut [f64],
+) -> bool {
     let (nb, nv) = (model.nbodies(), model.nv);
     if model.coupled {
         for (l, out) in out.chunks_mut(nv * nv).take(used).enumerate() {
@@ -384,8 +398,9 @@ fn write_matrices<const W: usize>(model: &Model, body: &[Lanes<W>], used: usize,
                 }
             }
         }
+        false
     } else {
-        write_rows(body, used, out, nv * nv);
+        write_rows(body, used, out, nv * nv)
     }
 }
 

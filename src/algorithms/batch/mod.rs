@@ -81,6 +81,9 @@ pub(crate) struct LaneBuffers<const W: usize> {
     pub(crate) composite: Vec<mass_matrix::Composite<W>>,
     /// The derivatives' buffers, made on first use.
     pub(crate) derivatives: Option<Box<derivatives::Buffers<W>>>,
+    /// Whether the last kernel run vouched that every value it wrote is finite (checked in
+    /// registers on the way out; see [`LaneData::wrote_finite`]).
+    pub(crate) finite: bool,
 }
 
 impl<const W: usize> LaneBuffers<W> {
@@ -103,6 +106,7 @@ impl<const W: usize> LaneBuffers<W> {
             m: vec![Lanes::default(); nb * nb],
             composite: vec![mass_matrix::Composite::default(); nb],
             derivatives: None,
+            finite: false,
         }
     }
 
@@ -235,6 +239,31 @@ impl LaneData {
         }
     }
 
+    /// Whether the last kernel run on these buffers checked every value it wrote to be finite
+    /// and found them so (the mass matrix, regressor, derivative and linearisation kernels do,
+    /// on models without couplings or armature; otherwise, and after [`Self::forget_finite`],
+    /// false: the caller checks the output itself).
+    pub fn wrote_finite(&self) -> bool {
+        match &self.buffers {
+            #[cfg(target_arch = "x86_64")]
+            Buffers::W8(b) => b.finite,
+            #[cfg(target_arch = "x86_64")]
+            Buffers::W4(b) => b.finite,
+            Buffers::Scalar(_) => false,
+        }
+    }
+
+    /// Clears [`Self::wrote_finite`] (before work that may not run a kernel).
+    pub fn forget_finite(&mut self) {
+        match &mut self.buffers {
+            #[cfg(target_arch = "x86_64")]
+            Buffers::W8(b) => b.finite = false,
+            #[cfg(target_arch = "x86_64")]
+            Buffers::W4(b) => b.finite = false,
+            Buffers::Scalar(_) => {}
+        }
+    }
+
     /// Fails unless these buffers were made for a model of `model`'s sizes.
     fn check(&self, model: &Model) -> Result<()> {
         if (self.nv, self.nbodies) == (model.nv, model.nbodies()) {
@@ -271,6 +300,7 @@ pub(crate) fn dispatch<K: LaneKernel<Output = Result<T>>, T>(
     kernel: K,
 ) -> Result<T> {
     lanes.check(model)?;
+    lanes.forget_finite();
     match &mut lanes.buffers {
         // SAFETY: `W8` and `W4` buffers are made only when the processor has the instruction
         // set (`LaneData::with_isa`, `Isa::detect`).

@@ -96,16 +96,18 @@ impl LaneKernel for Regressor<'_> {
         let nv = model.nv;
         let p = PARAMS_PER_BODY * model.nbodies();
         let mut first = 0;
+        let mut finite = self.out.is_some();
         while first < self.k {
             data.load(model, self.x, first);
             // the entries left zero are the same for every group: cleared once per call
             regressor_lanes(model, data, self.gravity, first == 0);
             if let Some(out) = self.out.as_deref_mut() {
                 let used = (self.k - first).min(W);
-                write_rows(&data.regressor, used, &mut out[first * nv * p..], nv * p);
+                finite &= write_rows(&data.regressor, used, &mut out[first * nv * p..], nv * p);
             }
             first += W;
         }
+        data.finite = finite;
         Ok(())
     }
 
@@ -169,29 +171,10 @@ fn regressor_lanes<const W: usize>(
                 lin,
             };
         }
-        // I_q x for the unit inertias of [Ixx, Ixy, Iyy, Ixz, Iyz, Izz], then rotated
-        let z = Lanes::default();
-        let unit = |x: &Vector3Lanes<W>| {
-            [
-                Vector3Lanes { x: x.x, y: z, z },
-                Vector3Lanes { x: x.y, y: x.x, z },
-                Vector3Lanes { x: z, y: x.y, z },
-                Vector3Lanes {
-                    x: x.z,
-                    y: z,
-                    z: x.x,
-                },
-                Vector3Lanes {
-                    x: z,
-                    y: x.z,
-                    z: x.y,
-                },
-                Vector3Lanes { x: z, y: z, z: x.z },
-            ]
-        };
-        let (ia, iw) = (unit(&al), unit(&w));
-        for q in serial(0..6) {
-            cols[4 + q].ang = r.mul(&ia[q].add(&w.cross(&iw[q])));
+        // I_q al + w x (I_q w) for the unit inertias of [Ixx, Ixy, Iyy, Ixz, Iyz, Izz],
+        // written out (the unit inertias are mostly zeros), then rotated into the base frame
+        for (q, c) in serial(unit_inertia_columns(&w, &al).iter().enumerate()) {
+            cols[4 + q].ang = r.mul(c);
         }
         // project on the motion subspaces of the body and its ancestors
         let first = PARAMS_PER_BODY * i;
@@ -219,4 +202,25 @@ fn regressor_lanes<const W: usize>(
         }
     }
     data.regressor = out;
+}
+
+/// `I_q al + w x (I_q w)` (body frame) for the unit rotational inertias `I_q` of
+/// `[Ixx, Ixy, Iyy, Ixz, Iyz, Izz]` (`I_xy` has ones at (x, y) and (y, x)), with the products of
+/// `w`'s components shared: 6 multiplies and 14 adds where the general form takes 72 flops.
+#[inline(always)]
+fn unit_inertia_columns<const W: usize>(
+    w: &Vector3Lanes<W>,
+    al: &Vector3Lanes<W>,
+) -> [Vector3Lanes<W>; 6] {
+    let (xy, xz, yz) = (w.x * w.y, w.x * w.z, w.y * w.z);
+    let (xx, yy, zz) = (w.x * w.x, w.y * w.y, w.z * w.z);
+    let v = |x, y, z| Vector3Lanes { x, y, z };
+    [
+        v(al.x, xz, -xy),
+        v(al.y - xz, al.x + yz, xx - yy),
+        v(-yz, al.y, xy),
+        v(al.z + xy, zz - xx, al.x - yz),
+        v(yy - zz, al.z - xy, al.y + xz),
+        v(yz, -xz, al.z),
+    ]
 }
