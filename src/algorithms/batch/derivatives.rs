@@ -306,7 +306,14 @@ impl LaneKernel for Derivatives<'_> {
         while first < self.k {
             let used = (self.k - first).min(W);
             data.load(model, self.x, first);
-            recursion(model, data, &mut d, &minus_g, self.g_static.is_some());
+            recursion(
+                model,
+                data,
+                &mut d,
+                &minus_g,
+                self.g_static.is_some(),
+                first == 0,
+            );
             let [tau, m, dq, dv] = &mut self.out;
             finite &= write_vectors(model, &d.tau, used, &mut tau[first * n..]);
             finite &= write_matrices(model, &d.m, used, &mut m[first * nn..]);
@@ -405,7 +412,8 @@ fn write_matrices<const W: usize>(
 }
 
 /// The recursion for the loaded lanes: body-level `tau`, `M`, `d tau / d q` and
-/// `d tau / d qd` into `d`.
+/// `d tau / d qd` into `d` (`Gs` too when `at_rest`); `clear` zeroes the matrices first (the
+/// pairs outside a subtree are never written: needed on the first group of a call only).
 #[inline(always)]
 fn recursion<const W: usize>(
     model: &Model,
@@ -413,6 +421,7 @@ fn recursion<const W: usize>(
     d: &mut Buffers<W>,
     minus_g: &crate::spatial::Motion,
     at_rest: bool,
+    clear: bool,
 ) {
     let nb = model.nbodies();
     let base_a = SpatialLanes {
@@ -458,8 +467,12 @@ fn recursion<const W: usize>(
         }
     }
 
-    for x in [&mut d.m, &mut d.dq, &mut d.dv, &mut d.gs] {
-        x.fill(Lanes::default());
+    // only the pairs of a body and its subtree are written, the same in every group: the
+    // others are cleared once per call
+    if clear {
+        for x in [&mut d.m, &mut d.dq, &mut d.dv, &mut d.gs] {
+            x.fill(Lanes::default());
+        }
     }
     for i in serial((0..nb).rev()) {
         let b = &model.bodies[i];

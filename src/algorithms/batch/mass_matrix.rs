@@ -70,7 +70,11 @@ impl LaneKernel for MassMatrix<'_> {
                 data.composite[i] = transformed(&b.origin_inertia, &r, &p);
             }
             let m = &mut data.m;
-            m.fill(Lanes::default());
+            // only the pairs of a body and its ancestors are written, the same in every group:
+            // the others are cleared once per call
+            if first == 0 {
+                m.fill(Lanes::default());
+            }
             for i in serial((0..nb).rev()) {
                 let (c, s) = (&data.composite[i], &data.o_s[i]);
                 let f = SpatialLanes {
