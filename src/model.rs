@@ -318,23 +318,31 @@ impl Model {
         self.armature.iter().any(|&a| a != 0.0)
     }
 
-    /// Adds the armature torques `armature[i] * qdd[i]` to `tau` (both `nv`).
+    /// Adds the armature torques `armature[i] * qdd[i]` to `tau` (both `nv`); returns whether
+    /// the entries it changed are finite (true when there is no armature).
     #[inline]
-    pub(crate) fn add_armature_torque(&self, qdd: &[f64], tau: &mut [f64]) {
+    pub(crate) fn add_armature_torque(&self, qdd: &[f64], tau: &mut [f64]) -> bool {
+        let mut finite = true;
         if self.has_armature() {
             for ((t, a), x) in tau.iter_mut().zip(&self.armature).zip(qdd) {
                 *t += a * x;
+                finite &= t.is_finite();
             }
         }
+        finite
     }
 
-    /// Adds the armature to the diagonal of the column-major `nv x nv` matrix `m`.
+    /// Adds the armature to the diagonal of the column-major `nv x nv` matrix `m`; returns
+    /// whether the diagonal is finite after it.
     #[inline]
-    pub(crate) fn add_armature_inertia(&self, m: &mut [f64]) {
+    pub(crate) fn add_armature_inertia(&self, m: &mut [f64]) -> bool {
         let n = self.nv;
+        let mut finite = true;
         for (i, a) in self.armature.iter().enumerate() {
             m[i * n + i] += a;
+            finite &= m[i * n + i].is_finite();
         }
+        finite
     }
 
     /// Total moving mass (kg).

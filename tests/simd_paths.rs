@@ -385,6 +385,10 @@ fn a_kernel_vouches_for_its_output_only_when_every_value_is_finite() {
             assert!(y.iter().any(|v| !v.is_finite()));
             qd[bad * n + 1] = 0.2;
         }
+        // the mass matrix of the A465 (which has an armature, added after the rows) too
+        let mut m = vec![0.0; k * n * n];
+        mass_matrix_batch(&model, &mut lanes, &q, &mut m).unwrap();
+        assert_eq!(lanes.wrote_finite(), vector_path, "{}", describe(path));
         lanes.forget_finite();
         assert!(!lanes.wrote_finite());
     }

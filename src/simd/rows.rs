@@ -15,6 +15,7 @@ use super::Lanes;
 /// +0 for a finite `v`, NaN otherwise; the differences' bits or-ed together), so that a caller
 /// need not read its output back to vouch for it.
 #[inline(always)]
+#[allow(clippy::eq_op)] // `v - v` is the finiteness test, not a mistake
 pub(crate) fn write_rows<const W: usize>(
     src: &[Lanes<W>],
     used: usize,

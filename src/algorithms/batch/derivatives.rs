@@ -301,8 +301,8 @@ impl LaneKernel for Derivatives<'_> {
         let (n, nn) = (model.nv, model.nv * model.nv);
         let minus_g = model.base_acceleration(self.gravity);
         let mut first = 0;
-        // the armature is added after the rows are written: not vouched for then
-        let mut finite = !model.coupled && !model.has_armature();
+        // vouched for: rows checked as they are written, the armature's entries after it
+        let mut finite = !model.coupled;
         while first < self.k {
             let used = (self.k - first).min(W);
             data.load(model, self.x, first);
@@ -320,8 +320,9 @@ impl LaneKernel for Derivatives<'_> {
             finite &= write_matrices(model, &d.dq, used, &mut dq[first * nn..]);
             finite &= write_matrices(model, &d.dv, used, &mut dv[first * nn..]);
             for s in first..first + used {
-                model.add_armature_torque(&self.x[2][s * n..(s + 1) * n], &mut tau[s * n..][..n]);
-                model.add_armature_inertia(&mut m[s * nn..(s + 1) * nn]);
+                finite &= model
+                    .add_armature_torque(&self.x[2][s * n..(s + 1) * n], &mut tau[s * n..][..n]);
+                finite &= model.add_armature_inertia(&mut m[s * nn..(s + 1) * nn]);
             }
             if let Some(gs) = self.g_static.as_deref_mut() {
                 finite &= write_matrices(model, &d.gs, used, &mut gs[first * nn..]);

@@ -59,8 +59,8 @@ impl LaneKernel for MassMatrix<'_> {
     fn wide<const W: usize>(self, model: &Model, data: &mut LaneBuffers<W>) -> Result<()> {
         let (nv, nb) = (model.nv, model.nbodies());
         let mut first = 0;
-        // the armature is added after the rows are written: not vouched for then
-        let mut finite = !model.coupled && !model.has_armature();
+        // vouched for: rows checked as they are written, the diagonal after the armature
+        let mut finite = !model.coupled;
         while first < self.k {
             data.load(model, [self.q, &[], &[]], first);
             // base-frame poses, motion subspaces and body inertias
@@ -114,7 +114,7 @@ impl LaneKernel for MassMatrix<'_> {
                 finite &= write_rows(m, used, out, nv * nv);
             }
             for o in out.chunks_mut(nv * nv).take(used) {
-                model.add_armature_inertia(o);
+                finite &= model.add_armature_inertia(o);
             }
             first += W;
         }
