@@ -114,7 +114,8 @@ where
 /// are written: the first that is not finite (finite inputs so large that the arithmetic
 /// overflows) fails, naming the algorithm and the sample, so no inf or NaN is handed back.
 /// A block whose lane kernel checked every value it wrote ([`LaneData::wrote_finite`]) is not
-/// read back; `f` must write a block's outputs through one kernel call or none.
+/// read back, and the samples after it go in one call; `f` must write a block's outputs
+/// through one kernel call or none.
 /// `layout`: each output's name and values per sample; `outs`: the outputs of `states`.
 fn in_blocks<F>(
     algorithm: &str,
@@ -129,7 +130,7 @@ where
 {
     let per_sample: usize = layout.iter().map(|o| o.1).sum();
     let block = (CHECK_BLOCK_VALUES / per_sample.max(1)) / 8 * 8;
-    let block = block.max(8);
+    let mut block = block.max(8);
     let k = states.len();
     let mut first = 0;
     loop {
@@ -153,6 +154,12 @@ where
         first = end;
         if first >= k {
             return Ok(());
+        }
+        if vouched {
+            // the kernel checks what it writes: the rest in one call (a kernel call has a
+            // fixed cost, clearing its buffers, that small blocks of a large model would pay
+            // again and again); should it not vouch there, the rest is read back
+            block = k - first;
         }
     }
 }
