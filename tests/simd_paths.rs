@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{mimic_pair, random_tree_urdf, Rng};
+use common::{mimic_pair, random_aligned_tree_urdf, random_tree_urdf, Rng};
 use nalgebra::DMatrix;
 use perturbid_rs::algorithms::batch::{
     derivatives_batch, linearize_batch, regressor_group, DerivativesOut, LinearizationsOut,
@@ -292,6 +292,12 @@ fn models() -> Vec<Model> {
         robots::builtin("a465:physical").unwrap(),
         model_from_urdf_str(&mimic_pair(true), "mimic", &LoadOptions::default()).unwrap(),
         model_from_urdf_str(&random_tree_urdf(60, 60), "tree60", &LoadOptions::default()).unwrap(),
+        model_from_urdf_str(
+            &random_aligned_tree_urdf(61, 40),
+            "aligned40",
+            &LoadOptions::default(),
+        )
+        .unwrap(),
     ]
 }
 
@@ -314,9 +320,14 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(16))]
     #[test]
     fn every_path_equals_the_one_sample_algorithms_on_random_trees(
-        seed in any::<u64>(), nlinks in 1usize..9, k in 1usize..19,
+        seed in any::<u64>(), nlinks in 1usize..9, k in 1usize..19, aligned in any::<bool>(),
     ) {
-        let text = random_tree_urdf(seed, nlinks);
+        // aligned: most joints take the kernels' shortcut for axis-aligned placements
+        let text = if aligned {
+            random_aligned_tree_urdf(seed, nlinks)
+        } else {
+            random_tree_urdf(seed, nlinks)
+        };
         let model = model_from_urdf_str(&text, "random", &LoadOptions::default()).unwrap();
         let mut rng = Rng(seed ^ 0xA5A5);
         for path in PATHS {

@@ -28,13 +28,8 @@ pub(crate) fn write_rows<const W: usize>(
     #[cfg(target_arch = "x86_64")]
     if W.is_multiple_of(4) && std::arch::is_x86_feature_detected!("avx") {
         done = n - n % 4;
-        for c in (0..done).step_by(4) {
-            for lb in (0..used).step_by(4) {
-                // SAFETY: the processor has AVX (checked above); every pointer comes from a
-                // bounds-checked slice of 4 values.
-                bits |= unsafe { transpose4(&src[c..c + 4], lb, used - lb, dst, stride, c) };
-            }
-        }
+        // SAFETY: the processor has AVX (checked above)
+        bits = unsafe { transpose_blocks(&src[..done], used, dst, stride) };
     }
     for l in 0..used {
         let row = &mut dst[l * stride..l * stride + n];
@@ -47,12 +42,37 @@ pub(crate) fn write_rows<const W: usize>(
     bits == 0
 }
 
-/// Lanes `lb..lb + rows.min(4)` of the 4 quantities `src` into columns `c..c + 4` of those
-/// rows of `dst` (row `l` at `l * stride`); returns the bits of `v - v` of the values written,
-/// or-ed together (zero when all are finite).
+/// The blocks of 4 quantities by 4 lanes of `src` (a multiple of 4 quantities) into `dst`, as
+/// [`write_rows`]; returns 0 when every value written is finite (the bits of `v - v`, or-ed in
+/// a register over all blocks and reduced once).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
 #[inline]
+#[allow(clippy::eq_op)]
+unsafe fn transpose_blocks<const W: usize>(
+    src: &[Lanes<W>],
+    used: usize,
+    dst: &mut [f64],
+    stride: usize,
+) -> u64 {
+    use std::arch::x86_64::{_mm256_castpd_si256, _mm256_setzero_pd, _mm256_testz_si256};
+    let mut bad = _mm256_setzero_pd();
+    for c in (0..src.len()).step_by(4) {
+        for lb in (0..used).step_by(4) {
+            transpose4(&src[c..c + 4], lb, used - lb, dst, stride, c, &mut bad);
+        }
+    }
+    let bad = _mm256_castpd_si256(bad);
+    u64::from(_mm256_testz_si256(bad, bad) == 0)
+}
+
+/// Lanes `lb..lb + rows.min(4)` of the 4 quantities `src` into columns `c..c + 4` of those
+/// rows of `dst` (row `l` at `l * stride`); ors `v - v` of the values written into `bad` (all
+/// zero bits while they are finite).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+#[inline]
+#[allow(clippy::too_many_arguments)]
 unsafe fn transpose4<const W: usize>(
     src: &[Lanes<W>],
     lb: usize,
@@ -60,10 +80,11 @@ unsafe fn transpose4<const W: usize>(
     dst: &mut [f64],
     stride: usize,
     c: usize,
-) -> u64 {
+    bad: &mut std::arch::x86_64::__m256d,
+) {
     use std::arch::x86_64::{
-        _mm256_loadu_pd, _mm256_or_pd, _mm256_permute2f128_pd, _mm256_setzero_pd, _mm256_storeu_pd,
-        _mm256_sub_pd, _mm256_unpackhi_pd, _mm256_unpacklo_pd,
+        _mm256_loadu_pd, _mm256_or_pd, _mm256_permute2f128_pd, _mm256_storeu_pd, _mm256_sub_pd,
+        _mm256_unpackhi_pd, _mm256_unpacklo_pd,
     };
     // no closures here: one compiled out of line would lose the target feature
     let a = _mm256_loadu_pd(src[0].0[lb..lb + 4].as_ptr());
@@ -80,13 +101,9 @@ unsafe fn transpose4<const W: usize>(
         _mm256_permute2f128_pd::<0x31>(t1, t3),
     ];
     let first = lb * stride + c;
-    let mut bad = _mm256_setzero_pd();
     for v in out.iter().take(rows) {
-        bad = _mm256_or_pd(bad, _mm256_sub_pd(*v, *v));
+        *bad = _mm256_or_pd(*bad, _mm256_sub_pd(*v, *v));
     }
-    let mut lanes = [0.0f64; 4];
-    _mm256_storeu_pd(lanes.as_mut_ptr(), bad);
-    let bits = lanes.iter().fold(0u64, |b, x| b | x.to_bits());
     if rows >= 4 {
         // the usual case: one bounds check for the 4 rows, then 4 plain stores
         let block = &mut dst[first..first + 3 * stride + 4];
@@ -101,7 +118,6 @@ unsafe fn transpose4<const W: usize>(
             _mm256_storeu_pd(dst[at..at + 4].as_mut_ptr(), *v);
         }
     }
-    bits
 }
 
 #[cfg(test)]

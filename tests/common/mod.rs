@@ -30,6 +30,17 @@ impl Rng {
 /// a random earlier link by a revolute, continuous, prismatic or fixed joint (the first joint
 /// always moves), with random origins, axes and physically valid inertias.
 pub fn random_tree_urdf(seed: u64, nlinks: usize) -> String {
+    tree_urdf(seed, nlinks, false)
+}
+
+/// As [`random_tree_urdf`], with joint axes along +-x, +-y or +-z and joint origins turned by
+/// multiples of pi/2 (as most robots' URDFs are: the kernels' shortcut for such joints), every
+/// fifth joint left general.
+pub fn random_aligned_tree_urdf(seed: u64, nlinks: usize) -> String {
+    tree_urdf(seed, nlinks, true)
+}
+
+fn tree_urdf(seed: u64, nlinks: usize, aligned: bool) -> String {
     let mut r = Rng(seed);
     let mut s = String::from("<robot name=\"random\">\n  <link name=\"base\"/>\n");
     for k in 1..=nlinks {
@@ -63,13 +74,43 @@ pub fn random_tree_urdf(seed: u64, nlinks: usize) -> String {
         } else {
             ["revolute", "continuous", "prismatic", "fixed", "revolute"][r.below(5)]
         };
+        let xyz = [
+            r.uniform(-0.3, 0.3),
+            r.uniform(-0.3, 0.3),
+            r.uniform(0.0, 0.4),
+        ];
+        let (rpy, axis) = if aligned && r.below(5) != 0 {
+            // quarter turns and a signed unit axis; some translations along one axis only
+            let quarter = std::f64::consts::FRAC_PI_2;
+            let rpy = [0; 3].map(|_| quarter * (r.below(4) as f64 - 1.0));
+            let mut axis = [0.0; 3];
+            axis[r.below(3)] = if r.below(2) == 0 { 1.0 } else { -1.0 };
+            (rpy, axis)
+        } else {
+            (
+                [
+                    r.uniform(-3.0, 3.0),
+                    r.uniform(-1.5, 1.5),
+                    r.uniform(-3.0, 3.0),
+                ],
+                [
+                    r.uniform(-1.0, 1.0),
+                    r.uniform(-1.0, 1.0),
+                    r.uniform(0.2, 1.0),
+                ],
+            )
+        };
+        let xyz = if aligned && r.below(2) == 0 {
+            let j = r.below(3);
+            [0, 1, 2].map(|i| if i == j { xyz[i] } else { 0.0 })
+        } else {
+            xyz
+        };
         s += &format!(
             "  <joint name=\"j{k}\" type=\"{kind}\"><parent link=\"{parent}\"/><child link=\"l{k}\"/>\
              <origin xyz=\"{} {} {}\" rpy=\"{} {} {}\"/><axis xyz=\"{} {} {}\"/>\
              <limit lower=\"-2\" upper=\"2\" effort=\"100\" velocity=\"3\"/></joint>\n",
-            r.uniform(-0.3, 0.3), r.uniform(-0.3, 0.3), r.uniform(0.0, 0.4),
-            r.uniform(-3.0, 3.0), r.uniform(-1.5, 1.5), r.uniform(-3.0, 3.0),
-            r.uniform(-1.0, 1.0), r.uniform(-1.0, 1.0), r.uniform(0.2, 1.0)
+            xyz[0], xyz[1], xyz[2], rpy[0], rpy[1], rpy[2], axis[0], axis[1], axis[2]
         );
     }
     s + "</robot>\n"
