@@ -215,30 +215,33 @@ pub(crate) fn output_array<'py>(
     k: usize,
     single: bool,
     dims: &[usize],
-) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+) -> PyResult<Output<'py>> {
     let mut shape: Vec<usize> = if single { Vec::new() } else { vec![k] };
     shape.extend_from_slice(dims);
     let Some(out) = out else {
         let values = shape.iter().try_fold(1usize, |a, &d| a.checked_mul(d));
-        return match values {
+        let array = match values {
             // SAFETY: every element is written before the array reaches Python (the algorithms
             // write every entry of their output, and on an error the array is dropped)
-            Some(v) if v <= DIRECT_ALLOCATION => {
-                Ok(unsafe { PyArrayDyn::<f64>::new(py, shape, false) })
-            }
+            Some(v) if v <= DIRECT_ALLOCATION => unsafe {
+                PyArrayDyn::<f64>::new(py, shape, false)
+            },
             // numpy's own allocation: a MemoryError when the memory is not there (rust-numpy's
             // direct allocation would panic)
             Some(v) if v <= isize::MAX as usize / 8 => {
                 let empty = py.import("numpy")?.call_method1("empty", (shape,))?;
-                Ok(empty.cast_into::<PyArrayDyn<f64>>()?)
+                empty.cast_into::<PyArrayDyn<f64>>()?
             }
-            _ => Err(Error::Shape {
-                argument: "the result".into(),
-                expected: "an array that fits in memory".into(),
-                got: format!("shape {shape:?}"),
+            _ => {
+                return Err(Error::Shape {
+                    argument: "the result".into(),
+                    expected: "an array that fits in memory".into(),
+                    got: format!("shape {shape:?}"),
+                }
+                .into())
             }
-            .into()),
         };
+        return Ok(Output { array, fresh: true });
     };
     let wrong = |got: String| Error::Shape {
         argument: "out".into(),
@@ -266,47 +269,81 @@ pub(crate) fn output_array<'py>(
     if !arr.is_c_contiguous() {
         return Err(wrong("an array that is not C-contiguous".into()).into());
     }
-    Ok(arr)
+    Ok(Output {
+        array: arr,
+        fresh: false,
+    })
 }
 
-/// Lends the memory of `out` for writing to `f` (numpy's borrow checks refuse an array that
-/// is being read, or not writeable); `inputs` are the call's arguments, refused as outputs
-/// too when they were copied rather than borrowed.
+/// A batched method's result array: one made for the call (`fresh`: nothing else refers to it
+/// until it is returned, so it is written without numpy's borrow bookkeeping, which costs more
+/// than a one-sample call's work) or the caller's `out` (lent through that bookkeeping).
+pub(crate) struct Output<'py> {
+    array: Bound<'py, PyArrayDyn<f64>>,
+    fresh: bool,
+}
+
+impl<'py> Output<'py> {
+    /// The array, for returning to Python.
+    pub(crate) fn into_any(self) -> Bound<'py, PyAny> {
+        self.array.into_any()
+    }
+}
+
+/// Lends the memory of `out` for writing to `f`: a fresh array directly, the caller's through
+/// numpy's borrow checks (which refuse an array that is being read, or not writeable); `inputs`
+/// are the call's arguments, refused as outputs too when they were copied rather than borrowed.
 pub(crate) fn write_into<T>(
-    out: &Bound<'_, PyArrayDyn<f64>>,
+    out: &Output<'_>,
     inputs: &[&Samples<'_>],
     f: impl FnOnce(&mut [f64]) -> Result<T>,
 ) -> Result<T> {
     write_into_all([out], inputs, |[values]| f(values))
 }
 
-/// [`write_into`] for several arrays at once (the outputs of one call): each must be distinct
-/// and share no memory with the inputs.
+/// [`write_into`] for several arrays at once (the outputs of one call): each of the caller's
+/// must be distinct and share no memory with the inputs.
 pub(crate) fn write_into_all<T, const N: usize>(
-    outs: [&Bound<'_, PyArrayDyn<f64>>; N],
+    outs: [&Output<'_>; N],
     inputs: &[&Samples<'_>],
     f: impl FnOnce([&mut [f64]; N]) -> Result<T>,
 ) -> Result<T> {
-    for out in outs {
+    let lent = || outs.iter().filter(|o| !o.fresh);
+    for out in lent() {
         for input in inputs {
-            input.check_apart_from(out)?;
+            input.check_apart_from(&out.array)?;
         }
     }
     let mut guards = Vec::with_capacity(N);
-    for out in outs {
-        guards.push(out.try_readwrite().map_err(|e| Error::Shape {
+    for out in lent() {
+        guards.push(out.array.try_readwrite().map_err(|e| Error::Shape {
             argument: "out".into(),
             expected: "writeable arrays that share no memory with the inputs or each other".into(),
             got: format!("an array numpy refuses to lend for writing: {e}"),
         })?);
     }
-    let mut slices = Vec::with_capacity(N);
+    let not_contiguous = |e: numpy::AsSliceError| Error::Shape {
+        argument: "out".into(),
+        expected: "C-contiguous arrays".into(),
+        got: e.to_string(),
+    };
+    let mut lent_slices = Vec::with_capacity(N);
     for guard in &mut guards {
-        slices.push(guard.as_slice_mut().map_err(|e| Error::Shape {
-            argument: "out".into(),
-            expected: "C-contiguous arrays".into(),
-            got: e.to_string(),
-        })?);
+        lent_slices.push(guard.as_slice_mut().map_err(not_contiguous)?);
+    }
+    let mut lent_slices = lent_slices.into_iter();
+    let mut slices = Vec::with_capacity(N);
+    for out in outs {
+        if out.fresh {
+            // SAFETY: the array was made for this call and nothing else refers to it until it
+            // is returned (no borrow bookkeeping needed, with or without the GIL)
+            slices.push(unsafe { out.array.as_slice_mut() }.map_err(not_contiguous)?);
+        } else {
+            let Some(s) = lent_slices.next() else {
+                unreachable!("one guard per lent array")
+            };
+            slices.push(s);
+        }
     }
     let Ok(slices) = <[&mut [f64]; N]>::try_from(slices) else {
         unreachable!("one slice per array")

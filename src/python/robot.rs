@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::{Mutex, MutexGuard};
 
-use numpy::{PyArray1, PyArrayMethods};
+use numpy::PyArray1;
 use pyo3::prelude::*;
 
 use super::detached;
@@ -63,27 +63,14 @@ impl PyRobot {
     {
         let n = self.model.nv;
         let batch = read_batch(n, args)?;
-        let fresh = out.is_none();
         let out = output_array(py, out, batch.k, batch.single, out_dims)?;
-        let work = |values: &mut [f64]| {
-            let states = batch.states(n)?;
-            f(&self.model, &mut self.workspace(), &states, values)
-        };
-        if fresh {
-            // SAFETY: the array was made above and nothing else refers to it until it is
-            // returned (no borrow bookkeeping needed for it, with or without the GIL)
-            let values = unsafe { out.as_slice_mut() }.map_err(|e| crate::Error::Shape {
-                argument: "the result".into(),
-                expected: "a C-contiguous array".into(),
-                got: e.to_string(),
-            })?;
-            compute(py, name, batch.k, n, || work(values))?;
-        } else {
-            let inputs: Vec<&Samples> = args.iter().map(|a| a.1).collect();
-            write_into(&out, &inputs, |values| {
-                compute(py, name, batch.k, n, || work(values))
-            })?;
-        }
+        let inputs: Vec<&Samples> = args.iter().map(|a| a.1).collect();
+        write_into(&out, &inputs, |values| {
+            compute(py, name, batch.k, n, || {
+                let states = batch.states(n)?;
+                f(&self.model, &mut self.workspace(), &states, values)
+            })
+        })?;
         Ok(out.into_any())
     }
 }
