@@ -121,6 +121,18 @@ pub(crate) fn forward<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, 
     }
 }
 
+/// Body `i`'s pose in the base frame for its loaded coordinate (stored with the motion subspace
+/// there, as by [`place_in_base`], and returned).
+#[inline(always)]
+pub(crate) fn pose_in_base<const W: usize>(
+    model: &Model,
+    data: &mut LaneBuffers<W>,
+    i: usize,
+) -> (Rotation3Lanes<W>, Vector3Lanes<W>) {
+    let (rot, pos) = pose(&model.bodies[i], data.qb[i]);
+    place_in_base(model, data, i, &rot, &pos)
+}
+
 /// Body `i`'s pose in the base frame from its pose `rot`, `pos` in its parent (whose base-frame
 /// pose is already in `data`): stores it with the motion subspace there (`o_rot`, `o_pos`,
 /// `o_s`) and returns it.

@@ -1,7 +1,7 @@
 //! Joint-space mass matrices of many samples on the lanes (the composite rigid body algorithm
 //! in the base frame).
 
-use super::kinematics::{place_in_base, pose};
+use super::kinematics::pose_in_base;
 use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
 use crate::data::Data;
 use crate::error::Result;
@@ -42,6 +42,18 @@ pub(crate) struct Composite<const W: usize> {
     pub(crate) i: Rotation3Lanes<W>,
 }
 
+impl<const W: usize> Composite<W> {
+    /// The composite of two bodies (inertias in one frame).
+    #[inline(always)]
+    pub(crate) fn add(&self, o: &Self) -> Self {
+        Self {
+            mass: self.mass + o.mass,
+            h: self.h.add(&o.h),
+            i: self.i.add(&o.i),
+        }
+    }
+}
+
 impl<const W: usize> Default for Composite<W> {
     fn default() -> Self {
         Self {
@@ -63,11 +75,9 @@ impl LaneKernel for MassMatrix<'_> {
         let mut finite = !model.coupled;
         while first < self.k {
             data.load(model, [self.q, &[], &[]], first);
-            // base-frame poses, motion subspaces and body inertias
-            for (i, b) in serial(model.bodies.iter().enumerate()) {
-                let (rot, pos) = pose(b, data.qb[i]);
-                let (r, p) = place_in_base(model, data, i, &rot, &pos);
-                data.composite[i] = transformed(&b.origin_inertia, &r, &p);
+            // base-frame poses and motion subspaces
+            for i in serial(0..nb) {
+                pose_in_base(model, data, i);
             }
             let m = &mut data.m;
             // only the pairs of a body and its ancestors are written, the same in every group:
@@ -75,8 +85,16 @@ impl LaneKernel for MassMatrix<'_> {
             if first == 0 {
                 m.fill(Lanes::default());
             }
+            // composite inertias from the leaves up: each child's arrives in its parent's
+            // `data.composite`, the first to arrive (the last child in depth-first order) by
+            // assignment, so nothing is cleared
             for i in serial((0..nb).rev()) {
-                let (c, s) = (&data.composite[i], &data.o_s[i]);
+                let b = &model.bodies[i];
+                let mut c = transformed(&b.origin_inertia, &data.o_rot[i], &data.o_pos[i]);
+                if i + 1 < b.subtree_end {
+                    c = c.add(&data.composite[i]);
+                }
+                let s = &data.o_s[i];
                 let f = SpatialLanes {
                     ang: c.i.mul(&s.ang).add(&c.h.cross(&s.lin)),
                     lin: s.lin.scale_add(c.mass, &s.ang.cross(&c.h)),
@@ -88,12 +106,12 @@ impl LaneKernel for MassMatrix<'_> {
                     m[k * nb + i] = mik;
                     j = model.bodies[k].parent;
                 }
-                if let Some(p) = model.bodies[i].parent {
-                    let child = data.composite[i];
-                    let parent = &mut data.composite[p];
-                    parent.mass += child.mass;
-                    parent.h = parent.h.add(&child.h);
-                    parent.i = parent.i.add(&child.i);
+                match b.parent {
+                    Some(p) if b.subtree_end == model.bodies[p].subtree_end => {
+                        data.composite[p] = c
+                    }
+                    Some(p) => data.composite[p] = data.composite[p].add(&c),
+                    None => {}
                 }
             }
             // onto the degrees of freedom (mimic couplings), for the lanes in use
