@@ -68,6 +68,49 @@ pub(crate) struct PoseTerms {
     pub(crate) r1: Matrix3<f64>,
     pub(crate) r2: Matrix3<f64>,
     pub(crate) t1: Vector3<f64>,
+    /// Set for a revolute joint whose placement rotation permutes and flips the axes and whose
+    /// axis is one of them: the multi-sample kernels then form its base-frame rotation from
+    /// columns of its parent's, without 3x3 products.
+    pub(crate) aligned: Option<AlignedRevolute>,
+}
+
+/// A revolute joint with `R(x) = R0 Rot_k(sign x)`: the axis is `sign e_k` and column `j` of
+/// the placement rotation `R0` is `col_sign[j] e_{col_row[j]}` (entries within 1e-12 of 0 or
+/// +-1 taken as exact: a rotation from an `rpy` of multiples of pi/2 holds `6e-17` for its
+/// zeros). `Rot_k` turns `e_a` towards `e_b` for `(k, a, b)` cyclic.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct AlignedRevolute {
+    pub(crate) k: usize,
+    pub(crate) sign: f64,
+    pub(crate) col_row: [usize; 3],
+    pub(crate) col_sign: [f64; 3],
+}
+
+impl AlignedRevolute {
+    /// The alignment of a revolute joint of placement rotation `r0` and unit `axis`, if any.
+    pub(crate) fn of(r0: &Matrix3<f64>, axis: &Vector3<f64>) -> Option<Self> {
+        let (k, sign) = signed_unit(axis)?;
+        let mut col_row = [0; 3];
+        let mut col_sign = [0.0; 3];
+        for j in 0..3 {
+            (col_row[j], col_sign[j]) = signed_unit(&r0.column(j).into_owned())?;
+        }
+        Some(Self {
+            k,
+            sign,
+            col_row,
+            col_sign,
+        })
+    }
+}
+
+/// `(k, s)` when `v` is `s e_k` for `s = +-1` (each component within 1e-12).
+fn signed_unit(v: &Vector3<f64>) -> Option<(usize, f64)> {
+    const TOL: f64 = 1e-12;
+    let k = v.iamax();
+    let s = v[k].signum();
+    let unit = (v[k] - s).abs() <= TOL && (0..3).all(|j| j == k || v[j].abs() <= TOL);
+    unit.then_some((k, s))
 }
 
 impl PoseTerms {
@@ -78,6 +121,7 @@ impl PoseTerms {
             r2: r1 * k,
             r1,
             t1: placement.rotation * axis,
+            aligned: AlignedRevolute::of(&placement.rotation, axis),
         }
     }
 }

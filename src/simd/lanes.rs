@@ -136,8 +136,9 @@ impl<const W: usize> std::ops::Neg for Lanes<W> {
     }
 }
 
-/// A 3-vector per lane.
+/// A 3-vector per lane (laid out as `[Lanes<W>; 3]`: see [`Vector3Lanes::at`]).
 #[derive(Clone, Copy, Debug)]
+#[repr(C)]
 pub(crate) struct Vector3Lanes<const W: usize> {
     pub(crate) x: Lanes<W>,
     pub(crate) y: Lanes<W>,
@@ -261,6 +262,22 @@ impl<const W: usize> Vector3Lanes<W> {
             y: self.dot_const(&m.row(1).transpose()),
             z: self.dot_const(&m.row(2).transpose()),
         }
+    }
+    /// Component `k` (0, 1, 2) for an index known only at run time: one load from memory
+    /// (where [`Vector3Lanes::get`] would select among registers).
+    #[inline(always)]
+    pub(crate) fn at(&self, k: usize) -> &Lanes<W> {
+        // SAFETY: `repr(C)` with three fields of one type and no padding between them is laid
+        // out as `[Lanes<W>; 3]`, and the reference's lifetime is `self`'s
+        let a = unsafe { &*(self as *const Self as *const [Lanes<W>; 3]) };
+        &a[k]
+    }
+    /// [`Vector3Lanes::at`], for writing.
+    #[inline(always)]
+    pub(crate) fn at_mut(&mut self, k: usize) -> &mut Lanes<W> {
+        // SAFETY: as in `at`, with the exclusive borrow of `self`
+        let a = unsafe { &mut *(self as *mut Self as *mut [Lanes<W>; 3]) };
+        &mut a[k]
     }
     /// Component `k` (0, 1, 2).
     #[inline(always)]

@@ -121,16 +121,63 @@ pub(crate) fn forward<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, 
     }
 }
 
-/// Body `i`'s pose in the base frame for its loaded coordinate (stored with the motion subspace
-/// there, as by [`place_in_base`], and returned).
+/// Body `i`'s pose in the base frame for its loaded coordinate, stored with the motion subspace
+/// there (`o_rot`, `o_pos`, `o_s`, as by [`place_in_base`]). A revolute joint with an
+/// axis-aligned placement below another body takes columns of its parent's base rotation,
+/// scaled by the cosine and sine (no 3x3 product); the others go through [`pose`] and
+/// [`place_in_base`].
 #[inline(always)]
-pub(crate) fn pose_in_base<const W: usize>(
+pub(crate) fn store_pose_in_base<const W: usize>(
     model: &Model,
     data: &mut LaneBuffers<W>,
     i: usize,
-) -> (Rotation3Lanes<W>, Vector3Lanes<W>) {
-    let (rot, pos) = pose(&model.bodies[i], data.qb[i]);
-    place_in_base(model, data, i, &rot, &pos)
+) {
+    let b = &model.bodies[i];
+    let (Some(al), Some(parent), JointKind::Revolute) = (&b.pose_terms.aligned, b.parent, b.kind)
+    else {
+        let (rot, pos) = pose(b, data.qb[i]);
+        place_in_base(model, data, i, &rot, &pos);
+        return;
+    };
+    let (s, c) = sin_cos(data.qb[i]);
+    let rp = &data.o_rot[parent];
+    // R = Rp R0 Rot_k(sign x): column j of Rp R0 is col_sign[j] times column col_row[j] of Rp
+    // (read from memory by index)
+    let column = |m: usize| Vector3Lanes {
+        x: *rp.0[0].at(m),
+        y: *rp.0[1].at(m),
+        z: *rp.0[2].at(m),
+    };
+    let (k, a, bb) = (al.k, (al.k + 1) % 3, (al.k + 2) % 3);
+    let (pa, pb) = (column(al.col_row[a]), column(al.col_row[bb]));
+    let pk = column(al.col_row[k]).scale(al.col_sign[k]);
+    let (ca, cb) = (c * al.col_sign[a], c * al.col_sign[bb]);
+    let (sa, sb) = (
+        s * (al.sign * al.col_sign[a]),
+        s * (al.sign * al.col_sign[bb]),
+    );
+    // Rot_k e_a = cos e_a + sin e_b, Rot_k e_b = cos e_b - sin e_a
+    let col_a = pa.mul_lanes_add(ca, &pb.mul_lanes(sb));
+    let col_b = pb.mul_lanes(cb).sub(&pa.mul_lanes(sa));
+    let p = data.o_pos[parent].add(&rp.mul_const_vector(&b.placement.translation));
+    let axis = pk.scale(al.sign);
+    data.o_s[i] = SpatialLanes {
+        ang: axis,
+        lin: p.cross(&axis),
+    };
+    data.o_pos[i] = p;
+    let r = &mut data.o_rot[i];
+    for (row, (ea, eb, ek)) in [
+        (col_a.x, col_b.x, pk.x),
+        (col_a.y, col_b.y, pk.y),
+        (col_a.z, col_b.z, pk.z),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let row = &mut r.0[row];
+        (*row.at_mut(a), *row.at_mut(bb), *row.at_mut(k)) = (ea, eb, ek);
+    }
 }
 
 /// Body `i`'s pose in the base frame from its pose `rot`, `pos` in its parent (whose base-frame

@@ -1,7 +1,7 @@
 //! Joint-space mass matrices of many samples on the lanes (the composite rigid body algorithm
 //! in the base frame).
 
-use super::kinematics::pose_in_base;
+use super::kinematics::store_pose_in_base;
 use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
 use crate::data::Data;
 use crate::error::Result;
@@ -77,7 +77,7 @@ impl LaneKernel for MassMatrix<'_> {
             data.load(model, [self.q, &[], &[]], first);
             // base-frame poses and motion subspaces
             for i in serial(0..nb) {
-                pose_in_base(model, data, i);
+                store_pose_in_base(model, data, i);
             }
             let m = &mut data.m;
             // only the pairs of a body and its ancestors are written, the same in every group:
