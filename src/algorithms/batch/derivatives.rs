@@ -2,7 +2,7 @@
 //! of many samples on the lanes: the base-frame recursion of [`crate::rnea_derivatives`]
 //! (Carpentier & Mansard, RSS 2018), one sample per lane.
 
-use super::kinematics::{place_in_base, pose};
+use super::kinematics::store_pose_in_base;
 use super::mass_matrix::{transformed, Composite};
 use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
 use crate::data::Data;
@@ -430,8 +430,8 @@ fn recursion<const W: usize>(
         lin: Vector3Lanes::splat(&minus_g.linear),
     };
     for (i, b) in serial(model.bodies.iter().enumerate()) {
-        let (rot, pos) = pose(b, data.qb[i]);
-        let (r, p) = place_in_base(model, data, i, &rot, &pos);
+        store_pose_in_base(model, data, i);
+        let (r, p) = (data.o_rot[i], data.o_pos[i]);
         let j = data.o_s[i];
         let (ov_p, oa_p) = match b.parent {
             Some(k) => (d.ov[k], d.oa[k]),
