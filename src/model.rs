@@ -114,14 +114,17 @@ fn signed_unit(v: &Vector3<f64>) -> Option<(usize, f64)> {
 }
 
 impl PoseTerms {
-    pub(crate) fn new(placement: &Se3, axis: &Vector3<f64>) -> Self {
+    pub(crate) fn new(kind: JointKind, placement: &Se3, axis: &Vector3<f64>) -> Self {
         let k = skew(axis);
         let r1 = placement.rotation * k;
         Self {
             r2: r1 * k,
             r1,
             t1: placement.rotation * axis,
-            aligned: AlignedRevolute::of(&placement.rotation, axis),
+            aligned: match kind {
+                JointKind::Revolute => AlignedRevolute::of(&placement.rotation, axis),
+                JointKind::Prismatic => None,
+            },
         }
     }
 }
@@ -131,7 +134,7 @@ impl Body {
     /// builders call it; call [`Model::refresh`] after editing those fields of a model.
     pub fn refresh(&mut self) {
         self.origin_inertia = OriginInertia::from(&self.inertia);
-        self.pose_terms = PoseTerms::new(&self.placement, &self.axis);
+        self.pose_terms = PoseTerms::new(self.kind, &self.placement, &self.axis);
     }
 
     /// The joint's motion subspace: the body's twist per unit joint velocity, in its own frame.
@@ -450,5 +453,68 @@ pub(crate) fn check_finite_vector(argument: &str, x: &[f64], n: usize) -> Result
             value: x[index],
         }),
         None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spatial::Se3;
+
+    #[test]
+    fn aligned_joints_are_recognised_and_their_rotation_is_the_joints() {
+        // quarter-turn origins (with the 6e-17 of cos(pi/2)) and signed unit axes
+        let quarter = std::f64::consts::FRAC_PI_2;
+        for (rpy, axis) in [
+            ([0.0, 0.0, 0.0], Vector3::z()),
+            ([quarter, 0.0, -quarter], -Vector3::y()),
+            ([-quarter, quarter, std::f64::consts::PI], Vector3::x()),
+        ] {
+            let placement = Se3::from_xyz_rpy([0.1, 0.0, 0.3], rpy);
+            let t = PoseTerms::new(JointKind::Revolute, &placement, &axis);
+            let al = t.aligned.expect("aligned");
+            // R0 Rot_k(sign x) rebuilt from the description equals the joint's rotation
+            let x = 0.7;
+            let r0 = Matrix3::from_fn(|r, c| {
+                if r == al.col_row[c] {
+                    al.col_sign[c]
+                } else {
+                    0.0
+                }
+            });
+            let mut e = Vector3::zeros();
+            e[al.k] = 1.0;
+            let rot = nalgebra::Rotation3::from_axis_angle(
+                &nalgebra::Unit::new_normalize(e),
+                al.sign * x,
+            );
+            let want = joint_pose(JointKind::Revolute, &placement, &axis, x).rotation;
+            assert!(
+                (r0 * rot.matrix() - want).amax() < 1e-15,
+                "{rpy:?} {axis:?}"
+            );
+        }
+        // a general axis or origin, or a prismatic joint, is not
+        let general = Se3::from_xyz_rpy([0.0; 3], [0.3, 0.0, 0.0]);
+        assert!(PoseTerms::new(JointKind::Revolute, &general, &Vector3::z())
+            .aligned
+            .is_none());
+        let tilted = Vector3::new(0.0, 0.6, 0.8);
+        assert!(
+            PoseTerms::new(JointKind::Revolute, &Se3::identity(), &tilted)
+                .aligned
+                .is_none()
+        );
+        assert!(
+            PoseTerms::new(JointKind::Prismatic, &Se3::identity(), &Vector3::z())
+                .aligned
+                .is_none()
+        );
+    }
+
+    #[test]
+    fn the_a465s_joints_take_the_aligned_path() {
+        let model = crate::robots::builtin("a465").unwrap();
+        assert!(model.bodies.iter().all(|b| b.pose_terms.aligned.is_some()));
     }
 }

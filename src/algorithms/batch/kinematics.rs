@@ -133,8 +133,8 @@ pub(crate) fn store_pose_in_base<const W: usize>(
     i: usize,
 ) {
     let b = &model.bodies[i];
-    let (Some(al), Some(parent), JointKind::Revolute) = (&b.pose_terms.aligned, b.parent, b.kind)
-    else {
+    // (set for revolute joints only)
+    let (Some(al), Some(parent)) = (&b.pose_terms.aligned, b.parent) else {
         let (rot, pos) = pose(b, data.qb[i]);
         place_in_base(model, data, i, &rot, &pos);
         return;
