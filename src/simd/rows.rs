@@ -28,8 +28,13 @@ pub(crate) fn write_rows<const W: usize>(
     #[cfg(target_arch = "x86_64")]
     if W.is_multiple_of(4) && std::arch::is_x86_feature_detected!("avx") {
         done = n - n % 4;
-        // SAFETY: the processor has AVX (checked above)
-        bits = unsafe { transpose_blocks(&src[..done], used, dst, stride) };
+        for c in (0..done).step_by(4) {
+            for lb in (0..used).step_by(4) {
+                // SAFETY: the processor has AVX (checked above); every pointer comes from a
+                // bounds-checked slice of 4 values.
+                bits |= unsafe { transpose4(&src[c..c + 4], lb, used - lb, dst, stride, c) };
+            }
+        }
     }
     for l in 0..used {
         let row = &mut dst[l * stride..l * stride + n];
@@ -42,37 +47,13 @@ pub(crate) fn write_rows<const W: usize>(
     bits == 0
 }
 
-/// The blocks of 4 quantities by 4 lanes of `src` (a multiple of 4 quantities) into `dst`, as
-/// [`write_rows`]; returns 0 when every value written is finite (the bits of `v - v`, or-ed in
-/// a register over all blocks and reduced once).
+/// Lanes `lb..lb + rows.min(4)` of the 4 quantities `src` into columns `c..c + 4` of those
+/// rows of `dst` (row `l` at `l * stride`); returns 0 when the values written are all finite
+/// (`v - v` of each or-ed in a register and tested once: no store, no reload).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
 #[inline]
 #[allow(clippy::eq_op)]
-unsafe fn transpose_blocks<const W: usize>(
-    src: &[Lanes<W>],
-    used: usize,
-    dst: &mut [f64],
-    stride: usize,
-) -> u64 {
-    use std::arch::x86_64::{_mm256_castpd_si256, _mm256_setzero_pd, _mm256_testz_si256};
-    let mut bad = _mm256_setzero_pd();
-    for c in (0..src.len()).step_by(4) {
-        for lb in (0..used).step_by(4) {
-            transpose4(&src[c..c + 4], lb, used - lb, dst, stride, c, &mut bad);
-        }
-    }
-    let bad = _mm256_castpd_si256(bad);
-    u64::from(_mm256_testz_si256(bad, bad) == 0)
-}
-
-/// Lanes `lb..lb + rows.min(4)` of the 4 quantities `src` into columns `c..c + 4` of those
-/// rows of `dst` (row `l` at `l * stride`); ors `v - v` of the values written into `bad` (all
-/// zero bits while they are finite).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx")]
-#[inline]
-#[allow(clippy::too_many_arguments)]
 unsafe fn transpose4<const W: usize>(
     src: &[Lanes<W>],
     lb: usize,
@@ -80,11 +61,11 @@ unsafe fn transpose4<const W: usize>(
     dst: &mut [f64],
     stride: usize,
     c: usize,
-    bad: &mut std::arch::x86_64::__m256d,
-) {
+) -> u64 {
     use std::arch::x86_64::{
-        _mm256_loadu_pd, _mm256_or_pd, _mm256_permute2f128_pd, _mm256_storeu_pd, _mm256_sub_pd,
-        _mm256_unpackhi_pd, _mm256_unpacklo_pd,
+        _mm256_castpd_si256, _mm256_loadu_pd, _mm256_or_pd, _mm256_permute2f128_pd,
+        _mm256_setzero_pd, _mm256_storeu_pd, _mm256_sub_pd, _mm256_testz_si256, _mm256_unpackhi_pd,
+        _mm256_unpacklo_pd,
     };
     // no closures here: one compiled out of line would lose the target feature
     let a = _mm256_loadu_pd(src[0].0[lb..lb + 4].as_ptr());
@@ -101,9 +82,12 @@ unsafe fn transpose4<const W: usize>(
         _mm256_permute2f128_pd::<0x31>(t1, t3),
     ];
     let first = lb * stride + c;
+    let mut bad = _mm256_setzero_pd();
     for v in out.iter().take(rows) {
-        *bad = _mm256_or_pd(*bad, _mm256_sub_pd(*v, *v));
+        bad = _mm256_or_pd(bad, _mm256_sub_pd(*v, *v));
     }
+    let bad = _mm256_castpd_si256(bad);
+    let bits = u64::from(_mm256_testz_si256(bad, bad) == 0);
     if rows >= 4 {
         // the usual case: one bounds check for the 4 rows, then 4 plain stores
         let block = &mut dst[first..first + 3 * stride + 4];
@@ -118,6 +102,7 @@ unsafe fn transpose4<const W: usize>(
             _mm256_storeu_pd(dst[at..at + 4].as_mut_ptr(), *v);
         }
     }
+    bits
 }
 
 #[cfg(test)]
