@@ -226,9 +226,7 @@ impl<const W: usize> Composite<W> {
     }
     #[inline(always)]
     fn add_assign(&mut self, o: &Self) {
-        self.mass += o.mass;
-        self.h = self.h.add(&o.h);
-        self.i = self.i.add(&o.i);
+        *self = self.add(o);
     }
 }
 
