@@ -264,6 +264,13 @@ impl Model {
         }
     }
 
+    /// Whether bodies `i` and `j` lie on one chain from the base (one is the other, or an
+    /// ancestor of it): the pairs whose mass matrix entry can be non-zero.
+    pub fn related(&self, i: usize, j: usize) -> bool {
+        let (a, b) = (i.min(j), i.max(j));
+        b < self.bodies[a].subtree_end
+    }
+
     /// Number of moving bodies (>= `nv` when joints are coupled).
     pub fn nbodies(&self) -> usize {
         self.bodies.len()

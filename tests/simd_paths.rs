@@ -356,6 +356,27 @@ fn buffers_of_another_model_are_refused() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("buffers for this model"), "{e}");
+    // the same sizes, another tree: a chain of three against three links on the base (the
+    // mass matrix kernel keeps the chain's zero pattern in its buffers)
+    let tree = |parents: [&str; 3]| {
+        let mut s = String::from("<robot name=\"t\"><link name=\"base\"/>");
+        for (k, p) in parents.iter().enumerate() {
+            s += &format!(
+                "<link name=\"l{k}\"><inertial><mass value=\"1\"/><inertia ixx=\"0.1\" \
+                 ixy=\"0\" ixz=\"0\" iyy=\"0.1\" iyz=\"0\" izz=\"0.1\"/></inertial></link>\
+                 <joint name=\"j{k}\" type=\"continuous\"><parent link=\"{p}\"/>\
+                 <child link=\"l{k}\"/><origin xyz=\"0.1 0 0\"/><axis xyz=\"0 0 1\"/></joint>"
+            );
+        }
+        let model = model_from_urdf_str(&(s + "</robot>"), "t", &LoadOptions::default());
+        model.unwrap()
+    };
+    let (chain, star) = (tree(["base", "l0", "l1"]), tree(["base"; 3]));
+    let mut lanes = LaneData::new(&chain);
+    let mut m = vec![0.0; 9];
+    let e = mass_matrix_batch(&star, &mut lanes, &[0.0; 3], &mut m).unwrap_err();
+    assert!(e.to_string().contains("other parents"), "{e}");
+    mass_matrix_batch(&chain, &mut lanes, &[0.0; 3], &mut m).unwrap();
 }
 
 #[test]
@@ -402,5 +423,34 @@ fn a_kernel_vouches_for_its_output_only_when_every_value_is_finite() {
         assert_eq!(lanes.wrote_finite(), vector_path, "{}", describe(path));
         lanes.forget_finite();
         assert!(!lanes.wrote_finite());
+    }
+}
+
+#[test]
+fn bodies_are_related_when_one_is_an_ancestor_of_the_other_and_only_those_pair_in_m() {
+    // the mass matrix kernels write the pairs of unrelated bodies as zeros without computing
+    // them: that must be what the one-sample algorithm gives there
+    let mut rng = Rng(5);
+    for model in models() {
+        let nb = model.nbodies();
+        let ancestors = |mut b: usize| {
+            let mut out = vec![b];
+            while let Some(p) = model.bodies[b].parent {
+                out.push(p);
+                b = p;
+            }
+            out
+        };
+        let mut data = Data::new(&model);
+        mass_matrix(&model, &mut data, &rng.vector(model.nv, 3.0)).unwrap();
+        for i in 0..nb {
+            for j in 0..nb {
+                let want = ancestors(i).contains(&j) || ancestors(j).contains(&i);
+                assert_eq!(model.related(i, j), want, "bodies {i}, {j}");
+                if !want && !model.coupled {
+                    assert_eq!(data.m[(i, j)], 0.0, "M[{i}, {j}] of unrelated bodies");
+                }
+            }
+        }
     }
 }

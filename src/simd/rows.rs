@@ -22,6 +22,22 @@ pub(crate) fn write_rows<const W: usize>(
     dst: &mut [f64],
     stride: usize,
 ) -> bool {
+    write_rows_with_zeros(src, |_| false, used, dst, stride)
+}
+
+/// As [`write_rows`], where `zero(c)` says that quantities `4c..4c + 4` of `src` are zero in
+/// every lane (a structural zero of the kernel): with AVX those are stored as zeros without
+/// being read. `zero` must be true only for such blocks (the values written are then equal to
+/// [`write_rows`]'s); the quantities past the last whole block are read in any case.
+#[inline(always)]
+#[allow(clippy::eq_op)]
+pub(crate) fn write_rows_with_zeros<const W: usize>(
+    src: &[Lanes<W>],
+    zero: impl Fn(usize) -> bool,
+    used: usize,
+    dst: &mut [f64],
+    stride: usize,
+) -> bool {
     let n = src.len();
     let mut done = 0;
     let mut bits = 0u64;
@@ -29,6 +45,13 @@ pub(crate) fn write_rows<const W: usize>(
     if W.is_multiple_of(4) && std::arch::is_x86_feature_detected!("avx") {
         done = n - n % 4;
         for c in (0..done).step_by(4) {
+            if zero(c / 4) {
+                for l in 0..used {
+                    let at = l * stride + c;
+                    dst[at..at + 4].fill(0.0);
+                }
+                continue;
+            }
             for lb in (0..used).step_by(4) {
                 // SAFETY: the processor has AVX (checked above); every pointer comes from a
                 // bounds-checked slice of 4 values.
@@ -157,6 +180,44 @@ mod tests {
         finiteness::<1>();
         finiteness::<4>();
         finiteness::<8>();
+    }
+
+    fn zeros_unread<const W: usize>() {
+        // blocks said to be zero are written as zeros whatever `src` holds there (they are not
+        // read); the others, and the tail past the last whole block, are the lanes transposed
+        for n in [4, 7, 12, 13] {
+            let src: Vec<Lanes<W>> = (0..n)
+                .map(|c| Lanes::splat(if (c / 4) % 2 == 1 { f64::NAN } else { c as f64 }))
+                .collect();
+            for used in 1..=W {
+                let mut dst = vec![-1.0; used * n];
+                let finite = write_rows_with_zeros(&src, |b| b % 2 == 1, used, &mut dst, n);
+                let skipped = W.is_multiple_of(4) && std::arch::is_x86_feature_detected!("avx");
+                for l in 0..used {
+                    for c in 0..n {
+                        let got = dst[l * n + c];
+                        if (c / 4) % 2 == 0 {
+                            assert_eq!(got, c as f64);
+                        } else if skipped && c < n - n % 4 {
+                            assert_eq!(got, 0.0, "W {W} n {n} used {used} c {c}");
+                        } else {
+                            assert!(got.is_nan());
+                        }
+                    }
+                }
+                let read = |c: usize| !skipped || c >= n - n % 4;
+                let nan_read = (0..n).any(|c| (c / 4) % 2 == 1 && read(c));
+                assert_eq!(finite, !nan_read, "W {W} n {n}");
+            }
+        }
+    }
+
+    #[test]
+    #[cfg(target_arch = "x86_64")]
+    fn blocks_of_structural_zeros_are_written_without_being_read() {
+        zeros_unread::<1>();
+        zeros_unread::<4>();
+        zeros_unread::<8>();
     }
 
     #[test]

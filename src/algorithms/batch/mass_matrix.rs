@@ -6,7 +6,9 @@ use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
 use crate::data::Data;
 use crate::error::Result;
 use crate::model::Model;
-use crate::simd::{serial, write_rows, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
+use crate::simd::{
+    serial, write_rows_with_zeros, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes,
+};
 use crate::spatial::OriginInertia;
 
 /// Joint-space mass matrices `M(q)` of a batch, [`LaneData::width`] samples at a time (the
@@ -79,9 +81,10 @@ impl LaneKernel for MassMatrix<'_> {
             for i in serial(0..nb) {
                 store_pose_in_base(model, data, i);
             }
-            let m = &mut data.m;
+            let (m, blocks) = (&mut data.m, &data.m_blocks);
             // only the pairs of a body and its ancestors are written, the same in every group:
-            // the others are cleared once per call
+            // the others are cleared once per call (and those in blocks of 4 structural zeros
+            // are not even read: `m_blocks`)
             if first == 0 {
                 m.fill(Lanes::default());
             }
@@ -129,7 +132,7 @@ impl LaneKernel for MassMatrix<'_> {
                     }
                 }
             } else {
-                finite &= write_rows(m, used, out, nv * nv);
+                finite &= write_rows_with_zeros(m, |c| !blocks[c], used, out, nv * nv);
             }
             for o in out.chunks_mut(nv * nv).take(used) {
                 finite &= model.add_armature_inertia(o);
@@ -168,11 +171,21 @@ pub(crate) fn transformed<const W: usize>(
         r.0[1].mul_const(&b.i),
         r.0[2].mul_const(&b.i),
     ];
-    let entry = |row: usize, c: usize| {
+    // a function, not a closure: one compiled out of line would lose the instruction set
+    #[inline(always)]
+    fn entry<const W: usize>(
+        ri: &[Vector3Lanes<W>; 3],
+        r: &Rotation3Lanes<W>,
+        w: &Vector3Lanes<W>,
+        p: &Vector3Lanes<W>,
+        row: usize,
+        c: usize,
+    ) -> Lanes<W> {
         let v = ri[row].dot(&r.0[c]);
         w.get(row)
             .neg_mul_add(p.get(c), p.get(row).neg_mul_add(w.get(c), v))
-    };
+    }
+    let entry = |row, c| entry(&ri, r, &w, p, row, c);
     let i = symmetric(
         [entry(0, 0) + d, entry(1, 1) + d, entry(2, 2) + d],
         [entry(0, 1), entry(0, 2), entry(1, 2)],

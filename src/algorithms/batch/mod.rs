@@ -42,6 +42,10 @@ pub struct LaneData {
     isa: Isa,
     nv: usize,
     nbodies: usize,
+    /// The parent of every body of the model these buffers were made for: the kernels keep
+    /// structural facts in them (the mass matrix's zero blocks), so a model of the same sizes
+    /// but another tree is refused.
+    parents: Vec<Option<usize>>,
     buffers: Buffers,
 }
 
@@ -78,6 +82,10 @@ pub(crate) struct LaneBuffers<const W: usize> {
     pub(crate) regressor: Vec<Lanes<W>>,
     /// Body-level mass matrix (row-major `nbodies x nbodies`) and composite inertias.
     pub(crate) m: Vec<Lanes<W>>,
+    /// Per block of 4 consecutive entries of `m`: whether one of them pairs a body with one of
+    /// its ancestors or descendants (the others are structural zeros, written without being
+    /// read; a tree's mass matrix is mostly such zeros).
+    pub(crate) m_blocks: Vec<bool>,
     pub(crate) composite: Vec<mass_matrix::Composite<W>>,
     /// The derivatives' buffers, made on first use.
     pub(crate) derivatives: Option<Box<derivatives::Buffers<W>>>,
@@ -104,6 +112,9 @@ impl<const W: usize> LaneBuffers<W> {
             tau: vec![Lanes::default(); nb],
             regressor: vec![Lanes::default(); model.nv * PARAMS_PER_BODY * nb],
             m: vec![Lanes::default(); nb * nb],
+            m_blocks: (0..nb * nb / 4)
+                .map(|c| (4 * c..4 * c + 4).any(|e| model.related(e / nb, e % nb)))
+                .collect(),
             composite: vec![mass_matrix::Composite::default(); nb],
             derivatives: None,
             finite: false,
@@ -196,6 +207,7 @@ impl LaneData {
             },
             nv: model.nv,
             nbodies: model.nbodies(),
+            parents: model.bodies.iter().map(|b| b.parent).collect(),
             buffers,
         }
     }
@@ -266,7 +278,13 @@ impl LaneData {
 
     /// Fails unless these buffers were made for a model of `model`'s sizes.
     fn check(&self, model: &Model) -> Result<()> {
-        if (self.nv, self.nbodies) == (model.nv, model.nbodies()) {
+        let sizes = (self.nv, self.nbodies) == (model.nv, model.nbodies());
+        if sizes
+            && self
+                .parents
+                .iter()
+                .eq(model.bodies.iter().map(|b| &b.parent))
+        {
             return Ok(());
         }
         Err(Error::Shape {
@@ -276,7 +294,11 @@ impl LaneData {
                 model.nv,
                 model.nbodies()
             ),
-            got: format!("buffers for {} dofs and {} bodies", self.nv, self.nbodies),
+            got: if sizes {
+                "buffers for a model of these sizes whose bodies have other parents".into()
+            } else {
+                format!("buffers for {} dofs and {} bodies", self.nv, self.nbodies)
+            },
         })
     }
 }
