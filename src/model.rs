@@ -84,22 +84,37 @@ pub(crate) struct AlignedRevolute {
     pub(crate) sign: f64,
     pub(crate) col_row: [usize; 3],
     pub(crate) col_sign: [f64; 3],
+    /// The same by role, in the order `(k, a, b)`: the body-frame axes `[k, a, b]`, the rows
+    /// `col_row` and signs `col_sign` of those columns, and the placement translation `p`
+    /// (parent frame) turned into the body's axes, `R0^T p`, by role.
+    pub(crate) roles: [usize; 3],
+    pub(crate) rows: [usize; 3],
+    pub(crate) signs: [f64; 3],
+    pub(crate) p_roles: [f64; 3],
 }
 
 impl AlignedRevolute {
     /// The alignment of a revolute joint of placement rotation `r0` and unit `axis`, if any.
-    pub(crate) fn of(r0: &Matrix3<f64>, axis: &Vector3<f64>) -> Option<Self> {
+    pub(crate) fn of(placement: &Se3, axis: &Vector3<f64>) -> Option<Self> {
+        let r0 = &placement.rotation;
         let (k, sign) = signed_unit(axis)?;
         let mut col_row = [0; 3];
         let mut col_sign = [0.0; 3];
         for j in 0..3 {
             (col_row[j], col_sign[j]) = signed_unit(&r0.column(j).into_owned())?;
         }
+        let roles = [k, (k + 1) % 3, (k + 2) % 3];
+        let rows = roles.map(|j| col_row[j]);
+        let signs = roles.map(|j| col_sign[j]);
         Some(Self {
             k,
             sign,
             col_row,
             col_sign,
+            roles,
+            rows,
+            signs,
+            p_roles: [0, 1, 2].map(|j| signs[j] * placement.translation[rows[j]]),
         })
     }
 }
@@ -122,7 +137,7 @@ impl PoseTerms {
             r1,
             t1: placement.rotation * axis,
             aligned: match kind {
-                JointKind::Revolute => AlignedRevolute::of(&placement.rotation, axis),
+                JointKind::Revolute => AlignedRevolute::of(placement, axis),
                 JointKind::Prismatic => None,
             },
         }

@@ -2,7 +2,7 @@
 //! accelerations, base-frame poses and motion subspaces, on `W` lanes.
 
 use super::LaneBuffers;
-use crate::model::{Body, JointKind, Model};
+use crate::model::{AlignedRevolute, Body, JointKind, Model};
 use crate::simd::{serial, sin_cos, write_rows, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
 use crate::spatial::{Inertia, Motion, Se3};
 
@@ -79,15 +79,35 @@ pub(crate) fn apply<const W: usize>(inertia: &Inertia, m: &SpatialLanes<W>) -> S
     }
 }
 
-/// The forward pass on the loaded coordinates: every body's pose in its parent (`rot`, `pos`),
-/// twist `v` and acceleration `a` (gravity included as a base acceleration `g`) in its frame.
+/// Whether the forward pass stores every body's pose in its parent (`Poses::All`: the kernels
+/// that read `rot` and `pos` afterwards) or, for axis-aligned revolute joints, only the cosine
+/// and sine of the joint angle (`Poses::Sparse`: inverse dynamics, whose backward pass takes
+/// those joints' sparse rotations as well, [`aligned_to_parent`]).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Poses {
+    All,
+    Sparse,
+}
+
+/// The forward pass on the loaded coordinates: every body's pose in its parent (`rot`, `pos`;
+/// with [`Poses::Sparse`], `cos_sin` instead for an axis-aligned revolute joint), twist `v` and
+/// acceleration `a` (gravity included as a base acceleration `g`) in its frame.
 #[inline(always)]
-pub(crate) fn forward<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, g: &Motion) {
+pub(crate) fn forward<const W: usize>(
+    model: &Model,
+    data: &mut LaneBuffers<W>,
+    g: &Motion,
+    poses: Poses,
+) {
     let base = SpatialLanes {
         ang: Vector3Lanes::splat(&g.angular),
         lin: Vector3Lanes::splat(&g.linear),
     };
     for (i, b) in serial(model.bodies.iter().enumerate()) {
+        if let (Poses::Sparse, Some(al)) = (poses, &b.pose_terms.aligned) {
+            aligned_forward(b, al, data, i, &base);
+            continue;
+        }
         let (rot, pos) = pose(b, data.qb[i]);
         let (mut v, mut a) = match b.parent {
             Some(p) => (
@@ -118,6 +138,128 @@ pub(crate) fn forward<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, 
         data.pos[i] = pos;
         data.v[i] = v;
         data.a[i] = a;
+    }
+}
+
+/// The forward step of body `i`, whose revolute joint is axis-aligned (`al`): `R = R0 Rot_k`,
+/// with `R0` a signed permutation, so that the parent's twist and acceleration are read by
+/// index, permuted, and turned about one axis (5 products a vector instead of a 3x3 one), and
+/// the joint's own terms touch one or two components. Stores `v`, `a` and `cos_sin` of body
+/// `i` (not `rot`, `pos`); the parent's motion is `base` (with no twist) for a root body.
+#[inline(always)]
+fn aligned_forward<const W: usize>(
+    b: &Body,
+    al: &AlignedRevolute,
+    data: &mut LaneBuffers<W>,
+    i: usize,
+    base: &SpatialLanes<W>,
+) {
+    let (s, c) = sin_cos(data.qb[i]);
+    let s = s * al.sign;
+    data.cos_sin[i] = [c, s];
+    // Rot^T's entries times R0's signs: [c s_a, s s_b, s s_a, c s_b]
+    let [sa, sb] = [al.signs[1], al.signs[2]];
+    let turn = [c * sa, s * sb, s * sa, c * sb];
+    let pos = &b.placement.translation;
+    let still = SpatialLanes::default();
+    let (vp, ap) = match b.parent {
+        Some(p) => (&data.v[p], &data.a[p]),
+        None => (&still, base),
+    };
+    // by role (k, a, b): k the joint axis
+    let [mut vang, vlin] = aligned_in_child(al, pos, &turn, vp);
+    let [mut aang, mut alin] = aligned_in_child(al, pos, &turn, ap);
+    // the joint: v += w e_k, a += qdd e_k + v x (w e_k), where (v x e_k) = (0, v_b, -v_a)
+    let w = data.vb[i] * al.sign;
+    vang[0] = vang[0] + w;
+    aang[0] = data.ab[i].mul_add_s(al.sign, aang[0]);
+    aang[1] = vang[2].mul_add(w, aang[1]);
+    aang[2] = vang[1].neg_mul_add(w, aang[2]);
+    alin[1] = vlin[2].mul_add(w, alin[1]);
+    alin[2] = vlin[1].neg_mul_add(w, alin[2]);
+    let (v, a) = (&mut data.v[i], &mut data.a[i]);
+    for (j, &r) in al.roles.iter().enumerate() {
+        *v.ang.at_mut(r) = vang[j];
+        *v.lin.at_mut(r) = vlin[j];
+        *a.ang.at_mut(r) = aang[j];
+        *a.lin.at_mut(r) = alin[j];
+    }
+}
+
+/// The motion `m` of an aligned joint's parent (in the parent's frame, in memory) in the
+/// child's frame, `R^T (m.ang, m.lin - p x m.ang)` with `R = R0 Rot_k`, by role `(k, a, b)`:
+/// `[angular, linear]`. `turn` holds `[c s_a, s s_b, s s_a, c s_b]` (cosine, sine, and the
+/// signs of `R0`'s columns a and b).
+#[inline(always)]
+fn aligned_in_child<const W: usize>(
+    al: &AlignedRevolute,
+    pos: &nalgebra::Vector3<f64>,
+    turn: &[Lanes<W>; 4],
+    m: &SpatialLanes<W>,
+) -> [[Lanes<W>; 3]; 2] {
+    let [ca, sb, sa, cb] = *turn;
+    let (ang, lin) = (&m.ang, &m.lin);
+    let mut raw = [[Lanes::default(); 3]; 2];
+    for (j, &r) in al.rows.iter().enumerate() {
+        let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
+        raw[0][j] = *ang.at(r);
+        // (lin - p x ang)[r] = lin[r] - p[r1] ang[r2] + p[r2] ang[r1]
+        raw[1][j] = ang
+            .at(r1)
+            .mul_add_s(pos[r2], ang.at(r2).mul_add_s(-pos[r1], *lin.at(r)));
+    }
+    // R0^T x = (s_k x[r_k], s_a x[r_a], s_b x[r_b]); Rot_k^T turns (a, b) by -angle (no
+    // closure, no `map`: one compiled out of line would lose the instruction set)
+    let [x, y] = raw;
+    [
+        [
+            x[0] * al.signs[0],
+            ca.mul_add(x[1], sb * x[2]),
+            cb.mul_sub(x[2], sa * x[1]),
+        ],
+        [
+            y[0] * al.signs[0],
+            ca.mul_add(y[1], sb * y[2]),
+            cb.mul_sub(y[2], sa * y[1]),
+        ],
+    ]
+}
+
+/// The backward step of an aligned joint (see [`aligned_forward`]): adds body `i`'s wrench
+/// `f` (its frame) to its parent's `fp` (the parent's frame), `(R f.ang + p x R f.lin,
+/// R f.lin)`, turning about one axis and permuting into the parent's components by index.
+/// `cos_sin` as the forward step stored it.
+#[inline(always)]
+pub(crate) fn aligned_to_parent<const W: usize>(
+    al: &AlignedRevolute,
+    [c, s]: [Lanes<W>; 2],
+    f: &SpatialLanes<W>,
+    fp: &mut SpatialLanes<W>,
+) {
+    let [k, a, b] = al.roles;
+    let (fa, fl) = (&f.ang, &f.lin);
+    // Rot_k by role: (x_k, c x_a - s x_b, s x_a + c x_b)
+    let y = [
+        *fl.at(k),
+        c.mul_sub(*fl.at(a), s * *fl.at(b)),
+        s.mul_add(*fl.at(a), c * *fl.at(b)),
+    ];
+    let ra = [
+        *fa.at(k),
+        c.mul_sub(*fa.at(a), s * *fa.at(b)),
+        s.mul_add(*fa.at(a), c * *fa.at(b)),
+    ];
+    // z = Rot f.ang + p' x y with p' = R0^T p by role
+    let p = al.p_roles;
+    let z = [
+        y[2].mul_add_s(p[1], y[1].mul_add_s(-p[2], ra[0])),
+        y[0].mul_add_s(p[2], y[2].mul_add_s(-p[0], ra[1])),
+        y[1].mul_add_s(p[0], y[0].mul_add_s(-p[1], ra[2])),
+    ];
+    // R0 x = sum_j s_j x_j e_{r_j}
+    for (j, &r) in al.rows.iter().enumerate() {
+        *fp.lin.at_mut(r) = y[j].mul_add_s(al.signs[j], *fp.lin.at(r));
+        *fp.ang.at_mut(r) = z[j].mul_add_s(al.signs[j], *fp.ang.at(r));
     }
 }
 

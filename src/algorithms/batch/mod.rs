@@ -68,6 +68,9 @@ pub(crate) struct LaneBuffers<const W: usize> {
     /// Each body's pose in its parent (rotation by rows, translation).
     pub(crate) rot: Vec<Rotation3Lanes<W>>,
     pub(crate) pos: Vec<Vector3Lanes<W>>,
+    /// Cosine and sine of each axis-aligned revolute joint's turn (inverse dynamics keeps
+    /// these instead of `rot`, `pos`: `kinematics::Poses::Sparse`).
+    pub(crate) cos_sin: Vec<[Lanes<W>; 2]>,
     /// Each body's pose in the base frame and its motion subspace there.
     pub(crate) o_rot: Vec<Rotation3Lanes<W>>,
     pub(crate) o_pos: Vec<Vector3Lanes<W>>,
@@ -103,6 +106,7 @@ impl<const W: usize> LaneBuffers<W> {
             ab: vec![Lanes::default(); nb],
             rot: vec![Rotation3Lanes::default(); nb],
             pos: vec![Vector3Lanes::default(); nb],
+            cos_sin: vec![[Lanes::default(); 2]; nb],
             o_rot: vec![Rotation3Lanes::default(); nb],
             o_pos: vec![Vector3Lanes::default(); nb],
             o_s: vec![SpatialLanes::default(); nb],

@@ -1,6 +1,6 @@
 //! The joint-torque regressor of many samples on the lanes.
 
-use super::kinematics::{forward, place_in_base};
+use super::kinematics::{forward, place_in_base, Poses};
 use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
 use crate::algorithms::regressor::{joint_torque_regressor, PARAMS_PER_BODY};
 use crate::data::Data;
@@ -142,7 +142,7 @@ fn regressor_lanes<const W: usize>(
     clear: bool,
 ) {
     let cols_all = PARAMS_PER_BODY * model.nbodies();
-    forward(model, data, &model.base_acceleration(gravity));
+    forward(model, data, &model.base_acceleration(gravity), Poses::All);
     let mut out = std::mem::take(&mut data.regressor);
     if clear || model.coupled {
         out.fill(Lanes::default());

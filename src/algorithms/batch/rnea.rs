@@ -1,6 +1,6 @@
 //! Inverse dynamics of many samples on the lanes.
 
-use super::kinematics::{apply, contract_torques, forward};
+use super::kinematics::{aligned_to_parent, apply, contract_torques, forward, Poses};
 use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
 use crate::data::Data;
 use crate::error::Result;
@@ -64,7 +64,7 @@ impl LaneKernel for Rnea<'_> {
         let mut first = 0;
         while first < self.k {
             data.load(model, self.x, first);
-            forward(model, data, &g);
+            forward(model, data, &g, Poses::Sparse);
             wrenches(model, data);
             let used = (self.k - first).min(W);
             contract_torques(model, &data.f, &mut data.tau, first, used, self.tau);
@@ -107,8 +107,9 @@ impl LaneKernel for Rnea<'_> {
     }
 }
 
-/// The backward pass: body wrenches `f = I a + v x* (I v)`, accumulated from the leaves into
-/// `data.f` (each in its body's frame).
+/// The backward pass after [`forward`] with [`Poses::Sparse`]: body wrenches
+/// `f = I a + v x* (I v)`, accumulated from the leaves into `data.f` (each in its body's
+/// frame).
 #[inline(always)]
 pub(crate) fn wrenches<const W: usize>(model: &Model, data: &mut LaneBuffers<W>) {
     for (i, b) in serial(model.bodies.iter().enumerate()) {
@@ -117,7 +118,11 @@ pub(crate) fn wrenches<const W: usize>(model: &Model, data: &mut LaneBuffers<W>)
         data.f[i] = ia.add(&v.cross_force(&h));
     }
     for i in serial((0..model.nbodies()).rev()) {
-        if let Some(p) = model.bodies[i].parent {
+        let b = &model.bodies[i];
+        if let (Some(p), Some(al)) = (b.parent, &b.pose_terms.aligned) {
+            let f = data.f[i];
+            aligned_to_parent(al, data.cos_sin[i], &f, &mut data.f[p]);
+        } else if let Some(p) = b.parent {
             let (rot, pos, f) = (&data.rot[i], &data.pos[i], data.f[i]);
             let lin = rot.mul(&f.lin);
             let ang = rot.mul(&f.ang).add(&pos.cross(&lin));
