@@ -417,6 +417,24 @@ fn a_kernel_vouches_for_its_output_only_when_every_value_is_finite() {
             assert!(y.iter().any(|v| !v.is_finite()));
             qd[bad * n + 1] = 0.2;
         }
+        // the torques too, on a finite and an overflowing sample
+        let mut tau = vec![0.0; k * n];
+        for (bad, vouched) in [(None, vector_path), (Some(k - 1), false), (Some(3), false)] {
+            if let Some(s) = bad {
+                qd[s * n + 2] = 1e200;
+            }
+            let (v, a) = (Some(&qd[..]), Some(&qdd[..]));
+            let done = rnea_lanes(&model, &mut lanes, &q, v, a, Gravity::Included, &mut tau);
+            qd.iter_mut().for_each(|v| *v = 0.2);
+            if !vector_path && bad.is_some() {
+                // the one-sample algorithm refuses the overflow itself
+                assert!(done.is_err());
+                continue;
+            }
+            done.unwrap();
+            assert_eq!(lanes.wrote_finite(), vouched, "{} {bad:?}", describe(path));
+            assert_eq!(tau.iter().all(|v| v.is_finite()), bad.is_none());
+        }
         // the mass matrix of the A465 (which has an armature, added after the rows) too
         let mut m = vec![0.0; k * n * n];
         mass_matrix_batch(&model, &mut lanes, &q, &mut m).unwrap();

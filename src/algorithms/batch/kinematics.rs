@@ -369,7 +369,8 @@ pub(crate) fn subspace_in<const W: usize>(
 
 /// Writes the joint torques of lanes `0..used` (samples `first..first + used`) into the
 /// row-major `tau` from the body wrenches `f` (in the body frames): `tau_dof += multiplier *
-/// S^T f`. `body_tau` (one per body) is work space.
+/// S^T f`. `body_tau` (one per body) is work space. Returns whether every torque written was
+/// checked finite (always false for a coupled model, whose torques are not checked here).
 #[inline(always)]
 pub(crate) fn contract_torques<const W: usize>(
     model: &Model,
@@ -378,7 +379,7 @@ pub(crate) fn contract_torques<const W: usize>(
     first: usize,
     used: usize,
     tau: &mut [f64],
-) {
+) -> bool {
     let nv = model.nv;
     for ((t, b), f) in serial(body_tau.iter_mut().zip(&model.bodies).zip(f)) {
         *t = if b.kind == JointKind::Revolute {
@@ -388,8 +389,7 @@ pub(crate) fn contract_torques<const W: usize>(
         };
     }
     if !model.coupled {
-        write_rows(body_tau, used, &mut tau[first * nv..], nv);
-        return;
+        return write_rows(body_tau, used, &mut tau[first * nv..], nv);
     }
     for s in first..first + used {
         tau[s * nv..(s + 1) * nv].fill(0.0);
@@ -399,4 +399,5 @@ pub(crate) fn contract_torques<const W: usize>(
             tau[(first + l) * nv + b.dof] += b.multiplier * t.0[l];
         }
     }
+    false
 }

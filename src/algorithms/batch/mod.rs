@@ -256,7 +256,7 @@ impl LaneData {
     }
 
     /// Whether the last kernel run on these buffers checked every value it wrote to be finite
-    /// and found them so (the mass matrix, regressor, derivative and linearisation kernels do,
+    /// and found them so (the inverse dynamics, mass matrix, regressor, derivative and linearisation kernels do,
     /// on models without couplings or armature; otherwise, and after [`Self::forget_finite`],
     /// false: the caller checks the output itself).
     pub fn wrote_finite(&self) -> bool {

@@ -62,21 +62,25 @@ impl LaneKernel for Rnea<'_> {
     fn wide<const W: usize>(self, model: &Model, data: &mut LaneBuffers<W>) -> Result<()> {
         let g = model.base_acceleration(self.gravity);
         let mut first = 0;
+        // vouched for: torques checked in registers as they are written, then after the
+        // armature's share
+        let mut finite = true;
         while first < self.k {
             data.load(model, self.x, first);
             forward(model, data, &g, Poses::Sparse);
             wrenches(model, data);
             let used = (self.k - first).min(W);
-            contract_torques(model, &data.f, &mut data.tau, first, used, self.tau);
+            finite &= contract_torques(model, &data.f, &mut data.tau, first, used, self.tau);
             first += W;
         }
         let qdd = self.x[2];
         if !qdd.is_empty() {
             let nv = model.nv;
             for (t, a) in self.tau.chunks_mut(nv).zip(qdd.chunks(nv)) {
-                model.add_armature_torque(a, t);
+                finite &= model.add_armature_torque(a, t);
             }
         }
+        data.finite = finite;
         Ok(())
     }
 
