@@ -124,8 +124,8 @@ pub(crate) fn wrenches<const W: usize>(model: &Model, data: &mut LaneBuffers<W>)
     for i in serial((0..model.nbodies()).rev()) {
         let b = &model.bodies[i];
         if let (Some(p), Some(al)) = (b.parent, &b.pose_terms.aligned) {
-            let f = data.f[i];
-            aligned_to_parent(al, data.cos_sin[i], &f, &mut data.f[p]);
+            let (head, tail) = data.f.split_at_mut(i);
+            aligned_to_parent(al, data.cos_sin[i], &tail[0], &mut head[p]);
         } else if let Some(p) = b.parent {
             let (rot, pos, f) = (&data.rot[i], &data.pos[i], data.f[i]);
             let lin = rot.mul(&f.lin);
