@@ -79,32 +79,18 @@ pub(crate) fn apply<const W: usize>(inertia: &Inertia, m: &SpatialLanes<W>) -> S
     }
 }
 
-/// Whether the forward pass stores every body's pose in its parent (`Poses::All`: the kernels
-/// that read `rot` and `pos` afterwards) or, for axis-aligned revolute joints, only the cosine
-/// and sine of the joint angle (`Poses::Sparse`: inverse dynamics, whose backward pass takes
-/// those joints' sparse rotations as well, [`aligned_to_parent`]).
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Poses {
-    All,
-    Sparse,
-}
-
 /// The forward pass on the loaded coordinates: every body's pose in its parent (`rot`, `pos`;
-/// with [`Poses::Sparse`], `cos_sin` instead for an axis-aligned revolute joint), twist `v` and
+/// for an axis-aligned revolute joint only the cosine and sine of its turn, `cos_sin`: see
+/// [`aligned_to_parent`] and [`aligned_pose_in_base`] for what takes them), twist `v` and
 /// acceleration `a` (gravity included as a base acceleration `g`) in its frame.
 #[inline(always)]
-pub(crate) fn forward<const W: usize>(
-    model: &Model,
-    data: &mut LaneBuffers<W>,
-    g: &Motion,
-    poses: Poses,
-) {
+pub(crate) fn forward<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, g: &Motion) {
     let base = SpatialLanes {
         ang: Vector3Lanes::splat(&g.angular),
         lin: Vector3Lanes::splat(&g.linear),
     };
     for (i, b) in serial(model.bodies.iter().enumerate()) {
-        if let (Poses::Sparse, Some(al)) = (poses, &b.pose_terms.aligned) {
+        if let Some(al) = &b.pose_terms.aligned {
             aligned_forward(b, al, data, i, &base);
             continue;
         }
@@ -282,6 +268,21 @@ pub(crate) fn store_pose_in_base<const W: usize>(
         return;
     };
     let (s, c) = sin_cos(data.qb[i]);
+    aligned_pose_in_base(model, data, i, al, parent, [c, s * al.sign]);
+}
+
+/// [`store_pose_in_base`] for body `i` below `parent` with an aligned joint `al`, given the
+/// cosine and sine of its turn (`[cos x, sign sin x]`, as the forward pass keeps them).
+#[inline(always)]
+pub(crate) fn aligned_pose_in_base<const W: usize>(
+    model: &Model,
+    data: &mut LaneBuffers<W>,
+    i: usize,
+    al: &AlignedRevolute,
+    parent: usize,
+    [c, s]: [Lanes<W>; 2],
+) {
+    let b = &model.bodies[i];
     let rp = &data.o_rot[parent];
     // R = Rp R0 Rot_k(sign x): column j of Rp R0 is col_sign[j] times column col_row[j] of Rp
     // (read from memory by index)
@@ -294,10 +295,7 @@ pub(crate) fn store_pose_in_base<const W: usize>(
     let (pa, pb) = (column(al.col_row[a]), column(al.col_row[bb]));
     let pk = column(al.col_row[k]).scale(al.col_sign[k]);
     let (ca, cb) = (c * al.col_sign[a], c * al.col_sign[bb]);
-    let (sa, sb) = (
-        s * (al.sign * al.col_sign[a]),
-        s * (al.sign * al.col_sign[bb]),
-    );
+    let (sa, sb) = (s * al.col_sign[a], s * al.col_sign[bb]);
     // Rot_k e_a = cos e_a + sin e_b, Rot_k e_b = cos e_b - sin e_a
     let col_a = pa.mul_lanes_add(ca, &pb.mul_lanes(sb));
     let col_b = pb.mul_lanes(cb).sub(&pa.mul_lanes(sa));

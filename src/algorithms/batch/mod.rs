@@ -68,8 +68,8 @@ pub(crate) struct LaneBuffers<const W: usize> {
     /// Each body's pose in its parent (rotation by rows, translation).
     pub(crate) rot: Vec<Rotation3Lanes<W>>,
     pub(crate) pos: Vec<Vector3Lanes<W>>,
-    /// Cosine and sine of each axis-aligned revolute joint's turn (inverse dynamics keeps
-    /// these instead of `rot`, `pos`: `kinematics::Poses::Sparse`).
+    /// Cosine and sine of each axis-aligned revolute joint's turn, `[cos x, sign sin x]`: the
+    /// forward pass keeps these instead of `rot`, `pos` for such joints.
     pub(crate) cos_sin: Vec<[Lanes<W>; 2]>,
     /// Each body's pose in the base frame and its motion subspace there.
     pub(crate) o_rot: Vec<Rotation3Lanes<W>>,

@@ -1,13 +1,13 @@
 //! The joint-torque regressor of many samples on the lanes.
 
-use super::kinematics::{forward, place_in_base, Poses};
+use super::kinematics::{aligned_pose_in_base, forward, place_in_base, pose};
 use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
 use crate::algorithms::regressor::{joint_torque_regressor, PARAMS_PER_BODY};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
-use crate::simd::{serial, write_rows, Lanes, SpatialLanes, Vector3Lanes};
+use crate::simd::{serial, write_rows, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
 
 /// The joint-torque regressor of a batch, [`LaneData::width`] samples at a time: `out`
 /// (row-major `k x nv x 10 nbodies`, N m per parameter unit) holds for every sample the matrix
@@ -142,40 +142,67 @@ fn regressor_lanes<const W: usize>(
     clear: bool,
 ) {
     let cols_all = PARAMS_PER_BODY * model.nbodies();
-    forward(model, data, &model.base_acceleration(gravity), Poses::All);
+    forward(model, data, &model.base_acceleration(gravity));
     let mut out = std::mem::take(&mut data.regressor);
     if clear || model.coupled {
         out.fill(Lanes::default());
     }
     for i in serial(0..model.nbodies()) {
-        let (rot, pos) = (data.rot[i], data.pos[i]);
-        let (r, p) = place_in_base(model, data, i, &rot, &pos);
+        let b = &model.bodies[i];
+        match (&b.pose_terms.aligned, b.parent) {
+            // the forward pass kept cos and sin, not the pose in the parent
+            (Some(al), Some(parent)) => {
+                aligned_pose_in_base(model, data, i, al, parent, data.cos_sin[i]);
+            }
+            (Some(_), None) => {
+                let (rot, pos) = pose(b, data.qb[i]);
+                place_in_base(model, data, i, &rot, &pos);
+            }
+            _ => {
+                let (rot, pos) = (data.rot[i], data.pos[i]);
+                place_in_base(model, data, i, &rot, &pos);
+            }
+        }
+        // read in place (a copy of the pose would go through memcpy)
+        let (r, p) = (&data.o_rot[i], &data.o_pos[i]);
         // the body's 10 columns in the base frame (see `world_body_regressor`)
         let (v, a) = (&data.v[i], &data.a[i]);
         let (w, al) = (v.ang, a.ang);
         let ac = r.mul(&a.lin.add(&w.cross(&v.lin)));
         let (ww, alw) = (r.mul(&w), r.mul(&al));
         let w2 = w.dot(&w);
-        let mut cols = [SpatialLanes::default(); 10];
-        cols[0] = SpatialLanes {
-            ang: p.cross(&ac),
-            lin: ac,
+        // (built whole, not from zeroed arrays: the zeroing could become a memset call; no
+        // closures: one compiled out of line would lose the instruction set)
+        let f = FirstMoment {
+            r,
+            p,
+            w,
+            ww,
+            alw,
+            w2,
+            ac,
         };
-        for k in serial(0..3) {
-            let rk = r.column(k);
-            let lin = ww
-                .mul_lanes_add(w.get(k), &alw.cross(&rk))
-                .sub(&rk.mul_lanes(w2));
-            cols[1 + k] = SpatialLanes {
-                ang: rk.cross(&ac).add(&p.cross(&lin)),
-                lin,
-            };
-        }
+        let cols = [
+            SpatialLanes {
+                ang: p.cross(&ac),
+                lin: ac,
+            },
+            f.column(0),
+            f.column(1),
+            f.column(2),
+        ];
         // I_q al + w x (I_q w) for the unit inertias of [Ixx, Ixy, Iyy, Ixz, Iyz, Izz],
         // written out (the unit inertias are mostly zeros), then rotated into the base frame
-        for (q, c) in serial(unit_inertia_columns(&w, &al).iter().enumerate()) {
-            cols[4 + q].ang = r.mul(c);
-        }
+        // (torques only: these columns move no mass)
+        let u = unit_inertia_columns(&w, &al);
+        let turned = [
+            r.mul(&u[0]),
+            r.mul(&u[1]),
+            r.mul(&u[2]),
+            r.mul(&u[3]),
+            r.mul(&u[4]),
+            r.mul(&u[5]),
+        ];
         // project on the motion subspaces of the body and its ancestors
         let first = PARAMS_PER_BODY * i;
         let mut j = Some(i);
@@ -184,13 +211,18 @@ fn regressor_lanes<const W: usize>(
             let sk = &data.o_s[k];
             let at = bk.dof * cols_all + first;
             let row = &mut out[at..at + PARAMS_PER_BODY];
-            let mut y = [Lanes::default(); PARAMS_PER_BODY];
-            for (c, f) in serial(cols[..4].iter().enumerate()) {
-                y[c] = sk.dot(f);
-            }
-            for (c, f) in serial(cols[4..].iter().enumerate()) {
-                y[4 + c] = sk.ang.dot(&f.ang);
-            }
+            let y = [
+                sk.dot(&cols[0]),
+                sk.dot(&cols[1]),
+                sk.dot(&cols[2]),
+                sk.dot(&cols[3]),
+                sk.ang.dot(&turned[0]),
+                sk.ang.dot(&turned[1]),
+                sk.ang.dot(&turned[2]),
+                sk.ang.dot(&turned[3]),
+                sk.ang.dot(&turned[4]),
+                sk.ang.dot(&turned[5]),
+            ];
             if model.coupled {
                 for (o, y) in row.iter_mut().zip(&y) {
                     *o = y.mul_add_s(bk.multiplier, *o);
@@ -202,6 +234,35 @@ fn regressor_lanes<const W: usize>(
         }
     }
     data.regressor = out;
+}
+
+/// What a body's first-moment columns of the regressor share (base frame): its pose `r`, `p`,
+/// its angular velocity `w` (body frame) and `ww`, `alw` (angular velocity and acceleration in
+/// the base frame), `w2 = |w|^2`, and `ac` its origin's acceleration (base frame).
+struct FirstMoment<'a, const W: usize> {
+    r: &'a Rotation3Lanes<W>,
+    p: &'a Vector3Lanes<W>,
+    w: Vector3Lanes<W>,
+    ww: Vector3Lanes<W>,
+    alw: Vector3Lanes<W>,
+    w2: Lanes<W>,
+    ac: Vector3Lanes<W>,
+}
+
+impl<const W: usize> FirstMoment<'_, W> {
+    /// The wrench per unit of the first moment's component `k` (body frame).
+    #[inline(always)]
+    fn column(&self, k: usize) -> SpatialLanes<W> {
+        let rk = self.r.column(k);
+        let lin = self
+            .ww
+            .mul_lanes_add(self.w.get(k), &self.alw.cross(&rk))
+            .sub(&rk.mul_lanes(self.w2));
+        SpatialLanes {
+            ang: rk.cross(&self.ac).add(&self.p.cross(&lin)),
+            lin,
+        }
+    }
 }
 
 /// `I_q al + w x (I_q w)` (body frame) for the unit rotational inertias `I_q` of

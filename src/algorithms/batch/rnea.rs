@@ -1,6 +1,6 @@
 //! Inverse dynamics of many samples on the lanes.
 
-use super::kinematics::{aligned_to_parent, apply, contract_torques, forward, Poses};
+use super::kinematics::{aligned_to_parent, apply, contract_torques, forward};
 use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
 use crate::data::Data;
 use crate::error::Result;
@@ -67,7 +67,7 @@ impl LaneKernel for Rnea<'_> {
         let mut finite = true;
         while first < self.k {
             data.load(model, self.x, first);
-            forward(model, data, &g, Poses::Sparse);
+            forward(model, data, &g);
             wrenches(model, data);
             let used = (self.k - first).min(W);
             finite &= contract_torques(model, &data.f, &mut data.tau, first, used, self.tau);
@@ -111,7 +111,7 @@ impl LaneKernel for Rnea<'_> {
     }
 }
 
-/// The backward pass after [`forward`] with [`Poses::Sparse`]: body wrenches
+/// The backward pass after [`forward`]: body wrenches
 /// `f = I a + v x* (I v)`, accumulated from the leaves into `data.f` (each in its body's
 /// frame).
 #[inline(always)]
