@@ -184,7 +184,8 @@ class Robot:
 
 def simd_isa() -> str:
     """The instruction set the batched kernels run on here: "avx512" (8 samples side by side),
-    "avx2+fma" (4) or "scalar" (one at a time), detected at import."""
+    "avx2+fma" (4) or "scalar" (one at a time), detected at import: the widest the processor
+    has, no wider than the environment variable PERTURBID_SIMD names when it is set."""
 
 def a465_urdf(variant: str = "kinsheel2010") -> str:
     """The URDF text of a built-in A465 variant."""

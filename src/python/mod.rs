@@ -35,7 +35,7 @@ pub(crate) fn detached<T: Send>(
 }
 
 /// The instruction set the batched kernels run on here: "avx512" (8 samples side by side),
-/// "avx2+fma" (4) or "scalar" (one at a time).
+/// "avx2+fma" (4) or "scalar" (one at a time); `PERTURBID_SIMD` caps it (`Isa::detect`).
 #[pyfunction]
 fn simd_isa() -> &'static str {
     crate::simd::Isa::detect().name()

@@ -27,15 +27,42 @@ impl Isa {
     /// Every instruction set, widest first.
     pub const ALL: [Isa; 3] = [Isa::Avx512, Isa::Avx2Fma, Isa::Scalar];
 
-    /// The widest instruction set this processor has (detected once, then cached).
+    /// The widest instruction set this processor has (detected once, then cached), capped by
+    /// the environment variable [`Isa::CAP_VARIABLE`] when it names one (`avx512`, `avx2+fma`
+    /// or `scalar`: the widest available set no wider than it, to reproduce what a machine
+    /// without AVX-512 runs, or to set the vector paths aside). A value that names no set is
+    /// reported once on standard error and not used.
     pub fn detect() -> Isa {
         static BEST: OnceLock<Isa> = OnceLock::new();
         *BEST.get_or_init(|| {
-            Isa::ALL
-                .into_iter()
-                .find(|isa| isa.is_available())
-                .unwrap_or(Isa::Scalar)
+            let value = std::env::var(Self::CAP_VARIABLE).ok();
+            let cap = match value.as_deref().map(Isa::from_name) {
+                Some(None) => {
+                    eprintln!(
+                        "perturbid_rs: {}={:?} names no instruction set (avx512, avx2+fma, \
+                         scalar): ignored, the widest available is used",
+                        Self::CAP_VARIABLE,
+                        value.unwrap_or_default()
+                    );
+                    Isa::Avx512
+                }
+                Some(Some(cap)) => cap,
+                None => Isa::Avx512,
+            };
+            Isa::best_up_to(cap)
         })
+    }
+
+    /// The environment variable that caps [`Isa::detect`]: `PERTURBID_SIMD`.
+    pub const CAP_VARIABLE: &'static str = "PERTURBID_SIMD";
+
+    /// The widest instruction set this processor has that is no wider than `cap`.
+    pub fn best_up_to(cap: Isa) -> Isa {
+        Isa::ALL
+            .into_iter()
+            .filter(|isa| isa.lanes() <= cap.lanes())
+            .find(|isa| isa.is_available())
+            .unwrap_or(Isa::Scalar)
     }
 
     /// Whether this processor runs the kernels of `self`.
@@ -111,5 +138,16 @@ mod tests {
             assert_eq!(Isa::from_name(isa.name()), Some(isa));
         }
         assert_eq!(Isa::from_name("sse9"), None);
+        // a cap never gives a wider set, nor one this processor lacks
+        for cap in Isa::ALL {
+            let got = Isa::best_up_to(cap);
+            assert!(
+                got.lanes() <= cap.lanes() && got.is_available(),
+                "{cap}: {got}"
+            );
+            if cap.is_available() {
+                assert_eq!(got, cap);
+            }
+        }
     }
 }

@@ -103,6 +103,41 @@ def test_the_instruction_set_is_reported():
     assert pr.simd_isa() in {"avx512", "avx2+fma", "scalar"}
 
 
+def test_perturbid_simd_caps_the_instruction_set_and_the_results_agree():
+    """PERTURBID_SIMD names the widest set to use (as on a machine without AVX-512); a value
+    naming none is reported on stderr and not used; every path gives the same torques."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    code = ("import json, numpy as np, perturbid_rs as pr\n"
+            "r = pr.Robot.from_urdf_string(pr.robots.a465_urdf('kinsheel2010'), "
+            "check_triangle_inequality=False)\n"
+            "x = np.random.default_rng(3).uniform(-2, 2, (3, 37, 6))\n"
+            "print(pr.simd_isa()); print(json.dumps(r.rnea(*x).tolist()))")
+
+    def run(value):
+        env = {k: v for k, v in os.environ.items() if k != "PERTURBID_SIMD"}
+        if value is not None:
+            env["PERTURBID_SIMD"] = value
+        done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                              text=True, check=True)
+        isa, tau = done.stdout.splitlines()
+        return isa, np.array(json.loads(tau)), done.stderr
+
+    widest, tau, _ = run(None)
+    assert run("scalar")[0] == "scalar"
+    for cap in ["scalar", "avx2", "AVX2+FMA", "avx512"]:
+        isa, t, err = run(cap)
+        lanes = {"avx512": 8, "avx2+fma": 4, "avx2": 4, "scalar": 1}
+        assert lanes[isa] <= lanes[cap.lower()], (cap, isa)
+        np.testing.assert_allclose(t, tau, rtol=1e-12, atol=1e-9)
+        assert err == ""
+    isa, t, err = run("sse9")
+    assert isa == widest and "PERTURBID_SIMD" in err and "sse9" in err
+
+
 def test_a_result_past_a_gibibyte_is_allocated_by_numpy_and_equal(robot):
     """Results past 1 GiB come from numpy's allocator (a MemoryError, not a crash, when the
     memory is not there): the A465 regressor of 380,000 samples is 1.1 GB."""
