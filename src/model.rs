@@ -74,19 +74,16 @@ pub(crate) struct PoseTerms {
     pub(crate) aligned: Option<AlignedRevolute>,
 }
 
-/// A revolute joint with `R(x) = R0 Rot_k(sign x)`: the axis is `sign e_k` and column `j` of
-/// the placement rotation `R0` is `col_sign[j] e_{col_row[j]}` (entries within 1e-12 of 0 or
-/// +-1 taken as exact: a rotation from an `rpy` of multiples of pi/2 holds `6e-17` for its
-/// zeros). `Rot_k` turns `e_a` towards `e_b` for `(k, a, b)` cyclic.
+/// A revolute joint with `R(x) = R0 Rot_k(sign x)`: the axis is `sign e_k`, and the placement
+/// rotation `R0` a signed permutation (entries within 1e-12 of 0 or +-1 taken as exact: a
+/// rotation from an `rpy` of multiples of pi/2 holds `6e-17` for its zeros). Held by role, in
+/// the order `(k, a, b)` with `(k, a, b)` cyclic (`Rot_k` turns `e_a` towards `e_b`): the body
+/// axes `roles = [k, a, b]`; column `roles[j]` of `R0` is `signs[j] e_{rows[j]}`; `p_roles` is
+/// the placement translation `p` (parent frame) in the body's axes, `(R0^T p)[roles[j]]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct AlignedRevolute {
     pub(crate) k: usize,
     pub(crate) sign: f64,
-    pub(crate) col_row: [usize; 3],
-    pub(crate) col_sign: [f64; 3],
-    /// The same by role, in the order `(k, a, b)`: the body-frame axes `[k, a, b]`, the rows
-    /// `col_row` and signs `col_sign` of those columns, and the placement translation `p`
-    /// (parent frame) turned into the body's axes, `R0^T p`, by role.
     pub(crate) roles: [usize; 3],
     pub(crate) rows: [usize; 3],
     pub(crate) signs: [f64; 3],
@@ -109,8 +106,6 @@ impl AlignedRevolute {
         Some(Self {
             k,
             sign,
-            col_row,
-            col_sign,
             roles,
             rows,
             signs,
@@ -279,7 +274,8 @@ impl Model {
         }
     }
 
-    /// Whether bodies `i` and `j` lie on one chain from the base (one is the other, or an
+    /// Whether bodies `i` and `j` (indices into `bodies`, below [`Model::nbodies`]; panics
+    /// past it, as indexing does) lie on one chain from the base (one is the other, or an
     /// ancestor of it): the pairs whose mass matrix entry can be non-zero.
     pub fn related(&self, i: usize, j: usize) -> bool {
         let (a, b) = (i.min(j), i.max(j));
@@ -497,13 +493,10 @@ mod tests {
             let al = t.aligned.expect("aligned");
             // R0 Rot_k(sign x) rebuilt from the description equals the joint's rotation
             let x = 0.7;
-            let r0 = Matrix3::from_fn(|r, c| {
-                if r == al.col_row[c] {
-                    al.col_sign[c]
-                } else {
-                    0.0
-                }
-            });
+            let mut r0 = Matrix3::zeros();
+            for j in 0..3 {
+                r0[(al.rows[j], al.roles[j])] = al.signs[j];
+            }
             let mut e = Vector3::zeros();
             e[al.k] = 1.0;
             let rot = nalgebra::Rotation3::from_axis_angle(

@@ -284,18 +284,18 @@ pub(crate) fn aligned_pose_in_base<const W: usize>(
 ) {
     let b = &model.bodies[i];
     let rp = &data.o_rot[parent];
-    // R = Rp R0 Rot_k(sign x): column j of Rp R0 is col_sign[j] times column col_row[j] of Rp
+    // R = Rp R0 Rot_k(sign x): column roles[j] of Rp R0 is signs[j] times column rows[j] of Rp
     // (read from memory by index)
     let column = |m: usize| Vector3Lanes {
         x: *rp.0[0].at(m),
         y: *rp.0[1].at(m),
         z: *rp.0[2].at(m),
     };
-    let (k, a, bb) = (al.k, (al.k + 1) % 3, (al.k + 2) % 3);
-    let (pa, pb) = (column(al.col_row[a]), column(al.col_row[bb]));
-    let pk = column(al.col_row[k]).scale(al.col_sign[k]);
-    let (ca, cb) = (c * al.col_sign[a], c * al.col_sign[bb]);
-    let (sa, sb) = (s * al.col_sign[a], s * al.col_sign[bb]);
+    let [k, a, bb] = al.roles;
+    let (pa, pb) = (column(al.rows[1]), column(al.rows[2]));
+    let pk = column(al.rows[0]).scale(al.signs[0]);
+    let (ca, cb) = (c * al.signs[1], c * al.signs[2]);
+    let (sa, sb) = (s * al.signs[1], s * al.signs[2]);
     // Rot_k e_a = cos e_a + sin e_b, Rot_k e_b = cos e_b - sin e_a
     let col_a = pa.mul_lanes_add(ca, &pb.mul_lanes(sb));
     let col_b = pb.mul_lanes(cb).sub(&pa.mul_lanes(sa));

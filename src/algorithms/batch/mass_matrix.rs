@@ -185,10 +185,17 @@ pub(crate) fn transformed<const W: usize>(
         w.get(row)
             .neg_mul_add(p.get(c), p.get(row).neg_mul_add(w.get(c), v))
     }
-    let entry = |row, c| entry(&ri, r, &w, p, row, c);
     let i = symmetric(
-        [entry(0, 0) + d, entry(1, 1) + d, entry(2, 2) + d],
-        [entry(0, 1), entry(0, 2), entry(1, 2)],
+        [
+            entry(&ri, r, &w, p, 0, 0) + d,
+            entry(&ri, r, &w, p, 1, 1) + d,
+            entry(&ri, r, &w, p, 2, 2) + d,
+        ],
+        [
+            entry(&ri, r, &w, p, 0, 1),
+            entry(&ri, r, &w, p, 0, 2),
+            entry(&ri, r, &w, p, 1, 2),
+        ],
     );
     Composite {
         mass: b.mass,

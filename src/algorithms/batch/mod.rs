@@ -256,9 +256,9 @@ impl LaneData {
     }
 
     /// Whether the last kernel run on these buffers checked every value it wrote to be finite
-    /// and found them so (the inverse dynamics, mass matrix, regressor, derivative and linearisation kernels do,
-    /// on models without couplings or armature; otherwise, and after [`Self::forget_finite`],
-    /// false: the caller checks the output itself).
+    /// and found them so (the inverse dynamics, mass matrix, regressor, derivative and
+    /// linearisation kernels do, on models without couplings; otherwise, and after
+    /// [`Self::forget_finite`], false: the caller checks the output itself).
     pub fn wrote_finite(&self) -> bool {
         match &self.buffers {
             #[cfg(target_arch = "x86_64")]
@@ -280,7 +280,8 @@ impl LaneData {
         }
     }
 
-    /// Fails unless these buffers were made for a model of `model`'s sizes.
+    /// Fails unless these buffers were made for a model of `model`'s sizes and tree (every
+    /// body's parent).
     fn check(&self, model: &Model) -> Result<()> {
         let sizes = (self.nv, self.nbodies) == (model.nv, model.nbodies());
         if sizes
