@@ -32,9 +32,12 @@ pub(crate) fn pose<const W: usize>(b: &Body, x: Lanes<W>) -> (Rotation3Lanes<W>,
             (rot, Vector3Lanes::splat(&p.translation))
         }
         JointKind::Prismatic => {
-            let rot = Rotation3Lanes(
-                [0, 1, 2].map(|r| Vector3Lanes::splat(&p.rotation.row(r).transpose().into_owned())),
-            );
+            // (no `map` closure: LLVM kept it out of line, a call per prismatic joint)
+            let rot = Rotation3Lanes([
+                Vector3Lanes::splat(&p.rotation.row(0).transpose()),
+                Vector3Lanes::splat(&p.rotation.row(1).transpose()),
+                Vector3Lanes::splat(&p.rotation.row(2).transpose()),
+            ]);
             let t1 = &b.pose_terms.t1;
             (
                 rot,
