@@ -490,7 +490,8 @@ def main() -> int:
         lines.append(f"| {name} | {kernel} | {t_pin:.0f} | {t_our:.0f} | {r:.2f}x "
                      f"[{lo:.2f}-{hi:.2f}] | {all_} | {fl} | {cap} |")
     lines += ["", f"One `Robot.rnea` call from Python ({first.name}, one sample): "
-              f"{call[1]:.0f} ns against {call[0]:.0f} ns for `pinocchio.rnea` ({call[1] / call[0]:.2f}x its time)."]
+              f"{call[1]:.0f} ns against {call[0]:.0f} ns for `pinocchio.rnea` "
+              f"({call[1] / call[0]:.2f}x its time)."]
     lines.append("Store-bound ceiling: Pinocchio's time over the time numpy takes only to fill "
                  "the same output arrays with zeros (a memset), per sample: no kernel that "
                  "writes that output can beat Pinocchio by more.")
