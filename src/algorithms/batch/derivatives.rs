@@ -10,7 +10,9 @@ use crate::error::Result;
 use crate::gravity::Gravity;
 use crate::linearization::{linearize_into, Linearization};
 use crate::model::Model;
-use crate::simd::{serial, write_rows, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
+use crate::simd::{
+    serial, write_rows, write_rows_with_zeros, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes,
+};
 
 /// Where [`derivatives_batch`] writes, row-major over `k` samples.
 #[derive(Debug)]
@@ -313,17 +315,18 @@ impl LaneKernel for Derivatives<'_> {
                 first == 0,
             );
             let [tau, m, dq, dv] = &mut self.out;
+            let zeros = &data.m_blocks;
             finite &= write_vectors(model, &d.tau, used, &mut tau[first * n..]);
-            finite &= write_matrices(model, &d.m, used, &mut m[first * nn..]);
-            finite &= write_matrices(model, &d.dq, used, &mut dq[first * nn..]);
-            finite &= write_matrices(model, &d.dv, used, &mut dv[first * nn..]);
+            finite &= write_matrices(model, &d.m, zeros, used, &mut m[first * nn..]);
+            finite &= write_matrices(model, &d.dq, zeros, used, &mut dq[first * nn..]);
+            finite &= write_matrices(model, &d.dv, zeros, used, &mut dv[first * nn..]);
             for s in first..first + used {
                 finite &= model
                     .add_armature_torque(&self.x[2][s * n..(s + 1) * n], &mut tau[s * n..][..n]);
                 finite &= model.add_armature_inertia(&mut m[s * nn..(s + 1) * nn]);
             }
             if let Some(gs) = self.g_static.as_deref_mut() {
-                finite &= write_matrices(model, &d.gs, used, &mut gs[first * nn..]);
+                finite &= write_matrices(model, &d.gs, &data.m_blocks, used, &mut gs[first * nn..]);
             }
             first += W;
         }
@@ -386,10 +389,15 @@ fn write_vectors<const W: usize>(
 
 /// Lanes `0..used` of the body-level row-major matrix `body` as `C^T body C` (the degrees of
 /// freedom) into the row-major `out` (`used x nv x nv`); whether every value was checked finite.
+/// `related` is [`LaneBuffers::m_blocks`]: the blocks of 4 entries that pair no body with an
+/// ancestor or descendant are zero in every one of these matrices (a torque moves with the
+/// coordinates and rates of its body's ancestors and subtree only), and are written as zeros
+/// without being read.
 #[inline(always)]
 fn write_matrices<const W: usize>(
     model: &Model,
     body: &[Lanes<W>],
+    related: &[bool],
     used: usize,
     out: &mut [f64],
 ) -> bool {
@@ -406,7 +414,7 @@ fn write_matrices<const W: usize>(
         }
         false
     } else {
-        write_rows(body, used, out, nv * nv)
+        write_rows_with_zeros(body, |c| !related[c], used, out, nv * nv)
     }
 }
 

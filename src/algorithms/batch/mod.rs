@@ -85,9 +85,10 @@ pub(crate) struct LaneBuffers<const W: usize> {
     pub(crate) regressor: Vec<Lanes<W>>,
     /// Body-level mass matrix (row-major `nbodies x nbodies`) and composite inertias.
     pub(crate) m: Vec<Lanes<W>>,
-    /// Per block of 4 consecutive entries of `m`: whether one of them pairs a body with one of
-    /// its ancestors or descendants (the others are structural zeros, written without being
-    /// read; a tree's mass matrix is mostly such zeros).
+    /// Per block of 4 consecutive entries of `m` (or of any row-major `nbodies x nbodies`
+    /// matrix): whether one of them pairs a body with one of its ancestors or descendants (the
+    /// others are structural zeros of the mass matrix and of the torque derivatives, written
+    /// without being read; a tree's matrices are mostly such zeros).
     pub(crate) m_blocks: Vec<bool>,
     pub(crate) composite: Vec<mass_matrix::Composite<W>>,
     /// The derivatives' buffers, made on first use.
