@@ -8,7 +8,7 @@ use std::sync::OnceLock;
 /// | variant    | samples side by side | needs                                        |
 /// |------------|----------------------|----------------------------------------------|
 /// | `Avx512`   | 8                    | x86-64 with AVX-512 F, VL, DQ, AVX2 and FMA   |
-/// | `Avx2Fma`  | 4                    | x86-64 with AVX2 and FMA                      |
+/// | `Avx2Fma`  | 4 (8 in pairs: RNEA, M)  | x86-64 with AVX2 and FMA                      |
 /// | `Scalar`   | 1                    | nothing: the one-sample algorithms, in a loop |
 ///
 /// The vector paths fuse multiplies and adds (FMA), so their results differ from the scalar

@@ -11,6 +11,11 @@ use super::Lanes;
 /// 4 lanes are transposed in registers (4 loads, 8 shuffles, 4 stores) instead of being copied
 /// one value at a time.
 ///
+/// `wide`: the caller's buffers run on AVX-512 (`LaneBuffers::wide_stores`): then, with 8 lanes
+/// all in use and a processor that has AVX-512F, blocks of 8 quantities by 8 lanes are
+/// transposed in 512-bit registers and stored 64 bytes a row. False elsewhere, so that the
+/// AVX2 paths (8 lanes in register pairs included) keep to AVX2 instructions.
+///
 /// Returns whether every value written is finite, tested on the way in registers (`v - v` is
 /// +0 for a finite `v`, NaN otherwise; the differences' bits or-ed together), so that a caller
 /// need not read its output back to vouch for it.
@@ -21,8 +26,9 @@ pub(crate) fn write_rows<const W: usize>(
     used: usize,
     dst: &mut [f64],
     stride: usize,
+    wide: bool,
 ) -> bool {
-    write_rows_with_zeros(src, |_| false, used, dst, stride)
+    write_rows_with_zeros(src, |_| false, used, dst, stride, wide)
 }
 
 /// As [`write_rows`], where `zero(c)` says that quantities `4c..4c + 4` of `src` are zero in
@@ -37,6 +43,7 @@ pub(crate) fn write_rows_with_zeros<const W: usize>(
     used: usize,
     dst: &mut [f64],
     stride: usize,
+    wide: bool,
 ) -> bool {
     let n = src.len();
     let mut done = 0;
@@ -47,7 +54,7 @@ pub(crate) fn write_rows_with_zeros<const W: usize>(
         let mut c = 0;
         // 8 full lanes with AVX-512: blocks of 8 quantities, each row's 8 values one 64-byte
         // store (half the stores of two 4x4 blocks, and whole cache lines when aligned)
-        if W == 8 && used == 8 && std::arch::is_x86_feature_detected!("avx512f") {
+        if wide && W == 8 && used == 8 && std::arch::is_x86_feature_detected!("avx512f") {
             while c + 8 <= done {
                 match (zero(c / 4), zero(c / 4 + 1)) {
                     (true, true) => {
@@ -265,7 +272,7 @@ unsafe fn transpose4<const W: usize>(
 mod tests {
     use super::*;
 
-    fn check<const W: usize>() {
+    fn check<const W: usize>(wide: bool) {
         for n in [0, 1, 3, 4, 5, 8, 13, 16, 21, 24] {
             let src: Vec<Lanes<W>> = (0..n)
                 .map(|c| {
@@ -279,7 +286,7 @@ mod tests {
             for used in 1..=W {
                 let stride = n + 2;
                 let mut dst = vec![-1.0; used * stride];
-                assert!(write_rows(&src, used, &mut dst, stride));
+                assert!(write_rows(&src, used, &mut dst, stride, wide));
                 for l in 0..used {
                     for c in 0..stride {
                         let want = if c < n { (100 * c + l) as f64 } else { -1.0 };
@@ -290,7 +297,7 @@ mod tests {
         }
     }
 
-    fn finiteness<const W: usize>() {
+    fn finiteness<const W: usize>(wide: bool) {
         // a non-finite value is reported wherever it sits among the lanes written, and not
         // when it sits in a lane past `used`
         for n in [1, 4, 7, 8, 17] {
@@ -300,7 +307,7 @@ mod tests {
                     src[c].0[l] = bad;
                     for used in 1..=W {
                         let mut dst = vec![0.0; used * n];
-                        let finite = write_rows(&src, used, &mut dst, n);
+                        let finite = write_rows(&src, used, &mut dst, n, wide);
                         assert_eq!(finite, l >= used, "W {W} n {n} c {c} l {l} used {used}");
                     }
                 }
@@ -310,12 +317,14 @@ mod tests {
 
     #[test]
     fn rows_report_whether_the_values_written_are_finite() {
-        finiteness::<1>();
-        finiteness::<4>();
-        finiteness::<8>();
+        for wide in [false, true] {
+            finiteness::<1>(wide);
+            finiteness::<4>(wide);
+            finiteness::<8>(wide);
+        }
     }
 
-    fn zeros_unread<const W: usize>(zero: fn(usize) -> bool) {
+    fn zeros_unread<const W: usize>(zero: fn(usize) -> bool, wide: bool) {
         // blocks said to be zero are written as zeros whatever `src` holds there (they are not
         // read); the others, and the tail past the last whole block, are the lanes transposed
         for n in [4, 7, 12, 13, 16, 21, 24, 35] {
@@ -324,7 +333,7 @@ mod tests {
                 .collect();
             for used in 1..=W {
                 let mut dst = vec![-1.0; used * n];
-                let finite = write_rows_with_zeros(&src, zero, used, &mut dst, n);
+                let finite = write_rows_with_zeros(&src, zero, used, &mut dst, n, wide);
                 let skipped = W.is_multiple_of(4) && std::arch::is_x86_feature_detected!("avx");
                 for l in 0..used {
                     for c in 0..n {
@@ -351,17 +360,20 @@ mod tests {
         // every other block (the 8-lane path's blocks of 8 are half zero), every other
         // pair of blocks (wholly zero or not), a lone zero block
         let patterns: [fn(usize) -> bool; 3] = [|b| b % 2 == 1, |b| (b / 2) % 2 == 1, |b| b == 2];
-        for zero in patterns {
-            zeros_unread::<1>(zero);
-            zeros_unread::<4>(zero);
-            zeros_unread::<8>(zero);
+        for (zero, wide) in patterns.into_iter().flat_map(|z| [(z, false), (z, true)]) {
+            zeros_unread::<1>(zero, wide);
+            zeros_unread::<4>(zero, wide);
+            zeros_unread::<8>(zero, wide);
         }
     }
 
     #[test]
     fn rows_are_the_lanes_transposed() {
-        check::<1>();
-        check::<4>();
-        check::<8>();
+        // `wide` (the AVX-512 buffers' 8x8 blocks) where the processor has AVX-512, and not
+        for wide in [false, true] {
+            check::<1>(wide);
+            check::<4>(wide);
+            check::<8>(wide);
+        }
     }
 }

@@ -315,18 +315,19 @@ impl LaneKernel for Derivatives<'_> {
                 first == 0,
             );
             let [tau, m, dq, dv] = &mut self.out;
-            let zeros = &data.m_blocks;
-            finite &= write_vectors(model, &d.tau, used, &mut tau[first * n..]);
-            finite &= write_matrices(model, &d.m, zeros, used, &mut m[first * nn..]);
-            finite &= write_matrices(model, &d.dq, zeros, used, &mut dq[first * nn..]);
-            finite &= write_matrices(model, &d.dv, zeros, used, &mut dv[first * nn..]);
+            let (zeros, wide) = (&data.m_blocks, data.wide_stores);
+            finite &= write_vectors(model, &d.tau, used, &mut tau[first * n..], wide);
+            finite &= write_matrices(model, &d.m, zeros, used, &mut m[first * nn..], wide);
+            finite &= write_matrices(model, &d.dq, zeros, used, &mut dq[first * nn..], wide);
+            finite &= write_matrices(model, &d.dv, zeros, used, &mut dv[first * nn..], wide);
             for s in first..first + used {
                 finite &= model
                     .add_armature_torque(&self.x[2][s * n..(s + 1) * n], &mut tau[s * n..][..n]);
                 finite &= model.add_armature_inertia(&mut m[s * nn..(s + 1) * nn]);
             }
             if let Some(gs) = self.g_static.as_deref_mut() {
-                finite &= write_matrices(model, &d.gs, &data.m_blocks, used, &mut gs[first * nn..]);
+                let gs = &mut gs[first * nn..];
+                finite &= write_matrices(model, &d.gs, zeros, used, gs, wide);
             }
             first += W;
         }
@@ -365,13 +366,15 @@ impl LaneKernel for Derivatives<'_> {
 }
 
 /// Lanes `0..used` of the body torques `body` summed onto the degrees of freedom into the
-/// row-major `out` (`used x nv`); whether every value was checked finite (see `write_rows`).
+/// row-major `out` (`used x nv`); whether every value was checked finite (see `write_rows`, and
+/// there for `wide`).
 #[inline(always)]
 fn write_vectors<const W: usize>(
     model: &Model,
     body: &[Lanes<W>],
     used: usize,
     out: &mut [f64],
+    wide: bool,
 ) -> bool {
     let nv = model.nv;
     if model.coupled {
@@ -383,13 +386,13 @@ fn write_vectors<const W: usize>(
         }
         false
     } else {
-        write_rows(body, used, out, nv)
+        write_rows(body, used, out, nv, wide)
     }
 }
 
 /// Lanes `0..used` of the body-level row-major matrix `body` as `C^T body C` (the degrees of
-/// freedom) into the row-major `out` (`used x nv x nv`); whether every value was checked finite.
-/// `related` is [`LaneBuffers::m_blocks`]: the blocks of 4 entries that pair no body with an
+/// freedom) into the row-major `out` (`used x nv x nv`); whether every value was checked finite
+/// (`wide` as for `write_rows`). `related` is [`LaneBuffers::m_blocks`]: the blocks of 4 entries that pair no body with an
 /// ancestor or descendant are zero in every one of these matrices (a torque moves with the
 /// coordinates and rates of its body's ancestors and subtree only), and are written as zeros
 /// without being read.
@@ -400,6 +403,7 @@ fn write_matrices<const W: usize>(
     related: &[bool],
     used: usize,
     out: &mut [f64],
+    wide: bool,
 ) -> bool {
     let (nb, nv) = (model.nbodies(), model.nv);
     if model.coupled {
@@ -414,7 +418,7 @@ fn write_matrices<const W: usize>(
         }
         false
     } else {
-        write_rows_with_zeros(body, |c| !related[c], used, out, nv * nv)
+        write_rows_with_zeros(body, |c| !related[c], used, out, nv * nv, wide)
     }
 }
 

@@ -372,6 +372,7 @@ pub(crate) fn subspace_in<const W: usize>(
 /// row-major `tau` from the body wrenches `f` (in the body frames): `tau_dof += multiplier *
 /// S^T f`. `body_tau` (one per body) is work space. Returns whether every torque written was
 /// checked finite (always false for a coupled model, whose torques are not checked here).
+/// `wide` as for `write_rows`.
 #[inline(always)]
 pub(crate) fn contract_torques<const W: usize>(
     model: &Model,
@@ -380,6 +381,7 @@ pub(crate) fn contract_torques<const W: usize>(
     first: usize,
     used: usize,
     tau: &mut [f64],
+    wide: bool,
 ) -> bool {
     let nv = model.nv;
     for ((t, b), f) in serial(body_tau.iter_mut().zip(&model.bodies).zip(f)) {
@@ -390,7 +392,7 @@ pub(crate) fn contract_torques<const W: usize>(
         };
     }
     if !model.coupled {
-        return write_rows(body_tau, used, &mut tau[first * nv..], nv);
+        return write_rows(body_tau, used, &mut tau[first * nv..], nv, wide);
     }
     for s in first..first + used {
         tau[s * nv..(s + 1) * nv].fill(0.0);

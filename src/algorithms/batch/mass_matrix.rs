@@ -11,7 +11,8 @@ use crate::simd::{
 };
 use crate::spatial::OriginInertia;
 
-/// Joint-space mass matrices `M(q)` of a batch, [`LaneData::width`] samples at a time (the
+/// Joint-space mass matrices `M(q)` of a batch, [`LaneData::width`] samples at a time (8 on
+/// AVX2, in pairs of registers; the
 /// composite rigid body algorithm in the base frame, as [`crate::mass_matrix`]; equal to it up
 /// to rounding).
 ///
@@ -68,6 +69,7 @@ impl<const W: usize> Default for Composite<W> {
 
 impl LaneKernel for MassMatrix<'_> {
     type Output = Result<()>;
+    const PAIRS_ON_AVX2: bool = true;
 
     #[inline(always)]
     fn wide<const W: usize>(self, model: &Model, data: &mut LaneBuffers<W>) -> Result<()> {
@@ -81,7 +83,7 @@ impl LaneKernel for MassMatrix<'_> {
             for i in serial(0..nb) {
                 store_pose_in_base(model, data, i);
             }
-            let (m, blocks) = (&mut data.m, &data.m_blocks);
+            let (m, blocks, wide) = (&mut data.m, &data.m_blocks, data.wide_stores);
             // only the pairs of a body and its ancestors are written, the same in every group:
             // the others are cleared once per call (and those in blocks of 4 structural zeros
             // are not even read: `m_blocks`)
@@ -132,7 +134,7 @@ impl LaneKernel for MassMatrix<'_> {
                     }
                 }
             } else {
-                finite &= write_rows_with_zeros(m, |c| !blocks[c], used, out, nv * nv);
+                finite &= write_rows_with_zeros(m, |c| !blocks[c], used, out, nv * nv, wide);
             }
             for o in out.chunks_mut(nv * nv).take(used) {
                 finite &= model.add_armature_inertia(o);

@@ -53,8 +53,10 @@ pub struct LaneData {
 enum Buffers {
     #[cfg(target_arch = "x86_64")]
     W8(Box<LaneBuffers<8>>),
+    /// AVX2's 4 lanes, and the 8-lane buffers (pairs of registers) of the kernels that run
+    /// faster so ([`LaneKernel::PAIRS_ON_AVX2`]), made on first use.
     #[cfg(target_arch = "x86_64")]
-    W4(Box<LaneBuffers<4>>),
+    W4(Box<LaneBuffers<4>>, Option<Box<LaneBuffers<8>>>),
     Scalar(Box<Data>),
 }
 
@@ -96,10 +98,22 @@ pub(crate) struct LaneBuffers<const W: usize> {
     /// Whether the last kernel run vouched that every value it wrote is finite (checked in
     /// registers on the way out; see [`LaneData::wrote_finite`]).
     pub(crate) finite: bool,
+    /// Whether the kernels on these buffers run on AVX-512 (and may transpose their results
+    /// into the output by 512-bit blocks: `write_rows`).
+    pub(crate) wide_stores: bool,
 }
 
 impl<const W: usize> LaneBuffers<W> {
-    fn new(model: &Model) -> Self {
+    /// Buffers for every kernel; `wide_stores` when they run on AVX-512.
+    fn new(model: &Model, wide_stores: bool) -> Self {
+        Self {
+            regressor: vec![Lanes::default(); model.nv * PARAMS_PER_BODY * model.nbodies()],
+            ..Self::without_regressor(model, wide_stores)
+        }
+    }
+
+    /// Buffers for every kernel but the regressor's, whose buffer (the largest) is left empty.
+    fn without_regressor(model: &Model, wide_stores: bool) -> Self {
         let nb = model.nbodies();
         Self {
             qb: vec![Lanes::default(); nb],
@@ -115,7 +129,7 @@ impl<const W: usize> LaneBuffers<W> {
             a: vec![SpatialLanes::default(); nb],
             f: vec![SpatialLanes::default(); nb],
             tau: vec![Lanes::default(); nb],
-            regressor: vec![Lanes::default(); model.nv * PARAMS_PER_BODY * nb],
+            regressor: Vec::new(),
             m: vec![Lanes::default(); nb * nb],
             m_blocks: (0..nb * nb / 4)
                 .map(|c| (4 * c..4 * c + 4).any(|e| model.related(e / nb, e % nb)))
@@ -123,6 +137,7 @@ impl<const W: usize> LaneBuffers<W> {
             composite: vec![mass_matrix::Composite::default(); nb],
             derivatives: None,
             finite: false,
+            wide_stores,
         }
     }
 
@@ -191,7 +206,7 @@ impl LaneData {
         let mut lanes = Self::with_isa(model, Isa::Avx2Fma)?;
         #[cfg(target_arch = "x86_64")]
         {
-            lanes.buffers = Buffers::W8(Box::new(LaneBuffers::new(model)));
+            lanes.buffers = Buffers::W8(Box::new(LaneBuffers::new(model, false)));
         }
         Ok(lanes)
     }
@@ -199,9 +214,9 @@ impl LaneData {
     fn for_isa(model: &Model, isa: Isa) -> Self {
         let buffers = match isa {
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx512 => Buffers::W8(Box::new(LaneBuffers::new(model))),
+            Isa::Avx512 => Buffers::W8(Box::new(LaneBuffers::new(model, true))),
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2Fma => Buffers::W4(Box::new(LaneBuffers::new(model))),
+            Isa::Avx2Fma => Buffers::W4(Box::new(LaneBuffers::new(model, false)), None),
             _ => Buffers::Scalar(Box::new(Data::new(model))),
         };
         Self {
@@ -222,13 +237,16 @@ impl LaneData {
         self.isa
     }
 
-    /// Samples processed side by side (`self.isa().lanes()`).
+    /// Samples processed side by side (`self.isa().lanes()`) by the regressor and derivative
+    /// kernels (the group size of [`regressor_group`]). On AVX2 the inverse dynamics and the
+    /// mass matrix take 8 at a time, in pairs of registers: two independent streams of work
+    /// hide their recursions' latency.
     pub fn width(&self) -> usize {
         match &self.buffers {
             #[cfg(target_arch = "x86_64")]
             Buffers::W8(_) => 8,
             #[cfg(target_arch = "x86_64")]
-            Buffers::W4(_) => 4,
+            Buffers::W4(..) => 4,
             Buffers::Scalar(_) => 1,
         }
     }
@@ -248,7 +266,7 @@ impl LaneData {
             #[cfg(target_arch = "x86_64")]
             Buffers::W8(b) => b.regressor[joint * p + parameter].0[sample],
             #[cfg(target_arch = "x86_64")]
-            Buffers::W4(b) => b.regressor[joint * p + parameter].0[sample],
+            Buffers::W4(b, _) => b.regressor[joint * p + parameter].0[sample],
             Buffers::Scalar(d) => {
                 assert!(sample == 0, "sample {sample} of a one-sample group");
                 d.regressor[(joint, parameter)]
@@ -265,7 +283,7 @@ impl LaneData {
             #[cfg(target_arch = "x86_64")]
             Buffers::W8(b) => b.finite,
             #[cfg(target_arch = "x86_64")]
-            Buffers::W4(b) => b.finite,
+            Buffers::W4(b, _) => b.finite,
             Buffers::Scalar(_) => false,
         }
     }
@@ -276,7 +294,7 @@ impl LaneData {
             #[cfg(target_arch = "x86_64")]
             Buffers::W8(b) => b.finite = false,
             #[cfg(target_arch = "x86_64")]
-            Buffers::W4(b) => b.finite = false,
+            Buffers::W4(b, _) => b.finite = false,
             Buffers::Scalar(_) => {}
         }
     }
@@ -313,6 +331,13 @@ impl LaneData {
 /// algorithms; [`dispatch`] runs the version for the buffers' instruction set.
 pub(crate) trait LaneKernel {
     type Output;
+    /// Whether the kernel runs on 8 lanes in pairs of AVX2 registers where the buffers are
+    /// AVX2's 4: for a kernel bound by the latency of its recursions, which two independent
+    /// register streams hide (measured: the inverse dynamics 25-35 % faster so, the mass
+    /// matrix 5-8 %), not for one that runs out of registers (the derivatives, 10-15 %
+    /// slower) or gains nothing (the regressor, level). Such a kernel must not use the
+    /// regressor's buffer, which the paired buffers leave empty.
+    const PAIRS_ON_AVX2: bool = false;
     /// The kernel on `W` lanes. Implementations are `#[inline(always)]`, so that they are
     /// compiled inside the instruction set's function.
     fn wide<const W: usize>(self, model: &Model, buffers: &mut LaneBuffers<W>) -> Self::Output;
@@ -339,7 +364,16 @@ pub(crate) fn dispatch<K: LaneKernel<Output = Result<T>>, T>(
         #[cfg(target_arch = "x86_64")]
         Buffers::W8(b) => unsafe { run_avx2(kernel, model, b.as_mut()) },
         #[cfg(target_arch = "x86_64")]
-        Buffers::W4(b) => unsafe { run_avx2(kernel, model, b.as_mut()) },
+        Buffers::W4(b, paired) if K::PAIRS_ON_AVX2 => {
+            let p = paired
+                .get_or_insert_with(|| Box::new(LaneBuffers::without_regressor(model, false)));
+            let out = unsafe { run_avx2(kernel, model, p.as_mut()) };
+            // what `LaneData::wrote_finite` reads
+            b.finite = p.finite;
+            out
+        }
+        #[cfg(target_arch = "x86_64")]
+        Buffers::W4(b, _) => unsafe { run_avx2(kernel, model, b.as_mut()) },
         Buffers::Scalar(d) => kernel.scalar(model, d),
     }
 }

@@ -103,7 +103,8 @@ impl LaneKernel for Regressor<'_> {
             regressor_lanes(model, data, self.gravity, first == 0);
             if let Some(out) = self.out.as_deref_mut() {
                 let used = (self.k - first).min(W);
-                finite &= write_rows(&data.regressor, used, &mut out[first * nv * p..], nv * p);
+                let out = &mut out[first * nv * p..];
+                finite &= write_rows(&data.regressor, used, out, nv * p, data.wide_stores);
             }
             first += W;
         }

@@ -9,7 +9,7 @@ use crate::model::Model;
 use crate::simd::{serial, SpatialLanes};
 
 /// Inverse dynamics `tau = M(q) qdd + c(q, qd) + g(q)` of a batch, [`LaneData::width`] samples
-/// at a time.
+/// at a time (8 on AVX2, in pairs of registers).
 ///
 /// - `q` (rad or m), `qd` (rad/s or m/s), `qdd` (rad/s^2 or m/s^2): row-major `k x nv`
 ///   (sample `s`, dof `j` at `s * nv + j`); `qd` or `qdd` `None` for zeros. All arguments
@@ -57,6 +57,7 @@ struct Rnea<'a> {
 
 impl LaneKernel for Rnea<'_> {
     type Output = Result<()>;
+    const PAIRS_ON_AVX2: bool = true;
 
     #[inline(always)]
     fn wide<const W: usize>(self, model: &Model, data: &mut LaneBuffers<W>) -> Result<()> {
@@ -70,7 +71,8 @@ impl LaneKernel for Rnea<'_> {
             forward(model, data, &g);
             wrenches(model, data);
             let used = (self.k - first).min(W);
-            finite &= contract_torques(model, &data.f, &mut data.tau, first, used, self.tau);
+            let (f, wide) = (&data.f, data.wide_stores);
+            finite &= contract_torques(model, f, &mut data.tau, first, used, self.tau, wide);
             first += W;
         }
         let qdd = self.x[2];
