@@ -213,9 +213,12 @@ unsafe fn transpose8<const W: usize>(
 /// Lanes `lb..lb + rows.min(4)` of the 4 quantities `src` into columns `c..c + 4` of those
 /// rows of `dst` (row `l` at `l * stride`); returns 0 when the values written are all finite
 /// (`v - v` of each or-ed in a register and tested once: no store, no reload).
+///
+/// # Safety
+/// The processor has AVX. No `target_feature` of its own, as [`transpose8`]: always inlined
+/// into the kernels, which have AVX2.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx")]
-#[inline]
+#[inline(always)]
 #[allow(clippy::eq_op)]
 unsafe fn transpose4<const W: usize>(
     src: &[Lanes<W>],
