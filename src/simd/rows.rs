@@ -12,7 +12,7 @@ use super::Lanes;
 /// one value at a time.
 ///
 /// `wide`: the caller's buffers run on AVX-512 (`LaneBuffers::wide_stores`): then, with 8 lanes
-/// all in use and a processor that has AVX-512F, blocks of 8 quantities by 8 lanes are
+/// all in use and a processor with AVX-512F and DQ, blocks of 8 quantities by 8 lanes are
 /// transposed in 512-bit registers and stored 64 bytes a row. False elsewhere, so that the
 /// AVX2 paths (8 lanes in register pairs included) keep to AVX2 instructions.
 ///
@@ -54,7 +54,9 @@ pub(crate) fn write_rows_with_zeros<const W: usize>(
         let mut c = 0;
         // 8 full lanes with AVX-512: blocks of 8 quantities, each row's 8 values one 64-byte
         // store (half the stores of two 4x4 blocks, and whole cache lines when aligned)
-        if wide && W == 8 && used == 8 && std::arch::is_x86_feature_detected!("avx512f") {
+        let avx512 = std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512dq");
+        if wide && W == 8 && used == 8 && avx512 {
             while c + 8 <= done {
                 match (zero(c / 4), zero(c / 4 + 1)) {
                     (true, true) => {
@@ -63,7 +65,7 @@ pub(crate) fn write_rows_with_zeros<const W: usize>(
                             dst[at..at + 8].fill(0.0);
                         }
                     }
-                    // SAFETY: the processor has AVX-512F (checked above) and `W == 8`.
+                    // SAFETY: the processor has AVX-512F and DQ (checked above), `W == 8`.
                     (false, false) => bits |= unsafe { transpose8(&src[c..c + 8], dst, stride, c) },
                     _ => {
                         bits |= block4(src, zero(c / 4), used, dst, stride, c);
@@ -122,10 +124,10 @@ fn block4<const W: usize>(
 /// every value is finite (tested on the loaded quantities, as in [`transpose4`]).
 ///
 /// # Safety
-/// The processor has AVX-512F. The function has no `target_feature` of its own (that would
+/// The processor has AVX-512F and DQ (the `or` of doubles). The function has no `target_feature` of its own (that would
 /// forbid `inline(always)`, and LLVM then keeps it out of line): inside the AVX-512 kernels
-/// its intrinsics compile to single instructions, elsewhere (the 8-lane AVX2 test path) to
-/// calls.
+/// its intrinsics compile to single instructions. It is reached from AVX-512 buffers only
+/// (`wide`); the AVX2 kernels on 8 lanes contain it compiled to calls, never taken.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 #[allow(clippy::eq_op)]

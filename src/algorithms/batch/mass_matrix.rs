@@ -12,9 +12,8 @@ use crate::simd::{
 use crate::spatial::OriginInertia;
 
 /// Joint-space mass matrices `M(q)` of a batch, [`LaneData::width`] samples at a time (8 on
-/// AVX2, in pairs of registers; the
-/// composite rigid body algorithm in the base frame, as [`crate::mass_matrix`]; equal to it up
-/// to rounding).
+/// AVX2, in pairs of registers): the composite rigid body algorithm in the base frame, as
+/// [`crate::mass_matrix`], equal to it up to rounding.
 ///
 /// `q`: row-major `k x nv` (rad or m), finite (checked by the caller, as for
 /// [`super::rnea_lanes`]). `out`: row-major `k x nv x nv` (kg m^2, kg m or kg), both triangles
