@@ -124,10 +124,11 @@ fn block4<const W: usize>(
 /// every value is finite (tested on the loaded quantities, as in [`transpose4`]).
 ///
 /// # Safety
-/// The processor has AVX-512F and DQ (the `or` of doubles). The function has no `target_feature` of its own (that would
-/// forbid `inline(always)`, and LLVM then keeps it out of line): inside the AVX-512 kernels
-/// its intrinsics compile to single instructions. It is reached from AVX-512 buffers only
-/// (`wide`); the AVX2 kernels on 8 lanes contain it compiled to calls, never taken.
+/// The processor has AVX-512F and DQ (the `or` of doubles). The function has no
+/// `target_feature` of its own (that would forbid `inline(always)`, and LLVM then keeps it out
+/// of line): inside the AVX-512 kernels its intrinsics compile to single instructions. It is
+/// reached from AVX-512 buffers only (`wide`); the AVX2 kernels on 8 lanes contain it compiled
+/// to calls, never taken.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 #[allow(clippy::eq_op)]
