@@ -3,6 +3,36 @@
 
 use super::Lanes;
 
+/// The structural zeros of a lane buffer (entries a kernel never writes, zero in every lane):
+/// [`write_rows_with_zeros`] stores those as zeros without reading them.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ZeroPattern {
+    /// `written[c]`: how many of entries `0..c` the kernel writes (`n + 1` counts).
+    written: Vec<u32>,
+}
+
+impl ZeroPattern {
+    /// From whether the kernel writes each entry of the buffer, in order.
+    pub(crate) fn new(written: impl IntoIterator<Item = bool>) -> Self {
+        let mut counts = vec![0u32];
+        let mut sum = 0u32;
+        for w in written {
+            sum += u32::from(w);
+            counts.push(sum);
+        }
+        Self { written: counts }
+    }
+
+    /// Whether entries `c..c + len` are all structural zeros (false past the pattern's end).
+    #[inline(always)]
+    fn zero(&self, c: usize, len: usize) -> bool {
+        match (self.written.get(c), self.written.get(c + len)) {
+            (Some(a), Some(b)) => a == b,
+            _ => false,
+        }
+    }
+}
+
 /// Writes lanes `0..used` of `src` (`n` quantities, one value per lane each) into `dst` as rows:
 /// lane `l`'s `n` values at `dst[l * stride..l * stride + n]`, in the order of `src`.
 ///
@@ -16,11 +46,15 @@ use super::Lanes;
 /// transposed in 512-bit registers and stored 64 bytes a row. False elsewhere, so that the
 /// AVX2 paths (8 lanes in register pairs included) keep to AVX2 instructions.
 ///
+/// The blocks are laid on `dst`'s cache lines where every row falls alike on them (`stride` a
+/// multiple of the block): the first quantities up to a line's start go singly, so that no
+/// store of a block straddles two lines (a split store costs twice; numpy's arrays start
+/// 16 bytes into a line).
+///
 /// Returns whether every value written is finite, tested on the way in registers (`v - v` is
 /// +0 for a finite `v`, NaN otherwise; the differences' bits or-ed together), so that a caller
 /// need not read its output back to vouch for it.
 #[inline(always)]
-#[allow(clippy::eq_op)] // `v - v` is the finiteness test, not a mistake
 pub(crate) fn write_rows<const W: usize>(
     src: &[Lanes<W>],
     used: usize,
@@ -28,67 +62,116 @@ pub(crate) fn write_rows<const W: usize>(
     stride: usize,
     wide: bool,
 ) -> bool {
-    write_rows_with_zeros(src, |_| false, used, dst, stride, wide)
+    write_rows_with_zeros(src, None, used, dst, stride, wide)
 }
 
-/// As [`write_rows`], where `zero(c)` says that quantities `4c..4c + 4` of `src` are zero in
-/// every lane (a structural zero of the kernel): with AVX those are stored as zeros without
-/// being read. `zero` must be true only for such blocks (the values written are then equal to
-/// [`write_rows`]'s); the quantities past the last whole block are read in any case.
+/// As [`write_rows`], where `zeros` marks structural zeros of `src` (quantities zero in every
+/// lane): with AVX, blocks of those are stored as zeros without being read. The values written
+/// are then equal to [`write_rows`]'s.
 #[inline(always)]
-#[allow(clippy::eq_op)]
 pub(crate) fn write_rows_with_zeros<const W: usize>(
     src: &[Lanes<W>],
-    zero: impl Fn(usize) -> bool,
+    zeros: Option<&ZeroPattern>,
     used: usize,
     dst: &mut [f64],
     stride: usize,
     wide: bool,
 ) -> bool {
     let n = src.len();
-    let mut done = 0;
+    let mut c = 0;
     let mut bits = 0u64;
     #[cfg(target_arch = "x86_64")]
     if W.is_multiple_of(4) && std::arch::is_x86_feature_detected!("avx") {
-        done = n - n % 4;
-        let mut c = 0;
+        // where the rows start in a cache line (in values; f64 slices are 8-byte aligned)
+        let offset = (dst.as_ptr() as usize / 8) % 8;
+        let zero = |c: usize, len: usize| zeros.is_some_and(|z| z.zero(c, len));
         // 8 full lanes with AVX-512: blocks of 8 quantities, each row's 8 values one 64-byte
         // store (half the stores of two 4x4 blocks, and whole cache lines when aligned)
         let avx512 = std::arch::is_x86_feature_detected!("avx512f")
             && std::arch::is_x86_feature_detected!("avx512dq");
         if wide && W == 8 && used == 8 && avx512 {
-            while c + 8 <= done {
-                match (zero(c / 4), zero(c / 4 + 1)) {
-                    (true, true) => {
-                        for l in 0..8 {
-                            let at = l * stride + c;
-                            dst[at..at + 8].fill(0.0);
-                        }
-                    }
+            let head = if stride.is_multiple_of(8) {
+                ((8 - offset) % 8).min(n)
+            } else {
+                0
+            };
+            bits |= narrow(src, &zero, used, dst, stride, 0, head, head);
+            c = head;
+            while c + 8 <= n {
+                bits |= if zero(c, 8) {
+                    // SAFETY: the processor has AVX-512F (checked above)
+                    unsafe { zero8(dst, stride, c) };
+                    0
+                } else if zero(c, 4) || zero(c + 4, 4) {
+                    block4(src, zero(c, 4), used, dst, stride, c)
+                        | block4(src, zero(c + 4, 4), used, dst, stride, c + 4)
+                } else {
                     // SAFETY: the processor has AVX-512F and DQ (checked above), `W == 8`.
-                    (false, false) => bits |= unsafe { transpose8(&src[c..c + 8], dst, stride, c) },
-                    _ => {
-                        bits |= block4(src, zero(c / 4), used, dst, stride, c);
-                        bits |= block4(src, zero(c / 4 + 1), used, dst, stride, c + 4);
-                    }
-                }
+                    unsafe { transpose8(&src[c..c + 8], dst, stride, c) }
+                };
                 c += 8;
             }
+        } else if stride.is_multiple_of(4) {
+            // 32-byte stores within one line each: the first quantities singly up to a half line
+            let head = ((4 - offset % 4) % 4).min(n);
+            bits |= narrow(src, &zero, used, dst, stride, 0, head, head);
+            c = head;
         }
-        while c < done {
-            bits |= block4(src, zero(c / 4), used, dst, stride, c);
-            c += 4;
+        bits |= narrow(src, &zero, used, dst, stride, c, n, n - (n - c) % 4);
+        c = n;
+    }
+    (bits | scalars(src, used, dst, stride, c, n)) == 0
+}
+
+/// Quantities `from..to` of `src` into those columns of rows `0..used` of `dst`: blocks of 4
+/// by 4x4 transposes up to `blocks_end` (from `from` in steps of 4; zeros unread where `zero`
+/// says so), one value at a time after it. The finiteness bits as [`transpose4`]'s.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn narrow<const W: usize>(
+    src: &[Lanes<W>],
+    zero: &impl Fn(usize, usize) -> bool,
+    used: usize,
+    dst: &mut [f64],
+    stride: usize,
+    from: usize,
+    to: usize,
+    blocks_end: usize,
+) -> u64 {
+    let mut c = from;
+    let mut bits = 0;
+    while c + 4 <= blocks_end {
+        bits |= block4(src, zero(c, 4), used, dst, stride, c);
+        c += 4;
+    }
+    bits | scalars(src, used, dst, stride, c, to)
+}
+
+/// Quantities `from..to` of `src` into those columns of rows `0..used` of `dst`, one value at a
+/// time; the finiteness bits.
+#[inline(always)]
+#[allow(clippy::eq_op)] // `v - v` is the finiteness test, not a mistake
+fn scalars<const W: usize>(
+    src: &[Lanes<W>],
+    used: usize,
+    dst: &mut [f64],
+    stride: usize,
+    from: usize,
+    to: usize,
+) -> u64 {
+    let mut bits = 0u64;
+    if from < to {
+        for l in 0..used {
+            let row = &mut dst[l * stride..l * stride + to];
+            for c in super::serial(from..to) {
+                let v = src[c].0[l];
+                row[c] = v;
+                bits |= (v - v).to_bits();
+            }
         }
     }
-    for l in 0..used {
-        let row = &mut dst[l * stride..l * stride + n];
-        for c in super::serial(done..n) {
-            let v = src[c].0[l];
-            row[c] = v;
-            bits |= (v - v).to_bits();
-        }
-    }
-    bits == 0
+    bits
 }
 
 /// Quantities `c..c + 4` of `src` (zeros if `zero`) into columns `c..c + 4` of the rows
@@ -104,9 +187,25 @@ fn block4<const W: usize>(
     c: usize,
 ) -> u64 {
     if zero {
-        for l in 0..used {
-            let at = l * stride + c;
-            dst[at..at + 4].fill(0.0);
+        if used == W {
+            // one bounds check for the rows, then plain 32-byte stores
+            let block = &mut dst[c..c + (W - 1) * stride + 4];
+            let at = block.as_mut_ptr();
+            for l in 0..W {
+                // SAFETY: `block` holds `(W - 1) * stride + 4` values, so `l * stride + 4` fit
+                // for l < W; the callers checked for AVX
+                unsafe {
+                    std::arch::x86_64::_mm256_storeu_pd(
+                        at.add(l * stride),
+                        std::arch::x86_64::_mm256_setzero_pd(),
+                    )
+                };
+            }
+        } else {
+            for l in 0..used {
+                let at = l * stride + c;
+                dst[at..at + 4].fill(0.0);
+            }
         }
         return 0;
     }
@@ -117,6 +216,23 @@ fn block4<const W: usize>(
         bits |= unsafe { transpose4(&src[c..c + 4], lb, used - lb, dst, stride, c) };
     }
     bits
+}
+
+/// Zeros into columns `c..c + 8` of rows `0..8` of `dst` (row `l` at `l * stride`): one bounds
+/// check, 8 stores of 64 bytes.
+///
+/// # Safety
+/// The processor has AVX-512F; no `target_feature` of its own, as [`transpose8`].
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn zero8(dst: &mut [f64], stride: usize, c: usize) {
+    use std::arch::x86_64::{_mm512_setzero_pd, _mm512_storeu_pd};
+    let block = &mut dst[c..c + 7 * stride + 8];
+    let at = block.as_mut_ptr();
+    for l in 0..8 {
+        // SAFETY: `block` holds `7 * stride + 8` values, so `l * stride + 8` fit for l <= 7
+        _mm512_storeu_pd(at.add(l * stride), _mm512_setzero_pd());
+    }
 }
 
 /// The 8 lanes of the 8 quantities `src` (`W == 8`) into columns `c..c + 8` of rows `0..8` of
@@ -278,25 +394,48 @@ unsafe fn transpose4<const W: usize>(
 mod tests {
     use super::*;
 
+    /// `n` quantities, quantity `c` of lane `l` worth `100 c + l`.
+    fn numbered<const W: usize>(n: usize) -> Vec<Lanes<W>> {
+        (0..n)
+            .map(|c| {
+                let mut x = Lanes::<W>::default();
+                for l in 0..W {
+                    x.0[l] = (100 * c + l) as f64;
+                }
+                x
+            })
+            .collect()
+    }
+
+    /// Row strides that lay every row alike on the cache lines (multiples of 8 and of 4) and
+    /// that do not.
+    fn strides(n: usize) -> [usize; 3] {
+        [n + 2, n.div_ceil(8) * 8 + 8, n.div_ceil(4) * 4 + 4]
+    }
+
     fn check<const W: usize>(wide: bool) {
-        for n in [0, 1, 3, 4, 5, 8, 13, 16, 21, 24] {
-            let src: Vec<Lanes<W>> = (0..n)
-                .map(|c| {
-                    let mut x = Lanes::<W>::default();
-                    for l in 0..W {
-                        x.0[l] = (100 * c + l) as f64;
-                    }
-                    x
-                })
-                .collect();
+        for n in [0, 1, 3, 4, 5, 8, 13, 16, 21, 24, 35] {
+            let src = numbered::<W>(n);
             for used in 1..=W {
-                let stride = n + 2;
-                let mut dst = vec![-1.0; used * stride];
-                assert!(write_rows(&src, used, &mut dst, stride, wide));
-                for l in 0..used {
-                    for c in 0..stride {
-                        let want = if c < n { (100 * c + l) as f64 } else { -1.0 };
-                        assert_eq!(dst[l * stride + c], want, "W {W} n {n} used {used}");
+                for stride in strides(n) {
+                    // every start of the rows within a cache line
+                    let mut store = vec![-1.0; used * stride + 8];
+                    for start in 0..8 {
+                        store.fill(-1.0);
+                        let dst = &mut store[start..start + used * stride];
+                        assert!(write_rows(&src, used, dst, stride, wide));
+                        for l in 0..used {
+                            for c in 0..stride {
+                                let want = if c < n { (100 * c + l) as f64 } else { -1.0 };
+                                assert_eq!(
+                                    dst[l * stride + c],
+                                    want,
+                                    "W {W} n {n} used {used} stride {stride} start {start}"
+                                );
+                            }
+                        }
+                        assert!(store[..start].iter().all(|v| *v == -1.0));
+                        assert!(store[start + used * stride..].iter().all(|v| *v == -1.0));
                     }
                 }
             }
@@ -306,15 +445,24 @@ mod tests {
     fn finiteness<const W: usize>(wide: bool) {
         // a non-finite value is reported wherever it sits among the lanes written, and not
         // when it sits in a lane past `used`
-        for n in [1, 4, 7, 8, 17] {
+        for n in [1, 4, 7, 8, 17, 30] {
             for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
                 for (c, l) in [(0, 0), (n - 1, W - 1), (n / 2, W / 2)] {
                     let mut src = vec![Lanes::<W>::splat(1.5); n];
                     src[c].0[l] = bad;
                     for used in 1..=W {
-                        let mut dst = vec![0.0; used * n];
-                        let finite = write_rows(&src, used, &mut dst, n, wide);
-                        assert_eq!(finite, l >= used, "W {W} n {n} c {c} l {l} used {used}");
+                        for stride in strides(n) {
+                            let mut store = vec![0.0; used * stride + 8];
+                            for start in 0..8 {
+                                let dst = &mut store[start..start + used * stride];
+                                let finite = write_rows(&src, used, dst, stride, wide);
+                                assert_eq!(
+                                    finite,
+                                    l >= used,
+                                    "W {W} n {n} c {c} l {l} used {used} start {start}"
+                                );
+                            }
+                        }
                     }
                 }
             }
@@ -331,46 +479,75 @@ mod tests {
     }
 
     fn zeros_unread<const W: usize>(zero: fn(usize) -> bool, wide: bool) {
-        // blocks said to be zero are written as zeros whatever `src` holds there (they are not
-        // read); the others, and the tail past the last whole block, are the lanes transposed
-        for n in [4, 7, 12, 13, 16, 21, 24, 35] {
+        // quantities marked zero are written as zeros or, where the blocks do not cover them,
+        // read (here NaN: reported); the others are the lanes transposed; a long run of zeros
+        // is not read in full
+        for n in [4, 7, 12, 13, 16, 21, 24, 35, 64] {
+            let pattern = ZeroPattern::new((0..n).map(|c| !zero(c)));
             let src: Vec<Lanes<W>> = (0..n)
-                .map(|c| Lanes::splat(if zero(c / 4) { f64::NAN } else { c as f64 }))
+                .map(|c| Lanes::splat(if zero(c) { f64::NAN } else { c as f64 }))
                 .collect();
+            let avx = W.is_multiple_of(4) && std::arch::is_x86_feature_detected!("avx");
             for used in 1..=W {
-                let mut dst = vec![-1.0; used * n];
-                let finite = write_rows_with_zeros(&src, zero, used, &mut dst, n, wide);
-                let skipped = W.is_multiple_of(4) && std::arch::is_x86_feature_detected!("avx");
-                for l in 0..used {
-                    for c in 0..n {
-                        let got = dst[l * n + c];
-                        if !zero(c / 4) {
-                            assert_eq!(got, c as f64);
-                        } else if skipped && c < n - n % 4 {
-                            assert_eq!(got, 0.0, "W {W} n {n} used {used} c {c}");
-                        } else {
-                            assert!(got.is_nan());
+                for stride in strides(n) {
+                    let mut store = vec![-1.0; used * stride + 8];
+                    for start in 0..8 {
+                        let dst = &mut store[start..start + used * stride];
+                        let finite =
+                            write_rows_with_zeros(&src, Some(&pattern), used, dst, stride, wide);
+                        let mut nan = false;
+                        for l in 0..used {
+                            let row = &dst[l * stride..l * stride + n];
+                            for (c, got) in row.iter().enumerate() {
+                                if !zero(c) {
+                                    assert_eq!(*got, c as f64);
+                                } else {
+                                    assert!(*got == 0.0 || got.is_nan(), "W {W} n {n} c {c}");
+                                    nan |= got.is_nan();
+                                }
+                            }
+                            // 16 zeros in a row hold a whole block of 8 wherever the blocks
+                            // start
+                            let unread = (0..n).filter(|c| zero(*c) && row[*c] == 0.0).count();
+                            let run = (0..n.saturating_sub(15)).any(|c| (c..c + 16).all(zero));
+                            if avx && run {
+                                assert!(unread > 0, "W {W} n {n} stride {stride} start {start}");
+                            }
+                            if !avx {
+                                assert_eq!(unread, 0);
+                            }
                         }
+                        assert_eq!(finite, !nan, "W {W} n {n} start {start}");
                     }
                 }
-                let read = |c: usize| !skipped || c >= n - n % 4;
-                let nan_read = (0..n).any(|c| zero(c / 4) && read(c));
-                assert_eq!(finite, !nan_read, "W {W} n {n}");
             }
         }
     }
 
     #[test]
-    #[cfg(target_arch = "x86_64")]
-    fn blocks_of_structural_zeros_are_written_without_being_read() {
-        // every other block (the 8-lane path's blocks of 8 are half zero), every other
-        // pair of blocks (wholly zero or not), a lone zero block
-        let patterns: [fn(usize) -> bool; 3] = [|b| b % 2 == 1, |b| (b / 2) % 2 == 1, |b| b == 2];
+    fn structural_zeros_are_written_without_being_read() {
+        // every other block of 4 (the 8-lane path's blocks of 8 half zero), every other pair of
+        // blocks (wholly zero or not), a lone zero block, a long run, and odd runs
+        let patterns: [fn(usize) -> bool; 5] = [
+            |c| (c / 4) % 2 == 1,
+            |c| (c / 8) % 2 == 1,
+            |c| c / 4 == 2,
+            |c| (5..40).contains(&c),
+            |c| c % 11 < 6,
+        ];
         for (zero, wide) in patterns.into_iter().flat_map(|z| [(z, false), (z, true)]) {
             zeros_unread::<1>(zero, wide);
             zeros_unread::<4>(zero, wide);
             zeros_unread::<8>(zero, wide);
         }
+    }
+
+    #[test]
+    fn zero_pattern_ranges() {
+        let z = ZeroPattern::new([true, false, false, false, false, true, false]);
+        assert!(z.zero(1, 4) && !z.zero(0, 4) && !z.zero(2, 4) && z.zero(6, 1));
+        assert!(!z.zero(5, 4), "past the end is not zero");
+        assert!(z.zero(3, 0));
     }
 
     #[test]

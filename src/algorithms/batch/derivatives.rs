@@ -12,6 +12,7 @@ use crate::linearization::{linearize_into, Linearization};
 use crate::model::Model;
 use crate::simd::{
     serial, write_rows, write_rows_with_zeros, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes,
+    ZeroPattern,
 };
 
 /// Where [`derivatives_batch`] writes, row-major over `k` samples.
@@ -315,7 +316,7 @@ impl LaneKernel for Derivatives<'_> {
                 first == 0,
             );
             let [tau, m, dq, dv] = &mut self.out;
-            let (zeros, wide) = (&data.m_blocks, data.wide_stores);
+            let (zeros, wide) = (&data.m_zeros, data.wide_stores);
             finite &= write_vectors(model, &d.tau, used, &mut tau[first * n..], wide);
             finite &= write_matrices(model, &d.m, zeros, used, &mut m[first * nn..], wide);
             finite &= write_matrices(model, &d.dq, zeros, used, &mut dq[first * nn..], wide);
@@ -392,15 +393,14 @@ fn write_vectors<const W: usize>(
 
 /// Lanes `0..used` of the body-level row-major matrix `body` as `C^T body C` (the degrees of
 /// freedom) into the row-major `out` (`used x nv x nv`); whether every value was checked finite
-/// (`wide` as for `write_rows`). `related` is [`LaneBuffers::m_blocks`]: the blocks of 4
-/// entries that pair no body with an ancestor or descendant are zero in every one of these
-/// matrices (a torque moves with the coordinates and rates of its body's ancestors and subtree
+/// (`wide` as for `write_rows`). `zeros` is [`LaneBuffers::m_zeros`]: the entries that pair
+/// no body with an ancestor or descendant are zero in every one of these matrices (a torque moves with the coordinates and rates of its body's ancestors and subtree
 /// only), and are written as zeros without being read.
 #[inline(always)]
 fn write_matrices<const W: usize>(
     model: &Model,
     body: &[Lanes<W>],
-    related: &[bool],
+    zeros: &ZeroPattern,
     used: usize,
     out: &mut [f64],
     wide: bool,
@@ -418,7 +418,7 @@ fn write_matrices<const W: usize>(
         }
         false
     } else {
-        write_rows_with_zeros(body, |c| !related[c], used, out, nv * nv, wide)
+        write_rows_with_zeros(body, Some(zeros), used, out, nv * nv, wide)
     }
 }
 

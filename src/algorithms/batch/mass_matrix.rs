@@ -82,10 +82,10 @@ impl LaneKernel for MassMatrix<'_> {
             for i in serial(0..nb) {
                 store_pose_in_base(model, data, i);
             }
-            let (m, blocks, wide) = (&mut data.m, &data.m_blocks, data.wide_stores);
+            let (m, zeros, wide) = (&mut data.m, &data.m_zeros, data.wide_stores);
             // only the pairs of a body and its ancestors are written, the same in every group:
-            // the others are cleared once per call (and those in blocks of 4 structural zeros
-            // are not even read: `m_blocks`)
+            // the others are cleared once per call (and those in blocks of structural zeros
+            // are not even read: `m_zeros`)
             if first == 0 {
                 m.fill(Lanes::default());
             }
@@ -133,7 +133,7 @@ impl LaneKernel for MassMatrix<'_> {
                     }
                 }
             } else {
-                finite &= write_rows_with_zeros(m, |c| !blocks[c], used, out, nv * nv, wide);
+                finite &= write_rows_with_zeros(m, Some(zeros), used, out, nv * nv, wide);
             }
             for o in out.chunks_mut(nv * nv).take(used) {
                 finite &= model.add_armature_inertia(o);

@@ -29,7 +29,7 @@ use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Model;
 pub use crate::simd::Isa;
-use crate::simd::{Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
+use crate::simd::{Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes, ZeroPattern};
 
 /// The most samples any instruction set processes side by side (AVX-512's 8); a given
 /// [`LaneData`] uses [`LaneData::width`] of them.
@@ -85,13 +85,16 @@ pub(crate) struct LaneBuffers<const W: usize> {
     pub(crate) tau: Vec<Lanes<W>>,
     /// The regressor of the loaded lanes, row-major `nv x 10 nbodies`.
     pub(crate) regressor: Vec<Lanes<W>>,
+    /// The entries of `regressor` the kernel never writes (a degree of freedom that does not
+    /// move the body of the column): structural zeros, written out without being read.
+    pub(crate) regressor_zeros: ZeroPattern,
     /// Body-level mass matrix (row-major `nbodies x nbodies`) and composite inertias.
     pub(crate) m: Vec<Lanes<W>>,
-    /// Per block of 4 consecutive entries of `m` (or of any row-major `nbodies x nbodies`
-    /// matrix): whether one of them pairs a body with one of its ancestors or descendants (the
-    /// others are structural zeros of the mass matrix and of the torque derivatives, written
-    /// without being read; a tree's matrices are mostly such zeros).
-    pub(crate) m_blocks: Vec<bool>,
+    /// The entries of `m` (or of any row-major `nbodies x nbodies` matrix) that pair a body
+    /// with one that is neither an ancestor nor a descendant: structural zeros of the mass
+    /// matrix and of the torque derivatives, written without being read (a tree's matrices are
+    /// mostly such zeros).
+    pub(crate) m_zeros: ZeroPattern,
     pub(crate) composite: Vec<mass_matrix::Composite<W>>,
     /// The derivatives' buffers, made on first use.
     pub(crate) derivatives: Option<Box<derivatives::Buffers<W>>>,
@@ -106,8 +109,21 @@ pub(crate) struct LaneBuffers<const W: usize> {
 impl<const W: usize> LaneBuffers<W> {
     /// Buffers for every kernel; `wide_stores` when they run on AVX-512.
     fn new(model: &Model, wide_stores: bool) -> Self {
+        let cols = PARAMS_PER_BODY * model.nbodies();
+        // the entries `regressor_lanes` writes: a body's columns in the rows of the degrees of
+        // freedom of the body and its ancestors
+        let mut written = vec![false; model.nv * cols];
+        for i in 0..model.nbodies() {
+            let mut j = Some(i);
+            while let Some(k) = j {
+                let at = model.bodies[k].dof * cols + PARAMS_PER_BODY * i;
+                written[at..at + PARAMS_PER_BODY].fill(true);
+                j = model.bodies[k].parent;
+            }
+        }
         Self {
-            regressor: vec![Lanes::default(); model.nv * PARAMS_PER_BODY * model.nbodies()],
+            regressor: vec![Lanes::default(); written.len()],
+            regressor_zeros: ZeroPattern::new(written),
             ..Self::without_regressor(model, wide_stores)
         }
     }
@@ -130,10 +146,9 @@ impl<const W: usize> LaneBuffers<W> {
             f: vec![SpatialLanes::default(); nb],
             tau: vec![Lanes::default(); nb],
             regressor: Vec::new(),
+            regressor_zeros: ZeroPattern::default(),
             m: vec![Lanes::default(); nb * nb],
-            m_blocks: (0..nb * nb / 4)
-                .map(|c| (4 * c..4 * c + 4).any(|e| model.related(e / nb, e % nb)))
-                .collect(),
+            m_zeros: ZeroPattern::new((0..nb * nb).map(|e| model.related(e / nb, e % nb))),
             composite: vec![mass_matrix::Composite::default(); nb],
             derivatives: None,
             finite: false,

@@ -7,7 +7,9 @@ use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
-use crate::simd::{serial, write_rows, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
+use crate::simd::{
+    serial, write_rows_with_zeros, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes,
+};
 
 /// The joint-torque regressor of a batch, [`LaneData::width`] samples at a time: `out`
 /// (row-major `k x nv x 10 nbodies`, N m per parameter unit) holds for every sample the matrix
@@ -104,7 +106,8 @@ impl LaneKernel for Regressor<'_> {
             if let Some(out) = self.out.as_deref_mut() {
                 let used = (self.k - first).min(W);
                 let out = &mut out[first * nv * p..];
-                finite &= write_rows(&data.regressor, used, out, nv * p, data.wide_stores);
+                let (y, zeros) = (&data.regressor, Some(&data.regressor_zeros));
+                finite &= write_rows_with_zeros(y, zeros, used, out, nv * p, data.wide_stores);
             }
             first += W;
         }
