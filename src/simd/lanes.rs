@@ -312,15 +312,6 @@ impl<const W: usize> Rotation3Lanes<W> {
             o.tr_mul(&self.0[2]),
         ])
     }
-    /// Column `k`.
-    #[inline(always)]
-    pub(crate) fn column(&self, k: usize) -> Vector3Lanes<W> {
-        Vector3Lanes {
-            x: self.0[0].get(k),
-            y: self.0[1].get(k),
-            z: self.0[2].get(k),
-        }
-    }
     /// `self * a` for a constant vector `a`.
     #[inline(always)]
     pub(crate) fn mul_const_vector(&self, a: &Vector3<f64>) -> Vector3Lanes<W> {

@@ -6,10 +6,8 @@ use crate::algorithms::regressor::{joint_torque_regressor, PARAMS_PER_BODY};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
-use crate::model::Model;
-use crate::simd::{
-    serial, write_rows_with_zeros, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes,
-};
+use crate::model::{Body, JointKind, Model};
+use crate::simd::{serial, write_rows_with_zeros, Lanes, Vector3Lanes};
 
 /// The joint-torque regressor of a batch, [`LaneData::width`] samples at a time: `out`
 /// (row-major `k x nv x 10 nbodies`, N m per parameter unit) holds for every sample the matrix
@@ -169,64 +167,50 @@ fn regressor_lanes<const W: usize>(
         }
         // read in place (a copy of the pose would go through memcpy)
         let (r, p) = (&data.o_rot[i], &data.o_pos[i]);
-        // the body's 10 columns in the base frame (see `world_body_regressor`)
+        // the body's wrench per unit of each parameter, in its own frame about its origin
+        // (`world_body_regressor` in the body frame): mass `(0, c)`, first moment along `e_k`
+        // `(e_k x c, al x e_k + w w_k - e_k |w|^2)`, rotational inertia `(I_q al + w x I_q w,
+        // 0)`, with `c` the origin's acceleration; these are dotted with each ancestor's motion
+        // subspace brought into that frame, which is cheaper than turning the ten columns into
+        // the base frame once the body has few ancestors
         let (v, a) = (&data.v[i], &data.a[i]);
         let (w, al) = (v.ang, a.ang);
-        let ac = r.mul(&a.lin.add(&w.cross(&v.lin)));
-        let (ww, alw) = (r.mul(&w), r.mul(&al));
+        let c = a.lin.add(&w.cross(&v.lin));
         let w2 = w.dot(&w);
-        // (built whole, not from zeroed arrays: the zeroing could become a memset call; no
-        // closures: one compiled out of line would lose the instruction set)
-        let f = FirstMoment {
-            r,
-            p,
-            w,
-            ww,
-            alw,
-            w2,
-            ac,
-        };
-        let cols = [
-            SpatialLanes {
-                ang: p.cross(&ac),
-                lin: ac,
-            },
-            f.column(0),
-            f.column(1),
-            f.column(2),
-        ];
-        // I_q al + w x (I_q w) for the unit inertias of [Ixx, Ixy, Iyy, Ixz, Iyz, Izz],
-        // written out (the unit inertias are mostly zeros), then rotated into the base frame
-        // (torques only: these columns move no mass)
         let u = unit_inertia_columns(&w, &al);
-        let turned = [
-            r.mul(&u[0]),
-            r.mul(&u[1]),
-            r.mul(&u[2]),
-            r.mul(&u[3]),
-            r.mul(&u[4]),
-            r.mul(&u[5]),
-        ];
-        // project on the motion subspaces of the body and its ancestors
         let first = PARAMS_PER_BODY * i;
         let mut j = Some(i);
         while let Some(k) = j {
             let bk = &model.bodies[k];
-            let sk = &data.o_s[k];
             let at = bk.dof * cols_all + first;
             let row = &mut out[at..at + PARAMS_PER_BODY];
-            let y = [
-                sk.dot(&cols[0]),
-                sk.dot(&cols[1]),
-                sk.dot(&cols[2]),
-                sk.dot(&cols[3]),
-                sk.ang.dot(&turned[0]),
-                sk.ang.dot(&turned[1]),
-                sk.ang.dot(&turned[2]),
-                sk.ang.dot(&turned[3]),
-                sk.ang.dot(&turned[4]),
-                sk.ang.dot(&turned[5]),
-            ];
+            let y = if k == i {
+                // its own joint's subspace is a constant of the model in its own frame
+                own_columns(b, &c, &w, &al, w2, &u)
+            } else {
+                // ancestor k's motion subspace in the body's frame, about the body's origin
+                let sk = &data.o_s[k];
+                let sa = r.tr_mul(&sk.ang);
+                let sl = r.tr_mul(&sk.lin.add(&sk.ang.cross(p)));
+                // the first-moment entries at once: sl x al - sa x c + w (sl . w) - sl |w|^2
+                let fm = sl
+                    .cross(&al)
+                    .sub(&sa.cross(&c))
+                    .add(&w.mul_lanes(sl.dot(&w)))
+                    .sub(&sl.mul_lanes(w2));
+                [
+                    sl.dot(&c),
+                    fm.x,
+                    fm.y,
+                    fm.z,
+                    sa.dot(&u[0]),
+                    sa.dot(&u[1]),
+                    sa.dot(&u[2]),
+                    sa.dot(&u[3]),
+                    sa.dot(&u[4]),
+                    sa.dot(&u[5]),
+                ]
+            };
             if model.coupled {
                 for (o, y) in row.iter_mut().zip(&y) {
                     *o = y.mul_add_s(bk.multiplier, *o);
@@ -240,31 +224,53 @@ fn regressor_lanes<const W: usize>(
     data.regressor = out;
 }
 
-/// What a body's first-moment columns of the regressor share (base frame): its pose `r`, `p`,
-/// its angular velocity `w` (body frame) and `ww`, `alw` (angular velocity and acceleration in
-/// the base frame), `w2 = |w|^2`, and `ac` its origin's acceleration (base frame).
-struct FirstMoment<'a, const W: usize> {
-    r: &'a Rotation3Lanes<W>,
-    p: &'a Vector3Lanes<W>,
-    w: Vector3Lanes<W>,
-    ww: Vector3Lanes<W>,
-    alw: Vector3Lanes<W>,
+/// The regressor entries of body `b`'s own joint (see `regressor_lanes`): its motion subspace
+/// in its own frame is the axis, through the origin (revolute) or as a translation
+/// (prismatic).
+#[inline(always)]
+fn own_columns<const W: usize>(
+    b: &Body,
+    c: &Vector3Lanes<W>,
+    w: &Vector3Lanes<W>,
+    al: &Vector3Lanes<W>,
     w2: Lanes<W>,
-    ac: Vector3Lanes<W>,
-}
-
-impl<const W: usize> FirstMoment<'_, W> {
-    /// The wrench per unit of the first moment's component `k` (body frame).
-    #[inline(always)]
-    fn column(&self, k: usize) -> SpatialLanes<W> {
-        let rk = self.r.column(k);
-        let lin = self
-            .ww
-            .mul_lanes_add(self.w.get(k), &self.alw.cross(&rk))
-            .sub(&rk.mul_lanes(self.w2));
-        SpatialLanes {
-            ang: rk.cross(&self.ac).add(&self.p.cross(&lin)),
-            lin,
+    u: &[Vector3Lanes<W>; 6],
+) -> [Lanes<W>; PARAMS_PER_BODY] {
+    let a = &b.axis;
+    match b.kind {
+        JointKind::Revolute => {
+            let fm = c.cross_const(a);
+            [
+                Lanes::default(),
+                fm.x,
+                fm.y,
+                fm.z,
+                u[0].dot_const(a),
+                u[1].dot_const(a),
+                u[2].dot_const(a),
+                u[3].dot_const(a),
+                u[4].dot_const(a),
+                u[5].dot_const(a),
+            ]
+        }
+        JointKind::Prismatic => {
+            let fm = w
+                .mul_lanes(w.dot_const(a))
+                .sub(&al.cross_const(a))
+                .sub(&Vector3Lanes::of(a, w2));
+            let zero = Lanes::default();
+            [
+                c.dot_const(a),
+                fm.x,
+                fm.y,
+                fm.z,
+                zero,
+                zero,
+                zero,
+                zero,
+                zero,
+                zero,
+            ]
         }
     }
 }
