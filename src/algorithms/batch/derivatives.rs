@@ -4,7 +4,9 @@
 
 use super::kinematics::store_pose_in_base;
 use super::mass_matrix::{transformed, Composite};
-use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
+use super::{
+    armature_inertia, armature_torques, dispatch, samples, LaneBuffers, LaneData, LaneKernel,
+};
 use crate::data::Data;
 use crate::error::Result;
 use crate::gravity::Gravity;
@@ -302,7 +304,7 @@ impl LaneKernel for Derivatives<'_> {
         let (n, nn) = (model.nv, model.nv * model.nv);
         let minus_g = model.base_acceleration(self.gravity);
         let mut first = 0;
-        // vouched for: rows checked as they are written, the armature's entries after it
+        // vouched for: rows checked as they are written (the armature added in the lanes)
         let mut finite = !model.coupled;
         while first < self.k {
             let used = (self.k - first).min(W);
@@ -316,15 +318,19 @@ impl LaneKernel for Derivatives<'_> {
                 first == 0,
             );
             let [tau, m, dq, dv] = &mut self.out;
+            if !model.coupled {
+                armature_torques(model, &mut d.tau, &data.ab);
+                armature_inertia(model, &mut d.m);
+            }
             let (zeros, wide) = (&data.m_zeros, data.wide_stores);
             finite &= write_vectors(model, &d.tau, used, &mut tau[first * n..], wide);
             finite &= write_matrices(model, &d.m, zeros, used, &mut m[first * nn..], wide);
             finite &= write_matrices(model, &d.dq, zeros, used, &mut dq[first * nn..], wide);
             finite &= write_matrices(model, &d.dv, zeros, used, &mut dv[first * nn..], wide);
-            for s in first..first + used {
-                finite &= model
-                    .add_armature_torque(&self.x[2][s * n..(s + 1) * n], &mut tau[s * n..][..n]);
-                finite &= model.add_armature_inertia(&mut m[s * nn..(s + 1) * nn]);
+            // a coupled model's armature onto its degrees of freedom (not vouched for)
+            for s in (first..first + used).filter(|_| model.coupled) {
+                model.add_armature_torque(&self.x[2][s * n..(s + 1) * n], &mut tau[s * n..][..n]);
+                model.add_armature_inertia(&mut m[s * nn..(s + 1) * nn]);
             }
             if let Some(gs) = self.g_static.as_deref_mut() {
                 let gs = &mut gs[first * nn..];

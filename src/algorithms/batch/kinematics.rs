@@ -370,13 +370,16 @@ pub(crate) fn subspace_in<const W: usize>(
 
 /// Writes the joint torques of lanes `0..used` (samples `first..first + used`) into the
 /// row-major `tau` from the body wrenches `f` (in the body frames): `tau_dof += multiplier *
-/// S^T f`. `body_tau` (one per body) is work space. Returns whether every torque written was
-/// checked finite (always false for a coupled model, whose torques are not checked here).
-/// `wide` as for `write_rows`.
+/// S^T f`, plus the armature's `armature * qdd` for a model that is not coupled (`qdd` the
+/// loaded body accelerations; a coupled model's is the caller's). `body_tau` (one per body) is
+/// work space. Returns whether every torque written was checked finite (always false for a
+/// coupled model, whose torques are not checked here). `wide` as for `write_rows`.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn contract_torques<const W: usize>(
     model: &Model,
     f: &[SpatialLanes<W>],
+    qdd: &[Lanes<W>],
     body_tau: &mut [Lanes<W>],
     first: usize,
     used: usize,
@@ -392,6 +395,7 @@ pub(crate) fn contract_torques<const W: usize>(
         };
     }
     if !model.coupled {
+        super::armature_torques(model, body_tau, qdd);
         return write_rows(body_tau, used, &mut tau[first * nv..], nv, wide);
     }
     for s in first..first + used {

@@ -2,7 +2,7 @@
 //! in the base frame).
 
 use super::kinematics::store_pose_in_base;
-use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
+use super::{armature_inertia, dispatch, samples, LaneBuffers, LaneData, LaneKernel};
 use crate::data::Data;
 use crate::error::Result;
 use crate::model::Model;
@@ -74,7 +74,7 @@ impl LaneKernel for MassMatrix<'_> {
     fn wide<const W: usize>(self, model: &Model, data: &mut LaneBuffers<W>) -> Result<()> {
         let (nv, nb) = (model.nv, model.nbodies());
         let mut first = 0;
-        // vouched for: rows checked as they are written, the diagonal after the armature
+        // vouched for: rows checked as they are written (the armature added in the lanes)
         let mut finite = !model.coupled;
         while first < self.k {
             data.load(model, [self.q, &[], &[]], first);
@@ -131,12 +131,11 @@ impl LaneKernel for MassMatrix<'_> {
                                 bi.multiplier * bj.multiplier * m[i * nb + j].0[l];
                         }
                     }
+                    finite &= model.add_armature_inertia(o);
                 }
             } else {
+                armature_inertia(model, m);
                 finite &= write_rows_with_zeros(m, Some(zeros), used, out, nv * nv, wide);
-            }
-            for o in out.chunks_mut(nv * nv).take(used) {
-                finite &= model.add_armature_inertia(o);
             }
             first += W;
         }

@@ -187,6 +187,37 @@ impl<const W: usize> LaneBuffers<W> {
     }
 }
 
+/// A model whose bodies are its degrees of freedom (not coupled): its armature added in the
+/// lanes, `armature[i] * qdd[i]` onto the body torques `tau` (`qdd` the loaded accelerations,
+/// [`LaneBuffers::ab`]), before the rows are written: added to the output afterwards, it would
+/// read back values just stored.
+#[inline(always)]
+pub(crate) fn armature_torques<const W: usize>(
+    model: &Model,
+    tau: &mut [Lanes<W>],
+    qdd: &[Lanes<W>],
+) {
+    debug_assert!(!model.coupled);
+    for ((t, a), &arm) in tau.iter_mut().zip(qdd).zip(&model.armature) {
+        if arm != 0.0 {
+            *t = a.mul_add_s(arm, *t);
+        }
+    }
+}
+
+/// As [`armature_torques`], `armature[i]` onto the diagonal of the body-level row-major
+/// `nbodies x nbodies` matrix `m` (the mass matrix).
+#[inline(always)]
+pub(crate) fn armature_inertia<const W: usize>(model: &Model, m: &mut [Lanes<W>]) {
+    debug_assert!(!model.coupled);
+    let nb = model.nbodies();
+    for (i, &arm) in model.armature.iter().enumerate() {
+        if arm != 0.0 {
+            m[i * nb + i] = m[i * nb + i] + arm;
+        }
+    }
+}
+
 impl LaneData {
     /// Buffers sized for `model`, for the widest instruction set of this processor
     /// ([`Isa::detect`]).

@@ -63,20 +63,20 @@ impl LaneKernel for Rnea<'_> {
     fn wide<const W: usize>(self, model: &Model, data: &mut LaneBuffers<W>) -> Result<()> {
         let g = model.base_acceleration(self.gravity);
         let mut first = 0;
-        // vouched for: torques checked in registers as they are written, then after the
-        // armature's share
+        // vouched for: torques checked in registers as they are written (the armature's share
+        // added in the lanes)
         let mut finite = true;
         while first < self.k {
             data.load(model, self.x, first);
             forward(model, data, &g);
             wrenches(model, data);
             let used = (self.k - first).min(W);
-            let (f, wide) = (&data.f, data.wide_stores);
-            finite &= contract_torques(model, f, &mut data.tau, first, used, self.tau, wide);
+            let (f, qdd, wide) = (&data.f, &data.ab, data.wide_stores);
+            finite &= contract_torques(model, f, qdd, &mut data.tau, first, used, self.tau, wide);
             first += W;
         }
         let qdd = self.x[2];
-        if !qdd.is_empty() {
+        if model.coupled && !qdd.is_empty() {
             let nv = model.nv;
             for (t, a) in self.tau.chunks_mut(nv).zip(qdd.chunks(nv)) {
                 finite &= model.add_armature_torque(a, t);
