@@ -400,8 +400,9 @@ fn write_vectors<const W: usize>(
 /// Lanes `0..used` of the body-level row-major matrix `body` as `C^T body C` (the degrees of
 /// freedom) into the row-major `out` (`used x nv x nv`); whether every value was checked finite
 /// (`wide` as for `write_rows`). `zeros` is [`LaneBuffers::m_zeros`]: the entries that pair
-/// no body with an ancestor or descendant are zero in every one of these matrices (a torque moves with the coordinates and rates of its body's ancestors and subtree
-/// only), and are written as zeros without being read.
+/// no body with an ancestor or descendant are zero in every one of these matrices (a torque
+/// moves with the coordinates and rates of its body's ancestors and subtree only), and are
+/// written as zeros without being read.
 #[inline(always)]
 fn write_matrices<const W: usize>(
     model: &Model,
