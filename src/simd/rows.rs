@@ -95,7 +95,7 @@ pub(crate) fn write_rows_with_zeros<const W: usize>(
             } else {
                 0
             };
-            bits |= narrow(src, &zero, used, dst, stride, 0, head, head);
+            bits |= narrow(src, &zero, used, dst, stride, 0, head);
             c = head;
             while c + 8 <= n {
                 bits |= if zero(c, 8) {
@@ -114,21 +114,20 @@ pub(crate) fn write_rows_with_zeros<const W: usize>(
         } else if stride.is_multiple_of(4) {
             // 32-byte stores within one line each: the first quantities singly up to a half line
             let head = ((4 - offset % 4) % 4).min(n);
-            bits |= narrow(src, &zero, used, dst, stride, 0, head, head);
+            bits |= narrow(src, &zero, used, dst, stride, 0, head);
             c = head;
         }
-        bits |= narrow(src, &zero, used, dst, stride, c, n, n - (n - c) % 4);
+        bits |= narrow(src, &zero, used, dst, stride, c, n);
         c = n;
     }
     (bits | scalars(src, used, dst, stride, c, n)) == 0
 }
 
 /// Quantities `from..to` of `src` into those columns of rows `0..used` of `dst`: blocks of 4
-/// by 4x4 transposes up to `blocks_end` (from `from` in steps of 4; zeros unread where `zero`
-/// says so), one value at a time after it. The finiteness bits as [`transpose4`]'s.
+/// by 4x4 transposes from `from` on (zeros unread where `zero` says so), the last fewer than 4
+/// one value at a time. The finiteness bits as [`transpose4`]'s.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn narrow<const W: usize>(
     src: &[Lanes<W>],
     zero: &impl Fn(usize, usize) -> bool,
@@ -137,11 +136,10 @@ fn narrow<const W: usize>(
     stride: usize,
     from: usize,
     to: usize,
-    blocks_end: usize,
 ) -> u64 {
     let mut c = from;
     let mut bits = 0;
-    while c + 4 <= blocks_end {
+    while c + 4 <= to {
         bits |= block4(src, zero(c, 4), used, dst, stride, c);
         c += 4;
     }
