@@ -227,3 +227,50 @@ fn a_regressor_group_equals_the_one_sample_regressor() {
         assert!(regressor_group(&model, &mut lanes, &q, &qd, &qdd, Gravity::Included).is_err());
     }
 }
+
+#[test]
+fn outputs_past_the_caches_are_the_same_bits_as_small_calls_write() {
+    // past 16 MB of output (a job of the batch engine, or one kernel call) the AVX-512 kernels
+    // store whole cache lines non-temporally: the values must be those of the same kernels
+    // called on 8 samples at a time, bit for bit (elsewhere the test holds trivially)
+    use perturbid_rs::{mass_matrix_batch, regressor_batch, LaneData};
+    let tree = model_from_urdf_str(&random_tree_urdf(60, 60), "tree60", &LoadOptions::default());
+    let jobs = [
+        // the engine's parallel chunks (2.9 MB each) of a 24 MB job (no chunk of fewer samples
+        // than lanes: those go through the one-sample algorithms) and the mass matrix's serial
+        // 2.4 MB; the tree's serial 22 MB of regressor and 20 MB of mass matrices
+        (
+            robots::builtin("a465").unwrap(),
+            2 * PARALLEL_BATCH + 8,
+            2 * PARALLEL_BATCH + 8,
+        ),
+        (tree.unwrap(), 77, 700),
+    ];
+    for (model, k, k_m) in jobs {
+        let (n, p) = (model.nv, 10 * model.nbodies());
+        let [q, qd, qdd] = random_states(&model, k.max(k_m), 31);
+        let mut ws = Workspace::new(&model);
+        let r = ..k * n;
+        let states = States::new(n, &q[r], Some(&qd[r]), Some(&qdd[r])).unwrap();
+        let mut y = vec![f64::NAN; k * n * p];
+        parallel::regressor(&model, &mut ws, &states, Gravity::Included, &mut y).unwrap();
+        let mut m = vec![f64::NAN; k_m * n * n];
+        let many = States::new(n, &q[..k_m * n], None, None).unwrap();
+        parallel::mass_matrix(&model, &mut ws, &many, &mut m).unwrap();
+
+        let mut lanes = LaneData::new(&model);
+        let (mut y8, mut m8) = (vec![f64::NAN; y.len()], vec![f64::NAN; m.len()]);
+        for (c, yc) in y8.chunks_mut(8 * n * p).enumerate() {
+            let r = c * 8 * n..((c + 1) * 8 * n).min(k * n);
+            let x = [&q[r.clone()], &qd[r.clone()], &qdd[r]];
+            regressor_batch(&model, &mut lanes, x[0], x[1], x[2], Gravity::Included, yc).unwrap();
+        }
+        for (c, mc) in m8.chunks_mut(8 * n * n).enumerate() {
+            let r = c * 8 * n..((c + 1) * 8 * n).min(k_m * n);
+            mass_matrix_batch(&model, &mut lanes, &q[r], mc).unwrap();
+        }
+        let same = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+        assert!(same(&y, &y8), "regressor of {k} samples");
+        assert!(same(&m, &m8), "mass matrix of {k_m} samples");
+    }
+}

@@ -20,34 +20,48 @@ use proptest::prelude::*;
 
 const TOL: f64 = 1e-12;
 
-/// A path: an instruction set, or the 8-lane code on AVX2 (`None`), which checks AVX-512's
-/// 8-lane code where the processor has no AVX-512.
-type Path = Option<Isa>;
+/// A path: an instruction set; the 8-lane code on AVX2, which checks AVX-512's 8-lane code
+/// where the processor has no AVX-512; or AVX-512 storing as for a job far larger than the
+/// caches (non-temporal stores of whole cache lines: `LaneData::set_job_output`).
+#[derive(Clone, Copy, Debug)]
+enum Path {
+    Isa(Isa),
+    EightLanesOnAvx2,
+    Streaming,
+}
 
-const PATHS: [Path; 4] = [
-    Some(Isa::Avx512),
-    Some(Isa::Avx2Fma),
-    Some(Isa::Scalar),
-    None,
+const PATHS: [Path; 5] = [
+    Path::Isa(Isa::Avx512),
+    Path::Isa(Isa::Avx2Fma),
+    Path::Isa(Isa::Scalar),
+    Path::EightLanesOnAvx2,
+    Path::Streaming,
 ];
 
 /// The lane buffers of `path` for `model`, or `None` (with a note) when the processor lacks it.
 fn lanes_for(model: &Model, path: Path) -> Option<LaneData> {
-    let Some(isa) = path else {
-        return match LaneData::eight_lanes_on_avx2(model) {
-            Ok(l) => {
-                assert_eq!((l.isa(), l.width()), (Isa::Avx2Fma, 8));
-                Some(l)
-            }
-            Err(e) => {
-                eprintln!("skipped: 8 lanes on AVX2 need AVX2 ({e})");
-                None
-            }
-        };
+    let isa = match path {
+        Path::Isa(isa) => isa,
+        Path::Streaming => Isa::Avx512,
+        Path::EightLanesOnAvx2 => {
+            return match LaneData::eight_lanes_on_avx2(model) {
+                Ok(l) => {
+                    assert_eq!((l.isa(), l.width()), (Isa::Avx2Fma, 8));
+                    Some(l)
+                }
+                Err(e) => {
+                    eprintln!("skipped: 8 lanes on AVX2 need AVX2 ({e})");
+                    None
+                }
+            };
+        }
     };
     match LaneData::with_isa(model, isa) {
-        Ok(l) => {
+        Ok(mut l) => {
             assert_eq!((l.isa(), l.width()), (isa, isa.lanes()));
+            if let Path::Streaming = path {
+                l.set_job_output(usize::MAX);
+            }
             Some(l)
         }
         Err(e) => {
@@ -61,7 +75,11 @@ fn lanes_for(model: &Model, path: Path) -> Option<LaneData> {
 
 /// The path's name in messages.
 fn describe(path: Path) -> String {
-    path.map_or("8 lanes on avx2+fma".into(), |i| i.name().to_string())
+    match path {
+        Path::Isa(isa) => isa.name().to_string(),
+        Path::EightLanesOnAvx2 => "8 lanes on avx2+fma".into(),
+        Path::Streaming => "avx512 with non-temporal stores".into(),
+    }
 }
 
 fn close(got: f64, want: f64, scale: f64) -> bool {

@@ -86,9 +86,18 @@ where
         }
     }
     let layout: Vec<(&str, usize)> = outs.iter().map(|o| (o.0, o.2)).collect();
+    // the kernels store as for the whole output, whatever part each call writes
+    let job = outs
+        .iter()
+        .map(|o| o.1.len())
+        .sum::<usize>()
+        .saturating_mul(8);
     if k < PARALLEL_BATCH || outs.iter().any(|o| o.2 == 0) {
         let mut whole: Vec<&mut [f64]> = outs.iter_mut().map(|o| &mut *o.1).collect();
-        return in_blocks(algorithm, ws, states, &layout, &mut whole, &f);
+        ws.lanes.set_job_output(job);
+        let done = in_blocks(algorithm, ws, states, &layout, &mut whole, &f);
+        ws.lanes.set_job_output(0);
+        return done;
     }
     let chunks = k.div_ceil(PARALLEL_CHUNK);
     let mut per_chunk: Vec<Vec<&mut [f64]>> = (0..chunks).map(|_| Vec::new()).collect();
@@ -105,6 +114,7 @@ where
             let first = c * PARALLEL_CHUNK;
             let chunk = states.slice(first..(first + PARALLEL_CHUNK).min(k));
             let mut ws = Workspace::new(model);
+            ws.lanes.set_job_output(job);
             in_blocks(algorithm, &mut ws, &chunk, &layout, &mut parts, &f)
         })
 }

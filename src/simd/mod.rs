@@ -10,7 +10,7 @@ mod sin_cos;
 
 pub use isa::Isa;
 pub(crate) use lanes::{Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
-pub(crate) use rows::{write_rows, write_rows_with_zeros, ZeroPattern};
+pub(crate) use rows::{store_fence, write_rows, write_rows_with_zeros, Stores, ZeroPattern};
 pub(crate) use serial::serial;
 pub(crate) use sin_cos::sin_cos;
 

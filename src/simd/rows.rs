@@ -3,6 +3,56 @@
 
 use super::Lanes;
 
+/// How [`write_rows`] stores its blocks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) enum Stores {
+    /// Blocks of 4 quantities by 4 lanes in 256-bit registers (AVX2; the AVX2 kernels on 8
+    /// lanes too, so that they keep to AVX2 instructions).
+    #[default]
+    Narrow,
+    /// With 8 full lanes and AVX-512F and DQ: blocks of 8 by 8 in 512-bit registers, each row's
+    /// 8 values one 64-byte store (half the stores of two 4x4 blocks, whole cache lines when
+    /// aligned).
+    Wide,
+    /// As `Wide`, the blocks that fill whole cache lines stored non-temporally (`vmovntpd`:
+    /// straight to memory, neither read for ownership first nor left in the caches), for an
+    /// output far larger than the caches, whose every line would otherwise be read from memory
+    /// only to be overwritten and would push the kernel's buffers out of the caches on its way
+    /// (measured: the 60-dof tree's regressor, 288 kB a sample, 25 % faster so). A smaller
+    /// output stays in the caches with `Wide` (the A465's regressor, a few MB, 45 % slower with
+    /// these). The caller fences the stores ([`store_fence`]) before the output is read.
+    Streaming,
+}
+
+impl Stores {
+    /// Outputs of at least this many bytes are written with `Streaming` stores: half the
+    /// 32 MB L3 cache of the Zen 3 and Zen 4 measured, past which an output does not stay in
+    /// the caches from one call to the next. (Measured on the A465's regressor, serially:
+    /// `Streaming` 20-25 % slower at 6 MB, level at 12 MB, 25-30 % faster from 24 MB on.)
+    pub(crate) const STREAM_BYTES: usize = 16 << 20;
+
+    /// The stores for AVX-512 buffers (`wide`) or not, for an output of `bytes` in all.
+    #[inline]
+    pub(crate) fn for_output(wide: bool, bytes: usize) -> Self {
+        match (wide, bytes >= Self::STREAM_BYTES) {
+            (false, _) => Self::Narrow,
+            (true, false) => Self::Wide,
+            (true, true) => Self::Streaming,
+        }
+    }
+}
+
+/// Orders the non-temporal stores made so far before any later store (`sfence`): after a kernel
+/// that wrote with [`Stores::Streaming`], before its output is handed on.
+#[inline]
+pub(crate) fn store_fence() {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: SSE, which every x86_64 processor has
+    unsafe {
+        std::arch::x86_64::_mm_sfence()
+    };
+}
+
 /// The structural zeros of a lane buffer (entries a kernel never writes, zero in every lane):
 /// [`write_rows_with_zeros`] stores those as zeros without reading them.
 #[derive(Clone, Debug, Default)]
@@ -41,10 +91,9 @@ impl ZeroPattern {
 /// 4 lanes are transposed in registers (4 loads, 8 shuffles, 4 stores) instead of being copied
 /// one value at a time.
 ///
-/// `wide`: the caller's buffers run on AVX-512 (`LaneBuffers::wide_stores`): then, with 8 lanes
-/// all in use and a processor with AVX-512F and DQ, blocks of 8 quantities by 8 lanes are
-/// transposed in 512-bit registers and stored 64 bytes a row. False elsewhere, so that the
-/// AVX2 paths (8 lanes in register pairs included) keep to AVX2 instructions.
+/// `stores`: how (see [`Stores`]); anything but `Narrow` only from buffers that run on AVX-512
+/// (`LaneBuffers::wide_stores`), and used only with 8 lanes all in use and a processor with
+/// AVX-512F and DQ.
 ///
 /// The blocks are laid on `dst`'s cache lines where every row falls alike on them (`stride` a
 /// multiple of the block): the first quantities up to a line's start go singly, so that no
@@ -60,14 +109,15 @@ pub(crate) fn write_rows<const W: usize>(
     used: usize,
     dst: &mut [f64],
     stride: usize,
-    wide: bool,
+    stores: Stores,
 ) -> bool {
-    write_rows_with_zeros(src, None, used, dst, stride, wide)
+    write_rows_with_zeros(src, None, used, dst, stride, stores)
 }
 
 /// As [`write_rows`], where `zeros` marks structural zeros of `src` (quantities zero in every
-/// lane): with AVX, blocks of those are stored as zeros without being read. The values written
-/// are then equal to [`write_rows`]'s.
+/// lane): with AVX, blocks of those are stored as zeros without being read (with
+/// `Stores::Streaming` whole blocks of 8 only). The values written are then equal to
+/// [`write_rows`]'s.
 #[inline(always)]
 pub(crate) fn write_rows_with_zeros<const W: usize>(
     src: &[Lanes<W>],
@@ -75,7 +125,7 @@ pub(crate) fn write_rows_with_zeros<const W: usize>(
     used: usize,
     dst: &mut [f64],
     stride: usize,
-    wide: bool,
+    stores: Stores,
 ) -> bool {
     let n = src.len();
     let mut c = 0;
@@ -89,7 +139,8 @@ pub(crate) fn write_rows_with_zeros<const W: usize>(
         // store (half the stores of two 4x4 blocks, and whole cache lines when aligned)
         let avx512 = std::arch::is_x86_feature_detected!("avx512f")
             && std::arch::is_x86_feature_detected!("avx512dq");
-        if wide && W == 8 && used == 8 && avx512 {
+        if stores != Stores::Narrow && W == 8 && used == 8 && avx512 {
+            let stream = stores == Stores::Streaming;
             let head = if stride.is_multiple_of(8) {
                 ((8 - offset) % 8).min(n)
             } else {
@@ -100,14 +151,17 @@ pub(crate) fn write_rows_with_zeros<const W: usize>(
             while c + 8 <= n {
                 bits |= if zero(c, 8) {
                     // SAFETY: the processor has AVX-512F (checked above)
-                    unsafe { zero8(dst, stride, c) };
+                    unsafe { zero8(dst, stride, c, stream) };
                     0
-                } else if zero(c, 4) || zero(c + 4, 4) {
+                } else if !stream && (zero(c, 4) || zero(c + 4, 4)) {
+                    // (streaming, such a block goes whole, its zeros read from the buffer:
+                    // a 32-byte store into a line beside non-temporal ones costs 40 % on the
+                    // tree's mass matrix)
                     block4(src, zero(c, 4), used, dst, stride, c)
                         | block4(src, zero(c + 4, 4), used, dst, stride, c + 4)
                 } else {
                     // SAFETY: the processor has AVX-512F and DQ (checked above), `W == 8`.
-                    unsafe { transpose8(&src[c..c + 8], dst, stride, c) }
+                    unsafe { transpose8(&src[c..c + 8], dst, stride, c, stream) }
                 };
                 c += 8;
             }
@@ -217,31 +271,59 @@ fn block4<const W: usize>(
 }
 
 /// Zeros into columns `c..c + 8` of rows `0..8` of `dst` (row `l` at `l * stride`): one bounds
-/// check, 8 stores of 64 bytes.
+/// check, 8 stores of 64 bytes (non-temporal if `stream`, as [`store8`]).
 ///
 /// # Safety
 /// The processor has AVX-512F; no `target_feature` of its own, as [`transpose8`].
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn zero8(dst: &mut [f64], stride: usize, c: usize) {
-    use std::arch::x86_64::{_mm512_setzero_pd, _mm512_storeu_pd};
+unsafe fn zero8(dst: &mut [f64], stride: usize, c: usize, stream: bool) {
+    let zero = std::arch::x86_64::_mm512_setzero_pd();
+    store8(dst, stride, c, [zero; 8], stream);
+}
+
+/// `rows[l]` into columns `c..c + 8` of row `l` of `dst` (at `l * stride`) for `l < 8`: one
+/// bounds check, 8 stores of 64 bytes. With `stream`, where those are whole cache lines (the
+/// block's first row on a line, `stride` a multiple of 8 values), non-temporal ones.
+///
+/// # Safety
+/// The processor has AVX-512F; no `target_feature` of its own, as [`transpose8`].
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn store8(
+    dst: &mut [f64],
+    stride: usize,
+    c: usize,
+    rows: [std::arch::x86_64::__m512d; 8],
+    stream: bool,
+) {
+    use std::arch::x86_64::{_mm512_storeu_pd, _mm512_stream_pd};
     let block = &mut dst[c..c + 7 * stride + 8];
     let at = block.as_mut_ptr();
-    for l in 0..8 {
-        // SAFETY: `block` holds `7 * stride + 8` values, so `l * stride + 8` fit for l <= 7
-        _mm512_storeu_pd(at.add(l * stride), _mm512_setzero_pd());
+    if stream && (at as usize).is_multiple_of(64) && stride.is_multiple_of(8) {
+        for (l, v) in rows.into_iter().enumerate() {
+            // SAFETY: `block` holds `7 * stride + 8` values, so `l * stride + 8` fit for
+            // l <= 7; each row starts on a 64-byte boundary (checked above)
+            _mm512_stream_pd(at.add(l * stride), v);
+        }
+    } else {
+        for (l, v) in rows.into_iter().enumerate() {
+            // SAFETY: as above
+            _mm512_storeu_pd(at.add(l * stride), v);
+        }
     }
 }
 
 /// The 8 lanes of the 8 quantities `src` (`W == 8`) into columns `c..c + 8` of rows `0..8` of
-/// `dst` (row `l` at `l * stride`): 8 loads, 24 shuffles, 8 stores of 64 bytes. Returns 0 when
-/// every value is finite (tested on the loaded quantities, as in [`transpose4`]).
+/// `dst` (row `l` at `l * stride`): 8 loads, 24 shuffles, 8 stores of 64 bytes ([`store8`]).
+/// Returns 0 when every value is finite (tested on the loaded quantities, as in
+/// [`transpose4`]).
 ///
 /// # Safety
 /// The processor has AVX-512F and DQ (the `or` of doubles). The function has no
 /// `target_feature` of its own (that would forbid `inline(always)`, and LLVM then keeps it out
 /// of line): inside the AVX-512 kernels its intrinsics compile to single instructions. It is
-/// reached from AVX-512 buffers only (`wide`); the AVX2 kernels on 8 lanes contain it compiled
+/// reached from AVX-512 buffers only (`Stores::Wide`, `Streaming`); the AVX2 kernels on 8 lanes contain it compiled
 /// to calls, never taken.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
@@ -251,10 +333,11 @@ unsafe fn transpose8<const W: usize>(
     dst: &mut [f64],
     stride: usize,
     c: usize,
+    stream: bool,
 ) -> u64 {
     use std::arch::x86_64::{
-        _mm512_castpd_si512, _mm512_loadu_pd, _mm512_or_pd, _mm512_shuffle_f64x2, _mm512_storeu_pd,
-        _mm512_sub_pd, _mm512_test_epi64_mask, _mm512_unpackhi_pd, _mm512_unpacklo_pd,
+        _mm512_castpd_si512, _mm512_loadu_pd, _mm512_or_pd, _mm512_shuffle_f64x2, _mm512_sub_pd,
+        _mm512_test_epi64_mask, _mm512_unpackhi_pd, _mm512_unpacklo_pd,
     };
     // one 8-lane quantity (bounds-checked: fails unless W >= 8)
     #[inline(always)]
@@ -317,13 +400,7 @@ unsafe fn transpose8<const W: usize>(
         _mm512_shuffle_f64x2::<0xdd>(u[1], u[5]),
         _mm512_shuffle_f64x2::<0xdd>(u[3], u[7]),
     ];
-    // one bounds check for the 8 rows, then 8 plain stores
-    let block = &mut dst[c..c + 7 * stride + 8];
-    let at = block.as_mut_ptr();
-    for (l, v) in out.into_iter().enumerate() {
-        // SAFETY: `block` holds `7 * stride + 8` values, so `l * stride + 8` fit for l <= 7
-        _mm512_storeu_pd(at.add(l * stride), v);
-    }
+    store8(dst, stride, c, out, stream);
     bits
 }
 
@@ -411,7 +488,9 @@ mod tests {
         [n + 2, n.div_ceil(8) * 8 + 8, n.div_ceil(4) * 4 + 4]
     }
 
-    fn check<const W: usize>(wide: bool) {
+    const ALL_STORES: [Stores; 3] = [Stores::Narrow, Stores::Wide, Stores::Streaming];
+
+    fn check<const W: usize>(stores: Stores) {
         for n in [0, 1, 3, 4, 5, 8, 13, 16, 21, 24, 35] {
             let src = numbered::<W>(n);
             for used in 1..=W {
@@ -421,7 +500,7 @@ mod tests {
                     for start in 0..8 {
                         store.fill(-1.0);
                         let dst = &mut store[start..start + used * stride];
-                        assert!(write_rows(&src, used, dst, stride, wide));
+                        assert!(write_rows(&src, used, dst, stride, stores));
                         for l in 0..used {
                             for c in 0..stride {
                                 let want = if c < n { (100 * c + l) as f64 } else { -1.0 };
@@ -440,7 +519,7 @@ mod tests {
         }
     }
 
-    fn finiteness<const W: usize>(wide: bool) {
+    fn finiteness<const W: usize>(stores: Stores) {
         // a non-finite value is reported wherever it sits among the lanes written, and not
         // when it sits in a lane past `used`
         for n in [1, 4, 7, 8, 17, 30] {
@@ -453,7 +532,7 @@ mod tests {
                             let mut store = vec![0.0; used * stride + 8];
                             for start in 0..8 {
                                 let dst = &mut store[start..start + used * stride];
-                                let finite = write_rows(&src, used, dst, stride, wide);
+                                let finite = write_rows(&src, used, dst, stride, stores);
                                 assert_eq!(
                                     finite,
                                     l >= used,
@@ -469,14 +548,14 @@ mod tests {
 
     #[test]
     fn rows_report_whether_the_values_written_are_finite() {
-        for wide in [false, true] {
-            finiteness::<1>(wide);
-            finiteness::<4>(wide);
-            finiteness::<8>(wide);
+        for stores in ALL_STORES {
+            finiteness::<1>(stores);
+            finiteness::<4>(stores);
+            finiteness::<8>(stores);
         }
     }
 
-    fn zeros_unread<const W: usize>(zero: fn(usize) -> bool, wide: bool) {
+    fn zeros_unread<const W: usize>(zero: fn(usize) -> bool, stores: Stores) {
         // quantities marked zero are written as zeros or, where the blocks do not cover them,
         // read (here NaN: reported); the others are the lanes transposed; a long run of zeros
         // is not read in full
@@ -492,7 +571,7 @@ mod tests {
                     for start in 0..8 {
                         let dst = &mut store[start..start + used * stride];
                         let finite =
-                            write_rows_with_zeros(&src, Some(&pattern), used, dst, stride, wide);
+                            write_rows_with_zeros(&src, Some(&pattern), used, dst, stride, stores);
                         let mut nan = false;
                         for l in 0..used {
                             let row = &dst[l * stride..l * stride + n];
@@ -533,10 +612,13 @@ mod tests {
             |c| (5..40).contains(&c),
             |c| c % 11 < 6,
         ];
-        for (zero, wide) in patterns.into_iter().flat_map(|z| [(z, false), (z, true)]) {
-            zeros_unread::<1>(zero, wide);
-            zeros_unread::<4>(zero, wide);
-            zeros_unread::<8>(zero, wide);
+        for (zero, stores) in patterns
+            .into_iter()
+            .flat_map(|z| ALL_STORES.map(|s| (z, s)))
+        {
+            zeros_unread::<1>(zero, stores);
+            zeros_unread::<4>(zero, stores);
+            zeros_unread::<8>(zero, stores);
         }
     }
 
@@ -550,11 +632,12 @@ mod tests {
 
     #[test]
     fn rows_are_the_lanes_transposed() {
-        // `wide` (the AVX-512 buffers' 8x8 blocks) where the processor has AVX-512, and not
-        for wide in [false, true] {
-            check::<1>(wide);
-            check::<4>(wide);
-            check::<8>(wide);
+        // the AVX-512 buffers' 8x8 blocks (plain or non-temporal stores) where the processor
+        // has AVX-512, and the 4x4 ones
+        for stores in ALL_STORES {
+            check::<1>(stores);
+            check::<4>(stores);
+            check::<8>(stores);
         }
     }
 }

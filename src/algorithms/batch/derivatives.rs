@@ -13,8 +13,8 @@ use crate::gravity::Gravity;
 use crate::linearization::{linearize_into, Linearization};
 use crate::model::Model;
 use crate::simd::{
-    serial, write_rows, write_rows_with_zeros, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes,
-    ZeroPattern,
+    serial, write_rows, write_rows_with_zeros, Lanes, Rotation3Lanes, SpatialLanes, Stores,
+    Vector3Lanes, ZeroPattern,
 };
 
 /// Where [`derivatives_batch`] writes, row-major over `k` samples.
@@ -306,6 +306,9 @@ impl LaneKernel for Derivatives<'_> {
         let mut first = 0;
         // vouched for: rows checked as they are written (the armature added in the lanes)
         let mut finite = !model.coupled;
+        let values = self.out.iter().map(|o| o.len()).sum::<usize>()
+            + self.g_static.as_deref().map_or(0, <[f64]>::len);
+        let stores = data.stores(values);
         while first < self.k {
             let used = (self.k - first).min(W);
             data.load(model, self.x, first);
@@ -322,11 +325,11 @@ impl LaneKernel for Derivatives<'_> {
                 armature_torques(model, &mut d.tau, &data.ab);
                 armature_inertia(model, &mut d.m);
             }
-            let (zeros, wide) = (&data.m_zeros, data.wide_stores);
-            finite &= write_vectors(model, &d.tau, used, &mut tau[first * n..], wide);
-            finite &= write_matrices(model, &d.m, zeros, used, &mut m[first * nn..], wide);
-            finite &= write_matrices(model, &d.dq, zeros, used, &mut dq[first * nn..], wide);
-            finite &= write_matrices(model, &d.dv, zeros, used, &mut dv[first * nn..], wide);
+            let zeros = &data.m_zeros;
+            finite &= write_vectors(model, &d.tau, used, &mut tau[first * n..], stores);
+            finite &= write_matrices(model, &d.m, zeros, used, &mut m[first * nn..], stores);
+            finite &= write_matrices(model, &d.dq, zeros, used, &mut dq[first * nn..], stores);
+            finite &= write_matrices(model, &d.dv, zeros, used, &mut dv[first * nn..], stores);
             // a coupled model's armature onto its degrees of freedom (not vouched for)
             for s in (first..first + used).filter(|_| model.coupled) {
                 model.add_armature_torque(&self.x[2][s * n..(s + 1) * n], &mut tau[s * n..][..n]);
@@ -334,7 +337,7 @@ impl LaneKernel for Derivatives<'_> {
             }
             if let Some(gs) = self.g_static.as_deref_mut() {
                 let gs = &mut gs[first * nn..];
-                finite &= write_matrices(model, &d.gs, zeros, used, gs, wide);
+                finite &= write_matrices(model, &d.gs, zeros, used, gs, stores);
             }
             first += W;
         }
@@ -374,14 +377,14 @@ impl LaneKernel for Derivatives<'_> {
 
 /// Lanes `0..used` of the body torques `body` summed onto the degrees of freedom into the
 /// row-major `out` (`used x nv`); whether every value was checked finite (see `write_rows`, and
-/// there for `wide`).
+/// there for `stores`).
 #[inline(always)]
 fn write_vectors<const W: usize>(
     model: &Model,
     body: &[Lanes<W>],
     used: usize,
     out: &mut [f64],
-    wide: bool,
+    stores: Stores,
 ) -> bool {
     let nv = model.nv;
     if model.coupled {
@@ -393,13 +396,13 @@ fn write_vectors<const W: usize>(
         }
         false
     } else {
-        write_rows(body, used, out, nv, wide)
+        write_rows(body, used, out, nv, stores)
     }
 }
 
 /// Lanes `0..used` of the body-level row-major matrix `body` as `C^T body C` (the degrees of
 /// freedom) into the row-major `out` (`used x nv x nv`); whether every value was checked finite
-/// (`wide` as for `write_rows`). `zeros` is [`LaneBuffers::m_zeros`]: the entries that pair
+/// (`stores` as for `write_rows`). `zeros` is [`LaneBuffers::m_zeros`]: the entries that pair
 /// no body with an ancestor or descendant are zero in every one of these matrices (a torque
 /// moves with the coordinates and rates of its body's ancestors and subtree only), and are
 /// written as zeros without being read.
@@ -410,7 +413,7 @@ fn write_matrices<const W: usize>(
     zeros: &ZeroPattern,
     used: usize,
     out: &mut [f64],
-    wide: bool,
+    stores: Stores,
 ) -> bool {
     let (nb, nv) = (model.nbodies(), model.nv);
     if model.coupled {
@@ -425,7 +428,7 @@ fn write_matrices<const W: usize>(
         }
         false
     } else {
-        write_rows_with_zeros(body, Some(zeros), used, out, nv * nv, wide)
+        write_rows_with_zeros(body, Some(zeros), used, out, nv * nv, stores)
     }
 }
 

@@ -3,7 +3,9 @@
 
 use super::LaneBuffers;
 use crate::model::{AlignedRevolute, Body, JointKind, Model};
-use crate::simd::{serial, sin_cos, write_rows, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes};
+use crate::simd::{
+    serial, sin_cos, write_rows, Lanes, Rotation3Lanes, SpatialLanes, Stores, Vector3Lanes,
+};
 use crate::spatial::{Inertia, Motion, Se3};
 
 /// The pose of body `b` in its parent (rotation by rows, translation) for the lane coordinates
@@ -373,7 +375,7 @@ pub(crate) fn subspace_in<const W: usize>(
 /// S^T f`, plus the armature's `armature * qdd` for a model that is not coupled (`qdd` the
 /// loaded body accelerations; a coupled model's is the caller's). `body_tau` (one per body) is
 /// work space. Returns whether every torque written was checked finite (always false for a
-/// coupled model, whose torques are not checked here). `wide` as for `write_rows`.
+/// coupled model, whose torques are not checked here). `stores` as for `write_rows`.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn contract_torques<const W: usize>(
@@ -384,7 +386,7 @@ pub(crate) fn contract_torques<const W: usize>(
     first: usize,
     used: usize,
     tau: &mut [f64],
-    wide: bool,
+    stores: Stores,
 ) -> bool {
     let nv = model.nv;
     for ((t, b), f) in serial(body_tau.iter_mut().zip(&model.bodies).zip(f)) {
@@ -396,7 +398,7 @@ pub(crate) fn contract_torques<const W: usize>(
     }
     if !model.coupled {
         super::armature_torques(model, body_tau, qdd);
-        return write_rows(body_tau, used, &mut tau[first * nv..], nv, wide);
+        return write_rows(body_tau, used, &mut tau[first * nv..], nv, stores);
     }
     for s in first..first + used {
         tau[s * nv..(s + 1) * nv].fill(0.0);

@@ -76,13 +76,14 @@ impl LaneKernel for MassMatrix<'_> {
         let mut first = 0;
         // vouched for: rows checked as they are written (the armature added in the lanes)
         let mut finite = !model.coupled;
+        let stores = data.stores(self.out.len());
         while first < self.k {
             data.load(model, [self.q, &[], &[]], first);
             // base-frame poses and motion subspaces
             for i in serial(0..nb) {
                 store_pose_in_base(model, data, i);
             }
-            let (m, zeros, wide) = (&mut data.m, &data.m_zeros, data.wide_stores);
+            let (m, zeros) = (&mut data.m, &data.m_zeros);
             // only the pairs of a body and its ancestors are written, the same in every group:
             // the others are cleared once per call (and those in blocks of structural zeros
             // are not even read: `m_zeros`)
@@ -135,7 +136,7 @@ impl LaneKernel for MassMatrix<'_> {
                 }
             } else {
                 armature_inertia(model, m);
-                finite &= write_rows_with_zeros(m, Some(zeros), used, out, nv * nv, wide);
+                finite &= write_rows_with_zeros(m, Some(zeros), used, out, nv * nv, stores);
             }
             first += W;
         }

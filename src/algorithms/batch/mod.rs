@@ -29,7 +29,7 @@ use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::model::Model;
 pub use crate::simd::Isa;
-use crate::simd::{Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes, ZeroPattern};
+use crate::simd::{Lanes, Rotation3Lanes, SpatialLanes, Stores, Vector3Lanes, ZeroPattern};
 
 /// The most samples any instruction set processes side by side (AVX-512's 8); a given
 /// [`LaneData`] uses [`LaneData::width`] of them.
@@ -46,6 +46,8 @@ pub struct LaneData {
     /// structural facts in them (the mass matrix's zero blocks), so a model of the same sizes
     /// but another tree is refused.
     parents: Vec<Option<usize>>,
+    /// See [`Self::set_job_output`].
+    job_output: usize,
     buffers: Buffers,
 }
 
@@ -104,6 +106,9 @@ pub(crate) struct LaneBuffers<const W: usize> {
     /// Whether the kernels on these buffers run on AVX-512 (and may transpose their results
     /// into the output by 512-bit blocks: `write_rows`).
     pub(crate) wide_stores: bool,
+    /// The bytes of output of the whole job the next kernel call is part of (see
+    /// [`LaneData::set_job_output`]).
+    pub(crate) job_output: usize,
 }
 
 impl<const W: usize> LaneBuffers<W> {
@@ -153,7 +158,17 @@ impl<const W: usize> LaneBuffers<W> {
             derivatives: None,
             finite: false,
             wide_stores,
+            job_output: 0,
         }
+    }
+
+    /// How a kernel that writes `values` output values (f64) in all stores its rows (see
+    /// [`Stores`]; non-temporal stores only on AVX-512 and for outputs, or jobs, far larger
+    /// than the caches).
+    #[inline(always)]
+    pub(crate) fn stores(&self, values: usize) -> Stores {
+        let bytes = values.saturating_mul(8).max(self.job_output);
+        Stores::for_output(self.wide_stores, bytes)
     }
 
     /// Loads the body coordinates of samples `first..first + W` of the row-major `k x nv`
@@ -274,6 +289,7 @@ impl LaneData {
             nv: model.nv,
             nbodies: model.nbodies(),
             parents: model.bodies.iter().map(|b| b.parent).collect(),
+            job_output: 0,
             buffers,
         }
     }
@@ -318,6 +334,15 @@ impl LaneData {
                 d.regressor[(joint, parameter)]
             }
         }
+    }
+
+    /// Declares that the kernel calls that follow write parts of one job's output of `bytes`
+    /// bytes in all (0: each call is a job of its own, the default), as the batch engine does
+    /// when it splits a batch over threads or blocks: past a few MB (`Stores::STREAM_BYTES`)
+    /// the AVX-512 kernels then store whole cache lines non-temporally, as they would for one
+    /// call writing it all. Only the speed depends on it.
+    pub fn set_job_output(&mut self, bytes: usize) {
+        self.job_output = bytes;
     }
 
     /// Whether the last kernel run on these buffers checked every value it wrote to be finite
@@ -400,11 +425,15 @@ pub(crate) fn dispatch<K: LaneKernel<Output = Result<T>>, T>(
 ) -> Result<T> {
     lanes.check(model)?;
     lanes.forget_finite();
-    match &mut lanes.buffers {
+    let job = lanes.job_output;
+    let out = match &mut lanes.buffers {
         // SAFETY: `W8` and `W4` buffers are made only when the processor has the instruction
         // set (`LaneData::with_isa`, `Isa::detect`).
         #[cfg(target_arch = "x86_64")]
-        Buffers::W8(b) if lanes.isa == Isa::Avx512 => unsafe { run_avx512(kernel, model, b) },
+        Buffers::W8(b) if lanes.isa == Isa::Avx512 => {
+            b.job_output = job;
+            unsafe { run_avx512(kernel, model, b) }
+        }
         // 8 lanes in pairs of AVX2 registers: the 8-lane code tested where AVX-512 is missing
         // (`LaneData::eight_lanes_on_avx2`)
         #[cfg(target_arch = "x86_64")]
@@ -421,7 +450,11 @@ pub(crate) fn dispatch<K: LaneKernel<Output = Result<T>>, T>(
         #[cfg(target_arch = "x86_64")]
         Buffers::W4(b, _) => unsafe { run_avx2(kernel, model, b.as_mut()) },
         Buffers::Scalar(d) => kernel.scalar(model, d),
-    }
+    };
+    // the output's non-temporal stores ordered before anything the caller stores next (a
+    // thread of the batch engine signalling that its part is done)
+    crate::simd::store_fence();
+    out
 }
 
 #[cfg(target_arch = "x86_64")]

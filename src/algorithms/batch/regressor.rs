@@ -97,6 +97,7 @@ impl LaneKernel for Regressor<'_> {
         let p = PARAMS_PER_BODY * model.nbodies();
         let mut first = 0;
         let mut finite = self.out.is_some();
+        let stores = data.stores(self.out.as_deref().map_or(0, <[f64]>::len));
         while first < self.k {
             data.load(model, self.x, first);
             // the entries left zero are the same for every group: cleared once per call
@@ -105,7 +106,7 @@ impl LaneKernel for Regressor<'_> {
                 let used = (self.k - first).min(W);
                 let out = &mut out[first * nv * p..];
                 let (y, zeros) = (&data.regressor, Some(&data.regressor_zeros));
-                finite &= write_rows_with_zeros(y, zeros, used, out, nv * p, data.wide_stores);
+                finite &= write_rows_with_zeros(y, zeros, used, out, nv * p, stores);
             }
             first += W;
         }

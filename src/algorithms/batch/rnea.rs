@@ -66,13 +66,14 @@ impl LaneKernel for Rnea<'_> {
         // vouched for: torques checked in registers as they are written (the armature's share
         // added in the lanes)
         let mut finite = true;
+        let stores = data.stores(self.tau.len());
         while first < self.k {
             data.load(model, self.x, first);
             forward(model, data, &g);
             wrenches(model, data);
             let used = (self.k - first).min(W);
-            let (f, qdd, wide) = (&data.f, &data.ab, data.wide_stores);
-            finite &= contract_torques(model, f, qdd, &mut data.tau, first, used, self.tau, wide);
+            let (f, qdd) = (&data.f, &data.ab);
+            finite &= contract_torques(model, f, qdd, &mut data.tau, first, used, self.tau, stores);
             first += W;
         }
         let qdd = self.x[2];
