@@ -21,28 +21,28 @@ use proptest::prelude::*;
 const TOL: f64 = 1e-12;
 
 /// A path: an instruction set; the 8-lane code on AVX2, which checks AVX-512's 8-lane code
-/// where the processor has no AVX-512; or AVX-512 storing as for a job far larger than the
-/// caches (non-temporal stores of whole cache lines: `LaneData::set_job_output`).
+/// where the processor has no AVX-512; or an instruction set storing as for a job far larger
+/// than the caches (non-temporal stores of whole cache lines: `LaneData::set_job_output`).
 #[derive(Clone, Copy, Debug)]
 enum Path {
     Isa(Isa),
     EightLanesOnAvx2,
-    Streaming,
+    Streaming(Isa),
 }
 
-const PATHS: [Path; 5] = [
+const PATHS: [Path; 6] = [
     Path::Isa(Isa::Avx512),
     Path::Isa(Isa::Avx2Fma),
     Path::Isa(Isa::Scalar),
     Path::EightLanesOnAvx2,
-    Path::Streaming,
+    Path::Streaming(Isa::Avx512),
+    Path::Streaming(Isa::Avx2Fma),
 ];
 
 /// The lane buffers of `path` for `model`, or `None` (with a note) when the processor lacks it.
 fn lanes_for(model: &Model, path: Path) -> Option<LaneData> {
     let isa = match path {
-        Path::Isa(isa) => isa,
-        Path::Streaming => Isa::Avx512,
+        Path::Isa(isa) | Path::Streaming(isa) => isa,
         Path::EightLanesOnAvx2 => {
             return match LaneData::eight_lanes_on_avx2(model) {
                 Ok(l) => {
@@ -59,7 +59,7 @@ fn lanes_for(model: &Model, path: Path) -> Option<LaneData> {
     match LaneData::with_isa(model, isa) {
         Ok(mut l) => {
             assert_eq!((l.isa(), l.width()), (isa, isa.lanes()));
-            if let Path::Streaming = path {
+            if let Path::Streaming(_) = path {
                 l.set_job_output(usize::MAX);
             }
             Some(l)
@@ -78,7 +78,7 @@ fn describe(path: Path) -> String {
     match path {
         Path::Isa(isa) => isa.name().to_string(),
         Path::EightLanesOnAvx2 => "8 lanes on avx2+fma".into(),
-        Path::Streaming => "avx512 with non-temporal stores".into(),
+        Path::Streaming(isa) => format!("{isa} with non-temporal stores"),
     }
 }
 

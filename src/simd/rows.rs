@@ -5,45 +5,42 @@ use super::Lanes;
 
 /// How [`write_rows`] stores its blocks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(crate) enum Stores {
-    /// Blocks of 4 quantities by 4 lanes in 256-bit registers (AVX2; the AVX2 kernels on 8
-    /// lanes too, so that they keep to AVX2 instructions).
-    #[default]
-    Narrow,
-    /// With 8 full lanes and AVX-512F and DQ: blocks of 8 by 8 in 512-bit registers, each row's
-    /// 8 values one 64-byte store (half the stores of two 4x4 blocks, whole cache lines when
-    /// aligned).
-    Wide,
-    /// As `Wide`, the blocks that fill whole cache lines stored non-temporally (`vmovntpd`:
-    /// straight to memory, neither read for ownership first nor left in the caches), for an
-    /// output far larger than the caches, whose every line would otherwise be read from memory
-    /// only to be overwritten and would push the kernel's buffers out of the caches on its way
-    /// (measured: the 60-dof tree's regressor, 288 kB a sample, 25 % faster so). A smaller
-    /// output stays in the caches with `Wide` (the A465's regressor, a few MB, 45 % slower with
-    /// these). The caller fences the stores ([`store_fence`]) before the output is read.
-    Streaming,
+pub(crate) struct Stores {
+    /// With 8 full lanes and AVX-512F and DQ: blocks of 8 quantities by 8 lanes in 512-bit
+    /// registers, each row's 8 values one 64-byte store (half the stores of two 4x4 blocks,
+    /// whole cache lines when aligned). Otherwise blocks of 4 by 4 in 256-bit registers (AVX2;
+    /// the AVX2 kernels on 8 lanes too, so that they keep to AVX2 instructions).
+    pub(crate) wide: bool,
+    /// The blocks that fill whole cache lines stored non-temporally (`vmovntpd`: straight to
+    /// memory, neither read for ownership first nor left in the caches; with 4x4 blocks, two
+    /// of them make a row's line, its two halves stored back to back), for an output far
+    /// larger than the caches, whose every line would otherwise be read from memory only to be
+    /// overwritten and would push the kernel's buffers out of the caches on its way (measured,
+    /// AVX-512: the 60-dof tree's regressor, 288 kB a sample, 40 % faster so). A smaller
+    /// output stays in the caches without (the A465's regressor, a few MB, 20-45 % slower
+    /// with these). The kernels fence the stores ([`store_fence`]) before they return.
+    pub(crate) stream: bool,
 }
 
 impl Stores {
-    /// Outputs of at least this many bytes are written with `Streaming` stores: half the
-    /// 32 MB L3 cache of the Zen 3 and Zen 4 measured, past which an output does not stay in
-    /// the caches from one call to the next. (Measured on the A465's regressor, serially:
-    /// `Streaming` 20-25 % slower at 6 MB, level at 12 MB, 25-30 % faster from 24 MB on.)
+    /// Outputs of at least this many bytes are written with `stream`: half the 32 MB L3 cache
+    /// of the Zen 3 and Zen 4 measured, past which an output does not stay in the caches from
+    /// one call to the next. (Measured on the A465's regressor, serially, AVX-512: streaming
+    /// 20-25 % slower at 6 MB, level at 12 MB, 25-30 % faster from 24 MB on.)
     pub(crate) const STREAM_BYTES: usize = 16 << 20;
 
     /// The stores for AVX-512 buffers (`wide`) or not, for an output of `bytes` in all.
     #[inline]
     pub(crate) fn for_output(wide: bool, bytes: usize) -> Self {
-        match (wide, bytes >= Self::STREAM_BYTES) {
-            (false, _) => Self::Narrow,
-            (true, false) => Self::Wide,
-            (true, true) => Self::Streaming,
+        Self {
+            wide,
+            stream: bytes >= Self::STREAM_BYTES,
         }
     }
 }
 
 /// Orders the non-temporal stores made so far before any later store (`sfence`): after a kernel
-/// that wrote with [`Stores::Streaming`], before its output is handed on.
+/// that wrote with [`Stores::stream`], before its output is handed on.
 #[inline]
 pub(crate) fn store_fence() {
     #[cfg(target_arch = "x86_64")]
@@ -116,7 +113,7 @@ pub(crate) fn write_rows<const W: usize>(
 
 /// As [`write_rows`], where `zeros` marks structural zeros of `src` (quantities zero in every
 /// lane): with AVX, blocks of those are stored as zeros without being read (with
-/// `Stores::Streaming` whole blocks of 8 only). The values written are then equal to
+/// [`Stores::stream`] whole blocks of 8 only). The values written are then equal to
 /// [`write_rows`]'s.
 #[inline(always)]
 pub(crate) fn write_rows_with_zeros<const W: usize>(
@@ -139,8 +136,8 @@ pub(crate) fn write_rows_with_zeros<const W: usize>(
         // store (half the stores of two 4x4 blocks, and whole cache lines when aligned)
         let avx512 = std::arch::is_x86_feature_detected!("avx512f")
             && std::arch::is_x86_feature_detected!("avx512dq");
-        if stores != Stores::Narrow && W == 8 && used == 8 && avx512 {
-            let stream = stores == Stores::Streaming;
+        let stream = stores.stream;
+        if stores.wide && W == 8 && used == 8 && avx512 {
             let head = if stride.is_multiple_of(8) {
                 ((8 - offset) % 8).min(n)
             } else {
@@ -165,6 +162,15 @@ pub(crate) fn write_rows_with_zeros<const W: usize>(
                 };
                 c += 8;
             }
+        } else if stream && used == W && stride.is_multiple_of(8) {
+            // whole lines from pairs of 4x4 blocks, streamed: the first quantities singly up to
+            // a line's start
+            let head = ((8 - offset) % 8).min(n);
+            bits |= narrow(src, &zero, used, dst, stride, 0, head);
+            // SAFETY: the processor has AVX (checked above), `used == W`
+            let (b, end) = unsafe { stream_lines4(src, zeros, dst, stride, head) };
+            bits |= b;
+            c = end;
         } else if stride.is_multiple_of(4) {
             // 32-byte stores within one line each: the first quantities singly up to a half line
             let head = ((4 - offset % 4) % 4).min(n);
@@ -323,7 +329,7 @@ unsafe fn store8(
 /// The processor has AVX-512F and DQ (the `or` of doubles). The function has no
 /// `target_feature` of its own (that would forbid `inline(always)`, and LLVM then keeps it out
 /// of line): inside the AVX-512 kernels its intrinsics compile to single instructions. It is
-/// reached from AVX-512 buffers only (`Stores::Wide`, `Streaming`); the AVX2 kernels on 8 lanes contain it compiled
+/// reached from AVX-512 buffers only ([`Stores::wide`]); the AVX2 kernels on 8 lanes contain it compiled
 /// to calls, never taken.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
@@ -413,7 +419,6 @@ unsafe fn transpose8<const W: usize>(
 /// into the kernels, which have AVX2.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-#[allow(clippy::eq_op)]
 unsafe fn transpose4<const W: usize>(
     src: &[Lanes<W>],
     lb: usize,
@@ -422,9 +427,42 @@ unsafe fn transpose4<const W: usize>(
     stride: usize,
     c: usize,
 ) -> u64 {
+    use std::arch::x86_64::_mm256_storeu_pd;
+    let (out, bits) = transposed4(src, lb, rows);
+    let first = lb * stride + c;
+    if rows >= 4 {
+        // the usual case: one bounds check for the 4 rows, then 4 plain stores
+        let block = &mut dst[first..first + 3 * stride + 4];
+        let at = block.as_mut_ptr();
+        for (l, v) in out.into_iter().enumerate() {
+            // SAFETY: `block` holds `3 * stride + 4` values, so `l * stride + 4` fit for l <= 3
+            _mm256_storeu_pd(at.add(l * stride), v);
+        }
+    } else {
+        for (l, v) in out.iter().enumerate().take(rows) {
+            let at = first + l * stride;
+            _mm256_storeu_pd(dst[at..at + 4].as_mut_ptr(), *v);
+        }
+    }
+    bits
+}
+
+/// Lanes `lb..lb + 4` of the 4 quantities `src` as 4 rows of 4 values, and 0 when those of the
+/// first `rows` are all finite (as [`transpose4`]).
+///
+/// # Safety
+/// As [`transpose4`].
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+#[allow(clippy::eq_op)]
+unsafe fn transposed4<const W: usize>(
+    src: &[Lanes<W>],
+    lb: usize,
+    rows: usize,
+) -> ([std::arch::x86_64::__m256d; 4], u64) {
     use std::arch::x86_64::{
         _mm256_castpd_si256, _mm256_loadu_pd, _mm256_or_pd, _mm256_permute2f128_pd,
-        _mm256_setzero_pd, _mm256_storeu_pd, _mm256_sub_pd, _mm256_testz_si256, _mm256_unpackhi_pd,
+        _mm256_setzero_pd, _mm256_sub_pd, _mm256_testz_si256, _mm256_unpackhi_pd,
         _mm256_unpacklo_pd,
     };
     // no closures here: one compiled out of line would lose the target feature
@@ -441,25 +479,84 @@ unsafe fn transpose4<const W: usize>(
         _mm256_permute2f128_pd::<0x31>(t0, t2),
         _mm256_permute2f128_pd::<0x31>(t1, t3),
     ];
-    let first = lb * stride + c;
     let mut bad = _mm256_setzero_pd();
     for v in out.iter().take(rows) {
         bad = _mm256_or_pd(bad, _mm256_sub_pd(*v, *v));
     }
     let bad = _mm256_castpd_si256(bad);
-    let bits = u64::from(_mm256_testz_si256(bad, bad) == 0);
-    if rows >= 4 {
-        // the usual case: one bounds check for the 4 rows, then 4 plain stores
-        let block = &mut dst[first..first + 3 * stride + 4];
-        let at = block.as_mut_ptr();
-        for (l, v) in out.into_iter().enumerate() {
-            // SAFETY: `block` holds `3 * stride + 4` values, so `l * stride + 4` fit for l <= 3
-            _mm256_storeu_pd(at.add(l * stride), v);
-        }
-    } else {
-        for (l, v) in out.iter().enumerate().take(rows) {
-            let at = first + l * stride;
-            _mm256_storeu_pd(dst[at..at + 4].as_mut_ptr(), *v);
+    (out, u64::from(_mm256_testz_si256(bad, bad) == 0))
+}
+
+/// Quantities from `from` on, by blocks of 8, into those columns of all `W` rows of `dst` (row
+/// `l` at `l * stride`) with [`lines4`] (blocks that are all zeros by `zeros` not read);
+/// returns the finiteness bits (as [`transpose4`]'s) and where the blocks end. Kept out of
+/// line: inlined into every kernel's every output, this rarely taken path made the AVX2
+/// derivatives 5-7 % slower.
+///
+/// # Safety
+/// The processor has AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline(never)]
+unsafe fn stream_lines4<const W: usize>(
+    src: &[Lanes<W>],
+    zeros: Option<&ZeroPattern>,
+    dst: &mut [f64],
+    stride: usize,
+    from: usize,
+) -> (u64, usize) {
+    let mut c = from;
+    let mut bits = 0;
+    while c + 8 <= src.len() {
+        let zero = zeros.is_some_and(|z| z.zero(c, 8));
+        // SAFETY: the processor has AVX2 (this function's feature)
+        bits |= unsafe { lines4(src, zero, dst, stride, c) };
+        c += 8;
+    }
+    (bits, c)
+}
+
+/// Quantities `c..c + 8` of `src` (zeros if `zero`) into columns `c..c + 8` of all `W` rows of
+/// `dst` (row `l` at `l * stride`) by pairs of 4x4 transposes, each row's 8 values two 32-byte
+/// stores back to back: non-temporal where they make a whole cache line (the block's first row
+/// on a line, `stride` a multiple of 8 values). The finiteness bits as [`transpose4`]'s.
+///
+/// # Safety
+/// As [`transpose4`].
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn lines4<const W: usize>(
+    src: &[Lanes<W>],
+    zero: bool,
+    dst: &mut [f64],
+    stride: usize,
+    c: usize,
+) -> u64 {
+    use std::arch::x86_64::{_mm256_setzero_pd, _mm256_storeu_pd, _mm256_stream_pd};
+    let block = &mut dst[c..c + (W - 1) * stride + 8];
+    let at = block.as_mut_ptr();
+    let stream = (at as usize).is_multiple_of(64) && stride.is_multiple_of(8);
+    let mut bits = 0;
+    for lb in (0..W).step_by(4) {
+        let (lo, hi) = if zero {
+            ([_mm256_setzero_pd(); 4], [_mm256_setzero_pd(); 4])
+        } else {
+            let (lo, b0) = transposed4(&src[c..c + 4], lb, 4);
+            let (hi, b1) = transposed4(&src[c + 4..c + 8], lb, 4);
+            bits |= b0 | b1;
+            (lo, hi)
+        };
+        for l in 0..4 {
+            // SAFETY: `block` holds `(W - 1) * stride + 8` values, so `(lb + l) * stride + 8`
+            // fit for lb + l < W; streamed only on a 64-byte boundary (checked above)
+            let row = at.add((lb + l) * stride);
+            if stream {
+                _mm256_stream_pd(row, lo[l]);
+                _mm256_stream_pd(row.add(4), hi[l]);
+            } else {
+                _mm256_storeu_pd(row, lo[l]);
+                _mm256_storeu_pd(row.add(4), hi[l]);
+            }
         }
     }
     bits
@@ -488,7 +585,24 @@ mod tests {
         [n + 2, n.div_ceil(8) * 8 + 8, n.div_ceil(4) * 4 + 4]
     }
 
-    const ALL_STORES: [Stores; 3] = [Stores::Narrow, Stores::Wide, Stores::Streaming];
+    const ALL_STORES: [Stores; 4] = [
+        Stores {
+            wide: false,
+            stream: false,
+        },
+        Stores {
+            wide: true,
+            stream: false,
+        },
+        Stores {
+            wide: false,
+            stream: true,
+        },
+        Stores {
+            wide: true,
+            stream: true,
+        },
+    ];
 
     fn check<const W: usize>(stores: Stores) {
         for n in [0, 1, 3, 4, 5, 8, 13, 16, 21, 24, 35] {

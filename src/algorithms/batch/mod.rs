@@ -339,7 +339,7 @@ impl LaneData {
     /// Declares that the kernel calls that follow write parts of one job's output of `bytes`
     /// bytes in all (0: each call is a job of its own, the default), as the batch engine does
     /// when it splits a batch over threads or blocks: past a few MB (`Stores::STREAM_BYTES`)
-    /// the AVX-512 kernels then store whole cache lines non-temporally, as they would for one
+    /// the kernels then store whole cache lines non-temporally, as they would for one
     /// call writing it all. Only the speed depends on it.
     pub fn set_job_output(&mut self, bytes: usize) {
         self.job_output = bytes;
@@ -437,18 +437,25 @@ pub(crate) fn dispatch<K: LaneKernel<Output = Result<T>>, T>(
         // 8 lanes in pairs of AVX2 registers: the 8-lane code tested where AVX-512 is missing
         // (`LaneData::eight_lanes_on_avx2`)
         #[cfg(target_arch = "x86_64")]
-        Buffers::W8(b) => unsafe { run_avx2(kernel, model, b.as_mut()) },
+        Buffers::W8(b) => {
+            b.job_output = job;
+            unsafe { run_avx2(kernel, model, b.as_mut()) }
+        }
         #[cfg(target_arch = "x86_64")]
         Buffers::W4(b, paired) if K::PAIRS_ON_AVX2 => {
             let p = paired
                 .get_or_insert_with(|| Box::new(LaneBuffers::without_regressor(model, false)));
+            p.job_output = job;
             let out = unsafe { run_avx2(kernel, model, p.as_mut()) };
             // what `LaneData::wrote_finite` reads
             b.finite = p.finite;
             out
         }
         #[cfg(target_arch = "x86_64")]
-        Buffers::W4(b, _) => unsafe { run_avx2(kernel, model, b.as_mut()) },
+        Buffers::W4(b, _) => {
+            b.job_output = job;
+            unsafe { run_avx2(kernel, model, b.as_mut()) }
+        }
         Buffers::Scalar(d) => kernel.scalar(model, d),
     };
     // the output's non-temporal stores ordered before anything the caller stores next (a
