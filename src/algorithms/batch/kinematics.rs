@@ -148,9 +148,7 @@ fn aligned_forward<const W: usize>(
     let (s, c) = sin_cos(data.qb[i]);
     let s = s * al.sign;
     data.cos_sin[i] = [c, s];
-    // Rot^T's entries times R0's signs: [c s_a, s s_b, s s_a, c s_b]
-    let [sa, sb] = [al.signs[1], al.signs[2]];
-    let turn = [c * sa, s * sb, s * sa, c * sb];
+    let turn = al.turn([c, s]);
     let pos = &b.placement.translation;
     let still = SpatialLanes::default();
     let (vp, ap) = match b.parent {
@@ -174,6 +172,16 @@ fn aligned_forward<const W: usize>(
         *v.lin.at_mut(r) = vlin[j];
         *a.ang.at_mut(r) = aang[j];
         *a.lin.at_mut(r) = alin[j];
+    }
+}
+
+impl AlignedRevolute {
+    /// `Rot_k^T`'s entries times `R0`'s signs, `[c s_a, s s_b, s s_a, c s_b]`, from the turn's
+    /// `[cos x, sign sin x]` (as the forward pass keeps them): what [`aligned_in_child`] takes.
+    #[inline(always)]
+    pub(crate) fn turn<const W: usize>(&self, [c, s]: [Lanes<W>; 2]) -> [Lanes<W>; 4] {
+        let [sa, sb] = [self.signs[1], self.signs[2]];
+        [c * sa, s * sb, s * sa, c * sb]
     }
 }
 

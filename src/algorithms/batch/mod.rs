@@ -90,6 +90,8 @@ pub(crate) struct LaneBuffers<const W: usize> {
     /// The entries of `regressor` the kernel never writes (a degree of freedom that does not
     /// move the body of the column): structural zeros, written out without being read.
     pub(crate) regressor_zeros: ZeroPattern,
+    /// The regressor's ancestors' motion subspaces, each body's in its own axes.
+    pub(crate) chain: regressor::Chain<W>,
     /// Body-level mass matrix (row-major `nbodies x nbodies`) and composite inertias.
     pub(crate) m: Vec<Lanes<W>>,
     /// The entries of `m` (or of any row-major `nbodies x nbodies` matrix) that pair a body
@@ -129,6 +131,7 @@ impl<const W: usize> LaneBuffers<W> {
         Self {
             regressor: vec![Lanes::default(); written.len()],
             regressor_zeros: ZeroPattern::new(written),
+            chain: regressor::Chain::new(model),
             ..Self::without_regressor(model, wide_stores)
         }
     }
@@ -152,6 +155,7 @@ impl<const W: usize> LaneBuffers<W> {
             tau: vec![Lanes::default(); nb],
             regressor: Vec::new(),
             regressor_zeros: ZeroPattern::default(),
+            chain: regressor::Chain::default(),
             m: vec![Lanes::default(); nb * nb],
             m_zeros: ZeroPattern::new((0..nb * nb).map(|e| model.related(e / nb, e % nb))),
             composite: vec![mass_matrix::Composite::default(); nb],
@@ -338,9 +342,9 @@ impl LaneData {
 
     /// Declares that the kernel calls that follow write parts of one job's output of `bytes`
     /// bytes in all (0: each call is a job of its own, the default), as the batch engine does
-    /// when it splits a batch over threads or blocks: past a few MB (`Stores::STREAM_BYTES`)
-    /// the kernels then store whole cache lines non-temporally, as they would for one
-    /// call writing it all. Only the speed depends on it.
+    /// when it splits a batch over threads or blocks: past 16 MB (`Stores::STREAM_BYTES`) the
+    /// kernels then store whole cache lines non-temporally, as they would for one call writing
+    /// it all. Only the speed depends on it.
     pub fn set_job_output(&mut self, bytes: usize) {
         self.job_output = bytes;
     }

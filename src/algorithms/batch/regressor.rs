@@ -1,13 +1,14 @@
 //! The joint-torque regressor of many samples on the lanes.
 
-use super::kinematics::{aligned_pose_in_base, forward, place_in_base, pose};
+use super::kinematics::{act_inv, forward};
 use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
 use crate::algorithms::regressor::{joint_torque_regressor, PARAMS_PER_BODY};
 use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::{Body, JointKind, Model};
-use crate::simd::{serial, write_rows_with_zeros, Lanes, Vector3Lanes};
+use crate::simd::{serial, write_rows_with_zeros, Lanes, SpatialLanes, Vector3Lanes};
+use nalgebra::Vector3;
 
 /// The joint-torque regressor of a batch, [`LaneData::width`] samples at a time: `out`
 /// (row-major `k x nv x 10 nbodies`, N m per parameter unit) holds for every sample the matrix
@@ -132,6 +133,181 @@ impl LaneKernel for Regressor<'_> {
     }
 }
 
+/// The regressor's work space: for every body, the motion subspaces of its ancestors in its own
+/// axes (those of the bodies on the path from the root to the current one, by depth), and the
+/// constants that carry them from a parent's axes to a child's.
+///
+/// A body's axes are held in the order of its joint's roles (`AlignedRevolute::roles`, a cyclic
+/// permutation, under which cross products keep their form) for an aligned revolute joint,
+/// x, y, z otherwise: an aligned joint's transform then produces every component at a fixed
+/// place (its permutation only picks which of the parent's components it reads, from memory),
+/// and only the ten regressor entries go to permuted columns.
+#[derive(Clone, Debug)]
+pub(crate) struct Chain<const W: usize> {
+    bodies: Vec<BodyAxes>,
+    /// Subspaces by depth: a body at depth `d` (its ancestors' count) keeps its `d` ancestors'
+    /// (parent first) from `d (d - 1) / 2` on.
+    subspaces: Vec<SpatialLanes<W>>,
+}
+
+impl<const W: usize> Default for Chain<W> {
+    fn default() -> Self {
+        Self {
+            bodies: Vec::new(),
+            subspaces: Vec::new(),
+        }
+    }
+}
+
+/// One body's constants for [`Chain`].
+#[derive(Clone, Debug)]
+struct BodyAxes {
+    depth: usize,
+    /// The body axis held as component `j`.
+    order: [usize; 3],
+    /// For each component `j` of the body (aligned) or each parent axis (otherwise): where the
+    /// parent holds the parent axis it comes from, and the two after it (cyclically).
+    from_parent: [[usize; 3]; 3],
+    /// The joint placement's translation in the parent's held axes.
+    p_parent: [f64; 3],
+    /// The parent's own motion subspace (angular, linear) in the parent's held axes.
+    parent_subspace: [[f64; 3]; 2],
+    /// The joint axis in the body's held axes.
+    axis: Vector3<f64>,
+    /// The regressor column (within the body's ten) of each of the ten entries computed in the
+    /// held axes: mass, first moment along each held axis, rotational inertia of each pair.
+    slots: [usize; PARAMS_PER_BODY],
+}
+
+impl<const W: usize> Chain<W> {
+    pub(crate) fn new(model: &Model) -> Self {
+        let mut bodies: Vec<BodyAxes> = Vec::with_capacity(model.nbodies());
+        for b in &model.bodies {
+            // (parents come first)
+            let parent = b.parent.map(|p| (&model.bodies[p], &bodies[p]));
+            let order = match &b.pose_terms.aligned {
+                Some(al) => al.roles,
+                None => [0, 1, 2],
+            };
+            let parent_order = parent.map_or([0, 1, 2], |(_, a)| a.order);
+            // where the parent holds its axis r
+            let held = |r: usize| parent_order.iter().position(|&o| o == r).unwrap_or(r);
+            let from = |r: usize| [held(r), (held(r) + 1) % 3, (held(r) + 2) % 3];
+            let from_parent = match &b.pose_terms.aligned {
+                Some(al) => al.rows.map(from),
+                None => [0, 1, 2].map(from),
+            };
+            let t = &b.placement.translation;
+            let p_parent = parent_order.map(|r| t[r]);
+            let parent_subspace = parent.map_or([[0.0; 3]; 2], |(pb, pa)| {
+                let axis = pa.axis;
+                match pb.kind {
+                    JointKind::Revolute => [[axis.x, axis.y, axis.z], [0.0; 3]],
+                    JointKind::Prismatic => [[0.0; 3], [axis.x, axis.y, axis.z]],
+                }
+            });
+            let axis = Vector3::new(b.axis[order[0]], b.axis[order[1]], b.axis[order[2]]);
+            // [Ixx, Ixy, Iyy, Ixz, Iyz, Izz]: the column of the product of axes r and s
+            let inertia = |r: usize, s: usize| 4 + [[0, 1, 3], [1, 2, 4], [3, 4, 5]][r][s];
+            let [o0, o1, o2] = order;
+            let slots = [
+                0,
+                1 + o0,
+                1 + o1,
+                1 + o2,
+                inertia(o0, o0),
+                inertia(o0, o1),
+                inertia(o1, o1),
+                inertia(o0, o2),
+                inertia(o1, o2),
+                inertia(o2, o2),
+            ];
+            bodies.push(BodyAxes {
+                depth: parent.map_or(0, |(_, a)| a.depth + 1),
+                order,
+                from_parent,
+                p_parent,
+                parent_subspace,
+                axis,
+                slots,
+            });
+        }
+        let deepest = bodies.iter().map(|a| a.depth).max().unwrap_or(0);
+        Self {
+            bodies,
+            subspaces: vec![SpatialLanes::default(); deepest * (deepest + 1) / 2],
+        }
+    }
+}
+
+/// `v` (body frame, in memory) in the held axes `order`.
+#[inline(always)]
+fn held<const W: usize>(v: &Vector3Lanes<W>, order: &[usize; 3]) -> Vector3Lanes<W> {
+    Vector3Lanes {
+        x: *v.at(order[0]),
+        y: *v.at(order[1]),
+        z: *v.at(order[2]),
+    }
+}
+
+/// The motion `m` held in the parent's axes, in body `b`'s held axes (`axes`), for the pose the
+/// forward pass left (`data`, body `i`).
+#[inline(always)]
+fn to_child<const W: usize>(
+    b: &Body,
+    axes: &BodyAxes,
+    data: &LaneBuffers<W>,
+    i: usize,
+    turn: &[Lanes<W>; 4],
+    m: &SpatialLanes<W>,
+) -> SpatialLanes<W> {
+    let p = &axes.p_parent;
+    let f = &axes.from_parent;
+    // (m.lin - p x m.ang) at the parent's held axis f[j][0], with the two after it
+    let raw_lin = |j: usize| {
+        let [q, q1, q2] = f[j];
+        m.ang
+            .at(q1)
+            .mul_add_s(p[q2], m.ang.at(q2).mul_add_s(-p[q1], *m.lin.at(q)))
+    };
+    match &b.pose_terms.aligned {
+        Some(al) => {
+            // R0^T then Rot_k^T: (s_k x_0, c x_1 + s x_2, c x_2 - s x_1) with the signs in `turn`
+            let [ca, sb, sa, cb] = *turn;
+            let x = [*m.ang.at(f[0][0]), *m.ang.at(f[1][0]), *m.ang.at(f[2][0])];
+            let y = [raw_lin(0), raw_lin(1), raw_lin(2)];
+            SpatialLanes {
+                ang: Vector3Lanes {
+                    x: x[0] * al.signs[0],
+                    y: ca.mul_add(x[1], sb * x[2]),
+                    z: cb.mul_sub(x[2], sa * x[1]),
+                },
+                lin: Vector3Lanes {
+                    x: y[0] * al.signs[0],
+                    y: ca.mul_add(y[1], sb * y[2]),
+                    z: cb.mul_sub(y[2], sa * y[1]),
+                },
+            }
+        }
+        None => {
+            // the parent's motion in its natural axes, then the general transform
+            let natural = SpatialLanes {
+                ang: Vector3Lanes {
+                    x: *m.ang.at(f[0][0]),
+                    y: *m.ang.at(f[1][0]),
+                    z: *m.ang.at(f[2][0]),
+                },
+                lin: Vector3Lanes {
+                    x: *m.lin.at(f[0][0]),
+                    y: *m.lin.at(f[1][0]),
+                    z: *m.lin.at(f[2][0]),
+                },
+            };
+            act_inv(&data.rot[i], &data.pos[i], &natural)
+        }
+    }
+}
+
 /// The joint-torque regressor (see [`crate::algorithms::regressor::joint_torque_regressor`]) of
 /// the loaded group of lanes: `data.regressor` row-major `nv x 10 nbodies`, one lane per
 /// sample. `gravity` includes gravity. The entries of a degree of freedom that does not move
@@ -144,101 +320,123 @@ fn regressor_lanes<const W: usize>(
     gravity: Gravity,
     clear: bool,
 ) {
-    let cols_all = PARAMS_PER_BODY * model.nbodies();
     forward(model, data, &model.base_acceleration(gravity));
     let mut out = std::mem::take(&mut data.regressor);
+    let mut chain = std::mem::take(&mut data.chain);
     if clear || model.coupled {
         out.fill(Lanes::default());
     }
     for i in serial(0..model.nbodies()) {
         let b = &model.bodies[i];
-        match (&b.pose_terms.aligned, b.parent) {
-            // the forward pass kept cos and sin, not the pose in the parent
-            (Some(al), Some(parent)) => {
-                aligned_pose_in_base(model, data, i, al, parent, data.cos_sin[i]);
-            }
-            (Some(_), None) => {
-                let (rot, pos) = pose(b, data.qb[i]);
-                place_in_base(model, data, i, &rot, &pos);
-            }
-            _ => {
-                let (rot, pos) = (data.rot[i], data.pos[i]);
-                place_in_base(model, data, i, &rot, &pos);
-            }
-        }
-        // read in place (a copy of the pose would go through memcpy)
-        let (r, p) = (&data.o_rot[i], &data.o_pos[i]);
+        let axes = &chain.bodies[i];
         // the body's wrench per unit of each parameter, in its own frame about its origin
-        // (`world_body_regressor` in the body frame): mass `(0, c)`, first moment along `e_k`
-        // `(e_k x c, al x e_k + w w_k - e_k |w|^2)`, rotational inertia `(I_q al + w x I_q w,
-        // 0)`, with `c` the origin's acceleration; these are dotted with each ancestor's motion
-        // subspace brought into that frame, which is cheaper than turning the ten columns into
-        // the base frame once the body has few ancestors
+        // (`world_body_regressor` in the body frame) and its held axes: mass `(0, c)`, first
+        // moment along `e_k` `(e_k x c, al x e_k + w w_k - e_k |w|^2)`, rotational inertia
+        // `(I_q al + w x I_q w, 0)`, with `c` the origin's acceleration; these are dotted with
+        // each ancestor's motion subspace in the same axes, carried down from the parent's
+        // (one motion transform a pair: 16 operations for an aligned joint)
         let (v, a) = (&data.v[i], &data.a[i]);
-        let (w, al) = (v.ang, a.ang);
-        let c = a.lin.add(&w.cross(&v.lin));
+        let (w, al) = (held(&v.ang, &axes.order), held(&a.ang, &axes.order));
+        let c = held(&a.lin, &axes.order).add(&w.cross(&held(&v.lin, &axes.order)));
         let w2 = w.dot(&w);
         let u = unit_inertia_columns(&w, &al);
         let first = PARAMS_PER_BODY * i;
-        let mut j = Some(i);
-        while let Some(k) = j {
-            let bk = &model.bodies[k];
-            let at = bk.dof * cols_all + first;
-            let row = &mut out[at..at + PARAMS_PER_BODY];
-            let y = if k == i {
-                // its own joint's subspace is a constant of the model in its own frame
-                own_columns(b, &c, &w, &al, w2, &u)
+        // its own joint's subspace is a constant of the model in its own frame
+        let own = own_columns(b.kind, &axes.axis, &c, &w, &al, w2, &u);
+        put(model, &mut out, i, first, &axes.slots, &own);
+        let Some(parent) = b.parent else { continue };
+        let d = axes.depth;
+        let (above, below) = chain.subspaces.split_at_mut(d * (d - 1) / 2);
+        let from = &above[(d - 1) * d.saturating_sub(2) / 2..];
+        let to = &mut below[..d];
+        let turn = match &b.pose_terms.aligned {
+            Some(al) => al.turn(data.cos_sin[i]),
+            None => [Lanes::default(); 4],
+        };
+        // (a leaf's subspaces are not needed further down)
+        let keep = b.subtree_end > i + 1;
+        let mut j = Some(parent);
+        for e in serial(0..d) {
+            let Some(k) = j else { break };
+            let s = if e == 0 {
+                let [pa, pl] = &axes.parent_subspace;
+                let own = SpatialLanes {
+                    ang: Vector3Lanes::splat(&Vector3::new(pa[0], pa[1], pa[2])),
+                    lin: Vector3Lanes::splat(&Vector3::new(pl[0], pl[1], pl[2])),
+                };
+                to_child(b, axes, data, i, &turn, &own)
             } else {
-                // ancestor k's motion subspace in the body's frame, about the body's origin
-                let sk = &data.o_s[k];
-                let sa = r.tr_mul(&sk.ang);
-                let sl = r.tr_mul(&sk.lin.add(&sk.ang.cross(p)));
-                // the first-moment entries at once: sl x al - sa x c + w (sl . w) - sl |w|^2
-                let fm = sl
-                    .cross(&al)
-                    .sub(&sa.cross(&c))
-                    .add(&w.mul_lanes(sl.dot(&w)))
-                    .sub(&sl.mul_lanes(w2));
-                [
-                    sl.dot(&c),
-                    fm.x,
-                    fm.y,
-                    fm.z,
-                    sa.dot(&u[0]),
-                    sa.dot(&u[1]),
-                    sa.dot(&u[2]),
-                    sa.dot(&u[3]),
-                    sa.dot(&u[4]),
-                    sa.dot(&u[5]),
-                ]
+                to_child(b, axes, data, i, &turn, &from[e - 1])
             };
-            if model.coupled {
-                for (o, y) in row.iter_mut().zip(&y) {
-                    *o = y.mul_add_s(bk.multiplier, *o);
-                }
-            } else {
-                row.copy_from_slice(&y);
+            if keep {
+                to[e] = s;
             }
-            j = bk.parent;
+            let (sa, sl) = (&s.ang, &s.lin);
+            // the first-moment entries at once: sl x al - sa x c + w (sl . w) - sl |w|^2
+            let fm = sl
+                .cross(&al)
+                .sub(&sa.cross(&c))
+                .add(&w.mul_lanes(sl.dot(&w)))
+                .sub(&sl.mul_lanes(w2));
+            let y = [
+                sl.dot(&c),
+                fm.x,
+                fm.y,
+                fm.z,
+                sa.dot(&u[0]),
+                sa.dot(&u[1]),
+                sa.dot(&u[2]),
+                sa.dot(&u[3]),
+                sa.dot(&u[4]),
+                sa.dot(&u[5]),
+            ];
+            put(model, &mut out, k, first, &axes.slots, &y);
+            j = model.bodies[k].parent;
         }
     }
+    data.chain = chain;
     data.regressor = out;
 }
 
-/// The regressor entries of body `b`'s own joint (see `regressor_lanes`): its motion subspace
-/// in its own frame is the axis, through the origin (revolute) or as a translation
+/// The ten entries `y` (in the held axes' order) into body columns `first..first + 10` of body
+/// `k`'s degree of freedom's row of the regressor `out` (row-major `nv x 10 nbodies`), at
+/// `slots`; for a coupled model times the body's multiplier, added. (A function, not a
+/// closure: one compiled out of line would lose the instruction set.)
+#[inline(always)]
+fn put<const W: usize>(
+    model: &Model,
+    out: &mut [Lanes<W>],
+    k: usize,
+    first: usize,
+    slots: &[usize; PARAMS_PER_BODY],
+    y: &[Lanes<W>; PARAMS_PER_BODY],
+) {
+    let bk = &model.bodies[k];
+    let at = bk.dof * PARAMS_PER_BODY * model.nbodies() + first;
+    let row = &mut out[at..at + PARAMS_PER_BODY];
+    for (&s, y) in slots.iter().zip(y) {
+        row[s] = if model.coupled {
+            y.mul_add_s(bk.multiplier, row[s])
+        } else {
+            *y
+        };
+    }
+}
+
+/// The regressor entries of a body's own joint (see `regressor_lanes`), in its held axes: its
+/// motion subspace there is the axis `a`, through the origin (revolute) or as a translation
 /// (prismatic).
 #[inline(always)]
 fn own_columns<const W: usize>(
-    b: &Body,
+    kind: JointKind,
+    a: &Vector3<f64>,
     c: &Vector3Lanes<W>,
     w: &Vector3Lanes<W>,
     al: &Vector3Lanes<W>,
     w2: Lanes<W>,
     u: &[Vector3Lanes<W>; 6],
 ) -> [Lanes<W>; PARAMS_PER_BODY] {
-    let a = &b.axis;
-    match b.kind {
+    match kind {
         JointKind::Revolute => {
             let fm = c.cross_const(a);
             [
