@@ -88,9 +88,9 @@ impl ZeroPattern {
 /// 4 lanes are transposed in registers (4 loads, 8 shuffles, 4 stores) instead of being copied
 /// one value at a time.
 ///
-/// `stores`: how (see [`Stores`]); anything but `Narrow` only from buffers that run on AVX-512
+/// `stores`: how (see [`Stores`]); `wide` only from buffers that run on AVX-512
 /// (`LaneBuffers::wide_stores`), and used only with 8 lanes all in use and a processor with
-/// AVX-512F and DQ.
+/// AVX-512F and DQ; `stream` only for full groups (`used == W`).
 ///
 /// The blocks are laid on `dst`'s cache lines where every row falls alike on them (`stride` a
 /// multiple of the block): the first quantities up to a line's start go singly, so that no
@@ -329,8 +329,8 @@ unsafe fn store8(
 /// The processor has AVX-512F and DQ (the `or` of doubles). The function has no
 /// `target_feature` of its own (that would forbid `inline(always)`, and LLVM then keeps it out
 /// of line): inside the AVX-512 kernels its intrinsics compile to single instructions. It is
-/// reached from AVX-512 buffers only ([`Stores::wide`]); the AVX2 kernels on 8 lanes contain it compiled
-/// to calls, never taken.
+/// reached from AVX-512 buffers only ([`Stores::wide`]); the AVX2 kernels on 8 lanes contain
+/// it compiled to calls, never taken.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 #[allow(clippy::eq_op)]

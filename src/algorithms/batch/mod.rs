@@ -167,7 +167,7 @@ impl<const W: usize> LaneBuffers<W> {
     }
 
     /// How a kernel that writes `values` output values (f64) in all stores its rows (see
-    /// [`Stores`]; non-temporal stores only on AVX-512 and for outputs, or jobs, far larger
+    /// [`Stores`]: 8x8 blocks on AVX-512, non-temporal stores for outputs, or jobs, far larger
     /// than the caches).
     #[inline(always)]
     pub(crate) fn stores(&self, values: usize) -> Stores {
