@@ -196,7 +196,6 @@ fn aligned_in_child<const W: usize>(
     turn: &[Lanes<W>; 4],
     m: &SpatialLanes<W>,
 ) -> [[Lanes<W>; 3]; 2] {
-    let [ca, sb, sa, cb] = *turn;
     let (ang, lin) = (&m.ang, &m.lin);
     let mut raw = [[Lanes::default(); 3]; 2];
     for (j, &r) in al.rows.iter().enumerate() {
@@ -207,20 +206,26 @@ fn aligned_in_child<const W: usize>(
             .at(r1)
             .mul_add_s(pos[r2], ang.at(r2).mul_add_s(-pos[r1], *lin.at(r)));
     }
-    // R0^T x = (s_k x[r_k], s_a x[r_a], s_b x[r_b]); Rot_k^T turns (a, b) by -angle (no
-    // closure, no `map`: one compiled out of line would lose the instruction set)
     let [x, y] = raw;
+    [turned(x, al.signs[0], turn), turned(y, al.signs[0], turn)]
+}
+
+/// `Rot_k^T R0^T v` by role `(k, a, b)` for an aligned joint, from `x`, the components of `v`
+/// that `R0` sends to the roles (`v[rows[j]]`, unsigned): `R0^T v = (s_k x_0, s_a x_1, s_b
+/// x_2)`, and `Rot_k^T` turns `(a, b)` by -angle; `turn` as [`AlignedRevolute::turn`] gives it
+/// (the signs `s_a`, `s_b` folded in). No closure, no `map`: one compiled out of line would
+/// lose the instruction set.
+#[inline(always)]
+pub(crate) fn turned<const W: usize>(
+    x: [Lanes<W>; 3],
+    sign_k: f64,
+    turn: &[Lanes<W>; 4],
+) -> [Lanes<W>; 3] {
+    let [ca, sb, sa, cb] = *turn;
     [
-        [
-            x[0] * al.signs[0],
-            ca.mul_add(x[1], sb * x[2]),
-            cb.mul_sub(x[2], sa * x[1]),
-        ],
-        [
-            y[0] * al.signs[0],
-            ca.mul_add(y[1], sb * y[2]),
-            cb.mul_sub(y[2], sa * y[1]),
-        ],
+        x[0] * sign_k,
+        ca.mul_add(x[1], sb * x[2]),
+        cb.mul_sub(x[2], sa * x[1]),
     ]
 }
 

@@ -1,6 +1,6 @@
 //! The joint-torque regressor of many samples on the lanes.
 
-use super::kinematics::{act_inv, forward};
+use super::kinematics::{act_inv, forward, turned};
 use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
 use crate::algorithms::regressor::{joint_torque_regressor, PARAMS_PER_BODY};
 use crate::data::Data;
@@ -272,20 +272,20 @@ fn to_child<const W: usize>(
     };
     match &b.pose_terms.aligned {
         Some(al) => {
-            // R0^T then Rot_k^T: (s_k x_0, c x_1 + s x_2, c x_2 - s x_1) with the signs in `turn`
-            let [ca, sb, sa, cb] = *turn;
             let x = [*m.ang.at(f[0][0]), *m.ang.at(f[1][0]), *m.ang.at(f[2][0])];
             let y = [raw_lin(0), raw_lin(1), raw_lin(2)];
+            let ([ax, ay, az], [lx, ly, lz]) =
+                (turned(x, al.signs[0], turn), turned(y, al.signs[0], turn));
             SpatialLanes {
                 ang: Vector3Lanes {
-                    x: x[0] * al.signs[0],
-                    y: ca.mul_add(x[1], sb * x[2]),
-                    z: cb.mul_sub(x[2], sa * x[1]),
+                    x: ax,
+                    y: ay,
+                    z: az,
                 },
                 lin: Vector3Lanes {
-                    x: y[0] * al.signs[0],
-                    y: ca.mul_add(y[1], sb * y[2]),
-                    z: cb.mul_sub(y[2], sa * y[1]),
+                    x: lx,
+                    y: ly,
+                    z: lz,
                 },
             }
         }
