@@ -261,19 +261,15 @@ fn to_child<const W: usize>(
     turn: &[Lanes<W>; 4],
     m: &SpatialLanes<W>,
 ) -> SpatialLanes<W> {
-    let p = &axes.p_parent;
     let f = &axes.from_parent;
-    // (m.lin - p x m.ang) at the parent's held axis f[j][0], with the two after it
-    let raw_lin = |j: usize| {
-        let [q, q1, q2] = f[j];
-        m.ang
-            .at(q1)
-            .mul_add_s(p[q2], m.ang.at(q2).mul_add_s(-p[q1], *m.lin.at(q)))
-    };
     match &b.pose_terms.aligned {
         Some(al) => {
             let x = [*m.ang.at(f[0][0]), *m.ang.at(f[1][0]), *m.ang.at(f[2][0])];
-            let y = [raw_lin(0), raw_lin(1), raw_lin(2)];
+            let y = [
+                raw_lin(axes, m, 0),
+                raw_lin(axes, m, 1),
+                raw_lin(axes, m, 2),
+            ];
             let ([ax, ay, az], [lx, ly, lz]) =
                 (turned(x, al.signs[0], turn), turned(y, al.signs[0], turn));
             SpatialLanes {
@@ -306,6 +302,17 @@ fn to_child<const W: usize>(
             act_inv(&data.rot[i], &data.pos[i], &natural)
         }
     }
+}
+
+/// `(m.lin - p x m.ang)` at the parent's held axis `from_parent[j][0]` (with the two after it),
+/// `p` the joint placement in the parent's held axes. A function, not a closure: one compiled
+/// out of line would lose the instruction set.
+#[inline(always)]
+fn raw_lin<const W: usize>(axes: &BodyAxes, m: &SpatialLanes<W>, j: usize) -> Lanes<W> {
+    let (p, [q, q1, q2]) = (&axes.p_parent, axes.from_parent[j]);
+    m.ang
+        .at(q1)
+        .mul_add_s(p[q2], m.ang.at(q2).mul_add_s(-p[q1], *m.lin.at(q)))
 }
 
 /// The joint-torque regressor (see [`crate::algorithms::regressor::joint_torque_regressor`]) of
