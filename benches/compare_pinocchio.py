@@ -56,31 +56,6 @@ FLAGS = ["-O3", "-march=native", "-DNDEBUG", "-std=c++17", "-DBOOST_MPL_LIMIT_LI
          "-DBOOST_FUSION_INVOKE_MAX_ARITY=12"]
 
 
-def tree_urdf(nlinks: int = 60, seed: int = 60) -> str:
-    """A random tree of revolute joints (each link on a random earlier one), valid inertias."""
-    rng = np.random.default_rng(seed)
-    parts = ['<robot name="tree60">', '<link name="base"/>']
-    for k in range(1, nlinks + 1):
-        a, b, c = rng.uniform(0.01, 0.2, 3)
-        x = rng.uniform(-0.2, 0.2, 3)
-        parts.append(
-            f'<link name="l{k}"><inertial><origin xyz="{x[0]} {x[1]} {x[2]}"/>'
-            f'<mass value="{rng.uniform(0.2, 3.0)}"/><inertia ixx="{b + c}" ixy="0" ixz="0" '
-            f'iyy="{a + c}" iyz="0" izz="{a + b}"/></inertial></link>')
-    for k in range(1, nlinks + 1):
-        parent = "base" if k == 1 or (p := int(rng.integers(0, k))) == 0 else f"l{p}"
-        axis = rng.normal(size=3)
-        axis /= np.linalg.norm(axis)
-        o, r = rng.uniform(-0.3, 0.3, 3), rng.uniform(-1, 1, 3)
-        parts.append(
-            f'<joint name="j{k}" type="revolute"><parent link="{parent}"/><child link="l{k}"/>'
-            f'<origin xyz="{o[0]} {o[1]} {o[2]}" rpy="{r[0]} {r[1]} {r[2]}"/>'
-            f'<axis xyz="{axis[0]} {axis[1]} {axis[2]}"/>'
-            '<limit lower="-3" upper="3" effort="100" velocity="5"/></joint>')
-    parts.append("</robot>")
-    return "\n".join(parts)
-
-
 def robots():
     """(name, perturbid_rs Robot, Pinocchio model) of the A465, the Panda and the tree (with
     our robots' armature: URDF has no element for it that Pinocchio reads)."""
@@ -111,7 +86,7 @@ def _robots():
         out.append(("panda", ours, panda))
     else:
         print(f"skipped the Panda (no {path}): pip install example-robot-data", file=sys.stderr)
-    text = tree_urdf()
+    text = (ROOT / "benches" / "tree60.urdf").read_text()
     out.append(("tree60", pr.Robot.from_urdf_string(text), pin.buildModelFromXML(text)))
     return out
 

@@ -288,7 +288,9 @@ pub fn panda_model() -> Option<perturbid_rs::Model> {
     perturbid_rs::model_from_urdf_file(&panda_urdf()?, &options).ok()
 }
 
-/// The robots of the speed comparisons: the A465, the Panda when installed, a 60-dof tree.
+/// The robots of the speed comparisons: the A465, the Panda when installed, and the 60-dof
+/// tree `benches/tree60.urdf` (the one benches/compare_pinocchio.py measures against
+/// Pinocchio).
 pub fn speed_robots() -> Vec<(&'static str, perturbid_rs::Model)> {
     let mut out = vec![("a465", perturbid_rs::robots::builtin("a465").unwrap())];
     match panda_model() {
@@ -298,11 +300,11 @@ pub fn speed_robots() -> Vec<(&'static str, perturbid_rs::Model)> {
              (pip install example-robot-data)"
         ),
     }
-    let tree = random_tree_urdf(60, 60);
+    let tree = include_str!("../../benches/tree60.urdf");
     let options = perturbid_rs::LoadOptions::default();
     out.push((
         "tree60",
-        perturbid_rs::model_from_urdf_str(&tree, "tree60", &options).unwrap(),
+        perturbid_rs::model_from_urdf_str(tree, "tree60", &options).unwrap(),
     ));
     out
 }
