@@ -5,7 +5,7 @@
 use super::kinematics::store_pose_in_base;
 use super::mass_matrix::{transformed, Composite};
 use super::{
-    armature_inertia, armature_torques, dispatch, samples, LaneBuffers, LaneData, LaneKernel,
+    armature_inertia, armature_torques, dispatch, samples, LaneBuffers, LaneData, LaneKernel, Trig,
 };
 use crate::data::Data;
 use crate::error::Result;
@@ -311,7 +311,7 @@ impl LaneKernel for Derivatives<'_> {
         let stores = data.stores(values);
         while first < self.k {
             let used = (self.k - first).min(W);
-            data.load(model, self.x, first);
+            data.load(model, self.x, first, Trig::Loaded);
             recursion(
                 model,
                 data,

@@ -9,13 +9,17 @@ use crate::simd::{
 use crate::spatial::{Inertia, Motion, Se3};
 
 /// The pose of body `b` in its parent (rotation by rows, translation) for the lane coordinates
-/// `x` (see `Body::pose_in_parent`).
+/// `x` (rad or m; see `Body::pose_in_parent`), `(s, c)` the sine and cosine of `x` (used for a
+/// revolute joint only).
 #[inline(always)]
-pub(crate) fn pose<const W: usize>(b: &Body, x: Lanes<W>) -> (Rotation3Lanes<W>, Vector3Lanes<W>) {
+pub(crate) fn pose<const W: usize>(
+    b: &Body,
+    x: Lanes<W>,
+    (s, c): (Lanes<W>, Lanes<W>),
+) -> (Rotation3Lanes<W>, Vector3Lanes<W>) {
     let p: &Se3 = &b.placement;
     match b.kind {
         JointKind::Revolute => {
-            let (s, c) = sin_cos(x);
             let c1 = Lanes::splat(1.0) - c;
             let t = &b.pose_terms;
             let mut rot = Rotation3Lanes::default();
@@ -99,7 +103,7 @@ pub(crate) fn forward<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, 
             aligned_forward(b, al, data, i, &base);
             continue;
         }
-        let (rot, pos) = pose(b, data.qb[i]);
+        let (rot, pos) = pose(b, data.qb[i], sin_cos(data.qb[i]));
         let (mut v, mut a) = match b.parent {
             Some(p) => (
                 act_inv(&rot, &pos, &data.v[p]),
@@ -271,7 +275,8 @@ pub(crate) fn aligned_to_parent<const W: usize>(
 /// there (`o_rot`, `o_pos`, `o_s`, as by [`place_in_base`]). A revolute joint with an
 /// axis-aligned placement below another body takes columns of its parent's base rotation,
 /// scaled by the cosine and sine (no 3x3 product); the others go through [`pose`] and
-/// [`place_in_base`].
+/// [`place_in_base`]. Every revolute joint's sine and cosine are read from
+/// `data.sin_cos` (loaded with [`super::Trig::Loaded`]).
 #[inline(always)]
 pub(crate) fn store_pose_in_base<const W: usize>(
     model: &Model,
@@ -281,11 +286,11 @@ pub(crate) fn store_pose_in_base<const W: usize>(
     let b = &model.bodies[i];
     // (set for revolute joints only)
     let (Some(al), Some(parent)) = (&b.pose_terms.aligned, b.parent) else {
-        let (rot, pos) = pose(b, data.qb[i]);
+        let (rot, pos) = pose(b, data.qb[i], data.sin_cos[i]);
         place_in_base(model, data, i, &rot, &pos);
         return;
     };
-    let (s, c) = sin_cos(data.qb[i]);
+    let (s, c) = data.sin_cos[i];
     aligned_pose_in_base(model, data, i, al, parent, [c, s * al.sign]);
 }
 

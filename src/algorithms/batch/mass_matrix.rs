@@ -2,7 +2,7 @@
 //! in the base frame).
 
 use super::kinematics::store_pose_in_base;
-use super::{armature_inertia, dispatch, samples, LaneBuffers, LaneData, LaneKernel};
+use super::{armature_inertia, dispatch, samples, LaneBuffers, LaneData, LaneKernel, Trig};
 use crate::data::Data;
 use crate::error::Result;
 use crate::model::Model;
@@ -78,7 +78,7 @@ impl LaneKernel for MassMatrix<'_> {
         let mut finite = !model.coupled;
         let stores = data.stores(self.out.len());
         while first < self.k {
-            data.load(model, [self.q, &[], &[]], first);
+            data.load(model, [self.q, &[], &[]], first, Trig::Loaded);
             // base-frame poses and motion subspaces
             for i in serial(0..nb) {
                 store_pose_in_base(model, data, i);

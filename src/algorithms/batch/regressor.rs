@@ -1,7 +1,7 @@
 //! The joint-torque regressor of many samples on the lanes.
 
 use super::kinematics::{act_inv, forward, turned};
-use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
+use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel, Trig};
 use crate::algorithms::regressor::{joint_torque_regressor, PARAMS_PER_BODY};
 use crate::data::Data;
 use crate::error::{Error, Result};
@@ -100,7 +100,7 @@ impl LaneKernel for Regressor<'_> {
         let mut finite = self.out.is_some();
         let stores = data.stores(self.out.as_deref().map_or(0, <[f64]>::len));
         while first < self.k {
-            data.load(model, self.x, first);
+            data.load(model, self.x, first, Trig::InPlace);
             // the entries left zero are the same for every group: cleared once per call
             regressor_lanes(model, data, self.gravity, first == 0);
             if let Some(out) = self.out.as_deref_mut() {

@@ -1,7 +1,7 @@
 //! Inverse dynamics of many samples on the lanes.
 
 use super::kinematics::{aligned_to_parent, apply, contract_torques, forward};
-use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel};
+use super::{dispatch, samples, LaneBuffers, LaneData, LaneKernel, Trig};
 use crate::data::Data;
 use crate::error::Result;
 use crate::gravity::Gravity;
@@ -68,7 +68,7 @@ impl LaneKernel for Rnea<'_> {
         let mut finite = true;
         let stores = data.stores(self.tau.len());
         while first < self.k {
-            data.load(model, self.x, first);
+            data.load(model, self.x, first, Trig::InPlace);
             forward(model, data, &g);
             wrenches(model, data);
             let used = (self.k - first).min(W);
