@@ -75,7 +75,7 @@ pub(crate) enum Trig {
     /// By [`LaneBuffers::load`], every revolute joint's into [`LaneBuffers::sin_cos`], in a
     /// loop of their own: for [`kinematics::store_pose_in_base`], where the polynomials were
     /// cut by LLVM's vectoriser into pieces of 4, 2 and 1 lanes interleaved with the
-    /// rotation's products (the tree's AVX-512 mass matrix 12 % faster loaded).
+    /// rotation's products (the tree's AVX-512 mass matrix 12-15 % faster loaded).
     Loaded,
 }
 
