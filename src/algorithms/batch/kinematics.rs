@@ -103,7 +103,13 @@ pub(crate) fn forward<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, 
             aligned_forward(b, al, data, i, &base);
             continue;
         }
-        let (rot, pos) = pose(b, data.qb[i], sin_cos(data.qb[i]));
+        let x = data.qb[i];
+        // (a prismatic joint's pose takes no sine or cosine: none computed)
+        let sc = match b.kind {
+            JointKind::Revolute => sin_cos(x),
+            JointKind::Prismatic => (Lanes::default(), Lanes::default()),
+        };
+        let (rot, pos) = pose(b, x, sc);
         let (mut v, mut a) = match b.parent {
             Some(p) => (
                 act_inv(&rot, &pos, &data.v[p]),
