@@ -97,9 +97,10 @@ impl ZeroPattern {
 /// store of a block straddles two lines (a split store costs twice; numpy's arrays start
 /// 16 bytes into a line).
 ///
-/// Returns whether every value written is finite, tested on the way in registers (`v - v` is
-/// +0 for a finite `v`, NaN otherwise; the differences' bits or-ed together), so that a caller
-/// need not read its output back to vouch for it.
+/// Returns whether every value written is finite, tested on the way in registers, so that a
+/// caller need not read its output back to vouch for it: the blocks' values are summed (see
+/// [`transpose4`]; a sum that overflows from finite values has the rows read back), the values
+/// written singly tested by `v - v` (+0 for a finite `v`, NaN otherwise).
 #[inline(always)]
 pub(crate) fn write_rows<const W: usize>(
     src: &[Lanes<W>],
@@ -115,6 +116,12 @@ pub(crate) fn write_rows<const W: usize>(
 /// lane): with AVX, blocks of those are stored as zeros without being read (with
 /// [`Stores::stream`] whole blocks of 8 only). The values written are then equal to
 /// [`write_rows`]'s.
+///
+/// The blocks are written by functions kept out of line, one per instruction set
+/// ([`blocks_avx512`], [`blocks_avx`]): inlined into the kernels, the writes' code perturbed
+/// the kernels' own (measured: a change in the writes alone made the 60-dof tree's AVX2 RNEA,
+/// whose output is 60 values a sample, 5 % slower), and the AVX2 kernels on 8 lanes carried
+/// the AVX-512 blocks compiled to calls, never taken.
 #[inline(always)]
 pub(crate) fn write_rows_with_zeros<const W: usize>(
     src: &[Lanes<W>],
@@ -129,65 +136,154 @@ pub(crate) fn write_rows_with_zeros<const W: usize>(
     let mut bits = 0u64;
     #[cfg(target_arch = "x86_64")]
     if W.is_multiple_of(4) && std::arch::is_x86_feature_detected!("avx") {
-        // where the rows start in a cache line (in values; f64 slices are 8-byte aligned)
-        let offset = (dst.as_ptr() as usize / 8) % 8;
-        let zero = |c: usize, len: usize| zeros.is_some_and(|z| z.zero(c, len));
         // 8 full lanes with AVX-512: blocks of 8 quantities, each row's 8 values one 64-byte
         // store (half the stores of two 4x4 blocks, and whole cache lines when aligned)
         let avx512 = std::arch::is_x86_feature_detected!("avx512f")
             && std::arch::is_x86_feature_detected!("avx512dq");
-        let stream = stores.stream;
-        if stores.wide && W == 8 && used == 8 && avx512 {
-            let head = if stride.is_multiple_of(8) {
-                ((8 - offset) % 8).min(n)
-            } else {
-                0
-            };
-            bits |= narrow(src, &zero, used, dst, stride, 0, head);
-            c = head;
-            while c + 8 <= n {
-                bits |= if zero(c, 8) {
-                    // SAFETY: the processor has AVX-512F (checked above)
-                    unsafe { zero8(dst, stride, c, stream) };
-                    0
-                } else if !stream && (zero(c, 4) || zero(c + 4, 4)) {
-                    // (streaming, such a block goes whole, its zeros read from the buffer:
-                    // a 32-byte store into a line beside non-temporal ones costs 40 % on the
-                    // tree's mass matrix)
-                    block4(src, zero(c, 4), used, dst, stride, c)
-                        | block4(src, zero(c + 4, 4), used, dst, stride, c + 4)
-                } else {
-                    // SAFETY: the processor has AVX-512F and DQ (checked above), `W == 8`.
-                    unsafe { transpose8(&src[c..c + 8], dst, stride, c, stream) }
-                };
-                c += 8;
-            }
-        } else if stream && used == W && stride.is_multiple_of(8) {
-            // whole lines from pairs of 4x4 blocks, streamed: the first quantities singly up to
-            // a line's start
-            let head = ((8 - offset) % 8).min(n);
-            bits |= narrow(src, &zero, used, dst, stride, 0, head);
-            // SAFETY: the processor has AVX (checked above), `used == W`
-            let (b, end) = unsafe { stream_lines4(src, zeros, dst, stride, head) };
-            bits |= b;
-            c = end;
-        } else if stride.is_multiple_of(4) {
-            // 32-byte stores within one line each: the first quantities singly up to a half line
-            let head = ((4 - offset % 4) % 4).min(n);
-            bits |= narrow(src, &zero, used, dst, stride, 0, head);
-            c = head;
-        }
-        bits |= narrow(src, &zero, used, dst, stride, c, n);
+        bits = if stores.wide && W == 8 && used == 8 && avx512 {
+            // SAFETY: the processor has AVX-512F and DQ (checked above), `W == 8 == used`
+            unsafe { blocks_avx512(src, zeros, dst, stride, stores.stream) }
+        } else {
+            // SAFETY: the processor has AVX (checked above)
+            unsafe { blocks_avx(src, zeros, used, dst, stride, stores.stream) }
+        };
         c = n;
     }
-    (bits | scalars(src, used, dst, stride, c, n)) == 0
+    bits |= scalars(src, used, dst, stride, c, n);
+    bits == 0 || rows_finite(dst, used, stride, n)
+}
+
+/// Whether the first `n` values of rows `0..used` of `dst` (row `l` at `l * stride`) are all
+/// finite: read back after a block sum that overflowed (or a value that is not finite), which
+/// flags finite values too. Rare, and kept out of the kernels.
+#[cold]
+#[inline(never)]
+fn rows_finite(dst: &[f64], used: usize, stride: usize, n: usize) -> bool {
+    (0..used).all(|l| {
+        dst[l * stride..l * stride + n]
+            .iter()
+            .all(|v| v.is_finite())
+    })
+}
+
+/// [`write_rows_with_zeros`]'s work with AVX-512 (8 full lanes, `W == 8`): blocks of 8 by 8 in
+/// 512-bit registers ([`transpose8`]), from a cache line's start where every row falls alike
+/// on the lines (`stride` a multiple of 8), the rest by [`narrow`]. Returns the finiteness
+/// bits: 0 when every value is vouched finite.
+///
+/// # Safety
+/// The processor has AVX-512F and DQ, and `W == 8`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx512f,avx512dq")]
+#[inline(never)]
+unsafe fn blocks_avx512<const W: usize>(
+    src: &[Lanes<W>],
+    zeros: Option<&ZeroPattern>,
+    dst: &mut [f64],
+    stride: usize,
+    stream: bool,
+) -> u64 {
+    use std::arch::x86_64::{_mm256_setzero_pd, _mm512_setzero_pd};
+    let (n, used) = (src.len(), W);
+    let zero = |c: usize, len: usize| zeros.is_some_and(|z| z.zero(c, len));
+    let (mut sum, mut wide_sum) = (_mm256_setzero_pd(), _mm512_setzero_pd());
+    // where the rows start in a cache line (in values; f64 slices are 8-byte aligned)
+    let offset = (dst.as_ptr() as usize / 8) % 8;
+    let head = if stride.is_multiple_of(8) {
+        ((8 - offset) % 8).min(n)
+    } else {
+        0
+    };
+    let mut bits = narrow(src, &zero, used, dst, stride, 0, head, &mut sum);
+    let mut c = head;
+    while c + 8 <= n {
+        if zero(c, 8) {
+            zero8(dst, stride, c, stream);
+        } else if !stream && (zero(c, 4) || zero(c + 4, 4)) {
+            // (streaming, such a block goes whole, its zeros read from the buffer: a 32-byte
+            // store into a line beside non-temporal ones costs 40 % on the tree's mass matrix)
+            block4(src, zero(c, 4), used, dst, stride, c, &mut sum);
+            block4(src, zero(c + 4, 4), used, dst, stride, c + 4, &mut sum);
+        } else {
+            transpose8(&src[c..c + 8], dst, stride, c, stream, &mut wide_sum);
+        }
+        c += 8;
+    }
+    bits |= narrow(src, &zero, used, dst, stride, c, n, &mut sum);
+    bits | not_finite4(sum) | not_finite8(wide_sum)
+}
+
+/// [`write_rows_with_zeros`]'s work with AVX: blocks of 4 by 4 in 256-bit registers, from a
+/// half cache line's start where every row falls alike on them (`stride` a multiple of 4), or
+/// whole lines streamed ([`stream_lines4`]). Returns the finiteness bits as
+/// [`blocks_avx512`].
+///
+/// # Safety
+/// The processor has AVX.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+#[inline(never)]
+unsafe fn blocks_avx<const W: usize>(
+    src: &[Lanes<W>],
+    zeros: Option<&ZeroPattern>,
+    used: usize,
+    dst: &mut [f64],
+    stride: usize,
+    stream: bool,
+) -> u64 {
+    let n = src.len();
+    let zero = |c: usize, len: usize| zeros.is_some_and(|z| z.zero(c, len));
+    let mut sum = std::arch::x86_64::_mm256_setzero_pd();
+    let offset = (dst.as_ptr() as usize / 8) % 8;
+    let mut bits = 0;
+    let mut c = 0;
+    if stream && used == W && stride.is_multiple_of(8) {
+        // whole lines from pairs of 4x4 blocks, streamed: the first quantities singly up to a
+        // line's start
+        let head = ((8 - offset) % 8).min(n);
+        bits |= narrow(src, &zero, used, dst, stride, 0, head, &mut sum);
+        c = stream_lines4(src, zeros, dst, stride, head, &mut sum);
+    } else if stride.is_multiple_of(4) {
+        // 32-byte stores within one line each: the first quantities singly up to a half line
+        let head = ((4 - offset % 4) % 4).min(n);
+        bits |= narrow(src, &zero, used, dst, stride, 0, head, &mut sum);
+        c = head;
+    }
+    bits |= narrow(src, &zero, used, dst, stride, c, n, &mut sum);
+    bits | not_finite4(sum)
+}
+
+/// 1 unless every lane of the running sum `sum` is finite (see [`transpose4`]).
+///
+/// # Safety
+/// The processor has AVX; no `target_feature` of its own, as [`transpose8`].
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn not_finite4(sum: std::arch::x86_64::__m256d) -> u64 {
+    let mut lanes = [0.0; 4];
+    std::arch::x86_64::_mm256_storeu_pd(lanes.as_mut_ptr(), sum);
+    u64::from(!lanes.iter().all(|v| v.is_finite()))
+}
+
+/// As [`not_finite4`], for a 512-bit sum.
+///
+/// # Safety
+/// The processor has AVX-512F; no `target_feature` of its own, as [`transpose8`].
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn not_finite8(sum: std::arch::x86_64::__m512d) -> u64 {
+    let mut lanes = [0.0; 8];
+    std::arch::x86_64::_mm512_storeu_pd(lanes.as_mut_ptr(), sum);
+    u64::from(!lanes.iter().all(|v| v.is_finite()))
 }
 
 /// Quantities `from..to` of `src` into those columns of rows `0..used` of `dst`: blocks of 4
 /// by 4x4 transposes from `from` on (zeros unread where `zero` says so), the last fewer than 4
-/// one value at a time. The finiteness bits as [`transpose4`]'s.
+/// one value at a time. The blocks' values are added to `sum` (see [`transpose4`]); returns the
+/// finiteness bits of the values written singly (as [`scalars`]).
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn narrow<const W: usize>(
     src: &[Lanes<W>],
     zero: &impl Fn(usize, usize) -> bool,
@@ -196,14 +292,14 @@ fn narrow<const W: usize>(
     stride: usize,
     from: usize,
     to: usize,
+    sum: &mut std::arch::x86_64::__m256d,
 ) -> u64 {
     let mut c = from;
-    let mut bits = 0;
     while c + 4 <= to {
-        bits |= block4(src, zero(c, 4), used, dst, stride, c);
+        block4(src, zero(c, 4), used, dst, stride, c, sum);
         c += 4;
     }
-    bits | scalars(src, used, dst, stride, c, to)
+    scalars(src, used, dst, stride, c, to)
 }
 
 /// Quantities `from..to` of `src` into those columns of rows `0..used` of `dst`, one value at a
@@ -233,7 +329,7 @@ fn scalars<const W: usize>(
 }
 
 /// Quantities `c..c + 4` of `src` (zeros if `zero`) into columns `c..c + 4` of the rows
-/// `0..used` of `dst` by 4x4 transposes; the finiteness bits as [`transpose4`]'s.
+/// `0..used` of `dst` by 4x4 transposes, their values added to `sum` (see [`transpose4`]).
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn block4<const W: usize>(
@@ -243,7 +339,8 @@ fn block4<const W: usize>(
     dst: &mut [f64],
     stride: usize,
     c: usize,
-) -> u64 {
+    sum: &mut std::arch::x86_64::__m256d,
+) {
     if zero {
         if used == W {
             // one bounds check for the rows, then plain 32-byte stores
@@ -265,15 +362,27 @@ fn block4<const W: usize>(
                 dst[at..at + 4].fill(0.0);
             }
         }
-        return 0;
+    } else {
+        // the block's own sum first, then one add to the running one: a single chain of adds
+        // through every block would bound the blocks' rate by the adds' latency
+        // SAFETY: the callers checked for AVX
+        let mut block = unsafe { std::arch::x86_64::_mm256_setzero_pd() };
+        if used == W {
+            // (the usual case: every row count known to the compiler)
+            for lb in (0..W).step_by(4) {
+                // SAFETY: the callers checked for AVX; every pointer comes from a
+                // bounds-checked slice.
+                unsafe { transpose4(&src[c..c + 4], lb, 4, dst, stride, c, &mut block) };
+            }
+        } else {
+            for lb in (0..used).step_by(4) {
+                // SAFETY: as above
+                unsafe { transpose4(&src[c..c + 4], lb, used - lb, dst, stride, c, &mut block) };
+            }
+        }
+        // SAFETY: as above
+        *sum = unsafe { std::arch::x86_64::_mm256_add_pd(*sum, block) };
     }
-    let mut bits = 0;
-    for lb in (0..used).step_by(4) {
-        // SAFETY: the callers checked for AVX; every pointer comes from a bounds-checked
-        // slice of 4 values.
-        bits |= unsafe { transpose4(&src[c..c + 4], lb, used - lb, dst, stride, c) };
-    }
-    bits
 }
 
 /// Zeros into columns `c..c + 8` of rows `0..8` of `dst` (row `l` at `l * stride`): one bounds
@@ -322,28 +431,25 @@ unsafe fn store8(
 
 /// The 8 lanes of the 8 quantities `src` (`W == 8`) into columns `c..c + 8` of rows `0..8` of
 /// `dst` (row `l` at `l * stride`): 8 loads, 24 shuffles, 8 stores of 64 bytes ([`store8`]).
-/// Returns 0 when every value is finite (tested on the loaded quantities, as in
-/// [`transpose4`]).
+/// The loaded quantities are added to `sum` (8 adds; see [`transpose4`]).
 ///
 /// # Safety
-/// The processor has AVX-512F and DQ (the `or` of doubles). The function has no
-/// `target_feature` of its own (that would forbid `inline(always)`, and LLVM then keeps it out
-/// of line): inside the AVX-512 kernels its intrinsics compile to single instructions. It is
-/// reached from AVX-512 buffers only ([`Stores::wide`]); the AVX2 kernels on 8 lanes contain
-/// it compiled to calls, never taken.
+/// The processor has AVX-512F. The function has no `target_feature` of its own (that would
+/// forbid `inline(always)`): inlined into [`blocks_avx512`], its intrinsics compile to single
+/// instructions there.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-#[allow(clippy::eq_op)]
 unsafe fn transpose8<const W: usize>(
     src: &[Lanes<W>],
     dst: &mut [f64],
     stride: usize,
     c: usize,
     stream: bool,
-) -> u64 {
+    sum: &mut std::arch::x86_64::__m512d,
+) {
     use std::arch::x86_64::{
-        _mm512_castpd_si512, _mm512_loadu_pd, _mm512_or_pd, _mm512_shuffle_f64x2, _mm512_sub_pd,
-        _mm512_test_epi64_mask, _mm512_unpackhi_pd, _mm512_unpacklo_pd,
+        _mm512_add_pd, _mm512_loadu_pd, _mm512_shuffle_f64x2, _mm512_unpackhi_pd,
+        _mm512_unpacklo_pd,
     };
     // one 8-lane quantity (bounds-checked: fails unless W >= 8)
     #[inline(always)]
@@ -360,18 +466,11 @@ unsafe fn transpose8<const W: usize>(
         _mm512_loadu_pd(at(src, 6)),
         _mm512_loadu_pd(at(src, 7)),
     ];
-    let bad = _mm512_or_pd(
-        _mm512_or_pd(
-            _mm512_or_pd(_mm512_sub_pd(r[0], r[0]), _mm512_sub_pd(r[1], r[1])),
-            _mm512_or_pd(_mm512_sub_pd(r[2], r[2]), _mm512_sub_pd(r[3], r[3])),
-        ),
-        _mm512_or_pd(
-            _mm512_or_pd(_mm512_sub_pd(r[4], r[4]), _mm512_sub_pd(r[5], r[5])),
-            _mm512_or_pd(_mm512_sub_pd(r[6], r[6]), _mm512_sub_pd(r[7], r[7])),
-        ),
+    let block = _mm512_add_pd(
+        _mm512_add_pd(_mm512_add_pd(r[0], r[1]), _mm512_add_pd(r[2], r[3])),
+        _mm512_add_pd(_mm512_add_pd(r[4], r[5]), _mm512_add_pd(r[6], r[7])),
     );
-    let bad = _mm512_castpd_si512(bad);
-    let bits = u64::from(_mm512_test_epi64_mask(bad, bad) != 0);
+    *sum = _mm512_add_pd(*sum, block);
     // pairs: t0 = [r0_0 r1_0 r0_2 r1_2 r0_4 r1_4 r0_6 r1_6], t1 the odd lanes, ...
     let t = [
         _mm512_unpacklo_pd(r[0], r[1]),
@@ -407,16 +506,20 @@ unsafe fn transpose8<const W: usize>(
         _mm512_shuffle_f64x2::<0xdd>(u[3], u[7]),
     ];
     store8(dst, stride, c, out, stream);
-    bits
 }
 
 /// Lanes `lb..lb + rows.min(4)` of the 4 quantities `src` into columns `c..c + 4` of those
-/// rows of `dst` (row `l` at `l * stride`); returns 0 when the values written are all finite
-/// (`v - v` of each or-ed in a register and tested once: no store, no reload).
+/// rows of `dst` (row `l` at `l * stride`), the values written added to `sum`.
+///
+/// The sum is the finiteness test of every value a call of [`write_rows`] writes in blocks:
+/// kept in a register across the blocks (4 adds a block, where `v - v` or-ed and tested took
+/// 8 operations and a test), it is finite only if every value added is (an infinity or a NaN
+/// makes it infinite or NaN). It can also overflow from finite values; the caller then reads
+/// the values back.
 ///
 /// # Safety
 /// The processor has AVX. No `target_feature` of its own, as [`transpose8`]: always inlined
-/// into the kernels, which have AVX2.
+/// into [`blocks_avx`] and [`blocks_avx512`], which have it.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn transpose4<const W: usize>(
@@ -426,9 +529,10 @@ unsafe fn transpose4<const W: usize>(
     dst: &mut [f64],
     stride: usize,
     c: usize,
-) -> u64 {
+    sum: &mut std::arch::x86_64::__m256d,
+) {
     use std::arch::x86_64::_mm256_storeu_pd;
-    let (out, bits) = transposed4(src, lb, rows);
+    let out = transposed4(src, lb, rows, sum);
     let first = lb * stride + c;
     if rows >= 4 {
         // the usual case: one bounds check for the 4 rows, then 4 plain stores
@@ -444,25 +548,23 @@ unsafe fn transpose4<const W: usize>(
             _mm256_storeu_pd(dst[at..at + 4].as_mut_ptr(), *v);
         }
     }
-    bits
 }
 
-/// Lanes `lb..lb + 4` of the 4 quantities `src` as 4 rows of 4 values, and 0 when those of the
-/// first `rows` are all finite (as [`transpose4`]).
+/// Lanes `lb..lb + 4` of the 4 quantities `src` as 4 rows of 4 values; those of the first
+/// `rows` added to `sum` (as [`transpose4`]).
 ///
 /// # Safety
 /// As [`transpose4`].
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-#[allow(clippy::eq_op)]
 unsafe fn transposed4<const W: usize>(
     src: &[Lanes<W>],
     lb: usize,
     rows: usize,
-) -> ([std::arch::x86_64::__m256d; 4], u64) {
+    sum: &mut std::arch::x86_64::__m256d,
+) -> [std::arch::x86_64::__m256d; 4] {
     use std::arch::x86_64::{
-        _mm256_castpd_si256, _mm256_loadu_pd, _mm256_or_pd, _mm256_permute2f128_pd,
-        _mm256_setzero_pd, _mm256_sub_pd, _mm256_testz_si256, _mm256_unpackhi_pd,
+        _mm256_add_pd, _mm256_loadu_pd, _mm256_permute2f128_pd, _mm256_unpackhi_pd,
         _mm256_unpacklo_pd,
     };
     // no closures here: one compiled out of line would lose the target feature
@@ -479,24 +581,28 @@ unsafe fn transposed4<const W: usize>(
         _mm256_permute2f128_pd::<0x31>(t0, t2),
         _mm256_permute2f128_pd::<0x31>(t1, t3),
     ];
-    let mut bad = _mm256_setzero_pd();
-    for v in out.iter().take(rows) {
-        bad = _mm256_or_pd(bad, _mm256_sub_pd(*v, *v));
+    if rows >= 4 {
+        // all four rows: the quantities as loaded, without waiting for the shuffles
+        let block = _mm256_add_pd(_mm256_add_pd(a, b), _mm256_add_pd(x, y));
+        *sum = _mm256_add_pd(*sum, block);
+    } else {
+        for v in out.iter().take(rows) {
+            *sum = _mm256_add_pd(*sum, *v);
+        }
     }
-    let bad = _mm256_castpd_si256(bad);
-    (out, u64::from(_mm256_testz_si256(bad, bad) == 0))
+    out
 }
 
 /// Quantities from `from` on, by blocks of 8, into those columns of all `W` rows of `dst` (row
 /// `l` at `l * stride`) with [`lines4`] (blocks that are all zeros by `zeros` not read);
-/// returns the finiteness bits (as [`transpose4`]'s) and where the blocks end. Kept out of
-/// line: inlined into every kernel's every output, this rarely taken path made the AVX2
-/// derivatives 5-7 % slower.
+/// their values added to `sum` (see [`transpose4`]); returns where the blocks end. Kept out of
+/// line, the streamed outputs' own path (inlined into [`blocks_avx`], the tree's AVX2 mass
+/// matrix, which streams, measured 1-4 % slower: near the noise).
 ///
 /// # Safety
-/// The processor has AVX2.
+/// The processor has AVX.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx")]
 #[inline(never)]
 unsafe fn stream_lines4<const W: usize>(
     src: &[Lanes<W>],
@@ -504,22 +610,22 @@ unsafe fn stream_lines4<const W: usize>(
     dst: &mut [f64],
     stride: usize,
     from: usize,
-) -> (u64, usize) {
+    sum: &mut std::arch::x86_64::__m256d,
+) -> usize {
     let mut c = from;
-    let mut bits = 0;
     while c + 8 <= src.len() {
         let zero = zeros.is_some_and(|z| z.zero(c, 8));
-        // SAFETY: the processor has AVX2 (this function's feature)
-        bits |= unsafe { lines4(src, zero, dst, stride, c) };
+        // SAFETY: as this function's
+        unsafe { lines4(src, zero, dst, stride, c, sum) };
         c += 8;
     }
-    (bits, c)
+    c
 }
 
 /// Quantities `c..c + 8` of `src` (zeros if `zero`) into columns `c..c + 8` of all `W` rows of
 /// `dst` (row `l` at `l * stride`) by pairs of 4x4 transposes, each row's 8 values two 32-byte
 /// stores back to back: non-temporal where they make a whole cache line (the block's first row
-/// on a line, `stride` a multiple of 8 values). The finiteness bits as [`transpose4`]'s.
+/// on a line, `stride` a multiple of 8 values). The values added to `sum` (see [`transpose4`]).
 ///
 /// # Safety
 /// As [`transpose4`].
@@ -531,20 +637,22 @@ unsafe fn lines4<const W: usize>(
     dst: &mut [f64],
     stride: usize,
     c: usize,
-) -> u64 {
-    use std::arch::x86_64::{_mm256_setzero_pd, _mm256_storeu_pd, _mm256_stream_pd};
+    sum: &mut std::arch::x86_64::__m256d,
+) {
+    use std::arch::x86_64::{_mm256_add_pd, _mm256_setzero_pd, _mm256_storeu_pd, _mm256_stream_pd};
     let block = &mut dst[c..c + (W - 1) * stride + 8];
     let at = block.as_mut_ptr();
     let stream = (at as usize).is_multiple_of(64) && stride.is_multiple_of(8);
-    let mut bits = 0;
+    // the block's own sum, then one add to the running one (as in `block4`)
+    let mut values = _mm256_setzero_pd();
     for lb in (0..W).step_by(4) {
         let (lo, hi) = if zero {
             ([_mm256_setzero_pd(); 4], [_mm256_setzero_pd(); 4])
         } else {
-            let (lo, b0) = transposed4(&src[c..c + 4], lb, 4);
-            let (hi, b1) = transposed4(&src[c + 4..c + 8], lb, 4);
-            bits |= b0 | b1;
-            (lo, hi)
+            (
+                transposed4(&src[c..c + 4], lb, 4, &mut values),
+                transposed4(&src[c + 4..c + 8], lb, 4, &mut values),
+            )
         };
         for l in 0..4 {
             // SAFETY: `block` holds `(W - 1) * stride + 8` values, so `(lb + l) * stride + 8`
@@ -559,7 +667,7 @@ unsafe fn lines4<const W: usize>(
             }
         }
     }
-    bits
+    *sum = _mm256_add_pd(*sum, values);
 }
 
 #[cfg(test)]
@@ -666,6 +774,32 @@ mod tests {
             finiteness::<1>(stores);
             finiteness::<4>(stores);
             finiteness::<8>(stores);
+            overflow::<1>(stores);
+            overflow::<4>(stores);
+            overflow::<8>(stores);
+        }
+    }
+
+    fn overflow<const W: usize>(stores: Stores) {
+        // finite values whose sum overflows (the blocks' test) are reported finite, and an
+        // infinity beside them is not
+        for n in [4, 8, 17, 30] {
+            for bad in [None, Some(n / 2)] {
+                let mut src = vec![Lanes::<W>::splat(f64::MAX); n];
+                if let Some(c) = bad {
+                    src[c].0[0] = f64::INFINITY;
+                }
+                for used in 1..=W {
+                    for stride in strides(n) {
+                        let mut store = vec![0.0; used * stride + 8];
+                        for start in 0..8 {
+                            let dst = &mut store[start..start + used * stride];
+                            let finite = write_rows(&src, used, dst, stride, stores);
+                            assert_eq!(finite, bad.is_none(), "W {W} n {n} used {used}");
+                        }
+                    }
+                }
+            }
         }
     }
 
