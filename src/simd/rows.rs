@@ -183,7 +183,10 @@ unsafe fn blocks_avx512<const W: usize>(
     stride: usize,
     stream: bool,
 ) -> u64 {
-    use std::arch::x86_64::{_mm256_setzero_pd, _mm512_setzero_pd};
+    use std::arch::x86_64::{
+        _mm256_add_pd, _mm256_setzero_pd, _mm512_castpd512_pd256, _mm512_extractf64x4_pd,
+        _mm512_setzero_pd,
+    };
     let (n, used) = (src.len(), W);
     let zero = |c: usize, len: usize| zeros.is_some_and(|z| z.zero(c, len));
     let (mut sum, mut wide_sum) = (_mm256_setzero_pd(), _mm512_setzero_pd());
@@ -210,7 +213,12 @@ unsafe fn blocks_avx512<const W: usize>(
         c += 8;
     }
     bits |= narrow(src, &zero, used, dst, stride, c, n, &mut sum);
-    bits | not_finite4(sum) | not_finite8(wide_sum)
+    // the 512-bit sum's halves into the 256-bit one (finite only if both are)
+    let halves = _mm256_add_pd(
+        _mm512_castpd512_pd256(wide_sum),
+        _mm512_extractf64x4_pd::<1>(wide_sum),
+    );
+    bits | not_finite4(_mm256_add_pd(sum, halves))
 }
 
 /// [`write_rows_with_zeros`]'s work with AVX: blocks of 4 by 4 in 256-bit registers, from a
@@ -262,18 +270,6 @@ unsafe fn blocks_avx<const W: usize>(
 unsafe fn not_finite4(sum: std::arch::x86_64::__m256d) -> u64 {
     let mut lanes = [0.0; 4];
     std::arch::x86_64::_mm256_storeu_pd(lanes.as_mut_ptr(), sum);
-    u64::from(!lanes.iter().all(|v| v.is_finite()))
-}
-
-/// As [`not_finite4`], for a 512-bit sum.
-///
-/// # Safety
-/// The processor has AVX-512F; no `target_feature` of its own, as [`transpose8`].
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-unsafe fn not_finite8(sum: std::arch::x86_64::__m512d) -> u64 {
-    let mut lanes = [0.0; 8];
-    std::arch::x86_64::_mm512_storeu_pd(lanes.as_mut_ptr(), sum);
     u64::from(!lanes.iter().all(|v| v.is_finite()))
 }
 
