@@ -268,6 +268,24 @@ mod tests {
         }
     }
 
+    /// `f(used, dst, stride, start)` for every count of lanes used, every stride of
+    /// [`strides`] and every start of the rows within a cache line.
+    fn each_layout<const W: usize>(n: usize, mut f: impl FnMut(usize, &mut [f64], usize, usize)) {
+        for used in 1..=W {
+            for stride in strides(n) {
+                let mut store = vec![0.0; used * stride + 8];
+                for start in 0..8 {
+                    f(
+                        used,
+                        &mut store[start..start + used * stride],
+                        stride,
+                        start,
+                    );
+                }
+            }
+        }
+    }
+
     fn finiteness<const W: usize>(stores: Stores) {
         // a non-finite value is reported wherever it sits among the lanes written, and not
         // when it sits in a lane past `used`
@@ -276,20 +294,14 @@ mod tests {
                 for (c, l) in [(0, 0), (n - 1, W - 1), (n / 2, W / 2)] {
                     let mut src = vec![Lanes::<W>::splat(1.5); n];
                     src[c].0[l] = bad;
-                    for used in 1..=W {
-                        for stride in strides(n) {
-                            let mut store = vec![0.0; used * stride + 8];
-                            for start in 0..8 {
-                                let dst = &mut store[start..start + used * stride];
-                                let finite = write_rows(&src, used, dst, stride, stores);
-                                assert_eq!(
-                                    finite,
-                                    l >= used,
-                                    "W {W} n {n} c {c} l {l} used {used} start {start}"
-                                );
-                            }
-                        }
-                    }
+                    each_layout::<W>(n, |used, dst, stride, start| {
+                        let finite = write_rows(&src, used, dst, stride, stores);
+                        assert_eq!(
+                            finite,
+                            l >= used,
+                            "W {W} n {n} c {c} l {l} used {used} start {start}"
+                        );
+                    });
                 }
             }
         }
@@ -316,16 +328,10 @@ mod tests {
                 if let Some(c) = bad {
                     src[c].0[0] = f64::INFINITY;
                 }
-                for used in 1..=W {
-                    for stride in strides(n) {
-                        let mut store = vec![0.0; used * stride + 8];
-                        for start in 0..8 {
-                            let dst = &mut store[start..start + used * stride];
-                            let finite = write_rows(&src, used, dst, stride, stores);
-                            assert_eq!(finite, bad.is_none(), "W {W} n {n} used {used}");
-                        }
-                    }
-                }
+                each_layout::<W>(n, |used, dst, stride, _| {
+                    let finite = write_rows(&src, used, dst, stride, stores);
+                    assert_eq!(finite, bad.is_none(), "W {W} n {n} used {used}");
+                });
             }
         }
     }
