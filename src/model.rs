@@ -15,7 +15,10 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::error::{Error, Location, Result};
 use crate::gravity::Gravity;
-use crate::spatial::{skew, Inertia, Motion, OriginInertia, Se3};
+use crate::spatial::{skew, Inertia, Motion, OriginInertia, Se3, SplitInertia};
+
+mod turned_frame;
+pub(crate) use turned_frame::TurnedFrame;
 
 pub use crate::gravity::STANDARD_GRAVITY;
 
@@ -55,8 +58,13 @@ pub struct Body {
     pub offset: f64,
     /// `inertia` in the form the composite-body algorithms sum.
     pub(crate) origin_inertia: OriginInertia,
+    /// `origin_inertia.i` split for turning (the multi-sample mass matrix).
+    pub(crate) split_inertia: SplitInertia,
     /// `placement` and `axis` premultiplied for [`Body::pose_in_parent`].
     pub(crate) pose_terms: PoseTerms,
+    /// The body's frame turned for the multi-sample mass matrix (`None`: its own frame). It
+    /// depends on the parent's, so [`Model::refresh`] sets it, not [`Body::refresh`].
+    pub(crate) turned: Option<TurnedFrame>,
 }
 
 /// A joint's pose in its parent as a function of its coordinate `x`, premultiplied once:
@@ -140,10 +148,12 @@ impl PoseTerms {
 }
 
 impl Body {
-    /// Recomputes the terms the algorithms cache from `placement`, `axis` and `inertia`. The
-    /// builders call it; call [`Model::refresh`] after editing those fields of a model.
+    /// Recomputes the terms the algorithms cache from `placement`, `axis` and `inertia`, those
+    /// of this body alone. The builders call it; call [`Model::refresh`] after editing those
+    /// fields of a model (it also recomputes the terms that depend on several bodies).
     pub fn refresh(&mut self) {
         self.origin_inertia = OriginInertia::from(&self.inertia);
+        self.split_inertia = SplitInertia::of(&self.origin_inertia.i);
         self.pose_terms = PoseTerms::new(self.kind, &self.placement, &self.axis);
     }
 
@@ -271,6 +281,10 @@ impl Model {
     pub fn refresh(&mut self) {
         for b in &mut self.bodies {
             b.refresh();
+        }
+        let turned = turned_frame::turned_frames(&self.bodies);
+        for (b, t) in self.bodies.iter_mut().zip(turned) {
+            b.turned = t;
         }
     }
 

@@ -318,6 +318,26 @@ impl<const W: usize> Rotation3Lanes<W> {
             o.tr_mul(&self.0[2]),
         ])
     }
+    /// The constant matrix `m` in every lane.
+    #[inline(always)]
+    pub(crate) fn splat(m: &Matrix3<f64>) -> Self {
+        Rotation3Lanes([
+            Vector3Lanes::splat(&m.row(0).transpose()),
+            Vector3Lanes::splat(&m.row(1).transpose()),
+            Vector3Lanes::splat(&m.row(2).transpose()),
+        ])
+    }
+    /// `self * m` for a constant matrix `m`.
+    #[inline(always)]
+    pub(crate) fn mul_const_matrix(&self, m: &Matrix3<f64>) -> Self {
+        // row r of the product is m^T times row r of self
+        let mt = m.transpose();
+        Rotation3Lanes([
+            self.0[0].mul_const(&mt),
+            self.0[1].mul_const(&mt),
+            self.0[2].mul_const(&mt),
+        ])
+    }
     /// `self * a` for a constant vector `a`.
     #[inline(always)]
     pub(crate) fn mul_const_vector(&self, a: &Vector3<f64>) -> Vector3Lanes<W> {

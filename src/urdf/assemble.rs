@@ -52,7 +52,6 @@ impl Builder<'_> {
         let n = bodies.len();
         for (i, b) in bodies.iter_mut().enumerate() {
             b.subtree_end = i + 1;
-            b.refresh();
         }
         for i in (0..n).rev() {
             if let Some(p) = bodies[i].parent {
@@ -73,7 +72,7 @@ impl Builder<'_> {
                 robot: robot.name.clone(),
             });
         }
-        let model = Model {
+        let mut model = Model {
             name: robot.name.clone(),
             source: self.source.to_string(),
             nv: joint_names.len(),
@@ -89,6 +88,8 @@ impl Builder<'_> {
             coupled,
             joint_lines,
         };
+        // (every body's own terms again, and those that depend on several bodies)
+        model.refresh();
         model.check_every_dof_moves_mass()?;
         Ok(model)
     }

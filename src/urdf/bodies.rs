@@ -68,7 +68,9 @@ impl Builder<'_> {
                         multiplier,
                         offset,
                         origin_inertia: Default::default(),
+                        split_inertia: Default::default(),
                         pose_terms: Default::default(),
+                        turned: None,
                     });
                     body_joint.push(j);
                     (Some(bodies.len() - 1), Se3::identity())

@@ -460,7 +460,8 @@ fn recursion<const W: usize>(
         let vj = j.mul_lanes(data.vb[i]);
         let ov = ov_p.add(&vj);
         let oa = oa_p.add(&j.mul_lanes(data.ab[i])).add(&ov.cross(&vj));
-        let y = transformed(&b.origin_inertia, &r, &p);
+        let o = &b.origin_inertia;
+        let y = transformed(o.mass, &o.h, &b.split_inertia, &r, &p);
         let oh = y.apply(&ov);
         d.of[i] = y.apply(&oa).add(&ov.cross_force(&oh));
         d.ov[i] = ov;

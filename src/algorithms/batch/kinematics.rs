@@ -2,7 +2,7 @@
 //! accelerations, base-frame poses and motion subspaces, on `W` lanes.
 
 use super::LaneBuffers;
-use crate::model::{AlignedRevolute, Body, JointKind, Model};
+use crate::model::{AlignedRevolute, Body, JointKind, Model, TurnedFrame};
 use crate::simd::{
     serial, sin_cos, write_rows, Lanes, Rotation3Lanes, SpatialLanes, Stores, Vector3Lanes,
 };
@@ -298,6 +298,74 @@ pub(crate) fn store_pose_in_base<const W: usize>(
     };
     let (s, c) = data.sin_cos[i];
     aligned_pose_in_base(model, data, i, al, parent, [c, s * al.sign]);
+}
+
+/// Body `i`'s turned frame (`t`, see [`TurnedFrame`]) in the base frame for its loaded
+/// coordinate, stored as [`store_pose_in_base`] stores a frame (`o_rot`, `o_pos`, `o_s`); the
+/// parent's stored frame must be its turned one if it has one. A revolute joint's sine and
+/// cosine are read from `data.sin_cos`. The subspace is the rotation's third column (the joint
+/// axis is the turned frame's z).
+#[inline(always)]
+pub(crate) fn store_turned_pose_in_base<const W: usize>(
+    model: &Model,
+    data: &mut LaneBuffers<W>,
+    i: usize,
+    t: &TurnedFrame,
+) {
+    let b = &model.bodies[i];
+    // the joint's origin, and the turned frame at zero coordinate, in the base frame
+    let local = match b.kind {
+        JointKind::Revolute => None,
+        JointKind::Prismatic => {
+            Some(Vector3Lanes::of(&t.slide, data.qb[i]).add(&Vector3Lanes::splat(&t.pos)))
+        }
+    };
+    let (a, p) = match b.parent {
+        Some(k) => {
+            let (rp, pp) = (&data.o_rot[k], &data.o_pos[k]);
+            let p = match &local {
+                Some(l) => pp.add(&rp.mul(l)),
+                None => pp.add(&rp.mul_const_vector(&t.pos)),
+            };
+            (rp.mul_const_matrix(&t.rot), p)
+        }
+        None => (
+            Rotation3Lanes::splat(&t.rot),
+            local.unwrap_or_else(|| Vector3Lanes::splat(&t.pos)),
+        ),
+    };
+    let axis = Vector3Lanes {
+        x: a.0[0].z,
+        y: a.0[1].z,
+        z: a.0[2].z,
+    };
+    let (r, s) = match b.kind {
+        JointKind::Revolute => {
+            // A Rot_z(x): columns (c a_0 + s a_1, c a_1 - s a_0, a_2)
+            let (sn, cs) = data.sin_cos[i];
+            let mut r = a;
+            for row in serial(r.0.iter_mut()) {
+                let (x0, x1) = (row.x, row.y);
+                row.x = x0.mul_add(cs, x1 * sn);
+                row.y = x1.mul_sub(cs, x0 * sn);
+            }
+            let s = SpatialLanes {
+                ang: axis,
+                lin: p.cross(&axis),
+            };
+            (r, s)
+        }
+        JointKind::Prismatic => (
+            a,
+            SpatialLanes {
+                ang: Vector3Lanes::default(),
+                lin: axis,
+            },
+        ),
+    };
+    data.o_s[i] = s;
+    data.o_rot[i] = r;
+    data.o_pos[i] = p;
 }
 
 /// [`store_pose_in_base`] for body `i` below `parent` with an aligned joint `al`, given the

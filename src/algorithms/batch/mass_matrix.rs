@@ -1,7 +1,7 @@
 //! Joint-space mass matrices of many samples on the lanes (the composite rigid body algorithm
 //! in the base frame).
 
-use super::kinematics::store_pose_in_base;
+use super::kinematics::{store_pose_in_base, store_turned_pose_in_base};
 use super::{armature_inertia, dispatch, samples, LaneBuffers, LaneData, LaneKernel, Trig};
 use crate::data::Data;
 use crate::error::Result;
@@ -9,7 +9,8 @@ use crate::model::Model;
 use crate::simd::{
     serial, write_rows_with_zeros, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes,
 };
-use crate::spatial::OriginInertia;
+use crate::spatial::SplitInertia;
+use nalgebra::Vector3;
 
 /// Joint-space mass matrices `M(q)` of a batch, [`LaneData::width`] samples at a time (8 on
 /// AVX2, in pairs of registers): the composite rigid body algorithm in the base frame, as
@@ -79,9 +80,13 @@ impl LaneKernel for MassMatrix<'_> {
         let stores = data.stores(self.out.len());
         while first < self.k {
             data.load(model, [self.q, &[], &[]], first, Trig::Loaded);
-            // base-frame poses and motion subspaces
+            // base-frame poses (of the turned frames where there are: the inertias below are
+            // taken in the same frames) and motion subspaces
             for i in serial(0..nb) {
-                store_pose_in_base(model, data, i);
+                match &model.bodies[i].turned {
+                    Some(t) => store_turned_pose_in_base(model, data, i, t),
+                    None => store_pose_in_base(model, data, i),
+                }
             }
             let (m, zeros) = (&mut data.m, &data.m_zeros);
             // only the pairs of a body and its ancestors are written, the same in every group:
@@ -95,7 +100,12 @@ impl LaneKernel for MassMatrix<'_> {
             // assignment, so nothing is cleared
             for i in serial((0..nb).rev()) {
                 let b = &model.bodies[i];
-                let mut c = transformed(&b.origin_inertia, &data.o_rot[i], &data.o_pos[i]);
+                let (h, split) = match &b.turned {
+                    Some(t) => (&t.h, &t.split),
+                    None => (&b.origin_inertia.h, &b.split_inertia),
+                };
+                let mass = b.origin_inertia.mass;
+                let mut c = transformed(mass, h, split, &data.o_rot[i], &data.o_pos[i]);
                 if i + 1 < b.subtree_end {
                     c = c.add(&data.composite[i]);
                 }
@@ -155,52 +165,54 @@ impl LaneKernel for MassMatrix<'_> {
 }
 
 /// A body's (constant) origin-form inertia expressed in the base frame, for its pose `r`, `p`
-/// there (see `OriginInertia::transformed`).
+/// there (see `OriginInertia::transformed`): `mass` (kg), first moment `h` (kg m) and the
+/// rotational inertia about the origin as `split` ([`SplitInertia`]), in the body's frame.
 #[inline(always)]
 pub(crate) fn transformed<const W: usize>(
-    b: &OriginInertia,
+    mass: f64,
+    h: &Vector3<f64>,
+    split: &SplitInertia,
     r: &Rotation3Lanes<W>,
     p: &Vector3Lanes<W>,
 ) -> Composite<W> {
-    let hr = r.mul_const_vector(&b.h);
-    let w = p.scale_add(0.5 * b.mass, &hr);
-    let d = p.dot(&w) * 2.0;
-    // rows of R I (I symmetric), then R I R^T - w p^T - p w^T + d 1: symmetric, so each
-    // entry above the diagonal is computed once
-    let ri = [
-        r.0[0].mul_const(&b.i),
-        r.0[1].mul_const(&b.i),
-        r.0[2].mul_const(&b.i),
-    ];
+    let hr = r.mul_const_vector(h);
+    let w = p.scale_add(0.5 * mass, &hr);
+    // R I R^T - w p^T - p w^T + d 1 with R I R^T = base 1 + x x^T + y y^T (x, y turned):
+    // symmetric, so each entry above the diagonal is computed once
+    let d = p.dot(&w).mul_add_s(2.0, Lanes::splat(split.base));
+    let x = r.mul_const_vector(&split.x);
+    let y = r.mul_const_vector(&split.y);
     // a function, not a closure: one compiled out of line would lose the instruction set
     #[inline(always)]
     fn entry<const W: usize>(
-        ri: &[Vector3Lanes<W>; 3],
-        r: &Rotation3Lanes<W>,
-        w: &Vector3Lanes<W>,
-        p: &Vector3Lanes<W>,
+        [x, y, w, p]: [&Vector3Lanes<W>; 4],
         row: usize,
         c: usize,
     ) -> Lanes<W> {
-        let v = ri[row].dot(&r.0[c]);
+        let v = x.get(row).mul_add(x.get(c), y.get(row) * y.get(c));
         w.get(row)
             .neg_mul_add(p.get(c), p.get(row).neg_mul_add(w.get(c), v))
     }
+    #[inline(always)]
+    fn diagonal<const W: usize>(
+        [x, y, w, p]: [&Vector3Lanes<W>; 4],
+        d: Lanes<W>,
+        row: usize,
+    ) -> Lanes<W> {
+        let (xr, yr) = (x.get(row), y.get(row));
+        xr.mul_add(
+            xr,
+            yr.mul_add(yr, (w.get(row) * p.get(row)).mul_add_s(-2.0, d)),
+        )
+    }
+    let v = [&x, &y, &w, p];
     let i = symmetric(
-        [
-            entry(&ri, r, &w, p, 0, 0) + d,
-            entry(&ri, r, &w, p, 1, 1) + d,
-            entry(&ri, r, &w, p, 2, 2) + d,
-        ],
-        [
-            entry(&ri, r, &w, p, 0, 1),
-            entry(&ri, r, &w, p, 0, 2),
-            entry(&ri, r, &w, p, 1, 2),
-        ],
+        [diagonal(v, d, 0), diagonal(v, d, 1), diagonal(v, d, 2)],
+        [entry(v, 0, 1), entry(v, 0, 2), entry(v, 1, 2)],
     );
     Composite {
-        mass: b.mass,
-        h: p.scale_add(b.mass, &hr),
+        mass,
+        h: p.scale_add(mass, &hr),
         i,
     }
 }
