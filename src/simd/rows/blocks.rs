@@ -39,7 +39,15 @@ pub(super) unsafe fn blocks_avx512<const W: usize>(
     let mut c = head;
     while c + 8 <= n {
         if zero(c, 8) {
-            zero8(dst, stride, c, stream);
+            // a run of zero blocks: each row's part written in one go (whole lines, one row
+            // after the other, rather than the rows in turn a line at a time)
+            let mut end = c + 8;
+            while end + 8 <= n && zero(end, 8) {
+                end += 8;
+            }
+            zero_run(dst, stride, c, end, stream);
+            c = end;
+            continue;
         } else if !stream && (zero(c, 4) || zero(c + 4, 4)) {
             // (streaming, such a block goes whole, its zeros read from the buffer: a 32-byte
             // store into a line beside non-temporal ones costs 40 % on the tree's mass matrix)
@@ -189,15 +197,33 @@ fn block4<const W: usize>(
     }
 }
 
-/// Zeros into columns `c..c + 8` of rows `0..8` of `dst` (row `l` at `l * stride`): one bounds
-/// check, 8 stores of 64 bytes (non-temporal if `stream`, as [`store8`]).
+/// Zeros into columns `from..to` (`to - from` a multiple of 8) of rows `0..8` of `dst` (row
+/// `l` at `l * stride`), a row at a time: 64-byte stores, non-temporal if `stream` where they
+/// are whole cache lines (as [`store8`]).
 ///
 /// # Safety
 /// The processor has AVX-512F; no `target_feature` of its own, as [`transpose8`].
 #[inline(always)]
-unsafe fn zero8(dst: &mut [f64], stride: usize, c: usize, stream: bool) {
-    let zero = std::arch::x86_64::_mm512_setzero_pd();
-    store8(dst, stride, c, [zero; 8], stream);
+unsafe fn zero_run(dst: &mut [f64], stride: usize, from: usize, to: usize, stream: bool) {
+    use std::arch::x86_64::{_mm512_setzero_pd, _mm512_storeu_pd, _mm512_stream_pd};
+    let block = &mut dst[from..to + 7 * stride];
+    let at = block.as_mut_ptr();
+    let z = _mm512_setzero_pd();
+    let lines = stream && (at as usize).is_multiple_of(64) && stride.is_multiple_of(8);
+    for l in 0..8 {
+        let mut c = 0;
+        while c < to - from {
+            // SAFETY: `block` holds `to - from + 7 * stride` values, so `l * stride + c + 8`
+            // fit for l <= 7 and c + 8 <= to - from; whole lines where streamed (checked above)
+            let p = at.add(l * stride + c);
+            if lines {
+                _mm512_stream_pd(p, z);
+            } else {
+                _mm512_storeu_pd(p, z);
+            }
+            c += 8;
+        }
+    }
 }
 
 /// `rows[l]` into columns `c..c + 8` of row `l` of `dst` (at `l * stride`) for `l < 8`: one
@@ -393,8 +419,8 @@ unsafe fn transposed4<const W: usize>(
 }
 
 /// Quantities from `from` on, by blocks of 8, into those columns of all `W` rows of `dst` (row
-/// `l` at `l * stride`) with [`lines4`] (blocks that are all zeros by `zeros` not read);
-/// their values added to `sum` (see [`transpose4`]); returns where the blocks end. Kept out of
+/// `l` at `l * stride`) with [`lines4`], runs of blocks that are all zeros by `zeros` unread
+/// and written a row at a time ([`zero_run4`]); their values added to `sum` (see [`transpose4`]); returns where the blocks end. Kept out of
 /// line, the streamed outputs' own path (inlined into [`blocks_avx`], the tree's AVX2 mass
 /// matrix, which streams, measured 1-4 % slower: near the noise).
 ///
@@ -410,14 +436,57 @@ unsafe fn stream_lines4<const W: usize>(
     from: usize,
     sum: &mut std::arch::x86_64::__m256d,
 ) -> usize {
+    let n = src.len();
+    let zero = |c: usize| zeros.is_some_and(|z| z.zero(c, 8));
     let mut c = from;
-    while c + 8 <= src.len() {
-        let zero = zeros.is_some_and(|z| z.zero(c, 8));
+    while c + 8 <= n {
+        if W == 8 && zero(c) {
+            // a run of zero blocks, a row at a time (as in `blocks_avx512`)
+            let mut end = c + 8;
+            while end + 8 <= n && zero(end) {
+                end += 8;
+            }
+            // SAFETY: as this function's
+            unsafe { zero_run4::<W>(dst, stride, c, end) };
+            c = end;
+            continue;
+        }
         // SAFETY: as this function's
-        unsafe { lines4(src, zero, dst, stride, c, sum) };
+        unsafe { lines4(src, zero(c), dst, stride, c, sum) };
         c += 8;
     }
     c
+}
+
+/// Zeros into columns `from..to` (`to - from` a multiple of 8) of rows `0..W` of `dst` (row
+/// `l` at `l * stride`), a row at a time, in pairs of 32-byte stores: non-temporal where they
+/// make whole cache lines (as [`lines4`]).
+///
+/// # Safety
+/// As [`transpose4`].
+#[inline(always)]
+unsafe fn zero_run4<const W: usize>(dst: &mut [f64], stride: usize, from: usize, to: usize) {
+    use std::arch::x86_64::{_mm256_setzero_pd, _mm256_storeu_pd, _mm256_stream_pd};
+    let block = &mut dst[from..to + (W - 1) * stride];
+    let at = block.as_mut_ptr();
+    let z = _mm256_setzero_pd();
+    let lines = (at as usize).is_multiple_of(64) && stride.is_multiple_of(8);
+    for l in 0..W {
+        let mut c = 0;
+        while c < to - from {
+            // SAFETY: `block` holds `to - from + (W - 1) * stride` values, so `l * stride + c
+            // + 8` fit for l < W and c + 8 <= to - from; whole lines where streamed
+            let p = at.add(l * stride + c);
+            if lines {
+                _mm256_stream_pd(p, z);
+                _mm256_stream_pd(p.add(4), z);
+            } else {
+                _mm256_storeu_pd(p, z);
+                _mm256_storeu_pd(p.add(4), z);
+            }
+            c += 8;
+        }
+    }
 }
 
 /// Quantities `c..c + 8` of `src` (zeros if `zero`) into columns `c..c + 8` of all `W` rows of
