@@ -274,10 +274,7 @@ unsafe fn transpose8<const W: usize>(
     stream: bool,
     sum: &mut std::arch::x86_64::__m512d,
 ) {
-    use std::arch::x86_64::{
-        _mm512_add_pd, _mm512_loadu_pd, _mm512_shuffle_f64x2, _mm512_unpackhi_pd,
-        _mm512_unpacklo_pd,
-    };
+    use std::arch::x86_64::{_mm512_add_pd, _mm512_loadu_pd};
     // one 8-lane quantity (bounds-checked: fails unless W >= 8)
     #[inline(always)]
     fn at<const W: usize>(src: &[Lanes<W>], q: usize) -> *const f64 {
@@ -298,6 +295,20 @@ unsafe fn transpose8<const W: usize>(
         _mm512_add_pd(_mm512_add_pd(r[4], r[5]), _mm512_add_pd(r[6], r[7])),
     );
     *sum = _mm512_add_pd(*sum, block);
+    let out = transposed8(r);
+    store8(dst, stride, c, out, stream);
+}
+
+/// The 8x8 matrix of rows `r` transposed (entry `j` of output `l` is entry `l` of `r[j]`): 24
+/// shuffles.
+///
+/// # Safety
+/// The processor has AVX-512F; no `target_feature` of its own, as [`transpose8`].
+#[inline(always)]
+pub(in crate::simd) unsafe fn transposed8(
+    r: [std::arch::x86_64::__m512d; 8],
+) -> [std::arch::x86_64::__m512d; 8] {
+    use std::arch::x86_64::{_mm512_shuffle_f64x2, _mm512_unpackhi_pd, _mm512_unpacklo_pd};
     // pairs: t0 = [r0_0 r1_0 r0_2 r1_2 r0_4 r1_4 r0_6 r1_6], t1 the odd lanes, ...
     let t = [
         _mm512_unpacklo_pd(r[0], r[1]),
@@ -322,7 +333,7 @@ unsafe fn transpose8<const W: usize>(
         _mm512_shuffle_f64x2::<0xdd>(t[5], t[7]),
     ];
     // lane l's 8 quantities: [u(l) pieces 0, 2 | u(l + 4) pieces 0, 2], or 1, 3 for l + 4
-    let out = [
+    [
         _mm512_shuffle_f64x2::<0x88>(u[0], u[4]),
         _mm512_shuffle_f64x2::<0x88>(u[2], u[6]),
         _mm512_shuffle_f64x2::<0x88>(u[1], u[5]),
@@ -331,8 +342,27 @@ unsafe fn transpose8<const W: usize>(
         _mm512_shuffle_f64x2::<0xdd>(u[2], u[6]),
         _mm512_shuffle_f64x2::<0xdd>(u[1], u[5]),
         _mm512_shuffle_f64x2::<0xdd>(u[3], u[7]),
-    ];
-    store8(dst, stride, c, out, stream);
+    ]
+}
+
+/// The 4x4 matrix of rows `a`, `b`, `x`, `y` transposed: 8 shuffles.
+///
+/// # Safety
+/// The processor has AVX; no `target_feature` of its own, as [`transpose8`].
+#[inline(always)]
+pub(in crate::simd) unsafe fn transposed4x4(
+    [a, b, x, y]: [std::arch::x86_64::__m256d; 4],
+) -> [std::arch::x86_64::__m256d; 4] {
+    use std::arch::x86_64::{_mm256_permute2f128_pd, _mm256_unpackhi_pd, _mm256_unpacklo_pd};
+    // [a0 b0 a2 b2], [a1 b1 a3 b3], [x0 y0 x2 y2], [x1 y1 x3 y3]
+    let (t0, t1) = (_mm256_unpacklo_pd(a, b), _mm256_unpackhi_pd(a, b));
+    let (t2, t3) = (_mm256_unpacklo_pd(x, y), _mm256_unpackhi_pd(x, y));
+    [
+        _mm256_permute2f128_pd::<0x20>(t0, t2),
+        _mm256_permute2f128_pd::<0x20>(t1, t3),
+        _mm256_permute2f128_pd::<0x31>(t0, t2),
+        _mm256_permute2f128_pd::<0x31>(t1, t3),
+    ]
 }
 
 /// Lanes `lb..lb + rows.min(4)` of the 4 quantities `src` into columns `c..c + 4` of those
@@ -388,24 +418,13 @@ unsafe fn transposed4<const W: usize>(
     rows: usize,
     sum: &mut std::arch::x86_64::__m256d,
 ) -> [std::arch::x86_64::__m256d; 4] {
-    use std::arch::x86_64::{
-        _mm256_add_pd, _mm256_loadu_pd, _mm256_permute2f128_pd, _mm256_unpackhi_pd,
-        _mm256_unpacklo_pd,
-    };
+    use std::arch::x86_64::{_mm256_add_pd, _mm256_loadu_pd};
     // no closures here: one compiled out of line would lose the target feature
     let a = _mm256_loadu_pd(src[0].0[lb..lb + 4].as_ptr());
     let b = _mm256_loadu_pd(src[1].0[lb..lb + 4].as_ptr());
     let x = _mm256_loadu_pd(src[2].0[lb..lb + 4].as_ptr());
     let y = _mm256_loadu_pd(src[3].0[lb..lb + 4].as_ptr());
-    // [a0 b0 a2 b2], [a1 b1 a3 b3], [x0 y0 x2 y2], [x1 y1 x3 y3]
-    let (t0, t1) = (_mm256_unpacklo_pd(a, b), _mm256_unpackhi_pd(a, b));
-    let (t2, t3) = (_mm256_unpacklo_pd(x, y), _mm256_unpackhi_pd(x, y));
-    let out = [
-        _mm256_permute2f128_pd::<0x20>(t0, t2),
-        _mm256_permute2f128_pd::<0x20>(t1, t3),
-        _mm256_permute2f128_pd::<0x31>(t0, t2),
-        _mm256_permute2f128_pd::<0x31>(t1, t3),
-    ];
+    let out = transposed4x4([a, b, x, y]);
     if rows >= 4 {
         // all four rows: the quantities as loaded, without waiting for the shuffles
         let block = _mm256_add_pd(_mm256_add_pd(a, b), _mm256_add_pd(x, y));
