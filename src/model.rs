@@ -149,12 +149,18 @@ impl PoseTerms {
 
 impl Body {
     /// Recomputes the terms the algorithms cache from `placement`, `axis` and `inertia`, those
-    /// of this body alone. The builders call it; call [`Model::refresh`] after editing those
-    /// fields of a model (it also recomputes the terms that depend on several bodies).
+    /// of this body alone (an edited `inertia` is then fully in effect). The builders call it;
+    /// call [`Model::refresh`] after editing `placement` or `axis` (it also recomputes the
+    /// terms that depend on several bodies: the frames the multi-sample mass matrix turns).
     pub fn refresh(&mut self) {
         self.origin_inertia = OriginInertia::from(&self.inertia);
         self.split_inertia = SplitInertia::of(&self.origin_inertia.i);
         self.pose_terms = PoseTerms::new(self.kind, &self.placement, &self.axis);
+        // an edited inertia reaches the turned frame's too (its placement needs the parent's)
+        if let Some(mut t) = self.turned.take() {
+            t.turn_inertia(self);
+            self.turned = Some(t);
+        }
     }
 
     /// The joint's motion subspace: the body's twist per unit joint velocity, in its own frame.

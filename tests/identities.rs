@@ -452,6 +452,34 @@ proptest! {
     }
 }
 
+/// An inertia edited in place and refreshed body by body (`Body::refresh`, not
+/// `Model::refresh`) reaches the multi-sample mass matrix, whose turned frames hold their own
+/// copy of it.
+#[test]
+fn an_inertia_refreshed_by_its_body_reaches_the_mass_matrix_batch() {
+    let text = random_tree_urdf(7, 12);
+    let mut model = model_from_urdf_str(&text, "random", &LoadOptions::default()).unwrap();
+    for (i, b) in model.bodies.iter_mut().enumerate() {
+        b.inertia = perturbid_rs::spatial::Inertia::new(
+            0.5 + i as f64,
+            nalgebra::Vector3::new(0.1, -0.05 * i as f64, 0.2),
+            nalgebra::Matrix3::new(
+                0.3,
+                0.01,
+                0.0,
+                0.01,
+                0.2 + 0.01 * i as f64,
+                0.02,
+                0.0,
+                0.02,
+                0.25,
+            ),
+        );
+        b.refresh();
+    }
+    check_mass_matrix_batch(&model, &mut Rng(11), 9);
+}
+
 #[test]
 fn mass_matrix_batch_equals_crba_on_the_a465_and_a_mimic_pair() {
     let mut rng = Rng(10);

@@ -37,6 +37,18 @@ pub(crate) struct TurnedFrame {
     pub(crate) split: SplitInertia,
 }
 
+impl TurnedFrame {
+    /// Sets `h` and `split` from body `b`'s inertia and axis (the body's own terms, which
+    /// [`Body::refresh`] renews after an edit of the inertia; the frame's placement depends on
+    /// the parent's and is [`super::Model::refresh`]'s).
+    pub(crate) fn turn_inertia(&mut self, b: &Body) {
+        let q = turn_onto(&b.axis);
+        let i = q.transpose() * b.origin_inertia.i * q;
+        self.h = q.transpose() * b.origin_inertia.h;
+        self.split = SplitInertia::of(&((i + i.transpose()) * 0.5));
+    }
+}
+
 /// A rotation `Q` with `Q e_z = a` for a unit axis `a` (the identity for `a = e_z` exactly):
 /// columns `(u, a x u, a)`, `u` a unit vector orthogonal to `a`.
 pub(crate) fn turn_onto(a: &Vector3<f64>) -> Matrix3<f64> {
@@ -65,17 +77,17 @@ pub(crate) fn turned_frames(bodies: &[Body]) -> Vec<Option<TurnedFrame>> {
         let qp_t = parent.unwrap_or_else(Matrix3::identity).transpose();
         let q = turn_onto(&b.axis);
         let r0 = &b.placement.rotation;
-        let i = q.transpose() * b.origin_inertia.i * q;
-        out.push(Some(TurnedFrame {
+        let mut t = TurnedFrame {
             rot: qp_t * r0 * q,
             pos: qp_t * b.placement.translation,
             slide: match b.kind {
                 JointKind::Revolute => Vector3::zeros(),
                 JointKind::Prismatic => qp_t * r0 * b.axis,
             },
-            h: q.transpose() * b.origin_inertia.h,
-            split: SplitInertia::of(&((i + i.transpose()) * 0.5)),
-        }));
+            ..TurnedFrame::default()
+        };
+        t.turn_inertia(b);
+        out.push(Some(t));
         turns.push(Some(q));
     }
     out
