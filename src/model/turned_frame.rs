@@ -68,7 +68,8 @@ pub(crate) fn turned_frames(bodies: &[Body]) -> Vec<Option<TurnedFrame>> {
     let mut turns: Vec<Option<Matrix3<f64>>> = Vec::with_capacity(bodies.len());
     let mut out = Vec::with_capacity(bodies.len());
     for b in bodies {
-        let parent = b.parent.and_then(|p| turns[p]);
+        // (a parent after its child, which no builder makes, is taken as not turned)
+        let parent = b.parent.and_then(|p| turns.get(p).copied().flatten());
         if b.pose_terms.aligned.is_some() && parent.is_none() {
             turns.push(None);
             out.push(None);

@@ -1,6 +1,7 @@
 //! SIMD arithmetic for the multi-sample kernels: the lane types (several samples side by side,
 //! one per vector lane), `sin`/`cos` of every lane, the transpose of lanes into the rows of an
-//! output and of the input's rows into lanes, loops kept from a second vectorisation, and the run-time choice of instruction set.
+//! output and of the input's rows into lanes, loops kept from a second vectorisation, and the
+//! run-time choice of instruction set.
 
 mod isa;
 mod lanes;

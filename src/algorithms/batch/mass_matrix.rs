@@ -12,8 +12,9 @@ use crate::simd::{
 use crate::spatial::SplitInertia;
 use nalgebra::Vector3;
 
-/// Joint-space mass matrices `M(q)` of a batch, [`LaneData::width`] samples at a time: the composite rigid body algorithm in the base frame, as
-/// [`crate::mass_matrix`], equal to it up to rounding.
+/// Joint-space mass matrices `M(q)` of a batch, [`LaneData::width`] samples at a time: the
+/// composite rigid body algorithm in the base frame, as [`crate::mass_matrix`], equal to it up
+/// to rounding.
 ///
 /// `q`: row-major `k x nv` (rad or m), finite (checked by the caller, as for
 /// [`super::rnea_lanes`]). `out`: row-major `k x nv x nv` (kg m^2, kg m or kg), both triangles
@@ -68,8 +69,8 @@ impl<const W: usize> Default for Composite<W> {
 
 impl LaneKernel for MassMatrix<'_> {
     type Output = Result<()>;
-    // 4 lanes on AVX2 (measured against pairs of registers: the tree 4-5 % faster, the arms
-    // level; the inertias turned in `transformed` hold fewer values at once than in pairs)
+    // 4 lanes on AVX2 (measured against pairs of registers, since the split inertias and the
+    // turned frames: the tree 4-5 % faster, the arms level)
     const PAIRS_ON_AVX2: bool = false;
 
     #[inline(always)]

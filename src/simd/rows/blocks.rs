@@ -438,10 +438,11 @@ unsafe fn transposed4<const W: usize>(
 }
 
 /// Quantities from `from` on, by blocks of 8, into those columns of all `W` rows of `dst` (row
-/// `l` at `l * stride`) with [`lines4`], runs of blocks that are all zeros by `zeros` unread
-/// and written a row at a time ([`zero_run4`]); their values added to `sum` (see [`transpose4`]); returns where the blocks end. Kept out of
-/// line, the streamed outputs' own path (inlined into [`blocks_avx`], the tree's AVX2 mass
-/// matrix, which streams, measured 1-4 % slower: near the noise).
+/// `l` at `l * stride`) with [`lines4`] (blocks that are all zeros by `zeros` not read); on 8
+/// lanes, runs of such blocks are written a row at a time ([`zero_run4`]; on 4 lanes that was
+/// 3-6 % slower). Their values are added to `sum` (see [`transpose4`]); returns where the
+/// blocks end. Kept out of line, the streamed outputs' own path (inlined into [`blocks_avx`],
+/// the tree's AVX2 mass matrix, which streams, measured 1-4 % slower: near the noise).
 ///
 /// # Safety
 /// The processor has AVX.
