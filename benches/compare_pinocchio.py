@@ -177,6 +177,12 @@ class Side:
             return (e((k, n)), *(e((k, n, n)) for _ in range(4)))
         return e((k, n))
 
+    def big(self, k, kernel):
+        """`k` samples (this side's, repeated) and an output of `kernel` for them."""
+        reps = -(-k // self.k)
+        x = {key: np.tile(v, (reps, 1))[:k] for key, v in self.x.items()}
+        return x, {kernel: self.output_for(kernel, k)}
+
     def ours(self, kernel, x=None, out=None):
         """Our batched call of `kernel` on the samples `x` into `out` (default: this side's
         first `samples_for(kernel)` samples and outputs)."""
@@ -334,9 +340,7 @@ def all_cores(side: Side, kernel: str, rounds: int):
     big_k = 8192
     if big_k * 8 * side.per_sample(kernel) > 4 * OUTPUT_CAP:
         return None
-    reps = -(-big_k // side.k)
-    big = {key: np.tile(v, (reps, 1))[:big_k] for key, v in side.x.items()}
-    out = {kernel: side.output_for(kernel, big_k)}
+    big, out = side.big(big_k, kernel)
     k_peer = side.samples_for(kernel)
     ratios = []
     for _ in range(rounds):
@@ -371,13 +375,56 @@ def flop_counts() -> dict:
     return {(r["robot"], r["kernel"]): r["flops_per_sample"] for r in rows}
 
 
-def cpu_ghz() -> float | None:
-    try:
-        mhz = [float(x.split(":")[1]) for x in Path("/proc/cpuinfo").read_text().splitlines()
-               if x.startswith("cpu MHz")]
-        return max(mhz) / 1e3 if mhz else None
-    except OSError:
+def measured_peak(isa: str) -> float | None:
+    """GFlop/s one core issues with fused multiply-adds at the width of our `isa` path
+    (benches/peak_flops.c, built here with gcc: 512-bit for avx512, 256-bit for avx2+fma), or
+    None (the scalar path, no gcc, not x86-64). Measured, since neither the number of FMA
+    pipes (one or two 512-bit ones on Intel's Xeons, two 256-bit ones on AMD's Zen 3 and 4)
+    nor the clock under load can be read off /proc/cpuinfo."""
+    bits = {"avx512": "512", "avx2+fma": "256"}.get(isa)
+    if bits is None or shutil.which("gcc") is None:
         return None
+    exe = Path(tempfile.gettempdir()) / f"perturbid_peak_flops-{os.getpid()}"
+    try:
+        built = subprocess.run(["gcc", "-O2", str(ROOT / "benches" / "peak_flops.c"), "-o",
+                                str(exe)], capture_output=True, text=True)
+        if built.returncode != 0:
+            print("no peak (peak_flops.c did not build):\n" + built.stderr[-1000:],
+                  file=sys.stderr)
+            return None
+        done = subprocess.run([str(exe), bits], capture_output=True, text=True, check=True)
+        return float(json.loads(done.stdout)["gflops"])
+    finally:
+        exe.unlink(missing_ok=True)
+
+
+def cpu_model() -> str:
+    """The processor's name as /proc/cpuinfo gives it ("" where it does not)."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return ""
+
+
+class pinned:
+    """Within the block the calling thread, and every process it starts, runs on `cpus` only
+    (Linux's affinity; nothing elsewhere): both sides of a one-core round on the same core."""
+
+    def __init__(self, cpus):
+        self.cpus = set(cpus)
+
+    def __enter__(self):
+        self.before = os.sched_getaffinity(0) if hasattr(os, "sched_getaffinity") else None
+        if self.before is not None:
+            os.sched_setaffinity(0, self.cpus)
+        return self
+
+    def __exit__(self, *exc):
+        if self.before is not None:
+            os.sched_setaffinity(0, self.before)
 
 
 def python_call(side: Side, calls: int = 20000, rounds: int = 5):
@@ -420,11 +467,20 @@ def main() -> int:
     ap.add_argument("--samples", type=int, default=2048, help="per one-core batch (< 4096)")
     ap.add_argument("--no-write", action="store_true", help="print only")
     ap.add_argument("--robots", default="a465,panda,tree60")
+    ap.add_argument("--cpu", type=int, default=None,
+                    help="the core of the one-core rounds (default: the lowest allowed)")
     args = ap.parse_args()
     peer = build_peer()
     flops = flop_counts()
-    ghz = cpu_ghz()
-    peak = 16 * ghz if ghz else None  # double flops per cycle: two 256-bit FMA pipes
+    isa = pr.simd_isa()
+    everywhere = os.sched_getaffinity(0) if hasattr(os, "sched_getaffinity") else set()
+    # the one-core rounds: Pinocchio's process and our calls in turns on one core, so that a
+    # slow spell of that core (on a shared host, a busy neighbour) falls on both sides
+    one = {args.cpu if args.cpu is not None else min(everywhere)} if everywhere else set()
+    if one and not one <= everywhere:
+        raise SystemExit(f"--cpu {args.cpu}: not one of this process's cores {sorted(everywhere)}")
+    with pinned(one):
+        peak = measured_peak(isa)
     rows, failures, first = [], [], None
     with tempfile.TemporaryDirectory() as work:
         for name, robot, model in robots():
@@ -433,9 +489,13 @@ def main() -> int:
             side = Side(name, robot, model, args.samples, work, peer)
             first = first or side
             failures += agree(side)
+            # the engine's threads started before any pinning (they keep the cores they
+            # start with): a batch past the parallel threshold
+            side.ours("rnea", *side.big(8192, "rnea"))
             for kernel in KERNELS:
-                t_pin, t_our, t_store, ratios = run_kernel(side, kernel, args.rounds,
-                                                           args.passes)
+                with pinned(one):
+                    t_pin, t_our, t_store, ratios = run_kernel(side, kernel, args.rounds,
+                                                               args.passes)
                 many = all_cores(side, kernel, max(2, args.rounds // 2))
                 f = flops.get((name, kernel))
                 rate = f / t_our if f else None
@@ -445,16 +505,17 @@ def main() -> int:
                       f"store {t_store:8.1f} ns  "
                       f"x{statistics.median(ratios):5.2f} [{min(ratios):.2f}-{max(ratios):.2f}]"
                       f"  all cores {'n/a' if many is None else f'x{many:.2f}'}", file=sys.stderr)
-        call = python_call(first)
+        with pinned(one):
+            call = python_call(first)
     if failures:
         print("RESULTS DIFFER:\n" + "\n".join(failures), file=sys.stderr)
         return 1
-    isa = pr.simd_isa()
     who = "Pinocchio C++ (one call per sample)" if peer else \
         "Pinocchio from Python (one call per sample, Python's overhead included)"
     lines = [
-        f"Measured {time.strftime('%Y-%m-%d')} on {os.cpu_count()} cores "
-        f"({pr.simd_isa()} path, {isa_lanes(isa)} lanes), against {who}, "
+        f"Measured {time.strftime('%Y-%m-%d')} on {os.cpu_count()} cores of "
+        f"{cpu_model() or 'an unnamed processor'} ({isa} path, {isa_lanes(isa)} lanes; the "
+        f"one-core rounds on core {min(one) if one else 'any'}), against {who}, "
         f"`python benches/compare_pinocchio.py` (medians of {args.rounds} rounds taken in turns;"
         " the brackets are the lowest and highest per-round ratio: the machine's noise).",
         "",
@@ -479,8 +540,9 @@ def main() -> int:
                  "far faster than one holding data (on the Zen 4 measured, 0.7 ns against "
                  "2-3 ns).")
     if peak:
-        lines.append(f"Peak: 16 double flops per cycle per core at {ghz:.2f} GHz "
-                     f"({peak:.0f} GFlop/s; two 256-bit FMA pipes as on AMD Zen 3 and 4).")
+        lines.append(f"Peak: {peak:.0f} GFlop/s, measured on that core before the rounds "
+                     f"(`benches/peak_flops.c`: fused multiply-adds {isa_lanes(isa) * 64} bits "
+                     "wide, the width of the path measured, twelve independent ones at a time).")
     table = "\n".join(lines)
     print(table)
     if not args.no_write:
