@@ -30,10 +30,11 @@ pub(crate) struct Stores {
 }
 
 impl Stores {
-    /// Outputs of at least this many bytes are written with `stream`: half the 32 MB L3 cache
-    /// of the Zen 3 and Zen 4 measured, past which an output does not stay in the caches from
-    /// one call to the next. (Measured on the A465's regressor, serially, AVX-512: streaming
-    /// 20-25 % slower at 6 MB, level at 12 MB, 25-30 % faster from 24 MB on.)
+    /// Outputs of at least this many bytes are written with `stream` on AMD's processors (and
+    /// any but Intel's): half the 32 MB L3 cache of the Zen 3 and Zen 4 measured, past which
+    /// an output does not stay in the caches from one call to the next. (Measured on the
+    /// A465's regressor, serially, AVX-512: streaming 20-25 % slower at 6 MB, level at 12 MB,
+    /// 25-30 % faster from 24 MB on.)
     pub(crate) const STREAM_BYTES: usize = 16 << 20;
 
     /// The stores for AVX-512 buffers (`wide`) or not, for an output of `bytes` in all.
@@ -41,9 +42,51 @@ impl Stores {
     pub(crate) fn for_output(wide: bool, bytes: usize) -> Self {
         Self {
             wide,
-            stream: bytes >= Self::STREAM_BYTES,
+            stream: bytes >= stream_bytes(),
         }
     }
+}
+
+/// The output size from which [`Stores::stream`] is used on this processor (detected once):
+/// on Intel's, the core's L2 cache (CPUID leaf 4), past which a row stored the usual way is
+/// read from an L3 that is slow to write to (measured on a Xeon, Emerald Rapids, 2 MB of L2:
+/// the A465's regressor streamed 20 % slower at 1.5 MB, 7-9 % faster at 3-12 MB);
+/// [`Stores::STREAM_BYTES`] elsewhere.
+pub(crate) fn stream_bytes() -> usize {
+    static BYTES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *BYTES.get_or_init(|| intel_l2_bytes().map_or(Stores::STREAM_BYTES, |l2| l2.max(1 << 20)))
+}
+
+/// The size of the L2 cache of an Intel processor (CPUID leaf 4), `None` on any other.
+fn intel_l2_bytes() -> Option<usize> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::__cpuid_count;
+        // leaf 4 is read only where leaf 0 says it exists
+        let vendor = __cpuid_count(0, 0);
+        let intel = (vendor.ebx, vendor.edx, vendor.ecx) == (0x756e_6547, 0x4965_6e69, 0x6c65_746e);
+        if !intel || vendor.eax < 4 {
+            return None;
+        }
+        for sub in 0..16 {
+            let c = __cpuid_count(4, sub);
+            let kind = c.eax & 0x1f;
+            if kind == 0 {
+                break;
+            }
+            // a data or unified cache at level 2
+            if (c.eax >> 5) & 0x7 == 2 && (kind == 1 || kind == 3) {
+                let ways = ((c.ebx >> 22) & 0x3ff) as usize + 1;
+                let partitions = ((c.ebx >> 12) & 0x3ff) as usize + 1;
+                let line = (c.ebx & 0xfff) as usize + 1;
+                let sets = c.ecx as usize + 1;
+                return Some(ways * partitions * line * sets);
+            }
+        }
+        None
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    None
 }
 
 /// Orders the non-temporal stores made so far before any later store (`sfence`): after a kernel
@@ -411,6 +454,36 @@ mod tests {
         assert!(z.zero(1, 4) && !z.zero(0, 4) && !z.zero(2, 4) && z.zero(6, 1));
         assert!(!z.zero(5, 4), "past the end is not zero");
         assert!(z.zero(3, 0));
+    }
+
+    #[test]
+    fn intel_l2_from_cpuid_is_the_one_linux_reports() {
+        // CPUID leaf 4 against Linux's own reading of the caches (sysfs), where both exist
+        let Some(l2) = intel_l2_bytes() else {
+            assert_eq!(
+                stream_bytes(),
+                Stores::STREAM_BYTES,
+                "not Intel: the fixed threshold"
+            );
+            return;
+        };
+        let dir = std::path::Path::new("/sys/devices/system/cpu/cpu0/cache");
+        let level2 = (0..8).find_map(|i| {
+            let read = |f: &str| std::fs::read_to_string(dir.join(format!("index{i}/{f}")));
+            let (level, kind, size) = (read("level").ok()?, read("type").ok()?, read("size").ok()?);
+            (level.trim() == "2" && kind.trim() != "Instruction").then(|| size.trim().to_string())
+        });
+        match level2 {
+            Some(size) => {
+                let kib: usize = size
+                    .trim_end_matches('K')
+                    .parse()
+                    .expect("sysfs cache size");
+                assert_eq!(l2, kib * 1024, "CPUID leaf 4 against sysfs ({size})");
+            }
+            None => assert!((128 << 10..=64 << 20).contains(&l2), "L2 of {l2} bytes"),
+        }
+        assert_eq!(stream_bytes(), l2.max(1 << 20));
     }
 
     #[test]

@@ -399,9 +399,10 @@ impl LaneData {
 
     /// Declares that the kernel calls that follow write parts of one job's output of `bytes`
     /// bytes in all (0: each call is a job of its own, the default), as the batch engine does
-    /// when it splits a batch over threads or blocks: past 16 MB (`Stores::STREAM_BYTES`) the
-    /// kernels then store whole cache lines non-temporally, as they would for one call writing
-    /// it all. Only the speed depends on it.
+    /// when it splits a batch over threads or blocks: past 16 MB (on Intel's processors, the
+    /// L2 cache's size: `simd::rows::stream_bytes`) the kernels then store whole cache lines
+    /// non-temporally, as they would for one call writing it all. Only the speed depends on
+    /// it.
     pub fn set_job_output(&mut self, bytes: usize) {
         self.job_output = bytes;
     }
