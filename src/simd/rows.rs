@@ -57,7 +57,8 @@ pub(crate) fn stream_bytes() -> usize {
     *BYTES.get_or_init(|| intel_l2_bytes().map_or(Stores::STREAM_BYTES, |l2| l2.max(1 << 20)))
 }
 
-/// The size of the L2 cache of an Intel processor (CPUID leaf 4), `None` on any other.
+/// The size of the L2 cache of an Intel processor (CPUID leaf 4), `None` on any other (or
+/// past 1 GB).
 fn intel_l2_bytes() -> Option<usize> {
     #[cfg(target_arch = "x86_64")]
     {
@@ -80,7 +81,12 @@ fn intel_l2_bytes() -> Option<usize> {
                 let partitions = ((c.ebx >> 12) & 0x3ff) as usize + 1;
                 let line = (c.ebx & 0xfff) as usize + 1;
                 let sets = c.ecx as usize + 1;
-                return Some(ways * partitions * line * sets);
+                // a size no processor has (a hypervisor's invention) is not used
+                let bytes = ways
+                    .saturating_mul(partitions)
+                    .saturating_mul(line)
+                    .saturating_mul(sets);
+                return (bytes <= 1 << 30).then_some(bytes);
             }
         }
         None
