@@ -406,6 +406,9 @@ mod tests {
                             write_rows_with_zeros(&src, Some(&pattern), used, dst, stride, stores);
                         let mut nan = false;
                         for l in 0..used {
+                            // nothing written past a row's quantities (the runs' masked stores)
+                            let gap = &dst[l * stride + n..(l + 1) * stride];
+                            assert!(gap.iter().all(|v| *v == -1.0), "W {W} n {n} l {l}");
                             let row = &dst[l * stride..l * stride + n];
                             for (c, got) in row.iter().enumerate() {
                                 if !zero(c) {
@@ -427,6 +430,9 @@ mod tests {
                             }
                         }
                         assert_eq!(finite, !nan, "W {W} n {n} start {start}");
+                        assert!(store[..start].iter().all(|v| *v == -1.0));
+                        assert!(store[start + used * stride..].iter().all(|v| *v == -1.0));
+                        store.fill(-1.0);
                     }
                 }
             }
