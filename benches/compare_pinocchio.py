@@ -489,9 +489,10 @@ def main() -> int:
             side = Side(name, robot, model, args.samples, work, peer)
             first = first or side
             failures += agree(side)
-            # the engine's threads started before any pinning (they keep the cores they
-            # start with): a batch past the parallel threshold
-            side.ours("rnea", *side.big(8192, "rnea"))
+            if first is side:
+                # the engine's threads started before any pinning (they keep the cores they
+                # start with): a batch past the parallel threshold
+                side.ours("rnea", *side.big(8192, "rnea"))
             for kernel in KERNELS:
                 with pinned(one):
                     t_pin, t_our, t_store, ratios = run_kernel(side, kernel, args.rounds,
