@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import ctypes
+import functools
 import hashlib
 import json
 import os
@@ -265,29 +266,17 @@ class Side:
         return min(times)
 
 
-_STORE_FILL: list = []
-
-
+@functools.cache
 def store_fill():
-    """`fill_nt(address, count)` of benches/store_fill.c (built once per run with gcc into a
-    temporary directory), or None where it cannot be built (no gcc, not x86-64)."""
-    if not _STORE_FILL:
-        fn = None
-        work = Path(tempfile.mkdtemp(prefix="perturbid_store_fill-"))
-        lib = work / "store_fill.so"
-        if shutil.which("gcc") is not None:
-            built = subprocess.run(["gcc", "-O2", "-shared", "-fPIC",
-                                    str(ROOT / "benches" / "store_fill.c"), "-o", str(lib)],
-                                   capture_output=True, text=True)
-            if built.returncode == 0:
-                fn = ctypes.CDLL(str(lib)).fill_nt
-                fn.argtypes, fn.restype = [ctypes.c_void_p, ctypes.c_size_t], None
-            else:
-                print("no non-temporal fill (store_fill.c did not build): the ceiling from "
-                      "memset alone\n" + built.stderr[-1000:], file=sys.stderr)
-        shutil.rmtree(work, ignore_errors=True)  # the library stays mapped
-        _STORE_FILL.append(fn)
-    return _STORE_FILL[0]
+    """`fill_nt(address, count)` of benches/store_fill.c (built once per run into a temporary
+    directory), or None where it cannot be built (the ceiling then from `memset` alone)."""
+    with tempfile.TemporaryDirectory(prefix="perturbid_store_fill-") as work:
+        lib = Path(work) / "store_fill.so"
+        if not build_c("store_fill.c", lib, "-shared", "-fPIC"):
+            return None
+        fn = ctypes.CDLL(str(lib)).fill_nt  # stays mapped once the file is gone
+    fn.argtypes, fn.restype = [ctypes.c_void_p, ctypes.c_size_t], None
+    return fn
 
 
 def warm_ns(call, samples, min_seconds=0.02):
@@ -409,27 +398,34 @@ def flop_counts() -> dict:
     return {(r["robot"], r["kernel"]): r["flops_per_sample"] for r in rows}
 
 
+def build_c(source: str, output: Path, *flags: str) -> bool:
+    """benches/`source` compiled with gcc (`-O2` and `flags`) into `output`; False, with
+    gcc's message on standard error, where it cannot be (no gcc, not x86-64)."""
+    if shutil.which("gcc") is None:
+        print(f"no gcc: {source} not built", file=sys.stderr)
+        return False
+    built = subprocess.run(["gcc", "-O2", *flags, str(ROOT / "benches" / source), "-o",
+                            str(output)], capture_output=True, text=True)
+    if built.returncode != 0:
+        print(f"{source} did not build:\n" + built.stderr[-1000:], file=sys.stderr)
+    return built.returncode == 0
+
+
 def measured_peak(isa: str) -> float | None:
     """GFlop/s one core issues with fused multiply-adds at the width of our `isa` path
-    (benches/peak_flops.c, built here with gcc: 512-bit for avx512, 256-bit for avx2+fma), or
-    None (the scalar path, no gcc, not x86-64). Measured, since neither the number of FMA
-    pipes (one or two 512-bit ones on Intel's Xeons, two 256-bit ones on AMD's Zen 3 and 4)
-    nor the clock under load can be read off /proc/cpuinfo."""
+    (benches/peak_flops.c: 512-bit for avx512, 256-bit for avx2+fma), or None (the scalar
+    path, or the probe not built). Measured, since neither the number of FMA pipes (one or
+    two 512-bit ones on Intel's Xeons, two 256-bit ones on AMD's Zen 3 and 4) nor the clock
+    under load can be read off /proc/cpuinfo."""
     bits = {"avx512": "512", "avx2+fma": "256"}.get(isa)
-    if bits is None or shutil.which("gcc") is None:
+    if bits is None:
         return None
-    exe = Path(tempfile.gettempdir()) / f"perturbid_peak_flops-{os.getpid()}"
-    try:
-        built = subprocess.run(["gcc", "-O2", str(ROOT / "benches" / "peak_flops.c"), "-o",
-                                str(exe)], capture_output=True, text=True)
-        if built.returncode != 0:
-            print("no peak (peak_flops.c did not build):\n" + built.stderr[-1000:],
-                  file=sys.stderr)
+    with tempfile.TemporaryDirectory(prefix="perturbid_peak_flops-") as work:
+        exe = Path(work) / "peak_flops"
+        if not build_c("peak_flops.c", exe):
             return None
         done = subprocess.run([str(exe), bits], capture_output=True, text=True, check=True)
         return float(json.loads(done.stdout)["gflops"])
-    finally:
-        exe.unlink(missing_ok=True)
 
 
 def cpu_model() -> str:
