@@ -2,12 +2,13 @@
 //! registers (4x4 in 256-bit ones with AVX, 8x8 in 512-bit ones with AVX-512), stored a row at a
 //! time (non-temporally where asked), with the finiteness test of the values on the way.
 
-use super::{scalars, ZeroPattern};
+use super::{scalars, Stores, ZeroPattern};
 use crate::simd::Lanes;
 
 /// [`super::write_rows_with_zeros`]'s work with AVX-512 (8 full lanes, `W == 8`): blocks of 8
 /// by 8 in 512-bit registers ([`transpose8`]), from a cache line's start where every row falls
-/// alike on the lines (`stride` a multiple of 8), the rest by [`narrow`]. Returns the
+/// alike on the lines (`stride` a multiple of 8), each row on its own lines where they do not
+/// and `stores.lined` asks for it ([`lined8`]), the rest by [`narrow`]. Returns the
 /// finiteness bits: 0 when every value is vouched finite.
 ///
 /// # Safety
@@ -19,12 +20,10 @@ pub(super) unsafe fn blocks_avx512<const W: usize>(
     zeros: Option<&ZeroPattern>,
     dst: &mut [f64],
     stride: usize,
-    stream: bool,
+    stores: Stores,
 ) -> u64 {
-    use std::arch::x86_64::{
-        _mm256_add_pd, _mm256_setzero_pd, _mm512_castpd512_pd256, _mm512_extractf64x4_pd,
-        _mm512_setzero_pd,
-    };
+    use std::arch::x86_64::{_mm256_add_pd, _mm256_setzero_pd, _mm512_setzero_pd};
+    let stream = stores.stream;
     let (n, used) = (src.len(), W);
     let zero = |c: usize, len: usize| zeros.is_some_and(|z| z.zero(c, len));
     let (mut sum, mut wide_sum) = (_mm256_setzero_pd(), _mm512_setzero_pd());
@@ -35,6 +34,12 @@ pub(super) unsafe fn blocks_avx512<const W: usize>(
     } else {
         0
     };
+    if stores.lined && !stride.is_multiple_of(8) {
+        // rows that fall each its own way on the lines: each laid on its own
+        let c = lined8(src, &zero, dst, stride, stream, &mut wide_sum);
+        let bits = narrow(src, &zero, used, dst, stride, c, n, &mut sum);
+        return bits | not_finite4(_mm256_add_pd(sum, halves(wide_sum)));
+    }
     let mut bits = narrow(src, &zero, used, dst, stride, 0, head, &mut sum);
     let mut c = head;
     while c + 8 <= n {
@@ -59,12 +64,127 @@ pub(super) unsafe fn blocks_avx512<const W: usize>(
         c += 8;
     }
     bits |= narrow(src, &zero, used, dst, stride, c, n, &mut sum);
-    // the 512-bit sum's halves into the 256-bit one (finite only if both are)
-    let halves = _mm256_add_pd(
-        _mm512_castpd512_pd256(wide_sum),
-        _mm512_extractf64x4_pd::<1>(wide_sum),
-    );
-    bits | not_finite4(_mm256_add_pd(sum, halves))
+    bits | not_finite4(_mm256_add_pd(sum, halves(wide_sum)))
+}
+
+/// The halves of a 512-bit finiteness sum added into one of 256 bits (finite only if both are).
+///
+/// # Safety
+/// The processor has AVX-512F; no `target_feature` of its own, as [`transpose8`].
+#[inline(always)]
+unsafe fn halves(sum: std::arch::x86_64::__m512d) -> std::arch::x86_64::__m256d {
+    use std::arch::x86_64::{_mm256_add_pd, _mm512_castpd512_pd256, _mm512_extractf64x4_pd};
+    _mm256_add_pd(
+        _mm512_castpd512_pd256(sum),
+        _mm512_extractf64x4_pd::<1>(sum),
+    )
+}
+
+/// [`blocks_avx512`]'s blocks of 8 where the rows do not fall alike on the cache lines
+/// (`stride` no multiple of 8 values: the Panda's 7 x 70 regressor, its 7 x 7 matrices): every
+/// store one aligned cache line of one row. Each row's values are shifted to its own lines
+/// across two consecutive transposed blocks (one `vpermt2pd` a row); a row's first and last
+/// lines, shared with what lies beside it, are masked stores. Where the same blocks went
+/// straight to `c..c + 8`, most of their 64-byte stores straddled two lines, each costing
+/// twice. Writes quantities `0..8 (n / 8)`, which it returns (the rest for [`narrow`]); their
+/// values are added to `sum` (see [`transpose4`]). Blocks that `zero` marks are not read.
+/// With `stream`, the whole lines are stored non-temporally (as [`store8`]).
+///
+/// # Safety
+/// The processor has AVX-512F; no `target_feature` of its own, as [`transpose8`].
+#[inline(always)]
+unsafe fn lined8<const W: usize>(
+    src: &[Lanes<W>],
+    zero: &impl Fn(usize, usize) -> bool,
+    dst: &mut [f64],
+    stride: usize,
+    stream: bool,
+    sum: &mut std::arch::x86_64::__m512d,
+) -> usize {
+    use std::arch::x86_64::{
+        _mm512_add_epi64, _mm512_add_pd, _mm512_loadu_pd, _mm512_mask_storeu_pd,
+        _mm512_permutex2var_pd, _mm512_set1_epi64, _mm512_set_epi64, _mm512_setzero_pd,
+        _mm512_store_pd, _mm512_stream_pd,
+    };
+    let blocks = src.len() / 8;
+    if blocks == 0 {
+        return 0;
+    }
+    // rows 0..8, quantities 0..8 blocks (bounds-checked once)
+    let rows = &mut dst[..7 * stride + 8 * blocks];
+    let base = rows.as_mut_ptr();
+    // row l starts `shift[l]` values into a line; line k of the row holds its quantities
+    // 8 k - shift .. 8 k - shift + 8: the last `shift` of block k - 1, the first of block k,
+    // which `vpermt2pd` picks by `pick[l]` (entry j: 8 - shift + j, of the first block if
+    // below 8)
+    let shift: [usize; 8] = std::array::from_fn(|l| (base.add(l * stride) as usize / 8) % 8);
+    // (a loop, not a closure: one compiled out of line would lose the target feature)
+    let mut pick = [_mm512_set1_epi64(0); 8];
+    for (p, s) in pick.iter_mut().zip(shift) {
+        *p = _mm512_add_epi64(
+            _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0),
+            _mm512_set1_epi64((8 - s) as i64),
+        );
+    }
+    // the start of the line of row l that holds quantity c - shift (before `base` for the
+    // first line of row 0 when it starts within a line: only the masked store's lanes within
+    // the rows touch memory)
+    let start = |l: usize, c: usize| base.add(l * stride + c).wrapping_sub(shift[l]);
+    let mut previous = ([_mm512_setzero_pd(); 8], true);
+    for k in 0..blocks {
+        let c = 8 * k;
+        let current = if zero(c, 8) {
+            ([_mm512_setzero_pd(); 8], true)
+        } else {
+            // one 8-lane quantity (bounds-checked: fails unless W >= 8)
+            let at = |q: usize| src[c + q].0[..8].as_ptr();
+            let r = [
+                _mm512_loadu_pd(at(0)),
+                _mm512_loadu_pd(at(1)),
+                _mm512_loadu_pd(at(2)),
+                _mm512_loadu_pd(at(3)),
+                _mm512_loadu_pd(at(4)),
+                _mm512_loadu_pd(at(5)),
+                _mm512_loadu_pd(at(6)),
+                _mm512_loadu_pd(at(7)),
+            ];
+            let block = _mm512_add_pd(
+                _mm512_add_pd(_mm512_add_pd(r[0], r[1]), _mm512_add_pd(r[2], r[3])),
+                _mm512_add_pd(_mm512_add_pd(r[4], r[5]), _mm512_add_pd(r[6], r[7])),
+            );
+            *sum = _mm512_add_pd(*sum, block);
+            (transposed8(r), false)
+        };
+        for l in 0..8 {
+            let (p, v) = if current.1 && previous.1 {
+                (start(l, c), _mm512_setzero_pd())
+            } else {
+                let v = _mm512_permutex2var_pd(previous.0[l], pick[l], current.0[l]);
+                (start(l, c), v)
+            };
+            // SAFETY: `p` is on a 64-byte boundary; the line's values are quantities
+            // c - shift .. c - shift + 8 of row l, all within `rows` for k > 0 (c - shift >= 0,
+            // c + 8 - shift <= 8 blocks), for k = 0 those from `shift` on (the mask)
+            if k == 0 && shift[l] > 0 {
+                _mm512_mask_storeu_pd(p, 0xffu8 << shift[l], v);
+            } else if stream {
+                _mm512_stream_pd(p, v);
+            } else {
+                _mm512_store_pd(p, v);
+            }
+        }
+        previous = current;
+    }
+    // each row's last line: the last `shift` values of the last block
+    for (l, s) in shift.into_iter().enumerate() {
+        if s > 0 {
+            let v = _mm512_permutex2var_pd(previous.0[l], pick[l], _mm512_setzero_pd());
+            // SAFETY: the lanes below `shift` are quantities 8 blocks - shift .. 8 blocks of
+            // row l, within `rows`
+            _mm512_mask_storeu_pd(start(l, 8 * blocks), (1u8 << s) - 1, v);
+        }
+    }
+    8 * blocks
 }
 
 /// [`super::write_rows_with_zeros`]'s work with AVX: blocks of 4 by 4 in 256-bit registers,
