@@ -295,7 +295,7 @@ def warm_ns(call, samples, min_seconds=0.02):
 def agree(side: Side) -> list[str]:
     """Checks every kernel's results against Pinocchio's (the C++ peer's files, or pin's Python
     calls), and the parameters identified from either regressor; returns the failures."""
-    n, k, perm = side.robot.n, min(side.k, 256), side.perm
+    k, perm = min(side.k, 256), side.perm
     m, d = side.model, side.model.createData()
     inv = np.argsort(perm)
     x = {key: v[:k] for key, v in side.x.items()}

@@ -61,7 +61,7 @@ def main(argv: list[str] | None = None) -> int:
     print(row("paper, perturbation", D1_PERTURBATION))
     print(row("  with 0.05 N m noise", noisy.D[:, 0]))
     print(row("  standard error", noisy.stderr["D"][:, 0]))
-    print(f"\ncond(X): " + ", ".join(f"{k} {v:.2f}" for k, v in model.cond.items()))
+    print("\ncond(X): " + ", ".join(f"{k} {v:.2f}" for k, v in model.cond.items()))
     worst_t = np.abs(model.torque - TN).max()
     worst_d = np.abs(model.D - actual).max() / np.abs(actual).max()
     print(f"largest difference: T* vs paper {worst_t:.4f} N m; identified D* vs M(q*) {worst_d:.1e} (relative)")

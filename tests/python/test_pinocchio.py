@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from conftest import Pair, erd_dir, pair_from_text, pair_from_urdf, pin, relerr
+from conftest import Pair, erd_dir, pair_from_urdf, pin, relerr
 import perturbid_rs as pr
 
 TOL = 1e-9
