@@ -523,6 +523,25 @@ mod tests {
     }
 
     #[test]
+    fn rows_are_lined_on_intel_processors_only() {
+        // CPUID's vendor against Linux's reading of it, where there is one
+        let Ok(info) = std::fs::read_to_string("/proc/cpuinfo") else {
+            return;
+        };
+        let Some(vendor) = info.lines().find_map(|l| {
+            l.strip_prefix("vendor_id")
+                .map(|v| v.trim_start_matches([' ', '\t', ':']))
+        }) else {
+            return;
+        };
+        let intel = vendor.trim() == "GenuineIntel";
+        assert_eq!(lined_rows(), intel, "vendor {vendor}");
+        for wide in [false, true] {
+            assert_eq!(Stores::for_output(wide, 0).lined, wide && intel);
+        }
+    }
+
+    #[test]
     fn rows_are_the_lanes_transposed() {
         // the AVX-512 buffers' 8x8 blocks (plain or non-temporal stores) where the processor
         // has AVX-512, and the 4x4 ones
