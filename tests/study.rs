@@ -140,7 +140,14 @@ fn a_study_agrees_with_the_methods_one_by_one() {
     let summary = read(&out.join("summary.csv"));
     assert!(summary.starts_with("robot,speed_class,true_robot,noise,design,k,perturbation,method,metric,distance,count,median,p05,p95\n"));
     assert!(read(&out.join("summary.md")).contains("| local_separated |"));
-    assert!(read(&out.join("error_vs_distance.svg")).starts_with("<svg"));
+    let figure = read(&out.join("error_vs_distance.svg"));
+    assert!(figure.starts_with("<svg"));
+    // a median curve and its 5-95 % band for every method of the panel
+    assert_eq!(
+        figure.matches("<polygon").count(),
+        figure.matches("<polyline").count()
+    );
+    assert!(figure.contains("<polygon"));
 }
 
 #[test]

@@ -30,7 +30,7 @@ class StudyResult:
 
     ``results_csv``: the tidy table (one row per case, method, metric and distance);
     ``summary_csv``: medians and 5-95 % intervals over points and seeds; ``figure``: median
-    relative RMS error against distance; ``parquet``: the results as Parquet (pyarrow), or None.
+    relative RMS error against distance (log axis), its 5-95 % interval shaded; ``parquet``: the results as Parquet (pyarrow), or None.
     """
 
     out: Path

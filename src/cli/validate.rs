@@ -146,6 +146,7 @@ fn figure(joints: &[String], t: &[f64], measured: &[f64], predicted: &[f64]) -> 
                         dash: "",
                         x: t,
                         y: &m,
+                        band: None,
                     },
                     Series {
                         name: "predicted",
@@ -153,6 +154,7 @@ fn figure(joints: &[String], t: &[f64], measured: &[f64], predicted: &[f64]) -> 
                         dash: "6 4",
                         x: t,
                         y: &p,
+                        band: None,
                     },
                     Series {
                         name: "residual",
@@ -160,6 +162,7 @@ fn figure(joints: &[String], t: &[f64], measured: &[f64], predicted: &[f64]) -> 
                         dash: "2 2",
                         x: t,
                         y: &r,
+                        band: None,
                     },
                 ],
             )

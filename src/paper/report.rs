@@ -137,6 +137,7 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
                 dash: "",
                 x: &f.t,
                 y: &f.actual,
+                band: None,
             },
             svg::Series {
                 name: "local model (perturbation method)",
@@ -144,6 +145,7 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
                 dash: "6 4",
                 x: &f.t,
                 y: &f.local,
+                band: None,
             },
             svg::Series {
                 name: &median,
@@ -151,6 +153,7 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
                 dash: "2 3",
                 x: &f.t,
                 y: &f.global_linear,
+                band: None,
             },
             svg::Series {
                 name: &low,
@@ -158,6 +161,7 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
                 dash: "1 2",
                 x: &f.t,
                 y: &f.global_linear_min,
+                band: None,
             },
             svg::Series {
                 name: &high,
@@ -165,6 +169,7 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
                 dash: "1 2",
                 x: &f.t,
                 y: &f.global_linear_max,
+                band: None,
             },
             svg::Series {
                 name: &base,
@@ -172,6 +177,7 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
                 dash: "10 3 2 3",
                 x: &f.t,
                 y: &f.base_parameters,
+                band: None,
             },
         ];
         let title = format!(

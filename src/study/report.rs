@@ -256,10 +256,11 @@ against the true plant's. robot_time: seconds of motion the method's experiments
     md
 }
 
-/// (distance, median) points of one method's curve.
-type Curve = Vec<(f64, f64)>;
+/// (distance, median, 5 %, 95 %) points of one method's curve.
+type Curve = Vec<(f64, f64, f64, f64)>;
 
-/// Median relative RMS error against distance, one curve per method and section.
+/// Median relative RMS error against distance on a log axis, one curve per method and
+/// section, each with its 5-95 % interval over points and seeds shaded around it.
 fn figure(summary: &[SummaryRow]) -> String {
     let colors = [
         "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b",
@@ -271,7 +272,7 @@ fn figure(summary: &[SummaryRow]) -> String {
         curves
             .entry((s.group[..7].to_vec(), s.group[7].clone()))
             .or_default()
-            .push((d, s.median));
+            .push((d, s.median, s.p05, s.p95));
     }
     let mut sections: BTreeMap<Vec<String>, Vec<(String, Curve)>> = BTreeMap::new();
     for ((section, method), mut pts) in curves {
@@ -281,32 +282,41 @@ fn figure(summary: &[SummaryRow]) -> String {
     let panels: Vec<String> = sections
         .iter()
         .map(|(key, methods)| {
-            let data: Vec<(String, Vec<f64>, Vec<f64>)> = methods
+            // per method: x, median, 5 %, 95 %
+            let data: Vec<(String, [Vec<f64>; 4])> = methods
                 .iter()
                 .map(|(m, pts)| {
+                    let column = |f: fn(&(f64, f64, f64, f64)) -> f64| pts.iter().map(f).collect();
                     (
                         m.clone(),
-                        pts.iter().map(|p| p.0).collect(),
-                        pts.iter().map(|p| p.1).collect(),
+                        [
+                            column(|p| p.0),
+                            column(|p| p.1),
+                            column(|p| p.2),
+                            column(|p| p.3),
+                        ],
                     )
                 })
                 .collect();
             let series: Vec<crate::svg::Series<'_>> = data
                 .iter()
                 .enumerate()
-                .map(|(i, (m, x, y))| crate::svg::Series {
+                .map(|(i, (m, [x, y, low, high]))| crate::svg::Series {
                     name: m,
                     color: colors[i % colors.len()],
                     dash: dashes[i % dashes.len()],
                     x,
                     y,
+                    band: Some([low, high]),
                 })
                 .collect();
-            crate::svg::line_plot(
+            // the methods' errors lie orders of magnitude apart: decades
+            crate::svg::scaled_plot(
                 &format!("{} / speed {} / true robot {}", key[0], key[1], key[2]),
                 "distance from P (perturbation sizes)",
-                "median relative RMS error",
+                "relative RMS error: median, 5-95 % shaded",
                 &series,
+                crate::svg::Scale::Log,
             )
         })
         .collect();
