@@ -130,7 +130,15 @@ pub fn scaled_plot(
     scale: Scale,
 ) -> String {
     let (w, h) = (960.0, 480.0);
-    let (left, right, top, bottom) = (80.0, 180.0, 40.0, 60.0);
+    // the legend's column as wide as its longest name (about 7 px a character at 13 px),
+    // within half the width
+    let longest = series
+        .iter()
+        .map(|s| s.name.chars().count())
+        .max()
+        .unwrap_or(0);
+    let right = (46.0 + 7.0 * longest as f64).clamp(180.0, w / 2.0);
+    let (left, top, bottom) = (80.0, 40.0, 60.0);
     let finite = |v: &&f64| v.is_finite();
     let xs = series.iter().flat_map(|s| s.x.iter()).filter(finite);
     let (x0, x1) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
@@ -407,5 +415,40 @@ mod tests {
             .map(|t| t.1)
             .collect();
         assert_eq!(labels, ["0.5", "1", "2", "5"]);
+    }
+
+    #[test]
+    fn the_legend_is_as_wide_as_its_longest_name() {
+        let (x, y) = ([0.0, 1.0], [0.0, 1.0]);
+        let name = "direct: globally linearised, median of 5 (range shaded)";
+        let series = |name| Series {
+            name,
+            color: "#000000",
+            dash: "",
+            x: &x,
+            y: &y,
+            band: None,
+        };
+        // the name's text starts far enough left for about 7 px a character
+        let start = |plot: &str| -> f64 {
+            let text = plot
+                .lines()
+                .filter(|l| l.starts_with("<text x="))
+                .last()
+                .unwrap();
+            text["<text x=\"".len()..]
+                .split('"')
+                .next()
+                .unwrap()
+                .parse()
+                .unwrap()
+        };
+        let long = line_plot("t", "x", "y", &[series(name)]);
+        assert!(start(&long) + 7.0 * name.len() as f64 <= 960.0 + 1e-9);
+        // a short one keeps the usual 180 px column
+        assert_eq!(
+            start(&line_plot("t", "x", "y", &[series("m")])),
+            960.0 - 180.0 + 46.0
+        );
     }
 }

@@ -124,11 +124,7 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
         } else {
             format!("fig{number}_joint{}_{}.svg", f.joint, f.excitation)
         };
-        let (median, low, high) = (
-            format!("direct: globally linearised, median of {seeds} excitations"),
-            "  lowest of them".to_string(),
-            "  highest of them".to_string(),
-        );
+        let median = format!("direct: globally linearised, median of {seeds} (range shaded)");
         let base = format!("direct: base parameters, median of {seeds}");
         let series = [
             svg::Series {
@@ -153,23 +149,7 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
                 dash: "2 3",
                 x: &f.t,
                 y: &f.global_linear,
-                band: None,
-            },
-            svg::Series {
-                name: &low,
-                color: "#9ecae1",
-                dash: "1 2",
-                x: &f.t,
-                y: &f.global_linear_min,
-                band: None,
-            },
-            svg::Series {
-                name: &high,
-                color: "#9ecae1",
-                dash: "1 2",
-                x: &f.t,
-                y: &f.global_linear_max,
-                band: None,
+                band: Some([&f.global_linear_min, &f.global_linear_max]),
             },
             svg::Series {
                 name: &base,
@@ -298,8 +278,8 @@ fn markdown_report(r: &PaperResult, figs: &[String]) -> String {
     s.push_str("\n## Figs. 3-5: torques along a trajectory through the operating point\n\n");
     s.push_str(&format!(
         "The trajectory is `q(t) = q* + qd* t + qdd* t²/2` for t in [-3, 3] s, which passes P at t = 0. \
-         The direct models are fitted on {seeds} excitations (seeds {}..{}) and drawn as their median with the lowest \
-         and highest of them; first with excitations designed within the joint limits (ours), then with excitations \
+         The direct models are fitted on {seeds} excitations (seeds {}..{}) and drawn as their median with the range from the lowest \
+         to the highest of them shaded; first with excitations designed within the joint limits (ours), then with excitations \
          kept within q* ± 0.5 rad, like the paper's, which stays near the point.\n\n",
         r.direct[0].seeds.first().copied().unwrap_or(0),
         r.direct[0].seeds.last().copied().unwrap_or(0),
