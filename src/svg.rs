@@ -431,11 +431,7 @@ mod tests {
         };
         // the name's text starts far enough left for about 7 px a character
         let start = |plot: &str| -> f64 {
-            let text = plot
-                .lines()
-                .filter(|l| l.starts_with("<text x="))
-                .last()
-                .unwrap();
+            let text = plot.lines().rfind(|l| l.starts_with("<text x=")).unwrap();
             text["<text x=\"".len()..]
                 .split('"')
                 .next()
