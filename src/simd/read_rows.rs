@@ -48,22 +48,12 @@ unsafe fn blocks_avx512<const W: usize>(
     rows: &[usize; W],
     dst: &mut [Lanes<W>],
 ) -> usize {
-    use std::arch::x86_64::{_mm512_loadu_pd, _mm512_storeu_pd};
+    use std::arch::x86_64::_mm512_storeu_pd;
     let n = dst.len();
     let mut c = 0;
     while c + 8 <= n {
         // one bounds-checked row of 8 values
-        let at = |l: usize| src[rows[l] + c..rows[l] + c + 8].as_ptr();
-        let r = [
-            _mm512_loadu_pd(at(0)),
-            _mm512_loadu_pd(at(1)),
-            _mm512_loadu_pd(at(2)),
-            _mm512_loadu_pd(at(3)),
-            _mm512_loadu_pd(at(4)),
-            _mm512_loadu_pd(at(5)),
-            _mm512_loadu_pd(at(6)),
-            _mm512_loadu_pd(at(7)),
-        ];
+        let r = super::rows::load8(|l| src[rows[l] + c..rows[l] + c + 8].as_ptr());
         for (q, v) in super::rows::transposed8(r).into_iter().enumerate() {
             // (bounds-checked: fails unless W >= 8)
             _mm512_storeu_pd(dst[c + q].0[..8].as_mut_ptr(), v);

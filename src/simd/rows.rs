@@ -8,7 +8,7 @@ mod blocks;
 #[cfg(target_arch = "x86_64")]
 use blocks::{blocks_avx, blocks_avx512};
 #[cfg(target_arch = "x86_64")]
-pub(super) use blocks::{transposed4x4, transposed8};
+pub(super) use blocks::{load8, transposed4x4, transposed8};
 
 /// How [`write_rows`] stores its blocks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

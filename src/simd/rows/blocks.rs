@@ -102,9 +102,8 @@ unsafe fn lined8<const W: usize>(
     sum: &mut std::arch::x86_64::__m512d,
 ) -> usize {
     use std::arch::x86_64::{
-        _mm512_add_epi64, _mm512_add_pd, _mm512_loadu_pd, _mm512_mask_storeu_pd,
-        _mm512_permutex2var_pd, _mm512_set1_epi64, _mm512_set_epi64, _mm512_setzero_pd,
-        _mm512_store_pd, _mm512_stream_pd,
+        _mm512_add_epi64, _mm512_mask_storeu_pd, _mm512_permutex2var_pd, _mm512_set1_epi64,
+        _mm512_set_epi64, _mm512_setzero_pd, _mm512_store_pd, _mm512_stream_pd,
     };
     let blocks = src.len() / 8;
     if blocks == 0 {
@@ -136,23 +135,7 @@ unsafe fn lined8<const W: usize>(
         let current = if zero(c, 8) {
             ([_mm512_setzero_pd(); 8], true)
         } else {
-            // one 8-lane quantity (bounds-checked: fails unless W >= 8)
-            let at = |q: usize| src[c + q].0[..8].as_ptr();
-            let r = [
-                _mm512_loadu_pd(at(0)),
-                _mm512_loadu_pd(at(1)),
-                _mm512_loadu_pd(at(2)),
-                _mm512_loadu_pd(at(3)),
-                _mm512_loadu_pd(at(4)),
-                _mm512_loadu_pd(at(5)),
-                _mm512_loadu_pd(at(6)),
-                _mm512_loadu_pd(at(7)),
-            ];
-            let block = _mm512_add_pd(
-                _mm512_add_pd(_mm512_add_pd(r[0], r[1]), _mm512_add_pd(r[2], r[3])),
-                _mm512_add_pd(_mm512_add_pd(r[4], r[5]), _mm512_add_pd(r[6], r[7])),
-            );
-            *sum = _mm512_add_pd(*sum, block);
+            let r = loaded8(&src[c..c + 8], sum);
             (transposed8(r), false)
         };
         for l in 0..8 {
@@ -394,29 +377,52 @@ unsafe fn transpose8<const W: usize>(
     stream: bool,
     sum: &mut std::arch::x86_64::__m512d,
 ) {
-    use std::arch::x86_64::{_mm512_add_pd, _mm512_loadu_pd};
-    // one 8-lane quantity (bounds-checked: fails unless W >= 8)
-    #[inline(always)]
-    fn at<const W: usize>(src: &[Lanes<W>], q: usize) -> *const f64 {
-        src[q].0[..8].as_ptr()
-    }
-    let r = [
-        _mm512_loadu_pd(at(src, 0)),
-        _mm512_loadu_pd(at(src, 1)),
-        _mm512_loadu_pd(at(src, 2)),
-        _mm512_loadu_pd(at(src, 3)),
-        _mm512_loadu_pd(at(src, 4)),
-        _mm512_loadu_pd(at(src, 5)),
-        _mm512_loadu_pd(at(src, 6)),
-        _mm512_loadu_pd(at(src, 7)),
-    ];
+    let r = loaded8(src, sum);
+    let out = transposed8(r);
+    store8(dst, stride, c, out, stream);
+}
+
+/// The 8 lanes of the 8 quantities `src` (`W == 8`; bounds-checked: fails unless `W >= 8` and
+/// `src` holds 8), loaded; their sum added to `sum` (8 adds; see [`transpose4`]).
+///
+/// # Safety
+/// The processor has AVX-512F; no `target_feature` of its own, as [`transpose8`].
+#[inline(always)]
+unsafe fn loaded8<const W: usize>(
+    src: &[Lanes<W>],
+    sum: &mut std::arch::x86_64::__m512d,
+) -> [std::arch::x86_64::__m512d; 8] {
+    use std::arch::x86_64::_mm512_add_pd;
+    let r = load8(|q| src[q].0[..8].as_ptr());
     let block = _mm512_add_pd(
         _mm512_add_pd(_mm512_add_pd(r[0], r[1]), _mm512_add_pd(r[2], r[3])),
         _mm512_add_pd(_mm512_add_pd(r[4], r[5]), _mm512_add_pd(r[6], r[7])),
     );
     *sum = _mm512_add_pd(*sum, block);
-    let out = transposed8(r);
-    store8(dst, stride, c, out, stream);
+    r
+}
+
+/// The 8 values at each of `at(0)`, ..., `at(7)` (512-bit loads).
+///
+/// # Safety
+/// The processor has AVX-512F; each pointer is valid for 8 values. No `target_feature` of
+/// its own, as [`transpose8`] (`at` computes pointers only: compiled out of line, it would
+/// lose no instruction set).
+#[inline(always)]
+pub(in crate::simd) unsafe fn load8(
+    at: impl Fn(usize) -> *const f64,
+) -> [std::arch::x86_64::__m512d; 8] {
+    use std::arch::x86_64::_mm512_loadu_pd;
+    [
+        _mm512_loadu_pd(at(0)),
+        _mm512_loadu_pd(at(1)),
+        _mm512_loadu_pd(at(2)),
+        _mm512_loadu_pd(at(3)),
+        _mm512_loadu_pd(at(4)),
+        _mm512_loadu_pd(at(5)),
+        _mm512_loadu_pd(at(6)),
+        _mm512_loadu_pd(at(7)),
+    ]
 }
 
 /// The 8x8 matrix of rows `r` transposed (entry `j` of output `l` is entry `l` of `r[j]`): 24
