@@ -17,13 +17,21 @@ LONG_DESIGN = "import perturbid_rs as pr; pr.design_excitation(pr.robots.a465(),
 
 
 def interrupt(args, **kwargs):
-    child = subprocess.Popen(args, stderr=subprocess.PIPE, text=True, **kwargs)
-    time.sleep(2.0)  # well into the work (imports and the base parameters come first)
-    assert child.poll() is None, child.stderr.read()
-    sent = time.monotonic()
-    child.send_signal(signal.SIGINT)
-    _, err = child.communicate(timeout=30)
-    return child.returncode, err, time.monotonic() - sent
+    """Starts `args`, sends SIGINT well into the work, and returns the exit code, stderr and the
+    seconds from the signal to the exit. Taken twice when the first took 3 s or more: on a
+    shared virtual machine a process can get no processor for seconds (seen once: both tests
+    5.5-6 s in one full run, 0.02-0.07 s at every delay right after); work that does not stop
+    on Ctrl-C takes far longer both times."""
+    for attempt in range(2):
+        child = subprocess.Popen(args, stderr=subprocess.PIPE, text=True, **kwargs)
+        time.sleep(2.0)  # well into the work (imports and the base parameters come first)
+        assert child.poll() is None, child.stderr.read()
+        sent = time.monotonic()
+        child.send_signal(signal.SIGINT)
+        _, err = child.communicate(timeout=30)
+        took = time.monotonic() - sent
+        if took < 3 or attempt == 1:
+            return child.returncode, err, took
 
 
 def test_python_gets_keyboard_interrupt():
