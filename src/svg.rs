@@ -59,6 +59,8 @@ impl Scale {
                 .into_iter()
                 .map(|t| (t, fmt_tick(t)))
                 .collect(),
+            // nothing to draw (no value the scale can show)
+            Scale::Log if !(lo.is_finite() && hi.is_finite() && lo <= hi) => Vec::new(),
             Scale::Log => {
                 // 1, 2 and 5 times the powers of ten in range; the powers alone over three
                 // decades or more; round values in between over less than one
@@ -446,5 +448,24 @@ mod tests {
             start(&line_plot("t", "x", "y", &[series("m")])),
             960.0 - 180.0 + 46.0
         );
+    }
+
+    #[test]
+    fn a_log_axis_with_nothing_to_draw_is_an_empty_plot() {
+        let (x, y) = ([0.0, 1.0], [0.0, f64::NAN]);
+        let series = [Series {
+            name: "m",
+            color: "#000000",
+            dash: "",
+            x: &x,
+            y: &y,
+            band: Some([&y, &y]),
+        }];
+        let plot = scaled_plot("t", "x", "y", &series, Scale::Log);
+        assert!(plot.starts_with("<svg") && plot.ends_with("</svg>\n"));
+        assert!(!plot.contains("<polygon"));
+        assert!(Scale::Log
+            .ticks(f64::INFINITY, f64::NEG_INFINITY)
+            .is_empty());
     }
 }
