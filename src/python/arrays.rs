@@ -2,12 +2,49 @@
 
 use nalgebra::DMatrix;
 use numpy::{
-    AllowTypeChange, PyArray1, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods,
+    AllowTypeChange, PyArray1, PyArrayDescrMethods, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods,
+    PyUntypedArray, PyUntypedArrayMethods,
 };
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use std::borrow::Cow;
 
-pub(crate) type ArrayLike<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+/// An array argument of real numbers: a numpy array or anything `numpy.asarray` takes, as
+/// float64 (a copy when of another real dtype). Complex, boolean, string, object and time
+/// dtypes are refused with a `TypeError` (which Python names the argument in) instead of
+/// numpy's conversion, which drops an imaginary part with only a warning, and reads `True` as 1.
+pub(crate) struct ArrayLike<'py>(PyArrayLikeDyn<'py, f64, AllowTypeChange>);
+
+impl<'py> std::ops::Deref for ArrayLike<'py> {
+    type Target = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for ArrayLike<'py> {
+    type Error = PyErr;
+
+    fn extract(ob: pyo3::Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        // the dtype numpy gives it (lists and scalars converted once, here)
+        let array = match ob.cast::<PyUntypedArray>() {
+            Ok(a) => a.to_owned(),
+            Err(_) => {
+                let numpy = ob.py().import("numpy")?;
+                numpy
+                    .call_method1("asarray", (ob,))?
+                    .cast_into::<PyUntypedArray>()?
+            }
+        };
+        let dtype = array.dtype();
+        if !matches!(dtype.kind(), b'f' | b'i' | b'u') {
+            return Err(PyTypeError::new_err(format!(
+                "expected real numbers (an array of floats or integers), got dtype {dtype}"
+            )));
+        }
+        Ok(Self(array.as_any().extract()?))
+    }
+}
 
 /// Values a [`Samples`] copies instead of borrowing (a few samples of a robot's joints).
 const COPY_UP_TO: usize = 64;
@@ -383,13 +420,20 @@ pub(crate) fn rows<'py>(py: Python<'py>, v: &[f64], n: usize) -> PyResult<Bound<
 
 /// A 1-D array-like of length `n` (or a scalar broadcast to `n`).
 pub(crate) fn per_joint(name: &str, value: &Bound<'_, PyAny>, n: usize) -> PyResult<Vec<f64>> {
-    if let Ok(x) = value.extract::<f64>() {
-        return Ok(vec![x; n]);
-    }
     let arr: ArrayLike<'_> = value.extract().map_err(|_| Error::InvalidArgument {
         argument: name.into(),
-        message: "expected a number or a sequence of numbers".into(),
+        message: "expected a real number or a sequence of real numbers".into(),
     })?;
+    if arr.ndim() == 0 {
+        return Ok(vec![
+            arr.as_array()
+                .iter()
+                .copied()
+                .next()
+                .unwrap_or(f64::NAN);
+            n
+        ]);
+    }
     if arr.shape() != [n] {
         return Err(Error::Shape {
             argument: name.into(),

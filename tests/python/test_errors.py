@@ -95,6 +95,32 @@ def test_non_numeric_input(robot):
         robot.rnea(["a"] * 6, np.zeros(6), np.zeros(6))
 
 
+@pytest.mark.parametrize(
+    "value, dtype",
+    [
+        # numpy's own conversion drops the imaginary part with only a warning
+        (np.full(6, 0.5 + 1j), "complex128"),
+        ([0.5 + 1j] * 6, "complex128"),
+        (np.ones(6, bool), "bool"),
+        (["1"] * 6, "<U1"),
+        ([object()] * 6, "object"),
+        (np.zeros(6, "datetime64[s]"), "datetime64"),
+    ],
+)
+def test_only_real_numbers_are_taken(robot, value, dtype):
+    z = np.zeros((3, 6))
+    with pytest.raises(TypeError, match=f"expected real numbers .* got dtype {dtype}"):
+        robot.mass_matrix(value)
+    batch = np.array(value)[None].repeat(3, axis=0)
+    with pytest.raises(TypeError, match="expected real numbers"):
+        robot.rnea(z, batch, z)
+    with pytest.raises(TypeError, match="expected real numbers"):
+        robot.linearize(z, z, batch)
+    # integers of any width and float32 are real numbers, converted
+    for real in (np.arange(6), np.arange(6, dtype=np.uint8), np.arange(6, dtype=np.float32)):
+        np.testing.assert_allclose(robot.mass_matrix(real), robot.mass_matrix(np.arange(6.0)))
+
+
 def test_any_memory_layout_is_read_in_logical_order(robot):
     rng = np.random.default_rng(5)
     Q, QD, QDD = rng.uniform(-1, 1, (3, 9, 6))
@@ -182,3 +208,12 @@ def test_a_free_gripper_finger_is_warned_about():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert pr.Robot.from_urdf(path, lock={"panda_finger_joint1": 0.02}).n == 7
+
+
+def test_per_joint_sizes_take_real_numbers_only(robot):
+    op = pr.OperatingPoint(np.full(6, 0.3), np.full(6, 0.5), np.zeros(6))
+    for dq in (0.01, np.float32(0.01), np.float64(0.01), [0.01] * 6):
+        assert pr.plan_experiments(robot, op, dq=dq) is not None
+    for dq in (1j, np.complex64(0.01), True, "0.01", [0.01 + 0j] * 6):
+        with pytest.raises(pr.InputError, match="dq: expected a real number"):
+            pr.plan_experiments(robot, op, dq=dq)
