@@ -126,4 +126,11 @@ impl Data {
             aba_c: vec![Motion::zeros(); nb],
         }
     }
+
+    /// Whether these buffers have `model`'s sizes (degrees of freedom, bodies, and the body-level
+    /// results of a coupled model), as [`Data::new`] makes them.
+    pub(crate) fn fits(&self, model: &Model) -> bool {
+        let nc = if model.coupled { model.nbodies() } else { 0 };
+        self.tau.len() == model.nv && self.qb.len() == model.nbodies() && self.m_b.nrows() == nc
+    }
 }

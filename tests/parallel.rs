@@ -274,3 +274,51 @@ fn outputs_past_the_caches_are_the_same_bits_as_small_calls_write() {
         assert!(same(&m, &m8), "mass matrix of {k_m} samples");
     }
 }
+
+#[test]
+fn one_workspace_serves_every_model_and_its_clones_too() {
+    // the engine's threads keep their buffers in the caller's workspace between calls: one made
+    // for another model (other sizes, or the same sizes and another tree) must not be used
+    let k = PARALLEL_BATCH + 5;
+    let tree = |seed| {
+        model_from_urdf_str(
+            &random_tree_urdf(seed, 9),
+            "<test>",
+            &LoadOptions::default(),
+        )
+        .unwrap()
+    };
+    let mut list = models();
+    list.extend([tree(8), tree(9), robots::builtin("a465").unwrap()]);
+    let mut shared = Workspace::new(&list[0]);
+    for (i, model) in list.iter().enumerate() {
+        let n = model.nv;
+        let [q, qd, qdd] = random_states(model, k, 40 + i as u64);
+        let states = States::new(n, &q, Some(&qd), Some(&qdd)).unwrap();
+        let mut fresh = Workspace::new(model);
+        let run = |ws: &mut Workspace| {
+            let mut tau = vec![f64::NAN; k * n];
+            parallel::rnea(model, ws, &states, Gravity::Included, &mut tau).unwrap();
+            let mut mm = vec![f64::NAN; k * n * n];
+            parallel::mass_matrix(model, ws, &states, &mut mm).unwrap();
+            let mut qdd_out = vec![f64::NAN; k * n];
+            let fd = States::new(n, &q, Some(&qd), None).unwrap();
+            parallel::forward_dynamics(model, ws, &fd, &tau, Gravity::Included, &mut qdd_out)
+                .unwrap();
+            [tau, mm, qdd_out]
+        };
+        let expected = run(&mut fresh);
+        // the shared workspace's own buffers are for the first model only: its parallel
+        // threads' must be remade, and a clone starts without them
+        let got = run(&mut shared);
+        let cloned = run(&mut fresh.clone());
+        for (what, e) in expected.iter().enumerate() {
+            assert!(e.iter().all(|v| v.is_finite()), "model {i}, output {what}");
+            assert_eq!(e, &got[what], "model {i}, output {what}, shared workspace");
+            assert_eq!(
+                e, &cloned[what],
+                "model {i}, output {what}, cloned workspace"
+            );
+        }
+    }
+}

@@ -432,6 +432,11 @@ impl LaneData {
         }
     }
 
+    /// Whether these buffers were made for a model of `model`'s sizes and tree (see `check`).
+    pub(crate) fn fits(&self, model: &Model) -> bool {
+        self.check(model).is_ok()
+    }
+
     /// Fails unless these buffers were made for a model of `model`'s sizes and tree (every
     /// body's parent).
     fn check(&self, model: &Model) -> Result<()> {
