@@ -2,7 +2,7 @@
 //! of many samples on the lanes: the base-frame recursion of [`crate::rnea_derivatives`]
 //! (Carpentier & Mansard, RSS 2018), one sample per lane.
 
-use super::kinematics::store_pose_in_base;
+use super::kinematics::{store_pose_in_base, store_turned_pose_in_base};
 use super::mass_matrix::{transformed, Composite};
 use super::{
     armature_inertia, armature_torques, dispatch, samples, LaneBuffers, LaneData, LaneKernel, Trig,
@@ -450,7 +450,19 @@ fn recursion<const W: usize>(
         lin: Vector3Lanes::splat(&minus_g.linear),
     };
     for (i, b) in serial(model.bodies.iter().enumerate()) {
-        store_pose_in_base(model, data, i);
+        // the base-frame pose of the body's turned frame where it has one (as the mass matrix:
+        // the inertia below is then taken in that frame; every other quantity here is in the
+        // base frame, whatever frame the bodies are described in)
+        let (h, split) = match &b.turned {
+            Some(t) => {
+                store_turned_pose_in_base(model, data, i, t);
+                (&t.h, &t.split)
+            }
+            None => {
+                store_pose_in_base(model, data, i);
+                (&b.origin_inertia.h, &b.split_inertia)
+            }
+        };
         let (r, p) = (data.o_rot[i], data.o_pos[i]);
         let j = data.o_s[i];
         let (ov_p, oa_p) = match b.parent {
@@ -460,8 +472,7 @@ fn recursion<const W: usize>(
         let vj = j.mul_lanes(data.vb[i]);
         let ov = ov_p.add(&vj);
         let oa = oa_p.add(&j.mul_lanes(data.ab[i])).add(&ov.cross(&vj));
-        let o = &b.origin_inertia;
-        let y = transformed(o.mass, &o.h, &b.split_inertia, &r, &p);
+        let y = transformed(b.origin_inertia.mass, h, split, &r, &p);
         let oh = y.apply(&ov);
         d.of[i] = y.apply(&oa).add(&ov.cross_force(&oh));
         d.ov[i] = ov;
