@@ -1,5 +1,6 @@
 //! Body frames turned so that each joint moves about or along its frame's z axis: the frames the
-//! multi-sample mass matrix works in (`algorithms::batch::mass_matrix`).
+//! multi-sample mass matrix and derivatives work in (`algorithms::batch::mass_matrix`,
+//! `algorithms::batch::derivatives`, whose recursions are in the base frame).
 //!
 //! A body's turned frame is its frame turned by a constant rotation `Q` with `Q e_z = a` (`a`
 //! the unit joint axis). Then the joint's rotation `Rot_a(x) = Q Rot_z(x) Q^T`, so the turned
@@ -7,9 +8,9 @@
 //! there and the constant `C = Q_p^T R0 Q`: one 3x3 product by a constant and a turn about z
 //! (two columns mixed by the cosine and sine), where the joint's own frame takes the
 //! Rodrigues terms and a 3x3 product of two variable matrices. The motion subspace in the base
-//! frame is the turned frame's third column, read, not computed. The mass matrix does not
-//! depend on the frames the bodies are described in, only on the inertias being described in
-//! the frame used, so the inertias are turned too (`Q^T h`, `Q^T I Q`).
+//! frame is the turned frame's third column, read, not computed. Neither the mass matrix nor
+//! the derivatives depend on the frames the bodies are described in, only on the inertias
+//! being described in the frame used, so the inertias are turned too (`Q^T h`, `Q^T I Q`).
 //!
 //! Only the bodies that gain are turned: an axis-aligned revolute joint below a body that is
 //! not turned keeps its frame and its own path (`AlignedRevolute`: columns of the parent's
