@@ -186,6 +186,44 @@ fn documents_refuse_unknown_keys_with_their_path() {
 }
 
 #[test]
+fn buffers_made_for_another_model_are_refused_not_indexed() {
+    use perturbid_rs::{
+        aba, forward_dynamics, gravity_torque, linearize, mass_matrix, rnea, rnea_derivatives,
+        Data, Gravity,
+    };
+    let a465 = robots::builtin("a465").unwrap();
+    let pair = model_from_urdf_str(&mimic_pair(true), "<pair>", &LoadOptions::default()).unwrap();
+    assert_ne!(pair.nv, a465.nv);
+    // the A465's algorithms on the small model's buffers: an index past their end would panic
+    let mut small = Data::new(&pair);
+    let z = vec![0.1; a465.nv];
+    let errors = [
+        rnea(&a465, &mut small, &z, &z, &z, Gravity::Included).err(),
+        gravity_torque(&a465, &mut small, &z).err(),
+        mass_matrix(&a465, &mut small, &z).err(),
+        rnea_derivatives(&a465, &mut small, &z, &z, &z, Gravity::Included).err(),
+        linearize(&a465, &mut small, &z, &z, &z, Gravity::Included).err(),
+        forward_dynamics(&a465, &mut small, &z, &z, &z, Gravity::Included).err(),
+        aba(&a465, &mut small, &z, &z, &z, Gravity::Included).err(),
+    ];
+    for (i, e) in errors.into_iter().enumerate() {
+        let e = e.unwrap_or_else(|| panic!("algorithm {i} took another model's buffers"));
+        assert_eq!(e.kind(), ErrorKind::Input, "algorithm {i}: {e}");
+        assert!(
+            e.to_string()
+                .contains("data: expected buffers for this model (6 dofs"),
+            "{e}"
+        );
+    }
+    // and the other way round (larger buffers than the model needs are refused too)
+    let mut large = Data::new(&a465);
+    let zp = vec![0.1; pair.nv];
+    assert!(rnea(&pair, &mut large, &zp, &zp, &zp, Gravity::Included).is_err());
+    // the right buffers still work after the refusals
+    assert!(rnea(&a465, &mut Data::new(&a465), &z, &z, &z, Gravity::Included).is_ok());
+}
+
+#[test]
 fn a_panic_at_the_boundary_becomes_an_internal_error() {
     let e = catch_panics("Robot.rnea", || -> perturbid_rs::Result<()> {
         panic!("boom")
