@@ -6,8 +6,9 @@
 //!   where one exists (inverse dynamics, mass matrix, regressor, derivatives, linearisation),
 //!   one sample at a time otherwise (forward dynamics);
 //! - on the calling thread with the caller's [`Workspace`] below [`PARALLEL_BATCH`] samples,
-//!   and in chunks of [`PARALLEL_CHUNK`] samples over rayon's thread pool above it, each chunk
-//!   with its own buffers (no allocation per sample).
+//!   and in chunks of [`PARALLEL_CHUNK`] samples over rayon's thread pool above it, each thread
+//!   with its own buffers, kept in the caller's [`Workspace`] from one call to the next (no
+//!   allocation per sample, nor per call once made).
 //!
 //! Results equal the one-sample algorithms up to rounding. Errors name the sample of the batch.
 
