@@ -385,6 +385,18 @@ impl Error {
     }
 }
 
+/// A number from input as an error message shows it: as Rust prints it where that is short
+/// (0, and magnitudes from 1e-4 to below 1e9), in exponent form otherwise (`1e300`, not 301
+/// digits), `NaN` and `inf` as such.
+pub(crate) fn shown(v: f64) -> String {
+    let a = v.abs();
+    if !v.is_finite() || a == 0.0 || (1e-4..1e9).contains(&a) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
 /// Runs `f`, turning a panic into [`Error::Internal`] naming `context`: the last line of
 /// defence at the library's boundaries (Python, the command line), so that a bug reaches the
 /// user as an error, not as an abort.
@@ -398,6 +410,20 @@ pub type Result<T> = std::result::Result<T, Error>;
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn numbers_in_messages_stay_short() {
+        use super::shown;
+        assert_eq!(shown(1.839), "1.839");
+        assert_eq!(shown(-0.072), "-0.072");
+        assert_eq!(shown(0.0), "0");
+        assert_eq!(shown(1e300), "1e300");
+        assert_eq!(shown(-2.5e-320), "-2.5e-320");
+        assert_eq!(shown(123456789.0), "123456789");
+        assert_eq!(shown(f64::NAN), "NaN");
+        assert_eq!(shown(f64::NEG_INFINITY), "-inf");
+    }
+
     use super::*;
 
     #[test]

@@ -1,6 +1,6 @@
 //! A recording: what a robot logs while it runs a trajectory.
 
-use crate::error::{Error, Result};
+use crate::error::{shown, Error, Result};
 
 /// Sampled measurements of one run, row-major (`q[i * n + j]` is joint `j` at sample `i`).
 ///
@@ -92,8 +92,8 @@ impl Recording {
         if let Some(i) = (1..k).find(|&i| self.t[i] <= self.t[i - 1]) {
             return Err(self.error(format!(
                 "time is not increasing at sample {i}: t = {} after {}",
-                self.t[i],
-                self.t[i - 1]
+                shown(self.t[i]),
+                shown(self.t[i - 1])
             )));
         }
         let columns = [
@@ -117,7 +117,7 @@ impl Recording {
                     "{what} of joint {} at sample {} (t = {}) is {}, expected a finite number",
                     p % self.n + 1,
                     p / self.n,
-                    self.t[p / self.n],
+                    shown(self.t[p / self.n]),
                     values[p]
                 )));
             }

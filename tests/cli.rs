@@ -379,6 +379,15 @@ fn bad_inputs_get_one_line_errors_and_no_output() {
         &["identify", s(&plan), &f, &f, "--out", s(&model)],
         &["time.csv", "time does not increase at data row 3"],
     );
+    // ... after a huge time: the number in exponent form, not 301 digits
+    let f = csv(
+        "huge_time.csv",
+        &format!("{header}\n{}\n{}\n", row(1e300), row(0.001)),
+    );
+    fails(
+        &["identify", s(&plan), &f, &f, "--out", s(&model)],
+        &["huge_time.csv", "(t = 0.001 after 1e300)"],
+    );
     // fewer joints than the robot has
     let f = csv("few.csv", "t,q1,q2,tau1,tau2\n0,0,0,0,0\n0.1,0,0,0,0\n");
     fails(

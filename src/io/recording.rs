@@ -3,7 +3,7 @@
 //! `qdd_<joint>`, `tau_<joint>`).
 
 use super::table::Table;
-use crate::error::{Error, Result};
+use crate::error::{shown, Error, Result};
 use crate::recording::Recording;
 use crate::trajectory::Samples;
 
@@ -42,8 +42,8 @@ impl<'a> Columns<'a> {
                 format!(
                     "time does not increase at data row {} (t = {} after {})",
                     i + 1,
-                    t[i],
-                    t[i - 1]
+                    shown(t[i]),
+                    shown(t[i - 1])
                 ),
             ));
         }

@@ -9,7 +9,7 @@ use super::operating_point::OperatingPoint;
 use super::perturbation::{perturbations, Design, Sizes};
 use crate::choice::choice;
 use crate::document::{invalid, Document};
-use crate::error::{Error, Result};
+use crate::error::{shown, Error, Result};
 use crate::model::Model;
 use crate::trajectory::{
     check_limits, transition, Segment, SegmentKind, Trajectory, TransitionLimits,
@@ -263,8 +263,10 @@ impl Document for Plan {
                     || [&c.q, &c.qd, &c.qdd].iter().any(|v| v.len() != n)
             }) {
                 return Err(bad(at(&format!(
-                    "the crossing at t = {} s is outside the trajectory ({start} to {end} s) or not for {n} joints",
-                    c.time
+                    "the crossing at t = {} s is outside the trajectory ({} to {} s) or not for {n} joints",
+                    shown(c.time),
+                    shown(start),
+                    shown(end)
                 ))));
             }
             if !(e.window.is_finite() && e.window > 0.0) {

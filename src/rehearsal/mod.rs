@@ -20,7 +20,7 @@ pub use true_robot::{Controller, FrictionSpec, Harmonic, LinkError, Payload, Sen
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-use crate::error::{Error, Result};
+use crate::error::{shown, Error, Result};
 use crate::gravity::Gravity;
 use crate::local::Plan;
 use crate::model::Model;
@@ -87,7 +87,7 @@ pub fn rehearse(
             message: format!(
                 "the torque of joint {} at t = {} s is {}: the true robot's numbers overflow",
                 i % n + 1,
-                reference.t[i / n],
+                shown(reference.t[i / n]),
                 tau[i]
             ),
         });
