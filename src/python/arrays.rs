@@ -26,6 +26,7 @@ impl<'a, 'py> FromPyObject<'a, 'py> for ArrayLike<'py> {
     type Error = PyErr;
 
     fn extract(ob: pyo3::Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        refuse_masked(&ob)?;
         // the dtype numpy gives it (lists and scalars converted once, here)
         let array = match ob.cast::<PyUntypedArray>() {
             Ok(a) => a.to_owned(),
@@ -44,6 +45,26 @@ impl<'a, 'py> FromPyObject<'a, 'py> for ArrayLike<'py> {
         }
         Ok(Self(array.as_any().extract()?))
     }
+}
+
+/// Refuses a numpy masked array (`numpy.ma`): its masked entries still hold values, which
+/// reading its memory would use as data. A plain ndarray is told by its exact type (a pointer
+/// comparison); only subclasses pay for the name.
+fn refuse_masked(ob: &pyo3::Borrowed<'_, '_, PyAny>) -> PyResult<()> {
+    if ob.is_exact_instance_of::<PyUntypedArray>() {
+        return Ok(());
+    }
+    let masked = ob.get_type().mro().iter().any(|t| {
+        t.cast::<pyo3::types::PyType>()
+            .is_ok_and(|t| t.name().is_ok_and(|n| n.to_string() == "MaskedArray"))
+    });
+    if masked {
+        return Err(PyTypeError::new_err(
+            "expected an array of real numbers, got a masked array: its masked entries would be \
+             read as data (fill them, e.g. a.filled(np.nan), or drop those samples)",
+        ));
+    }
+    Ok(())
 }
 
 /// Values a [`Samples`] copies instead of borrowing (a few samples of a robot's joints).
@@ -70,6 +91,7 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Samples<'py> {
     type Error = PyErr;
 
     fn extract(ob: pyo3::Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        refuse_masked(&ob)?;
         if let Ok(a) = ob.cast::<PyArrayDyn<f64>>() {
             let (shape, len) = (a.shape(), a.len());
             if shape.len() <= 2 && len <= COPY_UP_TO && a.is_c_contiguous() {

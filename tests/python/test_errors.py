@@ -217,3 +217,19 @@ def test_per_joint_sizes_take_real_numbers_only(robot):
     for dq in (1j, np.complex64(0.01), True, "0.01", [0.01 + 0j] * 6):
         with pytest.raises(pr.InputError, match="dq: expected a real number"):
             pr.plan_experiments(robot, op, dq=dq)
+
+
+def test_masked_arrays_are_refused_not_read_through(robot):
+    # a masked entry still holds a value; reading the array's memory would use it as data
+    q = np.ma.masked_array(np.full(6, 0.3), mask=[0, 0, 1, 0, 0, 0])
+    q.data[2] = 1e3
+    for call in (lambda: robot.gravity(q), lambda: robot.mass_matrix(np.ma.masked_array(np.zeros((100, 6)))),
+                 lambda: robot.rnea(np.zeros(6), q, np.zeros(6))):
+        with pytest.raises(TypeError, match="masked array: its masked entries would be read as data"):
+            call()
+    # filled, it is an ordinary array
+    np.testing.assert_allclose(robot.gravity(q.filled(0.3)), robot.gravity(np.full(6, 0.3)))
+    # and an ndarray subclass that is not masked is taken
+    class Tagged(np.ndarray):
+        pass
+    np.testing.assert_allclose(robot.gravity(np.full(6, 0.3).view(Tagged)), robot.gravity(np.full(6, 0.3)))
