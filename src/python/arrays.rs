@@ -56,7 +56,7 @@ fn refuse_masked(ob: &pyo3::Borrowed<'_, '_, PyAny>) -> PyResult<()> {
     }
     let masked = ob.get_type().mro().iter().any(|t| {
         t.cast::<pyo3::types::PyType>()
-            .is_ok_and(|t| t.name().is_ok_and(|n| n.to_string() == "MaskedArray"))
+            .is_ok_and(|t| t.name().is_ok_and(|n| n == "MaskedArray"))
     });
     if masked {
         return Err(PyTypeError::new_err(
