@@ -338,6 +338,23 @@ mod tests {
             .collect()
     }
 
+    /// A solid black curve named `name` through `x`, `y`, with `band` shaded about it.
+    fn black<'a>(
+        name: &'a str,
+        x: &'a [f64],
+        y: &'a [f64],
+        band: Option<[&'a [f64]; 2]>,
+    ) -> Series<'a> {
+        Series {
+            name,
+            color: "#000000",
+            dash: "",
+            x,
+            y,
+            band,
+        }
+    }
+
     #[test]
     fn a_band_is_shaded_under_its_curve_and_inside_the_axes() {
         let (x, y) = ([0.0, 1.0, 2.0, f64::NAN], [1.0, 2.0, 3.0, 4.0]);
@@ -383,14 +400,7 @@ mod tests {
     fn a_log_axis_has_decades_and_leaves_out_what_it_cannot_draw() {
         let x = [1.0, 2.0, 3.0, 4.0, 5.0];
         let y = [0.001, 0.01, 0.0, 1.0, 10.0];
-        let series = [Series {
-            name: "m",
-            color: "#000000",
-            dash: "",
-            x: &x,
-            y: &y,
-            band: None,
-        }];
+        let series = [black("m", &x, &y, None)];
         let plot = scaled_plot("t", "x", "y", &series, Scale::Log);
         // the zero left out; equal steps for equal ratios (0.001, 0.01; 1, 10)
         let line = points(plot.lines().find(|l| l.starts_with("<polyline")).unwrap());
@@ -423,14 +433,7 @@ mod tests {
     fn the_legend_is_as_wide_as_its_longest_name() {
         let (x, y) = ([0.0, 1.0], [0.0, 1.0]);
         let name = "direct: globally linearised, median of 5 (range shaded)";
-        let series = |name| Series {
-            name,
-            color: "#000000",
-            dash: "",
-            x: &x,
-            y: &y,
-            band: None,
-        };
+        let series = |name| black(name, &x, &y, None);
         // the name's text starts far enough left for about 7 px a character
         let start = |plot: &str| -> f64 {
             let text = plot.lines().rfind(|l| l.starts_with("<text x=")).unwrap();
@@ -453,14 +456,7 @@ mod tests {
     #[test]
     fn a_log_axis_with_nothing_to_draw_is_an_empty_plot() {
         let (x, y) = ([0.0, 1.0], [0.0, f64::NAN]);
-        let series = [Series {
-            name: "m",
-            color: "#000000",
-            dash: "",
-            x: &x,
-            y: &y,
-            band: Some([&y, &y]),
-        }];
+        let series = [black("m", &x, &y, Some([&y, &y]))];
         let plot = scaled_plot("t", "x", "y", &series, Scale::Log);
         assert!(plot.starts_with("<svg") && plot.ends_with("</svg>\n"));
         assert!(!plot.contains("<polygon"));
