@@ -133,4 +133,25 @@ impl Data {
         let nc = if model.coupled { model.nbodies() } else { 0 };
         self.tau.len() == model.nv && self.qb.len() == model.nbodies() && self.m_b.nrows() == nc
     }
+
+    /// Fails unless [`Data::fits`] `model` (as `LaneData`'s check): the one-sample algorithms
+    /// would index past buffers made for a smaller model.
+    pub(crate) fn check(&self, model: &Model) -> crate::error::Result<()> {
+        if self.fits(model) {
+            return Ok(());
+        }
+        Err(crate::error::Error::Shape {
+            argument: "data".into(),
+            expected: format!(
+                "buffers for this model ({} dofs, {} bodies): Data::new(&model)",
+                model.nv,
+                model.nbodies()
+            ),
+            got: format!(
+                "buffers for {} dofs and {} bodies",
+                self.tau.len(),
+                self.qb.len()
+            ),
+        })
+    }
 }

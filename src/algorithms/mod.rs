@@ -19,7 +19,7 @@ pub mod rnea;
 use nalgebra::{DMatrix, DVector};
 
 use crate::data::Data;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::model::Model;
 
 /// Checks the state vectors and writes the body coordinates into `data`.
@@ -32,22 +32,7 @@ pub(crate) fn load_state(
     qd: Option<&[f64]>,
     qdd: Option<&[f64]>,
 ) -> Result<()> {
-    if !data.fits(model) {
-        // (indexing would panic on buffers made for a smaller model)
-        return Err(Error::Shape {
-            argument: "data".into(),
-            expected: format!(
-                "buffers for this model ({} dofs, {} bodies): Data::new(&model)",
-                model.nv,
-                model.nbodies()
-            ),
-            got: format!(
-                "buffers for {} dofs and {} bodies",
-                data.tau.len(),
-                data.qb.len()
-            ),
-        });
-    }
+    data.check(model)?;
     model.check_vector("q", q)?;
     if let Some(qd) = qd {
         model.check_vector("qd", qd)?;
