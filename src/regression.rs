@@ -24,7 +24,8 @@ pub struct LeastSquares {
     /// Number of rows K.
     pub rows: usize,
     /// The diagonal of `(X^T X)^-1` (p): with a noise level `sigma`, the standard errors are
-    /// `sigma * sqrt(cov_diag)`.
+    /// `sigma * sqrt(cov_diag)` (computed from scaled columns, so the standard errors stay
+    /// finite where `cov_diag` itself leaves f64's range: 0 or inf).
     pub cov_diag: Vec<f64>,
 }
 
@@ -65,7 +66,17 @@ pub fn least_squares(
             message: format!("non-finite value in the least-squares data (entry {i})"),
         });
     }
-    let scale: Vec<f64> = (0..p).map(|j| x.column(j).norm()).collect();
+    // column norms scaled by the column's largest magnitude (1e-200 squares to 0, 1e200 to inf)
+    let scale: Vec<f64> = (0..p)
+        .map(|j| {
+            let a = x.column(j).amax();
+            if a > 0.0 {
+                a * (x.column(j) / a).norm()
+            } else {
+                0.0
+            }
+        })
+        .collect();
     if let Some(j) = scale.iter().position(|&s| s == 0.0) {
         return Err(Error::RankDeficient {
             context: context.into(),
@@ -108,43 +119,78 @@ pub fn least_squares(
             missing,
         });
     }
-    // A^T (scaled) = V S^-1 U^T Y
+    // Y's columns scaled to a largest magnitude of 1 (a torque of 1e300 N m squares to inf)
+    let yscale: Vec<f64> = (0..m)
+        .map(|c| {
+            let a = y.column(c).amax();
+            if a > 0.0 {
+                a
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    // A^T (both scaled) = V S^-1 U^T Y
     let mut uty = vec![0.0; p * m];
     for i in 0..p {
         for c in 0..m {
             let mut acc = 0.0;
             for r in 0..k {
-                acc += u[(r, i)] * y[(r, c)];
+                acc += u[(r, i)] * (y[(r, c)] / yscale[c]);
             }
             uty[i * m + c] = acc / s[i];
         }
     }
+    // coefficients for the scaled Y, unscaled X
     let mut coef = DMatrix::zeros(m, p);
-    let mut cov_diag = vec![0.0; p];
+    // the diagonal of (X^T X)^-1 for the scaled X; the unscaled one divides it by scale^2,
+    // which can leave f64's range where the standard errors do not
+    let mut cov_scaled = vec![0.0; p];
     for j in 0..p {
         for i in 0..p {
             let vji = v[(j, i)];
             for c in 0..m {
                 coef[(c, j)] += vji * uty[i * m + c];
             }
-            cov_diag[j] += vji * vji / (s[i] * s[i]);
+            cov_scaled[j] += vji * vji / (s[i] * s[i]);
         }
         for c in 0..m {
             coef[(c, j)] /= scale[j];
         }
-        cov_diag[j] /= scale[j] * scale[j];
     }
-    let residual = y - x * coef.transpose();
+    let cov_diag: Vec<f64> = (0..p)
+        .map(|j| cov_scaled[j] / scale[j] / scale[j])
+        .collect();
+    let ys = DMatrix::from_fn(k, m, |r, c| y[(r, c)] / yscale[c]);
+    let residual = ys - x * coef.transpose();
     let dof = (k - p) as f64;
     let mut residual_rms = DVector::zeros(m);
     let mut stderr = DMatrix::zeros(m, p);
     for c in 0..m {
         let ss = residual.column(c).norm_squared();
-        residual_rms[c] = (ss / k as f64).sqrt();
-        let sigma = if k > p { (ss / dof).sqrt() } else { f64::NAN };
+        residual_rms[c] = yscale[c] * (ss / k as f64).sqrt();
+        let sigma = if k > p {
+            yscale[c] * (ss / dof).sqrt()
+        } else {
+            f64::NAN
+        };
         for j in 0..p {
-            stderr[(c, j)] = sigma * cov_diag[j].sqrt();
+            stderr[(c, j)] = sigma * cov_scaled[j].sqrt() / scale[j];
+            coef[(c, j)] *= yscale[c];
         }
+    }
+    let overflow = coef.iter().any(|v| !v.is_finite())
+        || residual_rms.iter().any(|v| !v.is_finite())
+        || (k > p && stderr.iter().any(|v| !v.is_finite()));
+    if overflow {
+        return Err(Error::Numerical {
+            operation: context.into(),
+            message: format!(
+                "the fit's coefficients or standard errors overflow (outputs up to {} against regressors as small as {}): rescale the data",
+                crate::error::shown(yscale.iter().cloned().fold(0.0, f64::max)),
+                crate::error::shown(x.iter().fold(f64::INFINITY, |a, v| if *v != 0.0 { a.min(v.abs()) } else { a }))
+            ),
+        });
     }
     Ok(LeastSquares {
         coef,

@@ -527,6 +527,59 @@ fn rank_deficient_design_names_the_missing_direction() {
     assert!(ls.residual_rms.norm() < 1e-12);
 }
 
+/// Outputs far from 1 are fitted as well as outputs near it: the coefficients, residuals and
+/// standard errors scale with the outputs (a torque column of 1e300 N m squared to inf before),
+/// and a fit whose coefficients would overflow is an error, not an infinity.
+#[test]
+fn least_squares_scales_with_the_outputs_and_refuses_overflow() {
+    let names: Vec<String> = ["a", "b", "c"].map(String::from).to_vec();
+    let x = DMatrix::from_fn(12, 3, |i, j| {
+        ((i * 5 + j * 7) % 11) as f64 - 5.0 + 0.3 * j as f64
+    });
+    let y = DMatrix::from_fn(12, 2, |i, c| {
+        (x[(i, 0)] - 2.0 * x[(i, 1)] + c as f64 * x[(i, 2)]) + ((i * 3 + c) % 4) as f64 * 0.1
+    });
+    let base = least_squares(&x, &y, "base", &names).unwrap();
+    for scale in [1e-300, 1e-100, 1e100, 1e300] {
+        let ls = least_squares(&x, &(&y * scale), "scaled", &names).unwrap();
+        assert!(
+            ls.stderr.iter().all(|s| s.is_finite() && *s > 0.0),
+            "{scale:e}: {}",
+            ls.stderr
+        );
+        for (a, b) in ls.coef.iter().zip(base.coef.iter()) {
+            assert!(
+                (a / scale - b).abs() <= 1e-12 * b.abs().max(1.0),
+                "{scale:e}: {a:e} {b:e}"
+            );
+        }
+        for (a, b) in ls.stderr.iter().zip(base.stderr.iter()) {
+            assert!((a / scale - b).abs() <= 1e-10 * b, "{scale:e}: {a:e} {b:e}");
+        }
+        for (a, b) in ls.residual_rms.iter().zip(base.residual_rms.iter()) {
+            assert!((a / scale - b).abs() <= 1e-10 * b, "{scale:e}: {a:e} {b:e}");
+        }
+    }
+    // so do regressors: a column of 1e-200 is not taken for zeros, nor one of 1e200 for inf
+    for scale in [1e-200, 1e200] {
+        let ls = least_squares(&(&x * scale), &y, "scaled", &names).unwrap();
+        for (a, b) in ls.coef.iter().zip(base.coef.iter()) {
+            assert!(
+                (a * scale - b).abs() <= 1e-12 * b.abs().max(1.0),
+                "{scale:e}: {a:e} {b:e}"
+            );
+        }
+        assert!((ls.cond - base.cond).abs() <= 1e-10 * base.cond);
+    }
+    // regressors of 1e-300 against outputs of 1e300: coefficients past f64
+    let e = least_squares(&(&x * 1e-300), &(&y * 1e300), "experiment 'D'", &names).unwrap_err();
+    assert!(matches!(e, Error::Numerical { .. }), "{e}");
+    assert!(
+        e.to_string().contains("experiment 'D'") && e.to_string().contains("overflow"),
+        "{e}"
+    );
+}
+
 #[test]
 fn detected_crossing_times_recover_a_shifted_log() {
     let model = a465::model("kinsheel2010").unwrap();
@@ -650,4 +703,75 @@ fn a_sound_d_star_raises_no_mass_matrix_warning() {
             m.diagnostics.warnings
         );
     }
+}
+
+/// A torque channel that reads one value throughout (dead, saturated, or far coarser than the
+/// perturbations' effect) gives a row of zeros whose standard errors of zero would claim
+/// certainty: the row's standard errors become NaN, a warning names the experiment, joint and
+/// value, and the other rows keep their values. Without it, no warning.
+#[test]
+fn a_torque_channel_that_does_not_change_is_warned_about() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let op = table2();
+    let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+    let mut sim = SimulationOptions::new(&model);
+    sim.torque_noise = vec![0.01; n];
+    let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    let clean = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    assert!(
+        !clean
+            .diagnostics
+            .warnings
+            .iter()
+            .any(|w| w.contains("same value")),
+        "{:?}",
+        clean.diagnostics.warnings
+    );
+    // joint 3's channel stuck at 12.5 N m in the D experiment's recording
+    let mut stuck = recs.clone();
+    let d = stuck
+        .iter_mut()
+        .find(|r| r.experiment.as_deref() == Some("D"))
+        .unwrap();
+    for i in 0..d.t.len() {
+        d.tau[i * n + 2] = 12.5;
+    }
+    let m = identify_local(&plan, &stuck, &IdentifyOptions::default()).unwrap();
+    let w: Vec<&String> = m
+        .diagnostics
+        .warnings
+        .iter()
+        .filter(|w| w.contains("same value"))
+        .collect();
+    assert_eq!(w.len(), 1, "{:?}", m.diagnostics.warnings);
+    assert!(
+        w[0].contains("experiment 'D'")
+            && w[0].contains("'joint3' (12.5 N m)")
+            && w[0].contains("D*"),
+        "{}",
+        w[0]
+    );
+    let est = m.d.as_ref().unwrap();
+    for i in 0..n {
+        for j in 0..n {
+            assert_eq!(est.stderr[(i, j)].is_nan(), i == 2, "{}", est.stderr);
+        }
+    }
+    // the other rows are those of the clean identification but for the noise, and finite
+    let c = clean.d.as_ref().unwrap();
+    for i in (0..n).filter(|&i| i != 2) {
+        for j in 0..n {
+            assert_eq!(est.matrix[(i, j)], c.matrix[(i, j)]);
+        }
+    }
+    // the combined estimate's row for joint 3 is no more certain
+    let opts = IdentifyOptions {
+        estimator: Estimator::Combined,
+        ..IdentifyOptions::default()
+    };
+    let m = identify_local(&plan, &stuck, &opts).unwrap();
+    let comb = m.combined.as_ref().unwrap();
+    assert!(comb.stderr.row(2).iter().all(|s| s.is_nan()));
+    assert!(comb.stderr.row(1).iter().all(|s| s.is_finite()));
 }

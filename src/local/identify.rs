@@ -82,6 +82,40 @@ pub struct ExperimentValues {
     /// The crossings at which a joint's velocity reverses within the fit window, and how its
     /// torque was read there.
     pub reversals: Vec<Reversal>,
+    /// Per joint, the value (N m) every torque sample read for this experiment had, when all
+    /// of them (every crossing's window and the reference posture's) had the same one: a torque
+    /// signal that did not change (see [`flat_torques`]).
+    pub flat_torque: Vec<Option<f64>>,
+}
+
+/// Per joint, `Some(value)` when every torque sample of `rec` in the windows `[tc - half, tc +
+/// half]` (one per centre `tc`) has the same value, bit for bit: a torque signal that did not
+/// change where the experiment was read (a dead or saturated channel, or a resolution coarser
+/// than the perturbations' effect). `None` where any sample differs or no window holds a
+/// sample.
+pub fn flat_torques(rec: &Recording, centres: &[f64], half: f64) -> Vec<Option<f64>> {
+    let n = rec.n;
+    let mut first: Vec<Option<f64>> = vec![None; n];
+    let mut flat = vec![true; n];
+    for &tc in centres {
+        let lo = rec.t.partition_point(|&t| t < tc - half);
+        let hi = rec.t.partition_point(|&t| t <= tc + half);
+        for i in lo..hi {
+            for j in 0..n {
+                let v = rec.tau[i * n + j];
+                match first[j] {
+                    None => first[j] = Some(v),
+                    Some(f) if f.to_bits() != v.to_bits() => flat[j] = false,
+                    Some(_) => {}
+                }
+            }
+        }
+    }
+    first
+        .into_iter()
+        .zip(flat)
+        .map(|(f, flat)| f.filter(|_| flat))
+        .collect()
 }
 
 /// How to read the torque of each joint at the crossing at plan time `tp` (the recording's
@@ -213,13 +247,52 @@ pub fn experiment_values(
             )
         })
         .transpose()?;
+    let centres: Vec<f64> = experiment
+        .crossings
+        .iter()
+        .chain(&experiment.reference)
+        .map(|c| c.time + offset)
+        .collect();
     Ok(ExperimentValues {
         kind: experiment.kind,
         offset,
         crossings,
         reference,
         reversals,
+        flat_torque: flat_torques(rec, &centres, half),
     })
+}
+
+/// The warning for the joints whose torque read one value (N m) in every sample of an
+/// experiment that perturbs the robot: `(joint, value)` each.
+fn flat_torque_warning(kind: ExperimentKind, joints: &[(&str, f64)]) -> String {
+    let matrix = match kind {
+        ExperimentKind::D => "D*",
+        ExperimentKind::H => "H*",
+        ExperimentKind::GDynamic => "G*",
+        ExperimentKind::GStatic => "Gs*",
+        ExperimentKind::Nominal => "T*",
+    };
+    // 6 significant digits, and no -0
+    let value = |v: f64| {
+        let v: f64 = format!("{v:.5e}").parse().unwrap_or(v);
+        crate::error::shown(if v == 0.0 { 0.0 } else { v })
+    };
+    let list = joints
+        .iter()
+        .map(|(j, v)| format!("'{j}' ({} N m)", value(*v)))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let (whose, rows) = if joints.len() == 1 {
+        ("torque of joint", "reads the same value in every sample around the crossings, though the experiment perturbs the robot: a torque signal that does not change (a dead or saturated channel, or a resolution coarser than the perturbations' effect); its row of {} is")
+    } else {
+        ("torques of joints", "read the same value in every sample around the crossings, though the experiment perturbs the robot: torque signals that do not change (dead or saturated channels, or a resolution coarser than the perturbations' effect); their rows of {} are")
+    };
+    let rows = rows.replace("{}", matrix);
+    format!(
+        "experiment '{}': the {whose} {list} {rows} not measured (standard errors set to NaN)",
+        kind.name()
+    )
 }
 
 pub(super) fn state(c: &CrossingValues, v: usize) -> &[f64] {
@@ -432,6 +505,44 @@ pub fn identify_local(
         None
     };
 
+    // a torque that did not change gives a row of zeros with standard errors of zero: claim
+    // no certainty for it
+    let mut d = d;
+    let mut h = h;
+    let mut g = g;
+    let mut g_static = g_static;
+    let mut combined = combined;
+    let mut flat_warnings = vec![];
+    for v in &values {
+        let Some(estimate) = (match v.kind {
+            ExperimentKind::D => d.as_mut(),
+            ExperimentKind::H => h.as_mut(),
+            ExperimentKind::GDynamic => g.as_mut(),
+            ExperimentKind::GStatic => g_static.as_mut(),
+            ExperimentKind::Nominal => None,
+        }) else {
+            continue;
+        };
+        let mut flat = vec![];
+        for (j, value) in v.flat_torque.iter().enumerate() {
+            // at rest a torque can be exactly 0 in every posture (gravity compensated, or a
+            // joint about a vertical axis): only a moving robot's torque must change
+            let at_rest = v.kind == ExperimentKind::GStatic;
+            let Some(value) = value.filter(|&x| !(at_rest && x == 0.0)) else {
+                continue;
+            };
+            estimate.stderr.row_mut(j).fill(f64::NAN);
+            if v.kind != ExperimentKind::GStatic {
+                if let Some(c) = combined.as_mut() {
+                    c.stderr.row_mut(j).fill(f64::NAN);
+                }
+            }
+            flat.push((plan.joint_names[j].as_str(), value));
+        }
+        if !flat.is_empty() {
+            flat_warnings.push(flat_torque_warning(v.kind, &flat));
+        }
+    }
     let disagreement = combined
         .as_ref()
         .map_or_else(Vec::new, |c| compare_combined(c, [&d, &h, &g], n));
@@ -465,6 +576,7 @@ pub fn identify_local(
     {
         diagnostics.warnings.push(w);
     }
+    diagnostics.warnings.extend(flat_warnings);
     diagnostics.combined = disagreement;
     diagnostics.unperturbed_deviation = deviation;
     Ok(LocalModel {
