@@ -59,6 +59,48 @@ pub(crate) fn check_joints(states: &States<'_>, nv: usize) -> Result<()> {
     Ok(())
 }
 
+/// Refuses torques (row-major `k x nv`, N m) in which a joint's column holds one value in
+/// every one of `k >= 2` samples, bit for bit, while the robot moves (some `qd` or `qdd` is
+/// not 0) or the value is not 0: a dead or saturated channel, or one far coarser than the
+/// motion's effect, from which a fit would take a row of zeros for certain. A torque of exactly
+/// 0 at rest throughout stays allowed (gravity compensated, a joint about a vertical axis).
+/// `names` name the joints.
+pub(crate) fn refuse_flat_torques(
+    states: &States<'_>,
+    tau: &[f64],
+    names: &[String],
+) -> Result<()> {
+    let nv = states.nv();
+    let k = states.len();
+    if k < 2 || tau.len() != k * nv {
+        return Ok(());
+    }
+    let moving = [states.qd(), states.qdd()]
+        .into_iter()
+        .flatten()
+        .any(|x| x.iter().any(|&v| v != 0.0));
+    for j in 0..nv {
+        let first = tau[j];
+        let flat = (1..k).all(|s| tau[s * nv + j].to_bits() == first.to_bits());
+        if flat && (moving || first != 0.0) {
+            let name = names
+                .get(j)
+                .cloned()
+                .unwrap_or_else(|| format!("{}", j + 1));
+            return Err(Error::InvalidArgument {
+                argument: "tau".into(),
+                message: format!(
+                    "the torque of joint '{name}' (column {}) is {} N m in all {k} samples{}: a dead or saturated channel, or one far coarser than the motion's effect; a fit would take it for a torque that does not depend on the motion",
+                    j + 1,
+                    crate::error::shown(first),
+                    if moving { " while the robot moves" } else { "" }
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// The first-order expansion `T + D (qdd - qdd*) + H (qd - qd*) + G (q - q*)` about `op` at
 /// every sample of `states` (row-major `k x nv` out): the form of the local and the globally
 /// linearised models.

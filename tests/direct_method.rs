@@ -671,3 +671,64 @@ fn negative_friction_and_still_joints_are_warned_about() {
         "{w:?}"
     );
 }
+
+/// A torque column that holds one value in every sample while the robot moves is a dead or
+/// saturated channel: the direct method and the globally linearised model refuse it by joint
+/// and column. A torque of exactly 0 at rest throughout stays allowed (a static
+/// identification with a joint about a vertical axis).
+#[test]
+fn a_torque_column_that_never_changes_is_refused() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let traj = a465_excitation();
+    let s = traj.sample_periods(1.0, 100.0);
+    let states = States::new(6, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
+    let tau = torques(&model, &s.q, &s.qd, &s.qdd, Gravity::Included);
+    let options = BaseOptions::default();
+    identify_base_parameters(&model, &states, &tau, &options).unwrap();
+    for stuck in [12.5, 0.0] {
+        let mut dead = tau.clone();
+        for i in (3..dead.len()).step_by(6) {
+            dead[i] = stuck;
+        }
+        let e = identify_base_parameters(&model, &states, &dead, &options)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("joint 'joint4' (column 4)")
+                && e.contains(&format!("is {stuck} N m in all {} samples", s.len())),
+            "{e}"
+        );
+        let op = OperatingPoint::new(s.q[..6].to_vec(), s.qd[..6].to_vec(), s.qdd[..6].to_vec())
+            .unwrap();
+        let e = identify_global_linear(&op, &states, &dead)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("joint 'joint4'"), "{e}");
+    }
+    // at rest in 40 postures: joint 1 (a vertical axis) has exactly 0 N m in all of them,
+    // which is right, and the static fit goes ahead
+    let k = 40;
+    let q: Vec<f64> = (0..k * 6).map(|i| (i as f64 * 0.37).sin()).collect();
+    let zeros = vec![0.0; k * 6];
+    let rest = States::new(6, &q, Some(&zeros), Some(&zeros)).unwrap();
+    let mut tau = torques(&model, &q, &zeros, &zeros, Gravity::Included);
+    for i in (0..tau.len()).step_by(6) {
+        tau[i] = 0.0;
+    }
+    let statics = BaseOptions {
+        friction: FrictionTerms::NONE,
+        ..BaseOptions::default()
+    };
+    if let Err(e) = identify_base_parameters(&model, &rest, &tau, &statics) {
+        assert!(!e.to_string().contains("all 40 samples"), "{e}");
+    }
+    // a non-zero value held at rest is refused all the same
+    for i in (0..tau.len()).step_by(6) {
+        tau[i] = 0.25;
+    }
+    let e = identify_base_parameters(&model, &rest, &tau, &statics).unwrap_err();
+    assert!(
+        e.to_string().contains("is 0.25 N m in all 40 samples:"),
+        "{e}"
+    );
+}

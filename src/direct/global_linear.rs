@@ -55,6 +55,8 @@ pub fn identify_global_linear(
     let nv = op.n();
     check_joints(states, nv)?;
     states.check_companion("tau", tau, nv)?;
+    let joint_names: Vec<String> = (1..=nv).map(|j| format!("joint{j}")).collect();
+    crate::torque_model::refuse_flat_torques(states, tau, &joint_names)?;
     let k = states.len();
     let (q, qd, qdd) = (states.q(), states.qd_or_zeros(), states.qdd_or_zeros());
     let x = DMatrix::from_fn(k, 1 + 3 * nv, |s, c| match c {
@@ -71,7 +73,7 @@ pub fn identify_global_linear(
     let ls = least_squares(&x, &y, "globally linearised model", &names)?;
     Ok(GlobalLinearModel {
         format: GlobalLinearModel::tag(),
-        joint_names: (1..=nv).map(|j| format!("joint{j}")).collect(),
+        joint_names,
         op: op.clone(),
         offset: ls.coef.column(0).iter().copied().collect(),
         d: ls.coef.columns(1, nv).into_owned(),

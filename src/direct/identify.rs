@@ -178,6 +178,7 @@ fn fit_with_factors(
     states.check_companion("tau", tau, nv)?;
     crate::limits::check_range("tolerance", options.tolerance, 1e-15, 0.1)?;
     crate::limits::check_count("states", options.states, 1, 1_000_000)?;
+    crate::torque_model::refuse_flat_torques(states, tau, &model.joint_names)?;
     let k = states.len();
     let layout = ParameterLayout::new(model, options.friction.for_model(model));
     let base = BaseParameters::from_random_states(
