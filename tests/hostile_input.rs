@@ -668,3 +668,48 @@ fn overflow_deep_in_a_batch_names_its_sample() {
         assert!(y.iter().all(|v| v.is_finite()));
     }
 }
+
+/// A Fourier excitation whose coefficients would sample to inf or NaN (finite, but their sum
+/// past f64's range) is refused by joint and quantity, as are more harmonics than the limit.
+#[test]
+fn fourier_coefficients_past_the_range_of_f64_are_refused() {
+    use nalgebra::DMatrix;
+    use perturbid_rs::trajectory::FourierTrajectory;
+    let ok = FourierTrajectory::new(
+        1.0,
+        vec![0.0; 2],
+        DMatrix::zeros(2, 3),
+        DMatrix::zeros(2, 3),
+    );
+    assert!(ok.is_ok());
+    let mut a = DMatrix::zeros(2, 3);
+    a[(1, 2)] = 1e308;
+    let mut b = DMatrix::zeros(2, 3);
+    b[(1, 2)] = 1e308;
+    let e = FourierTrajectory::new(1.0, vec![0.0; 2], a, b)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("joint 2") && e.contains("beyond f64's range"),
+        "{e}"
+    );
+    let mut a = DMatrix::zeros(2, 3);
+    a[(0, 2)] = 1e306;
+    let e = FourierTrajectory::new(1e3, vec![0.0; 2], a.clone(), DMatrix::zeros(2, 3))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("joint 1") && e.contains("accelerations"), "{e}");
+    // the same coefficients at a slower pulsation sample finitely
+    let t = FourierTrajectory::new(1.0, vec![0.0; 2], a, DMatrix::zeros(2, 3)).unwrap();
+    let s = t.sample_periods(1.0, 10.0);
+    assert!(s.q.iter().chain(&s.qd).chain(&s.qdd).all(|v| v.is_finite()));
+    let e = FourierTrajectory::new(
+        1.0,
+        vec![0.0],
+        DMatrix::zeros(1, 1001),
+        DMatrix::zeros(1, 1001),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.starts_with("harmonics: 1001"), "{e}");
+}

@@ -22,7 +22,8 @@ pub struct FourierTrajectory {
 }
 
 impl FourierTrajectory {
-    /// Checks the shapes (`a`, `b`: `len(q0) x L`, `L >= 1`), finiteness and `w_f > 0`.
+    /// Checks the shapes (`a`, `b`: `len(q0) x L`, `1 <= L <= MAX_HARMONICS`), finiteness,
+    /// `w_f > 0`, and that the positions, velocities and accelerations stay within f64's range.
     pub fn new(w_f: f64, q0: Vec<f64>, a: DMatrix<f64>, b: DMatrix<f64>) -> Result<Self> {
         let n = q0.len();
         if !(w_f.is_finite() && w_f > 0.0) {
@@ -52,6 +53,32 @@ impl FourierTrajectory {
                     argument: name.into(),
                     index: i,
                     value: v[i],
+                });
+            }
+        }
+        crate::limits::check_count("harmonics", a.ncols(), 1, crate::limits::MAX_HARMONICS)?;
+        // the bounds of |q|, |qd| and |qdd| over time: coefficients whose sum leaves f64's
+        // range would sample to inf or NaN
+        for i in 0..n {
+            let (mut q, mut v, mut acc) = (q0[i].abs(), 0.0, 0.0);
+            for l in 0..a.ncols() {
+                let w = w_f * (l + 1) as f64;
+                let c = a[(i, l)].abs() + b[(i, l)].abs();
+                q += c / w;
+                v += c;
+                acc += c * w;
+            }
+            if let Some((what, _)) = [("positions", q), ("velocities", v), ("accelerations", acc)]
+                .into_iter()
+                .find(|(_, x)| !x.is_finite())
+            {
+                return Err(Error::InvalidArgument {
+                    argument: "a, b".into(),
+                    message: format!(
+                        "joint {}: the coefficients (with w_f = {}) give {what} beyond f64's range; expected an excitation a robot can run",
+                        i + 1,
+                        crate::error::shown(w_f)
+                    ),
                 });
             }
         }
