@@ -234,8 +234,27 @@ pub(crate) fn check_plan_robot(model: &Model, plan: &crate::local::Plan) -> Resu
     Ok(())
 }
 
+/// Experiment `e` of `plan` sampled at the plan's rate, checked against `model`'s limits as
+/// [`crate::local::plan_experiments`] checks a plan it makes: a plan read from a file (edited
+/// by hand, or made for a robot with wider limits) runs on a robot only within its limits.
+pub(crate) fn experiment_samples(
+    model: &Model,
+    plan: &crate::local::Plan,
+    e: &crate::local::Experiment,
+) -> Result<crate::trajectory::Samples> {
+    let samples = e.trajectory.sample(plan.rate);
+    crate::trajectory::check_limits(
+        model,
+        &samples,
+        &format!("experiment '{}' of the plan", e.kind.name()),
+        "; the plan does not suit this robot's limits: plan again for it",
+    )?;
+    Ok(samples)
+}
+
 /// Simulates one recording per experiment of `plan` (in the plan's order) for `model`, which
-/// must have the plan's joints. Each experiment gets its own random stream of `options.seed`.
+/// must have the plan's joints and whose limits every experiment must keep. Each experiment
+/// gets its own random stream of `options.seed`.
 pub fn simulate_plan(
     model: &Model,
     plan: &crate::local::Plan,
@@ -249,7 +268,7 @@ pub fn simulate_plan(
             crate::interrupt::check("simulation")?;
             simulate_samples(
                 model,
-                &e.trajectory.sample(plan.rate),
+                &experiment_samples(model, plan, e)?,
                 options,
                 i as u64,
                 &format!("simulated experiment '{}'", e.kind.name()),

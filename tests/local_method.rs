@@ -775,3 +775,77 @@ fn a_torque_channel_that_does_not_change_is_warned_about() {
     assert!(comb.stderr.row(2).iter().all(|s| s.is_nan()));
     assert!(comb.stderr.row(1).iter().all(|s| s.is_finite()));
 }
+
+/// A plan read from a file is what the robot will run: a hand edit that makes its trajectory
+/// jump, leave f64's range, start moving, or disagree with its crossings is refused with the
+/// experiment, segment or crossing and joint; a plan made for wider limits than the robot's is
+/// refused when simulated on it.
+#[test]
+fn hand_edited_plans_are_refused_where_they_break_the_trajectory() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
+    let text = plan.to_json();
+    assert!(Plan::from_json(&text).is_ok());
+    let edited = |f: &dyn Fn(&mut serde_json::Value)| {
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        f(&mut v);
+        Plan::from_json(&v.to_string())
+            .map(|_| ())
+            .unwrap_err()
+            .to_string()
+    };
+    // D's fourth segment with one coefficient changed: a jump at one of its ends
+    let e = edited(&|v| {
+        let c = &mut v["experiments"][4]["trajectory"]["segments"][3]["coeffs"][2][4];
+        *c = serde_json::json!(c.as_f64().unwrap() + 1.0);
+    });
+    assert!(
+        e.contains("experiments[4] ('D')")
+            && e.contains("joint 3: the position jumps")
+            && (e.contains("between segments[3] and segments[4]")
+                || e.contains("between segments[2] and segments[3]")),
+        "{e}"
+    );
+    let e = edited(&|v| {
+        v["experiments"][2]["trajectory"]["segments"][5]["coeffs"][1][5] = serde_json::json!(1e308)
+    });
+    assert!(
+        e.contains("experiments[2]") && e.contains("beyond f64's range"),
+        "{e}"
+    );
+    let e = edited(&|v| {
+        let c = &mut v["experiments"][1]["crossings"][0]["q"][0];
+        *c = serde_json::json!(c.as_f64().unwrap() + 0.01);
+    });
+    assert!(
+        e.contains("crossings[0].q[0] is")
+            && e.contains("the crossing and the trajectory disagree"),
+        "{e}"
+    );
+    let e = edited(&|v| {
+        let cs = v["experiments"][3]["crossings"].as_array_mut().unwrap();
+        cs.swap(0, 1);
+    });
+    assert!(
+        e.contains("crossings[1] at t =") && e.contains("time order"),
+        "{e}"
+    );
+    // the first segment set moving: it starts with a velocity, or jumps into the next
+    let e = edited(&|v| {
+        v["experiments"][0]["trajectory"]["segments"][0]["coeffs"][0][1] = serde_json::json!(0.5)
+    });
+    assert!(
+        e.contains("jumps") || e.contains("must start and end at rest"),
+        "{e}"
+    );
+    // a robot with a lower velocity limit on joint 2 than the plan was made for
+    let mut slow = model.clone();
+    slow.limits[1].velocity = 0.05;
+    let e = simulate_plan(&slow, &plan, &noise_free(&slow, Gravity::Included))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("joint2") && e.contains("plan again for it"),
+        "{e}"
+    );
+}

@@ -250,6 +250,9 @@ impl Document for Plan {
                 previous = Some(seg.t1);
             }
             crate::limits::sample_count(&at("trajectory"), e.duration(), plan.rate)?;
+            e.trajectory
+                .check_smooth()
+                .map_err(|m| bad(at(&format!("trajectory: {m}"))))?;
             if e.deltas.nrows() != e.crossings.len() && e.kind != ExperimentKind::Nominal {
                 return Err(bad(at(&format!(
                     "{} perturbations for {} crossings",
@@ -268,6 +271,52 @@ impl Document for Plan {
                     shown(start),
                     shown(end)
                 ))));
+            }
+            if let Some(k) =
+                (1..e.crossings.len()).find(|&k| e.crossings[k].time < e.crossings[k - 1].time)
+            {
+                return Err(bad(at(&format!(
+                    "crossings[{k}] at t = {} s comes before crossings[{}] at {} s; crossings are in time order",
+                    shown(e.crossings[k].time),
+                    k - 1,
+                    shown(e.crossings[k - 1].time)
+                ))));
+            }
+            // every crossing (and the reference posture) is a state the trajectory passes
+            let named = e
+                .crossings
+                .iter()
+                .enumerate()
+                .map(|(k, c)| (format!("crossings[{k}]"), c))
+                .chain(e.reference.iter().map(|c| ("reference".to_string(), c)));
+            for (name, c) in named {
+                if [&c.q, &c.qd, &c.qdd].iter().any(|v| v.len() != n) {
+                    return Err(bad(at(&format!("{name} is not for {n} joints"))));
+                }
+                if !(c.time >= start && c.time <= end) {
+                    return Err(bad(at(&format!(
+                        "{name} at t = {} s is outside the trajectory ({} to {} s)",
+                        shown(c.time),
+                        shown(start),
+                        shown(end)
+                    ))));
+                }
+                let (q, qd, qdd) = e.trajectory.segment_at(c.time).state(c.time);
+                for (what, planned, passed) in
+                    [("q", &c.q, &q), ("qd", &c.qd, &qd), ("qdd", &c.qdd, &qdd)]
+                {
+                    if let Some(j) = (0..n).find(|&j| {
+                        let off = (planned[j] - passed[j]).abs();
+                        off.is_nan() || off > 1e-6 * (1.0 + planned[j].abs())
+                    }) {
+                        return Err(bad(at(&format!(
+                            "{name}.{what}[{j}] is {}, but the trajectory passes {} at t = {} s: the crossing and the trajectory disagree",
+                            shown(planned[j]),
+                            shown(passed[j]),
+                            shown(c.time)
+                        ))));
+                    }
+                }
             }
             if !(e.window.is_finite() && e.window > 0.0) {
                 return Err(bad(at(&format!("window {} s is not positive", e.window))));

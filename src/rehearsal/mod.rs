@@ -96,8 +96,8 @@ pub fn rehearse(
 }
 
 /// One rehearsed recording per experiment of `plan` (in the plan's order, each marked with
-/// its experiment), the plan's trajectories sampled at its rate. Each experiment gets its own
-/// random stream of the robot's seed.
+/// its experiment), the plan's trajectories sampled at its rate and checked against the
+/// nominal model's limits. Each experiment gets its own random stream of the robot's seed.
 pub fn rehearse_plan(nominal: &Model, robot: &TrueRobot, plan: &Plan) -> Result<Vec<Recording>> {
     crate::simulation::check_plan_robot(nominal, plan)?;
     plan.experiments
@@ -108,7 +108,7 @@ pub fn rehearse_plan(nominal: &Model, robot: &TrueRobot, plan: &Plan) -> Result<
             rehearse(
                 nominal,
                 robot,
-                &e.trajectory.sample(plan.rate),
+                &crate::simulation::experiment_samples(nominal, plan, e)?,
                 i as u64,
                 &format!("rehearsed experiment '{}'", e.kind.name()),
             )

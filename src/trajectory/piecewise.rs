@@ -120,6 +120,95 @@ impl Trajectory {
         &self.segments[i.saturating_sub(1).min(self.segments.len() - 1)]
     }
 
+    /// Checks what a robot needs of a trajectory read from a file (the shapes, times and
+    /// coefficients' finiteness are the caller's to check first): every segment's reference
+    /// time finite and its positions, velocities and accelerations within f64's range; the
+    /// segments joined without a jump in position, velocity or acceleration (C2); at rest at
+    /// both ends. Each to `1e-6` relative to the magnitudes of the polynomial's terms there.
+    /// The error says what broke, with the segment, joint and time.
+    pub fn check_smooth(&self) -> std::result::Result<(), String> {
+        const TOL: f64 = 1e-6;
+        // the state at t by segment `seg`, with the size of its terms (the rounding scale)
+        let at = |seg: &Segment, j: usize, t: f64| {
+            let c = &seg.coeffs[j];
+            let s = (t - seg.t_ref).abs();
+            let mut scale = [0.0f64; 3];
+            for (k, ck) in c.iter().enumerate() {
+                let ck = ck.abs();
+                scale[0] += ck * s.powi(k as i32);
+                if k >= 1 {
+                    scale[1] += k as f64 * ck * s.powi(k as i32 - 1);
+                }
+                if k >= 2 {
+                    scale[2] += (k * (k - 1)) as f64 * ck * s.powi(k as i32 - 2);
+                }
+            }
+            let (q, v, a) = seg.eval(j, t);
+            ([q, v, a], scale)
+        };
+        const WHAT: [&str; 3] = ["position", "velocity", "acceleration"];
+        for (i, seg) in self.segments.iter().enumerate() {
+            if !seg.t_ref.is_finite() {
+                return Err(format!("segments[{i}]: t_ref {} is not finite", seg.t_ref));
+            }
+            for j in 0..self.n {
+                for t in [seg.t0, seg.t1] {
+                    let (x, scale) = at(seg, j, t);
+                    if let Some(d) = (0..3).find(|&d| !(x[d].is_finite() && scale[d].is_finite())) {
+                        return Err(format!(
+                            "segments[{i}], joint {}: the {} at t = {} s is beyond f64's range",
+                            j + 1,
+                            WHAT[d],
+                            crate::error::shown(t)
+                        ));
+                    }
+                }
+            }
+        }
+        for (i, pair) in self.segments.windows(2).enumerate() {
+            let t = pair[0].t1;
+            for j in 0..self.n {
+                let (x0, s0) = at(&pair[0], j, t);
+                let (x1, s1) = at(&pair[1], j, pair[1].t0);
+                for d in 0..3 {
+                    if (x1[d] - x0[d]).abs() > TOL * (1.0 + s0[d].max(s1[d])) {
+                        return Err(format!(
+                            "joint {}: the {} jumps from {} to {} at t = {} s, between segments[{i}] and segments[{}]; a robot cannot follow a jump",
+                            j + 1,
+                            WHAT[d],
+                            crate::error::shown(x0[d]),
+                            crate::error::shown(x1[d]),
+                            crate::error::shown(t),
+                            i + 1
+                        ));
+                    }
+                }
+            }
+        }
+        let ends = [
+            ("starts", self.segments.first(), self.start()),
+            ("ends", self.segments.last(), self.end()),
+        ];
+        for (which, seg, t) in ends {
+            let Some(seg) = seg else { continue };
+            for j in 0..self.n {
+                let (x, scale) = at(seg, j, t);
+                for d in 1..3 {
+                    if x[d].abs() > TOL * (1.0 + scale[d]) {
+                        return Err(format!(
+                            "joint {}: the trajectory {which} with {} {} at t = {} s; it must start and end at rest",
+                            j + 1,
+                            WHAT[d],
+                            crate::error::shown(x[d]),
+                            crate::error::shown(t)
+                        ));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Samples at `rate` Hz from the start to the end (both included, when the duration is a
     /// whole number of periods): `t_i = start + i / rate`.
     pub fn sample(&self, rate: f64) -> Samples {
