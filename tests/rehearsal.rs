@@ -293,6 +293,23 @@ fn bad_true_robot_documents_are_refused_by_name() {
         e.contains("friction.coulomb[1] is -0.2, expected >= 0"),
         "{e}"
     );
+    // a delay or jitter past a second would hold the log's end torques and invent the rest
+    for sensors in [
+        r#"{"delay": 1e18}"#,
+        r#"{"jitter": 2.0}"#,
+        r#"{"delay": -1e-3}"#,
+    ] {
+        let e = TrueRobot::from_json(&format!(
+            r#"{{"format": "perturbid-true-robot/1", "sensors": {sensors}}}"#
+        ))
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("must be in [0, 1] s"), "{sensors}: {e}");
+    }
+    assert!(TrueRobot::from_json(
+        r#"{"format": "perturbid-true-robot/1", "sensors": {"delay": 1.0, "jitter": 0.0}}"#
+    )
+    .is_ok());
     let short = doc(r#"{"format": "perturbid-true-robot/1", "friction": {"viscous": [0.1, 0.2]}}"#);
     let e = rehearse(&model, &short, &reference(6, 0.1, 100.0), 0, "x")
         .unwrap_err()

@@ -258,10 +258,13 @@ impl Document for TrueRobot {
                 )));
             }
         }
-        if !(s.jitter.is_finite() && s.jitter >= 0.0 && s.delay.is_finite() && s.delay >= 0.0) {
+        // a second is far past any sensor's timing; past it the log's first and last torques
+        // would be held (the recording does not reach that far) and the rest invented
+        if !((0.0..=1.0).contains(&s.jitter) && (0.0..=1.0).contains(&s.delay)) {
             return Err(bad(format!(
-                "sensors.jitter {} s and sensors.delay {} s must be finite and >= 0",
-                s.jitter, s.delay
+                "sensors.jitter {} s and sensors.delay {} s must be in [0, 1] s",
+                crate::error::shown(s.jitter),
+                crate::error::shown(s.delay)
             )));
         }
         if !(self.parameter_error.is_finite() && (0.0..=0.5).contains(&self.parameter_error)) {
