@@ -113,6 +113,73 @@ pub(crate) fn format_tag(text: &str, context: &str) -> Result<String> {
     })
 }
 
+/// Checks that every value of the field `field` of a document `what` is a magnitude (a
+/// standard error, a residual, a noise level): finite and `>= 0`, or with `unknown_ok` NaN
+/// (`null` in the file: no residual degree of freedom). Errors name the entry (`field[3]`).
+pub(crate) fn check_magnitudes(
+    what: &str,
+    field: &str,
+    values: &[f64],
+    unknown_ok: bool,
+) -> Result<()> {
+    check_magnitudes_at(
+        what,
+        values.iter().copied(),
+        |k| format!("{field}[{k}]"),
+        unknown_ok,
+    )
+}
+
+/// [`check_magnitudes`] for a matrix saved as a list of rows; errors name the entry as the
+/// file has it (`field[row][column]`, 0-based).
+pub(crate) fn check_magnitude_rows(
+    what: &str,
+    field: &str,
+    m: &nalgebra::DMatrix<f64>,
+    unknown_ok: bool,
+) -> Result<()> {
+    let (rows, cols) = m.shape();
+    let row_major = (0..rows).flat_map(|i| (0..cols).map(move |j| m[(i, j)]));
+    let at = |k: usize| format!("{field}[{}][{}]", k / cols.max(1), k % cols.max(1));
+    check_magnitudes_at(what, row_major, at, unknown_ok)
+}
+
+fn check_magnitudes_at(
+    what: &str,
+    values: impl Iterator<Item = f64>,
+    at: impl Fn(usize) -> String,
+    unknown_ok: bool,
+) -> Result<()> {
+    let mut values = values.enumerate();
+    match values.find(|(_, x)| !((x.is_finite() && *x >= 0.0) || (unknown_ok && x.is_nan()))) {
+        Some((k, x)) => Err(invalid(
+            what,
+            format!(
+                "{} is {}, expected a finite number >= 0{}",
+                at(k),
+                crate::error::shown(x),
+                if unknown_ok { " or null" } else { "" }
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Checks that the condition number `cond` of the field `field` of a document `what` is one:
+/// at least 1 (an infinite one is a design without full rank).
+pub(crate) fn check_condition(what: &str, field: &str, cond: f64) -> Result<()> {
+    if cond >= 1.0 - 1e-9 {
+        return Ok(());
+    }
+    Err(invalid(
+        what,
+        format!(
+            "{field} is {}, expected a condition number >= 1",
+            crate::error::shown(cond)
+        ),
+    ))
+}
+
 /// An error about a document's content (after parsing), for [`Document::validate`].
 pub(crate) fn invalid(what: &str, message: String) -> Error {
     Error::Json {

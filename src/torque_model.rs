@@ -123,7 +123,26 @@ pub(crate) fn predict_linear(
             + g * delta(&states.q()[r], &op.q);
         out.extend(tau.iter());
     }
+    check_prediction(&out, nv)?;
     Ok(out)
+}
+
+/// Fails when a predicted torque (row-major `k x nv`) is not finite: a model's coefficients
+/// (read from a file) or a state so large that the arithmetic overflowed. No inf or NaN is
+/// handed back.
+pub(crate) fn check_prediction(tau: &[f64], nv: usize) -> Result<()> {
+    match crate::states::first_non_finite(tau) {
+        Some(i) => Err(Error::Numerical {
+            operation: "prediction".into(),
+            message: format!(
+                "the torque of joint {} at sample {} is {}: the model's coefficients or the state are too large to compute with",
+                i % nv.max(1) + 1,
+                i / nv.max(1),
+                tau[i]
+            ),
+        }),
+        None => Ok(()),
+    }
 }
 
 /// A base-parameter model together with the robot whose regressor it needs

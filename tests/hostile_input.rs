@@ -713,3 +713,98 @@ fn fourier_coefficients_past_the_range_of_f64_are_refused() {
     .to_string();
     assert!(e.starts_with("harmonics: 1001"), "{e}");
 }
+
+/// Model files edited by hand: standard errors, residuals and noise levels are magnitudes
+/// (negative ones refused by field and entry), condition numbers at least 1, the operating
+/// points of the joints' length; coefficients too large to predict with give an error, not inf.
+#[test]
+fn model_documents_hold_magnitudes_where_they_say_so() {
+    use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
+    use perturbid_rs::local::{identify_local, IdentifyOptions, LocalModel};
+    use perturbid_rs::{simulate_plan, SimulationOptions, States};
+    let model = robots::builtin("a465").unwrap();
+    let op =
+        OperatingPoint::new(TABLE2_Q.to_vec(), TABLE2_QD.to_vec(), TABLE2_QDD.to_vec()).unwrap();
+    let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+    let mut sim = SimulationOptions::new(&model);
+    sim.torque_noise = vec![0.01; 6];
+    let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    let local = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    let text = local.to_json();
+    let edit = |f: &dyn Fn(&mut serde_json::Value)| {
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        f(&mut v);
+        LocalModel::from_json(&v.to_string())
+    };
+    for (f, says) in [
+        (
+            &(|v: &mut serde_json::Value| v["h"]["stderr"][2][3] = serde_json::json!(-0.5))
+                as &dyn Fn(&mut serde_json::Value),
+            "H.stderr[2][3] is -0.5, expected a finite number >= 0 or null",
+        ),
+        (
+            &|v: &mut serde_json::Value| v["d"]["residual_rms"][1] = serde_json::json!(-1e19),
+            "D.residual_rms[1] is -1e19, expected a finite number >= 0",
+        ),
+        (
+            &|v: &mut serde_json::Value| v["torque_stderr"][0] = serde_json::json!(-1),
+            "torque_stderr[0] is -1",
+        ),
+        (
+            &|v: &mut serde_json::Value| v["g"]["cond"] = serde_json::json!(0.5),
+            "G.cond is 0.5, expected a condition number >= 1",
+        ),
+        (
+            &|v: &mut serde_json::Value| {
+                v["planned_op"]["q"].as_array_mut().unwrap().pop();
+            },
+            "planned_op.q has 5 entries, torque has 6",
+        ),
+    ] {
+        let e = edit(f).unwrap_err().to_string();
+        assert!(e.contains(says), "{says}: {e}");
+    }
+    // an unknown standard error (null) is fine
+    edit(&|v| v["d"]["stderr"][0][0] = serde_json::Value::Null).unwrap();
+    // D* with an entry of 1e308: a prediction away from the operating point overflows
+    let huge = edit(&|v| v["d"]["matrix"][0][0] = serde_json::json!(1e308)).unwrap();
+    let qdd: Vec<f64> = TABLE2_QDD.iter().map(|a| a + 10.0).collect();
+    let states = States::single(6, &TABLE2_Q, Some(&TABLE2_QD), Some(&qdd)).unwrap();
+    let e = huge.predict(&states).unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::Numerical, "{e}");
+    assert!(
+        e.to_string()
+            .contains("torque of joint 1 at sample 0 is inf"),
+        "{e}"
+    );
+    assert!(huge
+        .predict(&States::single(6, &TABLE2_Q, Some(&TABLE2_QD), Some(&TABLE2_QDD)).unwrap())
+        .is_ok());
+    // a base-parameter model with a negative noise level
+    let k = 300;
+    let x = |i: usize, f: f64| ((i * 7) as f64 * f).sin();
+    let q: Vec<f64> = (0..k * 6).map(|i| x(i, 0.37)).collect();
+    let qd: Vec<f64> = (0..k * 6).map(|i| x(i, 0.53)).collect();
+    let qdd: Vec<f64> = (0..k * 6).map(|i| x(i, 0.71)).collect();
+    let states = States::new(6, &q, Some(&qd), Some(&qdd)).unwrap();
+    let mut tau = vec![0.0; k * 6];
+    perturbid_rs::parallel::rnea(
+        &model,
+        &mut perturbid_rs::parallel::Workspace::new(&model),
+        &states,
+        perturbid_rs::Gravity::Included,
+        &mut tau,
+    )
+    .unwrap();
+    for (i, t) in tau.iter_mut().enumerate() {
+        *t += 0.01 * ((i * 13) as f64).sin();
+    }
+    let fit = identify_base_parameters(&model, &states, &tau, &BaseOptions::default()).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&fit.to_json()).unwrap();
+    assert!(BaseModel::from_json(&v.to_string()).is_ok());
+    v["sigma"][4] = serde_json::json!(-0.1);
+    let e = BaseModel::from_json(&v.to_string())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("sigma[4] is -0.1"), "{e}");
+}

@@ -5,7 +5,7 @@
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-use crate::document::{invalid, Document};
+use crate::document::{check_condition, check_magnitude_rows, check_magnitudes, invalid, Document};
 use crate::error::Result;
 use crate::local::OperatingPoint;
 use crate::regression::least_squares;
@@ -90,7 +90,8 @@ impl Document for GlobalLinearModel {
     const VERSION: u32 = 1;
     const WHAT: &'static str = "globally linearised model";
 
-    /// Checks every shape against the number of joints.
+    /// Checks every shape against the number of joints, and that standard errors and
+    /// residuals are magnitudes (`>= 0`, or unknown) and the condition number at least 1.
     fn validate(&self) -> Result<()> {
         let n = self.offset.len();
         let square = [&self.d, &self.h, &self.g]
@@ -109,6 +110,8 @@ impl Document for GlobalLinearModel {
                 format!("its parts do not all have the {n} joints of the offset"),
             ));
         }
-        Ok(())
+        check_magnitude_rows(Self::WHAT, "stderr", &self.stderr, true)?;
+        check_magnitudes(Self::WHAT, "residual_rms", &self.residual_rms, false)?;
+        check_condition(Self::WHAT, "cond", self.cond)
     }
 }

@@ -8,7 +8,7 @@ use super::base::{BaseParameters, BASE_TOLERANCE};
 use super::parameters::{regressor_matrix, FrictionTerms, ParameterLayout};
 use super::streaming;
 use crate::choice::choice;
-use crate::document::{invalid, Document};
+use crate::document::{check_condition, check_magnitudes, invalid, Document};
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
@@ -223,7 +223,9 @@ impl Document for BaseModel {
     const VERSION: u32 = 1;
     const WHAT: &'static str = "base-parameter model";
 
-    /// Checks that the base parameters, their map and the layout agree in size.
+    /// Checks that the base parameters, their map and the layout agree in size, that the
+    /// per-joint fields have one value a joint, and that standard errors, residuals and noise
+    /// levels are magnitudes (the noise levels positive) and the condition number at least 1.
     fn validate(&self) -> Result<()> {
         let m = self;
         let p = m.base.kept.len();
@@ -237,7 +239,27 @@ impl Document for BaseModel {
                 "the base parameters, their map and the layout disagree in size".into(),
             ));
         }
-        Ok(())
+        let n = m.joint_names.len();
+        if m.residual_rms.len() != n || m.sigma.len() != n {
+            return Err(invalid(
+                Self::WHAT,
+                format!(
+                    "residual_rms has {} entries and sigma {}, expected one per joint ({n})",
+                    m.residual_rms.len(),
+                    m.sigma.len()
+                ),
+            ));
+        }
+        check_magnitudes(Self::WHAT, "stderr", &m.stderr, true)?;
+        check_magnitudes(Self::WHAT, "residual_rms", &m.residual_rms, false)?;
+        check_magnitudes(Self::WHAT, "sigma", &m.sigma, false)?;
+        if let Some(j) = m.sigma.iter().position(|&s| s == 0.0) {
+            return Err(invalid(
+                Self::WHAT,
+                format!("sigma[{j}] is 0, expected a positive noise level (a weight)"),
+            ));
+        }
+        check_condition(Self::WHAT, "cond", m.cond)
     }
 }
 
@@ -273,9 +295,11 @@ impl BaseModel {
             states,
             self.gravity,
         )?);
-        Ok((phi * DVector::from_column_slice(&self.theta))
+        let tau = (phi * DVector::from_column_slice(&self.theta))
             .as_slice()
-            .to_vec())
+            .to_vec();
+        crate::torque_model::check_prediction(&tau, model.nv)?;
+        Ok(tau)
     }
 
     /// The mass matrix `M(q)` (`nv x nv`) of the identified parameters at `q`: column `j` is

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::diagnostics::Diagnostics;
 use super::operating_point::OperatingPoint;
 use crate::choice::choice;
-use crate::document::{invalid, Document};
+use crate::document::{check_condition, check_magnitude_rows, check_magnitudes, invalid, Document};
 use crate::error::{Error, Result};
 use crate::states::States;
 use crate::torque_model::predict_linear;
@@ -130,7 +130,8 @@ impl Document for LocalModel {
     const VERSION: u32 = 1;
     const WHAT: &'static str = "local model";
 
-    /// Checks every shape against the number of joints.
+    /// Checks every shape against the number of joints, and that standard errors and
+    /// residuals are magnitudes (`>= 0`, or unknown) and condition numbers at least 1.
     fn validate(&self) -> Result<()> {
         let m = self;
         let bad = |message: String| invalid(Self::WHAT, message);
@@ -141,11 +142,16 @@ impl Document for LocalModel {
             ("op.q", m.op.q.len()),
             ("op.qd", m.op.qd.len()),
             ("op.qdd", m.op.qdd.len()),
+            ("planned_op.q", m.planned_op.q.len()),
+            ("planned_op.qd", m.planned_op.qd.len()),
+            ("planned_op.qdd", m.planned_op.qdd.len()),
         ] {
             if len != n {
                 return Err(bad(format!("{what} has {len} entries, torque has {n}")));
             }
         }
+        // standard errors and residuals are magnitudes: unknown (NaN, `null`) or >= 0
+        check_magnitudes(Self::WHAT, "torque_stderr", &m.torque_stderr, true)?;
         for (what, e, cols) in [
             ("D", &m.d, n),
             ("H", &m.h, n),
@@ -160,6 +166,10 @@ impl Document for LocalModel {
                 {
                     return Err(bad(format!("{what} is not {n} x {cols}")));
                 }
+                check_magnitude_rows(Self::WHAT, &format!("{what}.stderr"), &e.stderr, true)?;
+                let rms = format!("{what}.residual_rms");
+                check_magnitudes(Self::WHAT, &rms, &e.residual_rms, false)?;
+                check_condition(Self::WHAT, &format!("{what}.cond"), e.cond)?;
             }
         }
         Ok(())
