@@ -210,7 +210,7 @@ pub enum Error {
     },
 
     /// A number in the URDF that is NaN or infinite where a finite value is required.
-    #[error("{location}: {element} '{name}': {field} is {value}, expected a finite number below 1e12 in size")]
+    #[error("{location}: {element} '{name}': {field} is {}, expected a finite number below 1e12 in size", shown(*.value))]
     NonFiniteUrdf {
         location: Box<Location>,
         element: &'static str,
@@ -285,6 +285,15 @@ pub enum Error {
         message: String,
     },
 
+    /// A joint's `<dynamics>` that no passive joint has: a negative damping or friction (it
+    /// would push the joint instead of resisting its motion).
+    #[error("{location}: joint '{joint}' <dynamics>: {message}")]
+    InvalidDynamics {
+        location: Box<Location>,
+        joint: String,
+        message: String,
+    },
+
     /// A model with no degree of freedom: every joint is fixed or locked.
     #[error("{source_name}: robot '{robot}' has no moving joint (every joint is fixed or locked); nothing can be identified")]
     NoDegreeOfFreedom { source_name: String, robot: String },
@@ -343,6 +352,7 @@ impl Error {
             | Error::NonFiniteUrdf { .. }
             | Error::InvalidLimit { .. }
             | Error::InvalidArmature { .. }
+            | Error::InvalidDynamics { .. }
             | Error::NoDegreeOfFreedom { .. }
             | Error::UnknownRobot { .. } => ErrorKind::Model,
             Error::Interrupted { .. } => ErrorKind::Interrupted,

@@ -264,3 +264,49 @@ fn an_empty_robot_has_no_root() {
     assert!(matches!(e, Error::RootCount { .. }), "{e}");
     assert!(e.to_string().contains("found 0"), "{e}");
 }
+
+/// A negative damping or friction would push the joint: refused with the joint and line. Huge
+/// numbers are shown short in every message (1e300, not 301 digits).
+#[test]
+fn negative_dynamics_are_refused_and_numbers_are_shown_short() {
+    for (dynamics, says) in [
+        (
+            r#"<dynamics damping="-0.1" friction="0"/>"#,
+            "damping -0.1 is negative",
+        ),
+        (
+            r#"<dynamics damping="0" friction="-2"/>"#,
+            "friction -2 is negative",
+        ),
+    ] {
+        let extra = format!("{LIMIT}{dynamics}");
+        let e = load(&robot(
+            &(joint("j1", "revolute", "base", "a", &extra)
+                + &joint("j2", "revolute", "a", "b", LIMIT)),
+        ));
+        assert!(matches!(e, Error::InvalidDynamics { .. }), "{e}");
+        assert!(
+            e.to_string()
+                .starts_with("bad.urdf:5: joint 'j1' <dynamics>: ")
+                && e.to_string().contains(says),
+            "{e}"
+        );
+    }
+    for (extra, says) in [
+        (
+            r#"<limit lower="1e300" upper="-1e300" effort="1" velocity="1"/>"#,
+            "lower (1e300) is above upper (-1e300)",
+        ),
+        (
+            r#"<origin xyz="1e300 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/>"#,
+            "origin xyz is 1e300, expected a finite number below 1e12",
+        ),
+    ] {
+        let e = load(&robot(
+            &(joint("j1", "revolute", "base", "a", extra)
+                + &joint("j2", "revolute", "a", "b", LIMIT)),
+        ))
+        .to_string();
+        assert!(e.contains(says) && e.len() < 200, "{e}");
+    }
+}

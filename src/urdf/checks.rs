@@ -5,7 +5,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::convert::kind_name;
 use super::Builder;
-use crate::error::{Error, Result};
+use crate::error::{shown, Error, Result};
 
 /// The largest mass (kg) or inertia (kg m^2) accepted in a link.
 pub const MAX_INERTIAL: f64 = 1e9;
@@ -68,13 +68,14 @@ impl Builder<'_> {
             if l.lower > l.upper {
                 return Err(invalid(format!(
                     "lower ({}) is above upper ({})",
-                    l.lower, l.upper
+                    shown(l.lower),
+                    shown(l.upper)
                 )));
             }
             if l.lower == l.upper {
                 return Err(invalid(format!(
                     "lower = upper = {}: the joint cannot move; make it fixed, or lock it when loading",
-                    l.lower
+                    shown(l.lower)
                 )));
             }
         }
@@ -88,20 +89,20 @@ impl Builder<'_> {
         if l.velocity <= 0.0 && given(l.velocity) {
             return Err(invalid(format!(
                 "velocity {} {unit}/s is not positive; a moving joint needs a positive speed limit",
-                l.velocity
+                shown(l.velocity)
             )));
         }
         if l.effort < 0.0 {
             let effort_unit = if unit == "m" { "N" } else { "N m" };
             return Err(invalid(format!(
                 "effort {} {effort_unit} is negative; give a positive limit, or 0 for none",
-                l.effort
+                shown(l.effort)
             )));
         }
         if l.acceleration <= 0.0 {
             return Err(invalid(format!(
                 "acceleration {} {unit}/s^2 is not positive; leave it out for none",
-                l.acceleration
+                shown(l.acceleration)
             )));
         }
         if let Some(d) = &joint.dynamics {
@@ -111,6 +112,18 @@ impl Builder<'_> {
                 "dynamics damping/friction",
                 &[d.damping, d.friction],
             )?;
+            for (field, value) in [("damping", d.damping), ("friction", d.friction)] {
+                if value < 0.0 {
+                    return Err(Error::InvalidDynamics {
+                        location: self.joint_location(name),
+                        joint: name.to_string(),
+                        message: format!(
+                            "{field} {} is negative: it would push the joint instead of resisting its motion; expected >= 0",
+                            shown(value)
+                        ),
+                    });
+                }
+            }
         }
         if let Some(m) = &joint.mimic {
             self.finite(
@@ -145,7 +158,7 @@ impl Builder<'_> {
         if inertial.mass.value < 0.0 {
             return Err(invalid(format!(
                 "mass {} kg is negative",
-                inertial.mass.value
+                shown(inertial.mass.value)
             )));
         }
         // finite values whose products overflow (1e308) would turn every result into inf or
