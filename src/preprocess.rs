@@ -67,17 +67,25 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     if parts.len() == 1 {
         return preprocess_part(rec, options);
     }
+    // microseconds for a log's times; exponent form for absurd ones (1e300 s)
+    let time = |t: f64| {
+        if t.abs() < 1e9 {
+            format!("{t:.6}")
+        } else {
+            crate::error::shown(t)
+        }
+    };
     let mut done = Vec::with_capacity(parts.len());
     for (k, part) in parts.iter().enumerate() {
         let p = preprocess_part(part, options).map_err(|e| match e {
             Error::Recording { message, .. } => Error::Recording {
                 recording: rec.name.clone(),
                 message: format!(
-                    "part {} of {} (t = {:.6} s to {:.6} s, between gaps): {message}",
+                    "part {} of {} (t = {} s to {} s, between gaps): {message}",
                     k + 1,
                     parts.len(),
-                    part.t[0],
-                    part.t[part.len() - 1]
+                    time(part.t[0]),
+                    time(part.t[part.len() - 1])
                 ),
             },
             other => other,
