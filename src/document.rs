@@ -88,7 +88,10 @@ pub trait Document: Serialize + DeserializeOwned {
     /// Reads and checks a document file.
     fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        Self::from_json_in(&crate::io::read_text(path)?, &path.display().to_string())
+        Self::from_json_in(
+            &crate::io::read_document(path)?,
+            &path.display().to_string(),
+        )
     }
 
     /// Writes the document to `path` atomically (a temporary file renamed into place).

@@ -17,6 +17,11 @@ pub const MAX_HARMONICS: usize = 1_000;
 pub const MAX_FIT_SAMPLES: usize = 1_000_000;
 /// Criterion evaluations of one excitation design.
 pub const MAX_EVALUATIONS: usize = 10_000_000;
+/// Bytes read from one table or log (CSV): 2 GiB (about eight hours of a 7-joint arm at
+/// 1 kHz with every column).
+pub const MAX_TEXT_BYTES: u64 = 2 << 30;
+/// Bytes read from one document (JSON, TOML, URDF): 256 MiB, far past any plan, model or robot.
+pub const MAX_DOCUMENT_BYTES: u64 = 256 << 20;
 /// A recording's longest gap between time stamps, in multiples of its median interval, before
 /// resampling refuses to fill it with interpolated values.
 pub const MAX_GAP_INTERVALS: f64 = 20.0;

@@ -252,7 +252,10 @@ impl ModelFile {
     /// Reads and parses a model file.
     pub fn load(path: impl AsRef<std::path::Path>) -> Result<Self> {
         let path = path.as_ref();
-        Self::from_json(&crate::io::read_text(path)?, &path.display().to_string())
+        Self::from_json(
+            &crate::io::read_document(path)?,
+            &path.display().to_string(),
+        )
     }
 
     /// The names of the joints the model is for.

@@ -808,3 +808,33 @@ fn model_documents_hold_magnitudes_where_they_say_so() {
         .to_string();
     assert!(e.contains("sigma[4] is -0.1"), "{e}");
 }
+
+/// Files are read only up to a bound: a document larger than 256 MiB is refused before it is
+/// read, and a device that never ends (`/dev/zero`) is read no further than the bound instead of
+/// until memory runs out.
+#[test]
+fn files_are_read_only_up_to_a_bound() {
+    use perturbid_rs::rehearsal::TrueRobot;
+    let dir = std::env::temp_dir().join(format!("perturbid-big-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let big = dir.join("big.json");
+    // sparse: no disk space, 300 MiB of length
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(300 << 20)
+        .unwrap();
+    let e = Plan::load(&big).unwrap_err().to_string();
+    assert!(e.contains("big.json: larger than 256 MB"), "{e}");
+    let e = perturbid_rs::model_from_urdf_file(&big, &LoadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("larger than 256 MB, the most read for a document"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+    if std::path::Path::new("/dev/zero").exists() {
+        let e = TrueRobot::load("/dev/zero").unwrap_err().to_string();
+        assert!(e.starts_with("/dev/zero: larger than 256 MB"), "{e}");
+    }
+}

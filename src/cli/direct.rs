@@ -67,7 +67,7 @@ pub(crate) fn excite(a: ExciteArgs) -> Result<String> {
         margin: a.margin,
         workspace: match &a.workspace {
             Some(path) => crate::direct::workspace_from_json(
-                &crate::io::read_text(path)?,
+                &crate::io::read_document(path)?,
                 &path.display().to_string(),
             )?,
             None => vec![],

@@ -74,7 +74,7 @@ pub(crate) fn load_table(path: &Path) -> Result<Table> {
 
 /// A JSON document from a file, parsed by `parse`; errors are prefixed with the path.
 pub(crate) fn load_json<T>(path: &Path, parse: impl Fn(&str) -> Result<T>) -> Result<T> {
-    let text = read_text(path)?;
+    let text = crate::io::read_document(path)?;
     parse(&text).map_err(|e| match e {
         Error::Json { context, message } => Error::Json {
             context: format!("{} ({context})", path.display()),

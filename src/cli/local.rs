@@ -207,7 +207,7 @@ enum Reference {
 }
 
 fn load_reference(path: &Path) -> Result<Reference> {
-    let text = crate::io::read_text(path)?;
+    let text = crate::io::read_document(path)?;
     let context = path.display().to_string();
     if let Ok(tag) = crate::document::format_tag(&text, &context) {
         if tag.starts_with(Plan::FORMAT) {

@@ -13,12 +13,47 @@ pub(crate) fn io_error(path: &Path, source: std::io::Error) -> Error {
     }
 }
 
-/// The contents of a text file; the error names the path. A file of an output set whose
-/// writing was interrupted is refused ([`check_not_partial`]).
+/// The contents of a text file (a table or log: at most
+/// [`MAX_TEXT_BYTES`](crate::limits::MAX_TEXT_BYTES)); the error names the path. A file of
+/// an output set whose writing was interrupted is refused ([`check_not_partial`]).
 pub fn read_text(path: impl AsRef<Path>) -> Result<String> {
-    let path = path.as_ref();
+    read_bounded(path.as_ref(), crate::limits::MAX_TEXT_BYTES, "table")
+}
+
+/// The contents of a document (JSON, TOML, URDF: at most
+/// [`MAX_DOCUMENT_BYTES`](crate::limits::MAX_DOCUMENT_BYTES)), as [`read_text`].
+pub fn read_document(path: impl AsRef<Path>) -> Result<String> {
+    read_bounded(path.as_ref(), crate::limits::MAX_DOCUMENT_BYTES, "document")
+}
+
+/// Reads at most `max` bytes of `path` (`what` it is, for the error): a regular file larger
+/// than that is refused before it is read, and a device or pipe (`/dev/zero`) is read no
+/// further than the bound.
+fn read_bounded(path: &Path, max: u64, what: &str) -> Result<String> {
+    use std::io::Read;
     check_not_partial(path)?;
-    std::fs::read_to_string(path).map_err(|e| io_error(path, e))
+    let too_large = || {
+        io_error(
+            path,
+            std::io::Error::other(format!(
+                "larger than {} MB, the most read for a {what} (docs/limits.md)",
+                max >> 20
+            )),
+        )
+    };
+    let file = std::fs::File::open(path).map_err(|e| io_error(path, e))?;
+    let meta = file.metadata().map_err(|e| io_error(path, e))?;
+    if meta.is_file() && meta.len() > max {
+        return Err(too_large());
+    }
+    let mut text = String::new();
+    file.take(max + 1)
+        .read_to_string(&mut text)
+        .map_err(|e| io_error(path, e))?;
+    if text.len() as u64 > max {
+        return Err(too_large());
+    }
+    Ok(text)
 }
 
 /// Writes `bytes` to a temporary file beside `path` (hidden, named after this process so that

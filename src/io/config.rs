@@ -40,7 +40,7 @@ pub fn parse_toml<T: DeserializeOwned>(source: &str, text: &str) -> Result<T> {
 /// Reads and parses the TOML file `path` (size-bounded like every input, see
 /// [`crate::io::read_text`]). Returns the text too, for the locations of later checks.
 pub fn read_toml<T: DeserializeOwned>(path: &Path) -> Result<(T, String)> {
-    let text = crate::io::read_text(path)?;
+    let text = crate::io::read_document(path)?;
     Ok((parse_toml(&path.display().to_string(), &text)?, text))
 }
 

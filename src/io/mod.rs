@@ -9,7 +9,7 @@ pub mod output_set;
 pub mod recording;
 pub mod table;
 
-pub use atomic::{read_text, write_atomic};
+pub use atomic::{read_document, read_text, write_atomic};
 pub use output_set::{check_not_partial, OutputSet};
 pub use recording::{read_recording, read_states, recording_table, samples_table, States};
 pub use table::{csv_text, Table};

@@ -72,7 +72,7 @@ impl Study {
         for (r, spec) in config.robots.iter().enumerate() {
             let is_file = spec.name.ends_with(".urdf") || spec.name.contains('/');
             let urdf = if is_file {
-                Some(crate::io::read_text(base.join(&spec.name))?)
+                Some(crate::io::read_document(base.join(&spec.name))?)
             } else {
                 None
             };
@@ -128,7 +128,7 @@ impl Study {
             let doc: serde_json::Value = match (&t.file, &t.document) {
                 (Some(f), None) => {
                     let path = base.join(f);
-                    let text = crate::io::read_text(&path)?;
+                    let text = crate::io::read_document(&path)?;
                     // checked as a document first, so that its errors name the file
                     TrueRobot::from_json_in(&text, &path.display().to_string())?;
                     serde_json::from_str(&text).expect("parsed above")

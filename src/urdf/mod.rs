@@ -63,10 +63,7 @@ impl Default for LoadOptions {
 /// Reads and builds a model from a URDF file.
 pub fn model_from_urdf_file(path: impl AsRef<Path>, options: &LoadOptions) -> Result<Model> {
     let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-        path: path.display().to_string(),
-        source,
-    })?;
+    let text = crate::io::read_document(path)?;
     model_from_urdf_str(&text, &path.display().to_string(), options)
 }
 
