@@ -46,7 +46,7 @@ impl OperatingPoint {
             let name = &model.joint_names[j];
             let bad = |what: &str, value: f64, range: String| Error::InvalidArgument {
                 argument: format!("operating point {what}[{j}] (joint '{name}')"),
-                message: format!("{value} is outside {range}"),
+                message: format!("{} is outside {range}", crate::error::shown(value)),
             };
             if self.q[j] < lim.lower || self.q[j] > lim.upper {
                 return Err(bad(

@@ -270,6 +270,8 @@ pub const MAX_SEEDS: u64 = 1_000_000;
 /// Sampled points per speed class, and perturbations per experiment.
 pub const MAX_POINTS: usize = 10_000;
 pub const MAX_K: usize = 10_000;
+/// Perturbation sizes and evaluation distances, as multiples of the default perturbations.
+pub const MAX_MULTIPLE: f64 = 100.0;
 
 impl StudyConfig {
     /// Checks what serde cannot: non-empty lists, positive finite numbers, bounds.
@@ -352,6 +354,59 @@ impl StudyConfig {
                 "direct.max_evaluations",
                 format!("{}; expected 1..=100000", self.direct.max_evaluations),
             ));
+        }
+        // a value listed twice would run the same cases twice and count them twice
+        fn twice<T: PartialEq>(v: &[T]) -> Option<&T> {
+            v.iter()
+                .enumerate()
+                .find(|(i, x)| v[..*i].contains(x))
+                .map(|(_, x)| x)
+        }
+        let lists: [(&str, Option<String>); 8] = [
+            (
+                "local.designs",
+                twice(&self.local.designs).map(|x| x.to_string()),
+            ),
+            ("local.k", twice(&self.local.k).map(|x| x.to_string())),
+            (
+                "local.perturbation",
+                twice(&self.local.perturbation).map(|x| x.to_string()),
+            ),
+            (
+                "evaluation.distances",
+                twice(&self.evaluation.distances).map(|x| x.to_string()),
+            ),
+            ("methods", twice(&self.methods).map(|x| x.to_string())),
+            ("noise", twice(&self.noise).map(|x| x.to_string())),
+            (
+                "sample_points.speed_classes",
+                self.sample_points
+                    .as_ref()
+                    .and_then(|s| twice(&s.speed_classes))
+                    .map(|x| x.to_string()),
+            ),
+            ("robots", twice(&self.robots).map(|r| r.name.clone())),
+        ];
+        for (key, value) in lists {
+            if let Some(value) = value {
+                return Err(bad(key, format!("'{value}' is listed twice")));
+            }
+        }
+        // multiples of the default perturbations and distances in them: past 100 the states
+        // leave any robot's range
+        for (key, v) in [
+            ("local.perturbation", &self.local.perturbation),
+            ("evaluation.distances", &self.evaluation.distances),
+        ] {
+            if let Some(x) = v.iter().find(|x| **x > MAX_MULTIPLE) {
+                return Err(bad(
+                    key,
+                    format!(
+                        "{}; expected at most {MAX_MULTIPLE} (multiples of the default perturbation sizes)",
+                        crate::error::shown(*x)
+                    ),
+                ));
+            }
         }
         let mut names = std::collections::BTreeSet::new();
         for t in &self.true_robots {

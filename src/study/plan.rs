@@ -85,7 +85,9 @@ impl Study {
             let model = robot.model()?;
             for p in &config.points {
                 if p.q.len() == model.nv && p.qd.len() == model.nv && p.qdd.len() == model.nv {
+                    // within this robot's limits: a case at it could not be planned
                     crate::local::OperatingPoint::new(p.q.clone(), p.qd.clone(), p.qdd.clone())
+                        .and_then(|op| op.check(&model))
                         .map_err(|e| Error::Config {
                             location: format!("{source}, points '{}'", p.name),
                             message: e.to_string(),
