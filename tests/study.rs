@@ -227,43 +227,43 @@ fn bad_configurations_name_the_place() {
         e.starts_with("s.toml:4:") && e.contains("local_magic"),
         "{e}"
     );
-    // a value listed twice would run its cases twice
-    let e = parse(&STUDY.replace("distances = [1, 4]", "distances = [1, 4, 1]"));
-    assert!(
-        e.contains("evaluation.distances: '1' is listed twice"),
-        "{e}"
-    );
-    let e = parse(&STUDY.replace(
-        "methods = [\"local_separated\",",
-        "methods = [\"local_separated\", \"local_separated\",",
-    ));
-    assert!(
-        e.contains("methods: 'local_separated' is listed twice"),
-        "{e}"
-    );
-    let e = parse(&STUDY.replace(
-        "name = \"a465\"",
-        "name = \"a465\"\n[[robots]]\nname = \"a465\"",
-    ));
-    assert!(e.contains("robots: 'a465' is listed twice"), "{e}");
-    // multiples of the perturbations past 100, a point outside the robot's limits
-    let e = parse(&STUDY.replace("distances = [1, 4]", "distances = [1, 1e308]"));
-    assert!(
-        e.contains("evaluation.distances: 1e308; expected at most 100"),
-        "{e}"
-    );
-    let e = parse(&format!("{STUDY}\n[local]\nperturbation = [1, 500]\n"));
-    assert!(
-        e.contains("local.perturbation: 500; expected at most 100"),
-        "{e}"
-    );
-    let e = parse(&STUDY.replace("q = [0.7854, ", "q = [1e308, "));
-    assert!(
-        e.contains("points 'paper'")
-            && e.contains("q[0] (joint 'joint1')")
-            && e.contains("1e308 is outside"),
-        "{e}"
-    );
+    // a value listed twice would run its cases twice; multiples of the perturbations past
+    // 100; a point outside the robot's limits
+    for (from, to, says) in [
+        (
+            "distances = [1, 4]",
+            "distances = [1, 4, 1]",
+            "evaluation.distances: '1' is listed twice",
+        ),
+        (
+            "methods = [\"local_separated\",",
+            "methods = [\"local_separated\", \"local_separated\",",
+            "methods: 'local_separated' is listed twice",
+        ),
+        (
+            "name = \"a465\"",
+            "name = \"a465\"\n[[robots]]\nname = \"a465\"",
+            "robots: 'a465' is listed twice",
+        ),
+        (
+            "distances = [1, 4]",
+            "distances = [1, 1e308]",
+            "evaluation.distances: 1e308; expected at most 100",
+        ),
+        (
+            "samples = 4",
+            "samples = 4\n[local]\nperturbation = [1, 500]",
+            "local.perturbation: 500; expected at most 100",
+        ),
+        (
+            "q = [0.7854, ",
+            "q = [1e308, ",
+            "points 'paper': operating point q[0] (joint 'joint1'): 1e308 is outside",
+        ),
+    ] {
+        let e = parse(&STUDY.replace(from, to));
+        assert!(e.contains(says), "{says}: {e}");
+    }
     let e = parse(&format!("{STUDY}\n[[true_robots]]\nname = \"x\"\ndocument = {{ payload = {{ link = \"nowhere\", mass = 1.0, com = [0,0,0], inertia = [0,0,0,0,0,0] }} }}\n"));
     assert!(
         e.contains("true_robots 'x'") && e.contains("nowhere"),
