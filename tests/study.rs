@@ -256,6 +256,11 @@ fn bad_configurations_name_the_place() {
             "local.perturbation: 500; expected at most 100",
         ),
         (
+            "samples = 4",
+            "samples = 4\n[sample_points]\ncount = 2\nspeed_classes = []",
+            "sample_points.speed_classes: an empty list",
+        ),
+        (
             "q = [0.7854, ",
             "q = [1e308, ",
             "points 'paper': operating point q[0] (joint 'joint1'): 1e308 is outside",

@@ -290,6 +290,12 @@ impl StudyConfig {
             ));
         }
         if let Some(s) = &self.sample_points {
+            if s.count > 0 && s.speed_classes.is_empty() {
+                return Err(bad(
+                    "sample_points.speed_classes",
+                    "an empty list: no point would be sampled; give slow, fast or both".into(),
+                ));
+            }
             if s.count > MAX_POINTS {
                 return Err(bad(
                     "sample_points.count",
