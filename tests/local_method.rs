@@ -765,6 +765,24 @@ fn a_torque_channel_that_does_not_change_is_warned_about() {
             assert_eq!(est.matrix[(i, j)], c.matrix[(i, j)]);
         }
     }
+    // recorded in the diagnostics, and left out of the robot's parameters from the model
+    assert_eq!(m.diagnostics.unmeasured.len(), 1);
+    let u = &m.diagnostics.unmeasured[0];
+    assert_eq!(
+        (u.experiment.as_str(), u.joint.as_str(), u.value),
+        ("D", "joint3", 12.5)
+    );
+    let from = |m: &LocalModel| {
+        perturbid_rs::local::identify_parameters_from_local(
+            &model,
+            std::slice::from_ref(m),
+            &perturbid_rs::local::FromLocalOptions::default(),
+        )
+        .unwrap()
+    };
+    assert_eq!(from(&m).rows + n, from(&clean).rows);
+    let back = LocalModel::from_json(&m.to_json()).unwrap();
+    assert_eq!(back.diagnostics.unmeasured, m.diagnostics.unmeasured);
     // the combined estimate's row for joint 3 is no more certain
     let opts = IdentifyOptions {
         estimator: Estimator::Combined,
@@ -774,6 +792,8 @@ fn a_torque_channel_that_does_not_change_is_warned_about() {
     let comb = m.combined.as_ref().unwrap();
     assert!(comb.stderr.row(2).iter().all(|s| s.is_nan()));
     assert!(comb.stderr.row(1).iter().all(|s| s.is_finite()));
+    // there joint 3's rows of D*, H* and G* all come from the one fit: all left out
+    assert_eq!(from(&m).rows + 3 * n, from(&clean).rows);
 }
 
 /// A plan read from a file is what the robot will run: a hand edit that makes its trajectory

@@ -329,7 +329,9 @@ class LocalModel:
         """Coulomb steps (N m) from the friction-aware H regression, per joint."""
     @property
     def diagnostics(self) -> dict[str, Any]:
-        """offsets (experiment -> clock offset, s), reversals (list of dicts), warnings."""
+        """offsets (experiment -> clock offset, s), reversals (list of dicts), combined,
+        unperturbed_deviation, unmeasured (list of dicts: experiment, joint, value in N m, for
+        torques that read one value throughout), warnings."""
     def linearize(self, op: OperatingPoint) -> dict[str, Any]:
         """torque (n,), D, H, G (n, n) and G_static (n, n) or None at op."""
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:

@@ -55,6 +55,18 @@ pub struct BlockAgreement {
     pub standard_errors: f64,
 }
 
+/// A joint whose torque read one value in every sample of an experiment that perturbs the
+/// robot (a dead or saturated channel): its row of that experiment's matrix is not measured.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Unmeasured {
+    /// The experiment (`G_static`, `G`, `H`, `D`).
+    pub experiment: String,
+    pub joint: String,
+    /// The value every torque sample had (N m).
+    pub value: f64,
+}
+
 /// Diagnostics of a local identification; see the module documentation.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -73,6 +85,10 @@ pub struct Diagnostics {
     /// The combined estimate against the separated one, block by block (when both exist).
     #[serde(default)]
     pub combined: Vec<BlockAgreement>,
+    /// The rows not measured (their standard errors NaN), with a warning: a torque that did
+    /// not change. [`super::identify_parameters_from_local`] leaves them out.
+    #[serde(default)]
+    pub unmeasured: Vec<Unmeasured>,
     /// What the user should know: each is also given as a Python warning and printed by the
     /// command line.
     #[serde(default)]

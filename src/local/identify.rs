@@ -10,7 +10,7 @@ use super::crossing::{
 use super::diagnose::{
     compare_combined, diagnose, disagreement_warning, mass_matrix_warning, unperturbed_deviation,
 };
-use super::diagnostics::{Reversal, ReversalHandling};
+use super::diagnostics::{Reversal, ReversalHandling, Unmeasured};
 use super::friction_aware::friction_aware_h;
 use super::model::{Estimate, Estimator, LocalModel};
 use super::operating_point::OperatingPoint;
@@ -513,6 +513,7 @@ pub fn identify_local(
     let mut g_static = g_static;
     let mut combined = combined;
     let mut flat_warnings = vec![];
+    let mut unmeasured = vec![];
     for v in &values {
         let Some(estimate) = (match v.kind {
             ExperimentKind::D => d.as_mut(),
@@ -538,6 +539,11 @@ pub fn identify_local(
                 }
             }
             flat.push((plan.joint_names[j].as_str(), value));
+            unmeasured.push(Unmeasured {
+                experiment: v.kind.name().to_string(),
+                joint: plan.joint_names[j].clone(),
+                value,
+            });
         }
         if !flat.is_empty() {
             flat_warnings.push(flat_torque_warning(v.kind, &flat));
@@ -577,6 +583,7 @@ pub fn identify_local(
         diagnostics.warnings.push(w);
     }
     diagnostics.warnings.extend(flat_warnings);
+    diagnostics.unmeasured = unmeasured;
     diagnostics.combined = disagreement;
     diagnostics.unperturbed_deviation = deviation;
     Ok(LocalModel {

@@ -43,7 +43,9 @@ pub mod plan;
 pub mod point_design;
 
 pub use crossing::{values_at, values_at_with, CrossingValues, FitOptions, TorqueFit};
-pub use diagnostics::{BlockAgreement, ClockOffset, Diagnostics, Reversal, ReversalHandling};
+pub use diagnostics::{
+    BlockAgreement, ClockOffset, Diagnostics, Reversal, ReversalHandling, Unmeasured,
+};
 pub use identify::{identify_local, CrossingTimes, IdentifyOptions};
 pub use model::{Estimate, Estimator, LocalModel};
 pub use operating_point::OperatingPoint;

@@ -6,7 +6,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::model::{Estimate, LocalModel};
+use super::model::{Estimate, Estimator, LocalModel};
 use crate::algorithms::linearization_regressor::linearization_regressor;
 use crate::direct::base::{BaseParameters, BASE_TOLERANCE};
 use crate::direct::{
@@ -88,10 +88,15 @@ fn push_block(
     values: &[f64],
     stderr: &[f64],
     nv: usize,
+    unmeasured: &[bool],
 ) {
     let scale = values.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let floor = WEIGHT_FLOOR * scale + 1e-12;
     for (r, (&v, &se)) in values.iter().zip(stderr).enumerate() {
+        let torque_row = if values.len() == nv { r } else { r / nv };
+        if unmeasured.get(torque_row).copied().unwrap_or(false) {
+            continue;
+        }
         let se = if se.is_finite() {
             se.max(floor)
         } else {
@@ -100,7 +105,7 @@ fn push_block(
         x.push(regressor.row(r).iter().map(|a| a / se).collect());
         y.push(v / se);
         w.push(se);
-        joint_of_row.push(if values.len() == nv { r } else { r / nv });
+        joint_of_row.push(torque_row);
     }
 }
 
@@ -115,7 +120,9 @@ fn entries(m: &DMatrix<f64>) -> Vec<f64> {
 /// points: see the module documentation. Each model's T*, D*, H*, G*, Gs (as `options` says,
 /// where identified) is a block of rows, each row divided by its standard error; the
 /// combinations the rows determine are found by a column-pivoted QR, and solved by least
-/// squares. The operating points are the models' planned ones (where T* holds).
+/// squares. The operating points are the models' planned ones (where T* holds). Rows a model
+/// marks as not measured (`diagnostics.unmeasured`: a torque that did not change) are left
+/// out.
 ///
 /// Errors: no model, a model for other joints than `robot`'s.
 pub fn identify_parameters_from_local(
@@ -157,9 +164,26 @@ pub fn identify_parameters_from_local(
                 &m.torque,
                 &m.torque_stderr,
                 nv,
+                &[],
             );
         }
-        let mut block = |e: &Option<Estimate>, r: &DMatrix<f64>| {
+        // the rows of a torque that did not change (the combined estimate's D, H and G share
+        // theirs)
+        let unmeasured = |experiment: &str| -> Vec<bool> {
+            let combined = m.estimator == Estimator::Combined && experiment != "G_static";
+            robot
+                .joint_names
+                .iter()
+                .map(|j| {
+                    m.diagnostics.unmeasured.iter().any(|u| {
+                        &u.joint == j
+                            && (u.experiment == experiment
+                                || (combined && u.experiment != "G_static"))
+                    })
+                })
+                .collect()
+        };
+        let mut block = |e: &Option<Estimate>, r: &DMatrix<f64>, experiment: &str| {
             if let Some(e) = e {
                 push_block(
                     &mut x,
@@ -170,20 +194,21 @@ pub fn identify_parameters_from_local(
                     &entries(&e.matrix),
                     &entries(&e.stderr),
                     nv,
+                    &unmeasured(experiment),
                 );
             }
         };
         if options.use_d {
-            block(&m.d, &reg.d);
+            block(&m.d, &reg.d, "D");
         }
         if options.use_h {
-            block(&m.h, &reg.h);
+            block(&m.h, &reg.h, "H");
         }
         if options.use_g {
-            block(&m.g, &reg.g);
+            block(&m.g, &reg.g, "G");
         }
         if options.use_g_static && options.gravity == Gravity::Included {
-            block(&m.g_static, &reg.g_static);
+            block(&m.g_static, &reg.g_static, "G_static");
         }
     }
     let rows = x.len();

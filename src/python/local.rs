@@ -460,6 +460,18 @@ impl PyLocalModel {
         }
         out.set_item("combined", combined)?;
         out.set_item("unperturbed_deviation", d.unperturbed_deviation)?;
+        let unmeasured = d
+            .unmeasured
+            .iter()
+            .map(|u| {
+                let e = PyDict::new(py);
+                e.set_item("experiment", &u.experiment)?;
+                e.set_item("joint", &u.joint)?;
+                e.set_item("value", u.value)?;
+                Ok(e)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        out.set_item("unmeasured", unmeasured)?;
         out.set_item("warnings", d.warnings.clone())?;
         Ok(out)
     }
