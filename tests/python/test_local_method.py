@@ -272,3 +272,23 @@ def test_suggested_operating_points_reach_every_base_parameter():
     assert all(isinstance(op, pr.OperatingPoint) for op, _ in picks)
     with pytest.raises(pr.InputError, match="candidates"):
         pr.suggest_operating_points(robot, candidates=0)
+
+
+def test_a_dead_torque_channel_is_warned_about_and_marked_unmeasured():
+    robot = pr.robots.a465()
+    plan = pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2))
+    recs = pr.simulate(robot, plan, torque_noise=0.01, seed=3)
+    stuck = []
+    for r in recs:
+        tau = r.tau.copy()
+        if r.experiment == "D":
+            tau[:, 2] = 12.5
+        stuck.append(pr.Recording(r.t, r.q, tau, name=r.name, experiment=r.experiment))
+    with pytest.warns(pr.PerturbidWarning, match="experiment 'D': the torque of joint 'joint3' \\(12.5 N m\\) reads the same value"):
+        model = pr.identify_local(plan, stuck)
+    assert model.diagnostics["unmeasured"] == [{"experiment": "D", "joint": "joint3", "value": 12.5}]
+    se = model.stderr["D"]
+    assert np.isnan(se[2]).all() and np.isfinite(np.delete(se, 2, axis=0)).all()
+    # and the clean recordings raise no such warning
+    clean = pr.identify_local(plan, recs)
+    assert clean.diagnostics["unmeasured"] == []
