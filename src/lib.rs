@@ -41,6 +41,7 @@ pub mod simd;
 pub mod simulation;
 pub mod spatial;
 pub mod states;
+pub mod student_t;
 pub mod study;
 pub mod svg;
 pub mod torque_model;

@@ -169,21 +169,32 @@ pub(super) fn diagnose(values: &[ExperimentValues]) -> Diagnostics {
 /// How many standard errors a departure must exceed to be warned about.
 const SIGNIFICANT: f64 = 3.0;
 
+/// The chance that noise alone makes [`mass_matrix_warning`] call a sound D* asymmetric, over
+/// all its pairs.
+const FALSE_ALARM: f64 = 0.01;
+
 /// D* is a mass matrix: symmetric and positive definite. A warning when it departs from either
-/// by more than [`SIGNIFICANT`] standard errors: pairs `D_ij`, `D_ji` that differ beyond their
-/// combined standard error, and a negative eigenvalue of the symmetric part beyond the
-/// Frobenius norm of the standard errors (which bounds how far noise moves an eigenvalue).
+/// beyond its noise: pairs `D_ij`, `D_ji` that differ by more than Student's t quantile of
+/// their combined standard error (the residual degrees of freedom `crossings - N`, Bonferroni
+/// over the `N (N - 1) / 2` pairs, so that noise alone warns once in 1 / [`FALSE_ALARM`]; 3
+/// standard errors per pair warned on a quarter of sound A465 identifications with 6 degrees
+/// of freedom), and a negative eigenvalue of the symmetric part beyond [`SIGNIFICANT`] times
+/// the Frobenius norm of the standard errors (which bounds how far noise moves an
+/// eigenvalue).
 pub(super) fn mass_matrix_warning(d: &Estimate, joints: &[String]) -> Option<String> {
     let n = joints.len();
     let (m, se) = (&d.matrix, &d.stderr);
-    if !se.iter().all(|s| s.is_finite()) {
+    let dof = d.crossings.saturating_sub(n);
+    if !se.iter().all(|s| s.is_finite()) || dof == 0 {
         return None; // no standard errors: nothing to judge by
     }
+    let pairs = (n * (n - 1) / 2).max(1) as f64;
+    let threshold = crate::student_t::upper_quantile(FALSE_ALARM / (2.0 * pairs), dof as f64);
     let mut asymmetric = vec![];
     for i in 0..n {
         for j in (i + 1)..n {
             let diff = (m[(i, j)] - m[(j, i)]).abs();
-            let bound = SIGNIFICANT * (se[(i, j)].powi(2) + se[(j, i)].powi(2)).sqrt();
+            let bound = threshold * (se[(i, j)].powi(2) + se[(j, i)].powi(2)).sqrt();
             if diff > bound {
                 asymmetric.push(format!(
                     "D({},{}) = {:.4} vs D({},{}) = {:.4}",
@@ -207,7 +218,8 @@ pub(super) fn mass_matrix_warning(d: &Estimate, joints: &[String]) -> Option<Str
     let mut parts = vec![];
     if !asymmetric.is_empty() {
         parts.push(format!(
-            "not symmetric beyond {SIGNIFICANT} standard errors ({})",
+            "not symmetric beyond {threshold:.1} standard errors, which noise passes once in {:.0} identifications ({})",
+            1.0 / FALSE_ALARM,
             asymmetric.join("; ")
         ));
     }
@@ -238,7 +250,7 @@ mod tests {
             stderr: DMatrix::from_element(n, n, se),
             cond: 1.0,
             residual_rms: vec![0.0; n],
-            crossings: 2 * n,
+            crossings: 100,
         }
     }
 
@@ -254,13 +266,23 @@ mod tests {
         let mut skew = m.clone();
         skew[(0, 2)] += 0.05; // 0.05 apart with standard errors 0.01: 3.5 sigma
         let w = mass_matrix_warning(&estimate(skew.clone(), 0.01), &joints).unwrap();
+        // 97 degrees of freedom, 3 pairs: t at 1 - 0.01 / 6
         assert!(
             w.contains(
-                "not symmetric beyond 3 standard errors (D(j1,j3) = 0.0500 vs D(j3,j1) = 0.0000)"
+                "not symmetric beyond 3.0 standard errors, which noise passes once in 100 identifications (D(j1,j3) = 0.0500 vs D(j3,j1) = 0.0000)"
             ),
             "{w}"
         );
-        assert_eq!(mass_matrix_warning(&estimate(skew, 0.02), &joints), None);
+        assert_eq!(
+            mass_matrix_warning(&estimate(skew.clone(), 0.02), &joints),
+            None
+        );
+        // with 3 degrees of freedom the same 3.5 sigma is within the noise (t = 7.5)
+        let few = Estimate {
+            crossings: 6,
+            ..estimate(skew, 0.01)
+        };
+        assert_eq!(mass_matrix_warning(&few, &joints), None);
         // an indefinite one, beyond its noise
         let mut indefinite = m.clone();
         indefinite[(2, 2)] = -0.4;
