@@ -261,17 +261,6 @@ impl Document for Plan {
                 ))));
             }
             let (start, end) = (e.trajectory.start(), e.trajectory.end());
-            if let Some(c) = e.crossings.iter().find(|c| {
-                !(c.time >= start && c.time <= end)
-                    || [&c.q, &c.qd, &c.qdd].iter().any(|v| v.len() != n)
-            }) {
-                return Err(bad(at(&format!(
-                    "the crossing at t = {} s is outside the trajectory ({} to {} s) or not for {n} joints",
-                    shown(c.time),
-                    shown(start),
-                    shown(end)
-                ))));
-            }
             if let Some(k) =
                 (1..e.crossings.len()).find(|&k| e.crossings[k].time < e.crossings[k - 1].time)
             {
