@@ -133,6 +133,16 @@ pub(crate) fn check_magnitudes(
     )
 }
 
+/// [`check_magnitudes`] for one value, named `field` in errors.
+pub(crate) fn check_magnitude(what: &str, field: &str, value: f64, unknown_ok: bool) -> Result<()> {
+    check_magnitudes_at(
+        what,
+        std::iter::once(value),
+        |_| field.to_string(),
+        unknown_ok,
+    )
+}
+
 /// [`check_magnitudes`] for a matrix saved as a list of rows; errors name the entry as the
 /// file has it (`field[row][column]`, 0-based).
 pub(crate) fn check_magnitude_rows(

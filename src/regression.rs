@@ -27,6 +27,10 @@ pub struct LeastSquares {
     /// `sigma * sqrt(cov_diag)` (computed from scaled columns, so the standard errors stay
     /// finite where `cov_diag` itself leaves f64's range: 0 or inf).
     pub cov_diag: Vec<f64>,
+    /// The leverage of every row (K): the diagonal of the hat matrix `X (X^T X)^-1 X^T`, in
+    /// [0, 1], summing to p. A residual's variance is `sigma^2 (1 - leverage)` for noise of
+    /// equal variance.
+    pub leverage: Vec<f64>,
 }
 
 /// Relative singular-value threshold below which a design counts as rank deficient.
@@ -192,6 +196,9 @@ pub fn least_squares(
             ),
         });
     }
+    let leverage = (0..k)
+        .map(|r| (0..p).map(|i| u[(r, i)] * u[(r, i)]).sum())
+        .collect();
     Ok(LeastSquares {
         coef,
         cond: smax / smin,
@@ -199,6 +206,7 @@ pub fn least_squares(
         stderr,
         rows: k,
         cov_diag,
+        leverage,
     })
 }
 

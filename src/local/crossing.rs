@@ -22,6 +22,15 @@ pub struct CrossingValues {
     /// Standard errors of `q`, `qd`, `qdd` from the scatter of the positions about their
     /// quadratic fit (measurement noise, quantisation; NaN with no residual degree of freedom).
     pub state_stderr: [Vec<f64>; 3],
+    /// Per joint, the noise gain of `tau`: its standard error per unit of white noise on the
+    /// torque samples (the root sum of squares of the fit's weights at the crossing; about
+    /// `sqrt(4.8 / samples)` for the default fit). Windows narrowed at a velocity reversal hold
+    /// fewer samples and have larger gains.
+    pub tau_gain: Vec<f64>,
+    /// Per joint, the scatter of the torque samples about their fit: the sum of squared
+    /// residuals (N^2 m^2) and its degrees of freedom. Pooled over an experiment's crossings
+    /// it estimates the torque samples' noise level.
+    pub tau_scatter: Vec<(f64, usize)>,
 }
 
 /// How to read crossing values from a recording.
@@ -51,11 +60,25 @@ impl Default for FitOptions {
     }
 }
 
-/// Least-squares weights of a polynomial fit of degree `degree` over the samples `t[lo..hi]`
-/// with `u = (t - tc) / half`: row `d` of the result maps the samples onto coefficient `d`.
-///
-/// With `step = Some((reversal, slope))` a last column `sign(slope (t - reversal))` models a
-/// Coulomb step (row `degree + 1` maps onto its height).
+/// Basis function `d` of a polynomial fit of degree `degree` about `tc` with `u = (t - tc) /
+/// half`: `u^d`, and with `step = Some((reversal, slope))` a last one (`d = degree + 1`),
+/// `sign(slope (t - reversal))`, modelling a Coulomb step.
+fn basis(t: f64, tc: f64, half: f64, degree: usize, step: Option<(f64, f64)>, d: usize) -> f64 {
+    match step {
+        Some((reversal, slope)) if d == degree + 1 => {
+            let x = slope * (t - reversal);
+            if x == 0.0 {
+                0.0
+            } else {
+                x.signum()
+            }
+        }
+        _ => ((t - tc) / half).powi(d as i32),
+    }
+}
+
+/// Least-squares weights of a polynomial fit of degree `degree` (and a step, see [`basis`])
+/// over the samples `t[lo..hi]`: row `d` of the result maps the samples onto coefficient `d`.
 fn fit_weights(
     t: &[f64],
     tc: f64,
@@ -64,17 +87,7 @@ fn fit_weights(
     step: Option<(f64, f64)>,
 ) -> Result<DMatrix<f64>> {
     let cols = degree + 1 + usize::from(step.is_some());
-    let v = DMatrix::from_fn(t.len(), cols, |i, d| match step {
-        Some((reversal, slope)) if d == degree + 1 => {
-            let x = slope * (t[i] - reversal);
-            if x == 0.0 {
-                0.0
-            } else {
-                x.signum()
-            }
-        }
-        _ => ((t[i] - tc) / half).powi(d as i32),
-    });
+    let v = DMatrix::from_fn(t.len(), cols, |i, d| basis(t[i], tc, half, degree, step, d));
     v.pseudo_inverse(1e-12).map_err(|m| Error::Numerical {
         operation: "crossing fit".into(),
         message: m.into(),
@@ -93,6 +106,64 @@ fn apply(
     (0..count)
         .map(|i| w[(row, i)] * values[(lo + i) * n + j])
         .sum()
+}
+
+/// One joint's torque read at a crossing: the value (N m), its noise gain and the samples'
+/// scatter about the fit (see [`CrossingValues::tau_gain`] and [`CrossingValues::tau_scatter`]).
+struct TorqueReading {
+    value: f64,
+    gain: f64,
+    scatter: (f64, usize),
+}
+
+/// Reads joint `j`'s torque at `tc` from the samples `lo..lo + count` of `rec` with the fit
+/// weights `w` of degree `degree` about `tc` with half-width `half` (and the step `step`: its
+/// height counts on the crossing's side, none exactly at the reversal).
+#[allow(clippy::too_many_arguments)]
+fn read_torque(
+    rec: &Recording,
+    w: &DMatrix<f64>,
+    (lo, count): (usize, usize),
+    tc: f64,
+    half: f64,
+    degree: usize,
+    step: Option<(f64, f64)>,
+    j: usize,
+) -> TorqueReading {
+    let n = rec.n;
+    let cols = w.nrows();
+    let c: Vec<f64> = (0..cols)
+        .map(|d| apply(w, d, &rec.tau, lo, count, n, j))
+        .collect();
+    // the value at tc: the constant term, and the step's height on tc's side of it
+    let side = match step {
+        Some((reversal, slope)) if tc != reversal => (slope * (tc - reversal)).signum(),
+        _ => 0.0,
+    };
+    let at = |i: usize| {
+        w[(0, i)]
+            + if side != 0.0 {
+                side * w[(cols - 1, i)]
+            } else {
+                0.0
+            }
+    };
+    let value = c[0] + if side != 0.0 { side * c[cols - 1] } else { 0.0 };
+    let gain = (0..count).map(|i| at(i).powi(2)).sum::<f64>().sqrt();
+    let ss = (0..count)
+        .map(|i| {
+            let t = rec.t[lo + i];
+            let fit: f64 = (0..cols)
+                .map(|d| c[d] * basis(t, tc, half, degree, step, d))
+                .sum();
+            (rec.tau[(lo + i) * n + j] - fit).powi(2)
+        })
+        .sum();
+    TorqueReading {
+        value,
+        gain,
+        scatter: (ss, count.saturating_sub(cols)),
+    }
 }
 
 /// How the torque of one joint is read at a crossing.
@@ -195,6 +266,8 @@ pub fn values_at_with(
         qdd: vec![0.0; n],
         tau: vec![0.0; n],
         state_stderr: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
+        tau_gain: vec![0.0; n],
+        tau_scatter: vec![(0.0, 0); n],
     };
     // sum of squared weights per coefficient: the variance factor of each estimate
     let gain: Vec<f64> = (0..3)
@@ -223,25 +296,52 @@ pub fn values_at_with(
         out.state_stderr[0][j] = sigma * gain[0];
         out.state_stderr[1][j] = sigma * gain[1] / half;
         out.state_stderr[2][j] = 2.0 * sigma * gain[2] / (half * half);
-        out.tau[j] = match *fit {
-            TorqueFit::Window(h) if h >= half => apply(&wt, 0, &rec.tau, lo, count, n, j),
+        let reading = match *fit {
+            TorqueFit::Window(h) if h >= half => read_torque(
+                rec,
+                &wt,
+                (lo, count),
+                tc,
+                half,
+                options.torque_degree,
+                None,
+                j,
+            ),
             TorqueFit::Window(h) => {
                 let (lo_j, hi_j) = span(h);
                 if hi_j - lo_j < needed {
                     return Err(too_few(hi_j - lo_j, h));
                 }
                 let w = fit_weights(&rec.t[lo_j..hi_j], tc, h, options.torque_degree, None)?;
-                apply(&w, 0, &rec.tau, lo_j, hi_j - lo_j, n, j)
+                read_torque(
+                    rec,
+                    &w,
+                    (lo_j, hi_j - lo_j),
+                    tc,
+                    h,
+                    options.torque_degree,
+                    None,
+                    j,
+                )
             }
             TorqueFit::Step { reversal, slope } => {
-                let step = (reversal, slope);
-                let w = fit_weights(t, tc, half, options.torque_degree, Some(step))?;
-                let side = (slope * (tc - reversal)).signum();
-                let side = if tc == reversal { 0.0 } else { side };
-                apply(&w, 0, &rec.tau, lo, count, n, j)
-                    + side * apply(&w, options.torque_degree + 1, &rec.tau, lo, count, n, j)
+                let step = Some((reversal, slope));
+                let w = fit_weights(t, tc, half, options.torque_degree, step)?;
+                read_torque(
+                    rec,
+                    &w,
+                    (lo, count),
+                    tc,
+                    half,
+                    options.torque_degree,
+                    step,
+                    j,
+                )
             }
         };
+        out.tau[j] = reading.value;
+        out.tau_gain[j] = reading.gain;
+        out.tau_scatter[j] = reading.scatter;
         if options.recorded_derivatives {
             if let Some(qd) = &rec.qd {
                 out.qd[j] = apply(&wt, 0, qd, lo, count, n, j);

@@ -1,6 +1,6 @@
 //! What happened while a local model was identified: the clock offset found for each
-//! recording, the crossings whose torque fit had to avoid a velocity reversal, and warnings
-//! about values the model cannot fully vouch for. Saved with the model.
+//! recording, the crossings whose torque fit had to avoid a velocity reversal, the torques'
+//! noise, and warnings about values the model cannot fully vouch for. Saved with the model.
 
 use serde::{Deserialize, Serialize};
 
@@ -67,6 +67,24 @@ pub struct Unmeasured {
     pub value: f64,
 }
 
+/// The noise in one joint's torques read in one experiment (see [`super::noise`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TorqueNoise {
+    /// The experiment (`G_static`, `G`, `H`, `D`).
+    pub experiment: String,
+    pub joint: String,
+    /// The torque samples' noise (N m): the standard deviation of one sample about its
+    /// window's fit, pooled over the experiment's crossings.
+    pub samples: f64,
+    /// What varied from pass to pass beyond the samples' noise (N m, a standard deviation; 0
+    /// when the samples' noise explains the regression's residuals): repeatability, noise
+    /// slower than a window, and with symmetric pairs the even-order terms the pairs cancel from
+    /// the estimate but not from the residuals (for H the velocity-squared terms; then the
+    /// standard errors bound the error from above). `None` without residual degrees of freedom.
+    pub passes: Option<f64>,
+}
+
 /// Diagnostics of a local identification; see the module documentation.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -89,6 +107,9 @@ pub struct Diagnostics {
     /// not change. [`super::identify_parameters_from_local`] leaves them out.
     #[serde(default)]
     pub unmeasured: Vec<Unmeasured>,
+    /// The torque noise of every joint in each separated regression (G_static, G, H, D).
+    #[serde(default)]
+    pub noise: Vec<TorqueNoise>,
     /// What the user should know: each is also given as a Python warning and printed by the
     /// command line.
     #[serde(default)]

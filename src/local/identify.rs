@@ -10,15 +10,16 @@ use super::crossing::{
 use super::diagnose::{
     compare_combined, diagnose, disagreement_warning, mass_matrix_warning, unperturbed_deviation,
 };
-use super::diagnostics::{Reversal, ReversalHandling, Unmeasured};
+use super::diagnostics::{Reversal, ReversalHandling, TorqueNoise, Unmeasured};
 use super::friction_aware::friction_aware_h;
 use super::model::{Estimate, Estimator, LocalModel};
+use super::noise::{reading_variance, sample_variance, weighted_least_squares};
 use super::operating_point::OperatingPoint;
 use super::plan::{Experiment, ExperimentKind, Plan};
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::recording::Recording;
-use crate::regression::{least_squares, LeastSquares};
+use crate::regression::LeastSquares;
 
 /// Where the crossing times come from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -303,6 +304,22 @@ pub(super) fn state(c: &CrossingValues, v: usize) -> &[f64] {
     }
 }
 
+/// The variances (N^2 m^2, one row per crossing of `experiments` in order, one column per
+/// joint) that the torque samples' noise gives the torques read at the crossings, the noise
+/// level pooled within each experiment (see [`super::noise`]).
+fn reading_variances(experiments: &[&ExperimentValues], n: usize) -> DMatrix<f64> {
+    let rows: Vec<Vec<f64>> = experiments
+        .iter()
+        .flat_map(|v| {
+            let variance = sample_variance(&v.crossings, n);
+            v.crossings
+                .iter()
+                .map(move |c| reading_variance(c, &variance))
+        })
+        .collect();
+    DMatrix::from_fn(rows.len(), n, |i, j| rows[i][j])
+}
+
 fn estimate(ls: LeastSquares) -> Estimate {
     Estimate {
         cond: ls.cond,
@@ -445,6 +462,7 @@ pub fn identify_local(
     };
     let op_state = [op.q.clone(), op.qd.clone(), op.qdd.clone()];
 
+    let noise = std::cell::RefCell::new(vec![]);
     let separated = |kind: ExperimentKind, prefix: &str| -> Result<Option<Estimate>> {
         let Some(v) = find(kind) else { return Ok(None) };
         let var = kind.perturbed().expect("perturbed experiment");
@@ -455,13 +473,23 @@ pub fn identify_local(
         };
         let x = DMatrix::from_fn(k, n, |i, j| state(&v.crossings[i], var)[j] - base_x[j]);
         let y = DMatrix::from_fn(k, n, |i, j| v.crossings[i].tau[j] - base_tau[j]);
-        let ls = least_squares(
+        let weighted = weighted_least_squares(
             &x,
             &y,
+            &reading_variances(&[v], n),
             &format!("experiment '{}'", kind.name()),
             &names(prefix),
         )?;
-        Ok(Some(estimate(ls)))
+        let samples = sample_variance(&v.crossings, n);
+        for ((joint, s2), a) in plan.joint_names.iter().zip(&samples).zip(&weighted.common) {
+            noise.borrow_mut().push(TorqueNoise {
+                experiment: kind.name().to_string(),
+                joint: joint.clone(),
+                samples: s2.sqrt(),
+                passes: Some(a.sqrt()).filter(|v| v.is_finite()),
+            });
+        }
+        Ok(Some(estimate(weighted.fit)))
     };
     let d = separated(ExperimentKind::D, "dqdd")?;
     let (h, coulomb) = match (options.friction_aware_h, find(ExperimentKind::H)) {
@@ -484,23 +512,27 @@ pub fn identify_local(
     let g_static = separated(ExperimentKind::GStatic, "dq")?;
 
     let combined = if d.is_some() && h.is_some() && g.is_some() {
-        let rows: Vec<&CrossingValues> = values
+        let stacked: Vec<&ExperimentValues> = values
             .iter()
             .filter(|v| v.kind != ExperimentKind::GStatic)
-            .flat_map(|v| v.crossings.iter())
             .collect();
+        let rows: Vec<&CrossingValues> = stacked.iter().flat_map(|v| v.crossings.iter()).collect();
         let x = DMatrix::from_fn(rows.len(), 3 * n, |i, c| {
             let var = 2 - c / n; // columns: dqdd, dqd, dq
             state(rows[i], var)[c % n] - op_state[var][c % n]
         });
         let y = DMatrix::from_fn(rows.len(), n, |i, j| rows[i].tau[j] - torque[j]);
         let columns: Vec<String> = [names("dqdd"), names("dqd"), names("dq")].concat();
-        Some(estimate(least_squares(
-            &x,
-            &y,
-            "combined estimate (nominal, G, H, D)",
-            &columns,
-        )?))
+        Some(estimate(
+            weighted_least_squares(
+                &x,
+                &y,
+                &reading_variances(&stacked, n),
+                "combined estimate (nominal, G, H, D)",
+                &columns,
+            )?
+            .fit,
+        ))
     } else {
         None
     };
@@ -584,6 +616,10 @@ pub fn identify_local(
     }
     diagnostics.warnings.extend(flat_warnings);
     diagnostics.unmeasured = unmeasured;
+    let mut noise = noise.into_inner();
+    // in the plan's order of experiments
+    noise.sort_by_key(|e| values.iter().position(|v| v.kind.name() == e.experiment));
+    diagnostics.noise = noise;
     diagnostics.combined = disagreement;
     diagnostics.unperturbed_deviation = deviation;
     Ok(LocalModel {

@@ -36,6 +36,7 @@ pub mod diagnostics;
 mod friction_aware;
 pub mod identify;
 pub mod model;
+pub mod noise;
 pub mod operating_point;
 pub mod parameters;
 pub mod perturbation;
@@ -44,7 +45,7 @@ pub mod point_design;
 
 pub use crossing::{values_at, values_at_with, CrossingValues, FitOptions, TorqueFit};
 pub use diagnostics::{
-    BlockAgreement, ClockOffset, Diagnostics, Reversal, ReversalHandling, Unmeasured,
+    BlockAgreement, ClockOffset, Diagnostics, Reversal, ReversalHandling, TorqueNoise, Unmeasured,
 };
 pub use identify::{identify_local, CrossingTimes, IdentifyOptions};
 pub use model::{Estimate, Estimator, LocalModel};

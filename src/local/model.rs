@@ -7,7 +7,9 @@ use serde::{Deserialize, Serialize};
 use super::diagnostics::Diagnostics;
 use super::operating_point::OperatingPoint;
 use crate::choice::choice;
-use crate::document::{check_condition, check_magnitude_rows, check_magnitudes, invalid, Document};
+use crate::document::{
+    check_condition, check_magnitude, check_magnitude_rows, check_magnitudes, invalid, Document,
+};
 use crate::error::{Error, Result};
 use crate::states::States;
 use crate::torque_model::predict_linear;
@@ -170,6 +172,13 @@ impl Document for LocalModel {
                 let rms = format!("{what}.residual_rms");
                 check_magnitudes(Self::WHAT, &rms, &e.residual_rms, false)?;
                 check_condition(Self::WHAT, &format!("{what}.cond"), e.cond)?;
+            }
+        }
+        for (i, e) in m.diagnostics.noise.iter().enumerate() {
+            let what = format!("diagnostics.noise[{i}]");
+            check_magnitude(Self::WHAT, &format!("{what}.samples"), e.samples, false)?;
+            if let Some(p) = e.passes {
+                check_magnitude(Self::WHAT, &format!("{what}.passes"), p, false)?;
             }
         }
         Ok(())

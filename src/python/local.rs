@@ -425,7 +425,10 @@ impl PyLocalModel {
     /// (relative difference, largest difference in standard errors) of the combined estimate
     /// against the separated one), `unperturbed_deviation` (how far the variables an experiment
     /// did not perturb stray, in standard errors of their measurement: ~1 for noise, far above
-    /// for tracking errors), `warnings` (list of str).
+    /// for tracking errors), `unmeasured` (list of dicts: `experiment`, `joint`, `value` in N m,
+    /// for torques that read one value throughout), `noise` (list of dicts: `experiment`,
+    /// `joint`, `samples` (N m, one torque sample's noise), `passes` (N m, what varied from pass
+    /// to pass beyond it, or None)), `warnings` (list of str).
     #[getter]
     fn diagnostics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = &self.model.diagnostics;
@@ -472,6 +475,19 @@ impl PyLocalModel {
             })
             .collect::<PyResult<Vec<_>>>()?;
         out.set_item("unmeasured", unmeasured)?;
+        let noise = d
+            .noise
+            .iter()
+            .map(|e| {
+                let entry = PyDict::new(py);
+                entry.set_item("experiment", &e.experiment)?;
+                entry.set_item("joint", &e.joint)?;
+                entry.set_item("samples", e.samples)?;
+                entry.set_item("passes", e.passes)?;
+                Ok(entry)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        out.set_item("noise", noise)?;
         out.set_item("warnings", d.warnings.clone())?;
         Ok(out)
     }

@@ -292,3 +292,30 @@ def test_a_dead_torque_channel_is_warned_about_and_marked_unmeasured():
     # and the clean recordings raise no such warning
     clean = pr.identify_local(plan, recs)
     assert clean.diagnostics["unmeasured"] == []
+
+
+def test_the_torque_noise_is_reported_per_experiment_and_joint():
+    robot = pr.robots.a465()
+    plan = pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2))
+    levels = np.array([0.005, 0.01, 0.02, 0.01, 0.004, 0.002])
+    model = pr.identify_local(plan, pr.simulate(robot, plan, torque_noise=levels, seed=4, friction=None))
+    noise = model.diagnostics["noise"]
+    # the separated regressions in the plan's order, one entry a joint
+    assert [(e["experiment"], e["joint"]) for e in noise] == [
+        (x, f"joint{j}") for x in ["G_static", "G", "H", "D"] for j in range(1, 7)
+    ]
+    for e in noise:
+        j = int(e["joint"][-1]) - 1
+        assert abs(e["samples"] / levels[j] - 1) < 0.15, e
+        assert e["passes"] is not None and e["passes"] >= 0
+    # what varies from pass to pass in H beyond the samples' noise: the velocity-squared terms
+    # the +- pairs cancel from H* (several mN m at this point), far above D's
+    passes = {(e["experiment"], e["joint"]): e["passes"] for e in noise}
+    assert passes[("H", "joint1")] > 0.003 and passes[("D", "joint1")] < passes[("H", "joint1")]
+    # saved with the model; a hand-edited negative noise is refused by name
+    back = pr.LocalModel.from_json(model.to_json())
+    assert back.diagnostics["noise"] == noise
+    doc = json.loads(model.to_json())
+    doc["diagnostics"]["noise"][2]["samples"] = -1.0
+    with pytest.raises(pr.InputError, match=r"diagnostics.noise\[2\].samples is -1"):
+        pr.LocalModel.from_json(json.dumps(doc))
