@@ -156,7 +156,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // at equal robot time, and with one period only
     let mut direct_active = vec![];
     for periods in [(local_time / traj.period()).max(1.0), 1.0] {
-        let s = traj.sample_periods(periods, 100.0);
+        let s = traj.sample_periods(periods, 100.0).unwrap();
         let rec = rehearse(&nominal, &robot, &s, 0, "excitation")?;
         let states = States::new(n, &rec.q, Some(&s.qd), Some(&s.qdd))?;
         let options = BaseOptions {

@@ -38,7 +38,7 @@ pub fn check_range(name: &str, value: f64, low: f64, high: f64) -> Result<()> {
     };
     Err(Error::InvalidArgument {
         argument: name.into(),
-        message: format!("{value}; expected {expected}"),
+        message: format!("{}; expected {expected}", crate::error::shown(value)),
     })
 }
 
@@ -71,7 +71,9 @@ pub fn sample_count(what: &str, duration: f64, rate: f64) -> Result<usize> {
         return Err(Error::InvalidArgument {
             argument: what.into(),
             message: format!(
-                "{duration} s at {rate} Hz is {count:.3e} samples; at most {MAX_SAMPLES:e} are made (docs/limits.md)"
+                "{} s at {} Hz is {count:.3e} samples; at most {MAX_SAMPLES:e} are made (docs/limits.md)",
+                crate::error::shown(duration),
+                crate::error::shown(rate)
             ),
         });
     }

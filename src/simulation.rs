@@ -152,16 +152,33 @@ impl SimulationOptions {
 
     fn check(&self, n: usize) -> Result<()> {
         self.friction.check(n)?;
-        for (what, v) in [
-            ("torque_noise", &self.torque_noise),
-            ("position_noise", &self.position_noise),
-            ("quantization", &self.quantization),
+        // the largest: far past any sensor, so that a slip of the exponent is an error, not
+        // a recording of noise (1e300 N m) or of a robot that never moved (1e300 rad a count)
+        for (what, v, largest) in [
+            ("torque_noise", &self.torque_noise, 1e6),
+            ("position_noise", &self.position_noise, 1.0),
+            ("quantization", &self.quantization, 1.0),
         ] {
             crate::model::check_finite_vector(what, v, n)?;
-            if let Some(j) = v.iter().position(|&x| x < 0.0) {
+            // a resolution is 0 (none) or at least 1e-12 (positions divided by it stay finite)
+            let smallest = if what == "quantization" { 1e-12 } else { 0.0 };
+            let fits = |x: f64| x == 0.0 || (smallest..=largest).contains(&x);
+            if let Some(j) = v.iter().position(|&x| !fits(x)) {
                 return Err(Error::InvalidArgument {
                     argument: format!("{what}[{j}]"),
-                    message: format!("{}; expected a value >= 0", v[j]),
+                    message: format!(
+                        "{}; expected {}",
+                        crate::error::shown(v[j]),
+                        if smallest > 0.0 {
+                            format!(
+                                "0 (none) or a value in [{}, {}]",
+                                crate::error::shown(smallest),
+                                crate::error::shown(largest)
+                            )
+                        } else {
+                            format!("a value in [0, {}]", crate::error::shown(largest))
+                        }
+                    ),
                 });
             }
         }

@@ -166,7 +166,7 @@ fn excite_identify_direct_predict() {
     assert_eq!(traj.harmonics(), 5);
     // a recording with qd and qdd, noise-free: identification without preprocessing is exact
     let model = a465::model("kinsheel2010").unwrap();
-    let samples = traj.sample_periods(1.0, 100.0);
+    let samples = traj.sample_periods(1.0, 100.0).unwrap();
     let mut rec =
         simulate_samples(&model, &samples, &SimulationOptions::new(&model), 0, "x").unwrap();
     rec.qd = Some(samples.qd.clone());
@@ -263,7 +263,7 @@ fn excite_identify_direct_predict() {
     assert_eq!(residuals.lines().count(), samples.t.len() + 1);
     let svg = std::fs::read_to_string(d.join("validation/validation.svg")).unwrap();
     assert_eq!(svg.matches("measured and predicted torque").count(), 6);
-    let raw_samples = traj.sample_periods(5.0, 1000.0);
+    let raw_samples = traj.sample_periods(5.0, 1000.0).unwrap();
     let raw = simulate_samples(
         &model,
         &raw_samples,
@@ -749,4 +749,98 @@ fn plan_warns_and_identify_friction_aware_h() {
     );
     let model = LocalModel::load(d.join("model.json")).unwrap();
     assert!(model.coulomb.is_some());
+}
+
+/// Options that would be ignored or would invent data are refused, their values shown as
+/// given: `--periods` and `--rate` with a plan (its experiments run once at the plan's rate),
+/// a `--validate` fraction that leaves no sample to validate on, an excitation's sampling
+/// rate of 0 (one row at t = NaN before) and a base frequency whose period allocated without
+/// bound.
+#[test]
+fn options_that_would_be_ignored_or_invent_data_are_refused() {
+    let d = tmp("ignored");
+    let op = d.join("op.json");
+    write(
+        &op,
+        r#"{"q": [0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0], "qd": [0.089, -0.106, 0.022, 0.056, 0.011, 0.014], "qdd": [-0.155, -0.5, 0.034, -0.291, -0.008, 0.171]}"#,
+    );
+    let plan_dir = d.join("plan");
+    ok(&[
+        "plan",
+        "a465",
+        "--op",
+        s(&op),
+        "--out",
+        s(&plan_dir),
+        "--experiments",
+        "nominal,D",
+    ]);
+    let plan = plan_dir.join("plan.json");
+    let rec = d.join("rec");
+    for (option, value) in [("--periods", "2"), ("--rate", "500")] {
+        fails(
+            &[
+                "simulate",
+                "a465",
+                s(&plan),
+                "--out",
+                s(&rec),
+                option,
+                value,
+            ],
+            &[option, "given for a plan", "plan's rate (1000 Hz"],
+        );
+        nothing_written(&d, "rec");
+    }
+    let exc = d.join("exc");
+    for (option, value, says) in [
+        ("--rate", "0", "rate: 0; expected a positive finite number"),
+        ("--base-frequency", "1e-300", "base_frequency: 1e-300;"),
+    ] {
+        fails(
+            &[
+                "excite",
+                "a465",
+                "--max-evaluations",
+                "2",
+                "--out",
+                s(&exc),
+                option,
+                value,
+            ],
+            &[says],
+        );
+        nothing_written(&d, "exc");
+    }
+    ok(&[
+        "excite",
+        "a465",
+        "--max-evaluations",
+        "20",
+        "--out",
+        s(&exc),
+    ]);
+    let log = d.join("log.csv");
+    ok(&[
+        "simulate",
+        "a465",
+        s(&exc.join("excitation.json")),
+        "--out",
+        s(&log),
+        "--rate",
+        "200",
+    ]);
+    fails(
+        &[
+            "identify-direct",
+            "a465",
+            s(&log),
+            "--preprocess",
+            "--validate",
+            "1e-9",
+            "--out",
+            s(&d.join("base.json")),
+        ],
+        &["--validate: 1e-9 of", "leaves none to validate on"],
+    );
 }

@@ -188,3 +188,21 @@ fn locks_and_robot_files_follow_the_pipeline() {
     );
     assert!(ok(&["run", s(&d.join("p.toml"))]).contains("1 degrees of freedom"));
 }
+
+/// A pipeline's numbers reach the command as they were written, short: 1e-320 was passed as
+/// 320 digits; a whole number written 2.0 is still a count.
+#[test]
+fn numbers_pass_to_the_commands_short() {
+    let d = tmp("pipeline-numbers");
+    write(
+        &d.join("p.toml"),
+        "[[step]]\nrun = \"excite\"\nrobot = \"a465\"\nharmonics = 2.0\nmargin = 1e-320\nbase_frequency = 0.05\n",
+    );
+    let dry = ok(&["run", s(&d.join("p.toml")), "--dry-run"]);
+    assert!(
+        dry.contains("--harmonics=2 ")
+            && dry.contains("--margin=1e-320 ")
+            && dry.contains("--base-frequency=0.05 "),
+        "{dry}"
+    );
+}

@@ -170,7 +170,7 @@ fn base_parameter_identification_is_exact_without_noise() {
     for variant in ["kinsheel2010", "physical"] {
         let model = a465::model(variant).unwrap();
         let traj = a465_excitation();
-        let s = traj.sample_periods(1.0, 100.0);
+        let s = traj.sample_periods(1.0, 100.0).unwrap();
         let viscous = [0.5, 0.4, 0.3, 0.2, 0.1, 0.05];
         let coulomb = [1.0, 0.8, 0.6, 0.4, 0.2, 0.1];
         let mut tau = torques(&model, &s.q, &s.qd, &s.qdd, Gravity::Included);
@@ -269,7 +269,7 @@ fn global_linear_model() {
 
     // One period of L harmonics spans only 2L + 1 functions of time, and q, qd and qdd all live
     // in it: with 5 harmonics the 19 columns [1 dqdd dqd dq] have rank 11, and the error says so.
-    let s = a465_excitation().sample_periods(1.0, 100.0);
+    let s = a465_excitation().sample_periods(1.0, 100.0).unwrap();
     let tau = torques(&model, &s.q, &s.qd, &s.qdd, Gravity::Excluded);
     let e = identify_global_linear(
         &op,
@@ -290,7 +290,7 @@ fn global_linear_model() {
         DMatrix::from_fn(6, 10, |_, _| rng.uniform(-0.06, 0.06)),
     )
     .unwrap();
-    let s = rich.sample_periods(1.0, 50.0);
+    let s = rich.sample_periods(1.0, 50.0).unwrap();
     let tau = torques(&model, &s.q, &s.qd, &s.qdd, Gravity::Excluded);
     let lin = identify_global_linear(
         &op,
@@ -373,7 +373,7 @@ fn excitation_design_respects_limits_starts_at_rest_and_improves() {
         assert!(v.abs() < 1e-12 && a.abs() < 1e-12, "rest at t = 0");
     }
     // the limits (checked again here, independently of the design's own check)
-    let s = traj.sample_periods(1.0, 500.0);
+    let s = traj.sample_periods(1.0, 500.0).unwrap();
     for k in 0..s.len() {
         for j in 0..6 {
             let lim = &model.limits[j];
@@ -544,7 +544,7 @@ fn base_model_linearisation_is_exact() {
     let model = a465::model("kinsheel2010").unwrap();
     let n = model.nv;
     let traj = a465_excitation();
-    let s = traj.sample_periods(1.0, 100.0);
+    let s = traj.sample_periods(1.0, 100.0).unwrap();
     let viscous = [0.5, 0.4, 0.3, 0.2, 0.1, 0.05];
     let coulomb = [1.0, 0.8, 0.6, 0.4, 0.2, 0.1];
     let mut tau = torques(&model, &s.q, &s.qd, &s.qdd, Gravity::Included);
@@ -616,7 +616,7 @@ fn negative_friction_and_still_joints_are_warned_about() {
     use perturbid_rs::direct::ExcitationDesign;
     let model = a465::model("kinsheel2010").unwrap();
     let traj = a465_excitation();
-    let s = traj.sample_periods(1.0, 100.0);
+    let s = traj.sample_periods(1.0, 100.0).unwrap();
     let states = States::new(6, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
     let mut rng = Rng(3);
     let clean: Vec<f64> = torques(&model, &s.q, &s.qd, &s.qdd, Gravity::Included)
@@ -680,7 +680,7 @@ fn negative_friction_and_still_joints_are_warned_about() {
 fn a_torque_column_that_never_changes_is_refused() {
     let model = a465::model("kinsheel2010").unwrap();
     let traj = a465_excitation();
-    let s = traj.sample_periods(1.0, 100.0);
+    let s = traj.sample_periods(1.0, 100.0).unwrap();
     let states = States::new(6, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
     let tau = torques(&model, &s.q, &s.qd, &s.qdd, Gravity::Included);
     let options = BaseOptions::default();

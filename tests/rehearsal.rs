@@ -367,7 +367,7 @@ fn the_direct_method_recovers_the_true_robot_from_a_rehearsed_excitation() {
         b,
     )
     .unwrap();
-    let s = traj.sample_periods(1.0, 100.0);
+    let s = traj.sample_periods(1.0, 100.0).unwrap();
     let robot = doc(r#"{"format": "perturbid-true-robot/1",
         "payload": {"link": "link6", "mass": 1.2, "com": [0.01, 0.0, 0.06], "inertia": [0.002, 0, 0, 0.002, 0, 0.001]},
         "link_errors": [{"link": "link3", "mass": 0.1, "com": [0.01, 0.0, 0.0], "inertia": -0.2}],

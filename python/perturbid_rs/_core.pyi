@@ -378,8 +378,8 @@ def simulate(
     seed: int = 0,
     *,
     true_robot: Optional["TrueRobot"] = None,
-    rate: float = 1000.0,
-    periods: float = 1.0,
+    rate: Optional[float] = None,
+    periods: Optional[float] = None,
 ) -> list[Recording]: ...
 @overload
 def simulate(
@@ -393,8 +393,8 @@ def simulate(
     seed: int = 0,
     *,
     true_robot: Optional["TrueRobot"] = None,
-    rate: float = 1000.0,
-    periods: float = 1.0,
+    rate: Optional[float] = None,
+    periods: Optional[float] = None,
 ) -> Recording: ...
 
 @final

@@ -93,7 +93,7 @@ pub(crate) fn excite(a: ExciteArgs) -> Result<String> {
     )?;
     set.add(
         "excitation.csv",
-        samples_table(&traj.sample_periods(1.0, a.rate), "").to_csv(),
+        samples_table(&traj.sample_periods(1.0, a.rate)?, "").to_csv(),
     )?;
     set.commit()?;
     for w in design.warnings(&model) {
@@ -161,12 +161,24 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     if !(0.0..1.0).contains(&a.validate) {
         return Err(Error::InvalidArgument {
             argument: "--validate".into(),
-            message: format!("{}; expected a fraction in [0, 1)", a.validate),
+            message: format!(
+                "{}; expected a fraction in [0, 1)",
+                crate::error::shown(a.validate)
+            ),
         });
     }
     let n = model.nv;
     let k = rec.len();
     let split = ((1.0 - a.validate) * k as f64).round() as usize;
+    if a.validate > 0.0 && split >= k {
+        return Err(Error::InvalidArgument {
+            argument: "--validate".into(),
+            message: format!(
+                "{} of {k} samples leaves none to validate on; give a larger fraction, or 0 for none",
+                crate::error::shown(a.validate)
+            ),
+        });
+    }
     let (qd, qdd) = (
         rec.qd.clone().expect("preprocessed"),
         rec.qdd.clone().expect("preprocessed"),

@@ -175,12 +175,13 @@ pub(crate) struct SimulateArgs {
     /// closed-loop tracking. Replaces the options below.
     #[arg(long)]
     true_robot: Option<PathBuf>,
-    /// An excitation: periods to run.
-    #[arg(long, default_value_t = 1.0)]
-    periods: f64,
-    /// An excitation: sampling rate of the log (Hz).
-    #[arg(long, default_value_t = 1000.0)]
-    rate: f64,
+    /// An excitation: periods to run (default 1; a plan's experiments run once).
+    #[arg(long)]
+    periods: Option<f64>,
+    /// An excitation: sampling rate of the log (Hz; default 1000; a plan's experiments are
+    /// sampled at the plan's rate).
+    #[arg(long)]
+    rate: Option<f64>,
     /// Leave gravity out of the torques (as if compensated).
     #[arg(long)]
     no_gravity: bool,
@@ -271,7 +272,23 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<String> {
     o.quantization = vec![a.quantization; n];
     o.seed = a.seed;
     let plan = match reference {
-        Reference::Plan(plan) => plan,
+        Reference::Plan(plan) => {
+            if let Some((option, value)) = [("--periods", a.periods), ("--rate", a.rate)]
+                .into_iter()
+                .find_map(|(o, v)| v.map(|v| (o, v)))
+            {
+                return Err(Error::InvalidArgument {
+                    argument: option.into(),
+                    message: format!(
+                        "{} given for a plan ({}): it applies to an excitation; a plan's experiments run once each, sampled at the plan's rate ({} Hz; perturbid plan --rate)",
+                        crate::error::shown(value),
+                        a.input.display(),
+                        plan.rate
+                    ),
+                });
+            }
+            plan
+        }
         Reference::Excitation(traj) => {
             if traj.n() != n {
                 return Err(Error::InvalidArgument {
@@ -284,11 +301,8 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<String> {
                     ),
                 });
             }
-            crate::limits::check_range("--periods", a.periods, 1e-9, 1e6)?;
-            let count =
-                crate::limits::sample_count("--periods", a.periods * traj.period(), a.rate)?;
-            let t: Vec<f64> = (0..count).map(|i| i as f64 / a.rate).collect();
-            let samples = traj.sample(&t);
+            let samples =
+                traj.sample_periods(a.periods.unwrap_or(1.0), a.rate.unwrap_or(1000.0))?;
             let rec = match &true_robot {
                 Some(t) => rehearse(&model, t, &samples, 0, "excitation")?,
                 None => simulate_samples(&model, &samples, &o, 0, "excitation")?,

@@ -274,7 +274,12 @@ fn words(key: &str, value: &Value, arg: &clap::Arg, base: &Path, at: &str) -> Re
         match v {
             Value::String(s) => Ok(s.clone()),
             Value::Integer(i) => Ok(i.to_string()),
-            Value::Float(f) if f.is_finite() => Ok(format!("{f}")),
+            // whole numbers as integers (a count written 2.0), others short (1e-320, not 320
+            // digits): both read back exactly
+            Value::Float(f) if f.is_finite() && f.fract() == 0.0 && f.abs() < 1e15 => {
+                Ok(format!("{f}"))
+            }
+            Value::Float(f) if f.is_finite() => Ok(crate::error::shown(*f)),
             Value::Float(f) => Err(bad(format!("'{key}' is {f}, expected a finite number"))),
             Value::Boolean(b) if flag => Ok(b.to_string()),
             Value::Boolean(_) => Err(bad(format!("'{key}' takes a value, not true/false"))),

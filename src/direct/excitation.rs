@@ -293,7 +293,8 @@ pub fn design_excitation(
     check_count("harmonics", o.harmonics, 1, MAX_HARMONICS)?;
     check_count("samples", o.samples, 1, MAX_FIT_SAMPLES)?;
     check_count("max_evaluations", o.max_evaluations, 1, MAX_EVALUATIONS)?;
-    check_range("base_frequency", o.base_frequency, f64::MIN_POSITIVE, 1e3)?;
+    // a period of at most 1000 s: the design checks its limits at 1 kHz over a period
+    check_range("base_frequency", o.base_frequency, 1e-3, 1e3)?;
     check_range(
         "default_velocity",
         o.default_velocity,
@@ -508,7 +509,7 @@ pub fn design_excitation(
     }
     check_limits(
         model,
-        &traj.sample_periods(1.0, 1000.0),
+        &traj.sample_periods(1.0, 1000.0)?,
         "designed excitation",
         "; lower the margin",
     )?;
@@ -533,6 +534,15 @@ pub fn design_excitation(
         });
     }
     let (value, cond) = fine.criterion(&traj);
+    if !cond.is_finite() {
+        return Err(Error::Numerical {
+            operation: "excitation design".into(),
+            message: format!(
+                "the best excitation found does not excite every base parameter (cond(Phi_base) {cond}): the motion the limits leave it (margin {m}) is too small or too uniform; widen the margin or the joint limits, or give the design more evaluations",
+                m = crate::error::shown(o.margin)
+            ),
+        });
+    }
     let evaluations = *evaluations.borrow();
     Ok(ExcitationDesign {
         trajectory: traj,
@@ -548,7 +558,14 @@ impl ExcitationDesign {
     /// than 2 % of their range in a period, so that their parameters are barely excited. One
     /// warning per joint.
     pub fn warnings(&self, model: &Model) -> Vec<String> {
-        let s = self.trajectory.sample_periods(1.0, 200.0);
+        let s = match self.trajectory.sample_periods(1.0, 200.0) {
+            Ok(s) => s,
+            Err(e) => {
+                return vec![format!(
+                    "the excitation could not be sampled to check it: {e}"
+                )]
+            }
+        };
         let n = model.nv;
         (0..n)
             .filter_map(|j| {

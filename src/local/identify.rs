@@ -186,13 +186,39 @@ pub fn experiment_values(
     let offset = match options.times {
         CrossingTimes::Planned => 0.0,
         CrossingTimes::Detected { max_shift } => {
+            if !(max_shift.is_finite() && max_shift > 0.0) {
+                return Err(Error::InvalidArgument {
+                    argument: "max_shift".into(),
+                    message: format!(
+                        "{}; expected a positive number of seconds",
+                        crate::error::shown(max_shift)
+                    ),
+                });
+            }
+            // a larger offset leaves the recording and the plan no overlap to compare
+            let overlap = (rec.t[rec.len() - 1] - rec.t[0]) + experiment.trajectory.end()
+                - experiment.trajectory.start();
+            if max_shift > overlap {
+                return Err(Error::InvalidArgument {
+                    argument: "max_shift".into(),
+                    message: format!(
+                        "{} s for recording '{}': an offset that large leaves it no overlap with experiment '{}' (together {} s long); at most {} s",
+                        crate::error::shown(max_shift),
+                        rec.name,
+                        experiment.kind.name(),
+                        crate::error::shown((overlap * 1e3).round() / 1e3),
+                        crate::error::shown((overlap * 1e3).floor() / 1e3),
+                    ),
+                });
+            }
             let offset = detect_offset(experiment, rec, 1.25 * max_shift)?;
             if offset.abs() > max_shift {
                 return Err(Error::Recording {
                     recording: rec.name.clone(),
                     message: format!(
-                        "its clock is {offset:+.4} s off the plan of experiment '{}' (found in its positions), more than the {max_shift} s accepted: check that it is a run of this experiment, or raise max_shift (--max-shift)",
-                        experiment.kind.name()
+                        "its clock is {offset:+.4} s off the plan of experiment '{}' (found in its positions), more than the {} s accepted: check that it is a run of this experiment, or raise max_shift (--max-shift)",
+                        experiment.kind.name(),
+                        crate::error::shown(max_shift)
                     ),
                 });
             }

@@ -410,7 +410,7 @@ fn direct_run(
         ..ExcitationOptions::default()
     };
     let design = design_excitation(design_model, &ex, None)?;
-    let samples = design.trajectory.sample_periods(1.0, 50.0);
+    let samples = design.trajectory.sample_periods(1.0, 50.0)?;
     let rec = simulate_samples(model, &samples, sim, 99, "excitation")?;
     let batch = States::new(model.nv, &samples.q, Some(&samples.qd), Some(&samples.qdd))?;
     let global = identify_global_linear(op, &batch, &rec.tau)?;

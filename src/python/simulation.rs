@@ -14,11 +14,11 @@ use super::recording::{matrix_rows, PyRecording};
 use super::rehearsal::PyTrueRobot;
 use super::robot::PyRobot;
 use super::trajectory::PyFourier;
-use crate::error::{Error, Result};
+use crate::error::Error;
 use crate::recording::Recording;
 use crate::rehearsal::{rehearse, rehearse_plan};
 use crate::simulation::{simulate_plan, simulate_samples, Friction, SimulationOptions};
-use crate::trajectory::{FourierTrajectory, Samples};
+use crate::trajectory::Samples;
 
 /// The `friction` argument of `simulate`: a name ('urdf') or anything else (a dict).
 #[derive(FromPyObject)]
@@ -46,8 +46,10 @@ pub(crate) enum ReferenceArg<'py> {
 
 /// Simulates what the robot would log running `plan`: a Plan (one Recording per experiment,
 /// in the plan's order, returned as a list), or a FourierTrajectory / ExcitationDesign
-/// (`periods` periods sampled at `rate` Hz) or a tuple of arrays `(t, q, qd, qdd)` (shapes
-/// (k,), (k, n) x 3; s, rad, rad/s, rad/s^2), each returned as one Recording.
+/// (`periods` periods, default 1, sampled at `rate` Hz, default 1000) or a tuple of arrays
+/// `(t, q, qd, qdd)` (shapes (k,), (k, n) x 3; s, rad, rad/s, rad/s^2), each returned as one
+/// Recording. `rate` and `periods` are refused with a plan or arrays, which set their own
+/// times.
 ///
 /// On the model itself: torques from the dynamics with `gravity`, `friction` ('urdf', the
 /// default: the URDF's `<dynamics damping friction>`; None: none; or a dict with 'viscous',
@@ -60,8 +62,8 @@ pub(crate) enum ReferenceArg<'py> {
 /// ripple, sensors, closed-loop tracking; docs/rehearsal.md); `gravity=False`, a `friction`
 /// other than the default, noise, quantisation or a seed are then refused.
 #[pyfunction]
-#[pyo3(signature = (robot, plan, gravity=true, friction=Some(FrictionArg::Name("urdf".into())), torque_noise=None, position_noise=None, quantization=None, seed=0, *, true_robot=None, rate=1000.0, periods=1.0),
-    text_signature = "(robot, plan, gravity=True, friction='urdf', torque_noise=None, position_noise=None, quantization=None, seed=0, *, true_robot=None, rate=1000.0, periods=1.0)")]
+#[pyo3(signature = (robot, plan, gravity=true, friction=Some(FrictionArg::Name("urdf".into())), torque_noise=None, position_noise=None, quantization=None, seed=0, *, true_robot=None, rate=None, periods=None),
+    text_signature = "(robot, plan, gravity=True, friction='urdf', torque_noise=None, position_noise=None, quantization=None, seed=0, *, true_robot=None, rate=None, periods=None)")]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn simulate<'py>(
     py: Python<'py>,
@@ -74,8 +76,8 @@ pub(crate) fn simulate<'py>(
     quantization: Option<Bound<'_, PyAny>>,
     seed: u64,
     true_robot: Option<PyRef<'py, PyTrueRobot>>,
-    rate: f64,
-    periods: f64,
+    rate: Option<f64>,
+    periods: Option<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let default_friction = matches!(&friction, Some(FrictionArg::Name(n)) if n == "urdf");
     if true_robot.is_some()
@@ -93,12 +95,34 @@ pub(crate) fn simulate<'py>(
         .into());
     }
     let model = &robot.model;
+    let excitation = matches!(plan, ReferenceArg::Fourier(_) | ReferenceArg::Design(_));
+    if let (false, Some((name, value))) = (
+        excitation,
+        [("rate", rate), ("periods", periods)]
+            .into_iter()
+            .find_map(|(o, v)| v.map(|v| (o, v))),
+    ) {
+        return Err(Error::InvalidArgument {
+            argument: name.into(),
+            message: format!(
+                "{} given with {}: it applies to an excitation (FourierTrajectory or ExcitationDesign)",
+                crate::error::shown(value),
+                if matches!(plan, ReferenceArg::Plan(_)) {
+                    "a plan, whose experiments run once each at the plan's rate"
+                } else {
+                    "arrays, which give the times themselves"
+                }
+            ),
+        }
+        .into());
+    }
+    let (periods, rate) = (periods.unwrap_or(1.0), rate.unwrap_or(1000.0));
     let (plan, samples) = match plan {
         ReferenceArg::Plan(p) => (Some(p.plan.clone()), None),
-        ReferenceArg::Fourier(f) => (None, Some(excitation_samples(&f.traj, periods, rate)?)),
+        ReferenceArg::Fourier(f) => (None, Some(f.traj.sample_periods(periods, rate)?)),
         ReferenceArg::Design(d) => (
             None,
-            Some(excitation_samples(d.trajectory_ref(), periods, rate)?),
+            Some(d.trajectory_ref().sample_periods(periods, rate)?),
         ),
         ReferenceArg::Arrays((t, q, qd, qdd)) => {
             let t = vector("t", &t)?;
@@ -205,12 +229,4 @@ pub(crate) fn simulate<'py>(
         })?),
         _ => unreachable!("samples exist for every reference but a plan"),
     }
-}
-
-/// `periods` periods of `traj` sampled at `rate` Hz (bounded by the sample limit).
-fn excitation_samples(traj: &FourierTrajectory, periods: f64, rate: f64) -> Result<Samples> {
-    crate::limits::check_range("periods", periods, 1e-9, 1e6)?;
-    let count = crate::limits::sample_count("periods", periods * traj.period(), rate)?;
-    let t: Vec<f64> = (0..count).map(|i| i as f64 / rate).collect();
-    Ok(traj.sample(&t))
 }

@@ -244,7 +244,7 @@ fn direct_models(
         (None, Some(t)) => t / period,
         (None, None) => 1.0,
     };
-    let samples = design.trajectory.sample_periods(periods, d.rate);
+    let samples = design.trajectory.sample_periods(periods, d.rate)?;
     let time = samples.t.last().copied().unwrap_or(0.0) - samples.t[0];
     let rec = rehearse(model, plant, &samples, 1_000, "excitation")?;
     let states = States::new(model.nv, &samples.q, Some(&samples.qd), Some(&samples.qdd))?;

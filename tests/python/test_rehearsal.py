@@ -89,3 +89,11 @@ def test_bad_true_robots_are_refused():
         pr.simulate(robot, (t[::-1], q, qd, qdd))
     with pytest.raises(pr.InputError, match="periods"):
         pr.simulate(robot, pr.FourierTrajectory(np.ones((6, 1)), np.ones((6, 1)), np.zeros(6)), periods=1e12)
+    # rate and periods mean nothing for arrays or a plan (they set their own times): refused
+    with pytest.raises(pr.InputError, match="rate: 500 given with arrays"):
+        pr.simulate(robot, (t, q, qd, qdd), rate=500.0)
+    plan = pr.plan_experiments(robot, pr.OperatingPoint(q[0], np.zeros(6), np.zeros(6)), experiments=["G_static"])
+    with pytest.raises(pr.InputError, match="periods: 2 given with a plan"):
+        pr.simulate(robot, plan, periods=2.0)
+    with pytest.raises(pr.InputError, match=r"quantization\[0\]: 1e-320; expected 0 \(none\)"):
+        pr.simulate(robot, plan, quantization=1e-320)
