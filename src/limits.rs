@@ -22,6 +22,15 @@ pub const MAX_EVALUATIONS: usize = 10_000_000;
 pub const MAX_TEXT_BYTES: u64 = 2 << 30;
 /// Bytes read from one document (JSON, TOML, URDF): 256 MiB, far past any plan, model or robot.
 pub const MAX_DOCUMENT_BYTES: u64 = 256 << 20;
+/// A simulated sensor's noise: torque noise up to 10^6 N m (a slip of the exponent is an error,
+/// not a recording of noise).
+pub const MAX_TORQUE_NOISE: f64 = 1e6;
+/// A simulated encoder's resolution, when it has one: 10^-12 to 1 (rad or m) a count (positions
+/// divided by a finer one leave f64's range; every position of a coarser one reads 0).
+pub const POSITION_RESOLUTION: (f64, f64) = (1e-12, 1.0);
+/// A simulated torque sensor's resolution, when it has one: 10^-12 to 10^6 N m.
+pub const TORQUE_RESOLUTION: (f64, f64) = (1e-12, 1e6);
+
 /// A recording's longest gap between time stamps, in multiples of its median interval, before
 /// resampling refuses to fill it with interpolated values.
 pub const MAX_GAP_INTERVALS: f64 = 20.0;

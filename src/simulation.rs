@@ -154,14 +154,14 @@ impl SimulationOptions {
         self.friction.check(n)?;
         // the largest: far past any sensor, so that a slip of the exponent is an error, not
         // a recording of noise (1e300 N m) or of a robot that never moved (1e300 rad a count)
-        for (what, v, largest) in [
-            ("torque_noise", &self.torque_noise, 1e6),
-            ("position_noise", &self.position_noise, 1.0),
-            ("quantization", &self.quantization, 1.0),
+        use crate::limits::{MAX_TORQUE_NOISE, POSITION_RESOLUTION};
+        for (what, v, (smallest, largest)) in [
+            ("torque_noise", &self.torque_noise, (0.0, MAX_TORQUE_NOISE)),
+            ("position_noise", &self.position_noise, (0.0, 1.0)),
+            ("quantization", &self.quantization, POSITION_RESOLUTION),
         ] {
             crate::model::check_finite_vector(what, v, n)?;
-            // a resolution is 0 (none) or at least 1e-12 (positions divided by it stay finite)
-            let smallest = if what == "quantization" { 1e-12 } else { 0.0 };
+            // a resolution is 0 (none) or in its range
             let fits = |x: f64| x == 0.0 || (smallest..=largest).contains(&x);
             if let Some(j) = v.iter().position(|&x| !fits(x)) {
                 return Err(Error::InvalidArgument {

@@ -60,6 +60,21 @@ fn plan_simulate_identify_predict() {
         out.contains("D*: cond(X) 1.000") && out.contains("T* (N m)"),
         "{out}"
     );
+    // the torque noise of each separated regression, one line an experiment
+    let noise: Vec<&str> = out
+        .lines()
+        .skip_while(|l| !l.starts_with("torque noise (N m;"))
+        .skip(1)
+        .collect();
+    assert_eq!(noise.len(), 3, "{out}");
+    for x in ["G ", "H ", "D "] {
+        assert!(
+            noise
+                .iter()
+                .any(|l| l.trim_start().starts_with(x) && l.matches(" / ").count() == 6),
+            "{out}"
+        );
+    }
     let model =
         LocalModel::from_json(&std::fs::read_to_string(d.join("model.json")).unwrap()).unwrap();
     let m = a465::model("kinsheel2010").unwrap();

@@ -310,6 +310,34 @@ fn bad_true_robot_documents_are_refused_by_name() {
         r#"{"format": "perturbid-true-robot/1", "sensors": {"delay": 1.0, "jitter": 0.0}}"#
     )
     .is_ok());
+    // sensors past any sensor: noise of 1e300 N m, an encoder of 3 counts a revolution (every
+    // position rounded to 2 rad steps) or of 1e300 (positions over its step overflow), a
+    // torque resolution of 1e-320 N m
+    for (sensors, says) in [
+        (
+            r#"{"torque_noise": [1e300]}"#,
+            "sensors.torque_noise[0] is 1e300, expected a value in [0, 1000000]",
+        ),
+        (
+            r#"{"encoder_counts": [4096, 3]}"#,
+            "sensors.encoder_counts[1] is 3, expected 0 (none) or a value in [7, 1e12]",
+        ),
+        (
+            r#"{"encoder_counts": [1e300]}"#,
+            "sensors.encoder_counts[0] is 1e300",
+        ),
+        (
+            r#"{"torque_resolution": [0, 1e-320]}"#,
+            "sensors.torque_resolution[1] is 1e-320, expected 0 (none) or a value in [1e-12, 1000000]",
+        ),
+    ] {
+        let e = TrueRobot::from_json(&format!(
+            r#"{{"format": "perturbid-true-robot/1", "sensors": {sensors}}}"#
+        ))
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains(says), "{sensors}: {e}");
+    }
     let short = doc(r#"{"format": "perturbid-true-robot/1", "friction": {"viscous": [0.1, 0.2]}}"#);
     let e = rehearse(&model, &short, &reference(6, 0.1, 100.0), 0, "x")
         .unwrap_err()

@@ -487,5 +487,35 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
             fmt_matrix(&mut out, name, &e.matrix, &e.stderr);
         }
     }
+    fmt_noise(&mut out, &model.diagnostics.noise, &model.joint_names);
     Ok(out)
+}
+
+/// The torque noise per experiment and joint: one sample's, and what varied from pass to
+/// pass beyond it (`-` where not estimated).
+fn fmt_noise(out: &mut String, noise: &[crate::local::TorqueNoise], joints: &[String]) {
+    if noise.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        out,
+        "torque noise (N m; one sample's / what varied from pass to pass beyond it):"
+    );
+    let mut experiments: Vec<&str> = noise.iter().map(|e| e.experiment.as_str()).collect();
+    experiments.dedup();
+    for x in experiments {
+        let cells: Vec<String> = joints
+            .iter()
+            .map(|j| {
+                noise
+                    .iter()
+                    .find(|e| e.experiment == x && &e.joint == j)
+                    .map_or("-".into(), |e| {
+                        let passes = e.passes.map_or("-".into(), |p| format!("{p:.1e}"));
+                        format!("{:.1e} / {passes}", e.samples)
+                    })
+            })
+            .collect();
+        let _ = writeln!(out, "  {x:<9} {}", cells.join(", "));
+    }
 }

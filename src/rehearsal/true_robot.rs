@@ -250,6 +250,43 @@ impl Document for TrueRobot {
                 }
             }
         }
+        // the simulated sensors' ranges (docs/limits.md): an encoder of 0 counts (none) or a
+        // step of 1e-12 to 1 rad; a torque resolution of 0 (none) or 1e-12 to 1e6 N m
+        use crate::limits::{MAX_TORQUE_NOISE, POSITION_RESOLUTION, TORQUE_RESOLUTION};
+        // whole counts a revolution with steps in POSITION_RESOLUTION: 7 to 10^12
+        let counts = (7.0, 1e12);
+        debug_assert!(std::f64::consts::TAU / counts.0 <= POSITION_RESOLUTION.1);
+        debug_assert!(std::f64::consts::TAU / counts.1 >= POSITION_RESOLUTION.0);
+        for (what, v, (low, high)) in [
+            ("sensors.encoder_counts", &s.encoder_counts, counts),
+            (
+                "sensors.torque_noise",
+                &s.torque_noise,
+                (0.0, MAX_TORQUE_NOISE),
+            ),
+            (
+                "sensors.torque_resolution",
+                &s.torque_resolution,
+                TORQUE_RESOLUTION,
+            ),
+        ] {
+            let fits = |x: f64| x == 0.0 || (low..=high).contains(&x);
+            if let Some((i, x)) = v.iter().flatten().enumerate().find(|(_, x)| !fits(**x)) {
+                return Err(bad(format!(
+                    "{what}[{i}] is {}, expected {}",
+                    crate::error::shown(*x),
+                    if low > 0.0 {
+                        format!(
+                            "0 (none) or a value in [{}, {}]",
+                            crate::error::shown(low),
+                            crate::error::shown(high)
+                        )
+                    } else {
+                        format!("a value in [0, {}]", crate::error::shown(high))
+                    }
+                )));
+            }
+        }
         if let Some(c) = &s.torque_noise_correlation {
             if let Some(i) = c.iter().position(|&x| x >= 1.0) {
                 return Err(bad(format!(
