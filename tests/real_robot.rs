@@ -263,6 +263,21 @@ fn friction_aware_h_recovers_h_and_the_coulomb_steps() {
         }
     }
     assert!(reversed >= 1);
+    // the H experiment's torque noise is reported from the friction-aware regression too
+    // (noise-free data: no samples' noise; the pairs' differences fit exactly)
+    let h_noise: Vec<_> = m
+        .diagnostics
+        .noise
+        .iter()
+        .filter(|e| e.experiment == "H")
+        .collect();
+    assert_eq!(h_noise.len(), n, "{:?}", m.diagnostics.noise);
+    assert!(
+        h_noise
+            .iter()
+            .all(|e| e.samples < 1e-9 && e.passes.is_some_and(|p| p < 1e-6)),
+        "{h_noise:?}"
+    );
     // the plain regression on the same data is far off
     let plain = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
     assert!(rel(mat(&plain.h), &expected) > 1e-2);

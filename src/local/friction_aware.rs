@@ -4,22 +4,24 @@
 
 use nalgebra::DMatrix;
 
+use super::diagnostics::TorqueNoise;
 use super::identify::ExperimentValues;
 use super::model::{CoulombSteps, Estimate};
+use super::noise::{reading_variance, sample_variance, weighted_least_squares};
 use super::plan::{Experiment, Plan};
 use crate::direct::parameters::sign0;
 use crate::error::{Error, Result};
-use crate::regression::least_squares;
 
 /// H* and the Coulomb steps from the differences of the H experiment's +- pairs; see
 /// [`IdentifyOptions::friction_aware_h`]. One least-squares solve per torque row: the columns
 /// are the measured velocity differences and, where some pair reverses that row's joint, its
-/// step `sign(d_j)`.
+/// step `sign(d_j)`. Each pair weighs by the noise of its two torques (see [`super::noise`]);
+/// the torque noise is returned per joint (what varied from pass to pass: per pass).
 pub(super) fn friction_aware_h(
     plan: &Plan,
     e: &Experiment,
     v: &ExperimentValues,
-) -> Result<(Estimate, CoulombSteps)> {
+) -> Result<(Estimate, CoulombSteps, Vec<TorqueNoise>)> {
     let n = plan.n();
     let k = v.crossings.len();
     let refuse = |message: String| Error::InvalidArgument {
@@ -52,6 +54,13 @@ pub(super) fn friction_aware_h(
             2 * needed
         )));
     }
+    let samples = sample_variance(&v.crossings, n);
+    let variance: Vec<Vec<f64>> = v
+        .crossings
+        .iter()
+        .map(|c| reading_variance(c, &samples))
+        .collect();
+    let mut noise = Vec::with_capacity(n);
     let mut matrix = DMatrix::zeros(n, n);
     let mut stderr = DMatrix::zeros(n, n);
     let (mut cond, mut residual_rms) = (1.0f64, vec![0.0; n]);
@@ -80,15 +89,26 @@ pub(super) fn friction_aware_h(
         if reverses[j] {
             columns.push(format!("coulomb_step({})", plan.joint_names[j]));
         }
-        let ls = least_squares(
+        // a difference of two torques: the sum of their variances
+        let u = DMatrix::from_fn(m, 1, |i, _| variance[2 * i][j] + variance[2 * i + 1][j]);
+        let weighted = weighted_least_squares(
             &x,
             &y,
+            &u,
             &format!(
                 "friction-aware H regression, torque of joint '{}'",
                 plan.joint_names[j]
             ),
             &columns,
         )?;
+        noise.push(TorqueNoise {
+            experiment: e.kind.name().to_string(),
+            joint: plan.joint_names[j].clone(),
+            samples: samples[j].sqrt(),
+            // a pair's difference varies by twice one pass's variance
+            passes: Some((0.5 * weighted.common[0]).sqrt()).filter(|p| p.is_finite()),
+        });
+        let ls = weighted.fit;
         for c in 0..n {
             matrix[(j, c)] = ls.coef[(0, c)];
             stderr[(j, c)] = ls.stderr[(0, c)];
@@ -108,5 +128,5 @@ pub(super) fn friction_aware_h(
         stderr,
         crossings: k,
     };
-    Ok((estimate, steps))
+    Ok((estimate, steps, noise))
 }

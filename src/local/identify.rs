@@ -523,7 +523,8 @@ pub fn identify_local(
             let e = plan
                 .experiment(ExperimentKind::H)
                 .expect("values of a planned experiment");
-            let (h, c) = friction_aware_h(plan, e, v)?;
+            let (h, c, h_noise) = friction_aware_h(plan, e, v)?;
+            noise.borrow_mut().extend(h_noise);
             (Some(h), Some(c))
         }
         (true, None) => {
