@@ -31,6 +31,21 @@ pub const POSITION_RESOLUTION: (f64, f64) = (1e-12, 1.0);
 /// A simulated torque sensor's resolution, when it has one: 10^-12 to 10^6 N m.
 pub const TORQUE_RESOLUTION: (f64, f64) = (1e-12, 1e6);
 
+/// The first of a sensor's `values` outside its `range` (`(low, high)`: 0 for none or within
+/// `[low, high]` when `low > 0`, else within `[0, high]`), with what was expected, for the
+/// error message.
+pub fn outside_sensor_range(values: &[f64], (low, high): (f64, f64)) -> Option<(usize, String)> {
+    use crate::error::shown;
+    let fits = |x: f64| x == 0.0 || (low..=high).contains(&x);
+    let i = values.iter().position(|&x| !fits(x))?;
+    let expected = if low > 0.0 {
+        format!("0 (none) or a value in [{}, {}]", shown(low), shown(high))
+    } else {
+        format!("a value in [0, {}]", shown(high))
+    };
+    Some((i, expected))
+}
+
 /// A recording's longest gap between time stamps, in multiples of its median interval, before
 /// resampling refuses to fill it with interpolated values.
 pub const MAX_GAP_INTERVALS: f64 = 20.0;

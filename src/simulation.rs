@@ -155,30 +155,17 @@ impl SimulationOptions {
         // the largest: far past any sensor, so that a slip of the exponent is an error, not
         // a recording of noise (1e300 N m) or of a robot that never moved (1e300 rad a count)
         use crate::limits::{MAX_TORQUE_NOISE, POSITION_RESOLUTION};
-        for (what, v, (smallest, largest)) in [
+        for (what, v, range) in [
             ("torque_noise", &self.torque_noise, (0.0, MAX_TORQUE_NOISE)),
             ("position_noise", &self.position_noise, (0.0, 1.0)),
             ("quantization", &self.quantization, POSITION_RESOLUTION),
         ] {
             crate::model::check_finite_vector(what, v, n)?;
             // a resolution is 0 (none) or in its range
-            let fits = |x: f64| x == 0.0 || (smallest..=largest).contains(&x);
-            if let Some(j) = v.iter().position(|&x| !fits(x)) {
+            if let Some((j, expected)) = crate::limits::outside_sensor_range(v, range) {
                 return Err(Error::InvalidArgument {
                     argument: format!("{what}[{j}]"),
-                    message: format!(
-                        "{}; expected {}",
-                        crate::error::shown(v[j]),
-                        if smallest > 0.0 {
-                            format!(
-                                "0 (none) or a value in [{}, {}]",
-                                crate::error::shown(smallest),
-                                crate::error::shown(largest)
-                            )
-                        } else {
-                            format!("a value in [0, {}]", crate::error::shown(largest))
-                        }
-                    ),
+                    message: format!("{}; expected {expected}", crate::error::shown(v[j])),
                 });
             }
         }

@@ -12,16 +12,12 @@ mod cli_support;
 
 use std::process::Command;
 
-use cli_support::{bin, fails, nothing_written, ok, s, tmp, write};
+use cli_support::{bin, fails, nothing_written, ok, plan_nominal_and_d, s, table2_op, tmp, write};
 
 #[test]
 fn plan_simulate_identify_predict() {
     let d = tmp("local");
-    let op = d.join("op.json");
-    write(
-        &op,
-        r#"{"q": [0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0], "qd": [0.089, -0.106, 0.022, 0.056, 0.011, 0.014], "qdd": [-0.155, -0.5, 0.034, -0.291, -0.008, 0.171]}"#,
-    );
+    let op = table2_op(&d);
     let out = ok(&[
         "plan",
         "a465",
@@ -315,23 +311,7 @@ fn excite_identify_direct_predict() {
 #[test]
 fn bad_inputs_get_one_line_errors_and_no_output() {
     let d = tmp("errors");
-    let plan_dir = d.join("plan");
-    let op = d.join("op.json");
-    write(
-        &op,
-        r#"{"q": [0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0], "qd": [0.089, -0.106, 0.022, 0.056, 0.011, 0.014], "qdd": [-0.155, -0.5, 0.034, -0.291, -0.008, 0.171]}"#,
-    );
-    ok(&[
-        "plan",
-        "a465",
-        "--op",
-        s(&op),
-        "--out",
-        s(&plan_dir),
-        "--experiments",
-        "nominal,D",
-    ]);
-    let plan = plan_dir.join("plan.json");
+    let plan = plan_nominal_and_d(&d);
     let model = d.join("model.json");
     let csv = |name: &str, text: &str| -> String {
         let p = d.join(name);
@@ -706,11 +686,7 @@ fn excite_simulate_on_a_true_robot_identify_direct() {
 #[test]
 fn plan_warns_and_identify_friction_aware_h() {
     let d = tmp("friction-aware");
-    let op = d.join("op.json");
-    write(
-        &op,
-        r#"{"q": [0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0], "qd": [0.089, -0.106, 0.022, 0.056, 0.011, 0.014], "qdd": [-0.155, -0.5, 0.034, -0.291, -0.008, 0.171]}"#,
-    );
+    let op = table2_op(&d);
     let plain = bin()
         .args([
             "plan",
@@ -774,23 +750,7 @@ fn plan_warns_and_identify_friction_aware_h() {
 #[test]
 fn options_that_would_be_ignored_or_invent_data_are_refused() {
     let d = tmp("ignored");
-    let op = d.join("op.json");
-    write(
-        &op,
-        r#"{"q": [0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0], "qd": [0.089, -0.106, 0.022, 0.056, 0.011, 0.014], "qdd": [-0.155, -0.5, 0.034, -0.291, -0.008, 0.171]}"#,
-    );
-    let plan_dir = d.join("plan");
-    ok(&[
-        "plan",
-        "a465",
-        "--op",
-        s(&op),
-        "--out",
-        s(&plan_dir),
-        "--experiments",
-        "nominal,D",
-    ]);
-    let plan = plan_dir.join("plan.json");
+    let plan = plan_nominal_and_d(&d);
     let rec = d.join("rec");
     for (option, value) in [("--periods", "2"), ("--rate", "500")] {
         fails(

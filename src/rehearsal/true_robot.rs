@@ -270,20 +270,11 @@ impl Document for TrueRobot {
                 TORQUE_RESOLUTION,
             ),
         ] {
-            let fits = |x: f64| x == 0.0 || (low..=high).contains(&x);
-            if let Some((i, x)) = v.iter().flatten().enumerate().find(|(_, x)| !fits(**x)) {
+            let values = v.as_deref().unwrap_or_default();
+            if let Some((i, expected)) = crate::limits::outside_sensor_range(values, (low, high)) {
                 return Err(bad(format!(
-                    "{what}[{i}] is {}, expected {}",
-                    crate::error::shown(*x),
-                    if low > 0.0 {
-                        format!(
-                            "0 (none) or a value in [{}, {}]",
-                            crate::error::shown(low),
-                            crate::error::shown(high)
-                        )
-                    } else {
-                        format!("a value in [0, {}]", crate::error::shown(high))
-                    }
+                    "{what}[{i}] is {}, expected {expected}",
+                    crate::error::shown(values[i])
                 )));
             }
         }

@@ -54,6 +54,34 @@ pub fn s(p: &Path) -> &str {
 }
 
 /// No file named `name` and no temporary file in `dir`.
+/// Writes the paper's Table 2 operating point to `dir/op.json` and returns its path.
+pub fn table2_op(dir: &Path) -> PathBuf {
+    let op = dir.join("op.json");
+    write(
+        &op,
+        r#"{"q": [0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0], "qd": [0.089, -0.106, 0.022, 0.056, 0.011, 0.014], "qdd": [-0.155, -0.5, 0.034, -0.291, -0.008, 0.171]}"#,
+    );
+    op
+}
+
+/// Plans the nominal and D experiments of the A465 at Table 2 into `dir/plan`; returns the
+/// path of its plan.json.
+pub fn plan_nominal_and_d(dir: &Path) -> PathBuf {
+    let op = table2_op(dir);
+    let plan_dir = dir.join("plan");
+    ok(&[
+        "plan",
+        "a465",
+        "--op",
+        s(&op),
+        "--out",
+        s(&plan_dir),
+        "--experiments",
+        "nominal,D",
+    ]);
+    plan_dir.join("plan.json")
+}
+
 pub fn nothing_written(dir: &Path, name: &str) {
     assert!(!dir.join(name).exists(), "{name} was written");
     let tmp = std::fs::read_dir(dir)
