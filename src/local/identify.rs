@@ -331,19 +331,20 @@ pub(super) fn state(c: &CrossingValues, v: usize) -> &[f64] {
 }
 
 /// The variances (N^2 m^2, one row per crossing of `experiments` in order, one column per
-/// joint) that the torque samples' noise gives the torques read at the crossings, the noise
-/// level pooled within each experiment (see [`super::noise`]).
-fn reading_variances(experiments: &[&ExperimentValues], n: usize) -> DMatrix<f64> {
+/// joint) that the torque samples' noise gives the torques read at the crossings, and the
+/// samples' noise variance of each experiment, pooled within it, per joint (see
+/// [`super::noise`]).
+fn reading_variances(experiments: &[&ExperimentValues], n: usize) -> (DMatrix<f64>, Vec<Vec<f64>>) {
+    let samples: Vec<Vec<f64>> = experiments
+        .iter()
+        .map(|v| sample_variance(&v.crossings, n))
+        .collect();
     let rows: Vec<Vec<f64>> = experiments
         .iter()
-        .flat_map(|v| {
-            let variance = sample_variance(&v.crossings, n);
-            v.crossings
-                .iter()
-                .map(move |c| reading_variance(c, &variance))
-        })
+        .zip(&samples)
+        .flat_map(|(v, s2)| v.crossings.iter().map(|c| reading_variance(c, s2)))
         .collect();
-    DMatrix::from_fn(rows.len(), n, |i, j| rows[i][j])
+    (DMatrix::from_fn(rows.len(), n, |i, j| rows[i][j]), samples)
 }
 
 fn estimate(ls: LeastSquares) -> Estimate {
@@ -499,15 +500,20 @@ pub fn identify_local(
         };
         let x = DMatrix::from_fn(k, n, |i, j| state(&v.crossings[i], var)[j] - base_x[j]);
         let y = DMatrix::from_fn(k, n, |i, j| v.crossings[i].tau[j] - base_tau[j]);
+        let (u, samples) = reading_variances(&[v], n);
         let weighted = weighted_least_squares(
             &x,
             &y,
-            &reading_variances(&[v], n),
+            &u,
             &format!("experiment '{}'", kind.name()),
             &names(prefix),
         )?;
-        let samples = sample_variance(&v.crossings, n);
-        for ((joint, s2), a) in plan.joint_names.iter().zip(&samples).zip(&weighted.common) {
+        for ((joint, s2), a) in plan
+            .joint_names
+            .iter()
+            .zip(&samples[0])
+            .zip(&weighted.common)
+        {
             noise.borrow_mut().push(TorqueNoise {
                 experiment: kind.name().to_string(),
                 joint: joint.clone(),
@@ -554,7 +560,7 @@ pub fn identify_local(
             weighted_least_squares(
                 &x,
                 &y,
-                &reading_variances(&stacked, n),
+                &reading_variances(&stacked, n).0,
                 "combined estimate (nominal, G, H, D)",
                 &columns,
             )?
