@@ -174,6 +174,35 @@ impl Document for LocalModel {
                 check_condition(Self::WHAT, &format!("{what}.cond"), e.cond)?;
             }
         }
+        // the diagnostics' entries name an experiment and a joint of this model
+        let named = m
+            .diagnostics
+            .noise
+            .iter()
+            .map(|e| (&e.experiment, &e.joint))
+            .chain(
+                m.diagnostics
+                    .unmeasured
+                    .iter()
+                    .map(|u| (&u.experiment, &u.joint)),
+            );
+        for (experiment, joint) in named {
+            if !super::ExperimentKind::ALL
+                .iter()
+                .any(|k| k.name() == experiment.as_str())
+                || !m.joint_names.contains(joint)
+            {
+                return Err(bad(format!(
+                    "diagnostics name experiment '{experiment}' and joint '{joint}'; expected one of {} and of the model's joints ({})",
+                    super::ExperimentKind::ALL
+                        .iter()
+                        .map(|k| k.name())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    m.joint_names.join(", ")
+                )));
+            }
+        }
         for (i, e) in m.diagnostics.noise.iter().enumerate() {
             let what = format!("diagnostics.noise[{i}]");
             check_magnitude(Self::WHAT, &format!("{what}.samples"), e.samples, false)?;

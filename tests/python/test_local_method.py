@@ -319,3 +319,9 @@ def test_the_torque_noise_is_reported_per_experiment_and_joint():
     doc["diagnostics"]["noise"][2]["samples"] = -1.0
     with pytest.raises(pr.InputError, match=r"diagnostics.noise\[2\].samples is -1"):
         pr.LocalModel.from_json(json.dumps(doc))
+    # and entries naming a joint or an experiment the model does not have
+    for entry, value in [("joint", "joint9"), ("experiment", "Q")]:
+        doc = json.loads(model.to_json())
+        doc["diagnostics"]["noise"][0][entry] = value
+        with pytest.raises(pr.InputError, match=f"diagnostics name .*'{value}'"):
+            pr.LocalModel.from_json(json.dumps(doc))
