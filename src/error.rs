@@ -298,6 +298,16 @@ pub enum Error {
     #[error("{source_name}: robot '{robot}' has no moving joint (every joint is fixed or locked); nothing can be identified")]
     NoDegreeOfFreedom { source_name: String, robot: String },
 
+    /// A model with more moving bodies than [`crate::limits::MAX_BODIES`]: its buffers alone
+    /// (10 n^2 values a regressor, eight times over for the SIMD lanes) would not fit in memory.
+    #[error("{source_name}: robot '{robot}' has {bodies} moving bodies; at most {limit} are supported (each sample's regressor has 10 n^2 values; docs/limits.md)")]
+    TooManyBodies {
+        source_name: String,
+        robot: String,
+        bodies: usize,
+        limit: usize,
+    },
+
     /// Long work stopped by the user (Ctrl-C); nothing was written.
     #[error("{context}: interrupted")]
     Interrupted { context: String },
@@ -354,6 +364,7 @@ impl Error {
             | Error::InvalidArmature { .. }
             | Error::InvalidDynamics { .. }
             | Error::NoDegreeOfFreedom { .. }
+            | Error::TooManyBodies { .. }
             | Error::UnknownRobot { .. } => ErrorKind::Model,
             Error::Interrupted { .. } => ErrorKind::Interrupted,
             Error::Internal { .. } => ErrorKind::Internal,

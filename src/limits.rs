@@ -7,6 +7,15 @@ use crate::error::{Error, Result};
 
 /// Samples in one trajectory, recording or resampled log: 10^8 (a day at 1 kHz).
 pub const MAX_SAMPLES: f64 = 1e8;
+/// Values (samples x columns, f64) of one sampled trajectory, recording or resampled log that
+/// the library allocates from its input: 2^28, 2 GiB (a 7-joint arm's t, q, qd, qdd and tau for
+/// two and a half hours at 1 kHz; about what [`MAX_TEXT_BYTES`] of CSV holds). A larger one is
+/// refused before it is allocated instead of aborting the process on a smaller machine.
+pub const MAX_VALUES: f64 = 268_435_456.0;
+/// Moving bodies (joints with a degree of freedom, mimic joints included) of one model: 1,000.
+/// A model's buffers grow as the square of it (the regressor of one sample is `n x 10 n`,
+/// eight times over for the SIMD lanes): 1,000 bodies take about 1 GB.
+pub const MAX_BODIES: usize = 1000;
 /// Sampling rate (Hz): 10 MHz, far above any robot controller.
 pub const MAX_RATE: f64 = 1e7;
 /// Perturbations (crossings) per experiment.
@@ -87,21 +96,59 @@ pub fn check_count(name: &str, value: usize, low: usize, high: usize) -> Result<
 }
 
 /// The number of samples of `duration` seconds at `rate` Hz (both checked: finite, positive,
-/// the rate at most [`MAX_RATE`]), at most [`MAX_SAMPLES`]; `what` names the result in errors.
-pub fn sample_count(what: &str, duration: f64, rate: f64) -> Result<usize> {
+/// the rate at most [`MAX_RATE`]), at most [`MAX_SAMPLES`] and, with `columns` values each, at
+/// most [`MAX_VALUES`] values; `what` names the result in errors.
+pub fn sample_count(what: &str, duration: f64, rate: f64, columns: usize) -> Result<usize> {
     check_range("rate", rate, f64::MIN_POSITIVE, MAX_RATE)?;
     let count = duration * rate;
-    if !(count.is_finite() && count >= 0.0) || count + 1.0 > MAX_SAMPLES {
-        return Err(Error::InvalidArgument {
-            argument: what.into(),
-            message: format!(
-                "{} s at {} Hz is {count:.3e} samples; at most {MAX_SAMPLES:e} are made (docs/limits.md)",
-                crate::error::shown(duration),
-                crate::error::shown(rate)
-            ),
-        });
-    }
+    let given = || {
+        format!(
+            "{} s at {} Hz",
+            crate::error::shown(duration),
+            crate::error::shown(rate)
+        )
+    };
+    check_samples(what, count, columns, given)?;
     Ok(count as usize + 1)
+}
+
+/// Fails unless `values` (of one array the library would allocate) are at most
+/// [`MAX_VALUES`]. `given` says what the array is (`"the regressor of 300 states"`) and `what`
+/// names the argument that decides it, both for the error.
+pub fn check_values(what: &str, values: f64, given: impl FnOnce() -> String) -> Result<()> {
+    if values <= MAX_VALUES {
+        return Ok(());
+    }
+    Err(Error::InvalidArgument {
+        argument: what.into(),
+        message: format!(
+            "{} is {values:.3e} values; at most 2^28 (2 GiB) are made (docs/limits.md)",
+            given()
+        ),
+    })
+}
+
+/// Fails unless `intervals + 1` samples (`intervals` finite, not negative) of `columns` values
+/// each are within [`MAX_SAMPLES`] and [`MAX_VALUES`]. `given` says where the count comes from
+/// (`"4 s at 1000 Hz"`) and `what` names the result, both for the error.
+pub fn check_samples(
+    what: &str,
+    intervals: f64,
+    columns: usize,
+    given: impl FnOnce() -> String,
+) -> Result<()> {
+    let samples = intervals + 1.0;
+    let values = samples * columns.max(1) as f64;
+    if intervals.is_finite() && intervals >= 0.0 && samples <= MAX_SAMPLES && values <= MAX_VALUES {
+        return Ok(());
+    }
+    Err(Error::InvalidArgument {
+        argument: what.into(),
+        message: format!(
+            "{} give {samples:.3e} samples of {columns} values ({values:.3e} values); at most {MAX_SAMPLES:e} samples and 2^28 values (2 GiB) are made (docs/limits.md)",
+            given()
+        ),
+    })
 }
 
 #[cfg(test)]

@@ -170,7 +170,7 @@ fn preprocess_part(rec: &Recording, options: &PreprocessOptions) -> Result<Recor
     }
     let n = rec.n;
     let (t0, t1) = (rec.t[0], rec.t[rec.len() - 1]);
-    let count = crate::limits::sample_count("preprocess", t1 - t0, o.rate)?;
+    let count = crate::limits::sample_count("preprocess", t1 - t0, o.rate, 1 + 4 * n)?;
     check_gaps(rec)?;
     let grid: Vec<f64> = (0..count).map(|i| t0 + i as f64 / o.rate).collect();
     let dt = 1.0 / o.rate;

@@ -197,9 +197,9 @@ fn base_parameter_identification_is_exact_without_noise() {
                 &opts,
             )
             .unwrap();
-            // held-out states
+            // held-out states: more than two of the prediction's blocks of 1024 samples
             let mut rng = Rng(4);
-            let (q, qd, qdd) = random_states(&model, 30, &mut rng);
+            let (q, qd, qdd) = random_states(&model, 2500, &mut rng);
             let mut expected = torques(&model, &q, &qd, &qdd, Gravity::Included);
             for (i, t) in expected.iter_mut().enumerate() {
                 *t += viscous[i % 6] * qd[i] + coulomb[i % 6] * qd[i].signum();

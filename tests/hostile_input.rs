@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 
 use common::mimic_pair;
 use perturbid_rs::io::Table;
-use perturbid_rs::local::{plan_experiments, OperatingPoint, PlanOptions};
+use perturbid_rs::local::{plan_experiments, ExperimentKind, OperatingPoint, PlanOptions};
 use perturbid_rs::robots::a465::{TABLE2_Q, TABLE2_QD, TABLE2_QDD};
 use perturbid_rs::urdf::MAX_XML_DEPTH;
 use perturbid_rs::{
@@ -128,21 +128,28 @@ fn deep_nesting_is_refused_before_parsing() {
     load(&ok).unwrap();
 }
 
-#[test]
-fn a_long_chain_loads() {
-    // 5,000 links: the loader used to be quadratic (line numbers, the mass check)
-    let n = 5000;
+/// A chain of `n` links, every `every`-th joint revolute and the rest fixed.
+fn chain(n: usize, every: usize) -> String {
     let mut urdf = String::from(r#"<robot name="chain"><link name="l0"/>"#);
     for i in 1..=n {
+        let kind = if i % every == 0 { "revolute" } else { "fixed" };
         urdf.push_str(&format!(
             r#"<link name="l{i}"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
-<joint name="j{i}" type="revolute"><parent link="l{}"/><child link="l{i}"/><origin xyz="0 0 0.1"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>"#,
+<joint name="j{i}" type="{kind}"><parent link="l{}"/><child link="l{i}"/><origin xyz="0 0 0.1"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>"#,
             i - 1
         ));
     }
     urdf.push_str("</robot>");
+    urdf
+}
+
+#[test]
+fn a_long_chain_loads() {
+    // 5,000 links, 1,000 of them moving (the most a model may have): the loader used to be
+    // quadratic (line numbers, the mass check)
+    let urdf = chain(5000, 5);
     let m = load(&urdf).unwrap();
-    assert_eq!(m.nv, n);
+    assert_eq!(m.nv, 1000);
     // an error deep in the file names its line
     let bad = urdf.replace(
         r#"name="j4000" type="revolute""#,
@@ -150,6 +157,13 @@ fn a_long_chain_loads() {
     );
     let e = load(&bad).unwrap_err().to_string();
     assert!(e.starts_with("arm.urdf:4001: joint 'j4000'"), "{e}");
+    // one moving body more is refused before any buffer of n^2 values is made
+    let e = load(&chain(1001, 1)).unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::Model);
+    assert_eq!(
+        e.to_string(),
+        "arm.urdf: robot 'chain' has 1001 moving bodies; at most 1000 are supported (each sample's regressor has 10 n^2 values; docs/limits.md)"
+    );
 }
 
 #[test]
@@ -313,6 +327,35 @@ fn sizes_from_input_are_bounded_before_allocation() {
     };
     let e = preprocess(&rec, &options).unwrap_err().to_string();
     assert!(e.starts_with("rate: 1e15;"), "{e}");
+    // within every bound by itself, too many values together: a plan held for an hour a
+    // posture at 10 MHz, an excitation criterion over a million samples a period
+    let options = PlanOptions {
+        rate: 1e7,
+        dwell: 3600.0,
+        experiments: vec![ExperimentKind::GStatic],
+        ..PlanOptions::default()
+    };
+    let e = plan_experiments(&model, &op, &options).unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::Input);
+    let e = e.to_string();
+    assert!(
+        e.starts_with("experiment 'G_static' of the plan: 4")
+            && e.contains(" s at 10000000 Hz give 4.")
+            && e.ends_with("samples of 25 values (1.170e13 values); at most 1e8 samples and 2^28 values (2 GiB) are made (docs/limits.md)"),
+        "{e}"
+    );
+    let options = ExcitationOptions {
+        samples: 1_000_000,
+        ..ExcitationOptions::default()
+    };
+    let e = design_excitation(&model, &options, None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("samples: the criterion's regressor of 1000000 samples of 6 joints and ")
+            && e.ends_with("values; at most 2^28 (2 GiB) are made (docs/limits.md)"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -390,7 +433,10 @@ fn a_hand_edited_plan_is_checked_on_load() {
         .unwrap();
     last.t1 = 1e12;
     let e = Plan::from_json(&edited.to_json()).unwrap_err().to_string();
-    assert!(e.contains("at most 1e8 are made"), "{e}");
+    assert!(
+        e.contains("at most 1e8 samples and 2^28 values (2 GiB) are made"),
+        "{e}"
+    );
     // no experiment at all
     let mut edited = plan;
     edited.experiments.clear();
@@ -901,7 +947,7 @@ fn numbers_out_of_range_are_refused_as_given() {
         (
             1e9,
             100.0,
-            "periods: 1e9 periods of 10 s at 100 Hz are 1.000e12 samples",
+            "periods: 1e9 periods of 10 s at 100 Hz give 1.000e12 samples",
         ),
     ] {
         let e = traj.sample_periods(periods, rate).unwrap_err().to_string();

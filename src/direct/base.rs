@@ -99,6 +99,14 @@ impl BaseParameters {
         tolerance: f64,
         seed: u64,
     ) -> Result<Self> {
+        let values = (samples * model.nv) as f64 * layout.len() as f64;
+        crate::limits::check_values("base parameters", values, || {
+            format!(
+                "the regressor of {samples} random states of {} joints and {} parameters (the direct method is for models of up to about 100 joints)",
+                model.nv,
+                layout.len()
+            )
+        })?;
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let (mut q, mut qd, mut qdd) = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..samples {

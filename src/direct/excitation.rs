@@ -327,6 +327,14 @@ pub fn design_excitation(
     }
     let n = model.nv;
     let layout = ParameterLayout::new(model, o.friction.for_model(model));
+    let values = (o.samples * n) as f64 * layout.len() as f64;
+    crate::limits::check_values("samples", values, || {
+        format!(
+            "the criterion's regressor of {} samples of {n} joints and {} parameters",
+            o.samples,
+            layout.len()
+        )
+    })?;
     let base = BaseParameters::from_random_states(
         model,
         &layout,

@@ -5,7 +5,7 @@ use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 use super::base::{BaseParameters, BASE_TOLERANCE};
-use super::parameters::{regressor_matrix, FrictionTerms, ParameterLayout};
+use super::parameters::{regressor_blocks, FrictionTerms, ParameterLayout};
 use super::streaming;
 use crate::choice::choice;
 use crate::document::{check_condition, check_magnitudes, invalid, Document};
@@ -289,15 +289,12 @@ impl BaseModel {
     /// was identified for).
     pub fn predict(&self, model: &Model, states: &States<'_>) -> Result<Vec<f64>> {
         self.check(model)?;
-        let phi = self.base.select(&regressor_matrix(
-            model,
-            &self.base.layout,
-            states,
-            self.gravity,
-        )?);
-        let tau = (phi * DVector::from_column_slice(&self.theta))
-            .as_slice()
-            .to_vec();
+        let theta = DVector::from_column_slice(&self.theta);
+        let mut tau = Vec::with_capacity(states.len() * model.nv);
+        regressor_blocks(model, &self.base.layout, states, self.gravity, |_, phi| {
+            tau.extend_from_slice((self.base.select(phi) * &theta).as_slice());
+            Ok(())
+        })?;
         crate::torque_model::check_prediction(&tau, model.nv)?;
         Ok(tau)
     }

@@ -26,5 +26,5 @@ pub use identify::{
     identify_base_parameters, identify_consistent_parameters, BaseModel, BaseOptions, Weighting,
 };
 pub use parameter_table::ParameterRow;
-pub use parameters::{regressor_matrix, FrictionTerms, ParameterLayout};
+pub use parameters::{regressor_blocks, regressor_matrix, FrictionTerms, ParameterLayout};
 pub use workspace::{workspace_from_json, CartesianConstraint, Region};

@@ -249,7 +249,8 @@ impl Document for Plan {
                 }
                 previous = Some(seg.t1);
             }
-            crate::limits::sample_count(&at("trajectory"), e.duration(), plan.rate)?;
+            // t, q, qd, qdd and the torques a recording of it adds
+            crate::limits::sample_count(&at("trajectory"), e.duration(), plan.rate, 1 + 4 * n)?;
             e.trajectory
                 .check_smooth()
                 .map_err(|m| bad(at(&format!("trajectory: {m}"))))?;
@@ -485,6 +486,12 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
         };
         let trajectory = b.finish(&op.q);
         let context = format!("experiment '{}' of the plan", kind.name());
+        crate::limits::sample_count(
+            &context,
+            trajectory.end() - trajectory.start(),
+            o.rate,
+            1 + 4 * n,
+        )?;
         check_limits(
             model,
             &trajectory.sample(o.rate),

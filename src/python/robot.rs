@@ -349,20 +349,24 @@ impl PyRobot {
         let terms = super::arrays::friction_terms(Some(&friction))?;
         let layout = crate::direct::ParameterLayout::new(&self.model, terms);
         let total = layout.len();
-        let batch = read_batch(n, &args)?;
-        let phi = detached(py, "Robot.regressor", || {
-            crate::direct::regressor_matrix(&self.model, &layout, &batch.states(n)?, gravity.into())
-        })?;
-        let out = output_array(py, out, batch.k, batch.single, &[n, total])?;
-        write_into(&out, &[&q, &qd, &qdd], |values| {
-            for (r, row) in values.chunks_mut(total).enumerate() {
-                for (c, x) in row.iter_mut().enumerate() {
-                    *x = phi[(r, c)];
-                }
-            }
-            Ok(())
-        })?;
-        Ok(out.into_any())
+        self.batch(
+            py,
+            "Robot.regressor",
+            &args,
+            &[n, total],
+            out,
+            |m, _, s, out| {
+                crate::direct::regressor_blocks(m, &layout, s, gravity.into(), |range, phi| {
+                    let rows = &mut out[range.start * n * total..range.end * n * total];
+                    for (r, row) in rows.chunks_mut(total).enumerate() {
+                        for (c, x) in row.iter_mut().enumerate() {
+                            *x = phi[(r, c)];
+                        }
+                    }
+                    Ok(())
+                })
+            },
+        )
     }
 
     /// Physical consistency of a full parameter vector `theta` (default: the model's own

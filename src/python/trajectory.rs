@@ -54,11 +54,21 @@ impl PyFourier {
             Ok(x) => (vec![x], true),
             Err(_) => {
                 let a: ArrayLike<'_> = t.extract()?;
-                (a.as_array().iter().copied().collect(), false)
+                (super::arrays::vector("t", &a)?, false)
             }
         };
-        let s = self.traj.sample(&times);
+        if let Some(i) = times.iter().position(|x| !x.is_finite()) {
+            return Err(Error::InvalidArgument {
+                argument: format!("t[{i}]"),
+                message: format!("{}; expected a finite time (s)", times[i]),
+            }
+            .into());
+        }
         let n = self.traj.n();
+        crate::limits::check_samples("t", times.len().saturating_sub(1) as f64, 3 * n, || {
+            format!("{} times", times.len())
+        })?;
+        let s = self.traj.sample(&times);
         Ok((
             to_numpy(py, s.q, times.len(), single, &[n])?,
             to_numpy(py, s.qd, times.len(), single, &[n])?,

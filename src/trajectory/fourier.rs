@@ -132,24 +132,22 @@ impl FourierTrajectory {
 
     /// Samples over `periods` periods at `rate` Hz, from t = 0. Fails unless `periods` is
     /// positive and finite, `rate` positive and at most [`crate::limits::MAX_RATE`], and the
-    /// samples at most [`crate::limits::MAX_SAMPLES`].
+    /// samples within [`crate::limits::MAX_SAMPLES`] and, with the torques a simulation adds
+    /// (`1 + 4 N` values a sample), [`crate::limits::MAX_VALUES`].
     pub fn sample_periods(&self, periods: f64, rate: f64) -> crate::error::Result<Samples> {
         use crate::error::shown;
-        use crate::limits::{check_range, MAX_RATE, MAX_SAMPLES};
+        use crate::limits::{check_range, check_samples, MAX_RATE};
         check_range("periods", periods, f64::MIN_POSITIVE, f64::MAX)?;
         check_range("rate", rate, f64::MIN_POSITIVE, MAX_RATE)?;
         let count = (periods * self.period() * rate).round();
-        if !count.is_finite() || count + 1.0 > MAX_SAMPLES {
-            return Err(crate::error::Error::InvalidArgument {
-                argument: "periods".into(),
-                message: format!(
-                    "{} periods of {} s at {} Hz are {count:.3e} samples; at most {MAX_SAMPLES:e} are made (docs/limits.md)",
-                    shown(periods),
-                    shown(self.period()),
-                    shown(rate)
-                ),
-            });
-        }
+        check_samples("periods", count, 1 + 4 * self.n(), || {
+            format!(
+                "{} periods of {} s at {} Hz",
+                shown(periods),
+                shown(self.period()),
+                shown(rate)
+            )
+        })?;
         let count = count as usize + 1;
         let t: Vec<f64> = (0..count).map(|i| i as f64 / rate).collect();
         Ok(self.sample(&t))

@@ -72,6 +72,14 @@ impl Builder<'_> {
                 robot: robot.name.clone(),
             });
         }
+        if bodies.len() > crate::limits::MAX_BODIES {
+            return Err(Error::TooManyBodies {
+                source_name: self.source.to_string(),
+                robot: robot.name.clone(),
+                bodies: bodies.len(),
+                limit: crate::limits::MAX_BODIES,
+            });
+        }
         let mut model = Model {
             name: robot.name.clone(),
             source: self.source.to_string(),

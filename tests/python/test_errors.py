@@ -233,3 +233,43 @@ def test_masked_arrays_are_refused_not_read_through(robot):
     class Tagged(np.ndarray):
         pass
     np.testing.assert_allclose(robot.gravity(np.full(6, 0.3).view(Tagged)), robot.gravity(np.full(6, 0.3)))
+
+
+def test_trajectory_times_are_finite_one_dimensional_and_bounded():
+    traj = pr.FourierTrajectory(np.full((6, 2), 0.1), np.zeros((6, 2)), np.zeros(6))
+    with pytest.raises(pr.InputError, match=r"^t\[0\]: NaN; expected a finite time \(s\)$"):
+        traj.sample(np.nan)
+    with pytest.raises(pr.InputError, match=r"^t\[1\]: inf;"):
+        traj.sample([0.0, np.inf])
+    with pytest.raises(pr.InputError, match=r"^t: expected a 1-D array, got shape \[3, 2\]"):
+        traj.sample(np.zeros((3, 2)))
+    # 18 values a time: more than 2^28 values is refused before anything is allocated
+    with pytest.raises(pr.InputError, match=r"^t: 20000000 times give 2\.000e7 samples of 18 values"):
+        traj.sample(np.zeros(20_000_000))
+    assert [a.shape for a in traj.sample(np.zeros(0))] == [(0, 6)] * 3
+    q, qd, qdd = traj.sample(np.array([0.0, 1.0]))
+    assert q.shape == (2, 6) and np.all(np.isfinite(q))
+
+
+def test_a_robot_past_the_size_bound_is_refused_before_its_buffers(tmp_path):
+    link = '<link name="l{i}"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+    joint = ('<joint name="j{i}" type="revolute"><parent link="l{p}"/><child link="l{i}"/>'
+             '<axis xyz="0 1 0"/><limit lower="-1" upper="1" velocity="1" effort="10"/></joint>')
+    n = 1001
+    urdf = '<robot name="snake"><link name="l0"/>' + "".join(
+        link.format(i=i) + joint.format(i=i, p=i - 1) for i in range(1, n + 1)) + "</robot>"
+    with pytest.raises(pr.ModelError, match="robot 'snake' has 1001 moving bodies; at most 1000 are supported"):
+        pr.Robot.from_urdf_string(urdf)
+
+
+def test_the_friction_regressor_is_made_a_block_at_a_time(robot):
+    # 2500 samples: three blocks of the Rust side, the last one short; each sample's rows are
+    # the regressor of that sample alone
+    rng = np.random.default_rng(3)
+    q, qd, qdd = (rng.uniform(-1, 1, (2500, 6)) for _ in range(3))
+    full = robot.regressor(q, qd, qdd, friction="viscous,coulomb")
+    for s in (0, 1023, 1024, 2047, 2048, 2499):
+        np.testing.assert_array_equal(full[s], robot.regressor(q[s], qd[s], qdd[s], friction="viscous,coulomb"))
+    out = np.empty_like(full)
+    assert robot.regressor(q, qd, qdd, friction="viscous,coulomb", out=out) is out
+    np.testing.assert_array_equal(out, full)
