@@ -81,7 +81,8 @@ fn log_det(a: &DMatrix<f64>, ridge: f64) -> f64 {
 /// models give, `X` unweighted, with a ridge of 1e-9 of its trace). Returns `count` points
 /// (fewer if the candidates run out), each with the rank the design reaches with it.
 ///
-/// Errors: `candidates` or `count` of 0 or above 10,000.
+/// Errors: `candidates` or `count` of 0 or above 10,000, or candidates whose information
+/// matrices (`p x p` each, `p` base parameters) would exceed [`crate::limits::MAX_VALUES`].
 pub fn suggest_operating_points(
     robot: &Model,
     existing: &[OperatingPoint],
@@ -102,6 +103,9 @@ pub fn suggest_operating_points(
         1,
     )?;
     let p = base.len();
+    crate::limits::check_values("candidates", (candidates * p) as f64 * p as f64, || {
+        format!("the information matrices of {candidates} candidates on {p} base parameters")
+    })?;
     let mut info = DMatrix::zeros(p, p);
     for op in existing {
         if op.n() != robot.nv {
