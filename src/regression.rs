@@ -212,6 +212,31 @@ pub fn least_squares(
 
 /// `0.71 dq1 - 0.71 dq2`: a direction in terms of named columns (the 6 largest entries, largest
 /// first; entries below 5 % of the largest left out).
+/// The singular values of `x` (K x p, K >= p) with every column scaled to unit norm, largest
+/// first: all 1 for an orthogonal design; their extremes' ratio is [`LeastSquares::cond`], and
+/// `1 / s_min` is how many times the least well determined combination of the coefficients
+/// is less precise than with an orthogonal design of the same column norms. None when `x` has
+/// fewer rows than columns, a column of zeros or a value that is not finite.
+pub fn scaled_singular_values(x: &DMatrix<f64>) -> Option<Vec<f64>> {
+    let (k, p) = x.shape();
+    if k < p || p == 0 || x.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    let norms: Vec<f64> = (0..p)
+        .map(|j| {
+            let a = x.column(j).amax();
+            a * (x.column(j) / a).norm()
+        })
+        .collect();
+    if norms.iter().any(|&n| !(n > 0.0)) {
+        return None;
+    }
+    let xs = Mat::<f64>::from_fn(k, p, |i, j| x[(i, j)] / norms[j]);
+    let mut s: Vec<f64> = xs.singular_values().ok()?;
+    s.sort_by(|a, b| b.total_cmp(a));
+    Some(s)
+}
+
 fn describe_direction(d: &[f64], columns: &[String]) -> String {
     let norm = d.iter().map(|v| v * v).sum::<f64>().sqrt();
     let max = d.iter().fold(0.0f64, |a, v| a.max(v.abs()));

@@ -235,6 +235,9 @@ class Experiment:
         """Half-width (s) of the exact quadratic window around each crossing."""
     @property
     def duration(self) -> float: ...
+    @property
+    def cond(self) -> Optional[float]:
+        """cond(X) of the perturbations, each joint's column scaled to unit norm (1 for an orthogonal design; the planner warns above 30); None for the nominal experiment."""
 
 @final
 class Plan:

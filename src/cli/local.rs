@@ -144,9 +144,12 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
             &name,
             samples_table(&e.trajectory.sample(plan.rate), "").to_csv(),
         )?;
+        let cond = e
+            .design_cond()
+            .map_or(String::new(), |c| format!(", cond(X) {c:>6.2}"));
         let _ = writeln!(
             out,
-            "{:<9} {:>3} crossings, {:>7.2} s  -> {}",
+            "{:<9} {:>3} crossings, {:>7.2} s{cond:<17}  -> {}",
             e.kind.name(),
             e.crossings.len(),
             e.duration(),

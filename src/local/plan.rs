@@ -85,7 +85,20 @@ impl Experiment {
     pub fn duration(&self) -> f64 {
         self.trajectory.end() - self.trajectory.start()
     }
+
+    /// The condition number of the perturbations `deltas` with every joint's column scaled to
+    /// unit norm (what the experiment's regression reports as cond(X)): 1 for an orthogonal
+    /// design. None for the nominal experiment (no perturbation) or a design that leaves a joint
+    /// unperturbed.
+    pub fn design_cond(&self) -> Option<f64> {
+        let s = crate::regression::scaled_singular_values(&self.deltas)?;
+        Some(s[0] / s[s.len() - 1])
+    }
 }
+
+/// The condition number of a planned experiment's perturbations above which the planner warns
+/// (a random 6 x 6 design exceeds it about one time in four; an orthogonal design has 1).
+pub const DESIGN_COND_WARNING: f64 = 30.0;
 
 /// Options of [`plan_experiments`]; [`PlanOptions::default`] documents the defaults.
 #[derive(Clone, Debug, PartialEq)]
@@ -440,6 +453,9 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
         if kind == ExperimentKind::H {
             warnings.extend(velocity_reversal_warning(model, op, &deltas, o));
         }
+        if kind.perturbed().is_some() {
+            warnings.extend(design_warning(kind, &deltas));
+        }
         let mut b = Builder::new(n, o.rate, &lim, o.min_transition, &op.q);
         let rest_at = |q: &[f64]| Crossing {
             time: 0.0,
@@ -517,6 +533,27 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
         seed: o.seed,
         experiments,
         warnings,
+    })
+}
+
+/// The warning for a perturbation design whose cond(X) exceeds [`DESIGN_COND_WARNING`], with
+/// how much precision it gives away and what to plan instead.
+fn design_warning(kind: ExperimentKind, deltas: &DMatrix<f64>) -> Option<String> {
+    let s = crate::regression::scaled_singular_values(deltas)?;
+    let (largest, smallest) = (s[0], s[s.len() - 1]);
+    let cond = largest / smallest;
+    (cond > DESIGN_COND_WARNING).then(|| {
+        let estimate = match kind {
+            ExperimentKind::GStatic => "Gs",
+            ExperimentKind::GDynamic => "G*",
+            ExperimentKind::H => "H*",
+            _ => "D*",
+        };
+        format!(
+            "experiment '{}': its perturbations have cond(X) = {cond:.1} (each joint's column scaled to unit norm): the least well determined combination of {estimate}'s entries will be {:.1} times less precise than with an orthogonal design of the same column norms; plan with design 'orthogonal' (--design orthogonal) for cond(X) = 1, or with more perturbations (n, --n)",
+            kind.name(),
+            1.0 / smallest
+        )
     })
 }
 

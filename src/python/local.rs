@@ -78,12 +78,12 @@ impl PyPlan {
             op: self.plan.op.clone(),
         }
     }
-    /// Sampling rate of the trajectories (Hz).
     /// What the planner found the user should know (also issued as PerturbidWarning).
     #[getter]
     fn warnings(&self) -> Vec<String> {
         self.plan.warnings.clone()
     }
+    /// Sampling rate of the trajectories (Hz).
     #[getter]
     fn rate(&self) -> f64 {
         self.plan.rate
@@ -229,6 +229,12 @@ impl PyExperiment {
     #[getter]
     fn duration(&self) -> f64 {
         self.exp().duration()
+    }
+    /// cond(X) of the perturbations, each joint's column scaled to unit norm (1 for an
+    /// orthogonal design; the planner warns above 30); None for the nominal experiment.
+    #[getter]
+    fn cond(&self) -> Option<f64> {
+        self.exp().design_cond()
     }
     fn __repr__(&self) -> String {
         let e = self.exp();

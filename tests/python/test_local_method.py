@@ -325,3 +325,26 @@ def test_the_torque_noise_is_reported_per_experiment_and_joint():
         doc["diagnostics"]["noise"][0][entry] = value
         with pytest.raises(pr.InputError, match=f"diagnostics name .*'{value}'"):
             pr.LocalModel.from_json(json.dumps(doc))
+
+
+def test_a_poorly_conditioned_design_is_reported_and_warned_about():
+    robot = pr.robots.a465()
+    op = pr.OperatingPoint(*TABLE2)
+    with pytest.warns(pr.PerturbidWarning) as caught:
+        plan = pr.plan_experiments(robot, op, design="random", seed=0)
+    for e in plan.experiments:
+        if e.kind == "nominal":
+            assert e.cond is None
+            continue
+        x = e.deltas / np.linalg.norm(e.deltas, axis=0)
+        s = np.linalg.svd(x, compute_uv=False)
+        assert e.cond == pytest.approx(s[0] / s[-1], rel=1e-10)
+        warned = [str(w.message) for w in caught if f"experiment '{e.kind}': its perturbations have cond(X)" in str(w.message)]
+        assert len(warned) == (1 if s[0] / s[-1] > 30 else 0), (e.kind, s[0] / s[-1])
+        if warned:
+            assert f"cond(X) = {s[0] / s[-1]:.1f}" in warned[0]
+            assert f"will be {1 / s[-1]:.1f} times less precise" in warned[0]
+    assert plan.experiment("G").cond > 30  # this seed's G design: the warning is exercised
+    designed = pr.plan_experiments(robot, op, design="orthogonal", seed=0)
+    assert not any("its perturbations have cond(X)" in w for w in designed.warnings)
+    assert all(e.cond == pytest.approx(1.0, abs=1e-12) for e in designed.experiments if e.kind != "nominal")
