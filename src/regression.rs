@@ -225,10 +225,14 @@ pub fn scaled_singular_values(x: &DMatrix<f64>) -> Option<Vec<f64>> {
     let norms: Vec<f64> = (0..p)
         .map(|j| {
             let a = x.column(j).amax();
-            a * (x.column(j) / a).norm()
+            if a > 0.0 {
+                a * (x.column(j) / a).norm()
+            } else {
+                0.0
+            }
         })
         .collect();
-    if norms.iter().any(|&n| !(n > 0.0)) {
+    if norms.contains(&0.0) {
         return None;
     }
     let xs = Mat::<f64>::from_fn(k, p, |i, j| x[(i, j)] / norms[j]);
