@@ -196,7 +196,14 @@ fn friction_aware_h_recovers_h_and_the_coulomb_steps() {
     let n = model.nv;
     let op = table2();
     let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
-    let w = &plan.warnings;
+    // the warnings other than the design's (this seed's G design warns of its cond(X))
+    let reversals = |plan: &perturbid_rs::local::Plan| -> Vec<String> {
+        (plan.warnings.iter())
+            .filter(|w| !w.contains("its perturbations have cond(X)"))
+            .cloned()
+            .collect()
+    };
+    let w = &reversals(&plan);
     assert!(
         w.len() == 1
             && w[0].starts_with(
@@ -210,7 +217,7 @@ fn friction_aware_h_recovers_h_and_the_coulomb_steps() {
         ..PlanOptions::default()
     };
     let kept = plan_experiments(&model, &op, &keep).unwrap();
-    assert!(kept.warnings.is_empty(), "{:?}", kept.warnings);
+    assert!(reversals(&kept).is_empty(), "{:?}", kept.warnings);
     let h = kept
         .experiment(perturbid_rs::local::ExperimentKind::H)
         .unwrap();
@@ -223,7 +230,7 @@ fn friction_aware_h_recovers_h_and_the_coulomb_steps() {
         ..PlanOptions::default()
     };
     let plan = plan_experiments(&model, &op, &aware).unwrap();
-    assert!(plan.warnings.is_empty());
+    assert!(reversals(&plan).is_empty(), "{:?}", plan.warnings);
     let h_plan = plan
         .experiment(perturbid_rs::local::ExperimentKind::H)
         .unwrap();
