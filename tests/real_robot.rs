@@ -470,3 +470,68 @@ fn closed_loop_tracking_errors_favour_the_combined_estimate() {
         "{w:?}"
     );
 }
+
+/// A torque logged in steps coarser than its noise (0.05 N m against 0.002 N m): the rounding,
+/// much the same from pass to pass, hid from the regression's residuals, and D* entries erred
+/// by up to 700 of their standard errors. Detected, the step sets a floor under the standard
+/// errors (a rounding error of a step / sqrt(12) at every crossing), is reported in
+/// diagnostics.noise and warned about; a torque that is only noisy shows no step.
+#[test]
+fn torques_rounded_without_dithering_get_standard_errors_that_cover_the_rounding() {
+    use perturbid_rs::local::Design;
+    use perturbid_rs::rehearsal::{rehearse_plan, TrueRobot};
+    use perturbid_rs::Document;
+    let model = a465::model("kinsheel2010").unwrap();
+    let op = table2();
+    let options = PlanOptions {
+        design: Design::Orthogonal,
+        ..PlanOptions::default()
+    };
+    let plan = plan_experiments(&model, &op, &options).unwrap();
+    let truth = linearized(&model, &op);
+    let robot = |seed: usize, resolution: f64| {
+        let spec = format!(
+            r#"{{"format": "perturbid-true-robot/1", "seed": {seed}, "sensors": {{"torque_noise": [0.002, 0.002, 0.002, 0.002, 0.002, 0.002], "torque_resolution": [{r}, {r}, {r}, {r}, {r}, {r}]}}}}"#,
+            r = resolution
+        );
+        TrueRobot::from_json(&spec).unwrap()
+    };
+    let identify = |robot: &TrueRobot| {
+        let recordings = rehearse_plan(&model, robot, &plan).unwrap();
+        identify_local(&plan, &recordings, &IdentifyOptions::default()).unwrap()
+    };
+    let mut worst: f64 = 0.0;
+    for seed in 0..12 {
+        let m = identify(&robot(100 + seed, 0.05));
+        let d = m.d.as_ref().unwrap();
+        for ((e, se), t) in d.matrix.iter().zip(&d.stderr).zip(&truth.d) {
+            if se.is_finite() {
+                worst = worst.max((e - t).abs() / se);
+            }
+        }
+        let named = |x: &perturbid_rs::local::TorqueNoise| {
+            x.experiment == "D" && x.step.is_some_and(|q| (q - 0.05).abs() < 1e-9)
+        };
+        assert!(
+            m.diagnostics.noise.iter().any(named),
+            "{:?}",
+            m.diagnostics.noise
+        );
+        assert!(
+            (m.diagnostics.warnings.iter()).any(|w| w
+                .starts_with("experiment 'D': the torque of joint(s) 'joint")
+                && w.contains("(steps of 0.05 N m, scatter ")),
+            "{:?}",
+            m.diagnostics.warnings
+        );
+    }
+    assert!(worst < 4.0, "D* erred by {worst:.1} standard errors");
+    // noise alone (a resolution of 0: none) is no grid
+    let m = identify(&robot(100, 0.0));
+    assert!(m.diagnostics.noise.iter().all(|x| x.step.is_none()));
+    assert!(!m
+        .diagnostics
+        .warnings
+        .iter()
+        .any(|w| w.contains("steps coarser")));
+}

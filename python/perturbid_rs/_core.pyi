@@ -336,7 +336,8 @@ class LocalModel:
         unperturbed_deviation, unmeasured (list of dicts: experiment, joint, value in N m, for
         torques that read one value throughout), noise (list of dicts: experiment, joint,
         samples (N m, one torque sample's noise), passes (N m, what varied from pass to pass
-        beyond it, or None)), warnings."""
+        beyond it, or None), step (N m, the step the torque was logged in where it is coarser
+        than its noise, or None)), warnings."""
     def linearize(self, op: OperatingPoint) -> dict[str, Any]:
         """torque (n,), D, H, G (n, n) and G_static (n, n) or None at op."""
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:

@@ -502,7 +502,7 @@ fn fmt_noise(out: &mut String, noise: &[crate::local::TorqueNoise], joints: &[St
     }
     let _ = writeln!(
         out,
-        "torque noise (N m; one sample's / what varied from pass to pass beyond it):"
+        "torque noise (N m; one sample's / what varied from pass to pass beyond it; the steps of a torque logged coarser than its noise):"
     );
     let mut experiments: Vec<&str> = noise.iter().map(|e| e.experiment.as_str()).collect();
     experiments.dedup();
@@ -515,7 +515,10 @@ fn fmt_noise(out: &mut String, noise: &[crate::local::TorqueNoise], joints: &[St
                     .find(|e| e.experiment == x && &e.joint == j)
                     .map_or("-".into(), |e| {
                         let passes = e.passes.map_or("-".into(), |p| format!("{p:.1e}"));
-                        format!("{:.1e} / {passes}", e.samples)
+                        let step = e
+                            .step
+                            .map_or(String::new(), |q| format!(" (steps {q:.1e})"));
+                        format!("{:.1e} / {passes}{step}", e.samples)
                     })
             })
             .collect();

@@ -83,6 +83,11 @@ pub struct TorqueNoise {
     /// the estimate but not from the residuals (for H the velocity-squared terms; then the
     /// standard errors bound the error from above). `None` without residual degrees of freedom.
     pub passes: Option<f64>,
+    /// The step (N m) the torque was logged in, where its samples lie on a grid coarser than
+    /// their noise (not dithered; see [`super::quantisation`]): the standard errors of its rows
+    /// include a rounding error of `step / sqrt(12)` at every crossing. `None` otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step: Option<f64>,
 }
 
 /// Diagnostics of a local identification; see the module documentation.

@@ -101,14 +101,21 @@ pub(super) fn friction_aware_h(
             ),
             &columns,
         )?;
+        let step = super::quantisation::undithered_step(v.torque_step[j], samples[j]);
+        let mut ls = weighted.fit;
+        if let Some(q) = step {
+            // a pair's difference: two readings' rounding
+            let sigma = std::f64::consts::SQRT_2 * super::quantisation::rounding_stderr(q);
+            super::quantisation::floor_stderr(&mut ls, 0, sigma);
+        }
         noise.push(TorqueNoise {
             experiment: e.kind.name().to_string(),
             joint: plan.joint_names[j].clone(),
             samples: samples[j].sqrt(),
             // a pair's difference varies by twice one pass's variance
             passes: Some((0.5 * weighted.common[0]).sqrt()).filter(|p| p.is_finite()),
+            step,
         });
-        let ls = weighted.fit;
         for c in 0..n {
             matrix[(j, c)] = ls.coef[(0, c)];
             stderr[(j, c)] = ls.stderr[(0, c)];

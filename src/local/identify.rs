@@ -16,6 +16,7 @@ use super::model::{Estimate, Estimator, LocalModel};
 use super::noise::{reading_variance, sample_variance, weighted_least_squares};
 use super::operating_point::OperatingPoint;
 use super::plan::{Experiment, ExperimentKind, Plan};
+use super::quantisation;
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::recording::Recording;
@@ -87,10 +88,13 @@ pub struct ExperimentValues {
     /// of them (every crossing's window and the reference posture's) had the same one: a torque
     /// signal that did not change (see [`flat_torques`]).
     pub flat_torque: Vec<Option<f64>>,
+    /// Per joint, the step (N m) of the grid the torque samples read for this experiment lie
+    /// on, if any (see [`super::quantisation::torque_steps`]).
+    pub torque_step: Vec<Option<f64>>,
 }
 
 /// Per joint, `Some(value)` when every torque sample of `rec` in the windows `[tc - half, tc +
-/// half]` (one per centre `tc`) has the same value, bit for bit: a torque signal that did not
+/// half]` (one per centre `tc`) has the same value (0 and -0 are one): a torque signal that did not
 /// change where the experiment was read (a dead or saturated channel, or a resolution coarser
 /// than the perturbations' effect). `None` where any sample differs or no window holds a
 /// sample.
@@ -106,7 +110,7 @@ pub fn flat_torques(rec: &Recording, centres: &[f64], half: f64) -> Vec<Option<f
                 let v = rec.tau[i * n + j];
                 match first[j] {
                     None => first[j] = Some(v),
-                    Some(f) if f.to_bits() != v.to_bits() => flat[j] = false,
+                    Some(f) if f != v => flat[j] = false, // -0 reads as 0
                     Some(_) => {}
                 }
             }
@@ -287,6 +291,7 @@ pub fn experiment_values(
         reference,
         reversals,
         flat_torque: flat_torques(rec, &centres, half),
+        torque_step: quantisation::torque_steps(rec, &centres, half),
     })
 }
 
@@ -458,6 +463,7 @@ pub fn identify_local(
                     .collect()
             };
             let tau = mean(&|c| &c.tau);
+            let samples = sample_variance(&v.crossings, n);
             let se = (0..n)
                 .map(|j| {
                     let ss: f64 = v
@@ -465,8 +471,10 @@ pub fn identify_local(
                         .iter()
                         .map(|c| (c.tau[j] - tau[j]).powi(2))
                         .sum();
+                    let rounding = quantisation::undithered_step(v.torque_step[j], samples[j])
+                        .map_or(0.0, |q| quantisation::rounding_stderr(q) / k.sqrt());
                     if k > 1.0 {
-                        (ss / (k - 1.0) / k).sqrt()
+                        (ss / (k - 1.0) / k).sqrt().max(rounding)
                     } else {
                         f64::NAN
                     }
@@ -508,20 +516,27 @@ pub fn identify_local(
             &format!("experiment '{}'", kind.name()),
             &names(prefix),
         )?;
-        for ((joint, s2), a) in plan
+        let mut fit = weighted.fit;
+        for (j, ((joint, s2), a)) in plan
             .joint_names
             .iter()
             .zip(&samples[0])
             .zip(&weighted.common)
+            .enumerate()
         {
+            let step = quantisation::undithered_step(v.torque_step[j], *s2);
+            if let Some(q) = step {
+                quantisation::floor_stderr(&mut fit, j, quantisation::rounding_stderr(q));
+            }
             noise.borrow_mut().push(TorqueNoise {
                 experiment: kind.name().to_string(),
                 joint: joint.clone(),
                 samples: s2.sqrt(),
                 passes: Some(a.sqrt()).filter(|v| v.is_finite()),
+                step,
             });
         }
-        Ok(Some(estimate(weighted.fit)))
+        Ok(Some(estimate(fit)))
     };
     let d = separated(ExperimentKind::D, "dqdd")?;
     let (h, coulomb) = match (options.friction_aware_h, find(ExperimentKind::H)) {
@@ -556,16 +571,20 @@ pub fn identify_local(
         });
         let y = DMatrix::from_fn(rows.len(), n, |i, j| rows[i].tau[j] - torque[j]);
         let columns: Vec<String> = [names("dqdd"), names("dqd"), names("dq")].concat();
-        Some(estimate(
-            weighted_least_squares(
-                &x,
-                &y,
-                &reading_variances(&stacked, n).0,
-                "combined estimate (nominal, G, H, D)",
-                &columns,
-            )?
-            .fit,
-        ))
+        let (u, samples) = reading_variances(&stacked, n);
+        let mut fit =
+            weighted_least_squares(&x, &y, &u, "combined estimate (nominal, G, H, D)", &columns)?
+                .fit;
+        for j in 0..n {
+            // the coarsest step any of the stacked experiments read this torque in, undithered
+            let step = (stacked.iter().zip(&samples))
+                .filter_map(|(v, s2)| quantisation::undithered_step(v.torque_step[j], s2[j]))
+                .fold(None, |a: Option<f64>, q| Some(a.map_or(q, |a| a.max(q))));
+            if let Some(q) = step {
+                quantisation::floor_stderr(&mut fit, j, quantisation::rounding_stderr(q));
+            }
+        }
+        Some(estimate(fit))
     } else {
         None
     };
@@ -652,6 +671,7 @@ pub fn identify_local(
     let mut noise = noise.into_inner();
     // in the plan's order of experiments
     noise.sort_by_key(|e| values.iter().position(|v| v.kind.name() == e.experiment));
+    diagnostics.warnings.extend(quantisation::warnings(&noise));
     diagnostics.noise = noise;
     diagnostics.combined = disagreement;
     diagnostics.unperturbed_deviation = deviation;

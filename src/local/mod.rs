@@ -42,6 +42,7 @@ pub mod parameters;
 pub mod perturbation;
 pub mod plan;
 pub mod point_design;
+pub mod quantisation;
 
 pub use crossing::{values_at, values_at_with, CrossingValues, FitOptions, TorqueFit};
 pub use diagnostics::{

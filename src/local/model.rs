@@ -209,6 +209,15 @@ impl Document for LocalModel {
             if let Some(p) = e.passes {
                 check_magnitude(Self::WHAT, &format!("{what}.passes"), p, false)?;
             }
+            if let Some(q) = e.step {
+                check_magnitude(Self::WHAT, &format!("{what}.step"), q, false)?;
+                if q == 0.0 {
+                    return Err(invalid(
+                        Self::WHAT,
+                        format!("{what}.step is 0; expected a positive step (N m) or null"),
+                    ));
+                }
+            }
         }
         Ok(())
     }

@@ -434,7 +434,9 @@ impl PyLocalModel {
     /// for tracking errors), `unmeasured` (list of dicts: `experiment`, `joint`, `value` in N m,
     /// for torques that read one value throughout), `noise` (list of dicts: `experiment`,
     /// `joint`, `samples` (N m, one torque sample's noise), `passes` (N m, what varied from pass
-    /// to pass beyond it, or None)), `warnings` (list of str).
+    /// to pass beyond it, or None), `step` (N m, the step the torque was logged in where it is
+    /// coarser than its noise: the standard errors of its rows include the rounding; else
+    /// None)), `warnings` (list of str).
     #[getter]
     fn diagnostics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = &self.model.diagnostics;
@@ -490,6 +492,7 @@ impl PyLocalModel {
                 entry.set_item("joint", &e.joint)?;
                 entry.set_item("samples", e.samples)?;
                 entry.set_item("passes", e.passes)?;
+                entry.set_item("step", e.step)?;
                 Ok(entry)
             })
             .collect::<PyResult<Vec<_>>>()?;

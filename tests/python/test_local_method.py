@@ -308,6 +308,7 @@ def test_the_torque_noise_is_reported_per_experiment_and_joint():
         j = int(e["joint"][-1]) - 1
         assert abs(e["samples"] / levels[j] - 1) < 0.15, e
         assert e["passes"] is not None and e["passes"] >= 0
+        assert e["step"] is None  # noise alone is no grid of steps
     # what varies from pass to pass in H beyond the samples' noise: the velocity-squared terms
     # the +- pairs cancel from H* (several mN m at this point), far above D's
     passes = {(e["experiment"], e["joint"]): e["passes"] for e in noise}
@@ -318,6 +319,10 @@ def test_the_torque_noise_is_reported_per_experiment_and_joint():
     doc = json.loads(model.to_json())
     doc["diagnostics"]["noise"][2]["samples"] = -1.0
     with pytest.raises(pr.InputError, match=r"diagnostics.noise\[2\].samples is -1"):
+        pr.LocalModel.from_json(json.dumps(doc))
+    doc = json.loads(model.to_json())
+    doc["diagnostics"]["noise"][1]["step"] = 0.0
+    with pytest.raises(pr.InputError, match=r"diagnostics.noise\[1\].step is 0; expected a positive step"):
         pr.LocalModel.from_json(json.dumps(doc))
     # and entries naming a joint or an experiment the model does not have
     for entry, value in [("joint", "joint9"), ("experiment", "Q")]:

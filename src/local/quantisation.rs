@@ -1,0 +1,186 @@
+//! Torques logged at a coarse resolution (docs/method.md, section 4).
+//!
+//! A torque channel rounded to whole steps `q` (an ADC, a fixed-point field, a motor current
+//! logged in counts) errs by up to `q / 2` in each sample. Where the samples' noise is at
+//! least about half a step, the rounding is dithered: it acts as more white noise
+//! (`q^2 / 12` a sample), averages out in each window's fit and shows in the samples' scatter
+//! like any noise. Where the noise is smaller, the rounding is a function of the torque: a
+//! window that stays within one step reads one level whatever the perturbation did, and the
+//! errors, though up to `q / 2` at every crossing, can agree between passes so well that the
+//! regression's residuals do not show them. On the A465 at Table 2 with 0.05 N m steps and
+//! 0.002 N m of noise, D* entries erred by up to 700 of their standard errors.
+//!
+//! So a torque whose samples lie on a grid coarser than their noise (`s^2 < q^2 / 3`, with
+//! `s` the samples' scatter about their fits: noise plus dithered rounding of `q^2 / 12`) gets
+//! standard errors of at least those of an independent rounding error of `q / sqrt(12)` at
+//! every crossing, and a warning.
+
+use super::diagnostics::TorqueNoise;
+use crate::recording::Recording;
+use crate::regression::LeastSquares;
+
+/// The fewest distinct values a window's samples must take for their spacing to say anything
+/// about a grid beyond "two levels" (two levels are a grid of their difference).
+const MIN_LEVELS: usize = 2;
+
+/// Tolerance of "a whole multiple of the step", in steps: a value logged with a few
+/// significant digits is still on its grid, and a continuous signal's differences (whose
+/// ratios to the smallest are anything) pass it at a few of its many gaps, never at all.
+const ON_GRID: f64 = 0.01;
+
+/// The most steps of a grid the smallest difference between the values read may span: a
+/// torque held within each window reads few of its grid's levels, e.g. 0.1 and 0.15 N m apart
+/// on a grid of 0.05.
+const MAX_STEPS_IN_GAP: usize = 10;
+
+/// The step of the uniform grid the finite `values` lie on: the largest `d / m` (`d` the
+/// smallest difference between two distinct values, `m` up to [`MAX_STEPS_IN_GAP`]) of which
+/// every difference between neighbouring distinct values is a whole multiple (to [`ON_GRID`]
+/// of a step). None for fewer than two distinct values, or values off any such grid (a
+/// continuous signal: its neighbours' differences are no multiples of a common step).
+pub fn grid_step(values: &[f64]) -> Option<f64> {
+    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    v.sort_by(f64::total_cmp);
+    v.dedup_by(|a, b| a == b); // -0 and 0 are one level
+    if v.len() < MIN_LEVELS {
+        return None;
+    }
+    let gaps: Vec<f64> = v.windows(2).map(|w| w[1] - w[0]).collect();
+    let smallest = gaps.iter().copied().fold(f64::INFINITY, f64::min);
+    if !(smallest > 0.0 && smallest.is_finite()) {
+        return None;
+    }
+    (1..=MAX_STEPS_IN_GAP)
+        .map(|m| smallest / m as f64)
+        .find(|&step| {
+            gaps.iter().all(|&g| {
+                let m = g / step;
+                (m - m.round()).abs() <= ON_GRID
+            })
+        })
+}
+
+/// Per joint, the grid step (N m) of the torque samples of `rec` in the windows `[tc - half, tc
+/// + half]` (one per centre `tc`, the recording's clock), see [`grid_step`]; None where they lie
+/// on no grid or take fewer than two values (a flat channel: [`super::identify::flat_torques`]).
+pub fn torque_steps(rec: &Recording, centres: &[f64], half: f64) -> Vec<Option<f64>> {
+    let n = rec.n;
+    let mut columns: Vec<Vec<f64>> = vec![vec![]; n];
+    for &tc in centres {
+        let lo = rec.t.partition_point(|&t| t < tc - half);
+        let hi = rec.t.partition_point(|&t| t <= tc + half);
+        for i in lo..hi {
+            for (j, column) in columns.iter_mut().enumerate() {
+                column.push(rec.tau[i * n + j]);
+            }
+        }
+    }
+    columns.iter().map(|c| grid_step(c)).collect()
+}
+
+/// Whether a torque logged in steps of `step` (N m) is rounded without dithering: its samples'
+/// scatter about their fits (`variance`, N^2 m^2: noise plus the rounding's `step^2 / 12` when
+/// dithered) is below `step^2 / 3`, the scatter of noise of half a step.
+pub fn undithered(step: f64, variance: f64) -> bool {
+    variance < step * step / 3.0
+}
+
+/// The standard deviation (N m) of the rounding error of one reading of a torque logged in
+/// steps of `step` without dithering, taken as independent from crossing to crossing:
+/// `step / sqrt(12)`, a uniform error over one step.
+pub fn rounding_stderr(step: f64) -> f64 {
+    step / 12f64.sqrt()
+}
+
+/// `step` when a torque logged in steps of `step` (N m, see [`torque_steps`]) is rounded
+/// without dithering by its samples' scatter `variance` (N^2 m^2, see [`undithered`]); None
+/// otherwise.
+pub fn undithered_step(step: Option<f64>, variance: f64) -> Option<f64> {
+    step.filter(|&q| undithered(q, variance))
+}
+
+/// Raises the standard errors of output `c` of `fit` to at least those an independent error
+/// of `sigma` (N m) in every row of its regression gives, `sigma sqrt(cov_diag)`. Standard
+/// errors that are NaN (no residual degree of freedom) stay NaN.
+pub fn floor_stderr(fit: &mut LeastSquares, c: usize, sigma: f64) {
+    for (p, &v) in fit.cov_diag.iter().enumerate() {
+        let se = &mut fit.stderr[(c, p)];
+        if se.is_finite() {
+            *se = se.max(sigma * v.sqrt());
+        }
+    }
+}
+
+/// One warning per experiment whose torques were rounded without dithering (the entries of
+/// `noise` with a `step`), naming the joints, their steps and their samples' scatter.
+pub fn warnings(noise: &[TorqueNoise]) -> Vec<String> {
+    let mut experiments: Vec<&str> = noise
+        .iter()
+        .filter(|e| e.step.is_some())
+        .map(|e| e.experiment.as_str())
+        .collect();
+    experiments.dedup();
+    experiments
+        .into_iter()
+        .map(|x| {
+            let joints: Vec<String> = noise
+                .iter()
+                .filter(|e| e.experiment == x)
+                .filter_map(|e| {
+                    e.step.map(|q| {
+                        format!(
+                            "'{}' (steps of {} N m, scatter {:.2e} N m)",
+                            e.joint,
+                            // four significant digits: the step is a difference of readings
+                            crate::error::shown(format!("{q:.3e}").parse().unwrap_or(q)),
+                            e.samples
+                        )
+                    })
+                })
+                .collect();
+            format!(
+                "experiment '{x}': the torque of joint(s) {} is logged in steps coarser than its noise (below half a step), so the rounding does not average out and can agree between passes: the standard errors of its rows include a rounding error of a step / sqrt(12) at every crossing, and torque changes smaller than a step are lost; log the torque at a finer resolution or perturb more",
+                joints.join(", ")
+            )
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grids_are_found_and_continuous_values_are_not() {
+        // 0.05 N m steps about an offset, printed with six significant digits
+        let on: Vec<f64> = [3, 7, 8, 12, 20, 21, 5]
+            .iter()
+            .map(|&k| format!("{:.6}", 1.234 + 0.05 * k as f64).parse().unwrap())
+            .collect();
+        let step = grid_step(&on).unwrap();
+        assert!((step - 0.05).abs() < 1e-9, "{step}");
+        // levels 0.1 and 0.15 apart are on a grid of 0.05 (a torque held within each window
+        // reads one level there); -0 and 0 are one level
+        let few = [0.35, -0.25, -0.0, 0.1, -0.4, 0.5, 0.0];
+        assert!((grid_step(&few).unwrap() - 0.05).abs() < 1e-12);
+        // two levels are a grid of their difference; one is none
+        assert_eq!(grid_step(&[1.0, 1.5, 1.0]), Some(0.5));
+        assert_eq!(grid_step(&[2.0, 2.0]), None);
+        assert_eq!(grid_step(&[0.0, -0.0]), None);
+        // a continuous signal: neighbours' differences are no multiples of the smallest
+        let continuous: Vec<f64> = (0..200).map(|i| (i as f64 * 0.37).sin()).collect();
+        assert_eq!(grid_step(&continuous), None);
+        // non-finite values are left out
+        assert_eq!(grid_step(&[0.0, f64::NAN, 0.25, 1.0]), Some(0.25));
+    }
+
+    #[test]
+    fn dithering_is_noise_of_half_a_step() {
+        let q: f64 = 0.05;
+        // rounding alone (scatter q^2 / 12) is not dithered; noise of q / 2 (with the
+        // rounding: q^2 / 4 + q^2 / 12 = q^2 / 3) is
+        assert!(undithered(q, q * q / 12.0));
+        assert!(!undithered(q, q * q / 3.0));
+        assert!((rounding_stderr(q) - q / 12f64.sqrt()).abs() < 1e-15);
+    }
+}
