@@ -21,17 +21,17 @@ use crate::regression::LeastSquares;
 
 /// The fewest distinct values a window's samples must take for their spacing to say anything
 /// about a grid beyond "two levels" (two levels are a grid of their difference).
-const MIN_LEVELS: usize = 2;
+pub const MIN_LEVELS: usize = 2;
 
 /// Tolerance of "a whole multiple of the step", in steps: a value logged with a few
 /// significant digits is still on its grid, and a continuous signal's differences (whose
 /// ratios to the smallest are anything) pass it at a few of its many gaps, never at all.
-const ON_GRID: f64 = 0.01;
+pub const ON_GRID: f64 = 0.01;
 
 /// The most steps of a grid the smallest difference between the values read may span: a
 /// torque held within each window reads few of its grid's levels, e.g. 0.1 and 0.15 N m apart
 /// on a grid of 0.05.
-const MAX_STEPS_IN_GAP: usize = 10;
+pub const MAX_STEPS_IN_GAP: usize = 10;
 
 /// The step of the uniform grid the finite `values` lie on: the largest `d / m` (`d` the
 /// smallest difference between two distinct values, `m` up to [`MAX_STEPS_IN_GAP`]) of which
