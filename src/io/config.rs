@@ -28,12 +28,32 @@ pub fn location(source: &str, text: &str, offset: usize) -> String {
 /// Parses TOML `text` (from `source`, for messages) into `T`; a syntax error, a missing or
 /// unknown key or a value of the wrong type names the line and column.
 pub fn parse_toml<T: DeserializeOwned>(source: &str, text: &str) -> Result<T> {
-    toml::from_str(text).map_err(|e| Error::Config {
-        location: match e.span() {
-            Some(span) => location(source, text, span.start),
-            None => source.to_string(),
-        },
-        message: e.message().trim().to_string(),
+    toml::from_str(text).map_err(|e| {
+        let mut message = e.message().trim().to_string();
+        // the parser's "duplicate key" says where, not which: the key is the span's text
+        let span = e.span().unwrap_or(0..0);
+        let key = text.get(span.clone()).map(str::trim).unwrap_or("");
+        if message == "duplicate key" && !key.is_empty() && key.len() <= 200 && !key.contains('\n')
+        {
+            let quoted = if key.starts_with(['"', '\'']) {
+                key.to_string()
+            } else {
+                format!("'{key}'")
+            };
+            let table = text[..span.start].trim_end().ends_with('[');
+            message = if table {
+                format!("the table {quoted} is given twice; every table is given once")
+            } else {
+                format!("the key {quoted} is given twice in its table; every key is given once")
+            };
+        }
+        Error::Config {
+            location: match e.span() {
+                Some(span) => location(source, text, span.start),
+                None => source.to_string(),
+            },
+            message,
+        }
     })
 }
 
@@ -65,5 +85,16 @@ mod tests {
         let e = parse_toml::<Doc>("p.toml", "a = [\n").unwrap_err();
         assert!(e.to_string().starts_with("p.toml:"), "{e}");
         assert_eq!(line_col("ab\ncd", 4), (2, 2));
+        // a key given twice is named, as written
+        let e = parse_toml::<Doc>("p.toml", "a = 1.0\n\"a\" = 2.0\n").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "p.toml:2:1: the key \"a\" is given twice in its table; every key is given once"
+        );
+        let e = parse_toml::<Doc>("p.toml", "a = 1.0\n[b]\nx = 1\n[b]\n").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "p.toml:4:2: the table 'b' is given twice; every table is given once"
+        );
     }
 }
