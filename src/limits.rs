@@ -34,6 +34,11 @@ pub const MAX_DOCUMENT_BYTES: u64 = 256 << 20;
 /// A simulated sensor's noise: torque noise up to 10^6 N m (a slip of the exponent is an error,
 /// not a recording of noise).
 pub const MAX_TORQUE_NOISE: f64 = 1e6;
+/// A simulated joint's friction: levels up to 10^6 (N m, or N m s/rad for viscous friction),
+/// Stribeck speeds up to 10^6 rad/s, and the amplitudes of a true robot's position-dependent
+/// friction, cogging and ripple up to 10^6 (a slip of the exponent is an error, not a robot
+/// whose torques drown everything in friction).
+pub const MAX_FRICTION: f64 = 1e6;
 /// A simulated encoder's resolution, when it has one: 10^-12 to 1 (rad or m) a count (positions
 /// divided by a finer one leave f64's range; every position of a coarser one reads 0).
 pub const POSITION_RESOLUTION: (f64, f64) = (1e-12, 1.0);

@@ -94,6 +94,16 @@ impl Friction {
             ("friction stribeck_velocity", &self.stribeck_velocity),
         ] {
             crate::model::check_finite_vector(what, v, n)?;
+            if let Some(j) = v.iter().position(|x| x.abs() > crate::limits::MAX_FRICTION) {
+                return Err(Error::InvalidArgument {
+                    argument: format!("{what}[{j}]"),
+                    message: format!(
+                        "{}; expected at most {} in magnitude (docs/limits.md)",
+                        crate::error::shown(v[j]),
+                        crate::error::shown(crate::limits::MAX_FRICTION)
+                    ),
+                });
+            }
             if what != "friction viscous" {
                 if let Some(j) = v.iter().position(|&x| x < 0.0) {
                     return Err(Error::InvalidArgument {

@@ -338,6 +338,32 @@ fn bad_true_robot_documents_are_refused_by_name() {
         .to_string();
         assert!(e.contains(says), "{sensors}: {e}");
     }
+    // friction past any joint's (1e300 N m drowns every torque) and offsets past half a turn
+    for (body, says) in [
+        (
+            r#""friction": {"coulomb": [0.1, 1e300]}"#,
+            "friction.coulomb[1] is 1e300, expected at most 1000000 in magnitude",
+        ),
+        (
+            r#""friction": {"viscous": [-2e6]}"#,
+            "friction.viscous[0] is -2000000, expected at most 1000000 in magnitude",
+        ),
+        (
+            r#""joint_offsets": [0.0, 4.0]"#,
+            "joint_offsets[1] is 4, expected at most pi (rad or m) in magnitude",
+        ),
+        (
+            r#""cogging": [[{"order": 2, "amplitude": 1e7}]]"#,
+            "cogging[0][0]: order 2 (expected in (0, 1e5]), amplitude 10000000 (expected at most 1e6 in magnitude)",
+        ),
+    ] {
+        let e = TrueRobot::from_json(&format!(
+            r#"{{"format": "perturbid-true-robot/1", {body}}}"#
+        ))
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains(says), "{body}: {e}");
+    }
     let short = doc(r#"{"format": "perturbid-true-robot/1", "friction": {"viscous": [0.1, 0.2]}}"#);
     let e = rehearse(&model, &short, &reference(6, 0.1, 100.0), 0, "x")
         .unwrap_err()

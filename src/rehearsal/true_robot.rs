@@ -250,6 +250,41 @@ impl Document for TrueRobot {
                 }
             }
         }
+        // friction and joint offsets within what a robot can have (docs/limits.md)
+        use std::f64::consts::PI;
+        for (what, v, max) in [
+            ("friction.viscous", &f.viscous, crate::limits::MAX_FRICTION),
+            ("friction.coulomb", &f.coulomb, crate::limits::MAX_FRICTION),
+            (
+                "friction.coulomb_negative",
+                &f.coulomb_negative,
+                crate::limits::MAX_FRICTION,
+            ),
+            (
+                "friction.stribeck",
+                &f.stribeck,
+                crate::limits::MAX_FRICTION,
+            ),
+            (
+                "friction.stribeck_velocity",
+                &f.stribeck_velocity,
+                crate::limits::MAX_FRICTION,
+            ),
+            ("joint_offsets", &self.joint_offsets, PI),
+        ] {
+            let values = v.as_deref().unwrap_or_default();
+            if let Some(i) = values.iter().position(|x| x.abs() > max) {
+                return Err(bad(format!(
+                    "{what}[{i}] is {}, expected at most {} in magnitude",
+                    crate::error::shown(values[i]),
+                    if max == PI {
+                        "pi (rad or m)".to_string()
+                    } else {
+                        crate::error::shown(max)
+                    }
+                )));
+            }
+        }
         // the simulated sensors' ranges (docs/limits.md): an encoder of 0 counts (none) or a
         // step of 1e-12 to 1 rad; a torque resolution of 0 (none) or 1e-12 to 1e6 N m
         use crate::limits::{MAX_TORQUE_NOISE, POSITION_RESOLUTION, TORQUE_RESOLUTION};
@@ -312,10 +347,11 @@ impl Document for TrueRobot {
                         && x.order > 0.0
                         && x.order <= 1e5
                         && x.amplitude.is_finite()
+                        && x.amplitude.abs() <= crate::limits::MAX_FRICTION
                         && x.phase.is_finite())
                     {
                         return Err(bad(format!(
-                            "{what}[{j}][{k}]: order {} (expected in (0, 1e5]), amplitude {}, phase {} must be finite",
+                            "{what}[{j}][{k}]: order {} (expected in (0, 1e5]), amplitude {} (expected at most 1e6 in magnitude), phase {} must be finite",
                             x.order, x.amplitude, x.phase
                         )));
                     }

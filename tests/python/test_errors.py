@@ -273,3 +273,10 @@ def test_the_friction_regressor_is_made_a_block_at_a_time(robot):
     out = np.empty_like(full)
     assert robot.regressor(q, qd, qdd, friction="viscous,coulomb", out=out) is out
     np.testing.assert_array_equal(out, full)
+
+
+def test_simulated_friction_is_bounded(robot):
+    op = pr.OperatingPoint([0.1] * 6, [0.1] * 6, [0.0] * 6)
+    plan = pr.plan_experiments(robot, op, experiments=["nominal"])
+    with pytest.raises(pr.InputError, match=r"friction coulomb\[2\]: 1e300; expected at most 1000000 in magnitude"):
+        pr.simulate(robot, plan, friction={"coulomb": [0.1, 0.1, 1e300, 0.1, 0.1, 0.1]})
