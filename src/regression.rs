@@ -70,17 +70,7 @@ pub fn least_squares(
             message: format!("non-finite value in the least-squares data (entry {i})"),
         });
     }
-    // column norms scaled by the column's largest magnitude (1e-200 squares to 0, 1e200 to inf)
-    let scale: Vec<f64> = (0..p)
-        .map(|j| {
-            let a = x.column(j).amax();
-            if a > 0.0 {
-                a * (x.column(j) / a).norm()
-            } else {
-                0.0
-            }
-        })
-        .collect();
+    let scale = column_norms(x);
     if let Some(j) = scale.iter().position(|&s| s == 0.0) {
         return Err(Error::RankDeficient {
             context: context.into(),
@@ -222,7 +212,20 @@ pub fn scaled_singular_values(x: &DMatrix<f64>) -> Option<Vec<f64>> {
     if k < p || p == 0 || x.iter().any(|v| !v.is_finite()) {
         return None;
     }
-    let norms: Vec<f64> = (0..p)
+    let norms = column_norms(x);
+    if norms.contains(&0.0) {
+        return None;
+    }
+    let xs = Mat::<f64>::from_fn(k, p, |i, j| x[(i, j)] / norms[j]);
+    let mut s: Vec<f64> = xs.singular_values().ok()?;
+    s.sort_by(|a, b| b.total_cmp(a));
+    Some(s)
+}
+
+/// The 2-norm of every column of `x` (0 for a column of zeros), each computed on the column
+/// divided by its largest magnitude: 1e-200 would square to 0 and 1e200 to inf.
+fn column_norms(x: &DMatrix<f64>) -> Vec<f64> {
+    (0..x.ncols())
         .map(|j| {
             let a = x.column(j).amax();
             if a > 0.0 {
@@ -231,14 +234,7 @@ pub fn scaled_singular_values(x: &DMatrix<f64>) -> Option<Vec<f64>> {
                 0.0
             }
         })
-        .collect();
-    if norms.contains(&0.0) {
-        return None;
-    }
-    let xs = Mat::<f64>::from_fn(k, p, |i, j| x[(i, j)] / norms[j]);
-    let mut s: Vec<f64> = xs.singular_values().ok()?;
-    s.sort_by(|a, b| b.total_cmp(a));
-    Some(s)
+        .collect()
 }
 
 fn describe_direction(d: &[f64], columns: &[String]) -> String {
