@@ -93,33 +93,40 @@ pub struct ExperimentValues {
     pub torque_step: Vec<Option<f64>>,
 }
 
+/// Per joint, the torque samples (N m) of `rec` in the windows `[tc - half, tc + half]`, one
+/// per centre `tc` (the recording's clock), window after window.
+pub fn window_torques(rec: &Recording, centres: &[f64], half: f64) -> Vec<Vec<f64>> {
+    let n = rec.n;
+    let mut columns: Vec<Vec<f64>> = vec![vec![]; n];
+    for &tc in centres {
+        let lo = rec.t.partition_point(|&t| t < tc - half);
+        let hi = rec.t.partition_point(|&t| t <= tc + half);
+        for i in lo..hi {
+            for (j, column) in columns.iter_mut().enumerate() {
+                column.push(rec.tau[i * n + j]);
+            }
+        }
+    }
+    columns
+}
+
 /// Per joint, `Some(value)` when every torque sample of `rec` in the windows `[tc - half, tc +
 /// half]` (one per centre `tc`) has the same value (0 and -0 are one): a torque signal that did not
 /// change where the experiment was read (a dead or saturated channel, or a resolution coarser
 /// than the perturbations' effect). `None` where any sample differs or no window holds a
 /// sample.
 pub fn flat_torques(rec: &Recording, centres: &[f64], half: f64) -> Vec<Option<f64>> {
-    let n = rec.n;
-    let mut first: Vec<Option<f64>> = vec![None; n];
-    let mut flat = vec![true; n];
-    for &tc in centres {
-        let lo = rec.t.partition_point(|&t| t < tc - half);
-        let hi = rec.t.partition_point(|&t| t <= tc + half);
-        for i in lo..hi {
-            for j in 0..n {
-                let v = rec.tau[i * n + j];
-                match first[j] {
-                    None => first[j] = Some(v),
-                    Some(f) if f != v => flat[j] = false, // -0 reads as 0
-                    Some(_) => {}
-                }
-            }
-        }
-    }
-    first
-        .into_iter()
-        .zip(flat)
-        .map(|(f, flat)| f.filter(|_| flat))
+    flat(&window_torques(rec, centres, half))
+}
+
+/// [`flat_torques`] of the window samples `columns` ([`window_torques`]).
+fn flat(columns: &[Vec<f64>]) -> Vec<Option<f64>> {
+    columns
+        .iter()
+        .map(|c| {
+            let first = *c.first()?;
+            c.iter().all(|&v| v == first).then_some(first) // -0 reads as 0
+        })
         .collect()
 }
 
@@ -284,14 +291,15 @@ pub fn experiment_values(
         .chain(&experiment.reference)
         .map(|c| c.time + offset)
         .collect();
+    let torques = window_torques(rec, &centres, half);
     Ok(ExperimentValues {
         kind: experiment.kind,
         offset,
         crossings,
         reference,
         reversals,
-        flat_torque: flat_torques(rec, &centres, half),
-        torque_step: quantisation::torque_steps(rec, &centres, half),
+        flat_torque: flat(&torques),
+        torque_step: quantisation::torque_steps(&torques),
     })
 }
 

@@ -16,7 +16,6 @@
 //! every crossing, and a warning.
 
 use super::diagnostics::TorqueNoise;
-use crate::recording::Recording;
 use crate::regression::LeastSquares;
 
 /// The fewest distinct values a window's samples must take for their spacing to say anything
@@ -60,21 +59,10 @@ pub fn grid_step(values: &[f64]) -> Option<f64> {
         })
 }
 
-/// Per joint, the grid step (N m) of the torque samples of `rec` in the windows `[tc - half, tc
-/// + half]` (one per centre `tc`, the recording's clock), see [`grid_step`]; None where they lie
-/// on no grid or take fewer than two values (a flat channel: [`super::identify::flat_torques`]).
-pub fn torque_steps(rec: &Recording, centres: &[f64], half: f64) -> Vec<Option<f64>> {
-    let n = rec.n;
-    let mut columns: Vec<Vec<f64>> = vec![vec![]; n];
-    for &tc in centres {
-        let lo = rec.t.partition_point(|&t| t < tc - half);
-        let hi = rec.t.partition_point(|&t| t <= tc + half);
-        for i in lo..hi {
-            for (j, column) in columns.iter_mut().enumerate() {
-                column.push(rec.tau[i * n + j]);
-            }
-        }
-    }
+/// Per joint, the grid step (N m) of the torque samples an experiment read in its windows
+/// (`columns`, [`super::identify::window_torques`]), see [`grid_step`]; None where they lie on
+/// no grid or take fewer than two values (a flat channel: [`super::identify::flat_torques`]).
+pub fn torque_steps(columns: &[Vec<f64>]) -> Vec<Option<f64>> {
     columns.iter().map(|c| grid_step(c)).collect()
 }
 
