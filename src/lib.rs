@@ -14,6 +14,7 @@
 #![allow(clippy::result_large_err)]
 
 pub mod algorithms;
+pub mod band_fit;
 mod choice;
 #[cfg(feature = "cli")]
 pub mod cli;

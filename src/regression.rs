@@ -224,7 +224,7 @@ pub fn scaled_singular_values(x: &DMatrix<f64>) -> Option<Vec<f64>> {
 
 /// The 2-norm of every column of `x` (0 for a column of zeros), each computed on the column
 /// divided by its largest magnitude: 1e-200 would square to 0 and 1e200 to inf.
-fn column_norms(x: &DMatrix<f64>) -> Vec<f64> {
+pub(crate) fn column_norms(x: &DMatrix<f64>) -> Vec<f64> {
     (0..x.ncols())
         .map(|j| {
             let a = x.column(j).amax();

@@ -337,7 +337,8 @@ class LocalModel:
         torques that read one value throughout), noise (list of dicts: experiment, joint,
         samples (N m, one torque sample's noise), passes (N m, what varied from pass to pass
         beyond it, or None), step (N m, the step the torque was logged in where it is coarser
-        than its noise, or None)), warnings."""
+        than its noise, or None), position_step (rad, the encoder step of positions read by
+        the band of half a count about them, or None)), warnings."""
     def linearize(self, op: OperatingPoint) -> dict[str, Any]:
         """torque (n,), D, H, G (n, n) and G_static (n, n) or None at op."""
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:

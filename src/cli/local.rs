@@ -502,7 +502,7 @@ fn fmt_noise(out: &mut String, noise: &[crate::local::TorqueNoise], joints: &[St
     }
     let _ = writeln!(
         out,
-        "torque noise (N m; one sample's / what varied from pass to pass beyond it; the steps of a torque logged coarser than its noise):"
+        "torque noise (N m; one sample's / what varied from pass to pass beyond it; the steps of a torque logged coarser than its noise; the encoder steps of positions read by their band):"
     );
     let mut experiments: Vec<&str> = noise.iter().map(|e| e.experiment.as_str()).collect();
     experiments.dedup();
@@ -518,7 +518,10 @@ fn fmt_noise(out: &mut String, noise: &[crate::local::TorqueNoise], joints: &[St
                         let step = e
                             .step
                             .map_or(String::new(), |q| format!(" (steps {q:.1e})"));
-                        format!("{:.1e} / {passes}{step}", e.samples)
+                        let encoder = e
+                            .position_step
+                            .map_or(String::new(), |q| format!(" (encoder {q:.1e} rad)"));
+                        format!("{:.1e} / {passes}{step}{encoder}", e.samples)
                     })
             })
             .collect();

@@ -5,6 +5,7 @@
 use nalgebra::DMatrix;
 
 use super::plan::Experiment;
+use super::rounded_positions::band_state;
 use crate::error::{Error, Result};
 use crate::recording::Recording;
 use crate::trajectory::Trajectory;
@@ -31,6 +32,10 @@ pub struct CrossingValues {
     /// residuals (N^2 m^2) and its degrees of freedom. Pooled over an experiment's crossings
     /// it estimates the torque samples' noise level.
     pub tau_scatter: Vec<(f64, usize)>,
+    /// Per joint, whether `q`, `qd`, `qdd` and their standard errors were read from positions
+    /// rounded to encoder counts by the band of half a count about them
+    /// ([`super::rounded_positions`]) rather than by least squares.
+    pub position_band: Vec<bool>,
 }
 
 /// How to read crossing values from a recording.
@@ -193,6 +198,7 @@ pub fn values_at(
         tc,
         half,
         &vec![TorqueFit::Window(half); rec.n],
+        &[],
         options,
         what,
     )
@@ -205,12 +211,17 @@ pub(crate) fn samples_needed(options: &FitOptions) -> usize {
 
 /// [`values_at`] with the torque of each joint read as `torque[j]` says (a narrower window, or
 /// a step at a velocity reversal; see [`TorqueFit`]); the positions are always fitted over
-/// `+-half`.
+/// `+-half`. `position_steps` (one per joint, or empty for none) gives the encoder step (rad)
+/// of each joint's positions where they lie on a grid
+/// ([`super::rounded_positions::position_steps`]): such a joint's state is read by the band of
+/// half a step where every reading of the window lies in it
+/// ([`super::rounded_positions::band_state`]), by least squares otherwise.
 pub fn values_at_with(
     rec: &Recording,
     tc: f64,
     half: f64,
     torque: &[TorqueFit],
+    position_steps: &[Option<f64>],
     options: &FitOptions,
     what: &str,
 ) -> Result<CrossingValues> {
@@ -220,6 +231,13 @@ pub fn values_at_with(
             argument: "torque fits".into(),
             expected: format!("{n} (one per joint)"),
             got: torque.len().to_string(),
+        });
+    }
+    if !(position_steps.is_empty() || position_steps.len() == n) {
+        return Err(Error::Shape {
+            argument: "position steps".into(),
+            expected: format!("{n} (one per joint) or none"),
+            got: position_steps.len().to_string(),
         });
     }
     let (first, last) = (rec.t[0], rec.t[rec.len() - 1]);
@@ -268,6 +286,7 @@ pub fn values_at_with(
         state_stderr: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
         tau_gain: vec![0.0; n],
         tau_scatter: vec![(0.0, 0); n],
+        position_band: vec![false; n],
     };
     // sum of squared weights per coefficient: the variance factor of each estimate
     let gain: Vec<f64> = (0..3)
@@ -296,6 +315,18 @@ pub fn values_at_with(
         out.state_stderr[0][j] = sigma * gain[0];
         out.state_stderr[1][j] = sigma * gain[1] / half;
         out.state_stderr[2][j] = 2.0 * sigma * gain[2] / (half * half);
+        if let Some(step) = position_steps.get(j).copied().flatten() {
+            let q: Vec<f64> = (0..count).map(|i| rec.q[(lo + i) * n + j]).collect();
+            if let Some(b) = band_state(t, &q, tc, half, step) {
+                out.q[j] = b.values[0];
+                out.qd[j] = b.values[1];
+                out.qdd[j] = b.values[2];
+                for (v, se) in b.stderr.iter().enumerate() {
+                    out.state_stderr[v][j] = *se;
+                }
+                out.position_band[j] = true;
+            }
+        }
         let reading = match *fit {
             TorqueFit::Window(h) if h >= half => read_torque(
                 rec,

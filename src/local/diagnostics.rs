@@ -88,6 +88,13 @@ pub struct TorqueNoise {
     /// include a rounding error of `step / sqrt(12)` at every crossing. `None` otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub step: Option<f64>,
+    /// The encoder step (rad) the joint's positions were logged in, where the state of at
+    /// least one of the experiment's crossings was read by the band of half a step about its
+    /// positions (rounding without noise; see [`super::rounded_positions`]): the standard errors
+    /// of every regression count the errors such positions give their regressors. `None`
+    /// otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position_step: Option<f64>,
 }
 
 /// Diagnostics of a local identification; see the module documentation.

@@ -108,6 +108,17 @@ pub(super) fn friction_aware_h(
             let sigma = std::f64::consts::SQRT_2 * super::quantisation::rounding_stderr(q);
             super::quantisation::floor_stderr(&mut ls, 0, sigma);
         }
+        // the measured velocity differences err by both passes' errors; the Coulomb step's
+        // column is exact
+        let row_var = DMatrix::from_fn(m, p, |i, c| {
+            if c < n {
+                v.crossings[2 * i].state_stderr[1][c].powi(2)
+                    + v.crossings[2 * i + 1].state_stderr[1][c].powi(2)
+            } else {
+                0.0
+            }
+        });
+        super::errors_in_variables::floor_stderr(&mut ls, &x, &row_var, &vec![0.0; p])?;
         noise.push(TorqueNoise {
             experiment: e.kind.name().to_string(),
             joint: plan.joint_names[j].clone(),
@@ -115,6 +126,7 @@ pub(super) fn friction_aware_h(
             // a pair's difference varies by twice one pass's variance
             passes: Some((0.5 * weighted.common[0]).sqrt()).filter(|p| p.is_finite()),
             step,
+            position_step: v.position_step[j],
         });
         for c in 0..n {
             matrix[(j, c)] = ls.coef[(0, c)];

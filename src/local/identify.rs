@@ -11,12 +11,14 @@ use super::diagnose::{
     compare_combined, diagnose, disagreement_warning, mass_matrix_warning, unperturbed_deviation,
 };
 use super::diagnostics::{Reversal, ReversalHandling, TorqueNoise, Unmeasured};
+use super::errors_in_variables;
 use super::friction_aware::friction_aware_h;
 use super::model::{Estimate, Estimator, LocalModel};
 use super::noise::{reading_variance, sample_variance, weighted_least_squares};
 use super::operating_point::OperatingPoint;
 use super::plan::{Experiment, ExperimentKind, Plan};
 use super::quantisation;
+use super::rounded_positions::{self, Resolution};
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::recording::Recording;
@@ -91,6 +93,10 @@ pub struct ExperimentValues {
     /// Per joint, the step (N m) of the grid the torque samples read for this experiment lie
     /// on, if any (see [`super::quantisation::torque_steps`]).
     pub torque_step: Vec<Option<f64>>,
+    /// Per joint, the encoder step (rad) of the recording's positions where the state of at
+    /// least one crossing (or the reference posture) was read by the band of half a step
+    /// ([`super::rounded_positions`]); None otherwise.
+    pub position_step: Vec<Option<f64>>,
 }
 
 /// Per joint, the torque samples (N m) of `rec` in the windows `[tc - half, tc + half]`, one
@@ -249,6 +255,7 @@ pub fn experiment_values(
     let min_half = 0.5 * samples_needed(&options.fit) as f64 * dt;
     let name = experiment.kind.name();
     let mut reversals = vec![];
+    let steps = rounded_positions::position_steps(rec);
     let mut read = |tp: f64, crossing: Option<usize>, what: String| {
         let fits = torque_fits(
             experiment,
@@ -260,7 +267,7 @@ pub fn experiment_values(
             crossing,
             &mut reversals,
         );
-        values_at_with(rec, tp + offset, half, &fits, &options.fit, &what)
+        values_at_with(rec, tp + offset, half, &fits, &steps, &options.fit, &what)
     };
     let crossings = experiment
         .crossings
@@ -292,6 +299,15 @@ pub fn experiment_values(
         .map(|c| c.time + offset)
         .collect();
     let torques = window_torques(rec, &centres, half);
+    let position_step = (0..rec.n)
+        .map(|j| {
+            let banded = crossings
+                .iter()
+                .chain(&reference)
+                .any(|c| c.position_band[j]);
+            steps[j].filter(|_| banded)
+        })
+        .collect();
     Ok(ExperimentValues {
         kind: experiment.kind,
         offset,
@@ -300,6 +316,7 @@ pub fn experiment_values(
         reversals,
         flat_torque: flat(&torques),
         torque_step: quantisation::torque_steps(&torques),
+        position_step,
     })
 }
 
@@ -504,8 +521,25 @@ pub fn identify_local(
         None => (vec![f64::NAN; n], vec![f64::NAN; n], plan.op.clone()),
     };
     let op_state = [op.q.clone(), op.qd.clone(), op.qdd.clone()];
+    // the variance of the operating point's error: the nominal passes follow one trajectory,
+    // so their reading errors need not average out (the mean of their variances, not / K)
+    let op_var: [Vec<f64>; 3] = std::array::from_fn(|var| {
+        (0..n)
+            .map(|j| {
+                nominal.map_or(0.0, |v| {
+                    let k = v.crossings.len().max(1) as f64;
+                    v.crossings
+                        .iter()
+                        .map(|c| c.state_stderr[var][j].powi(2))
+                        .sum::<f64>()
+                        / k
+                })
+            })
+            .collect()
+    });
 
     let noise = std::cell::RefCell::new(vec![]);
+    let resolution_warnings = std::cell::RefCell::new(vec![]);
     let separated = |kind: ExperimentKind, prefix: &str| -> Result<Option<Estimate>> {
         let Some(v) = find(kind) else { return Ok(None) };
         let var = kind.perturbed().expect("perturbed experiment");
@@ -513,6 +547,10 @@ pub fn identify_local(
         let (base_tau, base_x): (&[f64], &[f64]) = match &v.reference {
             Some(r) => (&r.tau, &r.q),
             None => (&torque, &op_state[var]),
+        };
+        let base_var: Vec<f64> = match &v.reference {
+            Some(r) => r.state_stderr[0].iter().map(|s| s * s).collect(),
+            None => op_var[var].clone(),
         };
         let x = DMatrix::from_fn(k, n, |i, j| state(&v.crossings[i], var)[j] - base_x[j]);
         let y = DMatrix::from_fn(k, n, |i, j| v.crossings[i].tau[j] - base_tau[j]);
@@ -525,6 +563,22 @@ pub fn identify_local(
             &names(prefix),
         )?;
         let mut fit = weighted.fit;
+        let row_var = DMatrix::from_fn(k, n, |i, j| v.crossings[i].state_stderr[var][j].powi(2));
+        errors_in_variables::floor_stderr(&mut fit, &x, &row_var, &base_var)?;
+        let resolutions: Vec<Resolution> = (0..n)
+            .filter_map(|j| {
+                let se: Vec<f64> = v.crossings.iter().map(|c| c.state_stderr[var][j]).collect();
+                let dx: Vec<f64> = x.column(j).iter().copied().collect();
+                Resolution::of(&plan.joint_names[j], v.position_step[j]?, &se, &dx)
+            })
+            .collect();
+        resolution_warnings
+            .borrow_mut()
+            .extend(rounded_positions::resolution_warning(
+                kind.name(),
+                var,
+                &resolutions,
+            ));
         for (j, ((joint, s2), a)) in plan
             .joint_names
             .iter()
@@ -542,6 +596,7 @@ pub fn identify_local(
                 samples: s2.sqrt(),
                 passes: Some(a.sqrt()).filter(|v| v.is_finite()),
                 step,
+                position_step: v.position_step[j],
             });
         }
         Ok(Some(estimate(fit)))
@@ -583,6 +638,11 @@ pub fn identify_local(
         let mut fit =
             weighted_least_squares(&x, &y, &u, "combined estimate (nominal, G, H, D)", &columns)?
                 .fit;
+        let row_var = DMatrix::from_fn(rows.len(), 3 * n, |i, c| {
+            rows[i].state_stderr[2 - c / n][c % n].powi(2)
+        });
+        let base_var: Vec<f64> = (0..3 * n).map(|c| op_var[2 - c / n][c % n]).collect();
+        errors_in_variables::floor_stderr(&mut fit, &x, &row_var, &base_var)?;
         for j in 0..n {
             // the coarsest step any of the stacked experiments read this torque in, undithered
             let step = (stacked.iter().zip(&samples))
@@ -680,6 +740,9 @@ pub fn identify_local(
     // in the plan's order of experiments
     noise.sort_by_key(|e| values.iter().position(|v| v.kind.name() == e.experiment));
     diagnostics.warnings.extend(quantisation::warnings(&noise));
+    diagnostics
+        .warnings
+        .extend(resolution_warnings.into_inner());
     diagnostics.noise = noise;
     diagnostics.combined = disagreement;
     diagnostics.unperturbed_deviation = deviation;

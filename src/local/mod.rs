@@ -33,6 +33,7 @@
 pub mod crossing;
 mod diagnose;
 pub mod diagnostics;
+pub mod errors_in_variables;
 mod friction_aware;
 pub mod identify;
 pub mod model;
@@ -43,6 +44,7 @@ pub mod perturbation;
 pub mod plan;
 pub mod point_design;
 pub mod quantisation;
+pub mod rounded_positions;
 
 pub use crossing::{values_at, values_at_with, CrossingValues, FitOptions, TorqueFit};
 pub use diagnostics::{

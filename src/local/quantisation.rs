@@ -32,11 +32,19 @@ pub const ON_GRID: f64 = 0.01;
 /// on a grid of 0.05.
 pub const MAX_STEPS_IN_GAP: usize = 10;
 
+/// The smallest grid step [`grid_step`] reports, relative to the largest magnitude of the
+/// values: every f64 in `[0.5, 1)` is a whole multiple of 2^-53, so a signal that is
+/// continuous but for a few values one rounding error apart would otherwise be "on a grid" of
+/// that rounding error. Encoders of 2^24 counts a revolution (3.7e-7 rad) and torques logged in
+/// 1e-4 N m steps about 100 N m (1e-6) stay far above it.
+pub const MIN_RELATIVE_STEP: f64 = 1e-9;
+
 /// The step of the uniform grid the finite `values` lie on: the largest `d / m` (`d` the
 /// smallest difference between two distinct values, `m` up to [`MAX_STEPS_IN_GAP`]) of which
 /// every difference between neighbouring distinct values is a whole multiple (to [`ON_GRID`]
-/// of a step). None for fewer than two distinct values, or values off any such grid (a
-/// continuous signal: its neighbours' differences are no multiples of a common step).
+/// of a step), and at least [`MIN_RELATIVE_STEP`] of the largest magnitude. None for fewer than
+/// two distinct values, or values off any such grid (a continuous signal: its neighbours'
+/// differences are no multiples of a common step above its rounding errors).
 pub fn grid_step(values: &[f64]) -> Option<f64> {
     let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
     v.sort_by(f64::total_cmp);
@@ -46,11 +54,14 @@ pub fn grid_step(values: &[f64]) -> Option<f64> {
     }
     let gaps: Vec<f64> = v.windows(2).map(|w| w[1] - w[0]).collect();
     let smallest = gaps.iter().copied().fold(f64::INFINITY, f64::min);
+    let largest = v[0].abs().max(v[v.len() - 1].abs());
     if !(smallest > 0.0 && smallest.is_finite()) {
         return None;
     }
+    let floor = MIN_RELATIVE_STEP * largest;
     (1..=MAX_STEPS_IN_GAP)
         .map(|m| smallest / m as f64)
+        .take_while(|&step| step >= floor)
         .find(|&step| {
             gaps.iter().all(|&g| {
                 let m = g / step;
@@ -160,6 +171,11 @@ mod tests {
         assert_eq!(grid_step(&continuous), None);
         // non-finite values are left out
         assert_eq!(grid_step(&[0.0, f64::NAN, 0.25, 1.0]), Some(0.25));
+        // a continuous signal whose values at rest differ by a rounding error: every f64 in
+        // [0.5, 1) is a multiple of 2^-53, which is no grid
+        let mut rest: Vec<f64> = continuous.iter().map(|v| 0.75 + 0.2 * v).collect();
+        rest.extend([0.78, 0.78 + f64::EPSILON / 2.0, 0.78 + f64::EPSILON]);
+        assert_eq!(grid_step(&rest), None);
     }
 
     #[test]

@@ -493,6 +493,7 @@ impl PyLocalModel {
                 entry.set_item("samples", e.samples)?;
                 entry.set_item("passes", e.passes)?;
                 entry.set_item("step", e.step)?;
+                entry.set_item("position_step", e.position_step)?;
                 Ok(entry)
             })
             .collect::<PyResult<Vec<_>>>()?;
