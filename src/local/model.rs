@@ -209,12 +209,16 @@ impl Document for LocalModel {
             if let Some(p) = e.passes {
                 check_magnitude(Self::WHAT, &format!("{what}.passes"), p, false)?;
             }
-            if let Some(q) = e.step {
-                check_magnitude(Self::WHAT, &format!("{what}.step"), q, false)?;
+            for (field, step, unit) in [
+                ("step", e.step, "N m"),
+                ("position_step", e.position_step, "rad"),
+            ] {
+                let Some(q) = step else { continue };
+                check_magnitude(Self::WHAT, &format!("{what}.{field}"), q, false)?;
                 if q == 0.0 {
                     return Err(invalid(
                         Self::WHAT,
-                        format!("{what}.step is 0; expected a positive step (N m) or null"),
+                        format!("{what}.{field} is 0; expected a positive step ({unit}) or null"),
                     ));
                 }
             }

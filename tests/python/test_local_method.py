@@ -309,6 +309,7 @@ def test_the_torque_noise_is_reported_per_experiment_and_joint():
         assert abs(e["samples"] / levels[j] - 1) < 0.15, e
         assert e["passes"] is not None and e["passes"] >= 0
         assert e["step"] is None  # noise alone is no grid of steps
+        assert e["position_step"] is None  # nor are continuous positions
     # what varies from pass to pass in H beyond the samples' noise: the velocity-squared terms
     # the +- pairs cancel from H* (several mN m at this point), far above D's
     passes = {(e["experiment"], e["joint"]): e["passes"] for e in noise}
@@ -330,6 +331,33 @@ def test_the_torque_noise_is_reported_per_experiment_and_joint():
         doc["diagnostics"]["noise"][0][entry] = value
         with pytest.raises(pr.InputError, match=f"diagnostics name .*'{value}'"):
             pr.LocalModel.from_json(json.dumps(doc))
+
+
+def test_positions_in_coarse_encoder_counts_are_read_by_their_band():
+    # 4,096 counts a revolution: the crossings' states are read by the band of half a count,
+    # the step is reported per experiment and joint, the joints whose perturbations the
+    # encoder cannot resolve are warned about, and D* stays within its standard errors
+    robot = pr.robots.a465()
+    op = pr.OperatingPoint(*TABLE2)
+    plan = pr.plan_experiments(robot, op, design="orthogonal")
+    truth = robot.linearize(*TABLE2)
+    tr = pr.TrueRobot({"sensors": {"encoder_counts": [4096] * 6, "torque_noise": [0.01] * 6}, "seed": 5})
+    with pytest.warns(pr.PerturbidWarning, match=r"experiment 'D': the encoders of joint\(s\) .*'joint3' \(steps of 1.53e-3 rad: accelerations known to"):
+        model = pr.identify_local(plan, pr.simulate(robot, plan, true_robot=tr))
+    steps = [e["position_step"] for e in model.diagnostics["noise"]]
+    assert len(steps) == 24 and all(abs(s / (2 * np.pi / 4096) - 1) < 1e-6 for s in steps)
+    z = np.abs(model.D - truth.D) / model.stderr["D"]
+    assert z.max() < 4, z
+    # saved with the model; a hand-edited step of 0 or a string is refused by name
+    back = pr.LocalModel.from_json(model.to_json())
+    assert back.diagnostics["noise"] == model.diagnostics["noise"]
+    doc = json.loads(model.to_json())
+    doc["diagnostics"]["noise"][3]["position_step"] = 0.0
+    with pytest.raises(pr.InputError, match=r"diagnostics.noise\[3\].position_step is 0; expected a positive step \(rad\)"):
+        pr.LocalModel.from_json(json.dumps(doc))
+    doc["diagnostics"]["noise"][3]["position_step"] = "fine"
+    with pytest.raises(pr.InputError, match="position_step"):
+        pr.LocalModel.from_json(json.dumps(doc))
 
 
 def test_a_poorly_conditioned_design_is_reported_and_warned_about():
