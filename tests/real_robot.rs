@@ -609,6 +609,14 @@ fn positions_in_coarse_encoder_counts_get_standard_errors_that_cover_them() {
             "{c} counts: a D* entry erred by {bias:.2} standard errors on average"
         );
     }
+    // 1,024 counts: joint 6 reads one level in every window of the D experiment, so its
+    // measured acceleration perturbations are all zero; the error says why
+    let recordings = rehearse_plan(&model, &robot(100, &counts(1024)), &plan).unwrap();
+    let e = identify_local(&plan, &recordings, &IdentifyOptions::default()).unwrap_err();
+    assert!(
+        e.to_string().contains("not excited: dqdd(joint6) (the column is all zeros: the encoder of joint 'joint6', in steps of 6.14e-3 rad, reads the same acceleration at every crossing"),
+        "{e}"
+    );
     // continuous positions: no grid, no band
     let m = identify(&robot(100, ""));
     assert!(m

@@ -44,12 +44,14 @@ pub(super) fn compare_combined(
 }
 
 /// How far the variables an experiment did not perturb stray from the operating point at the
-/// crossings of nominal, G, H and D, in standard errors of their measurement (RMS over
-/// crossings, joints and variables): about 1 when the deviations are measurement noise, far
-/// above when the robot did not follow its plan (tracking errors). `None` without such values.
+/// crossings of nominal, G, H and D, in standard errors of their measurement (the crossing's
+/// and the operating point's, `op_var` its variances; RMS over crossings, joints and
+/// variables): about 1 when the deviations are measurement noise, far above when the robot did
+/// not follow its plan (tracking errors). `None` without such values.
 pub(super) fn unperturbed_deviation(
     values: &[ExperimentValues],
     op_state: &[Vec<f64>; 3],
+    op_var: &[Vec<f64>; 3],
 ) -> Option<f64> {
     let (mut ss, mut count) = (0.0, 0usize);
     for v in values.iter().filter(|v| v.kind != ExperimentKind::GStatic) {
@@ -57,7 +59,8 @@ pub(super) fn unperturbed_deviation(
         for c in &v.crossings {
             for var in (0..3).filter(|&var| Some(var) != perturbed) {
                 for (j, x) in state(c, var).iter().enumerate() {
-                    let se = c.state_stderr[var][j];
+                    // the crossing's error and the operating point's
+                    let se = (c.state_stderr[var][j].powi(2) + op_var[var][j]).sqrt();
                     let dev = x - op_state[var][j];
                     // a floor against noise-free data, where both are rounding errors
                     let se = se.max(1e-9 * (x.abs() + 1e-3));

@@ -521,18 +521,25 @@ pub fn identify_local(
         None => (vec![f64::NAN; n], vec![f64::NAN; n], plan.op.clone()),
     };
     let op_state = [op.q.clone(), op.qd.clone(), op.qdd.clone()];
-    // the variance of the operating point's error: the nominal passes follow one trajectory,
-    // so their reading errors need not average out (the mean of their variances, not / K)
+    // the variance of the operating point's error, the mean of the nominal crossings': noise
+    // averages over their K passes (/ K), but positions read by their band are rounded the same
+    // way in every pass of one trajectory, and need not average out
     let op_var: [Vec<f64>; 3] = std::array::from_fn(|var| {
         (0..n)
             .map(|j| {
                 nominal.map_or(0.0, |v| {
                     let k = v.crossings.len().max(1) as f64;
-                    v.crossings
+                    let mean = v
+                        .crossings
                         .iter()
                         .map(|c| c.state_stderr[var][j].powi(2))
                         .sum::<f64>()
-                        / k
+                        / k;
+                    if v.crossings.iter().any(|c| c.position_band[j]) {
+                        mean
+                    } else {
+                        mean / k
+                    }
                 })
             })
             .collect()
@@ -553,6 +560,24 @@ pub fn identify_local(
             None => op_var[var].clone(),
         };
         let x = DMatrix::from_fn(k, n, |i, j| state(&v.crossings[i], var)[j] - base_x[j]);
+        if let Some(j) = (0..n).find(|&j| x.column(j).iter().all(|d| *d == 0.0)) {
+            if let Some(step) = v.position_step[j] {
+                return Err(Error::RankDeficient {
+                    context: format!("experiment '{}'", kind.name()),
+                    rows: k,
+                    cols: n,
+                    rank: n - 1,
+                    missing: format!(
+                        "{}({}) (the column is all zeros: the encoder of joint '{}', in steps of {:.2e} rad, reads the same {} at every crossing and at the operating point, resolving none of the perturbations; perturb more, widen the crossing window or log the positions more finely)",
+                        prefix,
+                        plan.joint_names[j],
+                        plan.joint_names[j],
+                        step,
+                        ["position", "velocity", "acceleration"][var]
+                    ),
+                });
+            }
+        }
         let y = DMatrix::from_fn(k, n, |i, j| v.crossings[i].tau[j] - base_tau[j]);
         let (u, samples) = reading_variances(&[v], n);
         let weighted = weighted_least_squares(
@@ -724,7 +749,7 @@ pub fn identify_local(
         }
     };
     let mut diagnostics = diagnose(&values);
-    let deviation = unperturbed_deviation(&values, &op_state);
+    let deviation = unperturbed_deviation(&values, &op_state, &op_var);
     if let Some(w) = disagreement_warning(&disagreement, options.estimator, deviation) {
         diagnostics.warnings.push(w);
     }
