@@ -21,6 +21,7 @@
 //! band (the primal is infeasible): noise beyond the rounding, or motion that is no polynomial
 //! of the degree.
 
+#[cfg(test)]
 use nalgebra::{DMatrix, DVector};
 
 /// The most coefficients (`degree + 1`) [`coefficient_ranges`] takes.
@@ -61,11 +62,24 @@ pub fn coefficient_ranges(
     {
         return None;
     }
-    let start = initial_rows(u, m)?;
-    let rows = DMatrix::from_fn(m, n, |d, i| u[i].powi(d as i32));
-    (0..m)
+    match m {
+        1 => ranges::<1>(u, y, delta),
+        2 => ranges::<2>(u, y, delta),
+        3 => ranges::<3>(u, y, delta),
+        _ => ranges::<4>(u, y, delta),
+    }
+}
+
+/// [`coefficient_ranges`] for `M` coefficients, on checked inputs.
+fn ranges<const M: usize>(u: &[f64], y: &[f64], delta: f64) -> Option<Vec<[f64; 2]>> {
+    let start = initial_rows(u, M)?;
+    let rows: Vec<[f64; M]> = u
+        .iter()
+        .map(|&x| std::array::from_fn(|d| x.powi(d as i32)))
+        .collect();
+    (0..M)
         .map(|d| {
-            let mut c = DVector::zeros(m);
+            let mut c = [0.0; M];
             c[d] = 1.0;
             let highest = maximise(&rows, y, delta, &c, &start)?;
             c[d] = -1.0;
@@ -74,6 +88,39 @@ pub fn coefficient_ranges(
             Some([lowest.min(highest), highest.max(lowest)])
         })
         .collect()
+}
+
+fn dot<const M: usize>(a: &[f64; M], b: &[f64; M]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// Solves `a x = b` (`a[r][k]`: row r, column k) by Gaussian elimination with partial
+/// pivoting; None when `a` is singular to working precision.
+fn solve<const M: usize>(mut a: [[f64; M]; M], mut b: [f64; M]) -> Option<[f64; M]> {
+    let norm = a.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    for k in 0..M {
+        let pivot = (k..M).max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs()))?;
+        if a[pivot][k].abs() <= 1e-14 * norm || a[pivot][k].is_nan() {
+            return None;
+        }
+        a.swap(k, pivot);
+        b.swap(k, pivot);
+        let (top, below) = a.split_at_mut(k + 1);
+        let row_k = &top[k];
+        for (i, row) in below.iter_mut().enumerate() {
+            let f = row[k] / row_k[k];
+            for (x, r) in row.iter_mut().zip(row_k).skip(k) {
+                *x -= f * r;
+            }
+            b[k + 1 + i] -= f * b[k];
+        }
+    }
+    let mut x = [0.0; M];
+    for k in (0..M).rev() {
+        let s: f64 = (k + 1..M).map(|l| a[k][l] * x[l]).sum();
+        x[k] = (b[k] - s) / a[k][k];
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
 /// Indices of `m` readings at distinct abscissae spread over the range of `u` (a well
@@ -104,61 +151,65 @@ struct Column {
 }
 
 /// The maximum of `c . p` over the coefficients `p` whose polynomial stays within `delta` of
-/// every reading (`rows`: m x n, column i the monomials at `u_i`); None when there are none
-/// (the dual unbounded) or the simplex method does not settle.
-fn maximise(
-    rows: &DMatrix<f64>,
+/// every reading (`rows[i]` the monomials at `u_i`); None when there are none (the dual
+/// unbounded) or the simplex method does not settle within [`MAX_STEPS`].
+fn maximise<const M: usize>(
+    rows: &[[f64; M]],
     y: &[f64],
     delta: f64,
-    c: &DVector<f64>,
+    c: &[f64; M],
     start: &[usize],
 ) -> Option<f64> {
-    let (m, n) = rows.shape();
     let cost = |col: Column| delta + col.sign * y[col.reading];
-    let column = |col: Column| rows.column(col.reading) * col.sign;
+    // B (column k the basic column k: sign times the monomials of its reading) and B^T
+    let basis_matrix = |basis: &[Column; M]| -> [[f64; M]; M] {
+        std::array::from_fn(|r| std::array::from_fn(|k| basis[k].sign * rows[basis[k].reading][r]))
+    };
+    let transpose = |a: [[f64; M]; M]| -> [[f64; M]; M] {
+        std::array::from_fn(|r| std::array::from_fn(|k| a[k][r]))
+    };
     // a feasible start: c in the basis of the starting readings, each with the sign that makes
     // its weight non-negative
-    let a0 = DMatrix::from_fn(m, m, |r, k| rows[(r, start[k])]);
-    let w0 = a0.clone().lu().solve(c)?;
-    let mut basis: Vec<Column> = start
-        .iter()
-        .zip(w0.iter())
-        .map(|(&reading, &w)| Column {
-            reading,
-            sign: if w < 0.0 { -1.0 } else { 1.0 },
-        })
-        .collect();
+    let mut basis: [Column; M] = std::array::from_fn(|k| Column {
+        reading: start[k],
+        sign: 1.0,
+    });
+    let w0 = solve(basis_matrix(&basis), *c)?;
+    for (col, w) in basis.iter_mut().zip(w0) {
+        if w < 0.0 {
+            col.sign = -1.0;
+        }
+    }
     let scale = y.iter().fold(delta, |a, v| a.max(v.abs()));
+    let tolerance = TOLERANCE * scale;
     let mut stalled = 0usize;
     let mut previous = f64::INFINITY;
     for _ in 0..MAX_STEPS {
-        let b = DMatrix::from_fn(m, m, |r, k| column(basis[k])[r]);
-        let lu = b.clone().lu();
-        let x_b = lu.solve(c)?;
-        let cost_b = DVector::from_fn(m, |k, _| cost(basis[k]));
+        let b = basis_matrix(&basis);
+        let x_b = solve(b, *c)?;
+        let cost_b: [f64; M] = std::array::from_fn(|k| cost(basis[k]));
         // the dual's prices: the candidate polynomial's coefficients
-        let p = b.transpose().lu().solve(&cost_b)?;
-        let objective = cost_b.dot(&x_b);
-        if objective < previous - TOLERANCE * scale {
+        let p = solve(transpose(b), cost_b)?;
+        let objective = dot(&cost_b, &x_b);
+        if objective < previous - tolerance {
             stalled = 0;
         } else {
             stalled += 1;
         }
         previous = previous.min(objective);
         // the entering column: the most violated side of the band (Dantzig), or after a run
-        // of steps without progress the first violated one (Bland's rule: no cycling)
-        let bland = stalled > 2 * m;
+        // of steps without progress the first violated one (Bland's rule against cycling)
+        let bland = stalled > 2 * M;
         let mut entering: Option<(Column, f64)> = None;
-        for i in 0..n {
-            let value = rows.column(i).dot(&p);
-            for sign in [1.0, -1.0] {
-                let col = Column { reading: i, sign };
-                if basis.contains(&col) {
-                    continue;
-                }
-                let reduced = cost(col) - sign * value;
-                if reduced < -TOLERANCE * scale && entering.is_none_or(|(_, r)| reduced < r) {
-                    entering = Some((col, reduced));
+        for (i, row) in rows.iter().enumerate() {
+            // the candidate's residual: a reduced cost below 0 is a reading outside the band
+            let residual = dot(row, &p) - y[i];
+            for (sign, reduced) in [(1.0, delta - residual), (-1.0, delta + residual)] {
+                if reduced < -tolerance && entering.is_none_or(|(_, r)| reduced < r) {
+                    let col = Column { reading: i, sign };
+                    if !basis.contains(&col) {
+                        entering = Some((col, reduced));
+                    }
                 }
             }
             if bland && entering.is_some() {
@@ -168,8 +219,8 @@ fn maximise(
         let Some((col, _)) = entering else {
             return Some(objective);
         };
-        let direction = lu.solve(&column(col))?;
-        let leaving = (0..m)
+        let direction = solve(b, rows[col.reading].map(|v| col.sign * v))?;
+        let leaving = (0..M)
             .filter(|&k| direction[k] > TOLERANCE)
             .min_by(|&a, &b| {
                 (x_b[a].max(0.0) / direction[a]).total_cmp(&(x_b[b].max(0.0) / direction[b]))
