@@ -526,6 +526,25 @@ fn torques_rounded_without_dithering_get_standard_errors_that_cover_the_rounding
         );
     }
     assert!(worst < 4.0, "D* erred by {worst:.1} standard errors");
+    // at rest joints 1, 4 and 6 read exactly 0 in every sample (a vertical axis, no gravity
+    // load): one level shows no grid, but the other torques' steps say it is likely a level of
+    // one, so their Gs rows are no longer exact (standard errors of 0 before) and are warned of
+    let m = identify(&robot(100, 0.05));
+    let gs = m.g_static.as_ref().unwrap();
+    for j in [0, 3, 5] {
+        assert!(
+            gs.stderr.row(j).iter().all(|se| *se > 1e-4),
+            "{}",
+            gs.stderr
+        );
+    }
+    assert!(
+        (m.diagnostics.warnings.iter()).any(|w| w.starts_with(
+            "experiment 'G_static': the torque of joint(s) 'joint1', 'joint4', 'joint6' read exactly 0 in every sample at rest"
+        ) && w.contains("(the finest 0.05 N m)")),
+        "{:?}",
+        m.diagnostics.warnings
+    );
     // noise alone (a resolution of 0: none) is no grid
     let m = identify(&robot(100, 0.0));
     assert!(m.diagnostics.noise.iter().all(|x| x.step.is_none()));

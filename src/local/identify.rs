@@ -546,7 +546,7 @@ pub fn identify_local(
     });
 
     let noise = std::cell::RefCell::new(vec![]);
-    let resolution_warnings = std::cell::RefCell::new(vec![]);
+    let extra_warnings = std::cell::RefCell::new(vec![]);
     let separated = |kind: ExperimentKind, prefix: &str| -> Result<Option<Estimate>> {
         let Some(v) = find(kind) else { return Ok(None) };
         let var = kind.perturbed().expect("perturbed experiment");
@@ -597,7 +597,7 @@ pub fn identify_local(
                 Resolution::of(&plan.joint_names[j], v.position_step[j]?, &se, &dx)
             })
             .collect();
-        resolution_warnings
+        extra_warnings
             .borrow_mut()
             .extend(rounded_positions::resolution_warning(
                 kind.name(),
@@ -623,6 +623,27 @@ pub fn identify_local(
                 step,
                 position_step: v.position_step[j],
             });
+        }
+        // at rest a torque may read exactly 0 throughout and be kept (a vertical axis, gravity
+        // compensated); one level shows no grid, but when the other torques are rounded, its
+        // 0 is likely a level of one too
+        if kind == ExperimentKind::GStatic {
+            let finest = (0..n)
+                .filter_map(|j| quantisation::undithered_step(v.torque_step[j], samples[0][j]))
+                .min_by(f64::total_cmp);
+            let zeros: Vec<usize> = (0..n).filter(|&j| v.flat_torque[j] == Some(0.0)).collect();
+            if let (Some(q), false) = (finest, zeros.is_empty()) {
+                for &j in &zeros {
+                    quantisation::floor_stderr(&mut fit, j, quantisation::rounding_stderr(q));
+                }
+                let names: Vec<&str> = zeros
+                    .iter()
+                    .map(|&j| plan.joint_names[j].as_str())
+                    .collect();
+                extra_warnings
+                    .borrow_mut()
+                    .push(quantisation::flat_zero_warning(kind.name(), &names, q));
+            }
         }
         Ok(Some(estimate(fit)))
     };
@@ -765,9 +786,7 @@ pub fn identify_local(
     // in the plan's order of experiments
     noise.sort_by_key(|e| values.iter().position(|v| v.kind.name() == e.experiment));
     diagnostics.warnings.extend(quantisation::warnings(&noise));
-    diagnostics
-        .warnings
-        .extend(resolution_warnings.into_inner());
+    diagnostics.warnings.extend(extra_warnings.into_inner());
     diagnostics.noise = noise;
     diagnostics.combined = disagreement;
     diagnostics.unperturbed_deviation = deviation;

@@ -145,6 +145,19 @@ pub fn warnings(noise: &[TorqueNoise]) -> Vec<String> {
         .collect()
 }
 
+/// The warning for the torques of `joints` that read exactly 0 in every sample of
+/// `experiment` at rest while the experiment's other torques are rounded without dithering,
+/// the finest to steps of `step` (N m): their standard errors include that rounding.
+pub fn flat_zero_warning(experiment: &str, joints: &[&str], step: f64) -> String {
+    let list: Vec<String> = joints.iter().map(|j| format!("'{j}'")).collect();
+    format!(
+        "experiment '{experiment}': the torque of joint(s) {} read exactly 0 in every sample at rest, and the other torques are logged in steps coarser than their noise (the finest {} N m), so this 0 is likely a level of such a grid and hides anything below half a step: the standard errors of its rows include a rounding error of {} N m / sqrt(12) at every crossing (conservative if its channel is finer)",
+        list.join(", "),
+        crate::error::shown(format!("{step:.3e}").parse().unwrap_or(step)),
+        crate::error::shown(format!("{step:.3e}").parse().unwrap_or(step)),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
