@@ -562,20 +562,15 @@ pub fn identify_local(
         let x = DMatrix::from_fn(k, n, |i, j| state(&v.crossings[i], var)[j] - base_x[j]);
         if let Some(j) = (0..n).find(|&j| x.column(j).iter().all(|d| *d == 0.0)) {
             if let Some(step) = v.position_step[j] {
-                return Err(Error::RankDeficient {
-                    context: format!("experiment '{}'", kind.name()),
-                    rows: k,
-                    cols: n,
-                    rank: n - 1,
-                    missing: format!(
-                        "{}({}) (the column is all zeros: the encoder of joint '{}', in steps of {:.2e} rad, reads the same {} at every crossing and at the operating point, resolving none of the perturbations; perturb more, widen the crossing window or log the positions more finely)",
-                        prefix,
-                        plan.joint_names[j],
-                        plan.joint_names[j],
-                        step,
-                        ["position", "velocity", "acceleration"][var]
-                    ),
-                });
+                return Err(rounded_positions::unresolved(
+                    kind.name(),
+                    (k, n),
+                    &format!("{prefix}({})", plan.joint_names[j]),
+                    &plan.joint_names[j],
+                    step,
+                    var,
+                    v.reference.is_some(),
+                ));
             }
         }
         let y = DMatrix::from_fn(k, n, |i, j| v.crossings[i].tau[j] - base_tau[j]);

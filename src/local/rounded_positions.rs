@@ -18,6 +18,7 @@
 //! ([`super::errors_in_variables`]).
 
 use crate::band_fit::coefficient_ranges;
+use crate::error::Error;
 use crate::recording::Recording;
 
 use super::quantisation::grid_step;
@@ -72,6 +73,37 @@ pub fn band_state(t: &[f64], q: &[f64], tc: f64, half: f64, step: f64) -> Option
         scale[2] * width(2),
     ];
     (values.iter().chain(&stderr).all(|v| v.is_finite())).then_some(BandState { values, stderr })
+}
+
+/// The error for an experiment (`shape`: its K crossings x N joints) whose measured
+/// perturbations of `variable` (0 = q, 1 = qd, 2 = qdd) are all zero for `joint` (its column
+/// `column`), whose positions were read by the band of encoder steps of `step` rad: the encoder
+/// resolves none of them. `reference`: measured from the reference posture rather than the
+/// operating point.
+pub fn unresolved(
+    experiment: &str,
+    shape: (usize, usize),
+    column: &str,
+    joint: &str,
+    step: f64,
+    variable: usize,
+    reference: bool,
+) -> Error {
+    let what = ["position", "velocity", "acceleration"][variable.min(2)];
+    let base = if reference {
+        "the reference posture"
+    } else {
+        "the operating point"
+    };
+    Error::RankDeficient {
+        context: format!("experiment '{experiment}'"),
+        rows: shape.0,
+        cols: shape.1,
+        rank: shape.1.saturating_sub(1),
+        missing: format!(
+            "{column} (the column is all zeros: the encoder of joint '{joint}', in steps of {step:.2e} rad, reads the same {what} at every crossing and at {base}, resolving none of the perturbations; perturb more, widen the crossing window or log the positions more finely)"
+        ),
+    }
 }
 
 /// A measured perturbation is called coarse when the median standard error of its crossings
