@@ -636,6 +636,51 @@ fn positions_in_coarse_encoder_counts_get_standard_errors_that_cover_them() {
         e.to_string().contains("not excited: dqdd(joint6) (the column is all zeros: the encoder of joint 'joint6', in steps of 6.14e-3 rad, reads the same acceleration at every crossing"),
         "{e}"
     );
+    // planned with the encoder's step, the planner warns of the D experiment beforehand and
+    // names a window that resolves it; planned so, D* is within 1 % at 4,096 counts
+    let step = std::f64::consts::TAU / 4096.0;
+    let with_step = |window: f64| PlanOptions {
+        design: Design::Orthogonal,
+        window,
+        encoder_step: Some(vec![step; 6]),
+        ..PlanOptions::default()
+    };
+    let warned = plan_experiments(&model, &op, &with_step(0.05)).unwrap();
+    let w: Vec<&String> = warned
+        .warnings
+        .iter()
+        .filter(|w| w.contains("its encoders would measure"))
+        .collect();
+    assert!(
+        w.len() == 1
+            && w[0].starts_with(
+                "experiment 'D': its encoders would measure the perturbations of joint(s) 'joint1'"
+            )
+            && w[0].contains("a crossing window of about 0.19 s (window, --window; now 0.05 s)"),
+        "{w:?}"
+    );
+    let wide = plan_experiments(&model, &op, &with_step(0.2)).unwrap();
+    assert!(
+        !wide.warnings.iter().any(|w| w.contains("its encoders")),
+        "{:?}",
+        wide.warnings
+    );
+    let recordings = rehearse_plan(&model, &robot(100, &counts(4096)), &wide).unwrap();
+    let m = identify_local(&wide, &recordings, &IdentifyOptions::default()).unwrap();
+    assert!(
+        rel(mat(&m.d), &truth.d) < 0.01,
+        "{}",
+        rel(mat(&m.d), &truth.d)
+    );
+    // the steps are checked: one per joint, each in [0, 1]
+    for bad in [vec![step; 5], vec![-step; 6], vec![f64::NAN; 6]] {
+        let o = PlanOptions {
+            encoder_step: Some(bad),
+            ..PlanOptions::default()
+        };
+        let e = plan_experiments(&model, &op, &o).unwrap_err();
+        assert!(e.to_string().contains("encoder_step"), "{e}");
+    }
     // continuous positions: no grid, no band
     let m = identify(&robot(100, ""));
     assert!(m

@@ -368,6 +368,7 @@ def plan_experiments(
     symmetric: bool = True,
     keep_velocity_sign: bool = False,
     friction_aware_h: bool = False,
+    encoder_step: Optional[ArrayLike] = None,
 ) -> Plan:
     """Plans the nominal, G_static, G, H and D experiments at op; refuses plans breaking limits."""
 

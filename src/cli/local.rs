@@ -81,6 +81,11 @@ pub(crate) struct PlanArgs {
     /// Plan enough H passes (2 (N + 2), in +- pairs) for `identify --friction-aware-h`.
     #[arg(long)]
     friction_aware_h: bool,
+    /// The step of the robot's encoders for every joint (rad or m a count; 4,096 counts a
+    /// revolution: 0.001534), when known: the planner warns of perturbations they would not
+    /// resolve, with the window that would.
+    #[arg(long)]
+    encoder_step: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -126,6 +131,7 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
         experiments: a.experiments,
         keep_velocity_sign: a.keep_velocity_sign,
         friction_aware_h: a.friction_aware_h,
+        encoder_step: a.encoder_step.map(|s| vec![s; n]),
         ..PlanOptions::default()
     };
     o.sizes.position = size(a.dq, a.dq_fraction, n);

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::operating_point::OperatingPoint;
 use super::perturbation::{perturbations, Design, Sizes};
+use super::rounded_positions;
 use crate::choice::choice;
 use crate::document::{invalid, Document};
 use crate::error::{shown, Error, Result};
@@ -137,6 +138,14 @@ pub struct PlanOptions {
     /// ([`crate::local::IdentifyOptions::friction_aware_h`]): at least `2 (N + 2)`, in +- pairs
     /// (`N + 1` pairs determine it, one more gives its standard errors).
     pub friction_aware_h: bool,
+    /// The steps (rad, or m for a prismatic joint; one per joint, 0 for a joint whose step is
+    /// not known) of the encoders the robot logs its positions in, when known (default none).
+    /// Each experiment's crossings are then read as the identification will read them (the
+    /// planned positions over each window rounded to the steps and read by their band, see
+    /// [`super::rounded_positions::planned_resolution`]), and the joints whose perturbations
+    /// they would resolve to worse than a tenth of their size get a warning with the window or
+    /// perturbation size that would resolve them.
+    pub encoder_step: Option<Vec<f64>>,
 }
 
 impl Default for PlanOptions {
@@ -157,6 +166,7 @@ impl Default for PlanOptions {
             min_transition: 0.2,
             keep_velocity_sign: false,
             friction_aware_h: false,
+            encoder_step: None,
         }
     }
 }
@@ -350,6 +360,18 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
     if let Some(count) = o.count {
         check_count("count", count, 2, MAX_PERTURBATIONS)?;
     }
+    if let Some(steps) = &o.encoder_step {
+        if steps.len() != n {
+            return Err(Error::Shape {
+                argument: "encoder_step".into(),
+                expected: format!("{n} values (one per joint)"),
+                got: format!("{} values", steps.len()),
+            });
+        }
+        for (j, step) in steps.iter().enumerate() {
+            check_range(&format!("encoder_step[{j}]"), *step, 0.0, 1.0)?;
+        }
+    }
     if o.experiments.is_empty() {
         return Err(Error::InvalidArgument {
             argument: "experiments".into(),
@@ -514,14 +536,29 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
             &context,
             "; reduce the perturbation sizes or move the operating point away from the limit",
         )?;
-        experiments.push(Experiment {
+        let experiment = Experiment {
             kind,
             deltas,
             crossings,
             reference,
             window,
             trajectory,
-        });
+        };
+        if let (Some(steps), Some(var)) = (&o.encoder_step, kind.perturbed()) {
+            let joints = rounded_positions::planned_resolution(
+                &experiment,
+                &model.joint_names,
+                steps,
+                o.rate,
+            );
+            warnings.extend(rounded_positions::planned_resolution_warning(
+                kind.name(),
+                var,
+                &joints,
+                experiment.window,
+            ));
+        }
+        experiments.push(experiment);
     }
     Ok(Plan {
         format: Plan::tag(),

@@ -17,6 +17,7 @@
 //! values. The regressions then count these errors of their regressors
 //! ([`super::errors_in_variables`]).
 
+use super::plan::Experiment;
 use crate::band_fit::coefficient_ranges;
 use crate::error::Error;
 use crate::recording::Recording;
@@ -181,6 +182,106 @@ pub fn resolution_warning(
             coarse.join(", ")
         )
     })
+}
+
+/// The most readings of one window [`planned_resolution`] rounds and reads: a longer window
+/// (up to 60 s at up to 10 MHz) is read at every few samples, which can only widen its ranges.
+pub const MAX_PLANNED_READINGS: usize = 10_001;
+
+/// How finely encoders of steps `steps` (rad, or m for a prismatic joint; one per joint, 0 for
+/// unknown) will resolve `experiment`'s perturbations if the robot follows it exactly: each
+/// crossing's planned positions over its window, sampled at `rate` (Hz), rounded to the steps
+/// and read by [`band_state`] as the identification will read them. One entry per joint with a
+/// step; empty for the nominal experiment. A crossing whose band is not read (none is: the
+/// planned quadratic is in it, unless the simplex method exceeds its steps) is left out.
+pub fn planned_resolution(
+    experiment: &Experiment,
+    joint_names: &[String],
+    steps: &[f64],
+    rate: f64,
+) -> Vec<Resolution> {
+    let Some(var) = experiment.kind.perturbed() else {
+        return vec![];
+    };
+    let half = experiment.window;
+    let each_side = (half * rate).round().max(1.0) as usize;
+    let stride = (2 * each_side + 1).div_ceil(MAX_PLANNED_READINGS).max(1);
+    let offsets: Vec<f64> = (0..=2 * each_side)
+        .step_by(stride)
+        .map(|i| (i as f64 - each_side as f64) / rate)
+        .collect();
+    let traj = &experiment.trajectory;
+    (0..steps.len().min(joint_names.len()))
+        .filter(|&j| steps[j] > 0.0 && steps[j].is_finite())
+        .filter_map(|j| {
+            let step = steps[j];
+            let stderr: Vec<f64> = experiment
+                .crossings
+                .iter()
+                .map(|c| {
+                    let t: Vec<f64> = offsets.iter().map(|d| c.time + d).collect();
+                    let q: Vec<f64> = t
+                        .iter()
+                        .map(|&x| (traj.segment_at(x).eval(j, x).0 / step).round() * step)
+                        .collect();
+                    band_state(&t, &q, c.time, half, step).map_or(f64::INFINITY, |b| b.stderr[var])
+                })
+                .collect();
+            let perturbations: Vec<f64> = experiment.deltas.column(j).iter().copied().collect();
+            Resolution::of(&joint_names[j], step, &stderr, &perturbations)
+        })
+        .collect()
+}
+
+/// The planner's warning for an experiment perturbing `variable` (0 = q, 1 = qd, 2 = qdd) with
+/// crossing windows of half-width `window` (s) whose encoders would resolve some joints'
+/// perturbations to worse than [`COARSE_FRACTION`] of their size (the [`Resolution::coarse`]
+/// ones of `joints`, from [`planned_resolution`]), with the window or the perturbation size
+/// that would resolve them (an acceleration's resolution improves about as the window squared,
+/// a velocity's as the window, a position's not at all); None when none would.
+pub fn planned_resolution_warning(
+    experiment: &str,
+    variable: usize,
+    joints: &[Resolution],
+    window: f64,
+) -> Option<String> {
+    let (what, unit) = match variable {
+        0 => ("positions", "rad"),
+        1 => ("velocities", "rad/s"),
+        _ => ("accelerations", "rad/s^2"),
+    };
+    let coarse: Vec<&Resolution> = joints.iter().filter(|r| r.coarse()).collect();
+    if coarse.is_empty() {
+        return None;
+    }
+    let factor = coarse
+        .iter()
+        .map(|r| r.stderr / (COARSE_FRACTION * r.perturbation))
+        .fold(1.0f64, f64::max);
+    let list: Vec<String> = coarse
+        .iter()
+        .map(|r| {
+            format!(
+                "'{}' (steps of {:.2e}: {what} resolved to {:.2e} {unit} at the crossings, perturbed by {:.2e} {unit} RMS)",
+                r.joint, r.step, r.stderr, r.perturbation
+            )
+        })
+        .collect();
+    let remedy = match variable {
+        0 => format!("perturbations about {factor:.1} times larger (dq)"),
+        1 => format!(
+            "a crossing window of about {:.2} s (window, --window; now {window} s) or perturbations about {factor:.1} times larger (dqd)",
+            window * factor
+        ),
+        _ => format!(
+            "a crossing window of about {:.2} s (window, --window; now {window} s) or perturbations about {factor:.1} times larger (dqdd)",
+            window * factor.sqrt()
+        ),
+    };
+    Some(format!(
+        "experiment '{experiment}': its encoders would measure the perturbations of joint(s) {} to worse than a tenth of their size, even on a robot that follows the plan exactly, and the estimate would lose precision; {remedy} would resolve them",
+        list.join(", ")
+    ))
 }
 
 #[cfg(test)]

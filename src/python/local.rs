@@ -259,13 +259,18 @@ impl PyExperiment {
 /// - `experiments`: a subset of ['nominal', 'G_static', 'G', 'H', 'D'];
 /// - `keep_velocity_sign`: keep the velocity perturbations below 0.9 |qd*| of each joint, so
 ///   that friction cancels from H* (otherwise a joint they reverse gets a PerturbidWarning);
-/// - `friction_aware_h`: plan 2 (N + 2) H passes (N + 1 pairs determine it, one more gives its standard errors) for `identify_local(friction_aware_h=True)`.
+/// - `friction_aware_h`: plan 2 (N + 2) H passes (N + 1 pairs determine it, one more gives its standard errors) for `identify_local(friction_aware_h=True)`;
+/// - `encoder_step`: the steps the robot's encoders log positions in (rad, or m for a
+///   prismatic joint; a number or one per joint, 0 for unknown), when known: each experiment's
+///   crossings are read as the identification will read them, and the joints whose
+///   perturbations they would resolve to worse than a tenth get a warning with the window or
+///   perturbation size that would resolve them (a revolution of 4,096 counts: 2 pi / 4096).
 ///
 /// Raises InputError when the plan would break a joint limit (naming joint, time and limit).
 /// The planner's warnings are issued as `PerturbidWarning` and kept in `Plan.warnings`.
 #[pyfunction]
 #[pyo3(signature = (robot, op, design="random", n=None, seed=0, rate=1000.0, *, experiments=None, dq=None, dqd=None, dqdd=None,
-    dq_fraction=0.01, dqd_fraction=0.05, dqdd_fraction=0.05, window=0.05, dwell=1.0, margin=0.8, symmetric=true, keep_velocity_sign=false, friction_aware_h=false))]
+    dq_fraction=0.01, dqd_fraction=0.05, dqdd_fraction=0.05, window=0.05, dwell=1.0, margin=0.8, symmetric=true, keep_velocity_sign=false, friction_aware_h=false, encoder_step=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn plan_experiments(
     py: Python<'_>,
@@ -288,6 +293,7 @@ pub(crate) fn plan_experiments(
     symmetric: bool,
     keep_velocity_sign: bool,
     friction_aware_h: bool,
+    encoder_step: Option<Bound<'_, PyAny>>,
 ) -> PyResult<PyPlan> {
     let nv = robot.model.nv;
     let size = |name: &str, abs: &Option<Bound<'_, PyAny>>, frac: f64| -> PyResult<Size> {
@@ -307,6 +313,9 @@ pub(crate) fn plan_experiments(
         symmetric,
         keep_velocity_sign,
         friction_aware_h,
+        encoder_step: encoder_step
+            .map(|v| per_joint("encoder_step", &v, nv))
+            .transpose()?,
         ..PlanOptions::default()
     };
     options.sizes.position = size("dq", &dq, dq_fraction)?;

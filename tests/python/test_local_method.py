@@ -1,6 +1,7 @@
 """The paper's method from Python: plan, simulate, identify, against Pinocchio (the oracle)."""
 
 import json
+import warnings
 
 import numpy as np
 import pinocchio as pin
@@ -358,6 +359,23 @@ def test_positions_in_coarse_encoder_counts_are_read_by_their_band():
     doc["diagnostics"]["noise"][3]["position_step"] = "fine"
     with pytest.raises(pr.InputError, match="position_step"):
         pr.LocalModel.from_json(json.dumps(doc))
+
+
+def test_the_planner_warns_of_perturbations_the_encoders_cannot_resolve():
+    robot = pr.robots.a465()
+    op = pr.OperatingPoint(*TABLE2)
+    step = 2 * np.pi / 4096
+    with pytest.warns(pr.PerturbidWarning, match=r"experiment 'D': its encoders would measure the perturbations of joint\(s\) 'joint1'.*a crossing window of about 0.19 s"):
+        pr.plan_experiments(robot, op, design="orthogonal", encoder_step=step)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        plan = pr.plan_experiments(robot, op, design="orthogonal", window=0.2, encoder_step=[step] * 6)
+    assert not [w for w in caught if "its encoders" in str(w.message)]
+    assert not [w for w in plan.warnings if "its encoders" in w]
+    # one per joint, in [0, 1], finite
+    for bad in [[step] * 5, -step, float("nan"), "fine"]:
+        with pytest.raises(pr.InputError, match="encoder_step"):
+            pr.plan_experiments(robot, op, encoder_step=bad)
 
 
 def test_a_poorly_conditioned_design_is_reported_and_warned_about():
