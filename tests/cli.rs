@@ -708,6 +708,31 @@ fn plan_warns_and_identify_friction_aware_h() {
         ),
         "{err}"
     );
+    // the encoders' step, when given, is checked against the D experiment's perturbations
+    let coarse = bin()
+        .args([
+            "plan",
+            "a465",
+            "--op",
+            s(&op),
+            "--out",
+            s(&d.join("coarse")),
+            "--experiments",
+            "nominal,D",
+            "--design",
+            "orthogonal",
+            "--encoder-step",
+            "0.001534",
+        ])
+        .output()
+        .unwrap();
+    assert!(coarse.status.success());
+    let err = String::from_utf8_lossy(&coarse.stderr);
+    assert!(
+        err.contains("perturbid: warning: experiment 'D': its encoders would measure the perturbations of joint(s) 'joint1'")
+            && err.contains("a crossing window of about 0.1") && err.contains(" s (window, --window; now 0.05 s)"),
+        "{err}"
+    );
     ok(&[
         "plan",
         "a465",
