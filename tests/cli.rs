@@ -687,21 +687,17 @@ fn excite_simulate_on_a_true_robot_identify_direct() {
 fn plan_warns_and_identify_friction_aware_h() {
     let d = tmp("friction-aware");
     let op = table2_op(&d);
-    let plain = bin()
-        .args([
-            "plan",
-            "a465",
-            "--op",
-            s(&op),
-            "--out",
-            s(&d.join("plain")),
-            "--experiments",
-            "nominal,H",
-        ])
-        .output()
-        .unwrap();
-    assert!(plain.status.success());
-    let err = String::from_utf8_lossy(&plain.stderr);
+    // plans the A465 at Table 2 into `out` with `extra` arguments; its warnings
+    let plan = |out: &str, extra: &[&str]| {
+        let o = bin()
+            .args(["plan", "a465", "--op", s(&op), "--out", s(&d.join(out))])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let err = plan("plain", &["--experiments", "nominal,H"]);
     assert!(
         err.starts_with(
             "perturbid: warning: experiment 'H': the velocity perturbations reverse joint(s)"
@@ -709,28 +705,21 @@ fn plan_warns_and_identify_friction_aware_h() {
         "{err}"
     );
     // the encoders' step, when given, is checked against the D experiment's perturbations
-    let coarse = bin()
-        .args([
-            "plan",
-            "a465",
-            "--op",
-            s(&op),
-            "--out",
-            s(&d.join("coarse")),
+    let err = plan(
+        "coarse",
+        &[
             "--experiments",
             "nominal,D",
             "--design",
             "orthogonal",
             "--encoder-step",
             "0.001534",
-        ])
-        .output()
-        .unwrap();
-    assert!(coarse.status.success());
-    let err = String::from_utf8_lossy(&coarse.stderr);
+        ],
+    );
     assert!(
         err.contains("perturbid: warning: experiment 'D': its encoders would measure the perturbations of joint(s) 'joint1'")
-            && err.contains("a crossing window of about 0.1") && err.contains(" s (window, --window; now 0.05 s)"),
+            && err.contains("a crossing window of about 0.1")
+            && err.contains(" s (window, --window; now 0.05 s)"),
         "{err}"
     );
     ok(&[

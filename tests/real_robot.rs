@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{linearized, mat, rel, table2};
+use common::{a465_orthogonal_at_table2, linearized, mat, rel, table2};
 use nalgebra::DMatrix;
 use perturbid_rs::local::{
     identify_local, plan_experiments, CrossingTimes, IdentifyOptions, LocalModel, PlanOptions,
@@ -478,17 +478,9 @@ fn closed_loop_tracking_errors_favour_the_combined_estimate() {
 /// diagnostics.noise and warned about; a torque that is only noisy shows no step.
 #[test]
 fn torques_rounded_without_dithering_get_standard_errors_that_cover_the_rounding() {
-    use perturbid_rs::local::Design;
     use perturbid_rs::rehearsal::{rehearse_plan, TrueRobot};
     use perturbid_rs::Document;
-    let model = a465::model("kinsheel2010").unwrap();
-    let op = table2();
-    let options = PlanOptions {
-        design: Design::Orthogonal,
-        ..PlanOptions::default()
-    };
-    let plan = plan_experiments(&model, &op, &options).unwrap();
-    let truth = linearized(&model, &op);
+    let (model, _, plan, truth) = a465_orthogonal_at_table2();
     let robot = |seed: usize, resolution: f64| {
         let spec = format!(
             r#"{{"format": "perturbid-true-robot/1", "seed": {seed}, "sensors": {{"torque_noise": [0.002, 0.002, 0.002, 0.002, 0.002, 0.002], "torque_resolution": [{r}, {r}, {r}, {r}, {r}, {r}]}}}}"#,
@@ -560,22 +552,16 @@ fn torques_rounded_without_dithering_get_standard_errors_that_cover_the_rounding
 /// accelerations by several times its own standard errors, and D* erred by up to 9.6 of its
 /// standard errors (errors in the regressors, which the residuals hide). Read by the band of
 /// half a count and with the regressors' errors counted, D* errs by 0.4 of its standard errors
-/// RMS (9.6 at most before, 1.8 RMS), the encoder step is reported in diagnostics.noise, and the joints whose perturbations
-/// the encoder cannot resolve are warned about. Finer encoders (409,600 counts) stay covered;
-/// continuous positions show no step.
+/// RMS (9.6 at most before, 1.8 RMS), the encoder step is reported in diagnostics.noise, and
+/// the joints whose perturbations the encoder cannot resolve are warned about. Finer encoders
+/// (409,600 counts) stay covered; continuous positions show no step. Planned with the encoder's
+/// step, the planner warns beforehand and names the window that resolves them.
 #[test]
 fn positions_in_coarse_encoder_counts_get_standard_errors_that_cover_them() {
     use perturbid_rs::local::Design;
     use perturbid_rs::rehearsal::{rehearse_plan, TrueRobot};
     use perturbid_rs::Document;
-    let model = a465::model("kinsheel2010").unwrap();
-    let op = table2();
-    let options = PlanOptions {
-        design: Design::Orthogonal,
-        ..PlanOptions::default()
-    };
-    let plan = plan_experiments(&model, &op, &options).unwrap();
-    let truth = linearized(&model, &op);
+    let (model, op, plan, truth) = a465_orthogonal_at_table2();
     let robot = |seed: usize, counts: &str| {
         let spec = format!(
             r#"{{"format": "perturbid-true-robot/1", "seed": {seed}, "sensors": {{"torque_noise": [0.01, 0.01, 0.01, 0.01, 0.01, 0.01]{counts}}}}}"#

@@ -144,6 +144,26 @@ pub fn linearized(
     .unwrap()
 }
 
+/// The A465 (the paper's parameters), Table 2, the orthogonal plan there, and the robot's own
+/// linearisation at it (gravity included): the truth a rehearsed identification is held to.
+pub fn a465_orthogonal_at_table2() -> (
+    perturbid_rs::Model,
+    perturbid_rs::OperatingPoint,
+    perturbid_rs::Plan,
+    perturbid_rs::Linearization,
+) {
+    use perturbid_rs::local::{plan_experiments, Design};
+    let model = perturbid_rs::robots::a465::model("kinsheel2010").unwrap();
+    let op = table2();
+    let options = perturbid_rs::PlanOptions {
+        design: Design::Orthogonal,
+        ..perturbid_rs::PlanOptions::default()
+    };
+    let plan = plan_experiments(&model, &op, &options).unwrap();
+    let truth = linearized(&model, &op);
+    (model, op, plan, truth)
+}
+
 /// |a - b| / |b| (Frobenius norms).
 pub fn rel(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
     (a - b).norm() / b.norm()
