@@ -511,6 +511,10 @@ class BaseParameterModel:
     @property
     def sigma(self) -> NDArray[np.float64]: ...
     @property
+    def residual_correlation(self) -> NDArray[np.float64]:
+        """Per joint, the residuals' long-run variance factor (>= 1); the standard errors are
+        scaled by the square root of the largest."""
+    @property
     def cond(self) -> float: ...
     @property
     def samples(self) -> int: ...

@@ -82,6 +82,12 @@ pub struct BaseModel {
     pub cond: f64,
     /// Samples used.
     pub samples: usize,
+    /// Per joint, the long-run variance factor of the fit's residuals (at least 1; see
+    /// [`super::residual_correlation`]): how many correlated samples count as one independent
+    /// one. `stderr` is scaled by the square root of the largest. Empty in a model saved before
+    /// it was computed.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub residual_correlation: Vec<f64>,
 }
 
 /// Identifies the base parameters of `model` from the samples of `states` (rad, rad/s,
@@ -201,7 +207,7 @@ fn fit_with_factors(
         ls = factors.solve(&sigma, &names)?;
         rms = factors.residual_rms(ls.coef.as_slice())?;
     }
-    let fit = BaseModel {
+    let mut fit = BaseModel {
         format: BaseModel::tag(),
         robot: model.name.clone(),
         joint_names: model.joint_names.clone(),
@@ -214,7 +220,22 @@ fn fit_with_factors(
         cond: ls.cond,
         samples: k,
         base,
+        residual_correlation: vec![],
     };
+    // residuals correlated from sample to sample (a filtered, lightly decimated log) carry less
+    // information than their number says
+    let predicted = fit.predict(model, states)?;
+    let residuals: Vec<f64> = tau.iter().zip(&predicted).map(|(t, p)| t - p).collect();
+    fit.residual_correlation = super::residual_correlation::long_run_factors(&residuals, nv);
+    let inflation = fit
+        .residual_correlation
+        .iter()
+        .copied()
+        .fold(1.0, f64::max)
+        .sqrt();
+    for se in &mut fit.stderr {
+        *se *= inflation;
+    }
     Ok((fit, factors))
 }
 
@@ -251,6 +272,28 @@ impl Document for BaseModel {
             ));
         }
         check_magnitudes(Self::WHAT, "stderr", &m.stderr, true)?;
+        if !(m.residual_correlation.is_empty() || m.residual_correlation.len() == n) {
+            return Err(invalid(
+                Self::WHAT,
+                format!(
+                    "residual_correlation has {} entries, expected one per joint ({n}) or none",
+                    m.residual_correlation.len()
+                ),
+            ));
+        }
+        if let Some(i) = m
+            .residual_correlation
+            .iter()
+            .position(|f| !(f.is_finite() && *f >= 1.0 && *f <= 1e6))
+        {
+            return Err(invalid(
+                Self::WHAT,
+                format!(
+                    "residual_correlation[{i}] is {}; expected a factor from 1 to 1e6",
+                    crate::error::shown(m.residual_correlation[i])
+                ),
+            ));
+        }
         check_magnitudes(Self::WHAT, "residual_rms", &m.residual_rms, false)?;
         check_magnitudes(Self::WHAT, "sigma", &m.sigma, false)?;
         if let Some(j) = m.sigma.iter().position(|&s| s == 0.0) {

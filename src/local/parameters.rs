@@ -287,6 +287,8 @@ pub fn identify_parameters_from_local(
         sigma: vec![1.0; nv],
         cond: ls.cond,
         samples: rows,
+        // rows from local models, not a time series
+        residual_correlation: vec![],
     };
     let consistent = match &options.consistent {
         None => None,

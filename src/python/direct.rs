@@ -262,6 +262,13 @@ impl PyBaseModel {
     fn sigma<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_slice(py, &self.fit.sigma)
     }
+    /// Per joint, the long-run variance factor of the residuals (>= 1; empty for a model saved
+    /// before it was computed or built from local models): the standard errors are scaled by
+    /// the square root of the largest.
+    #[getter]
+    fn residual_correlation<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.fit.residual_correlation)
+    }
     #[getter]
     fn cond(&self) -> f64 {
         self.fit.cond

@@ -1,6 +1,7 @@
 """The direct method from Python: regressor against Pinocchio, base parameters, the globally
 linearised model, excitation design, and the real Franka Emika Panda log."""
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -90,6 +91,21 @@ def test_base_parameters_on_simulated_a465_are_exact():
     theta = np.concatenate([robot.parameters, robot.armature])
     np.testing.assert_allclose(fit.theta_base, theta[fit.kept] + fit.K @ theta[fit.dropped], rtol=1e-7, atol=1e-9)
     assert fit.mass_matrix(np.tile(TABLE2_Q, (2, 1))).shape == (2, 6, 6)
+
+
+def test_standard_errors_count_residuals_correlated_by_the_filter():
+    # a log low-pass filtered at 10 Hz and kept at 100 Hz: about five correlated samples to
+    # every independent one, which the standard errors now count
+    robot = pr.robots.a465()
+    traj = excitation(robot, 5, 0.1, 0.12, 1)
+    t = np.arange(0, 2 * traj.period, 0.001)
+    q, qd, qdd = traj.sample(t)
+    tau = robot.rnea(q, qd, qdd) + np.random.default_rng(3).normal(0, 0.05, q.shape)
+    rec = pr.preprocess(t, q, tau)
+    fit = pr.identify_base_parameters(robot, rec.q, rec.qd, rec.qdd, rec.tau, friction=None, weighting="ols")
+    f = fit.residual_correlation
+    assert f.shape == (6,) and (f > 2).all() and (f < 20).all(), f
+    assert json.loads(fit.to_json())["residual_correlation"] == pytest.approx(list(f))
 
 
 def test_global_linear_model_is_a_workspace_average():
