@@ -224,7 +224,8 @@ fn fit_with_factors(
     };
     // residuals correlated from sample to sample (a filtered, lightly decimated log) carry less
     // information than their number says
-    let predicted = fit.predict(model, states)?;
+    let head = states.slice(0..k.min(super::residual_correlation::SAMPLES));
+    let predicted = fit.predict(model, &head)?;
     let residuals: Vec<f64> = tau.iter().zip(&predicted).map(|(t, p)| t - p).collect();
     fit.residual_correlation = super::residual_correlation::long_run_factors(&residuals, nv);
     let inflation = fit
