@@ -34,6 +34,7 @@ pub mod crossing;
 mod diagnose;
 pub mod diagnostics;
 pub mod errors_in_variables;
+mod flat_channels;
 mod friction_aware;
 pub mod identify;
 pub mod model;

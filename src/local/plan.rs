@@ -550,7 +550,7 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
                 &model.joint_names,
                 steps,
                 o.rate,
-            );
+            )?;
             warnings.extend(rounded_positions::planned_resolution_warning(
                 kind.name(),
                 var,

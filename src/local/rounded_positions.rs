@@ -19,7 +19,7 @@
 
 use super::plan::Experiment;
 use crate::band_fit::coefficient_ranges;
-use crate::error::Error;
+use crate::error::{Error, Result};
 use crate::recording::Recording;
 
 use super::quantisation::grid_step;
@@ -193,15 +193,16 @@ pub const MAX_PLANNED_READINGS: usize = 10_001;
 /// crossing's planned positions over its window, sampled at `rate` (Hz), rounded to the steps
 /// and read by [`band_state`] as the identification will read them. One entry per joint with a
 /// step; empty for the nominal experiment. A crossing whose band is not read (none is: the
-/// planned quadratic is in it, unless the simplex method exceeds its steps) is left out.
+/// planned quadratic is in it, unless the simplex method exceeds its steps) is left out. Stops
+/// on Ctrl-C (`Error::Interrupted`) between crossings.
 pub fn planned_resolution(
     experiment: &Experiment,
     joint_names: &[String],
     steps: &[f64],
     rate: f64,
-) -> Vec<Resolution> {
+) -> Result<Vec<Resolution>> {
     let Some(var) = experiment.kind.perturbed() else {
-        return vec![];
+        return Ok(vec![]);
     };
     let half = experiment.window;
     let each_side = (half * rate).round().max(1.0) as usize;
@@ -211,26 +212,33 @@ pub fn planned_resolution(
         .map(|i| (i as f64 - each_side as f64) / rate)
         .collect();
     let traj = &experiment.trajectory;
-    (0..steps.len().min(joint_names.len()))
-        .filter(|&j| steps[j] > 0.0 && steps[j].is_finite())
-        .filter_map(|j| {
-            let step = steps[j];
-            let stderr: Vec<f64> = experiment
-                .crossings
+    let mut out = vec![];
+    for j in 0..steps.len().min(joint_names.len()) {
+        let step = steps[j];
+        if !(step > 0.0 && step.is_finite()) {
+            continue;
+        }
+        let mut stderr = Vec::with_capacity(experiment.crossings.len());
+        for c in &experiment.crossings {
+            crate::interrupt::check("planning")?;
+            let t: Vec<f64> = offsets.iter().map(|d| c.time + d).collect();
+            let q: Vec<f64> = t
                 .iter()
-                .map(|c| {
-                    let t: Vec<f64> = offsets.iter().map(|d| c.time + d).collect();
-                    let q: Vec<f64> = t
-                        .iter()
-                        .map(|&x| (traj.segment_at(x).eval(j, x).0 / step).round() * step)
-                        .collect();
-                    band_state(&t, &q, c.time, half, step).map_or(f64::INFINITY, |b| b.stderr[var])
-                })
+                .map(|&x| (traj.segment_at(x).eval(j, x).0 / step).round() * step)
                 .collect();
-            let perturbations: Vec<f64> = experiment.deltas.column(j).iter().copied().collect();
-            Resolution::of(&joint_names[j], step, &stderr, &perturbations)
-        })
-        .collect()
+            stderr.push(
+                band_state(&t, &q, c.time, half, step).map_or(f64::INFINITY, |b| b.stderr[var]),
+            );
+        }
+        let perturbations: Vec<f64> = experiment.deltas.column(j).iter().copied().collect();
+        out.extend(Resolution::of(
+            &joint_names[j],
+            step,
+            &stderr,
+            &perturbations,
+        ));
+    }
+    Ok(out)
 }
 
 /// The planner's warning for an experiment perturbing `variable` (0 = q, 1 = qd, 2 = qdd) with
