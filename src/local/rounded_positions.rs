@@ -107,6 +107,15 @@ pub fn unresolved(
     }
 }
 
+/// The plural name and unit of a perturbed variable (0 = q, 1 = qd, 2 = qdd) in warnings.
+fn variable_name(variable: usize) -> (&'static str, &'static str) {
+    match variable {
+        0 => ("positions", "rad"),
+        1 => ("velocities", "rad/s"),
+        _ => ("accelerations", "rad/s^2"),
+    }
+}
+
 /// A measured perturbation is called coarse when the median standard error of its crossings
 /// exceeds this fraction of its RMS over them ([`resolution_warning`]).
 pub const COARSE_FRACTION: f64 = 0.1;
@@ -161,11 +170,7 @@ pub fn resolution_warning(
     variable: usize,
     joints: &[Resolution],
 ) -> Option<String> {
-    let (what, unit) = match variable {
-        0 => ("positions", "rad"),
-        1 => ("velocities", "rad/s"),
-        _ => ("accelerations", "rad/s^2"),
-    };
+    let (what, unit) = variable_name(variable);
     let coarse: Vec<String> = joints
         .iter()
         .filter(|r| r.coarse())
@@ -253,11 +258,7 @@ pub fn planned_resolution_warning(
     joints: &[Resolution],
     window: f64,
 ) -> Option<String> {
-    let (what, unit) = match variable {
-        0 => ("positions", "rad"),
-        1 => ("velocities", "rad/s"),
-        _ => ("accelerations", "rad/s^2"),
-    };
+    let (what, unit) = variable_name(variable);
     let coarse: Vec<&Resolution> = joints.iter().filter(|r| r.coarse()).collect();
     if coarse.is_empty() {
         return None;
