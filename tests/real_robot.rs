@@ -164,8 +164,10 @@ fn clock_offsets_are_found_and_corrected() {
             rel(mat(&naive.h), mat(&reference.h)),
             rel(mat(&m.h), mat(&reference.h)),
         );
+        // (the screening for glitches replaces the samples a misplaced Coulomb step leaves on
+        // its wrong side, which makes the misaligned read less wrong: 50x, 100x before)
         assert!(
-            wrong > 100.0 * right && wrong > 0.05,
+            wrong > 20.0 * right && wrong > 0.05,
             "{offset}: H* {wrong:.2e} off at planned times, {right:.2e} aligned"
         );
     }

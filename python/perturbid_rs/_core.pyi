@@ -338,7 +338,10 @@ class LocalModel:
         samples (N m, one torque sample's noise), passes (N m, what varied from pass to pass
         beyond it, or None), step (N m, the step the torque was logged in where it is coarser
         than its noise, or None), position_step (rad, the encoder step of positions read by
-        the band of half a count about them, or None)), warnings."""
+        the band of half a count about them, or None)), glitches (list of dicts: experiment,
+        crossing, signal ('q', 'qd', 'qdd', 'tau'), joint, sample (0-based), time (s), value,
+        noise_levels (or None beyond any scale), replaced (True for an isolated glitch replaced
+        by the fit of its window's other samples)), warnings."""
     def linearize(self, op: OperatingPoint) -> dict[str, Any]:
         """torque (n,), D, H, G (n, n) and G_static (n, n) or None at op."""
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:

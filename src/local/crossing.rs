@@ -4,6 +4,7 @@
 
 use nalgebra::DMatrix;
 
+use super::glitches::{self, Screened};
 use super::plan::Experiment;
 use super::rounded_positions::band_state;
 use crate::error::{Error, Result};
@@ -36,6 +37,87 @@ pub struct CrossingValues {
     /// rounded to encoder counts by the band of half a count about them
     /// ([`super::rounded_positions`]) rather than by least squares.
     pub position_band: Vec<bool>,
+    /// Samples of this crossing's windows found far off their fits ([`super::glitches`]):
+    /// replaced by the fit of the others where isolated, left in otherwise.
+    pub glitches: Vec<WindowGlitch>,
+}
+
+/// A recorded signal of a joint.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Signal {
+    /// Position (rad).
+    Q,
+    /// Recorded velocity (rad/s).
+    Qd,
+    /// Recorded acceleration (rad/s^2).
+    Qdd,
+    /// Torque (N m).
+    Tau,
+}
+
+impl Signal {
+    /// The signals in the order of [`SignalScales::noise`].
+    pub const ALL: [Signal; 4] = [Signal::Q, Signal::Qd, Signal::Qdd, Signal::Tau];
+
+    /// The signal's place in [`Signal::ALL`].
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The column prefix of the signal in recordings (`q`, `qd`, `qdd`, `tau`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Signal::Q => "q",
+            Signal::Qd => "qd",
+            Signal::Qdd => "qdd",
+            Signal::Tau => "tau",
+        }
+    }
+
+    /// The signal's unit.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Signal::Q => "rad",
+            Signal::Qd => "rad/s",
+            Signal::Qdd => "rad/s^2",
+            Signal::Tau => "N m",
+        }
+    }
+}
+
+/// A sample found far off its window's fit (see [`super::glitches`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WindowGlitch {
+    pub signal: Signal,
+    /// Joint index (0-based).
+    pub joint: usize,
+    /// Index of the sample in the recording (0-based).
+    pub sample: usize,
+    /// Its time in the recording's clock (s).
+    pub time: f64,
+    /// Its recorded value (the signal's unit).
+    pub value: f64,
+    /// How far off the fit of the others, in the window's robust noise levels.
+    pub noise_levels: f64,
+    /// Whether it was replaced by the fit of the others (an isolated glitch) or left in (one
+    /// of more than [`super::glitches::MAX_PER_WINDOW`] such samples in the window).
+    pub replaced: bool,
+}
+
+/// What is known of a recording's signals before its crossings are read, per joint (empty
+/// vectors: nothing known): the grids (steps) they lie on, found over the whole recording or
+/// the experiment's windows, and their noise levels over the experiment's windows. The steps
+/// select the band read of rounded positions; all of it sets the least noise level the
+/// glitch screening of one window assumes ([`super::glitches`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SignalScales {
+    /// Encoder steps of the positions (rad; [`super::rounded_positions::position_steps`]).
+    pub position_step: Vec<Option<f64>>,
+    /// Steps of the torques (N m; [`super::quantisation::torque_steps`]).
+    pub torque_step: Vec<Option<f64>>,
+    /// The noise level of each signal (indexed by [`Signal::index`]: q, qd, qdd, tau; the
+    /// signal's unit) over the experiment's windows ([`noise_levels`]).
+    pub noise: Vec<[f64; 4]>,
 }
 
 /// How to read crossing values from a recording.
@@ -82,35 +164,108 @@ fn basis(t: f64, tc: f64, half: f64, degree: usize, step: Option<(f64, f64)>, d:
     }
 }
 
-/// Least-squares weights of a polynomial fit of degree `degree` (and a step, see [`basis`])
-/// over the samples `t[lo..hi]`: row `d` of the result maps the samples onto coefficient `d`.
-fn fit_weights(
-    t: &[f64],
-    tc: f64,
-    half: f64,
-    degree: usize,
-    step: Option<(f64, f64)>,
-) -> Result<DMatrix<f64>> {
-    let cols = degree + 1 + usize::from(step.is_some());
-    let v = DMatrix::from_fn(t.len(), cols, |i, d| basis(t[i], tc, half, degree, step, d));
-    v.pseudo_inverse(1e-12).map_err(|m| Error::Numerical {
-        operation: "crossing fit".into(),
-        message: m.into(),
-    })
+/// A polynomial fit of degree `degree` (and a step, see [`basis`]) over the samples at `t`:
+/// the basis functions at the samples (K x C) and the least-squares weights (C x K, row `d`
+/// maps the samples onto coefficient `d`).
+struct WindowFit {
+    basis: DMatrix<f64>,
+    weights: DMatrix<f64>,
 }
 
-fn apply(
-    w: &DMatrix<f64>,
-    row: usize,
+impl WindowFit {
+    fn new(t: &[f64], tc: f64, half: f64, degree: usize, step: Option<(f64, f64)>) -> Result<Self> {
+        let cols = degree + 1 + usize::from(step.is_some());
+        let v = DMatrix::from_fn(t.len(), cols, |i, d| basis(t[i], tc, half, degree, step, d));
+        let weights = v
+            .clone()
+            .pseudo_inverse(1e-12)
+            .map_err(|m| Error::Numerical {
+                operation: "crossing fit".into(),
+                message: m.into(),
+            })?;
+        Ok(Self { basis: v, weights })
+    }
+
+    /// Coefficient `d` of the fit of the window's samples `y`.
+    fn coefficient(&self, d: usize, y: &[f64]) -> f64 {
+        y.iter()
+            .enumerate()
+            .map(|(i, v)| self.weights[(d, i)] * v)
+            .sum()
+    }
+
+    /// The sum of squared residuals of `y` about its fit.
+    fn scatter(&self, y: &[f64]) -> f64 {
+        let c: Vec<f64> = (0..self.weights.nrows())
+            .map(|d| self.coefficient(d, y))
+            .collect();
+        y.iter()
+            .enumerate()
+            .map(|(i, v)| {
+                let fit: f64 = c
+                    .iter()
+                    .enumerate()
+                    .map(|(d, c)| c * self.basis[(i, d)])
+                    .sum();
+                (v - fit).powi(2)
+            })
+            .sum()
+    }
+
+    /// Screens `y` for glitches ([`super::glitches`]), with a noise level of at least the
+    /// signal's over the experiment's windows, the rounding of its grid (when it lies on one)
+    /// and 1e-8 of the window's largest value.
+    fn screen(&self, y: &[f64], floor: Floor) -> Screened {
+        let size = y.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let floor = floor
+            .step
+            .map_or(0.0, |s| s / 12f64.sqrt())
+            .max(floor.noise)
+            .max(1e-8 * size)
+            .max(f64::MIN_POSITIVE);
+        glitches::screen(&self.basis, &self.weights, y, floor)
+    }
+}
+
+/// Joint `j`'s samples `lo..lo + count` of the row-major `values` (N per sample).
+fn samples(values: &[f64], (lo, count): (usize, usize), n: usize, j: usize) -> Vec<f64> {
+    (lo..lo + count).map(|i| values[i * n + j]).collect()
+}
+
+/// The least noise level a window's screening assumes for one signal: its level over the
+/// experiment's windows (0 unknown) and the step of a grid it lies on.
+struct Floor {
+    noise: f64,
+    step: Option<f64>,
+}
+
+/// One signal's samples in a window after screening, with what was found recorded in `out`.
+#[allow(clippy::too_many_arguments)]
+fn screened(
+    fit: &WindowFit,
+    rec: &Recording,
     values: &[f64],
-    lo: usize,
-    count: usize,
-    n: usize,
+    range: (usize, usize),
+    floor: Floor,
+    signal: Signal,
     j: usize,
-) -> f64 {
-    (0..count)
-        .map(|i| w[(row, i)] * values[(lo + i) * n + j])
-        .sum()
+    out: &mut Vec<WindowGlitch>,
+) -> Screened {
+    let y = samples(values, range, rec.n, j);
+    let s = fit.screen(&y, floor);
+    for f in &s.flagged {
+        let sample = range.0 + f.index;
+        out.push(WindowGlitch {
+            signal,
+            joint: j,
+            sample,
+            time: rec.t[sample],
+            value: f.value,
+            noise_levels: f.noise_levels,
+            replaced: s.isolated,
+        });
+    }
+    s
 }
 
 /// One joint's torque read at a crossing: the value (N m), its noise gain and the samples'
@@ -121,25 +276,18 @@ struct TorqueReading {
     scatter: (f64, usize),
 }
 
-/// Reads joint `j`'s torque at `tc` from the samples `lo..lo + count` of `rec` with the fit
-/// weights `w` of degree `degree` about `tc` with half-width `half` (and the step `step`: its
-/// height counts on the crossing's side, none exactly at the reversal).
-#[allow(clippy::too_many_arguments)]
+/// Reads a torque at `tc` from its window's samples `y` (glitches replaced) with `fit` (and
+/// the step `step`: its height counts on the crossing's side, none exactly at the reversal);
+/// `replaced` samples count as left out of the scatter's degrees of freedom.
 fn read_torque(
-    rec: &Recording,
-    w: &DMatrix<f64>,
-    (lo, count): (usize, usize),
+    fit: &WindowFit,
+    y: &[f64],
     tc: f64,
-    half: f64,
-    degree: usize,
     step: Option<(f64, f64)>,
-    j: usize,
+    replaced: usize,
 ) -> TorqueReading {
-    let n = rec.n;
+    let w = &fit.weights;
     let cols = w.nrows();
-    let c: Vec<f64> = (0..cols)
-        .map(|d| apply(w, d, &rec.tau, lo, count, n, j))
-        .collect();
     // the value at tc: the constant term, and the step's height on tc's side of it
     let side = match step {
         Some((reversal, slope)) if tc != reversal => (slope * (tc - reversal)).signum(),
@@ -153,21 +301,17 @@ fn read_torque(
                 0.0
             }
     };
-    let value = c[0] + if side != 0.0 { side * c[cols - 1] } else { 0.0 };
-    let gain = (0..count).map(|i| at(i).powi(2)).sum::<f64>().sqrt();
-    let ss = (0..count)
-        .map(|i| {
-            let t = rec.t[lo + i];
-            let fit: f64 = (0..cols)
-                .map(|d| c[d] * basis(t, tc, half, degree, step, d))
-                .sum();
-            (rec.tau[(lo + i) * n + j] - fit).powi(2)
-        })
-        .sum();
+    let value = fit.coefficient(0, y)
+        + if side != 0.0 {
+            side * fit.coefficient(cols - 1, y)
+        } else {
+            0.0
+        };
+    let gain = (0..y.len()).map(|i| at(i).powi(2)).sum::<f64>().sqrt();
     TorqueReading {
         value,
         gain,
-        scatter: (ss, count.saturating_sub(cols)),
+        scatter: (fit.scatter(y), y.len().saturating_sub(cols + replaced)),
     }
 }
 
@@ -198,7 +342,7 @@ pub fn values_at(
         tc,
         half,
         &vec![TorqueFit::Window(half); rec.n],
-        &[],
+        &SignalScales::default(),
         options,
         what,
     )
@@ -209,74 +353,266 @@ pub(crate) fn samples_needed(options: &FitOptions) -> usize {
     2.max(options.torque_degree) + 3
 }
 
+/// A crossing's window in a recording: its samples `lo..lo + count` (times `t`), the
+/// position fit, the full window's torque fit, and each joint's torque fit where it differs
+/// (narrowed, or with a step) with its samples and step.
+struct Window<'a> {
+    lo: usize,
+    count: usize,
+    t: &'a [f64],
+    fq: WindowFit,
+    ft: WindowFit,
+    torque: Vec<JointTorqueFit>,
+}
+
+/// One joint's torque fit in a window: its own fit where it differs from the window's, the
+/// samples it covers (first, count) and the Coulomb step it models.
+struct JointTorqueFit {
+    fit: Option<WindowFit>,
+    range: (usize, usize),
+    step: Option<(f64, f64)>,
+}
+
+impl<'a> Window<'a> {
+    /// The window of `+-half` s about `tc` (the recording's clock) with each joint's torque
+    /// read as `torque[j]` says; fails when it is not inside the recording or holds too few
+    /// samples.
+    fn new(
+        rec: &'a Recording,
+        tc: f64,
+        half: f64,
+        torque: &[TorqueFit],
+        options: &FitOptions,
+        what: &str,
+    ) -> Result<Self> {
+        let n = rec.n;
+        if torque.len() != n {
+            return Err(Error::Shape {
+                argument: "torque fits".into(),
+                expected: format!("{n} (one per joint)"),
+                got: torque.len().to_string(),
+            });
+        }
+        let (first, last) = (rec.t[0], rec.t[rec.len() - 1]);
+        let eps = 1e-9 * half;
+        if tc - half < first - eps || tc + half > last + eps {
+            return Err(Error::Recording {
+                recording: rec.name.clone(),
+                message: format!(
+                    "{what} at t = {tc:.4} s needs data from {:.4} to {:.4} s; the recording covers {first:.4} to {last:.4} s (too short, or its clock is offset from the plan's: align it with detected crossing times)",
+                    tc - half,
+                    tc + half
+                ),
+            });
+        }
+        let span = |h: f64| {
+            let e = 1e-9 * h;
+            let lo = rec.t.partition_point(|&t| t < tc - h - e);
+            let hi = rec.t.partition_point(|&t| t <= tc + h + e);
+            (lo, hi)
+        };
+        let (lo, hi) = span(half);
+        let count = hi - lo;
+        let needed = samples_needed(options);
+        let too_few = |count: usize, h: f64| {
+            Error::Recording {
+            recording: rec.name.clone(),
+            message: format!(
+                "{what} at t = {tc:.4} s: {count} samples in the +-{h} s window, need at least {needed}"
+            ),
+        }
+        };
+        if count < needed {
+            return Err(too_few(count, half));
+        }
+        let t = &rec.t[lo..hi];
+        let degree = options.torque_degree;
+        let torque = torque
+            .iter()
+            .map(|fit| {
+                Ok(match *fit {
+                    TorqueFit::Window(h) if h >= half => JointTorqueFit {
+                        fit: None,
+                        range: (lo, count),
+                        step: None,
+                    },
+                    TorqueFit::Window(h) => {
+                        let (lo_j, hi_j) = span(h);
+                        if hi_j - lo_j < needed {
+                            return Err(too_few(hi_j - lo_j, h));
+                        }
+                        JointTorqueFit {
+                            fit: Some(WindowFit::new(&rec.t[lo_j..hi_j], tc, h, degree, None)?),
+                            range: (lo_j, hi_j - lo_j),
+                            step: None,
+                        }
+                    }
+                    TorqueFit::Step { reversal, slope } => {
+                        let step = Some((reversal, slope));
+                        JointTorqueFit {
+                            fit: Some(WindowFit::new(t, tc, half, degree, step)?),
+                            range: (lo, count),
+                            step,
+                        }
+                    }
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Self {
+            lo,
+            count,
+            t,
+            fq: WindowFit::new(t, tc, half, 2, None)?,
+            ft: WindowFit::new(t, tc, half, degree, None)?,
+            torque,
+        })
+    }
+
+    /// Joint `j`'s torque fit.
+    fn torque_fit(&self, j: usize) -> &WindowFit {
+        self.torque[j].fit.as_ref().unwrap_or(&self.ft)
+    }
+}
+
+/// The noise level (the signal's unit) of each signal of each joint over the windows of
+/// `+-half` s about the times `centres` (the recording's clock; each with its joints' torque
+/// fits): per window, 1.4826 times the median studentised residual about the fit that reads
+/// it ([`super::glitches::level`]); over the windows, their median. One row per joint,
+/// indexed by [`Signal::index`]; 0 where unknown (a signal not recorded, or not read from
+/// its own column). Windows that cannot be read (outside the recording, too few samples)
+/// are passed over: reading them says why.
+pub fn noise_levels(
+    rec: &Recording,
+    centres: &[(f64, Vec<TorqueFit>)],
+    half: f64,
+    options: &FitOptions,
+) -> Vec<[f64; 4]> {
+    let windows: Vec<Window> = centres
+        .iter()
+        .filter_map(|(tc, fits)| Window::new(rec, *tc, half, fits, options, "").ok())
+        .collect();
+    levels(rec, &windows, options)
+}
+
+/// [`noise_levels`] over windows already made.
+fn levels(rec: &Recording, windows: &[Window], options: &FitOptions) -> Vec<[f64; 4]> {
+    let n = rec.n;
+    let mut per_window: Vec<[Vec<f64>; 4]> = (0..n).map(|_| Default::default()).collect();
+    for w in windows {
+        let range = (w.lo, w.count);
+        for (j, levels) in per_window.iter_mut().enumerate() {
+            let mut add = |signal: Signal, fit: &WindowFit, values: &[f64], range| {
+                let y = samples(values, range, n, j);
+                levels[signal.index()].push(glitches::level(&fit.basis, &fit.weights, &y));
+            };
+            add(Signal::Q, &w.fq, &rec.q, range);
+            add(Signal::Tau, w.torque_fit(j), &rec.tau, w.torque[j].range);
+            if options.recorded_derivatives {
+                if let Some(qd) = &rec.qd {
+                    add(Signal::Qd, &w.ft, qd, range);
+                }
+                if let Some(qdd) = &rec.qdd {
+                    add(Signal::Qdd, &w.ft, qdd, range);
+                }
+            }
+        }
+    }
+    per_window
+        .into_iter()
+        .map(|levels| {
+            levels.map(|mut l| {
+                if l.is_empty() {
+                    return 0.0;
+                }
+                let mid = l.len() / 2;
+                *l.select_nth_unstable_by(mid, f64::total_cmp).1
+            })
+        })
+        .collect()
+}
+
+/// Reads the values at every window of `windows` (the time in the recording's clock, each
+/// joint's torque fit, and what the window is, for messages) as [`values_at_with`] does,
+/// with `scales`' noise levels set to the signals' over these windows ([`noise_levels`]),
+/// each window's fits made once. Returns the values in the order of `windows`, and the
+/// scales used.
+pub fn values_in_windows(
+    rec: &Recording,
+    windows: &[(f64, Vec<TorqueFit>, String)],
+    half: f64,
+    scales: SignalScales,
+    options: &FitOptions,
+) -> Result<(Vec<CrossingValues>, SignalScales)> {
+    let made = windows
+        .iter()
+        .map(|(tc, fits, what)| Window::new(rec, *tc, half, fits, options, what))
+        .collect::<Result<Vec<_>>>()?;
+    let scales = SignalScales {
+        noise: levels(rec, &made, options),
+        ..scales
+    };
+    check_scales(&scales, rec.n)?;
+    let values = made
+        .iter()
+        .zip(windows)
+        .map(|(w, (tc, _, _))| read(rec, w, *tc, half, &scales, options))
+        .collect();
+    Ok((values, scales))
+}
+
+/// Checks that `scales` has one entry per joint (or none) of each kind.
+fn check_scales(scales: &SignalScales, n: usize) -> Result<()> {
+    for (name, len) in [
+        ("position steps", scales.position_step.len()),
+        ("torque steps", scales.torque_step.len()),
+        ("noise levels", scales.noise.len()),
+    ] {
+        if !(len == 0 || len == n) {
+            return Err(Error::Shape {
+                argument: name.into(),
+                expected: format!("{n} (one per joint) or none"),
+                got: len.to_string(),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// [`values_at`] with the torque of each joint read as `torque[j]` says (a narrower window, or
 /// a step at a velocity reversal; see [`TorqueFit`]); the positions are always fitted over
-/// `+-half`. `position_steps` (one per joint, or empty for none) gives the encoder step (rad)
-/// of each joint's positions where they lie on a grid
-/// ([`super::rounded_positions::position_steps`]): such a joint's state is read by the band of
-/// half a step where every reading of the window lies in it
-/// ([`super::rounded_positions::band_state`]), by least squares otherwise.
+/// `+-half`. `scales` gives what is known of the signals (one entry per joint each, or empty
+/// for none): a joint whose positions lie on an encoder's grid
+/// ([`super::rounded_positions::position_steps`]) has its state read by the band of half a
+/// step where every reading of the window lies in it
+/// ([`super::rounded_positions::band_state`]), by least squares otherwise. Every signal's
+/// window is screened for isolated glitches first ([`super::glitches`]; the noise levels and
+/// steps of `scales` are the least noise levels assumed), reported in
+/// [`CrossingValues::glitches`].
 pub fn values_at_with(
     rec: &Recording,
     tc: f64,
     half: f64,
     torque: &[TorqueFit],
-    position_steps: &[Option<f64>],
+    scales: &SignalScales,
     options: &FitOptions,
     what: &str,
 ) -> Result<CrossingValues> {
+    check_scales(scales, rec.n)?;
+    let w = Window::new(rec, tc, half, torque, options, what)?;
+    Ok(read(rec, &w, tc, half, scales, options))
+}
+
+/// The values at `tc` read from the window `w` (see [`values_at_with`]).
+fn read(
+    rec: &Recording,
+    w: &Window,
+    tc: f64,
+    half: f64,
+    scales: &SignalScales,
+    options: &FitOptions,
+) -> CrossingValues {
     let n = rec.n;
-    if torque.len() != n {
-        return Err(Error::Shape {
-            argument: "torque fits".into(),
-            expected: format!("{n} (one per joint)"),
-            got: torque.len().to_string(),
-        });
-    }
-    if !(position_steps.is_empty() || position_steps.len() == n) {
-        return Err(Error::Shape {
-            argument: "position steps".into(),
-            expected: format!("{n} (one per joint) or none"),
-            got: position_steps.len().to_string(),
-        });
-    }
-    let (first, last) = (rec.t[0], rec.t[rec.len() - 1]);
-    let eps = 1e-9 * half;
-    if tc - half < first - eps || tc + half > last + eps {
-        return Err(Error::Recording {
-            recording: rec.name.clone(),
-            message: format!(
-                "{what} at t = {tc:.4} s needs data from {:.4} to {:.4} s; the recording covers {first:.4} to {last:.4} s (too short, or its clock is offset from the plan's: align it with detected crossing times)",
-                tc - half,
-                tc + half
-            ),
-        });
-    }
-    let span = |h: f64| {
-        let e = 1e-9 * h;
-        let lo = rec.t.partition_point(|&t| t < tc - h - e);
-        let hi = rec.t.partition_point(|&t| t <= tc + h + e);
-        (lo, hi)
-    };
-    let (lo, hi) = span(half);
-    let count = hi - lo;
-    let needed = samples_needed(options);
-    let too_few = |count: usize, h: f64| Error::Recording {
-        recording: rec.name.clone(),
-        message: format!(
-            "{what} at t = {tc:.4} s: {count} samples in the +-{h} s window, need at least {needed}"
-        ),
-    };
-    if count < needed {
-        return Err(too_few(count, half));
-    }
-    let t = &rec.t[lo..hi];
-    let wq = fit_weights(t, tc, half, 2, None)?;
-    let wt = if options.torque_degree == 2 {
-        wq.clone()
-    } else {
-        fit_weights(t, tc, half, options.torque_degree, None)?
-    };
+    let (lo, count, t) = (w.lo, w.count, w.t);
     let mut out = CrossingValues {
         time: tc,
         q: vec![0.0; n],
@@ -287,37 +623,61 @@ pub fn values_at_with(
         tau_gain: vec![0.0; n],
         tau_scatter: vec![(0.0, 0); n],
         position_band: vec![false; n],
+        glitches: vec![],
     };
     // sum of squared weights per coefficient: the variance factor of each estimate
     let gain: Vec<f64> = (0..3)
-        .map(|d| (0..count).map(|i| wq[(d, i)].powi(2)).sum::<f64>().sqrt())
+        .map(|d| {
+            (0..count)
+                .map(|i| w.fq.weights[(d, i)].powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
         .collect();
-    for (j, fit) in torque.iter().enumerate() {
-        let c = [
-            apply(&wq, 0, &rec.q, lo, count, n, j),
-            apply(&wq, 1, &rec.q, lo, count, n, j),
-            apply(&wq, 2, &rec.q, lo, count, n, j),
-        ];
+    for j in 0..n {
+        let noise = |signal: Signal| scales.noise.get(j).map_or(0.0, |l| l[signal.index()]);
+        let position_step = scales.position_step.get(j).copied().flatten();
+        let floor = |signal: Signal, step: Option<f64>| Floor {
+            noise: noise(signal),
+            step,
+        };
+        let mut screen = |fit: &WindowFit, values: &[f64], range, signal, step| {
+            screened(
+                fit,
+                rec,
+                values,
+                range,
+                floor(signal, step),
+                signal,
+                j,
+                &mut out.glitches,
+            )
+        };
+        let q = screen(&w.fq, &rec.q, (lo, count), Signal::Q, position_step);
+        let c = [0, 1, 2].map(|d| w.fq.coefficient(d, &q.values));
         out.q[j] = c[0];
         out.qd[j] = c[1] / half;
         out.qdd[j] = 2.0 * c[2] / (half * half);
-        let ss: f64 = (0..count)
-            .map(|i| {
-                let u = (t[i] - tc) / half;
-                (rec.q[(lo + i) * n + j] - (c[0] + u * (c[1] + u * c[2]))).powi(2)
-            })
-            .sum();
-        let sigma = if count > 3 {
-            (ss / (count - 3) as f64).sqrt()
+        let dof = count.saturating_sub(3 + q.replaced());
+        let sigma = if dof > 0 {
+            (w.fq.scatter(&q.values) / dof as f64).sqrt()
         } else {
             f64::NAN
         };
         out.state_stderr[0][j] = sigma * gain[0];
         out.state_stderr[1][j] = sigma * gain[1] / half;
         out.state_stderr[2][j] = 2.0 * sigma * gain[2] / (half * half);
-        if let Some(step) = position_steps.get(j).copied().flatten() {
-            let q: Vec<f64> = (0..count).map(|i| rec.q[(lo + i) * n + j]).collect();
-            if let Some(b) = band_state(t, &q, tc, half, step) {
+        if let Some(step) = position_step {
+            // the band of the samples kept: an isolated glitch is no reading of the encoder
+            let left_out: Vec<usize> = match q.isolated {
+                true => q.flagged.iter().map(|f| f.index).collect(),
+                false => vec![],
+            };
+            let (tk, qk): (Vec<f64>, Vec<f64>) = (0..count)
+                .filter(|i| !left_out.contains(i))
+                .map(|i| (t[i], rec.q[(lo + i) * n + j]))
+                .unzip();
+            if let Some(b) = band_state(&tk, &qk, tc, half, step) {
                 out.q[j] = b.values[0];
                 out.qd[j] = b.values[1];
                 out.qdd[j] = b.values[2];
@@ -327,65 +687,34 @@ pub fn values_at_with(
                 out.position_band[j] = true;
             }
         }
-        let reading = match *fit {
-            TorqueFit::Window(h) if h >= half => read_torque(
-                rec,
-                &wt,
-                (lo, count),
-                tc,
-                half,
-                options.torque_degree,
-                None,
-                j,
-            ),
-            TorqueFit::Window(h) => {
-                let (lo_j, hi_j) = span(h);
-                if hi_j - lo_j < needed {
-                    return Err(too_few(hi_j - lo_j, h));
-                }
-                let w = fit_weights(&rec.t[lo_j..hi_j], tc, h, options.torque_degree, None)?;
-                read_torque(
-                    rec,
-                    &w,
-                    (lo_j, hi_j - lo_j),
-                    tc,
-                    h,
-                    options.torque_degree,
-                    None,
-                    j,
-                )
-            }
-            TorqueFit::Step { reversal, slope } => {
-                let step = Some((reversal, slope));
-                let w = fit_weights(t, tc, half, options.torque_degree, step)?;
-                read_torque(
-                    rec,
-                    &w,
-                    (lo, count),
-                    tc,
-                    half,
-                    options.torque_degree,
-                    step,
-                    j,
-                )
-            }
-        };
+        let torque_step = scales.torque_step.get(j).copied().flatten();
+        let jt = &w.torque[j];
+        let y = screen(
+            w.torque_fit(j),
+            &rec.tau,
+            jt.range,
+            Signal::Tau,
+            torque_step,
+        );
+        let reading = read_torque(w.torque_fit(j), &y.values, tc, jt.step, y.replaced());
         out.tau[j] = reading.value;
         out.tau_gain[j] = reading.gain;
         out.tau_scatter[j] = reading.scatter;
         if options.recorded_derivatives {
             if let Some(qd) = &rec.qd {
-                out.qd[j] = apply(&wt, 0, qd, lo, count, n, j);
+                let v = screen(&w.ft, qd, (lo, count), Signal::Qd, None);
+                out.qd[j] = w.ft.coefficient(0, &v.values);
                 if options.torque_degree >= 1 && rec.qdd.is_none() {
-                    out.qdd[j] = apply(&wt, 1, qd, lo, count, n, j) / half;
+                    out.qdd[j] = w.ft.coefficient(1, &v.values) / half;
                 }
             }
             if let Some(qdd) = &rec.qdd {
-                out.qdd[j] = apply(&wt, 0, qdd, lo, count, n, j);
+                let a = screen(&w.ft, qdd, (lo, count), Signal::Qdd, None);
+                out.qdd[j] = w.ft.coefficient(0, &a.values);
             }
         }
     }
-    Ok(out)
+    out
 }
 
 /// The times in `[a, b]` at which joint `j`'s planned velocity changes sign, in order (exact

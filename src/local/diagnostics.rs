@@ -97,6 +97,33 @@ pub struct TorqueNoise {
     pub position_step: Option<f64>,
 }
 
+/// A sample found far off its crossing window's fit (docs/method.md, section 7; see
+/// [`super::glitches`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Glitch {
+    pub experiment: String,
+    /// The crossing whose window held it; `None` for the reference posture's.
+    pub crossing: Option<usize>,
+    /// The signal: `q`, `qd`, `qdd` or `tau`.
+    pub signal: String,
+    pub joint: String,
+    /// Index of the sample in its recording (0-based: data row `sample + 1` of a CSV file).
+    pub sample: usize,
+    /// Its time in the recording's clock (s).
+    pub time: f64,
+    /// Its recorded value (rad, rad/s, rad/s^2 or N m).
+    pub value: f64,
+    /// How far off the fit of the window's other samples, in their robust noise levels;
+    /// `None` beyond any scale (further than a million times the spread of the window's
+    /// values from their median: set aside before any fit).
+    pub noise_levels: Option<f64>,
+    /// True: replaced by the fit of the others (an isolated glitch, as if not recorded).
+    /// False: kept, one of more than [`super::glitches::MAX_PER_WINDOW`] such samples in its
+    /// window (not isolated: something the fit does not model).
+    pub replaced: bool,
+}
+
 /// Diagnostics of a local identification; see the module documentation.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -122,6 +149,10 @@ pub struct Diagnostics {
     /// The torque noise of every joint in each separated regression (G_static, G, H, D).
     #[serde(default)]
     pub noise: Vec<TorqueNoise>,
+    /// Samples found far off their crossing windows' fits: glitches of the log, replaced, or
+    /// not isolated and kept (with a warning).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub glitches: Vec<Glitch>,
     /// What the user should know: each is also given as a Python warning and printed by the
     /// command line.
     #[serde(default)]

@@ -4,8 +4,8 @@
 use nalgebra::DMatrix;
 
 use super::crossing::{
-    detect_offset, samples_needed, values_at_with, velocity_reversals, CrossingValues, FitOptions,
-    TorqueFit,
+    detect_offset, samples_needed, values_in_windows, velocity_reversals, CrossingValues,
+    FitOptions, SignalScales, TorqueFit,
 };
 use super::diagnose::{
     compare_combined, diagnose, disagreement_warning, mass_matrix_warning, unperturbed_deviation,
@@ -15,6 +15,7 @@ use super::errors_in_variables;
 use super::flat_channels::{flat, flat_torque_warning};
 pub use super::flat_channels::{flat_torques, window_torques};
 use super::friction_aware::friction_aware_h;
+use super::glitches;
 use super::model::{Estimate, Estimator, LocalModel};
 use super::noise::{reading_variance, sample_variance, weighted_least_squares};
 use super::operating_point::OperatingPoint;
@@ -220,57 +221,61 @@ pub fn experiment_values(
     let min_half = 0.5 * samples_needed(&options.fit) as f64 * dt;
     let name = experiment.kind.name();
     let mut reversals = vec![];
-    let steps = rounded_positions::position_steps(rec);
-    let mut read = |tp: f64, crossing: Option<usize>, what: String| {
-        let fits = torque_fits(
-            experiment,
-            joint_names,
-            tp,
-            offset,
-            half,
-            min_half,
-            crossing,
-            &mut reversals,
-        );
-        values_at_with(rec, tp + offset, half, &fits, &steps, &options.fit, &what)
-    };
-    let crossings = experiment
+    // every window: the crossings' in order, then the reference posture's, each with its
+    // joints' torque fits
+    let windows: Vec<(f64, Option<usize>, String, Vec<TorqueFit>)> = experiment
         .crossings
         .iter()
         .enumerate()
         .map(|(k, c)| {
-            read(
+            (
                 c.time,
                 Some(k),
                 format!("experiment '{name}', crossing {k}"),
             )
         })
-        .collect::<Result<Vec<_>>>()?;
-    let reference = experiment
-        .reference
-        .as_ref()
-        .map(|c| {
-            read(
-                c.time,
-                None,
-                format!("experiment '{name}', reference posture"),
-            )
+        .chain(experiment.reference.iter().map(|c| {
+            let what = format!("experiment '{name}', reference posture");
+            (c.time, None, what)
+        }))
+        .map(|(tp, crossing, what)| {
+            let fits = torque_fits(
+                experiment,
+                joint_names,
+                tp,
+                offset,
+                half,
+                min_half,
+                crossing,
+                &mut reversals,
+            );
+            (tp, crossing, what, fits)
         })
-        .transpose()?;
-    let centres: Vec<f64> = experiment
-        .crossings
-        .iter()
-        .chain(&experiment.reference)
-        .map(|c| c.time + offset)
         .collect();
+    let centres: Vec<f64> = windows.iter().map(|w| w.0 + offset).collect();
     let torques = window_torques(rec, &centres, half);
+    let in_clock: Vec<(f64, Vec<TorqueFit>, String)> = windows
+        .into_iter()
+        .map(|(tp, _, what, fits)| (tp + offset, fits, what))
+        .collect();
+    let scales = SignalScales {
+        position_step: rounded_positions::position_steps(rec),
+        torque_step: quantisation::torque_steps(&torques),
+        noise: vec![],
+    };
+    let (mut values, scales) = values_in_windows(rec, &in_clock, half, scales, &options.fit)?;
+    let reference = match experiment.reference {
+        Some(_) => values.pop(),
+        None => None,
+    };
+    let crossings = values;
     let position_step = (0..rec.n)
         .map(|j| {
             let banded = crossings
                 .iter()
                 .chain(&reference)
                 .any(|c| c.position_band[j]);
-            steps[j].filter(|_| banded)
+            scales.position_step[j].filter(|_| banded)
         })
         .collect();
     Ok(ExperimentValues {
@@ -280,7 +285,7 @@ pub fn experiment_values(
         reference,
         reversals,
         flat_torque: flat(&torques),
-        torque_step: quantisation::torque_steps(&torques),
+        torque_step: scales.torque_step,
         position_step,
     })
 }
@@ -378,6 +383,7 @@ pub fn identify_local(
 ) -> Result<LocalModel> {
     let n = plan.n();
     let mut values = Vec::new();
+    let mut recording_names: Vec<String> = Vec::new();
     for (e, r) in plan
         .experiments
         .iter()
@@ -395,6 +401,7 @@ pub fn identify_local(
             });
         }
         values.push(experiment_values(e, r, &plan.joint_names, options)?);
+        recording_names.push(r.name.clone());
     }
     let find = |kind| values.iter().find(|v: &&ExperimentValues| v.kind == kind);
     let names = |prefix: &str| -> Vec<String> {
@@ -698,6 +705,11 @@ pub fn identify_local(
         }
     };
     let mut diagnostics = diagnose(&values);
+    for (v, name) in values.iter().zip(&recording_names) {
+        let (found, warnings) = glitches::report(v, name, &plan.joint_names);
+        diagnostics.glitches.extend(found);
+        diagnostics.warnings.extend(warnings);
+    }
     let deviation = unperturbed_deviation(&values, &op_state, &op_var);
     if let Some(w) = disagreement_warning(&disagreement, options.estimator, deviation) {
         diagnostics.warnings.push(w);

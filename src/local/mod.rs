@@ -36,6 +36,7 @@ pub mod diagnostics;
 pub mod errors_in_variables;
 mod flat_channels;
 mod friction_aware;
+pub mod glitches;
 pub mod identify;
 pub mod model;
 pub mod noise;
@@ -47,7 +48,10 @@ pub mod point_design;
 pub mod quantisation;
 pub mod rounded_positions;
 
-pub use crossing::{values_at, values_at_with, CrossingValues, FitOptions, TorqueFit};
+pub use crossing::{
+    noise_levels, values_at, values_at_with, values_in_windows, CrossingValues, FitOptions, Signal,
+    SignalScales, TorqueFit, WindowGlitch,
+};
 pub use diagnostics::{
     BlockAgreement, ClockOffset, Diagnostics, Reversal, ReversalHandling, TorqueNoise, Unmeasured,
 };

@@ -185,6 +185,12 @@ impl Document for LocalModel {
                     .unmeasured
                     .iter()
                     .map(|u| (&u.experiment, &u.joint)),
+            )
+            .chain(
+                m.diagnostics
+                    .glitches
+                    .iter()
+                    .map(|g| (&g.experiment, &g.joint)),
             );
         for (experiment, joint) in named {
             if !super::ExperimentKind::ALL
@@ -201,6 +207,23 @@ impl Document for LocalModel {
                         .join(", "),
                     m.joint_names.join(", ")
                 )));
+            }
+        }
+        for (i, g) in m.diagnostics.glitches.iter().enumerate() {
+            let what = format!("diagnostics.glitches[{i}]");
+            if !["q", "qd", "qdd", "tau"].contains(&g.signal.as_str()) {
+                return Err(bad(format!(
+                    "{what}.signal is '{}'; expected one of q, qd, qdd, tau",
+                    g.signal
+                )));
+            }
+            for (field, v) in [("time", g.time), ("value", g.value)] {
+                if !v.is_finite() {
+                    return Err(bad(format!("{what}.{field} is not a finite number")));
+                }
+            }
+            if let Some(z) = g.noise_levels {
+                check_magnitude(Self::WHAT, &format!("{what}.noise_levels"), z, false)?;
             }
         }
         for (i, e) in m.diagnostics.noise.iter().enumerate() {

@@ -445,7 +445,13 @@ impl PyLocalModel {
     /// `joint`, `samples` (N m, one torque sample's noise), `passes` (N m, what varied from pass
     /// to pass beyond it, or None), `step` (N m, the step the torque was logged in where it is
     /// coarser than its noise: the standard errors of its rows include the rounding; else
-    /// None)), `warnings` (list of str).
+    /// None)), `glitches` (list of dicts: `experiment`, `crossing` (None for the reference
+    /// posture), `signal` ('q', 'qd', 'qdd' or 'tau'), `joint`, `sample` (0-based index in its
+    /// recording), `time` (s, the recording's clock), `value` (as recorded), `noise_levels`
+    /// (how far off the fit of its window's other samples, or None beyond any scale: a million
+    /// times the spread of the window's values),
+    /// `replaced` (True: an isolated glitch replaced by that fit; False: kept, one of more than
+    /// 3 in its window)), `warnings` (list of str).
     #[getter]
     fn diagnostics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = &self.model.diagnostics;
@@ -507,6 +513,24 @@ impl PyLocalModel {
             })
             .collect::<PyResult<Vec<_>>>()?;
         out.set_item("noise", noise)?;
+        let glitches = d
+            .glitches
+            .iter()
+            .map(|g| {
+                let e = PyDict::new(py);
+                e.set_item("experiment", &g.experiment)?;
+                e.set_item("crossing", g.crossing)?;
+                e.set_item("signal", &g.signal)?;
+                e.set_item("joint", &g.joint)?;
+                e.set_item("sample", g.sample)?;
+                e.set_item("time", g.time)?;
+                e.set_item("value", g.value)?;
+                e.set_item("noise_levels", g.noise_levels)?;
+                e.set_item("replaced", g.replaced)?;
+                Ok(e)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        out.set_item("glitches", glitches)?;
         out.set_item("warnings", d.warnings.clone())?;
         Ok(out)
     }

@@ -295,6 +295,31 @@ def test_a_dead_torque_channel_is_warned_about_and_marked_unmeasured():
     assert clean.diagnostics["unmeasured"] == []
 
 
+def test_a_glitch_in_a_log_is_replaced_and_reported():
+    robot = pr.robots.a465()
+    plan = pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2))
+    recs = pr.simulate(robot, plan, torque_noise=0.02, position_noise=1e-5, seed=5, friction=None)
+    clean = pr.identify_local(plan, recs)
+    assert clean.diagnostics["glitches"] == []
+    (d,) = [e for e in plan.experiments if e.kind == "D"]
+    spiked = []
+    for r in recs:
+        tau = r.tau.copy()
+        if r.experiment == "D":
+            i = int(np.searchsorted(r.t, d.crossing_times[2] + 0.004))
+            tau[i, 1] += 60.0
+            sample = i
+        spiked.append(pr.Recording(r.t, r.q, tau, name=r.name, experiment=r.experiment))
+    with pytest.warns(pr.PerturbidWarning, match=f"tau of 'joint2' at t = .* \\(sample {sample}\\) read"):
+        model = pr.identify_local(plan, spiked)
+    (g,) = model.diagnostics["glitches"]
+    assert g["experiment"] == "D" and g["signal"] == "tau" and g["joint"] == "joint2"
+    assert g["sample"] == sample and g["replaced"] is True and g["noise_levels"] > 10
+    assert g["value"] == pytest.approx(spiked[[r.experiment for r in recs].index("D")].tau[sample, 1])
+    # as if the sample had not been recorded: the model is the clean one to its noise
+    np.testing.assert_allclose(model.D, clean.D, atol=0.2 * np.max(clean.stderr["D"]))
+
+
 def test_the_torque_noise_is_reported_per_experiment_and_joint():
     robot = pr.robots.a465()
     plan = pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2))

@@ -1,0 +1,220 @@
+//! Logs with glitches, as real robots write them: single samples far off (a corrupted message,
+//! a sensor's spike, a value that overflows), and bursts of them. Each case is checked
+//! against the model identified from the same log without them.
+
+mod common;
+
+use common::{mat, table2};
+use perturbid_rs::document::Document;
+use perturbid_rs::local::{
+    identify_local, plan_experiments, IdentifyOptions, LocalModel, Plan, PlanOptions,
+};
+use perturbid_rs::robots::a465;
+use perturbid_rs::{simulate_plan, Recording, SimulationOptions};
+
+/// The paper's plan at Table 2 and its noisy rehearsal (0.05 N m of torque noise, 1e-5 rad of
+/// position noise, friction-free).
+fn noisy_logs() -> (Plan, Vec<Recording>) {
+    let model = a465::model("kinsheel2010").unwrap();
+    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
+    let mut sim = SimulationOptions::new(&model);
+    sim.torque_noise = vec![0.05; model.nv];
+    sim.position_noise = vec![1e-5; model.nv];
+    sim.seed = 11;
+    let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    (plan, recs)
+}
+
+/// The recording of experiment `name`.
+fn log<'a>(recs: &'a mut [Recording], name: &str) -> &'a mut Recording {
+    recs.iter_mut()
+        .find(|r| r.experiment.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no recording of {name}"))
+}
+
+/// The sample of `rec` nearest to `t` (s).
+fn sample_at(rec: &Recording, t: f64) -> usize {
+    rec.t.partition_point(|&s| s < t)
+}
+
+/// The largest difference between two models' D*, H* and G*, in the clean model's standard
+/// errors.
+fn worst_in_stderr(a: &LocalModel, clean: &LocalModel) -> f64 {
+    [(&a.d, &clean.d), (&a.h, &clean.h), (&a.g, &clean.g)]
+        .into_iter()
+        .map(|(x, c)| {
+            let c = c.as_ref().unwrap();
+            (mat(x) - &c.matrix)
+                .zip_map(&c.stderr, |d, s| (d / s).abs())
+                .max()
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn isolated_glitches_are_replaced_and_reported() {
+    let (plan, mut recs) = noisy_logs();
+    let options = IdentifyOptions::default();
+    let clean = identify_local(&plan, &recs, &options).unwrap();
+    assert!(
+        clean.diagnostics.glitches.is_empty(),
+        "glitches in a clean log: {:?}",
+        clean.diagnostics.glitches
+    );
+    let n = plan.joint_names.len();
+    let crossing = |kind: &str, k: usize| {
+        plan.experiments
+            .iter()
+            .find(|e| e.kind.name() == kind)
+            .unwrap()
+            .crossings[k]
+            .time
+    };
+    // a torque spike of 50 N m in D's first window (joint 6, whose window is narrowed at a
+    // velocity reversal), a position 0.01 rad off in H's, and a torque that overflows any
+    // scale in the nominal passes'
+    let d = log(&mut recs, "D");
+    let i_d = sample_at(d, crossing("D", 0) + 0.003);
+    d.tau[i_d * n + 5] = 50.0;
+    let h = log(&mut recs, "H");
+    let i_h = sample_at(h, crossing("H", 3) - 0.01);
+    h.q[i_h * n] += 0.01;
+    let nominal = log(&mut recs, "nominal");
+    let i_n = sample_at(nominal, crossing("nominal", 5) + 0.02);
+    nominal.tau[i_n * n + 2] = 1e300;
+    let m = identify_local(&plan, &recs, &options).unwrap();
+    let worst = worst_in_stderr(&m, &clean);
+    assert!(
+        worst < 0.5,
+        "{worst:.2} standard errors off the clean model"
+    );
+    let found: Vec<(&str, &str, &str, usize, bool)> = m
+        .diagnostics
+        .glitches
+        .iter()
+        .map(|g| {
+            (
+                g.experiment.as_str(),
+                g.signal.as_str(),
+                g.joint.as_str(),
+                g.sample,
+                g.replaced,
+            )
+        })
+        .collect();
+    let names = &plan.joint_names;
+    for expected in [
+        ("D", "tau", names[5].as_str(), i_d, true),
+        ("H", "q", names[0].as_str(), i_h, true),
+        ("nominal", "tau", names[2].as_str(), i_n, true),
+    ] {
+        assert!(found.contains(&expected), "{expected:?} not in {found:?}");
+    }
+    assert_eq!(found.len(), 3, "{found:?}");
+    let overflow = m
+        .diagnostics
+        .glitches
+        .iter()
+        .find(|g| g.experiment == "nominal")
+        .unwrap();
+    assert_eq!(overflow.noise_levels, None);
+    assert_eq!(overflow.value, 1e300);
+    // one warning per experiment, naming the sample
+    let warned: Vec<&String> = m
+        .diagnostics
+        .warnings
+        .iter()
+        .filter(|w| w.contains("glitches of the log"))
+        .collect();
+    assert_eq!(warned.len(), 3, "{:?}", m.diagnostics.warnings);
+    assert!(
+        warned
+            .iter()
+            .any(|w| w.contains(&format!("(sample {i_d}) read 50 N m"))),
+        "{warned:?}"
+    );
+    // saved and loaded with the model
+    let back = LocalModel::from_json(&m.to_json()).unwrap();
+    assert_eq!(back.diagnostics.glitches, m.diagnostics.glitches);
+}
+
+#[test]
+fn a_burst_is_not_taken_for_glitches() {
+    let (plan, mut recs) = noisy_logs();
+    let n = plan.joint_names.len();
+    let h_time = plan
+        .experiments
+        .iter()
+        .find(|e| e.kind.name() == "H")
+        .unwrap()
+        .crossings[2]
+        .time;
+    // joint 2's torque (about -11 N m) reads 0 for 6 samples: a dropout
+    let h = log(&mut recs, "H");
+    let i = sample_at(h, h_time);
+    for s in i..i + 6 {
+        h.tau[s * n + 1] = 0.0;
+    }
+    let m = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    let kept: Vec<_> = m
+        .diagnostics
+        .glitches
+        .iter()
+        .filter(|g| !g.replaced)
+        .collect();
+    assert!(!kept.is_empty(), "{:?}", m.diagnostics.glitches);
+    assert!(kept
+        .iter()
+        .all(|g| g.experiment == "H" && g.crossing == Some(2) && g.signal == "tau"));
+    assert!(
+        m.diagnostics
+            .warnings
+            .iter()
+            .any(|w| w.contains("crossing 2: more than 3 samples of tau")
+                && w.contains("not isolated")),
+        "{:?}",
+        m.diagnostics.warnings
+    );
+}
+
+#[test]
+fn saved_glitches_are_checked_on_load() {
+    let (plan, mut recs) = noisy_logs();
+    let n = plan.joint_names.len();
+    let d = log(&mut recs, "D");
+    let t0 = plan.experiments.last().unwrap().crossings[1].time;
+    let i = sample_at(d, t0);
+    d.tau[i * n] += 40.0;
+    let m = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    assert_eq!(m.diagnostics.glitches.len(), 1);
+    let json: serde_json::Value = serde_json::from_str(&m.to_json()).unwrap();
+    let edited = |field: &str, value: serde_json::Value| {
+        let mut j = json.clone();
+        j["diagnostics"]["glitches"][0][field] = value;
+        j.to_string()
+    };
+    for (field, value) in [
+        ("signal", serde_json::json!("torque")),
+        ("replaced", serde_json::json!("yes")),
+        ("noise_levels", serde_json::json!(-1.0)),
+        ("time", serde_json::json!("later")),
+        ("joint", serde_json::json!("elbow")),
+        ("experiment", serde_json::json!("E")),
+    ] {
+        let e = LocalModel::from_json(&edited(field, value))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(field) || e.contains("elbow") || e.contains("'E'"),
+            "{field}: {e}"
+        );
+    }
+    // a model without glitches saves none, and an older file without the field loads
+    let clean = {
+        let (plan, recs) = noisy_logs();
+        identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap()
+    };
+    let text = clean.to_json();
+    assert!(!text.contains("glitches"));
+    assert_eq!(LocalModel::from_json(&text).unwrap(), clean);
+}
