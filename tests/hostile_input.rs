@@ -174,6 +174,16 @@ fn csv_headers_are_checked_in_one_pass() {
     let zeros = vec!["0"; wide.len()].join(",");
     let t = Table::parse("wide.csv", &format!("{}\n{zeros}\n", wide.join(","))).unwrap();
     assert_eq!(t.columns.len(), 200_000);
+    // a table written with another separator reads as one column: said so
+    for (sep, name) in [(";", "semicolons"), ("\t", "tabs")] {
+        let text = format!("t{sep}q1{sep}tau1\n0{sep}1,5{sep}2\n");
+        let e = Table::parse("log.csv", &text).unwrap_err().to_string();
+        assert!(
+            e.starts_with("log.csv: line 1: one column named")
+                && e.contains(&format!("separated by {name}")),
+            "{e}"
+        );
+    }
 }
 
 #[test]

@@ -99,6 +99,20 @@ impl Table {
         if let Some(c) = t.columns.iter().position(String::is_empty) {
             return Err(t.error(format!("line {header_line}: column {} has no name", c + 1)));
         }
+        // a table written with another separator reads as one column
+        if let [only] = t.columns.as_slice() {
+            if let Some((sep, name)) = [(';', "semicolons"), ('\t', "tabs"), ('|', "bars")]
+                .into_iter()
+                .find(|(c, _)| only.contains(*c))
+            {
+                let shown: String = only.chars().take(60).collect();
+                return Err(t.error(format!(
+                    "line {header_line}: one column named '{}', its names separated by {name}: the columns must be separated by commas (replace each '{}' with ',', and a decimal comma with a point)",
+                    shown.escape_debug(),
+                    sep.escape_debug()
+                )));
+            }
+        }
         for record in records {
             let (line, fields) = record.map_err(csv_error)?;
             if fields.len() != t.columns.len() {

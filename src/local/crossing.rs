@@ -765,6 +765,89 @@ pub fn velocity_reversals(traj: &Trajectory, j: usize, a: f64, b: f64) -> Vec<f6
     out
 }
 
+/// Checks that `rec` can be a run of `experiment` with its clock within `max_shift` s of the
+/// plan's (before the offset is sought): its time stamps must reach the plan's span, shifted
+/// by at most `max_shift`. A log stamped in seconds since 1970 or since a controller booted
+/// does not, and the error says how far apart they are.
+pub fn check_clock(experiment: &Experiment, rec: &Recording, max_shift: f64) -> Result<()> {
+    let (start, end) = (experiment.trajectory.start(), experiment.trajectory.end());
+    let (first, last) = (rec.t[0], rec.t[rec.len() - 1]);
+    if first - max_shift <= end && last + max_shift >= start {
+        return Ok(());
+    }
+    let rounded = |v: f64| crate::error::shown((v * 1e3).round() / 1e3);
+    Err(Error::Recording {
+        recording: rec.name.clone(),
+        message: format!(
+            "its time stamps run from {} to {} s and experiment '{}' from {} to {} s of the plan's clock, {} s apart, more than the {} s of clock offset accepted: its time must count from the start of the experiment (subtract the time of the run's start, as for a log stamped in seconds since 1970 or since the controller started)",
+            rounded(first),
+            rounded(last),
+            experiment.kind.name(),
+            rounded(start),
+            rounded(end),
+            rounded(if first > end { first - end } else { start - last }),
+            crate::error::shown(max_shift),
+        ),
+    })
+}
+
+/// How far one joint's recorded positions stray from the planned ones (rad or m; see
+/// [`position_misfit`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PositionMisfit {
+    /// The mean difference, recorded minus planned: where the joint was held off the plan.
+    pub mean: f64,
+    /// The RMS of the difference about its mean: how the recorded motion differs in shape.
+    pub shape: f64,
+    /// The RMS of the planned motion about its mean over the same samples.
+    pub motion: f64,
+}
+
+/// Per joint, how far the recorded positions stray from `experiment`'s planned ones with the
+/// recording's clock `offset` s ahead of the plan's, over the samples within the plan's span
+/// (about 2,000 of them). `None` when no sample lies within the plan's span.
+pub fn position_misfit(
+    experiment: &Experiment,
+    rec: &Recording,
+    offset: f64,
+) -> Option<Vec<PositionMisfit>> {
+    let n = rec.n;
+    let traj = &experiment.trajectory;
+    let (start, end) = (traj.start(), traj.end());
+    let stride = (rec.len() / 2_000).max(1);
+    let mut diff: Vec<Vec<f64>> = vec![vec![]; n];
+    let mut planned: Vec<Vec<f64>> = vec![vec![]; n];
+    for i in (0..rec.len()).step_by(stride) {
+        let tp = rec.t[i] - offset;
+        if tp < start || tp > end {
+            continue;
+        }
+        let seg = traj.segment_at(tp);
+        for j in 0..n {
+            let q = seg.eval(j, tp).0;
+            diff[j].push(rec.q[i * n + j] - q);
+            planned[j].push(q);
+        }
+    }
+    if diff[0].is_empty() {
+        return None;
+    }
+    let mean = |x: &[f64]| x.iter().sum::<f64>() / x.len() as f64;
+    let spread = |x: &[f64]| {
+        let m = mean(x);
+        (x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / x.len() as f64).sqrt()
+    };
+    Some(
+        (0..n)
+            .map(|j| PositionMisfit {
+                mean: mean(&diff[j]),
+                shape: spread(&diff[j]),
+                motion: spread(&planned[j]),
+            })
+            .collect(),
+    )
+}
+
 /// The time offset `d` (s, within `+-max_shift`) such that the recording at `t` follows the
 /// plan at `t - d`: least squares over positions, a grid search at a resolution of
 /// `max_shift / 200` on about 250 samples, refined by Gauss-Newton on about 20,000
@@ -779,17 +862,23 @@ pub fn detect_offset(experiment: &Experiment, rec: &Recording, max_shift: f64) -
     let n = rec.n;
     let traj = &experiment.trajectory;
     let (start, end) = (traj.start(), traj.end());
+    // the squared differences about each joint's mean difference: a constant offset (an
+    // encoder's zero, or a joint held off the plan, which is checked after) carries no timing
+    // and would otherwise pull the offset towards where the difference's mean is smallest
     let cost = |d: f64, stride: usize| -> f64 {
-        let mut acc = 0.0;
+        let (mut sum, mut sq) = (vec![0.0; n], vec![0.0; n]);
+        let mut count = 0.0;
         for i in (0..rec.len()).step_by(stride) {
             let tp = (rec.t[i] - d).clamp(start, end);
             let seg = traj.segment_at(tp);
             for j in 0..n {
                 let e = rec.q[i * n + j] - seg.eval(j, tp).0;
-                acc += e * e;
+                sum[j] += e;
+                sq[j] += e * e;
             }
+            count += 1.0;
         }
-        acc
+        (0..n).map(|j| sq[j] - sum[j] * sum[j] / count).sum()
     };
     let stride = (rec.len() / 250).max(1);
     let step = max_shift / 200.0;
@@ -807,20 +896,36 @@ pub fn detect_offset(experiment: &Experiment, rec: &Recording, max_shift: f64) -
     let (lo, hi) = (best.1 - step, best.1 + step);
     let mut d = best.1;
     for _ in 0..20 {
-        let (mut num, mut den) = (0.0, 0.0);
+        // per joint, the sums of e, v, e v and v^2 (e the difference, v the planned speed):
+        // the step of the centred problem, each joint's mean difference taken off
+        let mut sums = vec![[0.0; 4]; n];
+        let mut count = 0.0;
         for i in (0..rec.len()).step_by(fine) {
             let tp = rec.t[i] - d;
             if tp < start || tp > end {
                 continue;
             }
             let seg = traj.segment_at(tp);
-            for j in 0..n {
+            for (j, s) in sums.iter_mut().enumerate() {
                 let (q, v, _) = seg.eval(j, tp);
-                num += (rec.q[i * n + j] - q) * v;
-                den += v * v;
+                let e = rec.q[i * n + j] - q;
+                s[0] += e;
+                s[1] += v;
+                s[2] += e * v;
+                s[3] += v * v;
             }
+            count += 1.0;
         }
-        if den <= 0.0 {
+        if count < 2.0 {
+            break;
+        }
+        let (num, den) = sums.iter().fold((0.0, 0.0), |(num, den), s| {
+            (
+                num + s[2] - s[0] * s[1] / count,
+                den + s[3] - s[1] * s[1] / count,
+            )
+        });
+        if den.is_nan() || den <= 0.0 {
             break;
         }
         let next = (d - num / den).clamp(lo, hi);

@@ -4,8 +4,8 @@
 use nalgebra::DMatrix;
 
 use super::crossing::{
-    detect_offset, samples_needed, values_in_windows, velocity_reversals, CrossingValues,
-    FitOptions, SignalScales, TorqueFit,
+    check_clock, detect_offset, position_misfit, samples_needed, values_in_windows,
+    velocity_reversals, CrossingValues, FitOptions, SignalScales, TorqueFit,
 };
 use super::diagnose::{
     compare_combined, diagnose, disagreement_warning, mass_matrix_warning, unperturbed_deviation,
@@ -158,6 +158,87 @@ fn torque_fits(
         .collect()
 }
 
+/// Refuses a recording whose samples are too sparse for a window of `+-half` s to hold the
+/// samples the fits need at its median sample interval (over at most 10,000 intervals),
+/// with a word on the time's unit: a log stamped in milliseconds or nanoseconds reads as one
+/// sample every second or every 10^6 s.
+fn check_sample_interval(rec: &Recording, half: f64, fit: &FitOptions) -> Result<()> {
+    let stride = (rec.len() / 10_000).max(1);
+    let mut dt: Vec<f64> = (stride..rec.len())
+        .step_by(stride)
+        .map(|i| rec.t[i] - rec.t[i - 1])
+        .collect();
+    if dt.is_empty() {
+        return Ok(());
+    }
+    let mid = dt.len() / 2;
+    let median = *dt.select_nth_unstable_by(mid, f64::total_cmp).1;
+    let held = (2.0 * half / median).floor() + 1.0;
+    let needed = samples_needed(fit);
+    if held >= needed as f64 {
+        return Ok(());
+    }
+    Err(Error::Recording {
+        recording: rec.name.clone(),
+        message: format!(
+            "its median sample interval is {} s, so a crossing window of +-{} s holds at most {held} samples where the fits need {needed}: check that its times are in seconds (a log stamped in milliseconds or nanoseconds reads as a sample every second or every 10^6 s), or record faster, or widen the window",
+            crate::error::shown(format!("{median:.3e}").parse().unwrap_or(median)),
+            crate::error::shown(half),
+        ),
+    })
+}
+
+/// How far a joint's recorded positions may stray from the plan once aligned (rad or m):
+/// their mean difference, and the RMS of the difference about it (or half the planned
+/// motion's RMS where that is more). A robot that tracks its encoders stays far below (its
+/// tracking errors); a recording of another experiment, positions in degrees or columns in
+/// another order are far above.
+const POSITION_MISFIT: f64 = 0.05;
+
+/// Refuses a recording whose positions do not follow `experiment`'s plan at the clock offset
+/// found (`offset` s, the best within `+-searched` s), naming the joints.
+fn check_positions(
+    experiment: &Experiment,
+    rec: &Recording,
+    joint_names: &[String],
+    offset: f64,
+    searched: f64,
+) -> Result<()> {
+    let Some(misfit) = position_misfit(experiment, rec, offset) else {
+        return Ok(());
+    };
+    let off: Vec<String> = misfit
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| {
+            !(m.mean.abs() <= POSITION_MISFIT && m.shape <= POSITION_MISFIT.max(0.5 * m.motion))
+        })
+        .map(|(j, m)| {
+            let name = joint_names
+                .get(j)
+                .cloned()
+                .unwrap_or_else(|| format!("{}", j + 1));
+            format!(
+                "'{name}' {:+.3} off on average and {:.3} RMS about that, where the plan moves it {:.3} RMS",
+                m.mean, m.shape, m.motion
+            )
+        })
+        .collect();
+    if off.is_empty() {
+        return Ok(());
+    }
+    Err(Error::Recording {
+        recording: rec.name.clone(),
+        message: format!(
+            "its positions do not follow the plan of experiment '{}' at any clock offset within +-{} s: at the best ({offset:+.4} s) the joints {} (rad or m), where a robot that tracks its encoders stays within {POSITION_MISFIT}: check that it is a run of this experiment, that its columns follow the plan's joints ({}) and that its positions are in radians (metres for prismatic joints)",
+            experiment.kind.name(),
+            crate::error::shown(searched),
+            off.join(", "),
+            joint_names.join(", "),
+        ),
+    })
+}
+
 /// Reads the values at every crossing of `experiment` from `rec`. `joint_names` name the
 /// joints in diagnostics.
 pub fn experiment_values(
@@ -166,6 +247,15 @@ pub fn experiment_values(
     joint_names: &[String],
     options: &IdentifyOptions,
 ) -> Result<ExperimentValues> {
+    let half = options.fit.window.unwrap_or(experiment.window);
+    crate::limits::check_range("window", half, 0.0, 60.0)?;
+    if !(half.is_finite() && half > 0.0) {
+        return Err(Error::InvalidArgument {
+            argument: "window".into(),
+            message: format!("{half}; expected a positive number of seconds"),
+        });
+    }
+    check_sample_interval(rec, half, &options.fit)?;
     let offset = match options.times {
         CrossingTimes::Planned => 0.0,
         CrossingTimes::Detected { max_shift } => {
@@ -194,7 +284,9 @@ pub fn experiment_values(
                     ),
                 });
             }
+            check_clock(experiment, rec, max_shift)?;
             let offset = detect_offset(experiment, rec, 1.25 * max_shift)?;
+            check_positions(experiment, rec, joint_names, offset, 1.25 * max_shift)?;
             if offset.abs() > max_shift {
                 return Err(Error::Recording {
                     recording: rec.name.clone(),
@@ -208,14 +300,6 @@ pub fn experiment_values(
             offset
         }
     };
-    let half = options.fit.window.unwrap_or(experiment.window);
-    crate::limits::check_range("window", half, 0.0, 60.0)?;
-    if !(half.is_finite() && half > 0.0) {
-        return Err(Error::InvalidArgument {
-            argument: "window".into(),
-            message: format!("{half}; expected a positive number of seconds"),
-        });
-    }
     // the narrowest torque window that still holds enough samples at the recording's rate
     let dt = (rec.t[rec.len() - 1] - rec.t[0]) / (rec.len() - 1) as f64;
     let min_half = 0.5 * samples_needed(&options.fit) as f64 * dt;

@@ -49,11 +49,12 @@ pub mod quantisation;
 pub mod rounded_positions;
 
 pub use crossing::{
-    noise_levels, values_at, values_at_with, values_in_windows, CrossingValues, FitOptions, Signal,
-    SignalScales, TorqueFit, WindowGlitch,
+    check_clock, noise_levels, position_misfit, values_at, values_at_with, values_in_windows,
+    CrossingValues, FitOptions, PositionMisfit, Signal, SignalScales, TorqueFit, WindowGlitch,
 };
 pub use diagnostics::{
-    BlockAgreement, ClockOffset, Diagnostics, Reversal, ReversalHandling, TorqueNoise, Unmeasured,
+    BlockAgreement, ClockOffset, Diagnostics, Glitch, Reversal, ReversalHandling, TorqueNoise,
+    Unmeasured,
 };
 pub use identify::{identify_local, CrossingTimes, IdentifyOptions};
 pub use model::{Estimate, Estimator, LocalModel};

@@ -186,6 +186,12 @@ def test_errors():
     short = pr.Recording(recs[1].t[:2000], recs[1].q[:2000], recs[1].tau[:2000], name="short.csv", experiment="D")
     with pytest.raises(pr.InputError, match="short.csv: experiment 'D', crossing .*too short"):
         pr.identify_local(plan, [recs[0], short])
+    epoch = pr.Recording(recs[1].t + 1.7e9, recs[1].q, recs[1].tau, name="ros.csv", experiment="D")
+    with pytest.raises(pr.InputError, match="ros.csv: its time stamps run from 1.7e9 .* count from the start of the experiment"):
+        pr.identify_local(plan, [recs[0], epoch])
+    degrees = pr.Recording(recs[1].t, np.degrees(recs[1].q), recs[1].tau, name="deg.csv", experiment="D")
+    with pytest.raises(pr.InputError, match="deg.csv: its positions do not follow the plan .* in radians"):
+        pr.identify_local(plan, [recs[0], degrees])
     with pytest.raises(pr.InputError, match="line 1"):
         pr.LocalModel.from_json("{")
     with pytest.raises(pr.InputError, match="friction"):

@@ -1,6 +1,8 @@
-//! Logs with glitches, as real robots write them: single samples far off (a corrupted message,
-//! a sensor's spike, a value that overflows), and bursts of them. Each case is checked
-//! against the model identified from the same log without them.
+//! Logs as real robots and careless hands write them: glitches (single samples far off, from a
+//! corrupted message, a sensor's spike, a value that overflows) and bursts of them, checked
+//! against the model identified from the same log without them; and logs that cannot be runs
+//! of the plan as they stand (a clock in seconds since 1970 or in nanoseconds, positions in
+//! degrees, columns swapped, a joint held off the plan), refused naming why.
 
 mod common;
 
@@ -217,4 +219,61 @@ fn saved_glitches_are_checked_on_load() {
     let text = clean.to_json();
     assert!(!text.contains("glitches"));
     assert_eq!(LocalModel::from_json(&text).unwrap(), clean);
+}
+
+/// Runs `edit` on a copy of the noisy logs' D recording and identifies; the error's text.
+fn refused(edit: impl Fn(&mut Recording)) -> String {
+    let (plan, mut recs) = noisy_logs();
+    edit(log(&mut recs, "D"));
+    identify_local(&plan, &recs, &IdentifyOptions::default())
+        .unwrap_err()
+        .to_string()
+}
+
+#[test]
+fn logs_that_cannot_be_runs_of_the_plan_are_refused_naming_why() {
+    let n = 6;
+    // stamped in seconds since 1970
+    let e = refused(|r| r.t.iter_mut().for_each(|t| *t += 1.7e9));
+    assert!(
+        e.contains("its time stamps run from 1.7e9")
+            && e.contains("its time must count from the start of the experiment"),
+        "{e}"
+    );
+    // stamped in nanoseconds
+    let e = refused(|r| r.t.iter_mut().for_each(|t| *t *= 1e9));
+    assert!(
+        e.contains("its median sample interval is 1000000 s")
+            && e.contains("check that its times are in seconds"),
+        "{e}"
+    );
+    // positions in degrees
+    let e = refused(|r| r.q.iter_mut().for_each(|q| *q = q.to_degrees()));
+    assert!(
+        e.contains("its positions do not follow the plan of experiment 'D'")
+            && e.contains("in radians"),
+        "{e}"
+    );
+    // the first two position columns swapped
+    let e = refused(|r| {
+        for row in r.q.chunks_mut(n) {
+            row.swap(0, 1);
+        }
+    });
+    assert!(
+        e.contains("its positions do not follow the plan") && e.contains("'joint1' -0.39"),
+        "{e}"
+    );
+    // a joint held 0.1 rad off the plan throughout
+    let e = refused(|r| r.q.iter_mut().step_by(n).for_each(|q| *q += 0.1));
+    assert!(e.contains("'joint1' +0.100 off on average"), "{e}");
+    // tracking errors of a few mrad, and a clock 0.2 s off, are no reason to refuse
+    let (plan, mut recs) = noisy_logs();
+    for r in &mut recs {
+        r.t.iter_mut().for_each(|t| *t += 0.2);
+        for (i, q) in r.q.iter_mut().enumerate() {
+            *q += 0.003 * ((i / n) as f64 * 0.01).sin();
+        }
+    }
+    identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
 }
