@@ -9,7 +9,7 @@ mod common;
 use common::{mat, table2};
 use perturbid_rs::document::Document;
 use perturbid_rs::local::{
-    identify_local, plan_experiments, IdentifyOptions, LocalModel, Plan, PlanOptions,
+    identify_local, plan_experiments, CrossingTimes, IdentifyOptions, LocalModel, Plan, PlanOptions,
 };
 use perturbid_rs::robots::a465;
 use perturbid_rs::{simulate_plan, Recording, SimulationOptions};
@@ -276,4 +276,54 @@ fn logs_that_cannot_be_runs_of_the_plan_are_refused_naming_why() {
         }
     }
     identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+}
+
+/// A log that starts long before the run (the robot idle at its start posture for 5 s): the
+/// default tolerance is refused with where the run starts and what to raise; raised, the run
+/// is found and the model is the one of the log without the idle start.
+#[test]
+fn a_run_late_in_its_log_is_found_where_allowed_and_named_where_not() {
+    let (plan, recs) = noisy_logs();
+    let idle = 5.0;
+    let late: Vec<Recording> = recs
+        .iter()
+        .map(|r| {
+            let n = r.n;
+            let dt = r.t[1] - r.t[0];
+            let k = (idle / dt).round() as usize;
+            let t: Vec<f64> = (0..k)
+                .map(|i| i as f64 * dt)
+                .chain(r.t.iter().map(|t| t + idle))
+                .collect();
+            let held = |v: &[f64]| -> Vec<f64> {
+                (0..k)
+                    .flat_map(|_| v[..n].to_vec())
+                    .chain(v.iter().copied())
+                    .collect()
+            };
+            let mut out =
+                Recording::new(r.name.clone(), n, t, held(&r.q), held(&r.tau), None, None).unwrap();
+            out.experiment = r.experiment.clone();
+            out
+        })
+        .collect();
+    let e = identify_local(&plan, &late, &IdentifyOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("best with its clock +5.000 s ahead of the plan's")
+            && e.contains("raise max_shift (--max-shift) to at least 5.5"),
+        "{e}"
+    );
+    let raised = IdentifyOptions {
+        times: CrossingTimes::Detected { max_shift: 7.0 },
+        ..IdentifyOptions::default()
+    };
+    let m = identify_local(&plan, &late, &raised).unwrap();
+    for o in &m.diagnostics.offsets {
+        assert!((o.offset - idle).abs() < 1e-4, "{o:?}");
+    }
+    let clean = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    let worst = worst_in_stderr(&m, &clean);
+    assert!(worst < 0.05, "{worst}");
 }

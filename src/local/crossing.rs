@@ -859,6 +859,42 @@ pub fn detect_offset(experiment: &Experiment, rec: &Recording, max_shift: f64) -
             message: format!("{max_shift}; expected a positive number of seconds"),
         });
     }
+    Ok(detect_offset_in(experiment, rec, -max_shift, max_shift, 200).0)
+}
+
+/// The offsets `d` (s) at which some sample of `rec` falls within `experiment`'s plan
+/// (`rec.t - d` meets its span): the widest range worth searching.
+pub fn overlap_offsets(experiment: &Experiment, rec: &Recording) -> (f64, f64) {
+    let traj = &experiment.trajectory;
+    (rec.t[0] - traj.end(), rec.t[rec.len() - 1] - traj.start())
+}
+
+/// The offsets `d` (s) at which `rec` holds every window of `experiment` (its crossings' and
+/// reference posture's, `+-window` s about their planned times plus `d`): where a run could be
+/// read whole. `None` when the recording is too short for any.
+pub fn covering_offsets(experiment: &Experiment, rec: &Recording) -> Option<(f64, f64)> {
+    let times = experiment
+        .crossings
+        .iter()
+        .chain(&experiment.reference)
+        .map(|c| c.time);
+    let lo = times.clone().fold(f64::INFINITY, f64::min) - experiment.window;
+    let hi = times.fold(f64::NEG_INFINITY, f64::max) + experiment.window;
+    let range = (rec.t[0] - lo, rec.t[rec.len() - 1] - hi);
+    (range.0 <= range.1).then_some(range)
+}
+
+/// [`detect_offset`] over `[lo, hi]` (s, `lo <= hi`), with a grid of `2 half_points + 1`
+/// offsets before the refinement; also returns the cost at the offset found (the positions'
+/// squared differences about each joint's mean, summed over about 250 samples), to compare
+/// searches.
+pub fn detect_offset_in(
+    experiment: &Experiment,
+    rec: &Recording,
+    lo: f64,
+    hi: f64,
+    half_points: usize,
+) -> (f64, f64) {
     let n = rec.n;
     let traj = &experiment.trajectory;
     let (start, end) = (traj.start(), traj.end());
@@ -881,19 +917,23 @@ pub fn detect_offset(experiment: &Experiment, rec: &Recording, max_shift: f64) -
         (0..n).map(|j| sq[j] - sum[j] * sum[j] / count).sum()
     };
     let stride = (rec.len() / 250).max(1);
-    let step = max_shift / 200.0;
-    let mut best = (f64::INFINITY, 0.0);
-    for g in -200..=200 {
-        let d = g as f64 * step;
+    let half_points = half_points.max(1);
+    let step = (hi - lo) / (2 * half_points) as f64;
+    let mut best = (f64::INFINITY, 0.5 * (lo + hi));
+    for g in 0..=2 * half_points {
+        let d = lo + g as f64 * step;
         let c = cost(d, stride);
         if c < best.0 {
             best = (c, d);
         }
     }
+    if step.is_nan() || step <= 0.0 {
+        return (best.1, best.0);
+    }
     // Gauss-Newton refinement in [d - step, d + step]: the residual q_rec(t) - q_plan(t - d)
     // changes with d at the planned speed
     let fine = (rec.len() / 20_000).max(1);
-    let (lo, hi) = (best.1 - step, best.1 + step);
+    let (lo, hi) = ((best.1 - step).max(lo), (best.1 + step).min(hi));
     let mut d = best.1;
     for _ in 0..20 {
         // per joint, the sums of e, v, e v and v^2 (e the difference, v the planned speed):
@@ -935,5 +975,5 @@ pub fn detect_offset(experiment: &Experiment, rec: &Recording, max_shift: f64) -
             break;
         }
     }
-    Ok(d)
+    (d, cost(d, stride))
 }

@@ -4,8 +4,9 @@
 use nalgebra::DMatrix;
 
 use super::crossing::{
-    check_clock, detect_offset, position_misfit, samples_needed, values_in_windows,
-    velocity_reversals, CrossingValues, FitOptions, SignalScales, TorqueFit,
+    check_clock, covering_offsets, detect_offset_in, overlap_offsets, position_misfit,
+    samples_needed, values_in_windows, velocity_reversals, CrossingValues, FitOptions,
+    SignalScales, TorqueFit,
 };
 use super::diagnose::{
     compare_combined, diagnose, disagreement_warning, mass_matrix_warning, unperturbed_deviation,
@@ -188,12 +189,17 @@ fn check_sample_interval(rec: &Recording, half: f64, fit: &FitOptions) -> Result
     })
 }
 
-/// How far a joint's recorded positions may stray from the plan once aligned (rad or m):
-/// their mean difference, and the RMS of the difference about it (or half the planned
-/// motion's RMS where that is more). A robot that tracks its encoders stays far below (its
-/// tracking errors); a recording of another experiment, positions in degrees or columns in
-/// another order are far above.
+/// How far a joint's recorded positions may stray from the plan on average once aligned (rad
+/// or m). A robot that tracks its encoders stays far below (its tracking errors); positions in
+/// degrees or columns in another order are far above.
 const POSITION_MISFIT: f64 = 0.05;
+
+/// How far the recorded motion may differ in shape from the planned one (the RMS of the
+/// difference about its mean, rad or m): half the planned motion's RMS, or this, or two encoder
+/// steps, whichever is more. A recording of another experiment, or of the robot at rest where
+/// the plan moves it, differs by about the whole motion; a joint the plan barely moves must
+/// still follow it to within its tracking errors.
+const SHAPE_MISFIT: f64 = 0.01;
 
 /// Refuses a recording whose positions do not follow `experiment`'s plan at the clock offset
 /// found (`offset` s, the best within `+-searched` s), naming the joints.
@@ -201,8 +207,8 @@ fn check_positions(
     experiment: &Experiment,
     rec: &Recording,
     joint_names: &[String],
-    offset: f64,
-    searched: f64,
+    steps: &[Option<f64>],
+    (offset, searched): (f64, f64),
 ) -> Result<()> {
     let Some(misfit) = position_misfit(experiment, rec, offset) else {
         return Ok(());
@@ -210,8 +216,10 @@ fn check_positions(
     let off: Vec<String> = misfit
         .iter()
         .enumerate()
-        .filter(|(_, m)| {
-            !(m.mean.abs() <= POSITION_MISFIT && m.shape <= POSITION_MISFIT.max(0.5 * m.motion))
+        .filter(|(j, m)| {
+            let step = steps.get(*j).copied().flatten().unwrap_or(0.0);
+            let shape = SHAPE_MISFIT.max(0.5 * m.motion).max(2.0 * step);
+            !(m.mean.abs() <= POSITION_MISFIT && m.shape <= shape)
         })
         .map(|(j, m)| {
             let name = joint_names
@@ -230,7 +238,7 @@ fn check_positions(
     Err(Error::Recording {
         recording: rec.name.clone(),
         message: format!(
-            "its positions do not follow the plan of experiment '{}' at any clock offset within +-{} s: at the best ({offset:+.4} s) the joints {} (rad or m), where a robot that tracks its encoders stays within {POSITION_MISFIT}: check that it is a run of this experiment, that its columns follow the plan's joints ({}) and that its positions are in radians (metres for prismatic joints)",
+            "its positions do not follow the plan of experiment '{}' at any clock offset within +-{} s: at the best ({offset:+.4} s) the joints {} (rad or m), where a robot that tracks its encoders stays within {POSITION_MISFIT} on average and within half the planned motion about that: check that it is a run of this experiment, that its columns follow the plan's joints ({}) and that its positions are in radians (metres for prismatic joints)",
             experiment.kind.name(),
             crate::error::shown(searched),
             off.join(", "),
@@ -256,6 +264,7 @@ pub fn experiment_values(
         });
     }
     check_sample_interval(rec, half, &options.fit)?;
+    let steps = rounded_positions::position_steps(rec);
     let offset = match options.times {
         CrossingTimes::Planned => 0.0,
         CrossingTimes::Detected { max_shift } => {
@@ -268,25 +277,42 @@ pub fn experiment_values(
                     ),
                 });
             }
-            // a larger offset leaves the recording and the plan no overlap to compare
-            let overlap = (rec.t[rec.len() - 1] - rec.t[0]) + experiment.trajectory.end()
-                - experiment.trajectory.start();
-            if max_shift > overlap {
-                return Err(Error::InvalidArgument {
-                    argument: "max_shift".into(),
-                    message: format!(
-                        "{} s for recording '{}': an offset that large leaves it no overlap with experiment '{}' (together {} s long); at most {} s",
-                        crate::error::shown(max_shift),
-                        rec.name,
-                        experiment.kind.name(),
-                        crate::error::shown((overlap * 1e3).round() / 1e3),
-                        crate::error::shown((overlap * 1e3).floor() / 1e3),
-                    ),
-                });
-            }
             check_clock(experiment, rec, max_shift)?;
-            let offset = detect_offset(experiment, rec, 1.25 * max_shift)?;
-            check_positions(experiment, rec, joint_names, offset, 1.25 * max_shift)?;
+            // the offsets within 1.25 times the tolerance at which the recording holds every
+            // window, or else (to say later which window it misses) that leave some overlap:
+            // one that leaves the plan's motion mostly outside the recording compares rest
+            // with rest, and fits trivially
+            let searched = 1.25 * max_shift;
+            let covering = covering_offsets(experiment, rec)
+                .filter(|(a, b)| a.max(-searched) <= b.min(searched));
+            let (first, last) = covering.unwrap_or_else(|| overlap_offsets(experiment, rec));
+            let (lo, hi) = (first.max(-searched), last.min(searched));
+            let (offset, cost) = detect_offset_in(experiment, rec, lo, hi, 200);
+            let positions =
+                check_positions(experiment, rec, joint_names, &steps, (offset, searched));
+            // beyond the tolerance, or not following the plan there: the run may start later
+            // in the log; look over the whole overlap, at about the same resolution (bounded),
+            // and say where it fits
+            if positions.is_err() || offset.abs() > max_shift {
+                let step = (hi - lo) / 400.0;
+                let points = (((last - first) / step.max(1e-3)) as usize / 2).clamp(200, 20_000);
+                let (first, last) = covering_offsets(experiment, rec).unwrap_or((first, last));
+                let (wide, wide_cost) = detect_offset_in(experiment, rec, first, last, points);
+                let fits =
+                    check_positions(experiment, rec, joint_names, &steps, (wide, searched)).is_ok();
+                if wide.abs() > max_shift && wide_cost < 0.25 * cost && fits {
+                    return Err(Error::Recording {
+                        recording: rec.name.clone(),
+                        message: format!(
+                            "its positions follow the plan of experiment '{}' best with its clock {wide:+.3} s ahead of the plan's (found over its whole span), more than the {} s of clock offset accepted: if the run starts that late in the log, raise max_shift (--max-shift) to at least {}",
+                            experiment.kind.name(),
+                            crate::error::shown(max_shift),
+                            crate::error::shown((wide.abs() * 1.1 * 10.0).ceil() / 10.0),
+                        ),
+                    });
+                }
+            }
+            positions?;
             if offset.abs() > max_shift {
                 return Err(Error::Recording {
                     recording: rec.name.clone(),
@@ -343,7 +369,7 @@ pub fn experiment_values(
         .map(|(tp, _, what, fits)| (tp + offset, fits, what))
         .collect();
     let scales = SignalScales {
-        position_step: rounded_positions::position_steps(rec),
+        position_step: steps,
         torque_step: quantisation::torque_steps(&torques),
         noise: vec![],
     };

@@ -49,8 +49,9 @@ pub mod quantisation;
 pub mod rounded_positions;
 
 pub use crossing::{
-    check_clock, noise_levels, position_misfit, values_at, values_at_with, values_in_windows,
-    CrossingValues, FitOptions, PositionMisfit, Signal, SignalScales, TorqueFit, WindowGlitch,
+    check_clock, covering_offsets, detect_offset, detect_offset_in, noise_levels, overlap_offsets,
+    position_misfit, values_at, values_at_with, values_in_windows, CrossingValues, FitOptions,
+    PositionMisfit, Signal, SignalScales, TorqueFit, WindowGlitch,
 };
 pub use diagnostics::{
     BlockAgreement, ClockOffset, Diagnostics, Glitch, Reversal, ReversalHandling, TorqueNoise,
