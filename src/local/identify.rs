@@ -3,8 +3,8 @@
 
 use nalgebra::DMatrix;
 
+use super::clock::{align, check_sample_interval};
 use super::crossing::{
-    check_clock, covering_offsets, detect_offset_in, overlap_offsets, position_misfit,
     samples_needed, values_in_windows, velocity_reversals, CrossingValues, FitOptions,
     SignalScales, TorqueFit,
 };
@@ -159,94 +159,6 @@ fn torque_fits(
         .collect()
 }
 
-/// Refuses a recording whose samples are too sparse for a window of `+-half` s to hold the
-/// samples the fits need at its median sample interval (over at most 10,000 intervals),
-/// with a word on the time's unit: a log stamped in milliseconds or nanoseconds reads as one
-/// sample every second or every 10^6 s.
-fn check_sample_interval(rec: &Recording, half: f64, fit: &FitOptions) -> Result<()> {
-    let stride = (rec.len() / 10_000).max(1);
-    let mut dt: Vec<f64> = (stride..rec.len())
-        .step_by(stride)
-        .map(|i| rec.t[i] - rec.t[i - 1])
-        .collect();
-    if dt.is_empty() {
-        return Ok(());
-    }
-    let mid = dt.len() / 2;
-    let median = *dt.select_nth_unstable_by(mid, f64::total_cmp).1;
-    let held = (2.0 * half / median).floor() + 1.0;
-    let needed = samples_needed(fit);
-    if held >= needed as f64 {
-        return Ok(());
-    }
-    Err(Error::Recording {
-        recording: rec.name.clone(),
-        message: format!(
-            "its median sample interval is {} s, so a crossing window of +-{} s holds at most {held} samples where the fits need {needed}: check that its times are in seconds (a log stamped in milliseconds or nanoseconds reads as a sample every second or every 10^6 s), or record faster, or widen the window",
-            crate::error::shown(format!("{median:.3e}").parse().unwrap_or(median)),
-            crate::error::shown(half),
-        ),
-    })
-}
-
-/// How far a joint's recorded positions may stray from the plan on average once aligned (rad
-/// or m). A robot that tracks its encoders stays far below (its tracking errors); positions in
-/// degrees or columns in another order are far above.
-const POSITION_MISFIT: f64 = 0.05;
-
-/// How far the recorded motion may differ in shape from the planned one (the RMS of the
-/// difference about its mean, rad or m): half the planned motion's RMS, or this, or two encoder
-/// steps, whichever is more. A recording of another experiment, or of the robot at rest where
-/// the plan moves it, differs by about the whole motion; a joint the plan barely moves must
-/// still follow it to within its tracking errors.
-const SHAPE_MISFIT: f64 = 0.01;
-
-/// Refuses a recording whose positions do not follow `experiment`'s plan at the clock offset
-/// found (`offset` s, the best within `+-searched` s), naming the joints.
-fn check_positions(
-    experiment: &Experiment,
-    rec: &Recording,
-    joint_names: &[String],
-    steps: &[Option<f64>],
-    (offset, searched): (f64, f64),
-) -> Result<()> {
-    let Some(misfit) = position_misfit(experiment, rec, offset) else {
-        return Ok(());
-    };
-    let off: Vec<String> = misfit
-        .iter()
-        .enumerate()
-        .filter(|(j, m)| {
-            let step = steps.get(*j).copied().flatten().unwrap_or(0.0);
-            let shape = SHAPE_MISFIT.max(0.5 * m.motion).max(2.0 * step);
-            !(m.mean.abs() <= POSITION_MISFIT && m.shape <= shape)
-        })
-        .map(|(j, m)| {
-            let name = joint_names
-                .get(j)
-                .cloned()
-                .unwrap_or_else(|| format!("{}", j + 1));
-            format!(
-                "'{name}' {:+.3} off on average and {:.3} RMS about that, where the plan moves it {:.3} RMS",
-                m.mean, m.shape, m.motion
-            )
-        })
-        .collect();
-    if off.is_empty() {
-        return Ok(());
-    }
-    Err(Error::Recording {
-        recording: rec.name.clone(),
-        message: format!(
-            "its positions do not follow the plan of experiment '{}' at any clock offset within +-{} s: at the best ({offset:+.4} s) the joints {} (rad or m), where a robot that tracks its encoders stays within {POSITION_MISFIT} on average and within half the planned motion about that: check that it is a run of this experiment, that its columns follow the plan's joints ({}) and that its positions are in radians (metres for prismatic joints)",
-            experiment.kind.name(),
-            crate::error::shown(searched),
-            off.join(", "),
-            joint_names.join(", "),
-        ),
-    })
-}
-
 /// Reads the values at every crossing of `experiment` from `rec`. `joint_names` name the
 /// joints in diagnostics.
 pub fn experiment_values(
@@ -268,62 +180,7 @@ pub fn experiment_values(
     let offset = match options.times {
         CrossingTimes::Planned => 0.0,
         CrossingTimes::Detected { max_shift } => {
-            if !(max_shift.is_finite() && max_shift > 0.0) {
-                return Err(Error::InvalidArgument {
-                    argument: "max_shift".into(),
-                    message: format!(
-                        "{}; expected a positive number of seconds",
-                        crate::error::shown(max_shift)
-                    ),
-                });
-            }
-            check_clock(experiment, rec, max_shift)?;
-            // the offsets within 1.25 times the tolerance at which the recording holds every
-            // window, or else (to say later which window it misses) that leave some overlap:
-            // one that leaves the plan's motion mostly outside the recording compares rest
-            // with rest, and fits trivially
-            let searched = 1.25 * max_shift;
-            let covering = covering_offsets(experiment, rec)
-                .filter(|(a, b)| a.max(-searched) <= b.min(searched));
-            let (first, last) = covering.unwrap_or_else(|| overlap_offsets(experiment, rec));
-            let (lo, hi) = (first.max(-searched), last.min(searched));
-            let (offset, cost) = detect_offset_in(experiment, rec, lo, hi, 200);
-            let positions =
-                check_positions(experiment, rec, joint_names, &steps, (offset, searched));
-            // beyond the tolerance, or not following the plan there: the run may start later
-            // in the log; look over the whole overlap, at about the same resolution (bounded),
-            // and say where it fits
-            if positions.is_err() || offset.abs() > max_shift {
-                let step = (hi - lo) / 400.0;
-                let points = (((last - first) / step.max(1e-3)) as usize / 2).clamp(200, 20_000);
-                let (first, last) = covering_offsets(experiment, rec).unwrap_or((first, last));
-                let (wide, wide_cost) = detect_offset_in(experiment, rec, first, last, points);
-                let fits =
-                    check_positions(experiment, rec, joint_names, &steps, (wide, searched)).is_ok();
-                if wide.abs() > max_shift && wide_cost < 0.25 * cost && fits {
-                    return Err(Error::Recording {
-                        recording: rec.name.clone(),
-                        message: format!(
-                            "its positions follow the plan of experiment '{}' best with its clock {wide:+.3} s ahead of the plan's (found over its whole span), more than the {} s of clock offset accepted: if the run starts that late in the log, raise max_shift (--max-shift) to at least {}",
-                            experiment.kind.name(),
-                            crate::error::shown(max_shift),
-                            crate::error::shown((wide.abs() * 1.1 * 10.0).ceil() / 10.0),
-                        ),
-                    });
-                }
-            }
-            positions?;
-            if offset.abs() > max_shift {
-                return Err(Error::Recording {
-                    recording: rec.name.clone(),
-                    message: format!(
-                        "its clock is {offset:+.4} s off the plan of experiment '{}' (found in its positions), more than the {} s accepted: check that it is a run of this experiment, or raise max_shift (--max-shift)",
-                        experiment.kind.name(),
-                        crate::error::shown(max_shift)
-                    ),
-                });
-            }
-            offset
+            align(experiment, rec, joint_names, &steps, max_shift)?
         }
     };
     // the narrowest torque window that still holds enough samples at the recording's rate

@@ -30,6 +30,7 @@
 //! # Ok::<(), perturbid_rs::Error>(())
 //! ```
 
+pub mod clock;
 pub mod crossing;
 mod diagnose;
 pub mod diagnostics;
@@ -48,10 +49,13 @@ pub mod point_design;
 pub mod quantisation;
 pub mod rounded_positions;
 
+pub use clock::{
+    check_clock, covering_offsets, detect_offset, detect_offset_in, overlap_offsets,
+    position_misfit, PositionMisfit,
+};
 pub use crossing::{
-    check_clock, covering_offsets, detect_offset, detect_offset_in, noise_levels, overlap_offsets,
-    position_misfit, values_at, values_at_with, values_in_windows, CrossingValues, FitOptions,
-    PositionMisfit, Signal, SignalScales, TorqueFit, WindowGlitch,
+    noise_levels, values_at, values_at_with, values_in_windows, CrossingValues, FitOptions, Signal,
+    SignalScales, TorqueFit, WindowGlitch,
 };
 pub use diagnostics::{
     BlockAgreement, ClockOffset, Diagnostics, Glitch, Reversal, ReversalHandling, TorqueNoise,
