@@ -29,7 +29,9 @@ pub mod json;
 pub mod limits;
 pub mod linearization;
 pub mod local;
+pub mod log_screening;
 pub mod model;
+pub mod outliers;
 #[cfg(feature = "cli")]
 pub mod paper;
 pub mod preprocess;

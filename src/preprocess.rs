@@ -32,6 +32,11 @@ pub struct PreprocessOptions {
     ///
     /// [`MAX_GAP_INTERVALS`]: crate::limits::MAX_GAP_INTERVALS
     pub split_at_gaps: bool,
+    /// Find the log's glitches (single samples far off the curve their neighbours follow)
+    /// and replace them by the fit of their neighbours before anything else (default true;
+    /// [`crate::log_screening`]). They are listed in the result's
+    /// [`Recording::glitches`].
+    pub screen_glitches: bool,
 }
 
 impl Default for PreprocessOptions {
@@ -44,11 +49,14 @@ impl Default for PreprocessOptions {
             trim: 0.5,
             decimate: 10,
             split_at_gaps: false,
+            screen_glitches: true,
         }
     }
 }
 
-/// Preprocesses a recording: resamples `q`, `tau` (and `qd` when logged; otherwise qd is the
+/// Preprocesses a recording: replaces its glitches (when `options.screen_glitches`: single
+/// samples far off the curve their neighbours follow, see [`crate::log_screening`]; listed in
+/// the result's [`Recording::glitches`]), resamples `q`, `tau` (and `qd` when logged; otherwise qd is the
 /// derivative of q) onto a uniform grid at `rate`, filters qd and tau (and q if asked) with a
 /// zero-phase Butterworth low-pass, differentiates the filtered qd into qdd, trims and
 /// decimates. The result is a recording with `qd` and `qdd`, named `<name> (preprocessed)`.
@@ -60,6 +68,21 @@ impl Default for PreprocessOptions {
 ///
 /// [`MAX_GAP_INTERVALS`]: crate::limits::MAX_GAP_INTERVALS
 pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Recording> {
+    if !options.screen_glitches {
+        return preprocess_screened(rec, options);
+    }
+    if !options.split_at_gaps {
+        check_gaps(rec)?;
+    }
+    let (screened, glitches) = crate::log_screening::screen_recording(rec)?;
+    Ok(Recording {
+        glitches,
+        ..preprocess_screened(&screened, options)?
+    })
+}
+
+/// [`preprocess`] of a recording whose glitches were screened (or are not to be).
+fn preprocess_screened(rec: &Recording, options: &PreprocessOptions) -> Result<Recording> {
     if !options.split_at_gaps {
         return preprocess_part(rec, options);
     }
@@ -252,7 +275,9 @@ fn gaps(rec: &Recording) -> (f64, Vec<usize>) {
     (median, at)
 }
 
-fn gap_positions(rec: &Recording) -> Vec<usize> {
+/// The indices `i` after which `t[i + 1] - t[i]` is a gap (longer than
+/// [`MAX_GAP_INTERVALS`](crate::limits::MAX_GAP_INTERVALS) median sample intervals).
+pub(crate) fn gap_positions(rec: &Recording) -> Vec<usize> {
     gaps(rec).1
 }
 

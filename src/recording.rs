@@ -19,6 +19,9 @@ pub struct Recording {
     /// The experiment of a plan this recording is a run of (`nominal`, `G_static`, `G`, `H`,
     /// `D`), when it says; see [`Recording::experiment`].
     pub experiment: Option<String>,
+    /// Samples of the log this recording was preprocessed from that were taken for glitches
+    /// and replaced first ([`crate::log_screening`]); empty for a recording as logged.
+    pub glitches: Vec<crate::log_screening::LogGlitch>,
 }
 
 impl Recording {
@@ -43,6 +46,7 @@ impl Recording {
             qd,
             qdd,
             experiment: None,
+            glitches: vec![],
         };
         r.check()?;
         Ok(r)

@@ -306,6 +306,66 @@ fn excite_identify_direct_predict() {
         &["validate", s(&d.join("base.json")), s(&d.join("raw.csv"))],
         &["--robot", "base-parameter model"],
     );
+    // a glitch in the raw log (joint 2's torque at sample 2000 read 50 N m off): replaced
+    // before preprocessing, warned of on stderr and listed in validation.json and the model
+    let mut spiked = raw.clone();
+    spiked.tau[2000 * 6 + 1] += 50.0;
+    write(
+        &d.join("spiked.csv"),
+        &recording_table(&spiked, "").to_csv(),
+    );
+    let run = |args: &[&str]| {
+        let o = bin().args(args).output().unwrap();
+        assert!(o.status.success(), "{args:?}");
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let warned = run(&[
+        "validate",
+        s(&d.join("base.json")),
+        s(&d.join("spiked.csv")),
+        "--robot",
+        "a465",
+        "--out",
+        s(&d.join("spiked_validation")),
+    ]);
+    assert!(
+        warned.contains("taken for glitches") && warned.contains("tau of 'joint2'"),
+        "{warned}"
+    );
+    let spiked_v: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(d.join("spiked_validation/validation.json")).unwrap(),
+    )
+    .unwrap();
+    let listed = spiked_v["log_glitches"].as_array().unwrap();
+    assert!(
+        listed
+            .iter()
+            .any(|g| g["sample"] == 2000 && g["joint"] == 1 && g["signal"] == "tau"),
+        "{listed:?}"
+    );
+    for (a, b) in spiked_v["joints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(v["joints"].as_array().unwrap())
+    {
+        let (a, b) = (a["rms"].as_f64().unwrap(), b["rms"].as_f64().unwrap());
+        assert!((a - b).abs() < 0.01 * b + 1e-9, "{a} against {b}");
+    }
+    run(&[
+        "identify-direct",
+        "a465",
+        s(&d.join("spiked.csv")),
+        "--out",
+        s(&d.join("spiked_base.json")),
+        "--friction",
+        "none",
+    ]);
+    let fit = perturbid_rs::direct::BaseModel::load(d.join("spiked_base.json")).unwrap();
+    assert!(fit
+        .log_glitches
+        .iter()
+        .any(|g| g.sample == 2000 && g.joint == 1 && g.value == spiked.tau[2000 * 6 + 1]));
 }
 
 #[test]

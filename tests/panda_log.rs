@@ -4,10 +4,10 @@
 
 mod common;
 
-use common::panda_urdf;
+use common::{panda_log, panda_urdf};
 use perturbid_rs::direct::{identify_base_parameters, BaseOptions, Weighting};
 use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
-use perturbid_rs::{LoadOptions, Recording, States};
+use perturbid_rs::{LoadOptions, States};
 
 /// Real data (the Panda log of Gaz et al. 2019, which lies beside the repository in
 /// `../shared/data/panda-gaz2019`; see docs/data.md): the reference protocol reaches the
@@ -15,26 +15,13 @@ use perturbid_rs::{LoadOptions, Recording, States};
 /// with the reason, when the log or the Panda URDF is not there.
 #[test]
 fn panda_real_data_matches_the_reference() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/panda-gaz2019");
-    let Ok(text) = std::fs::read_to_string(dir.join("excitation.csv")) else {
-        eprintln!(
-            "SKIPPED: {} is not there (the real Panda log lies beside the repository; see docs/data.md)",
-            dir.join("excitation.csv").display()
-        );
+    let Some(rec) = panda_log() else {
         return;
     };
     let Some(urdf) = panda_urdf() else {
         eprintln!("SKIPPED: the Panda URDF of example-robot-data is not installed (pip install example-robot-data; tests/run_all.sh does)");
         return;
     };
-    let (mut t, mut q, mut qd, mut tau) = (vec![], vec![], vec![], vec![]);
-    for line in text.lines().skip(1) {
-        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
-        t.push(v[0]);
-        q.extend_from_slice(&v[1..8]);
-        qd.extend_from_slice(&v[8..15]);
-        tau.extend_from_slice(&v[15..22]);
-    }
     let mut lock = std::collections::BTreeMap::new();
     lock.insert("panda_finger_joint1".to_string(), 0.0);
     let model = perturbid_rs::model_from_urdf_file(
@@ -45,11 +32,7 @@ fn panda_real_data_matches_the_reference() {
         },
     )
     .unwrap();
-    let rec = preprocess(
-        &Recording::new("panda", 7, t, q, tau, Some(qd), None).unwrap(),
-        &PreprocessOptions::default(),
-    )
-    .unwrap();
+    let rec = preprocess(&rec, &PreprocessOptions::default()).unwrap();
     let k = rec.len();
     let split = (0.7 * k as f64) as usize * 7;
     let (qd, qdd) = (rec.qd.as_ref().unwrap(), rec.qdd.as_ref().unwrap());

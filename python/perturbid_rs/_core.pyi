@@ -292,6 +292,10 @@ class Recording:
     def qd(self) -> Optional[NDArray[np.float64]]: ...
     @property
     def qdd(self) -> Optional[NDArray[np.float64]]: ...
+    @property
+    def glitches(self) -> list[dict[str, Any]]:
+        """Samples of the log this was preprocessed from taken for glitches and replaced first
+        (signal, joint, sample, time, value, noise_levels, replaced_by, repeats_previous)."""
     def __len__(self) -> int: ...
 
 @final
@@ -664,6 +668,7 @@ def preprocess(
     trim: float = 0.5,
     filter_position: bool = False,
     split_at_gaps: bool = False,
+    screen_glitches: bool = True,
     name: str = "recording",
 ) -> Recording: ...
 

@@ -219,6 +219,10 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         )?
     };
     progress.done();
+    let fit = crate::direct::BaseModel {
+        log_glitches: rec.glitches.clone(),
+        ..fit
+    };
     for w in fit.warnings() {
         eprintln!("perturbid: warning: {w}");
     }

@@ -151,6 +151,11 @@ impl PreprocessArgs {
             ..crate::preprocess::PreprocessOptions::default()
         };
         let rec = crate::preprocess::preprocess(&rec, &o)?;
+        if let Some(w) =
+            crate::log_screening::warning(&rec.glitches, &path.display().to_string(), joints)
+        {
+            eprintln!("perturbid: warning: {w}");
+        }
         let _ = writeln!(
             out,
             "preprocessed: {} Hz, {} Hz zero-phase low-pass, every {}th sample, {} s trimmed: {} samples",

@@ -32,7 +32,9 @@ pub(crate) struct ValidateArgs {
     #[command(flatten)]
     preprocessing: PreprocessArgs,
     /// Output folder: residuals.csv (t, measured - predicted per joint), validation.json (the
-    /// per-joint table) and validation.svg (measured and predicted torques, and residuals).
+    /// per-joint table, and `log_glitches`: the samples of the log replaced as glitches before
+    /// preprocessing, when there were any) and validation.svg (measured and predicted torques,
+    /// and residuals).
     #[arg(long, default_value = "validation")]
     out: PathBuf,
 }
@@ -86,9 +88,14 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     }
     let mut set = OutputSet::new(&a.out, "validation");
     set.add("residuals.csv", table.to_csv())?;
+    // the log's glitches replaced before preprocessing beside the table, when there were any
+    let mut json = serde_json::to_value(&v).expect("serialisable");
+    if !rec.glitches.is_empty() {
+        json["log_glitches"] = serde_json::to_value(&rec.glitches).expect("serialisable");
+    }
     set.add(
         "validation.json",
-        serde_json::to_string_pretty(&v).expect("serialisable"),
+        serde_json::to_string_pretty(&json).expect("serialisable"),
     )?;
     set.add(
         "validation.svg",

@@ -88,6 +88,11 @@ pub struct BaseModel {
     /// it was computed.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub residual_correlation: Vec<f64>,
+    /// Samples of the log the data were preprocessed from that were taken for glitches and
+    /// replaced first ([`crate::log_screening`]; set by the caller that preprocessed them,
+    /// such as the command line); empty when none were, or the data came otherwise.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub log_glitches: Vec<crate::log_screening::LogGlitch>,
 }
 
 /// Identifies the base parameters of `model` from the samples of `states` (rad, rad/s,
@@ -221,6 +226,7 @@ fn fit_with_factors(
         samples: k,
         base,
         residual_correlation: vec![],
+        log_glitches: vec![],
     };
     // residuals correlated from sample to sample (a filtered, lightly decimated log) carry less
     // information than their number says
@@ -294,6 +300,14 @@ impl Document for BaseModel {
                     crate::error::shown(m.residual_correlation[i])
                 ),
             ));
+        }
+        if let Some((i, problem)) = m
+            .log_glitches
+            .iter()
+            .enumerate()
+            .find_map(|(i, g)| g.problem(n).map(|p| (i, p)))
+        {
+            return Err(invalid(Self::WHAT, format!("log_glitches[{i}]: {problem}")));
         }
         check_magnitudes(Self::WHAT, "residual_rms", &m.residual_rms, false)?;
         check_magnitudes(Self::WHAT, "sigma", &m.sigma, false)?;

@@ -289,6 +289,7 @@ pub fn identify_parameters_from_local(
         samples: rows,
         // rows from local models, not a time series
         residual_correlation: vec![],
+        log_glitches: vec![],
     };
     let consistent = match &options.consistent {
         None => None,

@@ -19,9 +19,12 @@ use crate::recording::Recording;
 /// qd and qdd. A gap in `t` longer than 20 median sample intervals is an InputError naming its
 /// time, unless `split_at_gaps`: then each part between gaps is preprocessed on its own and the
 /// parts are concatenated (the gaps stay in `t`; nothing is interpolated across them).
+/// First, unless `screen_glitches=False`, single samples far off the curve their neighbours
+/// follow (glitches of the log) are replaced by the fit of their neighbours: a
+/// PerturbidWarning lists them, and the result's `glitches` holds them.
 #[pyfunction]
-#[pyo3(signature = (t, q, tau, qd=None, *, rate=1000.0, cutoff=Some(10.0), order=4, decimate=10, trim=0.5, filter_position=false, split_at_gaps=false, name="recording"),
-    text_signature = "(t, q, tau, qd=None, *, rate=1000.0, cutoff=10.0, order=4, decimate=10, trim=0.5, filter_position=False, split_at_gaps=False, name='recording')")]
+#[pyo3(signature = (t, q, tau, qd=None, *, rate=1000.0, cutoff=Some(10.0), order=4, decimate=10, trim=0.5, filter_position=false, split_at_gaps=false, screen_glitches=true, name="recording"),
+    text_signature = "(t, q, tau, qd=None, *, rate=1000.0, cutoff=10.0, order=4, decimate=10, trim=0.5, filter_position=False, split_at_gaps=False, screen_glitches=True, name='recording')")]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn preprocess(
     py: Python<'_>,
@@ -36,6 +39,7 @@ pub(crate) fn preprocess(
     trim: f64,
     filter_position: bool,
     split_at_gaps: bool,
+    screen_glitches: bool,
     name: &str,
 ) -> PyResult<PyRecording> {
     let rec = PyRecording::build(t, q, tau, qd, None, name)?;
@@ -47,7 +51,11 @@ pub(crate) fn preprocess(
         trim,
         decimate,
         split_at_gaps,
+        screen_glitches,
     };
     let out: Recording = detached(py, "preprocess", || preprocess_rs(&rec, &options))?;
+    if let Some(w) = crate::log_screening::warning(&out.glitches, name, &[]) {
+        super::errors::warn_all(py, &[w])?;
+    }
     Ok(PyRecording { rec: Arc::new(out) })
 }

@@ -125,6 +125,30 @@ impl PyRecording {
             .map(|v| rows(py, v, self.rec.n))
             .transpose()
     }
+    /// The samples of the log this recording was preprocessed from that were taken for
+    /// glitches and replaced first: a list of dicts `signal` (q, qd, qdd, tau), `joint`
+    /// (0-based column index), `sample` (0-based row of the log), `time` (s), `value` (as
+    /// logged), `noise_levels` (None beyond any scale), `replaced_by`, `repeats_previous`.
+    /// Empty for a recording as logged.
+    #[getter]
+    fn glitches<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, pyo3::types::PyDict>>> {
+        self.rec
+            .glitches
+            .iter()
+            .map(|g| {
+                let e = pyo3::types::PyDict::new(py);
+                e.set_item("signal", &g.signal)?;
+                e.set_item("joint", g.joint)?;
+                e.set_item("sample", g.sample)?;
+                e.set_item("time", g.time)?;
+                e.set_item("value", g.value)?;
+                e.set_item("noise_levels", g.noise_levels)?;
+                e.set_item("replaced_by", g.replaced_by)?;
+                e.set_item("repeats_previous", g.repeats_previous)?;
+                Ok(e)
+            })
+            .collect()
+    }
     fn __len__(&self) -> usize {
         self.rec.len()
     }

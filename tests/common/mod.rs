@@ -328,3 +328,27 @@ pub fn speed_robots() -> Vec<(&'static str, perturbid_rs::Model)> {
     ));
     out
 }
+
+/// The real Panda log of Gaz et al. (2019) beside the repository
+/// (`../shared/data/panda-gaz2019/excitation.csv`, docs/data.md) as a recording of its 7
+/// joints with `qd`; `None`, saying on stderr that the test is skipped, when it is not there.
+pub fn panda_log() -> Option<perturbid_rs::Recording> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/panda-gaz2019/excitation.csv");
+    let Ok(text) = std::fs::read_to_string(&path) else {
+        eprintln!(
+            "SKIPPED: {} is not there (the real Panda log lies beside the repository; see docs/data.md)",
+            path.display()
+        );
+        return None;
+    };
+    let (mut t, mut q, mut qd, mut tau) = (vec![], vec![], vec![], vec![]);
+    for line in text.lines().skip(1) {
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        t.push(v[0]);
+        q.extend_from_slice(&v[1..8]);
+        qd.extend_from_slice(&v[8..15]);
+        tau.extend_from_slice(&v[15..22]);
+    }
+    Some(perturbid_rs::Recording::new("panda", 7, t, q, tau, Some(qd), None).unwrap())
+}

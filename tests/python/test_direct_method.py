@@ -415,3 +415,31 @@ def test_validation_tables_and_figures():
         plot.measured_and_predicted(t[:-1], tau, tau)
     with pytest.raises(pr.InputError):
         pr.validate(fit, q, qd, qdd, tau[:-1])
+
+
+def test_preprocess_replaces_a_logs_glitches_and_says_so():
+    """A torque spike and a row of zero positions in a log are replaced before filtering: a
+    PerturbidWarning names them, the result's glitches list them, and the preprocessed
+    signals equal those of the clean log to well within the noise-free filter's output;
+    screen_glitches=False keeps them (and the spike then shows in the filtered torque)."""
+    rng = np.random.default_rng(3)
+    t = np.cumsum(rng.uniform(0.0008, 0.0012, 8000))
+    q = np.stack([0.3 * np.sin(2 * np.pi * 0.2 * t + k) for k in range(3)], axis=1)
+    tau = np.stack([2.0 * np.cos(2 * np.pi * 0.3 * t + k) for k in range(3)], axis=1)
+    tau += 0.02 * rng.standard_normal(tau.shape)
+    clean = pr.preprocess(t, q, tau, name="clean")
+    assert clean.glitches == []
+    bad_q, bad_tau = q.copy(), tau.copy()
+    bad_tau[4000, 1] += 40.0
+    bad_q[5000, :] = 0.0
+    with pytest.warns(pr.PerturbidWarning, match=r"4 sample\(s\).*tau of joint 2 at t = .* read"):
+        screened = pr.preprocess(t, bad_q, bad_tau, name="log")
+    found = sorted((g["signal"], g["joint"], g["sample"]) for g in screened.glitches)
+    assert found == [("q", 0, 5000), ("q", 1, 5000), ("q", 2, 5000), ("tau", 1, 4000)]
+    spike = next(g for g in screened.glitches if g["signal"] == "tau")
+    assert spike["value"] == bad_tau[4000, 1] and abs(spike["replaced_by"] - tau[4000, 1]) < 0.1
+    assert np.max(np.abs(screened.tau - clean.tau)) < 0.01
+    assert np.max(np.abs(screened.q - clean.q)) < 1e-6
+    kept = pr.preprocess(t, bad_q, bad_tau, screen_glitches=False)
+    assert kept.glitches == []
+    assert np.max(np.abs(kept.tau - clean.tau)) > 0.3

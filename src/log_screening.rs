@@ -1,0 +1,360 @@
+//! Glitches in a whole log, found and replaced before preprocessing (docs/method.md, section
+//! 7): a sample of one signal far off the smooth curve its neighbours follow (a corrupted or
+//! dropped message read as zeros, a sensor's spike, an encoder's missed count). Without the
+//! screening, one position sample of the A465's excitation log off by 0.05 rad moved the
+//! direct method's base parameters by 12 of their standard errors, a row of positions read as
+//! zeros by 450, and a torque of 1e300 ended the fit with an overflow, all silently; the
+//! low-pass filter spreads a glitch over its neighbours rather than removing it.
+//!
+//! Each column (a joint's `q`, `qd`, `qdd` when logged, `tau`) is screened on its own, in two
+//! passes:
+//! 1. **Candidates.** A sample's difference from the straight line through its two neighbours
+//!    (in time), against the column's robust level of that difference: samples beyond
+//!    [`CANDIDATE_LEVELS`] of it, and their neighbours within two samples (the inner samples
+//!    of a short burst sit on the line through their own kind).
+//! 2. **Judgement.** Each candidate is judged in the window of [`HALF_WINDOW`] samples either
+//!    side of it (shifted inside the log at its ends; never across a gap), against a cubic in
+//!    time, by [`crate::outliers::screen`]: it is a glitch when its studentised residual is more
+//!    than [`NOISE_LEVELS`] robust noise levels off the fit of the others, and at most
+//!    [`MAX_PER_WINDOW`] samples of its window are. The level is the window's own, with the
+//!    candidate left out, and at least the column's median level over evenly spread windows,
+//!    the rounding of a grid the column lies on, and 1e-8 of its largest value.
+//!
+//! A glitch is replaced by the fit of the others in its window, as if it had not been logged.
+//! A step the signal really makes (Coulomb friction at a velocity reversal, an impact) puts
+//! many samples of the windows around it off any cubic: their noise level rises, or more than
+//! [`MAX_PER_WINDOW`] are off, and nothing is replaced. A sample is only judged in the window
+//! centred on it, so a step near a window's edge is never taken for a glitch.
+//!
+//! What is not found: bursts of more than [`MAX_PER_WINDOW`] samples (masked: see
+//! docs/limits.md), and a log's repeated rows (a logger that writes its last message again:
+//! the real Panda log of `../shared` repeats 6 % of its rows; replacing them moved the direct
+//! method's parameters by 0.02 standard errors, so they are left as logged unless a repeated
+//! position is itself far off, then it is a glitch like any other).
+
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{shown, Result};
+use crate::outliers::{screen, Screened, MAX_PER_WINDOW, NOISE_LEVELS};
+use crate::recording::Recording;
+
+/// Samples each side of a judged sample in its window (the window has `2 HALF_WINDOW + 1`).
+pub const HALF_WINDOW: usize = 10;
+
+/// Degree of the polynomial in time each window is fitted with.
+pub const DEGREE: usize = 3;
+
+/// A sample whose difference from the line through its neighbours exceeds this many robust
+/// levels of that difference (over its column) is a candidate, judged in its window.
+pub const CANDIDATE_LEVELS: f64 = 5.0;
+
+/// A candidate whose studentised residual from the fit of its whole window is below this
+/// fraction of [`NOISE_LEVELS`] times its column's floor is not screened further: screening
+/// divides by a level at least that floor, and leaving other glitches of the window out
+/// could only raise the residual that far where they happened to cancel it.
+const QUICK_LOOK: f64 = 0.3;
+
+/// How many evenly spread windows of a column give its median noise level (the floor of every
+/// window's level).
+const LEVEL_WINDOWS: usize = 400;
+
+/// A sample of a log taken for a glitch and replaced before preprocessing.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LogGlitch {
+    /// The signal: `q`, `qd`, `qdd` or `tau`.
+    pub signal: String,
+    /// The joint's index (0-based, in the recording's column order).
+    pub joint: usize,
+    /// Index of the sample in the log (0-based: data row `sample + 1` of a CSV file).
+    pub sample: usize,
+    /// Its time in the log's clock (s).
+    pub time: f64,
+    /// Its logged value (rad, rad/s, rad/s^2 or N m).
+    pub value: f64,
+    /// How far off the fit of the others in its window, in their robust noise levels; `None`
+    /// beyond any scale (further than a million times the spread of the window's values).
+    pub noise_levels: Option<f64>,
+    /// The value it was replaced by: the fit of the others at its time.
+    pub replaced_by: f64,
+    /// Whether it repeats the sample before it exactly: a logger that wrote its last message
+    /// again, with a new time stamp (a stale sample rather than a reading).
+    pub repeats_previous: bool,
+}
+
+impl LogGlitch {
+    /// What is wrong with a glitch read from a file, if anything: an unknown signal, a joint
+    /// index not below `joints`, a non-finite time, value or replacement, noise levels that
+    /// are not positive.
+    pub fn problem(&self, joints: usize) -> Option<String> {
+        if !["q", "qd", "qdd", "tau"].contains(&self.signal.as_str()) {
+            return Some(format!(
+                "signal '{}' is not one of q, qd, qdd, tau",
+                self.signal
+            ));
+        }
+        if self.joint >= joints {
+            return Some(format!(
+                "joint {} is not a joint index below {joints}",
+                self.joint
+            ));
+        }
+        if !(self.time.is_finite() && self.value.is_finite() && self.replaced_by.is_finite()) {
+            return Some("time, value and replaced_by must be finite".into());
+        }
+        if self.noise_levels.is_some_and(|z| z.is_nan() || z <= 0.0) {
+            return Some("noise_levels must be a positive number or null".into());
+        }
+        None
+    }
+}
+
+/// Screens every column of `rec` for glitches (see the module documentation) and returns the
+/// recording with them replaced, and the glitches in log order (by sample, then signal and
+/// joint). Windows never span a gap longer than
+/// [`MAX_GAP_INTERVALS`](crate::limits::MAX_GAP_INTERVALS) median sample intervals; a stretch
+/// between gaps shorter than one window is not screened. Stops on Ctrl-C.
+pub fn screen_recording(rec: &Recording) -> Result<(Recording, Vec<LogGlitch>)> {
+    let n = rec.n;
+    let signals: Vec<(&str, &Vec<f64>)> = [
+        ("q", Some(&rec.q)),
+        ("qd", rec.qd.as_ref()),
+        ("qdd", rec.qdd.as_ref()),
+        ("tau", Some(&rec.tau)),
+    ]
+    .into_iter()
+    .filter_map(|(s, v)| v.map(|v| (s, v)))
+    .collect();
+    let mut found = vec![];
+    for (a, b) in segments(rec) {
+        let columns: Vec<Vec<f64>> = signals
+            .iter()
+            .flat_map(|(_, v)| (0..n).map(move |j| (a..b).map(|i| v[i * n + j]).collect()))
+            .collect();
+        for (c, k, g) in screen_segment(&rec.t[a..b], &columns)? {
+            let (signal, values) = signals[c / n];
+            let (j, i) = (c % n, a + k);
+            found.push(LogGlitch {
+                signal: signal.to_string(),
+                joint: j,
+                sample: i,
+                time: rec.t[i],
+                value: values[i * n + j],
+                noise_levels: Some(g.noise_levels).filter(|z| z.is_finite()),
+                replaced_by: g.replaced_by,
+                repeats_previous: i > 0 && values[i * n + j] == values[(i - 1) * n + j],
+            });
+        }
+    }
+    let mut out = rec.clone();
+    for g in &found {
+        let column = match g.signal.as_str() {
+            "q" => &mut out.q,
+            "qd" => out.qd.as_mut().expect("screened"),
+            "qdd" => out.qdd.as_mut().expect("screened"),
+            _ => &mut out.tau,
+        };
+        column[g.sample * n + g.joint] = g.replaced_by;
+    }
+    Ok((out, found))
+}
+
+/// The stretches `[a, b)` of `rec`'s samples between gaps.
+fn segments(rec: &Recording) -> Vec<(usize, usize)> {
+    let mut bounds = vec![0];
+    bounds.extend(crate::preprocess::gap_positions(rec).iter().map(|&i| i + 1));
+    bounds.push(rec.len());
+    bounds.windows(2).map(|w| (w[0], w[1])).collect()
+}
+
+/// A glitch of one column: how far off, and the value it is replaced by.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Found {
+    noise_levels: f64,
+    replaced_by: f64,
+}
+
+/// The median of the finite values of `x` (None for none).
+fn median(mut x: Vec<f64>) -> Option<f64> {
+    x.retain(|v| v.is_finite());
+    if x.is_empty() {
+        return None;
+    }
+    let mid = x.len() / 2;
+    Some(*x.select_nth_unstable_by(mid, f64::total_cmp).1)
+}
+
+/// The candidates of one column `y` sampled at `t` (see the module documentation).
+fn candidates(t: &[f64], y: &[f64]) -> Vec<bool> {
+    let k = y.len();
+    let mut e = vec![0.0; k];
+    for i in 1..k - 1 {
+        let s = (t[i] - t[i - 1]) / (t[i + 1] - t[i - 1]);
+        e[i] = y[i] - (y[i - 1] + s * (y[i + 1] - y[i - 1]));
+    }
+    e[0] = e[1];
+    e[k - 1] = e[k - 2];
+    let level = median(e.iter().map(|x| x.abs()).collect()).unwrap_or(0.0) * 1.4826;
+    let far = |x: f64| !x.is_finite() || x.abs() > CANDIDATE_LEVELS * level;
+    let mut candidate = vec![false; k];
+    for i in (0..k).filter(|&i| far(e[i])) {
+        for c in &mut candidate[i.saturating_sub(2)..(i + 3).min(k)] {
+            *c = true;
+        }
+    }
+    candidate
+}
+
+/// The glitches of the `columns` (each sampled at `t`: one stretch between gaps) as (column,
+/// index, glitch), in index order. Each window's basis is built once for all columns.
+fn screen_segment(t: &[f64], columns: &[Vec<f64>]) -> Result<Vec<(usize, usize, Found)>> {
+    let k = t.len();
+    let width = 2 * HALF_WINDOW + 1;
+    if k < width {
+        return Ok(vec![]);
+    }
+    let candidate: Vec<Vec<bool>> = columns.iter().map(|y| candidates(t, y)).collect();
+    let judged: Vec<usize> = (0..k).filter(|&i| candidate.iter().any(|c| c[i])).collect();
+    if judged.is_empty() {
+        return Ok(vec![]);
+    }
+    let window = |i: usize| {
+        let a = i.saturating_sub(HALF_WINDOW).min(k - width);
+        a..a + width
+    };
+    // the floor of every window's level: the rounding of a grid, a tiny fraction of the
+    // column's size, and its median level over evenly spread windows
+    let spread = (k / LEVEL_WINDOWS).max(1);
+    let mut levels: Vec<Vec<f64>> = vec![vec![]; columns.len()];
+    for i in (HALF_WINDOW..k - HALF_WINDOW).step_by(spread) {
+        let r = window(i);
+        if let Some((v, w)) = basis(&t[r.clone()], t[i]) {
+            for (c, y) in columns.iter().enumerate() {
+                levels[c].push(crate::outliers::level(&v, &w, &y[r.clone()]));
+            }
+        }
+    }
+    let floors: Vec<f64> = columns
+        .iter()
+        .zip(&candidate)
+        .zip(levels)
+        .map(|((y, cand), levels)| {
+            let ordinary: Vec<f64> = (0..k).filter(|&i| !cand[i]).map(|i| y[i]).collect();
+            let size = ordinary.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let step = crate::local::quantisation::grid_step(&ordinary).unwrap_or(0.0);
+            median(levels)
+                .unwrap_or(0.0)
+                .max(step / 12f64.sqrt())
+                .max(1e-8 * size)
+                .max(f64::MIN_POSITIVE)
+        })
+        .collect();
+    // each candidate judged in its own window
+    let mut found = vec![];
+    for (done, &i) in judged.iter().enumerate() {
+        if done % 1000 == 999 {
+            crate::interrupt::check("screening the log for glitches")?;
+        }
+        let r = window(i);
+        let Some((v, w)) = basis(&t[r.clone()], t[i]) else {
+            continue;
+        };
+        let at = i - r.start;
+        // the sample's leverage in its window, for the quick look below
+        let h: f64 = (0..=DEGREE).map(|d| v[(at, d)] * w[(d, at)]).sum();
+        for (c, y) in columns.iter().enumerate().filter(|(c, _)| candidate[*c][i]) {
+            let y = &y[r.clone()];
+            // a quick look: the sample's residual from the fit of the whole window, studentised;
+            // screening cannot find it a glitch unless this is far above the level's floor
+            let fit: f64 = (0..=DEGREE)
+                .map(|d| v[(at, d)] * (0..width).map(|m| w[(d, m)] * y[m]).sum::<f64>())
+                .sum();
+            let studentised = (y[at] - fit).abs() / (1.0 - h).max(1e-12).sqrt();
+            if studentised < QUICK_LOOK * NOISE_LEVELS * floors[c] {
+                continue;
+            }
+            let s: Screened = screen(&v, &w, y, floors[c]);
+            if !s.isolated {
+                continue;
+            }
+            if let Some(f) = s.flagged.iter().find(|f| f.index == at) {
+                let g = Found {
+                    noise_levels: f.noise_levels,
+                    replaced_by: s.values[at],
+                };
+                found.push((c, i, g));
+            }
+        }
+    }
+    Ok(found)
+}
+
+/// The cubic basis of a window at times `t` about `tc`, scaled to [-1, 1], and its
+/// least-squares weights (`(V^T V)^-1 V^T` by Cholesky: the scaled cubic is well
+/// conditioned); None where the times do not span a cubic.
+fn basis(t: &[f64], tc: f64) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
+    let half = t.iter().fold(0.0f64, |m, x| m.max((x - tc).abs()));
+    if !(half > 0.0 && half.is_finite()) {
+        return None;
+    }
+    let v = DMatrix::from_fn(t.len(), DEGREE + 1, |r, d| {
+        ((t[r] - tc) / half).powi(d as i32)
+    });
+    let w = v.tr_mul(&v).cholesky()?.solve(&v.transpose());
+    w.iter().all(|x| x.is_finite()).then_some((v, w))
+}
+
+/// How many glitches a warning lists before "and N more".
+const LISTED: usize = 5;
+
+/// The warning that tells of the glitches `found` in the log `recording` (None for none);
+/// `joint_names` name the joints by index (where it has none, `joint 3` names index 2).
+pub fn warning(found: &[LogGlitch], recording: &str, joint_names: &[String]) -> Option<String> {
+    if found.is_empty() {
+        return None;
+    }
+    let unit = |s: &str| match s {
+        "q" => "rad",
+        "qd" => "rad/s",
+        "qdd" => "rad/s^2",
+        _ => "N m",
+    };
+    let mut listed: Vec<String> = found
+        .iter()
+        .take(LISTED)
+        .map(|g| {
+            let joint = joint_names
+                .get(g.joint)
+                .map_or_else(|| format!("joint {}", g.joint + 1), |j| format!("'{j}'"));
+            let off = g
+                .noise_levels
+                .map_or("off beyond any scale".to_string(), |z| {
+                    format!("{z:.0} noise levels off")
+                });
+            format!(
+                "{} of {joint} at t = {:.4} s (sample {}) read {} {}, {off}",
+                g.signal,
+                g.time,
+                g.sample,
+                shown(g.value),
+                unit(&g.signal)
+            )
+        })
+        .collect();
+    if found.len() > LISTED {
+        listed.push(format!("and {} more", found.len() - LISTED));
+    }
+    let repeated = found.iter().filter(|g| g.repeats_previous).count();
+    let stale = if repeated > 0 {
+        format!(" ({repeated} of them repeat the sample before exactly: stale samples of a logger that wrote its last message again with a new time stamp; such repeats that stay near the curve are kept as logged)")
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "log '{recording}': {} sample(s), each alone in its window of {} samples beyond {NOISE_LEVELS} noise levels of the cubic through the others (at most {MAX_PER_WINDOW} such in a window), were taken for glitches of the log and replaced by that fit before preprocessing{stale}: {}",
+        found.len(),
+        2 * HALF_WINDOW + 1,
+        listed.join("; ")
+    ))
+}
