@@ -88,7 +88,7 @@ impl LogGlitch {
     /// index not below `joints`, a non-finite time, value or replacement, noise levels that
     /// are not positive.
     pub fn problem(&self, joints: usize) -> Option<String> {
-        if !["q", "qd", "qdd", "tau"].contains(&self.signal.as_str()) {
+        if !SIGNALS.contains(&self.signal.as_str()) {
             return Some(format!(
                 "signal '{}' is not one of q, qd, qdd, tau",
                 self.signal
@@ -117,15 +117,7 @@ impl LogGlitch {
 /// between gaps shorter than one window is not screened. Stops on Ctrl-C.
 pub fn screen_recording(rec: &Recording) -> Result<(Recording, Vec<LogGlitch>)> {
     let n = rec.n;
-    let signals: Vec<(&str, &Vec<f64>)> = [
-        ("q", Some(&rec.q)),
-        ("qd", rec.qd.as_ref()),
-        ("qdd", rec.qdd.as_ref()),
-        ("tau", Some(&rec.tau)),
-    ]
-    .into_iter()
-    .filter_map(|(s, v)| v.map(|v| (s, v)))
-    .collect();
+    let signals = signals(rec);
     let mut found = vec![];
     for (a, b) in segments(rec) {
         let columns: Vec<Vec<f64>> = signals
@@ -158,6 +150,23 @@ pub fn screen_recording(rec: &Recording) -> Result<(Recording, Vec<LogGlitch>)> 
         column[g.sample * n + g.joint] = g.replaced_by;
     }
     Ok((out, found))
+}
+
+/// The signals a log may have, by their column prefix.
+const SIGNALS: [&str; 4] = ["q", "qd", "qdd", "tau"];
+
+/// The signals `rec` has (its columns, row-major), by their column prefix.
+fn signals(rec: &Recording) -> Vec<(&'static str, &Vec<f64>)> {
+    [
+        Some(&rec.q),
+        rec.qd.as_ref(),
+        rec.qdd.as_ref(),
+        Some(&rec.tau),
+    ]
+    .into_iter()
+    .zip(SIGNALS)
+    .filter_map(|(v, s)| v.map(|v| (s, v)))
+    .collect()
 }
 
 /// The stretches `[a, b)` of `rec`'s samples between gaps.
@@ -305,6 +314,127 @@ fn basis(t: &[f64], tc: f64) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
     w.iter().all(|x| x.is_finite()).then_some((v, w))
 }
 
+/// The fewest rows a dropout has: a single row read as zeros is judged by the glitch screening
+/// like any other sample.
+pub const MIN_DROPOUT: usize = 2;
+
+/// A run of rows of a log in which every joint of one signal reads exactly 0 while the robot
+/// moves (a lost message logged as zeros): removed before preprocessing.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LogDropout {
+    /// The signal read as zeros: `q`, `qd`, `qdd` or `tau`.
+    pub signal: String,
+    /// Index of its first row in the log (0-based: data row `first_sample + 1` of a CSV file).
+    pub first_sample: usize,
+    /// How many rows (at least [`MIN_DROPOUT`]).
+    pub samples: usize,
+    /// Times of its first and last rows (s).
+    pub from: f64,
+    pub to: f64,
+}
+
+impl LogDropout {
+    /// What is wrong with a dropout read from a file, if anything: an unknown signal, fewer
+    /// than [`MIN_DROPOUT`] rows, times not finite and in order.
+    pub fn problem(&self) -> Option<String> {
+        if !SIGNALS.contains(&self.signal.as_str()) {
+            return Some(format!(
+                "signal '{}' is not one of q, qd, qdd, tau",
+                self.signal
+            ));
+        }
+        if self.samples < MIN_DROPOUT {
+            return Some(format!(
+                "{} samples; a dropout has at least {MIN_DROPOUT}",
+                self.samples
+            ));
+        }
+        if !(self.from.is_finite() && self.to.is_finite() && self.from <= self.to) {
+            return Some("from and to must be finite times, from <= to".into());
+        }
+        None
+    }
+}
+
+/// The dropouts of `rec`: runs of at least [`MIN_DROPOUT`] rows in which every joint of a
+/// signal reads exactly 0, with a row on either side in which some joint of it does not. For
+/// `qd`, `qdd` and `tau` the positions must change across the run (from the row before it to
+/// the row after it): a robot at rest with no gravity may read zeros. In log order.
+pub fn find_dropouts(rec: &Recording) -> Vec<LogDropout> {
+    let n = rec.n;
+    let k = rec.len();
+    let mut found = vec![];
+    for (signal, values) in signals(rec) {
+        let zero = |i: usize| values[i * n..(i + 1) * n].iter().all(|&x| x == 0.0);
+        let mut i = 1;
+        while i < k {
+            if !zero(i) {
+                i += 1;
+                continue;
+            }
+            let a = i;
+            while i < k && zero(i) {
+                i += 1;
+            }
+            // rows a..i read zeros; a - 1 does not (a >= 1 and the run starts there)
+            if i == k || zero(a - 1) || i - a < MIN_DROPOUT {
+                continue;
+            }
+            let moves = signal == "q" || rec.q[(a - 1) * n..a * n] != rec.q[i * n..(i + 1) * n];
+            if moves {
+                found.push(LogDropout {
+                    signal: signal.to_string(),
+                    first_sample: a,
+                    samples: i - a,
+                    from: rec.t[a],
+                    to: rec.t[i - 1],
+                });
+            }
+        }
+    }
+    found.sort_by_key(|d| d.first_sample);
+    found
+}
+
+/// `rec` without the rows of `dropouts` (a row in several is removed once).
+pub fn without_dropouts(rec: &Recording, dropouts: &[LogDropout]) -> Result<Recording> {
+    if dropouts.is_empty() {
+        return Ok(rec.clone());
+    }
+    let n = rec.n;
+    let mut keep = vec![true; rec.len()];
+    for d in dropouts {
+        for k in &mut keep[d.first_sample..d.first_sample + d.samples] {
+            *k = false;
+        }
+    }
+    let rows = |x: &[f64]| -> Vec<f64> {
+        (0..keep.len())
+            .filter(|&i| keep[i])
+            .flat_map(|i| x[i * n..(i + 1) * n].iter().copied())
+            .collect()
+    };
+    let out = Recording::new(
+        rec.name.clone(),
+        n,
+        (0..keep.len())
+            .filter(|&i| keep[i])
+            .map(|i| rec.t[i])
+            .collect(),
+        rows(&rec.q),
+        rows(&rec.tau),
+        rec.qd.as_deref().map(rows),
+        rec.qdd.as_deref().map(rows),
+    )?;
+    Ok(Recording {
+        experiment: rec.experiment.clone(),
+        glitches: rec.glitches.clone(),
+        dropouts: dropouts.to_vec(),
+        ..out
+    })
+}
+
 /// How many glitches a warning lists before "and N more".
 const LISTED: usize = 5;
 
@@ -355,6 +485,32 @@ pub fn warning(found: &[LogGlitch], recording: &str, joint_names: &[String]) -> 
         "log '{recording}': {} sample(s), each alone in its window of {} samples beyond {NOISE_LEVELS} noise levels of the cubic through the others (at most {MAX_PER_WINDOW} such in a window), were taken for glitches of the log and replaced by that fit before preprocessing{stale}: {}",
         found.len(),
         2 * HALF_WINDOW + 1,
+        listed.join("; ")
+    ))
+}
+
+/// The warning that tells of the `dropouts` removed from the log `recording` (None for none).
+pub fn dropout_warning(dropouts: &[LogDropout], recording: &str) -> Option<String> {
+    if dropouts.is_empty() {
+        return None;
+    }
+    let mut listed: Vec<String> = dropouts
+        .iter()
+        .take(LISTED)
+        .map(|d| {
+            format!(
+                "{} rows from sample {} (t = {:.4} s to {:.4} s) read 0 for every joint's {}",
+                d.samples, d.first_sample, d.from, d.to, d.signal
+            )
+        })
+        .collect();
+    if dropouts.len() > LISTED {
+        listed.push(format!("and {} more", dropouts.len() - LISTED));
+    }
+    Some(format!(
+        "log '{recording}': {} dropout(s), rows in which every joint of a signal reads exactly 0 while the robot moves (a lost message logged as zeros), were removed before preprocessing, which bridges them as it bridges irregular sampling (a stretch longer than {} median sample intervals is a gap): {}",
+        dropouts.len(),
+        crate::limits::MAX_GAP_INTERVALS,
         listed.join("; ")
     ))
 }

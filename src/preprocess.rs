@@ -33,9 +33,10 @@ pub struct PreprocessOptions {
     /// [`MAX_GAP_INTERVALS`]: crate::limits::MAX_GAP_INTERVALS
     pub split_at_gaps: bool,
     /// Find the log's glitches (single samples far off the curve their neighbours follow)
-    /// and replace them by the fit of their neighbours before anything else (default true;
-    /// [`crate::log_screening`]). They are listed in the result's
-    /// [`Recording::glitches`].
+    /// and replace them by the fit of their neighbours, and remove its dropouts (rows in which
+    /// every joint of a signal reads exactly 0 while the robot moves), before anything else
+    /// (default true; [`crate::log_screening`]). They are listed in the result's
+    /// [`Recording::glitches`] and [`Recording::dropouts`].
     pub screen_glitches: bool,
 }
 
@@ -54,9 +55,11 @@ impl Default for PreprocessOptions {
     }
 }
 
-/// Preprocesses a recording: replaces its glitches (when `options.screen_glitches`: single
-/// samples far off the curve their neighbours follow, see [`crate::log_screening`]; listed in
-/// the result's [`Recording::glitches`]), resamples `q`, `tau` (and `qd` when logged; otherwise qd is the
+/// Preprocesses a recording: replaces its glitches and removes its dropouts (when
+/// `options.screen_glitches`: single samples far off the curve their neighbours follow, and
+/// rows in which every joint of a signal reads exactly 0 while the robot moves, see
+/// [`crate::log_screening`]; listed in the result's [`Recording::glitches`] and
+/// [`Recording::dropouts`]), resamples `q`, `tau` (and `qd` when logged; otherwise qd is the
 /// derivative of q) onto a uniform grid at `rate`, filters qd and tau (and q if asked) with a
 /// zero-phase Butterworth low-pass, differentiates the filtered qd into qdd, trims and
 /// decimates. The result is a recording with `qd` and `qdd`, named `<name> (preprocessed)`.
@@ -75,9 +78,24 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
         check_gaps(rec)?;
     }
     let (screened, glitches) = crate::log_screening::screen_recording(rec)?;
+    let dropouts = crate::log_screening::find_dropouts(&screened);
+    let kept = crate::log_screening::without_dropouts(&screened, &dropouts)?;
+    let out = preprocess_screened(&kept, options).map_err(|e| match e {
+        Error::Recording { recording, message } if !dropouts.is_empty() => Error::Recording {
+            recording,
+            message: format!(
+                "{message} (after removing {} dropout(s), rows that read 0 for every joint of a signal, the first {} rows from t = {:.6} s)",
+                dropouts.len(),
+                dropouts[0].samples,
+                dropouts[0].from
+            ),
+        },
+        other => other,
+    })?;
     Ok(Recording {
         glitches,
-        ..preprocess_screened(&screened, options)?
+        dropouts,
+        ..out
     })
 }
 

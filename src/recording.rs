@@ -22,6 +22,10 @@ pub struct Recording {
     /// Samples of the log this recording was preprocessed from that were taken for glitches
     /// and replaced first ([`crate::log_screening`]); empty for a recording as logged.
     pub glitches: Vec<crate::log_screening::LogGlitch>,
+    /// Runs of rows of the log this recording was preprocessed from in which every joint of a
+    /// signal read exactly 0 while the robot moved, removed first
+    /// ([`crate::log_screening::find_dropouts`]); empty for a recording as logged.
+    pub dropouts: Vec<crate::log_screening::LogDropout>,
 }
 
 impl Recording {
@@ -47,6 +51,7 @@ impl Recording {
             qdd,
             experiment: None,
             glitches: vec![],
+            dropouts: vec![],
         };
         r.check()?;
         Ok(r)

@@ -2,8 +2,9 @@
 //! spikes and rows of zeros leave the direct method's parameters where the clean log puts
 //! them (and move them by many standard errors unscreened); velocity reversals' Coulomb steps
 //! and clean noise are left alone; a replaced value is the cubic fit of the others in its
-//! window, checked against an independent least-squares fit; windows stop at gaps; saved
-//! glitches are checked on load; the real Panda log loses nothing but stale positions.
+//! window, checked against an independent least-squares fit; windows stop at gaps; rows of
+//! zeros while the robot moves (dropouts) are removed, and zeros at rest kept; saved glitches
+//! and dropouts are checked on load; the real Panda log loses nothing but stale positions.
 
 mod common;
 
@@ -11,7 +12,7 @@ use common::{panda_log, panda_urdf, Rng};
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
 use perturbid_rs::document::Document;
-use perturbid_rs::log_screening::{screen_recording, HALF_WINDOW};
+use perturbid_rs::log_screening::{find_dropouts, screen_recording, HALF_WINDOW};
 use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::robots::a465;
 use perturbid_rs::trajectory::FourierTrajectory;
@@ -182,6 +183,83 @@ fn spikes_and_a_row_of_zeros_are_replaced_and_leave_the_parameters_alone() {
     );
 }
 
+#[test]
+fn dropouts_are_removed_and_zeros_at_rest_kept() {
+    let clean = noisy_log();
+    let n = 6;
+    let (_, reference) = identify(&clean, true);
+    // fifteen rows of torques read as zeros while the robot moves (bridged: under 20 intervals)
+    let mut rec = clean.clone();
+    for x in &mut rec.tau[7000 * n..7015 * n] {
+        *x = 0.0;
+    }
+    let found = find_dropouts(&rec);
+    assert_eq!(found.len(), 1, "{found:?}");
+    let d = &found[0];
+    assert_eq!(
+        (d.signal.as_str(), d.first_sample, d.samples),
+        ("tau", 7000, 15)
+    );
+    assert_eq!((d.from, d.to), (rec.t[7000], rec.t[7014]));
+    let (p, fit) = identify(&rec, true);
+    assert_eq!(p.dropouts, found);
+    assert!(
+        moved(&fit, &reference) < 0.1,
+        "{}",
+        moved(&fit, &reference)
+    );
+    let (p, fit) = identify(&rec, false);
+    assert!(p.dropouts.is_empty());
+    assert!(moved(&fit, &reference) > 1.0, "{}", moved(&fit, &reference));
+    // a hundred rows leave a gap: refused naming it and the dropout, or split on request
+    let mut long = clean.clone();
+    for x in &mut long.tau[7000 * n..7100 * n] {
+        *x = 0.0;
+    }
+    let e = preprocess(&long, &PreprocessOptions::default()).unwrap_err();
+    assert!(
+        e.to_string().contains("gap") && e.to_string().contains("after removing 1 dropout"),
+        "{e}"
+    );
+    let split = preprocess(
+        &long,
+        &PreprocessOptions {
+            split_at_gaps: true,
+            ..PreprocessOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(split.dropouts.len(), 1);
+    // zeros while the robot stands still are readings (no gravity, say): kept
+    let mut rest = clean.clone();
+    let held: Vec<f64> = rest.q[6999 * n..7000 * n].to_vec();
+    for i in 7000..=7010 {
+        rest.q[i * n..(i + 1) * n].copy_from_slice(&held);
+    }
+    for x in &mut rest.tau[7000 * n..7010 * n] {
+        *x = 0.0;
+    }
+    assert!(find_dropouts(&rest).is_empty());
+    // a row of zero positions is a dropout of positions; one row alone is no dropout
+    let mut q = clean.clone();
+    for x in &mut q.q[3000 * n..3002 * n] {
+        *x = 0.0;
+    }
+    for x in &mut q.q[5000 * n..5001 * n] {
+        *x = 0.0;
+    }
+    let found = find_dropouts(&q);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!(
+        (
+            found[0].signal.as_str(),
+            found[0].first_sample,
+            found[0].samples
+        ),
+        ("q", 3000, 2)
+    );
+}
+
 /// A replaced value is the least-squares cubic in time through the other samples of its
 /// window (its glitch left out), computed here independently by an SVD solve.
 #[test]
@@ -241,30 +319,49 @@ fn windows_stop_at_gaps_and_short_stretches_are_not_judged() {
 fn saved_log_glitches_are_checked_on_load() {
     let mut rec = noisy_log();
     rec.tau[4000 * 6 + 1] += 50.0;
-    let (_, fit) = identify(&rec, true);
+    for x in &mut rec.tau[7000 * 6..7004 * 6] {
+        *x = 0.0;
+    }
+    let (p, fit) = identify(&rec, true);
     let fit = BaseModel {
-        log_glitches: preprocess(&rec, &PreprocessOptions::default())
-            .unwrap()
-            .glitches,
+        log_glitches: p.glitches,
+        log_dropouts: p.dropouts,
         ..fit
     };
-    assert_eq!(fit.log_glitches.len(), 1);
+    assert_eq!((fit.log_glitches.len(), fit.log_dropouts.len()), (1, 1));
     let text = fit.to_json();
     assert_eq!(BaseModel::from_json(&text).unwrap(), fit);
-    for (from, to, says) in [
+    let value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    type Edit = fn(&mut serde_json::Value);
+    let edits: [(Edit, &str); 5] = [
         (
-            "\"signal\":\"tau\"",
-            "\"signal\":\"force\"",
-            "signal 'force'",
+            |v| v["log_glitches"][0]["signal"] = "force".into(),
+            "log_glitches[0]: signal 'force'",
         ),
-        ("\"joint\":1,", "\"joint\":6,", "joint 6"),
-        ("\"noise_levels\":", "\"noise_levels\":-", "noise_levels"),
-    ] {
-        let compact = text.replace(": ", ":").replace(",\n", ",");
-        let bad = compact.replacen(from, to, 1);
-        assert_ne!(bad, compact, "{from}");
-        let e = BaseModel::from_json(&bad).unwrap_err().to_string();
-        assert!(e.contains("log_glitches[0]") && e.contains(says), "{e}");
+        (
+            |v| v["log_glitches"][0]["joint"] = 6.into(),
+            "log_glitches[0]: joint 6",
+        ),
+        (
+            |v| v["log_glitches"][0]["noise_levels"] = (-1.0).into(),
+            "log_glitches[0]: noise_levels",
+        ),
+        (
+            |v| v["log_dropouts"][0]["samples"] = 1.into(),
+            "log_dropouts[0]: 1 samples",
+        ),
+        (
+            |v| v["log_dropouts"][0]["to"] = 0.0.into(),
+            "log_dropouts[0]: from and to",
+        ),
+    ];
+    for (edit, says) in edits {
+        let mut bad = value.clone();
+        edit(&mut bad);
+        let e = BaseModel::from_json(&bad.to_string())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(says), "{e}");
     }
 }
 
@@ -284,6 +381,7 @@ fn the_real_panda_log_loses_only_stale_positions() {
     let (_, found) = screen_recording(&rec).unwrap();
     assert!(!found.is_empty() && found.len() < 100, "{}", found.len());
     assert!(found.iter().all(|g| g.signal == "q"), "{found:?}");
+    assert!(find_dropouts(&rec).is_empty());
     let stale = found.iter().filter(|g| g.repeats_previous).count();
     assert!(stale * 10 >= found.len() * 9, "{stale} of {}", found.len());
     let mut lock = std::collections::BTreeMap::new();

@@ -296,6 +296,10 @@ class Recording:
     def glitches(self) -> list[dict[str, Any]]:
         """Samples of the log this was preprocessed from taken for glitches and replaced first
         (signal, joint, sample, time, value, noise_levels, replaced_by, repeats_previous)."""
+    @property
+    def dropouts(self) -> list[dict[str, Any]]:
+        """Runs of rows of the log this was preprocessed from removed as dropouts (every joint
+        of a signal read exactly 0 while the robot moved): signal, first_sample, samples, from, to."""
     def __len__(self) -> int: ...
 
 @final

@@ -221,6 +221,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     progress.done();
     let fit = crate::direct::BaseModel {
         log_glitches: rec.glitches.clone(),
+        log_dropouts: rec.dropouts.clone(),
         ..fit
     };
     for w in fit.warnings() {

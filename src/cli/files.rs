@@ -156,6 +156,11 @@ impl PreprocessArgs {
         {
             eprintln!("perturbid: warning: {w}");
         }
+        if let Some(w) =
+            crate::log_screening::dropout_warning(&rec.dropouts, &path.display().to_string())
+        {
+            eprintln!("perturbid: warning: {w}");
+        }
         let _ = writeln!(
             out,
             "preprocessed: {} Hz, {} Hz zero-phase low-pass, every {}th sample, {} s trimmed: {} samples",

@@ -32,8 +32,9 @@ pub(crate) struct ValidateArgs {
     #[command(flatten)]
     preprocessing: PreprocessArgs,
     /// Output folder: residuals.csv (t, measured - predicted per joint), validation.json (the
-    /// per-joint table, and `log_glitches`: the samples of the log replaced as glitches before
-    /// preprocessing, when there were any) and validation.svg (measured and predicted torques,
+    /// per-joint table, and `log_glitches` and `log_dropouts`: the samples of the log replaced
+    /// as glitches and the rows removed as dropouts before preprocessing, when there were any)
+    /// and validation.svg (measured and predicted torques,
     /// and residuals).
     #[arg(long, default_value = "validation")]
     out: PathBuf,
@@ -92,6 +93,9 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     let mut json = serde_json::to_value(&v).expect("serialisable");
     if !rec.glitches.is_empty() {
         json["log_glitches"] = serde_json::to_value(&rec.glitches).expect("serialisable");
+    }
+    if !rec.dropouts.is_empty() {
+        json["log_dropouts"] = serde_json::to_value(&rec.dropouts).expect("serialisable");
     }
     set.add(
         "validation.json",

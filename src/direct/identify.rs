@@ -93,6 +93,10 @@ pub struct BaseModel {
     /// such as the command line); empty when none were, or the data came otherwise.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub log_glitches: Vec<crate::log_screening::LogGlitch>,
+    /// Rows of that log removed first as dropouts (every joint of a signal read exactly 0
+    /// while the robot moved; [`crate::log_screening::find_dropouts`]), set likewise.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub log_dropouts: Vec<crate::log_screening::LogDropout>,
 }
 
 /// Identifies the base parameters of `model` from the samples of `states` (rad, rad/s,
@@ -227,6 +231,7 @@ fn fit_with_factors(
         base,
         residual_correlation: vec![],
         log_glitches: vec![],
+        log_dropouts: vec![],
     };
     // residuals correlated from sample to sample (a filtered, lightly decimated log) carry less
     // information than their number says
@@ -308,6 +313,14 @@ impl Document for BaseModel {
             .find_map(|(i, g)| g.problem(n).map(|p| (i, p)))
         {
             return Err(invalid(Self::WHAT, format!("log_glitches[{i}]: {problem}")));
+        }
+        if let Some((i, problem)) = m
+            .log_dropouts
+            .iter()
+            .enumerate()
+            .find_map(|(i, d)| d.problem().map(|p| (i, p)))
+        {
+            return Err(invalid(Self::WHAT, format!("log_dropouts[{i}]: {problem}")));
         }
         check_magnitudes(Self::WHAT, "residual_rms", &m.residual_rms, false)?;
         check_magnitudes(Self::WHAT, "sigma", &m.sigma, false)?;

@@ -290,6 +290,7 @@ pub fn identify_parameters_from_local(
         // rows from local models, not a time series
         residual_correlation: vec![],
         log_glitches: vec![],
+        log_dropouts: vec![],
     };
     let consistent = match &options.consistent {
         None => None,

@@ -20,8 +20,9 @@ use crate::recording::Recording;
 /// time, unless `split_at_gaps`: then each part between gaps is preprocessed on its own and the
 /// parts are concatenated (the gaps stay in `t`; nothing is interpolated across them).
 /// First, unless `screen_glitches=False`, single samples far off the curve their neighbours
-/// follow (glitches of the log) are replaced by the fit of their neighbours: a
-/// PerturbidWarning lists them, and the result's `glitches` holds them.
+/// follow (glitches of the log) are replaced by the fit of their neighbours, and rows in which
+/// every joint of a signal reads exactly 0 while the robot moves (dropouts) are removed: a
+/// PerturbidWarning lists them, and the result's `glitches` and `dropouts` hold them.
 #[pyfunction]
 #[pyo3(signature = (t, q, tau, qd=None, *, rate=1000.0, cutoff=Some(10.0), order=4, decimate=10, trim=0.5, filter_position=false, split_at_gaps=false, screen_glitches=true, name="recording"),
     text_signature = "(t, q, tau, qd=None, *, rate=1000.0, cutoff=10.0, order=4, decimate=10, trim=0.5, filter_position=False, split_at_gaps=False, screen_glitches=True, name='recording')")]
@@ -54,8 +55,13 @@ pub(crate) fn preprocess(
         screen_glitches,
     };
     let out: Recording = detached(py, "preprocess", || preprocess_rs(&rec, &options))?;
-    if let Some(w) = crate::log_screening::warning(&out.glitches, name, &[]) {
-        super::errors::warn_all(py, &[w])?;
-    }
+    let warnings: Vec<String> = [
+        crate::log_screening::warning(&out.glitches, name, &[]),
+        crate::log_screening::dropout_warning(&out.dropouts, name),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    super::errors::warn_all(py, &warnings)?;
     Ok(PyRecording { rec: Arc::new(out) })
 }

@@ -149,6 +149,26 @@ impl PyRecording {
             })
             .collect()
     }
+    /// The runs of rows of the log this recording was preprocessed from that were removed as
+    /// dropouts (every joint of a signal read exactly 0 while the robot moved): a list of
+    /// dicts `signal`, `first_sample` (0-based row of the log), `samples` (rows), `from`, `to`
+    /// (s). Empty for a recording as logged.
+    #[getter]
+    fn dropouts<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, pyo3::types::PyDict>>> {
+        self.rec
+            .dropouts
+            .iter()
+            .map(|d| {
+                let e = pyo3::types::PyDict::new(py);
+                e.set_item("signal", &d.signal)?;
+                e.set_item("first_sample", d.first_sample)?;
+                e.set_item("samples", d.samples)?;
+                e.set_item("from", d.from)?;
+                e.set_item("to", d.to)?;
+                Ok(e)
+            })
+            .collect()
+    }
     fn __len__(&self) -> usize {
         self.rec.len()
     }

@@ -421,7 +421,8 @@ def test_preprocess_replaces_a_logs_glitches_and_says_so():
     """A torque spike and a row of zero positions in a log are replaced before filtering: a
     PerturbidWarning names them, the result's glitches list them, and the preprocessed
     signals equal those of the clean log to well within the noise-free filter's output;
-    screen_glitches=False keeps them (and the spike then shows in the filtered torque)."""
+    screen_glitches=False keeps them (and the spike then shows in the filtered torque). Rows
+    of zero torques while the robot moves are removed as a dropout, and listed."""
     rng = np.random.default_rng(3)
     t = np.cumsum(rng.uniform(0.0008, 0.0012, 8000))
     q = np.stack([0.3 * np.sin(2 * np.pi * 0.2 * t + k) for k in range(3)], axis=1)
@@ -440,6 +441,15 @@ def test_preprocess_replaces_a_logs_glitches_and_says_so():
     assert spike["value"] == bad_tau[4000, 1] and abs(spike["replaced_by"] - tau[4000, 1]) < 0.1
     assert np.max(np.abs(screened.tau - clean.tau)) < 0.01
     assert np.max(np.abs(screened.q - clean.q)) < 1e-6
+    assert screened.dropouts == []
     kept = pr.preprocess(t, bad_q, bad_tau, screen_glitches=False)
     assert kept.glitches == []
     assert np.max(np.abs(kept.tau - clean.tau)) > 0.3
+    # eight rows of torques read as zeros while the robot moves: removed as a dropout
+    dropped = tau.copy()
+    dropped[6000:6008, :] = 0.0
+    with pytest.warns(pr.PerturbidWarning, match=r"1 dropout\(s\).*8 rows from sample 6000"):
+        bridged = pr.preprocess(t, q, dropped, name="dropout")
+    assert [(d["signal"], d["first_sample"], d["samples"]) for d in bridged.dropouts] == [("tau", 6000, 8)]
+    assert bridged.dropouts[0]["from"] == t[6000] and bridged.dropouts[0]["to"] == t[6007]
+    assert np.max(np.abs(bridged.tau - clean.tau)) < 0.05
