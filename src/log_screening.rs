@@ -332,6 +332,10 @@ pub struct LogDropout {
     /// Times of its first and last rows (s).
     pub from: f64,
     pub to: f64,
+    /// The experiment of a plan whose recording had it (local identification); absent for a
+    /// log preprocessed on its own.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub experiment: Option<String>,
 }
 
 impl LogDropout {
@@ -359,8 +363,9 @@ impl LogDropout {
 
 /// The dropouts of `rec`: runs of at least [`MIN_DROPOUT`] rows in which every joint of a
 /// signal reads exactly 0, with a row on either side in which some joint of it does not. For
-/// `qd`, `qdd` and `tau` the positions must change across the run (from the row before it to
-/// the row after it): a robot at rest with no gravity may read zeros. In log order.
+/// `qd`, `qdd` and `tau` the positions must change within the run (from its first row to its
+/// last): a robot holding a posture reads zero velocities and accelerations, and with no
+/// gravity may read zero torques. In log order.
 pub fn find_dropouts(rec: &Recording) -> Vec<LogDropout> {
     let n = rec.n;
     let k = rec.len();
@@ -381,7 +386,9 @@ pub fn find_dropouts(rec: &Recording) -> Vec<LogDropout> {
             if i == k || zero(a - 1) || i - a < MIN_DROPOUT {
                 continue;
             }
-            let moves = signal == "q" || rec.q[(a - 1) * n..a * n] != rec.q[i * n..(i + 1) * n];
+            // the robot moves during the run: its positions change from its first row to its
+            // last (a hold between two postures reads zero velocities and accelerations)
+            let moves = signal == "q" || rec.q[a * n..(a + 1) * n] != rec.q[(i - 1) * n..i * n];
             if moves {
                 found.push(LogDropout {
                     signal: signal.to_string(),
@@ -389,6 +396,7 @@ pub fn find_dropouts(rec: &Recording) -> Vec<LogDropout> {
                     samples: i - a,
                     from: rec.t[a],
                     to: rec.t[i - 1],
+                    experiment: None,
                 });
             }
         }
@@ -397,31 +405,33 @@ pub fn find_dropouts(rec: &Recording) -> Vec<LogDropout> {
     found
 }
 
+/// The indices of the rows of a log of `len` rows that `dropouts` leave.
+pub fn kept_rows(len: usize, dropouts: &[LogDropout]) -> Vec<usize> {
+    let mut keep = vec![true; len];
+    for d in dropouts {
+        for k in keep.iter_mut().skip(d.first_sample).take(d.samples) {
+            *k = false;
+        }
+    }
+    (0..len).filter(|&i| keep[i]).collect()
+}
+
 /// `rec` without the rows of `dropouts` (a row in several is removed once).
 pub fn without_dropouts(rec: &Recording, dropouts: &[LogDropout]) -> Result<Recording> {
     if dropouts.is_empty() {
         return Ok(rec.clone());
     }
     let n = rec.n;
-    let mut keep = vec![true; rec.len()];
-    for d in dropouts {
-        for k in &mut keep[d.first_sample..d.first_sample + d.samples] {
-            *k = false;
-        }
-    }
+    let keep = kept_rows(rec.len(), dropouts);
     let rows = |x: &[f64]| -> Vec<f64> {
-        (0..keep.len())
-            .filter(|&i| keep[i])
-            .flat_map(|i| x[i * n..(i + 1) * n].iter().copied())
+        keep.iter()
+            .flat_map(|&i| x[i * n..(i + 1) * n].iter().copied())
             .collect()
     };
     let out = Recording::new(
         rec.name.clone(),
         n,
-        (0..keep.len())
-            .filter(|&i| keep[i])
-            .map(|i| rec.t[i])
-            .collect(),
+        keep.iter().map(|&i| rec.t[i]).collect(),
         rows(&rec.q),
         rows(&rec.tau),
         rec.qd.as_deref().map(rows),
@@ -489,8 +499,12 @@ pub fn warning(found: &[LogGlitch], recording: &str, joint_names: &[String]) -> 
     ))
 }
 
-/// The warning that tells of the `dropouts` removed from the log `recording` (None for none).
-pub fn dropout_warning(dropouts: &[LogDropout], recording: &str) -> Option<String> {
+/// What [`dropout_warning`] says became of the rows removed before preprocessing.
+pub const BRIDGED_BY_PREPROCESSING: &str = "before preprocessing, which bridges them as it bridges irregular sampling (a stretch longer than 20 median sample intervals is a gap)";
+
+/// The warning that tells of the `dropouts` removed from the log `recording` (None for none);
+/// `removed` says when and with what consequence (such as [`BRIDGED_BY_PREPROCESSING`]).
+pub fn dropout_warning(dropouts: &[LogDropout], recording: &str, removed: &str) -> Option<String> {
     if dropouts.is_empty() {
         return None;
     }
@@ -508,9 +522,8 @@ pub fn dropout_warning(dropouts: &[LogDropout], recording: &str) -> Option<Strin
         listed.push(format!("and {} more", dropouts.len() - LISTED));
     }
     Some(format!(
-        "log '{recording}': {} dropout(s), rows in which every joint of a signal reads exactly 0 while the robot moves (a lost message logged as zeros), were removed before preprocessing, which bridges them as it bridges irregular sampling (a stretch longer than {} median sample intervals is a gap): {}",
+        "log '{recording}': {} dropout(s), rows in which every joint of a signal reads exactly 0 while the robot moves (a lost message logged as zeros), were removed {removed}: {}",
         dropouts.len(),
-        crate::limits::MAX_GAP_INTERVALS,
         listed.join("; ")
     ))
 }

@@ -179,6 +179,76 @@ fn a_burst_is_not_taken_for_glitches() {
     );
 }
 
+/// Rows of zeros in every torque of a window (a lost message logged as zeros) are removed
+/// before the windows are read: the model stays where the clean logs put it, and a glitch
+/// after them is still named by its row in the log.
+#[test]
+fn a_dropout_is_removed_before_the_windows_are_read() {
+    let (plan, mut recs) = noisy_logs();
+    let clean = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    let n = plan.joint_names.len();
+    let h_time = plan
+        .experiments
+        .iter()
+        .find(|e| e.kind.name() == "H")
+        .unwrap()
+        .crossings[2]
+        .time;
+    let h = log(&mut recs, "H");
+    let i = sample_at(h, h_time);
+    for x in &mut h.tau[i * n..(i + 6) * n] {
+        *x = 0.0;
+    }
+    h.tau[(i + 12) * n] += 40.0;
+    let m = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    let d = &m.diagnostics.dropouts;
+    assert_eq!(d.len(), 1, "{d:?}");
+    assert_eq!(
+        (
+            d[0].experiment.as_deref(),
+            d[0].signal.as_str(),
+            d[0].first_sample,
+            d[0].samples
+        ),
+        (Some("H"), "tau", i, 6)
+    );
+    let g = &m.diagnostics.glitches;
+    assert_eq!(g.len(), 1, "{g:?}");
+    assert_eq!((g[0].sample, g[0].joint.as_str()), (i + 12, "joint1"));
+    assert!(
+        m.diagnostics
+            .warnings
+            .iter()
+            .any(|w| w.contains("experiment 'H'") && w.contains("1 dropout(s)")),
+        "{:?}",
+        m.diagnostics.warnings
+    );
+    assert!(
+        worst_in_stderr(&m, &clean) < 0.5,
+        "{}",
+        worst_in_stderr(&m, &clean)
+    );
+    // saved and loaded; an unknown experiment or a single row is refused on load
+    let back = LocalModel::from_json(&m.to_json()).unwrap();
+    assert_eq!(back.diagnostics.dropouts, m.diagnostics.dropouts);
+    let json: serde_json::Value = serde_json::from_str(&m.to_json()).unwrap();
+    for (field, value, says) in [
+        (
+            "experiment",
+            serde_json::json!("E"),
+            "experiment Some(\"E\")",
+        ),
+        ("samples", serde_json::json!(1), "1 samples"),
+    ] {
+        let mut j = json.clone();
+        j["diagnostics"]["dropouts"][0][field] = value;
+        let e = LocalModel::from_json(&j.to_string())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("dropouts[0]") && e.contains(says), "{e}");
+    }
+}
+
 #[test]
 fn saved_glitches_are_checked_on_load() {
     let (plan, mut recs) = noisy_logs();

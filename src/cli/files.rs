@@ -156,9 +156,11 @@ impl PreprocessArgs {
         {
             eprintln!("perturbid: warning: {w}");
         }
-        if let Some(w) =
-            crate::log_screening::dropout_warning(&rec.dropouts, &path.display().to_string())
-        {
+        if let Some(w) = crate::log_screening::dropout_warning(
+            &rec.dropouts,
+            &path.display().to_string(),
+            crate::log_screening::BRIDGED_BY_PREPROCESSING,
+        ) {
             eprintln!("perturbid: warning: {w}");
         }
         let _ = writeln!(

@@ -153,6 +153,11 @@ pub struct Diagnostics {
     /// not isolated and kept (with a warning).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub glitches: Vec<Glitch>,
+    /// Rows of the recordings removed before their windows were read: every joint of a
+    /// signal read exactly 0 while the robot moved ([`crate::log_screening::find_dropouts`];
+    /// each names its experiment).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub dropouts: Vec<crate::log_screening::LogDropout>,
     /// What the user should know: each is also given as a Python warning and printed by the
     /// command line.
     #[serde(default)]

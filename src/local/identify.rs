@@ -351,6 +351,7 @@ pub fn identify_local(
     let n = plan.n();
     let mut values = Vec::new();
     let mut recording_names: Vec<String> = Vec::new();
+    let (mut dropouts, mut dropout_warnings) = (vec![], vec![]);
     for (e, r) in plan
         .experiments
         .iter()
@@ -367,7 +368,34 @@ pub fn identify_local(
                 ),
             });
         }
-        values.push(experiment_values(e, r, &plan.joint_names, options)?);
+        // rows of zeros while the robot moves are not readings: removed before the windows
+        // are read, the samples the diagnostics name counted in the recording as logged
+        let found = crate::log_screening::find_dropouts(r);
+        let v = if found.is_empty() {
+            experiment_values(e, r, &plan.joint_names, options)?
+        } else {
+            let kept = crate::log_screening::without_dropouts(r, &found)?;
+            let mut v = experiment_values(e, &kept, &plan.joint_names, options)?;
+            let rows = crate::log_screening::kept_rows(r.len(), &found);
+            for c in v.crossings.iter_mut().chain(v.reference.iter_mut()) {
+                for g in &mut c.glitches {
+                    g.sample = rows[g.sample];
+                }
+            }
+            v
+        };
+        if let Some(w) = crate::log_screening::dropout_warning(
+            &found,
+            &r.name,
+            "before the crossing windows were read (their fits use the samples left)",
+        ) {
+            dropout_warnings.push(format!("experiment '{}': {w}", e.kind.name()));
+        }
+        dropouts.extend(found.into_iter().map(|d| crate::log_screening::LogDropout {
+            experiment: Some(e.kind.name().to_string()),
+            ..d
+        }));
+        values.push(v);
         recording_names.push(r.name.clone());
     }
     let find = |kind| values.iter().find(|v: &&ExperimentValues| v.kind == kind);
@@ -672,6 +700,8 @@ pub fn identify_local(
         }
     };
     let mut diagnostics = diagnose(&values);
+    diagnostics.dropouts = dropouts;
+    diagnostics.warnings.append(&mut dropout_warnings);
     for (v, name) in values.iter().zip(&recording_names) {
         let (found, warnings) = glitches::report(v, name, &plan.joint_names);
         diagnostics.glitches.extend(found);

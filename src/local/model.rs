@@ -226,6 +226,17 @@ impl Document for LocalModel {
                 check_magnitude(Self::WHAT, &format!("{what}.noise_levels"), z, false)?;
             }
         }
+        for (i, d) in m.diagnostics.dropouts.iter().enumerate() {
+            let problem = d.problem().or_else(|| match &d.experiment {
+                Some(e) if super::ExperimentKind::ALL.iter().any(|k| k.name() == e) => None,
+                other => Some(format!(
+                    "experiment {other:?} is not one of the plan's experiments"
+                )),
+            });
+            if let Some(p) = problem {
+                return Err(bad(format!("diagnostics.dropouts[{i}]: {p}")));
+            }
+        }
         for (i, e) in m.diagnostics.noise.iter().enumerate() {
             let what = format!("diagnostics.noise[{i}]");
             check_magnitude(Self::WHAT, &format!("{what}.samples"), e.samples, false)?;

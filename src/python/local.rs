@@ -451,7 +451,10 @@ impl PyLocalModel {
     /// (how far off the fit of its window's other samples, or None beyond any scale: a million
     /// times the spread of the window's values),
     /// `replaced` (True: an isolated glitch replaced by that fit; False: kept, one of more than
-    /// 3 in its window)), `warnings` (list of str).
+    /// 3 in its window)), `dropouts` (list of dicts: `experiment`, `signal`, `first_sample`
+    /// (0-based row of its recording), `samples`, `from`, `to` (s): rows in which every joint
+    /// of a signal read exactly 0 while the robot moved, removed before the windows were
+    /// read), `warnings` (list of str).
     #[getter]
     fn diagnostics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = &self.model.diagnostics;
@@ -531,6 +534,21 @@ impl PyLocalModel {
             })
             .collect::<PyResult<Vec<_>>>()?;
         out.set_item("glitches", glitches)?;
+        let dropouts = d
+            .dropouts
+            .iter()
+            .map(|r| {
+                let e = PyDict::new(py);
+                e.set_item("experiment", &r.experiment)?;
+                e.set_item("signal", &r.signal)?;
+                e.set_item("first_sample", r.first_sample)?;
+                e.set_item("samples", r.samples)?;
+                e.set_item("from", r.from)?;
+                e.set_item("to", r.to)?;
+                Ok(e)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        out.set_item("dropouts", dropouts)?;
         out.set_item("warnings", d.warnings.clone())?;
         Ok(out)
     }

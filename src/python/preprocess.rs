@@ -57,7 +57,11 @@ pub(crate) fn preprocess(
     let out: Recording = detached(py, "preprocess", || preprocess_rs(&rec, &options))?;
     let warnings: Vec<String> = [
         crate::log_screening::warning(&out.glitches, name, &[]),
-        crate::log_screening::dropout_warning(&out.dropouts, name),
+        crate::log_screening::dropout_warning(
+            &out.dropouts,
+            name,
+            crate::log_screening::BRIDGED_BY_PREPROCESSING,
+        ),
     ]
     .into_iter()
     .flatten()

@@ -324,6 +324,22 @@ def test_a_glitch_in_a_log_is_replaced_and_reported():
     assert g["value"] == pytest.approx(spiked[[r.experiment for r in recs].index("D")].tau[sample, 1])
     # as if the sample had not been recorded: the model is the clean one to its noise
     np.testing.assert_allclose(model.D, clean.D, atol=0.2 * np.max(clean.stderr["D"]))
+    assert model.diagnostics["dropouts"] == [] == clean.diagnostics["dropouts"]
+    # six rows of zeros in every torque of a D window: a dropout, removed before the windows
+    # are read
+    dropped = []
+    for r in recs:
+        tau = r.tau.copy()
+        if r.experiment == "D":
+            i = int(np.searchsorted(r.t, d.crossing_times[1]))
+            tau[i : i + 6, :] = 0.0
+            first = i
+        dropped.append(pr.Recording(r.t, r.q, tau, name=r.name, experiment=r.experiment))
+    with pytest.warns(pr.PerturbidWarning, match="experiment 'D'.*1 dropout"):
+        model = pr.identify_local(plan, dropped)
+    (drop,) = model.diagnostics["dropouts"]
+    assert (drop["experiment"], drop["signal"], drop["first_sample"], drop["samples"]) == ("D", "tau", first, 6)
+    np.testing.assert_allclose(model.D, clean.D, atol=0.2 * np.max(clean.stderr["D"]))
 
 
 def test_the_torque_noise_is_reported_per_experiment_and_joint():
