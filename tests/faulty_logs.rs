@@ -144,13 +144,7 @@ fn isolated_glitches_are_replaced_and_reported() {
 fn a_burst_is_not_taken_for_glitches() {
     let (plan, mut recs) = noisy_logs();
     let n = plan.joint_names.len();
-    let h_time = plan
-        .experiments
-        .iter()
-        .find(|e| e.kind.name() == "H")
-        .unwrap()
-        .crossings[2]
-        .time;
+    let h_time = crossing_time(&plan, "H", 2);
     // joint 2's torque (about -11 N m) reads 0 for 6 samples: a dropout
     let h = log(&mut recs, "H");
     let i = sample_at(h, h_time);
@@ -187,13 +181,7 @@ fn a_dropout_is_removed_before_the_windows_are_read() {
     let (plan, mut recs) = noisy_logs();
     let clean = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
     let n = plan.joint_names.len();
-    let h_time = plan
-        .experiments
-        .iter()
-        .find(|e| e.kind.name() == "H")
-        .unwrap()
-        .crossings[2]
-        .time;
+    let h_time = crossing_time(&plan, "H", 2);
     let h = log(&mut recs, "H");
     let i = sample_at(h, h_time);
     for x in &mut h.tau[i * n..(i + 6) * n] {
@@ -289,6 +277,16 @@ fn saved_glitches_are_checked_on_load() {
     let text = clean.to_json();
     assert!(!text.contains("glitches"));
     assert_eq!(LocalModel::from_json(&text).unwrap(), clean);
+}
+
+/// The planned time of crossing `k` of experiment `kind` (s).
+fn crossing_time(plan: &Plan, kind: &str, k: usize) -> f64 {
+    plan.experiments
+        .iter()
+        .find(|e| e.kind.name() == kind)
+        .unwrap()
+        .crossings[k]
+        .time
 }
 
 /// Runs `edit` on a copy of the noisy logs' D recording and identifies; the error's text.

@@ -537,16 +537,7 @@ impl PyLocalModel {
         let dropouts = d
             .dropouts
             .iter()
-            .map(|r| {
-                let e = PyDict::new(py);
-                e.set_item("experiment", &r.experiment)?;
-                e.set_item("signal", &r.signal)?;
-                e.set_item("first_sample", r.first_sample)?;
-                e.set_item("samples", r.samples)?;
-                e.set_item("from", r.from)?;
-                e.set_item("to", r.to)?;
-                Ok(e)
-            })
+            .map(|r| super::recording::dropout_dict(py, r))
             .collect::<PyResult<Vec<_>>>()?;
         out.set_item("dropouts", dropouts)?;
         out.set_item("warnings", d.warnings.clone())?;

@@ -17,6 +17,24 @@ pub(crate) struct PyRecording {
     pub rec: Arc<Recording>,
 }
 
+/// A dropout as a Python dict: `experiment` (when it has one), `signal`, `first_sample`,
+/// `samples`, `from`, `to`.
+pub(crate) fn dropout_dict<'py>(
+    py: Python<'py>,
+    d: &crate::log_screening::LogDropout,
+) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    let e = pyo3::types::PyDict::new(py);
+    if let Some(x) = &d.experiment {
+        e.set_item("experiment", x)?;
+    }
+    e.set_item("signal", &d.signal)?;
+    e.set_item("first_sample", d.first_sample)?;
+    e.set_item("samples", d.samples)?;
+    e.set_item("from", d.from)?;
+    e.set_item("to", d.to)?;
+    Ok(e)
+}
+
 pub(crate) fn matrix_rows(
     name: &str,
     a: &ArrayLike<'_>,
@@ -158,15 +176,7 @@ impl PyRecording {
         self.rec
             .dropouts
             .iter()
-            .map(|d| {
-                let e = pyo3::types::PyDict::new(py);
-                e.set_item("signal", &d.signal)?;
-                e.set_item("first_sample", d.first_sample)?;
-                e.set_item("samples", d.samples)?;
-                e.set_item("from", d.from)?;
-                e.set_item("to", d.to)?;
-                Ok(e)
-            })
+            .map(|d| dropout_dict(py, d))
             .collect()
     }
     fn __len__(&self) -> usize {
