@@ -64,14 +64,7 @@ fn isolated_glitches_are_replaced_and_reported() {
         clean.diagnostics.glitches
     );
     let n = plan.joint_names.len();
-    let crossing = |kind: &str, k: usize| {
-        plan.experiments
-            .iter()
-            .find(|e| e.kind.name() == kind)
-            .unwrap()
-            .crossings[k]
-            .time
-    };
+    let crossing = |kind: &str, k: usize| crossing_time(&plan, kind, k);
     // a torque spike of 50 N m in D's first window (joint 6, whose window is narrowed at a
     // velocity reversal), a position 0.01 rad off in H's, and a torque that overflows any
     // scale in the nominal passes'
