@@ -152,8 +152,8 @@ pub fn screen_recording(rec: &Recording) -> Result<(Recording, Vec<LogGlitch>)> 
     Ok((out, found))
 }
 
-/// The signals a log may have, by their column prefix.
-const SIGNALS: [&str; 4] = ["q", "qd", "qdd", "tau"];
+/// The signals a log may have, by their column prefix (`q`, `qd`, `qdd`, `tau`).
+pub const SIGNALS: [&str; 4] = ["q", "qd", "qdd", "tau"];
 
 /// The signals `rec` has (its columns, row-major), by their column prefix.
 fn signals(rec: &Recording) -> Vec<(&'static str, &Vec<f64>)> {
