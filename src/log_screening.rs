@@ -26,13 +26,21 @@
 //! [`MAX_PER_WINDOW`] are off, and nothing is replaced. A sample is only judged in the window
 //! centred on it, so a step near a window's edge is never taken for a glitch.
 //!
-//! What is not found: bursts of more than [`MAX_PER_WINDOW`] samples (masked: see
-//! docs/limits.md), and a log's repeated rows (a logger that writes its last message again:
+//! **Held readings** are the bursts one sensor makes when its message is lost and its last
+//! value (or zeros) is logged in its place: a run of 2 to [`MAX_HELD`] exactly repeated values
+//! of one column while its joint moves is judged as a whole against the cubic through the
+//! samples either side of it (`judge_run`), and replaced as a whole when off by more than
+//! [`NOISE_LEVELS`] (its farthest sample, or its mean against the standard error of that
+//! mean). Rows of zeros for every joint of a signal are left to [`find_dropouts`], and rows
+//! that repeat the whole row before to the rule for stale rows below.
+//!
+//! What is not found: other bursts of more than [`MAX_PER_WINDOW`] samples (masked: see
+//! docs/limits.md), held runs longer than [`MAX_HELD`], and a log's repeated rows (a logger that writes its last message again:
 //! the real Panda log of `../shared` repeats 6 % of its rows; replacing them moved the direct
 //! method's parameters by 0.02 standard errors, so they are left as logged unless a repeated
 //! position is itself far off, then it is a glitch like any other).
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{shown, Result};
@@ -81,6 +89,12 @@ pub struct LogGlitch {
     /// Whether it repeats the sample before it exactly: a logger that wrote its last message
     /// again, with a new time stamp (a stale sample rather than a reading).
     pub repeats_previous: bool,
+    /// For a sample of a held reading (a run of this many exactly repeated readings of its
+    /// column while its joint moved, judged together and all replaced): the run's length;
+    /// its `noise_levels` are then the larger of its farthest sample's and its mean
+    /// deviation's (against the standard error of that mean). Absent for a single glitch.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub held: Option<usize>,
 }
 
 impl LogGlitch {
@@ -106,6 +120,12 @@ impl LogGlitch {
         if self.noise_levels.is_some_and(|z| z.is_nan() || z <= 0.0) {
             return Some("noise_levels must be a positive number or null".into());
         }
+        if self.held.is_some_and(|l| !(2..=MAX_HELD).contains(&l)) {
+            return Some(format!(
+                "held {}: a held reading is a run of 2 to {MAX_HELD} samples",
+                self.held.unwrap_or(0)
+            ));
+        }
         None
     }
 }
@@ -124,7 +144,8 @@ pub fn screen_recording(rec: &Recording) -> Result<(Recording, Vec<LogGlitch>)> 
             .iter()
             .flat_map(|(_, v)| (0..n).map(move |j| (a..b).map(|i| v[i * n + j]).collect()))
             .collect();
-        for (c, k, g) in screen_segment(&rec.t[a..b], &columns)? {
+        let names: Vec<&str> = signals.iter().map(|(s, _)| *s).collect();
+        for (c, k, g) in screen_segment(&rec.t[a..b], &columns, &names)? {
             let (signal, values) = signals[c / n];
             let (j, i) = (c % n, a + k);
             found.push(LogGlitch {
@@ -136,6 +157,7 @@ pub fn screen_recording(rec: &Recording) -> Result<(Recording, Vec<LogGlitch>)> 
                 noise_levels: Some(g.noise_levels).filter(|z| z.is_finite()),
                 replaced_by: g.replaced_by,
                 repeats_previous: i > 0 && values[i * n + j] == values[(i - 1) * n + j],
+                held: g.held,
             });
         }
     }
@@ -182,6 +204,7 @@ fn segments(rec: &Recording) -> Vec<(usize, usize)> {
 struct Found {
     noise_levels: f64,
     replaced_by: f64,
+    held: Option<usize>,
 }
 
 /// The median of the finite values of `x` (None for none).
@@ -215,9 +238,14 @@ fn candidates(t: &[f64], y: &[f64]) -> Vec<bool> {
     candidate
 }
 
-/// The glitches of the `columns` (each sampled at `t`: one stretch between gaps) as (column,
-/// index, glitch), in index order. Each window's basis is built once for all columns.
-fn screen_segment(t: &[f64], columns: &[Vec<f64>]) -> Result<Vec<(usize, usize, Found)>> {
+/// The glitches of the `columns` (each sampled at `t`: one stretch between gaps; the joints of
+/// each of the `signals` in turn, `q` first) as (column, index, glitch), in index order. Each
+/// window's basis is built once for all columns.
+fn screen_segment(
+    t: &[f64],
+    columns: &[Vec<f64>],
+    signals: &[&str],
+) -> Result<Vec<(usize, usize, Found)>> {
     let k = t.len();
     let width = 2 * HALF_WINDOW + 1;
     if k < width {
@@ -225,7 +253,8 @@ fn screen_segment(t: &[f64], columns: &[Vec<f64>]) -> Result<Vec<(usize, usize, 
     }
     let candidate: Vec<Vec<bool>> = columns.iter().map(|y| candidates(t, y)).collect();
     let judged: Vec<usize> = (0..k).filter(|&i| candidate.iter().any(|c| c[i])).collect();
-    if judged.is_empty() {
+    let runs = held_runs(columns, signals);
+    if judged.is_empty() && runs.is_empty() {
         return Ok(vec![]);
     }
     let window = |i: usize| {
@@ -291,12 +320,153 @@ fn screen_segment(t: &[f64], columns: &[Vec<f64>]) -> Result<Vec<(usize, usize, 
                 let g = Found {
                     noise_levels: f.noise_levels,
                     replaced_by: s.values[at],
+                    held: None,
                 };
                 found.push((c, i, g));
             }
         }
     }
+    for (c, run) in runs {
+        crate::interrupt::check("screening the log for held readings")?;
+        for (i, g) in judge_run(t, &columns[c], run, floors[c]) {
+            if !found.iter().any(|f| f.0 == c && f.1 == i) {
+                found.push((c, i, g));
+            }
+        }
+    }
+    found.sort_by_key(|f| f.1);
     Ok(found)
+}
+
+/// The longest run of exactly repeated readings of one column that is judged as a held
+/// reading: a sensor or logger that wrote its last value again (or zeros) for up to 10 ms at
+/// 1 kHz. Longer runs are left as logged (docs/limits.md).
+pub const MAX_HELD: usize = HALF_WINDOW;
+
+/// Fewest samples of the others on each side of a held run for its judgement: the cubic
+/// through them interpolates the run and never extrapolates.
+const HELD_SIDE: usize = DEGREE + 1;
+
+/// The runs of 2 to [`MAX_HELD`] exactly repeated readings in each column (as (column, first
+/// index..end)) while its joint moves: for `qd`, `qdd` and `tau` the joint's position changes
+/// within the run (a joint at rest reads its velocity, acceleration and torque again
+/// legitimately); for `q`, its logged velocity is not 0 throughout the run (always judged
+/// where no velocity is logged; the others' fit shows a real stop).
+fn held_runs(columns: &[Vec<f64>], signals: &[&str]) -> Vec<(usize, std::ops::Range<usize>)> {
+    let n = columns.len() / signals.len().max(1);
+    let qd = signals.iter().position(|&s| s == "qd");
+    // rows that repeat the row before in every column: a logger's stale rows (see the module
+    // documentation), not one sensor's held reading
+    let len = columns.first().map_or(0, Vec::len);
+    let stale: Vec<bool> = (0..len)
+        .map(|i| i > 0 && columns.iter().all(|y| y[i].to_bits() == y[i - 1].to_bits()))
+        .collect();
+    let mut runs = vec![];
+    for (c, y) in columns.iter().enumerate() {
+        let j = c % n;
+        let mut next = 0;
+        while next < y.len() {
+            let a = next;
+            while next < y.len() && y[next].to_bits() == y[a].to_bits() {
+                next += 1;
+            }
+            let b = next;
+            if !(2..=MAX_HELD).contains(&(b - a)) {
+                continue;
+            }
+            let moves = match signals[c / n] {
+                "q" => qd.is_none_or(|s| columns[s * n + j][a..b].iter().any(|&v| v != 0.0)),
+                _ => columns[j][a] != columns[j][b - 1],
+            };
+            // rows in which every joint of the signal reads 0 are a dropout's, removed
+            let signal = (c / n) * n..(c / n + 1) * n;
+            let dropout = y[a] == 0.0
+                && columns[signal]
+                    .iter()
+                    .all(|z| z[a..b].iter().all(|&x| x == 0.0));
+            let repeated_rows = stale[a + 1..b].iter().all(|&s| s);
+            if moves && !dropout && !repeated_rows {
+                runs.push((c, a..b));
+            }
+        }
+    }
+    runs
+}
+
+/// The samples of the held `run` of `y` (sampled at `t`) that are glitches: judged against the
+/// cubic through up to [`HALF_WINDOW`] samples either side of it (at least [`HELD_SIDE`] on
+/// each), by [`NOISE_LEVELS`] of their noise level (at least `floor`) with the prediction's own
+/// uncertainty. The others must be smooth themselves (at most [`MAX_PER_WINDOW`] glitches of
+/// their own, left out of the fit): a step the signal really makes near the run leaves it
+/// alone.
+fn judge_run(t: &[f64], y: &[f64], run: std::ops::Range<usize>, floor: f64) -> Vec<(usize, Found)> {
+    let before = run.start.saturating_sub(HALF_WINDOW)..run.start;
+    let after = run.end..(run.end + HALF_WINDOW).min(y.len());
+    if before.len() < HELD_SIDE || after.len() < HELD_SIDE {
+        return vec![];
+    }
+    let others: Vec<usize> = before.chain(after).collect();
+    let tc = 0.5 * (t[run.start] + t[run.end - 1]);
+    let times: Vec<f64> = others.iter().map(|&i| t[i]).collect();
+    let Some((v, w)) = basis(&times, tc) else {
+        return vec![];
+    };
+    let values: Vec<f64> = others.iter().map(|&i| y[i]).collect();
+    let s = screen(&v, &w, &values, floor);
+    if !s.isolated {
+        return vec![];
+    }
+    let level = crate::outliers::level(&v, &w, &s.values).max(floor);
+    let coef = &w * DVector::from_column_slice(&s.values);
+    let half = times.iter().fold(0.0f64, |m, x| m.max((x - tc).abs()));
+    // (V^T V)^-1 = W W^T: the fit's variance at new times, in units of the noise's
+    let covariance = &w * w.transpose();
+    let row = |i: usize| DVector::from_fn(DEGREE + 1, |d, _| ((t[i] - tc) / half).powi(d as i32));
+    let fits: Vec<f64> = run.clone().map(|i| row(i).dot(&coef)).collect();
+    if !fits.iter().all(|f| f.is_finite()) {
+        return vec![];
+    }
+    // each sample against the fit, and the run's mean deviation against its own spread
+    let farthest = run
+        .clone()
+        .zip(&fits)
+        .map(|(i, fit)| {
+            let x = row(i);
+            (y[i] - fit).abs() / (level * (1.0 + (x.transpose() * &covariance * &x)[0]).sqrt())
+        })
+        .fold(
+            0.0,
+            |m: f64, z| if z.is_nan() { f64::INFINITY } else { m.max(z) },
+        );
+    let length = run.len() as f64;
+    let mean_row = run.clone().map(row).sum::<DVector<f64>>() / length;
+    let mean = run
+        .clone()
+        .zip(&fits)
+        .map(|(i, fit)| y[i] - fit)
+        .sum::<f64>()
+        / length;
+    let spread =
+        level * (1.0 / length + (mean_row.transpose() * &covariance * &mean_row)[0]).sqrt();
+    // NaN where the deviations overflow: beyond any scale
+    let z = match mean.abs() / spread {
+        by_mean if by_mean.is_nan() => f64::INFINITY,
+        by_mean => farthest.max(by_mean),
+    };
+    if z <= NOISE_LEVELS {
+        return vec![];
+    }
+    let held = Some(run.len());
+    run.zip(fits)
+        .map(|(i, fit)| {
+            let found = Found {
+                noise_levels: z,
+                replaced_by: fit,
+                held,
+            };
+            (i, found)
+        })
+        .collect()
 }
 
 /// The cubic basis of a window at times `t` about `tc`, scaled to [-1, 1], and its
@@ -460,7 +630,17 @@ pub fn warning(found: &[LogGlitch], recording: &str, joint_names: &[String]) -> 
         "qdd" => "rad/s^2",
         _ => "N m",
     };
-    let mut listed: Vec<String> = found
+    // a held reading is listed once, by its first sample
+    let first_of_run = |g: &LogGlitch| {
+        g.held.is_none()
+            || !found.iter().any(|h| {
+                h.held.is_some()
+                    && (&h.signal, h.joint) == (&g.signal, g.joint)
+                    && h.sample + 1 == g.sample
+            })
+    };
+    let items: Vec<&LogGlitch> = found.iter().filter(|g| first_of_run(g)).collect();
+    let mut listed: Vec<String> = items
         .iter()
         .take(LISTED)
         .map(|g| {
@@ -472,29 +652,52 @@ pub fn warning(found: &[LogGlitch], recording: &str, joint_names: &[String]) -> 
                 .map_or("off beyond any scale".to_string(), |z| {
                     format!("{z:.0} noise levels off")
                 });
+            let (read, samples) = match g.held {
+                Some(l) => (
+                    "held",
+                    format!("samples {} to {}", g.sample, g.sample + l - 1),
+                ),
+                None => ("read", format!("sample {}", g.sample)),
+            };
             format!(
-                "{} of {joint} at t = {:.4} s (sample {}) read {} {}, {off}",
+                "{} of {joint} at t = {:.4} s ({samples}) {read} {} {}, {off}",
                 g.signal,
                 g.time,
-                g.sample,
                 shown(g.value),
                 unit(&g.signal)
             )
         })
         .collect();
-    if found.len() > LISTED {
-        listed.push(format!("and {} more", found.len() - LISTED));
+    if items.len() > LISTED {
+        listed.push(format!("and {} more", items.len() - LISTED));
     }
-    let repeated = found.iter().filter(|g| g.repeats_previous).count();
-    let stale = if repeated > 0 {
-        format!(" ({repeated} of them repeat the sample before exactly: stale samples of a logger that wrote its last message again with a new time stamp; such repeats that stay near the curve are kept as logged)")
-    } else {
-        String::new()
-    };
+    let single = found.iter().filter(|g| g.held.is_none()).count();
+    let runs = items.len() - single;
+    let mut kinds = vec![];
+    if single > 0 {
+        let repeated = found
+            .iter()
+            .filter(|g| g.held.is_none() && g.repeats_previous)
+            .count();
+        let stale = if repeated > 0 {
+            format!(" ({repeated} of them repeat the sample before exactly: stale samples of a logger that wrote its last message again with a new time stamp; such repeats that stay near the curve are kept as logged)")
+        } else {
+            String::new()
+        };
+        kinds.push(format!(
+            "{single} sample(s) each alone in its window of {} samples beyond {NOISE_LEVELS} noise levels of the cubic through the others (at most {MAX_PER_WINDOW} such in a window){stale}",
+            2 * HALF_WINDOW + 1
+        ));
+    }
+    if runs > 0 {
+        kinds.push(format!(
+            "{} sample(s) of {runs} held reading(s), a column that repeats one value for 2 to {MAX_HELD} samples while its joint moves, beyond {NOISE_LEVELS} noise levels of the cubic through up to {HALF_WINDOW} samples either side (a sensor's message lost and its last value or zeros logged in its place)",
+            found.len() - single
+        ));
+    }
     Some(format!(
-        "log '{recording}': {} sample(s), each alone in its window of {} samples beyond {NOISE_LEVELS} noise levels of the cubic through the others (at most {MAX_PER_WINDOW} such in a window), were taken for glitches of the log and replaced by that fit before preprocessing{stale}: {}",
-        found.len(),
-        2 * HALF_WINDOW + 1,
+        "log '{recording}': {} were taken for glitches of the log and replaced by that fit before preprocessing: {}",
+        kinds.join(", and "),
         listed.join("; ")
     ))
 }

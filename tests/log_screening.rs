@@ -12,7 +12,7 @@ use common::{panda_log, panda_urdf, Rng};
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
 use perturbid_rs::document::Document;
-use perturbid_rs::log_screening::{find_dropouts, screen_recording, HALF_WINDOW};
+use perturbid_rs::log_screening::{find_dropouts, screen_recording, warning, HALF_WINDOW};
 use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::robots::a465;
 use perturbid_rs::trajectory::FourierTrajectory;
@@ -183,6 +183,93 @@ fn spikes_and_a_row_of_zeros_are_replaced_and_leave_the_parameters_alone() {
     );
 }
 
+/// One joint's reading held or read as zeros for a few rows (its driver's message lost, the
+/// last value or zeros logged in its place) while the others are fine: a burst too long for
+/// the window test, judged as a run against the cubic through the samples either side.
+#[test]
+fn held_readings_of_one_joint_are_replaced() {
+    let clean = noisy_log();
+    let n = 6;
+    let (_, reference) = identify(&clean, true);
+    let mut rec = clean.clone();
+    for i in 4000..4006 {
+        rec.tau[i * n + 1] = 0.0; // one joint's torque read as zeros for 6 rows
+    }
+    for i in 6001..6005 {
+        rec.q[i * n + 1] = rec.q[6000 * n + 1]; // one joint's position held for 4 rows
+    }
+    // a torque held for 7 rows: over 7 ms of this slow excitation it changes by less than
+    // its noise, so the repeats are indistinguishable from readings and are kept
+    for i in 9001..9008 {
+        rec.tau[i * n + 4] = rec.tau[9000 * n + 4];
+    }
+    let (_, unscreened) = identify(&rec, false);
+    assert!(
+        moved(&unscreened, &reference) > 0.3,
+        "{}",
+        moved(&unscreened, &reference)
+    );
+    let (screened, found) = screen_recording(&rec).unwrap();
+    let at = |signal: &str, j: usize| -> Vec<usize> {
+        found
+            .iter()
+            .filter(|g| g.signal == signal && g.joint == j)
+            .map(|g| g.sample)
+            .collect()
+    };
+    assert_eq!(at("tau", 1), (4000..4006).collect::<Vec<_>>(), "{found:?}");
+    // the held run includes the reading it repeats, replaced within its noise
+    assert_eq!(at("q", 1), (6000..6005).collect::<Vec<_>>(), "{found:?}");
+    assert_eq!(found.len(), 11, "{found:?}");
+    assert_eq!(
+        screened.tau[9000 * n + 4..9008 * n + 4],
+        rec.tau[9000 * n + 4..9008 * n + 4]
+    );
+    for g in &found {
+        let (x, y) = match g.signal.as_str() {
+            "q" => (
+                screened.q[g.sample * n + g.joint],
+                clean.q[g.sample * n + g.joint],
+            ),
+            _ => (
+                screened.tau[g.sample * n + g.joint],
+                clean.tau[g.sample * n + g.joint],
+            ),
+        };
+        let tolerance = if g.signal == "q" { 1e-5 } else { 0.15 };
+        assert!((x - y).abs() < tolerance, "{g:?}: {x} against {y}");
+        assert!(g.noise_levels.unwrap() > 10.0, "{g:?}");
+        assert_eq!(g.held, Some(if g.signal == "q" { 5 } else { 6 }));
+        assert_eq!(g.repeats_previous, ![4000, 6000].contains(&g.sample));
+    }
+    // the warning lists each held reading once, by its samples
+    let warned = warning(&found, "log", &[]).unwrap();
+    assert!(
+        warned.contains("11 sample(s) of 2 held reading(s)")
+            && warned.contains("tau of joint 2 at t = 4.0011 s (samples 4000 to 4005) held 0 N m")
+            && !warned.contains("sample 4001"),
+        "{warned}"
+    );
+    let (_, fit) = identify(&rec, true);
+    assert!(
+        moved(&fit, &reference) < 0.05,
+        "{}",
+        moved(&fit, &reference)
+    );
+    // readings that repeat legitimately are kept: a torque on a coarse grid (0.05 N m, its
+    // noise 0.03 N m), repeated many times over while the joint moves, and a joint that holds
+    let mut grid = clean.clone();
+    for x in &mut grid.tau {
+        *x = (*x / 0.05).round() * 0.05;
+    }
+    let repeats = (1..grid.len())
+        .filter(|&i| grid.tau[i * n] == grid.tau[(i - 1) * n])
+        .count();
+    assert!(repeats > 1000, "{repeats}");
+    let (_, found) = screen_recording(&grid).unwrap();
+    assert!(found.is_empty(), "{found:?}");
+}
+
 #[test]
 fn dropouts_are_removed_and_zeros_at_rest_kept() {
     let clean = noisy_log();
@@ -343,7 +430,11 @@ fn saved_log_glitches_are_checked_on_load() {
     assert_eq!(BaseModel::from_json(&text).unwrap(), fit);
     let value: serde_json::Value = serde_json::from_str(&text).unwrap();
     type Edit = fn(&mut serde_json::Value);
-    let edits: [(Edit, &str); 5] = [
+    let edits: [(Edit, &str); 6] = [
+        (
+            |v| v["log_glitches"][0]["held"] = 1.into(),
+            "log_glitches[0]: held 1",
+        ),
         (
             |v| v["log_glitches"][0]["signal"] = "force".into(),
             "log_glitches[0]: signal 'force'",

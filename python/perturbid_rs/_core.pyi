@@ -295,7 +295,8 @@ class Recording:
     @property
     def glitches(self) -> list[dict[str, Any]]:
         """Samples of the log this was preprocessed from taken for glitches and replaced first
-        (signal, joint, sample, time, value, noise_levels, replaced_by, repeats_previous)."""
+        (signal, joint, sample, time, value, noise_levels, replaced_by, repeats_previous,
+        held: the length of the held reading it belongs to, or None)."""
     @property
     def dropouts(self) -> list[dict[str, Any]]:
         """Runs of rows of the log this was preprocessed from removed as dropouts (every joint

@@ -146,8 +146,9 @@ impl PyRecording {
     /// The samples of the log this recording was preprocessed from that were taken for
     /// glitches and replaced first: a list of dicts `signal` (q, qd, qdd, tau), `joint`
     /// (0-based column index), `sample` (0-based row of the log), `time` (s), `value` (as
-    /// logged), `noise_levels` (None beyond any scale), `replaced_by`, `repeats_previous`.
-    /// Empty for a recording as logged.
+    /// logged), `noise_levels` (None beyond any scale), `replaced_by`, `repeats_previous`,
+    /// `held` (the length of the held reading it belongs to, a run of one repeated value
+    /// judged as a whole; None for a single glitch). Empty for a recording as logged.
     #[getter]
     fn glitches<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, pyo3::types::PyDict>>> {
         self.rec
@@ -163,6 +164,7 @@ impl PyRecording {
                 e.set_item("noise_levels", g.noise_levels)?;
                 e.set_item("replaced_by", g.replaced_by)?;
                 e.set_item("repeats_previous", g.repeats_previous)?;
+                e.set_item("held", g.held)?;
                 Ok(e)
             })
             .collect()

@@ -453,3 +453,13 @@ def test_preprocess_replaces_a_logs_glitches_and_says_so():
     assert [(d["signal"], d["first_sample"], d["samples"]) for d in bridged.dropouts] == [("tau", 6000, 8)]
     assert bridged.dropouts[0]["from"] == t[6000] and bridged.dropouts[0]["to"] == t[6007]
     assert np.max(np.abs(bridged.tau - clean.tau)) < 0.05
+    # one joint's torque read as zeros for six rows (the others read on): a held reading,
+    # replaced as a whole
+    held = tau.copy()
+    held[3000:3006, 0] = 0.0
+    assert np.all(np.abs(tau[3000:3006, 0]) > 0.5)
+    with pytest.warns(pr.PerturbidWarning, match=r"6 sample\(s\) of 1 held reading\(s\).*samples 3000 to 3005\) held 0"):
+        repaired = pr.preprocess(t, q, held, name="held")
+    assert [(g["joint"], g["sample"], g["held"]) for g in repaired.glitches] == [(0, i, 6) for i in range(3000, 3006)]
+    assert all(g["held"] is None for g in screened.glitches)
+    assert np.max(np.abs(repaired.tau - clean.tau)) < 0.01
