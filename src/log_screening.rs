@@ -95,6 +95,10 @@ pub struct LogGlitch {
     /// deviation's (against the standard error of that mean). Absent for a single glitch.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub held: Option<usize>,
+    /// The experiment of a plan whose recording had it (local identification, which screens
+    /// held readings alone); absent for a log preprocessed on its own.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub experiment: Option<String>,
 }
 
 impl LogGlitch {
@@ -136,6 +140,18 @@ impl LogGlitch {
 /// [`MAX_GAP_INTERVALS`](crate::limits::MAX_GAP_INTERVALS) median sample intervals; a stretch
 /// between gaps shorter than one window is not screened. Stops on Ctrl-C.
 pub fn screen_recording(rec: &Recording) -> Result<(Recording, Vec<LogGlitch>)> {
+    screen_log(rec, false)
+}
+
+/// The held readings of `rec` alone (see the module documentation), found and replaced as by
+/// [`screen_recording`]: for the local method, whose crossing windows screen single glitches
+/// with their own fits. Stops on Ctrl-C.
+pub fn screen_held_readings(rec: &Recording) -> Result<(Recording, Vec<LogGlitch>)> {
+    screen_log(rec, true)
+}
+
+/// [`screen_recording`], or with `held_only` [`screen_held_readings`].
+fn screen_log(rec: &Recording, held_only: bool) -> Result<(Recording, Vec<LogGlitch>)> {
     let n = rec.n;
     let signals = signals(rec);
     let mut found = vec![];
@@ -145,7 +161,7 @@ pub fn screen_recording(rec: &Recording) -> Result<(Recording, Vec<LogGlitch>)> 
             .flat_map(|(_, v)| (0..n).map(move |j| (a..b).map(|i| v[i * n + j]).collect()))
             .collect();
         let names: Vec<&str> = signals.iter().map(|(s, _)| *s).collect();
-        for (c, k, g) in screen_segment(&rec.t[a..b], &columns, &names)? {
+        for (c, k, g) in screen_segment(&rec.t[a..b], &columns, &names, held_only)? {
             let (signal, values) = signals[c / n];
             let (j, i) = (c % n, a + k);
             found.push(LogGlitch {
@@ -158,6 +174,7 @@ pub fn screen_recording(rec: &Recording) -> Result<(Recording, Vec<LogGlitch>)> 
                 replaced_by: g.replaced_by,
                 repeats_previous: i > 0 && values[i * n + j] == values[(i - 1) * n + j],
                 held: g.held,
+                experiment: None,
             });
         }
     }
@@ -239,12 +256,13 @@ fn candidates(t: &[f64], y: &[f64]) -> Vec<bool> {
 }
 
 /// The glitches of the `columns` (each sampled at `t`: one stretch between gaps; the joints of
-/// each of the `signals` in turn, `q` first) as (column, index, glitch), in index order. Each
-/// window's basis is built once for all columns.
+/// each of the `signals` in turn, `q` first) as (column, index, glitch), in index order; with
+/// `held_only`, the held readings alone. Each window's basis is built once for all columns.
 fn screen_segment(
     t: &[f64],
     columns: &[Vec<f64>],
     signals: &[&str],
+    held_only: bool,
 ) -> Result<Vec<(usize, usize, Found)>> {
     let k = t.len();
     let width = 2 * HALF_WINDOW + 1;
@@ -252,7 +270,11 @@ fn screen_segment(
         return Ok(vec![]);
     }
     let candidate: Vec<Vec<bool>> = columns.iter().map(|y| candidates(t, y)).collect();
-    let judged: Vec<usize> = (0..k).filter(|&i| candidate.iter().any(|c| c[i])).collect();
+    let judged: Vec<usize> = if held_only {
+        vec![]
+    } else {
+        (0..k).filter(|&i| candidate.iter().any(|c| c[i])).collect()
+    };
     let runs = held_runs(columns, signals);
     if judged.is_empty() && runs.is_empty() {
         return Ok(vec![]);
@@ -618,9 +640,18 @@ pub fn without_dropouts(rec: &Recording, dropouts: &[LogDropout]) -> Result<Reco
 /// How many glitches a warning lists before "and N more".
 const LISTED: usize = 5;
 
-/// The warning that tells of the glitches `found` in the log `recording` (None for none);
-/// `joint_names` name the joints by index (where it has none, `joint 3` names index 2).
-pub fn warning(found: &[LogGlitch], recording: &str, joint_names: &[String]) -> Option<String> {
+/// What [`warning`] says the glitches were replaced before, for a whole log.
+pub const BEFORE_PREPROCESSING: &str = "before preprocessing";
+
+/// The warning that tells of the glitches `found` in the log `recording` (None for none),
+/// replaced `before` what (such as [`BEFORE_PREPROCESSING`]); `joint_names` name the joints by
+/// index (where it has none, `joint 3` names index 2).
+pub fn warning(
+    found: &[LogGlitch],
+    recording: &str,
+    joint_names: &[String],
+    before: &str,
+) -> Option<String> {
     if found.is_empty() {
         return None;
     }
@@ -696,7 +727,7 @@ pub fn warning(found: &[LogGlitch], recording: &str, joint_names: &[String]) -> 
         ));
     }
     Some(format!(
-        "log '{recording}': {} were taken for glitches of the log and replaced by that fit before preprocessing: {}",
+        "log '{recording}': {} were taken for glitches of the log and replaced by that fit {before}: {}",
         kinds.join(", and "),
         listed.join("; ")
     ))

@@ -243,7 +243,7 @@ fn held_readings_of_one_joint_are_replaced() {
         assert_eq!(g.repeats_previous, ![4000, 6000].contains(&g.sample));
     }
     // the warning lists each held reading once, by its samples
-    let warned = warning(&found, "log", &[]).unwrap();
+    let warned = warning(&found, "log", &[], "before preprocessing").unwrap();
     assert!(
         warned.contains("11 sample(s) of 2 held reading(s)")
             && warned.contains("tau of joint 2 at t = 4.0011 s (samples 4000 to 4005) held 0 N m")

@@ -151,9 +151,12 @@ impl PreprocessArgs {
             ..crate::preprocess::PreprocessOptions::default()
         };
         let rec = crate::preprocess::preprocess(&rec, &o)?;
-        if let Some(w) =
-            crate::log_screening::warning(&rec.glitches, &path.display().to_string(), joints)
-        {
+        if let Some(w) = crate::log_screening::warning(
+            &rec.glitches,
+            &path.display().to_string(),
+            joints,
+            crate::log_screening::BEFORE_PREPROCESSING,
+        ) {
             eprintln!("perturbid: warning: {w}");
         }
         if let Some(w) = crate::log_screening::dropout_warning(

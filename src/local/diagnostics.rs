@@ -158,6 +158,11 @@ pub struct Diagnostics {
     /// each names its experiment).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub dropouts: Vec<crate::log_screening::LogDropout>,
+    /// Samples of the recordings replaced before their windows were read: one joint's reading
+    /// held (a run of one repeated value while it moved, off the curve either side; see
+    /// [`crate::log_screening::screen_held_readings`]; each names its experiment).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub held_readings: Vec<crate::log_screening::LogGlitch>,
     /// What the user should know: each is also given as a Python warning and printed by the
     /// command line.
     #[serde(default)]

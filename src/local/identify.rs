@@ -352,6 +352,7 @@ pub fn identify_local(
     let mut values = Vec::new();
     let mut recording_names: Vec<String> = Vec::new();
     let (mut dropouts, mut dropout_warnings) = (vec![], vec![]);
+    let mut held_readings = vec![];
     for (e, r) in plan
         .experiments
         .iter()
@@ -368,8 +369,23 @@ pub fn identify_local(
                 ),
             });
         }
-        // rows of zeros while the robot moves are not readings: removed before the windows
-        // are read, the samples the diagnostics name counted in the recording as logged
+        // one joint's held readings (a lost message logged as its last value or zeros) are
+        // replaced, and rows of zeros while the robot moves removed, before the windows are
+        // read; the samples the diagnostics name are counted in the recording as logged
+        let (repaired, held) = crate::log_screening::screen_held_readings(r)?;
+        if let Some(w) = crate::log_screening::warning(
+            &held,
+            &r.name,
+            &plan.joint_names,
+            "before the crossing windows were read",
+        ) {
+            dropout_warnings.push(format!("experiment '{}': {w}", e.kind.name()));
+        }
+        held_readings.extend(held.into_iter().map(|g| crate::log_screening::LogGlitch {
+            experiment: Some(e.kind.name().to_string()),
+            ..g
+        }));
+        let r = &repaired;
         let found = crate::log_screening::find_dropouts(r);
         let v = if found.is_empty() {
             experiment_values(e, r, &plan.joint_names, options)?
@@ -701,6 +717,7 @@ pub fn identify_local(
     };
     let mut diagnostics = diagnose(&values);
     diagnostics.dropouts = dropouts;
+    diagnostics.held_readings = held_readings;
     diagnostics.warnings.append(&mut dropout_warnings);
     for (v, name) in values.iter().zip(&recording_names) {
         let (found, warnings) = glitches::report(v, name, &plan.joint_names);

@@ -237,6 +237,24 @@ impl Document for LocalModel {
                 return Err(bad(format!("diagnostics.dropouts[{i}]: {p}")));
             }
         }
+        for (i, g) in m.diagnostics.held_readings.iter().enumerate() {
+            let problem =
+                g.problem(m.joint_names.len())
+                    .or_else(|| match (&g.experiment, g.held) {
+                        (_, None) => Some("held: expected the length of its run".to_string()),
+                        (Some(e), _)
+                            if super::ExperimentKind::ALL.iter().any(|k| k.name() == e) =>
+                        {
+                            None
+                        }
+                        (other, _) => Some(format!(
+                            "experiment {other:?} is not one of the plan's experiments"
+                        )),
+                    });
+            if let Some(p) = problem {
+                return Err(bad(format!("diagnostics.held_readings[{i}]: {p}")));
+            }
+        }
         for (i, e) in m.diagnostics.noise.iter().enumerate() {
             let what = format!("diagnostics.noise[{i}]");
             check_magnitude(Self::WHAT, &format!("{what}.samples"), e.samples, false)?;

@@ -454,7 +454,9 @@ impl PyLocalModel {
     /// 3 in its window)), `dropouts` (list of dicts: `experiment`, `signal`, `first_sample`
     /// (0-based row of its recording), `samples`, `from`, `to` (s): rows in which every joint
     /// of a signal read exactly 0 while the robot moved, removed before the windows were
-    /// read), `warnings` (list of str).
+    /// read), `held_readings` (list of dicts: `experiment` and the keys of
+    /// `Recording.glitches`: samples of one joint's reading held while it moved, replaced
+    /// before the windows were read), `warnings` (list of str).
     #[getter]
     fn diagnostics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = &self.model.diagnostics;
@@ -540,6 +542,12 @@ impl PyLocalModel {
             .map(|r| super::recording::dropout_dict(py, r))
             .collect::<PyResult<Vec<_>>>()?;
         out.set_item("dropouts", dropouts)?;
+        let held = d
+            .held_readings
+            .iter()
+            .map(|g| super::recording::glitch_dict(py, g))
+            .collect::<PyResult<Vec<_>>>()?;
+        out.set_item("held_readings", held)?;
         out.set_item("warnings", d.warnings.clone())?;
         Ok(out)
     }

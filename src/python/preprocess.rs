@@ -56,7 +56,12 @@ pub(crate) fn preprocess(
     };
     let out: Recording = detached(py, "preprocess", || preprocess_rs(&rec, &options))?;
     let warnings: Vec<String> = [
-        crate::log_screening::warning(&out.glitches, name, &[]),
+        crate::log_screening::warning(
+            &out.glitches,
+            name,
+            &[],
+            crate::log_screening::BEFORE_PREPROCESSING,
+        ),
         crate::log_screening::dropout_warning(
             &out.dropouts,
             name,

@@ -19,6 +19,28 @@ pub(crate) struct PyRecording {
 
 /// A dropout as a Python dict: `experiment` (when it has one), `signal`, `first_sample`,
 /// `samples`, `from`, `to`.
+/// A glitch of a log as a dict (its keys in [`PyRecording::glitches`]; `experiment` too
+/// where it has one).
+pub(crate) fn glitch_dict<'py>(
+    py: Python<'py>,
+    g: &crate::log_screening::LogGlitch,
+) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    let e = pyo3::types::PyDict::new(py);
+    if let Some(x) = &g.experiment {
+        e.set_item("experiment", x)?;
+    }
+    e.set_item("signal", &g.signal)?;
+    e.set_item("joint", g.joint)?;
+    e.set_item("sample", g.sample)?;
+    e.set_item("time", g.time)?;
+    e.set_item("value", g.value)?;
+    e.set_item("noise_levels", g.noise_levels)?;
+    e.set_item("replaced_by", g.replaced_by)?;
+    e.set_item("repeats_previous", g.repeats_previous)?;
+    e.set_item("held", g.held)?;
+    Ok(e)
+}
+
 pub(crate) fn dropout_dict<'py>(
     py: Python<'py>,
     d: &crate::log_screening::LogDropout,
@@ -154,19 +176,7 @@ impl PyRecording {
         self.rec
             .glitches
             .iter()
-            .map(|g| {
-                let e = pyo3::types::PyDict::new(py);
-                e.set_item("signal", &g.signal)?;
-                e.set_item("joint", g.joint)?;
-                e.set_item("sample", g.sample)?;
-                e.set_item("time", g.time)?;
-                e.set_item("value", g.value)?;
-                e.set_item("noise_levels", g.noise_levels)?;
-                e.set_item("replaced_by", g.replaced_by)?;
-                e.set_item("repeats_previous", g.repeats_previous)?;
-                e.set_item("held", g.held)?;
-                Ok(e)
-            })
+            .map(|g| glitch_dict(py, g))
             .collect()
     }
     /// The runs of rows of the log this recording was preprocessed from that were removed as

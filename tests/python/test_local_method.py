@@ -340,6 +340,24 @@ def test_a_glitch_in_a_log_is_replaced_and_reported():
     (drop,) = model.diagnostics["dropouts"]
     assert (drop["experiment"], drop["signal"], drop["first_sample"], drop["samples"]) == ("D", "tau", first, 6)
     np.testing.assert_allclose(model.D, clean.D, atol=0.2 * np.max(clean.stderr["D"]))
+    assert model.diagnostics["held_readings"] == [] == clean.diagnostics["held_readings"]
+    # six rows of zeros in one joint's torque (the others read on): a held reading, replaced
+    # before the windows are read
+    held = []
+    for r in recs:
+        tau = r.tau.copy()
+        if r.experiment == "D":
+            i = int(np.searchsorted(r.t, d.crossing_times[1]))
+            tau[i : i + 6, 1] = 0.0
+            first = i
+        held.append(pr.Recording(r.t, r.q, tau, name=r.name, experiment=r.experiment))
+    with pytest.warns(pr.PerturbidWarning, match="experiment 'D'.*1 held reading"):
+        model = pr.identify_local(plan, held)
+    found = model.diagnostics["held_readings"]
+    assert [(g["experiment"], g["signal"], g["joint"], g["sample"], g["held"]) for g in found] == [
+        ("D", "tau", 1, s, 6) for s in range(first, first + 6)
+    ]
+    np.testing.assert_allclose(model.D, clean.D, atol=0.2 * np.max(clean.stderr["D"]))
 
 
 def test_the_torque_noise_is_reported_per_experiment_and_joint():
