@@ -366,7 +366,8 @@ fn screen_segment(
 pub const MAX_HELD: usize = HALF_WINDOW;
 
 /// Fewest samples of the others on each side of a held run for its judgement: the cubic
-/// through them interpolates the run and never extrapolates.
+/// through them interpolates the run and never extrapolates (and twice as many after it, whose
+/// own cubic tells whether the run ends with a jump).
 const HELD_SIDE: usize = DEGREE + 1;
 
 /// The runs of 2 to [`MAX_HELD`] exactly repeated readings in each column (as (column, first
@@ -420,7 +421,9 @@ fn held_runs(columns: &[Vec<f64>], signals: &[&str]) -> Vec<(usize, std::ops::Ra
 /// each), by [`NOISE_LEVELS`] of their noise level (at least `floor`) with the prediction's own
 /// uncertainty. The others must be smooth themselves (at most [`MAX_PER_WINDOW`] glitches of
 /// their own, left out of the fit): a step the signal really makes near the run leaves it
-/// alone.
+/// alone. And the run must end with a jump: its last sample beyond [`NOISE_LEVELS`] of the
+/// cubic through the samples after it, extrapolated one sample back (a signal levelling off,
+/// as a joint's torque does when it arrives at rest, continues from its last sample).
 fn judge_run(t: &[f64], y: &[f64], run: std::ops::Range<usize>, floor: f64) -> Vec<(usize, Found)> {
     let before = run.start.saturating_sub(HALF_WINDOW)..run.start;
     let after = run.end..(run.end + HALF_WINDOW).min(y.len());
@@ -476,6 +479,29 @@ fn judge_run(t: &[f64], y: &[f64], run: std::ops::Range<usize>, floor: f64) -> V
         by_mean => farthest.max(by_mean),
     };
     if z <= NOISE_LEVELS {
+        return vec![];
+    }
+    // a held reading ends with a jump back to the signal when the sensor reads again: its last
+    // sample is off the cubic through the samples after it, extrapolated one sample back. A
+    // signal that really levels off (a joint arriving at rest: a kink the two-sided cubic
+    // cannot follow) continues from its last sample and is left alone.
+    let after: Vec<usize> = (run.end..(run.end + HALF_WINDOW).min(y.len())).collect();
+    let last = run.end - 1;
+    if after.len() < 2 * HELD_SIDE {
+        return vec![];
+    }
+    let t_after: Vec<f64> = after.iter().map(|&i| t[i]).collect();
+    let y_after: Vec<f64> = after.iter().map(|&i| y[i]).collect();
+    let Some((va, wa)) = basis(&t_after, t[last]) else {
+        return vec![];
+    };
+    // the basis is in powers of the time from t[last]: there the fit is the constant's
+    // coefficient, and its variance (in units of the noise's) that coefficient's
+    let back: f64 = (0..after.len()).map(|m| wa[(0, m)] * y_after[m]).sum();
+    let variance: f64 = (0..after.len()).map(|m| wa[(0, m)].powi(2)).sum();
+    let level_after = crate::outliers::level(&va, &wa, &y_after).max(level);
+    let jump = (y[last] - back).abs() / (level_after * (1.0 + variance).sqrt());
+    if jump.is_finite() && jump <= NOISE_LEVELS {
         return vec![];
     }
     let held = Some(run.len());

@@ -497,6 +497,13 @@ fn torques_rounded_without_dithering_get_standard_errors_that_cover_the_rounding
     let mut worst: f64 = 0.0;
     for seed in 0..12 {
         let m = identify(&robot(100 + seed, 0.05));
+        // repeated steps of the grid, where a torque levels off as its joint arrives at rest,
+        // are readings, not held ones
+        assert!(
+            m.diagnostics.held_readings.is_empty(),
+            "{:?}",
+            m.diagnostics.held_readings
+        );
         let d = m.d.as_ref().unwrap();
         for ((e, se), t) in d.matrix.iter().zip(&d.stderr).zip(&truth.d) {
             if se.is_finite() {
