@@ -527,6 +527,10 @@ class BaseParameterModel:
         """Per joint, the residuals' long-run variance factor (>= 1); the standard errors are
         scaled by the square root of the largest."""
     @property
+    def torque_columns(self) -> list[dict[str, Any]]:
+        """Per joint, its torque column against the robot's own model (joint, scale,
+        explained, follows, follows_explained, gravity_rms, finding); findings are also warnings."""
+    @property
     def cond(self) -> float: ...
     @property
     def samples(self) -> int: ...

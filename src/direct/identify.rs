@@ -97,6 +97,12 @@ pub struct BaseModel {
     /// while the robot moved; [`crate::log_screening::find_dropouts`]), set likewise.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub log_dropouts: Vec<crate::log_screening::LogDropout>,
+    /// The data's torque columns against the robot's own model, one a joint
+    /// ([`super::torque_columns`]): swapped columns, the opposite sign convention or other
+    /// units are warned of ([`BaseModel::warnings`]). Empty in a model saved before it was
+    /// checked.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub torque_columns: Vec<super::torque_columns::TorqueColumn>,
 }
 
 /// Identifies the base parameters of `model` from the samples of `states` (rad, rad/s,
@@ -232,6 +238,12 @@ fn fit_with_factors(
         residual_correlation: vec![],
         log_glitches: vec![],
         log_dropouts: vec![],
+        torque_columns: super::torque_columns::check_torque_columns(
+            model,
+            states,
+            tau,
+            options.gravity,
+        )?,
     };
     // residuals correlated from sample to sample (a filtered, lightly decimated log) carry less
     // information than their number says
@@ -321,6 +333,26 @@ impl Document for BaseModel {
             .find_map(|(i, d)| d.problem().map(|p| (i, p)))
         {
             return Err(invalid(Self::WHAT, format!("log_dropouts[{i}]: {problem}")));
+        }
+        if !m.torque_columns.is_empty() && m.torque_columns.len() != n {
+            return Err(invalid(
+                Self::WHAT,
+                format!(
+                    "torque_columns: {} entries, expected one per joint ({n}) or none",
+                    m.torque_columns.len()
+                ),
+            ));
+        }
+        if let Some((i, problem)) = m
+            .torque_columns
+            .iter()
+            .enumerate()
+            .find_map(|(i, c)| c.problem(&m.joint_names).map(|p| (i, p)))
+        {
+            return Err(invalid(
+                Self::WHAT,
+                format!("torque_columns[{i}]: {problem}"),
+            ));
         }
         check_magnitudes(Self::WHAT, "residual_rms", &m.residual_rms, false)?;
         check_magnitudes(Self::WHAT, "sigma", &m.sigma, false)?;

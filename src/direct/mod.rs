@@ -14,6 +14,7 @@ pub mod parameter_table;
 pub mod parameters;
 pub mod residual_correlation;
 pub mod streaming;
+pub mod torque_columns;
 pub mod workspace;
 
 pub use base::BaseParameters;
@@ -28,4 +29,5 @@ pub use identify::{
 };
 pub use parameter_table::ParameterRow;
 pub use parameters::{regressor_blocks, regressor_matrix, FrictionTerms, ParameterLayout};
+pub use torque_columns::{check_torque_columns, TorqueColumn};
 pub use workspace::{workspace_from_json, CartesianConstraint, Region};

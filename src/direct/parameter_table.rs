@@ -44,12 +44,16 @@ impl BaseModel {
 }
 
 impl BaseModel {
-    /// What a person should know before trusting the fit: friction or armature coefficients
-    /// identified on their own (not in a combination) and negative beyond three standard
-    /// errors. No joint has them; the data hold an effect the model lacks, or are not what it
-    /// assumes. A consistent fit keeps them at zero.
+    /// What a person should know before trusting the fit: torque columns that do not read as
+    /// the robot's model says they should ([`super::torque_columns`]: swapped, of the opposite
+    /// sign, in other units), and friction or armature coefficients identified on their own
+    /// (not in a combination) and negative beyond three standard errors. No joint has them;
+    /// the data hold an effect the model lacks, or are not what it assumes. A consistent fit
+    /// keeps them at zero.
     pub fn warnings(&self) -> Vec<String> {
-        self.parameter_table()
+        let columns = super::torque_columns::findings(&self.torque_columns);
+        let negative = self
+            .parameter_table()
             .into_iter()
             .filter(|r| {
                 !r.combination
@@ -65,7 +69,7 @@ impl BaseModel {
                         r.name, r.value, std
                     )
                 })
-            })
-            .collect()
+            });
+        columns.into_iter().chain(negative).collect()
     }
 }

@@ -291,6 +291,8 @@ pub fn identify_parameters_from_local(
         residual_correlation: vec![],
         log_glitches: vec![],
         log_dropouts: vec![],
+        // rows from local models: no log's torque columns
+        torque_columns: vec![],
     };
     let consistent = match &options.consistent {
         None => None,

@@ -269,6 +269,32 @@ impl PyBaseModel {
     fn residual_correlation<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_slice(py, &self.fit.residual_correlation)
     }
+    /// The data's torque columns against the robot's own model, one dict a joint (empty for
+    /// a model saved before it was checked or built from local models): `joint`, `scale`
+    /// (the column on its own joint's model torque: 1 where the URDF is right, negative for
+    /// the opposite sign convention), `explained` (the fraction of what friction leaves that
+    /// its own joint's model explains), `follows` (the joint whose model explains it best),
+    /// `follows_explained`, `gravity_rms` (N m, the RMS of its joint's model gravity torque:
+    /// sign and scale are judged only where it is at least a tenth of the largest joint's),
+    /// `finding` (what looks wrong, or None); each finding was also a warning.
+    #[getter]
+    fn torque_columns<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        self.fit
+            .torque_columns
+            .iter()
+            .map(|c| {
+                let e = PyDict::new(py);
+                e.set_item("joint", &c.joint)?;
+                e.set_item("scale", c.scale)?;
+                e.set_item("explained", c.explained)?;
+                e.set_item("follows", &c.follows)?;
+                e.set_item("follows_explained", c.follows_explained)?;
+                e.set_item("gravity_rms", c.gravity_rms)?;
+                e.set_item("finding", c.finding(&self.fit.torque_columns))?;
+                Ok(e)
+            })
+            .collect()
+    }
     #[getter]
     fn cond(&self) -> f64 {
         self.fit.cond

@@ -93,6 +93,48 @@ def test_base_parameters_on_simulated_a465_are_exact():
     assert fit.mass_matrix(np.tile(TABLE2_Q, (2, 1))).shape == (2, 6, 6)
 
 
+def test_torque_columns_are_checked_against_the_model():
+    """A log whose shoulder and elbow torques are swapped, or whose elbow reads with the
+    opposite sign, is named in a PerturbidWarning and in fit.torque_columns; the model's own
+    torques raise nothing (checked against columns computed here by numpy least squares)."""
+    robot = pr.robots.a465()
+    traj = excitation(robot, 5, 0.1, 0.12, 1)
+    t = np.arange(0, traj.period, 0.005)
+    q, qd, qdd = traj.sample(t)
+    tau = robot.rnea(q, qd, qdd)
+    fit = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction=None, weighting="ols")
+    columns = fit.torque_columns
+    assert [c["joint"] for c in columns] == robot.joint_names
+    assert all(c["finding"] is None for c in columns)
+    # the elbow's gain and scale, independently: its column on its model's gravity torque and
+    # the rest of its inverse dynamics, beside friction, an offset and a rotor's inertia
+    g = robot.rnea(q, np.zeros_like(q), np.zeros_like(q))
+    rest = tau - g
+    j = 2
+    own = np.column_stack([qd[:, j], np.sign(qd[:, j]), qdd[:, j], np.ones(len(t))])
+    full = np.column_stack([g[:, j], rest[:, j], own])
+    y = tau[:, j]
+
+    def unexplained(x):
+        c = np.linalg.lstsq(x, y, rcond=None)[0]
+        return np.sum((y - x @ c) ** 2), c
+
+    base, _ = unexplained(own)
+    with_model, coef = unexplained(full)
+    assert columns[j]["explained"] == pytest.approx((base - with_model) / base, abs=1e-6)
+    assert columns[j]["scale"] == pytest.approx(coef[0], rel=1e-6)
+    swapped = tau.copy()
+    swapped[:, [1, 2]] = tau[:, [2, 1]]
+    with pytest.warns(pr.PerturbidWarning, match="joint 'joint2' follows the model of joint 'joint3'"):
+        fit = pr.identify_base_parameters(robot, q, qd, qdd, swapped, friction=None, weighting="ols")
+    assert [c["follows"] for c in fit.torque_columns][1:3] == ["joint3", "joint2"]
+    negated = tau.copy()
+    negated[:, 2] *= -1.0
+    with pytest.warns(pr.PerturbidWarning, match="joint 'joint3' reads -1.000 times"):
+        fit = pr.identify_base_parameters(robot, q, qd, qdd, negated, friction=None, weighting="ols")
+    assert "negate" in fit.torque_columns[2]["finding"]
+
+
 def test_standard_errors_count_residuals_correlated_by_the_filter():
     # a log low-pass filtered at 10 Hz and kept at 100 Hz: about five correlated samples to
     # every independent one, which the standard errors now count
