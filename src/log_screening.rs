@@ -348,10 +348,12 @@ fn screen_segment(
             }
         }
     }
+    let single: std::collections::HashSet<(usize, usize)> =
+        found.iter().map(|f| (f.0, f.1)).collect();
     for (c, run) in runs {
         crate::interrupt::check("screening the log for held readings")?;
         for (i, g) in judge_run(t, &columns[c], run, floors[c]) {
-            if !found.iter().any(|f| f.0 == c && f.1 == i) {
+            if !single.contains(&(c, i)) {
                 found.push((c, i, g));
             }
         }

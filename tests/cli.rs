@@ -352,7 +352,7 @@ fn excite_identify_direct_predict() {
         let (a, b) = (a["rms"].as_f64().unwrap(), b["rms"].as_f64().unwrap());
         assert!((a - b).abs() < 0.01 * b + 1e-9, "{a} against {b}");
     }
-    run(&[
+    let warned = run(&[
         "identify-direct",
         "a465",
         s(&d.join("spiked.csv")),
@@ -361,11 +361,38 @@ fn excite_identify_direct_predict() {
         "--friction",
         "none",
     ]);
+    assert!(!warned.contains("torque column"), "{warned}");
     let fit = perturbid_rs::direct::BaseModel::load(d.join("spiked_base.json")).unwrap();
     assert!(fit
         .log_glitches
         .iter()
         .any(|g| g.sample == 2000 && g.joint == 1 && g.value == spiked.tau[2000 * 6 + 1]));
+    assert_eq!(fit.torque_columns.len(), 6);
+    // the shoulder's and the elbow's torque columns swapped in the file: named on stderr,
+    // and kept in the model
+    let mut swapped = raw.clone();
+    for row in swapped.tau.chunks_mut(6) {
+        row.swap(1, 2);
+    }
+    write(
+        &d.join("swapped.csv"),
+        &recording_table(&swapped, "").to_csv(),
+    );
+    let warned = run(&[
+        "identify-direct",
+        "a465",
+        s(&d.join("swapped.csv")),
+        "--out",
+        s(&d.join("swapped_base.json")),
+        "--friction",
+        "none",
+    ]);
+    assert!(
+        warned.contains("the torque column of joint 'joint2' follows the model of joint 'joint3'"),
+        "{warned}"
+    );
+    let fit = perturbid_rs::direct::BaseModel::load(d.join("swapped_base.json")).unwrap();
+    assert_eq!(fit.torque_columns[2].follows, "joint2");
 }
 
 #[test]

@@ -8,11 +8,13 @@
 
 mod common;
 
-use common::{panda_log, panda_urdf, Rng};
+use common::{panda_log, panda_urdf, refused_on_load, Rng};
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
 use perturbid_rs::document::Document;
-use perturbid_rs::log_screening::{find_dropouts, screen_recording, warning, HALF_WINDOW};
+use perturbid_rs::log_screening::{
+    find_dropouts, screen_recording, warning, LogGlitch, HALF_WINDOW,
+};
 use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::robots::a465;
 use perturbid_rs::trajectory::FourierTrajectory;
@@ -93,6 +95,27 @@ fn moved(a: &BaseModel, clean: &BaseModel) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// Each glitch `found` was replaced in `screened` near the `clean` log's value (its noise:
+/// 1e-5 rad for positions, 0.15 N m for torques).
+fn replaced_near_clean(found: &[LogGlitch], screened: &Recording, clean: &Recording) {
+    let n = clean.n;
+    for g in found {
+        let (x, y) = match g.signal.as_str() {
+            "q" => (
+                screened.q[g.sample * n + g.joint],
+                clean.q[g.sample * n + g.joint],
+            ),
+            _ => (
+                screened.tau[g.sample * n + g.joint],
+                clean.tau[g.sample * n + g.joint],
+            ),
+        };
+        assert_eq!(x, g.replaced_by);
+        let tolerance = if g.signal == "q" { 1e-5 } else { 0.15 };
+        assert!((x - y).abs() < tolerance, "{g:?}: {x} against {y}");
+    }
+}
+
 #[test]
 fn a_clean_log_with_velocity_reversals_is_left_alone() {
     let rec = noisy_log();
@@ -144,21 +167,7 @@ fn spikes_and_a_row_of_zeros_are_replaced_and_leave_the_parameters_alone() {
     let g = found.iter().find(|g| g.sample == 5000).unwrap();
     assert_eq!((g.value, g.noise_levels), (1e300, None));
     // replaced near the clean values (a few noise levels), and nothing else touched
-    for g in &found {
-        let (x, y) = match g.signal.as_str() {
-            "q" => (
-                screened.q[g.sample * n + g.joint],
-                clean.q[g.sample * n + g.joint],
-            ),
-            _ => (
-                screened.tau[g.sample * n + g.joint],
-                clean.tau[g.sample * n + g.joint],
-            ),
-        };
-        assert_eq!(x, g.replaced_by);
-        let tolerance = if g.signal == "q" { 1e-5 } else { 0.15 };
-        assert!((x - y).abs() < tolerance, "{g:?}: {x} against {y}");
-    }
+    replaced_near_clean(&found, &screened, &clean);
     let changed = |a: &[f64], b: &[f64]| a.iter().zip(b).filter(|(x, y)| x != y).count();
     assert_eq!(
         changed(&screened.q, &rec.q) + changed(&screened.tau, &rec.tau),
@@ -225,19 +234,8 @@ fn held_readings_of_one_joint_are_replaced() {
         screened.tau[9000 * n + 4..9008 * n + 4],
         rec.tau[9000 * n + 4..9008 * n + 4]
     );
+    replaced_near_clean(&found, &screened, &clean);
     for g in &found {
-        let (x, y) = match g.signal.as_str() {
-            "q" => (
-                screened.q[g.sample * n + g.joint],
-                clean.q[g.sample * n + g.joint],
-            ),
-            _ => (
-                screened.tau[g.sample * n + g.joint],
-                clean.tau[g.sample * n + g.joint],
-            ),
-        };
-        let tolerance = if g.signal == "q" { 1e-5 } else { 0.15 };
-        assert!((x - y).abs() < tolerance, "{g:?}: {x} against {y}");
         assert!(g.noise_levels.unwrap() > 10.0, "{g:?}");
         assert_eq!(g.held, Some(if g.signal == "q" { 5 } else { 6 }));
         assert_eq!(g.repeats_previous, ![4000, 6000].contains(&g.sample));
@@ -456,14 +454,7 @@ fn saved_log_glitches_are_checked_on_load() {
             "log_dropouts[0]: from and to",
         ),
     ];
-    for (edit, says) in edits {
-        let mut bad = value.clone();
-        edit(&mut bad);
-        let e = BaseModel::from_json(&bad.to_string())
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains(says), "{e}");
-    }
+    refused_on_load::<BaseModel>(&value, &edits);
 }
 
 /// The real Panda log (beside the repository; skipped when absent): its torques and logged

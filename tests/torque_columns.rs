@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{panda_log, panda_urdf, Rng};
+use common::{panda_log, panda_urdf, refused_on_load, Rng};
 use nalgebra::DMatrix;
 use perturbid_rs::direct::torque_columns::{LOADED, SCALE_LIMIT};
 use perturbid_rs::direct::{
@@ -111,14 +111,7 @@ fn a_clean_log_reads_as_the_model_says() {
             "torque_columns: 5 entries",
         ),
     ];
-    for (edit, says) in edits {
-        let mut bad = value.clone();
-        edit(&mut bad);
-        let e = BaseModel::from_json(&bad.to_string())
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains(says), "{e}");
-    }
+    refused_on_load::<BaseModel>(&value, &edits);
 }
 
 #[test]

@@ -352,3 +352,17 @@ pub fn panda_log() -> Option<perturbid_rs::Recording> {
     }
     Some(perturbid_rs::Recording::new("panda", 7, t, q, tau, Some(qd), None).unwrap())
 }
+
+/// Each of `edits` applied to the saved document `value` makes loading it as a `T` fail with
+/// an error that contains the edit's text.
+pub fn refused_on_load<T: perturbid_rs::Document + std::fmt::Debug>(
+    value: &serde_json::Value,
+    edits: &[(fn(&mut serde_json::Value), &str)],
+) {
+    for (edit, says) in edits {
+        let mut bad = value.clone();
+        edit(&mut bad);
+        let e = T::from_json(&bad.to_string()).unwrap_err().to_string();
+        assert!(e.contains(says), "{e}");
+    }
+}
