@@ -353,11 +353,14 @@ pub fn panda_log() -> Option<perturbid_rs::Recording> {
     Some(perturbid_rs::Recording::new("panda", 7, t, q, tau, Some(qd), None).unwrap())
 }
 
+/// An edit of a saved document, and what the error of loading the edited one says.
+pub type RefusedEdit<'a> = (fn(&mut serde_json::Value), &'a str);
+
 /// Each of `edits` applied to the saved document `value` makes loading it as a `T` fail with
 /// an error that contains the edit's text.
 pub fn refused_on_load<T: perturbid_rs::Document + std::fmt::Debug>(
     value: &serde_json::Value,
-    edits: &[(fn(&mut serde_json::Value), &str)],
+    edits: &[RefusedEdit<'_>],
 ) {
     for (edit, says) in edits {
         let mut bad = value.clone();
