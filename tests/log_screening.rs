@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{panda_log, panda_urdf, refused_on_load, Rng};
+use common::{a465_excitation, panda_log, panda_urdf, refused_on_load, torques_with_friction, Rng};
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
 use perturbid_rs::document::Document;
@@ -17,8 +17,7 @@ use perturbid_rs::log_screening::{
 };
 use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::robots::a465;
-use perturbid_rs::trajectory::FourierTrajectory;
-use perturbid_rs::{parallel, Gravity, Recording, States};
+use perturbid_rs::{Recording, States};
 
 /// The A465 running a 5-harmonic excitation for 12 s at about 1 kHz (irregular steps), with
 /// viscous and Coulomb friction (steps at every velocity reversal), torque noise of 0.03 N m
@@ -27,35 +26,14 @@ fn noisy_log() -> Recording {
     let model = a465::model("physical").unwrap();
     let n = 6;
     let mut rng = Rng(5);
-    let a = DMatrix::from_fn(n, 5, |_, _| rng.uniform(-0.12, 0.12));
-    let b = DMatrix::from_fn(n, 5, |_, _| rng.uniform(-0.12, 0.12));
-    let traj = FourierTrajectory::new(
-        2.0 * std::f64::consts::PI * 0.1,
-        vec![0.2, 0.3, -0.4, 0.1, 0.5, -0.2],
-        a,
-        b,
-    )
-    .unwrap();
+    let traj = a465_excitation(&mut rng);
     let mut t = vec![0.0];
     while *t.last().unwrap() < 12.0 {
         let last = *t.last().unwrap();
         t.push(last + rng.uniform(0.0008, 0.0012));
     }
     let s = traj.sample(&t);
-    let states = States::new(n, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
-    let mut tau = vec![0.0; s.q.len()];
-    parallel::rnea(
-        &model,
-        &mut parallel::Workspace::new(&model),
-        &states,
-        Gravity::Included,
-        &mut tau,
-    )
-    .unwrap();
-    for (i, x) in tau.iter_mut().enumerate() {
-        let v = s.qd[i];
-        *x += 0.3 * v + 0.8 * v.signum() * f64::from(v != 0.0) + 0.03 * normal(&mut rng);
-    }
+    let tau = torques_with_friction(&model, &s, &mut rng, |r| 0.03 * normal(r));
     let count = 2f64.powi(20) / (2.0 * std::f64::consts::PI);
     let q = s.q.iter().map(|x| (x * count).round() / count).collect();
     Recording::new("log", n, t, q, tau, None, None).unwrap()

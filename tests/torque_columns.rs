@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{panda_log, panda_urdf, refused_on_load, Rng};
+use common::{a465_excitation, panda_log, panda_urdf, refused_on_load, torques_with_friction, Rng};
 use nalgebra::DMatrix;
 use perturbid_rs::direct::torque_columns::{LOADED, SCALE_LIMIT};
 use perturbid_rs::direct::{
@@ -16,7 +16,7 @@ use perturbid_rs::document::Document;
 use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::robots::a465;
 use perturbid_rs::trajectory::FourierTrajectory;
-use perturbid_rs::{parallel, Gravity, States};
+use perturbid_rs::{Gravity, States};
 
 /// Samples of an A465 excitation (5 harmonics, 12 s at 1 kHz) and the torques of a robot whose
 /// parameters are the paper's (`kinsheel2010`), with viscous and Coulomb friction and 0.03 N m
@@ -30,33 +30,11 @@ struct Log {
 
 fn a465_log() -> Log {
     let truth = a465::model("kinsheel2010").unwrap();
-    let n = 6;
     let mut rng = Rng(9);
-    let a = DMatrix::from_fn(n, 5, |_, _| rng.uniform(-0.12, 0.12));
-    let b = DMatrix::from_fn(n, 5, |_, _| rng.uniform(-0.12, 0.12));
-    let traj = FourierTrajectory::new(
-        2.0 * std::f64::consts::PI * 0.1,
-        vec![0.2, 0.3, -0.4, 0.1, 0.5, -0.2],
-        a,
-        b,
-    )
-    .unwrap();
+    let traj = a465_excitation(&mut rng);
     let t: Vec<f64> = (0..12_000).map(|i| i as f64 * 1e-3).collect();
     let s = traj.sample(&t);
-    let states = States::new(n, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
-    let mut tau = vec![0.0; s.q.len()];
-    parallel::rnea(
-        &truth,
-        &mut parallel::Workspace::new(&truth),
-        &states,
-        Gravity::Included,
-        &mut tau,
-    )
-    .unwrap();
-    for (i, x) in tau.iter_mut().enumerate() {
-        let v = s.qd[i];
-        *x += 0.3 * v + 0.8 * v.signum() * f64::from(v != 0.0) + 0.03 * rng.uniform(-1.7, 1.7);
-    }
+    let tau = torques_with_friction(&truth, &s, &mut rng, |r| 0.03 * r.uniform(-1.7, 1.7));
     Log {
         q: s.q,
         qd: s.qd,

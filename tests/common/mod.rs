@@ -369,3 +369,43 @@ pub fn refused_on_load<T: perturbid_rs::Document + std::fmt::Debug>(
         assert!(e.contains(says), "{e}");
     }
 }
+
+/// A 5-harmonic excitation of the A465 at 0.1 Hz about [0.2, 0.3, -0.4, 0.1, 0.5, -0.2] rad,
+/// its sine and cosine coefficients drawn uniformly within +-0.12 from `rng`.
+pub fn a465_excitation(rng: &mut Rng) -> perturbid_rs::trajectory::FourierTrajectory {
+    let a = DMatrix::from_fn(6, 5, |_, _| rng.uniform(-0.12, 0.12));
+    let b = DMatrix::from_fn(6, 5, |_, _| rng.uniform(-0.12, 0.12));
+    perturbid_rs::trajectory::FourierTrajectory::new(
+        2.0 * std::f64::consts::PI * 0.1,
+        vec![0.2, 0.3, -0.4, 0.1, 0.5, -0.2],
+        a,
+        b,
+    )
+    .unwrap()
+}
+
+/// The torques of `model` along `s` (row-major, N m) with gravity, viscous (0.3 N m s/rad)
+/// and Coulomb (0.8 N m, none at exactly zero speed) friction, and `noise(rng)` added to each.
+pub fn torques_with_friction(
+    model: &perturbid_rs::Model,
+    s: &perturbid_rs::trajectory::Samples,
+    rng: &mut Rng,
+    noise: impl Fn(&mut Rng) -> f64,
+) -> Vec<f64> {
+    use perturbid_rs::{parallel, Gravity, States};
+    let states = States::new(s.n, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
+    let mut tau = vec![0.0; s.q.len()];
+    parallel::rnea(
+        model,
+        &mut parallel::Workspace::new(model),
+        &states,
+        Gravity::Included,
+        &mut tau,
+    )
+    .unwrap();
+    for (i, x) in tau.iter_mut().enumerate() {
+        let v = s.qd[i];
+        *x += 0.3 * v + 0.8 * v.signum() * f64::from(v != 0.0) + noise(rng);
+    }
+    tau
+}
