@@ -8,7 +8,9 @@
 
 mod common;
 
-use common::{a465_excitation, panda_log, panda_urdf, refused_on_load, torques_with_friction, Rng};
+use common::{
+    a465_excitation, panda_log, panda_model, refused_on_load, torques_with_friction, Rng,
+};
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
 use perturbid_rs::document::Document;
@@ -444,7 +446,7 @@ fn the_real_panda_log_loses_only_stale_positions() {
     let Some(rec) = panda_log() else {
         return;
     };
-    let Some(urdf) = panda_urdf() else {
+    let Some(model) = panda_model() else {
         eprintln!("SKIPPED: the Panda URDF of example-robot-data is not installed");
         return;
     };
@@ -454,16 +456,6 @@ fn the_real_panda_log_loses_only_stale_positions() {
     assert!(find_dropouts(&rec).is_empty());
     let stale = found.iter().filter(|g| g.repeats_previous).count();
     assert!(stale * 10 >= found.len() * 9, "{stale} of {}", found.len());
-    let mut lock = std::collections::BTreeMap::new();
-    lock.insert("panda_finger_joint1".to_string(), 0.0);
-    let model = perturbid_rs::model_from_urdf_file(
-        urdf,
-        &perturbid_rs::LoadOptions {
-            lock,
-            ..perturbid_rs::LoadOptions::default()
-        },
-    )
-    .unwrap();
     let fit = |screen: bool| {
         let p = preprocess(
             &rec,

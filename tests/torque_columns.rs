@@ -5,7 +5,9 @@
 
 mod common;
 
-use common::{a465_excitation, panda_log, panda_urdf, refused_on_load, torques_with_friction, Rng};
+use common::{
+    a465_excitation, panda_log, panda_model, refused_on_load, torques_with_friction, Rng,
+};
 use nalgebra::DMatrix;
 use perturbid_rs::direct::torque_columns::{LOADED, SCALE_LIMIT};
 use perturbid_rs::direct::{
@@ -205,20 +207,10 @@ fn the_real_panda_log_reads_as_its_urdf_says() {
     let Some(rec) = panda_log() else {
         return;
     };
-    let Some(urdf) = panda_urdf() else {
+    let Some(model) = panda_model() else {
         eprintln!("SKIPPED: the Panda URDF of example-robot-data is not installed");
         return;
     };
-    let mut lock = std::collections::BTreeMap::new();
-    lock.insert("panda_finger_joint1".to_string(), 0.0);
-    let model = perturbid_rs::model_from_urdf_file(
-        urdf,
-        &perturbid_rs::LoadOptions {
-            lock,
-            ..perturbid_rs::LoadOptions::default()
-        },
-    )
-    .unwrap();
     let p = preprocess(&rec, &PreprocessOptions::default()).unwrap();
     let states = States::new(7, &p.q, p.qd.as_deref(), p.qdd.as_deref()).unwrap();
     let c = check_torque_columns(&model, &states, &p.tau, Gravity::Included).unwrap();
