@@ -25,7 +25,10 @@ use crate::trajectory::Samples;
 /// `coulomb_negative` differs from `coulomb` for asymmetric Coulomb friction; `stribeck` is the
 /// breakaway excess (static minus Coulomb level), 0 for none. At exactly zero speed the friction
 /// carries no torque: a rehearsal defines it rather than leaving it to the sign of a rounding
-/// error (a real joint at rest holds anything up to its breakaway level).
+/// error (a real joint at rest holds anything up to its breakaway level). Along a trajectory
+/// the simulations apply it in the joint's direction of motion instead
+/// ([`directions_of_motion`]), so that a joint
+/// touching zero speed at one sample without stopping keeps its friction there.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Friction {
     /// N m s/rad.
@@ -68,6 +71,13 @@ impl Friction {
 
     /// Friction torque of joint `j` at speed `qd`; see the type's documentation.
     pub fn torque(&self, j: usize, qd: f64) -> f64 {
+        self.torque_moving(j, qd, crate::direct::parameters::sign0(qd))
+    }
+
+    /// Friction torque of joint `j` at speed `qd` moving in `direction` (the sign of `qd`, or
+    /// where `qd` is zero the direction of motion around it, [`directions_of_motion`]: 1, -1,
+    /// or 0 at rest).
+    pub fn torque_moving(&self, j: usize, qd: f64, direction: f64) -> f64 {
         let stribeck = |level: f64| {
             if self.stribeck[j] == 0.0 {
                 level
@@ -75,9 +85,9 @@ impl Friction {
                 level + self.stribeck[j] * (-(qd / self.stribeck_velocity[j]).powi(2)).exp()
             }
         };
-        if qd > 0.0 {
+        if direction > 0.0 {
             self.viscous[j] * qd + stribeck(self.coulomb[j])
-        } else if qd < 0.0 {
+        } else if direction < 0.0 {
             self.viscous[j] * qd - stribeck(self.coulomb_negative[j])
         } else {
             0.0
@@ -183,8 +193,54 @@ impl SimulationOptions {
     }
 }
 
+/// Speeds within this fraction of a joint's largest speed along a trajectory are rounding
+/// errors of zero (a Fourier series summed at its rest point leaves about 1e-17 rad/s, of
+/// either sign), not motion.
+pub const ROUNDING_SPEED: f64 = 1e-12;
+
+/// The direction each joint moves in at each sample of the speeds `qd` (row-major, `n` per
+/// sample, successive in time; returned in the same layout): the sign of its speed (1, -1), and
+/// where that speed is zero (within [`ROUNDING_SPEED`] of the joint's largest), the direction
+/// of its neighbours when every neighbour it has (one at either end) moves the same way. Such
+/// a joint touches zero speed at that instant without stopping, and its friction, continuous
+/// over a sample as a real joint's is, keeps its sign: applied there as at rest (or with the
+/// sign of a rounding error), it would log a one-sample dip of the Coulomb level that no robot
+/// shows (and that the log screening rightly takes for a glitch). 0 at rest (a neighbour at
+/// zero speed too) and at a reversal (neighbours moving opposite ways).
+pub fn directions_of_motion(qd: &[f64], n: usize) -> Vec<f64> {
+    use crate::direct::parameters::sign0;
+    let k = qd.len().checked_div(n).unwrap_or(0);
+    let mut own = vec![0.0; k * n];
+    for j in 0..n {
+        let fastest = (0..k).map(|i| qd[i * n + j].abs()).fold(0.0, f64::max);
+        for i in 0..k {
+            let v = qd[i * n + j];
+            if v.abs() > ROUNDING_SPEED * fastest {
+                own[i * n + j] = sign0(v);
+            }
+        }
+    }
+    let mut out = own.clone();
+    for i in 0..k {
+        for j in 0..n {
+            if own[i * n + j] != 0.0 {
+                continue;
+            }
+            let before = (i > 0).then(|| own[(i - 1) * n + j]);
+            let after = (i + 1 < k).then(|| own[(i + 1) * n + j]);
+            out[i * n + j] = match (before, after) {
+                (Some(b), Some(a)) if a == b => a,
+                (None, Some(s)) | (Some(s), None) => s,
+                _ => 0.0,
+            };
+        }
+    }
+    out
+}
+
 /// Simulates what a robot logs along `samples` (its true `t, q, qd, qdd`): the torque
-/// `tau = rnea(q, qd, qdd) + tau_f(qd)` (gravity per `options`) plus noise, and the position
+/// `tau = rnea(q, qd, qdd) + tau_f(qd)` (gravity per `options`, the friction in each
+/// sample's direction of motion, [`directions_of_motion`]) plus noise, and the position
 /// plus noise, quantised. The recording holds `t`, `q` and `tau` only (a robot's velocity and
 /// acceleration estimates are not simulated). `stream` separates the random streams of several
 /// recordings made with one seed.
@@ -213,12 +269,15 @@ pub fn simulate_samples(
     let mut rigid = vec![0.0; k * n];
     let mut workspace = parallel::Workspace::new(model);
     parallel::rnea(model, &mut workspace, &states, options.gravity, &mut rigid)?;
+    let directions = directions_of_motion(&samples.qd, n);
     let (mut q, mut tau) = (Vec::with_capacity(k * n), Vec::with_capacity(k * n));
     for i in 0..k {
         let (qi, qdi) = (samples.q_at(i), samples.qd_at(i));
         for j in 0..n {
             let t = rigid[i * n + j]
-                + options.friction.torque(j, qdi[j])
+                + options
+                    .friction
+                    .torque_moving(j, qdi[j], directions[i * n + j])
                 + options.torque_noise[j] * gauss.sample(&mut rng);
             tau.push(t);
             let mut p = qi[j] + options.position_noise[j] * gauss.sample(&mut rng);

@@ -1,6 +1,8 @@
 //! The true robot of a rehearsal: every effect against an independent computation (its
 //! formula, rounding, the URDF loader, a statistic of the noise), and closed-loop tracking.
 
+mod common;
+
 use perturbid_rs::rehearsal::{rehearse, Controller, Harmonic, Payload, TrueRobot};
 use perturbid_rs::robots::a465;
 use perturbid_rs::trajectory::Samples;
@@ -453,4 +455,87 @@ fn the_direct_method_recovers_the_true_robot_from_a_rehearsed_excitation() {
     let mut nominal = Data::new(&model);
     mass_matrix(&model, &mut nominal, &q).unwrap();
     assert!((&m - &nominal.m).norm() > 1e-3 * nominal.m.norm());
+}
+
+/// A joint touching zero speed without stopping keeps its friction's direction: the hand-made
+/// speeds' directions by the rule (a touch, a reversal, a rest, the ends, rounding errors of
+/// either sign); and along an excitation that starts and ends each period at rest (`qd = qdd =
+/// 0`, where the summed series leaves speeds of about 1e-17 of either sign), the friction both
+/// simulators log there is the Coulomb level of the motion around it, so that a noisy log of it
+/// has no glitch for the screening to find (it had one at every period boundary).
+#[test]
+fn friction_keeps_its_direction_where_a_joint_touches_zero_speed() {
+    use perturbid_rs::simulation::{directions_of_motion, simulate_samples, Friction};
+    let qd = [
+        0.0, 1.0, 0.0, 2.0, 0.0, -1.0, 0.0, 0.0, 1e-17, 3.0, -1e-17, 3.0, 0.0,
+    ];
+    let expected = [1., 1., 1., 1., 0., -1., 0., 0., 0., 1., 1., 1., 1.];
+    assert_eq!(directions_of_motion(&qd, 1), expected);
+    // two joints interleaved: each judged on its own speeds
+    let two: Vec<f64> = qd.iter().flat_map(|&v| [v, -v]).collect();
+    let d = directions_of_motion(&two, 2);
+    for i in 0..qd.len() {
+        assert_eq!(
+            (d[2 * i], d[2 * i + 1]),
+            (expected[i], -expected[i]),
+            "sample {i}"
+        );
+    }
+
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let mut rng = common::Rng(7);
+    let e = common::a465_excitation(&mut rng);
+    // the last harmonic cancels the others' speed and acceleration at t = 0
+    let (w, h) = (e.w_f, e.harmonics());
+    let (mut a, mut b) = (e.a.clone(), e.b.clone());
+    for i in 0..n {
+        a[(i, h - 1)] = -(0..h - 1).map(|l| a[(i, l)]).sum::<f64>();
+        b[(i, h - 1)] = -(0..h - 1).map(|l| (l + 1) as f64 * b[(i, l)]).sum::<f64>() / h as f64;
+    }
+    let e = perturbid_rs::trajectory::FourierTrajectory::new(w, e.q0.clone(), a, b).unwrap();
+    let s = e.sample_periods(2.0, 1000.0).unwrap();
+    let boundaries = [0, 10_000, 20_000];
+    for &i in &boundaries {
+        for j in 0..n {
+            assert!(s.qd_at(i)[j].abs() < 1e-12 && s.qdd_at(i)[j].abs() < 1e-9);
+        }
+    }
+    let coulomb = [1.0, 0.8, 0.6, 0.4, 0.2, 0.1];
+    let json = format!(
+        r#"{{"format": "perturbid-true-robot/1", "friction": {{"coulomb": {coulomb:?}}}}}"#
+    );
+    let rehearsed = rehearse(&model, &doc(&json), &s, 0, "excitation").unwrap();
+    let mut options = perturbid_rs::simulation::SimulationOptions::new(&model);
+    options.friction = Friction::viscous_coulomb(vec![0.0; n], coulomb.to_vec());
+    let simulated = simulate_samples(&model, &s, &options, 0, "excitation").unwrap();
+    for rec in [&rehearsed, &simulated] {
+        for &i in &boundaries {
+            let tau = rigid(
+                &model,
+                s.q_at(i),
+                s.qd_at(i),
+                s.qdd_at(i),
+                Gravity::Included,
+            );
+            // the direction the joint moves in at the sample next to the boundary
+            let next = if i + 1 < s.len() { i + 1 } else { i - 1 };
+            for j in 0..n {
+                let friction = rec.tau[i * n + j] - tau[j];
+                let expected = coulomb[j] * s.qd_at(next)[j].signum();
+                assert!(
+                    (friction - expected).abs() < 1e-9,
+                    "{}: joint {j} at sample {i}: friction {friction}, expected {expected}",
+                    rec.name
+                );
+            }
+        }
+    }
+    let json = format!(
+        r#"{{"format": "perturbid-true-robot/1", "friction": {{"coulomb": {coulomb:?}}},
+            "sensors": {{"torque_noise": [0.05, 0.05, 0.05, 0.02, 0.02, 0.02]}}}}"#
+    );
+    let noisy = rehearse(&model, &doc(&json), &s, 0, "excitation").unwrap();
+    let (_, glitches) = perturbid_rs::log_screening::screen_recording(&noisy).unwrap();
+    assert!(glitches.is_empty(), "{glitches:?}");
 }

@@ -49,10 +49,17 @@ impl JointEffects {
     /// Friction torque of joint `j` (N m) at position `q` (rad), speed `v` (rad/s), time `t`
     /// (s from the start); 0 at exactly zero speed.
     pub fn friction(&self, j: usize, q: f64, v: f64, t: f64) -> f64 {
-        if v == 0.0 {
+        self.friction_moving(j, q, v, crate::direct::parameters::sign0(v), t)
+    }
+
+    /// [`Self::friction`] moving in `direction` (the sign of `v`, or where `v` is zero the
+    /// direction of motion around it, [`crate::simulation::directions_of_motion`]: 1, -1, or
+    /// 0 at rest).
+    pub fn friction_moving(&self, j: usize, q: f64, v: f64, direction: f64, t: f64) -> f64 {
+        if direction == 0.0 {
             return 0.0;
         }
-        let level = if v > 0.0 {
+        let level = if direction > 0.0 {
             self.coulomb[j]
         } else {
             self.coulomb_negative[j]
@@ -62,7 +69,7 @@ impl JointEffects {
         } else {
             self.stribeck[j] * (-(v / self.stribeck_velocity[j]).powi(2)).exp()
         };
-        (1.0 + self.drift[j] * t) * (self.viscous[j] * v + v.signum() * (level + stribeck))
+        (1.0 + self.drift[j] * t) * (self.viscous[j] * v + direction.signum() * (level + stribeck))
     }
 
     /// The torque applied to joint `j` at position `q` when its motor is commanded `u` (N m):

@@ -60,7 +60,9 @@ pub fn rehearse(
     let offsets = true_robot::per_joint("joint_offsets", &robot.joint_offsets, n, 0.0)?;
     let gravity = Gravity::from(robot.gravity);
     let motion = match &robot.controller {
-        None => tracking::follow_exactly(&true_model, &effects, gravity, reference, &offsets)?,
+        None => {
+            tracking::follow_exactly(&true_model, &effects, gravity, reference, &offsets, true)?
+        }
         Some(c) => tracking::follow_closed_loop(
             nominal,
             &true_model,
@@ -153,6 +155,7 @@ pub fn true_torques(
         Gravity::from(robot.gravity),
         &reference,
         &offsets,
+        false,
     )?;
     Ok(motion.command)
 }

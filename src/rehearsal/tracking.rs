@@ -24,13 +24,18 @@ pub struct Motion {
 }
 
 /// Exact tracking: the encoders read the reference, so the true joints are at `q_ref -
-/// offset`; the command is the one that applies the torque the true robot needs there.
+/// offset`; the command is the one that applies the torque the true robot needs there. With
+/// `successive`, the samples follow each other in time and the friction acts in each joint's
+/// direction of motion ([`crate::simulation::directions_of_motion`]: a joint touching zero
+/// speed at one sample keeps its friction there); otherwise each sample stands alone (zero
+/// friction at exactly zero speed).
 pub fn follow_exactly(
     robot: &Model,
     effects: &JointEffects,
     gravity: Gravity,
     reference: &Samples,
     offsets: &[f64],
+    successive: bool,
 ) -> Result<Motion> {
     let n = robot.nv;
     let k = reference.len();
@@ -45,11 +50,16 @@ pub fn follow_exactly(
     let mut ws = parallel::Workspace::new(robot);
     parallel::rnea(robot, &mut ws, &states, gravity, &mut rigid)?;
     let mut command = rigid;
+    let directions = successive.then(|| crate::simulation::directions_of_motion(&reference.qd, n));
     for i in 0..k {
         for j in 0..n {
             let (x, v) = (q[i * n + j], reference.qd[i * n + j]);
-            let need =
-                command[i * n + j] + effects.friction(j, x, v, reference.t[i] - reference.t[0]);
+            let direction = match &directions {
+                Some(d) => d[i * n + j],
+                None => crate::direct::parameters::sign0(v),
+            };
+            let t = reference.t[i] - reference.t[0];
+            let need = command[i * n + j] + effects.friction_moving(j, x, v, direction, t);
             command[i * n + j] = effects.command_for(j, x, need);
         }
     }

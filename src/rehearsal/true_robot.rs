@@ -65,7 +65,9 @@ pub struct LinkError {
 /// f = (1 + drift t) * (viscous v + sign(v) (level(q) + stribeck exp(-(v / stribeck_velocity)^2)))
 /// ```
 ///
-/// and `f = 0` at exactly zero speed. `coulomb_negative` defaults to `coulomb`.
+/// and `f = 0` at zero speed, except where a joint touches zero speed at one sample without
+/// stopping: there `sign(v)` is the direction of the motion around it (see
+/// [`crate::simulation::directions_of_motion`]). `coulomb_negative` defaults to `coulomb`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FrictionSpec {
