@@ -393,6 +393,40 @@ fn excite_identify_direct_predict() {
     );
     let fit = perturbid_rs::direct::BaseModel::load(d.join("swapped_base.json")).unwrap();
     assert_eq!(fit.torque_columns[2].follows, "joint2");
+    // the clean log's model validated against the swapped log: the swap named there too, and
+    // each column's check in validation.json; against the clean log, nothing said
+    let warned = run(&[
+        "validate",
+        s(&d.join("base.json")),
+        s(&d.join("swapped.csv")),
+        "--robot",
+        "a465",
+        "--out",
+        s(&d.join("swapped_validation")),
+    ]);
+    for (a, b) in [("joint2", "joint3"), ("joint3", "joint2")] {
+        let said = format!("the torque column of joint '{a}' follows the model of joint '{b}'");
+        assert!(warned.contains(&said), "{warned}");
+    }
+    assert!(warned.contains("swapped.csv"), "{warned}");
+    let listed: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(d.join("swapped_validation/validation.json")).unwrap(),
+    )
+    .unwrap();
+    let columns = listed["torque_columns"].as_array().unwrap();
+    assert_eq!(columns.len(), 6);
+    assert_eq!(columns[1]["follows"], "joint3");
+    assert!(!run(&[
+        "validate",
+        s(&d.join("base.json")),
+        s(&d.join("raw.csv")),
+        "--robot",
+        "a465",
+        "--out",
+        s(&d.join("raw_validation_again")),
+    ])
+    .contains("torque column"));
+    assert_eq!(v["torque_columns"].as_array().unwrap().len(), 6);
 }
 
 #[test]

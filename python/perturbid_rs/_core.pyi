@@ -656,11 +656,17 @@ class Validation:
     def residuals(self) -> NDArray[np.float64]: ...
     @property
     def samples(self) -> int: ...
+    @property
+    def torque_columns(self) -> list[dict[str, Any]]:
+        """For a BaseParameterModel, the measured torque columns against its robot's model
+        (as BaseParameterModel.torque_columns); empty otherwise."""
     def to_dataframe(self) -> Any:
         """The per-joint table as a pandas DataFrame (index joint; rms, relative_rms, max)."""
 
 def validate(model: Any, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, tau: ArrayLike) -> Validation:
-    """Validates any model with predict(q, qd, qdd) on measured states and torques."""
+    """Validates any model with predict(q, qd, qdd) on measured states and torques; for a
+    BaseParameterModel also checks the torque columns against its robot's model (a
+    PerturbidWarning per finding: swapped, the opposite sign, other units)."""
 
 def identify_global_linear(op: OperatingPoint, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, tau: ArrayLike) -> GlobalLinearModel: ...
 

@@ -8,6 +8,7 @@ use clap::Args;
 
 use super::files::{load_robot, refuse_overwriting_inputs, PreprocessArgs};
 use super::progress::Progress;
+use crate::direct::torque_columns::{check_torque_columns, findings};
 use crate::error::{Error, Result};
 use crate::io::{OutputSet, Table};
 use crate::states::States;
@@ -33,9 +34,10 @@ pub(crate) struct ValidateArgs {
     preprocessing: PreprocessArgs,
     /// Output folder: residuals.csv (t, measured - predicted per joint), validation.json (the
     /// per-joint table, and `log_glitches` and `log_dropouts`: the samples of the log replaced
-    /// as glitches and the rows removed as dropouts before preprocessing, when there were any)
-    /// and validation.svg (measured and predicted torques,
-    /// and residuals).
+    /// as glitches and the rows removed as dropouts before preprocessing, when there were any;
+    /// for a base-parameter model `torque_columns`, each torque column of the log against the
+    /// robot's model, whose findings are warned of) and validation.svg (measured and predicted
+    /// torques, and residuals).
     #[arg(long, default_value = "validation")]
     out: PathBuf,
 }
@@ -77,7 +79,20 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
         ModelFile::GlobalLinear(m) => m.predict(&states)?,
     };
     let v = validate(&joints, &predicted, &rec.tau)?;
+    // the log's torque columns against the robot's own model, as every direct fit checks
+    // its own log: swapped columns, another sign or other units show here by name, not only
+    // as large errors
+    let torque_columns = match (&file, &robot) {
+        (ModelFile::Base(fit), Some(r)) => {
+            progress.update("checking the torque columns");
+            check_torque_columns(r, &states, &rec.tau, fit.gravity)?
+        }
+        _ => vec![],
+    };
     progress.done();
+    for w in findings(&torque_columns) {
+        eprintln!("perturbid: warning: log '{}': {w}", a.data.display());
+    }
     // the residuals, the table and the figure, as one output set
     let mut columns = vec!["t".to_string()];
     columns.extend(joints.iter().map(|j| format!("residual_{j}")));
@@ -96,6 +111,9 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     }
     if !rec.dropouts.is_empty() {
         json["log_dropouts"] = serde_json::to_value(&rec.dropouts).expect("serialisable");
+    }
+    if !torque_columns.is_empty() {
+        json["torque_columns"] = serde_json::to_value(&torque_columns).expect("serialisable");
     }
     set.add(
         "validation.json",

@@ -19,7 +19,7 @@ use crate::direct::excitation::ExcitationDesign;
 use crate::direct::{
     design_excitation as design_rs, identify_base_parameters as base_rs,
     identify_global_linear as global_rs, BaseModel, BaseOptions, Criterion, ExcitationOptions,
-    FrictionTerms, GlobalLinearModel, Weighting,
+    FrictionTerms, GlobalLinearModel, TorqueColumn, Weighting,
 };
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -279,21 +279,7 @@ impl PyBaseModel {
     /// `finding` (what looks wrong, or None); each finding was also a warning.
     #[getter]
     fn torque_columns<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        self.fit
-            .torque_columns
-            .iter()
-            .map(|c| {
-                let e = PyDict::new(py);
-                e.set_item("joint", &c.joint)?;
-                e.set_item("scale", c.scale)?;
-                e.set_item("explained", c.explained)?;
-                e.set_item("follows", &c.follows)?;
-                e.set_item("follows_explained", c.follows_explained)?;
-                e.set_item("gravity_rms", c.gravity_rms)?;
-                e.set_item("finding", c.finding(&self.fit.torque_columns))?;
-                Ok(e)
-            })
-            .collect()
+        torque_column_dicts(py, &self.fit.torque_columns)
     }
     #[getter]
     fn cond(&self) -> f64 {
@@ -423,6 +409,28 @@ pub(crate) fn identify_base_parameters(
         fit,
         model: Arc::new(model.clone()),
     })
+}
+
+/// The torque columns' checks as dicts (see `BaseParameterModel.torque_columns`), each with
+/// its `finding` among `columns`.
+pub(crate) fn torque_column_dicts<'py>(
+    py: Python<'py>,
+    columns: &[TorqueColumn],
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    columns
+        .iter()
+        .map(|c| {
+            let e = PyDict::new(py);
+            e.set_item("joint", &c.joint)?;
+            e.set_item("scale", c.scale)?;
+            e.set_item("explained", c.explained)?;
+            e.set_item("follows", &c.follows)?;
+            e.set_item("follows_explained", c.follows_explained)?;
+            e.set_item("gravity_rms", c.gravity_rms)?;
+            e.set_item("finding", c.finding(columns))?;
+            Ok(e)
+        })
+        .collect()
 }
 
 /// The globally linearised model: constant D, H, G and an offset about an operating point.

@@ -3,18 +3,28 @@
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 
+use pyo3::types::PyDict;
+
 use super::arrays::{read_batch, to_numpy, ArrayLike};
+use super::detached;
+use super::direct::{torque_column_dicts, PyBaseModel};
+use super::errors::warn_all;
 use super::tables::dataframe;
+use crate::direct::torque_columns::{check_torque_columns, findings, TorqueColumn};
+use crate::states::States;
 use crate::validation::{validate as validate_rs, Validation};
 
 /// A model's torques against measured ones. Attributes: `joints` (names), `rms`,
 /// `relative_rms` (NaN where the measured torque is zero), `max` (n,) per joint (N m; fraction);
-/// `residuals` (k, n): measured - predicted (N m); `samples`. `to_dataframe()`: the per-joint
+/// `residuals` (k, n): measured - predicted (N m); `samples`; `torque_columns` (for a
+/// BaseParameterModel: the measured torque columns against its robot's model, as
+/// `BaseParameterModel.torque_columns`; empty otherwise). `to_dataframe()`: the per-joint
 /// table (pandas).
 #[pyclass(name = "Validation", module = "perturbid_rs", frozen)]
 pub(crate) struct PyValidation {
     v: Validation,
     n: usize,
+    torque_columns: Vec<TorqueColumn>,
 }
 
 #[pymethods]
@@ -55,6 +65,12 @@ impl PyValidation {
     fn samples(&self) -> usize {
         self.v.samples
     }
+    /// For a BaseParameterModel, each measured torque column against its robot's model (dicts
+    /// as `BaseParameterModel.torque_columns`, each finding also a warning); empty otherwise.
+    #[getter]
+    fn torque_columns<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        torque_column_dicts(py, &self.torque_columns)
+    }
     /// The per-joint table: index `joint`, columns `rms`, `relative_rms`, `max`.
     fn to_dataframe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         dataframe(
@@ -86,7 +102,9 @@ impl PyValidation {
 /// Validates `model` (anything with `predict(q, qd, qdd)`: a LocalModel, BaseParameterModel,
 /// GlobalLinearModel) on measured states and torques `q`, `qd`, `qdd`, `tau` ((k, n) each;
 /// rad, rad/s, rad/s^2, N m). The joints are named after `model.joint_names` where it has
-/// them. Returns a Validation.
+/// them. For a BaseParameterModel the torque columns are also checked against its robot's
+/// model (swapped columns, the opposite sign, other units: a PerturbidWarning each, and
+/// `Validation.torque_columns`). Returns a Validation.
 #[pyfunction]
 pub(crate) fn validate<'py>(
     model: Bound<'py, PyAny>,
@@ -110,7 +128,7 @@ pub(crate) fn validate<'py>(
         (n, batch.columns[0].to_vec())
     };
     let (n, measured) = measured;
-    let predicted = model.call_method1("predict", (q, qd, qdd))?;
+    let predicted = model.call_method1("predict", (&q, &qd, &qdd))?;
     let predicted: Vec<f64> = predicted
         .extract::<Bound<'py, numpy::PyArrayDyn<f64>>>()?
         .to_vec()?;
@@ -118,8 +136,32 @@ pub(crate) fn validate<'py>(
         Ok(j) => j.extract()?,
         Err(_) => (1..=n).map(|j| format!("joint{j}")).collect(),
     };
+    let v = validate_rs(&joints, &predicted, &measured)?;
+    // the measured torque columns against the robot's own model, as a direct fit checks its
+    // own data
+    let torque_columns = match model.cast::<PyBaseModel>() {
+        Ok(base) => {
+            let base = base.get();
+            let (q, qd, qdd): (ArrayLike, ArrayLike, ArrayLike) =
+                (q.extract()?, qd.extract()?, qdd.extract()?);
+            let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
+            let c = &batch.columns;
+            let columns = detached(model.py(), "validate", || {
+                check_torque_columns(
+                    &base.model,
+                    &States::new(n, &c[0], Some(&c[1]), Some(&c[2]))?,
+                    &measured,
+                    base.fit.gravity,
+                )
+            })?;
+            warn_all(model.py(), &findings(&columns))?;
+            columns
+        }
+        Err(_) => vec![],
+    };
     Ok(PyValidation {
-        v: validate_rs(&joints, &predicted, &measured)?,
+        v,
         n,
+        torque_columns,
     })
 }

@@ -2,6 +2,7 @@
 linearised model, excitation design, and the real Franka Emika Panda log."""
 
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -128,6 +129,16 @@ def test_torque_columns_are_checked_against_the_model():
     with pytest.warns(pr.PerturbidWarning, match="joint 'joint2' follows the model of joint 'joint3'"):
         fit = pr.identify_base_parameters(robot, q, qd, qdd, swapped, friction=None, weighting="ols")
     assert [c["follows"] for c in fit.torque_columns][1:3] == ["joint3", "joint2"]
+    # the clean model validated on the swapped log names the swap too; on its own log, nothing
+    clean = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction=None, weighting="ols")
+    with pytest.warns(pr.PerturbidWarning, match="joint 'joint3' follows the model of joint 'joint2'"):
+        v = pr.validate(clean, q, qd, qdd, swapped)
+    assert [c["follows"] for c in v.torque_columns][1:3] == ["joint3", "joint2"]
+    assert v.torque_columns[1]["finding"] is not None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        v = pr.validate(clean, q, qd, qdd, tau)
+    assert [c["explained"] for c in v.torque_columns] == [c["explained"] for c in columns]
     negated = tau.copy()
     negated[:, 2] *= -1.0
     with pytest.warns(pr.PerturbidWarning, match="joint 'joint3' reads -1.000 times"):
