@@ -9,6 +9,7 @@ mod direct;
 mod errors;
 mod linearization;
 mod local;
+mod local_model;
 mod preprocess;
 mod recording;
 mod rehearsal;
@@ -68,7 +69,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<local::PyPlan>()?;
     m.add_class::<local::PyExperiment>()?;
     m.add_class::<recording::PyRecording>()?;
-    m.add_class::<local::PyLocalModel>()?;
+    m.add_class::<local_model::PyLocalModel>()?;
     m.add_function(wrap_pyfunction!(local::plan_experiments, m)?)?;
     m.add_function(wrap_pyfunction!(simulation::simulate, m)?)?;
     m.add_class::<rehearsal::PyTrueRobot>()?;

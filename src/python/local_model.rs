@@ -1,0 +1,331 @@
+//! Python: `LocalModel`, the paper's local model at an operating point with its uncertainty and
+//! diagnostics (mirrors `crate::local::LocalModel`).
+
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use super::arrays::{matrix_to_numpy as mat, read_batch, to_numpy, vec1, ArrayLike};
+use super::local::PyOperatingPoint;
+use crate::document::Document;
+use crate::local::{Estimate, Estimator, LocalModel, ReversalHandling};
+
+/// The local model `tau ~= T* + D (qdd - qdd*) + H (qd - qd*) + G (q - q*)` at an operating
+/// point, with its uncertainty.
+///
+/// - `torque` (`T*`, `(n,)`), `D`, `H`, `G`, `G_static` (`(n, n)`, row = torque, column =
+///   joint; None when the plan had no such experiment);
+/// - `cond`: dict of cond(X) per estimate (columns scaled to unit norm);
+/// - `stderr`: dict of standard errors, same shapes ('torque', 'D', 'H', 'G', 'G_static');
+/// - `residual_rms`: dict of per-joint regression residual RMS (N m);
+/// - `planned_op`: the operating point of the plan, which the nominal passes crossed: T* holds
+///   there and `predict` expands about it; `op`: the point as measured at the nominal crossings
+///   (a diagnostic of the tracking; noisier than the plan);
+/// - `diagnostics`: clock offsets, velocity reversals met at crossings, warnings;
+/// - `coulomb`: the Coulomb steps of the friction-aware H regression, when used.
+#[pyclass(name = "LocalModel", module = "perturbid_rs", frozen)]
+pub(crate) struct PyLocalModel {
+    pub model: LocalModel,
+}
+
+impl PyLocalModel {
+    fn parts(&self) -> [(&'static str, &Option<Estimate>); 4] {
+        let m = &self.model;
+        [
+            ("D", &m.d),
+            ("H", &m.h),
+            ("G", &m.g),
+            ("G_static", &m.g_static),
+        ]
+    }
+    fn get<'py>(
+        &self,
+        py: Python<'py>,
+        e: &Option<Estimate>,
+    ) -> PyResult<Option<Bound<'py, PyAny>>> {
+        e.as_ref().map(|e| mat(py, &e.matrix)).transpose()
+    }
+}
+
+#[pymethods]
+impl PyLocalModel {
+    /// What happened during the identification: `offsets` (dict experiment -> clock offset
+    /// in s found between the recording and the plan), `reversals` (list of dicts:
+    /// `experiment`, `crossing` (None for the reference posture), `joint`, `at` (s from the
+    /// crossing), `handling` ('narrowed' or 'step'), `window` (s)), `combined` (dict block ->
+    /// (relative difference, largest difference in standard errors) of the combined estimate
+    /// against the separated one), `unperturbed_deviation` (how far the variables an experiment
+    /// did not perturb stray, in standard errors of their measurement: ~1 for noise, far above
+    /// for tracking errors), `unmeasured` (list of dicts: `experiment`, `joint`, `value` in N m,
+    /// for torques that read one value throughout), `noise` (list of dicts: `experiment`,
+    /// `joint`, `samples` (N m, one torque sample's noise), `passes` (N m, what varied from pass
+    /// to pass beyond it, or None), `step` (N m, the step the torque was logged in where it is
+    /// coarser than its noise: the standard errors of its rows include the rounding; else
+    /// None)), `glitches` (list of dicts: `experiment`, `crossing` (None for the reference
+    /// posture), `signal` ('q', 'qd', 'qdd' or 'tau'), `joint`, `sample` (0-based index in its
+    /// recording), `time` (s, the recording's clock), `value` (as recorded), `noise_levels`
+    /// (how far off the fit of its window's other samples, or None beyond any scale: a million
+    /// times the spread of the window's values),
+    /// `replaced` (True: an isolated glitch replaced by that fit; False: kept, one of more than
+    /// 3 in its window)), `dropouts` (list of dicts: `experiment`, `signal`, `first_sample`
+    /// (0-based row of its recording), `samples`, `from`, `to` (s): rows in which every joint
+    /// of a signal read exactly 0 while the robot moved, removed before the windows were
+    /// read), `held_readings` (list of dicts: `experiment` and the keys of
+    /// `Recording.glitches`: samples of one joint's reading held while it moved, replaced
+    /// before the windows were read), `warnings` (list of str).
+    #[getter]
+    fn diagnostics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = &self.model.diagnostics;
+        let out = PyDict::new(py);
+        let offsets = PyDict::new(py);
+        for o in &d.offsets {
+            offsets.set_item(&o.experiment, o.offset)?;
+        }
+        out.set_item("offsets", offsets)?;
+        let reversals = d
+            .reversals
+            .iter()
+            .map(|r| {
+                let e = PyDict::new(py);
+                e.set_item("experiment", &r.experiment)?;
+                e.set_item("crossing", r.crossing)?;
+                e.set_item("joint", &r.joint)?;
+                e.set_item("at", r.at)?;
+                let handling = match r.handling {
+                    ReversalHandling::Narrowed => "narrowed",
+                    ReversalHandling::Step => "step",
+                };
+                e.set_item("handling", handling)?;
+                e.set_item("window", r.window)?;
+                Ok(e)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        out.set_item("reversals", reversals)?;
+        let combined = PyDict::new(py);
+        for b in &d.combined {
+            combined.set_item(&b.block, (b.relative, b.standard_errors))?;
+        }
+        out.set_item("combined", combined)?;
+        out.set_item("unperturbed_deviation", d.unperturbed_deviation)?;
+        let unmeasured = d
+            .unmeasured
+            .iter()
+            .map(|u| {
+                let e = PyDict::new(py);
+                e.set_item("experiment", &u.experiment)?;
+                e.set_item("joint", &u.joint)?;
+                e.set_item("value", u.value)?;
+                Ok(e)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        out.set_item("unmeasured", unmeasured)?;
+        let noise = d
+            .noise
+            .iter()
+            .map(|e| {
+                let entry = PyDict::new(py);
+                entry.set_item("experiment", &e.experiment)?;
+                entry.set_item("joint", &e.joint)?;
+                entry.set_item("samples", e.samples)?;
+                entry.set_item("passes", e.passes)?;
+                entry.set_item("step", e.step)?;
+                entry.set_item("position_step", e.position_step)?;
+                Ok(entry)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        out.set_item("noise", noise)?;
+        let glitches = d
+            .glitches
+            .iter()
+            .map(|g| {
+                let e = PyDict::new(py);
+                e.set_item("experiment", &g.experiment)?;
+                e.set_item("crossing", g.crossing)?;
+                e.set_item("signal", &g.signal)?;
+                e.set_item("joint", &g.joint)?;
+                e.set_item("sample", g.sample)?;
+                e.set_item("time", g.time)?;
+                e.set_item("value", g.value)?;
+                e.set_item("noise_levels", g.noise_levels)?;
+                e.set_item("replaced", g.replaced)?;
+                Ok(e)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        out.set_item("glitches", glitches)?;
+        let dropouts = d
+            .dropouts
+            .iter()
+            .map(|r| super::recording::dropout_dict(py, r))
+            .collect::<PyResult<Vec<_>>>()?;
+        out.set_item("dropouts", dropouts)?;
+        let held = d
+            .held_readings
+            .iter()
+            .map(|g| super::recording::glitch_dict(py, g))
+            .collect::<PyResult<Vec<_>>>()?;
+        out.set_item("held_readings", held)?;
+        out.set_item("warnings", d.warnings.clone())?;
+        Ok(out)
+    }
+
+    /// The Coulomb steps from the friction-aware H regression (None when it was not used):
+    /// dict joint name -> step (N m; the two Coulomb levels summed) or None where no pair of H
+    /// passes reversed the joint.
+    #[getter]
+    fn coulomb<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(c) = &self.model.coulomb else {
+            return Ok(None);
+        };
+        let out = PyDict::new(py);
+        for (name, step) in c.joint_names.iter().zip(&c.step) {
+            out.set_item(name, *step)?;
+        }
+        Ok(Some(out))
+    }
+
+    /// The model as a tidy table (pandas): one row per entry, columns `term` ('T', 'D', 'H',
+    /// 'G', 'G_static'), `torque` (the joint whose torque the row is), `joint` (the joint
+    /// whose change multiplies the entry; empty for T*), `value` and `std` (NaN where
+    /// unknown). Units: N m for T*; N m s^2/rad, N m s/rad, N m/rad for D*, H*, G* (m in
+    /// place of rad for prismatic joints).
+    fn to_dataframe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let m = &self.model;
+        type Part<'a> = (
+            &'a str,
+            &'a nalgebra::DMatrix<f64>,
+            &'a nalgebra::DMatrix<f64>,
+        );
+        let parts: Vec<Part<'_>> = self
+            .parts()
+            .iter()
+            .filter_map(|(k, e)| e.as_ref().map(|e| (*k, &e.matrix, &e.stderr)))
+            .collect();
+        super::tables::linear_model_frame(py, &m.joint_names, &m.torque, &m.torque_stderr, &parts)
+    }
+    #[getter]
+    fn torque<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        vec1(py, &self.model.torque)
+    }
+    #[getter(D)]
+    fn d<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.get(py, &self.model.d)
+    }
+    #[getter(H)]
+    fn h<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.get(py, &self.model.h)
+    }
+    #[getter(G)]
+    fn g<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.get(py, &self.model.g)
+    }
+    #[getter(G_static)]
+    fn g_static<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.get(py, &self.model.g_static)
+    }
+    /// The combined estimate `[D H G]`, shape `(n, 3n)`, or None.
+    #[getter]
+    fn combined<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.get(py, &self.model.combined)
+    }
+    #[getter]
+    fn cond<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (k, e) in self.parts() {
+            if let Some(e) = e {
+                d.set_item(k, e.cond)?;
+            }
+        }
+        Ok(d)
+    }
+    #[getter]
+    fn stderr<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("torque", vec1(py, &self.model.torque_stderr))?;
+        for (k, e) in self.parts() {
+            if let Some(e) = e {
+                d.set_item(k, mat(py, &e.stderr)?)?;
+            }
+        }
+        Ok(d)
+    }
+    #[getter]
+    fn residual_rms<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (k, e) in self.parts() {
+            if let Some(e) = e {
+                d.set_item(k, vec1(py, &e.residual_rms))?;
+            }
+        }
+        Ok(d)
+    }
+    #[getter]
+    fn op(&self) -> PyOperatingPoint {
+        PyOperatingPoint {
+            op: self.model.op.clone(),
+        }
+    }
+    #[getter]
+    fn planned_op(&self) -> PyOperatingPoint {
+        PyOperatingPoint {
+            op: self.model.planned_op.clone(),
+        }
+    }
+    #[getter]
+    fn joint_names<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        PyList::new(py, &self.model.joint_names)
+    }
+    #[getter]
+    fn estimator(&self) -> &'static str {
+        match self.model.estimator {
+            Estimator::Separated => "separated",
+            Estimator::Combined => "combined",
+        }
+    }
+    /// The model at `op` (an OperatingPoint): dict `torque` (n,, its prediction there), `D`,
+    /// `H`, `G` (n, n; the same everywhere), `G_static` (n, n, or None without that
+    /// experiment): the question every identified model answers the same way.
+    fn linearize<'py>(
+        &self,
+        py: Python<'py>,
+        op: &PyOperatingPoint,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let e = crate::torque_model::TorqueModel::linearize(&self.model, &op.op)?;
+        super::arrays::expansion_dict(py, &e)
+    }
+    /// Predicted torques (N m) at `q`, `qd`, `qdd`: shape `(n,)` each or a batch `(k, n)`;
+    /// `T* + D (qdd - qdd*) + H (qd - qd*) + G (q - q*)` about the planned operating point.
+    fn predict<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayLike<'py>,
+        qd: ArrayLike<'py>,
+        qdd: ArrayLike<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.model.n();
+        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
+        let out = self.model.predict(&batch.states(n)?)?;
+        to_numpy(py, out, batch.k, batch.single, &[n])
+    }
+    /// The model as JSON text (matrices as lists of rows).
+    fn to_json(&self) -> String {
+        Document::to_json(&self.model)
+    }
+    #[staticmethod]
+    fn from_json(text: &str) -> PyResult<Self> {
+        Ok(Self {
+            model: <LocalModel as Document>::from_json(text)?,
+        })
+    }
+    fn __repr__(&self) -> String {
+        let parts: Vec<String> = self
+            .parts()
+            .iter()
+            .filter_map(|(k, e)| e.as_ref().map(|e| format!("{k}: cond {:.3}", e.cond)))
+            .collect();
+        format!(
+            "LocalModel(robot='{}', {} estimator, {})",
+            self.model.robot,
+            self.estimator(),
+            parts.join(", ")
+        )
+    }
+}
