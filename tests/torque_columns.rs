@@ -158,6 +158,100 @@ fn swapped_negated_and_rescaled_columns_are_named() {
     );
 }
 
+/// A log that does not match the robot at all: positions (and their derivatives) in degrees,
+/// gravity compensated in a log fitted with it. No column is named on its own, so the whole
+/// log is, by the loaded joints' gains; a single loaded joint (a SCARA's vertical axis, whose
+/// weight an offset takes) is never enough. The shoulder's and the elbow's position columns
+/// swapped read as their torque columns swapped.
+#[test]
+fn a_log_that_does_not_match_the_robot_is_named() {
+    use perturbid_rs::direct::torque_columns::unmatched;
+    let clean = a465_log();
+    let n = 6;
+    let truth = a465::model("kinsheel2010").unwrap();
+    let degrees = |v: &[f64]| v.iter().map(|x| x.to_degrees()).collect::<Vec<f64>>();
+    let swapped = |v: &[f64], a: usize, b: usize| {
+        let mut v = v.to_vec();
+        for row in v.chunks_mut(n) {
+            row.swap(a, b);
+        }
+        v
+    };
+    let mut gravity = vec![0.0; clean.tau.len()];
+    perturbid_rs::parallel::rnea(
+        &truth,
+        &mut perturbid_rs::parallel::Workspace::new(&truth),
+        &States::new(n, &clean.q, None, None).unwrap(),
+        Gravity::Included,
+        &mut gravity,
+    )
+    .unwrap();
+    let compensated: Vec<f64> = clean.tau.iter().zip(&gravity).map(|(t, g)| t - g).collect();
+    let cases = [
+        (
+            "degrees",
+            Log {
+                q: degrees(&clean.q),
+                qd: degrees(&clean.qd),
+                qdd: degrees(&clean.qdd),
+                tau: clean.tau.clone(),
+            },
+        ),
+        (
+            "gravity compensated",
+            Log {
+                q: clean.q.clone(),
+                qd: clean.qd.clone(),
+                qdd: clean.qdd.clone(),
+                tau: compensated,
+            },
+        ),
+    ];
+    for (what, log) in &cases {
+        let m = fit(log);
+        let w = m.warnings();
+        let said: Vec<&String> = w.iter().filter(|w| w.contains("torque column")).collect();
+        assert_eq!(said.len(), 1, "{what}: {w:?}");
+        assert!(
+            said[0].contains("does not match the robot") && said[0].contains("'joint2'"),
+            "{what}: {said:?}"
+        );
+        assert!(
+            m.torque_columns
+                .iter()
+                .all(|c| c.finding(&m.torque_columns).is_none()),
+            "{what}"
+        );
+    }
+    // the shoulder's and the elbow's positions swapped read as their torques swapped
+    let m = fit(&Log {
+        q: swapped(&clean.q, 1, 2),
+        qd: swapped(&clean.qd, 1, 2),
+        qdd: swapped(&clean.qdd, 1, 2),
+        tau: clean.tau.clone(),
+    });
+    let w = m.warnings().join("\n");
+    assert!(
+        w.contains("joint 'joint2' follows the model of joint 'joint3'")
+            && w.contains("position columns"),
+        "{w}"
+    );
+    // by hand: two loaded joints unexplained are a finding; one is not, nor a second that
+    // follows its own model
+    let m = fit(&cases[0].1);
+    let mut c = m.torque_columns.clone();
+    assert!(unmatched(&c).is_some());
+    let elbow = c[2].gravity_rms;
+    c[2].gravity_rms = 0.0;
+    assert_eq!(unmatched(&c), None, "a single loaded joint: {c:?}");
+    c[2].gravity_rms = elbow;
+    c[2].explained = 0.6;
+    assert_eq!(unmatched(&c), None);
+    assert!(unmatched(&[]).is_none());
+    // the clean log: nothing
+    assert!(unmatched(&fit(&clean).torque_columns).is_none());
+}
+
 /// The A465 carrying a 1 kg tool its model lacks (examples/a465_true_robot.json: friction,
 /// sensors, closed-loop tracking too), preprocessed as a real log: the wrist's torques read
 /// 20 times its model's gravity torque, which is small, and are not taken for other units;

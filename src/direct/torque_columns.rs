@@ -49,9 +49,47 @@ pub const LOADED: f64 = 0.1;
 pub const SAMPLES: usize = 5000;
 
 /// What looks wrong with the torque `columns` of a log (one a joint, from
-/// [`check_torque_columns`]): each column's [`TorqueColumn::finding`], in joint order.
+/// [`check_torque_columns`]): each column's [`TorqueColumn::finding`], in joint order; where
+/// none has one, the whole log's ([`unmatched`]).
 pub fn findings(columns: &[TorqueColumn]) -> Vec<String> {
-    columns.iter().filter_map(|c| c.finding(columns)).collect()
+    let each: Vec<String> = columns.iter().filter_map(|c| c.finding(columns)).collect();
+    if each.is_empty() {
+        unmatched(columns).into_iter().collect()
+    } else {
+        each
+    }
+}
+
+/// The whole log against the robot: where the links' weight loads at least two joints
+/// ([`LOADED`]) and not one of their columns follows its own joint's model (each gain below
+/// [`JUDGED`]), the log does not match the robot at all. Positions in degrees, position
+/// columns swapped, another robot's URDF and torques far out of step with the positions each
+/// do that (the A465 logged in degrees: gains of 1 % and 0 % at the shoulder and elbow,
+/// against 100 % in radians). Two loaded joints, since a single one may be a vertical axis
+/// whose constant weight an offset takes (a SCARA's). None otherwise.
+pub fn unmatched(columns: &[TorqueColumn]) -> Option<String> {
+    let heaviest = columns.iter().fold(0.0f64, |m, c| m.max(c.gravity_rms));
+    let loaded: Vec<&TorqueColumn> = columns
+        .iter()
+        .filter(|c| heaviest > 0.0 && c.gravity_rms >= LOADED * heaviest)
+        .collect();
+    // NaN (a model loaded unchecked) says nothing
+    if loaded.len() < 2
+        || loaded
+            .iter()
+            .any(|c| c.explained.is_nan() || c.explained >= JUDGED)
+    {
+        return None;
+    }
+    let gains: Vec<String> = loaded
+        .iter()
+        .map(|c| format!("'{}' {:.0} %", c.joint, 100.0 * c.explained.max(0.0)))
+        .collect();
+    Some(format!(
+        "no torque column of a joint the links' weight loads follows its own joint's model ({} of what friction, an offset and a rotor's inertia leave explained; at least {:.0} % expected): the log does not match the robot (positions in degrees, swapped, or from another zero or direction; another robot's URDF; torques out of step with the positions; gravity compensated in a log fitted with it), and no parameters fitted to it describe the robot",
+        gains.join(", "),
+        100.0 * JUDGED
+    ))
 }
 
 /// One torque column of a log against the robot's model.
@@ -98,7 +136,7 @@ impl TorqueColumn {
             && displaced
         {
             return Some(format!(
-                "the torque column of joint '{}' follows the model of joint '{}' ({} of what friction, an offset and a rotor's inertia leave explained, against {} by its own joint's): are the torque columns swapped or mislabelled?",
+                "the torque column of joint '{}' follows the model of joint '{}' ({} of what friction, an offset and a rotor's inertia leave explained, against {} by its own joint's): are the torque columns (or the position columns) swapped or mislabelled?",
                 self.joint,
                 self.follows,
                 percent(self.follows_explained),

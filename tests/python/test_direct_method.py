@@ -139,6 +139,10 @@ def test_torque_columns_are_checked_against_the_model():
         warnings.simplefilter("error")
         v = pr.validate(clean, q, qd, qdd, tau)
     assert [c["explained"] for c in v.torque_columns] == [c["explained"] for c in columns]
+    # positions (and their derivatives) in degrees: no column follows the robot's model
+    with pytest.warns(pr.PerturbidWarning, match="does not match the robot"):
+        v = pr.validate(clean, np.degrees(q), np.degrees(qd), np.degrees(qdd), tau)
+    assert all(c["explained"] < 0.5 and c["finding"] is None for c in v.torque_columns)
     negated = tau.copy()
     negated[:, 2] *= -1.0
     with pytest.warns(pr.PerturbidWarning, match="joint 'joint3' reads -1.000 times"):
