@@ -5,9 +5,7 @@
 
 mod common;
 
-use common::{
-    a465_excitation, panda_log, panda_model, refused_on_load, torques_with_friction, Rng,
-};
+use common::{a465_log, fit_physical, panda_log, panda_model, refused_on_load, A465Log, Rng};
 use nalgebra::DMatrix;
 use perturbid_rs::direct::torque_columns::{LOADED, SCALE_LIMIT};
 use perturbid_rs::direct::{
@@ -20,41 +18,10 @@ use perturbid_rs::robots::a465;
 use perturbid_rs::trajectory::FourierTrajectory;
 use perturbid_rs::{Gravity, States};
 
-/// Samples of an A465 excitation (5 harmonics, 12 s at 1 kHz) and the torques of a robot whose
-/// parameters are the paper's (`kinsheel2010`), with viscous and Coulomb friction and 0.03 N m
-/// of noise, for a model with the physical variant's parameters (its URDF is not the robot).
-struct Log {
-    q: Vec<f64>,
-    qd: Vec<f64>,
-    qdd: Vec<f64>,
-    tau: Vec<f64>,
-}
-
-fn a465_log() -> Log {
-    let truth = a465::model("kinsheel2010").unwrap();
-    let mut rng = Rng(9);
-    let traj = a465_excitation(&mut rng);
-    let t: Vec<f64> = (0..12_000).map(|i| i as f64 * 1e-3).collect();
-    let s = traj.sample(&t);
-    let tau = torques_with_friction(&truth, &s, &mut rng, |r| 0.03 * r.uniform(-1.7, 1.7));
-    Log {
-        q: s.q,
-        qd: s.qd,
-        qdd: s.qdd,
-        tau,
-    }
-}
-
-fn fit(log: &Log) -> BaseModel {
-    let model = a465::model("physical").unwrap();
-    let states = States::new(6, &log.q, Some(&log.qd), Some(&log.qdd)).unwrap();
-    identify_base_parameters(&model, &states, &log.tau, &BaseOptions::default()).unwrap()
-}
-
 #[test]
 fn a_clean_log_reads_as_the_model_says() {
     let log = a465_log();
-    let m = fit(&log);
+    let m = fit_physical(&log);
     assert_eq!(m.torque_columns.len(), 6);
     for c in &m.torque_columns {
         assert_eq!(c.finding(&m.torque_columns), None, "{c:?}");
@@ -99,7 +66,7 @@ fn swapped_negated_and_rescaled_columns_are_named() {
     let clean = a465_log();
     let n = 6;
     let edit = |f: &dyn Fn(&mut [f64])| {
-        let mut log = Log {
+        let mut log = A465Log {
             q: clean.q.clone(),
             qd: clean.qd.clone(),
             qdd: clean.qdd.clone(),
@@ -111,7 +78,7 @@ fn swapped_negated_and_rescaled_columns_are_named() {
         log
     };
     // the shoulder's and the elbow's torques swapped
-    let m = fit(&edit(&|r| r.swap(1, 2)));
+    let m = fit_physical(&edit(&|r| r.swap(1, 2)));
     let w = m.warnings().join("\n");
     assert!(
         w.contains("the torque column of joint 'joint2' follows the model of joint 'joint3'")
@@ -122,7 +89,7 @@ fn swapped_negated_and_rescaled_columns_are_named() {
         "{w}"
     );
     // the elbow's read with the opposite sign
-    let m = fit(&edit(&|r| r[2] = -r[2]));
+    let m = fit_physical(&edit(&|r| r[2] = -r[2]));
     let w = m.warnings();
     assert_eq!(w.len(), 1, "{w:?}");
     assert!(
@@ -130,7 +97,7 @@ fn swapped_negated_and_rescaled_columns_are_named() {
         "{w:?}"
     );
     // the shoulder's in mN m
-    let m = fit(&edit(&|r| r[1] *= 1000.0));
+    let m = fit_physical(&edit(&|r| r[1] *= 1000.0));
     let w = m.warnings();
     assert_eq!(w.len(), 1, "{w:?}");
     assert!(
@@ -190,7 +157,7 @@ fn a_log_that_does_not_match_the_robot_is_named() {
     let cases = [
         (
             "degrees",
-            Log {
+            A465Log {
                 q: degrees(&clean.q),
                 qd: degrees(&clean.qd),
                 qdd: degrees(&clean.qdd),
@@ -199,7 +166,7 @@ fn a_log_that_does_not_match_the_robot_is_named() {
         ),
         (
             "gravity compensated",
-            Log {
+            A465Log {
                 q: clean.q.clone(),
                 qd: clean.qd.clone(),
                 qdd: clean.qdd.clone(),
@@ -208,7 +175,7 @@ fn a_log_that_does_not_match_the_robot_is_named() {
         ),
     ];
     for (what, log) in &cases {
-        let m = fit(log);
+        let m = fit_physical(log);
         let w = m.warnings();
         let said: Vec<&String> = w.iter().filter(|w| w.contains("torque column")).collect();
         assert_eq!(said.len(), 1, "{what}: {w:?}");
@@ -224,7 +191,7 @@ fn a_log_that_does_not_match_the_robot_is_named() {
         );
     }
     // the shoulder's and the elbow's positions swapped read as their torques swapped
-    let m = fit(&Log {
+    let m = fit_physical(&A465Log {
         q: swapped(&clean.q, 1, 2),
         qd: swapped(&clean.qd, 1, 2),
         qdd: swapped(&clean.qdd, 1, 2),
@@ -238,7 +205,7 @@ fn a_log_that_does_not_match_the_robot_is_named() {
     );
     // by hand: two loaded joints unexplained are a finding; one is not, nor a second that
     // follows its own model
-    let m = fit(&cases[0].1);
+    let m = fit_physical(&cases[0].1);
     let mut c = m.torque_columns.clone();
     assert!(unmatched(&c).is_some());
     let elbow = c[2].gravity_rms;
@@ -249,7 +216,7 @@ fn a_log_that_does_not_match_the_robot_is_named() {
     assert_eq!(unmatched(&c), None);
     assert!(unmatched(&[]).is_none());
     // the clean log: nothing
-    assert!(unmatched(&fit(&clean).torque_columns).is_none());
+    assert!(unmatched(&fit_physical(&clean).torque_columns).is_none());
 }
 
 /// The A465 carrying a 1 kg tool its model lacks (examples/a465_true_robot.json: friction,

@@ -531,6 +531,11 @@ class BaseParameterModel:
         """Per joint, its torque column against the robot's own model (joint, scale,
         explained, follows, follows_explained, gravity_rms, finding); findings are also warnings."""
     @property
+    def torque_lag(self) -> Optional[dict[str, Any]]:
+        """The data's torques shifted against their positions (samples: positive where the
+        torques were logged after their positions; joints, unexplained, unexplained_at_lag,
+        finding), or None where not checked; a finding is also a warning."""
+    @property
     def cond(self) -> float: ...
     @property
     def samples(self) -> int: ...
@@ -660,6 +665,10 @@ class Validation:
     def torque_columns(self) -> list[dict[str, Any]]:
         """For a BaseParameterModel, the measured torque columns against its robot's model
         (as BaseParameterModel.torque_columns); empty otherwise."""
+    @property
+    def torque_lag(self) -> Optional[dict[str, Any]]:
+        """For a BaseParameterModel, the measured torques shifted against their positions
+        (as BaseParameterModel.torque_lag); None otherwise."""
     def to_dataframe(self) -> Any:
         """The per-joint table as a pandas DataFrame (index joint; rms, relative_rms, max)."""
 

@@ -9,6 +9,7 @@ use clap::Args;
 use super::files::{load_robot, refuse_overwriting_inputs, PreprocessArgs};
 use super::progress::Progress;
 use crate::direct::torque_columns::{check_torque_columns, findings};
+use crate::direct::torque_lag::check_torque_lag;
 use crate::error::{Error, Result};
 use crate::io::{OutputSet, Table};
 use crate::states::States;
@@ -36,7 +37,8 @@ pub(crate) struct ValidateArgs {
     /// per-joint table, and `log_glitches` and `log_dropouts`: the samples of the log replaced
     /// as glitches and the rows removed as dropouts before preprocessing, when there were any;
     /// for a base-parameter model `torque_columns`, each torque column of the log against the
-    /// robot's model, whose findings are warned of) and validation.svg (measured and predicted
+    /// robot's model, and `torque_lag`, its torques shifted against its positions, whose
+    /// findings are warned of) and validation.svg (measured and predicted
     /// torques, and residuals).
     #[arg(long, default_value = "validation")]
     out: PathBuf,
@@ -82,15 +84,19 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     // the log's torque columns against the robot's own model, as every direct fit checks
     // its own log: swapped columns, another sign or other units show here by name, not only
     // as large errors
-    let torque_columns = match (&file, &robot) {
+    let (torque_columns, torque_lag) = match (&file, &robot) {
         (ModelFile::Base(fit), Some(r)) => {
             progress.update("checking the torque columns");
-            check_torque_columns(r, &states, &rec.tau, fit.gravity)?
+            (
+                check_torque_columns(r, &states, &rec.tau, fit.gravity)?,
+                check_torque_lag(r, &states, &rec.tau, fit.gravity)?,
+            )
         }
-        _ => vec![],
+        _ => (vec![], None),
     };
     progress.done();
-    for w in findings(&torque_columns) {
+    let lagged = torque_lag.as_ref().and_then(|l| l.finding());
+    for w in findings(&torque_columns).into_iter().chain(lagged) {
         eprintln!("perturbid: warning: log '{}': {w}", a.data.display());
     }
     // the residuals, the table and the figure, as one output set
@@ -114,6 +120,9 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     }
     if !torque_columns.is_empty() {
         json["torque_columns"] = serde_json::to_value(&torque_columns).expect("serialisable");
+    }
+    if let Some(lag) = &torque_lag {
+        json["torque_lag"] = serde_json::to_value(lag).expect("serialisable");
     }
     set.add(
         "validation.json",

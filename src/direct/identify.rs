@@ -103,6 +103,11 @@ pub struct BaseModel {
     /// checked.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub torque_columns: Vec<super::torque_columns::TorqueColumn>,
+    /// The data's torques shifted against their positions ([`super::torque_lag`]): a lag
+    /// that fits far better is warned of ([`BaseModel::warnings`]). None where it was not
+    /// checked (no gravity in the data, a model saved before it was checked).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub torque_lag: Option<super::torque_lag::TorqueLag>,
 }
 
 /// Identifies the base parameters of `model` from the samples of `states` (rad, rad/s,
@@ -244,6 +249,7 @@ fn fit_with_factors(
             tau,
             options.gravity,
         )?,
+        torque_lag: super::torque_lag::check_torque_lag(model, states, tau, options.gravity)?,
     };
     // residuals correlated from sample to sample (a filtered, lightly decimated log) carry less
     // information than their number says
@@ -353,6 +359,13 @@ impl Document for BaseModel {
                 Self::WHAT,
                 format!("torque_columns[{i}]: {problem}"),
             ));
+        }
+        if let Some(problem) = m
+            .torque_lag
+            .as_ref()
+            .and_then(|l| l.problem(&m.joint_names))
+        {
+            return Err(invalid(Self::WHAT, format!("torque_lag: {problem}")));
         }
         check_magnitudes(Self::WHAT, "residual_rms", &m.residual_rms, false)?;
         check_magnitudes(Self::WHAT, "sigma", &m.sigma, false)?;

@@ -15,6 +15,7 @@ pub mod parameters;
 pub mod residual_correlation;
 pub mod streaming;
 pub mod torque_columns;
+pub mod torque_lag;
 pub mod workspace;
 
 pub use base::BaseParameters;
@@ -30,4 +31,5 @@ pub use identify::{
 pub use parameter_table::ParameterRow;
 pub use parameters::{regressor_blocks, regressor_matrix, FrictionTerms, ParameterLayout};
 pub use torque_columns::{check_torque_columns, TorqueColumn};
+pub use torque_lag::{check_torque_lag, TorqueLag};
 pub use workspace::{workspace_from_json, CartesianConstraint, Region};

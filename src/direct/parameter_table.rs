@@ -46,12 +46,14 @@ impl BaseModel {
 impl BaseModel {
     /// What a person should know before trusting the fit: torque columns that do not read as
     /// the robot's model says they should ([`super::torque_columns`]: swapped, of the opposite
-    /// sign, in other units), and friction or armature coefficients identified on their own
+    /// sign, in other units), torques out of step with their positions
+    /// ([`super::torque_lag`]), and friction or armature coefficients identified on their own
     /// (not in a combination) and negative beyond three standard errors. No joint has them;
     /// the data hold an effect the model lacks, or are not what it assumes. A consistent fit
     /// keeps them at zero.
     pub fn warnings(&self) -> Vec<String> {
-        let columns = super::torque_columns::findings(&self.torque_columns);
+        let mut columns = super::torque_columns::findings(&self.torque_columns);
+        columns.extend(self.torque_lag.as_ref().and_then(|l| l.finding()));
         let negative = self
             .parameter_table()
             .into_iter()

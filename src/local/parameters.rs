@@ -293,6 +293,7 @@ pub fn identify_parameters_from_local(
         log_dropouts: vec![],
         // rows from local models: no log's torque columns
         torque_columns: vec![],
+        torque_lag: None,
     };
     let consistent = match &options.consistent {
         None => None,

@@ -19,7 +19,7 @@ use crate::direct::excitation::ExcitationDesign;
 use crate::direct::{
     design_excitation as design_rs, identify_base_parameters as base_rs,
     identify_global_linear as global_rs, BaseModel, BaseOptions, Criterion, ExcitationOptions,
-    FrictionTerms, GlobalLinearModel, TorqueColumn, Weighting,
+    FrictionTerms, GlobalLinearModel, TorqueColumn, TorqueLag, Weighting,
 };
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -281,6 +281,21 @@ impl PyBaseModel {
     fn torque_columns<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         torque_column_dicts(py, &self.fit.torque_columns)
     }
+    /// The data's torques shifted against their positions, or None (not checked: no
+    /// velocities, a model saved before it was checked or built from local models): dict
+    /// `samples` (the shift that fits best, in samples of the data fitted; positive where the
+    /// torques were logged after the positions they belong to), `joints` (the columns judged),
+    /// `unexplained` and `unexplained_at_lag` (the geometric mean of the fraction of each
+    /// column its fit leaves unexplained, as logged and at that shift), `finding` (what looks
+    /// wrong, or None; also a warning).
+    #[getter]
+    fn torque_lag<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        self.fit
+            .torque_lag
+            .as_ref()
+            .map(|l| torque_lag_dict(py, l))
+            .transpose()
+    }
     #[getter]
     fn cond(&self) -> f64 {
         self.fit.cond
@@ -431,6 +446,20 @@ pub(crate) fn torque_column_dicts<'py>(
             Ok(e)
         })
         .collect()
+}
+
+/// The torques' lag as a dict (see `BaseParameterModel.torque_lag`).
+pub(crate) fn torque_lag_dict<'py>(
+    py: Python<'py>,
+    lag: &TorqueLag,
+) -> PyResult<Bound<'py, PyDict>> {
+    let e = PyDict::new(py);
+    e.set_item("samples", lag.samples)?;
+    e.set_item("joints", &lag.joints)?;
+    e.set_item("unexplained", lag.unexplained)?;
+    e.set_item("unexplained_at_lag", lag.unexplained_at_lag)?;
+    e.set_item("finding", lag.finding())?;
+    Ok(e)
 }
 
 /// The globally linearised model: constant D, H, G and an offset about an operating point.

@@ -7,10 +7,11 @@ use pyo3::types::PyDict;
 
 use super::arrays::{read_batch, to_numpy, ArrayLike};
 use super::detached;
-use super::direct::{torque_column_dicts, PyBaseModel};
+use super::direct::{torque_column_dicts, torque_lag_dict, PyBaseModel};
 use super::errors::warn_all;
 use super::tables::dataframe;
 use crate::direct::torque_columns::{check_torque_columns, findings, TorqueColumn};
+use crate::direct::torque_lag::{check_torque_lag, TorqueLag};
 use crate::states::States;
 use crate::validation::{validate as validate_rs, Validation};
 
@@ -18,13 +19,15 @@ use crate::validation::{validate as validate_rs, Validation};
 /// `relative_rms` (NaN where the measured torque is zero), `max` (n,) per joint (N m; fraction);
 /// `residuals` (k, n): measured - predicted (N m); `samples`; `torque_columns` (for a
 /// BaseParameterModel: the measured torque columns against its robot's model, as
-/// `BaseParameterModel.torque_columns`; empty otherwise). `to_dataframe()`: the per-joint
+/// `BaseParameterModel.torque_columns`; empty otherwise), `torque_lag` (likewise, as
+/// `BaseParameterModel.torque_lag`; None otherwise). `to_dataframe()`: the per-joint
 /// table (pandas).
 #[pyclass(name = "Validation", module = "perturbid_rs", frozen)]
 pub(crate) struct PyValidation {
     v: Validation,
     n: usize,
     torque_columns: Vec<TorqueColumn>,
+    torque_lag: Option<TorqueLag>,
 }
 
 #[pymethods]
@@ -71,6 +74,15 @@ impl PyValidation {
     fn torque_columns<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         torque_column_dicts(py, &self.torque_columns)
     }
+    /// For a BaseParameterModel, the measured torques shifted against their positions (a
+    /// dict as `BaseParameterModel.torque_lag`, its finding also a warning); None otherwise.
+    #[getter]
+    fn torque_lag<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        self.torque_lag
+            .as_ref()
+            .map(|l| torque_lag_dict(py, l))
+            .transpose()
+    }
     /// The per-joint table: index `joint`, columns `rms`, `relative_rms`, `max`.
     fn to_dataframe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         dataframe(
@@ -104,7 +116,8 @@ impl PyValidation {
 /// rad, rad/s, rad/s^2, N m). The joints are named after `model.joint_names` where it has
 /// them. For a BaseParameterModel the torque columns are also checked against its robot's
 /// model (swapped columns, the opposite sign, other units: a PerturbidWarning each, and
-/// `Validation.torque_columns`). Returns a Validation.
+/// `Validation.torque_columns`) and for a lag behind the positions (`Validation.torque_lag`).
+/// Returns a Validation.
 #[pyfunction]
 pub(crate) fn validate<'py>(
     model: Bound<'py, PyAny>,
@@ -139,29 +152,34 @@ pub(crate) fn validate<'py>(
     let v = validate_rs(&joints, &predicted, &measured)?;
     // the measured torque columns against the robot's own model, as a direct fit checks its
     // own data
-    let torque_columns = match model.cast::<PyBaseModel>() {
+    let (torque_columns, torque_lag) = match model.cast::<PyBaseModel>() {
         Ok(base) => {
             let base = base.get();
             let (q, qd, qdd): (ArrayLike, ArrayLike, ArrayLike) =
                 (q.extract()?, qd.extract()?, qdd.extract()?);
             let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
             let c = &batch.columns;
-            let columns = detached(model.py(), "validate", || {
-                check_torque_columns(
-                    &base.model,
-                    &States::new(n, &c[0], Some(&c[1]), Some(&c[2]))?,
-                    &measured,
-                    base.fit.gravity,
-                )
+            let (columns, lag) = detached(model.py(), "validate", || {
+                let states = States::new(n, &c[0], Some(&c[1]), Some(&c[2]))?;
+                let g = base.fit.gravity;
+                Ok((
+                    check_torque_columns(&base.model, &states, &measured, g)?,
+                    check_torque_lag(&base.model, &states, &measured, g)?,
+                ))
             })?;
             warn_all(model.py(), &findings(&columns))?;
-            columns
+            warn_all(
+                model.py(),
+                &lag.iter().filter_map(|l| l.finding()).collect::<Vec<_>>(),
+            )?;
+            (columns, lag)
         }
-        Err(_) => vec![],
+        Err(_) => (vec![], None),
     };
     Ok(PyValidation {
         v,
         n,
         torque_columns,
+        torque_lag,
     })
 }

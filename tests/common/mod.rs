@@ -409,3 +409,43 @@ pub fn torques_with_friction(
     }
     tau
 }
+
+/// Samples of an A465 excitation (5 harmonics, 12 s at 1 kHz; rad, rad/s, rad/s^2, row-major)
+/// and the torques (N m) of a robot whose parameters are the paper's (`kinsheel2010`), with
+/// viscous and Coulomb friction and 0.03 N m of noise.
+pub struct A465Log {
+    pub q: Vec<f64>,
+    pub qd: Vec<f64>,
+    pub qdd: Vec<f64>,
+    pub tau: Vec<f64>,
+}
+
+/// The log of [`A465Log`] (seed 9).
+pub fn a465_log() -> A465Log {
+    let truth = perturbid_rs::robots::a465::model("kinsheel2010").unwrap();
+    let mut rng = Rng(9);
+    let traj = a465_excitation(&mut rng);
+    let t: Vec<f64> = (0..12_000).map(|i| i as f64 * 1e-3).collect();
+    let s = traj.sample(&t);
+    let tau = torques_with_friction(&truth, &s, &mut rng, |r| 0.03 * r.uniform(-1.7, 1.7));
+    A465Log {
+        q: s.q,
+        qd: s.qd,
+        qdd: s.qdd,
+        tau,
+    }
+}
+
+/// `log` fitted by the direct method (default options) for a model with the A465's physical
+/// variant's parameters (its URDF is not the robot the log was made with).
+pub fn fit_physical(log: &A465Log) -> perturbid_rs::direct::BaseModel {
+    let model = perturbid_rs::robots::a465::model("physical").unwrap();
+    let states = perturbid_rs::States::new(6, &log.q, Some(&log.qd), Some(&log.qdd)).unwrap();
+    perturbid_rs::direct::identify_base_parameters(
+        &model,
+        &states,
+        &log.tau,
+        &perturbid_rs::direct::BaseOptions::default(),
+    )
+    .unwrap()
+}

@@ -150,6 +150,51 @@ def test_torque_columns_are_checked_against_the_model():
     assert "negate" in fit.torque_columns[2]["finding"]
 
 
+def test_torques_out_of_step_are_found():
+    """Torques logged 30 samples after their positions: the fit finds the shift and warns;
+    the fraction left unexplained as logged and at the shift is checked against numpy least
+    squares of each column on its joint's model torques and friction, offset and rotor terms
+    (the geometric mean over the columns); validate finds it too, and nothing on the log in
+    step."""
+    robot = pr.robots.a465()
+    traj = excitation(robot, 5, 0.1, 0.12, 1)
+    t = np.arange(0, traj.period, 0.005)
+    q, qd, qdd = traj.sample(t)
+    rng = np.random.default_rng(3)
+    tau = robot.rnea(q, qd, qdd) + rng.normal(0.0, 0.05, q.shape)
+    k = len(t)
+    late = tau[np.clip(np.arange(k) - 30, 0, k - 1)]
+    with pytest.warns(pr.PerturbidWarning, match="logged 30 sample"):
+        fit = pr.identify_base_parameters(robot, q, qd, qdd, late, friction=None, weighting="ols")
+    lag = fit.torque_lag
+    assert lag["samples"] == 30 and lag["finding"] is not None
+    assert lag["joints"] == robot.joint_names
+    g = robot.rnea(q, np.zeros_like(q), np.zeros_like(q))
+    rest = robot.rnea(q, qd, qdd) - g
+    reach = min(500, k // 4)
+    rows = np.arange(reach, k - reach)  # consecutive: fewer than 2000
+
+    def unexplained(shift):
+        logs = []
+        for j in range(robot.n):
+            x = np.column_stack([g[rows, j], rest[rows, j], qd[rows, j], np.sign(qd[rows, j]), qdd[rows, j], np.ones(len(rows))])
+            y = late[rows + shift, j]
+            c = np.linalg.lstsq(x, y, rcond=None)[0]
+            logs.append(np.log(max(np.sum((y - x @ c) ** 2) / np.sum((y - y.mean()) ** 2), 1e-15)))
+        return np.exp(np.mean(logs))
+
+    assert lag["unexplained"] == pytest.approx(unexplained(0), rel=1e-6)
+    assert lag["unexplained_at_lag"] == pytest.approx(unexplained(30), rel=1e-6)
+    clean = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction=None, weighting="ols")
+    assert clean.torque_lag["finding"] is None
+    with pytest.warns(pr.PerturbidWarning, match="logged 30 sample"):
+        v = pr.validate(clean, q, qd, qdd, late)
+    assert v.torque_lag["samples"] == 30
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert pr.validate(clean, q, qd, qdd, tau).torque_lag["finding"] is None
+
+
 def test_standard_errors_count_residuals_correlated_by_the_filter():
     # a log low-pass filtered at 10 Hz and kept at 100 Hz: about five correlated samples to
     # every independent one, which the standard errors now count
