@@ -19,6 +19,7 @@ mod choice;
 #[cfg(feature = "cli")]
 pub mod cli;
 pub mod data;
+pub mod decomposition;
 pub mod direct;
 pub mod document;
 pub mod error;

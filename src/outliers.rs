@@ -125,7 +125,7 @@ impl<'a> KeptFit<'a> {
             None
         } else {
             let vk = DMatrix::from_fn(kept.len(), cols, |r, c| v[(kept[r], c)]);
-            let wk = vk.clone().pseudo_inverse(1e-12).ok()?;
+            let wk = crate::decomposition::pseudo_inverse(vk.clone(), 1e-12)?;
             Some((vk, wk))
         };
         let mut fit = Self {

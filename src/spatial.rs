@@ -456,9 +456,16 @@ pub(crate) struct SplitInertia {
 
 impl SplitInertia {
     /// The split of the symmetric `i` (its upper triangle read). Eigenvalue gaps that rounding
-    /// makes negative are taken as 0.
+    /// makes negative are taken as 0. NaN throughout where `i` is not finite (what is computed
+    /// with it is NaN, and refused as such).
     pub(crate) fn of(i: &Matrix3<f64>) -> Self {
-        let e = i.symmetric_eigen();
+        let Some(e) = crate::decomposition::symmetric_eigen(*i) else {
+            return Self {
+                base: f64::NAN,
+                x: Vector3::repeat(f64::NAN),
+                y: Vector3::repeat(f64::NAN),
+            };
+        };
         let mut order = [0, 1, 2];
         order.sort_by(|&a, &b| e.eigenvalues[a].total_cmp(&e.eigenvalues[b]));
         let [l0, l1, l2] = order.map(|k| e.eigenvalues[k]);

@@ -428,7 +428,10 @@ fn excite_identify_direct_predict() {
     .contains("torque column"));
     assert_eq!(v["torque_columns"].as_array().unwrap().len(), 6);
     // and the torques' lag behind the positions: none in the clean log
-    assert!(v["torque_lag"]["samples"].as_i64().unwrap().abs() <= 1, "{v}");
+    assert!(
+        v["torque_lag"]["samples"].as_i64().unwrap().abs() <= 1,
+        "{v}"
+    );
 }
 
 #[test]

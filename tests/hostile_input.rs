@@ -1022,3 +1022,35 @@ fn numbers_out_of_range_are_refused_as_given() {
     let m = identify_local(&plan, &recs, &options).unwrap();
     assert!(m.diagnostics.offsets.iter().all(|o| o.offset.abs() < 1e-9));
 }
+
+/// Accelerations 1e200 times too large (finite, but their squares overflow): the fit ends, as
+/// every decomposition on the way is bounded (nalgebra's SVD and eigensolvers spun forever
+/// on the infinities), and names the log as not matching the robot. Run in a thread with a
+/// deadline, so that a regression fails instead of hanging the suite.
+#[test]
+fn overflowing_data_ends_the_fit_instead_of_hanging_it() {
+    let (send, receive) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let log = common::a465_log();
+        let qdd: Vec<f64> = log.qdd.iter().map(|a| a * 1e200).collect();
+        let model = perturbid_rs::robots::a465::model("physical").unwrap();
+        let states = perturbid_rs::States::new(6, &log.q, Some(&log.qd), Some(&qdd)).unwrap();
+        let fit = perturbid_rs::direct::identify_base_parameters(
+            &model,
+            &states,
+            &log.tau,
+            &perturbid_rs::direct::BaseOptions::default(),
+        );
+        let _ = send.send(fit.map(|f| f.warnings()).map_err(|e| e.to_string()));
+    });
+    let outcome = receive
+        .recv_timeout(std::time::Duration::from_secs(120))
+        .expect("the fit ended within 2 minutes");
+    match outcome {
+        Ok(w) => assert!(
+            w.iter().any(|w| w.contains("does not match the robot")),
+            "{w:?}"
+        ),
+        Err(e) => assert!(e.contains("not finite") || e.contains("overflow"), "{e}"),
+    }
+}

@@ -100,11 +100,11 @@ pub fn check_physical_consistency(
         let link = layout.names[10 * b]
             .rsplit_once('.')
             .map_or(String::new(), |(l, _)| l.to_string());
-        let mut eig: Vec<f64> = pseudo_inertia(p)
-            .symmetric_eigenvalues()
-            .iter()
-            .copied()
-            .collect();
+        // NaN eigenvalues where the parameters are not finite: judged below as not consistent
+        let mut eig: Vec<f64> = crate::decomposition::symmetric_eigen(pseudo_inertia(p))
+            .map_or(vec![f64::NAN; 4], |e| {
+                e.eigenvalues.iter().copied().collect()
+            });
         eig.sort_by(f64::total_cmp);
         let scale = eig.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let relative_min = if scale > 0.0 { eig[0] / scale } else { 0.0 };

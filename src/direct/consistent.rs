@@ -95,7 +95,10 @@ fn push_inside(layout: &ParameterLayout, squares: &[usize], theta: &mut DVector<
         let p: [f64; 10] = theta.as_slice()[10 * b..10 * b + 10]
             .try_into()
             .expect("10 per body");
-        let eig = pseudo_inertia(&p).symmetric_eigen();
+        // parameters that are not finite are left to the solver's own checks
+        let Some(eig) = crate::decomposition::symmetric_eigen(pseudo_inertia(&p)) else {
+            continue;
+        };
         let largest = eig.eigenvalues.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let lo = (1e-6 * largest).max(1e-12);
         let clipped = eig.eigenvalues.map(|v| v.max(lo));
@@ -463,7 +466,10 @@ impl ConsistentFit {
 /// The least-squares solution of `a x = b` by a thin SVD, singular values below `relative`
 /// times the largest dropped.
 fn solve_svd(a: DMatrix<f64>, b: &DVector<f64>, relative: f64) -> Result<DVector<f64>> {
-    let svd = a.svd(true, true);
+    let svd = crate::decomposition::svd(a, true, true).ok_or_else(|| Error::Numerical {
+        operation: "consistent least squares".into(),
+        message: "the system is not finite, or its SVD did not converge".into(),
+    })?;
     let eps = relative * svd.singular_values.max();
     svd.solve(b, eps).map_err(|m| Error::Numerical {
         operation: "consistent least squares".into(),

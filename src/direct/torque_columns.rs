@@ -302,8 +302,7 @@ fn residual_fraction(x: &DMatrix<f64>, y: &DVector<f64>) -> Option<(f64, DVector
     // for a diagnostic; the SVD of the small Gram matrix drops what the data do not span
     let gram = x.tr_mul(x);
     let largest = gram.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    let coef = gram
-        .svd(true, true)
+    let coef = crate::decomposition::svd(gram, true, true)?
         .solve(&x.tr_mul(y), 1e-12 * largest)
         .ok()?;
     let residual = (y - x * &coef).norm_squared();

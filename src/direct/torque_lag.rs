@@ -166,11 +166,13 @@ pub fn check_torque_lag(
             // the pseudo-inverse of the tall matrix itself (its singular values, not their
             // squares), so that nearly dependent columns (a rotor's inertia beside the model's
             // inertial torque) are kept as a least-squares solver keeps them
-            let svd = x.clone().svd(true, true);
-            let largest = svd.singular_values.max();
-            let solve = svd
-                .pseudo_inverse(1e-12 * largest)
-                .unwrap_or_else(|_| DMatrix::zeros(6, m));
+            // a matrix that is not finite fits nothing (the column is then unjudged)
+            let solve = crate::decomposition::svd(x.clone(), true, true)
+                .and_then(|svd| {
+                    let largest = svd.singular_values.max();
+                    svd.pseudo_inverse(1e-12 * largest).ok()
+                })
+                .unwrap_or_else(|| DMatrix::zeros(6, m));
             (solve, x)
         })
         .collect();

@@ -175,13 +175,12 @@ impl WindowFit {
     fn new(t: &[f64], tc: f64, half: f64, degree: usize, step: Option<(f64, f64)>) -> Result<Self> {
         let cols = degree + 1 + usize::from(step.is_some());
         let v = DMatrix::from_fn(t.len(), cols, |i, d| basis(t[i], tc, half, degree, step, d));
-        let weights = v
-            .clone()
-            .pseudo_inverse(1e-12)
-            .map_err(|m| Error::Numerical {
+        let weights = crate::decomposition::pseudo_inverse(v.clone(), 1e-12).ok_or_else(|| {
+            Error::Numerical {
                 operation: "crossing fit".into(),
-                message: m.into(),
-            })?;
+                message: "the window's basis is not finite, or its SVD did not converge".into(),
+            }
+        })?;
         Ok(Self { basis: v, weights })
     }
 

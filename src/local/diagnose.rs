@@ -212,11 +212,9 @@ pub(super) fn mass_matrix_warning(d: &Estimate, joints: &[String]) -> Option<Str
         }
     }
     let symmetric = (m + m.transpose()) * 0.5;
-    let smallest = symmetric
-        .symmetric_eigenvalues()
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
+    let smallest = crate::decomposition::symmetric_eigen(symmetric.clone()).map_or(f64::NAN, |e| {
+        e.eigenvalues.iter().copied().fold(f64::INFINITY, f64::min)
+    });
     let noise = se.norm();
     let mut parts = vec![];
     if !asymmetric.is_empty() {

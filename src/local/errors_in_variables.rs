@@ -57,12 +57,12 @@ pub fn floor_stderr(
         return Ok(()); // a column without perturbation: the regression has refused it already
     }
     let scaled = DMatrix::from_fn(k, p, |i, c| x[(i, c)] / norms[c]);
-    let b = scaled
-        .pseudo_inverse(RANK_TOLERANCE)
-        .map_err(|m| Error::Numerical {
+    let b = crate::decomposition::pseudo_inverse(scaled, RANK_TOLERANCE).ok_or_else(|| {
+        Error::Numerical {
             operation: "errors of the regressors".into(),
-            message: m.into(),
-        })?;
+            message: "the regressors are not finite, or their SVD did not converge".into(),
+        }
+    })?;
     let sums: Vec<f64> = (0..p)
         .map(|c| b.row(c).iter().sum::<f64>() / norms[c])
         .collect();

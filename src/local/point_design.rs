@@ -161,7 +161,8 @@ pub fn suggest_operating_points(
         let Some((i, value)) = best else { break };
         let (op, c) = pool.swap_remove(i);
         info += c;
-        let sv = info.clone().svd(false, false).singular_values;
+        let sv = crate::decomposition::svd(info.clone(), false, false)
+            .map_or_else(|| nalgebra::DVector::zeros(0), |s| s.singular_values);
         let top = sv.iter().cloned().fold(0.0, f64::max);
         // singular values of X^T X are squares: 1e-16 here is the QR's 1e-8
         let rank = sv.iter().filter(|&&s| s > 1e-16 * top).count();

@@ -176,7 +176,10 @@ impl Builder<'_> {
         let m = Matrix3::new(
             i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz,
         );
-        let mut eig: Vec<f64> = m.symmetric_eigenvalues().iter().copied().collect();
+        let mut eig: Vec<f64> = crate::decomposition::symmetric_eigen(m)
+            .map_or(vec![f64::NAN; 3], |e| {
+                e.eigenvalues.iter().copied().collect()
+            });
         eig.sort_by(|a, b| a.total_cmp(b));
         // "Rounding": URDFs print inertias to a few significant digits.
         let tol = 1e-6 * eig.iter().map(|e| e.abs()).sum::<f64>() + 1e-12;
