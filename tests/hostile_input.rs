@@ -1023,7 +1023,8 @@ fn numbers_out_of_range_are_refused_as_given() {
     assert!(m.diagnostics.offsets.iter().all(|o| o.offset.abs() < 1e-9));
 }
 
-/// Accelerations 1e200 times too large (finite, but their squares overflow): the fit ends, as
+/// Accelerations 1e200 or positions 1e150 times too large (finite, but squares on the way
+/// overflow): the fit ends, as
 /// every decomposition on the way is bounded (nalgebra's SVD and eigensolvers spun forever
 /// on the infinities), and names the log as not matching the robot. Run in a thread with a
 /// deadline, so that a regression fails instead of hanging the suite.
@@ -1032,25 +1033,36 @@ fn overflowing_data_ends_the_fit_instead_of_hanging_it() {
     let (send, receive) = std::sync::mpsc::channel();
     std::thread::spawn(move || {
         let log = common::a465_log();
-        let qdd: Vec<f64> = log.qdd.iter().map(|a| a * 1e200).collect();
+        let times = |v: &[f64], s: f64| v.iter().map(|a| a * s).collect::<Vec<f64>>();
         let model = perturbid_rs::robots::a465::model("physical").unwrap();
-        let states = perturbid_rs::States::new(6, &log.q, Some(&log.qd), Some(&qdd)).unwrap();
-        let fit = perturbid_rs::direct::identify_base_parameters(
-            &model,
-            &states,
-            &log.tau,
-            &perturbid_rs::direct::BaseOptions::default(),
-        );
-        let _ = send.send(fit.map(|f| f.warnings()).map_err(|e| e.to_string()));
+        let fit = |q: &[f64], qdd: &[f64], tau: &[f64]| {
+            let states = perturbid_rs::States::new(6, q, Some(&log.qd), Some(qdd)).unwrap();
+            let options = perturbid_rs::direct::BaseOptions::default();
+            perturbid_rs::direct::identify_base_parameters(&model, &states, tau, &options)
+                .map(|f| f.warnings())
+                .map_err(|e| e.to_string())
+        };
+        let _ = send.send([
+            // accelerations 1e200 times too large, positions 1e150 times (both hung)
+            fit(&log.q, &times(&log.qdd, 1e200), &log.tau),
+            fit(&times(&log.q, 1e150), &log.qdd, &log.tau),
+            // torques 1e300 times too large: residuals past f64's range, refused by joint
+            fit(&log.q, &log.qdd, &times(&log.tau, 1e300)),
+        ]);
     });
-    let outcome = receive
+    let [accelerations, positions, torques] = receive
         .recv_timeout(std::time::Duration::from_secs(120))
-        .expect("the fit ended within 2 minutes");
-    match outcome {
-        Ok(w) => assert!(
+        .expect("the fits ended within 2 minutes");
+    for w in [accelerations, positions] {
+        let w = w.unwrap();
+        assert!(
             w.iter().any(|w| w.contains("does not match the robot")),
             "{w:?}"
-        ),
-        Err(e) => assert!(e.contains("not finite") || e.contains("overflow"), "{e}"),
+        );
     }
+    let e = torques.unwrap_err();
+    assert!(
+        e.contains("the residuals of joint 'joint1' overflow"),
+        "{e}"
+    );
 }

@@ -222,6 +222,17 @@ fn fit_with_factors(
     let factors = streaming::JointFactors::new(model, &base, states, tau, g)?;
     let mut ls = factors.solve(&sigma, &names)?;
     let mut rms = factors.residual_rms(ls.coef.as_slice())?;
+    // residuals past f64's range (torques or states near 1e300) can be neither weighted nor
+    // vouched for
+    if let Some(j) = rms.iter().position(|r| !r.is_finite()) {
+        return Err(Error::Numerical {
+            operation: "base-parameter identification".into(),
+            message: format!(
+                "the residuals of joint '{}' overflow (RMS {}): the torques or states are too large for f64 arithmetic (near 1e300?); rescale the log to SI units",
+                model.joint_names[j], rms[j]
+            ),
+        });
+    }
     if options.weighting == Weighting::Wls {
         sigma = rms.iter().map(|&s| if s > 0.0 { s } else { 1.0 }).collect();
         ls = factors.solve(&sigma, &names)?;

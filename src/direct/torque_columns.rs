@@ -152,17 +152,17 @@ impl TorqueColumn {
         }
         if self.scale < 0.0 {
             return Some(format!(
-                "the torque of joint '{}' reads {:.3} times the robot's model torque ({} of what friction, an offset and a rotor's inertia leave explained): the log's sign convention is the opposite of the model's; negate the column",
+                "the torque of joint '{}' reads {} times the robot's model torque ({} of what friction, an offset and a rotor's inertia leave explained): the log's sign convention is the opposite of the model's; negate the column",
                 self.joint,
-                self.scale,
+                scale_shown(self.scale, 3),
                 percent(self.explained)
             ));
         }
         if !(1.0 / SCALE_LIMIT..=SCALE_LIMIT).contains(&self.scale) {
             return Some(format!(
-                "the torque of joint '{}' reads {:.4} times the robot's model torque ({} of what friction, an offset and a rotor's inertia leave explained): torques are expected in N m (N for a prismatic joint) at the joint, after any gear; check the column's units (mN m, a current) and the URDF's masses",
+                "the torque of joint '{}' reads {} times the robot's model torque ({} of what friction, an offset and a rotor's inertia leave explained): torques are expected in N m (N for a prismatic joint) at the joint, after any gear; check the column's units (mN m, a current) and the URDF's masses",
                 self.joint,
-                self.scale,
+                scale_shown(self.scale, 4),
                 percent(self.explained)
             ));
         }
@@ -287,6 +287,17 @@ pub fn check_torque_columns(
         });
     }
     Ok(out)
+}
+
+/// `x` with `decimals` decimals where it is between 1e-3 and 1e4 in size, in scientific
+/// notation with as many otherwise (a torque logged 1e150 times too large is no 150-digit
+/// number).
+fn scale_shown(x: f64, decimals: usize) -> String {
+    if (1e-3..1e4).contains(&x.abs()) {
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.decimals$e}")
+    }
 }
 
 /// The least-squares fit of `y` by the columns of `x`: its residual sum of squares as a
