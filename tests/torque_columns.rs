@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{a465_log, fit_physical, panda_log, panda_model, refused_on_load, A465Log, Rng};
+use common::{a465_log, fit_physical, panda_preprocessed, refused_on_load, A465Log, Rng};
 use nalgebra::DMatrix;
 use perturbid_rs::direct::torque_columns::{LOADED, SCALE_LIMIT};
 use perturbid_rs::direct::{
@@ -265,14 +265,9 @@ fn a_tool_the_model_lacks_is_no_finding() {
 /// example-robot-data: every judged column follows its own joint at a plausible scale.
 #[test]
 fn the_real_panda_log_reads_as_its_urdf_says() {
-    let Some(rec) = panda_log() else {
+    let Some((model, p)) = panda_preprocessed() else {
         return;
     };
-    let Some(model) = panda_model() else {
-        eprintln!("SKIPPED: the Panda URDF of example-robot-data is not installed");
-        return;
-    };
-    let p = preprocess(&rec, &PreprocessOptions::default()).unwrap();
     let states = States::new(7, &p.q, p.qd.as_deref(), p.qdd.as_deref()).unwrap();
     let c = check_torque_columns(&model, &states, &p.tau, Gravity::Included).unwrap();
     let judged: Vec<_> = c.iter().filter(|c| c.follows_explained >= 0.5).collect();

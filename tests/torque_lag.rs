@@ -5,11 +5,10 @@
 
 mod common;
 
-use common::{a465_log, fit_physical, panda_log, panda_model, refused_on_load, A465Log};
+use common::{a465_log, fit_physical, panda_preprocessed, refused_on_load, A465Log};
 use perturbid_rs::direct::torque_lag::{check_torque_lag, LAG_RATIO, MAX_LAG};
 use perturbid_rs::direct::BaseModel;
 use perturbid_rs::document::Document;
-use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::robots::a465;
 use perturbid_rs::{Gravity, States};
 
@@ -154,14 +153,9 @@ fn a_log_without_gravity_is_checked_too() {
 /// The real Panda log (beside the repository; skipped when absent): no shift fits it better.
 #[test]
 fn the_real_panda_log_is_in_step() {
-    let Some(rec) = panda_log() else {
+    let Some((model, p)) = panda_preprocessed() else {
         return;
     };
-    let Some(model) = panda_model() else {
-        eprintln!("SKIPPED: the Panda URDF of example-robot-data is not installed");
-        return;
-    };
-    let p = preprocess(&rec, &PreprocessOptions::default()).unwrap();
     let states = States::new(7, &p.q, p.qd.as_deref(), p.qdd.as_deref()).unwrap();
     let lag = check_torque_lag(&model, &states, &p.tau, Gravity::Included)
         .unwrap()

@@ -223,42 +223,14 @@ pub fn check_torque_columns(
         pick(states.qdd().unwrap_or_default()),
     );
     let measured = pick(tau);
-    // the model's gravity torque (what a URDF's masses and centres of mass, usually close,
-    // predict) and the rest of its inverse dynamics (inertias, often far off: a CAD model
-    // without its motors), each with its own scale in the fits
-    let mut ws = parallel::Workspace::new(model);
-    let mut weight = vec![0.0; q.len()];
-    let mut inertial = vec![0.0; q.len()];
-    if gravity == Gravity::Included {
-        parallel::rnea(
-            model,
-            &mut ws,
-            &States::new(n, &q, None, None)?,
-            Gravity::Included,
-            &mut weight,
-        )?;
-    }
-    parallel::rnea(
-        model,
-        &mut ws,
-        &States::new(n, &q, Some(&qd), Some(&qdd))?,
-        Gravity::Excluded,
-        &mut inertial,
-    )?;
+    let (weight, inertial) = model_torques(model, &q, &qd, &qdd, gravity)?;
     let m = rows.len();
     let column = |x: &[f64], j: usize| DVector::from_fn(m, |r, _| x[r * n + j]);
-    // joint kk's own terms the model may lack (viscous and Coulomb friction, an offset, a
-    // rotor's inertia), after its model's torque when `with_model`
+    // joint kk's regressors, from its model's gravity torque when `with_model`
     let regressors = |kk: usize, with_model: bool| {
-        let first = usize::from(with_model);
-        DMatrix::from_fn(m, 5 + first, |r, c| match c + 1 - first {
-            0 => weight[r * n + kk],
-            1 => inertial[r * n + kk],
-            2 => qd[r * n + kk],
-            3 => crate::direct::parameters::sign0(qd[r * n + kk]),
-            4 => qdd[r * n + kk],
-            _ => 1.0,
-        })
+        let all = joint_regressors(&weight, &inertial, &qd, &qdd, n, kk);
+        let first = usize::from(!with_model);
+        all.columns(first, 6 - first).into_owned()
     };
     let mut out = Vec::with_capacity(n);
     for j in 0..n {
@@ -287,6 +259,62 @@ pub fn check_torque_columns(
         });
     }
     Ok(out)
+}
+
+/// The model's gravity torque (what a URDF's masses and centres of mass, usually close,
+/// predict; zeros where the log excludes gravity) and the rest of its inverse dynamics
+/// (inertias, often far off: a CAD model without its motors) at the states `q`, `qd`, `qdd`
+/// (row-major `m x nv`; rad, rad/s, rad/s^2), each row-major `m x nv` (N m): the two parts of
+/// the model's torque that the checks of the torque columns scale separately.
+pub(crate) fn model_torques(
+    model: &Model,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    gravity: Gravity,
+) -> Result<(Vec<f64>, Vec<f64>)> {
+    let n = model.nv;
+    let mut ws = parallel::Workspace::new(model);
+    let mut weight = vec![0.0; q.len()];
+    let mut inertial = vec![0.0; q.len()];
+    if gravity == Gravity::Included {
+        parallel::rnea(
+            model,
+            &mut ws,
+            &States::new(n, q, None, None)?,
+            Gravity::Included,
+            &mut weight,
+        )?;
+    }
+    parallel::rnea(
+        model,
+        &mut ws,
+        &States::new(n, q, Some(qd), Some(qdd))?,
+        Gravity::Excluded,
+        &mut inertial,
+    )?;
+    Ok((weight, inertial))
+}
+
+/// Joint `j`'s regressors over `m` samples (`m x 6`): its model's gravity torque and the rest
+/// of its inverse dynamics (from [`model_torques`]), then its own terms a URDF lacks: viscous
+/// and Coulomb friction (`qd_j`, `sign(qd_j)`), a rotor's inertia (`qdd_j`) and an offset (1).
+pub(crate) fn joint_regressors(
+    weight: &[f64],
+    inertial: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    n: usize,
+    j: usize,
+) -> DMatrix<f64> {
+    DMatrix::from_fn(qd.len() / n, 6, |r, c| match c {
+        0 => weight[r * n + j],
+        1 => inertial[r * n + j],
+        2 => qd[r * n + j],
+        3 => crate::direct::parameters::sign0(qd[r * n + j]),
+        4 => qdd[r * n + j],
+        _ => 1.0,
+    })
 }
 
 /// `x` with `decimals` decimals where it is between 1e-3 and 1e4 in size, in scientific

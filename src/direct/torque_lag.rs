@@ -20,9 +20,9 @@
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
-use super::torque_columns::JUDGED;
+use super::torque_columns::{joint_regressors, model_torques, JUDGED};
 use crate::error::Result;
-use crate::{parallel, Gravity, Model, States};
+use crate::{Gravity, Model, States};
 
 /// The largest shift searched, in samples (and at most a quarter of the log either way).
 pub const MAX_LAG: usize = 500;
@@ -132,37 +132,12 @@ pub fn check_torque_lag(
             .collect()
     };
     let (q, qd, qdd) = (pick(states.q()), pick(qd_all), pick(qdd_all));
-    let mut ws = parallel::Workspace::new(model);
-    let mut weight = vec![0.0; q.len()];
-    let mut inertial = vec![0.0; q.len()];
-    if gravity == Gravity::Included {
-        parallel::rnea(
-            model,
-            &mut ws,
-            &States::new(n, &q, None, None)?,
-            Gravity::Included,
-            &mut weight,
-        )?;
-    }
-    parallel::rnea(
-        model,
-        &mut ws,
-        &States::new(n, &q, Some(&qd), Some(&qdd))?,
-        Gravity::Excluded,
-        &mut inertial,
-    )?;
+    let (weight, inertial) = model_torques(model, &q, &qd, &qdd, gravity)?;
     // per joint: its model's torques and its own terms, and the pseudo-inverse that fits any
     // shifted column by them (6 x m)
     let fitters: Vec<(DMatrix<f64>, DMatrix<f64>)> = (0..n)
         .map(|j| {
-            let x = DMatrix::from_fn(m, 6, |r, c| match c {
-                0 => weight[r * n + j],
-                1 => inertial[r * n + j],
-                2 => qd[r * n + j],
-                3 => crate::direct::parameters::sign0(qd[r * n + j]),
-                4 => qdd[r * n + j],
-                _ => 1.0,
-            });
+            let x = joint_regressors(&weight, &inertial, &qd, &qdd, n, j);
             // the pseudo-inverse of the tall matrix itself (its singular values, not their
             // squares), so that nearly dependent columns (a rotor's inertia beside the model's
             // inertial torque) are kept as a least-squares solver keeps them

@@ -449,3 +449,18 @@ pub fn fit_physical(log: &A465Log) -> perturbid_rs::direct::BaseModel {
     )
     .unwrap()
 }
+
+/// The real Panda log preprocessed with the default options, and the Panda model of
+/// example-robot-data; None where either is absent (each says why on stderr).
+pub fn panda_preprocessed() -> Option<(perturbid_rs::Model, perturbid_rs::Recording)> {
+    let rec = panda_log()?;
+    let Some(model) = panda_model() else {
+        eprintln!("SKIPPED: the Panda URDF of example-robot-data is not installed");
+        return None;
+    };
+    let options = perturbid_rs::preprocess::PreprocessOptions::default();
+    Some((
+        model,
+        perturbid_rs::preprocess::preprocess(&rec, &options).unwrap(),
+    ))
+}
