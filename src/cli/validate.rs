@@ -8,8 +8,8 @@ use clap::Args;
 
 use super::files::{load_robot, refuse_overwriting_inputs, PreprocessArgs};
 use super::progress::Progress;
-use crate::direct::torque_columns::{check_torque_columns, findings};
-use crate::direct::torque_lag::check_torque_lag;
+use crate::direct::torque_columns::check_torque_columns;
+use crate::direct::torque_lag::{check_torque_lag, log_findings};
 use crate::error::{Error, Result};
 use crate::io::{OutputSet, Table};
 use crate::states::States;
@@ -95,8 +95,7 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
         _ => (vec![], None),
     };
     progress.done();
-    let lagged = torque_lag.as_ref().and_then(|l| l.finding());
-    for w in findings(&torque_columns).into_iter().chain(lagged) {
+    for w in log_findings(&torque_columns, torque_lag.as_ref()) {
         eprintln!("perturbid: warning: log '{}': {w}", a.data.display());
     }
     // the residuals, the table and the figure, as one output set

@@ -52,8 +52,8 @@ impl BaseModel {
     /// the data hold an effect the model lacks, or are not what it assumes. A consistent fit
     /// keeps them at zero.
     pub fn warnings(&self) -> Vec<String> {
-        let mut columns = super::torque_columns::findings(&self.torque_columns);
-        columns.extend(self.torque_lag.as_ref().and_then(|l| l.finding()));
+        let columns =
+            super::torque_lag::log_findings(&self.torque_columns, self.torque_lag.as_ref());
         let negative = self
             .parameter_table()
             .into_iter()

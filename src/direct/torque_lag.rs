@@ -20,7 +20,7 @@
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
-use super::torque_columns::{joint_regressors, model_torques, JUDGED};
+use super::torque_columns::{joint_regressors, model_torques, TorqueColumn, JUDGED};
 use crate::error::Result;
 use crate::{Gravity, Model, States};
 
@@ -97,6 +97,14 @@ impl TorqueLag {
         }
         None
     }
+}
+
+/// What looks wrong with a log's torques against the robot's model: the `columns`' findings
+/// ([`super::torque_columns::findings`]) and then the `lag`'s, if any.
+pub fn log_findings(columns: &[TorqueColumn], lag: Option<&TorqueLag>) -> Vec<String> {
+    let mut out = super::torque_columns::findings(columns);
+    out.extend(lag.and_then(TorqueLag::finding));
+    out
 }
 
 /// The lag of the torque columns `tau` (row-major `k x nv`, N m) behind the positions of

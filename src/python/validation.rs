@@ -10,8 +10,8 @@ use super::detached;
 use super::direct::{torque_column_dicts, torque_lag_dict, PyBaseModel};
 use super::errors::warn_all;
 use super::tables::dataframe;
-use crate::direct::torque_columns::{check_torque_columns, findings, TorqueColumn};
-use crate::direct::torque_lag::{check_torque_lag, TorqueLag};
+use crate::direct::torque_columns::{check_torque_columns, TorqueColumn};
+use crate::direct::torque_lag::{check_torque_lag, log_findings, TorqueLag};
 use crate::states::States;
 use crate::validation::{validate as validate_rs, Validation};
 
@@ -167,11 +167,7 @@ pub(crate) fn validate<'py>(
                     check_torque_lag(&base.model, &states, &measured, g)?,
                 ))
             })?;
-            warn_all(model.py(), &findings(&columns))?;
-            warn_all(
-                model.py(),
-                &lag.iter().filter_map(|l| l.finding()).collect::<Vec<_>>(),
-            )?;
+            warn_all(model.py(), &log_findings(&columns, lag.as_ref()))?;
             (columns, lag)
         }
         Err(_) => (vec![], None),
