@@ -876,6 +876,114 @@ fn hand_edited_plans_are_refused_where_they_break_the_trajectory() {
     );
 }
 
+/// A plan's parts must agree: each crossing is the operating point moved by its row of
+/// perturbations (G-static at rest), a nominal experiment perturbs nothing, only G-static has a
+/// reference (and it must), every crossing's fit window lies in its own segment, and no
+/// experiment is planned twice. A hand edit of one part is refused naming the crossing,
+/// variable and joint, rather than fitted by one part (the recorded states) and diagnosed by
+/// another (the planned perturbations).
+#[test]
+fn hand_edited_plans_are_refused_where_their_parts_disagree() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
+    let text = plan.to_json();
+    let edited = |f: &dyn Fn(&mut serde_json::Value)| {
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        f(&mut v);
+        Plan::from_json(&v.to_string())
+            .map(|_| ())
+            .unwrap_err()
+            .to_string()
+    };
+    let names: Vec<&str> = plan.experiments.iter().map(|e| e.kind.name()).collect();
+    assert_eq!(names, ["nominal", "G_static", "G", "H", "D"]);
+    // H's perturbation of joint 3 at its fourth crossing, not its crossing
+    let e = edited(&|v| v["experiments"][3]["deltas"][3][2] = serde_json::json!(-1.0));
+    assert!(
+        e.contains("experiments[3] ('H'): crossings[3].qd[2] is")
+            && e.contains("the operating point's qd* plus deltas[3] give -0.978")
+            && e.contains("disagree"),
+        "{e}"
+    );
+    // the operating point's velocity of joint 1, not the crossings'
+    let e = edited(&|v| v["op"]["qd"][0] = serde_json::json!(0.1));
+    assert!(
+        e.contains("experiments[0] ('nominal'): crossings[0].qd[0] is 0.089")
+            && e.contains("the operating point's qd* is 0.1"),
+        "{e}"
+    );
+    // G's velocities are the operating point's, not perturbed
+    let e = edited(&|v| {
+        let c = &mut v["experiments"][2]["deltas"][0][1];
+        *c = serde_json::json!(c.as_f64().unwrap() + 0.01);
+    });
+    assert!(
+        e.contains("experiments[2] ('G'): crossings[0].q[1] is"),
+        "{e}"
+    );
+    let e = edited(&|v| v["experiments"][0]["deltas"][1][4] = serde_json::json!(0.01));
+    assert!(
+        e.contains("deltas[1][4] is 0.01; the nominal experiment perturbs nothing"),
+        "{e}"
+    );
+    let e = edited(&|v| v["experiments"][1]["reference"] = serde_json::Value::Null);
+    assert!(e.contains("('G_static'): it has no reference"), "{e}");
+    // a reference added to H (at a time and state its trajectory passes: its first crossing)
+    let e = edited(&|v| {
+        v["experiments"][3]["reference"] = v["experiments"][3]["crossings"][0].clone();
+    });
+    assert!(
+        e.contains("('H'): it has a reference; only G_static"),
+        "{e}"
+    );
+    // a fit window wider than H's crossing windows (they are +-0.05 s): it would reach into the
+    // transitions
+    let e = edited(&|v| v["experiments"][3]["window"] = serde_json::json!(0.06));
+    assert!(
+        e.contains("('H'): crossings[0] at t =")
+            && e.contains("with window +-0.06 s is not inside its segment")
+            && e.contains("the fit would reach beyond"),
+        "{e}"
+    );
+    // two crossing segments claim crossing 0 (the nominal experiment's sixth renumbered)
+    let e = edited(&|v| {
+        let segments = v["experiments"][0]["trajectory"]["segments"]
+            .as_array_mut()
+            .unwrap();
+        let sixth = segments
+            .iter_mut()
+            .find(|s| s["type"] == "crossing" && s["index"] == 5)
+            .unwrap();
+        sixth["index"] = serde_json::json!(0);
+    });
+    assert!(
+        e.contains(
+            "('nominal'): crossings[0] needs exactly one trajectory segment, a 'crossing' segment with index 0"
+        ),
+        "{e}"
+    );
+    // G-static's dwell turned into a crossing window
+    let e = edited(&|v| {
+        let segments = v["experiments"][1]["trajectory"]["segments"]
+            .as_array_mut()
+            .unwrap();
+        let dwell = segments.iter_mut().find(|s| s["type"] == "dwell").unwrap();
+        dwell["type"] = serde_json::json!("crossing");
+    });
+    assert!(
+        e.contains("is a 'crossing' segment with index 0, which the G_static experiment"),
+        "{e}"
+    );
+    let e = edited(&|v| {
+        let d = v["experiments"][4].clone();
+        v["experiments"].as_array_mut().unwrap().push(d);
+    });
+    assert!(
+        e.contains("experiments[4] and experiments[5] are both 'D'"),
+        "{e}"
+    );
+}
+
 /// Standard normal draws by Box-Muller.
 fn gauss(rng: &mut Rng) -> f64 {
     let u = rng.uniform(f64::MIN_POSITIVE, 1.0);
