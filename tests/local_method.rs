@@ -802,6 +802,160 @@ fn a_torque_channel_that_does_not_change_is_warned_about() {
     assert_eq!(from(&m).rows + 3 * n, from(&clean).rows);
 }
 
+/// Torques that do not return to T* between an experiment's perturbations: torque columns
+/// swapped in one recording, or one offset, are found with the joints and named (a swap as
+/// such; one in the nominal recording by G and D alike), listed in the diagnostics and kept
+/// through JSON; a clean rehearsal, and a channel stuck at one value (reported as unmeasured),
+/// have none. Without +- pairs the warning says the offset biases the estimate.
+#[test]
+fn torques_that_do_not_return_to_t_star_are_found() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
+    let mut sim = SimulationOptions::new(&model);
+    sim.torque_noise = vec![0.01; n];
+    let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    let run =
+        |recs: &[Recording]| identify_local(&plan, recs, &IdentifyOptions::default()).unwrap();
+    let offsets = |m: &LocalModel| -> Vec<(String, String)> {
+        m.diagnostics
+            .torque_offsets
+            .iter()
+            .map(|t| (t.experiment.clone(), t.joint.clone()))
+            .collect()
+    };
+    let pairs = |list: &[(&str, &str)]| -> Vec<(String, String)> {
+        list.iter()
+            .map(|(e, j)| (e.to_string(), j.to_string()))
+            .collect()
+    };
+    let says = |m: &LocalModel, text: &str| m.diagnostics.warnings.iter().any(|w| w.contains(text));
+    let clean = run(&recs);
+    assert!(
+        offsets(&clean).is_empty(),
+        "{:?}",
+        clean.diagnostics.torque_offsets
+    );
+    assert!(
+        !says(&clean, "do not return"),
+        "{:?}",
+        clean.diagnostics.warnings
+    );
+    let edited = |experiment: &str, edit: &dyn Fn(&mut Recording)| {
+        let mut r = recs.to_vec();
+        edit(
+            r.iter_mut()
+                .find(|r| r.experiment.as_deref() == Some(experiment))
+                .unwrap(),
+        );
+        run(&r)
+    };
+    let swap = |a: usize, b: usize| {
+        move |r: &mut Recording| {
+            for i in 0..r.t.len() {
+                r.tau.swap(i * n + a, i * n + b);
+            }
+        }
+    };
+    // joints 3 and 6 swapped in D: T* is -1.02 and 0.05 N m there
+    let m = edited("D", &swap(2, 5));
+    assert_eq!(offsets(&m), pairs(&[("D", "joint3"), ("D", "joint6")]));
+    let t = &m.diagnostics.torque_offsets[0];
+    let gap = clean.torque[5] - clean.torque[2];
+    assert!(
+        (t.offset - gap).abs() < 0.01 * gap.abs(),
+        "{t:?} against {gap}"
+    );
+    assert!(t.offset.abs() > 100.0 * t.stderr, "{t:?}");
+    assert!(
+        says(&m, "experiment 'D': the torques of 'joint3' (")
+            && says(&m, "'joint3' and 'joint6' are off by each other's T*")
+            && says(&m, "their rows of D* are each other's")
+            && says(
+                &m,
+                "does not bias them (the perturbations come in +- pairs)"
+            ),
+        "{:?}",
+        m.diagnostics.warnings
+    );
+    let back = LocalModel::from_json(&m.to_json()).unwrap();
+    assert_eq!(
+        back.diagnostics.torque_offsets,
+        m.diagnostics.torque_offsets
+    );
+    // the shoulder's torque 0.5 N m higher in G: an offset, no swap
+    let m = edited("G", &|r: &mut Recording| {
+        for i in 0..r.t.len() {
+            r.tau[i * n + 1] += 0.5;
+        }
+    });
+    assert_eq!(offsets(&m), pairs(&[("G", "joint2")]));
+    assert!((m.diagnostics.torque_offsets[0].offset - 0.5).abs() < 0.01);
+    assert!(
+        says(&m, "The recordings' torques look offset") && !says(&m, "swapped"),
+        "{:?}",
+        m.diagnostics.warnings
+    );
+    // the shoulder and the elbow swapped in the nominal recording: G and D see the same
+    let m = edited("nominal", &swap(1, 2));
+    assert_eq!(
+        offsets(&m),
+        pairs(&[
+            ("G", "joint2"),
+            ("G", "joint3"),
+            ("D", "joint2"),
+            ("D", "joint3")
+        ])
+    );
+    assert!(
+        says(
+            &m,
+            "experiments 'G' and 'D' find the same torque offsets of 'joint2', 'joint3'"
+        ) && says(&m, "the nominal recording"),
+        "{:?}",
+        m.diagnostics.warnings
+    );
+    // a channel stuck at one value is unmeasured, not an offset
+    let m = edited("D", &|r: &mut Recording| {
+        for i in 0..r.t.len() {
+            r.tau[i * n + 2] = 12.5;
+        }
+    });
+    assert!(offsets(&m).is_empty(), "{:?}", m.diagnostics.torque_offsets);
+    assert_eq!(m.diagnostics.unmeasured.len(), 1);
+    // perturbations not in +- pairs: the offset biases the estimate, and the warning says so
+    let lone = PlanOptions {
+        symmetric: false,
+        experiments: vec![ExperimentKind::Nominal, ExperimentKind::D],
+        ..PlanOptions::default()
+    };
+    let plan = plan_experiments(&model, &table2(), &lone).unwrap();
+    let mut recs = simulate_plan(&model, &plan, &sim).unwrap();
+    let d = recs
+        .iter_mut()
+        .find(|r| r.experiment.as_deref() == Some("D"))
+        .unwrap();
+    for i in 0..d.t.len() {
+        d.tau[i * n] += 0.3;
+    }
+    let m = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    assert_eq!(offsets(&m), pairs(&[("D", "joint1")]));
+    assert!(
+        says(
+            &m,
+            "biases them (the perturbations do not come in +- pairs)"
+        ),
+        "{:?}",
+        m.diagnostics.warnings
+    );
+    // a saved finding naming a joint the model does not have is refused on load
+    let mut v: serde_json::Value = serde_json::from_str(&back.to_json()).unwrap();
+    v["diagnostics"]["torque_offsets"][0]["joint"] = serde_json::json!("joint9");
+    let text = v.to_string();
+    let e = LocalModel::from_json(&text).unwrap_err().to_string();
+    assert!(e.contains("joint 'joint9'"), "{e}");
+}
+
 /// A plan read from a file is what the robot will run: a hand edit that makes its trajectory
 /// jump, leave f64's range, start moving, or disagree with its crossings is refused with the
 /// experiment, segment or crossing and joint; a plan made for wider limits than the robot's is

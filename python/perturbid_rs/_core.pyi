@@ -350,7 +350,10 @@ class LocalModel:
         the band of half a count about them, or None)), glitches (list of dicts: experiment,
         crossing, signal ('q', 'qd', 'qdd', 'tau'), joint, sample (0-based), time (s), value,
         noise_levels (or None beyond any scale), replaced (True for an isolated glitch replaced
-        by the fit of its window's other samples)), warnings."""
+        by the fit of its window's other samples)), dropouts, held_readings, torque_offsets
+        (list of dicts: experiment ('D', 'G', 'G_static'), joint, offset and stderr in N m:
+        torques that do not return to T*, or to G-static's reference, between the experiment's
+        perturbations), warnings."""
     def linearize(self, op: OperatingPoint) -> dict[str, Any]:
         """torque (n,), D, H, G (n, n) and G_static (n, n) or None at op."""
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:

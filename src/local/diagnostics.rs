@@ -149,6 +149,11 @@ pub struct Diagnostics {
     /// The torque noise of every joint in each separated regression (G_static, G, H, D).
     #[serde(default)]
     pub noise: Vec<TorqueNoise>,
+    /// Torques of an experiment (D, G, G_static) that do not return to the base they are
+    /// measured against (`T*`, or G-static's reference) between its perturbations, with a
+    /// warning ([`super::torque_offsets`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub torque_offsets: Vec<super::torque_offsets::TorqueOffset>,
     /// Samples found far off their crossing windows' fits: glitches of the log, replaced, or
     /// not isolated and kept (with a warning).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]

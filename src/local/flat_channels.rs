@@ -45,13 +45,7 @@ pub(super) fn flat(columns: &[Vec<f64>]) -> Vec<Option<f64>> {
 /// The warning for the joints whose torque read one value (N m) in every sample of an
 /// experiment that perturbs the robot: `(joint, value)` each.
 pub(super) fn flat_torque_warning(kind: ExperimentKind, joints: &[(&str, f64)]) -> String {
-    let matrix = match kind {
-        ExperimentKind::D => "D*",
-        ExperimentKind::H => "H*",
-        ExperimentKind::GDynamic => "G*",
-        ExperimentKind::GStatic => "Gs*",
-        ExperimentKind::Nominal => "T*",
-    };
+    let matrix = kind.estimate_name();
     // 6 significant digits, and no -0
     let value = |v: f64| {
         let v: f64 = format!("{v:.5e}").parse().unwrap_or(v);

@@ -23,6 +23,7 @@ use super::operating_point::OperatingPoint;
 use super::plan::{Experiment, ExperimentKind, Plan};
 use super::quantisation;
 use super::rounded_positions::{self, Resolution};
+use super::torque_offsets;
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::recording::Recording;
@@ -498,6 +499,7 @@ pub fn identify_local(
 
     let noise = std::cell::RefCell::new(vec![]);
     let extra_warnings = std::cell::RefCell::new(vec![]);
+    let offsets_found = std::cell::RefCell::new(vec![]);
     let separated = |kind: ExperimentKind, prefix: &str| -> Result<Option<Estimate>> {
         let Some(v) = find(kind) else { return Ok(None) };
         let var = kind.perturbed().expect("perturbed experiment");
@@ -525,6 +527,26 @@ pub fn identify_local(
             }
         }
         let y = DMatrix::from_fn(k, n, |i, j| v.crossings[i].tau[j] - base_tau[j]);
+        let base_tau_var: Vec<f64> = match &v.reference {
+            Some(r) => reading_variance(r, &sample_variance(&v.crossings, n)),
+            None => torque_stderr.iter().map(|s| s * s).collect(),
+        };
+        let mut intercepts = torque_offsets::intercepts(&x, &y, &base_tau_var);
+        // a channel that read one value throughout is reported as unmeasured instead
+        for (c, flat) in intercepts.iter_mut().zip(&v.flat_torque) {
+            if flat.is_some() {
+                *c = None;
+            }
+        }
+        let found = torque_offsets::findings(kind, &plan.joint_names, &intercepts, base_tau);
+        let swapped = torque_offsets::swapped_pairs(kind, &found, &plan.joint_names, base_tau);
+        let planned = plan
+            .experiment(kind)
+            .expect("values of a planned experiment");
+        if let Some(w) = torque_offsets::warning(kind, &found, &swapped, planned.in_pairs()) {
+            extra_warnings.borrow_mut().push(w);
+        }
+        offsets_found.borrow_mut().extend(found);
         let (u, samples) = reading_variances(&[v], n);
         let weighted = weighted_least_squares(
             &x,
@@ -736,11 +758,17 @@ pub fn identify_local(
     }
     diagnostics.warnings.extend(flat_warnings);
     diagnostics.unmeasured = unmeasured;
+    let mut torque_offsets = offsets_found.into_inner();
+    torque_offsets.sort_by_key(|t| values.iter().position(|v| v.kind.name() == t.experiment));
+    diagnostics.torque_offsets = torque_offsets;
     let mut noise = noise.into_inner();
     // in the plan's order of experiments
     noise.sort_by_key(|e| values.iter().position(|v| v.kind.name() == e.experiment));
     diagnostics.warnings.extend(quantisation::warnings(&noise));
     diagnostics.warnings.extend(extra_warnings.into_inner());
+    diagnostics
+        .warnings
+        .extend(torque_offsets::nominal_warning(&diagnostics.torque_offsets));
     diagnostics.noise = noise;
     diagnostics.combined = disagreement;
     diagnostics.unperturbed_deviation = deviation;

@@ -48,6 +48,7 @@ pub mod plan;
 pub mod point_design;
 pub mod quantisation;
 pub mod rounded_positions;
+pub mod torque_offsets;
 
 pub use clock::{
     check_clock, covering_offsets, detect_offset, detect_offset_in, overlap_offsets,

@@ -191,6 +191,12 @@ impl Document for LocalModel {
                     .glitches
                     .iter()
                     .map(|g| (&g.experiment, &g.joint)),
+            )
+            .chain(
+                m.diagnostics
+                    .torque_offsets
+                    .iter()
+                    .map(|t| (&t.experiment, &t.joint)),
             );
         for (experiment, joint) in named {
             if !super::ExperimentKind::ALL
@@ -225,6 +231,13 @@ impl Document for LocalModel {
             if let Some(z) = g.noise_levels {
                 check_magnitude(Self::WHAT, &format!("{what}.noise_levels"), z, false)?;
             }
+        }
+        for (i, t) in m.diagnostics.torque_offsets.iter().enumerate() {
+            let what = format!("diagnostics.torque_offsets[{i}]");
+            if !t.offset.is_finite() {
+                return Err(bad(format!("{what}.offset is not a finite number")));
+            }
+            check_magnitude(Self::WHAT, &format!("{what}.stderr"), t.stderr, false)?;
         }
         for (i, d) in m.diagnostics.dropouts.iter().enumerate() {
             let problem = d.problem().or_else(|| match &d.experiment {

@@ -50,6 +50,17 @@ impl ExperimentKind {
             ExperimentKind::D => Some(2),
         }
     }
+
+    /// The matrix the experiment estimates: `Gs`, `G*`, `H*` or `D*` (`T*` for the nominal).
+    pub fn estimate_name(self) -> &'static str {
+        match self {
+            ExperimentKind::Nominal => "T*",
+            ExperimentKind::GStatic => "Gs",
+            ExperimentKind::GDynamic => "G*",
+            ExperimentKind::H => "H*",
+            ExperimentKind::D => "D*",
+        }
+    }
 }
 
 /// A planned crossing: the time (s from the start of the experiment) and the state the robot
@@ -85,6 +96,16 @@ impl Experiment {
     /// Duration (s).
     pub fn duration(&self) -> f64 {
         self.trajectory.end() - self.trajectory.start()
+    }
+
+    /// True when the perturbations come in +- pairs (rows `2i` and `2i + 1` opposite), as the
+    /// planner's symmetric designs: then the even-order terms and a constant offset of the
+    /// torque changes leave the separated estimates unbiased.
+    pub fn in_pairs(&self) -> bool {
+        let d = &self.deltas;
+        d.nrows().is_multiple_of(2)
+            && (0..d.nrows() / 2)
+                .all(|i| (0..d.ncols()).all(|j| d[(2 * i, j)] == -d[(2 * i + 1, j)]))
     }
 
     /// The condition number of the perturbations `deltas` with every joint's column scaled to
@@ -742,12 +763,7 @@ fn design_warning(kind: ExperimentKind, deltas: &DMatrix<f64>) -> Option<String>
     let (largest, smallest) = (s[0], s[s.len() - 1]);
     let cond = largest / smallest;
     (cond > DESIGN_COND_WARNING).then(|| {
-        let estimate = match kind {
-            ExperimentKind::GStatic => "Gs",
-            ExperimentKind::GDynamic => "G*",
-            ExperimentKind::H => "H*",
-            _ => "D*",
-        };
+        let estimate = kind.estimate_name();
         format!(
             "experiment '{}': its perturbations have cond(X) = {cond:.1} (each joint's column scaled to unit norm): the least well determined combination of {estimate}'s entries will be {:.1} times less precise than with an orthogonal design of the same column norms; plan with design 'orthogonal' (--design orthogonal) for cond(X) = 1, or with more perturbations (n, --n)",
             kind.name(),

@@ -71,7 +71,11 @@ impl PyLocalModel {
     /// of a signal read exactly 0 while the robot moved, removed before the windows were
     /// read), `held_readings` (list of dicts: `experiment` and the keys of
     /// `Recording.glitches`: samples of one joint's reading held while it moved, replaced
-    /// before the windows were read), `warnings` (list of str).
+    /// before the windows were read), `torque_offsets` (list of dicts: `experiment` ('D', 'G'
+    /// or 'G_static'), `joint`, `offset` (N m) and `stderr` (N m): torques that do not return
+    /// to T*, or to G-static's reference, between the experiment's perturbations; each
+    /// experiment's with a warning naming columns that look swapped), `warnings` (list of
+    /// str).
     #[getter]
     fn diagnostics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = &self.model.diagnostics;
@@ -163,6 +167,19 @@ impl PyLocalModel {
             .map(|g| super::recording::glitch_dict(py, g))
             .collect::<PyResult<Vec<_>>>()?;
         out.set_item("held_readings", held)?;
+        let offsets = d
+            .torque_offsets
+            .iter()
+            .map(|t| {
+                let e = PyDict::new(py);
+                e.set_item("experiment", &t.experiment)?;
+                e.set_item("joint", &t.joint)?;
+                e.set_item("offset", t.offset)?;
+                e.set_item("stderr", t.stderr)?;
+                Ok(e)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        out.set_item("torque_offsets", offsets)?;
         out.set_item("warnings", d.warnings.clone())?;
         Ok(out)
     }

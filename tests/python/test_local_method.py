@@ -301,6 +301,29 @@ def test_a_dead_torque_channel_is_warned_about_and_marked_unmeasured():
     assert clean.diagnostics["unmeasured"] == []
 
 
+def test_torque_columns_swapped_in_one_recording_are_named():
+    robot = pr.robots.a465()
+    plan = pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2))
+    recs = pr.simulate(robot, plan, torque_noise=0.01, seed=3)
+    swapped = []
+    for r in recs:
+        tau = r.tau.copy()
+        if r.experiment == "G":
+            tau[:, [2, 5]] = tau[:, [5, 2]]
+        swapped.append(pr.Recording(r.t, r.q, tau, name=r.name, experiment=r.experiment))
+    with pytest.warns(pr.PerturbidWarning, match="'joint3' and 'joint6' are off by each other's T\\*"):
+        model = pr.identify_local(plan, swapped)
+    found = model.diagnostics["torque_offsets"]
+    assert [(f["experiment"], f["joint"]) for f in found] == [("G", "joint3"), ("G", "joint6")]
+    # each off by the difference of the two joints' T* (the clean identification's)
+    clean = pr.identify_local(plan, recs)
+    assert clean.diagnostics["torque_offsets"] == []
+    gap = clean.torque[5] - clean.torque[2]
+    assert abs(found[0]["offset"] - gap) < 0.01 * abs(gap)
+    assert abs(found[1]["offset"] + gap) < 0.01 * abs(gap)
+    assert all(abs(f["offset"]) > 100 * f["stderr"] for f in found)
+
+
 def test_a_glitch_in_a_log_is_replaced_and_reported():
     robot = pr.robots.a465()
     plan = pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2))
