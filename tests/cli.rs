@@ -416,6 +416,36 @@ fn excite_identify_direct_predict() {
     let columns = listed["torque_columns"].as_array().unwrap();
     assert_eq!(columns.len(), 6);
     assert_eq!(columns[1]["follows"], "joint3");
+    assert!(listed.get("position_range").is_none(), "{listed}");
+    // the log's positions in degrees: named as such, and the joints in validation.json
+    let mut degrees = raw.clone();
+    degrees.q.iter_mut().for_each(|q| *q = q.to_degrees());
+    write(
+        &d.join("degrees.csv"),
+        &recording_table(&degrees, "").to_csv(),
+    );
+    let warned = run(&[
+        "validate",
+        s(&d.join("base.json")),
+        s(&d.join("degrees.csv")),
+        "--robot",
+        "a465",
+        "--out",
+        s(&d.join("degrees_validation")),
+    ]);
+    assert!(
+        warned.contains("the log's positions look like degrees (convert them to rad)"),
+        "{warned}"
+    );
+    let listed: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(d.join("degrees_validation/validation.json")).unwrap(),
+    )
+    .unwrap();
+    let ranges = listed["position_range"].as_array().unwrap();
+    assert!(
+        ranges.len() >= 2 && ranges.iter().all(|r| r["degrees"] == true),
+        "{ranges:?}"
+    );
     assert!(!run(&[
         "validate",
         s(&d.join("base.json")),

@@ -539,6 +539,11 @@ class BaseParameterModel:
         torques were logged after their positions; joints, unexplained, unexplained_at_lag,
         finding), or None where not checked; a finding is also a warning."""
     @property
+    def position_range(self) -> list[dict[str, Any]]:
+        """The joints whose positions in the data leave their URDF limits by more than 5 % of
+        their range (joint, min, max, lower, upper in rad or m; degrees: True where, read as
+        degrees, they lie within the limits); their finding is also a warning."""
+    @property
     def cond(self) -> float: ...
     @property
     def samples(self) -> int: ...
@@ -672,6 +677,10 @@ class Validation:
     def torque_lag(self) -> Optional[dict[str, Any]]:
         """For a BaseParameterModel, the measured torques shifted against their positions
         (as BaseParameterModel.torque_lag); None otherwise."""
+    @property
+    def position_range(self) -> list[dict[str, Any]]:
+        """For a BaseParameterModel, the joints whose measured positions leave their limits
+        (as BaseParameterModel.position_range); empty otherwise."""
     def to_dataframe(self) -> Any:
         """The per-joint table as a pandas DataFrame (index joint; rms, relative_rms, max)."""
 

@@ -8,6 +8,7 @@ use clap::Args;
 
 use super::files::{load_robot, refuse_overwriting_inputs, PreprocessArgs};
 use super::progress::Progress;
+use crate::direct::position_range::check_position_range;
 use crate::direct::torque_columns::check_torque_columns;
 use crate::direct::torque_lag::{check_torque_lag, log_findings};
 use crate::error::{Error, Result};
@@ -37,8 +38,9 @@ pub(crate) struct ValidateArgs {
     /// per-joint table, and `log_glitches` and `log_dropouts`: the samples of the log replaced
     /// as glitches and the rows removed as dropouts before preprocessing, when there were any;
     /// for a base-parameter model `torque_columns`, each torque column of the log against the
-    /// robot's model, and `torque_lag`, its torques shifted against its positions, whose
-    /// findings are warned of) and validation.svg (measured and predicted
+    /// robot's model, `torque_lag`, its torques shifted against its positions, and
+    /// `position_range`, the joints whose positions leave their limits, whose findings are
+    /// warned of) and validation.svg (measured and predicted
     /// torques, and residuals).
     #[arg(long, default_value = "validation")]
     out: PathBuf,
@@ -84,18 +86,19 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     // the log's torque columns against the robot's own model, as every direct fit checks
     // its own log: swapped columns, another sign or other units show here by name, not only
     // as large errors
-    let (torque_columns, torque_lag) = match (&file, &robot) {
+    let (position_range, torque_columns, torque_lag) = match (&file, &robot) {
         (ModelFile::Base(fit), Some(r)) => {
             progress.update("checking the torque columns");
             (
+                check_position_range(r, &states),
                 check_torque_columns(r, &states, &rec.tau, fit.gravity)?,
                 check_torque_lag(r, &states, &rec.tau, fit.gravity)?,
             )
         }
-        _ => (vec![], None),
+        _ => (vec![], vec![], None),
     };
     progress.done();
-    for w in log_findings(&torque_columns, torque_lag.as_ref()) {
+    for w in log_findings(&position_range, &torque_columns, torque_lag.as_ref()) {
         eprintln!("perturbid: warning: log '{}': {w}", a.data.display());
     }
     // the residuals, the table and the figure, as one output set
@@ -122,6 +125,9 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     }
     if let Some(lag) = &torque_lag {
         json["torque_lag"] = serde_json::to_value(lag).expect("serialisable");
+    }
+    if !position_range.is_empty() {
+        json["position_range"] = serde_json::to_value(&position_range).expect("serialisable");
     }
     set.add(
         "validation.json",

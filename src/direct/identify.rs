@@ -108,6 +108,11 @@ pub struct BaseModel {
     /// checked (no gravity in the data, a model saved before it was checked).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub torque_lag: Option<super::torque_lag::TorqueLag>,
+    /// The joints whose positions in the data leave their URDF limits
+    /// ([`super::position_range`]): warned of ([`BaseModel::warnings`]), with positions in
+    /// degrees named as such. Empty where none do (or in a model saved before it was checked).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub position_range: Vec<super::position_range::JointRange>,
 }
 
 /// Identifies the base parameters of `model` from the samples of `states` (rad, rad/s,
@@ -261,6 +266,7 @@ fn fit_with_factors(
             options.gravity,
         )?,
         torque_lag: super::torque_lag::check_torque_lag(model, states, tau, options.gravity)?,
+        position_range: super::position_range::check_position_range(model, states),
     };
     // residuals correlated from sample to sample (a filtered, lightly decimated log) carry less
     // information than their number says
@@ -377,6 +383,16 @@ impl Document for BaseModel {
             .and_then(|l| l.problem(&m.joint_names))
         {
             return Err(invalid(Self::WHAT, format!("torque_lag: {problem}")));
+        }
+        if let Some((i, problem)) = m.position_range.iter().enumerate().find_map(|(i, r)| {
+            let unknown = (!m.joint_names.contains(&r.joint))
+                .then(|| format!("joint '{}' is not one of the model's", r.joint));
+            unknown.or_else(|| r.problem()).map(|p| (i, p))
+        }) {
+            return Err(invalid(
+                Self::WHAT,
+                format!("position_range[{i}]: {problem}"),
+            ));
         }
         check_magnitudes(Self::WHAT, "residual_rms", &m.residual_rms, false)?;
         check_magnitudes(Self::WHAT, "sigma", &m.sigma, false)?;

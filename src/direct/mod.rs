@@ -12,6 +12,7 @@ pub mod global_linear;
 pub mod identify;
 pub mod parameter_table;
 pub mod parameters;
+pub mod position_range;
 pub mod residual_correlation;
 pub mod streaming;
 pub mod torque_columns;

@@ -52,8 +52,11 @@ impl BaseModel {
     /// the data hold an effect the model lacks, or are not what it assumes. A consistent fit
     /// keeps them at zero.
     pub fn warnings(&self) -> Vec<String> {
-        let columns =
-            super::torque_lag::log_findings(&self.torque_columns, self.torque_lag.as_ref());
+        let columns = super::torque_lag::log_findings(
+            &self.position_range,
+            &self.torque_columns,
+            self.torque_lag.as_ref(),
+        );
         let negative = self
             .parameter_table()
             .into_iter()

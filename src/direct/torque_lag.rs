@@ -20,6 +20,7 @@
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
+use super::position_range::JointRange;
 use super::torque_columns::{joint_regressors, model_torques, TorqueColumn, JUDGED};
 use crate::error::Result;
 use crate::{Gravity, Model, States};
@@ -99,10 +100,16 @@ impl TorqueLag {
     }
 }
 
-/// What looks wrong with a log's torques against the robot's model: the `columns`' findings
+/// What looks wrong with a log against the robot's model: its positions beyond the joint
+/// limits (`ranges`, [`super::position_range::finding`]), the torque `columns`' findings
 /// ([`super::torque_columns::findings`]) and then the `lag`'s, if any.
-pub fn log_findings(columns: &[TorqueColumn], lag: Option<&TorqueLag>) -> Vec<String> {
-    let mut out = super::torque_columns::findings(columns);
+pub fn log_findings(
+    ranges: &[JointRange],
+    columns: &[TorqueColumn],
+    lag: Option<&TorqueLag>,
+) -> Vec<String> {
+    let mut out: Vec<String> = super::position_range::finding(ranges).into_iter().collect();
+    out.extend(super::torque_columns::findings(columns));
     out.extend(lag.and_then(TorqueLag::finding));
     out
 }

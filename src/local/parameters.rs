@@ -294,6 +294,7 @@ pub fn identify_parameters_from_local(
         // rows from local models: no log's torque columns
         torque_columns: vec![],
         torque_lag: None,
+        position_range: vec![],
     };
     let consistent = match &options.consistent {
         None => None,

@@ -16,6 +16,7 @@ use super::local::PyOperatingPoint;
 use super::robot::PyRobot;
 use super::trajectory::PyFourier;
 use crate::direct::excitation::ExcitationDesign;
+use crate::direct::position_range::JointRange;
 use crate::direct::{
     design_excitation as design_rs, identify_base_parameters as base_rs,
     identify_global_linear as global_rs, BaseModel, BaseOptions, Criterion, ExcitationOptions,
@@ -296,6 +297,14 @@ impl PyBaseModel {
             .map(|l| torque_lag_dict(py, l))
             .transpose()
     }
+    /// The joints whose positions in the data leave their URDF limits by more than 5 % of
+    /// their range: dicts `joint`, `min`, `max` (the positions logged), `lower`, `upper` (the
+    /// limits; rad or m) and `degrees` (True where, read as degrees, they lie within the
+    /// limits); their finding is also a warning. Empty where none do.
+    #[getter]
+    fn position_range<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        position_range_dicts(py, &self.fit.position_range)
+    }
     #[getter]
     fn cond(&self) -> f64 {
         self.fit.cond
@@ -443,6 +452,27 @@ pub(crate) fn torque_column_dicts<'py>(
             e.set_item("follows_explained", c.follows_explained)?;
             e.set_item("gravity_rms", c.gravity_rms)?;
             e.set_item("finding", c.finding(columns))?;
+            Ok(e)
+        })
+        .collect()
+}
+
+/// Joints whose positions leave their limits as dicts (see
+/// `BaseParameterModel.position_range`).
+pub(crate) fn position_range_dicts<'py>(
+    py: Python<'py>,
+    ranges: &[JointRange],
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    ranges
+        .iter()
+        .map(|r| {
+            let e = PyDict::new(py);
+            e.set_item("joint", &r.joint)?;
+            e.set_item("min", r.min)?;
+            e.set_item("max", r.max)?;
+            e.set_item("lower", r.lower)?;
+            e.set_item("upper", r.upper)?;
+            e.set_item("degrees", r.degrees)?;
             Ok(e)
         })
         .collect()

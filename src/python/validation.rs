@@ -7,9 +7,10 @@ use pyo3::types::PyDict;
 
 use super::arrays::{read_batch, to_numpy, ArrayLike};
 use super::detached;
-use super::direct::{torque_column_dicts, torque_lag_dict, PyBaseModel};
+use super::direct::{position_range_dicts, torque_column_dicts, torque_lag_dict, PyBaseModel};
 use super::errors::warn_all;
 use super::tables::dataframe;
+use crate::direct::position_range::{check_position_range, JointRange};
 use crate::direct::torque_columns::{check_torque_columns, TorqueColumn};
 use crate::direct::torque_lag::{check_torque_lag, log_findings, TorqueLag};
 use crate::states::States;
@@ -20,7 +21,8 @@ use crate::validation::{validate as validate_rs, Validation};
 /// `residuals` (k, n): measured - predicted (N m); `samples`; `torque_columns` (for a
 /// BaseParameterModel: the measured torque columns against its robot's model, as
 /// `BaseParameterModel.torque_columns`; empty otherwise), `torque_lag` (likewise, as
-/// `BaseParameterModel.torque_lag`; None otherwise). `to_dataframe()`: the per-joint
+/// `BaseParameterModel.torque_lag`; None otherwise), `position_range` (likewise, as
+/// `BaseParameterModel.position_range`; empty otherwise). `to_dataframe()`: the per-joint
 /// table (pandas).
 #[pyclass(name = "Validation", module = "perturbid_rs", frozen)]
 pub(crate) struct PyValidation {
@@ -28,6 +30,7 @@ pub(crate) struct PyValidation {
     n: usize,
     torque_columns: Vec<TorqueColumn>,
     torque_lag: Option<TorqueLag>,
+    position_range: Vec<JointRange>,
 }
 
 #[pymethods]
@@ -82,6 +85,13 @@ impl PyValidation {
             .as_ref()
             .map(|l| torque_lag_dict(py, l))
             .transpose()
+    }
+    /// For a BaseParameterModel, the joints whose measured positions leave their limits
+    /// (dicts as `BaseParameterModel.position_range`, their finding also a warning); empty
+    /// otherwise.
+    #[getter]
+    fn position_range<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        position_range_dicts(py, &self.position_range)
     }
     /// The per-joint table: index `joint`, columns `rms`, `relative_rms`, `max`.
     fn to_dataframe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
@@ -152,30 +162,32 @@ pub(crate) fn validate<'py>(
     let v = validate_rs(&joints, &predicted, &measured)?;
     // the measured torque columns against the robot's own model, as a direct fit checks its
     // own data
-    let (torque_columns, torque_lag) = match model.cast::<PyBaseModel>() {
+    let (position_range, torque_columns, torque_lag) = match model.cast::<PyBaseModel>() {
         Ok(base) => {
             let base = base.get();
             let (q, qd, qdd): (ArrayLike, ArrayLike, ArrayLike) =
                 (q.extract()?, qd.extract()?, qdd.extract()?);
             let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
             let c = &batch.columns;
-            let (columns, lag) = detached(model.py(), "validate", || {
+            let (ranges, columns, lag) = detached(model.py(), "validate", || {
                 let states = States::new(n, &c[0], Some(&c[1]), Some(&c[2]))?;
                 let g = base.fit.gravity;
                 Ok((
+                    check_position_range(&base.model, &states),
                     check_torque_columns(&base.model, &states, &measured, g)?,
                     check_torque_lag(&base.model, &states, &measured, g)?,
                 ))
             })?;
-            warn_all(model.py(), &log_findings(&columns, lag.as_ref()))?;
-            (columns, lag)
+            warn_all(model.py(), &log_findings(&ranges, &columns, lag.as_ref()))?;
+            (ranges, columns, lag)
         }
-        Err(_) => (vec![], None),
+        Err(_) => (vec![], vec![], None),
     };
     Ok(PyValidation {
         v,
         n,
         torque_columns,
         torque_lag,
+        position_range,
     })
 }

@@ -143,6 +143,19 @@ def test_torque_columns_are_checked_against_the_model():
     with pytest.warns(pr.PerturbidWarning, match="does not match the robot"):
         v = pr.validate(clean, np.degrees(q), np.degrees(qd), np.degrees(qdd), tau)
     assert all(c["explained"] < 0.5 and c["finding"] is None for c in v.torque_columns)
+    # ... and leave the joint limits: named as degrees, each joint's extent as numpy finds it
+    with pytest.warns(pr.PerturbidWarning, match="the log's positions look like degrees"):
+        v = pr.validate(clean, np.degrees(q), np.degrees(qd), np.degrees(qdd), tau)
+    assert v.position_range and all(r["degrees"] for r in v.position_range)
+    for r in v.position_range:
+        j = robot.joint_names.index(r["joint"])
+        assert (r["min"], r["max"]) == (np.degrees(q[:, j]).min(), np.degrees(q[:, j]).max())
+    with pytest.warns(pr.PerturbidWarning, match="look like degrees"):
+        fit = pr.identify_base_parameters(
+            robot, np.degrees(q), np.degrees(qd), np.degrees(qdd), tau, friction=None, weighting="ols"
+        )
+    assert [r["joint"] for r in fit.position_range] == [r["joint"] for r in v.position_range]
+    assert clean.position_range == [] and pr.validate(clean, q, qd, qdd, tau).position_range == []
     negated = tau.copy()
     negated[:, 2] *= -1.0
     with pytest.warns(pr.PerturbidWarning, match="joint 'joint3' reads -1.000 times"):
