@@ -211,6 +211,7 @@ fn preprocess_part(rec: &Recording, options: &PreprocessOptions) -> Result<Recor
     }
     let n = rec.n;
     let (t0, t1) = (rec.t[0], rec.t[rec.len() - 1]);
+    check_sample_interval(rec)?;
     let count = crate::limits::sample_count("preprocess", t1 - t0, o.rate, 1 + 4 * n)?;
     check_gaps(rec)?;
     let grid: Vec<f64> = (0..count).map(|i| t0 + i as f64 / o.rate).collect();
@@ -297,6 +298,29 @@ fn gaps(rec: &Recording) -> (f64, Vec<usize>) {
 /// [`MAX_GAP_INTERVALS`](crate::limits::MAX_GAP_INTERVALS) median sample intervals).
 pub(crate) fn gap_positions(rec: &Recording) -> Vec<usize> {
     gaps(rec).1
+}
+
+/// The longest median sample interval (s) of a log preprocessed: 2 Hz. No robot's dynamics
+/// are identified from slower samples, and a log whose time column is in milliseconds reads
+/// as 1 Hz.
+pub const SLOWEST_INTERVAL: f64 = 0.5;
+
+/// Refuses a log whose median sample interval is [`SLOWEST_INTERVAL`] or longer, asking
+/// whether its time is in milliseconds (it would otherwise be resampled into a log 1,000
+/// times slower than the robot moved, or refused for its size).
+fn check_sample_interval(rec: &Recording) -> Result<()> {
+    let median = gaps(rec).0;
+    if median < SLOWEST_INTERVAL {
+        return Ok(());
+    }
+    Err(Error::Recording {
+        recording: rec.name.clone(),
+        message: format!(
+            "its samples are {} s apart (the median interval; {} Hz): too slow to identify a robot's dynamics from. Is the time column in milliseconds or another unit? It is read in seconds",
+            crate::error::shown(median),
+            crate::error::shown(format!("{:.4e}", 1.0 / median).parse().unwrap_or(1.0 / median))
+        ),
+    })
 }
 
 /// Refuses a log with a gap longer than [`MAX_GAP_INTERVALS`] times its median sample

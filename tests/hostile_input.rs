@@ -419,6 +419,35 @@ fn a_gap_in_a_log_is_not_filled_with_invented_values() {
     );
 }
 
+/// A log whose time column is in milliseconds reads as samples 1 s apart: refused, asking
+/// about the unit, before it is resampled into a log 1,000 times slower than the robot moved
+/// (a short one) or refused for its size (a long one). 2.5 Hz passes this check.
+#[test]
+fn a_log_timed_in_milliseconds_is_asked_about() {
+    use perturbid_rs::preprocess::{preprocess, PreprocessOptions, SLOWEST_INTERVAL};
+    use perturbid_rs::Recording;
+    let log = |name: &str, k: usize, dt: f64| {
+        let t: Vec<f64> = (0..k).map(|i| i as f64 * dt).collect();
+        let q: Vec<f64> = t.iter().map(|x| (0.3 * x).sin()).collect();
+        Recording::new(name, 1, t, q.clone(), q, None, None).unwrap()
+    };
+    for k in [2_000, 100_000] {
+        // 2 s and 100 s at 1 kHz, timed in ms
+        let e = preprocess(&log("arm.csv", k, 1.0), &PreprocessOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("arm.csv: its samples are 1 s apart (the median interval; 1 Hz)")
+                && e.contains("Is the time column in milliseconds"),
+            "{e}"
+        );
+    }
+    assert_eq!(SLOWEST_INTERVAL, 0.5);
+    if let Err(e) = preprocess(&log("slow.csv", 200, 0.4), &PreprocessOptions::default()) {
+        assert!(!e.to_string().contains("milliseconds"), "{e}");
+    }
+}
+
 #[test]
 fn a_hand_edited_plan_is_checked_on_load() {
     let model = robots::builtin("a465").unwrap();

@@ -86,7 +86,7 @@ pub fn unmatched(columns: &[TorqueColumn]) -> Option<String> {
         .map(|c| format!("'{}' {:.0} %", c.joint, 100.0 * c.explained.max(0.0)))
         .collect();
     Some(format!(
-        "no torque column of a joint the links' weight loads follows its own joint's model ({} of what friction, an offset and a rotor's inertia leave explained; at least {:.0} % expected): the log does not match the robot (positions in degrees, swapped, or from another zero or direction; another robot's URDF; torques out of step with the positions; gravity compensated in a log fitted with it), and no parameters fitted to it describe the robot",
+        "no torque column of a joint the links' weight loads follows its own joint's model ({} of what the rest of its model torque, friction, an offset and a rotor's inertia leave explained by its gravity torque; at least {:.0} % expected): the log does not match the robot (positions in degrees, swapped, or from another zero or direction; another robot's URDF; torques out of step with the positions; gravity compensated in a log fitted with it), and no parameters fitted to it describe the robot",
         gains.join(", "),
         100.0 * JUDGED
     ))
@@ -136,7 +136,7 @@ impl TorqueColumn {
             && displaced
         {
             return Some(format!(
-                "the torque column of joint '{}' follows the model of joint '{}' ({} of what friction, an offset and a rotor's inertia leave explained, against {} by its own joint's): are the torque columns (or the position columns) swapped or mislabelled?",
+                "the torque column of joint '{}' follows the model of joint '{}' ({} of what the rest of its model torque, friction, an offset and a rotor's inertia leave explained by its gravity torque, against {} by its own joint's): are the torque columns (or the position columns) swapped or mislabelled?",
                 self.joint,
                 self.follows,
                 percent(self.follows_explained),
@@ -152,7 +152,7 @@ impl TorqueColumn {
         }
         if self.scale < 0.0 {
             return Some(format!(
-                "the torque of joint '{}' reads {} times the robot's model torque ({} of what friction, an offset and a rotor's inertia leave explained): the log's sign convention is the opposite of the model's; negate the column",
+                "the torque of joint '{}' reads {} times the robot's model torque ({} of what the rest of its model torque, friction, an offset and a rotor's inertia leave explained by its gravity torque): the log's sign convention is the opposite of the model's; negate the column",
                 self.joint,
                 scale_shown(self.scale, 3),
                 percent(self.explained)
@@ -160,7 +160,7 @@ impl TorqueColumn {
         }
         if !(1.0 / SCALE_LIMIT..=SCALE_LIMIT).contains(&self.scale) {
             return Some(format!(
-                "the torque of joint '{}' reads {} times the robot's model torque ({} of what friction, an offset and a rotor's inertia leave explained): torques are expected in N m (N for a prismatic joint) at the joint, after any gear; check the column's units (mN m, a current) and the URDF's masses",
+                "the torque of joint '{}' reads {} times the robot's model torque ({} of what the rest of its model torque, friction, an offset and a rotor's inertia leave explained by its gravity torque): torques are expected in N m (N for a prismatic joint) at the joint, after any gear; check the column's units (mN m, a current) and the URDF's masses",
                 self.joint,
                 scale_shown(self.scale, 4),
                 percent(self.explained)
