@@ -804,8 +804,8 @@ fn a_torque_channel_that_does_not_change_is_warned_about() {
 
 /// Torques that do not return to T* between an experiment's perturbations: torque columns
 /// swapped in one recording, or one offset, are found with the joints and named (a swap as
-/// such; one in the nominal recording by G and D alike), listed in the diagnostics and kept
-/// through JSON; a clean rehearsal, and a channel stuck at one value (reported as unmeasured),
+/// such; one in the nominal recording by G and D alike; in H only a swap), listed in the
+/// diagnostics and kept through JSON; a clean rehearsal, and a channel stuck at one value (reported as unmeasured),
 /// have none. Without +- pairs the warning says the offset biases the estimate.
 #[test]
 fn torques_that_do_not_return_to_t_star_are_found() {
@@ -883,6 +883,21 @@ fn torques_that_do_not_return_to_t_star_are_found() {
         back.diagnostics.torque_offsets,
         m.diagnostics.torque_offsets
     );
+    // in H only swaps are findings (its velocity-squared terms give an intercept of their
+    // own): joints 3 and 6 swapped there are found, the shoulder 0.5 N m higher is not
+    let m = edited("H", &swap(2, 5));
+    assert_eq!(offsets(&m), pairs(&[("H", "joint3"), ("H", "joint6")]));
+    assert!(
+        says(&m, "their rows of H* are each other's"),
+        "{:?}",
+        m.diagnostics.warnings
+    );
+    let m = edited("H", &|r: &mut Recording| {
+        for i in 0..r.t.len() {
+            r.tau[i * n + 1] += 0.5;
+        }
+    });
+    assert!(offsets(&m).is_empty(), "{:?}", m.diagnostics.torque_offsets);
     // the shoulder's torque 0.5 N m higher in G: an offset, no swap
     let m = edited("G", &|r: &mut Recording| {
         for i in 0..r.t.len() {
@@ -903,6 +918,8 @@ fn torques_that_do_not_return_to_t_star_are_found() {
         pairs(&[
             ("G", "joint2"),
             ("G", "joint3"),
+            ("H", "joint2"),
+            ("H", "joint3"),
             ("D", "joint2"),
             ("D", "joint3")
         ])
@@ -910,7 +927,7 @@ fn torques_that_do_not_return_to_t_star_are_found() {
     assert!(
         says(
             &m,
-            "experiments 'G' and 'D' find the same torque offsets of 'joint2', 'joint3'"
+            "experiments 'G', 'H' and 'D' find the same torque offsets of 'joint2', 'joint3'"
         ) && says(&m, "the nominal recording"),
         "{:?}",
         m.diagnostics.warnings
@@ -956,6 +973,16 @@ fn torques_that_do_not_return_to_t_star_are_found() {
     assert!(e.contains("joint 'joint9'"), "{e}");
 }
 
+/// The error of loading the plan saved as `text` after the edit `f` (which must be refused).
+fn refused_plan_edit(text: &str, f: &dyn Fn(&mut serde_json::Value)) -> String {
+    let mut v: serde_json::Value = serde_json::from_str(text).unwrap();
+    f(&mut v);
+    Plan::from_json(&v.to_string())
+        .map(|_| ())
+        .unwrap_err()
+        .to_string()
+}
+
 /// A plan read from a file is what the robot will run: a hand edit that makes its trajectory
 /// jump, leave f64's range, start moving, or disagree with its crossings is refused with the
 /// experiment, segment or crossing and joint; a plan made for wider limits than the robot's is
@@ -966,14 +993,7 @@ fn hand_edited_plans_are_refused_where_they_break_the_trajectory() {
     let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
     let text = plan.to_json();
     assert!(Plan::from_json(&text).is_ok());
-    let edited = |f: &dyn Fn(&mut serde_json::Value)| {
-        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
-        f(&mut v);
-        Plan::from_json(&v.to_string())
-            .map(|_| ())
-            .unwrap_err()
-            .to_string()
-    };
+    let edited = |f: &dyn Fn(&mut serde_json::Value)| refused_plan_edit(&text, f);
     // D's fourth segment with one coefficient changed: a jump at one of its ends
     let e = edited(&|v| {
         let c = &mut v["experiments"][4]["trajectory"]["segments"][3]["coeffs"][2][4];
@@ -1041,14 +1061,7 @@ fn hand_edited_plans_are_refused_where_their_parts_disagree() {
     let model = a465::model("kinsheel2010").unwrap();
     let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
     let text = plan.to_json();
-    let edited = |f: &dyn Fn(&mut serde_json::Value)| {
-        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
-        f(&mut v);
-        Plan::from_json(&v.to_string())
-            .map(|_| ())
-            .unwrap_err()
-            .to_string()
-    };
+    let edited = |f: &dyn Fn(&mut serde_json::Value)| refused_plan_edit(&text, f);
     let names: Vec<&str> = plan.experiments.iter().map(|e| e.kind.name()).collect();
     assert_eq!(names, ["nominal", "G_static", "G", "H", "D"]);
     // H's perturbation of joint 3 at its fourth crossing, not its crossing

@@ -16,9 +16,10 @@
 //! standard error counts the base's own noise, common to every row). A joint's is a finding
 //! where it exceeds [`STANDARD_ERRORS`] of its standard errors and a fraction of the largest
 //! torque of the base (`T*`, or G-static's reference; [`fraction`]). D, G and G-static are
-//! judged: D's torques are linear in the accelerations, and gravity's curvature over G's
-//! position perturbations is a small fraction of it. H is not: its velocity-squared terms give
-//! an intercept of their own, which can exceed `T*` itself in a gravity-compensated log.
+//! judged so: D's torques are linear in the accelerations, and gravity's curvature over G's
+//! position perturbations is a small fraction of it. In H only swaps are findings: its
+//! velocity-squared terms give an intercept of their own, which can exceed `T*` itself in a
+//! gravity-compensated log, but not two joints each off by the other's `T*`.
 
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
@@ -31,9 +32,10 @@ use crate::error::shown;
 pub const STANDARD_ERRORS: f64 = 10.0;
 
 /// The fraction of the base's largest torque an intercept of experiment `kind` must exceed to
-/// be a finding, or None where the experiment is not judged (the nominal one, H): above the
-/// rounding of D's exactly linear torques (1e-3), above the curvature of gravity over G's and
-/// G-static's position perturbations (0.02; 1e-3 of the torque at the Panda's).
+/// be a finding on its own, or None where only swaps are (H, whose velocity-squared terms give
+/// an intercept of their own; the nominal experiment has none): above the rounding of D's
+/// exactly linear torques (1e-3), above the curvature of gravity over G's and G-static's
+/// position perturbations (0.02; 1e-3 of the torque at the Panda's).
 pub fn fraction(kind: ExperimentKind) -> Option<f64> {
     match kind {
         ExperimentKind::D => Some(1e-3),
@@ -96,31 +98,47 @@ pub fn intercepts(x: &DMatrix<f64>, y: &DMatrix<f64>, base_var: &[f64]) -> Vec<O
 }
 
 /// The findings among `intercepts` (per joint) of experiment `kind`, whose base torques (`T*`,
-/// or G-static's reference) are `base` (N m); none for an experiment not judged.
+/// or G-static's reference) are `base` (N m): beyond [`STANDARD_ERRORS`] and the experiment's
+/// [`fraction`]; in H only the pairs of joints each off by the other's `T*` (a swap of their
+/// columns, [`swapped_pairs`]), whose pattern its velocity-squared terms do not mimic. None
+/// for the nominal experiment.
 pub fn findings(
     kind: ExperimentKind,
     joint_names: &[String],
     intercepts: &[Option<(f64, f64)>],
     base: &[f64],
 ) -> Vec<TorqueOffset> {
-    let Some(fraction) = fraction(kind) else {
+    if kind == ExperimentKind::Nominal {
         return vec![];
-    };
+    }
+    let lone = fraction(kind);
     let scale = base.iter().fold(0.0f64, |m, t| m.max(t.abs()));
-    joint_names
+    let found: Vec<TorqueOffset> = joint_names
         .iter()
         .zip(intercepts)
         .filter_map(|(joint, found)| {
             let (offset, stderr) = (*found)?;
-            (offset.abs() > STANDARD_ERRORS * stderr && offset.abs() > fraction * scale).then(
-                || TorqueOffset {
-                    experiment: kind.name().to_string(),
-                    joint: joint.clone(),
-                    offset,
-                    stderr,
-                },
-            )
+            let beyond = offset.abs() > lone.unwrap_or(0.0) * scale;
+            (offset.abs() > STANDARD_ERRORS * stderr && beyond).then(|| TorqueOffset {
+                experiment: kind.name().to_string(),
+                joint: joint.clone(),
+                offset,
+                stderr,
+            })
         })
+        .collect();
+    if lone.is_some() {
+        return found;
+    }
+    let swapped: Vec<&String> = swapped_pairs(kind, &found, joint_names, base)
+        .into_iter()
+        .flat_map(|(a, b)| [&a.joint, &b.joint])
+        .collect();
+    let keep: Vec<bool> = found.iter().map(|t| swapped.contains(&&t.joint)).collect();
+    found
+        .into_iter()
+        .zip(keep)
+        .filter_map(|(t, k)| k.then_some(t))
         .collect()
 }
 
@@ -219,25 +237,56 @@ pub fn warning(
     Some(text)
 }
 
-/// The warning where G and D (both measured against `T*`) find the same offset of the same
-/// joints (within a tenth and three standard errors each): then the nominal recording, whose
-/// torques give `T*`, is the one that differs.
+/// The warning where two or more of G, H and D (each measured against `T*`) find the same
+/// offset of the same joints (within a tenth and three standard errors each): then the
+/// nominal recording, whose torques give `T*`, is the one that differs.
 pub fn nominal_warning(found: &[TorqueOffset]) -> Option<String> {
-    let of = |kind: ExperimentKind| found.iter().filter(move |t| t.experiment == kind.name());
-    let common: Vec<String> = of(ExperimentKind::GDynamic)
-        .filter(|g| {
-            of(ExperimentKind::D).any(|d| {
-                d.joint == g.joint
-                    && (d.offset - g.offset).abs()
-                        <= 0.1 * d.offset.abs().max(g.offset.abs()) + 3.0 * (d.stderr + g.stderr)
-            })
-        })
-        .map(|g| format!("'{}'", g.joint))
+    let moving = [
+        ExperimentKind::GDynamic,
+        ExperimentKind::H,
+        ExperimentKind::D,
+    ]
+    .map(|k| k.name());
+    let agree = |a: &TorqueOffset, b: &TorqueOffset| {
+        a.joint == b.joint
+            && (a.offset - b.offset).abs()
+                <= 0.1 * a.offset.abs().max(b.offset.abs()) + 3.0 * (a.stderr + b.stderr)
+    };
+    let mut joints: Vec<String> = vec![];
+    let mut experiments: Vec<&str> = vec![];
+    for t in found
+        .iter()
+        .filter(|t| moving.contains(&t.experiment.as_str()))
+    {
+        let alike: Vec<&str> = found
+            .iter()
+            .filter(|o| moving.contains(&o.experiment.as_str()) && agree(t, o))
+            .map(|o| o.experiment.as_str())
+            .collect();
+        let joint = format!("'{}'", t.joint);
+        if alike.len() >= 2 && !joints.contains(&joint) {
+            joints.push(joint);
+            experiments.extend(
+                alike
+                    .iter()
+                    .filter(|e| !experiments.contains(e))
+                    .collect::<Vec<_>>(),
+            );
+        }
+    }
+    if joints.is_empty() {
+        return None;
+    }
+    // in the plan's order of kinds
+    let named: Vec<String> = moving
+        .iter()
+        .filter(|k| experiments.contains(k))
+        .map(|k| format!("'{k}'"))
         .collect();
-    (!common.is_empty()).then(|| {
-        format!(
-            "experiments 'G' and 'D' find the same torque offsets of {} against T*: the nominal recording, whose torques give T*, is the one that differs from the others (and with it T*)",
-            common.join(", ")
-        )
-    })
+    let (last, rest) = named.split_last()?;
+    Some(format!(
+        "experiments {} and {last} find the same torque offsets of {} against T*: the nominal recording, whose torques give T*, is the one that differs from the others (and with it T*)",
+        rest.join(", "),
+        joints.join(", ")
+    ))
 }

@@ -281,16 +281,26 @@ def test_suggested_operating_points_reach_every_base_parameter():
         pr.suggest_operating_points(robot, candidates=0)
 
 
+def with_torques(recs, experiment, edit):
+    """The recordings `recs` with `edit` applied in place to a copy of `experiment`'s torques."""
+    out = []
+    for r in recs:
+        tau = r.tau.copy()
+        if r.experiment == experiment:
+            edit(tau)
+        out.append(pr.Recording(r.t, r.q, tau, name=r.name, experiment=r.experiment))
+    return out
+
+
 def test_a_dead_torque_channel_is_warned_about_and_marked_unmeasured():
     robot = pr.robots.a465()
     plan = pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2))
     recs = pr.simulate(robot, plan, torque_noise=0.01, seed=3)
-    stuck = []
-    for r in recs:
-        tau = r.tau.copy()
-        if r.experiment == "D":
-            tau[:, 2] = 12.5
-        stuck.append(pr.Recording(r.t, r.q, tau, name=r.name, experiment=r.experiment))
+
+    def stick(tau):
+        tau[:, 2] = 12.5
+
+    stuck = with_torques(recs, "D", stick)
     with pytest.warns(pr.PerturbidWarning, match="experiment 'D': the torque of joint 'joint3' \\(12.5 N m\\) reads the same value"):
         model = pr.identify_local(plan, stuck)
     assert model.diagnostics["unmeasured"] == [{"experiment": "D", "joint": "joint3", "value": 12.5}]
@@ -305,12 +315,11 @@ def test_torque_columns_swapped_in_one_recording_are_named():
     robot = pr.robots.a465()
     plan = pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2))
     recs = pr.simulate(robot, plan, torque_noise=0.01, seed=3)
-    swapped = []
-    for r in recs:
-        tau = r.tau.copy()
-        if r.experiment == "G":
-            tau[:, [2, 5]] = tau[:, [5, 2]]
-        swapped.append(pr.Recording(r.t, r.q, tau, name=r.name, experiment=r.experiment))
+
+    def swap(tau):
+        tau[:, [2, 5]] = tau[:, [5, 2]]
+
+    swapped = with_torques(recs, "G", swap)
     with pytest.warns(pr.PerturbidWarning, match="'joint3' and 'joint6' are off by each other's T\\*"):
         model = pr.identify_local(plan, swapped)
     found = model.diagnostics["torque_offsets"]
