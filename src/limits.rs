@@ -31,6 +31,11 @@ pub const MAX_EVALUATIONS: usize = 10_000_000;
 pub const MAX_TEXT_BYTES: u64 = 2 << 30;
 /// Bytes read from one document (JSON, TOML, URDF): 256 MiB, far past any plan, model or robot.
 pub const MAX_DOCUMENT_BYTES: u64 = 256 << 20;
+/// A number of a saved local model (a torque, an entry of D*, H*, G*, Gs or their standard
+/// errors, a state of its operating point): at most 10^9 in size, beyond any robot's. Larger
+/// ones are hand edits or corruption, and would overflow the fits that read them (their squares
+/// summed over rows).
+pub const MAX_MODEL_VALUE: f64 = 1e9;
 /// A simulated sensor's noise: torque noise up to 10^6 N m (a slip of the exponent is an error,
 /// not a recording of noise).
 pub const MAX_TORQUE_NOISE: f64 = 1e6;

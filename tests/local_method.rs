@@ -681,6 +681,23 @@ fn unknown_standard_errors_survive_a_json_round_trip() {
     let back = LocalModel::from_json(&text).unwrap();
     assert!(back.d.as_ref().unwrap().stderr.iter().all(|s| s.is_nan()));
     assert_eq!(back.d.as_ref().unwrap().matrix, d.matrix);
+    // a number beyond any robot's (a slip of the exponent, corruption) is refused by entry:
+    // one such entry of D* disabled the block's other rows in the parameters fit and left
+    // residuals of 1e19 without a word
+    let value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    type Edit = fn(&mut serde_json::Value);
+    let edits: [(Edit, &str); 3] = [
+        (
+            |v| v["d"]["matrix"][5][1] = 1e20.into(),
+            "d.matrix[5][1] is 1e20; numbers of a local model are at most 1e9 in size",
+        ),
+        (
+            |v| v["torque"][2] = (-2e9).into(),
+            "torque[2] is -2e9; numbers",
+        ),
+        (|v| v["op"]["q"][0] = 1e300.into(), "op.q[0] is 1e300"),
+    ];
+    common::refused_on_load::<LocalModel>(&value, &edits);
 }
 
 /// The warning about a D* no mass matrix has (tested on constructed estimates in

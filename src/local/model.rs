@@ -154,6 +154,29 @@ impl Document for LocalModel {
         }
         // standard errors and residuals are magnitudes: unknown (NaN, `null`) or >= 0
         check_magnitudes(Self::WHAT, "torque_stderr", &m.torque_stderr, true)?;
+        // and no number beyond any robot's
+        let bounded = |field: &str, values: &mut dyn Iterator<Item = f64>| -> Result<()> {
+            let limit = crate::limits::MAX_MODEL_VALUE;
+            match values.enumerate().find(|(_, v)| v.abs() > limit) {
+                Some((k, v)) => Err(bad(format!(
+                    "{field}[{k}] is {}; numbers of a local model are at most {limit:e} in size (beyond any robot's)",
+                    crate::error::shown(v)
+                ))),
+                None => Ok(()),
+            }
+        };
+        for (field, v) in [
+            ("torque", &m.torque),
+            ("torque_stderr", &m.torque_stderr),
+            ("op.q", &m.op.q),
+            ("op.qd", &m.op.qd),
+            ("op.qdd", &m.op.qdd),
+            ("planned_op.q", &m.planned_op.q),
+            ("planned_op.qd", &m.planned_op.qd),
+            ("planned_op.qdd", &m.planned_op.qdd),
+        ] {
+            bounded(field, &mut v.iter().copied())?;
+        }
         for (what, e, cols) in [
             ("D", &m.d, n),
             ("H", &m.h, n),
@@ -171,6 +194,14 @@ impl Document for LocalModel {
                 check_magnitude_rows(Self::WHAT, &format!("{what}.stderr"), &e.stderr, true)?;
                 let rms = format!("{what}.residual_rms");
                 check_magnitudes(Self::WHAT, &rms, &e.residual_rms, false)?;
+                for (field, x) in [("matrix", &e.matrix), ("stderr", &e.stderr)] {
+                    // by rows, as the file lists them
+                    for i in 0..x.nrows() {
+                        let row = format!("{}.{field}[{i}]", what.to_lowercase());
+                        bounded(&row, &mut x.row(i).iter().copied())?;
+                    }
+                }
+                bounded(&rms, &mut e.residual_rms.iter().copied())?;
                 check_condition(Self::WHAT, &format!("{what}.cond"), e.cond)?;
             }
         }
