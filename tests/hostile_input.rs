@@ -851,8 +851,16 @@ fn model_documents_hold_magnitudes_where_they_say_so() {
     }
     // an unknown standard error (null) is fine
     edit(&|v| v["d"]["stderr"][0][0] = serde_json::Value::Null).unwrap();
-    // D* with an entry of 1e308: a prediction away from the operating point overflows
-    let huge = edit(&|v| v["d"]["matrix"][0][0] = serde_json::json!(1e308)).unwrap();
+    // D* with an entry of 1e308: refused on load, beyond any robot's; built in memory, a
+    // prediction away from the operating point overflows and is refused
+    let e = edit(&|v| v["d"]["matrix"][0][0] = serde_json::json!(1e308)).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("d.matrix[0][0] is 1e308; numbers of a local model are at most 1e9"),
+        "{e}"
+    );
+    let mut huge = edit(&|_| {}).unwrap();
+    huge.d.as_mut().unwrap().matrix[(0, 0)] = 1e308;
     let qdd: Vec<f64> = TABLE2_QDD.iter().map(|a| a + 10.0).collect();
     let states = States::single(6, &TABLE2_Q, Some(&TABLE2_QD), Some(&qdd)).unwrap();
     let e = huge.predict(&states).unwrap_err();
@@ -892,6 +900,41 @@ fn model_documents_hold_magnitudes_where_they_say_so() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("sigma[4] is -0.1"), "{e}");
+    // its parameter map and layout: sizes, each parameter once, numbers within any robot's
+    let value: serde_json::Value = serde_json::from_str(&fit.to_json()).unwrap();
+    type Edit = fn(&mut serde_json::Value);
+    let edits: [(Edit, &str); 5] = [
+        (
+            |v| v["base"]["layout"]["nv"] = serde_json::json!(9223372036854775807u64),
+            "base.layout is for 9223372036854775807 joints",
+        ),
+        (
+            |v| v["base"]["layout"]["nbodies"] = serde_json::json!(7),
+            "7 bodies with joint terms [",
+        ),
+        (
+            |v| v["base"]["dropped"][0] = v["base"]["kept"][0].clone(),
+            "must list each of the",
+        ),
+        (
+            |v| v["base"]["k"][0][0] = serde_json::json!(1e300),
+            "base.k holds 1e300; numbers of a base-parameter model are at most 1e9",
+        ),
+        (
+            |v| v["theta"][2] = serde_json::json!(-1e20),
+            "theta holds -1e20",
+        ),
+    ];
+    common::refused_on_load::<BaseModel>(&value, &edits);
+    // a parameter renamed: the model is refused on another robot's, and on its own
+    let mut v = value.clone();
+    v["base"]["layout"]["names"][0] = serde_json::json!("link9.m");
+    let renamed = BaseModel::from_json(&v.to_string()).unwrap();
+    let e = renamed.predict(&model, &states).unwrap_err().to_string();
+    assert!(
+        e.contains("the model's parameters are not the robot's: 'link9.m' where"),
+        "{e}"
+    );
 }
 
 /// Files are read only up to a bound: a document larger than 256 MiB is refused before it is

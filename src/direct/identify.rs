@@ -308,6 +308,58 @@ impl Document for BaseModel {
             ));
         }
         let n = m.joint_names.len();
+        let layout = &m.base.layout;
+        let expected = 10 * layout.nbodies + layout.nv * layout.friction.names().len();
+        if layout.nv != n || layout.names.len() != expected {
+            return Err(invalid(
+                Self::WHAT,
+                format!(
+                    "base.layout is for {} joints and {} bodies with joint terms [{}]: {expected} parameter names expected, {} given, for a model of {n} joints",
+                    layout.nv,
+                    layout.nbodies,
+                    layout.friction.names().join(", "),
+                    layout.names.len()
+                ),
+            ));
+        }
+        // kept and dropped: each parameter once, in ascending order
+        let ascending = |v: &[usize]| v.windows(2).all(|w| w[0] < w[1]);
+        let mut seen = vec![false; layout.len()];
+        let each_once = m
+            .base
+            .kept
+            .iter()
+            .chain(&m.base.dropped)
+            .all(|&i| i < seen.len() && !std::mem::replace(&mut seen[i], true));
+        if !(ascending(&m.base.kept) && ascending(&m.base.dropped) && each_once) {
+            return Err(invalid(
+                Self::WHAT,
+                format!(
+                    "base.kept and base.dropped must list each of the {} parameters once, each in ascending order",
+                    layout.len()
+                ),
+            ));
+        }
+        // no number beyond any robot's
+        let limit = crate::limits::MAX_MODEL_VALUE;
+        let k: Vec<f64> = m.base.k.iter().copied().collect();
+        for (field, values) in [
+            ("theta", &m.theta),
+            ("stderr", &m.stderr),
+            ("sigma", &m.sigma),
+            ("residual_rms", &m.residual_rms),
+            ("base.k", &k),
+        ] {
+            if let Some(i) = values.iter().position(|v| v.abs() > limit) {
+                return Err(invalid(
+                    Self::WHAT,
+                    format!(
+                        "{field} holds {}; numbers of a base-parameter model are at most {limit:e} in size (beyond any robot's)",
+                        crate::error::shown(values[i])
+                    ),
+                ));
+            }
+        }
         if m.residual_rms.len() != n || m.sigma.len() != n {
             return Err(invalid(
                 Self::WHAT,
@@ -422,6 +474,24 @@ impl BaseModel {
                     "the model was identified for '{}' with joints [{}]",
                     self.robot,
                     self.joint_names.join(", ")
+                ),
+            });
+        }
+        // the parameters are named after the robot's links and joints, in its order
+        let own = ParameterLayout::new(model, self.base.layout.friction);
+        if let Some((saved, robot)) = self
+            .base
+            .layout
+            .names
+            .iter()
+            .zip(&own.names)
+            .find(|(a, b)| a != b)
+        {
+            return Err(Error::InvalidArgument {
+                argument: "robot".into(),
+                message: format!(
+                    "the model's parameters are not the robot's: '{saved}' where '{}' has '{robot}' (the model was identified for '{}')",
+                    model.name, self.robot
                 ),
             });
         }
