@@ -45,6 +45,7 @@ pub mod operating_point;
 pub mod parameters;
 pub mod perturbation;
 pub mod plan;
+mod plan_checks;
 pub mod point_design;
 pub mod quantisation;
 pub mod rounded_positions;
