@@ -151,10 +151,64 @@ pub(crate) fn check_magnitude_rows(
     m: &nalgebra::DMatrix<f64>,
     unknown_ok: bool,
 ) -> Result<()> {
-    let (rows, cols) = m.shape();
-    let row_major = (0..rows).flat_map(|i| (0..cols).map(move |j| m[(i, j)]));
-    let at = |k: usize| format!("{field}[{}][{}]", k / cols.max(1), k % cols.max(1));
+    let (row_major, at) = by_rows(field, m);
     check_magnitudes_at(what, row_major, at, unknown_ok)
+}
+
+/// The entries of a matrix saved as a list of rows, in the file's order, with the name of
+/// the `k`-th (`field[row][column]`, 0-based).
+fn by_rows<'a>(
+    field: &'a str,
+    m: &'a nalgebra::DMatrix<f64>,
+) -> (
+    impl Iterator<Item = f64> + 'a,
+    impl Fn(usize) -> String + 'a,
+) {
+    let (rows, cols) = m.shape();
+    let row_major = (0..rows).flat_map(move |i| (0..cols).map(move |j| m[(i, j)]));
+    let at = move |k: usize| format!("{field}[{}][{}]", k / cols.max(1), k % cols.max(1));
+    (row_major, at)
+}
+
+/// Checks that no value of the field `field` of a saved model `what` (one of `kind`: "a local
+/// model") is beyond [`crate::limits::MAX_MODEL_VALUE`] in size: a slip of the exponent or
+/// corruption, which would otherwise pass into fits and predictions unseen. NaN (an unknown,
+/// `null`) is left to the field's own check. Errors name the entry (`field[3]`).
+pub(crate) fn check_bounded(what: &str, kind: &str, field: &str, values: &[f64]) -> Result<()> {
+    check_bounded_at(what, kind, values.iter().copied(), |k| {
+        format!("{field}[{k}]")
+    })
+}
+
+/// [`check_bounded`] for a matrix saved as a list of rows (`field[row][column]` in errors).
+pub(crate) fn check_bounded_rows(
+    what: &str,
+    kind: &str,
+    field: &str,
+    m: &nalgebra::DMatrix<f64>,
+) -> Result<()> {
+    let (row_major, at) = by_rows(field, m);
+    check_bounded_at(what, kind, row_major, at)
+}
+
+fn check_bounded_at(
+    what: &str,
+    kind: &str,
+    values: impl Iterator<Item = f64>,
+    at: impl Fn(usize) -> String,
+) -> Result<()> {
+    let limit = crate::limits::MAX_MODEL_VALUE;
+    match values.enumerate().find(|(_, v)| v.abs() > limit) {
+        Some((k, v)) => Err(invalid(
+            what,
+            format!(
+                "{} is {}; numbers of {kind} are at most {limit:e} in size (beyond any robot's)",
+                at(k),
+                crate::error::shown(v)
+            ),
+        )),
+        None => Ok(()),
+    }
 }
 
 fn check_magnitudes_at(

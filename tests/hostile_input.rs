@@ -918,11 +918,11 @@ fn model_documents_hold_magnitudes_where_they_say_so() {
         ),
         (
             |v| v["base"]["k"][0][0] = serde_json::json!(1e300),
-            "base.k holds 1e300; numbers of a base-parameter model are at most 1e9",
+            "base.k[0][0] is 1e300; numbers of a base-parameter model are at most 1e9",
         ),
         (
             |v| v["theta"][2] = serde_json::json!(-1e20),
-            "theta holds -1e20",
+            "theta[2] is -1e20",
         ),
     ];
     common::refused_on_load::<BaseModel>(&value, &edits);

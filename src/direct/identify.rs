@@ -8,7 +8,9 @@ use super::base::{BaseParameters, BASE_TOLERANCE};
 use super::parameters::{regressor_blocks, FrictionTerms, ParameterLayout};
 use super::streaming;
 use crate::choice::choice;
-use crate::document::{check_condition, check_magnitudes, invalid, Document};
+use crate::document::{
+    check_bounded, check_bounded_rows, check_condition, check_magnitudes, invalid, Document,
+};
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
@@ -341,25 +343,16 @@ impl Document for BaseModel {
             ));
         }
         // no number beyond any robot's
-        let limit = crate::limits::MAX_MODEL_VALUE;
-        let k: Vec<f64> = m.base.k.iter().copied().collect();
+        let kind = "a base-parameter model";
         for (field, values) in [
             ("theta", &m.theta),
             ("stderr", &m.stderr),
             ("sigma", &m.sigma),
             ("residual_rms", &m.residual_rms),
-            ("base.k", &k),
         ] {
-            if let Some(i) = values.iter().position(|v| v.abs() > limit) {
-                return Err(invalid(
-                    Self::WHAT,
-                    format!(
-                        "{field} holds {}; numbers of a base-parameter model are at most {limit:e} in size (beyond any robot's)",
-                        crate::error::shown(values[i])
-                    ),
-                ));
-            }
+            check_bounded(Self::WHAT, kind, field, values.as_slice())?;
         }
+        check_bounded_rows(Self::WHAT, kind, "base.k", &m.base.k)?;
         if m.residual_rms.len() != n || m.sigma.len() != n {
             return Err(invalid(
                 Self::WHAT,

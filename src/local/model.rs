@@ -8,7 +8,8 @@ use super::diagnostics::Diagnostics;
 use super::operating_point::OperatingPoint;
 use crate::choice::choice;
 use crate::document::{
-    check_condition, check_magnitude, check_magnitude_rows, check_magnitudes, invalid, Document,
+    check_bounded, check_bounded_rows, check_condition, check_magnitude, check_magnitude_rows,
+    check_magnitudes, invalid, Document,
 };
 use crate::error::{Error, Result};
 use crate::states::States;
@@ -155,16 +156,7 @@ impl Document for LocalModel {
         // standard errors and residuals are magnitudes: unknown (NaN, `null`) or >= 0
         check_magnitudes(Self::WHAT, "torque_stderr", &m.torque_stderr, true)?;
         // and no number beyond any robot's
-        let bounded = |field: &str, values: &mut dyn Iterator<Item = f64>| -> Result<()> {
-            let limit = crate::limits::MAX_MODEL_VALUE;
-            match values.enumerate().find(|(_, v)| v.abs() > limit) {
-                Some((k, v)) => Err(bad(format!(
-                    "{field}[{k}] is {}; numbers of a local model are at most {limit:e} in size (beyond any robot's)",
-                    crate::error::shown(v)
-                ))),
-                None => Ok(()),
-            }
-        };
+        let kind = "a local model";
         for (field, v) in [
             ("torque", &m.torque),
             ("torque_stderr", &m.torque_stderr),
@@ -175,7 +167,7 @@ impl Document for LocalModel {
             ("planned_op.qd", &m.planned_op.qd),
             ("planned_op.qdd", &m.planned_op.qdd),
         ] {
-            bounded(field, &mut v.iter().copied())?;
+            check_bounded(Self::WHAT, kind, field, v.as_slice())?;
         }
         for (what, e, cols) in [
             ("D", &m.d, n),
@@ -195,13 +187,10 @@ impl Document for LocalModel {
                 let rms = format!("{what}.residual_rms");
                 check_magnitudes(Self::WHAT, &rms, &e.residual_rms, false)?;
                 for (field, x) in [("matrix", &e.matrix), ("stderr", &e.stderr)] {
-                    // by rows, as the file lists them
-                    for i in 0..x.nrows() {
-                        let row = format!("{}.{field}[{i}]", what.to_lowercase());
-                        bounded(&row, &mut x.row(i).iter().copied())?;
-                    }
+                    let field = format!("{}.{field}", what.to_lowercase());
+                    check_bounded_rows(Self::WHAT, kind, &field, x)?;
                 }
-                bounded(&rms, &mut e.residual_rms.iter().copied())?;
+                check_bounded(Self::WHAT, kind, &rms, e.residual_rms.as_slice())?;
                 check_condition(Self::WHAT, &format!("{what}.cond"), e.cond)?;
             }
         }
