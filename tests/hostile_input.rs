@@ -935,6 +935,39 @@ fn model_documents_hold_magnitudes_where_they_say_so() {
         e.contains("the model's parameters are not the robot's: 'link9.m' where"),
         "{e}"
     );
+    // its base parameters are combinations that hold for one robot's kinematics: on a robot
+    // with the same names but link 3 a millimetre longer it is refused, naming a column; on
+    // one with other inertias and the same kinematics it is used
+    let text = perturbid_rs::robots::a465::urdf("kinsheel2010").unwrap();
+    let (from, to) = ("xyz=\"0 0 0.3048\"", "xyz=\"0 0 0.3058\"");
+    assert_eq!(text.matches(from).count(), 1);
+    let longer = model_from_urdf_str(
+        &text.replace(from, to),
+        "a465.urdf",
+        &LoadOptions::default(),
+    )
+    .unwrap();
+    let e = fit.predict(&longer, &states).unwrap_err().to_string();
+    assert!(
+        e.contains("the saved base parameters do not hold for 'a465_kinsheel2010': its regressor's column 'link3.m' differs from the combination"),
+        "{e}"
+    );
+    assert!(
+        e.contains("Was the model identified on other kinematics"),
+        "{e}"
+    );
+    let other_inertias = perturbid_rs::robots::a465::model("physical").unwrap();
+    assert_eq!(other_inertias.joint_names, model.joint_names);
+    assert!(fit.predict(&other_inertias, &states).is_ok());
+    // and a combination edited by 1 % in the file is refused the same way
+    let (i, d) = fit.base.k.iamax_full();
+    let mut v = value.clone();
+    v["base"]["k"][i][d] = serde_json::json!(fit.base.k[(i, d)] * 1.01);
+    let edited = BaseModel::from_json(&v.to_string()).unwrap();
+    let e = edited.predict(&model, &states).unwrap_err().to_string();
+    assert!(e.contains("the saved base parameters do not hold"), "{e}");
+    assert!(edited.mass_matrix(&model, &TABLE2_Q).is_err());
+    assert!(fit.mass_matrix(&model, &TABLE2_Q).is_ok());
 }
 
 /// Files are read only up to a bound: a document larger than 256 MiB is refused before it is

@@ -34,6 +34,44 @@ pub struct BaseParameters {
 /// Default relative rank tolerance of the pivoted QR.
 pub const BASE_TOLERANCE: f64 = 1e-8;
 
+/// The random states at which [`BaseParameters::check_on`] checks a saved map.
+pub const MAP_CHECK_STATES: usize = 3;
+
+/// The largest relative mismatch [`BaseParameters::check_on`] accepts between a dropped column
+/// and its combination of kept columns.
+pub const MAP_TOLERANCE: f64 = 1e-6;
+
+/// `samples` random states of `model` (row-major `samples x nv` positions, velocities and
+/// accelerations; rad, rad/s, rad/s^2), seeded: positions uniform within the limits, or +-pi
+/// where unlimited; speeds and accelerations uniform within their limits, or +-1.
+fn random_states(model: &Model, samples: usize, seed: u64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let (mut q, mut qd, mut qdd) = (Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..samples {
+        for lim in &model.limits {
+            let (lo, hi) = if lim.lower.is_finite() && lim.upper.is_finite() {
+                (lim.lower, lim.upper)
+            } else {
+                (-std::f64::consts::PI, std::f64::consts::PI)
+            };
+            q.push(rng.random_range(lo..=hi));
+            let v = if lim.velocity.is_finite() {
+                lim.velocity
+            } else {
+                1.0
+            };
+            qd.push(rng.random_range(-v..=v));
+            let a = if lim.acceleration.is_finite() {
+                lim.acceleration
+            } else {
+                1.0
+            };
+            qdd.push(rng.random_range(-a..=a));
+        }
+    }
+    (q, qd, qdd)
+}
+
 impl BaseParameters {
     /// Number of base parameters.
     pub fn len(&self) -> usize {
@@ -107,30 +145,7 @@ impl BaseParameters {
                 layout.len()
             )
         })?;
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let (mut q, mut qd, mut qdd) = (Vec::new(), Vec::new(), Vec::new());
-        for _ in 0..samples {
-            for lim in &model.limits {
-                let (lo, hi) = if lim.lower.is_finite() && lim.upper.is_finite() {
-                    (lim.lower, lim.upper)
-                } else {
-                    (-std::f64::consts::PI, std::f64::consts::PI)
-                };
-                q.push(rng.random_range(lo..=hi));
-                let v = if lim.velocity.is_finite() {
-                    lim.velocity
-                } else {
-                    1.0
-                };
-                qd.push(rng.random_range(-v..=v));
-                let a = if lim.acceleration.is_finite() {
-                    lim.acceleration
-                } else {
-                    1.0
-                };
-                qdd.push(rng.random_range(-a..=a));
-            }
-        }
+        let (q, qd, qdd) = random_states(model, samples, seed);
         let phi = regressor_matrix(
             model,
             layout,
@@ -138,6 +153,75 @@ impl BaseParameters {
             gravity,
         )?;
         Self::from_regressor(layout.clone(), &phi, tolerance)
+    }
+
+    /// Checks that this map is `model`'s: at [`MAP_CHECK_STATES`] seeded random states its
+    /// regressor (with or without `gravity`, as the map was found) has each dropped column
+    /// equal to the combination of kept columns that `k` says, to [`MAP_TOLERANCE`] of the
+    /// columns' sizes. A map saved from a robot with other kinematics (the same joint and link
+    /// names, other lengths or axes) or a hand-edited `k` fails, naming the worst dropped
+    /// parameter: base parameters found on one robot mean other combinations on the other.
+    pub fn check_on(&self, model: &Model, gravity: Gravity) -> Result<()> {
+        if self.layout.nv != model.nv || self.layout.nbodies != model.nbodies() {
+            return Err(Error::InvalidArgument {
+                argument: "robot".into(),
+                message: format!(
+                    "the base parameters are for {} joints and {} bodies, '{}' has {} and {}",
+                    self.layout.nv,
+                    self.layout.nbodies,
+                    model.name,
+                    model.nv,
+                    model.nbodies()
+                ),
+            });
+        }
+        if self.dropped.is_empty() {
+            return Ok(());
+        }
+        let (q, qd, qdd) = random_states(model, MAP_CHECK_STATES, 0x6d6170);
+        let phi = regressor_matrix(
+            model,
+            &self.layout,
+            &States::new(model.nv, &q, Some(&qd), Some(&qdd))?,
+            gravity,
+        )?;
+        let kept = self.select(&phi);
+        let norms: Vec<f64> = self.kept.iter().map(|&c| phi.column(c).norm()).collect();
+        // a column below this is zero but for rounding (a structural zero)
+        let floor = 1e-6 * phi.column_iter().map(|c| c.norm()).fold(0.0, f64::max);
+        let worst = self
+            .dropped
+            .iter()
+            .enumerate()
+            .map(|(d, &c)| {
+                let combination = &kept * self.k.column(d);
+                let size = phi.column(c).norm()
+                    + (0..self.kept.len())
+                        .map(|i| self.k[(i, d)].abs() * norms[i])
+                        .sum::<f64>();
+                let miss = (phi.column(c) - combination).norm();
+                (
+                    c,
+                    if size > 0.0 {
+                        miss / size.max(floor)
+                    } else {
+                        0.0
+                    },
+                )
+            })
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        match worst {
+            Some((c, miss)) if miss > MAP_TOLERANCE || miss.is_nan() => Err(Error::InvalidArgument {
+                argument: "robot".into(),
+                message: format!(
+                    "the saved base parameters do not hold for '{}': its regressor's column '{}' differs from the combination of kept columns the model saved by {} of their size (at most {MAP_TOLERANCE:e} on the robot the model was identified on). Was the model identified on other kinematics (link lengths, axes), or its base.k edited?",
+                    model.name,
+                    self.layout.names[c],
+                    crate::error::shown(miss)
+                ),
+            }),
+            _ => Ok(()),
+        }
     }
 
     /// Base parameters from a stacked regressor `phi` (rows >= columns) by a column-pivoted QR

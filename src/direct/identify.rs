@@ -488,13 +488,19 @@ impl BaseModel {
                 ),
             });
         }
-        Ok(())
+        // and its base parameters are the robot's combinations
+        self.base.check_on(model, self.gravity)
     }
 
     /// Predicted torques (row-major `k x nv`, N m) at a batch of states of `model` (the robot it
     /// was identified for).
     pub fn predict(&self, model: &Model, states: &States<'_>) -> Result<Vec<f64>> {
         self.check(model)?;
+        self.predict_checked(model, states)
+    }
+
+    /// [`Self::predict`] on a robot [`Self::check`] accepted.
+    fn predict_checked(&self, model: &Model, states: &States<'_>) -> Result<Vec<f64>> {
         let theta = DVector::from_column_slice(&self.theta);
         let mut tau = Vec::with_capacity(states.len() * model.nv);
         regressor_blocks(model, &self.base.layout, states, self.gravity, |_, phi| {
@@ -509,6 +515,11 @@ impl BaseModel {
     /// `Phi(q, 0, e_j) theta - Phi(q, 0, 0) theta` (docs/method.md, section 8b).
     pub fn mass_matrix(&self, model: &Model, q: &[f64]) -> Result<DMatrix<f64>> {
         self.check(model)?;
+        self.mass_matrix_checked(model, q)
+    }
+
+    /// [`Self::mass_matrix`] on a robot [`Self::on`] accepted (for loops over many `q`).
+    pub(crate) fn mass_matrix_checked(&self, model: &Model, q: &[f64]) -> Result<DMatrix<f64>> {
         let nv = model.nv;
         crate::model::check_finite_vector("q", q, nv)?;
         let mut qs = Vec::with_capacity((nv + 1) * nv);
@@ -520,7 +531,7 @@ impl BaseModel {
             }
         }
         let zeros = vec![0.0; (nv + 1) * nv];
-        let tau = self.predict(
+        let tau = self.predict_checked(
             model,
             &States::new(model.nv, &qs, Some(&zeros), Some(&qdd))?,
         )?;

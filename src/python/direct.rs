@@ -370,10 +370,11 @@ impl PyBaseModel {
         let n = self.model.nv;
         let batch = read_batch(n, &[("q", &q)])?;
         let mut out = Vec::with_capacity(batch.k * n * n);
+        self.fit.on(&self.model)?;
         for s in 0..batch.k {
             let m = self
                 .fit
-                .mass_matrix(&self.model, &batch.columns[0][s * n..(s + 1) * n])
+                .mass_matrix_checked(&self.model, &batch.columns[0][s * n..(s + 1) * n])
                 .map_err(|e| batch.in_sample(s, e))?;
             out.extend(m.transpose().iter());
         }
