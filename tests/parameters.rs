@@ -104,6 +104,10 @@ fn exact_local_models_at_a_few_points_recover_the_base_parameters() {
         "{:?}",
         one.unidentified
     );
+    // its map merges the unidentified directions, so it holds on the data only: not checked
+    // against the robot's regressor (that would refuse the model on its own robot)
+    assert!(!one.model.base.structural);
+    assert!(one.model.mass_matrix(&model, &a465::TABLE2_Q).is_ok());
     // T*, D*, H* at four points: every base parameter, to 1e-8
     let fit =
         identify_parameters_from_local(&model, &models, &FromLocalOptions::default()).unwrap();
@@ -112,6 +116,9 @@ fn exact_local_models_at_a_few_points_recover_the_base_parameters() {
         "unidentified: {:?}",
         fit.unidentified
     );
+    // every base parameter identified: the data's map is the robot's, and checked as such
+    assert!(fit.model.base.structural);
+    assert!(fit.model.base.check_on(&model, Gravity::Included).is_ok());
     let q = a465::TABLE2_Q;
     let mut data = Data::new(&model);
     mass_matrix(&model, &mut data, &q).unwrap();

@@ -29,6 +29,13 @@ pub struct BaseParameters {
     pub k: DMatrix<f64>,
     /// Relative tolerance on `|R_ii| / |R_00|` that decided the rank.
     pub tolerance: f64,
+    /// Whether the map is the robot's own, found on states that excite every direction its
+    /// kinematics allows ([`Self::from_random_states`]): then it holds at every state and
+    /// [`Self::check_on`] checks it against a robot. A map found on data that leave some of
+    /// the robot's base parameters unidentified (from local models at a few points) merges
+    /// those directions too, and holds only on such data. Files without it: false.
+    #[serde(default)]
+    pub structural: bool,
 }
 
 /// Default relative rank tolerance of the pivoted QR.
@@ -152,10 +159,14 @@ impl BaseParameters {
             &States::new(model.nv, &q, Some(&qd), Some(&qdd))?,
             gravity,
         )?;
-        Self::from_regressor(layout.clone(), &phi, tolerance)
+        Ok(Self {
+            structural: true,
+            ..Self::from_regressor(layout.clone(), &phi, tolerance)?
+        })
     }
 
-    /// Checks that this map is `model`'s: at [`MAP_CHECK_STATES`] seeded random states its
+    /// Checks that this map is `model`'s (a [`Self::structural`] one; others pass): at
+    /// [`MAP_CHECK_STATES`] seeded random states its
     /// regressor (with or without `gravity`, as the map was found) has each dropped column
     /// equal to the combination of kept columns that `k` says, to [`MAP_TOLERANCE`] of the
     /// columns' sizes. A map saved from a robot with other kinematics (the same joint and link
@@ -175,7 +186,7 @@ impl BaseParameters {
                 ),
             });
         }
-        if self.dropped.is_empty() {
+        if self.dropped.is_empty() || !self.structural {
             return Ok(());
         }
         let (q, qd, qdd) = random_states(model, MAP_CHECK_STATES, 0x6d6170);
@@ -273,6 +284,7 @@ impl BaseParameters {
             dropped: dropped.iter().map(|x| x.0).collect(),
             k,
             tolerance,
+            structural: false,
         })
     }
 }

@@ -274,6 +274,11 @@ pub fn identify_parameters_from_local(
         vec![]
     };
     let rank = base.len();
+    // the data's map is the robot's where they identify every base parameter
+    let base = BaseParameters {
+        structural: rank == robot_base.len(),
+        ..base
+    };
     let model = BaseModel {
         format: BaseModel::tag(),
         robot: robot.name.clone(),
