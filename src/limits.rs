@@ -36,6 +36,9 @@ pub const MAX_DOCUMENT_BYTES: u64 = 256 << 20;
 /// ones are hand edits or corruption, and would overflow the fits that read them (their squares
 /// summed over rows).
 pub const MAX_MODEL_VALUE: f64 = 1e9;
+
+/// The largest mass (kg) or inertia (kg m^2) accepted in a link or a payload.
+pub const MAX_INERTIAL: f64 = 1e9;
 /// A simulated sensor's noise: torque noise up to 10^6 N m (a slip of the exponent is an error,
 /// not a recording of noise).
 pub const MAX_TORQUE_NOISE: f64 = 1e6;

@@ -487,6 +487,48 @@ impl std::ops::AddAssign for OriginInertia {
     }
 }
 
+/// Why a mass `mass` (kg) and a symmetric rotational inertia `inertia` (kg m^2, about the
+/// centre of mass or any point) are not a rigid body's, or `None`: a negative mass, a mass or
+/// entry beyond [`crate::limits::MAX_INERTIAL`] (whose products would overflow), a tensor that
+/// is not positive semi-definite or, where `triangle` is given (a hint that ends that
+/// reason), principal moments that break the triangle inequality; each beyond rounding (1e-6
+/// of the principal moments' sum: files print inertias to a few digits). The reason names the
+/// principal moments where they are at fault.
+pub(crate) fn rigid_body_problem(
+    mass: f64,
+    inertia: &Matrix3<f64>,
+    triangle: Option<&str>,
+) -> Option<String> {
+    use crate::limits::MAX_INERTIAL;
+    if mass < 0.0 {
+        return Some(format!("mass {} kg is negative", crate::error::shown(mass)));
+    }
+    if mass.abs() > MAX_INERTIAL || inertia.iter().any(|v| v.abs() > MAX_INERTIAL) {
+        return Some(format!(
+            "a mass or inertia beyond {MAX_INERTIAL:e} (kg, kg m^2); no robot has them"
+        ));
+    }
+    let mut eig: Vec<f64> = crate::decomposition::symmetric_eigen(*inertia)
+        .map_or(vec![f64::NAN; 3], |e| {
+            e.eigenvalues.iter().copied().collect()
+        });
+    eig.sort_by(|a, b| a.total_cmp(b));
+    let tol = 1e-6 * eig.iter().map(|e| e.abs()).sum::<f64>() + 1e-12;
+    if eig.iter().any(|e| !e.is_finite()) || eig[0] < -tol {
+        return Some(format!(
+            "the inertia tensor is not positive semi-definite (principal moments {:.6e}, {:.6e}, {:.6e} kg m^2)",
+            eig[0], eig[1], eig[2]
+        ));
+    }
+    match triangle {
+        Some(hint) if eig[0] + eig[1] < eig[2] - tol => Some(format!(
+            "principal moments {:.6e} + {:.6e} < {:.6e} kg m^2 break the triangle inequality (no rigid body has them{hint})",
+            eig[0], eig[1], eig[2]
+        )),
+        _ => None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -358,6 +358,27 @@ fn bad_true_robot_documents_are_refused_by_name() {
             r#""cogging": [[{"order": 2, "amplitude": 1e7}]]"#,
             "cogging[0][0]: order 2 (expected in (0, 1e5]), amplitude 10000000 (expected at most 1e6 in magnitude)",
         ),
+        // a payload no one could bolt on: the simulated mass matrix would not be positive
+        (
+            r#""payload": {"link": "link6", "mass": 1.0, "inertia": [-1, 0, 0, 0.002, 0, 0.001]}"#,
+            "payload ([ixx, ixy, ixz, iyy, iyz, izz] = [-1.0, 0.0, 0.0, 0.002, 0.0, 0.001]): the inertia tensor is not positive semi-definite (principal moments -1.000000e0,",
+        ),
+        (
+            r#""payload": {"link": "link6", "mass": 1.0, "inertia": [0.002, 0, 0, 0.002, 0, 0.01]}"#,
+            "principal moments 2.000000e-3 + 2.000000e-3 < 1.000000e-2 kg m^2 break the triangle inequality",
+        ),
+        (
+            r#""payload": {"link": "link6", "mass": 1e10}"#,
+            "a mass or inertia beyond 1e9 (kg, kg m^2)",
+        ),
+        (
+            r#""payload": {"link": "link6", "mass": 1.0, "com": [0.0, 1e300, 0.0]}"#,
+            "payload.com[1] is 1e300 m, expected at most 1000 m in magnitude",
+        ),
+        (
+            r#""link_errors": [{"link": "link3", "com": [2e3, 0.0, 0.0]}]"#,
+            "link_errors[0].com[0] is 2000 m",
+        ),
     ] {
         let e = TrueRobot::from_json(&format!(
             r#"{{"format": "perturbid-true-robot/1", {body}}}"#

@@ -195,6 +195,10 @@ pub(crate) fn harmonics_at(harmonics: &[Harmonic], q: f64) -> f64 {
         .sum()
 }
 
+/// The largest offset (m) of a payload's centre of mass, or of a link error's, from its joint
+/// frame: no robot reaches a kilometre.
+pub const MAX_COM_OFFSET: f64 = 1e3;
+
 fn finite_all(what: &str, v: &[f64]) -> Result<()> {
     match v.iter().position(|x| !x.is_finite()) {
         Some(i) => Err(invalid(
@@ -370,15 +374,35 @@ impl Document for TrueRobot {
                 }
             }
         }
+        // a centre of mass within reach of a robot (beyond, m c^2 overflows)
+        let reach = |what: &str, com: &[f64; 3]| -> Result<()> {
+            finite_all(what, com)?;
+            match com.iter().position(|c| c.abs() > MAX_COM_OFFSET) {
+                Some(i) => Err(bad(format!(
+                    "{what}[{i}] is {} m, expected at most {MAX_COM_OFFSET} m in magnitude",
+                    crate::error::shown(com[i])
+                ))),
+                None => Ok(()),
+            }
+        };
         if let Some(p) = &self.payload {
-            finite_all("payload.com", &p.com)?;
+            reach("payload.com", &p.com)?;
             finite_all("payload.inertia", &p.inertia)?;
             if !(p.mass.is_finite() && p.mass >= 0.0) {
                 return Err(bad(format!("payload.mass is {}, expected >= 0 kg", p.mass)));
             }
+            // a body someone could bolt on: the simulation's mass matrix stays positive
+            let [xx, xy, xz, yy, yz, zz] = p.inertia;
+            let inertia = nalgebra::Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
+            if let Some(reason) = crate::spatial::rigid_body_problem(p.mass, &inertia, Some("")) {
+                return Err(bad(format!(
+                    "payload ([ixx, ixy, ixz, iyy, iyz, izz] = {:?}): {reason}",
+                    p.inertia
+                )));
+            }
         }
         for (i, e) in self.link_errors.iter().enumerate() {
-            finite_all(&format!("link_errors[{i}].com"), &e.com)?;
+            reach(&format!("link_errors[{i}].com"), &e.com)?;
             if !(e.mass.is_finite() && e.mass > -1.0 && e.inertia.is_finite() && e.inertia > -1.0) {
                 return Err(bad(format!(
                     "link_errors[{i}] ('{}'): mass {} and inertia {} must be relative errors above -1",

@@ -7,9 +7,6 @@ use super::convert::kind_name;
 use super::Builder;
 use crate::error::{shown, Error, Result};
 
-/// The largest mass (kg) or inertia (kg m^2) accepted in a link.
-pub const MAX_INERTIAL: f64 = 1e9;
-
 impl Builder<'_> {
     /// Finite numbers, a usable axis and a `<limit>` where the URDF requires one.
     pub(super) fn check_joint_numbers(&self, joint: &urdf_rs::Joint) -> Result<()> {
@@ -155,46 +152,15 @@ impl Builder<'_> {
             link: name.to_string(),
             reason,
         };
-        if inertial.mass.value < 0.0 {
-            return Err(invalid(format!(
-                "mass {} kg is negative",
-                shown(inertial.mass.value)
-            )));
-        }
-        // finite values whose products overflow (1e308) would turn every result into inf or
-        // NaN: no robot link is anywhere near these bounds
-        let too_large = |v: f64| v.abs() > MAX_INERTIAL;
-        if too_large(inertial.mass.value)
-            || [i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz]
-                .into_iter()
-                .any(too_large)
-        {
-            return Err(invalid(format!(
-                "a mass or inertia beyond {MAX_INERTIAL:e} (kg, kg m^2); no link has them"
-            )));
-        }
         let m = Matrix3::new(
             i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz,
         );
-        let mut eig: Vec<f64> = crate::decomposition::symmetric_eigen(m)
-            .map_or(vec![f64::NAN; 3], |e| {
-                e.eigenvalues.iter().copied().collect()
-            });
-        eig.sort_by(|a, b| a.total_cmp(b));
-        // "Rounding": URDFs print inertias to a few significant digits.
-        let tol = 1e-6 * eig.iter().map(|e| e.abs()).sum::<f64>() + 1e-12;
-        if eig.iter().any(|e| !e.is_finite()) || eig[0] < -tol {
-            return Err(invalid(format!(
-                "the inertia tensor is not positive semi-definite (principal moments {:.6e}, {:.6e}, {:.6e} kg m^2)",
-                eig[0], eig[1], eig[2]
-            )));
+        let triangle = self.options.check_triangle_inequality.then_some(
+            "; load with the triangle-inequality check off to accept lumped rotor inertias",
+        );
+        match crate::spatial::rigid_body_problem(inertial.mass.value, &m, triangle) {
+            Some(reason) => Err(invalid(reason)),
+            None => Ok(()),
         }
-        if self.options.check_triangle_inequality && eig[0] + eig[1] < eig[2] - tol {
-            return Err(invalid(format!(
-                "principal moments {:.6e} + {:.6e} < {:.6e} kg m^2 break the triangle inequality (no rigid body has them; load with the triangle-inequality check off to accept lumped rotor inertias)",
-                eig[0], eig[1], eig[2]
-            )));
-        }
-        Ok(())
     }
 }
