@@ -60,23 +60,39 @@ impl fmt::Display for LimitViolation {
             ..
         } = self;
         write!(f, "{context}: joint '{joint}' at t = {time:.4} s: ")?;
+        // six decimals, as a controller's units show them; past a million, an exponent
+        let x = |v: f64| {
+            if v.abs() < 1e6 {
+                format!("{v:.6}")
+            } else {
+                format!("{v:e}")
+            }
+        };
         match self.limit {
             Limit::Position { lower, upper } => {
                 let by = (lower - value).max(value - upper);
                 write!(
                     f,
-                    "position {value:.6} {unit} is outside [{lower:.6}, {upper:.6}] {unit} by {by:.6} {unit}"
+                    "position {} {unit} is outside [{}, {}] {unit} by {} {unit}",
+                    x(*value),
+                    x(lower),
+                    x(upper),
+                    x(by)
                 )?
             }
             Limit::Velocity(l) => write!(
                 f,
-                "velocity {value:.6} {unit}/s is outside the limit +-{l:.6} {unit}/s by {:.6} {unit}/s",
-                value.abs() - l
+                "velocity {} {unit}/s is outside the limit +-{} {unit}/s by {} {unit}/s",
+                x(*value),
+                x(l),
+                x(value.abs() - l)
             )?,
             Limit::Acceleration(l) => write!(
                 f,
-                "acceleration {value:.6} {unit}/s^2 is outside the limit +-{l:.6} {unit}/s^2 by {:.6} {unit}/s^2",
-                value.abs() - l
+                "acceleration {} {unit}/s^2 is outside the limit +-{} {unit}/s^2 by {} {unit}/s^2",
+                x(*value),
+                x(l),
+                x(value.abs() - l)
             )?,
         }
         write!(f, "{hint}")

@@ -11,7 +11,7 @@ use crate::gravity::Gravity;
 use crate::model::Model;
 use crate::recording::Recording;
 use crate::states::States;
-use crate::trajectory::Samples;
+use crate::trajectory::{FourierTrajectory, Samples};
 
 /// Joint friction as a function of the joint speed alone, per joint (SI: N m for revolute
 /// joints, N for prismatic ones; speeds in rad/s or m/s):
@@ -321,6 +321,38 @@ pub(crate) fn experiment_samples(
         &samples,
         &format!("experiment '{}' of the plan", e.kind.name()),
         "; the plan does not suit this robot's limits: plan again for it",
+    )?;
+    Ok(samples)
+}
+
+/// `traj` over `periods` periods at `rate` Hz (see [`FourierTrajectory::sample_periods`]),
+/// for `model`, whose joints it must have, checked against `model`'s limits as
+/// [`crate::direct::design_excitation`] checks the excitations it designs: one read from a
+/// file (edited by hand, or designed for a robot with wider limits) runs on a robot only
+/// within its limits.
+pub(crate) fn excitation_samples(
+    model: &Model,
+    traj: &FourierTrajectory,
+    periods: f64,
+    rate: f64,
+) -> Result<crate::trajectory::Samples> {
+    if traj.n() != model.nv {
+        return Err(Error::InvalidArgument {
+            argument: "excitation".into(),
+            message: format!(
+                "it is for {} joints; robot '{}' has {}",
+                traj.n(),
+                model.name,
+                model.nv
+            ),
+        });
+    }
+    let samples = traj.sample_periods(periods, rate)?;
+    crate::trajectory::check_limits(
+        model,
+        &samples,
+        "the excitation",
+        "; the excitation does not suit this robot's limits: design it again for it (perturbid excite)",
     )?;
     Ok(samples)
 }

@@ -175,6 +175,35 @@ fn excite_identify_direct_predict() {
     let traj: FourierTrajectory =
         serde_json::from_str(&std::fs::read_to_string(d.join("excitation.json")).unwrap()).unwrap();
     assert_eq!(traj.harmonics(), 5);
+    // simulated as it was designed, within the limits (between its design's samples too);
+    // edited by hand beyond them, it is refused, as a plan is: no robot runs it
+    ok(&[
+        "simulate",
+        "a465",
+        s(&d.join("excitation.json")),
+        "--rate",
+        "7919",
+        "--out",
+        s(&d.join("dense.csv")),
+    ]);
+    let mut fast = traj.clone();
+    fast.a[(1, 0)] *= 100.0;
+    write(&d.join("fast.json"), &serde_json::to_string(&fast).unwrap());
+    fails(
+        &[
+            "simulate",
+            "a465",
+            s(&d.join("fast.json")),
+            "--out",
+            s(&d.join("fast.csv")),
+        ],
+        &[
+            "the excitation: joint 'joint2' at t = ",
+            "is outside",
+            "design it again for it (perturbid excite)",
+        ],
+    );
+    assert!(!d.join("fast.csv").exists());
     // a recording with qd and qdd, noise-free: identification without preprocessing is exact
     let model = a465::model("kinsheel2010").unwrap();
     let samples = traj.sample_periods(1.0, 100.0).unwrap();

@@ -310,8 +310,12 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<String> {
                     ),
                 });
             }
-            let samples =
-                traj.sample_periods(a.periods.unwrap_or(1.0), a.rate.unwrap_or(1000.0))?;
+            let samples = crate::simulation::excitation_samples(
+                &model,
+                &traj,
+                a.periods.unwrap_or(1.0),
+                a.rate.unwrap_or(1000.0),
+            )?;
             let rec = match &true_robot {
                 Some(t) => rehearse(&model, t, &samples, 0, "excitation")?,
                 None => simulate_samples(&model, &samples, &o, 0, "excitation")?,

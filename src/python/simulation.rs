@@ -17,7 +17,9 @@ use super::trajectory::PyFourier;
 use crate::error::Error;
 use crate::recording::Recording;
 use crate::rehearsal::{rehearse, rehearse_plan};
-use crate::simulation::{simulate_plan, simulate_samples, Friction, SimulationOptions};
+use crate::simulation::{
+    excitation_samples, simulate_plan, simulate_samples, Friction, SimulationOptions,
+};
 use crate::trajectory::Samples;
 
 /// The `friction` argument of `simulate`: a name ('urdf') or anything else (a dict).
@@ -119,10 +121,18 @@ pub(crate) fn simulate<'py>(
     let (periods, rate) = (periods.unwrap_or(1.0), rate.unwrap_or(1000.0));
     let (plan, samples) = match plan {
         ReferenceArg::Plan(p) => (Some(p.plan.clone()), None),
-        ReferenceArg::Fourier(f) => (None, Some(f.traj.sample_periods(periods, rate)?)),
+        ReferenceArg::Fourier(f) => (
+            None,
+            Some(excitation_samples(model, &f.traj, periods, rate)?),
+        ),
         ReferenceArg::Design(d) => (
             None,
-            Some(d.trajectory_ref().sample_periods(periods, rate)?),
+            Some(excitation_samples(
+                model,
+                d.trajectory_ref(),
+                periods,
+                rate,
+            )?),
         ),
         ReferenceArg::Arrays((t, q, qd, qdd)) => {
             let t = vector("t", &t)?;

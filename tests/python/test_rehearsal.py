@@ -89,6 +89,10 @@ def test_bad_true_robots_are_refused():
         pr.simulate(robot, (t[::-1], q, qd, qdd))
     with pytest.raises(pr.InputError, match="periods"):
         pr.simulate(robot, pr.FourierTrajectory(np.ones((6, 1)), np.ones((6, 1)), np.zeros(6)), periods=1e12)
+    # an excitation beyond the robot's limits is not run, as a plan is not: no robot could
+    fast = pr.FourierTrajectory(np.full((6, 1), 50.0), np.zeros((6, 1)), np.zeros(6))
+    with pytest.raises(pr.InputError, match=r"^the excitation: joint 'joint1' at t = 0\.0000 s: velocity 50\.000000 rad/s is outside"):
+        pr.simulate(robot, fast)
     # rate and periods mean nothing for arrays or a plan (they set their own times): refused
     with pytest.raises(pr.InputError, match="rate: 500 given with arrays"):
         pr.simulate(robot, (t, q, qd, qdd), rate=500.0)
