@@ -35,6 +35,7 @@ pub mod model;
 pub mod outliers;
 #[cfg(feature = "cli")]
 pub mod paper;
+pub mod position_rounding;
 pub mod preprocess;
 pub mod recording;
 pub mod regression;

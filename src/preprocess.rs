@@ -147,6 +147,10 @@ fn preprocess_screened(rec: &Recording, options: &PreprocessOptions) -> Result<R
     )
     .map(|out| Recording {
         experiment: rec.experiment.clone(),
+        position_rounding: crate::position_rounding::worst_of(
+            done.iter()
+                .flat_map(|r| r.position_rounding.iter().cloned()),
+        ),
         ..out
     })
 }
@@ -257,6 +261,35 @@ fn preprocess_part(rec: &Recording, options: &PreprocessOptions) -> Result<Recor
         });
     }
     let keep: Vec<usize> = (skip..count - skip).step_by(o.decimate).collect();
+    // positions in coarse counts under velocities derived from them: the noise of their
+    // rounding, through the same chain (crate::position_rounding)
+    let at_keep = |c: &[f64]| -> Vec<f64> { keep.iter().map(|&i| c[i]).collect() };
+    let mut rounding = Vec::new();
+    if rec.qd.is_none() {
+        let derive = |noise: &[f64]| -> Option<(Vec<f64>, Vec<f64>)> {
+            let qd = smooth(differentiate(noise, dt)).ok()?;
+            let qdd = differentiate(&qd, dt);
+            Some((at_keep(&qd), at_keep(&qdd)))
+        };
+        let derived = cols[1].iter().zip(&cols[2]);
+        for (j, (q_grid, (qd, qdd))) in cols[0].iter().zip(derived).enumerate() {
+            crate::interrupt::check("preprocessing")?;
+            let smoothed = match (&filter, o.filter_position) {
+                (None, _) => None,
+                (Some(_), true) => Some(q_grid.clone()),
+                (Some(_), false) => smooth(q_grid.clone()).ok(),
+            };
+            rounding.extend(crate::position_rounding::measure(
+                j,
+                &column(&rec.q, j),
+                smoothed.as_deref(),
+                count,
+                &at_keep(qd),
+                &at_keep(qdd),
+                derive,
+            ));
+        }
+    }
     let rows = |c: &Vec<Vec<f64>>| -> Vec<f64> {
         keep.iter()
             .flat_map(|&i| (0..n).map(move |j| c[j][i]))
@@ -273,6 +306,7 @@ fn preprocess_part(rec: &Recording, options: &PreprocessOptions) -> Result<Recor
     )
     .map(|out| Recording {
         experiment: rec.experiment.clone(),
+        position_rounding: rounding,
         ..out
     })
 }

@@ -26,6 +26,10 @@ pub struct Recording {
     /// signal read exactly 0 while the robot moved, removed first
     /// ([`crate::log_screening::find_dropouts`]); empty for a recording as logged.
     pub dropouts: Vec<crate::log_screening::LogDropout>,
+    /// Per joint whose logged positions lie on a grid and whose velocity the preprocessing
+    /// derived from them, the noise their rounding leaves in qd and qdd
+    /// ([`crate::position_rounding`]); empty for a recording as logged.
+    pub position_rounding: Vec<crate::position_rounding::PositionRounding>,
 }
 
 impl Recording {
@@ -52,6 +56,7 @@ impl Recording {
             experiment: None,
             glitches: vec![],
             dropouts: vec![],
+            position_rounding: vec![],
         };
         r.check()?;
         Ok(r)

@@ -330,7 +330,7 @@ pub(crate) fn experiment_samples(
 /// [`crate::direct::design_excitation`] checks the excitations it designs: one read from a
 /// file (edited by hand, or designed for a robot with wider limits) runs on a robot only
 /// within its limits.
-pub(crate) fn excitation_samples(
+pub fn excitation_samples(
     model: &Model,
     traj: &FourierTrajectory,
     periods: f64,

@@ -301,6 +301,12 @@ class Recording:
     def dropouts(self) -> list[dict[str, Any]]:
         """Runs of rows of the log this was preprocessed from removed as dropouts (every joint
         of a signal read exactly 0 while the robot moved): signal, first_sample, samples, from, to."""
+    @property
+    def position_rounding(self) -> list[dict[str, Any]]:
+        """Per joint whose logged positions lie on a grid and whose velocity was derived from
+        them, the noise their rounding left in the preprocessed qd and qdd: joint (0-based),
+        step (rad or m), qd_ratio, qdd_ratio (RMS of the noise over RMS of the signal;
+        preprocess warns from 0.1)."""
     def __len__(self) -> int: ...
 
 @final

@@ -98,7 +98,12 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
         _ => (vec![], vec![], None),
     };
     progress.done();
-    for w in log_findings(&position_range, &torque_columns, torque_lag.as_ref()) {
+    let rounding = crate::position_rounding::warning(&rec.position_rounding, &joints)
+        .map(|w| format!("{w}{}", crate::position_rounding::IN_A_VALIDATION));
+    for w in log_findings(&position_range, &torque_columns, torque_lag.as_ref())
+        .into_iter()
+        .chain(rounding)
+    {
         eprintln!("perturbid: warning: log '{}': {w}", a.data.display());
     }
     // the residuals, the table and the figure, as one output set
@@ -128,6 +133,10 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     }
     if !position_range.is_empty() {
         json["position_range"] = serde_json::to_value(&position_range).expect("serialisable");
+    }
+    if !rec.position_rounding.is_empty() {
+        json["position_rounding"] =
+            serde_json::to_value(&rec.position_rounding).expect("serialisable");
     }
     set.add(
         "validation.json",

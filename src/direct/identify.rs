@@ -99,6 +99,12 @@ pub struct BaseModel {
     /// while the robot moved; [`crate::log_screening::find_dropouts`]), set likewise.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub log_dropouts: Vec<crate::log_screening::LogDropout>,
+    /// Per joint of that log whose positions lie on a grid and whose velocity was derived
+    /// from them, the noise their rounding left in qd and qdd ([`crate::position_rounding`];
+    /// set likewise): ratios of [`crate::position_rounding::NOISE_RATIO`] or more are warned
+    /// of ([`BaseModel::warnings`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub position_rounding: Vec<crate::position_rounding::PositionRounding>,
     /// The data's torque columns against the robot's own model, one a joint
     /// ([`super::torque_columns`]): swapped columns, the opposite sign convention or other
     /// units are warned of ([`BaseModel::warnings`]). Empty in a model saved before it was
@@ -261,6 +267,7 @@ fn fit_with_factors(
         residual_correlation: vec![],
         log_glitches: vec![],
         log_dropouts: vec![],
+        position_rounding: vec![],
         torque_columns: super::torque_columns::check_torque_columns(
             model,
             states,
@@ -401,6 +408,17 @@ impl Document for BaseModel {
             .find_map(|(i, d)| d.problem().map(|p| (i, p)))
         {
             return Err(invalid(Self::WHAT, format!("log_dropouts[{i}]: {problem}")));
+        }
+        if let Some((i, problem)) = m
+            .position_rounding
+            .iter()
+            .enumerate()
+            .find_map(|(i, r)| r.problem(n).map(|p| (i, p)))
+        {
+            return Err(invalid(
+                Self::WHAT,
+                format!("position_rounding[{i}]: {problem}"),
+            ));
         }
         if !m.torque_columns.is_empty() && m.torque_columns.len() != n {
             return Err(invalid(

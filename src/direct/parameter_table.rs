@@ -47,7 +47,8 @@ impl BaseModel {
     /// What a person should know before trusting the fit: torque columns that do not read as
     /// the robot's model says they should ([`super::torque_columns`]: swapped, of the opposite
     /// sign, in other units), torques out of step with their positions
-    /// ([`super::torque_lag`]), and friction or armature coefficients identified on their own
+    /// ([`super::torque_lag`]), positions logged in counts so coarse that their rounding
+    /// shows in the derived velocities ([`crate::position_rounding`]), and friction or armature coefficients identified on their own
     /// (not in a combination) and negative beyond three standard errors. No joint has them;
     /// the data hold an effect the model lacks, or are not what it assumes. A consistent fit
     /// keeps them at zero.
@@ -75,6 +76,13 @@ impl BaseModel {
                     )
                 })
             });
-        columns.into_iter().chain(negative).collect()
+        let rounding =
+            crate::position_rounding::warning(&self.position_rounding, &self.joint_names)
+                .map(|w| format!("{w}{}", crate::position_rounding::IN_A_FIT));
+        columns
+            .into_iter()
+            .chain(rounding)
+            .chain(negative)
+            .collect()
     }
 }

@@ -67,6 +67,8 @@ pub(crate) fn preprocess(
             name,
             crate::log_screening::BRIDGED_BY_PREPROCESSING,
         ),
+        crate::position_rounding::warning(&out.position_rounding, &[])
+            .map(|w| format!("{name}: {w}{}", crate::position_rounding::IN_A_FIT)),
     ]
     .into_iter()
     .flatten()

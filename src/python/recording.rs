@@ -191,6 +191,29 @@ impl PyRecording {
             .map(|d| dropout_dict(py, d))
             .collect()
     }
+    /// Per joint whose logged positions lie on a grid and whose velocity was derived from
+    /// them, the noise their rounding left in the preprocessed qd and qdd: a list of dicts
+    /// `joint` (0-based column index), `step` (rad or m), `qd_ratio`, `qdd_ratio` (RMS of the
+    /// noise over RMS of the signal; from 0.1 on, `preprocess` warns). Empty for a recording
+    /// as logged.
+    #[getter]
+    fn position_rounding<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<Vec<Bound<'py, pyo3::types::PyDict>>> {
+        self.rec
+            .position_rounding
+            .iter()
+            .map(|r| {
+                let e = pyo3::types::PyDict::new(py);
+                e.set_item("joint", r.joint)?;
+                e.set_item("step", r.step)?;
+                e.set_item("qd_ratio", r.qd_ratio)?;
+                e.set_item("qdd_ratio", r.qdd_ratio)?;
+                Ok(e)
+            })
+            .collect()
+    }
     fn __len__(&self) -> usize {
         self.rec.len()
     }

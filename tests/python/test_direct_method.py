@@ -578,3 +578,34 @@ def test_preprocess_replaces_a_logs_glitches_and_says_so():
     assert [(g["joint"], g["sample"], g["held"]) for g in repaired.glitches] == [(0, i, 6) for i in range(3000, 3006)]
     assert all(g["held"] is None for g in screened.glitches)
     assert np.max(np.abs(repaired.tau - clean.tau)) < 0.01
+
+
+def test_positions_in_coarse_counts_under_derived_velocities_are_warned_of():
+    """Positions rounded to 4,096 counts a revolution and no velocity channel: preprocess
+    estimates the noise their rounding leaves in qd and qdd (against the true noise, the same
+    log preprocessed unrounded: within a factor 2.5 on these slow joints), lists it on the recording and warns from
+    10 %; with the velocities logged, nothing is measured."""
+    t = np.arange(0.0, 20.0, 0.001)
+    q = np.stack([0.4 * np.sin(2 * np.pi * 0.1 * t + k) + 0.1 * np.sin(2 * np.pi * 0.3 * t) for k in range(3)], axis=1)
+    tau = np.stack([2.0 * np.cos(2 * np.pi * 0.3 * t + k) for k in range(3)], axis=1)
+    step = 2 * np.pi / 4096
+    exact = pr.preprocess(t, q, tau)
+    assert exact.position_rounding == []
+    with pytest.warns(pr.PerturbidWarning, match=r"coarse: positions logged in coarse counts, with velocities derived from them: .*joint 1 in steps of 1\.534e-3 leave"):
+        rec = pr.preprocess(t, np.round(q / step) * step, tau, name="coarse")
+    found = rec.position_rounding
+    assert [r["joint"] for r in found] == [0, 1, 2]
+    for r in found:
+        j = r["joint"]
+        assert r["step"] == pytest.approx(step, rel=1e-9)
+        true = np.sqrt(np.mean((rec.qdd[:, j] - exact.qdd[:, j]) ** 2) / np.mean(exact.qdd[:, j] ** 2))
+        # slow joints (under a count a millisecond): the estimate runs low, and the true noise
+        # itself varies by a factor 1.6 with where the grid lies
+        assert true / 2.5 < r["qdd_ratio"] < 2 * true, (j, r["qdd_ratio"], true)
+        assert r["qdd_ratio"] >= 0.1
+    w = 2 * np.pi * np.array([0.1, 0.3])
+    qd = np.stack([0.4 * w[0] * np.cos(w[0] * t + k) + 0.1 * w[1] * np.cos(w[1] * t) for k in range(3)], axis=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        logged = pr.preprocess(t, np.round(q / step) * step, tau, qd=qd)
+    assert logged.position_rounding == []
