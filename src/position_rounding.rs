@@ -70,7 +70,7 @@ impl PositionRounding {
     }
 }
 
-/// Realisations of the rounding [`measure`] passes through the chain; their mean squares are
+/// Realisations of the rounding the preprocessing passes through its chain; their mean squares are
 /// averaged.
 pub const REALISATIONS: u64 = 2;
 
