@@ -38,6 +38,13 @@ fn default_margin() -> f64 {
     0.05
 }
 
+/// The largest coordinate (m) of a constraint's point, plane or box (and of a plane normal's
+/// components): no robot reaches a thousand kilometres.
+pub const MAX_COORDINATE: f64 = 1e6;
+
+/// The margin (m) of a constraint is below this.
+pub const MAX_MARGIN: f64 = 1e3;
+
 impl CartesianConstraint {
     /// Checks the numbers and that `model` has the frame; returns the body the frame moves
     /// with (`None` for the base) and the point in that body's frame.
@@ -46,26 +53,41 @@ impl CartesianConstraint {
             argument: format!("workspace constraint on '{}'", self.frame),
             message,
         };
-        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite() && x.abs() < 1e6);
-        if !(finite(&self.point) && (0.0..1e3).contains(&self.margin)) {
+        // lengths within any robot's reach (beyond, a slip of the exponent or units)
+        let within = |v: &[f64]| v.iter().all(|x| x.abs() < MAX_COORDINATE);
+        let shown = |v: &[f64]| {
+            let each: Vec<String> = v.iter().map(|&x| crate::error::shown(x)).collect();
+            format!("[{}]", each.join(", "))
+        };
+        if !within(&self.point) {
             return Err(bad(format!(
-                "point {:?} and margin {} must be finite (m), the margin >= 0",
-                self.point, self.margin
+                "point {} (m) must lie within {MAX_COORDINATE:e} m of the frame's origin in every coordinate",
+                shown(&self.point)
+            )));
+        }
+        if !(0.0..MAX_MARGIN).contains(&self.margin) {
+            return Err(bad(format!(
+                "margin {} (m) must be from 0 to below {MAX_MARGIN} m",
+                crate::error::shown(self.margin)
             )));
         }
         match &self.region {
             Region::Above { normal, offset } => {
                 let n = Vector3::from(*normal);
-                if !finite(normal) || !offset.is_finite() || n.norm() < 1e-9 {
+                if !within(normal) || n.norm() < 1e-9 || !within(&[*offset]) {
                     return Err(bad(format!(
-                        "the plane's normal {normal:?} must be a finite non-zero vector and its offset {offset} finite"
+                        "the plane's normal {} must be a non-zero vector and it and its offset {} (m) within {MAX_COORDINATE:e} in size",
+                        shown(normal),
+                        crate::error::shown(*offset)
                     )));
                 }
             }
             Region::Inside { min, max } => {
-                if !finite(min) || !finite(max) || (0..3).any(|k| min[k] >= max[k]) {
+                if !within(min) || !within(max) || (0..3).any(|k| min[k] >= max[k]) {
                     return Err(bad(format!(
-                        "the box needs finite min {min:?} < max {max:?} in every coordinate"
+                        "the box needs min {} < max {} (m) in every coordinate, each within {MAX_COORDINATE:e} m",
+                        shown(min),
+                        shown(max)
                     )));
                 }
             }

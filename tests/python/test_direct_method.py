@@ -490,6 +490,16 @@ def test_excitation_within_the_workspace_and_effort_limits():
         pr.design_excitation(robot, max_evaluations=10, workspace=[{**floor[0], "frame": "panda_elbow"}])
     with pytest.raises(pr.InputError, match=r"at \[0\]\.region"):
         pr.design_excitation(robot, max_evaluations=10, workspace=[{**floor[0], "region": {"below": {}}}])
+    # numbers beyond any robot's reach are refused with the bound, in exponent form
+    for edit, says in [
+        ({"point": [9.2e20, 0.0, 0.1]}, r"point \[9\.2e20, 0, 0\.1\] \(m\) must lie within 1e6 m of the frame's origin"),
+        ({"margin": 1e300}, r"margin 1e300 \(m\) must be from 0 to below 1000 m"),
+        ({"margin": -0.01}, r"margin -0\.01 \(m\) must be from 0"),
+        ({"region": {"above": {"normal": [0.0, 0.0, 1.0], "offset": 1e300}}}, r"its offset 1e300 \(m\) within 1e6"),
+        ({"region": {"inside": {"min": [0.0, 0.0, 0.0], "max": [1.0, 1e300, 1.0]}}}, r"the box needs min \[0, 0, 0\] < max \[1, 1e300, 1\] \(m\)"),
+    ]:
+        with pytest.raises(pr.InputError, match=says):
+            pr.design_excitation(robot, max_evaluations=10, workspace=[{**floor[0], **edit}])
 
 
 def test_validation_tables_and_figures():
