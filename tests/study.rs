@@ -265,6 +265,17 @@ fn bad_configurations_name_the_place() {
             "q = [1e308, ",
             "points 'paper': operating point q[0] (joint 'joint1'): 1e308 is outside",
         ),
+        // names label the report: blank or multi-line ones would leave rows unreadable
+        (
+            "name = \"test\"",
+            "name = \"  \"",
+            "s.toml, name: name \"  \": expected a name to show in the report, on one line",
+        ),
+        (
+            "name = \"paper\"",
+            "name = \"pa\\nper\"",
+            "points: name \"pa\\nper\": expected a name",
+        ),
     ] {
         let e = parse(&STUDY.replace(from, to));
         assert!(e.contains(says), "{says}: {e}");

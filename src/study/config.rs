@@ -414,6 +414,18 @@ impl StudyConfig {
                 ));
             }
         }
+        // the names label the report's rows, tables and figure: something to read, on one line
+        let named = std::iter::once(("name", &self.name))
+            .chain(self.true_robots.iter().map(|t| ("true_robots", &t.name)))
+            .chain(self.points.iter().map(|p| ("points", &p.name)));
+        for (key, name) in named {
+            if name.trim().is_empty() || name.chars().any(char::is_control) {
+                return Err(bad(
+                    key,
+                    format!("name {name:?}: expected a name to show in the report, on one line"),
+                ));
+            }
+        }
         let mut names = std::collections::BTreeSet::new();
         for t in &self.true_robots {
             if !names.insert(&t.name) {
