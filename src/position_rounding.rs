@@ -11,7 +11,7 @@
 //! counts a revolution, qdd carried 11-26 % noise and the base parameters erred by 2.9
 //! standard errors RMS.
 //!
-//! So where a joint's logged positions lie on a grid ([`grid_step`]) and its velocity is
+//! So where a joint's logged positions lie on a grid ([`grid_step`](crate::local::quantisation::grid_step)) and its velocity is
 //! derived from them, a rounding error of the same motion (the filtered positions rounded again
 //! to the grid shifted by a random fraction of a step, [`REALISATIONS`] times, seeded) is
 //! passed through the same filter and differentiation, and its RMS compared with that of the
@@ -22,8 +22,6 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
-
-use crate::local::quantisation::grid_step;
 
 /// The ratio of rounding noise to signal (RMS) in qd or qdd warned of: a bias of about 1 %
 /// (`0.1^2`) toward zero of the parameters that term carries.
@@ -74,25 +72,23 @@ impl PositionRounding {
 /// averaged.
 pub const REALISATIONS: u64 = 2;
 
-/// The rounding's noise in one joint's derived qd and qdd. `q` holds the joint's logged
-/// positions (on the log's own times), `smooth` the positions on the preprocessing's uniform
+/// The rounding's noise in one joint's derived qd and qdd. `step` is the grid its logged
+/// positions lie on ([`grid_step`](crate::local::quantisation::grid_step), rad or m), `smooth` the positions on the preprocessing's uniform
 /// grid low-pass filtered (None without a filter), `derive` the preprocessing's chain from a
 /// noise on that grid to `(qd, qdd)` over the samples it keeps, and `qd`, `qdd` what the chain
 /// gave for the logged positions. With `smooth`, each realisation rounds it again to the
 /// grid shifted by a random fraction of a step: a rounding error of the same motion,
 /// sawtooths and slow steps at turnarounds included. Without, an independent error uniform
-/// over one step a sample (white: it leaves out the slow part). None where the positions lie
-/// on no grid or the chain fails.
+/// over one step a sample (white: it leaves out the slow part). None where the chain fails.
 pub(crate) fn measure(
     joint: usize,
-    q: &[f64],
+    step: f64,
     smooth: Option<&[f64]>,
     grid_len: usize,
     qd: &[f64],
     qdd: &[f64],
     derive: impl Fn(&[f64]) -> Option<(Vec<f64>, Vec<f64>)>,
 ) -> Option<PositionRounding> {
-    let step = grid_step(q)?;
     let mut rng = ChaCha8Rng::seed_from_u64(0x726f756e64 ^ joint as u64);
     let ms = |x: &[f64]| x.iter().map(|v| v * v).sum::<f64>() / x.len().max(1) as f64;
     let (mut noise_qd, mut noise_qdd) = (0.0, 0.0);

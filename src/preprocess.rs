@@ -63,6 +63,9 @@ impl Default for PreprocessOptions {
 /// derivative of q) onto a uniform grid at `rate`, filters qd and tau (and q if asked) with a
 /// zero-phase Butterworth low-pass, differentiates the filtered qd into qdd, trims and
 /// decimates. The result is a recording with `qd` and `qdd`, named `<name> (preprocessed)`.
+/// Where a joint's logged positions lie on a grid (encoder counts) and its velocity is derived
+/// from them, the noise their rounding leaves in qd and qdd is estimated and kept in
+/// [`Recording::position_rounding`] ([`crate::position_rounding`]).
 ///
 /// A gap in `t` longer than [`MAX_GAP_INTERVALS`] median sample intervals is an error naming
 /// its time, unless `options.split_at_gaps`: then each part between gaps is preprocessed on its
@@ -71,8 +74,11 @@ impl Default for PreprocessOptions {
 ///
 /// [`MAX_GAP_INTERVALS`]: crate::limits::MAX_GAP_INTERVALS
 pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Recording> {
+    // the grids of the positions as logged: a glitch replaced by its neighbours' fit is off
+    // the grid, and would hide it
+    let steps = crate::local::rounded_positions::position_steps(rec);
     if !options.screen_glitches {
-        return preprocess_screened(rec, options);
+        return preprocess_screened(rec, options, &steps);
     }
     if !options.split_at_gaps {
         check_gaps(rec)?;
@@ -80,7 +86,7 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     let (screened, glitches) = crate::log_screening::screen_recording(rec)?;
     let dropouts = crate::log_screening::find_dropouts(&screened);
     let kept = crate::log_screening::without_dropouts(&screened, &dropouts)?;
-    let out = preprocess_screened(&kept, options).map_err(|e| match e {
+    let out = preprocess_screened(&kept, options, &steps).map_err(|e| match e {
         Error::Recording { recording, message } if !dropouts.is_empty() => Error::Recording {
             recording,
             message: format!(
@@ -100,13 +106,18 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
 }
 
 /// [`preprocess`] of a recording whose glitches were screened (or are not to be).
-fn preprocess_screened(rec: &Recording, options: &PreprocessOptions) -> Result<Recording> {
+/// `steps`: per joint, the grid its logged positions lie on (for [`crate::position_rounding`]).
+fn preprocess_screened(
+    rec: &Recording,
+    options: &PreprocessOptions,
+    steps: &[Option<f64>],
+) -> Result<Recording> {
     if !options.split_at_gaps {
-        return preprocess_part(rec, options);
+        return preprocess_part(rec, options, steps);
     }
     let parts = split_at_gaps(rec)?;
     if parts.len() == 1 {
-        return preprocess_part(rec, options);
+        return preprocess_part(rec, options, steps);
     }
     // microseconds for a log's times; exponent form for absurd ones (1e300 s)
     let time = |t: f64| {
@@ -118,7 +129,7 @@ fn preprocess_screened(rec: &Recording, options: &PreprocessOptions) -> Result<R
     };
     let mut done = Vec::with_capacity(parts.len());
     for (k, part) in parts.iter().enumerate() {
-        let p = preprocess_part(part, options).map_err(|e| match e {
+        let p = preprocess_part(part, options, steps).map_err(|e| match e {
             Error::Recording { message, .. } => Error::Recording {
                 recording: rec.name.clone(),
                 message: format!(
@@ -202,7 +213,11 @@ pub fn split_at_gaps(rec: &Recording) -> Result<Vec<Recording>> {
     Ok(parts)
 }
 
-fn preprocess_part(rec: &Recording, options: &PreprocessOptions) -> Result<Recording> {
+fn preprocess_part(
+    rec: &Recording,
+    options: &PreprocessOptions,
+    steps: &[Option<f64>],
+) -> Result<Recording> {
     let o = options;
     if !(o.rate.is_finite() && o.rate > 0.0) || o.decimate == 0 || o.trim.is_nan() || o.trim < 0.0 {
         return Err(Error::InvalidArgument {
@@ -274,6 +289,9 @@ fn preprocess_part(rec: &Recording, options: &PreprocessOptions) -> Result<Recor
         let derived = cols[1].iter().zip(&cols[2]);
         for (j, (q_grid, (qd, qdd))) in cols[0].iter().zip(derived).enumerate() {
             crate::interrupt::check("preprocessing")?;
+            let Some(step) = steps.get(j).copied().flatten() else {
+                continue;
+            };
             let smoothed = match (&filter, o.filter_position) {
                 (None, _) => None,
                 (Some(_), true) => Some(q_grid.clone()),
@@ -281,7 +299,7 @@ fn preprocess_part(rec: &Recording, options: &PreprocessOptions) -> Result<Recor
             };
             rounding.extend(crate::position_rounding::measure(
                 j,
-                &column(&rec.q, j),
+                step,
                 smoothed.as_deref(),
                 count,
                 &at_keep(qd),

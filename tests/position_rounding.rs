@@ -80,6 +80,13 @@ fn the_rounding_noise_in_derived_accelerations_is_estimated_and_warned_of() {
             assert!(found.iter().any(|r| r.qdd_ratio >= NOISE_RATIO));
         }
     }
+    // a glitch of the log (a count missed by 20), replaced by its neighbours' fit before
+    // preprocessing, is off the grid: the grid is read from the log as logged
+    let mut glitched = log(4096.0);
+    glitched.q[6 * 5000 + 2] += 20.0 * std::f64::consts::TAU / 4096.0;
+    let screened = preprocess(&glitched, &options).unwrap();
+    assert!(!screened.glitches.is_empty());
+    assert_eq!(screened.position_rounding.len(), 6);
     // a logged velocity channel: qdd comes from it, and the positions' rounding is not measured
     let coarse = log(4096.0);
     let with_qd = Recording::new(
