@@ -30,6 +30,19 @@ pub struct Validation {
 /// Compares `predicted` with `measured` torques (both row-major `k x n`, `n =
 /// joint_names.len()`, N m or N). Errors: lengths that disagree or are not a whole number of
 /// samples, no sample, a non-finite value (named by sample and joint).
+/// The root mean square of finite `values` (0 for none), scaled by the largest so that values
+/// past 1e154, whose squares overflow, still give it (a measured torque of 1e308 gave inf).
+pub fn rms(values: impl Iterator<Item = f64> + Clone) -> f64 {
+    let largest = values.clone().fold(0.0, |a: f64, v| a.max(v.abs()));
+    if largest == 0.0 {
+        return 0.0;
+    }
+    let (sum, count) = values.fold((0.0, 0usize), |(s, c), v| {
+        (s + (v / largest).powi(2), c + 1)
+    });
+    largest * (sum / count as f64).sqrt()
+}
+
 pub fn validate(joint_names: &[String], predicted: &[f64], measured: &[f64]) -> Result<Validation> {
     let n = joint_names.len();
     if n == 0
@@ -64,18 +77,15 @@ pub fn validate(joint_names: &[String], predicted: &[f64], measured: &[f64]) -> 
     let residuals: Vec<f64> = measured.iter().zip(predicted).map(|(m, p)| m - p).collect();
     let joints = (0..n)
         .map(|j| {
-            let (mut e, mut m, mut max) = (0.0f64, 0.0f64, 0.0f64);
-            for s in 0..k {
-                let r = residuals[s * n + j];
-                e += r * r;
-                m += measured[s * n + j].powi(2);
-                max = max.max(r.abs());
-            }
+            let e = rms((0..k).map(|s| residuals[s * n + j]));
+            let m = rms((0..k).map(|s| measured[s * n + j]));
             JointError {
                 joint: joint_names[j].clone(),
-                rms: (e / k as f64).sqrt(),
-                relative_rms: (m > 0.0).then(|| (e / m).sqrt()),
-                max,
+                rms: e,
+                relative_rms: (m > 0.0).then(|| e / m),
+                max: (0..k)
+                    .map(|s| residuals[s * n + j].abs())
+                    .fold(0.0, f64::max),
             }
         })
         .collect();

@@ -276,6 +276,48 @@ fn excite_identify_direct_predict() {
         &["predict", s(&d.join("base.json")), s(&d.join("log.csv"))],
         &["--robot"],
     );
+    // a measured torque of 1e308 (its square overflows) and a position past its joint's
+    // limits: the error's RMS stays a number, and the state is said to be one the robot
+    // cannot take
+    let text = std::fs::read_to_string(d.join("log.csv")).unwrap();
+    let mut lines: Vec<Vec<String>> = text
+        .lines()
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect();
+    let col = |name: &str| lines[0].iter().position(|c| c == name).unwrap();
+    let (tau1, q2) = (col("tau1"), col("q2"));
+    lines[4][tau1] = "1e308".into();
+    lines[6][q2] = "10".into();
+    let edited: Vec<String> = lines.iter().map(|l| l.join(",")).collect();
+    write(&d.join("edited.csv"), &(edited.join("\n") + "\n"));
+    let run = bin()
+        .args([
+            "predict",
+            s(&d.join("base.json")),
+            s(&d.join("edited.csv")),
+            "--robot",
+            "a465",
+            "--out",
+            s(&d.join("pred2.csv")),
+        ])
+        .output()
+        .unwrap();
+    let (so, se) = (
+        String::from_utf8_lossy(&run.stdout),
+        String::from_utf8_lossy(&run.stderr),
+    );
+    assert!(run.status.success(), "{se}");
+    let k = (lines.len() - 1) as f64;
+    let joint1 = so
+        .lines()
+        .find(|l| l.trim_start().starts_with("joint1"))
+        .unwrap();
+    let rms: f64 = joint1.split_whitespace().last().unwrap().parse().unwrap();
+    assert!((rms / (1e308 / k.sqrt()) - 1.0).abs() < 1e-6, "{so}");
+    assert!(
+        se.contains("perturbid: warning: '") && se.contains("joint2"),
+        "{se}"
+    );
     // validation on the log with qdd: exact; on a raw log (positions and torques at 1 kHz,
     // five periods): preprocessed as for identification, close
     let out = ok(&[

@@ -279,24 +279,28 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
             "validation on the last {} samples: per joint RMS (N m) and relative RMS (%)",
             k - split
         );
-        for j in 0..n {
-            let (mut e, mut m) = (0.0, 0.0);
-            for (i, pv) in p.iter().enumerate().skip(j).step_by(n) {
-                let meas = rec.tau[split * n + i];
-                e += (pv - meas).powi(2);
-                m += meas * meas;
-            }
-            let cnt = (k - split) as f64;
+        let v = crate::validation::validate(&model.joint_names, &p, &rec.tau[split * n..])?;
+        for e in &v.joints {
             let _ = writeln!(
                 out,
-                "  {:<16} {:>10.4} {:>8.2}",
-                model.joint_names[j],
-                (e / cnt).sqrt(),
-                100.0 * (e / m).sqrt()
+                "  {:<16} {:>10} {:>8}",
+                e.joint,
+                number(e.rms),
+                e.relative_rms
+                    .map_or("-".to_string(), |r| format!("{:.2}", 100.0 * r))
             );
         }
     }
     Ok(out)
+}
+
+/// A torque error for a table: four decimals, or an exponent past a million.
+fn number(x: f64) -> String {
+    if x.abs() < 1e6 {
+        format!("{x:.4}")
+    } else {
+        format!("{x:.4e}")
+    }
 }
 
 #[derive(Args)]
@@ -332,7 +336,13 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
                     fit.robot
                 ),
             })?;
-            fit.on(&load_robot(robot, &a.lock)?)?.predict(&states)?
+            let robot = load_robot(robot, &a.lock)?;
+            // states the robot cannot take: predicted, and said
+            let ranges = crate::direct::position_range::check_position_range(&robot, &states);
+            if let Some(w) = crate::direct::position_range::finding(&ranges) {
+                eprintln!("perturbid: warning: '{}': {w}", a.data.display());
+            }
+            fit.on(&robot)?.predict(&states)?
         }
         ModelFile::Local(m) => m.predict(&states)?,
         ModelFile::GlobalLinear(m) => m.predict(&states)?,
@@ -358,12 +368,8 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
             out,
             "against the measured torques: per joint RMS error (N m)"
         );
-        for j in 0..n {
-            let e: f64 = (0..states.t.len())
-                .map(|i| (tau[i * n + j] - meas[i * n + j]).powi(2))
-                .sum::<f64>()
-                / states.t.len() as f64;
-            let _ = writeln!(out, "  {:<16} {:>10.4}", joints[j], e.sqrt());
+        for e in crate::validation::validate(&joints, &tau, meas)?.joints {
+            let _ = writeln!(out, "  {:<16} {:>10}", e.joint, number(e.rms));
         }
     }
     Ok(out)
