@@ -11,13 +11,14 @@
 //! counts a revolution, qdd carried 11-26 % noise and the base parameters erred by 2.9
 //! standard errors RMS.
 //!
-//! So where a joint's logged positions lie on a grid ([`grid_step`](crate::local::quantisation::grid_step)) and its velocity is
-//! derived from them, a rounding error of the same motion (the filtered positions rounded again
-//! to the grid shifted by a random fraction of a step, [`REALISATIONS`] times, seeded) is
-//! passed through the same filter and differentiation, and its RMS compared with that of the
-//! preprocessed qd and qdd over the samples kept (`tests/position_rounding.rs` checks it
-//! against the true noise, within a factor of 2; on joints slower than a count a millisecond
-//! it runs low, up to 2.5). A ratio of at least [`NOISE_RATIO`] is warned of.
+//! So where a joint's logged positions lie on a grid
+//! ([`grid_step`](crate::local::quantisation::grid_step)) and its velocity is derived from
+//! them, a rounding error of the same motion (the filtered positions rounded again to the grid
+//! shifted by a random fraction of a step, [`REALISATIONS`] times, seeded) is passed through
+//! the same filter and differentiation, and its RMS compared with that of the preprocessed qd
+//! and qdd over the samples kept (`tests/position_rounding.rs` checks it against the true
+//! noise, within a factor of 2; on joints slower than a count a millisecond it runs low, up
+//! to 2.5). A ratio of at least [`NOISE_RATIO`] is warned of.
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -68,18 +69,21 @@ impl PositionRounding {
     }
 }
 
-/// Realisations of the rounding the preprocessing passes through its chain; their mean squares are
-/// averaged.
+/// Realisations of the rounding the preprocessing passes through its chain; their mean
+/// squares are averaged.
 pub const REALISATIONS: u64 = 2;
 
 /// The rounding's noise in one joint's derived qd and qdd. `step` is the grid its logged
-/// positions lie on ([`grid_step`](crate::local::quantisation::grid_step), rad or m), `smooth` the positions on the preprocessing's uniform
-/// grid low-pass filtered (None without a filter), `derive` the preprocessing's chain from a
-/// noise on that grid to `(qd, qdd)` over the samples it keeps, and `qd`, `qdd` what the chain
-/// gave for the logged positions. With `smooth`, each realisation rounds it again to the
-/// grid shifted by a random fraction of a step: a rounding error of the same motion,
-/// sawtooths and slow steps at turnarounds included. Without, an independent error uniform
-/// over one step a sample (white: it leaves out the slow part). None where the chain fails.
+/// positions lie on ([`grid_step`](crate::local::quantisation::grid_step), rad or m),
+/// `smooth` the positions on the preprocessing's uniform grid low-pass filtered (None without
+/// a filter), `grid_len` that grid's length, `derive` the preprocessing's chain from a noise
+/// on that grid to `(qd, qdd)` over the samples it keeps, and `qd`, `qdd` what the chain gave
+/// for the logged positions. With `smooth`, each realisation rounds it again to the grid
+/// shifted by a random fraction of a step: a rounding error of the same motion, sawtooths and
+/// slow steps at turnarounds included. Without, an independent error uniform over one step a
+/// sample (white: it leaves out the slow part). None where the chain fails or the ratios are
+/// not numbers (signals whose squares overflow: a log beyond any robot's, refused or warned
+/// of elsewhere).
 pub(crate) fn measure(
     joint: usize,
     step: f64,
@@ -116,11 +120,12 @@ pub(crate) fn measure(
             0.0
         }
     };
-    Some(PositionRounding {
+    let (qd_ratio, qdd_ratio) = (ratio(noise_qd, qd), ratio(noise_qdd, qdd));
+    (qd_ratio.is_finite() && qdd_ratio.is_finite()).then_some(PositionRounding {
         joint,
         step,
-        qd_ratio: ratio(noise_qd, qd),
-        qdd_ratio: ratio(noise_qdd, qdd),
+        qd_ratio,
+        qdd_ratio,
     })
 }
 

@@ -335,7 +335,7 @@ pub fn excitation_samples(
     traj: &FourierTrajectory,
     periods: f64,
     rate: f64,
-) -> Result<crate::trajectory::Samples> {
+) -> Result<Samples> {
     if traj.n() != model.nv {
         return Err(Error::InvalidArgument {
             argument: "excitation".into(),

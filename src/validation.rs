@@ -27,9 +27,6 @@ pub struct Validation {
     pub residuals: Vec<f64>,
 }
 
-/// Compares `predicted` with `measured` torques (both row-major `k x n`, `n =
-/// joint_names.len()`, N m or N). Errors: lengths that disagree or are not a whole number of
-/// samples, no sample, a non-finite value (named by sample and joint).
 /// The root mean square of finite `values` (0 for none), scaled by the largest so that values
 /// past 1e154, whose squares overflow, still give it (a measured torque of 1e308 gave inf).
 pub fn rms(values: impl Iterator<Item = f64> + Clone) -> f64 {
@@ -43,6 +40,9 @@ pub fn rms(values: impl Iterator<Item = f64> + Clone) -> f64 {
     largest * (sum / count as f64).sqrt()
 }
 
+/// Compares `predicted` with `measured` torques (both row-major `k x n`, `n =
+/// joint_names.len()`, N m or N). Errors: lengths that disagree or are not a whole number of
+/// samples, no sample, a non-finite value (named by sample and joint).
 pub fn validate(joint_names: &[String], predicted: &[f64], measured: &[f64]) -> Result<Validation> {
     let n = joint_names.len();
     if n == 0

@@ -169,9 +169,10 @@ impl BaseParameters {
     /// [`MAP_CHECK_STATES`] seeded random states its regressor (with or without `gravity`, as
     /// the map was found) has each dropped column equal to the combination of kept columns
     /// that `k` says, to [`MAP_TOLERANCE`] of the columns' sizes (columns below 1e-6 of the
-    /// largest are zeros but for rounding). A map saved from a robot with other kinematics (the same joint and link
-    /// names, other lengths or axes) or a hand-edited `k` fails, naming the worst dropped
-    /// parameter: base parameters found on one robot mean other combinations on the other.
+    /// largest are zeros but for rounding). A map saved from a robot with other kinematics
+    /// (the same joint and link names, other lengths or axes) or a hand-edited `k` fails,
+    /// naming the worst dropped parameter: base parameters found on one robot mean other
+    /// combinations on the other.
     pub fn check_on(&self, model: &Model, gravity: Gravity) -> Result<()> {
         if self.layout.nv != model.nv || self.layout.nbodies != model.nbodies() {
             return Err(Error::InvalidArgument {
