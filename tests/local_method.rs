@@ -230,6 +230,78 @@ fn common_mode_gravity_and_friction() {
     );
 }
 
+/// Perturbations too small for the torque noise give estimates of noise: each is named (with
+/// how much larger the perturbations must be), and none at the paper's sizes where the torques
+/// respond beyond the noise.
+#[test]
+fn estimates_of_noise_alone_are_warned_of() {
+    let model = a465::model("kinsheel2010").unwrap();
+    // Table 2's posture at speeds where viscous friction gives H* a diagonal to measure (at
+    // Table 2's slow speeds and without friction, H* is a Coriolis term below this noise, and
+    // is warned of)
+    let op = OperatingPoint::new(
+        a465::TABLE2_Q.to_vec(),
+        vec![0.4, -0.35, 0.3, 0.5, -0.4, 0.45],
+        a465::TABLE2_QDD.to_vec(),
+    )
+    .unwrap();
+    let mut sim = noise_free(&model, Gravity::Included);
+    sim.friction = Friction::viscous_coulomb(vec![2.0, 1.5, 1.0, 0.5, 0.4, 0.3], vec![0.0; 6]);
+    sim.torque_noise = vec![0.05; 6];
+    let unresolved = |m: &LocalModel| -> Vec<String> {
+        m.diagnostics
+            .warnings
+            .iter()
+            .filter(|w| w.contains("differs from zero beyond its noise"))
+            .cloned()
+            .collect()
+    };
+    let paper_sizes = PlanOptions {
+        sizes: Sizes {
+            velocity: Size::Absolute(vec![0.1; 6]),
+            ..Sizes::default()
+        },
+        ..PlanOptions::default()
+    };
+    let (_, paper) = identify(&model, &op, &paper_sizes, &sim);
+    assert_eq!(unresolved(&paper), Vec::<String>::new());
+    let mut rigid = sim.clone();
+    rigid.friction = Friction::none(6);
+    let (_, slow) = identify(&model, &table2(), &PlanOptions::default(), &rigid);
+    assert!(
+        unresolved(&slow)
+            .iter()
+            .any(|w| w.starts_with("experiment 'H': no entry of H* ")),
+        "{:#?}",
+        slow.diagnostics.warnings
+    );
+    let tiny = PlanOptions {
+        sizes: Sizes {
+            position: Size::Fraction(1e-8),
+            velocity: Size::Fraction(1e-8),
+            acceleration: Size::Fraction(1e-8),
+        },
+        ..PlanOptions::default()
+    };
+    let (_, noise) = identify(&model, &op, &tiny, &sim);
+    let found = unresolved(&noise);
+    for (experiment, estimate) in [("G_static", "Gs"), ("G", "G*"), ("H", "H*"), ("D", "D*")] {
+        assert!(
+            found.iter().any(|w| w.starts_with(&format!(
+                "experiment '{experiment}': no entry of {estimate} "
+            ))),
+            "{experiment}: {found:#?}"
+        );
+    }
+    // the values are still there, with standard errors that say the same
+    let d = noise.d.as_ref().unwrap();
+    assert!(d
+        .matrix
+        .iter()
+        .zip(d.stderr.iter())
+        .all(|(v, s)| v.abs() < 6.0 * s));
+}
+
 /// With torque noise the D* error falls about as 1/sqrt(K).
 #[test]
 fn noise_error_falls_as_one_over_sqrt_k() {

@@ -10,6 +10,7 @@ use super::crossing::{
 };
 use super::diagnose::{
     compare_combined, diagnose, disagreement_warning, mass_matrix_warning, unperturbed_deviation,
+    unresolved_estimate_warning,
 };
 use super::diagnostics::{Reversal, ReversalHandling, TorqueNoise, Unmeasured};
 use super::errors_in_variables;
@@ -718,6 +719,18 @@ pub fn identify_local(
     let disagreement = combined
         .as_ref()
         .map_or_else(Vec::new, |c| compare_combined(c, [&d, &h, &g], n));
+    let unresolved: Vec<String> = [
+        (ExperimentKind::GStatic, &g_static),
+        (ExperimentKind::GDynamic, &g),
+        (ExperimentKind::H, &h),
+        (ExperimentKind::D, &d),
+    ]
+    .into_iter()
+    .filter_map(|(kind, e)| {
+        e.as_ref()
+            .and_then(|e| unresolved_estimate_warning(kind, e))
+    })
+    .collect();
     let (d, h, g) = match (options.estimator, &combined) {
         (Estimator::Separated, _) => (d, h, g),
         (Estimator::Combined, Some(c)) => {
@@ -757,6 +770,7 @@ pub fn identify_local(
         diagnostics.warnings.push(w);
     }
     diagnostics.warnings.extend(flat_warnings);
+    diagnostics.warnings.extend(unresolved);
     diagnostics.unmeasured = unmeasured;
     let mut torque_offsets = offsets_found.into_inner();
     torque_offsets.sort_by_key(|t| values.iter().position(|v| v.kind.name() == t.experiment));

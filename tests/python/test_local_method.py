@@ -496,3 +496,20 @@ def test_a_poorly_conditioned_design_is_reported_and_warned_about():
     designed = pr.plan_experiments(robot, op, design="orthogonal", seed=0)
     assert not any("its perturbations have cond(X)" in w for w in designed.warnings)
     assert all(e.cond == pytest.approx(1.0, abs=1e-12) for e in designed.experiments if e.kind != "nominal")
+
+
+def test_perturbations_too_small_for_the_torque_noise_are_warned_of():
+    robot = pr.robots.a465()
+    op = pr.OperatingPoint(TABLE2[0], [0.4, -0.35, 0.3, 0.5, -0.4, 0.45], TABLE2[2])
+    friction = {"viscous": [2.0, 1.5, 1.0, 0.5, 0.4, 0.3]}
+    tiny = dict(dq_fraction=1e-8, dqd_fraction=1e-8, dqdd_fraction=1e-8)
+    for sizes, unresolved in [(dict(dqd=[0.1] * 6), []), (tiny, ["G_static", "G", "H", "D"])]:
+        plan = pr.plan_experiments(robot, op, **sizes)
+        recs = pr.simulate(robot, plan, friction=friction, torque_noise=0.05, seed=4)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            model = pr.identify_local(plan, recs)
+        named = [w for w in model.diagnostics["warnings"] if "differs from zero beyond its noise" in w]
+        assert [w.split("'")[1] for w in named] == unresolved, named
+        assert all(any(w == str(c.message) for c in caught) for w in named)
+        assert all("times larger" in w for w in named)
