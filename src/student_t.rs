@@ -1,5 +1,6 @@
 //! Student's t distribution: the threshold a difference of estimates must pass when its
-//! standard error is itself estimated from few residual degrees of freedom.
+//! standard error is itself estimated from few residual degrees of freedom; and the F
+//! distribution's tail, for a regression's sum of squares against its residuals'.
 
 /// `ln Gamma(x)` for `x > 0` (Lanczos, g = 7, 9 terms: about 15 digits).
 fn ln_gamma(x: f64) -> f64 {
@@ -89,6 +90,13 @@ pub fn upper_quantile(p: f64, nu: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
+/// `P(F > f)` for the F distribution with `d1` and `d2` degrees of freedom, `f >= 0`: the
+/// chance that a regression on `d1` columns of pure noise explains `f` times its residuals'
+/// mean square (`d2` residual degrees of freedom) or more.
+pub fn f_upper_tail(f: f64, d1: f64, d2: f64) -> f64 {
+    incomplete_beta(d2 / (d2 + d1 * f), 0.5 * d2, 0.5 * d1)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -109,6 +117,19 @@ mod tests {
                 "p {p}, nu {nu}: {got} against {t}"
             );
         }
+        // F's upper 5 % and 1 % points (Abramowitz & Stegun 26.9), and t^2 = F(1, nu)
+        for (p, d1, d2, f) in [
+            (0.05, 6.0, 10.0, 3.2172),
+            (0.01, 6.0, 6.0, 8.4661),
+            (0.01, 3.0, 20.0, 4.9382),
+            (0.05, 1.0, 5.0, 6.6079),
+        ] {
+            let got = f_upper_tail(f, d1, d2);
+            assert!((got - p).abs() < 1e-4 * p, "F({d1}, {d2}) at {f}: {got}");
+        }
+        let t = 2.446_912;
+        assert!((f_upper_tail(t * t, 1.0, 6.0) - 0.05).abs() < 1e-7);
+        assert_eq!(f_upper_tail(0.0, 3.0, 7.0), 1.0);
         // the tail falls as t grows, and is 1/2 at 0
         assert!((upper_tail(0.0, 4.0) - 0.5).abs() < 1e-15);
         assert!(upper_tail(2.0, 4.0) > upper_tail(3.0, 4.0));

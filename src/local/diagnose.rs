@@ -238,69 +238,6 @@ pub(super) fn mass_matrix_warning(d: &Estimate, joints: &[String]) -> Option<Str
     })
 }
 
-/// The perturbations must move the torques beyond their noise. A warning when no entry of an
-/// estimate (`kind`'s N x N matrix) differs from zero by more than Student's t quantile of its
-/// standard error (the residual degrees of freedom `crossings - N`, Bonferroni over the `N^2`
-/// entries, so that an estimate of pure noise passes it once in 1 / [`FALSE_ALARM`]): the
-/// estimate is then noise, whatever its numbers. None when it has no standard errors, or when
-/// one entry stands out.
-///
-/// Zero is a true answer for H* at rest without viscous friction, and a small H* at slow
-/// operating points may be below the noise (the warning says so); otherwise perturbations too
-/// small for the torque sensor, or a torque channel that does not follow the robot, are the
-/// usual causes.
-pub(super) fn unresolved_estimate_warning(kind: ExperimentKind, e: &Estimate) -> Option<String> {
-    let n = e.matrix.nrows();
-    let dof = e.crossings.saturating_sub(n);
-    let ratios: Vec<f64> = (e.matrix.iter().zip(e.stderr.iter()))
-        .filter(|(_, s)| s.is_finite() && **s > 0.0)
-        .map(|(m, s)| (m / s).abs())
-        .collect();
-    if dof == 0 || ratios.is_empty() || ratios.iter().any(|t| !t.is_finite()) {
-        return None;
-    }
-    let entries = (n * n) as f64;
-    let threshold = crate::student_t::upper_quantile(FALSE_ALARM / (2.0 * entries), dof as f64);
-    let largest = ratios.iter().copied().fold(0.0, f64::max);
-    (largest <= threshold).then(|| {
-        let estimate = kind.estimate_name();
-        let variable = match kind {
-            ExperimentKind::D => "dqdd",
-            ExperimentKind::H => "dqd",
-            _ => "dq",
-        };
-        let expected_zero = if kind == ExperimentKind::H {
-            " H* is small at slow operating points without viscous friction (zero at rest), and this may be its measurement;"
-        } else {
-            ""
-        };
-        let larger = if largest > 0.0 {
-            let factor = (10.0 / largest).max(2.0);
-            format!(
-                "perturbations ({variable}) about {} times larger, or {} times as many crossings, would bring the largest to 10 standard errors if it is not zero",
-                shown_factor(factor),
-                shown_factor(factor * factor)
-            )
-        } else {
-            format!("larger perturbations ({variable}) or more crossings would resolve it if it is not zero")
-        };
-        format!(
-            "experiment '{}': no entry of {estimate} differs from zero beyond its noise (the largest by {largest:.1} standard errors, below the {threshold:.1} that noise alone reaches once in {:.0}): the perturbations did not move the torques measurably beyond their noise, so {estimate} is not resolved;{expected_zero} otherwise the perturbations are too small for the torque sensor, or its channel does not follow the robot: {larger}",
-            kind.name(),
-            1.0 / FALSE_ALARM,
-        )
-    })
-}
-
-/// A factor: whole below 100, with an exponent above.
-fn shown_factor(f: f64) -> String {
-    if f < 100.0 {
-        format!("{f:.0}")
-    } else {
-        format!("{f:.1e}")
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use nalgebra::DMatrix;
@@ -363,54 +300,5 @@ mod tests {
         let mut unknown = estimate(m, 0.01);
         unknown.stderr[(0, 0)] = f64::NAN;
         assert_eq!(mass_matrix_warning(&unknown, &joints), None);
-    }
-
-    #[test]
-    fn an_estimate_of_noise_alone_is_named() {
-        // 9 entries, 97 degrees of freedom: the Bonferroni quantile is about 3.3
-        let mut m = DMatrix::from_element(3, 3, 0.03);
-        let noise =
-            unresolved_estimate_warning(ExperimentKind::GDynamic, &estimate(m.clone(), 0.01))
-                .expect("3 standard errors everywhere is noise");
-        assert!(
-            noise.contains("no entry of G* differs from zero"),
-            "{noise}"
-        );
-        assert!(
-            noise.contains("the largest by 3.0 standard errors"),
-            "{noise}"
-        );
-        assert!(
-            noise.contains("(dq) about 3 times larger, or 11 times as many crossings"),
-            "{noise}"
-        );
-        assert!(!noise.contains("at rest"), "{noise}");
-        // one entry beyond the quantile is a measured response
-        m[(2, 1)] = 0.04;
-        assert_eq!(
-            unresolved_estimate_warning(ExperimentKind::GDynamic, &estimate(m.clone(), 0.01)),
-            None
-        );
-        // H* may be zero
-        let h =
-            unresolved_estimate_warning(ExperimentKind::H, &estimate(DMatrix::zeros(3, 3), 0.01))
-                .expect("zeros are not a response");
-        assert!(h.contains("H* is small at slow operating points"), "{h}");
-        assert!(
-            h.contains("larger perturbations (dqd) or more crossings"),
-            "{h}"
-        );
-        // without standard errors there is nothing to judge by
-        let mut unknown = estimate(DMatrix::zeros(3, 3), f64::NAN);
-        assert_eq!(
-            unresolved_estimate_warning(ExperimentKind::D, &unknown),
-            None
-        );
-        unknown.stderr.fill(0.01);
-        unknown.crossings = 3;
-        assert_eq!(
-            unresolved_estimate_warning(ExperimentKind::D, &unknown),
-            None
-        );
     }
 }

@@ -10,7 +10,6 @@ use super::crossing::{
 };
 use super::diagnose::{
     compare_combined, diagnose, disagreement_warning, mass_matrix_warning, unperturbed_deviation,
-    unresolved_estimate_warning,
 };
 use super::diagnostics::{Reversal, ReversalHandling, TorqueNoise, Unmeasured};
 use super::errors_in_variables;
@@ -23,6 +22,7 @@ use super::noise::{reading_variance, sample_variance, weighted_least_squares};
 use super::operating_point::OperatingPoint;
 use super::plan::{Experiment, ExperimentKind, Plan};
 use super::quantisation;
+use super::response;
 use super::rounded_positions::{self, Resolution};
 use super::torque_offsets;
 use crate::document::Document;
@@ -549,6 +549,13 @@ pub fn identify_local(
         }
         offsets_found.borrow_mut().extend(found);
         let (u, samples) = reading_variances(&[v], n);
+        // did the torques respond? (read by +- pairs when every planned crossing was read)
+        let measured: Vec<bool> = v.flat_torque.iter().map(Option::is_none).collect();
+        let in_pairs = planned.in_pairs() && planned.deltas.nrows() == k;
+        let found = response::responses(&x, &y, &u, in_pairs, &measured);
+        extra_warnings
+            .borrow_mut()
+            .extend(response::unresolved_warning(kind, &found));
         let weighted = weighted_least_squares(
             &x,
             &y,
@@ -719,18 +726,6 @@ pub fn identify_local(
     let disagreement = combined
         .as_ref()
         .map_or_else(Vec::new, |c| compare_combined(c, [&d, &h, &g], n));
-    let unresolved: Vec<String> = [
-        (ExperimentKind::GStatic, &g_static),
-        (ExperimentKind::GDynamic, &g),
-        (ExperimentKind::H, &h),
-        (ExperimentKind::D, &d),
-    ]
-    .into_iter()
-    .filter_map(|(kind, e)| {
-        e.as_ref()
-            .and_then(|e| unresolved_estimate_warning(kind, e))
-    })
-    .collect();
     let (d, h, g) = match (options.estimator, &combined) {
         (Estimator::Separated, _) => (d, h, g),
         (Estimator::Combined, Some(c)) => {
@@ -770,7 +765,6 @@ pub fn identify_local(
         diagnostics.warnings.push(w);
     }
     diagnostics.warnings.extend(flat_warnings);
-    diagnostics.warnings.extend(unresolved);
     diagnostics.unmeasured = unmeasured;
     let mut torque_offsets = offsets_found.into_inner();
     torque_offsets.sort_by_key(|t| values.iter().position(|v| v.kind.name() == t.experiment));

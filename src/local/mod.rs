@@ -48,6 +48,7 @@ pub mod plan;
 mod plan_checks;
 pub mod point_design;
 pub mod quantisation;
+pub mod response;
 pub mod rounded_positions;
 pub mod torque_offsets;
 

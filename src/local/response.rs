@@ -1,0 +1,280 @@
+//! Whether an experiment's perturbations moved the torques beyond their noise (our
+//! extension; docs/method.md, section 4).
+//!
+//! Perturbations too small for the torque sensor, or a torque channel that does not follow the
+//! robot, leave a regression of noise: its estimate has numbers, and standard errors as large,
+//! but nothing in it is measured. Each joint's torque changes are tested against their
+//! residuals (the regression's F statistic: the mean square the perturbations explain over the
+//! residuals' mean square, about 1 for noise alone), Bonferroni over the joints; the experiment
+//! is warned of when no joint's torque responds.
+//!
+//! With `+-` pairs the test reads the pairs' half-differences `(tau(+d) - tau(-d)) / 2` against
+//! `(x(+d) - x(-d)) / 2`: they hold the same linear response (the estimate of the pairs is the
+//! estimate of their half-differences) but not the even-order terms, which the pairs cancel from
+//! the estimate and leave in the full regression's residuals (the velocity-squared terms of H,
+//! gravity's curvature in G). Against those residuals a small but exact H* looks like noise.
+
+use nalgebra::DMatrix;
+
+use super::plan::ExperimentKind;
+
+/// The chance that an experiment of noise alone passes for a response (over all its joints).
+pub const FALSE_ALARM: f64 = 0.01;
+
+/// One joint's response: its F statistic with its degrees of freedom.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Response {
+    /// The mean square the perturbations explain over the residuals' mean square.
+    pub f: f64,
+    /// `P(F > f)` for noise alone.
+    pub p: f64,
+}
+
+/// The residual degrees of freedom below which the noise is read from the samples' scatter
+/// about their windows' fits (`u`, known rather than estimated): its F test is then taken with
+/// this many, close to the chi-square limit.
+const KNOWN_NOISE_DOF: f64 = 1000.0;
+
+/// Each joint's response in the regression `y = x B` (`x`: k x N perturbations measured, `y`:
+/// k x N torque changes, N m; `u`: k x N the variance of each torque reading from its samples'
+/// scatter, N^2 m^2), or None for a joint left out by `measured` (a flat channel). With
+/// `in_pairs`, rows `2i` and `2i + 1` are a `+-` pair, read by their half-differences. The
+/// noise is the residuals' mean square where the regression has residual degrees of freedom,
+/// otherwise (a plan of `N` pairs) the mean of `u`: that misses noise from pass to pass (it
+/// reads a response more readily), so plans with more crossings than the minimum test better.
+pub fn responses(
+    x: &DMatrix<f64>,
+    y: &DMatrix<f64>,
+    u: &DMatrix<f64>,
+    in_pairs: bool,
+    measured: &[bool],
+) -> Vec<Option<Response>> {
+    let none = vec![None; y.ncols()];
+    if x.nrows() != y.nrows() || u.shape() != y.shape() || measured.len() != y.ncols() {
+        return none;
+    }
+    let (x, y, u) = if in_pairs && x.nrows().is_multiple_of(2) {
+        let half = |m: &DMatrix<f64>, sign: f64, factor: f64| {
+            DMatrix::from_fn(m.nrows() / 2, m.ncols(), |i, j| {
+                factor * (m[(2 * i, j)] + sign * m[(2 * i + 1, j)])
+            })
+        };
+        (half(x, -1.0, 0.5), half(y, -1.0, 0.5), half(u, 1.0, 0.25))
+    } else {
+        (x.clone(), y.clone(), u.clone())
+    };
+    let (rows, columns) = x.shape();
+    if rows < columns || columns == 0 {
+        return none;
+    }
+    // scale the columns: perturbations of 1e-9 and of 1 rad may meet in one design
+    let scales: Vec<f64> = x.column_iter().map(|c| c.amax()).collect();
+    if scales.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+        return none;
+    }
+    let mut xs = x.clone();
+    for (mut c, s) in xs.column_iter_mut().zip(&scales) {
+        c /= *s;
+    }
+    let q = xs.qr().q();
+    let dof = rows - columns;
+    (0..y.ncols())
+        .map(|j| {
+            if !measured[j] {
+                return None;
+            }
+            let yj = y.column(j);
+            let scale = yj.amax();
+            if !(scale.is_finite() && scale > 0.0) {
+                return None;
+            }
+            let yj = yj / scale;
+            let explained = (q.transpose() * &yj).norm_squared();
+            let (noise, d2) = if dof > 0 {
+                (
+                    (yj.norm_squared() - explained).max(0.0) / dof as f64,
+                    dof as f64,
+                )
+            } else {
+                (u.column(j).mean() / (scale * scale), KNOWN_NOISE_DOF)
+            };
+            let f = (explained / columns as f64) / noise;
+            let p = if f.is_nan() {
+                1.0
+            } else {
+                crate::student_t::f_upper_tail(f.min(1e300), columns as f64, d2)
+            };
+            Some(Response { f, p })
+        })
+        .collect()
+}
+
+/// The warning for an experiment none of whose joints' torques responded to its perturbations
+/// beyond their noise (smallest `p` times the joints tested above [`FALSE_ALARM`]), with how
+/// much larger the perturbations, or how many more crossings, would make the strongest
+/// response clear (an F of 10 times the threshold's). None when one joint responds, or when
+/// none could be tested.
+pub fn unresolved_warning(kind: ExperimentKind, found: &[Option<Response>]) -> Option<String> {
+    let tested: Vec<Response> = found.iter().flatten().copied().collect();
+    if tested.is_empty() {
+        return None;
+    }
+    let smallest = tested.iter().map(|r| r.p).fold(1.0, f64::min);
+    if smallest * tested.len() as f64 <= FALSE_ALARM {
+        return None;
+    }
+    let strongest = tested
+        .iter()
+        .map(|r| r.f)
+        .filter(|f| f.is_finite())
+        .fold(0.0, f64::max);
+    let estimate = kind.estimate_name();
+    let variable = match kind {
+        ExperimentKind::D => "dqdd",
+        ExperimentKind::H => "dqd",
+        _ => "dq",
+    };
+    let slow = if kind == ExperimentKind::H {
+        " H* is small at slow operating points without viscous friction (zero at rest), and this may be its measurement;"
+    } else {
+        ""
+    };
+    // the F statistic grows with the square of the perturbations and with the crossings
+    let larger = if strongest > 0.0 {
+        let factor = (40.0 / strongest).sqrt().max(2.0);
+        format!(
+            "perturbations ({variable}) about {} times larger, or {} times as many crossings, would make it clear if it is not zero",
+            shown_factor(factor),
+            shown_factor(factor * factor)
+        )
+    } else {
+        format!(
+            "larger perturbations ({variable}) or more crossings would show it if it is not zero"
+        )
+    };
+    Some(format!(
+        "experiment '{}': no joint's torque responded to the perturbations beyond its noise (the strongest explains {strongest:.1} times the residuals' mean square, which noise alone reaches {:.0} % of the time), so {estimate} is not resolved: its values are within their noise of zero;{slow} otherwise the perturbations are too small for the torque sensor, or the torque channels do not follow the robot: {larger}",
+        kind.name(),
+        (100.0 * smallest).min(100.0)
+    ))
+}
+
+/// A factor: whole below 100, with an exponent above.
+fn shown_factor(f: f64) -> String {
+    if f < 100.0 {
+        format!("{f:.0}")
+    } else {
+        format!("{f:.1e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn design(k: usize, n: usize, seed: u64) -> DMatrix<f64> {
+        crate::local::perturbation::perturbations(
+            crate::local::Design::Random,
+            k,
+            &vec![1.0; n],
+            true,
+            seed,
+        )
+        .unwrap()
+    }
+
+    /// Seeded Gaussian noise of standard deviation `size`.
+    fn noise(k: usize, n: usize, size: f64, seed: u64) -> DMatrix<f64> {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, StandardNormal};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        DMatrix::from_fn(k, n, |_, _| {
+            size * <StandardNormal as Distribution<f64>>::sample(&StandardNormal, &mut rng)
+        })
+    }
+
+    #[test]
+    fn a_response_beyond_the_noise_is_found_and_noise_alone_is_named() {
+        let (k, n) = (24, 3);
+        let x = design(k, n, 1);
+        let b = DMatrix::from_row_slice(3, 3, &[1.0, 0.2, 0.0, 0.1, 2.0, 0.3, 0.0, 0.4, 1.5]);
+        let measured = vec![true; n];
+        let e = noise(k, n, 0.01, 2);
+        let u = DMatrix::from_element(k, n, 1e-4);
+        let clear = responses(&x, &(&x * b.transpose() + &e), &u, false, &measured);
+        assert!(clear.iter().all(|r| r.unwrap().p < 1e-10), "{clear:?}");
+        assert_eq!(unresolved_warning(ExperimentKind::GDynamic, &clear), None);
+        // the same response 1e4 times smaller than the noise
+        let lost = responses(&x, &(&x * b.transpose() * 1e-6 + &e), &u, false, &measured);
+        let w = unresolved_warning(ExperimentKind::GDynamic, &lost).expect("noise alone");
+        assert!(
+            w.starts_with("experiment 'G': no joint's torque responded"),
+            "{w}"
+        );
+        assert!(w.contains("so G* is not resolved"), "{w}");
+        assert!(w.contains("perturbations (dq) about"), "{w}");
+        assert!(!w.contains("slow operating points"), "{w}");
+        // a flat channel is not tested; nothing tested, nothing said
+        let none = responses(&x, &e, &u, false, &[false; 3]);
+        assert!(none.iter().all(Option::is_none));
+        assert_eq!(unresolved_warning(ExperimentKind::D, &none), None);
+        // without residual degrees of freedom the samples' noise is the noise
+        let (x3, e3, u3) = (
+            x.rows(0, 3).into_owned(),
+            e.rows(0, 3).into_owned(),
+            u.rows(0, 3).into_owned(),
+        );
+        let alone = responses(&x3, &e3, &u3, false, &measured);
+        assert!(
+            unresolved_warning(ExperimentKind::D, &alone).is_some(),
+            "{alone:?}"
+        );
+        let moved = responses(&x3, &(&x3 * b.transpose() + &e3), &u3, false, &measured);
+        assert_eq!(
+            unresolved_warning(ExperimentKind::D, &moved),
+            None,
+            "{moved:?}"
+        );
+        // shapes that do not fit are not tested
+        assert!(responses(&x, &e, &u3, false, &measured)
+            .iter()
+            .all(Option::is_none));
+    }
+
+    #[test]
+    fn pairs_are_read_by_their_half_differences() {
+        // a small exact linear response under a large even-order term that the pairs cancel
+        let (k, n) = (24, 3);
+        let x = design(k, n, 3);
+        let b = DMatrix::from_diagonal_element(3, 3, 0.01);
+        let e = noise(k, n, 1e-9, 4);
+        let mut y = &x * b.transpose() + e;
+        for i in 0..k {
+            for j in 0..n {
+                y[(i, j)] += 5.0 * x.row(i).norm_squared() * (1.0 + j as f64);
+            }
+        }
+        let measured = vec![true; n];
+        let u = DMatrix::from_element(k, n, 1e-18);
+        let full = responses(&x, &y, &u, false, &measured);
+        assert!(
+            unresolved_warning(ExperimentKind::H, &full).is_some(),
+            "{full:?}"
+        );
+        let pairs = responses(&x, &y, &u, true, &measured);
+        assert!(pairs.iter().all(|r| r.unwrap().p < 1e-10), "{pairs:?}");
+        assert_eq!(unresolved_warning(ExperimentKind::H, &pairs), None);
+    }
+
+    #[test]
+    fn h_at_slow_points_says_it_may_be_its_measurement() {
+        let (k, n) = (16, 2);
+        let x = design(k, n, 5);
+        let e = noise(k, n, 0.1, 6);
+        let u = DMatrix::from_element(k, n, 0.01);
+        let w = unresolved_warning(ExperimentKind::H, &responses(&x, &e, &u, true, &[true; 2]))
+            .unwrap();
+        assert!(w.contains("H* is small at slow operating points"), "{w}");
+        assert!(w.contains("perturbations (dqd)"), "{w}");
+    }
+}
