@@ -20,6 +20,11 @@ pub const MAX_BODIES: usize = 1000;
 pub const MAX_RATE: f64 = 1e7;
 /// Perturbations (crossings) per experiment.
 pub const MAX_PERTURBATIONS: usize = 100_000;
+/// The smallest perturbation a plan takes (rad or m, per second, per second squared): a
+/// hundredth of the finest encoders' step (about 1e-7 rad at 2^26 counts a revolution). A
+/// smaller one moves no torque a sensor reads, and underflows to 0 in a design's entries near
+/// 1e-308.
+pub const MIN_PERTURBATION: f64 = 1e-9;
 /// Harmonics per joint of a Fourier excitation.
 pub const MAX_HARMONICS: usize = 1_000;
 /// Samples per period at which an excitation's criterion is evaluated.

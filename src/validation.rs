@@ -75,6 +75,19 @@ pub fn validate(joint_names: &[String], predicted: &[f64], measured: &[f64]) -> 
     }
     let k = measured.len() / n;
     let residuals: Vec<f64> = measured.iter().zip(predicted).map(|(m, p)| m - p).collect();
+    // two finite torques of opposite signs past 9e307 differ by more than any f64
+    if let Some(i) = residuals.iter().position(|r| !r.is_finite()) {
+        return Err(Error::Numerical {
+            operation: "validation".into(),
+            message: format!(
+                "the error of sample {}, joint {} overflows (measured {}, predicted {}): torques this large cannot be compared",
+                i / n,
+                joint_names[i % n],
+                crate::error::shown(measured[i]),
+                crate::error::shown(predicted[i])
+            ),
+        });
+    }
     let joints = (0..n)
         .map(|j| {
             let e = rms((0..k).map(|s| residuals[s * n + j]));
@@ -94,4 +107,24 @@ pub fn validate(joint_names: &[String], predicted: &[f64], measured: &[f64]) -> 
         samples: k,
         residuals,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn errors_past_the_largest_number_are_refused_and_large_ones_kept() {
+        let joints = vec!["a".to_string(), "b".to_string()];
+        let err = validate(&joints, &[0.0, -1e308, 0.0, 0.0], &[0.0, 1e308, 0.0, 0.0]).unwrap_err();
+        let message = err.to_string();
+        assert!(
+            message.contains("sample 0, joint b overflows (measured 1e308, predicted -1e308)"),
+            "{message}"
+        );
+        // a torque of 1e308 against a prediction of 0 is an error of 1e308: kept, and its RMS too
+        let v = validate(&joints, &[0.0, 0.0, 0.0, 0.0], &[0.0, 1e308, 0.0, 1e308]).unwrap();
+        assert_eq!(v.joints[1].max, 1e308);
+        assert!((v.joints[1].rms / 1e308 - 1.0).abs() < 1e-12);
+    }
 }

@@ -9,7 +9,9 @@ use std::collections::BTreeMap;
 
 use common::mimic_pair;
 use perturbid_rs::io::Table;
-use perturbid_rs::local::{plan_experiments, ExperimentKind, OperatingPoint, PlanOptions};
+use perturbid_rs::local::{
+    plan_experiments, ExperimentKind, OperatingPoint, PlanOptions, Size, Sizes,
+};
 use perturbid_rs::robots::a465::{TABLE2_Q, TABLE2_QD, TABLE2_QDD};
 use perturbid_rs::urdf::MAX_XML_DEPTH;
 use perturbid_rs::{
@@ -692,6 +694,38 @@ fn key_messages_word_for_word() {
         says(e),
         "experiment 'H' of the plan: joint 'joint1' at t = 3.1640 s: velocity 3.143438 rad/s is outside the limit +-3.141600 rad/s by 0.001838 rad/s; reduce the perturbation sizes or move the operating point away from the limit"
     );
+    // perturbations below what any encoder reads, however they are asked for
+    let table2 =
+        OperatingPoint::new(TABLE2_Q.to_vec(), TABLE2_QD.to_vec(), TABLE2_QDD.to_vec()).unwrap();
+    let tiny = PlanOptions {
+        sizes: Sizes {
+            velocity: Size::Fraction(1e-300),
+            ..Sizes::default()
+        },
+        ..PlanOptions::default()
+    };
+    assert_eq!(
+        says(plan_experiments(&model, &table2, &tiny).unwrap_err()),
+        "velocity size[0]: perturbation size 3.1416e-300; expected at least 1e-9, a hundredth of the finest encoders' step: a smaller one moves no torque a sensor reads"
+    );
+    let tiny = PlanOptions {
+        sizes: Sizes {
+            position: Size::Absolute(vec![0.01, 0.01, 1e-12, 0.01, 0.01, 0.01]),
+            ..Sizes::default()
+        },
+        ..PlanOptions::default()
+    };
+    assert!(says(plan_experiments(&model, &table2, &tiny).unwrap_err())
+        .starts_with("position size[2]: perturbation size 1e-12; expected at least 1e-9"));
+    let mut qd = TABLE2_QD.to_vec();
+    qd[3] = 1e-12;
+    let crawling = OperatingPoint::new(TABLE2_Q.to_vec(), qd, TABLE2_QDD.to_vec()).unwrap();
+    let keep = PlanOptions {
+        keep_velocity_sign: true,
+        ..PlanOptions::default()
+    };
+    assert!(says(plan_experiments(&model, &crawling, &keep).unwrap_err())
+        .contains("joint 'joint4' has qd* = 1e-12: every velocity perturbation of a size a sensor reads reverses it"));
     // a file of an output set whose writing was killed
     let d = std::env::temp_dir().join(format!("perturbid-words-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);

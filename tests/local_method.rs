@@ -291,6 +291,37 @@ fn estimates_of_noise_alone_are_warned_of() {
             "{experiment}: {found:#?}"
         );
     }
+    // the friction-aware H regression reads its pairs' differences too
+    let aware = PlanOptions {
+        friction_aware_h: true,
+        ..tiny.clone()
+    };
+    let plan = plan_experiments(&model, &op, &aware).unwrap();
+    let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    let options = IdentifyOptions {
+        friction_aware_h: true,
+        ..IdentifyOptions::default()
+    };
+    let m = identify_local(&plan, &recs, &options).unwrap();
+    assert!(
+        unresolved(&m)
+            .iter()
+            .any(|w| w.starts_with("experiment 'H': no joint")),
+        "{:#?}",
+        m.diagnostics.warnings
+    );
+    let plan = plan_experiments(
+        &model,
+        &op,
+        &PlanOptions {
+            friction_aware_h: true,
+            ..paper_sizes.clone()
+        },
+    )
+    .unwrap();
+    let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    let m = identify_local(&plan, &recs, &options).unwrap();
+    assert_eq!(unresolved(&m), Vec::<String>::new());
     // the values are still there, with standard errors that say the same
     let d = noise.d.as_ref().unwrap();
     assert!(d

@@ -16,12 +16,13 @@ use crate::error::{Error, Result};
 /// [`IdentifyOptions::friction_aware_h`]. One least-squares solve per torque row: the columns
 /// are the measured velocity differences and, where some pair reverses that row's joint, its
 /// step `sign(d_j)`. Each pair weighs by the noise of its two torques (see [`super::noise`]);
-/// the torque noise is returned per joint (what varied from pass to pass: per pass).
+/// the torque noise is returned per joint (what varied from pass to pass: per pass), with the
+/// warning of [`super::response::unresolved_warning`] when no joint's torque responded.
 pub(super) fn friction_aware_h(
     plan: &Plan,
     e: &Experiment,
     v: &ExperimentValues,
-) -> Result<(Estimate, CoulombSteps, Vec<TorqueNoise>)> {
+) -> Result<(Estimate, CoulombSteps, Vec<TorqueNoise>, Option<String>)> {
     let n = plan.n();
     let k = v.crossings.len();
     let refuse = |message: String| Error::InvalidArgument {
@@ -69,6 +70,7 @@ pub(super) fn friction_aware_h(
         step: vec![None; n],
         stderr: vec![None; n],
     };
+    let mut responded = Vec::with_capacity(n);
     for j in 0..n {
         let p = n + usize::from(reverses[j]);
         let x = DMatrix::from_fn(m, p, |i, c| {
@@ -91,6 +93,13 @@ pub(super) fn friction_aware_h(
         }
         // a difference of two torques: the sum of their variances
         let u = DMatrix::from_fn(m, 1, |i, _| variance[2 * i][j] + variance[2 * i + 1][j]);
+        responded.extend(super::response::responses(
+            &x,
+            &y,
+            &u,
+            false,
+            &[v.flat_torque[j].is_none()],
+        ));
         let weighted = weighted_least_squares(
             &x,
             &y,
@@ -147,5 +156,6 @@ pub(super) fn friction_aware_h(
         stderr,
         crossings: k,
     };
-    Ok((estimate, steps, noise))
+    let unresolved = super::response::unresolved_warning(e.kind, &responded);
+    Ok((estimate, steps, noise, unresolved))
 }

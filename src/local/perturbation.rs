@@ -65,6 +65,20 @@ impl Size {
                 message: format!("perturbation size {s}; expected a positive finite number"),
             });
         }
+        if let Some((j, s)) = sizes
+            .iter()
+            .enumerate()
+            .find(|(_, s)| **s < crate::limits::MIN_PERTURBATION)
+        {
+            return Err(Error::InvalidArgument {
+                argument: format!("{argument}[{j}]"),
+                message: format!(
+                    "perturbation size {}; expected at least {:e}, a hundredth of the finest encoders' step: a smaller one moves no torque a sensor reads",
+                    crate::error::shown(*s),
+                    crate::limits::MIN_PERTURBATION
+                ),
+            });
+        }
         Ok(sizes)
     }
 }

@@ -439,12 +439,13 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
     if o.keep_velocity_sign {
         for (j, size) in sizes[1].iter_mut().enumerate() {
             let limit = 0.9 * op.qd[j].abs();
-            if limit == 0.0 {
+            if limit < crate::limits::MIN_PERTURBATION {
                 return Err(Error::InvalidArgument {
                     argument: "keep_velocity_sign".into(),
                     message: format!(
-                        "joint '{}' has qd* = 0: every velocity perturbation reverses it; identify H with the friction-aware regression (friction_aware_h) instead",
-                        model.joint_names[j]
+                        "joint '{}' has qd* = {}: every velocity perturbation of a size a sensor reads reverses it; identify H with the friction-aware regression (friction_aware_h) instead",
+                        model.joint_names[j],
+                        crate::error::shown(op.qd[j])
                     ),
                 });
             }

@@ -510,6 +510,6 @@ def test_perturbations_too_small_for_the_torque_noise_are_warned_of():
             warnings.simplefilter("always")
             model = pr.identify_local(plan, recs)
         named = [w for w in model.diagnostics["warnings"] if "responded to the perturbations beyond its noise" in w]
-        assert [w.split("'")[1] for w in named] == unresolved, named
+        assert sorted(w.split("'")[1] for w in named) == sorted(unresolved), named
         assert all(any(w == str(c.message) for c in caught) for w in named)
         assert all("times larger" in w for w in named)
