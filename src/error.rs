@@ -280,7 +280,7 @@ pub enum Error {
     Recording { recording: String, message: String },
 
     /// A JSON document that is not a valid plan or model.
-    #[error("{context}: {message}")]
+    #[error("{context}: {}", short_numbers(.message))]
     Json { context: String, message: String },
 
     /// A joint `<limit>` that no joint can have: lower above upper, a speed, effort or
@@ -339,7 +339,7 @@ pub enum Error {
 
     /// A configuration file (TOML: a pipeline, a study) that does not say what is expected;
     /// `location` is `file:line:column` or `file, step K`.
-    #[error("{location}: {message}")]
+    #[error("{location}: {}", short_numbers(.message))]
     Config { location: String, message: String },
 
     /// A built-in robot or variant name that does not exist.
@@ -434,6 +434,37 @@ pub(crate) fn shown(v: f64) -> String {
     }
 }
 
+/// `text` with every number of more than [`LONG_NUMBER`] characters written as [`shown`]
+/// writes it: the JSON and TOML readers' own messages print a float of 1e300 in 301 digits.
+pub(crate) fn short_numbers(text: &str) -> String {
+    let mut out = String::with_capacity(text.len().min(4096));
+    let mut rest = text;
+    while let Some(start) = rest.find(|c: char| c.is_ascii_digit()) {
+        let end = rest[start..]
+            .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .map_or(rest.len(), |e| start + e);
+        // a full stop after a number ends the sentence, not the number
+        let end = if rest[start..end].ends_with('.') {
+            end - 1
+        } else {
+            end
+        };
+        let number = &rest[start..end];
+        let value = number.parse::<f64>().ok().filter(|v| v.is_finite());
+        out.push_str(&rest[..start]);
+        match value {
+            Some(v) if number.len() > LONG_NUMBER => out.push_str(&shown(v)),
+            _ => out.push_str(number),
+        }
+        rest = &rest[end..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// The longest number [`short_numbers`] leaves as it is (`u64::MAX` has 20 digits).
+const LONG_NUMBER: usize = 24;
+
 /// Runs `f`, turning a panic into [`Error::Internal`] naming `context`: the last line of
 /// defence at the library's boundaries (Python, the command line), so that a bug reaches the
 /// user as an error, not as an abort.
@@ -459,6 +490,39 @@ mod tests {
         assert_eq!(shown(123456789.0), "123456789");
         assert_eq!(shown(f64::NAN), "NaN");
         assert_eq!(shown(f64::NEG_INFINITY), "-inf");
+    }
+
+    #[test]
+    fn long_numbers_in_readers_messages_are_shortened() {
+        use super::short_numbers;
+        let huge = format!("{}", 1e300);
+        assert_eq!(huge.len(), 301);
+        let e = super::Error::Json {
+            context: "plan.json".into(),
+            message: format!(
+                "invalid type: floating point `{huge}`, expected a string at line 3 column 12"
+            ),
+        };
+        assert_eq!(
+            e.to_string(),
+            "plan.json: invalid type: floating point `1e300`, expected a string at line 3 column 12"
+        );
+        let tiny = format!("{}", -2.5e-300);
+        assert_eq!(short_numbers(&format!("value {tiny}.")), "value -2.5e-300.");
+        // line numbers, u64s and ordinary decimals stay as they are
+        for kept in [
+            "line 18446744073709551615 column 7",
+            "0.1 and 12.5",
+            "1.2.3.4",
+            "",
+        ] {
+            assert_eq!(short_numbers(kept), kept);
+        }
+        let config = super::Error::Config {
+            location: "study.toml:4:9".into(),
+            message: format!("invalid value {}", 1e40),
+        };
+        assert_eq!(config.to_string(), "study.toml:4:9: invalid value 1e40");
     }
 
     use super::*;
