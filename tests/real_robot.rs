@@ -292,6 +292,79 @@ fn friction_aware_h_recovers_h_and_the_coulomb_steps() {
     assert!(rel(mat(&plain.h), &expected) > 1e-2);
 }
 
+/// The orthogonal design (`cond(X) = 1`, what the design warning advises) with the friction-aware
+/// H regression: the planner draws H magnitudes that vary (its Hadamard columns put every joint
+/// at one magnitude, where the Coulomb step sign(d) is proportional to the velocity change),
+/// and a plan made without it is refused by name rather than as a rank deficiency.
+#[test]
+fn the_orthogonal_design_serves_the_friction_aware_h_regression() {
+    use perturbid_rs::local::{Design, ExperimentKind};
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let op = table2();
+    let mut sim = SimulationOptions::new(&model);
+    sim.friction = Friction::none(n);
+    let clean_plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+    let clean = identify_local(
+        &clean_plan,
+        &simulate_plan(&model, &clean_plan, &sim).unwrap(),
+        &IdentifyOptions::default(),
+    )
+    .unwrap();
+    let viscous = vec![0.5, 0.4, 0.3, 0.2, 0.1, 0.05];
+    sim.friction = Friction::viscous_coulomb(viscous.clone(), vec![0.3; n]);
+    let options = IdentifyOptions {
+        friction_aware_h: true,
+        ..IdentifyOptions::default()
+    };
+    let aware = PlanOptions {
+        design: Design::Orthogonal,
+        friction_aware_h: true,
+        count: Some(32),
+        ..PlanOptions::default()
+    };
+    let plan = plan_experiments(&model, &op, &aware).unwrap();
+    let h = plan.experiment(ExperimentKind::H).unwrap();
+    assert!(h.design_cond().unwrap() < 1.0 + 1e-9);
+    let m = identify_local(
+        &plan,
+        &simulate_plan(&model, &plan, &sim).unwrap(),
+        &options,
+    )
+    .unwrap();
+    let expected = mat(&clean.h) + DMatrix::from_diagonal(&nalgebra::DVector::from_vec(viscous));
+    let err = rel(mat(&m.h), &expected);
+    assert!(err < 1e-6, "friction-aware H* off by {err:.2e}");
+    let steps = m.coulomb.as_ref().unwrap();
+    assert!(
+        steps.step.iter().flatten().all(|s| (s - 0.6).abs() < 1e-6),
+        "{steps:?}"
+    );
+    // the same design planned without friction_aware_h: Hadamard columns, refused by name
+    let plain = plan_experiments(
+        &model,
+        &op,
+        &PlanOptions {
+            friction_aware_h: false,
+            ..aware
+        },
+    )
+    .unwrap();
+    let e = identify_local(
+        &plain,
+        &simulate_plan(&model, &plain, &sim).unwrap(),
+        &options,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains(
+            "the H perturbations of joint 'joint1' reverse it at one magnitude in every pair"
+        ),
+        "{e}"
+    );
+}
+
 /// `predict` expands about the planned operating point, which every nominal pass crossed and
 /// where T* holds; with coarse encoders the point measured at the crossings is a noisy
 /// estimate of it (qdd through two derivatives of quantised positions) that would bias every

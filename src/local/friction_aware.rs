@@ -48,6 +48,17 @@ pub(super) fn friction_aware_h(
         0.5 * (sign0(qd0[j] + d) - sign0(qd0[j] - d))
     };
     let reverses: Vec<bool> = (0..n).map(|j| (0..m).any(|i| step(i, j) != 0.0)).collect();
+    // a joint reversed at one magnitude throughout: its step sign(d) is d / size
+    if let Some(j) = (0..n).find(|&j| {
+        let first = e.deltas[(0, j)].abs();
+        (0..m).all(|i| step(i, j) != 0.0)
+            && (0..m).all(|i| (e.deltas[(2 * i, j)].abs() - first).abs() <= 1e-9 * first)
+    }) {
+        return Err(refuse(format!(
+            "the H perturbations of joint '{}' reverse it at one magnitude in every pair (an orthogonal design's Hadamard columns), so its Coulomb step sign(d) is proportional to its velocity change and the two cannot be told apart; plan the H experiment for the friction-aware regression (PlanOptions::friction_aware_h, --friction-aware-h), which draws magnitudes that vary",
+            plan.joint_names[j]
+        )));
+    }
     let needed = n + usize::from(reverses.iter().any(|&r| r));
     if m < needed {
         return Err(refuse(format!(

@@ -136,6 +136,33 @@ pub fn perturbations(
     symmetric: bool,
     seed: u64,
 ) -> Result<DMatrix<f64>> {
+    perturbations_of(design, count, size, symmetric, seed, true)
+}
+
+/// [`perturbations`] whose magnitudes vary from crossing to crossing for every joint: the
+/// orthogonal design without its Sylvester-Hadamard columns (seeded random orthonormal columns
+/// instead, still `cond(X) = 1`). The friction-aware H regression needs it: its Coulomb-step
+/// column `sign(qd* + d) - sign(qd* - d)` is `sign(d)`, which a column of `+-size` equals up
+/// to scale wherever the perturbations reverse the joint, leaving the regression
+/// rank-deficient.
+pub fn varying_perturbations(
+    design: Design,
+    count: usize,
+    size: &[f64],
+    symmetric: bool,
+    seed: u64,
+) -> Result<DMatrix<f64>> {
+    perturbations_of(design, count, size, symmetric, seed, false)
+}
+
+fn perturbations_of(
+    design: Design,
+    count: usize,
+    size: &[f64],
+    symmetric: bool,
+    seed: u64,
+    hadamard: bool,
+) -> Result<DMatrix<f64>> {
     let n = size.len();
     let needed = if symmetric { 2 * n } else { n };
     if count < needed || (symmetric && count % 2 == 1) {
@@ -152,7 +179,7 @@ pub fn perturbations(
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let unit = match design {
         Design::Random => DMatrix::from_fn(m, n, |_, _| rng.random_range(-1.0..=1.0)),
-        Design::Orthogonal => orthogonal_unit(m, n, &mut rng),
+        Design::Orthogonal => orthogonal_unit(m, n, &mut rng, hadamard),
     };
     let mut out = DMatrix::zeros(count, n);
     for i in 0..m {
@@ -173,9 +200,9 @@ pub fn perturbations(
 ///
 /// When `m` is a multiple of `p`, the smallest power of two `>= n` (`> n` when possible, to skip
 /// the all-ones column), the rows of the `p x p` Sylvester-Hadamard matrix repeated: entries
-/// +-1, every joint at full size in every crossing. Otherwise seeded random orthonormal columns
-/// scaled so the largest entry is 1.
-fn orthogonal_unit(m: usize, n: usize, rng: &mut ChaCha8Rng) -> DMatrix<f64> {
+/// +-1, every joint at full size in every crossing. Otherwise, or without `hadamard`, seeded
+/// random orthonormal columns scaled so the largest entry is 1.
+fn orthogonal_unit(m: usize, n: usize, rng: &mut ChaCha8Rng, hadamard: bool) -> DMatrix<f64> {
     let p = (n + 1).next_power_of_two();
     let (p, skip) = if m.is_multiple_of(p) {
         (p, 1)
@@ -185,7 +212,7 @@ fn orthogonal_unit(m: usize, n: usize, rng: &mut ChaCha8Rng) -> DMatrix<f64> {
             usize::from(n.next_power_of_two() > n),
         )
     };
-    if m.is_multiple_of(p) && p >= n + skip {
+    if hadamard && m.is_multiple_of(p) && p >= n + skip {
         // Sylvester: H[i][j] = (-1)^popcount(i & j)
         return DMatrix::from_fn(m, n, |i, j| {
             if ((i % p) & (j + skip)).count_ones() % 2 == 0 {

@@ -6,7 +6,7 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use super::operating_point::OperatingPoint;
-use super::perturbation::{perturbations, Design, Sizes};
+use super::perturbation::{perturbations, varying_perturbations, Design, Sizes};
 use super::plan_checks;
 use super::rounded_positions;
 use crate::choice::choice;
@@ -504,6 +504,9 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
         };
         let deltas = match kind.perturbed() {
             None => DMatrix::zeros(count, n),
+            Some(v) if kind == ExperimentKind::H && o.friction_aware_h => {
+                varying_perturbations(o.design, count, &sizes[v], o.symmetric, seed)?
+            }
             Some(v) => perturbations(o.design, count, &sizes[v], o.symmetric, seed)?,
         };
         if kind == ExperimentKind::H {
