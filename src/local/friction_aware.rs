@@ -9,6 +9,7 @@ use super::identify::ExperimentValues;
 use super::model::{CoulombSteps, Estimate};
 use super::noise::{reading_variance, sample_variance, weighted_least_squares};
 use super::plan::{Experiment, Plan};
+use super::rounded_positions::{resolution_warning, Resolution};
 use crate::direct::parameters::sign0;
 use crate::error::{Error, Result};
 
@@ -17,12 +18,14 @@ use crate::error::{Error, Result};
 /// are the measured velocity differences and, where some pair reverses that row's joint, its
 /// step `sign(d_j)`. Each pair weighs by the noise of its two torques (see [`super::noise`]);
 /// the torque noise is returned per joint (what varied from pass to pass: per pass), with the
-/// warning of [`super::response::unresolved_warning`] when no joint's torque responded.
+/// warnings of [`super::response::unresolved_warning`] (no joint's torque responded) and of
+/// [`super::rounded_positions::resolution_warning`] (coarse encoders read the velocity
+/// changes to worse than a tenth of their size).
 pub(super) fn friction_aware_h(
     plan: &Plan,
     e: &Experiment,
     v: &ExperimentValues,
-) -> Result<(Estimate, CoulombSteps, Vec<TorqueNoise>, Option<String>)> {
+) -> Result<(Estimate, CoulombSteps, Vec<TorqueNoise>, Vec<String>)> {
     let n = plan.n();
     let k = v.crossings.len();
     let refuse = |message: String| Error::InvalidArgument {
@@ -167,6 +170,20 @@ pub(super) fn friction_aware_h(
         stderr,
         crossings: k,
     };
-    let unresolved = super::response::unresolved_warning(e.kind, &responded);
-    Ok((estimate, steps, noise, unresolved))
+    let mut warnings: Vec<String> = super::response::unresolved_warning(e.kind, &responded)
+        .into_iter()
+        .collect();
+    // coarse encoders: how well each pair's velocity change was read, as the plain regression
+    // reports it
+    let resolutions: Vec<Resolution> = (0..n)
+        .filter_map(|j| {
+            let se: Vec<f64> = v.crossings.iter().map(|c| c.state_stderr[1][j]).collect();
+            let half: Vec<f64> = (0..m)
+                .map(|i| 0.5 * (v.crossings[2 * i].qd[j] - v.crossings[2 * i + 1].qd[j]))
+                .collect();
+            Resolution::of(&plan.joint_names[j], v.position_step[j]?, &se, &half)
+        })
+        .collect();
+    warnings.extend(resolution_warning(e.kind.name(), 1, &resolutions));
+    Ok((estimate, steps, noise, warnings))
 }

@@ -629,9 +629,9 @@ pub fn identify_local(
             let e = plan
                 .experiment(ExperimentKind::H)
                 .expect("values of a planned experiment");
-            let (h, c, h_noise, unresolved) = friction_aware_h(plan, e, v)?;
+            let (h, c, h_noise, warnings) = friction_aware_h(plan, e, v)?;
             noise.borrow_mut().extend(h_noise);
-            extra_warnings.borrow_mut().extend(unresolved);
+            extra_warnings.borrow_mut().extend(warnings);
             (Some(h), Some(c))
         }
         (true, None) => {

@@ -513,3 +513,18 @@ def test_perturbations_too_small_for_the_torque_noise_are_warned_of():
         assert sorted(w.split("'")[1] for w in named) == sorted(unresolved), named
         assert all(any(w == str(c.message) for c in caught) for w in named)
         assert all("times larger" in w for w in named)
+
+
+def test_coarse_encoders_are_reported_by_the_friction_aware_h_regression_too():
+    # 4,096 counts a revolution leave joint 3's velocity changes in a 0.02 s window uncertain by
+    # more than a tenth: the plain H regression said so, the friction-aware one did not
+    robot = pr.robots.a465()
+    tr = pr.TrueRobot({"sensors": {"encoder_counts": [4096] * 6, "torque_noise": [0.01] * 6}, "seed": 5})
+    for aware in [False, True]:
+        plan = pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2), design="orthogonal", experiments=["nominal", "H"], window=0.02, friction_aware_h=aware)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            model = pr.identify_local(plan, pr.simulate(robot, plan, true_robot=tr), friction_aware_h=aware)
+        coarse = [w for w in model.diagnostics["warnings"] if w.startswith("experiment 'H': the encoders of joint(s) 'joint3' (steps of 1.53e-3 rad: velocities known to")]
+        assert len(coarse) == 1, (aware, model.diagnostics["warnings"])
+        assert (model.coulomb is not None) == aware
