@@ -20,6 +20,13 @@ pub const MAX_BODIES: usize = 1000;
 pub const MAX_RATE: f64 = 1e7;
 /// Perturbations (crossings) per experiment.
 pub const MAX_PERTURBATIONS: usize = 100_000;
+/// The base frequencies (Hz) of a Fourier excitation, designed or read: a period from 1,000 s
+/// down to a millisecond.
+pub const BASE_FREQUENCY: (f64, f64) = (1e-3, 1e3);
+/// The highest Butterworth order a preprocessing filter takes (each pass; zero-phase doubles
+/// it): far above the 2 to 8 of practice, and each order costs one more first- or second-order
+/// section per sample (an order of 1e9 allocated 5 GB and aborted).
+pub const MAX_FILTER_ORDER: usize = 32;
 /// The smallest perturbation a plan takes (rad or m, per second, per second squared): a
 /// hundredth of the finest encoders' step (about 1e-7 rad at 2^26 counts a revolution). A
 /// smaller one moves no torque a sensor reads, and underflows to 0 in a design's entries near

@@ -22,10 +22,15 @@ impl Biquad {
 /// A digital Butterworth low-pass of `order` with cutoff `cutoff` Hz at sampling rate `rate`
 /// Hz (bilinear transform with pre-warping), as second-order sections with unit DC gain.
 pub fn butterworth_lowpass(order: usize, cutoff: f64, rate: f64) -> Result<Vec<Biquad>> {
-    if order == 0 || !(cutoff > 0.0 && cutoff < 0.5 * rate) {
+    let max = crate::limits::MAX_FILTER_ORDER;
+    if !(1..=max).contains(&order) || !(cutoff > 0.0 && cutoff < 0.5 * rate) {
         return Err(Error::InvalidArgument {
             argument: "filter".into(),
-            message: format!("order {order}, cutoff {cutoff} Hz at {rate} Hz; need order >= 1 and 0 < cutoff < rate / 2"),
+            message: format!(
+                "order {order}, cutoff {} Hz at {} Hz; need 1 <= order <= {max} and 0 < cutoff < rate / 2",
+                crate::error::shown(cutoff),
+                crate::error::shown(rate)
+            ),
         });
     }
     let fs2 = 2.0 * rate;

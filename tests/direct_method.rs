@@ -434,6 +434,20 @@ fn zero_phase_butterworth_has_the_analytic_gain() {
     }
     assert!(butterworth_lowpass(4, 600.0, rate).is_err());
     assert!(filtfilt(&f, &[1.0; 10]).is_err());
+    // an order of 1e9 allocated 5 GB and aborted; the highest is refused by name, one under taken
+    let max = perturbid_rs::limits::MAX_FILTER_ORDER;
+    assert!(butterworth_lowpass(max, 10.0, rate).is_ok());
+    for order in [0, max + 1, 1_000_000_000, usize::MAX] {
+        let e = butterworth_lowpass(order, 10.0, rate)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!(
+                "order {order}, cutoff 10 Hz at 1000 Hz; need 1 <= order <= {max}"
+            )),
+            "{e}"
+        );
+    }
 }
 
 #[test]

@@ -831,6 +831,21 @@ fn fourier_coefficients_past_the_range_of_f64_are_refused() {
     .unwrap_err()
     .to_string();
     assert!(e.starts_with("harmonics: 1001"), "{e}");
+    // base frequencies from 1 mHz to 1 kHz, as designs take them (a period of 6e-300 s was
+    // taken, and sampled accelerations of 3e299)
+    let with = |w_f: f64| {
+        FourierTrajectory::new(w_f, vec![0.0], DMatrix::zeros(1, 1), DMatrix::zeros(1, 1))
+    };
+    let tau = std::f64::consts::TAU;
+    assert!(with(tau * 1e-3).is_ok() && with(tau * 1e3).is_ok());
+    for (w_f, says) in [
+        (1e300, "base pulsation: 1e300 rad/s (a base frequency of 1.5915494309189535e299 Hz); expected a base frequency in [0.001, 1000] Hz"),
+        (1e-9, "base pulsation: 1e-9 rad/s (a base frequency of 1.5915494309189535e-10 Hz)"),
+        (0.0, "base pulsation: 0 rad/s"),
+    ] {
+        let e = with(w_f).unwrap_err().to_string();
+        assert!(e.starts_with(says), "{e}");
+    }
 }
 
 /// Model files edited by hand: standard errors, residuals and noise levels are magnitudes

@@ -294,7 +294,8 @@ pub fn design_excitation(
     check_count("samples", o.samples, 1, MAX_FIT_SAMPLES)?;
     check_count("max_evaluations", o.max_evaluations, 1, MAX_EVALUATIONS)?;
     // a period of at most 1000 s: the design checks its limits at 1 kHz over a period
-    check_range("base_frequency", o.base_frequency, 1e-3, 1e3)?;
+    let (low, high) = crate::limits::BASE_FREQUENCY;
+    check_range("base_frequency", o.base_frequency, low, high)?;
     check_range(
         "default_velocity",
         o.default_velocity,

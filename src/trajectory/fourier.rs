@@ -23,13 +23,20 @@ pub struct FourierTrajectory {
 
 impl FourierTrajectory {
     /// Checks the shapes (`a`, `b`: `len(q0) x L`, `1 <= L <= MAX_HARMONICS`), finiteness,
-    /// `w_f > 0`, and that the positions, velocities and accelerations stay within f64's range.
+    /// `w_f / 2 pi` within [`crate::limits::BASE_FREQUENCY`], and that the positions, velocities and accelerations stay within f64's range.
     pub fn new(w_f: f64, q0: Vec<f64>, a: DMatrix<f64>, b: DMatrix<f64>) -> Result<Self> {
         let n = q0.len();
-        if !(w_f.is_finite() && w_f > 0.0) {
+        let (low, high) = crate::limits::BASE_FREQUENCY;
+        let hz = w_f / std::f64::consts::TAU;
+        // (a designed frequency at a bound may come back a rounding below it)
+        if !(w_f.is_finite() && (low * (1.0 - 1e-12)..=high * (1.0 + 1e-12)).contains(&hz)) {
             return Err(Error::InvalidArgument {
                 argument: "base pulsation".into(),
-                message: format!("{w_f}; expected a positive number of rad/s"),
+                message: format!(
+                    "{} rad/s (a base frequency of {} Hz); expected a base frequency in [{low}, {high}] Hz",
+                    crate::error::shown(w_f),
+                    crate::error::shown(hz)
+                ),
             });
         }
         for (name, m) in [("a", &a), ("b", &b)] {
