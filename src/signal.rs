@@ -23,7 +23,7 @@ impl Biquad {
 /// Hz (bilinear transform with pre-warping), as second-order sections with unit DC gain.
 pub fn butterworth_lowpass(order: usize, cutoff: f64, rate: f64) -> Result<Vec<Biquad>> {
     let max = crate::limits::MAX_FILTER_ORDER;
-    if !(1..=max).contains(&order) || !(cutoff > 0.0 && cutoff < 0.5 * rate) {
+    if !((1..=max).contains(&order) && cutoff > 0.0 && cutoff < 0.5 * rate) {
         return Err(Error::InvalidArgument {
             argument: "filter".into(),
             message: format!(
