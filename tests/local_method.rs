@@ -197,17 +197,23 @@ fn other_operating_points() {
     }
 }
 
+/// Table 2's posture and accelerations at speeds of 0.3 to 0.5 rad/s, away from zero: Coulomb
+/// friction keeps its sign and viscous friction gives H* a diagonal to measure.
+fn table2_moving() -> OperatingPoint {
+    OperatingPoint::new(
+        a465::TABLE2_Q.to_vec(),
+        vec![0.4, -0.35, 0.3, 0.5, -0.4, 0.45],
+        a465::TABLE2_QDD.to_vec(),
+    )
+    .unwrap()
+}
+
 /// The common-mode claim: gravity and friction change T* and G, not D*; H* only by the
 /// viscous slope. Velocities stay away from zero so Coulomb friction keeps its sign.
 #[test]
 fn common_mode_gravity_and_friction() {
     let model = a465::model("kinsheel2010").unwrap();
-    let op = OperatingPoint::new(
-        a465::TABLE2_Q.to_vec(),
-        vec![0.4, -0.35, 0.3, 0.5, -0.4, 0.45],
-        a465::TABLE2_QDD.to_vec(),
-    )
-    .unwrap();
+    let op = table2_moving();
     let opts = PlanOptions {
         sizes: Sizes {
             velocity: Size::Absolute(vec![0.1; 6]),
@@ -237,12 +243,7 @@ fn common_mode_gravity_and_friction() {
 fn estimates_of_noise_alone_are_warned_of() {
     let model = a465::model("kinsheel2010").unwrap();
     // Table 2's posture at speeds where viscous friction gives H* a diagonal to measure
-    let op = OperatingPoint::new(
-        a465::TABLE2_Q.to_vec(),
-        vec![0.4, -0.35, 0.3, 0.5, -0.4, 0.45],
-        a465::TABLE2_QDD.to_vec(),
-    )
-    .unwrap();
+    let op = table2_moving();
     let mut sim = noise_free(&model, Gravity::Included);
     sim.friction = Friction::viscous_coulomb(vec![2.0, 1.5, 1.0, 0.5, 0.4, 0.3], vec![0.0; 6]);
     sim.torque_noise = vec![0.05; 6];
