@@ -53,8 +53,9 @@ pub(super) fn friction_aware_h(
     let reverses: Vec<bool> = (0..n).map(|j| (0..m).any(|i| step(i, j) != 0.0)).collect();
     // a joint reversed at one magnitude throughout: its step sign(d) is d / size
     if let Some(j) = (0..n).find(|&j| {
-        let first = e.deltas[(0, j)].abs();
-        (0..m).all(|i| step(i, j) != 0.0)
+        let first = e.deltas.get((0, j)).map_or(0.0, |d| d.abs());
+        m > 0
+            && (0..m).all(|i| step(i, j) != 0.0)
             && (0..m).all(|i| (e.deltas[(2 * i, j)].abs() - first).abs() <= 1e-9 * first)
     }) {
         return Err(refuse(format!(
