@@ -549,13 +549,8 @@ pub fn identify_local(
         }
         offsets_found.borrow_mut().extend(found);
         let (u, samples) = reading_variances(&[v], n);
-        // did the torques respond? (read by +- pairs when every planned crossing was read)
-        let measured: Vec<bool> = v.flat_torque.iter().map(Option::is_none).collect();
-        let in_pairs = planned.in_pairs() && planned.deltas.nrows() == k;
-        let found = response::responses(&x, &y, &u, in_pairs, &measured);
-        extra_warnings
-            .borrow_mut()
-            .extend(response::unresolved_warning(kind, &found));
+        let unresolved = response::experiment_warning(planned, &x, &y, &u, &v.flat_torque);
+        extra_warnings.borrow_mut().extend(unresolved);
         let weighted = weighted_least_squares(
             &x,
             &y,

@@ -16,7 +16,7 @@
 
 use nalgebra::DMatrix;
 
-use super::plan::ExperimentKind;
+use super::plan::{Experiment, ExperimentKind};
 
 /// The chance that an experiment of noise alone passes for a response (over all its joints).
 pub const FALSE_ALARM: f64 = 0.01;
@@ -157,6 +157,22 @@ pub fn unresolved_warning(kind: ExperimentKind, found: &[Option<Response>]) -> O
         kind.name(),
         (100.0 * smallest).min(100.0)
     ))
+}
+
+/// The warning for `experiment` when none of its torques responded: [`responses`] of its
+/// regression (`x`, `y`, `u` as there, one row per crossing read), read by `+-` pairs when it
+/// was planned in pairs and every planned crossing was read, leaving out the channels that read
+/// one value throughout (`flat_torque`), and [`unresolved_warning`].
+pub(super) fn experiment_warning(
+    experiment: &Experiment,
+    x: &DMatrix<f64>,
+    y: &DMatrix<f64>,
+    u: &DMatrix<f64>,
+    flat_torque: &[Option<f64>],
+) -> Option<String> {
+    let measured: Vec<bool> = flat_torque.iter().map(Option::is_none).collect();
+    let in_pairs = experiment.in_pairs() && experiment.deltas.nrows() == x.nrows();
+    unresolved_warning(experiment.kind, &responses(x, y, u, in_pairs, &measured))
 }
 
 /// A factor: whole below 100, with an exponent above.
