@@ -390,6 +390,7 @@ def plan_experiments(
     keep_velocity_sign: bool = False,
     friction_aware_h: bool = False,
     encoder_step: Optional[ArrayLike] = None,
+    torque_noise: Optional[ArrayLike] = None,
 ) -> Plan:
     """Plans the nominal, G_static, G, H and D experiments at op; refuses plans breaking limits."""
 

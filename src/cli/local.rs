@@ -86,6 +86,12 @@ pub(crate) struct PlanArgs {
     /// resolve, with the window that would.
     #[arg(long)]
     encoder_step: Option<f64>,
+    /// The standard deviation of the robot's torque samples for every joint (N m), when known:
+    /// the planner predicts from the model whether the identification will find each
+    /// experiment's torques responding beyond that noise, and warns of those it would not, with
+    /// the perturbation size that would resolve them.
+    #[arg(long)]
+    torque_noise: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -132,6 +138,7 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
         keep_velocity_sign: a.keep_velocity_sign,
         friction_aware_h: a.friction_aware_h,
         encoder_step: a.encoder_step.map(|s| vec![s; n]),
+        torque_noise: a.torque_noise.map(|s| vec![s; n]),
         ..PlanOptions::default()
     };
     o.sizes.position = size(a.dq, a.dq_fraction, n);

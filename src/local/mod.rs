@@ -47,6 +47,7 @@ pub mod perturbation;
 pub mod plan;
 mod plan_checks;
 pub mod point_design;
+pub mod predicted_response;
 pub mod quantisation;
 pub mod response;
 pub mod rounded_positions;

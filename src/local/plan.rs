@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::operating_point::OperatingPoint;
 use super::perturbation::{perturbations, varying_perturbations, Design, Sizes};
 use super::plan_checks;
+use super::predicted_response;
 use super::rounded_positions;
 use crate::choice::choice;
 use crate::document::{invalid, Document};
@@ -168,6 +169,13 @@ pub struct PlanOptions {
     /// they would resolve to worse than a tenth of their size get a warning with the window or
     /// perturbation size that would resolve them.
     pub encoder_step: Option<Vec<f64>>,
+    /// The standard deviation of the robot's torque samples (N m, or N for a prismatic joint;
+    /// one per joint, 0 for a joint whose noise is not known), when known (default none). Each
+    /// perturbed experiment's torque changes are then predicted from the model and the
+    /// identification's response test run on draws of that noise
+    /// ([`super::predicted_response`]); an experiment it would find in fewer than 90 % of runs
+    /// gets a warning with the perturbation size that would resolve it.
+    pub torque_noise: Option<Vec<f64>>,
 }
 
 impl Default for PlanOptions {
@@ -189,6 +197,7 @@ impl Default for PlanOptions {
             keep_velocity_sign: false,
             friction_aware_h: false,
             encoder_step: None,
+            torque_noise: None,
         }
     }
 }
@@ -405,6 +414,23 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
             check_range(&format!("encoder_step[{j}]"), *step, 0.0, 1.0)?;
         }
     }
+    if let Some(noise) = &o.torque_noise {
+        if noise.len() != n {
+            return Err(Error::Shape {
+                argument: "torque_noise".into(),
+                expected: format!("{n} values (one per joint)"),
+                got: format!("{} values", noise.len()),
+            });
+        }
+        for (j, sigma) in noise.iter().enumerate() {
+            check_range(
+                &format!("torque_noise[{j}]"),
+                *sigma,
+                0.0,
+                crate::limits::MAX_TORQUE_NOISE,
+            )?;
+        }
+    }
     if o.experiments.is_empty() {
         return Err(Error::InvalidArgument {
             argument: "experiments".into(),
@@ -594,6 +620,17 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
                 &joints,
                 experiment.window,
             ));
+        }
+        if let Some(noise) = &o.torque_noise {
+            // T* averages the nominal crossings; G-static's reference is one reading
+            let base_readings = if experiment.reference.is_some() {
+                1
+            } else {
+                o.count.unwrap_or(2 * n)
+            };
+            let prediction =
+                predicted_response::predict(model, op, &experiment, noise, o.rate, base_readings)?;
+            warnings.extend(prediction.and_then(|p| predicted_response::warning(kind, &p, noise)));
         }
         experiments.push(experiment);
     }

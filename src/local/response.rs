@@ -115,14 +115,11 @@ pub fn responses(
 /// response clear (an F of 10 times the threshold's). None when one joint responds, or when
 /// none could be tested.
 pub fn unresolved_warning(kind: ExperimentKind, found: &[Option<Response>]) -> Option<String> {
+    if resolved(found)? {
+        return None;
+    }
     let tested: Vec<Response> = found.iter().flatten().copied().collect();
-    if tested.is_empty() {
-        return None;
-    }
     let smallest = tested.iter().map(|r| r.p).fold(1.0, f64::min);
-    if smallest * tested.len() as f64 <= FALSE_ALARM {
-        return None;
-    }
     let strongest = tested
         .iter()
         .map(|r| r.f)
@@ -157,6 +154,14 @@ pub fn unresolved_warning(kind: ExperimentKind, found: &[Option<Response>]) -> O
         kind.name(),
         (100.0 * smallest).min(100.0)
     ))
+}
+
+/// Whether one joint's torque responded: its `p` times the joints tested at most
+/// [`FALSE_ALARM`] (Bonferroni). None when no joint could be tested.
+pub fn resolved(found: &[Option<Response>]) -> Option<bool> {
+    let tested = found.iter().flatten().count();
+    let smallest = found.iter().flatten().map(|r| r.p).fold(1.0, f64::min);
+    (tested > 0).then_some(smallest * tested as f64 <= FALSE_ALARM)
 }
 
 /// The warning for `experiment` when none of its torques responded: [`responses`] of its

@@ -515,6 +515,25 @@ def test_perturbations_too_small_for_the_torque_noise_are_warned_of():
         assert all("times larger" in w for w in named)
 
 
+def test_the_planner_predicts_perturbations_too_small_for_the_torque_noise():
+    # the same two plans as above, now told the noise: the planner says beforehand which
+    # experiments the identification will not resolve, and the identification agrees
+    robot = pr.robots.a465()
+    op = pr.OperatingPoint(TABLE2[0], [0.4, -0.35, 0.3, 0.5, -0.4, 0.45], TABLE2[2])
+    tiny = dict(dq_fraction=1e-8, dqd_fraction=1e-8, dqdd_fraction=1e-8)
+    for sizes, predicted in [(dict(dqd=[0.1] * 6), []), (tiny, ["G_static", "G", "H", "D"])]:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            plan = pr.plan_experiments(robot, op, torque_noise=0.05, **sizes)
+        named = [w for w in plan.warnings if "the robot's model predicts" in w]
+        assert sorted(w.split("'")[1] for w in named) == sorted(predicted), named
+        assert all(any(w == str(c.message) for c in caught) for w in named)
+    # a number or one per joint, each in [0, 1e6] and finite
+    for bad in [[0.05] * 5, -0.05, float("nan"), 1e300, "noisy"]:
+        with pytest.raises(pr.InputError, match="torque_noise"):
+            pr.plan_experiments(robot, op, torque_noise=bad)
+
+
 def test_coarse_encoders_are_reported_by_the_friction_aware_h_regression_too():
     # 4,096 counts a revolution leave joint 3's velocity changes in a 0.02 s window uncertain by
     # more than a tenth: the plain H regression said so, the friction-aware one did not
