@@ -114,6 +114,7 @@ pub(super) fn friction_aware_h(
             &u,
             false,
             &[v.flat_torque[j].is_none()],
+            None,
         ));
         let weighted = weighted_least_squares(
             &x,

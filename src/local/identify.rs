@@ -498,6 +498,8 @@ pub fn identify_local(
             .collect()
     });
 
+    let passes =
+        nominal.and_then(|v| response::PassNoise::of(v.crossings.iter().map(|c| &c.tau[..])));
     let noise = std::cell::RefCell::new(vec![]);
     let extra_warnings = std::cell::RefCell::new(vec![]);
     let offsets_found = std::cell::RefCell::new(vec![]);
@@ -549,7 +551,8 @@ pub fn identify_local(
         }
         offsets_found.borrow_mut().extend(found);
         let (u, samples) = reading_variances(&[v], n);
-        let unresolved = response::experiment_warning(planned, &x, &y, &u, &v.flat_torque);
+        let flat = &v.flat_torque;
+        let unresolved = response::experiment_warning(planned, &x, &y, &u, flat, passes.as_ref());
         extra_warnings.borrow_mut().extend(unresolved);
         let weighted = weighted_least_squares(
             &x,

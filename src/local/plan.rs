@@ -622,14 +622,11 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
             ));
         }
         if let Some(noise) = &o.torque_noise {
-            // T* averages the nominal crossings; G-static's reference is one reading
-            let base_readings = if experiment.reference.is_some() {
-                1
-            } else {
-                o.count.unwrap_or(2 * n)
-            };
+            // the nominal crossings: T* is their mean, their scatter the noise between passes
+            let nominal = o.experiments.contains(&ExperimentKind::Nominal);
+            let readings = if nominal { o.count.unwrap_or(2 * n) } else { 0 };
             let prediction =
-                predicted_response::predict(model, op, &experiment, noise, o.rate, base_readings)?;
+                predicted_response::predict(model, op, &experiment, noise, o.rate, readings)?;
             warnings.extend(prediction.and_then(|p| predicted_response::warning(kind, &p, noise)));
         }
         experiments.push(experiment);

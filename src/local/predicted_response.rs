@@ -17,7 +17,7 @@ use rand_distr::{Distribution, StandardNormal};
 use super::crossing::{torque_reading_gain, FitOptions};
 use super::operating_point::OperatingPoint;
 use super::plan::{Crossing, Experiment, ExperimentKind};
-use super::response::{resolved, responses};
+use super::response::{resolved, responses, PassNoise};
 use crate::data::Data;
 use crate::error::{shown, Result};
 use crate::gravity::Gravity;
@@ -52,17 +52,18 @@ pub struct Prediction {
 
 /// Predicts the response of `experiment` (of a plan at `op`, sampled at `rate` Hz) under torque
 /// samples of standard deviation `noise` (N m or N per joint; 0 for a joint whose noise is not
-/// known, left out of the test), read by the default crossing fit. `base_readings`: how many
-/// readings the torque the changes are taken from averages (the nominal experiment's
-/// crossings; G-static's reference is one). None for the nominal experiment, or when the window
-/// is too short for the fit (the identification refuses it), or no joint is tested.
+/// known, left out of the test), read by the default crossing fit. `nominal_readings`: the
+/// nominal experiment's crossings (T* is their mean; their scatter is the identification's
+/// noise from pass to pass, [`PassNoise`]; 0 without one). None for the nominal experiment, or
+/// when the window is too short for the fit (the identification refuses it), or no joint is
+/// tested.
 pub fn predict(
     model: &Model,
     op: &OperatingPoint,
     experiment: &Experiment,
     noise: &[f64],
     rate: f64,
-    base_readings: usize,
+    nominal_readings: usize,
 ) -> Result<Option<Prediction>> {
     let n = model.nv;
     if experiment.kind.perturbed().is_none() || noise.len() != n {
@@ -80,24 +81,34 @@ pub fn predict(
     let x = &experiment.deltas;
     let (k, in_pairs) = (x.nrows(), experiment.in_pairs());
     let u = DMatrix::from_fn(k, n, |_, j| reading[j].powi(2));
-    let base = reading
-        .iter()
-        .map(|r| r / (base_readings.max(1) as f64).sqrt())
-        .collect::<Vec<_>>();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(experiment.kind as u64);
     let mut gauss = || <StandardNormal as Distribution<f64>>::sample(&StandardNormal, &mut rng);
-    let draws: Vec<DMatrix<f64>> = (0..DRAWS)
+    // each draw: the nominal readings (T* is their mean, their scatter the noise from pass to
+    // pass, response::PassNoise), G-static's reference, and the experiment's readings
+    let draws: Vec<(DMatrix<f64>, Option<PassNoise>)> = (0..DRAWS)
         .map(|_| {
-            let common: Vec<f64> = base.iter().map(|b| b * gauss()).collect();
-            DMatrix::from_fn(k, n, |_, j| reading[j] * gauss() + common[j])
+            let nominal: Vec<Vec<f64>> = (0..nominal_readings)
+                .map(|_| reading.iter().map(|r| r * gauss()).collect())
+                .collect();
+            let passes = PassNoise::of(nominal.iter().map(Vec::as_slice));
+            let base: Vec<f64> = match &experiment.reference {
+                Some(_) => reading.iter().map(|r| r * gauss()).collect(),
+                None if nominal_readings > 0 => (0..n)
+                    .map(|j| nominal.iter().map(|r| r[j]).sum::<f64>() / nominal_readings as f64)
+                    .collect(),
+                None => vec![0.0; n],
+            };
+            let e = DMatrix::from_fn(k, n, |_, j| reading[j] * gauss() - base[j]);
+            (e, passes)
         })
         .collect();
     let detected = |factor: f64| -> f64 {
         let found = draws
             .iter()
-            .filter(|e| {
-                let y = &changes * factor + *e;
-                resolved(&responses(x, &y, &u, in_pairs, &measured)) == Some(true)
+            .filter(|(e, passes)| {
+                let y = &changes * factor + e;
+                let found = responses(x, &y, &u, in_pairs, &measured, passes.as_ref());
+                resolved(&found) == Some(true)
             })
             .count();
         found as f64 / DRAWS as f64

@@ -30,6 +30,41 @@ pub struct Response {
     pub p: f64,
 }
 
+/// The noise of one torque reading from pass to pass through one state, from a set of such
+/// passes (the nominal experiment's crossings): each joint's variance of a reading about their
+/// mean (N^2 m^2, or N^2) with its degrees of freedom. It holds what the samples' scatter about
+/// a window's fit does not: noise slower than a window (a drifting or coloured sensor) and the
+/// robot's repeatability.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PassNoise {
+    pub variance: Vec<f64>,
+    pub dof: usize,
+}
+
+impl PassNoise {
+    /// The scatter of `readings` (K readings of N torques, N m or N, all through one state)
+    /// about their mean; None with fewer than 2, or readings of different lengths.
+    pub fn of<'a>(readings: impl IntoIterator<Item = &'a [f64]>) -> Option<Self> {
+        let readings: Vec<&[f64]> = readings.into_iter().collect();
+        let k = readings.len();
+        let n = readings.first()?.len();
+        if k < 2 || readings.iter().any(|r| r.len() != n) {
+            return None;
+        }
+        let variance = (0..n)
+            .map(|j| {
+                let mean = readings.iter().map(|r| r[j]).sum::<f64>() / k as f64;
+                let ss: f64 = readings.iter().map(|r| (r[j] - mean).powi(2)).sum();
+                ss / (k - 1) as f64
+            })
+            .collect();
+        Some(Self {
+            variance,
+            dof: k - 1,
+        })
+    }
+}
+
 /// The residual degrees of freedom below which the noise is read from the samples' scatter
 /// about their windows' fits (`u`, known rather than estimated): its F test is then taken with
 /// this many, close to the chi-square limit.
@@ -40,20 +75,25 @@ const KNOWN_NOISE_DOF: f64 = 1000.0;
 /// scatter, N^2 m^2), or None for a joint left out by `measured` (a flat channel). With
 /// `in_pairs`, rows `2i` and `2i + 1` are a `+-` pair, read by their half-differences. The
 /// noise is the residuals' mean square where the regression has residual degrees of freedom,
-/// otherwise (a plan of `N` pairs) the mean of `u`: that misses noise from pass to pass (it
-/// reads a response more readily), so plans with more crossings than the minimum test better.
+/// otherwise (a plan of `N` pairs) the mean of `u` or, where `passes` scatter beyond it (their
+/// variance over `u`'s F test at [`FALSE_ALARM`]), the variance of a row from `passes` (a
+/// half-difference of two readings: half a reading's), with its degrees of freedom: `u` alone
+/// misses noise from pass to pass and would take a drifting sensor's noise for a response.
 pub fn responses(
     x: &DMatrix<f64>,
     y: &DMatrix<f64>,
     u: &DMatrix<f64>,
     in_pairs: bool,
     measured: &[bool],
+    passes: Option<&PassNoise>,
 ) -> Vec<Option<Response>> {
     let none = vec![None; y.ncols()];
     if x.nrows() != y.nrows() || u.shape() != y.shape() || measured.len() != y.ncols() {
         return none;
     }
-    let (x, y, u) = if in_pairs && x.nrows().is_multiple_of(2) {
+    let paired = in_pairs && x.nrows().is_multiple_of(2);
+    let passes = passes.filter(|p| p.variance.len() == y.ncols() && p.dof > 0);
+    let (x, y, u) = if paired {
         let half = |m: &DMatrix<f64>, sign: f64, factor: f64| {
             DMatrix::from_fn(m.nrows() / 2, m.ncols(), |i, j| {
                 factor * (m[(2 * i, j)] + sign * m[(2 * i + 1, j)])
@@ -96,7 +136,19 @@ pub fn responses(
                     dof as f64,
                 )
             } else {
-                (u.column(j).mean() / (scale * scale), KNOWN_NOISE_DOF)
+                let samples = u.column(j).mean();
+                let pass = passes.map_or(0.0, |p| p.variance[j] * if paired { 0.5 } else { 1.0 });
+                // the passes' noise where the readings scatter beyond their samples' noise
+                let beyond = |p: &PassNoise| {
+                    let ratio = (pass / samples).min(1e300);
+                    ratio > 1.0
+                        && crate::student_t::f_upper_tail(ratio, p.dof as f64, KNOWN_NOISE_DOF)
+                            < FALSE_ALARM
+                };
+                match passes {
+                    Some(p) if beyond(p) => (pass / (scale * scale), p.dof as f64),
+                    _ => (samples / (scale * scale), KNOWN_NOISE_DOF),
+                }
             };
             let f = (explained / columns as f64) / noise;
             let p = if f.is_nan() {
@@ -167,17 +219,22 @@ pub fn resolved(found: &[Option<Response>]) -> Option<bool> {
 /// The warning for `experiment` when none of its torques responded: [`responses`] of its
 /// regression (`x`, `y`, `u` as there, one row per crossing read), read by `+-` pairs when it
 /// was planned in pairs and every planned crossing was read, leaving out the channels that read
-/// one value throughout (`flat_torque`), and [`unresolved_warning`].
+/// one value throughout (`flat_torque`), with the noise from pass to pass of `passes` where the
+/// regression has no residual degree of freedom, and [`unresolved_warning`].
 pub(super) fn experiment_warning(
     experiment: &Experiment,
     x: &DMatrix<f64>,
     y: &DMatrix<f64>,
     u: &DMatrix<f64>,
     flat_torque: &[Option<f64>],
+    passes: Option<&PassNoise>,
 ) -> Option<String> {
     let measured: Vec<bool> = flat_torque.iter().map(Option::is_none).collect();
     let in_pairs = experiment.in_pairs() && experiment.deltas.nrows() == x.nrows();
-    unresolved_warning(experiment.kind, &responses(x, y, u, in_pairs, &measured))
+    unresolved_warning(
+        experiment.kind,
+        &responses(x, y, u, in_pairs, &measured, passes),
+    )
 }
 
 /// A factor: whole below 100, with an exponent above.
@@ -214,6 +271,41 @@ mod tests {
         })
     }
 
+    /// Without residual degrees of freedom, noise from pass to pass (readings that scatter
+    /// 0.01 where their samples say 0.001) is the noise once the passes show it; passes that
+    /// scatter as their samples say leave the samples' noise (and its many degrees of freedom).
+    #[test]
+    fn the_passes_noise_is_taken_where_the_readings_scatter_beyond_their_samples() {
+        let (k, n) = (6, 3);
+        let x = design(k, n, 3);
+        let measured = vec![true; n];
+        let u = DMatrix::from_element(k, n, 1e-6);
+        let e = noise(k, n, 0.01, 4);
+        let readings = |size: f64, seed: u64| -> Vec<Vec<f64>> {
+            let r = noise(12, n, size, seed);
+            r.row_iter()
+                .map(|row| row.iter().copied().collect())
+                .collect()
+        };
+        let of = |r: &[Vec<f64>]| PassNoise::of(r.iter().map(Vec::as_slice));
+        let slow = of(&readings(0.01, 5)).unwrap();
+        assert_eq!(slow.dof, 11);
+        let alone = responses(&x, &e, &u, true, &measured, None);
+        assert_eq!(resolved(&alone), Some(true), "{alone:?}");
+        let named = responses(&x, &e, &u, true, &measured, Some(&slow));
+        assert_eq!(resolved(&named), Some(false), "{named:?}");
+        // a response well beyond the passes' noise is still found against it
+        let b = DMatrix::from_diagonal_element(n, n, 1.0);
+        let found = responses(&x, &(&x * &b + &e), &u, true, &measured, Some(&slow));
+        assert_eq!(resolved(&found), Some(true), "{found:?}");
+        // passes as noisy as their samples: the samples' test, unchanged
+        let white = of(&readings(0.001, 6)).unwrap();
+        assert_eq!(responses(&x, &e, &u, true, &measured, Some(&white)), alone);
+        // fewer than two readings hold no scatter
+        assert_eq!(of(&readings(0.01, 7)[..1]), None);
+        assert_eq!(of(&[vec![1.0, 2.0], vec![1.0]]), None);
+    }
+
     #[test]
     fn a_response_beyond_the_noise_is_found_and_noise_alone_is_named() {
         let (k, n) = (24, 3);
@@ -222,11 +314,18 @@ mod tests {
         let measured = vec![true; n];
         let e = noise(k, n, 0.01, 2);
         let u = DMatrix::from_element(k, n, 1e-4);
-        let clear = responses(&x, &(&x * b.transpose() + &e), &u, false, &measured);
+        let clear = responses(&x, &(&x * b.transpose() + &e), &u, false, &measured, None);
         assert!(clear.iter().all(|r| r.unwrap().p < 1e-10), "{clear:?}");
         assert_eq!(unresolved_warning(ExperimentKind::GDynamic, &clear), None);
         // the same response 1e4 times smaller than the noise
-        let lost = responses(&x, &(&x * b.transpose() * 1e-6 + &e), &u, false, &measured);
+        let lost = responses(
+            &x,
+            &(&x * b.transpose() * 1e-6 + &e),
+            &u,
+            false,
+            &measured,
+            None,
+        );
         let w = unresolved_warning(ExperimentKind::GDynamic, &lost).expect("noise alone");
         assert!(
             w.starts_with("experiment 'G': no joint's torque responded"),
@@ -236,7 +335,7 @@ mod tests {
         assert!(w.contains("perturbations (dq) about"), "{w}");
         assert!(!w.contains("slow operating points"), "{w}");
         // a flat channel is not tested; nothing tested, nothing said
-        let none = responses(&x, &e, &u, false, &[false; 3]);
+        let none = responses(&x, &e, &u, false, &[false; 3], None);
         assert!(none.iter().all(Option::is_none));
         assert_eq!(unresolved_warning(ExperimentKind::D, &none), None);
         // without residual degrees of freedom the samples' noise is the noise
@@ -245,19 +344,26 @@ mod tests {
             e.rows(0, 3).into_owned(),
             u.rows(0, 3).into_owned(),
         );
-        let alone = responses(&x3, &e3, &u3, false, &measured);
+        let alone = responses(&x3, &e3, &u3, false, &measured, None);
         assert!(
             unresolved_warning(ExperimentKind::D, &alone).is_some(),
             "{alone:?}"
         );
-        let moved = responses(&x3, &(&x3 * b.transpose() + &e3), &u3, false, &measured);
+        let moved = responses(
+            &x3,
+            &(&x3 * b.transpose() + &e3),
+            &u3,
+            false,
+            &measured,
+            None,
+        );
         assert_eq!(
             unresolved_warning(ExperimentKind::D, &moved),
             None,
             "{moved:?}"
         );
         // shapes that do not fit are not tested
-        assert!(responses(&x, &e, &u3, false, &measured)
+        assert!(responses(&x, &e, &u3, false, &measured, None)
             .iter()
             .all(Option::is_none));
     }
@@ -277,12 +383,12 @@ mod tests {
         }
         let measured = vec![true; n];
         let u = DMatrix::from_element(k, n, 1e-18);
-        let full = responses(&x, &y, &u, false, &measured);
+        let full = responses(&x, &y, &u, false, &measured, None);
         assert!(
             unresolved_warning(ExperimentKind::H, &full).is_some(),
             "{full:?}"
         );
-        let pairs = responses(&x, &y, &u, true, &measured);
+        let pairs = responses(&x, &y, &u, true, &measured, None);
         assert!(pairs.iter().all(|r| r.unwrap().p < 1e-10), "{pairs:?}");
         assert_eq!(unresolved_warning(ExperimentKind::H, &pairs), None);
     }
@@ -293,8 +399,11 @@ mod tests {
         let x = design(k, n, 5);
         let e = noise(k, n, 0.1, 6);
         let u = DMatrix::from_element(k, n, 0.01);
-        let w = unresolved_warning(ExperimentKind::H, &responses(&x, &e, &u, true, &[true; 2]))
-            .unwrap();
+        let w = unresolved_warning(
+            ExperimentKind::H,
+            &responses(&x, &e, &u, true, &[true; 2], None),
+        )
+        .unwrap();
         assert!(w.contains("H* is small at slow operating points"), "{w}");
         assert!(w.contains("perturbations (dqd)"), "{w}");
     }
