@@ -85,8 +85,8 @@ fn identifications_find_responses_as_often_as_predicted() {
 }
 
 /// Table 2 without friction under 0.05 N m of torque noise: H at 7 % and D at 0.015 % of the
-/// speed and acceleration limits are found about half the time (predicted 0.58 and 0.46 over
-/// 2,000 draws; 100 seeds found 0.68 and 0.40).
+/// speed and acceleration limits are found about half the time (predicted 0.62 and 0.48; 100
+/// seeds found 0.68 and 0.40).
 const FRACTION_H: f64 = 0.07;
 const FRACTION_D: f64 = 0.00015;
 

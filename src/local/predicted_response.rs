@@ -6,18 +6,20 @@
 //! robot time is spent. Given the noise of the torque samples, the planner predicts that test:
 //! the robot's model gives each crossing's torque change (rigid bodies and armature; no
 //! friction), the crossing's reading (a fit over its window, [`torque_reading_gain`]) gives
-//! its noise, and the test is run on [`DRAWS`] seeded draws of that noise. An experiment that
+//! its noise, and the test is run on [`DRAWS`] seeded draws of that noise (drawn in each
+//! joint's few coordinates that the test reads, so a draw costs the same for any number of
+//! crossings; checked against the test on whole rows of noise). An experiment that
 //! would pass in fewer than [`DETECTION`] of them is warned of, with how much larger the
 //! perturbations would have to be, and how precise its estimate would be.
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 
 use super::crossing::{torque_reading_gain, FitOptions};
 use super::operating_point::OperatingPoint;
 use super::plan::{Crossing, Experiment, ExperimentKind};
-use super::response::{resolved, responses, PassNoise};
+use super::response::{design_basis, half_differences, resolved, test, Response, Sums};
 use crate::data::Data;
 use crate::error::{shown, Result};
 use crate::gravity::Gravity;
@@ -54,7 +56,7 @@ pub struct Prediction {
 /// samples of standard deviation `noise` (N m or N per joint; 0 for a joint whose noise is not
 /// known, left out of the test), read by the default crossing fit. `nominal_readings`: the
 /// nominal experiment's crossings (T* is their mean; their scatter is the identification's
-/// noise from pass to pass, [`PassNoise`]; 0 without one). None for the nominal experiment, or
+/// noise from pass to pass, [`super::response::PassNoise`]; 0 without one). None for the nominal experiment, or
 /// when the window is too short for the fit (the identification refuses it), or no joint is
 /// tested.
 pub fn predict(
@@ -78,36 +80,65 @@ pub fn predict(
     }
     let reading: Vec<f64> = noise.iter().map(|s| s * gain).collect();
     let changes = torque_changes(model, op, experiment)?;
-    let x = &experiment.deltas;
-    let (k, in_pairs) = (x.nrows(), experiment.in_pairs());
+    let deltas = &experiment.deltas;
+    let k = deltas.nrows();
+    let paired = experiment.in_pairs() && k.is_multiple_of(2);
     let u = DMatrix::from_fn(k, n, |_, j| reading[j].powi(2));
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(experiment.kind as u64);
-    let mut gauss = || <StandardNormal as Distribution<f64>>::sample(&StandardNormal, &mut rng);
-    // each draw: the nominal readings (T* is their mean, their scatter the noise from pass to
-    // pass, response::PassNoise), G-static's reference, and the experiment's readings
-    let draws: Vec<(DMatrix<f64>, Option<PassNoise>)> = (0..DRAWS)
-        .map(|_| {
-            let nominal: Vec<Vec<f64>> = (0..nominal_readings)
-                .map(|_| reading.iter().map(|r| r * gauss()).collect())
-                .collect();
-            let passes = PassNoise::of(nominal.iter().map(Vec::as_slice));
-            let base: Vec<f64> = match &experiment.reference {
-                Some(_) => reading.iter().map(|r| r * gauss()).collect(),
-                None if nominal_readings > 0 => (0..n)
-                    .map(|j| nominal.iter().map(|r| r[j]).sum::<f64>() / nominal_readings as f64)
-                    .collect(),
-                None => vec![0.0; n],
-            };
-            let e = DMatrix::from_fn(k, n, |_, j| reading[j] * gauss() - base[j]);
-            (e, passes)
-        })
+    // the rows the test reads: +- pairs by their half-differences, where T* cancels
+    let (x, w) = if paired {
+        let (x, w, _) = half_differences(deltas, &changes, &u);
+        (x, w)
+    } else {
+        (deltas.clone(), changes.clone())
+    };
+    let Some(q) = design_basis(&x) else {
+        return Ok(None);
+    };
+    let (rows, columns) = q.shape();
+    let joints: Vec<Option<Reduced>> = (0..n)
+        .map(|j| measured[j].then(|| Reduced::new(&q, &w.column(j).into_owned())))
         .collect();
+    let row: f64 = if paired { 0.5 } else { 1.0 };
+    // the common offset of unpaired rows: T*'s error (the nominal readings' mean) or
+    // G-static's reference reading
+    let offset = match (&experiment.reference, paired) {
+        (_, true) => 0.0,
+        (Some(_), false) => 1.0,
+        (None, false) if nominal_readings > 0 => 1.0 / (nominal_readings as f64).sqrt(),
+        (None, false) => 0.0,
+    };
+    let draws = Draws::new(&joints, rows, nominal_readings, experiment.kind as u64)?;
     let detected = |factor: f64| -> f64 {
-        let found = draws
-            .iter()
-            .filter(|(e, passes)| {
-                let y = &changes * factor + e;
-                let found = responses(x, &y, &u, in_pairs, &measured, passes.as_ref());
+        let found = (0..DRAWS)
+            .filter(|&d| {
+                let found: Vec<Option<Response>> = joints
+                    .iter()
+                    .enumerate()
+                    .map(|(j, joint)| {
+                        let joint = joint.as_ref()?;
+                        let draw = &draws.joints[d][j];
+                        let sigma = reading[j] * row.sqrt();
+                        let coordinates: Vec<f64> = (0..joint.changes.len())
+                            .map(|i| {
+                                factor * joint.changes[i]
+                                    + sigma * draw.coordinates[i]
+                                    + reading[j] * offset * draw.offset * joint.ones[i]
+                            })
+                            .collect();
+                        let explained: f64 = coordinates[..columns].iter().map(|c| c * c).sum();
+                        let inside: f64 = coordinates.iter().map(|c| c * c).sum();
+                        let sums = Sums {
+                            explained,
+                            total: inside + sigma * sigma * draw.outside,
+                            columns,
+                            dof: rows - columns,
+                        };
+                        let pass = draw
+                            .pass
+                            .map(|v| (v * reading[j] * reading[j] * row, nominal_readings - 1));
+                        Some(test(sums, sigma * sigma, pass))
+                    })
+                    .collect();
                 resolved(&found) == Some(true)
             })
             .count();
@@ -139,9 +170,102 @@ pub fn predict(
     Ok(Some(Prediction {
         detected: at_plan,
         factor,
-        relative_error: relative_error(x, &changes, &reading),
+        relative_error: relative_error(deltas, &changes, &reading),
         reading,
     }))
+}
+
+/// One joint's rows in an orthonormal basis of the span of the perturbations (first, as
+/// [`design_basis`] gives it), its model's changes and the rows' common offset: the noise of
+/// the rows is Gaussian coordinates there and, outside, a chi-square of the rows' remaining
+/// degrees of freedom. The test needs nothing else, so a draw costs the same for 12 rows as
+/// for 100,000.
+struct Reduced {
+    /// The model's changes' coordinates (`columns` of the design, then up to two more).
+    changes: Vec<f64>,
+    /// The coordinates of a row-wise constant 1 (the common offset).
+    ones: Vec<f64>,
+}
+
+impl Reduced {
+    fn new(q: &DMatrix<f64>, changes: &DVector<f64>) -> Self {
+        let rows = q.nrows();
+        let mut basis: Vec<DVector<f64>> = q.column_iter().map(|c| c.into_owned()).collect();
+        for v in [changes.clone(), DVector::from_element(rows, 1.0)] {
+            // Gram-Schmidt, twice for its rounding; a direction already spanned adds nothing
+            let size = v.norm();
+            let mut r = v;
+            for _ in 0..2 {
+                for b in &basis {
+                    r -= b * b.dot(&r);
+                }
+            }
+            let left = r.norm();
+            if left > 1e-9 * size && left.is_finite() {
+                basis.push(r / left);
+            }
+        }
+        let ones = DVector::from_element(rows, 1.0);
+        Self {
+            changes: basis.iter().map(|b| b.dot(changes)).collect(),
+            ones: basis.iter().map(|b| b.dot(&ones)).collect(),
+        }
+    }
+}
+
+/// One draw of the noise for one joint, in units of its rows' standard deviation.
+struct Draw {
+    /// Gaussian coordinates in the joint's [`Reduced`] basis.
+    coordinates: Vec<f64>,
+    /// A chi-square of the rows' degrees of freedom outside that basis.
+    outside: f64,
+    /// The common offset's standard Gaussian.
+    offset: f64,
+    /// The nominal readings' variance over a reading's (a chi-square over its degrees of
+    /// freedom), None with fewer than two.
+    pass: Option<f64>,
+}
+
+/// [`DRAWS`] seeded draws for each joint, kept so that every factor tried meets the same noise.
+struct Draws {
+    joints: Vec<Vec<Draw>>,
+}
+
+impl Draws {
+    fn new(joints: &[Option<Reduced>], rows: usize, nominal: usize, seed: u64) -> Result<Self> {
+        use rand_distr::ChiSquared;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let chi = |dof: usize| ChiSquared::new(dof.max(1) as f64).ok();
+        let joints = (0..DRAWS)
+            .map(|_| {
+                joints
+                    .iter()
+                    .map(|joint| {
+                        let m = joint.as_ref().map_or(0, |r| r.changes.len());
+                        let mut gauss = || StandardNormal.sample(&mut rng);
+                        let coordinates: Vec<f64> = (0..m).map(|_| gauss()).collect();
+                        let offset = gauss();
+                        let outside = match (rows > m).then(|| chi(rows - m)).flatten() {
+                            Some(c) => c.sample(&mut rng),
+                            None => 0.0,
+                        };
+                        let pass = (nominal >= 2)
+                            .then(|| chi(nominal - 1))
+                            .flatten()
+                            .map(|c| c.sample(&mut rng) / (nominal - 1) as f64);
+                        Draw {
+                            coordinates,
+                            outside,
+                            offset,
+                            pass,
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
+        crate::interrupt::check("the planner's prediction")?;
+        Ok(Self { joints })
+    }
 }
 
 /// The model's torque change at each crossing (K x N, N m or N): `tau(crossing) - tau(op)`,
@@ -394,6 +518,146 @@ mod tests {
             predict(&model, &op, nominal, &noise, plan.rate, 12).unwrap(),
             None
         );
+    }
+
+    /// The identification's test itself ([`super::super::response::responses`]) on whole rows of
+    /// noise: each draw the nominal readings (T* their mean, their scatter the noise from pass
+    /// to pass), G-static's reference and the experiment's readings, `draws` times.
+    fn whole_rows(
+        model: &Model,
+        op: &OperatingPoint,
+        experiment: &Experiment,
+        noise: &[f64],
+        nominal_readings: usize,
+        draws: usize,
+    ) -> f64 {
+        use crate::local::response::{responses, PassNoise};
+        let n = model.nv;
+        let gain = torque_reading_gain(experiment.window, 1000.0, &FitOptions::default())
+            .unwrap()
+            .unwrap();
+        let reading: Vec<f64> = noise.iter().map(|s| s * gain).collect();
+        let changes = torque_changes(model, op, experiment).unwrap();
+        let x = &experiment.deltas;
+        let k = x.nrows();
+        let u = DMatrix::from_fn(k, n, |_, j| reading[j].powi(2));
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(99);
+        let mut gauss = || <StandardNormal as Distribution<f64>>::sample(&StandardNormal, &mut rng);
+        let found = (0..draws)
+            .filter(|_| {
+                let nominal: Vec<Vec<f64>> = (0..nominal_readings)
+                    .map(|_| reading.iter().map(|r| r * gauss()).collect())
+                    .collect();
+                let passes = PassNoise::of(nominal.iter().map(Vec::as_slice));
+                let base: Vec<f64> = match &experiment.reference {
+                    Some(_) => reading.iter().map(|r| r * gauss()).collect(),
+                    None => (0..n)
+                        .map(|j| nominal.iter().map(|r| r[j]).sum::<f64>() / nominal.len() as f64)
+                        .collect(),
+                };
+                let y = DMatrix::from_fn(k, n, |i, j| {
+                    changes[(i, j)] + reading[j] * gauss() - base[j]
+                });
+                let found = responses(
+                    x,
+                    &y,
+                    &u,
+                    experiment.in_pairs(),
+                    &[true; 6],
+                    passes.as_ref(),
+                );
+                resolved(&found) == Some(true)
+            })
+            .count();
+        found as f64 / draws as f64
+    }
+
+    /// `experiment` (a D experiment: its torques are linear in its perturbations) with its
+    /// perturbations scaled by `factor`.
+    fn scaled(op: &OperatingPoint, experiment: &Experiment, factor: f64) -> Experiment {
+        let mut e = experiment.clone();
+        e.deltas *= factor;
+        for c in &mut e.crossings {
+            for (j, a) in c.qdd.iter_mut().enumerate() {
+                *a = op.qdd[j] + factor * (*a - op.qdd[j]);
+            }
+        }
+        e
+    }
+
+    /// The reduced draws stand for whole rows of noise: their detection agrees with the test
+    /// run on whole rows (2,000 draws) within 0.1 (the two draws' standard deviations combine
+    /// to 0.04 at one half), paired and unpaired (where T*'s error is common to the rows),
+    /// from rare to sure detection, with and without the nominal passes.
+    #[test]
+    fn reduced_draws_detect_as_the_test_on_whole_rows() {
+        let model = crate::robots::a465::model("kinsheel2010").unwrap();
+        use crate::robots::a465::{TABLE2_Q, TABLE2_QD, TABLE2_QDD};
+        let op = OperatingPoint::new(TABLE2_Q.to_vec(), TABLE2_QD.to_vec(), TABLE2_QDD.to_vec())
+            .unwrap();
+        let noise = vec![0.05; 6];
+        for (symmetric, count) in [
+            (true, None),
+            (false, None),
+            (true, Some(24)),
+            (false, Some(9)),
+        ] {
+            let mut options = PlanOptions {
+                symmetric,
+                count,
+                ..PlanOptions::default()
+            };
+            options.sizes.acceleration = crate::local::Size::Fraction(1e-6);
+            let plan = plan_experiments(&model, &op, &options).unwrap();
+            let d = plan.experiment(ExperimentKind::D).unwrap();
+            let nominal = plan
+                .experiment(ExperimentKind::Nominal)
+                .unwrap()
+                .crossings
+                .len();
+            let p = predict(&model, &op, d, &noise, plan.rate, nominal)
+                .unwrap()
+                .unwrap();
+            for f in [0.3, 0.6, 1.0, 1.5] {
+                let e = scaled(&op, d, f * p.factor);
+                let reduced = predict(&model, &op, &e, &noise, plan.rate, nominal)
+                    .unwrap()
+                    .unwrap()
+                    .detected;
+                let whole = whole_rows(&model, &op, &e, &noise, nominal, 2000);
+                assert!(
+                    (reduced - whole).abs() <= 0.1,
+                    "symmetric {symmetric}, count {count:?}, {f} x the factor: reduced {reduced}, whole rows {whole}"
+                );
+            }
+        }
+    }
+
+    /// 100,000 perturbations (the most a plan takes) cost the prediction's draws no more than
+    /// 12 do: the rows are reduced once (the whole rows would be 200 draws of 4.8 MB each).
+    #[test]
+    fn the_prediction_of_many_perturbations_is_bounded() {
+        let (model, op, plan) = a465_plan(None, 1e-6);
+        let d = plan.experiment(ExperimentKind::D).unwrap();
+        let k = crate::limits::MAX_PERTURBATIONS;
+        let rows = d.deltas.nrows();
+        let mut big = d.clone();
+        big.deltas = DMatrix::from_fn(k, 6, |i, j| d.deltas[(i % rows, j)]);
+        big.crossings = (0..k).map(|i| d.crossings[i % rows].clone()).collect();
+        let noise = vec![0.05; 6];
+        let few = predict(&model, &op, d, &noise, plan.rate, 12)
+            .unwrap()
+            .unwrap();
+        let many = predict(&model, &op, &big, &noise, plan.rate, 12)
+            .unwrap()
+            .unwrap();
+        // the factor needed falls as the square root of the crossings
+        let expected = few.factor / (k as f64 / rows as f64).sqrt();
+        assert!(
+            (many.factor / expected - 1.0).abs() < 0.15,
+            "{few:?} {many:?}"
+        );
+        assert!(many.detected > few.detected, "{few:?} {many:?}");
     }
 
     #[test]

@@ -94,30 +94,14 @@ pub fn responses(
     let paired = in_pairs && x.nrows().is_multiple_of(2);
     let passes = passes.filter(|p| p.variance.len() == y.ncols() && p.dof > 0);
     let (x, y, u) = if paired {
-        let half = |m: &DMatrix<f64>, sign: f64, factor: f64| {
-            DMatrix::from_fn(m.nrows() / 2, m.ncols(), |i, j| {
-                factor * (m[(2 * i, j)] + sign * m[(2 * i + 1, j)])
-            })
-        };
-        (half(x, -1.0, 0.5), half(y, -1.0, 0.5), half(u, 1.0, 0.25))
+        half_differences(x, y, u)
     } else {
         (x.clone(), y.clone(), u.clone())
     };
-    let (rows, columns) = x.shape();
-    if rows < columns || columns == 0 {
+    let Some(q) = design_basis(&x) else {
         return none;
-    }
-    // scale the columns: perturbations of 1e-9 and of 1 rad may meet in one design
-    let scales: Vec<f64> = x.column_iter().map(|c| c.amax()).collect();
-    if scales.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
-        return none;
-    }
-    let mut xs = x.clone();
-    for (mut c, s) in xs.column_iter_mut().zip(&scales) {
-        c /= *s;
-    }
-    let q = xs.qr().q();
-    let dof = rows - columns;
+    };
+    let (rows, columns) = q.shape();
     (0..y.ncols())
         .map(|j| {
             if !measured[j] {
@@ -129,36 +113,102 @@ pub fn responses(
                 return None;
             }
             let yj = yj / scale;
-            let explained = (q.transpose() * &yj).norm_squared();
-            let (noise, d2) = if dof > 0 {
-                (
-                    (yj.norm_squared() - explained).max(0.0) / dof as f64,
-                    dof as f64,
-                )
-            } else {
-                let samples = u.column(j).mean();
-                let pass = passes.map_or(0.0, |p| p.variance[j] * if paired { 0.5 } else { 1.0 });
-                // the passes' noise where the readings scatter beyond their samples' noise
-                let beyond = |p: &PassNoise| {
-                    let ratio = (pass / samples).min(1e300);
-                    ratio > 1.0
-                        && crate::student_t::f_upper_tail(ratio, p.dof as f64, KNOWN_NOISE_DOF)
-                            < FALSE_ALARM
-                };
-                match passes {
-                    Some(p) if beyond(p) => (pass / (scale * scale), p.dof as f64),
-                    _ => (samples / (scale * scale), KNOWN_NOISE_DOF),
-                }
-            };
-            let f = (explained / columns as f64) / noise;
-            let p = if f.is_nan() {
-                1.0
-            } else {
-                crate::student_t::f_upper_tail(f.min(1e300), columns as f64, d2)
-            };
-            Some(Response { f, p })
+            let scale2 = scale * scale;
+            let row = if paired { 0.5 } else { 1.0 };
+            Some(test(
+                Sums {
+                    explained: (q.transpose() * &yj).norm_squared(),
+                    total: yj.norm_squared(),
+                    columns,
+                    dof: rows - columns,
+                },
+                u.column(j).mean() / scale2,
+                passes.map(|p| (p.variance[j] * row / scale2, p.dof)),
+            ))
         })
         .collect()
+}
+
+/// `+-` pairs (rows `2i`, `2i + 1`) read by their half-differences: `(x(+d) - x(-d)) / 2`
+/// against `(y(+d) - y(-d)) / 2`, each row's variance `(u(+d) + u(-d)) / 4`.
+pub(crate) fn half_differences(
+    x: &DMatrix<f64>,
+    y: &DMatrix<f64>,
+    u: &DMatrix<f64>,
+) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
+    let half = |m: &DMatrix<f64>, sign: f64, factor: f64| {
+        DMatrix::from_fn(m.nrows() / 2, m.ncols(), |i, j| {
+            factor * (m[(2 * i, j)] + sign * m[(2 * i + 1, j)])
+        })
+    };
+    (half(x, -1.0, 0.5), half(y, -1.0, 0.5), half(u, 1.0, 0.25))
+}
+
+/// An orthonormal basis (rows x columns) of the span of the perturbations `x`, its columns
+/// scaled first (perturbations of 1e-9 and of 1 rad may meet in one design); None with fewer
+/// rows than columns, no column, or a column that is zero or not finite.
+pub(crate) fn design_basis(x: &DMatrix<f64>) -> Option<DMatrix<f64>> {
+    let (rows, columns) = x.shape();
+    if rows < columns || columns == 0 {
+        return None;
+    }
+    let scales: Vec<f64> = x.column_iter().map(|c| c.amax()).collect();
+    if scales.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+        return None;
+    }
+    let mut xs = x.clone();
+    for (mut c, s) in xs.column_iter_mut().zip(&scales) {
+        c /= *s;
+    }
+    Some(xs.qr().q())
+}
+
+/// One joint's regression of its torque changes on the perturbations, as the test reads it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Sums {
+    /// The squared norm of the changes' projection on the perturbations.
+    pub explained: f64,
+    /// The changes' squared norm.
+    pub total: f64,
+    /// The perturbed joints (the regression's columns) and the residual degrees of freedom.
+    pub columns: usize,
+    pub dof: usize,
+}
+
+/// The F test of one joint's [`Sums`]: the noise is the residuals' mean square where there are
+/// residual degrees of freedom, otherwise `samples` (the mean variance of a row from the
+/// samples' noise) or, where `pass` (a row's variance from pass to pass, with its degrees of
+/// freedom) exceeds it beyond chance (their ratio's F test at [`FALSE_ALARM`]), `pass`. All in
+/// one unit.
+pub(crate) fn test(sums: Sums, samples: f64, pass: Option<(f64, usize)>) -> Response {
+    let Sums {
+        explained,
+        total,
+        columns,
+        dof,
+    } = sums;
+    let (noise, d2) = if dof > 0 {
+        ((total - explained).max(0.0) / dof as f64, dof as f64)
+    } else {
+        // the passes' noise where the readings scatter beyond their samples' noise
+        let beyond = |(variance, dof): (f64, usize)| {
+            let ratio = (variance / samples).min(1e300);
+            ratio > 1.0
+                && dof > 0
+                && crate::student_t::f_upper_tail(ratio, dof as f64, KNOWN_NOISE_DOF) < FALSE_ALARM
+        };
+        match pass {
+            Some((variance, dof)) if beyond((variance, dof)) => (variance, dof as f64),
+            _ => (samples, KNOWN_NOISE_DOF),
+        }
+    };
+    let f = (explained / columns as f64) / noise;
+    let p = if f.is_nan() {
+        1.0
+    } else {
+        crate::student_t::f_upper_tail(f.min(1e300), columns as f64, d2)
+    };
+    Response { f, p }
 }
 
 /// The warning for an experiment none of whose joints' torques responded to its perturbations
