@@ -949,6 +949,34 @@ fn plan_warns_and_identify_friction_aware_h() {
             && err.contains(" s (window, --window; now 0.05 s)"),
         "{err}"
     );
+    // the torque samples' noise, when given, is checked against each experiment's responses:
+    // at Table 2's slow speeds the model's H* is too small for 0.05 N m, D* is not
+    let err = plan(
+        "noisy",
+        &["--experiments", "nominal,H,D", "--torque-noise", "0.05"],
+    );
+    assert!(
+        err.contains("perturbid: warning: experiment 'H': with torque samples of up to 0.05 N m")
+            && err.contains("times larger, or"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("experiment 'D': with torque samples"),
+        "{err}"
+    );
+    fails(
+        &[
+            "plan",
+            "a465",
+            "--op",
+            s(&op),
+            "--out",
+            s(&d.join("refused")),
+            "--torque-noise=-0.05",
+        ],
+        &["torque_noise[0]", "-0.05"],
+    );
+    assert!(!d.join("refused").exists());
     ok(&[
         "plan",
         "a465",

@@ -572,14 +572,18 @@ mod tests {
         found as f64 / draws as f64
     }
 
-    /// `experiment` (a D experiment: its torques are linear in its perturbations) with its
-    /// perturbations scaled by `factor`.
+    /// `experiment` with its perturbations scaled by `factor` (D's torques are linear in them,
+    /// G-static's nearly so at small sizes).
     fn scaled(op: &OperatingPoint, experiment: &Experiment, factor: f64) -> Experiment {
         let mut e = experiment.clone();
         e.deltas *= factor;
         for c in &mut e.crossings {
-            for (j, a) in c.qdd.iter_mut().enumerate() {
-                *a = op.qdd[j] + factor * (*a - op.qdd[j]);
+            let (moved, held) = match e.kind {
+                ExperimentKind::D => (&mut c.qdd, &op.qdd),
+                _ => (&mut c.q, &op.q),
+            };
+            for (a, h) in moved.iter_mut().zip(held) {
+                *a = h + factor * (*a - h);
             }
         }
         e
@@ -608,27 +612,32 @@ mod tests {
                 ..PlanOptions::default()
             };
             options.sizes.acceleration = crate::local::Size::Fraction(1e-6);
+            options.sizes.position = crate::local::Size::Fraction(1e-6);
             let plan = plan_experiments(&model, &op, &options).unwrap();
-            let d = plan.experiment(ExperimentKind::D).unwrap();
             let nominal = plan
                 .experiment(ExperimentKind::Nominal)
                 .unwrap()
                 .crossings
                 .len();
-            let p = predict(&model, &op, d, &noise, plan.rate, nominal)
-                .unwrap()
-                .unwrap();
-            for f in [0.3, 0.6, 1.0, 1.5] {
-                let e = scaled(&op, d, f * p.factor);
-                let reduced = predict(&model, &op, &e, &noise, plan.rate, nominal)
+            // D, and G-static whose rows share its reference reading unless paired
+            for kind in [ExperimentKind::D, ExperimentKind::GStatic] {
+                let planned = plan.experiment(kind).unwrap();
+                let p = predict(&model, &op, planned, &noise, plan.rate, nominal)
                     .unwrap()
-                    .unwrap()
-                    .detected;
-                let whole = whole_rows(&model, &op, &e, &noise, nominal, 2000);
-                assert!(
-                    (reduced - whole).abs() <= 0.1,
-                    "symmetric {symmetric}, count {count:?}, {f} x the factor: reduced {reduced}, whole rows {whole}"
-                );
+                    .unwrap();
+                for f in [0.3, 0.6, 1.0, 1.5] {
+                    let e = scaled(&op, planned, f * p.factor);
+                    let reduced = predict(&model, &op, &e, &noise, plan.rate, nominal)
+                        .unwrap()
+                        .unwrap()
+                        .detected;
+                    let whole = whole_rows(&model, &op, &e, &noise, nominal, 2000);
+                    assert!(
+                        (reduced - whole).abs() <= 0.1,
+                        "{} symmetric {symmetric}, count {count:?}, {f} x the factor: reduced {reduced}, whole rows {whole}",
+                        kind.name()
+                    );
+                }
             }
         }
     }
