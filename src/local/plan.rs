@@ -402,35 +402,26 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
     if let Some(count) = o.count {
         check_count("count", count, 2, MAX_PERTURBATIONS)?;
     }
-    if let Some(steps) = &o.encoder_step {
-        if steps.len() != n {
+    let per_joint = |name: &str, values: &Option<Vec<f64>>, largest: f64| -> Result<()> {
+        let Some(values) = values else { return Ok(()) };
+        if values.len() != n {
             return Err(Error::Shape {
-                argument: "encoder_step".into(),
+                argument: name.into(),
                 expected: format!("{n} values (one per joint)"),
-                got: format!("{} values", steps.len()),
+                got: format!("{} values", values.len()),
             });
         }
-        for (j, step) in steps.iter().enumerate() {
-            check_range(&format!("encoder_step[{j}]"), *step, 0.0, 1.0)?;
+        for (j, v) in values.iter().enumerate() {
+            check_range(&format!("{name}[{j}]"), *v, 0.0, largest)?;
         }
-    }
-    if let Some(noise) = &o.torque_noise {
-        if noise.len() != n {
-            return Err(Error::Shape {
-                argument: "torque_noise".into(),
-                expected: format!("{n} values (one per joint)"),
-                got: format!("{} values", noise.len()),
-            });
-        }
-        for (j, sigma) in noise.iter().enumerate() {
-            check_range(
-                &format!("torque_noise[{j}]"),
-                *sigma,
-                0.0,
-                crate::limits::MAX_TORQUE_NOISE,
-            )?;
-        }
-    }
+        Ok(())
+    };
+    per_joint("encoder_step", &o.encoder_step, 1.0)?;
+    per_joint(
+        "torque_noise",
+        &o.torque_noise,
+        crate::limits::MAX_TORQUE_NOISE,
+    )?;
     if o.experiments.is_empty() {
         return Err(Error::InvalidArgument {
             argument: "experiments".into(),
