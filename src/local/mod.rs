@@ -46,6 +46,7 @@ pub mod parameters;
 pub mod perturbation;
 pub mod plan;
 mod plan_checks;
+mod plan_warnings;
 pub mod point_design;
 pub mod predicted_response;
 pub mod quantisation;

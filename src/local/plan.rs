@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::operating_point::OperatingPoint;
 use super::perturbation::{perturbations, varying_perturbations, Design, Sizes};
 use super::plan_checks;
+use super::plan_warnings;
 use super::predicted_response;
 use super::rounded_positions;
 use crate::choice::choice;
@@ -527,10 +528,10 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
             Some(v) => perturbations(o.design, count, &sizes[v], o.symmetric, seed)?,
         };
         if kind == ExperimentKind::H {
-            warnings.extend(velocity_reversal_warning(model, op, &deltas, o));
+            warnings.extend(plan_warnings::velocity_reversal(model, op, &deltas, o));
         }
         if kind.perturbed().is_some() {
-            warnings.extend(design_warning(kind, &deltas));
+            warnings.extend(plan_warnings::design(kind, &deltas));
         }
         let mut b = Builder::new(n, o.rate, &lim, o.min_transition, &op.q);
         let rest_at = |q: &[f64]| Crossing {
@@ -632,54 +633,6 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
         seed: o.seed,
         experiments,
         warnings,
-    })
-}
-
-/// The warning for a perturbation design whose cond(X) exceeds [`DESIGN_COND_WARNING`], with
-/// how much precision it gives away and what to plan instead.
-fn design_warning(kind: ExperimentKind, deltas: &DMatrix<f64>) -> Option<String> {
-    let s = crate::regression::scaled_singular_values(deltas)?;
-    let (largest, smallest) = (s[0], s[s.len() - 1]);
-    let cond = largest / smallest;
-    (cond > DESIGN_COND_WARNING).then(|| {
-        let estimate = kind.estimate_name();
-        format!(
-            "experiment '{}': its perturbations have cond(X) = {cond:.1} (each joint's column scaled to unit norm): the least well determined combination of {estimate}'s entries will be {:.1} times less precise than with an orthogonal design of the same column norms; plan with design 'orthogonal' (--design orthogonal) for cond(X) = 1, or with more perturbations (n, --n)",
-            kind.name(),
-            1.0 / smallest
-        )
-    })
-}
-
-/// The warning for H perturbations that reverse a joint's velocity between passes (`|delta| >
-/// |qd*|`): friction then changes sign and enters H*. None if there are none, or if the plan
-/// is made for the friction-aware regression.
-fn velocity_reversal_warning(
-    model: &Model,
-    op: &OperatingPoint,
-    deltas: &DMatrix<f64>,
-    o: &PlanOptions,
-) -> Option<String> {
-    if o.friction_aware_h {
-        return None;
-    }
-    let reversed: Vec<String> = (0..deltas.ncols())
-        .filter_map(|j| {
-            let largest = deltas.column(j).amax();
-            (largest > op.qd[j].abs()).then(|| {
-                format!(
-                    "'{}' (up to {largest:.3} against |qd*| = {:.3})",
-                    model.joint_names[j],
-                    op.qd[j].abs()
-                )
-            })
-        })
-        .collect();
-    (!reversed.is_empty()).then(|| {
-        format!(
-            "experiment 'H': the velocity perturbations reverse joint(s) {} between passes, so their friction changes sign and enters H* unless it is modelled: plan with keep_velocity_sign (--keep-velocity-sign) to keep them below 0.9 |qd*|, or with friction_aware_h (--friction-aware-h) and identify with the friction-aware H regression",
-            reversed.join(", ")
-        )
     })
 }
 
