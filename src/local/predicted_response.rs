@@ -56,9 +56,9 @@ pub struct Prediction {
 /// samples of standard deviation `noise` (N m or N per joint; 0 for a joint whose noise is not
 /// known, left out of the test), read by the default crossing fit. `nominal_readings`: the
 /// nominal experiment's crossings (T* is their mean; their scatter is the identification's
-/// noise from pass to pass, [`super::response::PassNoise`]; 0 without one). None for the nominal experiment, or
-/// when the window is too short for the fit (the identification refuses it), or no joint is
-/// tested.
+/// noise from pass to pass, [`super::response::PassNoise`]; 0 without one). None for the
+/// nominal experiment, or when the window is too short for the fit (the identification
+/// refuses it), or no joint is tested.
 pub fn predict(
     model: &Model,
     op: &OperatingPoint,
