@@ -54,6 +54,16 @@ impl ExperimentKind {
         }
     }
 
+    /// The perturbation's name in messages: `dq`, `dqd` or `dqdd` (`dq` for the nominal, which
+    /// perturbs nothing).
+    pub fn perturbation_name(self) -> &'static str {
+        match self.perturbed() {
+            Some(2) => "dqdd",
+            Some(1) => "dqd",
+            _ => "dq",
+        }
+    }
+
     /// The matrix the experiment estimates: `Gs`, `G*`, `H*` or `D*` (`T*` for the nominal).
     pub fn estimate_name(self) -> &'static str {
         match self {

@@ -324,11 +324,7 @@ pub fn warning(kind: ExperimentKind, prediction: &Prediction, noise: &[f64]) -> 
     if prediction.detected >= DETECTION {
         return None;
     }
-    let variable = match kind {
-        ExperimentKind::D => "dqdd",
-        ExperimentKind::H => "dqd",
-        _ => "dq",
-    };
+    let variable = kind.perturbation_name();
     let estimate = kind.estimate_name();
     let largest_noise = noise.iter().fold(0.0f64, |a, s| a.max(*s));
     let largest_reading = prediction.reading.iter().fold(0.0f64, |a, s| a.max(*s));

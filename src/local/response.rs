@@ -228,11 +228,7 @@ pub fn unresolved_warning(kind: ExperimentKind, found: &[Option<Response>]) -> O
         .filter(|f| f.is_finite())
         .fold(0.0, f64::max);
     let estimate = kind.estimate_name();
-    let variable = match kind {
-        ExperimentKind::D => "dqdd",
-        ExperimentKind::H => "dqd",
-        _ => "dq",
-    };
+    let variable = kind.perturbation_name();
     let slow = if kind == ExperimentKind::H {
         " H* is small at slow operating points without viscous friction (zero at rest), and this may be its measurement;"
     } else {
