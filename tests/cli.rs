@@ -56,14 +56,15 @@ fn plan_simulate_identify_predict() {
         out.contains("D*: cond(X) 1.000") && out.contains("T* (N m)"),
         "{out}"
     );
-    // the torque noise of each separated regression, one line an experiment
+    // the torque noise of the nominal passes and each separated regression, one line an
+    // experiment
     let noise: Vec<&str> = out
         .lines()
         .skip_while(|l| !l.starts_with("torque noise (N m;"))
         .skip(1)
         .collect();
-    assert_eq!(noise.len(), 3, "{out}");
-    for x in ["G ", "H ", "D "] {
+    assert_eq!(noise.len(), 4, "{out}");
+    for x in ["nominal ", "G ", "H ", "D "] {
         assert!(
             noise
                 .iter()
@@ -963,6 +964,36 @@ fn plan_warns_and_identify_friction_aware_h() {
     assert!(
         !err.contains("experiment 'D': with torque samples"),
         "{err}"
+    );
+    // readings that vary from pass to pass by 3 N m beyond that hide D* too
+    let err = plan(
+        "drifting",
+        &[
+            "--experiments",
+            "nominal,H,D",
+            "--torque-noise",
+            "0.05",
+            "--torque-pass-noise",
+            "3",
+        ],
+    );
+    assert!(
+        err.contains("experiment 'D': with torque samples of up to 0.05 N m (standard deviation) and readings varying by up to 3 N m from pass to pass"),
+        "{err}"
+    );
+    // and it needs the samples' noise
+    fails(
+        &[
+            "plan",
+            "a465",
+            "--op",
+            s(&op),
+            "--out",
+            s(&d.join("refused")),
+            "--torque-pass-noise",
+            "0.5",
+        ],
+        &["--torque-noise"],
     );
     fails(
         &[

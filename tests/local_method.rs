@@ -1382,10 +1382,10 @@ fn d_star_standard_errors_match_the_scatter_over_seeds() {
                 "seed {seed}: {e:?} against 0.01 N m"
             );
         }
-        // G_static, G, H, D: one entry a joint each
+        // nominal, G_static, G, H, D: one entry a joint each
         assert_eq!(
             m.diagnostics.noise.len(),
-            4 * n,
+            5 * n,
             "{:?}",
             m.diagnostics.noise
         );

@@ -349,8 +349,8 @@ class LocalModel:
     def diagnostics(self) -> dict[str, Any]:
         """offsets (experiment -> clock offset, s), reversals (list of dicts), combined,
         unperturbed_deviation, unmeasured (list of dicts: experiment, joint, value in N m, for
-        torques that read one value throughout), noise (list of dicts: experiment, joint,
-        samples (N m, one torque sample's noise), passes (N m, what varied from pass to pass
+        torques that read one value throughout), noise (list of dicts, the nominal passes'
+        first, then each separated regression's: experiment, joint, samples (N m, one torque sample's noise), passes (N m, what varied from pass to pass
         beyond it, or None), step (N m, the step the torque was logged in where it is coarser
         than its noise, or None), position_step (rad, the encoder step of positions read by
         the band of half a count about them, or None)), glitches (list of dicts: experiment,
@@ -391,6 +391,7 @@ def plan_experiments(
     friction_aware_h: bool = False,
     encoder_step: Optional[ArrayLike] = None,
     torque_noise: Optional[ArrayLike] = None,
+    torque_pass_noise: Optional[ArrayLike] = None,
 ) -> Plan:
     """Plans the nominal, G_static, G, H and D experiments at op; refuses plans breaking limits."""
 

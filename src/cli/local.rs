@@ -92,6 +92,12 @@ pub(crate) struct PlanArgs {
     /// the perturbation size that would resolve them.
     #[arg(long)]
     torque_noise: Option<f64>,
+    /// What the torque readings vary by from pass to pass beyond the samples' noise, for every
+    /// joint (N m a reading, a standard deviation: noise slower than a window, repeatability;
+    /// `perturbid identify` reports it as `passes`), with --torque-noise: added to every
+    /// reading in the prediction.
+    #[arg(long, requires = "torque_noise")]
+    torque_pass_noise: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -139,6 +145,7 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
         friction_aware_h: a.friction_aware_h,
         encoder_step: a.encoder_step.map(|s| vec![s; n]),
         torque_noise: a.torque_noise.map(|s| vec![s; n]),
+        torque_pass_noise: a.torque_pass_noise.map(|s| vec![s; n]),
         ..PlanOptions::default()
     };
     o.sizes.position = size(a.dq, a.dq_fraction, n);

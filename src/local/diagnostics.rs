@@ -146,7 +146,10 @@ pub struct Diagnostics {
     /// not change. [`super::identify_parameters_from_local`] leaves them out.
     #[serde(default)]
     pub unmeasured: Vec<Unmeasured>,
-    /// The torque noise of every joint in each separated regression (G_static, G, H, D).
+    /// The torque noise of every joint in the nominal passes (first: their `passes` is the
+    /// noise from pass to pass the planner's prediction takes,
+    /// [`super::PlanOptions::torque_pass_noise`]) and in each separated regression (G_static,
+    /// G, H, D), in the plan's order.
     #[serde(default)]
     pub noise: Vec<TorqueNoise>,
     /// Torques of an experiment (D, G, G_static) that do not return to the base they are

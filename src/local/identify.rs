@@ -18,7 +18,7 @@ pub use super::flat_channels::{flat_torques, window_torques};
 use super::friction_aware::friction_aware_h;
 use super::glitches;
 use super::model::{Estimate, Estimator, LocalModel};
-use super::noise::{reading_variance, sample_variance, weighted_least_squares};
+use super::noise::{nominal_noise, reading_variance, sample_variance, weighted_least_squares};
 use super::operating_point::OperatingPoint;
 use super::plan::{Experiment, ExperimentKind, Plan};
 use super::quantisation;
@@ -500,7 +500,8 @@ pub fn identify_local(
 
     let passes =
         nominal.and_then(|v| response::PassNoise::of(v.crossings.iter().map(|c| &c.tau[..])));
-    let noise = std::cell::RefCell::new(vec![]);
+    let noise =
+        std::cell::RefCell::new(nominal.map_or(vec![], |v| nominal_noise(v, &plan.joint_names)));
     let extra_warnings = std::cell::RefCell::new(vec![]);
     let offsets_found = std::cell::RefCell::new(vec![]);
     let separated = |kind: ExperimentKind, prefix: &str| -> Result<Option<Estimate>> {

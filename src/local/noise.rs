@@ -25,6 +25,8 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::crossing::CrossingValues;
+use super::diagnostics::TorqueNoise;
+use super::identify::ExperimentValues;
 use crate::error::Result;
 use crate::regression::{least_squares, LeastSquares};
 
@@ -46,6 +48,45 @@ pub fn sample_variance<'a>(
     ss.iter()
         .zip(&dof)
         .map(|(&s, &d)| if d > 0 { s / d as f64 } else { 0.0 })
+        .collect()
+}
+
+/// The noise of the nominal experiment's torques, one entry a joint of `joints`: its samples'
+/// ([`sample_variance`]) and what its readings, all through one state, scattered by beyond
+/// what the samples' noise gives them (the square root of their variance about their mean less
+/// the mean of [`reading_variance`], 0 where less; `None` with fewer than 2 readings). The
+/// planner's prediction takes the latter as the noise from pass to pass
+/// ([`super::PlanOptions::torque_pass_noise`]). The torque's step is not given (the nominal
+/// readings enter no regression); the encoder step is, as for every experiment.
+pub fn nominal_noise(nominal: &ExperimentValues, joints: &[String]) -> Vec<TorqueNoise> {
+    let n = joints.len();
+    let samples = sample_variance(&nominal.crossings, n);
+    let readings: Vec<&[f64]> = nominal.crossings.iter().map(|c| &c.tau[..]).collect();
+    let scatter = super::response::PassNoise::of(readings);
+    let k = nominal.crossings.len() as f64;
+    joints
+        .iter()
+        .enumerate()
+        .map(|(j, joint)| {
+            let from_samples: f64 = nominal
+                .crossings
+                .iter()
+                .map(|c| reading_variance(c, &samples)[j])
+                .sum::<f64>()
+                / k;
+            let passes = scatter
+                .as_ref()
+                .map(|s| (s.variance[j] - from_samples).max(0.0).sqrt())
+                .filter(|p| p.is_finite());
+            TorqueNoise {
+                experiment: nominal.kind.name().to_string(),
+                joint: joint.clone(),
+                samples: samples[j].sqrt(),
+                passes,
+                step: None,
+                position_step: nominal.position_step.get(j).copied().flatten(),
+            }
+        })
         .collect()
 }
 

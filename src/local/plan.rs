@@ -187,6 +187,13 @@ pub struct PlanOptions {
     /// ([`super::predicted_response`]); an experiment it would find in fewer than 90 % of runs
     /// gets a warning with the perturbation size that would resolve it.
     pub torque_noise: Option<Vec<f64>>,
+    /// What the robot's torque readings vary by from pass to pass beyond the samples' noise
+    /// (N m, or N for a prismatic joint, a standard deviation of one crossing's reading; one
+    /// per joint, 0 for none), when known (default none): noise slower than a window, a
+    /// drifting sensor, the robot's repeatability, as an identification reports it
+    /// ([`super::TorqueNoise::passes`]). The prediction of [`Self::torque_noise`] then adds it
+    /// to every reading; it needs `torque_noise` for each joint it is given for.
+    pub torque_pass_noise: Option<Vec<f64>>,
 }
 
 impl Default for PlanOptions {
@@ -209,6 +216,7 @@ impl Default for PlanOptions {
             friction_aware_h: false,
             encoder_step: None,
             torque_noise: None,
+            torque_pass_noise: None,
         }
     }
 }
@@ -433,6 +441,12 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
         &o.torque_noise,
         crate::limits::MAX_TORQUE_NOISE,
     )?;
+    per_joint(
+        "torque_pass_noise",
+        &o.torque_pass_noise,
+        crate::limits::MAX_TORQUE_NOISE,
+    )?;
+    predicted_response::check_pass_noise(model, &o.torque_noise, &o.torque_pass_noise)?;
     if o.experiments.is_empty() {
         return Err(Error::InvalidArgument {
             argument: "experiments".into(),
@@ -627,9 +641,19 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
             // the nominal crossings: T* is their mean, their scatter the noise between passes
             let nominal = o.experiments.contains(&ExperimentKind::Nominal);
             let readings = if nominal { o.count.unwrap_or(2 * n) } else { 0 };
-            let prediction =
-                predicted_response::predict(model, op, &experiment, noise, o.rate, readings)?;
-            warnings.extend(prediction.and_then(|p| predicted_response::warning(kind, &p, noise)));
+            let passes = o.torque_pass_noise.as_deref().unwrap_or_default();
+            let prediction = predicted_response::predict(
+                model,
+                op,
+                &experiment,
+                noise,
+                passes,
+                o.rate,
+                readings,
+            )?;
+            warnings.extend(
+                prediction.and_then(|p| predicted_response::warning(kind, &p, noise, passes)),
+            );
         }
         experiments.push(experiment);
     }

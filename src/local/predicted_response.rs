@@ -11,6 +11,11 @@
 //! crossings; checked against the test on whole rows of noise). An experiment that
 //! would pass in fewer than [`DETECTION`] of them is warned of, with how much larger the
 //! perturbations would have to be, and how precise its estimate would be.
+//!
+//! Noise slower than a window (a drifting sensor, the robot's repeatability) adds to every
+//! reading from pass to pass without showing in the samples' scatter about their fit; given it
+//! (as an identification reports it, [`super::TorqueNoise::passes`]), each reading's noise is
+//! both together, and the test reads it from the nominal passes as the identification does.
 
 use nalgebra::{DMatrix, DVector};
 use rand::SeedableRng;
@@ -48,27 +53,35 @@ pub struct Prediction {
     /// The estimate's standard errors over its size (RMS over the entries, Frobenius), as the
     /// model gives both; infinite when the model's estimate is zero.
     pub relative_error: f64,
-    /// Each joint's reading noise (N m or N, the standard error of one crossing's torque).
+    /// Each joint's reading noise (N m or N, the standard error of one crossing's torque:
+    /// the samples' noise through the window's fit and the noise from pass to pass together).
     pub reading: Vec<f64>,
 }
 
 /// Predicts the response of `experiment` (of a plan at `op`, sampled at `rate` Hz) under torque
 /// samples of standard deviation `noise` (N m or N per joint; 0 for a joint whose noise is not
-/// known, left out of the test), read by the default crossing fit. `nominal_readings`: the
-/// nominal experiment's crossings (T* is their mean; their scatter is the identification's
-/// noise from pass to pass, [`super::response::PassNoise`]; 0 without one). None for the
-/// nominal experiment, or when the window is too short for the fit (the identification
-/// refuses it), or no joint is tested.
+/// known, left out of the test), read by the default crossing fit, and a noise from pass to
+/// pass of standard deviation `passes` (N m or N a reading, per joint, independent from
+/// reading to reading, added to the samples' through the fit; empty or zeros for none).
+/// `nominal_readings`: the nominal experiment's crossings (T* is their mean; their scatter is
+/// the identification's noise from pass to pass, [`super::response::PassNoise`]; 0 without
+/// one). None for the nominal experiment, or when the window is too short for the fit (the
+/// identification refuses it), or no joint is tested.
 pub fn predict(
     model: &Model,
     op: &OperatingPoint,
     experiment: &Experiment,
     noise: &[f64],
+    passes: &[f64],
     rate: f64,
     nominal_readings: usize,
 ) -> Result<Option<Prediction>> {
     let n = model.nv;
-    if experiment.kind.perturbed().is_none() || noise.len() != n {
+    let passes_given = !passes.is_empty();
+    if experiment.kind.perturbed().is_none()
+        || noise.len() != n
+        || (passes_given && passes.len() != n)
+    {
         return Ok(None);
     }
     let Some(gain) = torque_reading_gain(experiment.window, rate, &FitOptions::default())? else {
@@ -78,7 +91,11 @@ pub fn predict(
     if !measured.contains(&true) {
         return Ok(None);
     }
-    let reading: Vec<f64> = noise.iter().map(|s| s * gain).collect();
+    // the samples' part of a reading's noise (what the identification reads about the fits)
+    let samples: Vec<f64> = noise.iter().map(|s| s * gain).collect();
+    let reading: Vec<f64> = (0..n)
+        .map(|j| samples[j].hypot(if passes_given { passes[j] } else { 0.0 }))
+        .collect();
     let changes = torque_changes(model, op, experiment)?;
     let deltas = &experiment.deltas;
     let k = deltas.nrows();
@@ -136,7 +153,8 @@ pub fn predict(
                         let pass = draw
                             .pass
                             .map(|v| (v * reading[j] * reading[j] * row, nominal_readings - 1));
-                        Some(test(sums, sigma * sigma, pass))
+                        let known = samples[j] * samples[j] * row;
+                        Some(test(sums, known, pass))
                     })
                     .collect();
                 resolved(&found) == Some(true)
@@ -173,6 +191,31 @@ pub fn predict(
         relative_error: relative_error(deltas, &changes, &reading),
         reading,
     }))
+}
+
+/// The planner's check that the noise from pass to pass (`torque_pass_noise`, one per joint,
+/// already checked in range) is given only for joints whose samples' noise (`torque_noise`) is:
+/// the prediction reads the one against the other, as the identification does.
+pub(super) fn check_pass_noise(
+    model: &Model,
+    noise: &Option<Vec<f64>>,
+    passes: &Option<Vec<f64>>,
+) -> Result<()> {
+    let Some(passes) = passes else { return Ok(()) };
+    let samples = noise.as_deref().unwrap_or_default();
+    let unknown = |j: usize| samples.get(j).is_none_or(|s| *s == 0.0);
+    match (0..passes.len()).find(|&j| passes[j] > 0.0 && unknown(j)) {
+        Some(j) => Err(crate::error::Error::InvalidArgument {
+            argument: format!("torque_pass_noise[{j}]"),
+            message: format!(
+                "{} for joint '{}', whose torque_noise is not given: the prediction reads the \
+                 noise from pass to pass against the samples' noise; give both",
+                shown(passes[j]),
+                model.joint_names.get(j).map_or("?", String::as_str)
+            ),
+        }),
+        None => Ok(()),
+    }
 }
 
 /// One joint's rows in an orthonormal basis of the span of the perturbations (first, as
@@ -319,14 +362,28 @@ fn relative_error(x: &DMatrix<f64>, y: &DMatrix<f64>, reading: &[f64]) -> f64 {
 }
 
 /// The planner's warning for an experiment predicted to pass the identification's response
-/// test in fewer than [`DETECTION`] of runs, or None.
-pub fn warning(kind: ExperimentKind, prediction: &Prediction, noise: &[f64]) -> Option<String> {
+/// test in fewer than [`DETECTION`] of runs, or None; `noise` and `passes` as [`predict`] was
+/// given them.
+pub fn warning(
+    kind: ExperimentKind,
+    prediction: &Prediction,
+    noise: &[f64],
+    passes: &[f64],
+) -> Option<String> {
     if prediction.detected >= DETECTION {
         return None;
     }
     let variable = kind.perturbation_name();
     let estimate = kind.estimate_name();
-    let largest_noise = noise.iter().fold(0.0f64, |a, s| a.max(*s));
+    let largest = |v: &[f64]| v.iter().fold(0.0f64, |a, s| a.max(*s));
+    let largest_noise = largest(noise);
+    let from_pass_to_pass = match largest(passes) {
+        p if p > 0.0 => format!(
+            " and readings varying by up to {} N m from pass to pass",
+            shown(p)
+        ),
+        _ => String::new(),
+    };
     let largest_reading = prediction.reading.iter().fold(0.0f64, |a, s| a.max(*s));
     let precision = if prediction.relative_error.is_finite() {
         format!(
@@ -355,7 +412,7 @@ pub fn warning(kind: ExperimentKind, prediction: &Prediction, noise: &[f64]) -> 
         )
     };
     Some(format!(
-        "experiment '{}': with torque samples of up to {} N m (standard deviation), read over each crossing's window to {} N m a crossing, the robot's model predicts that the identification finds its torques responding to the perturbations in only {:.0} % of runs, and {precision}{friction}: {advice}",
+        "experiment '{}': with torque samples of up to {} N m (standard deviation){from_pass_to_pass}, read over each crossing's window to {} N m a crossing, the robot's model predicts that the identification finds its torques responding to the perturbations in only {:.0} % of runs, and {precision}{friction}: {advice}",
         kind.name(),
         shown(largest_noise),
         three_digits(largest_reading),
@@ -480,7 +537,7 @@ mod tests {
         let (model, op, plan) = a465_plan(None, 1e-6);
         let noise = vec![0.05; 6];
         let d = plan.experiment(ExperimentKind::D).unwrap();
-        let p = predict(&model, &op, d, &noise, plan.rate, 12)
+        let p = predict(&model, &op, d, &noise, &[], plan.rate, 12)
             .unwrap()
             .unwrap();
         assert!(p.detected < 0.05, "{p:?}");
@@ -495,7 +552,7 @@ mod tests {
                 c.qdd[j] = op.qdd[j] + grow * (c.qdd[j] - op.qdd[j]);
             }
         }
-        let q = predict(&model, &op, &scaled, &noise, plan.rate, 12)
+        let q = predict(&model, &op, &scaled, &noise, &[], plan.rate, 12)
             .unwrap()
             .unwrap();
         assert!(q.detected >= DETECTION && q.factor == 1.0, "{q:?}");
@@ -506,24 +563,25 @@ mod tests {
         );
         // no joint's noise known, or the nominal experiment: nothing to predict
         assert_eq!(
-            predict(&model, &op, d, &[0.0; 6], plan.rate, 12).unwrap(),
+            predict(&model, &op, d, &[0.0; 6], &[], plan.rate, 12).unwrap(),
             None
         );
         let nominal = plan.experiment(ExperimentKind::Nominal).unwrap();
         assert_eq!(
-            predict(&model, &op, nominal, &noise, plan.rate, 12).unwrap(),
+            predict(&model, &op, nominal, &noise, &[], plan.rate, 12).unwrap(),
             None
         );
     }
 
     /// The identification's test itself ([`super::super::response::responses`]) on whole rows of
     /// noise: each draw the nominal readings (T* their mean, their scatter the noise from pass
-    /// to pass), G-static's reference and the experiment's readings, `draws` times.
+    /// to pass), G-static's reference and the experiment's readings, `draws` times; every
+    /// reading errs by the samples' noise through the fit and by `passes` (N m a reading).
     fn whole_rows(
         model: &Model,
         op: &OperatingPoint,
         experiment: &Experiment,
-        noise: &[f64],
+        (noise, passes): (&[f64], &[f64]),
         nominal_readings: usize,
         draws: usize,
     ) -> f64 {
@@ -532,11 +590,17 @@ mod tests {
         let gain = torque_reading_gain(experiment.window, 1000.0, &FitOptions::default())
             .unwrap()
             .unwrap();
-        let reading: Vec<f64> = noise.iter().map(|s| s * gain).collect();
+        let reading: Vec<f64> = noise
+            .iter()
+            .zip(passes)
+            .map(|(s, p)| (s * gain).hypot(*p))
+            .collect();
+        let u = DMatrix::from_fn(experiment.deltas.nrows(), n, |_, j| {
+            (noise[j] * gain).powi(2)
+        });
         let changes = torque_changes(model, op, experiment).unwrap();
         let x = &experiment.deltas;
         let k = x.nrows();
-        let u = DMatrix::from_fn(k, n, |_, j| reading[j].powi(2));
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(99);
         let mut gauss = || <StandardNormal as Distribution<f64>>::sample(&StandardNormal, &mut rng);
         let found = (0..draws)
@@ -588,7 +652,10 @@ mod tests {
     /// The reduced draws stand for whole rows of noise: their detection agrees with the test
     /// run on whole rows (2,000 draws) within 0.1 (the two draws' standard deviations combine
     /// to 0.04 at one half), paired and unpaired (where T*'s error is common to the rows),
-    /// from rare to sure detection, with and without the nominal passes.
+    /// from rare to sure detection, with and without the nominal passes, with and without
+    /// noise from pass to pass (twice the samples' through the fit, which the nominal passes
+    /// show the test when the regression has no residual, and less than that, which they may
+    /// not).
     #[test]
     fn reduced_draws_detect_as_the_test_on_whole_rows() {
         let model = crate::robots::a465::model("kinsheel2010").unwrap();
@@ -596,11 +663,16 @@ mod tests {
         let op = OperatingPoint::new(TABLE2_Q.to_vec(), TABLE2_QD.to_vec(), TABLE2_QDD.to_vec())
             .unwrap();
         let noise = vec![0.05; 6];
-        for (symmetric, count) in [
-            (true, None),
-            (false, None),
-            (true, Some(24)),
-            (false, Some(9)),
+        // the reading's noise from the samples at the default window: 0.05 sqrt(4.8 / 101)
+        let pass_levels = [vec![0.0; 6], vec![0.022; 6], vec![0.005; 6]];
+        for (symmetric, count, passes) in [
+            (true, None, &pass_levels[0]),
+            (false, None, &pass_levels[0]),
+            (true, Some(24), &pass_levels[0]),
+            (false, Some(9), &pass_levels[0]),
+            (true, None, &pass_levels[1]),
+            (false, Some(9), &pass_levels[1]),
+            (true, None, &pass_levels[2]),
         ] {
             let mut options = PlanOptions {
                 symmetric,
@@ -618,20 +690,21 @@ mod tests {
             // D, and G-static whose rows share its reference reading unless paired
             for kind in [ExperimentKind::D, ExperimentKind::GStatic] {
                 let planned = plan.experiment(kind).unwrap();
-                let p = predict(&model, &op, planned, &noise, plan.rate, nominal)
+                let p = predict(&model, &op, planned, &noise, passes, plan.rate, nominal)
                     .unwrap()
                     .unwrap();
                 for f in [0.3, 0.6, 1.0, 1.5] {
                     let e = scaled(&op, planned, f * p.factor);
-                    let reduced = predict(&model, &op, &e, &noise, plan.rate, nominal)
+                    let reduced = predict(&model, &op, &e, &noise, passes, plan.rate, nominal)
                         .unwrap()
                         .unwrap()
                         .detected;
-                    let whole = whole_rows(&model, &op, &e, &noise, nominal, 2000);
+                    let whole = whole_rows(&model, &op, &e, (&noise, passes), nominal, 2000);
                     assert!(
                         (reduced - whole).abs() <= 0.1,
-                        "{} symmetric {symmetric}, count {count:?}, {f} x the factor: reduced {reduced}, whole rows {whole}",
-                        kind.name()
+                        "{} symmetric {symmetric}, count {count:?}, passes {}, {f} x the factor: reduced {reduced}, whole rows {whole}",
+                        kind.name(),
+                        passes[0]
                     );
                 }
             }
@@ -650,10 +723,10 @@ mod tests {
         big.deltas = DMatrix::from_fn(k, 6, |i, j| d.deltas[(i % rows, j)]);
         big.crossings = (0..k).map(|i| d.crossings[i % rows].clone()).collect();
         let noise = vec![0.05; 6];
-        let few = predict(&model, &op, d, &noise, plan.rate, 12)
+        let few = predict(&model, &op, d, &noise, &[], plan.rate, 12)
             .unwrap()
             .unwrap();
-        let many = predict(&model, &op, &big, &noise, plan.rate, 12)
+        let many = predict(&model, &op, &big, &noise, &[], plan.rate, 12)
             .unwrap()
             .unwrap();
         // the factor needed falls as the square root of the crossings

@@ -271,12 +271,17 @@ impl PyExperiment {
 ///   experiment's torque changes are predicted from the model and the identification's
 ///   response test run on draws of that noise; an experiment it would find in fewer than 90 %
 ///   of runs gets a warning with the perturbation size that would resolve it.
+/// - `torque_pass_noise`: what the torque readings vary by from pass to pass beyond the
+///   samples' noise (N m a reading, a standard deviation; a number or one per joint, 0 for
+///   none): noise slower than a window, a drifting sensor, repeatability, as an identification
+///   reports it (`diagnostics['noise']`, `passes`). Added to every reading in the prediction;
+///   needs `torque_noise` for each joint it is given for.
 ///
 /// Raises InputError when the plan would break a joint limit (naming joint, time and limit).
 /// The planner's warnings are issued as `PerturbidWarning` and kept in `Plan.warnings`.
 #[pyfunction]
 #[pyo3(signature = (robot, op, design="random", n=None, seed=0, rate=1000.0, *, experiments=None, dq=None, dqd=None, dqdd=None,
-    dq_fraction=0.01, dqd_fraction=0.05, dqdd_fraction=0.05, window=0.05, dwell=1.0, margin=0.8, symmetric=true, keep_velocity_sign=false, friction_aware_h=false, encoder_step=None, torque_noise=None))]
+    dq_fraction=0.01, dqd_fraction=0.05, dqdd_fraction=0.05, window=0.05, dwell=1.0, margin=0.8, symmetric=true, keep_velocity_sign=false, friction_aware_h=false, encoder_step=None, torque_noise=None, torque_pass_noise=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn plan_experiments(
     py: Python<'_>,
@@ -301,6 +306,7 @@ pub(crate) fn plan_experiments(
     friction_aware_h: bool,
     encoder_step: Option<Bound<'_, PyAny>>,
     torque_noise: Option<Bound<'_, PyAny>>,
+    torque_pass_noise: Option<Bound<'_, PyAny>>,
 ) -> PyResult<PyPlan> {
     let nv = robot.model.nv;
     let size = |name: &str, abs: &Option<Bound<'_, PyAny>>, frac: f64| -> PyResult<Size> {
@@ -325,6 +331,9 @@ pub(crate) fn plan_experiments(
             .transpose()?,
         torque_noise: torque_noise
             .map(|v| per_joint("torque_noise", &v, nv))
+            .transpose()?,
+        torque_pass_noise: torque_pass_noise
+            .map(|v| per_joint("torque_pass_noise", &v, nv))
             .transpose()?,
         ..PlanOptions::default()
     };

@@ -56,8 +56,9 @@ impl PyLocalModel {
     /// against the separated one), `unperturbed_deviation` (how far the variables an experiment
     /// did not perturb stray, in standard errors of their measurement: ~1 for noise, far above
     /// for tracking errors), `unmeasured` (list of dicts: `experiment`, `joint`, `value` in N m,
-    /// for torques that read one value throughout), `noise` (list of dicts: `experiment`,
-    /// `joint`, `samples` (N m, one torque sample's noise), `passes` (N m, what varied from pass
+    /// for torques that read one value throughout), `noise` (list of dicts, the nominal
+    /// passes' first (their `passes` is what `plan_experiments(torque_pass_noise=)` takes),
+    /// then each separated regression's: `experiment`, `joint`, `samples` (N m, one torque sample's noise), `passes` (N m, what varied from pass
     /// to pass beyond it, or None), `step` (N m, the step the torque was logged in where it is
     /// coarser than its noise: the standard errors of its rows include the rounding; else
     /// None)), `glitches` (list of dicts: `experiment`, `crossing` (None for the reference

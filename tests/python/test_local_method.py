@@ -398,9 +398,9 @@ def test_the_torque_noise_is_reported_per_experiment_and_joint():
     levels = np.array([0.005, 0.01, 0.02, 0.01, 0.004, 0.002])
     model = pr.identify_local(plan, pr.simulate(robot, plan, torque_noise=levels, seed=4, friction=None))
     noise = model.diagnostics["noise"]
-    # the separated regressions in the plan's order, one entry a joint
+    # the nominal passes and the separated regressions in the plan's order, one entry a joint
     assert [(e["experiment"], e["joint"]) for e in noise] == [
-        (x, f"joint{j}") for x in ["G_static", "G", "H", "D"] for j in range(1, 7)
+        (x, f"joint{j}") for x in ["nominal", "G_static", "G", "H", "D"] for j in range(1, 7)
     ]
     for e in noise:
         j = int(e["joint"][-1]) - 1
@@ -408,6 +408,11 @@ def test_the_torque_noise_is_reported_per_experiment_and_joint():
         assert e["passes"] is not None and e["passes"] >= 0
         assert e["step"] is None  # noise alone is no grid of steps
         assert e["position_step"] is None  # nor are continuous positions
+    # white noise: the nominal readings scatter by about what their samples' noise gives them
+    # (a fit over 101 samples: sqrt(4.8 / 101) of a sample's), so little is left beyond it
+    for e in noise[:6]:
+        j = int(e["joint"][-1]) - 1
+        assert e["passes"] < 0.5 * levels[j], e
     # what varies from pass to pass in H beyond the samples' noise: the velocity-squared terms
     # the +- pairs cancel from H* (several mN m at this point), far above D's
     passes = {(e["experiment"], e["joint"]): e["passes"] for e in noise}
@@ -443,7 +448,7 @@ def test_positions_in_coarse_encoder_counts_are_read_by_their_band():
     with pytest.warns(pr.PerturbidWarning, match=r"experiment 'D': the encoders of joint\(s\) .*'joint3' \(steps of 1.53e-3 rad: accelerations known to"):
         model = pr.identify_local(plan, pr.simulate(robot, plan, true_robot=tr))
     steps = [e["position_step"] for e in model.diagnostics["noise"]]
-    assert len(steps) == 24 and all(abs(s / (2 * np.pi / 4096) - 1) < 1e-6 for s in steps)
+    assert len(steps) == 30 and all(abs(s / (2 * np.pi / 4096) - 1) < 1e-6 for s in steps)
     z = np.abs(model.D - truth.D) / model.stderr["D"]
     assert z.max() < 4, z
     # saved with the model; a hand-edited step of 0 or a string is refused by name
@@ -532,6 +537,22 @@ def test_the_planner_predicts_perturbations_too_small_for_the_torque_noise():
     for bad in [[0.05] * 5, -0.05, float("nan"), 1e300, "noisy"]:
         with pytest.raises(pr.InputError, match="torque_noise"):
             pr.plan_experiments(robot, op, torque_noise=bad)
+    # a sensor whose readings vary from pass to pass (noise slower than a window), as an
+    # identification reports it for the nominal passes: the velocity perturbations that its
+    # samples' noise alone resolves are lost in it
+    sizes = dict(dqd=[0.1] * 6)
+    plan = pr.plan_experiments(robot, op, torque_noise=0.01, **sizes)
+    assert not [w for w in plan.warnings if "the robot's model predicts" in w]
+    with pytest.warns(pr.PerturbidWarning, match=r"experiment 'H': with torque samples of up to 0.01 N m \(standard deviation\) and readings varying by up to 0.5 N m from pass to pass"):
+        pr.plan_experiments(robot, op, torque_noise=0.01, torque_pass_noise=0.5, **sizes)
+    for bad, name in [(-0.05, r"torque_pass_noise\[0\]"), ([0.05] * 7, "torque_pass_noise"), (float("inf"), r"torque_pass_noise\[0\]")]:
+        with pytest.raises(pr.InputError, match=name):
+            pr.plan_experiments(robot, op, torque_noise=0.01, torque_pass_noise=bad)
+    # it is read against the samples' noise: without it, refused by joint
+    with pytest.raises(pr.InputError, match=r"torque_pass_noise\[2\].*'joint3', whose torque_noise is not given"):
+        pr.plan_experiments(robot, op, torque_noise=[0.01, 0.01, 0, 0.01, 0.01, 0.01], torque_pass_noise=0.05)
+    with pytest.raises(pr.InputError, match=r"torque_pass_noise\[0\].*whose torque_noise is not given"):
+        pr.plan_experiments(robot, op, torque_pass_noise=0.05)
 
 
 def test_coarse_encoders_are_reported_by_the_friction_aware_h_regression_too():
