@@ -995,6 +995,85 @@ fn plan_warns_and_identify_friction_aware_h() {
         ],
         &["--torque-noise"],
     );
+    // or the nominal passes' noise an identification of the robot saved with its model
+    let white = d.join("white");
+    ok(&[
+        "plan",
+        "a465",
+        "--op",
+        s(&op),
+        "--out",
+        s(&white),
+        "--experiments",
+        "nominal,D",
+    ]);
+    let (plan_json, rec, model) = (
+        white.join("plan.json"),
+        d.join("white_rec"),
+        d.join("white.json"),
+    );
+    ok(&[
+        "simulate",
+        "a465",
+        s(&plan_json),
+        "--out",
+        s(&rec),
+        "--torque-noise",
+        "0.05",
+    ]);
+    ok(&["identify", s(&plan_json), s(&rec), "--out", s(&model)]);
+    let from_model = ["--experiments", "nominal,D", "--noise-from", s(&model)];
+    let err = plan(
+        "from_model",
+        &[&from_model[..], &["--dqdd-fraction", "1e-6"]].concat(),
+    );
+    let up_to: f64 = err
+        .split("experiment 'D': with torque samples of up to ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{err}"));
+    assert!((up_to / 0.05 - 1.0).abs() < 0.15, "{err}");
+    let err = plan("from_model_default", &from_model);
+    assert!(
+        !err.contains("experiment 'D': with torque samples"),
+        "{err}"
+    );
+    // of other joints, or given with the noise itself: refused
+    fails(
+        &[
+            "plan",
+            "a465",
+            "--lock",
+            "joint6=0",
+            "--op",
+            s(&op),
+            "--out",
+            s(&d.join("refused")),
+            "--noise-from",
+            s(&model),
+        ],
+        &[
+            "white.json (--noise-from)",
+            "the robot 'a465_kinsheel2010' has [joint1",
+        ],
+    );
+    fails(
+        &[
+            "plan",
+            "a465",
+            "--op",
+            s(&op),
+            "--out",
+            s(&d.join("refused")),
+            "--noise-from",
+            s(&model),
+            "--torque-noise",
+            "0.05",
+        ],
+        &["--noise-from", "cannot be used with"],
+    );
+    assert!(!d.join("refused").exists());
     fails(
         &[
             "plan",

@@ -187,9 +187,9 @@ fn noise_slower_than_a_window_is_not_taken_for_a_response() {
 }
 
 /// The user's loop for a sensor whose noise is slower than a window: identifications at the
-/// default sizes report the nominal passes' noise (`diagnostics.noise`, experiment
-/// `nominal`: the samples' and what the readings scattered by beyond it), and the planner, told
-/// both, predicts how often a plan of small perturbations will be found. Told the samples'
+/// default sizes report the nominal passes' noise (`LocalModel::nominal_noise`, from
+/// `diagnostics.noise`: the samples' and what the readings scattered by beyond it), and the
+/// planner, told both, predicts how often a plan of small perturbations will be found. Told the samples'
 /// noise alone it predicts every run: the readings scatter from pass to pass more than 4 times
 /// one sample's noise about its fit, which a crossing's fit reduces about 4.6-fold. Over 60 seeds the identification finds D's response
 /// about as often as predicted (within 0.2; the binomial standard deviation is at most 0.065),
@@ -230,15 +230,10 @@ fn the_noise_from_pass_to_pass_an_identification_reports_predicts_the_next_plan(
         let runs = 5;
         let (mut samples, mut passes) = (vec![0.0; 6], vec![0.0; 6]);
         for seed in 1000..1000 + runs {
-            let m = identify(&default, seed);
-            let nominal = m
-                .diagnostics
-                .noise
-                .iter()
-                .filter(|t| t.experiment == "nominal");
-            for (j, t) in nominal.enumerate() {
-                samples[j] += t.samples.powi(2) / runs as f64;
-                passes[j] += t.passes.unwrap().powi(2) / runs as f64;
+            let (s, p) = identify(&default, seed).nominal_noise().unwrap();
+            for j in 0..6 {
+                samples[j] += s[j].powi(2) / runs as f64;
+                passes[j] += p[j].powi(2) / runs as f64;
             }
         }
         let samples: Vec<f64> = samples.iter().map(|v| v.sqrt()).collect();

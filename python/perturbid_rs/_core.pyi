@@ -364,6 +364,9 @@ class LocalModel:
         """torque (n,), D, H, G (n, n) and G_static (n, n) or None at op."""
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:
         """Predicted torques (N m), shape (n,) or (k, n)."""
+    def nominal_noise(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The nominal passes' torque noise (n,) each: the samples' and what varied from pass
+        to pass beyond it (N m), for plan_experiments(torque_noise=, torque_pass_noise=)."""
     def to_json(self) -> str: ...
     @staticmethod
     def from_json(text: str) -> "LocalModel": ...

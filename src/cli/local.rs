@@ -98,6 +98,11 @@ pub(crate) struct PlanArgs {
     /// reading in the prediction.
     #[arg(long, requires = "torque_noise")]
     torque_pass_noise: Option<f64>,
+    /// A local model this robot's earlier identification saved: its nominal passes' noise, per
+    /// joint (the samples' and what varied from pass to pass beyond it), is taken as
+    /// --torque-noise and --torque-pass-noise.
+    #[arg(long, value_name = "MODEL", conflicts_with_all = ["torque_noise", "torque_pass_noise"])]
+    noise_from: Option<PathBuf>,
 }
 
 #[derive(Deserialize)]
@@ -120,6 +125,31 @@ fn load_op(path: &Path) -> Result<OperatingPoint> {
         })?;
         OperatingPoint::new(op.q, op.qd, op.qdd)
     })
+}
+
+/// The nominal passes' noise a saved local model of `model` reports, as the planner's
+/// `torque_noise` and `torque_pass_noise` ([`LocalModel::nominal_noise`]); refused, naming the
+/// file, for a model of other joints or without it.
+fn noise_from(
+    path: &Path,
+    model: &crate::model::Model,
+) -> Result<(Option<Vec<f64>>, Option<Vec<f64>>)> {
+    let local = LocalModel::load(path)?;
+    let refuse = |message: String| Error::Json {
+        context: format!("{} (--noise-from)", path.display()),
+        message,
+    };
+    if local.joint_names != model.joint_names {
+        return Err(refuse(format!(
+            "a local model of joints [{}] of '{}'; the robot '{}' has [{}]",
+            local.joint_names.join(", "),
+            local.robot,
+            model.name,
+            model.joint_names.join(", ")
+        )));
+    }
+    let (samples, passes) = local.nominal_noise().map_err(|e| refuse(e.to_string()))?;
+    Ok((Some(samples), Some(passes)))
 }
 
 fn size(abs: Option<f64>, fraction: f64, n: usize) -> Size {
@@ -151,6 +181,9 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
     o.sizes.position = size(a.dq, a.dq_fraction, n);
     o.sizes.velocity = size(a.dqd, a.dqd_fraction, n);
     o.sizes.acceleration = size(a.dqdd, a.dqdd_fraction, n);
+    if let Some(path) = &a.noise_from {
+        (o.torque_noise, o.torque_pass_noise) = noise_from(path, &model)?;
+    }
     let plan = plan_experiments(&model, &op, &o)?;
     for w in &plan.warnings {
         eprintln!("perturbid: warning: {w}");

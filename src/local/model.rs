@@ -126,6 +126,40 @@ impl LocalModel {
         ];
         predict_linear(states, &self.torque, parts, &self.planned_op)
     }
+
+    /// The torque noise of the nominal passes, per joint in `joint_names`' order (N m, or N
+    /// for a prismatic joint): the samples' standard deviation about their windows' fits, and
+    /// what the readings scattered by from pass to pass beyond it (0 where not estimated: fewer
+    /// than 2 nominal crossings), from [`Diagnostics::noise`]: what the planner's prediction
+    /// takes as [`super::PlanOptions::torque_noise`] and
+    /// [`super::PlanOptions::torque_pass_noise`] for the robot's next plan. A joint whose
+    /// samples read no noise (a simulation without it) gets 0 for both. Refused when a joint
+    /// has no nominal entry (a plan without a nominal experiment, or a model identified before
+    /// they were reported) or two.
+    pub fn nominal_noise(&self) -> Result<(Vec<f64>, Vec<f64>)> {
+        let nominal = super::ExperimentKind::Nominal.name();
+        let mut samples = Vec::with_capacity(self.joint_names.len());
+        let mut passes = Vec::with_capacity(self.joint_names.len());
+        for joint in &self.joint_names {
+            let found: Vec<&super::TorqueNoise> = (self.diagnostics.noise.iter())
+                .filter(|e| e.experiment == nominal && &e.joint == joint)
+                .collect();
+            let [entry] = found[..] else {
+                return Err(Error::InvalidArgument {
+                    argument: "diagnostics.noise".into(),
+                    message: format!(
+                        "the local model of '{}' has {} entries of the nominal passes' noise for joint '{joint}'; expected one (a model identified from a plan with a nominal experiment, by a version that reports it)",
+                        self.robot,
+                        found.len()
+                    ),
+                });
+            };
+            samples.push(entry.samples);
+            let beyond = entry.passes.unwrap_or(0.0);
+            passes.push(if entry.samples > 0.0 { beyond } else { 0.0 });
+        }
+        Ok((samples, passes))
+    }
 }
 
 impl Document for LocalModel {

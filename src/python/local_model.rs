@@ -323,6 +323,19 @@ impl PyLocalModel {
         let out = self.model.predict(&batch.states(n)?)?;
         to_numpy(py, out, batch.k, batch.single, &[n])
     }
+    /// The torque noise of the nominal passes: a tuple of two `(n,)` arrays (N m, or N for a
+    /// prismatic joint), the samples' standard deviation about their windows' fits and what
+    /// the readings varied by from pass to pass beyond it (0 where not estimated), for the
+    /// robot's next plan: `plan_experiments(..., torque_noise=samples,
+    /// torque_pass_noise=passes)`. Raises InputError for a model without them (a plan
+    /// without a nominal experiment, or identified before they were reported).
+    fn nominal_noise<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let (samples, passes) = self.model.nominal_noise()?;
+        Ok((vec1(py, &samples), vec1(py, &passes)))
+    }
     /// The model as JSON text (matrices as lists of rows).
     fn to_json(&self) -> String {
         Document::to_json(&self.model)

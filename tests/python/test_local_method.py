@@ -413,6 +413,13 @@ def test_the_torque_noise_is_reported_per_experiment_and_joint():
     for e in noise[:6]:
         j = int(e["joint"][-1]) - 1
         assert e["passes"] < 0.5 * levels[j], e
+    # the same, as arrays for the robot's next plan
+    samples, passes = model.nominal_noise()
+    assert samples.shape == passes.shape == (6,)
+    assert list(samples) == [e["samples"] for e in noise[:6]]
+    assert list(passes) == [e["passes"] for e in noise[:6]]
+    plan = pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2), torque_noise=samples, torque_pass_noise=passes, experiments=["nominal", "D"])
+    assert not [w for w in plan.warnings if "the robot's model predicts" in w]
     # what varies from pass to pass in H beyond the samples' noise: the velocity-squared terms
     # the +- pairs cancel from H* (several mN m at this point), far above D's
     passes = {(e["experiment"], e["joint"]): e["passes"] for e in noise}
@@ -420,6 +427,14 @@ def test_the_torque_noise_is_reported_per_experiment_and_joint():
     # saved with the model; a hand-edited negative noise is refused by name
     back = pr.LocalModel.from_json(model.to_json())
     assert back.diagnostics["noise"] == noise
+    # a model without the nominal passes' noise (an older version's) has none to give
+    doc = json.loads(model.to_json())
+    doc["diagnostics"]["noise"] = noise[6:]
+    with pytest.raises(pr.InputError, match="0 entries of the nominal passes' noise for joint 'joint1'"):
+        pr.LocalModel.from_json(json.dumps(doc)).nominal_noise()
+    doc["diagnostics"]["noise"] = noise + noise[:1]  # nor one with two (hand-edited)
+    with pytest.raises(pr.InputError, match="2 entries of the nominal passes' noise for joint 'joint1'"):
+        pr.LocalModel.from_json(json.dumps(doc)).nominal_noise()
     doc = json.loads(model.to_json())
     doc["diagnostics"]["noise"][2]["samples"] = -1.0
     with pytest.raises(pr.InputError, match=r"diagnostics.noise\[2\].samples is -1"):
