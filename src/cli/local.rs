@@ -130,10 +130,7 @@ fn load_op(path: &Path) -> Result<OperatingPoint> {
 /// The nominal passes' noise a saved local model of `model` reports, as the planner's
 /// `torque_noise` and `torque_pass_noise` ([`LocalModel::nominal_noise`]); refused, naming the
 /// file, for a model of other joints or without it.
-fn noise_from(
-    path: &Path,
-    model: &crate::model::Model,
-) -> Result<(Option<Vec<f64>>, Option<Vec<f64>>)> {
+fn noise_from(path: &Path, model: &crate::model::Model) -> Result<(Vec<f64>, Vec<f64>)> {
     let local = LocalModel::load(path)?;
     let refuse = |message: String| Error::Json {
         context: format!("{} (--noise-from)", path.display()),
@@ -148,8 +145,7 @@ fn noise_from(
             model.joint_names.join(", ")
         )));
     }
-    let (samples, passes) = local.nominal_noise().map_err(|e| refuse(e.to_string()))?;
-    Ok((Some(samples), Some(passes)))
+    local.nominal_noise().map_err(|e| refuse(e.to_string()))
 }
 
 fn size(abs: Option<f64>, fraction: f64, n: usize) -> Size {
@@ -182,7 +178,8 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
     o.sizes.velocity = size(a.dqd, a.dqd_fraction, n);
     o.sizes.acceleration = size(a.dqdd, a.dqdd_fraction, n);
     if let Some(path) = &a.noise_from {
-        (o.torque_noise, o.torque_pass_noise) = noise_from(path, &model)?;
+        let (samples, passes) = noise_from(path, &model)?;
+        (o.torque_noise, o.torque_pass_noise) = (Some(samples), Some(passes));
     }
     let plan = plan_experiments(&model, &op, &o)?;
     for w in &plan.warnings {
