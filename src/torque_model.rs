@@ -220,8 +220,8 @@ impl TorqueModel for GlobalLinearModel {
 #[derive(Clone, Debug, PartialEq)]
 pub enum ModelFile {
     Local(Box<LocalModel>),
-    Base(BaseModel),
-    GlobalLinear(GlobalLinearModel),
+    Base(Box<BaseModel>),
+    GlobalLinear(Box<GlobalLinearModel>),
 }
 
 impl ModelFile {
@@ -233,9 +233,9 @@ impl ModelFile {
         Ok(if kind == LocalModel::FORMAT {
             ModelFile::Local(Box::new(LocalModel::from_json_in(text, source)?))
         } else if kind == BaseModel::FORMAT {
-            ModelFile::Base(BaseModel::from_json_in(text, source)?)
+            ModelFile::Base(Box::new(BaseModel::from_json_in(text, source)?))
         } else if kind == GlobalLinearModel::FORMAT {
-            ModelFile::GlobalLinear(GlobalLinearModel::from_json_in(text, source)?)
+            ModelFile::GlobalLinear(Box::new(GlobalLinearModel::from_json_in(text, source)?))
         } else {
             return Err(Error::Json {
                 context: source.into(),

@@ -550,6 +550,11 @@ class BaseParameterModel:
         torques were logged after their positions; joints, unexplained, unexplained_at_lag,
         finding), or None where not checked; a finding is also a warning."""
     @property
+    def position_offsets(self) -> Optional[dict[str, Any]]:
+        """The joints' zero offsets the data's torques point to (joints, offsets in rad to add
+        to the logged positions, stderr, unexplained, unexplained_with_offsets, finding), or
+        None where no joint's offset is determined; a finding is also a warning."""
+    @property
     def position_range(self) -> list[dict[str, Any]]:
         """The joints whose positions in the data leave their URDF limits by more than 5 % of
         their range (joint, min, max, lower, upper in rad or m; degrees: True where, read as

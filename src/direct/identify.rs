@@ -121,6 +121,11 @@ pub struct BaseModel {
     /// degrees named as such. Empty where none do (or in a model saved before it was checked).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub position_range: Vec<super::position_range::JointRange>,
+    /// The joints' zero offsets the data's torques point to ([`super::position_offsets`]):
+    /// offsets that fit far better are warned of ([`BaseModel::warnings`]). None where no
+    /// joint's offset is determined (or in a model saved before it was checked).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position_offsets: Option<super::position_offsets::PositionOffsets>,
 }
 
 /// Identifies the base parameters of `model` from the samples of `states` (rad, rad/s,
@@ -276,6 +281,7 @@ fn fit_with_factors(
         )?,
         torque_lag: super::torque_lag::check_torque_lag(model, states, tau, options.gravity)?,
         position_range: super::position_range::check_position_range(model, states),
+        position_offsets: None,
     };
     // residuals correlated from sample to sample (a filtered, lightly decimated log) carry less
     // information than their number says
@@ -292,6 +298,8 @@ fn fit_with_factors(
     for se in &mut fit.stderr {
         *se *= inflation;
     }
+    fit.position_offsets =
+        super::position_offsets::check_position_offsets(model, &fit, states, tau)?;
     Ok((fit, factors))
 }
 
@@ -446,6 +454,10 @@ impl Document for BaseModel {
             .and_then(|l| l.problem(&m.joint_names))
         {
             return Err(invalid(Self::WHAT, format!("torque_lag: {problem}")));
+        }
+        if let Some(problem) = (m.position_offsets.as_ref()).and_then(|o| o.problem(&m.joint_names))
+        {
+            return Err(invalid(Self::WHAT, format!("position_offsets: {problem}")));
         }
         if let Some((i, problem)) = m.position_range.iter().enumerate().find_map(|(i, r)| {
             let unknown = (!m.joint_names.contains(&r.joint))

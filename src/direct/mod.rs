@@ -12,6 +12,7 @@ pub mod global_linear;
 pub mod identify;
 pub mod parameter_table;
 pub mod parameters;
+pub mod position_offsets;
 pub mod position_range;
 pub mod residual_correlation;
 pub mod streaming;
@@ -31,6 +32,7 @@ pub use identify::{
 };
 pub use parameter_table::ParameterRow;
 pub use parameters::{regressor_blocks, regressor_matrix, FrictionTerms, ParameterLayout};
+pub use position_offsets::{check_position_offsets, PositionOffsets};
 pub use torque_columns::{check_torque_columns, TorqueColumn};
 pub use torque_lag::{check_torque_lag, TorqueLag};
 pub use workspace::{workspace_from_json, CartesianConstraint, Region};

@@ -47,7 +47,8 @@ impl BaseModel {
     /// What a person should know before trusting the fit: torque columns that do not read as
     /// the robot's model says they should ([`super::torque_columns`]: swapped, of the opposite
     /// sign, in other units), torques out of step with their positions
-    /// ([`super::torque_lag`]), positions logged in counts so coarse that their rounding
+    /// ([`super::torque_lag`]), joints whose zeros in the data look offset
+    /// ([`super::position_offsets`]), positions logged in counts so coarse that their rounding
     /// shows in the derived velocities ([`crate::position_rounding`]), and friction or armature coefficients identified on their own
     /// (not in a combination) and negative beyond three standard errors. No joint has them;
     /// the data hold an effect the model lacks, or are not what it assumes. A consistent fit
@@ -79,8 +80,10 @@ impl BaseModel {
         let rounding =
             crate::position_rounding::warning(&self.position_rounding, &self.joint_names)
                 .map(|w| format!("{w}{}", crate::position_rounding::IN_A_FIT));
+        let offsets = (self.position_offsets.as_ref()).and_then(|o| o.finding());
         columns
             .into_iter()
+            .chain(offsets)
             .chain(rounding)
             .chain(negative)
             .collect()

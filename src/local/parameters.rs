@@ -301,6 +301,7 @@ pub fn identify_parameters_from_local(
         torque_columns: vec![],
         torque_lag: None,
         position_range: vec![],
+        position_offsets: None,
     };
     let consistent = match &options.consistent {
         None => None,

@@ -297,6 +297,26 @@ impl PyBaseModel {
             .map(|l| torque_lag_dict(py, l))
             .transpose()
     }
+    /// The joints' zero offsets the data's torques point to, or None (no joint's offset
+    /// determined by the data, or a model saved before it was checked): dict `joints` (those
+    /// whose offsets the data determine: not a vertical base axis, not the chain's last joint),
+    /// `offsets` (rad or m, to add to their logged positions), `stderr`, `unexplained` and
+    /// `unexplained_with_offsets` (the weighted residual RMS on the samples checked, as logged
+    /// and with the offsets), `finding` (what looks wrong, or None; also a warning).
+    #[getter]
+    fn position_offsets<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(o) = &self.fit.position_offsets else {
+            return Ok(None);
+        };
+        let e = PyDict::new(py);
+        e.set_item("joints", &o.joints)?;
+        e.set_item("offsets", &o.offsets)?;
+        e.set_item("stderr", &o.stderr)?;
+        e.set_item("unexplained", o.unexplained)?;
+        e.set_item("unexplained_with_offsets", o.unexplained_with_offsets)?;
+        e.set_item("finding", o.finding())?;
+        Ok(Some(e))
+    }
     /// The joints whose positions in the data leave their URDF limits by more than 5 % of
     /// their range: dicts `joint`, `min`, `max` (the positions logged), `lower`, `upper` (the
     /// limits; rad or m) and `degrees` (True where, read as degrees, they lie within the

@@ -208,6 +208,58 @@ def test_torques_out_of_step_are_found():
         assert pr.validate(clean, q, qd, qdd, tau).torque_lag["finding"] is None
 
 
+def test_joint_offsets_are_estimated_with_the_parameters():
+    """Positions of the A465's wrist logged 0.2 rad off its zero: the fit estimates every
+    determined joint's offset (not the vertical base axis's nor the last joint's, which the
+    parameters absorb), on 600 evenly spread samples; what its residual is as logged and with the offsets added is checked
+    against numpy least squares of the torques on the regressor and the rotors' inertias (the
+    same column space as the base parameters'); the estimates are saved with the model."""
+    robot = pr.robots.a465()
+    traj = excitation(robot, 5, 0.1, 0.12, 1)
+    t = np.arange(0, traj.period, 0.005)
+    q, qd, qdd = traj.sample(t)
+    k = len(t)
+    rows = np.arange(600) * k // 600  # the samples checked: 600 evenly spread
+    rng = np.random.default_rng(3)
+    tau = robot.rnea(q, qd, qdd) + rng.normal(0.0, 0.05, q.shape)
+    logged = q.copy()
+    logged[:, 4] += 0.2
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the offset the parameters absorb bends the wrist's rotor inertia
+        fit = pr.identify_base_parameters(robot, logged, qd, qdd, tau, friction=None, weighting="ols")
+    o = fit.position_offsets
+    # never the vertical base axis nor the last joint; the parallel shoulder and elbow can turn
+    # together as the parameters absorb, so one of them is left out as not determined
+    assert set(o["joints"]) <= {"joint2", "joint3", "joint4", "joint5"} and "joint5" in o["joints"], o
+    assert len(set(o["joints"]) & {"joint2", "joint3"}) == 1, o
+    assert all(s <= 0.1 for s in o["stderr"]), o
+    assert o["finding"] is None or "joint5" in o["finding"]
+
+    def rms(positions):
+        x = robot.regressor(positions[rows], qd[rows], qdd[rows])
+        x = x.reshape(-1, x.shape[-1])
+        # the A465's rotor inertias: one column a joint, its acceleration in its own rows
+        rotors = np.zeros((x.shape[0], robot.n))
+        for j in range(robot.n):
+            rotors[j :: robot.n, j] = qdd[rows, j]
+        x = np.hstack([x, rotors])
+        y = tau[rows].reshape(-1)
+        c = np.linalg.lstsq(x, y, rcond=1e-10)[0]
+        return np.sqrt(np.mean((y - x @ c) ** 2))
+
+    assert o["unexplained"] == pytest.approx(rms(logged), rel=1e-6)
+    moved = logged.copy()
+    for joint, d in zip(o["joints"], o["offsets"]):
+        moved[:, robot.joint_names.index(joint)] += d
+    assert o["unexplained_with_offsets"] == pytest.approx(rms(moved), rel=1e-6)
+    # the wrist's own offset is the one estimated (to within three standard errors)
+    i = o["joints"].index("joint5")
+    assert abs(o["offsets"][i] + 0.2) < 3 * o["stderr"][i] + 1e-3, o
+    # saved with the model
+    saved = json.loads(fit.to_json())["position_offsets"]
+    assert saved == {k: v for k, v in o.items() if k != "finding"}
+
+
 def test_standard_errors_count_residuals_correlated_by_the_filter():
     # a log low-pass filtered at 10 Hz and kept at 100 Hz: about five correlated samples to
     # every independent one, which the standard errors now count

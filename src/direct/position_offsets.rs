@@ -1,0 +1,418 @@
+//! A joint's zero offset in the log: positions logged a constant away from the robot's own
+//! (an encoder zeroed elsewhere after maintenance, another convention for a joint's zero). The
+//! direct method fits such a log without a word: the base parameters absorb what they can, and
+//! the fit only gets worse (docs/method.md, section 8).
+//!
+//! The check estimates every joint's offset `d` together with the base parameters, by
+//! Gauss-Newton on the fit: `tau = Phi(q + d, qd, qdd) theta`, linearised about the current
+//! `d` by the derivative of the fitted torques in each joint's position (a forward difference),
+//! refitting `theta` at each step, each step at most [`MAX_STEP`] in any joint. On the samples it
+//! checks ([`SAMPLES`] evenly spread), rows weighted by the fit's `sigma` as the fit weighs
+//! them. A joint whose offset the parameters absorb (a vertical base axis, whose turning moves
+//! no weight; the last joint of a chain, whose turning only turns its own link's parameters) is
+//! left out: its derivative lies within the regressor's columns. The offsets are a finding
+//! where they leave at most [`FINDING_RATIO`] of the weighted residual RMS the fit leaves as
+//! logged (what a single offset explains is its own, not the model's other errors): on the real
+//! Panda log the estimates (at most 0.018 rad, its sixth joint left out as not determined to
+//! [`MAX_STDERR`]) leave 0.97 of it; 0.1 rad added to its second joint left 0.43, and is
+//! estimated to 2 mrad of what was added. It costs about as much as (2 + N) regressors of
+//! [`SAMPLES`] samples a step.
+
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+use super::identify::BaseModel;
+use super::parameters::regressor_blocks;
+use crate::error::{shown, Result};
+use crate::{Model, States};
+
+/// How many evenly spread samples the check uses at most.
+pub const SAMPLES: usize = 600;
+
+/// The most Gauss-Newton steps taken.
+pub const STEPS: usize = 6;
+
+/// The largest step (rad or m) in any joint's offset: a trust region, so that the linearised fit
+/// does not leap where it no longer holds (6 steps reach 1.8 rad).
+pub const MAX_STEP: f64 = 0.3;
+
+/// A step below this in every joint (rad or m) ends the search.
+pub const CONVERGED: f64 = 1e-5;
+
+/// A joint whose offset's standard error exceeds this (rad or m) is taken as not determined by
+/// the log and left out.
+pub const MAX_STDERR: f64 = 0.1;
+
+/// The weighted residual RMS with the offsets, as a fraction of the fit's as logged, at or
+/// below which the offsets are a finding.
+pub const FINDING_RATIO: f64 = 0.8;
+
+/// A joint's derivative (per rad or m) whose norm outside the regressor's columns is below this
+/// fraction of its own, or of the fitted torques', is taken as absorbed by the parameters (its
+/// offset is not determined by the log).
+pub const ABSORBED: f64 = 1e-4;
+
+/// The step (rad or m) of the forward difference of the fitted torques in a position.
+const STEP: f64 = 1e-6;
+
+/// The joint offsets the log's torques point to.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PositionOffsets {
+    /// The joints whose offsets the log determines (the others' the parameters absorb).
+    pub joints: Vec<String>,
+    /// For each of `joints`, what to add to its logged positions (rad, or m for a prismatic
+    /// joint) for the torques to fit best.
+    pub offsets: Vec<f64>,
+    /// Their standard errors (rad or m), from the linearised fit (inflated as the fit's are for
+    /// correlated residuals).
+    pub stderr: Vec<f64>,
+    /// The weighted residual RMS on the samples checked as logged (in the fit's `sigma`).
+    pub unexplained: f64,
+    /// The same with the offsets added and the parameters refitted.
+    pub unexplained_with_offsets: f64,
+}
+
+impl PositionOffsets {
+    /// What is wrong, if the evidence is strong: the offsets leave at most [`FINDING_RATIO`]
+    /// of the residual. Names the joints whose offsets exceed three standard errors, the
+    /// largest first.
+    pub fn finding(&self) -> Option<String> {
+        let ratio = self.unexplained_with_offsets / self.unexplained;
+        if !(ratio.is_finite() && ratio <= FINDING_RATIO) {
+            return None;
+        }
+        let mut named: Vec<usize> = (0..self.joints.len())
+            .filter(|&i| self.offsets[i].abs() > 3.0 * self.stderr[i])
+            .collect();
+        if named.is_empty() {
+            return None;
+        }
+        named.sort_by(|&a, &b| self.offsets[b].abs().total_cmp(&self.offsets[a].abs()));
+        let list: Vec<String> = named
+            .iter()
+            .map(|&i| {
+                format!(
+                    "'{}' {:+.4} rad (standard error {:.1e})",
+                    self.joints[i], self.offsets[i], self.stderr[i]
+                )
+            })
+            .collect();
+        Some(format!(
+            "the torques fit the robot's model {:.1} times better (residual RMS) with the positions of joint(s) {} added to them: those joints' zeros in the log are likely not the URDF's (an encoder zeroed elsewhere, another convention); check them and add the offsets to the positions before identifying, or the parameters absorb what they can of them and the rest is error",
+            1.0 / ratio,
+            list.join(", ")
+        ))
+    }
+
+    /// What is wrong with offsets read from a file, if anything: a joint not among
+    /// `joint_names` or named twice, lengths that differ, numbers that are not finite or
+    /// negative where they cannot be.
+    pub fn problem(&self, joint_names: &[String]) -> Option<String> {
+        if let Some(j) = self.joints.iter().find(|j| !joint_names.contains(j)) {
+            return Some(format!("joint '{j}' is not one of the model's joints"));
+        }
+        if let Some(j) =
+            (1..self.joints.len()).find(|&i| self.joints[..i].contains(&self.joints[i]))
+        {
+            return Some(format!("joint '{}' is named twice", self.joints[j]));
+        }
+        let m = self.joints.len();
+        if self.offsets.len() != m || self.stderr.len() != m {
+            return Some(format!(
+                "{} offsets and {} standard errors for {m} joints",
+                self.offsets.len(),
+                self.stderr.len()
+            ));
+        }
+        if let Some(v) = self.offsets.iter().find(|v| !v.is_finite()) {
+            return Some(format!(
+                "an offset is {}; expected a finite number",
+                shown(*v)
+            ));
+        }
+        let ok = |x: f64| x.is_finite() && x >= 0.0;
+        if !self.stderr.iter().all(|s| ok(*s))
+            || !ok(self.unexplained)
+            || !ok(self.unexplained_with_offsets)
+        {
+            return Some(
+                "stderr, unexplained and unexplained_with_offsets must be finite and >= 0".into(),
+            );
+        }
+        None
+    }
+}
+
+/// Estimates the joint offsets of the log (`states`: rad, rad/s, rad/s^2; `tau`: row-major `k x
+/// nv`, N m) that `fit` (identified from it on `model`) was identified from. Joints whose offset
+/// the parameters absorb are left out, and so, one at a time from the least determined, are
+/// joints whose standard error exceeds [`MAX_STDERR`] (a pair of parallel axes can turn
+/// together as the parameters absorb, though neither alone does). None where the log has
+/// fewer samples than the fit has parameters and joints, no joint's offset is determined, or a
+/// number is not finite.
+pub fn check_position_offsets(
+    model: &Model,
+    fit: &BaseModel,
+    states: &States<'_>,
+    tau: &[f64],
+) -> Result<Option<PositionOffsets>> {
+    let n = model.nv;
+    let k = states.len();
+    states.check_companion("tau", tau, n)?;
+    let m = k.min(SAMPLES);
+    let p = fit.theta.len();
+    if m * n < 2 * (p + n) || fit.sigma.len() != n {
+        return Ok(None);
+    }
+    let rows: Vec<usize> = (0..m).map(|i| i * k / m).collect();
+    let pick = |x: &[f64]| -> Vec<f64> {
+        rows.iter()
+            .flat_map(|&i| x[i * n..(i + 1) * n].iter().copied())
+            .collect()
+    };
+    let weight: Vec<f64> = fit.sigma.iter().map(|s| 1.0 / s).collect();
+    let measured = pick(tau);
+    let problem = Problem {
+        model,
+        fit,
+        q: pick(states.q()),
+        qd: pick(&states.qd_or_zeros()),
+        qdd: pick(&states.qdd_or_zeros()),
+        y: DVector::from_fn(m * n, |r, _| measured[r] * weight[r % n]),
+        weight,
+    };
+    let a0 = problem.regressor(&vec![0.0; n])?;
+    let Some(columns) = Columns::new(&a0) else {
+        return Ok(None);
+    };
+    let logged = (&problem.y - columns.fitted(&problem.y)).norm();
+    let inflation = fit
+        .residual_correlation
+        .iter()
+        .copied()
+        .fold(1.0, f64::max)
+        .sqrt();
+    let mut left_out = vec![false; n];
+    loop {
+        let Some(found) = problem.gauss_newton(&left_out)? else {
+            return Ok(None);
+        };
+        let stderr: Vec<f64> = found.stderr.iter().map(|s| s * inflation).collect();
+        let worst = (0..found.free.len())
+            .filter(|&c| stderr[c] > MAX_STDERR || stderr[c].is_nan())
+            .max_by(|&a, &b| stderr[a].total_cmp(&stderr[b]));
+        if let Some(c) = worst {
+            left_out[found.free[c]] = true;
+            continue;
+        }
+        let rms = |norm: f64| norm / ((m * n) as f64).sqrt();
+        let offsets = PositionOffsets {
+            joints: found
+                .free
+                .iter()
+                .map(|&j| model.joint_names[j].clone())
+                .collect(),
+            offsets: found.free.iter().map(|&j| found.d[j]).collect(),
+            stderr,
+            unexplained: rms(logged),
+            unexplained_with_offsets: rms(found.residual),
+        };
+        return Ok(offsets
+            .problem(&model.joint_names)
+            .is_none()
+            .then_some(offsets));
+    }
+}
+
+/// The samples checked, weighted, and what the fit's regressor is built from.
+struct Problem<'a> {
+    model: &'a Model,
+    fit: &'a BaseModel,
+    /// Positions, velocities and accelerations of the samples (row-major, rad, rad/s, rad/s^2).
+    q: Vec<f64>,
+    qd: Vec<f64>,
+    qdd: Vec<f64>,
+    /// The torques (row-major), each joint's weighted by `weight`.
+    y: DVector<f64>,
+    /// `1 / sigma` per joint.
+    weight: Vec<f64>,
+}
+
+/// Offsets found by [`Problem::gauss_newton`].
+struct Found {
+    /// The joints estimated.
+    free: Vec<usize>,
+    /// Every joint's offset (0 for the others).
+    d: Vec<f64>,
+    /// The standard errors of `free`'s (not inflated).
+    stderr: Vec<f64>,
+    /// The weighted residual's norm with the offsets, the parameters refitted.
+    residual: f64,
+}
+
+impl Problem<'_> {
+    /// The weighted base regressor at positions `q + d`.
+    fn regressor(&self, d: &[f64]) -> Result<DMatrix<f64>> {
+        let n = self.model.nv;
+        let (rows, p) = (self.y.len(), self.fit.theta.len());
+        let q: Vec<f64> = self
+            .q
+            .iter()
+            .enumerate()
+            .map(|(i, v)| v + d[i % n])
+            .collect();
+        let s = States::new(n, &q, Some(&self.qd), Some(&self.qdd))?;
+        let mut a = DMatrix::zeros(rows, p);
+        regressor_blocks(
+            self.model,
+            &self.fit.base.layout,
+            &s,
+            self.fit.gravity,
+            |range, phi| {
+                let block = self.fit.base.select(phi);
+                let r0 = range.start * n;
+                for r in 0..block.nrows() {
+                    for c in 0..p {
+                        a[(r0 + r, c)] = block[(r, c)] * self.weight[(r0 + r) % n];
+                    }
+                }
+                Ok(())
+            },
+        )?;
+        Ok(a)
+    }
+
+    /// Up to [`STEPS`] Gauss-Newton steps (each at most [`MAX_STEP`] in any joint, stopping
+    /// below [`CONVERGED`]) on the offsets of the joints not `left_out` whose derivative the
+    /// parameters do not absorb; None where none is left or a fit fails.
+    fn gauss_newton(&self, left_out: &[bool]) -> Result<Option<Found>> {
+        let n = self.model.nv;
+        let rows = self.y.len();
+        let p = self.fit.theta.len();
+        let mut d = vec![0.0; n];
+        let mut free: Vec<usize> = vec![];
+        let mut stderr = vec![];
+        for _ in 0..STEPS {
+            crate::interrupt::check("checking the positions' zero offsets")?;
+            let a = self.regressor(&d)?;
+            let Some(columns) = Columns::new(&a) else {
+                return Ok(None);
+            };
+            let theta = columns.coefficients(&self.y);
+            let fitted = &a * &theta;
+            // the derivative of the fitted torques in each joint's position (a forward
+            // difference), and what of it the regressor's columns cannot take
+            let mut outside = Vec::with_capacity(n);
+            for j in 0..n {
+                if left_out[j] {
+                    outside.push(None);
+                    continue;
+                }
+                let mut e = d.clone();
+                e[j] += STEP;
+                let derivative = (self.regressor(&e)? * &theta - &fitted) / STEP;
+                let own = derivative.norm();
+                let rest = &derivative - columns.fitted(&derivative);
+                let determined = rest.norm() > ABSORBED * own.max(fitted.norm()) && own > 0.0;
+                outside.push(determined.then_some(rest));
+            }
+            free = (0..n).filter(|&j| outside[j].is_some()).collect();
+            if free.is_empty() {
+                return Ok(None);
+            }
+            // the offsets' step: the residual on the derivatives' parts outside the columns
+            let x = DMatrix::from_fn(rows, free.len(), |r, c| {
+                outside[free[c]].as_ref().map_or(0.0, |v| v[r])
+            });
+            let Some(derivatives) = Columns::new(&x) else {
+                return Ok(None);
+            };
+            let residual = &self.y - &fitted;
+            let mut step = derivatives.coefficients(&residual);
+            let left = (&residual - &x * &step).norm();
+            let dof = rows.saturating_sub(p + free.len()).max(1) as f64;
+            let covariance = derivatives.covariance();
+            stderr = (0..free.len())
+                .map(|c| (left * left / dof * covariance[(c, c)]).sqrt())
+                .collect();
+            let largest = step.amax();
+            if largest > MAX_STEP {
+                step *= MAX_STEP / largest;
+            }
+            for (c, &j) in free.iter().enumerate() {
+                d[j] += step[c];
+            }
+            if largest < CONVERGED || largest.is_nan() {
+                break;
+            }
+        }
+        let a = self.regressor(&d)?;
+        let Some(columns) = Columns::new(&a) else {
+            return Ok(None);
+        };
+        let residual = (&self.y - columns.fitted(&self.y)).norm();
+        Ok(Some(Found {
+            free,
+            d,
+            stderr,
+            residual,
+        }))
+    }
+}
+
+/// Least squares on the columns of a tall matrix `a` through their Gram matrix, scaled to unit
+/// diagonal and pseudo-inverted (directions below 1e-12 of the largest dropped): cheap for the
+/// few columns and many rows here, and exact enough for a diagnostic.
+struct Columns<'a> {
+    a: &'a DMatrix<f64>,
+    scale: DVector<f64>,
+    gram_inverse: DMatrix<f64>,
+}
+
+impl<'a> Columns<'a> {
+    /// None where `a` is not finite.
+    fn new(a: &'a DMatrix<f64>) -> Option<Self> {
+        let scale = DVector::from_iterator(
+            a.ncols(),
+            a.column_iter().map(|c| match c.norm() {
+                v if v > 0.0 && v.is_finite() => v,
+                _ => 1.0,
+            }),
+        );
+        let mut gram = a.tr_mul(a);
+        for r in 0..gram.nrows() {
+            for c in 0..gram.ncols() {
+                gram[(r, c)] /= scale[r] * scale[c];
+            }
+        }
+        let gram_inverse = crate::decomposition::pseudo_inverse(gram, 1e-12)?;
+        Some(Self {
+            a,
+            scale,
+            gram_inverse,
+        })
+    }
+
+    /// The coefficients of the least-squares fit of `v` by the columns.
+    fn coefficients(&self, v: &DVector<f64>) -> DVector<f64> {
+        let scaled = self.a.tr_mul(v).component_div(&self.scale);
+        (&self.gram_inverse * scaled).component_div(&self.scale)
+    }
+
+    /// The least-squares fit of `v` by the columns.
+    fn fitted(&self, v: &DVector<f64>) -> DVector<f64> {
+        self.a * self.coefficients(v)
+    }
+
+    /// `(A^T A)^-1`: the coefficients' covariance over the residual variance.
+    fn covariance(&self) -> DMatrix<f64> {
+        let mut c = self.gram_inverse.clone();
+        for r in 0..c.nrows() {
+            for k in 0..c.ncols() {
+                c[(r, k)] /= self.scale[r] * self.scale[k];
+            }
+        }
+        c
+    }
+}
