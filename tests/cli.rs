@@ -1039,6 +1039,18 @@ fn plan_warns_and_identify_friction_aware_h() {
         !err.contains("experiment 'D': with torque samples"),
         "{err}"
     );
+    // a model of data without noise has none to give, and says so
+    let (quiet_rec, quiet) = (d.join("quiet_rec"), d.join("quiet.json"));
+    ok(&["simulate", "a465", s(&plan_json), "--out", s(&quiet_rec)]);
+    ok(&["identify", s(&plan_json), s(&quiet_rec), "--out", s(&quiet)]);
+    let err = plan(
+        "from_quiet",
+        &["--experiments", "nominal,D", "--noise-from", s(&quiet)],
+    );
+    assert!(
+        err.contains("quiet.json reports no torque noise in its nominal passes"),
+        "{err}"
+    );
     // of other joints, or given with the noise itself: refused
     fails(
         &[

@@ -179,6 +179,12 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
     o.sizes.acceleration = size(a.dqdd, a.dqdd_fraction, n);
     if let Some(path) = &a.noise_from {
         let (samples, passes) = noise_from(path, &model)?;
+        if samples.iter().all(|s| *s == 0.0) {
+            eprintln!(
+                "perturbid: warning: {} reports no torque noise in its nominal passes (data without noise?): nothing is predicted",
+                path.display()
+            );
+        }
         (o.torque_noise, o.torque_pass_noise) = (Some(samples), Some(passes));
     }
     let plan = plan_experiments(&model, &op, &o)?;

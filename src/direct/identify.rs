@@ -289,18 +289,26 @@ fn fit_with_factors(
     let predicted = fit.predict(model, &head)?;
     let residuals: Vec<f64> = tau.iter().zip(&predicted).map(|(t, p)| t - p).collect();
     fit.residual_correlation = super::residual_correlation::long_run_factors(&residuals, nv);
-    let inflation = fit
-        .residual_correlation
-        .iter()
-        .copied()
-        .fold(1.0, f64::max)
-        .sqrt();
+    let inflation = fit.stderr_inflation();
     for se in &mut fit.stderr {
         *se *= inflation;
     }
     fit.position_offsets =
         super::position_offsets::check_position_offsets(model, &fit, states, tau)?;
     Ok((fit, factors))
+}
+
+impl BaseModel {
+    /// The factor the standard errors are inflated by for residuals correlated from sample to
+    /// sample: the square root of the largest joint's [`Self::residual_correlation`] (at
+    /// least 1).
+    pub fn stderr_inflation(&self) -> f64 {
+        self.residual_correlation
+            .iter()
+            .copied()
+            .fold(1.0, f64::max)
+            .sqrt()
+    }
 }
 
 impl Document for BaseModel {

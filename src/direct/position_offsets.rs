@@ -187,12 +187,7 @@ pub fn check_position_offsets(
         return Ok(None);
     };
     let logged = (&problem.y - columns.fitted(&problem.y)).norm();
-    let inflation = fit
-        .residual_correlation
-        .iter()
-        .copied()
-        .fold(1.0, f64::max)
-        .sqrt();
+    let inflation = fit.stderr_inflation();
     let mut left_out = vec![false; n];
     loop {
         let Some(found) = problem.gauss_newton(&left_out)? else {

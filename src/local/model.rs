@@ -133,7 +133,7 @@ impl LocalModel {
     /// than 2 nominal crossings), from [`Diagnostics::noise`]: what the planner's prediction
     /// takes as [`super::PlanOptions::torque_noise`] and
     /// [`super::PlanOptions::torque_pass_noise`] for the robot's next plan. A joint whose
-    /// samples read no noise (a simulation without it) gets 0 for both. Refused when a joint
+    /// samples scatter less than 1e-9 N m (rounding: data without noise) gets 0 for both. Refused when a joint
     /// has no nominal entry (a plan without a nominal experiment, or a model identified before
     /// they were reported) or two.
     pub fn nominal_noise(&self) -> Result<(Vec<f64>, Vec<f64>)> {
@@ -154,9 +154,13 @@ impl LocalModel {
                     ),
                 });
             };
-            samples.push(entry.samples);
-            let beyond = entry.passes.unwrap_or(0.0);
-            passes.push(if entry.samples > 0.0 { beyond } else { 0.0 });
+            let noisy = entry.samples >= 1e-9;
+            samples.push(if noisy { entry.samples } else { 0.0 });
+            passes.push(if noisy {
+                entry.passes.unwrap_or(0.0)
+            } else {
+                0.0
+            });
         }
         Ok((samples, passes))
     }
