@@ -6,6 +6,8 @@ use std::sync::Arc;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 
+use super::scalars;
+
 use super::arrays::ArrayLike;
 use super::detached;
 use super::direct::{base_options, states, FrictionNames, PyBaseModel};
@@ -148,8 +150,8 @@ pub(crate) fn identify_consistent_parameters(
     friction: Option<FrictionNames<'_>>,
     weighting: &str,
     gravity: bool,
-    prior_weight: f64,
-    max_iterations: usize,
+    #[pyo3(from_py_with = scalars::real)] prior_weight: f64,
+    #[pyo3(from_py_with = scalars::count)] max_iterations: usize,
 ) -> PyResult<PyConsistentFit> {
     let options = base_options(friction, weighting, gravity)?;
     let consistent = ConsistentOptions {

@@ -8,6 +8,8 @@ use std::sync::Arc;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 
+use super::scalars;
+
 use super::detached;
 use pyo3::types::PyDict;
 
@@ -123,14 +125,14 @@ fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<FrictionTerms> {
 pub(crate) fn design_excitation(
     py: Python<'_>,
     robot: &PyRobot,
-    harmonics: usize,
-    base_frequency: f64,
+    #[pyo3(from_py_with = scalars::count)] harmonics: usize,
+    #[pyo3(from_py_with = scalars::real)] base_frequency: f64,
     criterion: &str,
-    seed: u64,
+    #[pyo3(from_py_with = scalars::seed)] seed: u64,
     rest: bool,
-    samples: usize,
-    margin: f64,
-    max_evaluations: usize,
+    #[pyo3(from_py_with = scalars::count)] samples: usize,
+    #[pyo3(from_py_with = scalars::real)] margin: f64,
+    #[pyo3(from_py_with = scalars::count)] max_evaluations: usize,
     friction: Option<FrictionNames<'_>>,
     progress: bool,
     workspace: Option<Bound<'_, PyAny>>,
@@ -431,8 +433,8 @@ pub(crate) fn identify_base_parameters(
     friction: Option<FrictionNames<'_>>,
     weighting: &str,
     gravity: bool,
-    tolerance: f64,
-    seed: u64,
+    #[pyo3(from_py_with = scalars::real)] tolerance: f64,
+    #[pyo3(from_py_with = scalars::seed)] seed: u64,
 ) -> PyResult<PyBaseModel> {
     let options = BaseOptions {
         tolerance,

@@ -7,6 +7,8 @@ use std::sync::Arc;
 
 use pyo3::prelude::*;
 
+use super::scalars;
+
 use super::detached;
 use pyo3::types::PyDict;
 
@@ -288,19 +290,19 @@ pub(crate) fn plan_experiments(
     robot: &PyRobot,
     op: &PyOperatingPoint,
     design: &str,
-    n: Option<usize>,
-    seed: u64,
-    rate: f64,
+    #[pyo3(from_py_with = scalars::count_or_none)] n: Option<usize>,
+    #[pyo3(from_py_with = scalars::seed)] seed: u64,
+    #[pyo3(from_py_with = scalars::real)] rate: f64,
     experiments: Option<Vec<String>>,
     dq: Option<Bound<'_, PyAny>>,
     dqd: Option<Bound<'_, PyAny>>,
     dqdd: Option<Bound<'_, PyAny>>,
-    dq_fraction: f64,
-    dqd_fraction: f64,
-    dqdd_fraction: f64,
-    window: f64,
-    dwell: f64,
-    margin: f64,
+    #[pyo3(from_py_with = scalars::real)] dq_fraction: f64,
+    #[pyo3(from_py_with = scalars::real)] dqd_fraction: f64,
+    #[pyo3(from_py_with = scalars::real)] dqdd_fraction: f64,
+    #[pyo3(from_py_with = scalars::real)] window: f64,
+    #[pyo3(from_py_with = scalars::real)] dwell: f64,
+    #[pyo3(from_py_with = scalars::real)] margin: f64,
     symmetric: bool,
     keep_velocity_sign: bool,
     friction_aware_h: bool,
@@ -378,9 +380,9 @@ pub(crate) fn identify_local(
     plan: &PyPlan,
     recordings: Vec<Bound<'_, PyRecording>>,
     crossing_times: &str,
-    max_shift: f64,
-    window: Option<f64>,
-    torque_degree: usize,
+    #[pyo3(from_py_with = scalars::real)] max_shift: f64,
+    #[pyo3(from_py_with = scalars::real_or_none)] window: Option<f64>,
+    #[pyo3(from_py_with = scalars::count)] torque_degree: usize,
     recorded_derivatives: bool,
     estimator: &str,
     friction_aware_h: bool,
@@ -481,9 +483,9 @@ pub(crate) fn suggest_operating_points(
     py: Python<'_>,
     robot: &PyRobot,
     existing: Vec<PyRef<'_, PyOperatingPoint>>,
-    candidates: usize,
-    count: usize,
-    seed: u64,
+    #[pyo3(from_py_with = scalars::count)] candidates: usize,
+    #[pyo3(from_py_with = scalars::count)] count: usize,
+    #[pyo3(from_py_with = scalars::seed)] seed: u64,
     r#use: Option<Vec<String>>,
 ) -> PyResult<Vec<(PyOperatingPoint, usize)>> {
     use crate::local::{suggest_operating_points as suggest, FromLocalOptions};

@@ -14,6 +14,7 @@ mod preprocess;
 mod recording;
 mod rehearsal;
 mod robot;
+mod scalars;
 mod simulation;
 mod study;
 mod tables;

@@ -3,6 +3,8 @@
 
 use pyo3::prelude::*;
 
+use super::scalars;
+
 use super::detached;
 
 use super::arrays::ArrayLike;
@@ -33,11 +35,11 @@ pub(crate) fn preprocess(
     q: ArrayLike<'_>,
     tau: ArrayLike<'_>,
     qd: Option<ArrayLike<'_>>,
-    rate: f64,
-    cutoff: Option<f64>,
-    order: usize,
-    decimate: usize,
-    trim: f64,
+    #[pyo3(from_py_with = scalars::real)] rate: f64,
+    #[pyo3(from_py_with = scalars::real_or_none)] cutoff: Option<f64>,
+    #[pyo3(from_py_with = scalars::count)] order: usize,
+    #[pyo3(from_py_with = scalars::count)] decimate: usize,
+    #[pyo3(from_py_with = scalars::real)] trim: f64,
     filter_position: bool,
     split_at_gaps: bool,
     screen_glitches: bool,

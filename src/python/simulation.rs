@@ -4,6 +4,8 @@ use std::sync::Arc;
 
 use pyo3::prelude::*;
 
+use super::scalars;
+
 use super::detached;
 use pyo3::types::PyDict;
 
@@ -76,10 +78,10 @@ pub(crate) fn simulate<'py>(
     torque_noise: Option<Bound<'_, PyAny>>,
     position_noise: Option<Bound<'_, PyAny>>,
     quantization: Option<Bound<'_, PyAny>>,
-    seed: u64,
+    #[pyo3(from_py_with = scalars::seed)] seed: u64,
     true_robot: Option<PyRef<'py, PyTrueRobot>>,
-    rate: Option<f64>,
-    periods: Option<f64>,
+    #[pyo3(from_py_with = scalars::real_or_none)] rate: Option<f64>,
+    #[pyo3(from_py_with = scalars::real_or_none)] periods: Option<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let default_friction = matches!(&friction, Some(FrictionArg::Name(n)) if n == "urdf");
     if true_robot.is_some()

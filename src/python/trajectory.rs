@@ -3,6 +3,8 @@
 use numpy::PyArray1;
 use pyo3::prelude::*;
 
+use super::scalars;
+
 use super::arrays::{matrix, matrix_to_numpy as mat, to_numpy, ArrayLike};
 use crate::error::Error;
 use crate::trajectory::FourierTrajectory;
@@ -24,8 +26,8 @@ impl PyFourier {
         a: ArrayLike<'_>,
         b: ArrayLike<'_>,
         q0: ArrayLike<'_>,
-        w_f: Option<f64>,
-        base_frequency: Option<f64>,
+        #[pyo3(from_py_with = scalars::real_or_none)] w_f: Option<f64>,
+        #[pyo3(from_py_with = scalars::real_or_none)] base_frequency: Option<f64>,
     ) -> PyResult<Self> {
         let w_f = match (w_f, base_frequency) {
             (Some(_), Some(_)) => {

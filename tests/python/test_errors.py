@@ -219,6 +219,31 @@ def test_per_joint_sizes_take_real_numbers_only(robot):
             pr.plan_experiments(robot, op, dq=dq)
 
 
+def test_scalar_arguments_refuse_bools(robot):
+    # Python's bool is an int: pyo3 alone would read rate=True as 1 Hz and n=True as 1 pass
+    op = pr.OperatingPoint(np.full(6, 0.3), np.full(6, 0.5), np.zeros(6))
+    plan = pr.plan_experiments(robot, op, n=np.int64(12), seed=np.uint8(1), window=np.float32(0.05))
+    t = np.arange(3000) / 1000.0
+    q = np.zeros((3000, 6))
+    calls = {
+        "rate": lambda v: pr.plan_experiments(robot, op, rate=v),
+        "n": lambda v: pr.plan_experiments(robot, op, n=v),
+        "seed": lambda v: pr.simulate(robot, plan, seed=v),
+        "harmonics": lambda v: pr.design_excitation(robot, harmonics=v),
+        "order": lambda v: pr.preprocess(t, q, q, order=v),
+        "cutoff": lambda v: pr.preprocess(t, q, q, cutoff=v),
+        "max_shift": lambda v: pr.identify_local(plan, [], max_shift=v),
+        "count": lambda v: pr.suggest_operating_points(robot, count=v),
+        "tolerance": lambda v: pr.identify_base_parameters(robot, q, q, q, q, tolerance=v),
+        "base_frequency": lambda v: pr.FourierTrajectory(np.zeros((6, 1)), np.zeros((6, 1)), np.zeros(6), base_frequency=v),
+    }
+    for name, call in calls.items():
+        for value in (True, False, np.bool_(True)):
+            with pytest.raises(TypeError, match=r"expected (a real number|a non-negative integer).*got a bool") as e:
+                call(value)
+            assert any(name in note for note in getattr(e.value, "__notes__", [])), (name, e.value)
+
+
 def test_masked_arrays_are_refused_not_read_through(robot):
     # a masked entry still holds a value; reading the array's memory would use it as data
     q = np.ma.masked_array(np.full(6, 0.3), mask=[0, 0, 1, 0, 0, 0])

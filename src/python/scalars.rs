@@ -1,0 +1,64 @@
+//! Scalar arguments from Python: real numbers, counts and seeds, refusing `bool`.
+//!
+//! pyo3 reads a Python `bool` (a subclass of `int`) as 1 or 0 where an `f64`, `usize` or `u64`
+//! is asked for, so `rate=True` would run at 1 Hz and `n=True` plan one pass. The functions
+//! here are `#[pyo3(from_py_with = ...)]` extractors for such arguments: they refuse `bool`
+//! with a `TypeError` (which pyo3 prefixes with the argument's name) and otherwise extract as
+//! pyo3 does (`int`, `float` and numpy scalars; an integer from a `float` is refused).
+
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use pyo3::types::PyBool;
+
+fn not_bool(obj: &Bound<'_, PyAny>, expected: &str) -> PyResult<()> {
+    if obj.is_instance_of::<PyBool>() || is_numpy_bool(obj) {
+        return Err(PyTypeError::new_err(format!(
+            "expected {expected}, got a bool ({})",
+            obj.str().map(|s| s.to_string()).unwrap_or_default()
+        )));
+    }
+    Ok(())
+}
+
+/// numpy's `bool_` is not a Python `bool`; it converts to a number all the same.
+fn is_numpy_bool(obj: &Bound<'_, PyAny>) -> bool {
+    let ty = obj.get_type();
+    matches!(
+        (ty.module(), ty.name()),
+        (Ok(m), Ok(n)) if m == "numpy" && n == "bool"
+    )
+}
+
+/// A real number (`f64`): `int`, `float` or a numpy scalar, not a `bool`.
+pub(crate) fn real(obj: &Bound<'_, PyAny>) -> PyResult<f64> {
+    not_bool(obj, "a real number")?;
+    obj.extract()
+}
+
+/// A real number or `None`.
+pub(crate) fn real_or_none(obj: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
+    if obj.is_none() {
+        return Ok(None);
+    }
+    real(obj).map(Some)
+}
+
+/// A non-negative integer (`usize`): `int` or a numpy integer, not a `bool` nor a `float`.
+pub(crate) fn count(obj: &Bound<'_, PyAny>) -> PyResult<usize> {
+    not_bool(obj, "a non-negative integer")?;
+    obj.extract()
+}
+
+/// A non-negative integer or `None`.
+pub(crate) fn count_or_none(obj: &Bound<'_, PyAny>) -> PyResult<Option<usize>> {
+    if obj.is_none() {
+        return Ok(None);
+    }
+    count(obj).map(Some)
+}
+
+/// A random seed (`u64`): a non-negative integer, not a `bool`.
+pub(crate) fn seed(obj: &Bound<'_, PyAny>) -> PyResult<u64> {
+    not_bool(obj, "a non-negative integer seed")?;
+    obj.extract()
+}
