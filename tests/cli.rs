@@ -1027,12 +1027,14 @@ fn plan_warns_and_identify_friction_aware_h() {
         "from_model",
         &[&from_model[..], &["--dqdd-fraction", "1e-6"]].concat(),
     );
-    let up_to: f64 = err
-        .split("experiment 'D': with torque samples of up to ")
-        .nth(1)
-        .and_then(|r| r.split(' ').next())
-        .and_then(|v| v.parse().ok())
-        .unwrap_or_else(|| panic!("{err}"));
+    let noise_up_to = |err: &str| -> f64 {
+        err.split("experiment 'D': with torque samples of up to ")
+            .nth(1)
+            .and_then(|r| r.split(' ').next())
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("{err}"))
+    };
+    let up_to = noise_up_to(&err);
     assert!((up_to / 0.05 - 1.0).abs() < 0.15, "{err}");
     let err = plan("from_model_default", &from_model);
     assert!(
@@ -1050,6 +1052,20 @@ fn plan_warns_and_identify_friction_aware_h() {
     assert!(
         err.contains("quiet.json reports no torque noise in its nominal passes"),
         "{err}"
+    );
+    // several are pooled, the root mean square per joint: with the noise-free one, 1/sqrt(2)
+    let err = plan(
+        "pooled",
+        &[
+            &from_model[..],
+            &["--noise-from", s(&quiet), "--dqdd-fraction", "1e-6"],
+        ]
+        .concat(),
+    );
+    let pooled = noise_up_to(&err);
+    assert!(
+        (pooled * 2f64.sqrt() / up_to - 1.0).abs() < 1e-6,
+        "{pooled} {up_to}: {err}"
     );
     // of other joints, or given with the noise itself: refused
     fails(

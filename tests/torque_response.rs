@@ -9,7 +9,7 @@ mod common;
 use common::table2;
 use perturbid_rs::local::predicted_response::predict;
 use perturbid_rs::local::{identify_local, plan_experiments, ExperimentKind, IdentifyOptions};
-use perturbid_rs::local::{PlanOptions, Size};
+use perturbid_rs::local::{LocalModel, PlanOptions, Size};
 use perturbid_rs::robots::a465;
 use perturbid_rs::{simulate_plan, Friction, SimulationOptions};
 
@@ -227,17 +227,27 @@ fn the_noise_from_pass_to_pass_an_identification_reports_predicts_the_next_plan(
         // degrees of freedom a joint: the test finds a response in any joint, so a joint whose
         // noise one run underestimates makes the prediction optimistic)
         let default = plan_at(0.05, None);
-        let runs = 5;
-        let (mut samples, mut passes) = (vec![0.0; 6], vec![0.0; 6]);
-        for seed in 1000..1000 + runs {
-            let (s, p) = identify(&default, seed).nominal_noise().unwrap();
-            for j in 0..6 {
-                samples[j] += s[j].powi(2) / runs as f64;
-                passes[j] += p[j].powi(2) / runs as f64;
-            }
+        let runs: Vec<LocalModel> = (1000..1005).map(|seed| identify(&default, seed)).collect();
+        let (samples, passes) =
+            LocalModel::pooled_nominal_noise(&runs.iter().collect::<Vec<_>>()).unwrap();
+        // the root mean square of each run's, per joint
+        let each: Vec<(Vec<f64>, Vec<f64>)> =
+            runs.iter().map(|m| m.nominal_noise().unwrap()).collect();
+        let rms = |v: Vec<f64>| (v.iter().map(|x| x * x).sum::<f64>() / 5.0).sqrt();
+        for j in 0..6 {
+            let s = rms(each.iter().map(|e| e.0[j]).collect());
+            let p = rms(each.iter().map(|e| e.1[j]).collect());
+            assert!((samples[j] - s).abs() < 1e-15 * (1.0 + s), "{samples:?}");
+            assert!((passes[j] - p).abs() < 1e-15 * (1.0 + p), "{passes:?}");
         }
-        let samples: Vec<f64> = samples.iter().map(|v| v.sqrt()).collect();
-        let passes: Vec<f64> = passes.iter().map(|v| v.sqrt()).collect();
+        // refused: nothing to pool, or models of other joints (named by index)
+        assert!(LocalModel::pooled_nominal_noise(&[]).is_err());
+        let mut other = runs[1].clone();
+        other.joint_names[5] = "wrist".into();
+        let err = LocalModel::pooled_nominal_noise(&[&runs[0], &other])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("models[1]") && err.contains("wrist"), "{err}");
         for j in 0..6 {
             assert!(
                 passes[j] > 4.0 * samples[j],

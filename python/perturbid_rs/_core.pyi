@@ -367,6 +367,12 @@ class LocalModel:
     def nominal_noise(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The nominal passes' torque noise (n,) each: the samples' and what varied from pass
         to pass beyond it (N m), for plan_experiments(torque_noise=, torque_pass_noise=)."""
+    @staticmethod
+    def pooled_nominal_noise(
+        models: Sequence["LocalModel"],
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """nominal_noise() of several identifications of one robot's joints, pooled: the
+        root mean square per joint, (n,) each (N m)."""
     def to_json(self) -> str: ...
     @staticmethod
     def from_json(text: str) -> "LocalModel": ...

@@ -100,9 +100,10 @@ pub(crate) struct PlanArgs {
     torque_pass_noise: Option<f64>,
     /// A local model this robot's earlier identification saved: its nominal passes' noise, per
     /// joint (the samples' and what varied from pass to pass beyond it), is taken as
-    /// --torque-noise and --torque-pass-noise.
+    /// --torque-noise and --torque-pass-noise. Repeat it to pool several identifications
+    /// (root mean square per joint): one has only K - 1 degrees of freedom a joint.
     #[arg(long, value_name = "MODEL", conflicts_with_all = ["torque_noise", "torque_pass_noise"])]
-    noise_from: Option<PathBuf>,
+    noise_from: Vec<PathBuf>,
 }
 
 #[derive(Deserialize)]
@@ -127,25 +128,30 @@ fn load_op(path: &Path) -> Result<OperatingPoint> {
     })
 }
 
-/// The nominal passes' noise a saved local model of `model` reports, as the planner's
-/// `torque_noise` and `torque_pass_noise` ([`LocalModel::nominal_noise`]); refused, naming the
-/// file, for a model of other joints or without it.
-fn noise_from(path: &Path, model: &crate::model::Model) -> Result<(Vec<f64>, Vec<f64>)> {
-    let local = LocalModel::load(path)?;
-    let refuse = |message: String| Error::Json {
-        context: format!("{} (--noise-from)", path.display()),
-        message,
-    };
-    if local.joint_names != model.joint_names {
-        return Err(refuse(format!(
-            "a local model of joints [{}] of '{}'; the robot '{}' has [{}]",
-            local.joint_names.join(", "),
-            local.robot,
-            model.name,
-            model.joint_names.join(", ")
-        )));
+/// The nominal passes' noise the saved local models of `model` at `paths` report, pooled, as
+/// the planner's `torque_noise` and `torque_pass_noise` ([`LocalModel::pooled_nominal_noise`]);
+/// refused, naming the file, for a model of other joints or without it.
+fn noise_from(paths: &[PathBuf], model: &crate::model::Model) -> Result<(Vec<f64>, Vec<f64>)> {
+    let mut models = Vec::with_capacity(paths.len());
+    for path in paths {
+        let local = LocalModel::load(path)?;
+        let refuse = |message: String| Error::Json {
+            context: format!("{} (--noise-from)", path.display()),
+            message,
+        };
+        if local.joint_names != model.joint_names {
+            return Err(refuse(format!(
+                "a local model of joints [{}] of '{}'; the robot '{}' has [{}]",
+                local.joint_names.join(", "),
+                local.robot,
+                model.name,
+                model.joint_names.join(", ")
+            )));
+        }
+        local.nominal_noise().map_err(|e| refuse(e.to_string()))?;
+        models.push(local);
     }
-    local.nominal_noise().map_err(|e| refuse(e.to_string()))
+    LocalModel::pooled_nominal_noise(&models.iter().collect::<Vec<_>>())
 }
 
 fn size(abs: Option<f64>, fraction: f64, n: usize) -> Size {
@@ -177,12 +183,22 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
     o.sizes.position = size(a.dq, a.dq_fraction, n);
     o.sizes.velocity = size(a.dqd, a.dqd_fraction, n);
     o.sizes.acceleration = size(a.dqdd, a.dqdd_fraction, n);
-    if let Some(path) = &a.noise_from {
-        let (samples, passes) = noise_from(path, &model)?;
+    if !a.noise_from.is_empty() {
+        let (samples, passes) = noise_from(&a.noise_from, &model)?;
         if samples.iter().all(|s| *s == 0.0) {
+            let files: Vec<String> = a
+                .noise_from
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect();
+            let (verb, whose) = if files.len() == 1 {
+                ("reports", "its")
+            } else {
+                ("report", "their")
+            };
             eprintln!(
-                "perturbid: warning: {} reports no torque noise in its nominal passes (data without noise?): nothing is predicted",
-                path.display()
+                "perturbid: warning: {} {verb} no torque noise in {whose} nominal passes (data without noise?): nothing is predicted",
+                files.join(", ")
             );
         }
         (o.torque_noise, o.torque_pass_noise) = (Some(samples), Some(passes));

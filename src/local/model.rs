@@ -164,6 +164,53 @@ impl LocalModel {
         }
         Ok((samples, passes))
     }
+
+    /// [`Self::nominal_noise`] pooled over several identifications of one robot's joints (the
+    /// same `joint_names`, in order): per joint the root mean square of each model's samples'
+    /// noise and of its noise from pass to pass, every model weighted alike. One
+    /// identification's nominal noise has `K - 1` degrees of freedom a joint (11 by default),
+    /// so a plan predicted from it alone is optimistic where a joint's noise came out low; a
+    /// few pooled give the planner a steadier number. Refused without models, with models of
+    /// other joints (naming the first that differs, by index) or without nominal entries.
+    pub fn pooled_nominal_noise(models: &[&LocalModel]) -> Result<(Vec<f64>, Vec<f64>)> {
+        let Some(first) = models.first() else {
+            return Err(Error::InvalidArgument {
+                argument: "models".into(),
+                message: "no local model to pool the nominal noise of; expected at least one"
+                    .into(),
+            });
+        };
+        let n = first.joint_names.len();
+        let (mut samples, mut passes) = (vec![0.0; n], vec![0.0; n]);
+        for (i, m) in models.iter().enumerate() {
+            if m.joint_names != first.joint_names {
+                return Err(Error::InvalidArgument {
+                    argument: format!("models[{i}]"),
+                    message: format!(
+                        "a local model of joints [{}] of '{}'; models[0] is of [{}] of '{}': pool identifications of one robot's joints",
+                        m.joint_names.join(", "),
+                        m.robot,
+                        first.joint_names.join(", "),
+                        first.robot
+                    ),
+                });
+            }
+            let (s, p) = m.nominal_noise().map_err(|e| Error::InvalidArgument {
+                argument: format!("models[{i}]"),
+                message: e.to_string(),
+            })?;
+            for j in 0..n {
+                samples[j] += s[j] * s[j];
+                passes[j] += p[j] * p[j];
+            }
+        }
+        let rms = |v: Vec<f64>| -> Vec<f64> {
+            v.into_iter()
+                .map(|s| (s / models.len() as f64).sqrt())
+                .collect()
+        };
+        Ok((rms(samples), rms(passes)))
+    }
 }
 
 impl Document for LocalModel {

@@ -336,6 +336,21 @@ impl PyLocalModel {
         let (samples, passes) = self.model.nominal_noise()?;
         Ok((vec1(py, &samples), vec1(py, &passes)))
     }
+    /// `nominal_noise()` pooled over several identifications of one robot's joints (a
+    /// sequence of LocalModel): per joint the root mean square of each model's, every model
+    /// weighted alike; two (n,) arrays (N m). One identification's nominal noise has K - 1
+    /// degrees of freedom a joint, so a plan predicted from one alone is optimistic where a
+    /// joint's noise came out low. Raises InputError without models, for models of other
+    /// joints (`models[i]` named) or without nominal entries.
+    #[staticmethod]
+    fn pooled_nominal_noise<'py>(
+        py: Python<'py>,
+        models: Vec<PyRef<'py, Self>>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let models: Vec<&LocalModel> = models.iter().map(|m| &m.model).collect();
+        let (samples, passes) = LocalModel::pooled_nominal_noise(&models)?;
+        Ok((vec1(py, &samples), vec1(py, &passes)))
+    }
     /// The model as JSON text (matrices as lists of rows).
     fn to_json(&self) -> String {
         Document::to_json(&self.model)

@@ -420,6 +420,14 @@ def test_the_torque_noise_is_reported_per_experiment_and_joint():
     assert list(passes) == [e["passes"] for e in noise[:6]]
     plan = pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2), torque_noise=samples, torque_pass_noise=passes, experiments=["nominal", "D"])
     assert not [w for w in plan.warnings if "the robot's model predicts" in w]
+    # several identifications pooled: the root mean square per joint
+    other = pr.identify_local(plan, pr.simulate(robot, plan, torque_noise=2 * levels, seed=9, friction=None))
+    pooled = pr.LocalModel.pooled_nominal_noise([model, other])
+    for mine, theirs, both in zip(model.nominal_noise(), other.nominal_noise(), pooled):
+        np.testing.assert_allclose(both, np.sqrt((mine**2 + theirs**2) / 2), rtol=1e-15)
+    assert np.all(pooled[0] > 1.4 * samples)  # the other's samples are twice as noisy
+    with pytest.raises(pr.InputError, match="no local model"):
+        pr.LocalModel.pooled_nominal_noise([])
     # what varies from pass to pass in H beyond the samples' noise: the velocity-squared terms
     # the +- pairs cancel from H* (several mN m at this point), far above D's
     passes = {(e["experiment"], e["joint"]): e["passes"] for e in noise}
