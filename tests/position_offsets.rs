@@ -5,7 +5,9 @@
 mod common;
 
 use common::{a465_log, fit_physical, panda_model, panda_preprocessed, refused_on_load, Rng};
-use perturbid_rs::direct::position_offsets::{PositionOffsets, FINDING_RATIO, MAX_STDERR};
+use perturbid_rs::direct::position_offsets::{
+    check_position_offsets_in_validation, PositionOffsets, FINDING_RATIO, MAX_STDERR,
+};
 use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
 use perturbid_rs::document::Document;
 use perturbid_rs::States;
@@ -147,4 +149,82 @@ fn the_real_panda_log_has_no_offset_finding_and_an_added_one_is_found() {
         "{w}"
     );
     eprintln!("real, 0.1 added: {o:?}");
+}
+
+/// A saved fit validated on a new log with its parameters held
+/// (`check_position_offsets_in_validation`): the real Panda log's second half against the fit of
+/// its first has no finding; 0.1 rad added to the second half's second joint, or -0.3 rad to its
+/// fourth (which a refit nearly absorbs, but held parameters cannot), is found and named against
+/// the model.
+#[test]
+fn a_new_logs_offsets_are_found_against_a_saved_fit() {
+    let Some((model, p)) = panda_preprocessed() else {
+        return;
+    };
+    let n = 7;
+    let k = p.t.len() / 2;
+    let half = |x: &Option<Vec<f64>>, second: bool| -> Vec<f64> {
+        let x = x.as_deref().unwrap();
+        if second {
+            x[k * n..2 * k * n].to_vec()
+        } else {
+            x[..k * n].to_vec()
+        }
+    };
+    let (q1, q2) = (p.q[..k * n].to_vec(), p.q[k * n..2 * k * n].to_vec());
+    let (tau1, tau2) = (p.tau[..k * n].to_vec(), p.tau[k * n..2 * k * n].to_vec());
+    let (qd1, qdd1) = (half(&p.qd, false), half(&p.qdd, false));
+    let (qd2, qdd2) = (half(&p.qd, true), half(&p.qdd, true));
+    let states = States::new(n, &q1, Some(&qd1), Some(&qdd1)).unwrap();
+    let fit = identify_base_parameters(&model, &states, &tau1, &BaseOptions::default()).unwrap();
+    let check = |q: &[f64]| {
+        let states = States::new(n, q, Some(&qd2), Some(&qdd2)).unwrap();
+        check_position_offsets_in_validation(&model, &fit, &states, &tau2)
+            .unwrap()
+            .expect("checked")
+    };
+    let o = check(&q2);
+    eprintln!("second half: {o:?}");
+    assert!(o.validation_finding().is_none(), "{o:?}");
+    assert!(!o.joints.contains(&"panda_joint1".to_string()), "{o:?}");
+    for (joint, by) in [(1, 0.1), (3, -0.3)] {
+        let o = check(&offset(&q2, n, joint, by));
+        eprintln!("{joint} {by}: {o:?}");
+        let name = format!("panda_joint{}", joint + 1);
+        let (d, se) = estimate(&o, &name);
+        assert!(
+            (d + by).abs() < 0.02 && se < 0.01,
+            "{name}: {d} +- {se}: {o:?}"
+        );
+        let w = o.validation_finding().unwrap_or_else(|| panic!("{o:?}"));
+        assert!(w.contains(&format!("joint(s) '{name}' ")), "{w}");
+        assert!(
+            w.contains("not those of the log the model was identified from"),
+            "{w}"
+        );
+    }
+}
+
+/// The same on the A465 (no data needed): against the fit of its clean log, its vertical base
+/// axis is left out (turning it moves no weight), the log itself has no finding, and 0.05 rad at
+/// its elbow, which a refit nearly absorbs (parallel axes), is found and named.
+#[test]
+fn an_a465_logs_offsets_are_found_against_its_saved_fit() {
+    let log = a465_log();
+    let fit = fit_physical(&log);
+    let model = perturbid_rs::robots::a465::model("physical").unwrap();
+    let check = |q: &[f64]| {
+        let states = States::new(6, q, Some(&log.qd), Some(&log.qdd)).unwrap();
+        check_position_offsets_in_validation(&model, &fit, &states, &log.tau)
+            .unwrap()
+            .expect("checked")
+    };
+    let o = check(&log.q);
+    assert!(!o.joints.contains(&"joint1".to_string()), "{o:?}");
+    assert!(o.validation_finding().is_none(), "{o:?}");
+    let o = check(&offset(&log.q, 6, 2, 0.05));
+    let (d, se) = estimate(&o, "joint3");
+    assert!((d + 0.05).abs() < 3.0 * se.max(1e-3), "{d} +- {se}: {o:?}");
+    let w = o.validation_finding().unwrap_or_else(|| panic!("{o:?}"));
+    assert!(w.contains("joint(s) 'joint3' "), "{w}");
 }

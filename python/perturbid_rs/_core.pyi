@@ -703,6 +703,10 @@ class Validation:
     def position_range(self) -> list[dict[str, Any]]:
         """For a BaseParameterModel, the joints whose measured positions leave their limits
         (as BaseParameterModel.position_range); empty otherwise."""
+    @property
+    def position_offsets(self) -> Optional[dict[str, Any]]:
+        """For a BaseParameterModel, the joints' zero offsets of the data against its
+        parameters, held (as BaseParameterModel.position_offsets); None otherwise."""
     def to_dataframe(self) -> Any:
         """The per-joint table as a pandas DataFrame (index joint; rms, relative_rms, max)."""
 

@@ -8,6 +8,7 @@ use clap::Args;
 
 use super::files::{load_robot, refuse_overwriting_inputs, PreprocessArgs};
 use super::progress::Progress;
+use crate::direct::position_offsets::check_position_offsets_in_validation;
 use crate::direct::position_range::check_position_range;
 use crate::direct::torque_columns::check_torque_columns;
 use crate::direct::torque_lag::{check_torque_lag, log_findings};
@@ -39,8 +40,9 @@ pub(crate) struct ValidateArgs {
     /// as glitches and the rows removed as dropouts before preprocessing, when there were any;
     /// for a base-parameter model `torque_columns`, each torque column of the log against the
     /// robot's model, `torque_lag`, its torques shifted against its positions, and
-    /// `position_range`, the joints whose positions leave their limits, whose findings are
-    /// warned of) and validation.svg (measured and predicted
+    /// `position_range`, the joints whose positions leave their limits, and `position_offsets`,
+    /// the joints' zero offsets against the model's parameters, whose findings are warned of)
+    /// and validation.svg (measured and predicted
     /// torques, and residuals).
     #[arg(long, default_value = "validation")]
     out: PathBuf,
@@ -86,22 +88,24 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     // the log's torque columns against the robot's own model, as every direct fit checks
     // its own log: swapped columns, another sign or other units show here by name, not only
     // as large errors
-    let (position_range, torque_columns, torque_lag) = match (&file, &robot) {
+    let (position_range, torque_columns, torque_lag, offsets) = match (&file, &robot) {
         (ModelFile::Base(fit), Some(r)) => {
             progress.update("checking the torque columns");
             (
                 check_position_range(r, &states),
                 check_torque_columns(r, &states, &rec.tau, fit.gravity)?,
                 check_torque_lag(r, &states, &rec.tau, fit.gravity)?,
+                check_position_offsets_in_validation(r, fit, &states, &rec.tau)?,
             )
         }
-        _ => (vec![], vec![], None),
+        _ => (vec![], vec![], None, None),
     };
     progress.done();
     let rounding = crate::position_rounding::warning(&rec.position_rounding, &joints)
         .map(|w| format!("{w}{}", crate::position_rounding::IN_A_VALIDATION));
     for w in log_findings(&position_range, &torque_columns, torque_lag.as_ref())
         .into_iter()
+        .chain(offsets.as_ref().and_then(|o| o.validation_finding()))
         .chain(rounding)
     {
         eprintln!("perturbid: warning: log '{}': {w}", a.data.display());
@@ -133,6 +137,9 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     }
     if !position_range.is_empty() {
         json["position_range"] = serde_json::to_value(&position_range).expect("serialisable");
+    }
+    if let Some(o) = &offsets {
+        json["position_offsets"] = serde_json::to_value(o).expect("serialisable");
     }
     if !rec.position_rounding.is_empty() {
         json["position_rounding"] =

@@ -32,7 +32,9 @@ pub use identify::{
 };
 pub use parameter_table::ParameterRow;
 pub use parameters::{regressor_blocks, regressor_matrix, FrictionTerms, ParameterLayout};
-pub use position_offsets::{check_position_offsets, PositionOffsets};
+pub use position_offsets::{
+    check_position_offsets, check_position_offsets_in_validation, PositionOffsets,
+};
 pub use torque_columns::{check_torque_columns, TorqueColumn};
 pub use torque_lag::{check_torque_lag, TorqueLag};
 pub use workspace::{workspace_from_json, CartesianConstraint, Region};

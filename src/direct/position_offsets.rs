@@ -17,6 +17,11 @@
 //! [`MAX_STDERR`]) leave 0.97 of it; 0.1 rad added to its second joint left 0.43, and is
 //! estimated to 2 mrad of what was added. It costs about as much as (2 + N) regressors of
 //! [`SAMPLES`] samples a step.
+//!
+//! A saved model validated on a new log gets the same check with its parameters held
+//! ([`check_position_offsets_in_validation`]): a joint zeroed elsewhere since the model was
+//! identified (after maintenance, a new encoder) is then named against the model rather than
+//! only seen as a larger validation error.
 
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -78,6 +83,26 @@ impl PositionOffsets {
     /// of the residual. Names the joints whose offsets exceed three standard errors, the
     /// largest first.
     pub fn finding(&self) -> Option<String> {
+        let (ratio, list) = self.named()?;
+        Some(format!(
+            "the torques fit the robot's model {:.1} times better (residual RMS) with the positions of joint(s) {list} added to them: those joints' zeros in the log are likely not the URDF's (an encoder zeroed elsewhere, another convention); check them and add the offsets to the positions before identifying, or the parameters absorb what they can of them and the rest is error",
+            1.0 / ratio,
+        ))
+    }
+
+    /// The same for offsets found against a saved model's parameters in a validation
+    /// ([`check_position_offsets_in_validation`]).
+    pub fn validation_finding(&self) -> Option<String> {
+        let (ratio, list) = self.named()?;
+        Some(format!(
+            "the torques fit the model {:.1} times better (residual RMS) with the positions of joint(s) {list} added to them: those joints' zeros in this log are likely not those of the log the model was identified from (an encoder zeroed elsewhere since, another convention); check them and add the offsets to the positions, or the validation error is partly theirs",
+            1.0 / ratio,
+        ))
+    }
+
+    /// The residual's ratio and the joints beyond three standard errors, listed with their
+    /// offsets (the largest first), where the offsets leave at most [`FINDING_RATIO`] of it.
+    fn named(&self) -> Option<(f64, String)> {
         let ratio = self.unexplained_with_offsets / self.unexplained;
         if !(ratio.is_finite() && ratio <= FINDING_RATIO) {
             return None;
@@ -98,11 +123,7 @@ impl PositionOffsets {
                 )
             })
             .collect();
-        Some(format!(
-            "the torques fit the robot's model {:.1} times better (residual RMS) with the positions of joint(s) {} added to them: those joints' zeros in the log are likely not the URDF's (an encoder zeroed elsewhere, another convention); check them and add the offsets to the positions before identifying, or the parameters absorb what they can of them and the rest is error",
-            1.0 / ratio,
-            list.join(", ")
-        ))
+        Some((ratio, list.join(", ")))
     }
 
     /// What is wrong with offsets read from a file, if anything: a joint not among
@@ -157,6 +178,39 @@ pub fn check_position_offsets(
     states: &States<'_>,
     tau: &[f64],
 ) -> Result<Option<PositionOffsets>> {
+    check(model, fit, states, tau, Parameters::Refitted)
+}
+
+/// Estimates the joint offsets of a new log (`states`, `tau` as [`check_position_offsets`]'s)
+/// against the saved `fit` of `model`, its parameters held: what to add to the log's positions
+/// for the model to predict its torques best. A joint whose offset does not change the
+/// model's torques (a vertical base axis) is left out, and so are joints not determined to
+/// [`MAX_STDERR`] (the standard errors inflated by the fit's own factor). None as
+/// [`check_position_offsets`].
+pub fn check_position_offsets_in_validation(
+    model: &Model,
+    fit: &BaseModel,
+    states: &States<'_>,
+    tau: &[f64],
+) -> Result<Option<PositionOffsets>> {
+    check(model, fit, states, tau, Parameters::Held)
+}
+
+/// Whether the parameters are refitted with the offsets (the fit's own log) or held (a saved
+/// model against a new log).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Parameters {
+    Refitted,
+    Held,
+}
+
+fn check(
+    model: &Model,
+    fit: &BaseModel,
+    states: &States<'_>,
+    tau: &[f64],
+    parameters: Parameters,
+) -> Result<Option<PositionOffsets>> {
     let n = model.nv;
     let k = states.len();
     states.check_companion("tau", tau, n)?;
@@ -181,12 +235,11 @@ pub fn check_position_offsets(
         qdd: pick(&states.qdd_or_zeros()),
         y: DVector::from_fn(m * n, |r, _| measured[r] * weight[r % n]),
         weight,
+        parameters,
     };
-    let a0 = problem.regressor(&vec![0.0; n])?;
-    let Some(columns) = Columns::new(&a0) else {
+    let Some(logged) = problem.residual(&vec![0.0; n])? else {
         return Ok(None);
     };
-    let logged = (&problem.y - columns.fitted(&problem.y)).norm();
     let inflation = fit.stderr_inflation();
     let mut left_out = vec![false; n];
     loop {
@@ -232,6 +285,8 @@ struct Problem<'a> {
     y: DVector<f64>,
     /// `1 / sigma` per joint.
     weight: Vec<f64>,
+    /// Refitted at each step, or the fit's held.
+    parameters: Parameters,
 }
 
 /// Offsets found by [`Problem::gauss_newton`].
@@ -247,6 +302,30 @@ struct Found {
 }
 
 impl Problem<'_> {
+    /// The regressor's columns at `a`, for the parameters' refit (None where they are held),
+    /// and the parameters; None where `a` is not finite.
+    fn parameters<'a>(&self, a: &'a DMatrix<f64>) -> Option<(Option<Columns<'a>>, DVector<f64>)> {
+        match self.parameters {
+            Parameters::Refitted => {
+                let columns = Columns::new(a)?;
+                let theta = columns.coefficients(&self.y);
+                Some((Some(columns), theta))
+            }
+            Parameters::Held => Some((None, DVector::from_column_slice(&self.fit.theta))),
+        }
+    }
+
+    /// The weighted residual's norm with the offsets `d` (the parameters refitted or held);
+    /// None where it is not finite.
+    fn residual(&self, d: &[f64]) -> Result<Option<f64>> {
+        let a = self.regressor(d)?;
+        let Some((_, theta)) = self.parameters(&a) else {
+            return Ok(None);
+        };
+        let norm = (&self.y - &a * theta).norm();
+        Ok(norm.is_finite().then_some(norm))
+    }
+
     /// The weighted base regressor at positions `q + d`.
     fn regressor(&self, d: &[f64]) -> Result<DMatrix<f64>> {
         let n = self.model.nv;
@@ -291,10 +370,9 @@ impl Problem<'_> {
         for _ in 0..STEPS {
             crate::interrupt::check("checking the positions' zero offsets")?;
             let a = self.regressor(&d)?;
-            let Some(columns) = Columns::new(&a) else {
+            let Some((columns, theta)) = self.parameters(&a) else {
                 return Ok(None);
             };
-            let theta = columns.coefficients(&self.y);
             let fitted = &a * &theta;
             // the derivative of the fitted torques in each joint's position (a forward
             // difference), and what of it the regressor's columns cannot take
@@ -308,7 +386,10 @@ impl Problem<'_> {
                 e[j] += STEP;
                 let derivative = (self.regressor(&e)? * &theta - &fitted) / STEP;
                 let own = derivative.norm();
-                let rest = &derivative - columns.fitted(&derivative);
+                let rest = match &columns {
+                    Some(columns) => &derivative - columns.fitted(&derivative),
+                    None => derivative,
+                };
                 let determined = rest.norm() > ABSORBED * own.max(fitted.norm()) && own > 0.0;
                 outside.push(determined.then_some(rest));
             }
@@ -326,7 +407,8 @@ impl Problem<'_> {
             let residual = &self.y - &fitted;
             let mut step = derivatives.coefficients(&residual);
             let left = (&residual - &x * &step).norm();
-            let dof = rows.saturating_sub(p + free.len()).max(1) as f64;
+            let refitted = if columns.is_some() { p } else { 0 };
+            let dof = rows.saturating_sub(refitted + free.len()).max(1) as f64;
             let covariance = derivatives.covariance();
             stderr = (0..free.len())
                 .map(|c| (left * left / dof * covariance[(c, c)]).sqrt())
@@ -342,11 +424,9 @@ impl Problem<'_> {
                 break;
             }
         }
-        let a = self.regressor(&d)?;
-        let Some(columns) = Columns::new(&a) else {
+        let Some(residual) = self.residual(&d)? else {
             return Ok(None);
         };
-        let residual = (&self.y - columns.fitted(&self.y)).norm();
         Ok(Some(Found {
             free,
             d,

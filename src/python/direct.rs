@@ -18,6 +18,7 @@ use super::local::PyOperatingPoint;
 use super::robot::PyRobot;
 use super::trajectory::PyFourier;
 use crate::direct::excitation::ExcitationDesign;
+use crate::direct::position_offsets::PositionOffsets;
 use crate::direct::position_range::JointRange;
 use crate::direct::{
     design_excitation as design_rs, identify_base_parameters as base_rs,
@@ -182,6 +183,23 @@ pub(crate) fn design_excitation(
     Ok(PyExcitationDesign { design })
 }
 
+/// The joints' zero offsets as a dict (`BaseParameterModel.position_offsets`,
+/// `Validation.position_offsets`), with its `finding`.
+pub(crate) fn position_offsets_dict<'py>(
+    py: Python<'py>,
+    o: &PositionOffsets,
+    finding: Option<String>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let e = PyDict::new(py);
+    e.set_item("joints", &o.joints)?;
+    e.set_item("offsets", &o.offsets)?;
+    e.set_item("stderr", &o.stderr)?;
+    e.set_item("unexplained", o.unexplained)?;
+    e.set_item("unexplained_with_offsets", o.unexplained_with_offsets)?;
+    e.set_item("finding", finding)?;
+    Ok(e)
+}
+
 /// Row-major (k, n) samples of three arrays and optionally a fourth.
 pub(crate) fn states<'a>(
     n: usize,
@@ -307,17 +325,9 @@ impl PyBaseModel {
     /// and with the offsets), `finding` (what looks wrong, or None; also a warning).
     #[getter]
     fn position_offsets<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
-        let Some(o) = &self.fit.position_offsets else {
-            return Ok(None);
-        };
-        let e = PyDict::new(py);
-        e.set_item("joints", &o.joints)?;
-        e.set_item("offsets", &o.offsets)?;
-        e.set_item("stderr", &o.stderr)?;
-        e.set_item("unexplained", o.unexplained)?;
-        e.set_item("unexplained_with_offsets", o.unexplained_with_offsets)?;
-        e.set_item("finding", o.finding())?;
-        Ok(Some(e))
+        (self.fit.position_offsets.as_ref())
+            .map(|o| position_offsets_dict(py, o, o.finding()))
+            .transpose()
     }
     /// The joints whose positions in the data leave their URDF limits by more than 5 % of
     /// their range: dicts `joint`, `min`, `max` (the positions logged), `lower`, `upper` (the

@@ -7,9 +7,12 @@ use pyo3::types::PyDict;
 
 use super::arrays::{read_batch, to_numpy, ArrayLike};
 use super::detached;
-use super::direct::{position_range_dicts, torque_column_dicts, torque_lag_dict, PyBaseModel};
+use super::direct::{
+    position_offsets_dict, position_range_dicts, torque_column_dicts, torque_lag_dict, PyBaseModel,
+};
 use super::errors::warn_all;
 use super::tables::dataframe;
+use crate::direct::position_offsets::{check_position_offsets_in_validation, PositionOffsets};
 use crate::direct::position_range::{check_position_range, JointRange};
 use crate::direct::torque_columns::{check_torque_columns, TorqueColumn};
 use crate::direct::torque_lag::{check_torque_lag, log_findings, TorqueLag};
@@ -22,8 +25,10 @@ use crate::validation::{validate as validate_rs, Validation};
 /// BaseParameterModel: the measured torque columns against its robot's model, as
 /// `BaseParameterModel.torque_columns`; empty otherwise), `torque_lag` (likewise, as
 /// `BaseParameterModel.torque_lag`; None otherwise), `position_range` (likewise, as
-/// `BaseParameterModel.position_range`; empty otherwise). `to_dataframe()`: the per-joint
-/// table (pandas).
+/// `BaseParameterModel.position_range`; empty otherwise), `position_offsets` (for a
+/// BaseParameterModel: the joints' zero offsets of this data against its parameters, held; a
+/// dict as `BaseParameterModel.position_offsets`; None otherwise). `to_dataframe()`: the
+/// per-joint table (pandas).
 #[pyclass(name = "Validation", module = "perturbid_rs", frozen)]
 pub(crate) struct PyValidation {
     v: Validation,
@@ -31,6 +36,7 @@ pub(crate) struct PyValidation {
     torque_columns: Vec<TorqueColumn>,
     torque_lag: Option<TorqueLag>,
     position_range: Vec<JointRange>,
+    position_offsets: Option<PositionOffsets>,
 }
 
 #[pymethods]
@@ -93,6 +99,16 @@ impl PyValidation {
     fn position_range<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         position_range_dicts(py, &self.position_range)
     }
+    /// For a BaseParameterModel, the joints' zero offsets of the data against the model's
+    /// parameters, held (a dict as `BaseParameterModel.position_offsets`; its `finding` names
+    /// joints likely zeroed elsewhere since the model was identified, also a warning); None
+    /// otherwise, or where no joint's offset is determined.
+    #[getter]
+    fn position_offsets<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        (self.position_offsets.as_ref())
+            .map(|o| position_offsets_dict(py, o, o.validation_finding()))
+            .transpose()
+    }
     /// The per-joint table: index `joint`, columns `rms`, `relative_rms`, `max`.
     fn to_dataframe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         dataframe(
@@ -126,7 +142,8 @@ impl PyValidation {
 /// rad, rad/s, rad/s^2, N m). The joints are named after `model.joint_names` where it has
 /// them. For a BaseParameterModel the torque columns are also checked against its robot's
 /// model (swapped columns, the opposite sign, other units: a PerturbidWarning each, and
-/// `Validation.torque_columns`) and for a lag behind the positions (`Validation.torque_lag`).
+/// `Validation.torque_columns`), for a lag behind the positions (`Validation.torque_lag`) and
+/// for joints zeroed elsewhere than in the model's data (`Validation.position_offsets`).
 /// Returns a Validation.
 #[pyfunction]
 pub(crate) fn validate<'py>(
@@ -162,32 +179,42 @@ pub(crate) fn validate<'py>(
     let v = validate_rs(&joints, &predicted, &measured)?;
     // the measured torque columns against the robot's own model, as a direct fit checks its
     // own data
-    let (position_range, torque_columns, torque_lag) = match model.cast::<PyBaseModel>() {
-        Ok(base) => {
-            let base = base.get();
-            let (q, qd, qdd): (ArrayLike, ArrayLike, ArrayLike) =
-                (q.extract()?, qd.extract()?, qdd.extract()?);
-            let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
-            let c = &batch.columns;
-            let (ranges, columns, lag) = detached(model.py(), "validate", || {
-                let states = States::new(n, &c[0], Some(&c[1]), Some(&c[2]))?;
-                let g = base.fit.gravity;
-                Ok((
-                    check_position_range(&base.model, &states),
-                    check_torque_columns(&base.model, &states, &measured, g)?,
-                    check_torque_lag(&base.model, &states, &measured, g)?,
-                ))
-            })?;
-            warn_all(model.py(), &log_findings(&ranges, &columns, lag.as_ref()))?;
-            (ranges, columns, lag)
-        }
-        Err(_) => (vec![], vec![], None),
-    };
+    let (position_range, torque_columns, torque_lag, position_offsets) =
+        match model.cast::<PyBaseModel>() {
+            Ok(base) => {
+                let base = base.get();
+                let (q, qd, qdd): (ArrayLike, ArrayLike, ArrayLike) =
+                    (q.extract()?, qd.extract()?, qdd.extract()?);
+                let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
+                let c = &batch.columns;
+                let (ranges, columns, lag, offsets) = detached(model.py(), "validate", || {
+                    let states = States::new(n, &c[0], Some(&c[1]), Some(&c[2]))?;
+                    let g = base.fit.gravity;
+                    Ok((
+                        check_position_range(&base.model, &states),
+                        check_torque_columns(&base.model, &states, &measured, g)?,
+                        check_torque_lag(&base.model, &states, &measured, g)?,
+                        check_position_offsets_in_validation(
+                            &base.model,
+                            &base.fit,
+                            &states,
+                            &measured,
+                        )?,
+                    ))
+                })?;
+                let mut findings = log_findings(&ranges, &columns, lag.as_ref());
+                findings.extend(offsets.as_ref().and_then(|o| o.validation_finding()));
+                warn_all(model.py(), &findings)?;
+                (ranges, columns, lag, offsets)
+            }
+            Err(_) => (vec![], vec![], None, None),
+        };
     Ok(PyValidation {
         v,
         n,
         torque_columns,
         torque_lag,
         position_range,
+        position_offsets,
     })
 }

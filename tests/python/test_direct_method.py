@@ -260,6 +260,50 @@ def test_joint_offsets_are_estimated_with_the_parameters():
     assert saved == {k: v for k, v in o.items() if k != "finding"}
 
 
+def test_a_new_logs_offsets_are_found_against_a_saved_fit():
+    """validate() checks a new log's zero offsets against the fit's parameters, held: a joint
+    zeroed elsewhere since (0.1 rad at the elbow) is named in a warning and estimated; its
+    residuals with and without the offsets are the model's own predictions' (numpy)."""
+    robot = pr.robots.a465()
+    traj = excitation(robot, 5, 0.1, 0.12, 1)
+    t = np.arange(0, traj.period, 0.005)
+    q, qd, qdd = traj.sample(t)
+    rng = np.random.default_rng(5)
+    tau = robot.rnea(q, qd, qdd) + rng.normal(0.0, 0.05, q.shape)
+    fit = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction=None, weighting="ols")
+    assert fit.position_offsets["finding"] is None
+    new_tau = robot.rnea(q, qd, qdd) + rng.normal(0.0, 0.05, q.shape)  # the same motion again
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        v = pr.validate(fit, q, qd, qdd, new_tau)
+    assert v.position_offsets["finding"] is None and "joint1" not in v.position_offsets["joints"]
+    logged = q.copy()
+    logged[:, 2] += 0.1
+    with pytest.warns(pr.PerturbidWarning, match=r"joint\(s\) 'joint3' -0\.1\d* rad .*not those of the log the model was identified from"):
+        v = pr.validate(fit, logged, qd, qdd, new_tau)
+    o = v.position_offsets
+    i = o["joints"].index("joint3")
+    assert abs(o["offsets"][i] + 0.1) < 3 * o["stderr"][i] + 1e-3, o
+    rows = np.arange(600) * len(t) // 600
+
+    def rms(positions):
+        r = (new_tau - fit.predict(positions, qd, qdd))[rows] / fit.sigma
+        return np.sqrt(np.mean(r**2))
+
+    moved = logged.copy()
+    for joint, d in zip(o["joints"], o["offsets"]):
+        moved[:, robot.joint_names.index(joint)] += d
+    assert o["unexplained"] == pytest.approx(rms(logged), rel=1e-6)
+    assert o["unexplained_with_offsets"] == pytest.approx(rms(moved), rel=1e-6)
+    assert o["unexplained_with_offsets"] < 0.5 * o["unexplained"]
+    # a model of another kind (here anything with predict) has no parameters to hold
+    class Predictor:
+        def predict(self, q, qd, qdd):
+            return fit.predict(q, qd, qdd)
+
+    assert pr.validate(Predictor(), logged, qd, qdd, new_tau).position_offsets is None
+
+
 def test_standard_errors_count_residuals_correlated_by_the_filter():
     # a log low-pass filtered at 10 Hz and kept at 100 Hz: about five correlated samples to
     # every independent one, which the standard errors now count
