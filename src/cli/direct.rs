@@ -237,18 +237,14 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         fit.cond,
         a.out.display()
     );
-    // the parameter table: printed in full and saved as CSV and JSON beside the model
+    // the parameter table: printed in full and saved as CSV and JSON beside the model; the
+    // names last, as a base parameter's combination of a robot's parameters runs to hundreds
+    // of characters and would push every number past the terminal's edge
     let rows = fit.parameter_table();
-    let width = rows
-        .iter()
-        .map(|r| r.name.chars().count())
-        .max()
-        .unwrap_or(0)
-        .max(14);
     let _ = writeln!(
         out,
-        "{:<width$} {:>14} {:>12} {:>10}",
-        "base parameter", "value", "std. error", "rel. std"
+        "{:>14} {:>12} {:>10}  base parameter",
+        "value", "std. error", "rel. std"
     );
     let fmt_opt = |v: Option<f64>, percent: bool| match v {
         None => "-".to_string(),
@@ -258,11 +254,11 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     for r in &rows {
         let _ = writeln!(
             out,
-            "{:<width$} {:>14.6} {:>12} {:>10}",
-            r.name,
+            "{:>14.6} {:>12} {:>10}  {}",
             r.value,
             fmt_opt(r.std, false),
-            fmt_opt(r.relative_std, true)
+            fmt_opt(r.relative_std, true),
+            r.name
         );
     }
     let (csv, json) = write_parameter_table(&a.out, &rows)?;
