@@ -604,6 +604,54 @@ fn recordings_are_matched_by_experiment_not_order() {
     refused(&doubled, "are both runs of experiment 'D'");
 }
 
+/// The recordings of H and D swapped (each marked as the other): both are said not to show
+/// their plan's perturbations and to follow the other's, with encoder noise, torque noise and
+/// friction; the recordings as they are raise no such warning.
+#[test]
+fn swapped_recordings_are_named() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
+    let mut sim = SimulationOptions::new(&model);
+    sim.torque_noise = vec![0.05; 6];
+    sim.position_noise = vec![1e-5; 6];
+    sim.seed = 3;
+    let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    let options = IdentifyOptions::default();
+    let follows = |m: &LocalModel| -> Vec<String> {
+        (m.diagnostics.warnings.iter())
+            .filter(|w| w.contains("do not follow the plan's"))
+            .cloned()
+            .collect()
+    };
+    let as_recorded = identify_local(&plan, &recs, &options).unwrap();
+    assert!(
+        follows(&as_recorded).is_empty(),
+        "{:?}",
+        follows(&as_recorded)
+    );
+    let mut swapped = recs.clone();
+    for r in &mut swapped {
+        r.experiment = match r.experiment.as_deref() {
+            Some("H") => Some("D".into()),
+            Some("D") => Some("H".into()),
+            other => other.map(str::to_string),
+        };
+    }
+    let w = follows(&identify_local(&plan, &swapped, &options).unwrap());
+    assert_eq!(w.len(), 2, "{w:?}");
+    assert!(
+        w.iter().any(|w| w
+            .starts_with("experiment 'D': the perturbations its recording shows (dqdd)")
+            && w.contains("it follows the plan of experiment 'H' instead")),
+        "{w:?}"
+    );
+    assert!(
+        w.iter().any(|w| w.starts_with("experiment 'H'")
+            && w.contains("are the recordings of 'H' and 'D' swapped?")),
+        "{w:?}"
+    );
+}
+
 #[test]
 fn rank_deficient_design_names_the_missing_direction() {
     let x = DMatrix::from_row_slice(

@@ -435,12 +435,20 @@ impl<'a> Window<'a> {
         let count = hi - lo;
         let needed = samples_needed(options);
         let too_few = |count: usize, h: f64| {
+            // the longest interval between samples over the window (with the samples either
+            // side): a gap in the log, or a rate too low for the window
+            let (lo, hi) = span(h);
+            let (a, b) = (lo.saturating_sub(1), hi.min(rec.len() - 1));
+            let (from, to) = (a..b)
+                .map(|i| (rec.t[i], rec.t[i + 1]))
+                .max_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
+                .unwrap_or((rec.t[a], rec.t[b]));
             Error::Recording {
-            recording: rec.name.clone(),
-            message: format!(
-                "{what} at t = {tc:.4} s: {count} samples in the +-{h} s window, need at least {needed}"
-            ),
-        }
+                recording: rec.name.clone(),
+                message: format!(
+                    "{what} at t = {tc:.4} s: {count} samples in the +-{h:.4} s window, need at least {needed}; the recording has no sample from {from:.4} to {to:.4} s there (a gap in the log, or too low a rate)"
+                ),
+            }
         };
         if count < needed {
             return Err(too_few(count, half));

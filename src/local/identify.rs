@@ -774,9 +774,9 @@ pub fn identify_local(
     noise.sort_by_key(|e| values.iter().position(|v| v.kind.name() == e.experiment));
     diagnostics.warnings.extend(quantisation::warnings(&noise));
     diagnostics.warnings.extend(extra_warnings.into_inner());
-    diagnostics
-        .warnings
-        .extend(torque_offsets::nominal_warning(&diagnostics.torque_offsets));
+    (diagnostics.warnings).extend(super::followed_plan::warnings(plan, &values, &op_state));
+    let nominal_offsets = torque_offsets::nominal_warning(&diagnostics.torque_offsets);
+    diagnostics.warnings.extend(nominal_offsets);
     diagnostics.noise = noise;
     diagnostics.combined = disagreement;
     diagnostics.unperturbed_deviation = deviation;

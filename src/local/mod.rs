@@ -36,6 +36,7 @@ mod diagnose;
 pub mod diagnostics;
 pub mod errors_in_variables;
 mod flat_channels;
+mod followed_plan;
 mod friction_aware;
 pub mod glitches;
 pub mod identify;
