@@ -35,12 +35,20 @@ pub(crate) fn real(obj: &Bound<'_, PyAny>) -> PyResult<f64> {
     obj.extract()
 }
 
-/// A real number or `None`.
-pub(crate) fn real_or_none(obj: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
+/// `None` as such, anything else through `extract`.
+fn or_none<T>(
+    obj: &Bound<'_, PyAny>,
+    extract: fn(&Bound<'_, PyAny>) -> PyResult<T>,
+) -> PyResult<Option<T>> {
     if obj.is_none() {
         return Ok(None);
     }
-    real(obj).map(Some)
+    extract(obj).map(Some)
+}
+
+/// A real number or `None`.
+pub(crate) fn real_or_none(obj: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
+    or_none(obj, real)
 }
 
 /// A non-negative integer (`usize`): `int` or a numpy integer, not a `bool` nor a `float`.
@@ -51,10 +59,7 @@ pub(crate) fn count(obj: &Bound<'_, PyAny>) -> PyResult<usize> {
 
 /// A non-negative integer or `None`.
 pub(crate) fn count_or_none(obj: &Bound<'_, PyAny>) -> PyResult<Option<usize>> {
-    if obj.is_none() {
-        return Ok(None);
-    }
-    count(obj).map(Some)
+    or_none(obj, count)
 }
 
 /// A random seed (`u64`): a non-negative integer, not a `bool`.

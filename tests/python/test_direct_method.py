@@ -73,6 +73,18 @@ def excitation(robot, harmonics, frequency, amplitude, seed):
     )
 
 
+def noisy_log(step, seed):
+    """The A465 through one period of the test excitation sampled every `step` s, its torques
+    with 0.05 N m of white noise: robot, t, q, qd, qdd, tau and the generator."""
+    robot = pr.robots.a465()
+    traj = excitation(robot, 5, 0.1, 0.12, 1)
+    t = np.arange(0, traj.period, step)
+    q, qd, qdd = traj.sample(t)
+    rng = np.random.default_rng(seed)
+    tau = robot.rnea(q, qd, qdd) + rng.normal(0.0, 0.05, q.shape)
+    return robot, t, q, qd, qdd, tau, rng
+
+
 def test_base_parameters_on_simulated_a465_are_exact():
     robot = pr.robots.a465()
     traj = excitation(robot, 5, 0.1, 0.12, 1)
@@ -169,12 +181,7 @@ def test_torques_out_of_step_are_found():
     squares of each column on its joint's model torques and friction, offset and rotor terms
     (the geometric mean over the columns); validate finds it too, and nothing on the log in
     step."""
-    robot = pr.robots.a465()
-    traj = excitation(robot, 5, 0.1, 0.12, 1)
-    t = np.arange(0, traj.period, 0.005)
-    q, qd, qdd = traj.sample(t)
-    rng = np.random.default_rng(3)
-    tau = robot.rnea(q, qd, qdd) + rng.normal(0.0, 0.05, q.shape)
+    robot, t, q, qd, qdd, tau, rng = noisy_log(0.005, 3)
     k = len(t)
     late = tau[np.clip(np.arange(k) - 30, 0, k - 1)]
     with pytest.warns(pr.PerturbidWarning, match="logged 30 sample"):
@@ -214,14 +221,9 @@ def test_joint_offsets_are_estimated_with_the_parameters():
     parameters absorb), on 600 evenly spread samples; what its residual is as logged and with the offsets added is checked
     against numpy least squares of the torques on the regressor and the rotors' inertias (the
     same column space as the base parameters'); the estimates are saved with the model."""
-    robot = pr.robots.a465()
-    traj = excitation(robot, 5, 0.1, 0.12, 1)
-    t = np.arange(0, traj.period, 0.005)
-    q, qd, qdd = traj.sample(t)
+    robot, t, q, qd, qdd, tau, rng = noisy_log(0.005, 3)
     k = len(t)
     rows = np.arange(600) * k // 600  # the samples checked: 600 evenly spread
-    rng = np.random.default_rng(3)
-    tau = robot.rnea(q, qd, qdd) + rng.normal(0.0, 0.05, q.shape)
     logged = q.copy()
     logged[:, 4] += 0.2
     with warnings.catch_warnings():
@@ -264,12 +266,7 @@ def test_a_new_logs_offsets_are_found_against_a_saved_fit():
     """validate() checks a new log's zero offsets against the fit's parameters, held: a joint
     zeroed elsewhere since (0.1 rad at the elbow) is named in a warning and estimated; its
     residuals with and without the offsets are the model's own predictions' (numpy)."""
-    robot = pr.robots.a465()
-    traj = excitation(robot, 5, 0.1, 0.12, 1)
-    t = np.arange(0, traj.period, 0.005)
-    q, qd, qdd = traj.sample(t)
-    rng = np.random.default_rng(5)
-    tau = robot.rnea(q, qd, qdd) + rng.normal(0.0, 0.05, q.shape)
+    robot, t, q, qd, qdd, tau, rng = noisy_log(0.005, 5)
     fit = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction=None, weighting="ols")
     assert fit.position_offsets["finding"] is None
     new_tau = robot.rnea(q, qd, qdd) + rng.normal(0.0, 0.05, q.shape)  # the same motion again
