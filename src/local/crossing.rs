@@ -8,7 +8,8 @@ use super::glitches::{self, Screened};
 use super::rounded_positions::band_state;
 use crate::error::{Error, Result};
 use crate::recording::Recording;
-use crate::trajectory::Trajectory;
+
+pub use super::reversals::velocity_reversals;
 
 /// The state and torque at one crossing, estimated from a recording (length N each; rad, rad/s,
 /// rad/s^2, N m).
@@ -742,53 +743,5 @@ fn read(
             }
         }
     }
-    out
-}
-
-/// The times in `[a, b]` at which joint `j`'s planned velocity changes sign, in order (exact
-/// on the quadratic crossing segments, by bisection to 1e-12 s on the quintic transitions).
-pub fn velocity_reversals(traj: &Trajectory, j: usize, a: f64, b: f64) -> Vec<f64> {
-    let mut out = vec![];
-    let first = traj.segments.partition_point(|s| s.t1 < a);
-    for seg in traj.segments[first..].iter().take_while(|s| s.t0 <= b) {
-        let (lo, hi) = (a.max(seg.t0), b.min(seg.t1));
-        if lo > hi {
-            continue;
-        }
-        let c = &seg.coeffs[j];
-        let v = |t: f64| seg.eval(j, t).1;
-        if c[3] == 0.0 && c[4] == 0.0 && c[5] == 0.0 {
-            // v = c1 + 2 c2 s: one root at most
-            if c[2] != 0.0 {
-                let root = seg.t_ref - c[1] / (2.0 * c[2]);
-                if (lo..=hi).contains(&root) && v(lo).signum() != v(hi).signum() {
-                    out.push(root);
-                }
-            }
-            continue;
-        }
-        let m = 64;
-        let mut prev = (lo, v(lo));
-        for i in 1..=m {
-            let t = lo + (hi - lo) * i as f64 / m as f64;
-            let vt = v(t);
-            if prev.1 != 0.0 && vt != 0.0 && prev.1.signum() != vt.signum() {
-                let (mut x0, mut x1) = (prev.0, t);
-                while x1 - x0 > 1e-12 {
-                    let mid = 0.5 * (x0 + x1);
-                    if v(mid).signum() == prev.1.signum() {
-                        x0 = mid;
-                    } else {
-                        x1 = mid;
-                    }
-                }
-                out.push(0.5 * (x0 + x1));
-            }
-            if vt != 0.0 {
-                prev = (t, vt);
-            }
-        }
-    }
-    out.dedup_by(|x, y| (*x - *y).abs() < 1e-9);
     out
 }

@@ -5,8 +5,7 @@ use nalgebra::DMatrix;
 
 use super::clock::{align, check_sample_interval};
 use super::crossing::{
-    samples_needed, values_in_windows, velocity_reversals, CrossingValues, FitOptions,
-    SignalScales, TorqueFit,
+    samples_needed, values_in_windows, CrossingValues, FitOptions, SignalScales, TorqueFit,
 };
 use super::diagnose::{
     compare_combined, diagnose, disagreement_warning, mass_matrix_warning, unperturbed_deviation,
@@ -23,6 +22,7 @@ use super::operating_point::OperatingPoint;
 use super::plan::{Experiment, ExperimentKind, Plan};
 use super::quantisation;
 use super::response;
+use super::reversals::narrowed_window;
 use super::rounded_positions::{self, Resolution};
 use super::torque_offsets;
 use crate::document::Document;
@@ -124,14 +124,10 @@ fn torque_fits(
     let traj = &experiment.trajectory;
     (0..traj.n)
         .map(|j| {
-            let nearest = velocity_reversals(traj, j, tp - half, tp + half)
-                .into_iter()
-                .min_by(|a, b| (a - tp).abs().total_cmp(&(b - tp).abs()));
-            let Some(tr) = nearest else {
+            let Some((tr, narrowed)) = narrowed_window(traj, j, tp, half, min_half) else {
                 return TorqueFit::Window(half);
             };
-            let narrowed = 0.9 * (tr - tp).abs();
-            let (fit, handling, window) = if narrowed >= min_half {
+            let (fit, handling, window) = if let Some(narrowed) = narrowed {
                 (
                     TorqueFit::Window(narrowed),
                     ReversalHandling::Narrowed,

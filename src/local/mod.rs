@@ -52,6 +52,7 @@ pub mod point_design;
 pub mod predicted_response;
 pub mod quantisation;
 pub mod response;
+pub mod reversals;
 pub mod rounded_positions;
 pub mod torque_offsets;
 

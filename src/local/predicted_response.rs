@@ -5,8 +5,8 @@
 //! ([`super::response`]) and warns of an experiment none of whose torques responded: after the
 //! robot time is spent. Given the noise of the torque samples, the planner predicts that test:
 //! the robot's model gives each crossing's torque change (rigid bodies and armature; no
-//! friction), the crossing's reading (a fit over its window, [`torque_reading_gain`]) gives
-//! its noise, and the test is run on [`DRAWS`] seeded draws of that noise (drawn in each
+//! friction), the crossing's reading (a fit over its window, narrowed before a velocity
+//! reversal as the identification narrows it: [`reading_gains`]) gives its noise, and the test is run on [`DRAWS`] seeded draws of that noise (drawn in each
 //! joint's few coordinates that the test reads, so a draw costs the same for any number of
 //! crossings; checked against the test on whole rows of noise). An experiment that
 //! would pass in fewer than [`DETECTION`] of them is warned of, with how much larger the
@@ -21,10 +21,11 @@ use nalgebra::{DMatrix, DVector};
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 
-use super::crossing::{torque_reading_gain, FitOptions};
+use super::crossing::FitOptions;
 use super::operating_point::OperatingPoint;
 use super::plan::{Crossing, Experiment, ExperimentKind};
 use super::response::{design_basis, half_differences, resolved, test, Response, Sums};
+use super::reversals::reading_gains;
 use crate::data::Data;
 use crate::error::{shown, Result};
 use crate::gravity::Gravity;
@@ -84,7 +85,9 @@ pub fn predict(
     {
         return Ok(None);
     }
-    let Some(gain) = torque_reading_gain(experiment.window, rate, &FitOptions::default())? else {
+    // each joint's reading noise per unit of the samples', over the windows the
+    // identification reads (narrowed before a velocity reversal: fewer samples, more noise)
+    let Some(gains) = reading_gains(experiment, rate, &FitOptions::default())? else {
         return Ok(None);
     };
     let measured: Vec<bool> = noise.iter().map(|s| *s > 0.0).collect();
@@ -92,7 +95,7 @@ pub fn predict(
         return Ok(None);
     }
     // the samples' part of a reading's noise (what the identification reads about the fits)
-    let samples: Vec<f64> = noise.iter().map(|s| s * gain).collect();
+    let samples: Vec<f64> = noise.iter().zip(&gains).map(|(s, g)| s * g).collect();
     let reading: Vec<f64> = (0..n)
         .map(|j| samples[j].hypot(if passes_given { passes[j] } else { 0.0 }))
         .collect();
@@ -445,6 +448,8 @@ fn three_digits(v: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::local::crossing::torque_reading_gain;
+    use crate::local::reversals::narrowed_window;
     use crate::local::{plan_experiments, PlanOptions};
 
     /// The centre's standard error of a least-squares quadratic over `2m + 1` evenly spaced
@@ -576,7 +581,9 @@ mod tests {
     /// The identification's test itself ([`super::super::response::responses`]) on whole rows of
     /// noise: each draw the nominal readings (T* their mean, their scatter the noise from pass
     /// to pass), G-static's reference and the experiment's readings, `draws` times; every
-    /// reading errs by the samples' noise through the fit and by `passes` (N m a reading).
+    /// reading errs by the samples' noise through its own window's fit (narrowed before a
+    /// velocity reversal as the identification narrows it, and weighted so) and by `passes`
+    /// (N m a reading).
     fn whole_rows(
         model: &Model,
         op: &OperatingPoint,
@@ -587,20 +594,32 @@ mod tests {
     ) -> f64 {
         use crate::local::response::{responses, PassNoise};
         let n = model.nv;
-        let gain = torque_reading_gain(experiment.window, 1000.0, &FitOptions::default())
-            .unwrap()
-            .unwrap();
+        let options = FitOptions::default();
+        let gain = |h: f64| torque_reading_gain(h, 1000.0, &options).unwrap().unwrap();
+        let full = gain(experiment.window);
+        let min_half = 0.5 * crate::local::crossing::samples_needed(&options) as f64 / 1000.0;
+        let crossing_gain = |i: usize, j: usize| {
+            let c = &experiment.crossings[i];
+            let w = narrowed_window(
+                &experiment.trajectory,
+                j,
+                c.time,
+                experiment.window,
+                min_half,
+            );
+            w.and_then(|w| w.1).map_or(full, gain)
+        };
         let reading: Vec<f64> = noise
             .iter()
             .zip(passes)
-            .map(|(s, p)| (s * gain).hypot(*p))
+            .map(|(s, p)| (s * full).hypot(*p))
             .collect();
-        let u = DMatrix::from_fn(experiment.deltas.nrows(), n, |_, j| {
-            (noise[j] * gain).powi(2)
-        });
+        let k = experiment.deltas.nrows();
+        let gains = DMatrix::from_fn(k, n, crossing_gain);
+        let u = DMatrix::from_fn(k, n, |i, j| (noise[j] * gains[(i, j)]).powi(2));
+        let row_reading = DMatrix::from_fn(k, n, |i, j| u[(i, j)].sqrt().hypot(passes[j]));
         let changes = torque_changes(model, op, experiment).unwrap();
         let x = &experiment.deltas;
-        let k = x.nrows();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(99);
         let mut gauss = || <StandardNormal as Distribution<f64>>::sample(&StandardNormal, &mut rng);
         let found = (0..draws)
@@ -616,7 +635,7 @@ mod tests {
                         .collect(),
                 };
                 let y = DMatrix::from_fn(k, n, |i, j| {
-                    changes[(i, j)] + reading[j] * gauss() - base[j]
+                    changes[(i, j)] + row_reading[(i, j)] * gauss() - base[j]
                 });
                 let found = responses(
                     x,
@@ -708,6 +727,36 @@ mod tests {
                     );
                 }
             }
+        }
+        // at the default sizes D's accelerations reverse the slow wrist joints near most
+        // crossings, whose torques are read over narrowed windows (up to 2.5 times the noise):
+        // the prediction takes their mean square, the whole rows each crossing's own
+        let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+        let d = plan.experiment(ExperimentKind::D).unwrap();
+        let gains = reading_gains(d, plan.rate, &FitOptions::default())
+            .unwrap()
+            .unwrap();
+        let full = torque_reading_gain(d.window, plan.rate, &FitOptions::default())
+            .unwrap()
+            .unwrap();
+        assert!(
+            gains[4] > 1.3 * full && gains[0] == full,
+            "{gains:?} {full}"
+        );
+        let p = predict(&model, &op, d, &noise, &[], plan.rate, 12)
+            .unwrap()
+            .unwrap();
+        for f in [0.3, 0.6, 1.0, 1.5] {
+            let e = scaled(&op, d, f * p.factor);
+            let reduced = predict(&model, &op, &e, &noise, &[], plan.rate, 12)
+                .unwrap()
+                .unwrap()
+                .detected;
+            let whole = whole_rows(&model, &op, &e, (&noise, &[0.0; 6]), 12, 2000);
+            assert!(
+                (reduced - whole).abs() <= 0.1,
+                "default sizes, {f} x the factor: reduced {reduced}, whole rows {whole}"
+            );
         }
     }
 
