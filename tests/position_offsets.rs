@@ -6,7 +6,7 @@ mod common;
 
 use common::{a465_log, fit_physical, panda_model, panda_preprocessed, refused_on_load, Rng};
 use perturbid_rs::direct::position_offsets::{
-    check_position_offsets_in_validation, PositionOffsets, FINDING_RATIO, MAX_STDERR,
+    check_position_offsets_in_validation, PositionOffsets, WhyLeftOut, FINDING_RATIO, MAX_STDERR,
 };
 use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
 use perturbid_rs::document::Document;
@@ -36,6 +36,17 @@ fn the_a465_log_has_no_offset_and_the_absorbed_joints_are_left_out() {
     let m = fit_physical(&a465_log());
     let o = m.position_offsets.clone().expect("checked");
     assert_eq!(o.joints, ["joint2", "joint3", "joint4", "joint5"], "{o:?}");
+    // the others are said, with why
+    let left: Vec<(&str, WhyLeftOut)> = (o.left_out.iter())
+        .map(|l| (l.joint.as_str(), l.why))
+        .collect();
+    assert_eq!(
+        left,
+        [
+            ("joint1", WhyLeftOut::Absorbed),
+            ("joint6", WhyLeftOut::Absorbed)
+        ]
+    );
     assert!(o.finding().is_none(), "{o:?}");
     assert!(m.warnings().is_empty(), "{:?}", m.warnings());
     let text = m.to_json();
@@ -59,6 +70,22 @@ fn the_a465_log_has_no_offset_and_the_absorbed_joints_are_left_out() {
             (
                 |v| v["position_offsets"]["unexplained"] = (-1.0).into(),
                 "position_offsets: stderr, unexplained",
+            ),
+            (
+                |v| v["position_offsets"]["left_out"][0]["joint"] = "joint2".into(),
+                "position_offsets: left_out: joint 'joint2' is also estimated",
+            ),
+            (
+                |v| v["position_offsets"]["left_out"][1]["joint"] = "joint1".into(),
+                "position_offsets: left_out: joint 'joint1' is named twice",
+            ),
+            (
+                |v| v["position_offsets"]["left_out"][0]["stderr"] = (-0.5).into(),
+                "position_offsets: left_out: joint 'joint1' has stderr -0.5",
+            ),
+            (
+                |v| v["position_offsets"]["left_out"][0]["why"] = "lost".into(),
+                "unknown variant `lost`",
             ),
         ],
     );
@@ -113,6 +140,9 @@ fn offsets_of_a_simulated_panda_are_found_and_named() {
             );
         } else {
             assert!(!o.joints.contains(&name), "{o:?}");
+            let l = (o.left_out.iter()).find(|l| l.joint == name).unwrap();
+            assert_eq!(l.why, WhyLeftOut::Undetermined, "{o:?}");
+            assert!(l.stderr.unwrap() > MAX_STDERR, "{o:?}");
         }
         let strong = o.unexplained_with_offsets <= FINDING_RATIO * o.unexplained;
         assert_eq!(strong, named, "{o:?}");

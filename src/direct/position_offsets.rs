@@ -76,6 +76,33 @@ pub struct PositionOffsets {
     pub unexplained: f64,
     /// The same with the offsets added and the parameters refitted.
     pub unexplained_with_offsets: f64,
+    /// The joints not among `joints`, and why (absent in models saved before they were
+    /// reported).
+    #[serde(default)]
+    pub left_out: Vec<LeftOut>,
+}
+
+/// A joint whose offset the check does not estimate.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LeftOut {
+    pub joint: String,
+    pub why: WhyLeftOut,
+    /// For [`WhyLeftOut::Undetermined`]: its standard error (rad or m, inflated as the
+    /// estimates'), where it was a number.
+    pub stderr: Option<f64>,
+}
+
+/// Why a joint's offset is not estimated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WhyLeftOut {
+    /// Its offset changes nothing the fit can tell from the parameters: the torques' change
+    /// lies within the regressor's columns (refitted), or there is none (a saved model's,
+    /// held): a vertical base axis, the chain's last joint.
+    Absorbed,
+    /// Its standard error exceeds [`MAX_STDERR`] with the others estimated.
+    Undetermined,
 }
 
 impl PositionOffsets {
@@ -145,6 +172,20 @@ impl PositionOffsets {
                 self.offsets.len(),
                 self.stderr.len()
             ));
+        }
+        for (i, l) in self.left_out.iter().enumerate() {
+            let problem = if !joint_names.contains(&l.joint) {
+                "is not one of the model's joints".to_string()
+            } else if self.joints.contains(&l.joint) {
+                "is also estimated".to_string()
+            } else if self.left_out[..i].iter().any(|o| o.joint == l.joint) {
+                "is named twice".to_string()
+            } else if let Some(s) = l.stderr.filter(|s| !(s.is_finite() && *s >= 0.0)) {
+                format!("has stderr {}; expected a finite number >= 0", shown(s))
+            } else {
+                continue;
+            };
+            return Some(format!("left_out: joint '{}' {problem}", l.joint));
         }
         if let Some(v) = self.offsets.iter().find(|v| !v.is_finite()) {
             return Some(format!(
@@ -242,6 +283,8 @@ fn check(
     };
     let inflation = fit.stderr_inflation();
     let mut left_out = vec![false; n];
+    // the standard errors of the joints left out as undetermined, when they were
+    let mut undetermined: Vec<Option<f64>> = vec![None; n];
     loop {
         let Some(found) = problem.gauss_newton(&left_out)? else {
             return Ok(None);
@@ -252,8 +295,18 @@ fn check(
             .max_by(|&a, &b| stderr[a].total_cmp(&stderr[b]));
         if let Some(c) = worst {
             left_out[found.free[c]] = true;
+            undetermined[found.free[c]] = Some(stderr[c]).filter(|s| s.is_finite());
             continue;
         }
+        let reasons = (0..n).filter(|j| !found.free.contains(j)).map(|j| LeftOut {
+            joint: model.joint_names[j].clone(),
+            why: if left_out[j] {
+                WhyLeftOut::Undetermined
+            } else {
+                WhyLeftOut::Absorbed
+            },
+            stderr: undetermined[j],
+        });
         let rms = |norm: f64| norm / ((m * n) as f64).sqrt();
         let offsets = PositionOffsets {
             joints: found
@@ -265,6 +318,7 @@ fn check(
             stderr,
             unexplained: rms(logged),
             unexplained_with_offsets: rms(found.residual),
+            left_out: reasons.collect(),
         };
         return Ok(offsets
             .problem(&model.joint_names)

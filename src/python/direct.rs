@@ -196,6 +196,16 @@ pub(crate) fn position_offsets_dict<'py>(
     e.set_item("stderr", &o.stderr)?;
     e.set_item("unexplained", o.unexplained)?;
     e.set_item("unexplained_with_offsets", o.unexplained_with_offsets)?;
+    let left_out = (o.left_out.iter())
+        .map(|l| {
+            let d = PyDict::new(py);
+            d.set_item("joint", &l.joint)?;
+            d.set_item("why", serde_json::to_value(l.why).expect("a name").as_str())?;
+            d.set_item("stderr", l.stderr)?;
+            Ok(d)
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    e.set_item("left_out", left_out)?;
     e.set_item("finding", finding)?;
     Ok(e)
 }
@@ -322,7 +332,9 @@ impl PyBaseModel {
     /// whose offsets the data determine: not a vertical base axis, not the chain's last joint),
     /// `offsets` (rad or m, to add to their logged positions), `stderr`, `unexplained` and
     /// `unexplained_with_offsets` (the weighted residual RMS on the samples checked, as logged
-    /// and with the offsets), `finding` (what looks wrong, or None; also a warning).
+    /// and with the offsets), `left_out` (dicts `joint`, `why`: 'absorbed' by the parameters or
+    /// 'undetermined' beyond 0.1 rad, `stderr` of an undetermined one or None), `finding`
+    /// (what looks wrong, or None; also a warning).
     #[getter]
     fn position_offsets<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
         (self.fit.position_offsets.as_ref())

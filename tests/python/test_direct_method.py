@@ -235,6 +235,13 @@ def test_joint_offsets_are_estimated_with_the_parameters():
     assert set(o["joints"]) <= {"joint2", "joint3", "joint4", "joint5"} and "joint5" in o["joints"], o
     assert len(set(o["joints"]) & {"joint2", "joint3"}) == 1, o
     assert all(s <= 0.1 for s in o["stderr"]), o
+    # the others are said, with why: the base axis and the last joint absorbed, the parallel
+    # axis left out as undetermined (its standard error beyond 0.1 rad)
+    why = {l["joint"]: l["why"] for l in o["left_out"]}
+    assert set(why) | set(o["joints"]) == set(robot.joint_names) and not set(why) & set(o["joints"]), o
+    assert why["joint1"] == why["joint6"] == "absorbed", o
+    assert all(l["stderr"] > 0.1 for l in o["left_out"] if l["why"] == "undetermined"), o
+    assert "undetermined" in why.values(), o
     assert o["finding"] is None or "joint5" in o["finding"]
 
     def rms(positions):
