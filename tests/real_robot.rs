@@ -546,6 +546,50 @@ fn closed_loop_tracking_errors_favour_the_combined_estimate() {
     );
 }
 
+/// A robot in closed loop (400 N m/rad) with friction, a payload, torque noise and encoder
+/// counts lags its reference by two samples in G, but its commanded torque turns into the next
+/// transition at the planned segment's end: the reading windows keep clear of that kink by the
+/// lag, and no sample there is taken for a glitch (before, the last samples of 11 windows of
+/// 12 were, and the identification warned of a common cause).
+#[test]
+fn a_controllers_lag_does_not_read_the_next_transition() {
+    use perturbid_rs::rehearsal::{rehearse_plan, TrueRobot};
+    use perturbid_rs::Document;
+    let model = a465::model("kinsheel2010").unwrap();
+    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
+    let robot = TrueRobot::from_json(
+        r#"{"format": "perturbid-true-robot/1", "seed": 2,
+            "payload": {"link": "link6", "mass": 1.0, "com": [0.0, 0.0, 0.06],
+                        "inertia": [0.002, 0, 0, 0.002, 0, 0.001]},
+            "friction": {"viscous": [0.5, 0.4, 0.3, 0.2, 0.1, 0.05],
+                         "coulomb": [1.0, 0.8, 0.6, 0.4, 0.2, 0.1]},
+            "sensors": {"torque_noise": [0.05, 0.05, 0.05, 0.02, 0.02, 0.02],
+                        "encoder_counts": [409600, 409600, 409600, 409600, 409600, 409600]},
+            "controller": {"kp": [400, 400, 400, 400, 400, 400],
+                           "kd": [40, 40, 40, 40, 40, 40]}}"#,
+    )
+    .unwrap();
+    let recs = rehearse_plan(&model, &robot, &plan).unwrap();
+    let m = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    let lag = (m.diagnostics.offsets.iter())
+        .map(|o| o.offset.abs())
+        .fold(0.0, f64::max);
+    assert!(lag > 1.5 / plan.rate, "{:?}", m.diagnostics.offsets);
+    let w = &m.diagnostics.warnings;
+    assert!(!w.iter().any(|w| w.contains("taken for glitches")), "{w:?}");
+    // a window given by hand is read as given: there the kink is taken for glitches
+    let given = IdentifyOptions {
+        fit: perturbid_rs::local::FitOptions {
+            window: Some(plan.experiments[0].window),
+            ..Default::default()
+        },
+        ..IdentifyOptions::default()
+    };
+    let m = identify_local(&plan, &recs, &given).unwrap();
+    let w = &m.diagnostics.warnings;
+    assert!(w.iter().any(|w| w.contains("taken for glitches")), "{w:?}");
+}
+
 /// A torque logged in steps coarser than its noise (0.05 N m against 0.002 N m): the rounding,
 /// much the same from pass to pass, hid from the regression's residuals, and D* entries erred
 /// by up to 700 of their standard errors. Detected, the step sets a floor under the standard

@@ -3,7 +3,7 @@
 
 use nalgebra::DMatrix;
 
-use super::clock::{align, check_sample_interval};
+use super::clock::{align, check_sample_interval, lagged_half};
 use super::crossing::{
     samples_needed, values_in_windows, CrossingValues, FitOptions, SignalScales, TorqueFit,
 };
@@ -183,6 +183,10 @@ pub fn experiment_values(
     };
     // the narrowest torque window that still holds enough samples at the recording's rate
     let dt = (rec.t[rec.len() - 1] - rec.t[0]) / (rec.len() - 1) as f64;
+    let half = match options.fit.window {
+        None => lagged_half(half, offset, dt),
+        Some(_) => half,
+    };
     let min_half = 0.5 * samples_needed(&options.fit) as f64 * dt;
     let name = experiment.kind.name();
     let mut reversals = vec![];
