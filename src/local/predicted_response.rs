@@ -24,7 +24,9 @@ use rand_distr::{Distribution, StandardNormal};
 use super::crossing::FitOptions;
 use super::operating_point::OperatingPoint;
 use super::plan::{Crossing, Experiment, ExperimentKind};
-use super::response::{design_basis, half_differences, resolved, test, Response, Sums};
+use super::response::{
+    design_basis, half_differences, resolved, shown_factor, test, Response, Sums,
+};
 use super::reversals::reading_gains;
 use crate::data::Data;
 use crate::error::{shown, Result};
@@ -421,17 +423,6 @@ pub fn warning(
         three_digits(largest_reading),
         100.0 * prediction.detected
     ))
-}
-
-/// A factor: whole below 100 (one decimal below 10), with an exponent above.
-fn shown_factor(f: f64) -> String {
-    if f < 10.0 {
-        format!("{f:.1}")
-    } else if f < 100.0 {
-        format!("{f:.0}")
-    } else {
-        format!("{f:.1e}")
-    }
 }
 
 /// A computed value to three significant digits (exponent form outside 1e-3 to 1e4).

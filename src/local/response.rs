@@ -283,9 +283,12 @@ pub(super) fn experiment_warning(
     )
 }
 
-/// A factor: whole below 100, with an exponent above.
-fn shown_factor(f: f64) -> String {
-    if f < 100.0 {
+/// A factor: one decimal below 10, whole below 100, with an exponent above (the planner's
+/// prediction shows its factors so too).
+pub(crate) fn shown_factor(f: f64) -> String {
+    if f < 10.0 {
+        format!("{f:.1}")
+    } else if f < 100.0 {
         format!("{f:.0}")
     } else {
         format!("{f:.1e}")
