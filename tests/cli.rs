@@ -1093,20 +1093,35 @@ fn plan_warns_and_identify_friction_aware_h() {
         err.contains("quiet.json reports no torque noise in its nominal passes"),
         "{err}"
     );
-    // several are pooled, the root mean square per joint: with the noise-free one, 1/sqrt(2)
+    // several are pooled, the root mean square per joint (one twice: itself); a noise-free
+    // one among noisy ones would pull the pool down unseen: refused, both files named
     let err = plan(
         "pooled",
         &[
             &from_model[..],
-            &["--noise-from", s(&quiet), "--dqdd-fraction", "1e-6"],
+            &["--noise-from", s(&model), "--dqdd-fraction", "1e-6"],
         ]
         .concat(),
     );
     let pooled = noise_up_to(&err);
     assert!(
-        (pooled * 2f64.sqrt() / up_to - 1.0).abs() < 1e-6,
+        (pooled / up_to - 1.0).abs() < 1e-6,
         "{pooled} {up_to}: {err}"
     );
+    let quiet_out = d.join("pooled_quiet");
+    fails(
+        &[
+            &["plan", "a465", "--op", s(&op), "--out", s(&quiet_out)][..],
+            &from_model[..],
+            &["--noise-from", s(&quiet)],
+        ]
+        .concat(),
+        &[
+            "quiet.json (--noise-from) read no torque noise in the nominal passes at joint 'joint1' (data without noise: a simulation?) and ",
+            "white.json (--noise-from) read ",
+        ],
+    );
+    assert!(!quiet_out.exists());
     // of other joints, or given with the noise itself: refused
     fails(
         &[

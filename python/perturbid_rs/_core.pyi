@@ -372,7 +372,8 @@ class LocalModel:
         models: Sequence["LocalModel"],
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """nominal_noise() of several identifications of one robot's joints, pooled: the
-        root mean square per joint, (n,) each (N m)."""
+        root mean square per joint, (n,) each (N m). InputError when a joint is noise-free in
+        one model and noisy in another."""
     def to_json(self) -> str: ...
     @staticmethod
     def from_json(text: str) -> "LocalModel": ...

@@ -130,7 +130,8 @@ fn load_op(path: &Path) -> Result<OperatingPoint> {
 
 /// The nominal passes' noise the saved local models of `model` at `paths` report, pooled, as
 /// the planner's `torque_noise` and `torque_pass_noise` ([`LocalModel::pooled_nominal_noise`]);
-/// refused, naming the file, for a model of other joints or without it.
+/// refused, naming the file, for a model of other joints or without it, or a joint noise-free
+/// in one file and noisy in another.
 fn noise_from(paths: &[PathBuf], model: &crate::model::Model) -> Result<(Vec<f64>, Vec<f64>)> {
     let mut models = Vec::with_capacity(paths.len());
     for path in paths {
@@ -151,7 +152,9 @@ fn noise_from(paths: &[PathBuf], model: &crate::model::Model) -> Result<(Vec<f64
         local.nominal_noise().map_err(|e| refuse(e.to_string()))?;
         models.push(local);
     }
-    LocalModel::pooled_nominal_noise(&models.iter().collect::<Vec<_>>())
+    LocalModel::pool_nominal_noise(&models.iter().collect::<Vec<_>>(), |i| {
+        format!("{} (--noise-from)", paths[i].display())
+    })
 }
 
 fn size(abs: Option<f64>, fraction: f64, n: usize) -> Size {

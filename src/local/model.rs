@@ -171,8 +171,19 @@ impl LocalModel {
     /// identification's nominal noise has `K - 1` degrees of freedom a joint (11 by default),
     /// so a plan predicted from it alone is optimistic where a joint's noise came out low; a
     /// few pooled give the planner a steadier number. Refused without models, with models of
-    /// other joints (naming the first that differs, by index) or without nominal entries.
+    /// other joints (naming the first that differs, by index), without nominal entries, or
+    /// when a joint is noise-free in one model and noisy in another (a simulation without
+    /// noise among a robot's identifications: its zeros would pull the pool down unseen).
     pub fn pooled_nominal_noise(models: &[&LocalModel]) -> Result<(Vec<f64>, Vec<f64>)> {
+        Self::pool_nominal_noise(models, |i| format!("models[{i}]"))
+    }
+
+    /// [`Self::pooled_nominal_noise`] with `name(i)` naming model `i` in its errors (a file
+    /// on the command line).
+    pub(crate) fn pool_nominal_noise(
+        models: &[&LocalModel],
+        name: impl Fn(usize) -> String,
+    ) -> Result<(Vec<f64>, Vec<f64>)> {
         let Some(first) = models.first() else {
             return Err(Error::InvalidArgument {
                 argument: "models".into(),
@@ -182,26 +193,46 @@ impl LocalModel {
         };
         let n = first.joint_names.len();
         let (mut samples, mut passes) = (vec![0.0; n], vec![0.0; n]);
+        // per joint the first model read without noise and the first read with it
+        let (mut quiet, mut noisy) = (vec![None; n], vec![None; n]);
         for (i, m) in models.iter().enumerate() {
             if m.joint_names != first.joint_names {
                 return Err(Error::InvalidArgument {
-                    argument: format!("models[{i}]"),
+                    argument: name(i),
                     message: format!(
-                        "a local model of joints [{}] of '{}'; models[0] is of [{}] of '{}': pool identifications of one robot's joints",
+                        "a local model of joints [{}] of '{}'; {} is of [{}] of '{}': pool identifications of one robot's joints",
                         m.joint_names.join(", "),
                         m.robot,
+                        name(0),
                         first.joint_names.join(", "),
                         first.robot
                     ),
                 });
             }
             let (s, p) = m.nominal_noise().map_err(|e| Error::InvalidArgument {
-                argument: format!("models[{i}]"),
+                argument: name(i),
                 message: e.to_string(),
             })?;
             for j in 0..n {
                 samples[j] += s[j] * s[j];
                 passes[j] += p[j] * p[j];
+                let seen = if s[j] == 0.0 {
+                    &mut quiet[j]
+                } else {
+                    &mut noisy[j]
+                };
+                seen.get_or_insert((i, s[j]));
+                if let (Some((q, _)), Some((k, level))) = (quiet[j], noisy[j]) {
+                    return Err(Error::InvalidArgument {
+                        argument: name(q.max(k)),
+                        message: format!(
+                            "{} read no torque noise in the nominal passes at joint '{}' (data without noise: a simulation?) and {} read {level:.3e}; pool identifications of one robot's recordings",
+                            name(q),
+                            first.joint_names[j],
+                            name(k)
+                        ),
+                    });
+                }
             }
         }
         let rms = |v: Vec<f64>| -> Vec<f64> {

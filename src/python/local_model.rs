@@ -341,7 +341,8 @@ impl PyLocalModel {
     /// weighted alike; two (n,) arrays (N m). One identification's nominal noise has K - 1
     /// degrees of freedom a joint, so a plan predicted from one alone is optimistic where a
     /// joint's noise came out low. Raises InputError without models, for models of other
-    /// joints (`models[i]` named) or without nominal entries.
+    /// joints (`models[i]` named), without nominal entries, or when a joint is noise-free in
+    /// one model and noisy in another (a simulation without noise among recorded runs).
     #[staticmethod]
     fn pooled_nominal_noise<'py>(
         py: Python<'py>,

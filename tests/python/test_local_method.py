@@ -428,6 +428,10 @@ def test_the_torque_noise_is_reported_per_experiment_and_joint():
     assert np.all(pooled[0] > 1.4 * samples)  # the other's samples are twice as noisy
     with pytest.raises(pr.InputError, match="no local model"):
         pr.LocalModel.pooled_nominal_noise([])
+    # a noise-free simulation among them would pull the pool down unseen: refused
+    quiet = pr.identify_local(plan, pr.simulate(robot, plan, friction=None))
+    with pytest.raises(pr.InputError, match=r"models\[1\] read no torque noise .* at joint 'joint1' \(data without noise: a simulation\?\) and models\[0\] read"):
+        pr.LocalModel.pooled_nominal_noise([model, quiet, other])
     # what varies from pass to pass in H beyond the samples' noise: the velocity-squared terms
     # the +- pairs cancel from H* (several mN m at this point), far above D's
     passes = {(e["experiment"], e["joint"]): e["passes"] for e in noise}
