@@ -1,6 +1,7 @@
 """Type stubs of the extension module perturbid_rs._core (implemented in Rust)."""
 
 from os import PathLike
+from pathlib import Path
 from typing import Any, Literal, overload, Mapping, Optional, Sequence, Union, final
 
 import numpy as np
@@ -261,6 +262,12 @@ class Plan:
     def to_json(self) -> str: ...
     @staticmethod
     def from_json(text: str) -> "Plan": ...
+    def save(self, folder: Union[str, PathLike[str]]) -> list[Path]:
+        """Writes <experiment>.csv (t, q, qd, qdd for the controller) and plan.json into
+        ``folder``, all or none, as ``perturbid plan``; returns the paths written."""
+    @staticmethod
+    def load(path: Union[str, PathLike[str]]) -> "Plan":
+        """Reads and checks a plan.json."""
 
 @final
 class Recording:
@@ -275,6 +282,16 @@ class Recording:
         name: str = "recording",
         experiment: Optional[str] = None,
     ) -> "Recording": ...
+    @staticmethod
+    def load(
+        path: Union[str, PathLike[str]],
+        joints: Sequence[str],
+        experiment: Optional[str] = None,
+    ) -> "Recording":
+        """Reads a recording CSV (t, q1..qN, [qd, qdd,] tau1..tauN, or q_<joint>, ...) of
+        the robot's ``joints``, as the command line does; named by its path."""
+    def save(self, path: Union[str, PathLike[str]]) -> None:
+        """Writes the recording as CSV (atomically), read back exactly by ``load``."""
     @property
     def experiment(self) -> Optional[str]:
         """The experiment of a plan this is a run of (nominal, G_static, G, H, D), or None."""

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::files::{load_robot, load_table, refuse_overwriting_inputs, PreprocessArgs, RobotArg};
+use super::files::{load_robot, refuse_overwriting_inputs, PreprocessArgs, RobotArg};
 use super::out_dir;
 use super::progress::Progress;
 use crate::direct::{
@@ -321,7 +321,7 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
     refuse_overwriting_inputs(&a.out, &[&a.model, &a.data])?;
     let file = ModelFile::load(&a.model)?;
     let joints = file.joint_names().to_vec();
-    let rows = read_states(&load_table(&a.data)?, &joints)?;
+    let rows = read_states(&crate::io::Table::read(&a.data)?, &joints)?;
     let states = States::new(joints.len(), &rows.q, Some(&rows.qd), Some(&rows.qdd))?;
     let tau = match &file {
         ModelFile::Base(fit) => {

@@ -3,7 +3,6 @@
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::io::{read_text, Table};
 use crate::model::Model;
 use crate::{robots, urdf};
 
@@ -65,11 +64,6 @@ pub(crate) fn load_robot(robot: &str, lock: &[(String, f64)]) -> Result<Model> {
         eprintln!("perturbid: warning: {w}");
     }
     Ok(model)
-}
-
-/// A CSV table from a file.
-pub(crate) fn load_table(path: &Path) -> Result<Table> {
-    Table::parse(&path.display().to_string(), &read_text(path)?)
 }
 
 /// A JSON document from a file, parsed by `parse`; errors are prefixed with the path.
@@ -137,7 +131,7 @@ impl PreprocessArgs {
     ) -> Result<crate::recording::Recording> {
         use std::fmt::Write;
         progress.update(&format!("reading {}", path.display()));
-        let rec = crate::io::read_recording(&load_table(path)?, joints)?;
+        let rec = crate::io::load_recording(path, joints)?;
         if rec.qdd.is_some() && !self.preprocess {
             return Ok(rec);
         }

@@ -6,12 +6,12 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use serde::Deserialize;
 
-use super::files::{load_json, load_table, RobotArg};
+use super::files::{load_json, RobotArg};
 use super::out_dir;
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
-use crate::io::{read_recording, recording_table, samples_table, write_atomic, OutputSet};
+use crate::io::{load_recording, plan_files, recording_files, save_recording};
 use crate::local::{
     identify_local, plan_experiments, CrossingTimes, Design, Estimator, ExperimentKind,
     IdentifyOptions, LocalModel, OperatingPoint, Plan, PlanOptions, Size,
@@ -210,15 +210,10 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
     for w in &plan.warnings {
         eprintln!("perturbid: warning: {w}");
     }
-    let dir = out_dir(&a.out);
-    let mut set = OutputSet::new(&dir, "plan");
+    let set = plan_files(&plan, &out_dir(&a.out))?;
     let mut out = String::new();
     for e in &plan.experiments {
         let name = format!("{}.csv", e.kind.name());
-        set.add(
-            &name,
-            samples_table(&e.trajectory.sample(plan.rate), "").to_csv(),
-        )?;
         let cond = e
             .design_cond()
             .map_or(String::new(), |c| format!(", cond(X) {c:>6.2}"));
@@ -231,7 +226,6 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
             set.path_of(&name).display()
         );
     }
-    set.add("plan.json", plan.to_json())?;
     let _ = writeln!(out, "plan -> {}", set.path_of("plan.json").display());
     set.commit()?;
     Ok(out)
@@ -391,7 +385,7 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<String> {
             };
             let path = a.out.clone().unwrap_or_else(|| PathBuf::from("log.csv"));
             super::files::refuse_overwriting_inputs(&path, &[a.input.as_path()])?;
-            write_atomic(&path, recording_table(&rec, "").to_csv().as_bytes())?;
+            save_recording(&rec, &path)?;
             return Ok(format!(
                 "excitation: {} samples, {:.2} s -> {}\n",
                 rec.len(),
@@ -404,12 +398,10 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<String> {
         Some(t) => rehearse_plan(&model, t, &plan)?,
         None => simulate_plan(&model, &plan, &o)?,
     };
-    let dir = out_dir(&a.out);
-    let mut set = OutputSet::new(&dir, "recordings");
+    let set = recording_files(&plan, &recs, &out_dir(&a.out))?;
     let mut out = String::new();
     for (e, r) in plan.experiments.iter().zip(&recs) {
         let name = format!("{}.csv", e.kind.name());
-        set.add(&name, recording_table(r, "").to_csv())?;
         let _ = writeln!(
             out,
             "{:<9} {:>7} samples -> {}",
@@ -495,7 +487,7 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
     }
     let recs: Vec<Recording> = files
         .iter()
-        .map(|f| read_recording(&load_table(f)?, &plan.joint_names))
+        .map(|f| load_recording(f, &plan.joint_names))
         .collect::<Result<_>>()?;
     let options = IdentifyOptions {
         times: if a.planned_times {

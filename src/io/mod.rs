@@ -6,10 +6,15 @@
 pub mod atomic;
 pub mod config;
 pub mod output_set;
+pub mod plan_files;
 pub mod recording;
 pub mod table;
 
 pub use atomic::{read_document, read_text, write_atomic};
 pub use output_set::{check_not_partial, OutputSet};
-pub use recording::{read_recording, read_states, recording_table, samples_table, States};
+pub use plan_files::{plan_files, recording_files};
+pub use recording::{
+    load_recording, read_recording, read_states, recording_table, samples_table, save_recording,
+    States,
+};
 pub use table::{csv_text, Table};

@@ -24,6 +24,22 @@ struct Columns<'a> {
 
 impl<'a> Columns<'a> {
     fn new(table: &'a Table, joints: &'a [String]) -> Result<(Self, Vec<f64>)> {
+        if joints.is_empty() {
+            return Err(Error::InvalidArgument {
+                argument: "joints".into(),
+                message: format!("no joint names to read {} with", table.source),
+            });
+        }
+        if let Some(j) = (1..joints.len()).find(|&j| joints[..j].contains(&joints[j])) {
+            return Err(Error::InvalidArgument {
+                argument: "joints".into(),
+                message: format!(
+                    "joint '{}' named twice ([{}]); expected the robot's joint names",
+                    joints[j],
+                    joints.join(", ")
+                ),
+            });
+        }
         let t_col = table.index("t").ok_or_else(|| {
             bad(
                 table,
@@ -126,6 +142,20 @@ pub fn read_recording(table: &Table, joints: &[String]) -> Result<Recording> {
     let tau = c.get("tau", true)?.expect("required");
     c.finish()?;
     Recording::new(table.source.clone(), joints.len(), t, q, tau, qd, qdd)
+}
+
+/// Reads the recording in the CSV file at `path` ([`read_recording`]; at most
+/// [`MAX_TEXT_BYTES`](crate::limits::MAX_TEXT_BYTES)); named by its path, so a file named
+/// after an experiment (`D.csv`) pairs with it in `identify_local`.
+pub fn load_recording(path: &std::path::Path, joints: &[String]) -> Result<Recording> {
+    read_recording(&Table::read(path)?, joints)
+}
+
+/// Writes `rec` to the CSV file at `path` ([`recording_table`]), atomically: a file that
+/// [`load_recording`] reads back to the same numbers (what a preprocessed recording knows of
+/// its log's glitches and dropouts is not kept).
+pub fn save_recording(rec: &Recording, path: &std::path::Path) -> Result<()> {
+    super::write_atomic(path, recording_table(rec, "").to_csv().as_bytes())
 }
 
 /// States to evaluate a model at: `t`, `q`, `qd`, `qdd` required (row-major), `tau` optional

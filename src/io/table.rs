@@ -32,6 +32,13 @@ impl Table {
         }
     }
 
+    /// The table in the CSV file at `path` (at most
+    /// [`MAX_TEXT_BYTES`](crate::limits::MAX_TEXT_BYTES); see [`Self::parse`]); errors name
+    /// the path.
+    pub fn read(path: &std::path::Path) -> Result<Self> {
+        Self::parse(&path.display().to_string(), &super::read_text(path)?)
+    }
+
     /// Parses CSV text (RFC 4180 through the `csv` crate: quoted fields such as `"q1"` or
     /// `"a,b"` as other tools write them; a UTF-8 byte-order mark, blank lines and lines
     /// starting with `#` skipped). Every row must have one number per header column; a

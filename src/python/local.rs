@@ -3,6 +3,7 @@
 //! `suggest_operating_points` (mirrors `crate::local`; the `LocalModel` they return and take is
 //! in `local_model.rs`).
 
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use pyo3::prelude::*;
@@ -141,6 +142,26 @@ impl PyPlan {
     fn from_json(text: &str) -> PyResult<Self> {
         Ok(Self {
             plan: Arc::new(<Plan as Document>::from_json(text)?),
+        })
+    }
+    /// Writes the plan into `folder` as `perturbid plan` does, for the robot's controller:
+    /// one `<experiment>.csv` per experiment (`t` in s, `q1..qN` in rad or m, `qd1..qN`,
+    /// `qdd1..qN`, at the plan's rate) and `plan.json`, all or none (an interrupted write
+    /// leaves the previous set whole); returns the paths written, in that order. Raises
+    /// FileError when the folder cannot be written, InputError when it holds another output
+    /// set's files of the same names (recordings: choose another folder).
+    fn save(&self, py: Python<'_>, folder: PathBuf) -> PyResult<Vec<PathBuf>> {
+        let plan = self.plan.clone();
+        Ok(detached(py, "Plan.save", || {
+            crate::io::plan_files(&plan, &folder)?.commit()
+        })?)
+    }
+    /// Reads a plan from `path` (the plan.json of `Plan.save` or `perturbid plan`), checked
+    /// as `from_json` checks it; errors name the file.
+    #[staticmethod]
+    fn load(path: PathBuf) -> PyResult<Self> {
+        Ok(Self {
+            plan: Arc::new(Plan::load(&path)?),
         })
     }
     fn __repr__(&self) -> String {

@@ -1,5 +1,6 @@
 //! `Recording` in Python: what a robot logs (mirrors `crate::recording`).
 
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use numpy::PyUntypedArrayMethods;
@@ -123,6 +124,41 @@ impl PyRecording {
         let mut rec = Self::build(t, q, tau, qd, qdd, name)?;
         rec.experiment = experiment;
         Ok(Self { rec: Arc::new(rec) })
+    }
+    /// Reads a recording from the CSV file at `path`, as the command line does: a header
+    /// `t, q1..qN, [qd1..qN, qdd1..qN,] tau1..tauN`, or the same named after the joints
+    /// (`q_<joint>`, ...); `joints` are the robot's joint names in order (e.g.
+    /// `robot.joint_names` or `plan.joint_names`), N of them. t in s, positions in rad or m,
+    /// torques in N m or N. Named by its path, so `D.csv` pairs with experiment D in
+    /// `identify_local`; `experiment` marks it explicitly. Raises FileError for a file that
+    /// cannot be read (or larger than 2 GiB), InputError naming the file, line and column of
+    /// a bad value, a missing or unexpected column, or time that does not increase.
+    #[staticmethod]
+    #[pyo3(signature = (path, joints, experiment=None))]
+    fn load(
+        py: Python<'_>,
+        path: PathBuf,
+        joints: Vec<String>,
+        experiment: Option<String>,
+    ) -> PyResult<Self> {
+        let mut rec = super::detached(py, "Recording.load", || {
+            crate::io::load_recording(&path, &joints)
+        })?;
+        if experiment.is_some() {
+            rec.experiment = experiment;
+        }
+        Ok(Self { rec: Arc::new(rec) })
+    }
+    /// Writes the recording to the CSV file at `path` (atomically: a temporary file renamed
+    /// into place) with the header `t, q1..qN, [qd1..qN, qdd1..qN,] tau1..tauN`; numbers
+    /// written to read back exactly with `Recording.load`. What a preprocessed recording knows
+    /// of its log (glitches, dropouts, position rounding) and its `experiment` are not kept:
+    /// name the file after the experiment (`D.csv`).
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let rec = self.rec.clone();
+        Ok(super::detached(py, "Recording.save", || {
+            crate::io::save_recording(&rec, &path)
+        })?)
     }
     #[getter]
     fn name(&self) -> String {

@@ -1,0 +1,100 @@
+"""Plans and recordings through files, as between Python and a robot's controller: Plan.save /
+Plan.load and Recording.save / Recording.load give what the objects in memory give."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import perturbid_rs as pr
+
+TABLE2 = (
+    [0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0],
+    [0.0890, -0.1060, 0.0220, 0.0560, 0.0110, 0.0140],
+    [-0.1550, -0.5000, 0.0340, -0.2910, -0.0080, 0.1710],
+)
+
+
+def test_a_plan_and_its_recordings_through_files_identify_as_in_memory(tmp_path):
+    robot = pr.robots.a465()
+    plan = pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2), seed=1, keep_velocity_sign=True)
+    written = plan.save(tmp_path / "plan")
+    kinds = [e.kind for e in plan.experiments]
+    assert [p.name for p in written] == [f"{k}.csv" for k in kinds] + ["plan.json"]
+    # the files the command line writes for the same plan, byte for byte
+    (tmp_path / "op.json").write_text('{"q": %s, "qd": %s, "qdd": %s}' % TABLE2)
+    cli = subprocess.run(
+        [sys.executable, "-m", "perturbid_rs", "plan", "a465", "--op", str(tmp_path / "op.json"), "--seed", "1", "--keep-velocity-sign", "--out", str(tmp_path / "cli")],
+        capture_output=True,
+        text=True,
+    )
+    assert cli.returncode == 0, cli.stderr
+    for p in written:
+        assert (tmp_path / "cli" / p.name).read_bytes() == p.read_bytes(), p.name
+    loaded = pr.Plan.load(tmp_path / "plan" / "plan.json")
+    assert loaded.to_json() == plan.to_json()
+    # the controller's trajectory of D is the experiment's samples
+    d = np.loadtxt(tmp_path / "plan" / "D.csv", delimiter=",", skiprows=1)
+    experiment = plan.experiment("D")
+    np.testing.assert_array_equal(d[:, 0], experiment.t)
+    np.testing.assert_array_equal(d[:, 1:7], experiment.q)
+
+    recordings = pr.simulate(robot, loaded, torque_noise=0.05, seed=2)
+    for rec in recordings:
+        rec.save(tmp_path / f"{rec.experiment}.csv")
+    # read back by path: each pairs with its experiment by its file name
+    read = [pr.Recording.load(tmp_path / f"{k}.csv", plan.joint_names) for k in reversed(kinds)]
+    for rec in recordings:
+        back = next(r for r in read if r.name.endswith(f"/{rec.experiment}.csv"))
+        for field in ("t", "q", "tau"):
+            np.testing.assert_array_equal(getattr(back, field), getattr(rec, field))
+    a, b = pr.identify_local(plan, recordings), pr.identify_local(loaded, read)
+    for term in ("torque", "D", "H", "G", "G_static"):
+        np.testing.assert_array_equal(getattr(b, term), getattr(a, term))
+    # experiment= marks a file of any name
+    other = pr.Recording.load(tmp_path / "D.csv", plan.joint_names, experiment="D")
+    assert other.experiment == "D"
+
+
+def test_recording_files_from_other_tools_and_their_errors(tmp_path):
+    joints = ["shoulder", "elbow"]
+    # named after the joints, in any order, with velocities, quoted header, a BOM
+    path = tmp_path / "log.csv"
+    path.write_text('\ufeff"t",tau_elbow,q_shoulder,q_elbow,qd_shoulder,qd_elbow,tau_shoulder\n0,1,2,3,4,5,6\n0.001,1.5,2.5,3.5,4.5,5.5,6.5\n')
+    rec = pr.Recording.load(path, joints)
+    np.testing.assert_array_equal(rec.q, [[2, 3], [2.5, 3.5]])
+    np.testing.assert_array_equal(rec.qd, [[4, 5], [4.5, 5.5]])
+    np.testing.assert_array_equal(rec.tau, [[6, 1], [6.5, 1.5]])
+    assert rec.qdd is None and rec.name == str(path)
+    # numbers are written in the shortest digits that read back to the same double
+    rng = np.random.default_rng(3)
+    exact = pr.Recording(np.arange(5) * 0.1, rng.normal(size=(5, 2)) * 1e-7, rng.normal(size=(5, 2)) * 1e5)
+    exact.save(tmp_path / "exact.csv")
+    back = pr.Recording.load(tmp_path / "exact.csv", joints)
+    np.testing.assert_array_equal(back.q, exact.q)
+    np.testing.assert_array_equal(back.tau, exact.tau)
+
+    bad = tmp_path / "bad.csv"
+    bad.write_text("t,q1,q2,tau1,tau2\n0,1,2,3,4\n0.1,1,x,3,4\n")
+    with pytest.raises(pr.InputError, match=r"bad.csv.*line 3.*q2"):
+        pr.Recording.load(bad, joints)
+    with pytest.raises(pr.InputError, match=r"missing column\(s\) q3 \(or q_wrist\)"):
+        pr.Recording.load(tmp_path / "exact.csv", joints + ["wrist"])
+    with pytest.raises(pr.InputError, match="unexpected column 'q2'"):
+        pr.Recording.load(tmp_path / "exact.csv", ["shoulder"])
+    with pytest.raises(pr.InputError, match="joint 'elbow' named twice"):
+        pr.Recording.load(tmp_path / "exact.csv", ["elbow", "elbow"])
+    with pytest.raises(pr.InputError, match="no joint names"):
+        pr.Recording.load(tmp_path / "exact.csv", [])
+    with pytest.raises(TypeError):
+        pr.Recording.load(tmp_path / "exact.csv", "elbow")  # a string is not a list of names
+    with pytest.raises(pr.FileError, match="nothing.csv"):
+        pr.Recording.load(tmp_path / "nothing.csv", joints)
+    # a path that is a folder is named, and nothing is left beside it
+    (tmp_path / "folder.csv").mkdir()
+    with pytest.raises(pr.FileError, match="folder.csv"):
+        exact.save(tmp_path / "folder.csv")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.csv", "exact.csv", "folder.csv", "log.csv"]
