@@ -292,6 +292,17 @@ class Recording:
         the robot's ``joints``, as the command line does; named by its path."""
     def save(self, path: Union[str, PathLike[str]]) -> None:
         """Writes the recording as CSV (atomically), read back exactly by ``load``."""
+    @staticmethod
+    def from_dataframe(
+        frame: Any,
+        joints: Sequence[str],
+        name: str = "dataframe",
+        experiment: Optional[str] = None,
+    ) -> "Recording":
+        """A pandas DataFrame read by the CSV files' rules; ``t`` in s, datetimes or
+        timedeltas, as a column or the index named ``t``."""
+    def to_dataframe(self) -> Any:
+        """The recording as a DataFrame with its CSV file's columns (t, q1.., tau1..)."""
     @property
     def experiment(self) -> Optional[str]:
         """The experiment of a plan this is a run of (nominal, G_static, G, H, D), or None."""

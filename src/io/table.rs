@@ -98,13 +98,8 @@ impl Table {
         let (header_line, header) = first.map_err(csv_error)?;
         let columns: Vec<String> = header.iter().map(str::to_string).collect();
         let mut t = Table::new(source, columns);
-        // one pass with a set: a header of a million columns is read in linear time
-        let mut seen = std::collections::HashSet::with_capacity(t.columns.len());
-        if let Some(dup) = t.columns.iter().find(|c| !seen.insert(c.as_str())) {
-            return Err(t.error(format!("line {header_line}: column '{dup}' appears twice")));
-        }
-        if let Some(c) = t.columns.iter().position(String::is_empty) {
-            return Err(t.error(format!("line {header_line}: column {} has no name", c + 1)));
+        if let Some(problem) = t.header_problem() {
+            return Err(t.error(format!("line {header_line}: {problem}")));
         }
         // a table written with another separator reads as one column
         if let [only] = t.columns.as_slice() {
@@ -147,6 +142,55 @@ impl Table {
         }
         if t.rows() == 0 {
             return Err(t.error("no data rows after the header".into()));
+        }
+        Ok(t)
+    }
+
+    /// A column named twice or not at all, if any. One pass with a set: a header of a million
+    /// columns is checked in linear time.
+    fn header_problem(&self) -> Option<String> {
+        let mut seen = std::collections::HashSet::with_capacity(self.columns.len());
+        if let Some(dup) = self.columns.iter().find(|c| !seen.insert(c.as_str())) {
+            return Some(format!("column '{dup}' appears twice"));
+        }
+        let c = self.columns.iter().position(String::is_empty)?;
+        Some(format!("column {} has no name", c + 1))
+    }
+
+    /// A table from named columns of equal length (another tool's table, such as a pandas
+    /// DataFrame), checked as [`Self::parse`] checks a file: names present and distinct, at
+    /// least one row, every value finite (an error names its row, 1-based, and column).
+    pub fn from_columns(
+        source: impl Into<String>,
+        columns: Vec<(String, Vec<f64>)>,
+    ) -> Result<Self> {
+        let rows = columns.first().map_or(0, |c| c.1.len());
+        let mut t = Table::new(source, columns.iter().map(|c| c.0.clone()).collect());
+        if let Some(problem) = t.header_problem() {
+            return Err(t.error(problem));
+        }
+        if let Some((name, v)) = columns.iter().find(|c| c.1.len() != rows) {
+            return Err(t.error(format!(
+                "column '{name}' has {} rows, column '{}' {rows}",
+                v.len(),
+                t.columns[0]
+            )));
+        }
+        if rows == 0 {
+            return Err(t.error("no data rows".into()));
+        }
+        t.values.reserve(rows * columns.len());
+        for r in 0..rows {
+            for (name, v) in &columns {
+                if !v[r].is_finite() {
+                    return Err(t.error(format!(
+                        "row {}, column '{name}': {} is not a finite number",
+                        r + 1,
+                        v[r]
+                    )));
+                }
+                t.values.push(v[r]);
+            }
         }
         Ok(t)
     }

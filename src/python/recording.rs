@@ -160,6 +160,43 @@ impl PyRecording {
             crate::io::save_recording(&rec, &path)
         })?)
     }
+    /// Reads a recording from a pandas DataFrame by the rules of the command line's CSV files
+    /// (`Recording.load`): columns `t, q1..qN, [qd1..qN, qdd1..qN,] tau1..tauN` or named after
+    /// `joints` (`q_<joint>`, ...), in any order, nothing else. `t` in s, or datetimes or
+    /// timedeltas (seconds from the first row, to the nanosecond), as a column or as the index
+    /// named `t`. Numbers of any numeric dtype, pandas' nullable ones too (a missing value is
+    /// refused with its row). Raises InputError naming the column of a bool, text, category or
+    /// time column, a missing, repeated or unexpected column, a non-finite value (row and
+    /// column), time that does not increase; TypeError for what is not a DataFrame. Parquet
+    /// logs read through `pandas.read_parquet` (pyarrow).
+    #[staticmethod]
+    #[pyo3(signature = (frame, joints, name="dataframe", experiment=None))]
+    fn from_dataframe(
+        py: Python<'_>,
+        frame: &Bound<'_, PyAny>,
+        joints: Vec<String>,
+        name: &str,
+        experiment: Option<String>,
+    ) -> PyResult<Self> {
+        let columns = super::tables::frame_columns(frame, name)?;
+        let mut rec = super::detached(py, "Recording.from_dataframe", || {
+            crate::io::read_recording(&crate::io::Table::from_columns(name, columns)?, &joints)
+        })?;
+        rec.experiment = experiment;
+        Ok(Self { rec: Arc::new(rec) })
+    }
+    /// The recording as a pandas DataFrame with the columns of its CSV file: `t` (s), `q1..qN`,
+    /// `qd1..qN` and `qdd1..qN` when present, `tau1..tauN`; `from_dataframe` reads it back.
+    fn to_dataframe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let table = crate::io::recording_table(&self.rec, &self.rec.name);
+        let columns = (0..table.columns.len())
+            .map(|c| {
+                let values = numpy::PyArray1::from_vec(py, table.column(c)).into_any();
+                (table.columns[c].as_str(), values)
+            })
+            .collect();
+        super::tables::dataframe(py, columns, None)
+    }
     #[getter]
     fn name(&self) -> String {
         self.rec.name.clone()

@@ -1,8 +1,118 @@
-//! Python: results as tables, `to_dataframe()` on models, fits and validations (pandas, an
-//! optional dependency: `pip install perturbid_rs[tables]`).
+//! Python: tables in and out through pandas (an optional dependency: `pip install
+//! perturbid_rs[tables]`): `to_dataframe()` on recordings, models, fits and validations, and
+//! the columns of a DataFrame read as a recording (`Recording.from_dataframe`).
 
+use numpy::{PyReadonlyArray1, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+
+use crate::error::Error;
+
+/// The columns of the pandas DataFrame `frame` as named `f64` columns for
+/// [`crate::io::Table::from_columns`], `source` naming it in errors: numbers (floats, integers,
+/// pandas' nullable types, whose missing values become NaN and are refused there); the time
+/// column `t` may hold datetimes or timedeltas, read as seconds from its first row, and may be
+/// the index when named `t` and no column is. A column named by anything but a string, or
+/// holding booleans, text, categories or times (other than `t`), is refused by name; so is a
+/// frame of more than [`crate::limits::MAX_VALUES`] values. TypeError for what is not a frame.
+pub(crate) fn frame_columns(
+    frame: &Bound<'_, PyAny>,
+    source: &str,
+) -> PyResult<Vec<(String, Vec<f64>)>> {
+    let py = frame.py();
+    let bad = |message: String| -> PyErr {
+        Error::Recording {
+            recording: source.into(),
+            message,
+        }
+        .into()
+    };
+    if !(frame.hasattr("columns")? && frame.hasattr("iloc")? && frame.hasattr("index")?) {
+        return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "expected a pandas DataFrame, got {}",
+            frame.get_type().name()?
+        )));
+    }
+    let names: Vec<Bound<'_, PyAny>> = frame
+        .getattr("columns")?
+        .try_iter()?
+        .collect::<PyResult<_>>()?;
+    let rows = frame.len()?;
+    if rows as f64 * (names.len() + 1) as f64 > crate::limits::MAX_VALUES {
+        return Err(bad(format!(
+            "{rows} rows of {} columns: more than {} values (docs/limits.md)",
+            names.len(),
+            crate::limits::MAX_VALUES
+        )));
+    }
+    if rows == 0 {
+        return Err(bad("no data rows".into()));
+    }
+    let iloc = frame.getattr("iloc")?;
+    let mut columns: Vec<(String, Bound<'_, PyAny>)> = Vec::with_capacity(names.len() + 1);
+    for (c, n) in names.iter().enumerate() {
+        let name: String = n.extract().map_err(|_| {
+            let shown = n.repr().map_or("?".into(), |r| r.to_string());
+            let kind = n.get_type().name().map_or("?".into(), |k| k.to_string());
+            bad(format!(
+                "column {} is named {shown} ({kind}): expected a name such as 't', 'q1' or 'tau_<joint>'",
+                c + 1
+            ))
+        })?;
+        let series = iloc.get_item((pyo3::types::PySlice::full(py), c))?;
+        columns.push((name, series));
+    }
+    if !columns.iter().any(|(n, _)| n == "t") {
+        let index = frame.getattr("index")?;
+        if index
+            .getattr("name")?
+            .extract::<Option<String>>()
+            .ok()
+            .flatten()
+            .as_deref()
+            == Some("t")
+        {
+            columns.insert(0, ("t".into(), index.call_method0("to_series")?));
+        }
+    }
+    let numbers = PyDict::new(py);
+    numbers.set_item("dtype", "float64")?;
+    numbers.set_item("na_value", f64::NAN)?;
+    columns
+        .into_iter()
+        .map(|(name, series)| {
+            let dtype = series.getattr("dtype")?;
+            let kind: String = dtype.getattr("kind")?.extract()?;
+            let values = match kind.as_str() {
+                "f" | "i" | "u" => series.call_method("to_numpy", (), Some(&numbers))?,
+                "M" | "m" if name == "t" => {
+                    // differences in the column's own unit, to seconds: an epoch stamp keeps
+                    // its nanoseconds
+                    let start = series.getattr("iloc")?.get_item(0)?;
+                    series
+                        .call_method1("__sub__", (start,))?
+                        .getattr("dt")?
+                        .call_method0("total_seconds")?
+                        .call_method("to_numpy", (), Some(&numbers))?
+                }
+                _ => {
+                    let times = if matches!(kind.as_str(), "M" | "m") {
+                        " (only 't' may hold times)"
+                    } else {
+                        ""
+                    };
+                    return Err(bad(format!(
+                        "column '{name}' holds {} values: expected numbers{times}",
+                        dtype.str()?
+                    )));
+                }
+            };
+            let values: PyReadonlyArray1<'_, f64> = values.extract()?;
+            debug_assert_eq!(values.len(), rows);
+            Ok((name, values.as_array().to_vec()))
+        })
+        .collect()
+}
 
 /// A `pandas.DataFrame` of `columns` (name, values), in order, with `index` as its index when
 /// given. Raises ImportError naming the extra when pandas is not installed.

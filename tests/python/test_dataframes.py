@@ -1,0 +1,77 @@
+"""Recordings from and to pandas DataFrames (and through them parquet files, with pyarrow), read
+by the same rules as the command line's CSV files."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import perturbid_rs as pr
+
+
+def frame_of(count=50, seed=4):
+    rng = np.random.default_rng(seed)
+    t = np.arange(count) * 1e-3
+    q = rng.normal(size=(count, 2))
+    tau = rng.normal(size=(count, 2)) * 10
+    return t, q, tau
+
+
+def test_a_recording_round_trips_through_a_dataframe_and_parquet(tmp_path):
+    t, q, tau = frame_of()
+    rec = pr.Recording(t, q, tau, qd=2 * q, name="D.csv")
+    df = rec.to_dataframe()
+    assert list(df.columns) == ["t", "q1", "q2", "qd1", "qd2", "tau1", "tau2"]
+    np.testing.assert_array_equal(df["tau2"].to_numpy(), tau[:, 1])
+    df.to_parquet(tmp_path / "log.parquet")
+    back = pr.Recording.from_dataframe(pd.read_parquet(tmp_path / "log.parquet"), ["shoulder", "elbow"], experiment="D")
+    for field in ("t", "q", "qd", "tau"):
+        np.testing.assert_array_equal(getattr(back, field), getattr(rec, field))
+    assert back.qdd is None and back.experiment == "D" and back.name == "dataframe"
+
+
+def test_a_logger_s_frame_reads_by_joint_names_with_time_as_index_or_timestamps():
+    t, q, tau = frame_of()
+    joints = ["shoulder", "elbow"]
+    # named after the joints, in any order, integer torques (a logger's counts), time as index
+    df = pd.DataFrame({"tau_elbow": np.round(tau[:, 1]).astype(np.int32), "q_shoulder": q[:, 0], "q_elbow": q[:, 1], "tau_shoulder": tau[:, 0]}, index=pd.Index(100 + t, name="t"))
+    rec = pr.Recording.from_dataframe(df, joints, name="logger")
+    np.testing.assert_array_equal(rec.t, 100 + t)
+    np.testing.assert_array_equal(rec.q, q)
+    np.testing.assert_array_equal(rec.tau[:, 1], np.round(tau[:, 1]))
+    # epoch timestamps (tz-aware) as t: seconds from the first, to the nanosecond
+    stamps = pd.Timestamp("2026-11-28 12:00:00", tz="UTC") + pd.to_timedelta(np.arange(50) * 1_000_001, unit="ns")
+    df = pd.DataFrame({"t": stamps, "q1": q[:, 0], "q2": q[:, 1], "tau1": tau[:, 0], "tau2": tau[:, 1]})
+    rec = pr.Recording.from_dataframe(df, joints)
+    np.testing.assert_allclose(rec.t, np.arange(50) * 1_000_001 / 1e9, rtol=0, atol=1e-15)
+    # a timedelta column (time since start) too
+    df["t"] = pd.to_timedelta(np.arange(50) * 2, unit="ms")
+    np.testing.assert_allclose(pr.Recording.from_dataframe(df, joints).t, np.arange(50) * 2e-3, rtol=0, atol=1e-15)
+
+
+@pytest.mark.parametrize(
+    "change, expected",
+    [
+        (lambda df: df.assign(q2=df["q2"].astype(str)), r"column 'q2' holds (object|str) values: expected numbers"),
+        (lambda df: df.assign(q2=df["q2"] > 0), r"column 'q2' holds bool values: expected numbers"),
+        (lambda df: df.assign(q2=pd.array([None] + [1.0] * 49, dtype="Float64")), r"row 1, column 'q2': NaN is not a finite number"),
+        (lambda df: df.assign(q1=pd.Timestamp("2026-01-01") + pd.to_timedelta(df["t"], unit="s")), r"column 'q1' holds datetime64\[ns\] values: expected numbers \(only 't' may hold times\)"),
+        (lambda df: df.rename(columns={"tau2": "tau1"}), "column 'tau1' appears twice"),
+        (lambda df: df.rename(columns={"tau2": 7}), r"column 5 is named 7 \(int\): expected a name"),
+        (lambda df: df.assign(extra=1.0), "unexpected column 'extra'"),
+        (lambda df: df.drop(columns="t"), "no column 't'"),
+        (lambda df: df.iloc[::-1], "time does not increase at data row 2"),
+        (lambda df: df.iloc[:0], "no data rows"),
+    ],
+)
+def test_a_bad_frame_is_named(change, expected):
+    t, q, tau = frame_of()
+    df = pd.DataFrame({"t": t, "q1": q[:, 0], "q2": q[:, 1], "tau1": tau[:, 0], "tau2": tau[:, 1]})
+    with pytest.raises(pr.InputError, match=expected):
+        pr.Recording.from_dataframe(change(df), ["shoulder", "elbow"])
+
+
+def test_something_not_a_frame_is_a_type_error():
+    with pytest.raises(TypeError, match="a pandas DataFrame"):
+        pr.Recording.from_dataframe({"t": [0.0]}, ["a"])
