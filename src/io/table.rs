@@ -277,4 +277,34 @@ mod tests {
         let e = Table::parse("x.csv", "t,,q\n0,1,2\n").unwrap_err();
         assert!(e.to_string().contains("column 2 has no name"), "{e}");
     }
+
+    #[test]
+    fn columns_are_checked_as_a_file_is() {
+        let col = |name: &str, v: &[f64]| (name.to_string(), v.to_vec());
+        let t = Table::from_columns("df", vec![col("t", &[0.0, 1.0]), col("q1", &[2.0, 3.0])]);
+        assert_eq!(t.unwrap().values, [0.0, 2.0, 1.0, 3.0]);
+        let cases = [
+            (
+                vec![col("t", &[0.0]), col("t", &[1.0])],
+                "column 't' appears twice",
+            ),
+            (
+                vec![col("t", &[0.0]), col("", &[1.0])],
+                "column 2 has no name",
+            ),
+            (
+                vec![col("t", &[0.0, 1.0]), col("q1", &[1.0])],
+                "column 'q1' has 1 rows, column 't' 2",
+            ),
+            (vec![col("t", &[]), col("q1", &[])], "no data rows"),
+            (
+                vec![col("t", &[0.0, 1.0]), col("q1", &[1.0, f64::NAN])],
+                "row 2, column 'q1': NaN is not a finite number",
+            ),
+        ];
+        for (columns, expected) in cases {
+            let e = Table::from_columns("df", columns).unwrap_err().to_string();
+            assert!(e.starts_with("df: ") && e.contains(expected), "{e}");
+        }
+    }
 }
