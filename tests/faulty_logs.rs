@@ -9,7 +9,8 @@ mod common;
 use common::{mat, table2};
 use perturbid_rs::document::Document;
 use perturbid_rs::local::{
-    identify_local, plan_experiments, CrossingTimes, IdentifyOptions, LocalModel, Plan, PlanOptions,
+    identify_local, plan_experiments, CrossingTimes, ExperimentKind, IdentifyOptions, LocalModel,
+    Plan, PlanOptions,
 };
 use perturbid_rs::robots::a465;
 use perturbid_rs::{simulate_plan, Recording, SimulationOptions};
@@ -427,34 +428,15 @@ fn logs_that_cannot_be_runs_of_the_plan_are_refused_naming_why() {
 fn a_run_late_in_its_log_is_found_where_allowed_and_named_where_not() {
     let (plan, recs) = noisy_logs();
     let idle = 5.0;
-    let late: Vec<Recording> = recs
-        .iter()
-        .map(|r| {
-            let n = r.n;
-            let dt = r.t[1] - r.t[0];
-            let k = (idle / dt).round() as usize;
-            let t: Vec<f64> = (0..k)
-                .map(|i| i as f64 * dt)
-                .chain(r.t.iter().map(|t| t + idle))
-                .collect();
-            let held = |v: &[f64]| -> Vec<f64> {
-                (0..k)
-                    .flat_map(|_| v[..n].to_vec())
-                    .chain(v.iter().copied())
-                    .collect()
-            };
-            let mut out =
-                Recording::new(r.name.clone(), n, t, held(&r.q), held(&r.tau), None, None).unwrap();
-            out.experiment = r.experiment.clone();
-            out
-        })
-        .collect();
+    let late: Vec<Recording> = recs.iter().map(|r| idle_start(r, idle)).collect();
     let e = identify_local(&plan, &late, &IdentifyOptions::default())
         .unwrap_err()
         .to_string();
+    // 1.1 times the offset found, up in tenths (5.5, or 5.6 where it is found a hair beyond 5)
     assert!(
         e.contains("best with its clock +5.000 s ahead of the plan's")
-            && e.contains("raise max_shift (--max-shift) to at least 5.5"),
+            && (e.contains("raise max_shift (--max-shift) to at least 5.5")
+                || e.contains("raise max_shift (--max-shift) to at least 5.6")),
         "{e}"
     );
     let raised = IdentifyOptions {
@@ -468,4 +450,53 @@ fn a_run_late_in_its_log_is_found_where_allowed_and_named_where_not() {
     let clean = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
     let worst = worst_in_stderr(&m, &clean);
     assert!(worst < 0.05, "{worst}");
+}
+
+/// `r` with the robot idle at its first sample for `idle` s before the run.
+fn idle_start(r: &Recording, idle: f64) -> Recording {
+    let n = r.n;
+    let dt = r.t[1] - r.t[0];
+    let k = (idle / dt).round() as usize;
+    let t: Vec<f64> = (0..k)
+        .map(|i| i as f64 * dt)
+        .chain(r.t.iter().map(|t| t + idle))
+        .collect();
+    let held = |v: &[f64]| -> Vec<f64> {
+        (0..k)
+            .flat_map(|_| v[..n].to_vec())
+            .chain(v.iter().copied())
+            .collect()
+    };
+    let mut out =
+        Recording::new(r.name.clone(), n, t, held(&r.q), held(&r.tau), None, None).unwrap();
+    out.experiment = r.experiment.clone();
+    out
+}
+
+/// The nominal passes repeat every few tenths of a second, so a run a little beyond the
+/// tolerance late in its log also fits one repetition early, within it: it was identified
+/// from the wrong windows (T* off by 65 standard errors). Now it is named, as any late run.
+#[test]
+fn a_repeating_run_a_little_late_is_not_matched_one_repetition_off() {
+    let (plan, recs) = noisy_logs();
+    let nominal = plan.experiment(ExperimentKind::Nominal).unwrap();
+    let period = nominal.crossings[1].time - nominal.crossings[0].time;
+    for idle in [0.7, 1.0, 2.0] {
+        let late: Vec<Recording> = recs
+            .iter()
+            .map(|r| match r.experiment.as_deref() {
+                Some("nominal") => idle_start(r, idle),
+                _ => r.clone(),
+            })
+            .collect();
+        let e = identify_local(&plan, &late, &IdentifyOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!(
+                "experiment 'nominal' best with its clock +{idle:.3} s ahead"
+            )),
+            "{idle} (repeats every {period} s): {e}"
+        );
+    }
 }

@@ -41,10 +41,14 @@ pub(super) fn align(
     let (lo, hi) = (first.max(-searched), last.min(searched));
     let (offset, cost) = detect_offset_in(experiment, rec, lo, hi, 200);
     let positions = check_positions(experiment, rec, joint_names, steps, (offset, searched));
-    // beyond the tolerance, or not following the plan there: the run may start later
-    // in the log; look over the whole overlap, at about the same resolution (bounded),
-    // and say where it fits
-    if positions.is_err() || offset.abs() > max_shift {
+    // beyond the tolerance, not following the plan there, or a log long enough for the run
+    // to lie further in: the run may start later in the log; look over the whole overlap, at
+    // about the same resolution (bounded), and say where it fits. A motion that repeats (the
+    // nominal passes, back and forth every few tenths of a second) also fits one repetition
+    // off: a run 0.7 s late in its log matched at +0.4 s and was identified from the wrong
+    // windows (T* off by 65 of its standard errors)
+    let beyond = first < lo || last > hi;
+    if positions.is_err() || offset.abs() > max_shift || beyond {
         let step = (hi - lo) / 400.0;
         let points = (((last - first) / step.max(1e-3)) as usize / 2).clamp(200, 20_000);
         let (first, last) = covering_offsets(experiment, rec).unwrap_or((first, last));
