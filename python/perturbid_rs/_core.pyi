@@ -268,6 +268,9 @@ class Plan:
     @staticmethod
     def load(path: Union[str, PathLike[str]]) -> "Plan":
         """Reads and checks a plan.json."""
+    def split_session(self, log: "Recording", margin: float = 0.2) -> list["Recording"]:
+        """One log of the whole session (the experiments run one after the other, in order)
+        split into one Recording per experiment on the plan's clock."""
 
 @final
 class Recording:

@@ -9,6 +9,7 @@ mod paper;
 mod parameters;
 mod pipeline;
 mod progress;
+mod session;
 mod study;
 mod validate;
 
@@ -41,6 +42,9 @@ enum Command {
     Plan(local::PlanArgs),
     /// Simulate what the robot would log running a plan: one recording CSV per experiment.
     Simulate(local::SimulateArgs),
+    /// Split one log of a whole session (the plan's experiments run one after the other, with
+    /// moves and pauses between them) into one recording CSV per experiment for `identify`.
+    Split(session::SplitArgs),
     /// Identify the local model from a plan and its recordings; writes the model (JSON) and
     /// prints T*, D*, H*, G* with condition numbers and standard errors.
     Identify(local::IdentifyArgs),
@@ -82,6 +86,7 @@ fn run(cli: Cli) -> Result<String> {
         Command::Info(a) => info::run(a),
         Command::Plan(a) => local::plan(a),
         Command::Simulate(a) => local::simulate(a),
+        Command::Split(a) => session::split(a),
         Command::Identify(a) => local::identify(a),
         Command::Excite(a) => direct::excite(a),
         Command::IdentifyDirect(a) => direct::identify_direct(a),

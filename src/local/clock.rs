@@ -122,6 +122,14 @@ const POSITION_MISFIT: f64 = 0.05;
 /// still follow it to within its tracking errors.
 const SHAPE_MISFIT: f64 = 0.01;
 
+/// Whether a joint's recorded positions, `m` against the plan, are what a run of the plan shows
+/// (its encoder's `step`, rad or m, or 0): within [`POSITION_MISFIT`] on average and within
+/// [`SHAPE_MISFIT`], half the planned motion or two encoder steps (whichever is most) about that.
+pub(super) fn follows_plan(m: &PositionMisfit, step: f64) -> bool {
+    let shape = SHAPE_MISFIT.max(0.5 * m.motion).max(2.0 * step);
+    m.mean.abs() <= POSITION_MISFIT && m.shape <= shape
+}
+
 /// Refuses a recording whose positions do not follow `experiment`'s plan at the clock offset
 /// found (`offset` s, the best within `+-searched` s), naming the joints.
 fn check_positions(
@@ -137,11 +145,7 @@ fn check_positions(
     let off: Vec<String> = misfit
         .iter()
         .enumerate()
-        .filter(|(j, m)| {
-            let step = steps.get(*j).copied().flatten().unwrap_or(0.0);
-            let shape = SHAPE_MISFIT.max(0.5 * m.motion).max(2.0 * step);
-            !(m.mean.abs() <= POSITION_MISFIT && m.shape <= shape)
-        })
+        .filter(|(j, m)| !follows_plan(m, steps.get(*j).copied().flatten().unwrap_or(0.0)))
         .map(|(j, m)| {
             let name = joint_names
                 .get(j)

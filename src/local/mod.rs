@@ -54,6 +54,7 @@ pub mod quantisation;
 pub mod response;
 pub mod reversals;
 pub mod rounded_positions;
+pub mod session;
 pub mod torque_offsets;
 
 pub use clock::{
@@ -75,3 +76,4 @@ pub use parameters::{identify_parameters_from_local, FromLocalOptions, Parameter
 pub use perturbation::{Design, Size, Sizes};
 pub use plan::{plan_experiments, Crossing, Experiment, ExperimentKind, Plan, PlanOptions};
 pub use point_design::{suggest_operating_points, SuggestedPoint};
+pub use session::{split_session, SplitOptions};

@@ -156,6 +156,31 @@ impl PyPlan {
             crate::io::plan_files(&plan, &folder)?.commit()
         })?)
     }
+    /// Splits `log`, one Recording of a whole session in which the robot ran this plan's
+    /// experiments one after the other in the plan's order (moves and pauses of any length
+    /// between them, on any clock), into one Recording per experiment, in the plan's order:
+    /// each marked with its experiment, its time (s) on the plan's clock, holding its run and
+    /// `margin` s either side (default 0.2), for `identify_local`. Each run is sought after the
+    /// previous one where the log's positions follow the experiment's plan best. Raises
+    /// InputError naming the experiment and the time in the log when a run does not fit where
+    /// it must (out of order, missing, a log cut short) or its best stretch does not follow the
+    /// plan; KeyboardInterrupt on Ctrl-C.
+    #[pyo3(signature = (log, margin=0.2))]
+    fn split_session(
+        &self,
+        py: Python<'_>,
+        log: PyRef<'_, PyRecording>,
+        #[pyo3(from_py_with = scalars::real)] margin: f64,
+    ) -> PyResult<Vec<PyRecording>> {
+        let (plan, log) = (self.plan.clone(), log.rec.clone());
+        let runs = detached(py, "Plan.split_session", || {
+            crate::local::split_session(&plan, &log, &crate::local::SplitOptions { margin })
+        })?;
+        Ok(runs
+            .into_iter()
+            .map(|(rec, _)| PyRecording { rec: Arc::new(rec) })
+            .collect())
+    }
     /// Reads a plan from `path` (the plan.json of `Plan.save` or `perturbid plan`), checked
     /// as `from_json` checks it; errors name the file.
     #[staticmethod]

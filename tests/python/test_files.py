@@ -98,3 +98,43 @@ def test_recording_files_from_other_tools_and_their_errors(tmp_path):
     with pytest.raises(pr.FileError, match="folder.csv"):
         exact.save(tmp_path / "folder.csv")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.csv", "exact.csv", "folder.csv", "log.csv"]
+
+
+def test_a_session_log_splits_into_its_experiments(tmp_path):
+    # the controller ran the plan's experiments one after the other, with a pause at rest of
+    # 1 s between two (and 3 s before the first), and logged it all on its own clock
+    robot = pr.robots.a465()
+    plan = pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2), seed=1, keep_velocity_sign=True)
+    recordings = pr.simulate(robot, plan, torque_noise=0.05, seed=2)
+    dt = 1.0 / plan.rate
+    parts_t, parts_q, parts_tau, now = [], [], [], 100.0
+    for rec in recordings:
+        pause = 3.0 if not parts_t else 1.0
+        rest = int(round(pause / dt))
+        parts_q += [np.repeat(rec.q[:1], rest, axis=0), rec.q]
+        parts_tau += [np.repeat(rec.tau[:1], rest, axis=0), rec.tau]
+        count = rest + len(rec)
+        parts_t.append(now + np.arange(count) * dt)
+        now += count * dt
+    log = pr.Recording(np.concatenate(parts_t), np.vstack(parts_q), np.vstack(parts_tau), name="session")
+    runs = plan.split_session(log)
+    assert [r.experiment for r in runs] == [e.kind for e in plan.experiments]
+    a, b = pr.identify_local(plan, recordings), pr.identify_local(plan, runs)
+    for term in ("D", "H", "G"):
+        np.testing.assert_allclose(getattr(b, term), getattr(a, term), atol=0.05 * getattr(a, "stderr")[term].max())
+    # on the command line: the log's file into a folder that identify reads
+    log.save(tmp_path / "session.csv")
+    plan.save(tmp_path / "plan")
+    cli = subprocess.run(
+        [sys.executable, "-m", "perturbid_rs", "split", str(tmp_path / "plan" / "plan.json"), str(tmp_path / "session.csv"), "--out", str(tmp_path / "runs")],
+        capture_output=True,
+        text=True,
+    )
+    assert cli.returncode == 0, cli.stderr
+    assert "nominal   from    103.000 s of the log" in cli.stdout, cli.stdout
+    for rec in runs:
+        back = pr.Recording.load(tmp_path / "runs" / f"{rec.experiment}.csv", plan.joint_names)
+        np.testing.assert_array_equal(back.q, rec.q)
+    # a log cut short: the first run that no longer fits is named
+    with pytest.raises(pr.InputError, match=r"experiment '\w+': its run \(\d+\.\d+ s\) does not fit in the log between .* \(the log's end\)"):
+        plan.split_session(pr.Recording(log.t[: len(log) // 2], log.q[: len(log) // 2], log.tau[: len(log) // 2]))

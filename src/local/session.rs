@@ -1,0 +1,227 @@
+//! One log of a whole session split into a recording per experiment (docs/method.md, section
+//! 7). A controller that runs the plan's trajectories one after the other, with pauses and
+//! moves of any length between them, logs one file; the identification wants each experiment's
+//! run on the plan's clock. The runs are found in the plan's order, each after the previous
+//! one, where the log's positions follow the experiment's planned ones best.
+
+use super::clock::{follows_plan, position_misfit};
+use super::plan::{Experiment, Plan};
+use crate::error::{Error, Result};
+use crate::recording::Recording;
+
+/// How a session log is split ([`split_session`]).
+#[derive(Clone, Debug)]
+pub struct SplitOptions {
+    /// Seconds of log kept before each run's planned start and after its planned end (default
+    /// 0.2): room for the identification's own clock search, which refines each run's offset
+    /// below a sample.
+    pub margin: f64,
+}
+
+impl Default for SplitOptions {
+    fn default() -> Self {
+        Self { margin: 0.2 }
+    }
+}
+
+/// Coarse grid step (s) of the search for a run in the log.
+const COARSE_STEP: f64 = 0.02;
+/// At most this many coarse offsets per experiment: a longer session is searched more coarsely.
+const MAX_GRID: usize = 200_000;
+/// Candidates (the coarse grid's lowest local minima) refined per experiment.
+const CANDIDATES: usize = 16;
+
+/// The mean squared difference per sample, about each joint's mean, between the log's
+/// positions over the span of `e`'s plan placed at `d` s (log time = plan time + d) and the
+/// planned positions, on at most `samples` samples; infinite where the log holds fewer than 2.
+fn window_cost(e: &Experiment, log: &Recording, d: f64, samples: usize) -> f64 {
+    let traj = &e.trajectory;
+    let (start, end) = (traj.start(), traj.end());
+    let i0 = log.t.partition_point(|&t| t < start + d);
+    let i1 = log.t.partition_point(|&t| t <= end + d);
+    if i1 < i0 + 2 {
+        return f64::INFINITY;
+    }
+    let n = log.n;
+    let stride = ((i1 - i0) / samples.max(1)).max(1);
+    let (mut sum, mut sq) = (vec![0.0; n], vec![0.0; n]);
+    let mut count = 0.0;
+    for i in (i0..i1).step_by(stride) {
+        let tp = (log.t[i] - d).clamp(start, end);
+        let seg = traj.segment_at(tp);
+        for j in 0..n {
+            let diff = log.q[i * n + j] - seg.eval(j, tp).0;
+            sum[j] += diff;
+            sq[j] += diff * diff;
+        }
+        count += 1.0;
+    }
+    (0..n).map(|j| sq[j] - sum[j] * sum[j] / count).sum::<f64>() / count
+}
+
+/// The offset `d` in `[lo, hi]` (s) at which `e`'s plan fits the log best, with its cost: a
+/// coarse grid, then the lowest of its local minima refined at a millisecond.
+fn best_offset(e: &Experiment, log: &Recording, lo: f64, hi: f64) -> Result<(f64, f64)> {
+    let points = (((hi - lo) / COARSE_STEP).ceil() as usize).clamp(1, MAX_GRID);
+    let step = (hi - lo) / points as f64;
+    let mut coarse = Vec::with_capacity(points + 1);
+    for g in 0..=points {
+        if g % 1024 == 0 {
+            crate::interrupt::check("splitting the session log")?;
+        }
+        let d = lo + g as f64 * step;
+        coarse.push((window_cost(e, log, d, 100), d));
+    }
+    let mut minima: Vec<(f64, f64)> = (0..coarse.len())
+        .filter(|&g| {
+            let c = coarse[g].0;
+            (g == 0 || coarse[g - 1].0 >= c) && (g + 1 == coarse.len() || coarse[g + 1].0 >= c)
+        })
+        .map(|g| coarse[g])
+        .collect();
+    minima.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut best = (f64::INFINITY, 0.5 * (lo + hi));
+    for &(_, c) in minima.iter().take(CANDIDATES) {
+        let fine = (2.0 * step / 1e-3).ceil().clamp(2.0, 400.0) as usize;
+        for k in 0..=fine {
+            let d = (c - step + 2.0 * step * k as f64 / fine as f64).clamp(lo, hi);
+            let cost = window_cost(e, log, d, 400);
+            if cost < best.0 {
+                best = (cost, d);
+            }
+        }
+    }
+    Ok((best.1, best.0))
+}
+
+/// Splits `log`, a session in which the robot ran `plan`'s experiments one after the other in
+/// the plan's order (pauses and moves of any length between them, anything before the first
+/// and after the last), into one recording per experiment, in the plan's order: each marked
+/// with its experiment, named `<log name> [<experiment>]`, its time on the plan's clock (the
+/// log's minus the offset found), holding the run and [`SplitOptions::margin`] s either side.
+/// Its columns are the log's (`q` in rad or m, `tau` in N m or N, `qd`, `qdd` when logged).
+/// Each comes with the offset `d` (s) found: the log's time is the plan's plus `d`.
+///
+/// Each run is sought after the previous one's end, where the log's positions follow the
+/// experiment's plan best (the squared differences about each joint's mean, so an encoder's
+/// zero does not matter); a stretch that a later experiment's plan fits better is that
+/// experiment's, and the run is sought before it. Errors: a log of other joints, one that ends
+/// before an experiment could have run, or whose best stretch does not follow the plan (as the
+/// identification's position check: within 0.05 rad on average and half the planned motion
+/// about that), named with the experiment, the time in the log and the joints.
+pub fn split_session(
+    plan: &Plan,
+    log: &Recording,
+    o: &SplitOptions,
+) -> Result<Vec<(Recording, f64)>> {
+    if log.n != plan.n() {
+        return Err(Error::Recording {
+            recording: log.name.clone(),
+            message: format!(
+                "{} joint columns; the plan is of {} joints ({})",
+                log.n,
+                plan.n(),
+                plan.joint_names.join(", ")
+            ),
+        });
+    }
+    if !(o.margin.is_finite() && (0.0..=60.0).contains(&o.margin)) {
+        return Err(Error::InvalidArgument {
+            argument: "margin".into(),
+            message: format!("{}; expected 0 to 60 s", crate::error::shown(o.margin)),
+        });
+    }
+    let (first, last) = (log.t[0], log.t[log.len() - 1]);
+    let mut cursor = first;
+    let mut runs = Vec::with_capacity(plan.experiments.len());
+    for (k, e) in plan.experiments.iter().enumerate() {
+        let (start, end) = (e.trajectory.start(), e.trajectory.end());
+        let lo = cursor - start;
+        let mut hi = last - end;
+        let refuse = |message: String| Error::Recording {
+            recording: log.name.clone(),
+            message: format!("experiment '{}': {message}", e.kind.name()),
+        };
+        // the later experiment whose run the search was kept before, and where it starts
+        let mut before: Option<(&str, f64)> = None;
+        let (d, cost) = loop {
+            if hi < lo {
+                let until = match before {
+                    Some((kind, at)) => format!(
+                        "{} s, where experiment '{kind}' fits better",
+                        shown_time(at)
+                    ),
+                    None => format!("{} s (the log's end)", shown_time(last)),
+                };
+                return Err(refuse(format!(
+                    "its run ({:.2} s) does not fit in the log between {} s (the end of the previous run, or the log's start) and {until}: check that the log holds the whole session and that its experiments ran in the plan's order ({})",
+                    end - start,
+                    shown_time(cursor),
+                    plan.kinds()
+                )));
+            }
+            let (d, cost) = best_offset(e, log, lo, hi)?;
+            // a stretch a later experiment fits better, started at the same time, is its run
+            let later = plan.experiments[k + 1..].iter().find(|l| {
+                let dl = d + start - l.trajectory.start();
+                dl + l.trajectory.end() <= last && window_cost(l, log, dl, 400) < cost
+            });
+            match later {
+                Some(l) => {
+                    before = Some((l.kind.name(), d + start));
+                    hi = d - (end - start);
+                }
+                None => break (d, cost),
+            }
+        };
+        let misfit = position_misfit(e, log, d).unwrap_or_default();
+        let off: Vec<String> = (misfit.iter().enumerate())
+            .filter(|(_, m)| !follows_plan(m, 0.0))
+            .map(|(j, m)| {
+                format!(
+                    "'{}' {:+.3} off on average and {:.3} RMS about that, where the plan moves it {:.3} RMS",
+                    plan.joint_names[j], m.mean, m.shape, m.motion
+                )
+            })
+            .collect();
+        if !off.is_empty() || !cost.is_finite() {
+            return Err(refuse(format!(
+                "no stretch of the log after {} s follows its plan: at the best, from {} s, the joints {} (rad or m): check that the log holds the whole session, its experiments in the plan's order ({}), its columns the plan's joints, in radians",
+                shown_time(cursor),
+                shown_time(d + start),
+                off.join(", "),
+                plan.kinds()
+            )));
+        }
+        let (from, to) = (d + start - o.margin, d + end + o.margin);
+        let i0 = log.t.partition_point(|&t| t < from);
+        let i1 = log.t.partition_point(|&t| t <= to);
+        let n = log.n;
+        let rows = |v: &[f64]| v[i0 * n..i1 * n].to_vec();
+        let mut run = Recording::new(
+            format!("{} [{}]", log.name, e.kind.name()),
+            n,
+            log.t[i0..i1].iter().map(|t| t - d).collect(),
+            rows(&log.q),
+            rows(&log.tau),
+            log.qd.as_deref().map(rows),
+            log.qdd.as_deref().map(rows),
+        )?;
+        run.experiment = Some(e.kind.name().to_string());
+        log::info!(
+            target: "perturbid_rs::session",
+            "experiment '{}': from {} s in {}",
+            e.kind.name(),
+            shown_time(d + start),
+            log.name
+        );
+        runs.push((run, d));
+        cursor = d + end;
+    }
+    Ok(runs)
+}
+
+/// A time in the log (s), to the millisecond.
+fn shown_time(t: f64) -> String {
+    crate::error::shown((t * 1e3).round() / 1e3)
+}

@@ -1,0 +1,178 @@
+//! A whole session's log, the plan's experiments run one after the other with moves and pauses
+//! between them, split into one recording per experiment (`local::session`): the model from
+//! the split log is the one from the separate recordings; out of order or missing runs are named.
+
+mod common;
+
+use common::table2;
+use perturbid_rs::local::{
+    identify_local, plan_experiments, split_session, IdentifyOptions, LocalModel, Plan,
+    PlanOptions, SplitOptions,
+};
+use perturbid_rs::robots::a465;
+use perturbid_rs::{simulate_plan, Recording, SimulationOptions};
+
+fn runs() -> (Plan, Vec<Recording>) {
+    let model = a465::model("kinsheel2010").unwrap();
+    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
+    let mut sim = SimulationOptions::new(&model);
+    sim.torque_noise = vec![0.05; model.nv];
+    sim.position_noise = vec![1e-5; model.nv];
+    sim.seed = 11;
+    let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    (plan, recs)
+}
+
+/// One log of `recs` in the given order, on one clock starting at 1000 s: a homing move of 2 s
+/// from elsewhere first, and between two runs a smooth move of `pause` s from one's last
+/// posture to the next one's first (torques held), all at the runs' sample interval.
+fn session(recs: &[&Recording], pause: f64) -> Recording {
+    let n = recs[0].n;
+    let dt = recs[0].t[1] - recs[0].t[0];
+    let (mut t, mut q, mut tau) = (vec![], vec![], vec![]);
+    let mut now = 1000.0;
+    let step = |t: &mut Vec<f64>, now: &mut f64| {
+        t.push(*now);
+        *now += dt;
+    };
+    let moving = |from: &[f64],
+                  to: &[f64],
+                  torque: &[f64],
+                  seconds: f64,
+                  t: &mut Vec<f64>,
+                  q: &mut Vec<f64>,
+                  tau: &mut Vec<f64>,
+                  now: &mut f64| {
+        let k = (seconds / dt).round() as usize;
+        for i in 0..k {
+            let s = 0.5 - 0.5 * (std::f64::consts::PI * i as f64 / k as f64).cos();
+            q.extend((0..n).map(|j| from[j] + s * (to[j] - from[j])));
+            tau.extend_from_slice(torque);
+            step(t, now);
+        }
+    };
+    let elsewhere: Vec<f64> = recs[0].q[..n].iter().map(|v| v + 0.4).collect();
+    moving(
+        &elsewhere,
+        &recs[0].q[..n],
+        &recs[0].tau[..n],
+        2.0,
+        &mut t,
+        &mut q,
+        &mut tau,
+        &mut now,
+    );
+    for (k, r) in recs.iter().enumerate() {
+        for i in 0..r.len() {
+            q.extend_from_slice(&r.q[i * n..(i + 1) * n]);
+            tau.extend_from_slice(&r.tau[i * n..(i + 1) * n]);
+            step(&mut t, &mut now);
+        }
+        let last = &r.q[(r.len() - 1) * n..];
+        let next = recs.get(k + 1).map_or(last, |x| &x.q[..n]);
+        let held = &r.tau[(r.len() - 1) * n..];
+        moving(
+            last,
+            next,
+            held,
+            pause + 0.3 * k as f64,
+            &mut t,
+            &mut q,
+            &mut tau,
+            &mut now,
+        );
+    }
+    Recording::new("session.csv", n, t, q, tau, None, None).unwrap()
+}
+
+fn worst_in_stderr(a: &LocalModel, clean: &LocalModel) -> f64 {
+    let parts = |m: &LocalModel| [m.d.clone(), m.h.clone(), m.g.clone()];
+    let mut worst: f64 = 0.0;
+    for (x, y) in parts(a).iter().zip(parts(clean).iter()) {
+        let (x, y) = (x.as_ref().unwrap(), y.as_ref().unwrap());
+        for ((a, b), s) in x.matrix.iter().zip(y.matrix.iter()).zip(y.stderr.iter()) {
+            worst = worst.max((a - b).abs() / s);
+        }
+    }
+    worst
+}
+
+#[test]
+fn a_session_log_splits_into_the_runs_that_identify_as_the_separate_recordings() {
+    let (plan, recs) = runs();
+    let log = session(&recs.iter().collect::<Vec<_>>(), 1.5);
+    let split = split_session(&plan, &log, &SplitOptions::default()).unwrap();
+    assert_eq!(split.len(), plan.experiments.len());
+    // the first run starts after the 2 s homing move, at 1002 s of the log
+    assert!((split[0].1 - 1002.0).abs() < 2e-3, "{}", split[0].1);
+    for ((run, _), e) in split.iter().zip(&plan.experiments) {
+        assert_eq!(run.experiment.as_deref(), Some(e.kind.name()));
+        assert_eq!(run.name, format!("session.csv [{}]", e.kind.name()));
+        // the run on the plan's clock, with the margin either side
+        let (first, last) = (run.t[0], run.t[run.len() - 1]);
+        assert!((first + 0.2).abs() < 2e-3, "{first}");
+        assert!((last - e.trajectory.end() - 0.2).abs() < 2e-3, "{last}");
+    }
+    let split: Vec<Recording> = split.into_iter().map(|(r, _)| r).collect();
+    let from_log = identify_local(&plan, &split, &IdentifyOptions::default()).unwrap();
+    for o in &from_log.diagnostics.offsets {
+        assert!(o.offset.abs() < 2e-3, "{o:?}");
+    }
+    let separate = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    let worst = worst_in_stderr(&from_log, &separate);
+    assert!(worst < 0.05, "{worst}");
+}
+
+#[test]
+fn runs_out_of_order_missing_or_of_other_joints_are_named() {
+    let (plan, recs) = runs();
+    let kinds: Vec<&str> = recs
+        .iter()
+        .map(|r| r.experiment.as_deref().unwrap())
+        .collect();
+    let at = |k: &str| kinds.iter().position(|x| *x == k).unwrap();
+    let o = SplitOptions::default();
+    // D run before H: H is found, and then no room is left for D after it
+    let mut swapped: Vec<&Recording> = recs.iter().collect();
+    swapped.swap(at("H"), at("D"));
+    let e = split_session(&plan, &session(&swapped, 1.0), &o)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("experiment 'D': its run") && e.contains("in the plan's order"),
+        "{e}"
+    );
+    // H never run: D's run fits D better, and nothing before it follows H's plan
+    let missing: Vec<&Recording> = recs
+        .iter()
+        .filter(|r| r.experiment.as_deref() != Some("H"))
+        .collect();
+    let e = split_session(&plan, &session(&missing, 1.0), &o)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("experiment 'H': its run") && e.contains("where experiment 'D' fits better"),
+        "{e}"
+    );
+    // a log of five joints
+    let log = session(&recs.iter().collect::<Vec<_>>(), 1.0);
+    let five = Recording::new(
+        "five.csv",
+        5,
+        log.t.clone(),
+        log.q.chunks(6).flat_map(|r| r[..5].to_vec()).collect(),
+        log.tau.chunks(6).flat_map(|r| r[..5].to_vec()).collect(),
+        None,
+        None,
+    )
+    .unwrap();
+    let e = split_session(&plan, &five, &o).unwrap_err().to_string();
+    assert!(
+        e.contains("five.csv: 5 joint columns; the plan is of 6 joints"),
+        "{e}"
+    );
+    let e = split_session(&plan, &log, &SplitOptions { margin: -1.0 })
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("margin"), "{e}");
+}
