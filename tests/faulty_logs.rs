@@ -407,6 +407,18 @@ fn logs_that_cannot_be_runs_of_the_plan_are_refused_naming_why() {
         e.contains("its positions do not follow the plan") && e.contains("'joint1' -0.39"),
         "{e}"
     );
+    // the robot standing still at the run's first posture: D's slow motion (a few mrad) lies
+    // within the shape tolerance, but not a quarter of it was moved
+    let e = refused(|r| {
+        let first = r.q[..n].to_vec();
+        r.q.chunks_mut(n)
+            .for_each(|row| row.copy_from_slice(&first));
+    });
+    assert!(
+        e.contains("'joint1' moved 0.0000 RMS where the plan moves it")
+            && e.contains("not this run, or the robot standing still"),
+        "{e}"
+    );
     // a joint held 0.1 rad off the plan throughout
     let e = refused(|r| r.q.iter_mut().step_by(n).for_each(|q| *q += 0.1));
     assert!(e.contains("'joint1' +0.100 off on average"), "{e}");

@@ -604,9 +604,9 @@ fn recordings_are_matched_by_experiment_not_order() {
     refused(&doubled, "are both runs of experiment 'D'");
 }
 
-/// The recordings of H and D swapped (each marked as the other): both are said not to show
-/// their plan's perturbations and to follow the other's, with encoder noise, torque noise and
-/// friction; the recordings as they are raise no such warning.
+/// The recordings of H and D swapped (each marked as the other) are refused by the position
+/// check; H's recording given for D too is said not to show D's perturbations and to follow
+/// H's, with encoder noise and torque noise; the recordings as they are raise no such warning.
 #[test]
 fn swapped_recordings_are_named() {
     let model = a465::model("kinsheel2010").unwrap();
@@ -629,6 +629,8 @@ fn swapped_recordings_are_named() {
         "{:?}",
         follows(&as_recorded)
     );
+    // swapped both ways: D's recording moves the third joint less than a quarter of what H's
+    // plan moves it, and the position check refuses it as a run of H
     let mut swapped = recs.clone();
     for r in &mut swapped {
         r.experiment = match r.experiment.as_deref() {
@@ -637,17 +639,35 @@ fn swapped_recordings_are_named() {
             other => other.map(str::to_string),
         };
     }
-    let w = follows(&identify_local(&plan, &swapped, &options).unwrap());
-    assert_eq!(w.len(), 2, "{w:?}");
+    let e = identify_local(&plan, &swapped, &options)
+        .unwrap_err()
+        .to_string();
     assert!(
-        w.iter().any(|w| w
-            .starts_with("experiment 'D': the perturbations its recording shows (dqdd)")
-            && w.contains("it follows the plan of experiment 'H' instead")),
-        "{w:?}"
+        e.contains("do not follow the plan of experiment 'H'")
+            && e.contains("'joint3' moved 0.0014 RMS where the plan moves it 0.0078 RMS"),
+        "{e}"
     );
+    // H's run given for D too (it moves more than D's plan, which the position check allows):
+    // its perturbations do not follow D's plan, and follow H's
+    let mut twice = recs.clone();
+    let h = twice
+        .iter()
+        .position(|r| r.experiment.as_deref() == Some("H"))
+        .unwrap();
+    let d = twice
+        .iter()
+        .position(|r| r.experiment.as_deref() == Some("D"))
+        .unwrap();
+    twice[d] = Recording {
+        experiment: Some("D".into()),
+        ..twice[h].clone()
+    };
+    let w = follows(&identify_local(&plan, &twice, &options).unwrap());
+    assert_eq!(w.len(), 1, "{w:?}");
     assert!(
-        w.iter().any(|w| w.starts_with("experiment 'H'")
-            && w.contains("are the recordings of 'H' and 'D' swapped?")),
+        w[0].starts_with("experiment 'D': the perturbations its recording shows (dqdd)")
+            && w[0].contains("it follows the plan of experiment 'H' instead")
+            && w[0].contains("are the recordings of 'D' and 'H' swapped?"),
         "{w:?}"
     );
 }

@@ -171,6 +171,24 @@ fn runs_out_of_order_missing_or_of_other_joints_are_named() {
         e.contains("five.csv: 5 joint columns; the plan is of 6 joints"),
         "{e}"
     );
+    // the robot standing still all along: no stretch follows the nominal passes
+    let first = log.q[..6].to_vec();
+    let still = Recording::new(
+        "still.csv",
+        6,
+        log.t.clone(),
+        log.t.iter().flat_map(|_| first.clone()).collect(),
+        log.tau.clone(),
+        None,
+        None,
+    )
+    .unwrap();
+    let e = split_session(&plan, &still, &o).unwrap_err().to_string();
+    assert!(
+        e.contains("experiment 'nominal': no stretch of the log after 1000 s follows its plan")
+            && e.contains("moved 0.0000 RMS"),
+        "{e}"
+    );
     let e = split_session(&plan, &log, &SplitOptions { margin: -1.0 })
         .unwrap_err()
         .to_string();

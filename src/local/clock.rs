@@ -122,12 +122,42 @@ const POSITION_MISFIT: f64 = 0.05;
 /// still follow it to within its tracking errors.
 const SHAPE_MISFIT: f64 = 0.01;
 
+/// A joint the plan moves by at least this (RMS, rad or m) must move in its recording by at
+/// least [`STILL_FRACTION`] of it: a slow plan's motion lies within [`SHAPE_MISFIT`], so a
+/// recording of the robot standing still (or a dead encoder's constant reading) passed as a
+/// run of the nominal passes at the paper's point, and T* came from wherever the clock search
+/// placed the windows (32.9 N m for -1.19 at the base).
+const STILL_MOTION: f64 = 1e-3;
+/// See [`STILL_MOTION`]; a robot that tracks its plan moves about as much as planned.
+const STILL_FRACTION: f64 = 0.25;
+
+/// Whether a joint the plan moves stood still in the recording (`m`; `step` its encoder's
+/// step, rad or m, or 0): see [`STILL_MOTION`].
+fn still(m: &PositionMisfit, step: f64) -> bool {
+    m.motion >= STILL_MOTION.max(4.0 * step) && m.recorded < STILL_FRACTION * m.motion
+}
+
 /// Whether a joint's recorded positions, `m` against the plan, are what a run of the plan shows
 /// (its encoder's `step`, rad or m, or 0): within [`POSITION_MISFIT`] on average and within
-/// [`SHAPE_MISFIT`], half the planned motion or two encoder steps (whichever is most) about that.
+/// [`SHAPE_MISFIT`], half the planned motion or two encoder steps (whichever is most) about
+/// that, and moving where the plan moves it ([`STILL_MOTION`]).
 pub(super) fn follows_plan(m: &PositionMisfit, step: f64) -> bool {
     let shape = SHAPE_MISFIT.max(0.5 * m.motion).max(2.0 * step);
-    m.mean.abs() <= POSITION_MISFIT && m.shape <= shape
+    m.mean.abs() <= POSITION_MISFIT && m.shape <= shape && !still(m, step)
+}
+
+/// What a joint's misfit `m` says, for an error naming joint `name`.
+pub(super) fn misfit_shown(name: &str, m: &PositionMisfit, step: f64) -> String {
+    if still(m, step) {
+        return format!(
+            "'{name}' moved {:.4} RMS where the plan moves it {:.4} RMS (less than a quarter: not this run, or the robot standing still)",
+            m.recorded, m.motion
+        );
+    }
+    format!(
+        "'{name}' {:+.3} off on average and {:.3} RMS about that, where the plan moves it {:.3} RMS",
+        m.mean, m.shape, m.motion
+    )
 }
 
 /// Refuses a recording whose positions do not follow `experiment`'s plan at the clock offset
@@ -151,10 +181,7 @@ fn check_positions(
                 .get(j)
                 .cloned()
                 .unwrap_or_else(|| format!("{}", j + 1));
-            format!(
-                "'{name}' {:+.3} off on average and {:.3} RMS about that, where the plan moves it {:.3} RMS",
-                m.mean, m.shape, m.motion
-            )
+            misfit_shown(&name, m, steps.get(j).copied().flatten().unwrap_or(0.0))
         })
         .collect();
     if off.is_empty() {
@@ -163,7 +190,7 @@ fn check_positions(
     Err(Error::Recording {
         recording: rec.name.clone(),
         message: format!(
-            "its positions do not follow the plan of experiment '{}' at any clock offset within +-{} s: at the best ({offset:+.4} s) the joints {} (rad or m), where a robot that tracks its encoders stays within {POSITION_MISFIT} on average and within half the planned motion about that: check that it is a run of this experiment, that its columns follow the plan's joints ({}) and that its positions are in radians (metres for prismatic joints)",
+            "its positions do not follow the plan of experiment '{}' at any clock offset within +-{} s: at the best ({offset:+.4} s) the joints {} (rad or m), where a robot that tracks its encoders stays within {POSITION_MISFIT} on average and within half the planned motion about that, and moves about as much as planned: check that it is a run of this experiment (not of the robot standing still), that its columns follow the plan's joints ({}) and that its positions are in radians (metres for prismatic joints)",
             experiment.kind.name(),
             crate::error::shown(searched),
             off.join(", "),
@@ -208,6 +235,9 @@ pub struct PositionMisfit {
     pub shape: f64,
     /// The RMS of the planned motion about its mean over the same samples.
     pub motion: f64,
+    /// The RMS of the recorded positions about their mean over the same samples: how much the
+    /// joint moved.
+    pub recorded: f64,
 }
 
 /// Per joint, how far the recorded positions stray from `experiment`'s planned ones with the
@@ -224,6 +254,7 @@ pub fn position_misfit(
     let stride = (rec.len() / 2_000).max(1);
     let mut diff: Vec<Vec<f64>> = vec![vec![]; n];
     let mut planned: Vec<Vec<f64>> = vec![vec![]; n];
+    let mut recorded: Vec<Vec<f64>> = vec![vec![]; n];
     for i in (0..rec.len()).step_by(stride) {
         let tp = rec.t[i] - offset;
         if tp < start || tp > end {
@@ -234,6 +265,7 @@ pub fn position_misfit(
             let q = seg.eval(j, tp).0;
             diff[j].push(rec.q[i * n + j] - q);
             planned[j].push(q);
+            recorded[j].push(rec.q[i * n + j]);
         }
     }
     if diff[0].is_empty() {
@@ -250,6 +282,7 @@ pub fn position_misfit(
                 mean: mean(&diff[j]),
                 shape: spread(&diff[j]),
                 motion: spread(&planned[j]),
+                recorded: spread(&recorded[j]),
             })
             .collect(),
     )

@@ -4,7 +4,7 @@
 //! run on the plan's clock. The runs are found in the plan's order, each after the previous
 //! one, where the log's positions follow the experiment's planned ones best.
 
-use super::clock::{follows_plan, position_misfit};
+use super::clock::{follows_plan, misfit_shown, position_misfit};
 use super::plan::{Experiment, Plan};
 use crate::error::{Error, Result};
 use crate::recording::Recording;
@@ -177,12 +177,7 @@ pub fn split_session(
         let misfit = position_misfit(e, log, d).unwrap_or_default();
         let off: Vec<String> = (misfit.iter().enumerate())
             .filter(|(_, m)| !follows_plan(m, 0.0))
-            .map(|(j, m)| {
-                format!(
-                    "'{}' {:+.3} off on average and {:.3} RMS about that, where the plan moves it {:.3} RMS",
-                    plan.joint_names[j], m.mean, m.shape, m.motion
-                )
-            })
+            .map(|(j, m)| misfit_shown(&plan.joint_names[j], m, 0.0))
             .collect();
         if !off.is_empty() || !cost.is_finite() {
             return Err(refuse(format!(
