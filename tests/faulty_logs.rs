@@ -6,28 +6,15 @@
 
 mod common;
 
-use common::{mat, table2};
+use common::{a465_noisy_runs, worst_in_stderr};
 use perturbid_rs::document::Document;
 use perturbid_rs::local::{
-    identify_local, plan_experiments, CrossingTimes, ExperimentKind, IdentifyOptions, LocalModel,
-    Plan, PlanOptions,
+    identify_local, CrossingTimes, ExperimentKind, IdentifyOptions, LocalModel, Plan,
 };
-use perturbid_rs::robots::a465;
-use perturbid_rs::{simulate_plan, Recording, SimulationOptions};
+use perturbid_rs::Recording;
 
 /// The paper's plan at Table 2 and its noisy rehearsal (0.05 N m of torque noise, 1e-5 rad of
 /// position noise, friction-free).
-fn noisy_logs() -> (Plan, Vec<Recording>) {
-    let model = a465::model("kinsheel2010").unwrap();
-    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
-    let mut sim = SimulationOptions::new(&model);
-    sim.torque_noise = vec![0.05; model.nv];
-    sim.position_noise = vec![1e-5; model.nv];
-    sim.seed = 11;
-    let recs = simulate_plan(&model, &plan, &sim).unwrap();
-    (plan, recs)
-}
-
 /// The recording of experiment `name`.
 fn log<'a>(recs: &'a mut [Recording], name: &str) -> &'a mut Recording {
     recs.iter_mut()
@@ -40,23 +27,9 @@ fn sample_at(rec: &Recording, t: f64) -> usize {
     rec.t.partition_point(|&s| s < t)
 }
 
-/// The largest difference between two models' D*, H* and G*, in the clean model's standard
-/// errors.
-fn worst_in_stderr(a: &LocalModel, clean: &LocalModel) -> f64 {
-    [(&a.d, &clean.d), (&a.h, &clean.h), (&a.g, &clean.g)]
-        .into_iter()
-        .map(|(x, c)| {
-            let c = c.as_ref().unwrap();
-            (mat(x) - &c.matrix)
-                .zip_map(&c.stderr, |d, s| (d / s).abs())
-                .max()
-        })
-        .fold(0.0, f64::max)
-}
-
 #[test]
 fn isolated_glitches_are_replaced_and_reported() {
-    let (plan, mut recs) = noisy_logs();
+    let (plan, mut recs) = a465_noisy_runs();
     let options = IdentifyOptions::default();
     let clean = identify_local(&plan, &recs, &options).unwrap();
     assert!(
@@ -136,7 +109,7 @@ fn isolated_glitches_are_replaced_and_reported() {
 
 #[test]
 fn a_burst_is_not_taken_for_glitches() {
-    let (plan, mut recs) = noisy_logs();
+    let (plan, mut recs) = a465_noisy_runs();
     let n = plan.joint_names.len();
     let h_time = crossing_time(&plan, "H", 2);
     // joint 2's torque reads 8 N m high for 6 samples (a burst of varying values: not a held
@@ -173,7 +146,7 @@ fn a_burst_is_not_taken_for_glitches() {
 /// it moved H* by 3.3 standard errors, silently (the burst raised its window's noise level).
 #[test]
 fn a_held_reading_is_replaced_before_the_windows_are_read() {
-    let (plan, mut recs) = noisy_logs();
+    let (plan, mut recs) = a465_noisy_runs();
     let clean = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
     assert!(clean.diagnostics.held_readings.is_empty());
     let n = plan.joint_names.len();
@@ -253,7 +226,7 @@ fn a_held_reading_is_replaced_before_the_windows_are_read() {
 /// after them is still named by its row in the log.
 #[test]
 fn a_dropout_is_removed_before_the_windows_are_read() {
-    let (plan, mut recs) = noisy_logs();
+    let (plan, mut recs) = a465_noisy_runs();
     let clean = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
     let n = plan.joint_names.len();
     let h_time = crossing_time(&plan, "H", 2);
@@ -314,7 +287,7 @@ fn a_dropout_is_removed_before_the_windows_are_read() {
 
 #[test]
 fn saved_glitches_are_checked_on_load() {
-    let (plan, mut recs) = noisy_logs();
+    let (plan, mut recs) = a465_noisy_runs();
     let n = plan.joint_names.len();
     let d = log(&mut recs, "D");
     let t0 = plan.experiments.last().unwrap().crossings[1].time;
@@ -346,7 +319,7 @@ fn saved_glitches_are_checked_on_load() {
     }
     // a model without glitches saves none, and an older file without the field loads
     let clean = {
-        let (plan, recs) = noisy_logs();
+        let (plan, recs) = a465_noisy_runs();
         identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap()
     };
     let text = clean.to_json();
@@ -366,7 +339,7 @@ fn crossing_time(plan: &Plan, kind: &str, k: usize) -> f64 {
 
 /// Runs `edit` on a copy of the noisy logs' D recording and identifies; the error's text.
 fn refused(edit: impl Fn(&mut Recording)) -> String {
-    let (plan, mut recs) = noisy_logs();
+    let (plan, mut recs) = a465_noisy_runs();
     edit(log(&mut recs, "D"));
     identify_local(&plan, &recs, &IdentifyOptions::default())
         .unwrap_err()
@@ -423,7 +396,7 @@ fn logs_that_cannot_be_runs_of_the_plan_are_refused_naming_why() {
     let e = refused(|r| r.q.iter_mut().step_by(n).for_each(|q| *q += 0.1));
     assert!(e.contains("'joint1' +0.100 off on average"), "{e}");
     // tracking errors of a few mrad, and a clock 0.2 s off, are no reason to refuse
-    let (plan, mut recs) = noisy_logs();
+    let (plan, mut recs) = a465_noisy_runs();
     for r in &mut recs {
         r.t.iter_mut().for_each(|t| *t += 0.2);
         for (i, q) in r.q.iter_mut().enumerate() {
@@ -438,7 +411,7 @@ fn logs_that_cannot_be_runs_of_the_plan_are_refused_naming_why() {
 /// is found and the model is the one of the log without the idle start.
 #[test]
 fn a_run_late_in_its_log_is_found_where_allowed_and_named_where_not() {
-    let (plan, recs) = noisy_logs();
+    let (plan, recs) = a465_noisy_runs();
     let idle = 5.0;
     let late: Vec<Recording> = recs.iter().map(|r| idle_start(r, idle)).collect();
     let e = identify_local(&plan, &late, &IdentifyOptions::default())
@@ -490,7 +463,7 @@ fn idle_start(r: &Recording, idle: f64) -> Recording {
 /// from the wrong windows (T* off by 65 standard errors). Now it is named, as any late run.
 #[test]
 fn a_repeating_run_a_little_late_is_not_matched_one_repetition_off() {
-    let (plan, recs) = noisy_logs();
+    let (plan, recs) = a465_noisy_runs();
     let nominal = plan.experiment(ExperimentKind::Nominal).unwrap();
     let period = nominal.crossings[1].time - nominal.crossings[0].time;
     for idle in [0.7, 1.0, 2.0] {

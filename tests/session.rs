@@ -4,24 +4,9 @@
 
 mod common;
 
-use common::table2;
-use perturbid_rs::local::{
-    identify_local, plan_experiments, split_session, IdentifyOptions, LocalModel, Plan,
-    PlanOptions, SplitOptions,
-};
-use perturbid_rs::robots::a465;
-use perturbid_rs::{simulate_plan, Recording, SimulationOptions};
-
-fn runs() -> (Plan, Vec<Recording>) {
-    let model = a465::model("kinsheel2010").unwrap();
-    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
-    let mut sim = SimulationOptions::new(&model);
-    sim.torque_noise = vec![0.05; model.nv];
-    sim.position_noise = vec![1e-5; model.nv];
-    sim.seed = 11;
-    let recs = simulate_plan(&model, &plan, &sim).unwrap();
-    (plan, recs)
-}
+use common::{a465_noisy_runs, worst_in_stderr};
+use perturbid_rs::local::{identify_local, split_session, IdentifyOptions, SplitOptions};
+use perturbid_rs::Recording;
 
 /// One log of `recs` in the given order, on one clock starting at 1000 s: a homing move of 2 s
 /// from elsewhere first, and between two runs a smooth move of `pause` s from one's last
@@ -85,21 +70,9 @@ fn session(recs: &[&Recording], pause: f64) -> Recording {
     Recording::new("session.csv", n, t, q, tau, None, None).unwrap()
 }
 
-fn worst_in_stderr(a: &LocalModel, clean: &LocalModel) -> f64 {
-    let parts = |m: &LocalModel| [m.d.clone(), m.h.clone(), m.g.clone()];
-    let mut worst: f64 = 0.0;
-    for (x, y) in parts(a).iter().zip(parts(clean).iter()) {
-        let (x, y) = (x.as_ref().unwrap(), y.as_ref().unwrap());
-        for ((a, b), s) in x.matrix.iter().zip(y.matrix.iter()).zip(y.stderr.iter()) {
-            worst = worst.max((a - b).abs() / s);
-        }
-    }
-    worst
-}
-
 #[test]
 fn a_session_log_splits_into_the_runs_that_identify_as_the_separate_recordings() {
-    let (plan, recs) = runs();
+    let (plan, recs) = a465_noisy_runs();
     let log = session(&recs.iter().collect::<Vec<_>>(), 1.5);
     let split = split_session(&plan, &log, &SplitOptions::default()).unwrap();
     assert_eq!(split.len(), plan.experiments.len());
@@ -125,7 +98,7 @@ fn a_session_log_splits_into_the_runs_that_identify_as_the_separate_recordings()
 
 #[test]
 fn runs_out_of_order_missing_or_of_other_joints_are_named() {
-    let (plan, recs) = runs();
+    let (plan, recs) = a465_noisy_runs();
     let kinds: Vec<&str> = recs
         .iter()
         .map(|r| r.experiment.as_deref().unwrap())

@@ -324,6 +324,37 @@ pub fn covering_offsets(experiment: &Experiment, rec: &Recording) -> Option<(f64
     (range.0 <= range.1).then_some(range)
 }
 
+/// The squared differences between `rec`'s positions at the samples `rows` and `experiment`'s
+/// planned ones at their times less `d` s (clamped to the plan's span), taken about each
+/// joint's mean difference and summed over the joints (rad^2 or m^2), with the number of
+/// samples. A constant offset (an encoder's zero, or a joint held off the plan, which is
+/// checked after) carries no timing and would otherwise pull the offset towards where the
+/// difference's mean is smallest.
+pub(super) fn centred_misfit(
+    experiment: &Experiment,
+    rec: &Recording,
+    d: f64,
+    rows: impl Iterator<Item = usize>,
+) -> (f64, f64) {
+    let n = rec.n;
+    let traj = &experiment.trajectory;
+    let (start, end) = (traj.start(), traj.end());
+    let (mut sum, mut sq) = (vec![0.0; n], vec![0.0; n]);
+    let mut count = 0.0;
+    for i in rows {
+        let tp = (rec.t[i] - d).clamp(start, end);
+        let seg = traj.segment_at(tp);
+        for j in 0..n {
+            let e = rec.q[i * n + j] - seg.eval(j, tp).0;
+            sum[j] += e;
+            sq[j] += e * e;
+        }
+        count += 1.0;
+    }
+    let cost = (0..n).map(|j| sq[j] - sum[j] * sum[j] / count).sum();
+    (cost, count)
+}
+
 /// [`detect_offset`] over `[lo, hi]` (s, `lo <= hi`), with a grid of `2 half_points + 1`
 /// offsets before the refinement; also returns the cost at the offset found (the positions'
 /// squared differences about each joint's mean, summed over about 250 samples), to compare
@@ -338,23 +369,9 @@ pub fn detect_offset_in(
     let n = rec.n;
     let traj = &experiment.trajectory;
     let (start, end) = (traj.start(), traj.end());
-    // the squared differences about each joint's mean difference: a constant offset (an
-    // encoder's zero, or a joint held off the plan, which is checked after) carries no timing
-    // and would otherwise pull the offset towards where the difference's mean is smallest
-    let cost = |d: f64, stride: usize| -> f64 {
-        let (mut sum, mut sq) = (vec![0.0; n], vec![0.0; n]);
-        let mut count = 0.0;
-        for i in (0..rec.len()).step_by(stride) {
-            let tp = (rec.t[i] - d).clamp(start, end);
-            let seg = traj.segment_at(tp);
-            for j in 0..n {
-                let e = rec.q[i * n + j] - seg.eval(j, tp).0;
-                sum[j] += e;
-                sq[j] += e * e;
-            }
-            count += 1.0;
-        }
-        (0..n).map(|j| sq[j] - sum[j] * sum[j] / count).sum()
+    // the squared differences about each joint's mean difference ([`centred_misfit`])
+    let cost = |d: f64, stride: usize| {
+        centred_misfit(experiment, rec, d, (0..rec.len()).step_by(stride)).0
     };
     let stride = (rec.len() / 250).max(1);
     let half_points = half_points.max(1);

@@ -4,7 +4,7 @@
 //! run on the plan's clock. The runs are found in the plan's order, each after the previous
 //! one, where the log's positions follow the experiment's planned ones best.
 
-use super::clock::{follows_plan, misfit_shown, position_misfit};
+use super::clock::{centred_misfit, follows_plan, misfit_shown, position_misfit};
 use super::plan::{Experiment, Plan};
 use crate::error::{Error, Result};
 use crate::recording::Recording;
@@ -42,21 +42,9 @@ fn window_cost(e: &Experiment, log: &Recording, d: f64, samples: usize) -> f64 {
     if i1 < i0 + 2 {
         return f64::INFINITY;
     }
-    let n = log.n;
     let stride = ((i1 - i0) / samples.max(1)).max(1);
-    let (mut sum, mut sq) = (vec![0.0; n], vec![0.0; n]);
-    let mut count = 0.0;
-    for i in (i0..i1).step_by(stride) {
-        let tp = (log.t[i] - d).clamp(start, end);
-        let seg = traj.segment_at(tp);
-        for j in 0..n {
-            let diff = log.q[i * n + j] - seg.eval(j, tp).0;
-            sum[j] += diff;
-            sq[j] += diff * diff;
-        }
-        count += 1.0;
-    }
-    (0..n).map(|j| sq[j] - sum[j] * sum[j] / count).sum::<f64>() / count
+    let (cost, count) = centred_misfit(e, log, d, (i0..i1).step_by(stride));
+    cost / count
 }
 
 /// The offset `d` in `[lo, hi]` (s) at which `e`'s plan fits the log best, with its cost: a

@@ -464,3 +464,38 @@ pub fn panda_preprocessed() -> Option<(perturbid_rs::Model, perturbid_rs::Record
         perturbid_rs::preprocess::preprocess(&rec, &options).unwrap(),
     ))
 }
+
+/// The A465's plan at Table 2 (default options) and its simulated recordings with 0.05 N m of
+/// torque noise and 1e-5 rad of position noise (seed 11).
+pub fn a465_noisy_runs() -> (perturbid_rs::local::Plan, Vec<perturbid_rs::Recording>) {
+    let model = perturbid_rs::robots::a465::model("kinsheel2010").unwrap();
+    let plan = perturbid_rs::local::plan_experiments(
+        &model,
+        &table2(),
+        &perturbid_rs::local::PlanOptions::default(),
+    )
+    .unwrap();
+    let mut sim = perturbid_rs::SimulationOptions::new(&model);
+    sim.torque_noise = vec![0.05; model.nv];
+    sim.position_noise = vec![1e-5; model.nv];
+    sim.seed = 11;
+    let recs = perturbid_rs::simulate_plan(&model, &plan, &sim).unwrap();
+    (plan, recs)
+}
+
+/// The largest difference between two local models' D*, H* and G*, in the standard errors of
+/// the second (`clean`).
+pub fn worst_in_stderr(
+    a: &perturbid_rs::local::LocalModel,
+    clean: &perturbid_rs::local::LocalModel,
+) -> f64 {
+    [(&a.d, &clean.d), (&a.h, &clean.h), (&a.g, &clean.g)]
+        .into_iter()
+        .map(|(x, c)| {
+            let c = c.as_ref().unwrap();
+            (mat(x) - &c.matrix)
+                .zip_map(&c.stderr, |d, s| (d / s).abs())
+                .max()
+        })
+        .fold(0.0, f64::max)
+}
