@@ -34,10 +34,10 @@ pub(crate) fn split(a: SplitArgs) -> Result<String> {
     let plan = Plan::load(&a.plan)?;
     let log = load_recording(&a.log, &plan.joint_names)?;
     let runs = split_session(&plan, &log, &SplitOptions { margin: a.margin })?;
-    let recordings: Vec<_> = runs.iter().map(|(r, _)| r.clone()).collect();
+    let (recordings, offsets): (Vec<_>, Vec<f64>) = runs.into_iter().unzip();
     let set = recording_files(&plan, &recordings, &out_dir(&a.out))?;
     let mut out = String::new();
-    for (e, (run, offset)) in plan.experiments.iter().zip(&runs) {
+    for ((e, run), offset) in plan.experiments.iter().zip(&recordings).zip(&offsets) {
         let name = format!("{}.csv", e.kind.name());
         refuse_overwriting_inputs(&set.path_of(&name), &[a.log.as_path(), a.plan.as_path()])?;
         let _ = writeln!(
