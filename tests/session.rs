@@ -5,7 +5,9 @@
 mod common;
 
 use common::{a465_noisy_runs, worst_in_stderr};
-use perturbid_rs::local::{identify_local, split_session, IdentifyOptions, SplitOptions};
+use perturbid_rs::local::{
+    identify_local, position_misfit, split_session, IdentifyOptions, SplitOptions,
+};
 use perturbid_rs::Recording;
 
 /// One log of `recs` in the given order, on one clock starting at 1000 s: a homing move of 2 s
@@ -166,4 +168,39 @@ fn runs_out_of_order_missing_or_of_other_joints_are_named() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("margin"), "{e}");
+}
+
+#[test]
+fn a_runs_position_check_reads_the_runs_own_samples_however_long_the_session() {
+    let (plan, recs) = a465_noisy_runs();
+    // about 6 minutes of moves between the runs
+    let log = session(&recs.iter().collect::<Vec<_>>(), 60.0);
+    assert!(log.len() > 300_000, "{}", log.len());
+    let split = split_session(&plan, &log, &SplitOptions::default()).unwrap();
+    for ((_, d), e) in split.iter().zip(&plan.experiments) {
+        // the run with a second of the log either side, on the log's clock
+        let rows: Vec<usize> = (0..log.len())
+            .filter(|&i| {
+                log.t[i] >= e.trajectory.start() + d - 1.0
+                    && log.t[i] <= e.trajectory.end() + d + 1.0
+            })
+            .collect();
+        let n = log.n;
+        let excerpt = Recording::new(
+            "excerpt.csv",
+            n,
+            rows.iter().map(|&i| log.t[i]).collect(),
+            rows.iter()
+                .flat_map(|&i| log.q[i * n..(i + 1) * n].to_vec())
+                .collect(),
+            rows.iter()
+                .flat_map(|&i| log.tau[i * n..(i + 1) * n].to_vec())
+                .collect(),
+            None,
+            None,
+        )
+        .unwrap();
+        let in_log = position_misfit(e, &log, *d).unwrap();
+        assert_eq!(in_log, position_misfit(e, &excerpt, *d).unwrap());
+    }
 }

@@ -240,9 +240,26 @@ pub struct PositionMisfit {
     pub recorded: f64,
 }
 
+/// The rows of `rec` whose times lie within `experiment`'s planned span placed `d` s later (log
+/// time = plan time + `d`), every so many so as to take at most about `samples` of them: the
+/// same rows however much else the log holds (a run's check in a 10-minute session read a
+/// dozen samples when they were spread over the whole log).
+pub(super) fn span_rows(
+    experiment: &Experiment,
+    rec: &Recording,
+    d: f64,
+    samples: usize,
+) -> std::iter::StepBy<std::ops::Range<usize>> {
+    let traj = &experiment.trajectory;
+    let i0 = rec.t.partition_point(|&t| t < traj.start() + d);
+    let i1 = rec.t.partition_point(|&t| t <= traj.end() + d).max(i0);
+    (i0..i1).step_by(((i1 - i0) / samples.max(1)).max(1))
+}
+
 /// Per joint, how far the recorded positions stray from `experiment`'s planned ones with the
 /// recording's clock `offset` s ahead of the plan's, over the samples within the plan's span
-/// (about 2,000 of them). `None` when no sample lies within the plan's span.
+/// (about 2,000 of them, [`span_rows`]: however long the log, the run's own samples). `None`
+/// when no sample lies within the plan's span.
 pub fn position_misfit(
     experiment: &Experiment,
     rec: &Recording,
@@ -251,15 +268,11 @@ pub fn position_misfit(
     let n = rec.n;
     let traj = &experiment.trajectory;
     let (start, end) = (traj.start(), traj.end());
-    let stride = (rec.len() / 2_000).max(1);
     let mut diff: Vec<Vec<f64>> = vec![vec![]; n];
     let mut planned: Vec<Vec<f64>> = vec![vec![]; n];
     let mut recorded: Vec<Vec<f64>> = vec![vec![]; n];
-    for i in (0..rec.len()).step_by(stride) {
-        let tp = rec.t[i] - offset;
-        if tp < start || tp > end {
-            continue;
-        }
+    for i in span_rows(experiment, rec, offset, 2_000) {
+        let tp = (rec.t[i] - offset).clamp(start, end);
         let seg = traj.segment_at(tp);
         for j in 0..n {
             let q = seg.eval(j, tp).0;

@@ -4,7 +4,7 @@
 //! run on the plan's clock. The runs are found in the plan's order, each after the previous
 //! one, where the log's positions follow the experiment's planned ones best.
 
-use super::clock::{centred_misfit, follows_plan, misfit_shown, position_misfit};
+use super::clock::{centred_misfit, follows_plan, misfit_shown, position_misfit, span_rows};
 use super::plan::{Experiment, Plan};
 use crate::error::{Error, Result};
 use crate::recording::Recording;
@@ -35,15 +35,11 @@ const CANDIDATES: usize = 16;
 /// positions over the span of `e`'s plan placed at `d` s (log time = plan time + d) and the
 /// planned positions, on at most `samples` samples; infinite where the log holds fewer than 2.
 fn window_cost(e: &Experiment, log: &Recording, d: f64, samples: usize) -> f64 {
-    let traj = &e.trajectory;
-    let (start, end) = (traj.start(), traj.end());
-    let i0 = log.t.partition_point(|&t| t < start + d);
-    let i1 = log.t.partition_point(|&t| t <= end + d);
-    if i1 < i0 + 2 {
+    let rows = span_rows(e, log, d, samples);
+    if rows.len() < 2 {
         return f64::INFINITY;
     }
-    let stride = ((i1 - i0) / samples.max(1)).max(1);
-    let (cost, count) = centred_misfit(e, log, d, (i0..i1).step_by(stride));
+    let (cost, count) = centred_misfit(e, log, d, rows);
     cost / count
 }
 
