@@ -6,7 +6,7 @@ mod common;
 
 use common::{a465_noisy_runs, worst_in_stderr};
 use perturbid_rs::local::{
-    identify_local, position_misfit, split_session, IdentifyOptions, SplitOptions,
+    identify_local, position_misfit, split_session, CrossingTimes, IdentifyOptions, SplitOptions,
 };
 use perturbid_rs::Recording;
 
@@ -203,4 +203,48 @@ fn a_runs_position_check_reads_the_runs_own_samples_however_long_the_session() {
         let in_log = position_misfit(e, &log, *d).unwrap();
         assert_eq!(in_log, position_misfit(e, &excerpt, *d).unwrap());
     }
+}
+
+#[test]
+fn a_session_log_given_as_one_experiments_recording_is_named_or_read_at_its_run() {
+    let (plan, recs) = a465_noisy_runs();
+    let log = session(&recs.iter().collect::<Vec<_>>(), 20.0);
+    let split = split_session(&plan, &log, &SplitOptions::default()).unwrap();
+    // the session on a clock from 0, given as D's recording
+    let at = plan
+        .experiments
+        .iter()
+        .position(|e| e.kind.name() == "D")
+        .unwrap();
+    let run = split[at].1 - 1000.0;
+    assert!(run > 60.0, "{run}");
+    let mut whole = log.clone();
+    whole.t.iter_mut().for_each(|t| *t -= 1000.0);
+    whole.experiment = Some("D".into());
+    let mut given = recs.clone();
+    given[at] = whole;
+    let e = identify_local(&plan, &given, &IdentifyOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(&format!("'D' best with its clock {run:+.3} s ahead"))
+            && e.contains("perturbid split, Plan.split_session"),
+        "{e}"
+    );
+    // with the tolerance raised, the run itself (the nominal passes repeat every 0.3 s: a
+    // grid of max_shift / 200 found a repetition 1.2 s early)
+    let o = IdentifyOptions {
+        times: CrossingTimes::Detected {
+            max_shift: 1.1 * run,
+        },
+        ..IdentifyOptions::default()
+    };
+    let model = identify_local(&plan, &given, &o).unwrap();
+    let found = model
+        .diagnostics
+        .offsets
+        .iter()
+        .find(|x| x.experiment == "D")
+        .unwrap();
+    assert!((found.offset - run).abs() < 2e-3, "{found:?} {run}");
 }

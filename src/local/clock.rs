@@ -3,6 +3,7 @@
 //! against the planned ones), and the offset between the two clocks found in the positions.
 
 use super::crossing::samples_needed;
+use super::offset_search::detect_offset_in;
 use super::plan::Experiment;
 use super::FitOptions;
 use crate::error::{Error, Result};
@@ -55,10 +56,17 @@ pub(super) fn align(
         let (wide, wide_cost) = detect_offset_in(experiment, rec, first, last, points);
         let fits = check_positions(experiment, rec, joint_names, steps, (wide, searched)).is_ok();
         if wide.abs() > max_shift && wide_cost < 0.25 * cost && fits {
+            // a log more than twice the run's length may hold the whole session
+            let span = experiment.trajectory.end() - experiment.trajectory.start();
+            let session = if rec.t[rec.len() - 1] - rec.t[0] > 2.0 * span {
+                "; if it is a log of the whole session, split it into one recording per experiment first (perturbid split, Plan.split_session)"
+            } else {
+                ""
+            };
             return Err(Error::Recording {
                 recording: rec.name.clone(),
                 message: format!(
-                    "its positions follow the plan of experiment '{}' best with its clock {wide:+.3} s ahead of the plan's (found over its whole span), more than the {} s of clock offset accepted: if the run starts that late in the log, raise max_shift (--max-shift) to at least {}",
+                    "its positions follow the plan of experiment '{}' best with its clock {wide:+.3} s ahead of the plan's (found over its whole span), more than the {} s of clock offset accepted: if the run starts that late in the log, raise max_shift (--max-shift) to at least {}{session}",
                     experiment.kind.name(),
                     crate::error::shown(max_shift),
                     crate::error::shown((wide.abs() * 1.1 * 10.0).ceil() / 10.0),
@@ -258,7 +266,7 @@ pub(super) fn span_rows(
 
 /// Per joint, how far the recorded positions stray from `experiment`'s planned ones with the
 /// recording's clock `offset` s ahead of the plan's, over the samples within the plan's span
-/// (about 2,000 of them, [`span_rows`]: however long the log, the run's own samples). `None`
+/// (about 2,000 of them: however long the log, the run's own samples). `None`
 /// when no sample lies within the plan's span.
 pub fn position_misfit(
     experiment: &Experiment,
@@ -299,20 +307,6 @@ pub fn position_misfit(
             })
             .collect(),
     )
-}
-
-/// The time offset `d` (s, within `+-max_shift`) such that the recording at `t` follows the
-/// plan at `t - d`: least squares over positions, a grid search at a resolution of
-/// `max_shift / 200` on about 250 samples, refined by Gauss-Newton on about 20,000
-/// (sub-sample: exact on noise-free data).
-pub fn detect_offset(experiment: &Experiment, rec: &Recording, max_shift: f64) -> Result<f64> {
-    if !(max_shift.is_finite() && max_shift > 0.0) {
-        return Err(Error::InvalidArgument {
-            argument: "max_shift".into(),
-            message: format!("{max_shift}; expected a positive number of seconds"),
-        });
-    }
-    Ok(detect_offset_in(experiment, rec, -max_shift, max_shift, 200).0)
 }
 
 /// The offsets `d` (s) at which some sample of `rec` falls within `experiment`'s plan
@@ -366,86 +360,6 @@ pub(super) fn centred_misfit(
     }
     let cost = (0..n).map(|j| sq[j] - sum[j] * sum[j] / count).sum();
     (cost, count)
-}
-
-/// [`detect_offset`] over `[lo, hi]` (s, `lo <= hi`), with a grid of `2 half_points + 1`
-/// offsets before the refinement; also returns the cost at the offset found (the positions'
-/// squared differences about each joint's mean, summed over about 250 samples), to compare
-/// searches.
-pub fn detect_offset_in(
-    experiment: &Experiment,
-    rec: &Recording,
-    lo: f64,
-    hi: f64,
-    half_points: usize,
-) -> (f64, f64) {
-    let n = rec.n;
-    let traj = &experiment.trajectory;
-    let (start, end) = (traj.start(), traj.end());
-    // the squared differences about each joint's mean difference ([`centred_misfit`])
-    let cost = |d: f64, stride: usize| {
-        centred_misfit(experiment, rec, d, (0..rec.len()).step_by(stride)).0
-    };
-    let stride = (rec.len() / 250).max(1);
-    let half_points = half_points.max(1);
-    let step = (hi - lo) / (2 * half_points) as f64;
-    let mut best = (f64::INFINITY, 0.5 * (lo + hi));
-    for g in 0..=2 * half_points {
-        let d = lo + g as f64 * step;
-        let c = cost(d, stride);
-        if c < best.0 {
-            best = (c, d);
-        }
-    }
-    if step.is_nan() || step <= 0.0 {
-        return (best.1, best.0);
-    }
-    // Gauss-Newton refinement in [d - step, d + step]: the residual q_rec(t) - q_plan(t - d)
-    // changes with d at the planned speed
-    let fine = (rec.len() / 20_000).max(1);
-    let (lo, hi) = ((best.1 - step).max(lo), (best.1 + step).min(hi));
-    let mut d = best.1;
-    for _ in 0..20 {
-        // per joint, the sums of e, v, e v and v^2 (e the difference, v the planned speed):
-        // the step of the centred problem, each joint's mean difference taken off
-        let mut sums = vec![[0.0; 4]; n];
-        let mut count = 0.0;
-        for i in (0..rec.len()).step_by(fine) {
-            let tp = rec.t[i] - d;
-            if tp < start || tp > end {
-                continue;
-            }
-            let seg = traj.segment_at(tp);
-            for (j, s) in sums.iter_mut().enumerate() {
-                let (q, v, _) = seg.eval(j, tp);
-                let e = rec.q[i * n + j] - q;
-                s[0] += e;
-                s[1] += v;
-                s[2] += e * v;
-                s[3] += v * v;
-            }
-            count += 1.0;
-        }
-        if count < 2.0 {
-            break;
-        }
-        let (num, den) = sums.iter().fold((0.0, 0.0), |(num, den), s| {
-            (
-                num + s[2] - s[0] * s[1] / count,
-                den + s[3] - s[1] * s[1] / count,
-            )
-        });
-        if den.is_nan() || den <= 0.0 {
-            break;
-        }
-        let next = (d - num / den).clamp(lo, hi);
-        let done = (next - d).abs() < 1e-13;
-        d = next;
-        if done {
-            break;
-        }
-    }
-    (d, cost(d, stride))
 }
 
 /// The largest clock offset, as a fraction of the reading window's half-width, taken for a

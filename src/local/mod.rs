@@ -42,6 +42,7 @@ pub mod glitches;
 pub mod identify;
 pub mod model;
 pub mod noise;
+pub mod offset_search;
 pub mod operating_point;
 pub mod parameters;
 pub mod perturbation;
@@ -57,10 +58,7 @@ pub mod rounded_positions;
 pub mod session;
 pub mod torque_offsets;
 
-pub use clock::{
-    check_clock, covering_offsets, detect_offset, detect_offset_in, overlap_offsets,
-    position_misfit, PositionMisfit,
-};
+pub use clock::{check_clock, covering_offsets, overlap_offsets, position_misfit, PositionMisfit};
 pub use crossing::{
     noise_levels, values_at, values_at_with, values_in_windows, CrossingValues, FitOptions, Signal,
     SignalScales, TorqueFit, WindowGlitch,
@@ -71,6 +69,7 @@ pub use diagnostics::{
 };
 pub use identify::{identify_local, CrossingTimes, IdentifyOptions};
 pub use model::{Estimate, Estimator, LocalModel};
+pub use offset_search::{detect_offset, detect_offset_in};
 pub use operating_point::OperatingPoint;
 pub use parameters::{identify_parameters_from_local, FromLocalOptions, ParametersFromLocal};
 pub use perturbation::{Design, Size, Sizes};
