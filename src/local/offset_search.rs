@@ -21,8 +21,9 @@ const CANDIDATES: usize = 8;
 
 /// The time offset `d` (s, within `+-max_shift`) such that the recording at `t` follows the
 /// plan at `t - d`: least squares over positions, a grid search at a resolution of
-/// `max_shift / 200` on 256 times over the plan's span, refined by Gauss-Newton on about 20,000
-/// (sub-sample: exact on noise-free data).
+/// `max_shift / 200` or 20 ms, whichever is finer, on 256 times over the plan's span,
+/// its lowest minima refined by Gauss-Newton on about 20,000 samples (sub-sample: exact on
+/// noise-free data).
 pub fn detect_offset(experiment: &Experiment, rec: &Recording, max_shift: f64) -> Result<f64> {
     if !(max_shift.is_finite() && max_shift > 0.0) {
         return Err(Error::InvalidArgument {
@@ -67,7 +68,7 @@ impl SpanGrid {
     /// The squared differences between `rec`'s positions at the plan's times plus `d` s
     /// (linearly interpolated between samples; its first or last sample's outside the log)
     /// and the planned ones, taken about each joint's mean difference and summed over the
-    /// joints (rad^2 or m^2; see [`centred_misfit`] on why centred). The plan's span is read
+    /// joints (rad^2 or m^2; see `clock::centred_misfit` on why centred). The plan's span is read
     /// the same however long the log: a run in a session log of minutes was compared on the
     /// few of 250 samples spread over the whole log that fell within it, and an offset that
     /// leaves the plan's motion outside the log compares that motion with the log's end, not
@@ -103,8 +104,9 @@ impl SpanGrid {
     }
 }
 
-/// [`detect_offset`] over `[lo, hi]` (s, `lo <= hi`), with a grid of `2 half_points + 1`
-/// offsets before the refinement; also returns the cost at the offset found (the positions'
+/// [`detect_offset`] over `[lo, hi]` (s, `lo <= hi`), with a grid of at least
+/// `2 half_points + 1` offsets and at most 20 ms apart (at most 200,001) before the refinement
+/// of its 8 lowest local minima; also returns the cost at the offset found (the positions'
 /// squared differences about each joint's mean, summed over 256 times evenly over the plan's
 /// span), to compare searches.
 pub fn detect_offset_in(
