@@ -212,3 +212,55 @@ fn numbers_pass_to_the_commands_short() {
         "{dry}"
     );
 }
+
+/// The operating point written out, as `--help` shows it: on the command line as JSON, in a
+/// pipeline as a table or a JSON string, each gives the plan its file gives (the command line
+/// took the JSON for a file's name, and a pipeline for one beside it).
+#[test]
+fn an_operating_point_written_out_plans_as_its_file() {
+    let d = tmp("pipeline-op");
+    let op = table2_op(&d);
+    let json = std::fs::read_to_string(&op).unwrap();
+    let plan = |out: &str| std::fs::read_to_string(d.join(out).join("plan.json")).unwrap();
+    ok(&["plan", "a465", "--op", s(&op), "--out", s(&d.join("file"))]);
+    ok(&["plan", "a465", "--op", &json, "--out", s(&d.join("inline"))]);
+    assert_eq!(plan("inline"), plan("file"));
+    let q = "[0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0]";
+    let qd = "[0.089, -0.106, 0.022, 0.056, 0.011, 0.014]";
+    let qdd = "[-0.155, -0.5, 0.034, -0.291, -0.008, 0.171]";
+    write(
+        &d.join("p.toml"),
+        &format!("[[step]]\nrun = \"plan\"\nrobot = \"a465\"\nop = {{ q = {q}, qd = {qd}, qdd = {qdd} }}\nout = \"table\"\n\n[[step]]\nrun = \"plan\"\nrobot = \"a465\"\nop = '{json}'\nout = \"string\"\n"),
+    );
+    ok(&["run", s(&d.join("p.toml"))]);
+    assert_eq!(plan("table"), plan("file"));
+    assert_eq!(plan("string"), plan("file"));
+    // a mistake in it is named as the operating point's, and nothing is written
+    fails(
+        &[
+            "plan",
+            "a465",
+            "--op",
+            r#"{"q": [0.1]}"#,
+            "--out",
+            s(&d.join("bad")),
+        ],
+        &[
+            "--op (the operating point given as JSON)",
+            "missing field `qd`",
+        ],
+    );
+    assert!(!d.join("bad").exists());
+    // a name that is neither a file nor JSON is still read as a file, and said missing
+    fails(
+        &[
+            "plan",
+            "a465",
+            "--op",
+            s(&d.join("none.json")),
+            "--out",
+            s(&d.join("bad")),
+        ],
+        &["none.json", "No such file"],
+    );
+}

@@ -78,6 +78,14 @@ pub(crate) fn load_json<T>(path: &Path, parse: impl Fn(&str) -> Result<T>) -> Re
     })
 }
 
+/// Whether a file argument is JSON written out in place of a file's name: it starts with `{`
+/// and no file of that name exists.
+pub(crate) fn is_inline_json(arg: &Path) -> bool {
+    arg.to_str()
+        .is_some_and(|s| s.trim_start().starts_with('{'))
+        && !arg.exists()
+}
+
 /// Refuses an output file that is one of the inputs (it would be destroyed before, or while,
 /// it is read): `--out` equal to an input, also through another spelling of the same path.
 pub(crate) fn refuse_overwriting_inputs(out: &Path, inputs: &[&Path]) -> Result<()> {

@@ -25,7 +25,8 @@ use crate::trajectory::FourierTrajectory;
 pub(crate) struct PlanArgs {
     #[command(flatten)]
     robot: RobotArg,
-    /// The operating point: JSON {"q": [...], "qd": [...], "qdd": [...]} (rad, rad/s, rad/s^2).
+    /// The operating point: a JSON file, or the JSON itself, {"q": [...], "qd": [...], "qdd":
+    /// [...]} (rad, rad/s, rad/s^2).
     #[arg(long)]
     op: PathBuf,
     /// Output folder: plan.json and <experiment>.csv (t, q1..qN, qd1..qN, qdd1..qN).
@@ -114,8 +115,10 @@ struct OpFile {
     qdd: Vec<f64>,
 }
 
-fn load_op(path: &Path) -> Result<OperatingPoint> {
-    load_json(path, |text| {
+/// The operating point of `--op`: a JSON file, or (where no such file exists) the JSON itself
+/// when it starts with `{`, as `--help` shows it.
+fn load_op(arg: &Path) -> Result<OperatingPoint> {
+    let parse = |text: &str| {
         let op: OpFile = serde_json::from_str(text).map_err(|e| Error::Json {
             context: "operating point".into(),
             message: format!(
@@ -125,7 +128,17 @@ fn load_op(path: &Path) -> Result<OperatingPoint> {
             ),
         })?;
         OperatingPoint::new(op.q, op.qd, op.qdd)
-    })
+    };
+    match arg.to_str() {
+        Some(text) if super::files::is_inline_json(arg) => parse(text).map_err(|e| match e {
+            Error::Json { message, .. } => Error::Json {
+                context: "--op (the operating point given as JSON)".into(),
+                message,
+            },
+            other => other,
+        }),
+        _ => load_json(arg, parse),
+    }
 }
 
 /// The nominal passes' noise the saved local models of `model` at `paths` report, pooled, as

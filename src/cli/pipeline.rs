@@ -307,6 +307,13 @@ fn words(key: &str, value: &Value, arg: &clap::Arg, base: &Path, at: &str) -> Re
                 .map(|(joint, v)| Ok(format!("{joint}={}", scalar(v)?)))
                 .collect::<Result<Vec<_>>>()?
         }
+        // `op = { q = [...], qd = [...], qdd = [...] }`: the operating point written out, given
+        // to `--op` as its JSON
+        Value::Table(t) if arg.get_id().as_str() == "op" => {
+            return serde_json::to_string(t)
+                .map(|json| vec![json])
+                .map_err(|e| bad(format!("'{key}': {e}")))
+        }
         v => vec![scalar(v)?],
     };
     for w in &mut words {
@@ -319,7 +326,10 @@ fn words(key: &str, value: &Value, arg: &clap::Arg, base: &Path, at: &str) -> Re
 /// is a path, and the robot when such a file exists (otherwise it is a built-in name).
 fn resolve(word: &str, arg: &clap::Arg, base: &Path) -> String {
     let p = Path::new(word);
-    if p.is_absolute() || word.is_empty() {
+    if p.is_absolute()
+        || word.is_empty()
+        || (super::files::is_inline_json(p) && !base.join(p).exists())
+    {
         return word.to_string();
     }
     let is_path = matches!(
