@@ -640,7 +640,10 @@ fn bad_inputs_get_one_line_errors_and_no_output() {
     );
     fails(
         &["identify", s(&plan), &f, &f, "--out", s(&model)],
-        &["time.csv", "time does not increase at data row 3"],
+        &[
+            "time.csv",
+            "line 4, column 't': time does not increase (t = 0.001 after 0.002 on line 3)",
+        ],
     );
     // ... after a huge time: the number in exponent form, not 301 digits
     let f = csv(
@@ -649,7 +652,7 @@ fn bad_inputs_get_one_line_errors_and_no_output() {
     );
     fails(
         &["identify", s(&plan), &f, &f, "--out", s(&model)],
-        &["huge_time.csv", "(t = 0.001 after 1e300)"],
+        &["huge_time.csv", "(t = 0.001 after 1e300 on line 2)"],
     );
     // fewer joints than the robot has
     let f = csv("few.csv", "t,q1,q2,tau1,tau2\n0,0,0,0,0\n0.1,0,0,0,0\n");

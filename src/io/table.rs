@@ -42,7 +42,8 @@ impl Table {
     /// Parses CSV text (RFC 4180 through the `csv` crate: quoted fields such as `"q1"` or
     /// `"a,b"` as other tools write them; a UTF-8 byte-order mark, blank lines and lines
     /// starting with `#` skipped). Every row must have one number per header column; a
-    /// non-number, NaN or inf is an error naming the line (1-based) and the column.
+    /// non-number, NaN or inf is an error naming the line (1-based) and the column, and so is
+    /// a time (column `t`) that does not increase from one row to the next.
     pub fn parse(source: &str, text: &str) -> Result<Self> {
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let mut reader = csv::ReaderBuilder::new()
@@ -98,6 +99,13 @@ impl Table {
         let (header_line, header) = first.map_err(csv_error)?;
         let columns: Vec<String> = header.iter().map(str::to_string).collect();
         let mut t = Table::new(source, columns);
+        if t.columns.len() > 1 && t.columns.last().is_some_and(String::is_empty) {
+            // a logger that ends every line with a comma
+            return Err(t.error(format!(
+                "line {header_line}: column {}, the last, has no name: the line ends in a comma (remove the comma at the end of each line)",
+                t.columns.len()
+            )));
+        }
         if let Some(problem) = t.header_problem() {
             return Err(t.error(format!("line {header_line}: {problem}")));
         }
@@ -115,6 +123,10 @@ impl Table {
                 )));
             }
         }
+        // time must increase: checked here, where the line is known (a log whose clock
+        // stepped back was named by its data row, which blank and comment lines shift)
+        let time = t.index("t");
+        let mut previous = (f64::NEG_INFINITY, 0);
         for record in records {
             let (line, fields) = record.map_err(csv_error)?;
             if fields.len() != t.columns.len() {
@@ -138,6 +150,18 @@ impl Table {
                     )));
                 }
                 t.values.push(v);
+            }
+            if let Some(c) = time {
+                let now = t.values[t.values.len() - t.columns.len() + c];
+                if now <= previous.0 {
+                    return Err(t.error(format!(
+                        "line {line}, column 't': time does not increase (t = {} after {} on line {})",
+                        crate::error::shown(now),
+                        crate::error::shown(previous.0),
+                        previous.1
+                    )));
+                }
+                previous = (now, line);
             }
         }
         if t.rows() == 0 {
@@ -276,6 +300,20 @@ mod tests {
         assert!(e.to_string().contains("x.csv"), "{e}");
         let e = Table::parse("x.csv", "t,,q\n0,1,2\n").unwrap_err();
         assert!(e.to_string().contains("column 2 has no name"), "{e}");
+        let e = Table::parse("x.csv", "t,q1,\n0,1,\n").unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("line 1: column 3, the last, has no name: the line ends in a comma"),
+            "{e}"
+        );
+        // the line of a time that steps back, however many blank and comment lines before it
+        let e = Table::parse("x.csv", "t,q1\n# log\n0,1\n\n0.5,1\n0.5,2\n").unwrap_err();
+        assert!(
+            e.to_string().contains(
+                "line 6, column 't': time does not increase (t = 0.5 after 0.5 on line 5)"
+            ),
+            "{e}"
+        );
     }
 
     #[test]
