@@ -34,9 +34,9 @@ def row(label: str, values, fmt: str = "8.3f") -> str:
 
 def main(argv: list[str] | None = None) -> int:
     if argv:
-        from ._core import cli
+        from ._cli import run
 
-        return cli(["perturbid", *argv])
+        return run(argv)
     robot = robots.a465("kinsheel2010")
     op = OperatingPoint(Q, QD, QDD)
     plan = plan_experiments(robot, op, design="random", seed=0)

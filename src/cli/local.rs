@@ -475,6 +475,15 @@ fn fmt_matrix(
 
 pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
     let plan = Plan::load(&a.plan)?;
+    if let [only] = a.recordings.as_slice() {
+        // a ROS 2 bag's folder is not a folder of recordings
+        if let Some(message) = crate::io::foreign::foreign_table(only) {
+            return Err(Error::Recording {
+                recording: only.display().to_string(),
+                message,
+            });
+        }
+    }
     let files: Vec<PathBuf> = if a.recordings.len() == 1 && a.recordings[0].is_dir() {
         plan.experiments
             .iter()

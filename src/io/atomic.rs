@@ -15,9 +15,17 @@ pub(crate) fn io_error(path: &Path, source: std::io::Error) -> Error {
 
 /// The contents of a text file (a table or log: at most
 /// [`MAX_TEXT_BYTES`](crate::limits::MAX_TEXT_BYTES)); the error names the path. A file of
-/// an output set whose writing was interrupted is refused ([`check_not_partial`]).
+/// an output set whose writing was interrupted is refused ([`check_not_partial`]), and so is a
+/// file of another format (a ROS bag, a Parquet file, ...), named with the way to a table.
 pub fn read_text(path: impl AsRef<Path>) -> Result<String> {
-    read_bounded(path.as_ref(), crate::limits::MAX_TEXT_BYTES, "table")
+    let path = path.as_ref();
+    if let Some(message) = super::foreign::foreign_table(path) {
+        return Err(Error::Recording {
+            recording: path.display().to_string(),
+            message,
+        });
+    }
+    read_bounded(path, crate::limits::MAX_TEXT_BYTES, "table")
 }
 
 /// The contents of a document (JSON, TOML, URDF: at most

@@ -5,6 +5,7 @@
 
 pub mod atomic;
 pub mod config;
+pub(crate) mod foreign;
 pub mod output_set;
 pub mod plan_files;
 pub mod recording;

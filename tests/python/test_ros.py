@@ -182,3 +182,60 @@ def test_unset_header_stamps_are_named_and_the_receive_times_read_instead(tmp_pa
     rec = ros.read_joint_states(tmp_path / "bag", joints, stamp="receive")
     np.testing.assert_array_equal(rec.t, np.arange(30) * 1_000_000 * 1e-9)
     np.testing.assert_array_equal(rec.q, q)
+
+
+def test_a_session_bag_goes_through_the_command_line_as_its_recordings(tmp_path):
+    """A ROS user's path without Python code: `perturbid ros` writes the session's bag as a
+    recording CSV, `perturbid split` cuts it into the plan's runs, `perturbid identify` gives the
+    model the recordings give in Python; the Rust commands given the bag itself say how to
+    convert it (they said the folder was a directory, or a .bag not UTF-8 text)."""
+    import json
+    import os
+    import subprocess
+    import sysconfig
+    from pathlib import Path
+
+    exe = str(Path(sysconfig.get_path("scripts")) / ("perturbid.exe" if os.name == "nt" else "perturbid"))
+    robot = pr.robots.a465()
+    op = pr.OperatingPoint([0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0], [0.089, -0.106, 0.022, 0.056, 0.011, 0.014],
+                           [-0.155, -0.5, 0.034, -0.291, -0.008, 0.171])
+    plan = pr.plan_experiments(robot, op, design="orthogonal", experiments=["nominal", "D"])
+    recs = pr.simulate(robot, plan, gravity=False, friction=None, torque_noise=0.05, seed=3)
+    plan.save(str(tmp_path / "plan"))
+    # the session: the runs one after the other, 2 s at rest after each, stamped since 1970
+    start, messages = 1_700_000_000 * 10**9, []
+    for rec in recs:
+        for k in range(len(rec.t)):
+            messages.append(joint_state(robot.joint_names, rec.q[k], np.zeros(6), rec.tau[k], start + len(messages) * 10**6))
+        for _ in range(2000):
+            messages.append(joint_state(robot.joint_names, rec.q[-1], np.zeros(6), rec.tau[-1], start + len(messages) * 10**6))
+    write_bag(tmp_path / "bag", messages)
+
+    def run(*args):
+        return subprocess.run([exe, *map(str, args)], capture_output=True, text=True, cwd=tmp_path)
+
+    out = run("ros", "bag", "--robot", "a465", "--no-velocities", "--out", "session.csv")
+    assert out.returncode == 0, out.stderr
+    assert f"{len(messages)} samples of 6 joints" in out.stdout
+    log = pr.Recording.load(str(tmp_path / "session.csv"), robot.joint_names)
+    np.testing.assert_array_equal(log.q, np.array([m["position"] for m in messages]))
+    assert run("split", "plan/plan.json", "session.csv", "--out", "runs").returncode == 0
+    assert run("identify", "plan/plan.json", "runs", "--out", "model.json").returncode == 0
+    model = json.loads((tmp_path / "model.json").read_text())
+    direct = pr.identify_local(plan, recs)
+    np.testing.assert_allclose(model["d"]["matrix"], direct.D, atol=1e-9 * np.abs(direct.D).max())
+    # the Rust commands given the bag, or its folder as the recordings' folder
+    for args in (("identify-direct", "a465", "bag"), ("identify", "plan/plan.json", "bag")):
+        out = run(*args)
+        assert out.returncode == 1 and out.stderr.count("\n") == 1, out.stderr
+        assert "bag: a ROS 2 bag (a folder with metadata.yaml), not a CSV table" in out.stderr and "perturbid ros BAG" in out.stderr
+    # mistakes: a topic the bag lacks, an output that is the bag, a robot that is not one
+    bad = run("ros", "bag", "--robot", "a465", "--topic", "/arm", "--out", "x.csv")
+    assert bad.returncode == 1 and "topic '/arm' carries no sensor_msgs/msg/JointState" in bad.stderr and "Traceback" not in bad.stderr
+    assert not (tmp_path / "x.csv").exists()
+    bad = run("ros", "bag", "--robot", "a465", "--out", "bag")
+    assert bad.returncode == 1 and "--out bag is the bag bag" in bad.stderr
+    bad = run("ros", "bag", "--robot", "a466", "--out", "x.csv")
+    assert bad.returncode == 1 and "unknown robot" in bad.stderr and "Traceback" not in bad.stderr
+    # the command is listed where the Rust ones are
+    assert "ros  " in run("--help").stdout
