@@ -248,3 +248,28 @@ fn a_session_log_given_as_one_experiments_recording_is_named_or_read_at_its_run(
         .unwrap();
     assert!((found.offset - run).abs() < 2e-3, "{found:?} {run}");
 }
+
+/// The runs are placed on the plan's clock to well below a sample, by the clock search of a
+/// single recording: the log's clock 0.37 ms off the plan's samples, each run's time stamps come
+/// out on the plan's within 1 us on these noisy positions (the split's own search, a grid
+/// refined to 1 ms or finer, left the nominal run 50 us off).
+#[test]
+fn a_session_off_the_plans_sample_clock_splits_onto_it_below_a_sample() {
+    let (plan, recs) = a465_noisy_runs();
+    let mut log = session(&recs.iter().collect::<Vec<_>>(), 1.5);
+    for t in &mut log.t {
+        *t += 0.37e-3;
+    }
+    let split = split_session(&plan, &log, &SplitOptions::default()).unwrap();
+    for ((run, d), rec) in split.iter().zip(&recs) {
+        // the run's sample nearest the recording's 100th is that sample, at its time
+        let at = rec.t[100];
+        let nearest = run
+            .t
+            .iter()
+            .map(|t| t - at)
+            .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+            .unwrap();
+        assert!(nearest.abs() < 1e-5, "{}: {nearest} (d = {d})", run.name);
+    }
+}

@@ -3,14 +3,14 @@
 //! against the planned ones), and the offset between the two clocks found in the positions.
 
 use super::crossing::samples_needed;
-use super::offset_search::detect_offset_in;
+use super::offset_search::{search_offset, CANDIDATES};
 use super::plan::Experiment;
 use super::FitOptions;
 use crate::error::{Error, Result};
 use crate::recording::Recording;
 
 /// The offset (s) between `rec`'s clock and `experiment`'s plan, found in the positions within
-/// `+-max_shift` s (see [`detect_offset_in`]) and checked: the positions must follow the plan
+/// `+-max_shift` s (see [`detect_offset_in`](super::detect_offset_in)) and checked: the positions must follow the plan
 /// there (`steps`: the encoder steps of the positions, per joint, or empty), and where the best
 /// offset is refused the error says where over the recording's whole span the run is.
 /// `joint_names` name the joints in errors.
@@ -40,7 +40,8 @@ pub(super) fn align(
         covering_offsets(experiment, rec).filter(|(a, b)| a.max(-searched) <= b.min(searched));
     let (first, last) = covering.unwrap_or_else(|| overlap_offsets(experiment, rec));
     let (lo, hi) = (first.max(-searched), last.min(searched));
-    let (offset, cost) = detect_offset_in(experiment, rec, lo, hi, 200);
+    let check = || crate::interrupt::check("aligning the recordings with the plan");
+    let (offset, cost) = search_offset(experiment, rec, (lo, hi), 200, CANDIDATES, check)?;
     let positions = check_positions(experiment, rec, joint_names, steps, (offset, searched));
     // beyond the tolerance, not following the plan there, or a log long enough for the run
     // to lie further in: the run may start later in the log; look over the whole overlap, at
@@ -53,7 +54,8 @@ pub(super) fn align(
         let step = (hi - lo) / 400.0;
         let points = (((last - first) / step.max(1e-3)) as usize / 2).clamp(200, 20_000);
         let (first, last) = covering_offsets(experiment, rec).unwrap_or((first, last));
-        let (wide, wide_cost) = detect_offset_in(experiment, rec, first, last, points);
+        let (wide, wide_cost) =
+            search_offset(experiment, rec, (first, last), points, CANDIDATES, check)?;
         let fits = check_positions(experiment, rec, joint_names, steps, (wide, searched)).is_ok();
         if wide.abs() > max_shift && wide_cost < 0.25 * cost && fits {
             // a log more than twice the run's length may hold the whole session
@@ -329,37 +331,6 @@ pub fn covering_offsets(experiment: &Experiment, rec: &Recording) -> Option<(f64
     let hi = times.fold(f64::NEG_INFINITY, f64::max) + experiment.window;
     let range = (rec.t[0] - lo, rec.t[rec.len() - 1] - hi);
     (range.0 <= range.1).then_some(range)
-}
-
-/// The squared differences between `rec`'s positions at the samples `rows` and `experiment`'s
-/// planned ones at their times less `d` s (clamped to the plan's span), taken about each
-/// joint's mean difference and summed over the joints (rad^2 or m^2), with the number of
-/// samples. A constant offset (an encoder's zero, or a joint held off the plan, which is
-/// checked after) carries no timing and would otherwise pull the offset towards where the
-/// difference's mean is smallest.
-pub(super) fn centred_misfit(
-    experiment: &Experiment,
-    rec: &Recording,
-    d: f64,
-    rows: impl Iterator<Item = usize>,
-) -> (f64, f64) {
-    let n = rec.n;
-    let traj = &experiment.trajectory;
-    let (start, end) = (traj.start(), traj.end());
-    let (mut sum, mut sq) = (vec![0.0; n], vec![0.0; n]);
-    let mut count = 0.0;
-    for i in rows {
-        let tp = (rec.t[i] - d).clamp(start, end);
-        let seg = traj.segment_at(tp);
-        for j in 0..n {
-            let e = rec.q[i * n + j] - seg.eval(j, tp).0;
-            sum[j] += e;
-            sq[j] += e * e;
-        }
-        count += 1.0;
-    }
-    let cost = (0..n).map(|j| sq[j] - sum[j] * sum[j] / count).sum();
-    (cost, count)
 }
 
 /// The largest clock offset, as a fraction of the reading window's half-width, taken for a

@@ -4,7 +4,8 @@
 //! run on the plan's clock. The runs are found in the plan's order, each after the previous
 //! one, where the log's positions follow the experiment's planned ones best.
 
-use super::clock::{centred_misfit, follows_plan, misfit_shown, position_misfit, span_rows};
+use super::clock::{follows_plan, misfit_shown, position_misfit};
+use super::offset_search::{search_offset, span_cost};
 use super::plan::{Experiment, Plan};
 use crate::error::{Error, Result};
 use crate::recording::Recording;
@@ -24,58 +25,17 @@ impl Default for SplitOptions {
     }
 }
 
-/// Coarse grid step (s) of the search for a run in the log.
-const COARSE_STEP: f64 = 0.02;
-/// At most this many coarse offsets per experiment: a longer session is searched more coarsely.
-const MAX_GRID: usize = 200_000;
-/// Candidates (the coarse grid's lowest local minima) refined per experiment.
-const CANDIDATES: usize = 16;
+/// The grid's lowest minima refined for each run: other experiments' runs pass the same point,
+/// so twice as many as for one experiment's recording.
+const CANDIDATES: usize = 2 * super::offset_search::CANDIDATES;
 
-/// The mean squared difference per sample, about each joint's mean, between the log's
-/// positions over the span of `e`'s plan placed at `d` s (log time = plan time + d) and the
-/// planned positions, on at most `samples` samples; infinite where the log holds fewer than 2.
-fn window_cost(e: &Experiment, log: &Recording, d: f64, samples: usize) -> f64 {
-    let rows = span_rows(e, log, d, samples);
-    if rows.len() < 2 {
-        return f64::INFINITY;
-    }
-    let (cost, count) = centred_misfit(e, log, d, rows);
-    cost / count
-}
-
-/// The offset `d` in `[lo, hi]` (s) at which `e`'s plan fits the log best, with its cost: a
-/// coarse grid, then the lowest of its local minima refined at a millisecond.
+/// The offset `d` in `[lo, hi]` (s) at which `e`'s plan fits the log best, with its cost (see
+/// [`span_cost`]): the clock search of one recording (a grid of 20 ms or finer, its lowest
+/// minima refined), over the stretch of log where the run can lie.
 fn best_offset(e: &Experiment, log: &Recording, lo: f64, hi: f64) -> Result<(f64, f64)> {
-    let points = (((hi - lo) / COARSE_STEP).ceil() as usize).clamp(1, MAX_GRID);
-    let step = (hi - lo) / points as f64;
-    let mut coarse = Vec::with_capacity(points + 1);
-    for g in 0..=points {
-        if g % 1024 == 0 {
-            crate::interrupt::check("splitting the session log")?;
-        }
-        let d = lo + g as f64 * step;
-        coarse.push((window_cost(e, log, d, 100), d));
-    }
-    let mut minima: Vec<(f64, f64)> = (0..coarse.len())
-        .filter(|&g| {
-            let c = coarse[g].0;
-            (g == 0 || coarse[g - 1].0 >= c) && (g + 1 == coarse.len() || coarse[g + 1].0 >= c)
-        })
-        .map(|g| coarse[g])
-        .collect();
-    minima.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut best = (f64::INFINITY, 0.5 * (lo + hi));
-    for &(_, c) in minima.iter().take(CANDIDATES) {
-        let fine = (2.0 * step / 1e-3).ceil().clamp(2.0, 400.0) as usize;
-        for k in 0..=fine {
-            let d = (c - step + 2.0 * step * k as f64 / fine as f64).clamp(lo, hi);
-            let cost = window_cost(e, log, d, 400);
-            if cost < best.0 {
-                best = (cost, d);
-            }
-        }
-    }
-    Ok((best.1, best.0))
+    search_offset(e, log, (lo, hi), 1, CANDIDATES, || {
+        crate::interrupt::check("splitting the session log")
+    })
 }
 
 /// Splits `log`, a session in which the robot ran `plan`'s experiments one after the other in
@@ -148,7 +108,7 @@ pub fn split_session(
             // a stretch a later experiment fits better, started at the same time, is its run
             let later = plan.experiments[k + 1..].iter().find(|l| {
                 let dl = d + start - l.trajectory.start();
-                dl + l.trajectory.end() <= last && window_cost(l, log, dl, 400) < cost
+                dl + l.trajectory.end() <= last && span_cost(l, log, dl) < cost
             });
             match later {
                 Some(l) => {
