@@ -654,6 +654,26 @@ fn bad_inputs_get_one_line_errors_and_no_output() {
         &["identify", s(&plan), &f, &f, "--out", s(&model)],
         &["huge_time.csv", "(t = 0.001 after 1e300 on line 2)"],
     );
+    // a header in capitals
+    let f = csv(
+        "caps.csv",
+        &format!("{}\n{}\n{}\n", header.to_uppercase(), row(0.0), row(0.001)),
+    );
+    fails(
+        &["identify", s(&plan), &f, &f, "--out", s(&model)],
+        &[
+            "caps.csv",
+            "no column 't' (time, s) (names are lower case: t, q1, tau1, ...)",
+        ],
+    );
+    // one log for a plan of two experiments: the session split named
+    fails(
+        &["identify", s(&plan), &f, "--out", s(&model)],
+        &[
+            "1 files for 2 experiments",
+            "perturbid split PLAN LOG --out FOLDER",
+        ],
+    );
     // fewer joints than the robot has
     let f = csv("few.csv", "t,q1,q2,tau1,tau2\n0,0,0,0,0\n0.1,0,0,0,0\n");
     fails(

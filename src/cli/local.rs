@@ -500,7 +500,7 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
         return Err(Error::InvalidArgument {
             argument: "RECORDINGS".into(),
             message: format!(
-                "{} files for {} experiments ({}); give one CSV per experiment, named after it (D.csv), or a folder",
+                "{} files for {} experiments ({}); give one CSV per experiment, named after it (D.csv), or a folder of them; one log of the whole session is split into them first (perturbid split PLAN LOG --out FOLDER)",
                 files.len(),
                 plan.experiments.len(),
                 plan.kinds()

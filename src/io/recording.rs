@@ -41,10 +41,16 @@ impl<'a> Columns<'a> {
             });
         }
         let t_col = table.index("t").ok_or_else(|| {
+            // a header in capitals (T, Q1, TAU1) is not read as the names it spells
+            let case = if table.index("T").is_some() {
+                " (names are lower case: t, q1, tau1, ...)"
+            } else {
+                ""
+            };
             bad(
                 table,
                 format!(
-                    "no column 't' (time, s); the columns are: {}",
+                    "no column 't' (time, s){case}; the columns are: {}",
                     table.columns.join(", ")
                 ),
             )
