@@ -10,7 +10,7 @@ import argparse
 import math
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable, Optional
 
 from ._core import cli
 
@@ -62,6 +62,22 @@ def _robot(name: str, lock: list[str]) -> Any:
     return Robot.builtin(name)
 
 
+def _progress_line(what: str) -> Optional[Callable[[int, int], None]]:
+    """A progress line on stderr, as the Rust commands draw it: only on a terminal."""
+    if not sys.stderr.isatty():
+        return None
+
+    def show(done: int, total: int) -> None:
+        print(f"\r{what}: {done:,} of {total:,} ({100 * done // max(total, 1)} %)", end="", file=sys.stderr, flush=True)
+
+    return show
+
+
+def _clear_line() -> None:
+    if sys.stderr.isatty():
+        print("\r\033[K", end="", file=sys.stderr, flush=True)
+
+
 def ros_to_csv(args: list[str]) -> int:
     """``perturbid ros BAG [BAG ...] --robot ROBOT [--lock JOINT=VALUE] [--topic TOPIC]
     [--stamp header|receive] [--no-velocities] [--out log.csv]``. Returns the exit status."""
@@ -90,14 +106,18 @@ def ros_to_csv(args: list[str]) -> int:
 
         robot = _robot(a.robot, a.lock)
         rec = read_joint_states(a.bag if len(a.bag) > 1 else a.bag[0], robot.joint_names, a.topic,
-                                name=a.bag[0], velocities=not a.no_velocities, stamp=a.stamp)
+                                name=a.bag[0], velocities=not a.no_velocities, stamp=a.stamp,
+                                progress=_progress_line("reading messages"))
         rec.save(str(out))
     except (PerturbidError, ImportError, OSError) as e:
+        _clear_line()
         print(f"perturbid: {e}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
+        _clear_line()
         print("perturbid: interrupted; nothing written", file=sys.stderr)
         return 130
+    _clear_line()
     velocities = ", with velocities" if rec.qd is not None else ""
     print(f"{len(rec.t)} samples of {robot.n} joints ({', '.join(robot.joint_names)}), {rec.t[-1]:.3f} s{velocities} -> {out}")
     return 0

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from os import PathLike
 from pathlib import Path
-from typing import Any, Optional, Sequence, Union
+from typing import Any, Callable, Optional, Sequence, Union
 
 import numpy as np
 
@@ -53,6 +53,7 @@ def read_joint_states(
     experiment: Optional[str] = None,
     velocities: bool = True,
     stamp: str = "header",
+    progress: Optional[Callable[[int, int], None]] = None,
 ) -> Recording:
     """The recording of ``joints`` (the robot's joint names, e.g. ``robot.joint_names``) from
     the ``sensor_msgs/JointState`` messages of a ROS bag: a ROS 2 bag's folder (or its
@@ -67,6 +68,9 @@ def read_joint_states(
     positions; ``tau`` (N m or N, (m, n)) from the efforts; ``qd`` (rad/s or m/s) when
     ``velocities`` and every message read has them. Times are differenced in whole nanoseconds,
     so an epoch stamp loses nothing.
+
+    ``progress(read, total)``, when given, is called every 10,000 messages and at the end with
+    the messages read so far and the topic's count (a bag of hours takes minutes).
 
     Raises InputError naming the bag, topic, message and joint of any problem; ImportError
     naming the extra without rosbags.
@@ -107,13 +111,14 @@ def read_joint_states(
         counted = sum(int(c.msgcount) for c in connections)
         if counted > MAX_MESSAGES:
             raise InputError(f"{where}: topic '{topic}' has {counted} messages, more than {MAX_MESSAGES}; split the bag")
-        return _read(reader, connections, joints, topic, where, name, experiment, velocities, stamp, counted)
+        return _read(reader, connections, joints, topic, where, name, experiment, velocities, stamp, counted, progress)
     finally:
         reader.close()
 
 
 def _read(reader: Any, connections: list[Any], joints: list[str], topic: str, where: str, name: str,
-          experiment: Optional[str], velocities: bool, stamp: str, counted: int) -> Recording:
+          experiment: Optional[str], velocities: bool, stamp: str, counted: int,
+          progress: Optional[Callable[[int, int], None]] = None) -> Recording:
     """The messages of ``connections`` read into preallocated arrays and checked one by one."""
     n = len(joints)
     ns = np.empty(counted, dtype=np.int64)
@@ -128,6 +133,8 @@ def _read(reader: Any, connections: list[Any], joints: list[str], topic: str, wh
     for k, (connection, received, raw) in enumerate(reader.messages(connections=connections)):
         if k >= counted:
             raise InputError(f"{where}: topic '{topic}' holds more messages than the bag's index says ({counted})")
+        if progress is not None and k % 10_000 == 0:
+            progress(k, counted)
         msg: Any = reader.deserialize(raw, connection.msgtype)
         header = msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
         at = header if stamp == "header" else received
@@ -169,6 +176,8 @@ def _read(reader: Any, connections: list[Any], joints: list[str], topic: str, wh
                 j = int(np.argmin(np.isfinite(row)))
                 raise InputError(f"{said} has a non-finite {field} ({row[j]}) for joint {joints[j]}")
         m += 1
+    if progress is not None:
+        progress(counted, counted)
     if m == 0:
         if passed_over:
             raise InputError(f"{where}: no message on '{topic}' names joint {', '.join(joints)}; its messages name {', '.join(sorted(seen))}")

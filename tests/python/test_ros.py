@@ -81,6 +81,10 @@ def test_a_bag_written_with_rosbags_reads_back_as_the_recording(tmp_path):
     np.testing.assert_array_equal(rec.qd, qd)
     np.testing.assert_array_equal(rec.tau, tau)
     assert rec.experiment == "D"
+    # progress: every 10,000 messages from the first, and at the end
+    calls = []
+    ros.read_joint_states(tmp_path / "bag", joints, progress=lambda done, total: calls.append((done, total)))
+    assert calls == [(0, len(t)), (len(t), len(t))], calls
     # the bag named by its metadata.yaml reads the same
     np.testing.assert_array_equal(ros.read_joint_states(tmp_path / "bag" / "metadata.yaml", joints).q, q)
     # a joint the bag does not have, a topic it does not have: named
