@@ -6,7 +6,8 @@ mod common;
 
 use common::{a465_noisy_runs, worst_in_stderr};
 use perturbid_rs::local::{
-    identify_local, position_misfit, split_session, CrossingTimes, IdentifyOptions, SplitOptions,
+    identify_local, position_misfit, repeated_runs, split_session, CrossingTimes, IdentifyOptions,
+    SplitOptions,
 };
 use perturbid_rs::Recording;
 
@@ -78,6 +79,10 @@ fn a_session_log_splits_into_the_runs_that_identify_as_the_separate_recordings()
     let log = session(&recs.iter().collect::<Vec<_>>(), 1.5);
     let split = split_session(&plan, &log, &SplitOptions::default()).unwrap();
     assert_eq!(split.len(), plan.experiments.len());
+    // each experiment ran once (H's passes follow D's plan within the position check, and are
+    // not taken for a second run of D)
+    let repeated = repeated_runs(&plan, &log, &split).unwrap();
+    assert!(repeated.is_empty(), "{repeated:?}");
     // the first run starts after the 2 s homing move, at 1002 s of the log
     assert!((split[0].1 - 1002.0).abs() < 2e-3, "{}", split[0].1);
     for ((run, _), e) in split.iter().zip(&plan.experiments) {
@@ -272,4 +277,29 @@ fn a_session_off_the_plans_sample_clock_splits_onto_it_below_a_sample() {
             .unwrap();
         assert!(nearest.abs() < 1e-5, "{}: {nearest} (d = {d})", run.name);
     }
+}
+
+/// An experiment run twice (H rerun after it, then D): the split takes one run and names the
+/// other stretch, where it took one without a word; each of the others ran once.
+#[test]
+fn an_experiment_run_twice_is_named_with_both_stretches() {
+    let (plan, recs) = a465_noisy_runs();
+    let h = plan
+        .experiments
+        .iter()
+        .position(|e| e.kind.name() == "H")
+        .unwrap();
+    let mut order: Vec<&Recording> = recs.iter().collect();
+    order.insert(h + 1, &recs[h]);
+    let log = session(&order, 1.5);
+    let split = split_session(&plan, &log, &SplitOptions::default()).unwrap();
+    let repeated = repeated_runs(&plan, &log, &split).unwrap();
+    assert_eq!(repeated.len(), 1, "{repeated:?}");
+    let taken = split[h].1 + plan.experiments[h].trajectory.start();
+    assert!(
+        repeated[0].starts_with("experiment 'H' seems to have run twice in session.csv: its plan is followed also from ")
+            && repeated[0].contains(&format!("the run from {} s", (taken * 1e3).round() / 1e3)),
+        "{}",
+        repeated[0]
+    );
 }

@@ -270,7 +270,8 @@ class Plan:
         """Reads and checks a plan.json."""
     def split_session(self, log: "Recording", margin: float = 0.2) -> list["Recording"]:
         """One log of the whole session (the experiments run one after the other, in order)
-        split into one Recording per experiment on the plan's clock."""
+        split into one Recording per experiment on the plan's clock; an experiment that ran
+        twice gets a PerturbidWarning naming both stretches."""
 
 @final
 class Recording:

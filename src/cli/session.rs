@@ -11,7 +11,7 @@ use super::out_dir;
 use crate::document::Document;
 use crate::error::Result;
 use crate::io::{load_recording, recording_files};
-use crate::local::{split_session, Plan, SplitOptions};
+use crate::local::{repeated_runs, split_session, Plan, SplitOptions};
 
 #[derive(Args)]
 pub(crate) struct SplitArgs {
@@ -34,6 +34,9 @@ pub(crate) fn split(a: SplitArgs) -> Result<String> {
     let plan = Plan::load(&a.plan)?;
     let log = load_recording(&a.log, &plan.joint_names)?;
     let runs = split_session(&plan, &log, &SplitOptions { margin: a.margin })?;
+    for w in repeated_runs(&plan, &log, &runs)? {
+        eprintln!("perturbid: warning: {w}");
+    }
     let (recordings, offsets): (Vec<_>, Vec<f64>) = runs.into_iter().unzip();
     let set = recording_files(&plan, &recordings, &out_dir(&a.out))?;
     let mut out = String::new();

@@ -75,4 +75,4 @@ pub use parameters::{identify_parameters_from_local, FromLocalOptions, Parameter
 pub use perturbation::{Design, Size, Sizes};
 pub use plan::{plan_experiments, Crossing, Experiment, ExperimentKind, Plan, PlanOptions};
 pub use point_design::{suggest_operating_points, SuggestedPoint};
-pub use session::{split_session, SplitOptions};
+pub use session::{repeated_runs, split_session, SplitOptions};

@@ -160,6 +160,60 @@ pub fn split_session(
     Ok(runs)
 }
 
+/// A warning for each run of `runs` (from [`split_session`] of `plan` on `log`: a recording
+/// per experiment with its offset, s) whose experiment's plan is also followed, as the position
+/// check accepts a run, by a stretch of the log between the runs next to it: the experiment ran
+/// twice (rerun after a fault, or sent twice), and the split took the stretch that follows the
+/// plan more closely without a word of the other. Errors: Ctrl-C.
+pub fn repeated_runs(
+    plan: &Plan,
+    log: &Recording,
+    runs: &[(Recording, f64)],
+) -> Result<Vec<String>> {
+    let (first, last) = (log.t[0], log.t[log.len() - 1]);
+    let mut out = vec![];
+    for (k, (e, (_, d))) in plan.experiments.iter().zip(runs).enumerate() {
+        let (start, end) = (e.trajectory.start(), e.trajectory.end());
+        let before = match k.checked_sub(1) {
+            Some(p) => runs[p].1 + plan.experiments[p].trajectory.end(),
+            None => first,
+        };
+        let after = match runs.get(k + 1) {
+            Some((_, dn)) => dn + plan.experiments[k + 1].trajectory.start(),
+            None => last,
+        };
+        // the stretches between the neighbouring runs and this one, as offsets of its plan
+        for (lo, hi) in [
+            (before - start, d - (end - start)),
+            (d + (end - start), after - end),
+        ] {
+            if hi < lo {
+                continue;
+            }
+            let (other, cost) = search_offset(e, log, (lo, hi), 1, CANDIDATES, || {
+                crate::interrupt::check("looking for repeated runs in the session log")
+            })?;
+            let follows = position_misfit(e, log, other)
+                .is_some_and(|m| m.iter().all(|m| follows_plan(m, 0.0)));
+            // a stretch another experiment's plan fits better, started at the same time, is a
+            // run of that one that looks alike (H's passes follow D's plan within the check)
+            let alike = (plan.experiments.iter()).any(|l| {
+                l.kind != e.kind && span_cost(l, log, other + start - l.trajectory.start()) < cost
+            });
+            if follows && !alike {
+                out.push(format!(
+                    "experiment '{}' seems to have run twice in {}: its plan is followed also from {} s of the log, and the run from {} s, which follows it more closely, was taken; if the other is the one to use, cut the log to leave it alone between the runs before and after",
+                    e.kind.name(),
+                    log.name,
+                    shown_time(other + start),
+                    shown_time(d + start)
+                ));
+            }
+        }
+    }
+    Ok(out)
+}
+
 /// A time in the log (s), to the millisecond.
 fn shown_time(t: f64) -> String {
     crate::error::shown((t * 1e3).round() / 1e3)

@@ -164,7 +164,8 @@ impl PyPlan {
     /// previous one where the log's positions follow the experiment's plan best. Raises
     /// InputError naming the experiment and the time in the log when a run does not fit where
     /// it must (out of order, missing, a log cut short) or its best stretch does not follow the
-    /// plan; KeyboardInterrupt on Ctrl-C.
+    /// plan; KeyboardInterrupt on Ctrl-C. An experiment that ran twice (its plan followed also
+    /// between the runs next to it) gets a PerturbidWarning naming both stretches.
     #[pyo3(signature = (log, margin=0.2))]
     fn split_session(
         &self,
@@ -173,9 +174,13 @@ impl PyPlan {
         #[pyo3(from_py_with = scalars::real)] margin: f64,
     ) -> PyResult<Vec<PyRecording>> {
         let (plan, log) = (self.plan.clone(), log.rec.clone());
-        let runs = detached(py, "Plan.split_session", || {
-            crate::local::split_session(&plan, &log, &crate::local::SplitOptions { margin })
+        let (runs, repeated) = detached(py, "Plan.split_session", || {
+            let runs =
+                crate::local::split_session(&plan, &log, &crate::local::SplitOptions { margin })?;
+            let repeated = crate::local::repeated_runs(&plan, &log, &runs)?;
+            Ok((runs, repeated))
         })?;
+        super::errors::warn_all(py, &repeated)?;
         Ok(runs
             .into_iter()
             .map(|(rec, _)| PyRecording { rec: Arc::new(rec) })

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -117,7 +118,9 @@ def test_a_session_log_splits_into_its_experiments(tmp_path):
         parts_t.append(now + np.arange(count) * dt)
         now += count * dt
     log = pr.Recording(np.concatenate(parts_t), np.vstack(parts_q), np.vstack(parts_tau), name="session")
-    runs = plan.split_session(log)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", pr.PerturbidWarning)  # each experiment ran once
+        runs = plan.split_session(log)
     assert [r.experiment for r in runs] == [e.kind for e in plan.experiments]
     a, b = pr.identify_local(plan, recordings), pr.identify_local(plan, runs)
     for term in ("D", "H", "G"):
@@ -135,6 +138,18 @@ def test_a_session_log_splits_into_its_experiments(tmp_path):
     for rec in runs:
         back = pr.Recording.load(tmp_path / "runs" / f"{rec.experiment}.csv", plan.joint_names)
         np.testing.assert_array_equal(back.q, rec.q)
+    # the last experiment run again: a warning names both stretches, here and on the command line
+    last = recordings[-1]
+    again = pr.Recording(np.concatenate([log.t, now + 1.0 + last.t - last.t[0]]), np.vstack([log.q, last.q]), np.vstack([log.tau, last.tau]), name="session")
+    with pytest.warns(pr.PerturbidWarning, match=f"experiment '{last.experiment}' seems to have run twice in session: its plan is followed also from"):
+        plan.split_session(again)
+    again.save(tmp_path / "again.csv")
+    cli = subprocess.run(
+        [sys.executable, "-m", "perturbid_rs", "split", str(tmp_path / "plan" / "plan.json"), str(tmp_path / "again.csv"), "--out", str(tmp_path / "runs2")],
+        capture_output=True,
+        text=True,
+    )
+    assert cli.returncode == 0 and "perturbid: warning: experiment 'D' seems to have run twice" in cli.stderr, cli.stderr
     # a log cut short: the first run that no longer fits is named
     with pytest.raises(pr.InputError, match=r"experiment '\w+': its run \(\d+\.\d+ s\) does not fit in the log between .* \(the log's end\)"):
         plan.split_session(pr.Recording(log.t[: len(log) // 2], log.q[: len(log) // 2], log.tau[: len(log) // 2]))
