@@ -295,6 +295,11 @@ fn an_experiment_run_twice_is_named_with_both_stretches() {
     let split = split_session(&plan, &log, &SplitOptions::default()).unwrap();
     let repeated = repeated_runs(&plan, &log, &split).unwrap();
     assert_eq!(repeated.len(), 1, "{repeated:?}");
+    // runs that are not the split's, one each, are refused, not indexed
+    let e = repeated_runs(&plan, &log, &split[1..])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("4 runs for the plan's 5 experiments"), "{e}");
     let taken = split[h].1 + plan.experiments[h].trajectory.start();
     assert!(
         repeated[0].starts_with("experiment 'H' seems to have run twice in session.csv: its plan is followed also from ")

@@ -170,6 +170,17 @@ pub fn repeated_runs(
     log: &Recording,
     runs: &[(Recording, f64)],
 ) -> Result<Vec<String>> {
+    if runs.len() != plan.experiments.len() {
+        return Err(Error::InvalidArgument {
+            argument: "runs".into(),
+            message: format!(
+                "{} runs for the plan's {} experiments ({}); expected split_session's, one each",
+                runs.len(),
+                plan.experiments.len(),
+                plan.kinds()
+            ),
+        });
+    }
     let (first, last) = (log.t[0], log.t[log.len() - 1]);
     let mut out = vec![];
     for (k, (e, (_, d))) in plan.experiments.iter().zip(runs).enumerate() {
@@ -201,8 +212,13 @@ pub fn repeated_runs(
                 l.kind != e.kind && span_cost(l, log, other + start - l.trajectory.start()) < cost
             });
             if follows && !alike {
+                let closer = if span_cost(e, log, *d) <= cost {
+                    "more"
+                } else {
+                    "less"
+                };
                 out.push(format!(
-                    "experiment '{}' seems to have run twice in {}: its plan is followed also from {} s of the log, and the run from {} s, which follows it more closely, was taken; if the other is the one to use, cut the log to leave it alone between the runs before and after",
+                    "experiment '{}' seems to have run twice in {}: its plan is followed also from {} s of the log, and the run from {} s was taken, which follows it {closer} closely than the other; if the other is the one to use, cut the log to leave it alone between the runs before and after",
                     e.kind.name(),
                     log.name,
                     shown_time(other + start),
