@@ -110,6 +110,7 @@ pub(super) fn warnings(
             continue;
         };
         if own.cosine >= MIN_COSINE {
+            out.extend(stray_crossings(v, exp, var, &x));
             continue;
         }
         let other = (plan.experiments.iter())
@@ -136,7 +137,6 @@ pub(super) fn warnings(
             own.cosine, own.scale
         ));
     }
-    out.extend(stray_crossings(plan, values, op_state));
     out
 }
 
@@ -150,57 +150,46 @@ pub const STRAY_FRACTION: f64 = 1.0;
 /// median; a replayed stretch of log: 250 times).
 pub const STRAY_MEDIAN: f64 = 4.0;
 
-/// A warning for each crossing of an experiment that follows its plan as a whole whose recorded
+/// A warning for each crossing of `v` (a run of `exp`, its perturbed variable `var`, `x` its
+/// recorded perturbations, `K x N`), an experiment that follows its plan as a whole, whose recorded
 /// perturbation lies further than [`STRAY_FRACTION`] of the planned one's size from it, beyond
 /// [`STRAY_MEDIAN`] times the experiment's median and [`MEASURABLE`] times its measurement
 /// noise: a log that replays or drops samples there (300 samples of D's session log replayed
 /// from 0.3 s earlier read crossing 3 with crossing 2's accelerations, and D* came out 179 % off
 /// with no word of it), or a robot thrown off its trajectory there.
 fn stray_crossings(
-    plan: &Plan,
-    values: &[ExperimentValues],
-    op_state: &[Vec<f64>; 3],
+    v: &ExperimentValues,
+    exp: &Experiment,
+    var: usize,
+    x: &DMatrix<f64>,
 ) -> Vec<String> {
     let mut out = vec![];
-    for v in values {
-        let (Some(var), Some(exp)) = (v.kind.perturbed(), plan.experiment(v.kind)) else {
+    let planned = &exp.deltas;
+    // each crossing's stray as a fraction of its planned perturbation's size
+    let strays: Vec<f64> = (0..x.nrows())
+        .map(|i| (x.row(i) - planned.row(i)).norm() / planned.row(i).norm())
+        .collect();
+    let mut sorted: Vec<f64> = strays.iter().copied().filter(|s| s.is_finite()).collect();
+    sorted.sort_by(f64::total_cmp);
+    let Some(&median) = sorted.get(sorted.len() / 2) else {
+        return out;
+    };
+    for (i, &stray) in strays.iter().enumerate() {
+        let p = planned.row(i);
+        let noise_i: f64 = (v.crossings[i].state_stderr[var].iter().take(x.ncols()))
+            .map(|s| s * s)
+            .sum::<f64>()
+            .sqrt();
+        let gap = stray * p.norm();
+        let odd = stray > STRAY_FRACTION && stray > STRAY_MEDIAN * median;
+        if !(odd && gap > MEASURABLE * noise_i) {
             continue;
-        };
-        let base = match &v.reference {
-            Some(r) => state(r, var),
-            None => &op_state[var][..],
-        };
-        let (x, noise) = recorded(v, var, base);
-        let planned = &exp.deltas;
-        match agreement(&x, noise, planned) {
-            Some(own) if own.cosine >= MIN_COSINE => {}
-            _ => continue,
         }
-        // each crossing's stray as a fraction of its planned perturbation's size
-        let strays: Vec<f64> = (0..x.nrows())
-            .map(|i| (x.row(i) - planned.row(i)).norm() / planned.row(i).norm())
-            .collect();
-        let mut sorted: Vec<f64> = strays.iter().copied().filter(|s| s.is_finite()).collect();
-        sorted.sort_by(f64::total_cmp);
-        let Some(&median) = sorted.get(sorted.len() / 2) else {
-            continue;
+        let shown = |r: nalgebra::RowDVector<f64>| {
+            let cells: Vec<String> = r.iter().map(|v| format!("{v:+.3e}")).collect();
+            format!("[{}]", cells.join(", "))
         };
-        for (i, &stray) in strays.iter().enumerate() {
-            let p = planned.row(i);
-            let noise_i: f64 = (v.crossings[i].state_stderr[var].iter().take(x.ncols()))
-                .map(|s| s * s)
-                .sum::<f64>()
-                .sqrt();
-            let gap = stray * p.norm();
-            let odd = stray > STRAY_FRACTION && stray > STRAY_MEDIAN * median;
-            if !(odd && gap > MEASURABLE * noise_i) {
-                continue;
-            }
-            let shown = |r: nalgebra::RowDVector<f64>| {
-                let cells: Vec<String> = r.iter().map(|v| format!("{v:+.3e}")).collect();
-                format!("[{}]", cells.join(", "))
-            };
-            out.push(format!(
+        out.push(format!(
                 "experiment '{}', crossing {i} at t = {:.4} s: the perturbation its recording shows ({}) is {stray:.2} times the planned one's size away from it (recorded {}, planned {}), where the experiment's crossings stray {median:.2} times at the median; its regression uses it as recorded: check the log there for replayed, dropped or shifted samples, or the robot thrown off its trajectory",
                 v.kind.name(),
                 exp.crossings[i].time + v.offset,
@@ -208,7 +197,6 @@ fn stray_crossings(
                 shown(x.row(i).into_owned()),
                 shown(p.into_owned()),
             ));
-        }
     }
     out
 }
