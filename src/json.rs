@@ -90,3 +90,28 @@ pub mod stderr_vec {
         Ok(v.into_iter().map(|x| x.unwrap_or(f64::NAN)).collect())
     }
 }
+
+/// Serde adapter for a list of matrices (`Vec<DMatrix<f64>>`), each a list of rows.
+pub mod matrices {
+    use nalgebra::DMatrix;
+    use serde::{de::Error as _, Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(m: &[DMatrix<f64>], s: S) -> Result<S::Ok, S::Error> {
+        let all: Vec<Vec<Vec<f64>>> = m
+            .iter()
+            .map(|m| m.row_iter().map(|r| r.iter().copied().collect()).collect())
+            .collect();
+        all.serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<DMatrix<f64>>, D::Error> {
+        let all = Vec::<Vec<Vec<f64>>>::deserialize(d)?;
+        all.iter()
+            .enumerate()
+            .map(|(i, rows)| {
+                super::rows::from_rows(rows)
+                    .map_err(|e| D::Error::custom(format!("matrix {}: {e}", i + 1)))
+            })
+            .collect()
+    }
+}

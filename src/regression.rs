@@ -31,6 +31,10 @@ pub struct LeastSquares {
     /// [0, 1], summing to p. A residual's variance is `sigma^2 (1 - leverage)` for noise of
     /// equal variance.
     pub leverage: Vec<f64>,
+    /// The correlation of the coefficients of any one output, p x p: `(X^T X)^-1` scaled to a
+    /// unit diagonal (the design's alone, the same for every output; with the standard errors
+    /// of an output's row, `diag(se) R diag(se)` is its coefficients' covariance).
+    pub correlation: DMatrix<f64>,
 }
 
 /// Relative singular-value threshold below which a design counts as rank deficient.
@@ -189,6 +193,14 @@ pub fn least_squares(
     let leverage = (0..k)
         .map(|r| (0..p).map(|i| u[(r, i)] * u[(r, i)]).sum())
         .collect();
+    // (X^T X)^-1 of the scaled X is V S^-2 V^T; its correlation is that of the unscaled one
+    let correlation = DMatrix::from_fn(p, p, |a, b| {
+        if a == b {
+            return 1.0;
+        }
+        let c: f64 = (0..p).map(|i| v[(a, i)] * v[(b, i)] / (s[i] * s[i])).sum();
+        (c / (cov_scaled[a] * cov_scaled[b]).sqrt()).clamp(-1.0, 1.0)
+    });
     Ok(LeastSquares {
         coef,
         cond: smax / smin,
@@ -197,6 +209,7 @@ pub fn least_squares(
         rows: k,
         cov_diag,
         leverage,
+        correlation,
     })
 }
 

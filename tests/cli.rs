@@ -107,6 +107,59 @@ fn plan_simulate_identify_predict() {
         pred.columns,
         ["t", "tau1", "tau2", "tau3", "tau4", "tau5", "tau6"]
     );
+    // with --stderr: the same torques and, after them, the library's standard errors
+    ok(&[
+        "predict",
+        s(&d.join("model.json")),
+        s(&d.join("plan/D.csv")),
+        "--out",
+        s(&d.join("pred_se.csv")),
+        "--stderr",
+    ]);
+    let with_se = Table::parse(
+        "pred_se",
+        &std::fs::read_to_string(d.join("pred_se.csv")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(with_se.columns.len(), 13);
+    assert_eq!(with_se.columns[7], "tau1_stderr");
+    let model = LocalModel::load(d.join("model.json")).unwrap();
+    let states =
+        Table::parse("D", &std::fs::read_to_string(d.join("plan/D.csv")).unwrap()).unwrap();
+    let col = |t: &Table, name: &str| -> Vec<f64> {
+        let c = t.columns.iter().position(|c| c == name).unwrap();
+        (0..t.rows())
+            .map(|r| t.values[r * t.columns.len() + c])
+            .collect()
+    };
+    let pick = |names: &[&str]| -> Vec<f64> {
+        let cols: Vec<Vec<f64>> = names.iter().map(|n| col(&states, n)).collect();
+        (0..states.rows())
+            .flat_map(|r| cols.iter().map(move |c| c[r]))
+            .collect()
+    };
+    let (q, qd, qdd) = (
+        pick(&["q1", "q2", "q3", "q4", "q5", "q6"]),
+        pick(&["qd1", "qd2", "qd3", "qd4", "qd5", "qd6"]),
+        pick(&["qdd1", "qdd2", "qdd3", "qdd4", "qdd5", "qdd6"]),
+    );
+    let se = model
+        .predict_stderr(&perturbid_rs::States::new(6, &q, Some(&qd), Some(&qdd)).unwrap())
+        .unwrap();
+    for j in 0..6 {
+        assert_eq!(
+            col(&with_se, &format!("tau{}", j + 1)),
+            col(&pred, &format!("tau{}", j + 1))
+        );
+        let got = col(&with_se, &format!("tau{}_stderr", j + 1));
+        for (r, g) in got.iter().enumerate() {
+            let want = se[r * 6 + j];
+            assert!(
+                (g - want).abs() <= 1e-12 * want.abs() && want > 0.0,
+                "{g} against {want}"
+            );
+        }
+    }
     // an output that is an input is refused, also spelled another way, and the input survives
     let before = std::fs::read(d.join("plan/D.csv")).unwrap();
     let other_spelling = d.join("plan/../plan/D.csv");
@@ -277,6 +330,20 @@ fn excite_identify_direct_predict() {
         &["predict", s(&d.join("base.json")), s(&d.join("log.csv"))],
         &["--robot"],
     );
+    fails(
+        &[
+            "predict",
+            s(&d.join("base.json")),
+            s(&d.join("log.csv")),
+            "--robot",
+            "a465",
+            "--stderr",
+            "--out",
+            s(&d.join("pred_se.csv")),
+        ],
+        &["--stderr: ", "is not a local model"],
+    );
+    assert!(!d.join("pred_se.csv").exists());
     // a measured torque of 1e308 (its square overflows) and a position past its joint's
     // limits: the error's RMS stays a number, and the state is said to be one the robot
     // cannot take

@@ -396,6 +396,11 @@ class LocalModel:
         """torque (n,), D, H, G (n, n) and G_static (n, n) or None at op."""
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:
         """Predicted torques (N m), shape (n,) or (k, n)."""
+    def predict_stderr(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:
+        """Standard errors (N m) of predict's torques, shape (n,) or (k, n): T*'s and the
+        matrices' entries' with their correlation within each row; NaN where the model holds
+        an unknown standard error that the state weights. InputError for a model saved before
+        the correlations were stored."""
     def nominal_noise(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The nominal passes' torque noise (n,) each: the samples' and what varied from pass
         to pass beyond it (N m), for plan_experiments(torque_noise=, torque_pass_noise=)."""

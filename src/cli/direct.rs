@@ -309,6 +309,11 @@ pub(crate) struct PredictArgs {
     /// Output CSV: t, tau1..tauN predicted.
     #[arg(long, default_value = "predicted.csv")]
     out: PathBuf,
+    /// Also write each predicted torque's standard error, tau1_stderr..tauN_stderr (N m; NaN
+    /// where the model holds an unknown one): a local model's, from its entries' standard
+    /// errors and their correlation.
+    #[arg(long)]
+    stderr: bool,
     /// The robot, for a base-parameter model (URDF file or built-in name).
     #[arg(long)]
     robot: Option<String>,
@@ -343,14 +348,33 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
         ModelFile::Local(m) => m.predict(&states)?,
         ModelFile::GlobalLinear(m) => m.predict(&states)?,
     };
+    let stderr = match (&file, a.stderr) {
+        (_, false) => None,
+        (ModelFile::Local(m), true) => Some(m.predict_stderr(&states)?),
+        (_, true) => {
+            return Err(Error::InvalidArgument {
+                argument: "--stderr".into(),
+                message: format!(
+                    "'{}' is not a local model: only a local model's predictions have standard errors here (a base-parameter or globally linearised model stores no covariance of its parameters)",
+                    a.model.display()
+                ),
+            })
+        }
+    };
     let states = rows;
     let n = joints.len();
     let mut columns = vec!["t".to_string()];
     columns.extend((1..=n).map(|j| format!("tau{j}")));
+    if stderr.is_some() {
+        columns.extend((1..=n).map(|j| format!("tau{j}_stderr")));
+    }
     let mut table = Table::new("", columns);
     for (i, t) in states.t.iter().enumerate() {
         let mut row = vec![*t];
         row.extend_from_slice(&tau[i * n..(i + 1) * n]);
+        if let Some(se) = &stderr {
+            row.extend_from_slice(&se[i * n..(i + 1) * n]);
+        }
         table.push(&row);
     }
     write_atomic(&a.out, table.to_csv().as_bytes())?;

@@ -252,6 +252,7 @@ mod tests {
             cond: 1.0,
             residual_rms: vec![0.0; n],
             crossings: 100,
+            correlation: vec![],
         }
     }
 

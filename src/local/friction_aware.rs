@@ -86,6 +86,7 @@ pub(super) fn friction_aware_h(
         stderr: vec![None; n],
     };
     let mut responded = Vec::with_capacity(n);
+    let mut correlation = Vec::with_capacity(n);
     for j in 0..n {
         let p = n + usize::from(reverses[j]);
         let x = DMatrix::from_fn(m, p, |i, c| {
@@ -128,6 +129,8 @@ pub(super) fn friction_aware_h(
         )?;
         let step = super::quantisation::undithered_step(v.torque_step[j], samples[j]);
         let mut ls = weighted.fit;
+        // the H columns' block: the marginal correlation of those coefficients
+        correlation.push(weighted.correlation[0].view((0, 0), (n, n)).into_owned());
         if let Some(q) = step {
             // a pair's difference: two readings' rounding
             let sigma = std::f64::consts::SQRT_2 * super::quantisation::rounding_stderr(q);
@@ -171,6 +174,7 @@ pub(super) fn friction_aware_h(
         residual_rms,
         stderr,
         crossings: k,
+        correlation,
     };
     let mut warnings: Vec<String> = super::response::unresolved_warning(e.kind, &responded)
         .into_iter()

@@ -28,7 +28,6 @@ use super::torque_offsets;
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::recording::Recording;
-use crate::regression::LeastSquares;
 
 /// Where the crossing times come from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -282,16 +281,6 @@ fn reading_variances(experiments: &[&ExperimentValues], n: usize) -> (DMatrix<f6
         .flat_map(|(v, s2)| v.crossings.iter().map(|c| reading_variance(c, s2)))
         .collect();
     (DMatrix::from_fn(rows.len(), n, |i, j| rows[i][j]), samples)
-}
-
-fn estimate(ls: LeastSquares) -> Estimate {
-    Estimate {
-        cond: ls.cond,
-        residual_rms: ls.residual_rms.iter().copied().collect(),
-        crossings: ls.rows,
-        matrix: ls.coef,
-        stderr: ls.stderr,
-    }
 }
 
 /// Pairs each experiment of `plan` with its recording, by identity: each recording says which
@@ -562,7 +551,7 @@ pub fn identify_local(
             &format!("experiment '{}'", kind.name()),
             &names(prefix),
         )?;
-        let mut fit = weighted.fit;
+        let (mut fit, correlation) = (weighted.fit, weighted.correlation);
         let row_var = DMatrix::from_fn(k, n, |i, j| v.crossings[i].state_stderr[var][j].powi(2));
         errors_in_variables::floor_stderr(&mut fit, &x, &row_var, &base_var)?;
         let resolutions: Vec<Resolution> = (0..n)
@@ -620,7 +609,7 @@ pub fn identify_local(
                     .push(quantisation::flat_zero_warning(kind.name(), &names, q));
             }
         }
-        Ok(Some(estimate(fit)))
+        Ok(Some(Estimate::of_fit(fit, correlation)))
     };
     let d = separated(ExperimentKind::D, "dqdd")?;
     let (h, coulomb) = match (options.friction_aware_h, find(ExperimentKind::H)) {
@@ -657,9 +646,9 @@ pub fn identify_local(
         let y = DMatrix::from_fn(rows.len(), n, |i, j| rows[i].tau[j] - torque[j]);
         let columns: Vec<String> = [names("dqdd"), names("dqd"), names("dq")].concat();
         let (u, samples) = reading_variances(&stacked, n);
-        let mut fit =
-            weighted_least_squares(&x, &y, &u, "combined estimate (nominal, G, H, D)", &columns)?
-                .fit;
+        let weighted =
+            weighted_least_squares(&x, &y, &u, "combined estimate (nominal, G, H, D)", &columns)?;
+        let (mut fit, correlation) = (weighted.fit, weighted.correlation);
         let row_var = DMatrix::from_fn(rows.len(), 3 * n, |i, c| {
             rows[i].state_stderr[2 - c / n][c % n].powi(2)
         });
@@ -674,7 +663,7 @@ pub fn identify_local(
                 quantisation::floor_stderr(&mut fit, j, quantisation::rounding_stderr(q));
             }
         }
-        Some(estimate(fit))
+        Some(Estimate::of_fit(fit, correlation))
     } else {
         None
     };
@@ -729,14 +718,8 @@ pub fn identify_local(
     let (d, h, g) = match (options.estimator, &combined) {
         (Estimator::Separated, _) => (d, h, g),
         (Estimator::Combined, Some(c)) => {
-            let block = |b: usize| Estimate {
-                matrix: c.matrix.columns(b * n, n).into_owned(),
-                stderr: c.stderr.columns(b * n, n).into_owned(),
-                cond: c.cond,
-                residual_rms: c.residual_rms.clone(),
-                crossings: c.crossings,
-            };
-            (Some(block(0)), Some(block(1)), Some(block(2)))
+            let block = |b: usize| Some(c.columns(b * n, n));
+            (block(0), block(1), block(2))
         }
         (Estimator::Combined, None) => {
             return Err(Error::InvalidArgument {

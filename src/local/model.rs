@@ -12,6 +12,7 @@ use crate::document::{
     check_magnitudes, invalid, Document,
 };
 use crate::error::{Error, Result};
+use crate::regression::LeastSquares;
 use crate::states::States;
 use crate::torque_model::predict_linear;
 
@@ -32,6 +33,47 @@ pub struct Estimate {
     pub stderr: DMatrix<f64>,
     /// Crossings (rows) used.
     pub crossings: usize,
+    /// Per row of `matrix` (torque), the correlation of its entries (m x m for m columns, unit
+    /// diagonal): with the row's standard errors `se`, `diag(se) R diag(se)` is its covariance,
+    /// which [`LocalModel::predict_stderr`] needs. The design's under the row's weights;
+    /// floors raised on the standard errors (errors in variables, quantisation) keep it.
+    /// Empty in a model saved before it was stored.
+    #[serde(
+        default,
+        skip_serializing_if = "Vec::is_empty",
+        with = "crate::json::matrices"
+    )]
+    pub correlation: Vec<DMatrix<f64>>,
+}
+
+impl Estimate {
+    /// The estimate of a weighted fit whose standard errors may have been floored since: `fit`,
+    /// with the correlation of each output's coefficients `correlation` (one per output).
+    pub(crate) fn of_fit(fit: LeastSquares, correlation: Vec<DMatrix<f64>>) -> Self {
+        Self {
+            cond: fit.cond,
+            residual_rms: fit.residual_rms.iter().copied().collect(),
+            crossings: fit.rows,
+            matrix: fit.coef,
+            stderr: fit.stderr,
+            correlation,
+        }
+    }
+
+    /// Columns `first..first + count` of the estimate (a block `D`, `H` or `G` of the combined
+    /// one), with the correlations among them; the fit's statistics as they are.
+    pub(crate) fn columns(&self, first: usize, count: usize) -> Self {
+        Self {
+            matrix: self.matrix.columns(first, count).into_owned(),
+            stderr: self.stderr.columns(first, count).into_owned(),
+            cond: self.cond,
+            residual_rms: self.residual_rms.clone(),
+            crossings: self.crossings,
+            correlation: (self.correlation.iter())
+                .map(|r| r.view((first, first), (count, count)).into_owned())
+                .collect(),
+        }
+    }
 }
 
 choice! {
@@ -125,6 +167,16 @@ impl LocalModel {
             Self::part(&self.g, "G")?,
         ];
         predict_linear(states, &self.torque, parts, &self.planned_op)
+    }
+
+    /// The standard errors (row-major `k x N`, N m, or N for a prismatic joint) of the torques
+    /// [`Self::predict`] gives at the samples of `states`: from those of `T*` and of the
+    /// matrices' entries with their correlation within each row (docs/method.md, section 5).
+    /// NaN for a joint where the model holds an unknown standard error that the state weights.
+    /// Refused for a model without the D, H or G experiment, or saved before the correlations
+    /// were stored.
+    pub fn predict_stderr(&self, states: &States<'_>) -> Result<Vec<f64>> {
+        super::prediction_uncertainty::predict_stderr(self, states)
     }
 
     /// The torque noise of the nominal passes, per joint in `joint_names`' order (N m, or N
@@ -308,6 +360,7 @@ impl Document for LocalModel {
                 }
                 check_bounded(Self::WHAT, kind, &rms, e.residual_rms.as_slice())?;
                 check_condition(Self::WHAT, &format!("{what}.cond"), e.cond)?;
+                super::prediction_uncertainty::check_correlations(Self::WHAT, what, e, n)?;
             }
         }
         // the diagnostics' entries name an experiment and a joint of this model

@@ -129,14 +129,16 @@ pub fn weighted_least_squares(
         });
     }
     let mut common = vec![f64::NAN; m];
+    let mut correlation = vec![ordinary.correlation.clone(); m];
     if k <= p {
         return Ok(Weighted {
             fit: ordinary,
             common,
+            correlation,
         });
     }
     let mut out = ordinary.clone();
-    for (c, common) in common.iter_mut().enumerate() {
+    for (c, (common, correlation)) in common.iter_mut().zip(&mut correlation).enumerate() {
         let uc = u.column(c);
         if uc.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
             continue;
@@ -181,6 +183,7 @@ pub fn weighted_least_squares(
             let w: Vec<f64> = un.iter().map(|v| 1.0 / (a + v)).collect();
             fit_weighted(x, y, c, &w, context, columns)?
         };
+        correlation.copy_from(&fit.correlation);
         out.coef.row_mut(c).copy_from(&fit.coef.row(0));
         out.stderr.row_mut(c).copy_from(&fit.stderr.row(0));
         let r: DVector<f64> = y.column(c) - x * fit.coef.row(0).transpose();
@@ -191,7 +194,11 @@ pub fn weighted_least_squares(
             0.0
         };
     }
-    Ok(Weighted { fit: out, common })
+    Ok(Weighted {
+        fit: out,
+        common,
+        correlation,
+    })
 }
 
 /// Output `c` of `Y ~= X A^T` with row `k` weighted by `w[k] > 0` (relative weights: the
@@ -219,4 +226,7 @@ pub struct Weighted {
     /// it was not estimated (no residual degree of freedom, or a variance in `u` that is not
     /// finite).
     pub common: Vec<f64>,
+    /// Per output, the correlation of its coefficients (p x p, as
+    /// [`LeastSquares::correlation`]) under the weights it was fitted with.
+    pub correlation: Vec<DMatrix<f64>>,
 }

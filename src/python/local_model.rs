@@ -323,6 +323,23 @@ impl PyLocalModel {
         let out = self.model.predict(&batch.states(n)?)?;
         to_numpy(py, out, batch.k, batch.single, &[n])
     }
+    /// The standard errors (N m) of the torques `predict` gives at `q`, `qd`, `qdd` (shapes as
+    /// there): from those of `T*` and of the matrices' entries with their correlation within
+    /// each row. NaN for a joint where the model holds an unknown standard error that the
+    /// state weights. Raises InputError for a model saved before the correlations were stored
+    /// (identify it again) or without the D, H or G experiment.
+    fn predict_stderr<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayLike<'py>,
+        qd: ArrayLike<'py>,
+        qdd: ArrayLike<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.model.n();
+        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
+        let out = self.model.predict_stderr(&batch.states(n)?)?;
+        to_numpy(py, out, batch.k, batch.single, &[n])
+    }
     /// The torque noise of the nominal passes: a tuple of two `(n,)` arrays (N m, or N for a
     /// prismatic joint), the samples' standard deviation about their windows' fits and what
     /// the readings varied by from pass to pass beyond it (0 where not estimated), for the

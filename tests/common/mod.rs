@@ -262,6 +262,7 @@ pub fn exact_local(
             residual_rms: vec![0.0; n],
             stderr: DMatrix::from_element(n, n, 1e-9),
             crossings: 2 * n,
+            correlation: vec![DMatrix::identity(n, n); n],
         })
     };
     perturbid_rs::local::LocalModel {

@@ -124,6 +124,17 @@ def test_workflow_shapes_uncertainty_and_json():
     np.testing.assert_array_equal(back.stderr["G"], model.stderr["G"])
     doc = json.loads(model.to_json())
     assert doc["format"] == "perturbid-local-model/1" and len(doc["d"]["matrix"]) == 6
+    # the predictions' standard errors: T*'s at the operating point; off it, D's entries' with
+    # their correlation in each row (from the JSON), worked out here in numpy
+    np.testing.assert_allclose(model.predict_stderr(m.q, m.qd, m.qdd), model.stderr["torque"], rtol=1e-14)
+    se = model.predict_stderr(np.tile(m.q, (3, 1)), np.tile(m.qd, (3, 1)), np.tile(m.qdd, (3, 1)) + [[0.0], [0.1], [0.2]])
+    assert se.shape == (3, 6)
+    x = np.full(6, 0.2)
+    for j in range(6):
+        r = np.array(doc["d"]["correlation"][j])
+        s = model.stderr["D"][j] * x
+        expected = np.sqrt(model.stderr["torque"][j] ** 2 + s @ r @ s)
+        np.testing.assert_allclose(se[2, j], expected, rtol=1e-12)
     combined = pr.identify_local(plan, recs, estimator="combined")
     assert combined.combined.shape == (6, 18) and combined.estimator == "combined"
     # the model as a tidy table: every entry once, where the arrays have it
