@@ -248,6 +248,55 @@ pub(crate) fn check_condition(what: &str, field: &str, cond: f64) -> Result<()> 
 }
 
 /// An error about a document's content (after parsing), for [`Document::validate`].
+/// Checks a correlation matrix `field` of a document `what` read from a file: `cols x cols`,
+/// symmetric with a unit diagonal, entries in [-1, 1], positive semi-definite (else a variance
+/// formed with it could come out negative).
+pub(crate) fn check_correlation(
+    what: &str,
+    field: &str,
+    r: &nalgebra::DMatrix<f64>,
+    cols: usize,
+) -> Result<()> {
+    if r.shape() != (cols, cols) {
+        return Err(invalid(
+            what,
+            format!(
+                "{field} is {} x {}; expected {cols} x {cols}",
+                r.nrows(),
+                r.ncols()
+            ),
+        ));
+    }
+    for a in 0..cols {
+        for b in 0..cols {
+            let v = r[(a, b)];
+            let problem = if !v.is_finite() || v.abs() > 1.0 + 1e-12 {
+                Some("expected a correlation in [-1, 1]")
+            } else if a == b && (v - 1.0).abs() > 1e-9 {
+                Some("expected 1 on the diagonal")
+            } else if (v - r[(b, a)]).abs() > 1e-9 {
+                Some("expected a symmetric matrix")
+            } else {
+                None
+            };
+            if let Some(p) = problem {
+                return Err(invalid(
+                    what,
+                    format!("{field}, row {}, column {} is {v}; {p}", a + 1, b + 1),
+                ));
+            }
+        }
+    }
+    let loosened = r + nalgebra::DMatrix::identity(cols, cols) * 1e-9;
+    if nalgebra::Cholesky::new(loosened).is_none() {
+        return Err(invalid(
+            what,
+            format!("{field} is not positive semi-definite: no correlation of {cols} estimates"),
+        ));
+    }
+    Ok(())
+}
+
 pub(crate) fn invalid(what: &str, message: String) -> Error {
     Error::Json {
         context: what.into(),

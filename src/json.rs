@@ -91,6 +91,16 @@ pub mod stderr_vec {
     }
 }
 
+/// An empty matrix (0 x 0): the default of a matrix field a document saved before it existed.
+pub fn empty_matrix() -> nalgebra::DMatrix<f64> {
+    nalgebra::DMatrix::zeros(0, 0)
+}
+
+/// Whether a matrix field is empty (not written).
+pub fn is_empty_matrix(m: &nalgebra::DMatrix<f64>) -> bool {
+    m.is_empty()
+}
+
 /// Serde adapter for a list of matrices (`Vec<DMatrix<f64>>`), each a list of rows.
 pub mod matrices {
     use nalgebra::DMatrix;

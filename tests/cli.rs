@@ -330,20 +330,88 @@ fn excite_identify_direct_predict() {
         &["predict", s(&d.join("base.json")), s(&d.join("log.csv"))],
         &["--robot"],
     );
+    // --stderr: after the torques, the library's standard errors
+    ok(&[
+        "predict",
+        s(&d.join("base.json")),
+        s(&d.join("log.csv")),
+        "--robot",
+        "a465",
+        "--stderr",
+        "--out",
+        s(&d.join("pred_se.csv")),
+    ]);
+    let with_se = Table::read(&d.join("pred_se.csv")).unwrap();
+    assert_eq!(with_se.columns.len(), 13);
+    assert_eq!(with_se.columns[12], "tau6_stderr");
+    let log = Table::read(&d.join("log.csv")).unwrap();
+    let pick = |t: &Table, names: Vec<String>| -> Vec<f64> {
+        let w = t.columns.len();
+        let cols: Vec<usize> = (names.iter())
+            .map(|n| t.columns.iter().position(|c| c == n).unwrap())
+            .collect();
+        (0..t.rows())
+            .flat_map(|r| {
+                cols.iter()
+                    .map(move |c| t.values[r * w + c])
+                    .collect::<Vec<_>>()
+            })
+            .collect()
+    };
+    let named = |prefix: &str, suffix: &str| -> Vec<String> {
+        (1..=6).map(|j| format!("{prefix}{j}{suffix}")).collect()
+    };
+    let (q, qd, qdd) = (
+        pick(&log, named("q", "")),
+        pick(&log, named("qd", "")),
+        pick(&log, named("qdd", "")),
+    );
+    let base = perturbid_rs::direct::BaseModel::load(d.join("base.json")).unwrap();
+    let robot = a465::model("kinsheel2010").unwrap();
+    let states = perturbid_rs::States::new(6, &q, Some(&qd), Some(&qdd)).unwrap();
+    let want = base.predict_stderr(&robot, &states).unwrap();
+    let got = pick(&with_se, named("tau", "_stderr"));
+    for (g, w) in got.iter().zip(&want) {
+        assert!((g - w).abs() <= 1e-12 * w && *w > 0.0, "{g} against {w}");
+    }
+    // a globally linearised model stores no covariance: refused, nothing written
+    let op = perturbid_rs::OperatingPoint::new(vec![0.0; 6], vec![0.0; 6], vec![0.0; 6]).unwrap();
+    // states that excite every coefficient (the log's few harmonics do not)
+    let noise = |i: usize, salt: u64| {
+        let mut z = (i as u64).wrapping_mul(0x9E3779B97F4A7C15) ^ salt;
+        z ^= z >> 29;
+        z = z.wrapping_mul(0xBF58476D1CE4E5B9);
+        z ^= z >> 32;
+        (z % 10_000) as f64 / 10_000.0 - 0.5
+    };
+    let (lq, lqd, lqdd): (Vec<f64>, Vec<f64>, Vec<f64>) = (
+        (0..360).map(|i| noise(i, 1)).collect(),
+        (0..360).map(|i| noise(i, 2)).collect(),
+        (0..360).map(|i| noise(i, 3)).collect(),
+    );
+    let lin_tau: Vec<f64> = (0..360)
+        .map(|i| lq[i] + 0.5 * lqd[i] + 0.1 * lqdd[i] + 0.01 * noise(i, 4))
+        .collect();
+    let lin_states = perturbid_rs::States::new(6, &lq, Some(&lqd), Some(&lqdd)).unwrap();
+    perturbid_rs::direct::identify_global_linear(&op, &lin_states, &lin_tau)
+        .unwrap()
+        .save(d.join("global.json"))
+        .unwrap();
     fails(
         &[
             "predict",
-            s(&d.join("base.json")),
+            s(&d.join("global.json")),
             s(&d.join("log.csv")),
-            "--robot",
-            "a465",
             "--stderr",
             "--out",
-            s(&d.join("pred_se.csv")),
+            s(&d.join("pred_global.csv")),
         ],
-        &["--stderr: ", "is not a local model"],
+        &[
+            "--stderr: ",
+            "globally linearised model, which stores no covariance",
+        ],
     );
-    assert!(!d.join("pred_se.csv").exists());
+    assert!(!d.join("pred_global.csv").exists());
     // a measured torque of 1e308 (its square overflows) and a position past its joint's
     // limits: the error's RMS stays a number, and the state is said to be one the robot
     // cannot take

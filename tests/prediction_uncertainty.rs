@@ -6,6 +6,9 @@ mod common;
 
 use common::{table2, Rng};
 use nalgebra::DMatrix;
+use perturbid_rs::direct::{
+    identify_base_parameters, BaseModel, BaseOptions, FrictionTerms, Weighting,
+};
 use perturbid_rs::local::noise::weighted_least_squares;
 use perturbid_rs::local::{
     identify_local, plan_experiments, Estimator, ExperimentKind, IdentifyOptions, LocalModel,
@@ -13,7 +16,10 @@ use perturbid_rs::local::{
 };
 use perturbid_rs::regression::least_squares;
 use perturbid_rs::robots::a465;
-use perturbid_rs::{simulate_plan, Document, Friction, Gravity, SimulationOptions, States};
+use perturbid_rs::trajectory::FourierTrajectory;
+use perturbid_rs::{
+    rnea, simulate_plan, Data, Document, Friction, Gravity, SimulationOptions, States,
+};
 
 const NOISE: f64 = 0.3;
 
@@ -296,4 +302,129 @@ fn correlations_are_saved_and_checked_on_loading() {
             "{e}\nexpected: {expected}"
         );
     }
+}
+
+/// A base-parameter model's predicted standard errors against the scatter of its predictions
+/// over 100 identifications from one A465 excitation (1,000 samples) with white torque noise,
+/// at states on the trajectory and off it; the correlation survives a JSON round trip, a model
+/// saved without it refuses `predict_stderr`, and a hand-edited one is refused on loading.
+#[test]
+fn base_model_predicted_standard_errors_match_the_scatter_over_seeds() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let mut rng = Rng(21);
+    let a = DMatrix::from_fn(n, 5, |_, _| rng.uniform(-0.12, 0.12));
+    let b = DMatrix::from_fn(n, 5, |_, _| rng.uniform(-0.12, 0.12));
+    let start = vec![0.2, 0.3, -0.4, 0.1, 0.5, -0.2];
+    let traj = FourierTrajectory::new(2.0 * std::f64::consts::PI * 0.1, start, a, b).unwrap();
+    let s = traj.sample_periods(1.0, 100.0).unwrap();
+    let torques = |q: &[f64], qd: &[f64], qdd: &[f64]| -> Vec<f64> {
+        let mut data = Data::new(&model);
+        (0..q.len() / n)
+            .flat_map(|i| {
+                let r = i * n..(i + 1) * n;
+                rnea(
+                    &model,
+                    &mut data,
+                    &q[r.clone()],
+                    &qd[r.clone()],
+                    &qdd[r],
+                    Gravity::Included,
+                )
+                .unwrap();
+                data.tau.as_slice().to_vec()
+            })
+            .collect()
+    };
+    let exact = torques(&s.q, &s.qd, &s.qdd);
+    let states = States::new(n, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
+    // three samples of the trajectory and one off it
+    let (mut q, mut qd, mut qdd) = (vec![], vec![], vec![]);
+    for (i, shift) in [(37, 0.0), (250, 0.0), (611, 0.0), (420, 0.15)] {
+        let r = i * n..(i + 1) * n;
+        q.extend(s.q[r.clone()].iter().map(|v| v + shift));
+        qd.extend(s.qd[r.clone()].iter().map(|v| v - shift));
+        qdd.extend(s.qdd[r].iter().map(|v| v + 2.0 * shift));
+    }
+    let test = States::new(n, &q, Some(&qd), Some(&qdd)).unwrap();
+    let m = q.len();
+    let options = BaseOptions {
+        friction: FrictionTerms::NONE,
+        weighting: Weighting::Ols,
+        ..BaseOptions::default()
+    };
+    let seeds = 100;
+    let mut predictions = vec![vec![]; m];
+    let mut variances = vec![0.0; m];
+    let mut last = None;
+    for _ in 0..seeds {
+        let tau: Vec<f64> = (exact.iter())
+            .map(|t| {
+                // Box-Muller
+                let (u, v) = (rng.uniform(1e-12, 1.0), rng.uniform(0.0, 1.0));
+                t + 0.05 * (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
+            })
+            .collect();
+        let fit = identify_base_parameters(&model, &states, &tau, &options).unwrap();
+        let p = fit.predict(&model, &test).unwrap();
+        let se = fit.predict_stderr(&model, &test).unwrap();
+        for i in 0..m {
+            predictions[i].push(p[i]);
+            variances[i] += se[i] * se[i] / seeds as f64;
+        }
+        last = Some(fit);
+    }
+    let ratios: Vec<f64> = (0..m)
+        .map(|i| {
+            let v = &predictions[i];
+            let mean = v.iter().sum::<f64>() / v.len() as f64;
+            let sd =
+                (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (v.len() - 1) as f64).sqrt();
+            sd / variances[i].sqrt()
+        })
+        .collect();
+    let mean = ratios.iter().sum::<f64>() / m as f64;
+    eprintln!("base-parameter model: scatter / standard error, mean {mean:.3}; {ratios:.2?}");
+    assert!((0.85..1.15).contains(&mean), "{ratios:?}");
+    assert!(ratios.iter().all(|r| (0.65..1.4).contains(r)), "{ratios:?}");
+
+    let fit = last.unwrap();
+    let p = fit.theta.len();
+    assert_eq!(fit.correlation.shape(), (p, p));
+    let text = fit.to_json();
+    assert_eq!(BaseModel::from_json(&text).unwrap(), fit);
+    let edited = |f: &dyn Fn(&mut serde_json::Value)| {
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        f(&mut v);
+        BaseModel::from_json(&v.to_string()).map_err(|e| e.to_string())
+    };
+    let old = edited(&|v| {
+        v.as_object_mut().unwrap().remove("correlation");
+    })
+    .unwrap();
+    let e = old.predict_stderr(&model, &test).unwrap_err().to_string();
+    assert!(
+        e.contains("holds no correlation") && e.contains("identify it again"),
+        "{e}"
+    );
+    let e = edited(&|v| {
+        v["correlation"][1][0] = 2.0.into();
+        v["correlation"][0][1] = 2.0.into();
+    })
+    .unwrap_err();
+    assert!(
+        e.contains("correlation, row 1, column 2 is 2; expected a correlation in [-1, 1]"),
+        "{e}"
+    );
+    let e = edited(&|v| {
+        v["correlation"].as_array_mut().unwrap().pop();
+    })
+    .unwrap_err();
+    assert!(
+        e.contains(&format!(
+            "correlation is {} x {p}; expected {p} x {p}",
+            p - 1
+        )),
+        "{e}"
+    );
 }

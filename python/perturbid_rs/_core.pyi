@@ -612,6 +612,10 @@ class BaseParameterModel:
     def to_dataframe(self) -> Any:
         """The parameter table as a pandas DataFrame (index parameter; value, std, relative_std, combination)."""
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]: ...
+    def predict_stderr(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:
+        """Standard errors (N m) of predict's torques, shape (n,) or (k, n): from the parameters'
+        standard errors and their correlation (the model's uncertainty, not a measured torque's
+        scatter). InputError for a model saved before the correlation was stored."""
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]: ...
     def to_json(self) -> str: ...
 

@@ -310,8 +310,8 @@ pub(crate) struct PredictArgs {
     #[arg(long, default_value = "predicted.csv")]
     out: PathBuf,
     /// Also write each predicted torque's standard error, tau1_stderr..tauN_stderr (N m; NaN
-    /// where the model holds an unknown one): a local model's, from its entries' standard
-    /// errors and their correlation.
+    /// where the model holds an unknown one): a local or base-parameter model's, from its
+    /// estimates' standard errors and their correlation.
     #[arg(long)]
     stderr: bool,
     /// The robot, for a base-parameter model (URDF file or built-in name).
@@ -328,7 +328,7 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
     let joints = file.joint_names().to_vec();
     let rows = read_states(&crate::io::Table::read(&a.data)?, &joints)?;
     let states = States::new(joints.len(), &rows.q, Some(&rows.qd), Some(&rows.qdd))?;
-    let tau = match &file {
+    let (tau, stderr) = match &file {
         ModelFile::Base(fit) => {
             let robot = a.robot.as_deref().ok_or_else(|| Error::InvalidArgument {
                 argument: "--robot".into(),
@@ -343,23 +343,24 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
             if let Some(w) = crate::direct::position_range::finding(&ranges) {
                 eprintln!("perturbid: warning: '{}': {w}", a.data.display());
             }
-            fit.on(&robot)?.predict(&states)?
+            let tau = fit.on(&robot)?.predict(&states)?;
+            let se = a.stderr.then(|| fit.predict_stderr(&robot, &states));
+            (tau, se.transpose()?)
         }
-        ModelFile::Local(m) => m.predict(&states)?,
-        ModelFile::GlobalLinear(m) => m.predict(&states)?,
-    };
-    let stderr = match (&file, a.stderr) {
-        (_, false) => None,
-        (ModelFile::Local(m), true) => Some(m.predict_stderr(&states)?),
-        (_, true) => {
+        ModelFile::Local(m) => {
+            let se = a.stderr.then(|| m.predict_stderr(&states));
+            (m.predict(&states)?, se.transpose()?)
+        }
+        ModelFile::GlobalLinear(_) if a.stderr => {
             return Err(Error::InvalidArgument {
                 argument: "--stderr".into(),
                 message: format!(
-                    "'{}' is not a local model: only a local model's predictions have standard errors here (a base-parameter or globally linearised model stores no covariance of its parameters)",
+                    "'{}' is a globally linearised model, which stores no covariance of its coefficients: only a local or base-parameter model's predictions have standard errors",
                     a.model.display()
                 ),
             })
         }
+        ModelFile::GlobalLinear(m) => (m.predict(&states)?, None),
     };
     let states = rows;
     let n = joints.len();

@@ -126,6 +126,16 @@ pub struct BaseModel {
     /// joint's offset is determined (or in a model saved before it was checked).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub position_offsets: Option<super::position_offsets::PositionOffsets>,
+    /// The correlation of the estimates in `theta` (p x p, unit diagonal): with `stderr`,
+    /// `diag(stderr) R diag(stderr)` is their covariance, which [`BaseModel::predict_stderr`]
+    /// needs. In a physically consistent model, the unconstrained fit's (with its standard
+    /// errors). Empty (0 x 0) in a model saved before it was stored.
+    #[serde(
+        default = "crate::json::empty_matrix",
+        skip_serializing_if = "crate::json::is_empty_matrix",
+        with = "crate::json::rows"
+    )]
+    pub correlation: DMatrix<f64>,
 }
 
 /// Identifies the base parameters of `model` from the samples of `states` (rad, rad/s,
@@ -264,6 +274,7 @@ fn fit_with_factors(
         weighting: options.weighting,
         theta: ls.coef.row(0).iter().copied().collect(),
         stderr: ls.stderr.row(0).iter().copied().collect(),
+        correlation: ls.correlation.clone(),
         residual_rms: rms,
         sigma,
         cond: ls.cond,
@@ -387,6 +398,9 @@ impl Document for BaseModel {
             ));
         }
         check_magnitudes(Self::WHAT, "stderr", &m.stderr, true)?;
+        if !m.correlation.is_empty() {
+            crate::document::check_correlation(Self::WHAT, "correlation", &m.correlation, p)?;
+        }
         if !(m.residual_correlation.is_empty() || m.residual_correlation.len() == n) {
             return Err(invalid(
                 Self::WHAT,
@@ -535,6 +549,49 @@ impl BaseModel {
     pub fn predict(&self, model: &Model, states: &States<'_>) -> Result<Vec<f64>> {
         self.check(model)?;
         self.predict_checked(model, states)
+    }
+
+    /// The standard errors (row-major `k x nv`, N m, or N for a prismatic joint) of the torques
+    /// [`Self::predict`] gives at the samples of `states`: `sqrt(phi^T diag(se) R diag(se)
+    /// phi)` for each joint's row `phi` of the base regressor, with the parameters' standard
+    /// errors `se` ([`Self::stderr`]) and their correlation `R` ([`Self::correlation`]): the
+    /// uncertainty of the model's torque, not the scatter of a measured one about it. NaN for a
+    /// joint whose row weights a parameter of unknown standard error. Refused on a robot
+    /// [`Self::on`] refuses, for a model saved before the correlation was stored, and where
+    /// the arithmetic overflows.
+    pub fn predict_stderr(&self, model: &Model, states: &States<'_>) -> Result<Vec<f64>> {
+        self.check(model)?;
+        let p = self.theta.len();
+        if self.correlation.shape() != (p, p) {
+            return Err(Error::InvalidArgument {
+                argument: "predict_stderr".into(),
+                message: "the model holds no correlation of its parameters' estimates (a model saved before it was stored): identify it again from its log".into(),
+            });
+        }
+        let mut out = Vec::with_capacity(states.len() * model.nv);
+        regressor_blocks(model, &self.base.layout, states, self.gravity, |_, phi| {
+            let rows = self.base.select(phi);
+            for row in rows.row_iter() {
+                // a parameter of unknown standard error counts only where the row weights it
+                let z = DVector::from_fn(p, |a, _| match row[a] {
+                    0.0 => 0.0,
+                    x => x * self.stderr[a],
+                });
+                out.push(z.dot(&(&self.correlation * &z)).max(0.0).sqrt());
+            }
+            Ok(())
+        })?;
+        if let Some(i) = out.iter().position(|v| v.is_infinite()) {
+            return Err(Error::Numerical {
+                operation: "prediction's standard error".into(),
+                message: format!(
+                    "the standard error of joint {} at sample {} overflows: the state is too large to compute with",
+                    i % model.nv + 1,
+                    i / model.nv
+                ),
+            });
+        }
+        Ok(out)
     }
 
     /// [`Self::predict`] on a robot [`Self::check`] accepted.

@@ -289,6 +289,7 @@ pub fn identify_parameters_from_local(
         residual_rms: residual_rms(&theta),
         theta,
         stderr,
+        correlation: ls.correlation.clone(),
         sigma: vec![1.0; nv],
         cond: ls.cond,
         samples: rows,

@@ -11,10 +11,10 @@
 //! which the planned designs balance (+- pairs), and is counted once, in the prediction's own
 //! `T*`.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
 use super::model::{Estimate, Estimator, LocalModel};
-use crate::document::invalid;
+use crate::document::{check_correlation, invalid};
 use crate::error::{Error, Result};
 use crate::states::States;
 use crate::torque_model::check_joints;
@@ -113,41 +113,12 @@ pub(crate) fn check_correlations(kind: &str, what: &str, e: &Estimate, n: usize)
         )));
     }
     for (j, r) in e.correlation.iter().enumerate() {
-        let row = j + 1;
-        if r.shape() != (cols, cols) {
-            return Err(bad(format!(
-                "matrix {row} is {} x {}; expected {cols} x {cols}",
-                r.nrows(),
-                r.ncols()
-            )));
-        }
-        for a in 0..cols {
-            for b in 0..cols {
-                let v = r[(a, b)];
-                let problem = if !v.is_finite() || v.abs() > 1.0 + 1e-12 {
-                    Some("expected a correlation in [-1, 1]")
-                } else if a == b && (v - 1.0).abs() > 1e-9 {
-                    Some("expected 1 on the diagonal")
-                } else if (v - r[(b, a)]).abs() > 1e-9 {
-                    Some("expected a symmetric matrix")
-                } else {
-                    None
-                };
-                if let Some(p) = problem {
-                    return Err(bad(format!(
-                        "matrix {row}, row {}, column {} is {v}; {p}",
-                        a + 1,
-                        b + 1
-                    )));
-                }
-            }
-        }
-        let loosened = r + DMatrix::identity(cols, cols) * 1e-9;
-        if nalgebra::Cholesky::new(loosened).is_none() {
-            return Err(bad(format!(
-                "matrix {row} is not positive semi-definite: no correlation of {cols} estimates"
-            )));
-        }
+        check_correlation(
+            kind,
+            &format!("{what}.correlation matrix {}", j + 1),
+            r,
+            cols,
+        )?;
     }
     Ok(())
 }

@@ -399,6 +399,28 @@ impl PyBaseModel {
         })?;
         to_numpy(py, tau, batch.k, batch.single, &[n])
     }
+    /// The standard errors (N m) of the torques `predict` gives at `q`, `qd`, `qdd` (shapes as
+    /// there): from the parameters' standard errors and their correlation; the uncertainty of
+    /// the model's torque, not a measured one's scatter about it. Raises InputError for a
+    /// model saved before the correlation was stored.
+    fn predict_stderr<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayLike<'py>,
+        qd: ArrayLike<'py>,
+        qdd: ArrayLike<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.model.nv;
+        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
+        let c = &batch.columns;
+        let se = detached(py, "BaseParameterModel.predict_stderr", || {
+            self.fit.predict_stderr(
+                &self.model,
+                &States::new(self.model.nv, &c[0], Some(&c[1]), Some(&c[2]))?,
+            )
+        })?;
+        to_numpy(py, se, batch.k, batch.single, &[n])
+    }
     /// The model linearised exactly at `op` (an OperatingPoint): dict `torque` (n,), `D`, `H`,
     /// `G`, `G_static` (n, n; row = torque, column = joint), as a LocalModel answers it.
     fn linearize<'py>(

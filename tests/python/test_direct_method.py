@@ -104,6 +104,14 @@ def test_base_parameters_on_simulated_a465_are_exact():
     theta = np.concatenate([robot.parameters, robot.armature])
     np.testing.assert_allclose(fit.theta_base, theta[fit.kept] + fit.K @ theta[fit.dropped], rtol=1e-7, atol=1e-9)
     assert fit.mass_matrix(np.tile(TABLE2_Q, (2, 1))).shape == (2, 6, 6)
+    # the predictions' standard errors: per joint, sqrt(z^T R z) with z its base-regressor row
+    # times the parameters' standard errors and R their correlation (the JSON's), in numpy
+    se = fit.predict_stderr(qh[:5], qdh[:5], qddh[:5])
+    assert se.shape == (5, 6) and (se > 0).all()
+    r = np.array(json.loads(fit.to_json())["correlation"])
+    full = np.concatenate([robot.regressor(qh[:5], qdh[:5], qddh[:5]), qddh[:5, :, None] * np.eye(6)], axis=2)
+    z = full[:, :, fit.kept] * fit.stderr
+    np.testing.assert_allclose(se, np.sqrt(np.einsum("kja,ab,kjb->kj", z, r, z)), rtol=1e-9)
 
 
 def test_torque_columns_are_checked_against_the_model():
