@@ -14,6 +14,14 @@ pub struct JointError {
     pub relative_rms: Option<f64>,
     /// Largest `|measured - predicted|` (N m or N).
     pub max: f64,
+    /// RMS over the samples of the prediction's standard error (N m or N): the model's own
+    /// uncertainty at these states ([`Validation::with_model_stderr`]). A model that holds there
+    /// errs by about `sqrt(model_stderr_rms^2 + noise^2)` for the log's torque noise; an `rms`
+    /// far beyond it is the model's error (a local model far from its point, a missing effect),
+    /// not its identification's noise. None where the model carries none (a globally linearised
+    /// model, one saved before they were stored) or one is unknown.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model_stderr_rms: Option<f64>,
 }
 
 /// The validation of a model on measured torques.
@@ -99,6 +107,7 @@ pub fn validate(joint_names: &[String], predicted: &[f64], measured: &[f64]) -> 
                 max: (0..k)
                     .map(|s| residuals[s * n + j].abs())
                     .fold(0.0, f64::max),
+                model_stderr_rms: None,
             }
         })
         .collect();
@@ -107,6 +116,52 @@ pub fn validate(joint_names: &[String], predicted: &[f64], measured: &[f64]) -> 
         samples: k,
         residuals,
     })
+}
+
+impl Validation {
+    /// The validation with each joint's [`JointError::model_stderr_rms`] from the standard
+    /// errors of the predictions (row-major `samples x n`, N m or N: a model's
+    /// `predict_stderr` at the same states); a joint with an unknown one (NaN) gets None.
+    /// Refused when the length is not the validation's or a value is negative or infinite.
+    pub fn with_model_stderr(mut self, stderr: &[f64]) -> Result<Self> {
+        let n = self.joints.len();
+        if stderr.len() != self.samples * n {
+            return Err(Error::Shape {
+                argument: "model standard errors".into(),
+                expected: format!("{} x {n} like the torques", self.samples),
+                got: format!("{} values", stderr.len()),
+            });
+        }
+        if let Some(i) = stderr.iter().position(|v| *v < 0.0 || v.is_infinite()) {
+            return Err(Error::InvalidArgument {
+                argument: "model standard errors".into(),
+                message: format!(
+                    "sample {}, joint {} is {}: expected a standard error (>= 0, or NaN where unknown)",
+                    i / n,
+                    self.joints[i % n].joint,
+                    stderr[i]
+                ),
+            });
+        }
+        for (j, e) in self.joints.iter_mut().enumerate() {
+            let column = (0..self.samples).map(|s| stderr[s * n + j]);
+            e.model_stderr_rms = column.clone().all(|v| !v.is_nan()).then(|| rms(column));
+        }
+        Ok(self)
+    }
+}
+
+/// The standard errors a model's `predict_stderr` gave, for [`Validation::with_model_stderr`]:
+/// `None`, with the refusal's reason, for a model that carries none (saved before they were
+/// stored); any other error as it is.
+pub fn stored_stderr(result: Result<Vec<f64>>) -> Result<std::result::Result<Vec<f64>, String>> {
+    match result {
+        Ok(se) => Ok(Ok(se)),
+        Err(Error::InvalidArgument { argument, message }) if argument == "predict_stderr" => {
+            Ok(Err(message))
+        }
+        Err(e) => Err(e),
+    }
 }
 
 #[cfg(test)]
@@ -126,5 +181,20 @@ mod tests {
         let v = validate(&joints, &[0.0, 0.0, 0.0, 0.0], &[0.0, 1e308, 0.0, 1e308]).unwrap();
         assert_eq!(v.joints[1].max, 1e308);
         assert!((v.joints[1].rms / 1e308 - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn model_standard_errors_are_summarised_per_joint() {
+        let joints = vec!["a".to_string(), "b".to_string()];
+        let v = validate(&joints, &[0.0; 4], &[1.0, 2.0, 3.0, 4.0]).unwrap();
+        let v = v.with_model_stderr(&[0.3, f64::NAN, 0.4, 1.0]).unwrap();
+        assert!((v.joints[0].model_stderr_rms.unwrap() - 0.125f64.sqrt()).abs() < 1e-15);
+        assert_eq!(v.joints[1].model_stderr_rms, None);
+        let e = v
+            .clone()
+            .with_model_stderr(&[0.3, 0.1, -0.4, 1.0])
+            .unwrap_err();
+        assert!(e.to_string().contains("sample 1, joint a is -0.4"), "{e}");
+        assert!(v.with_model_stderr(&[0.3]).is_err());
     }
 }

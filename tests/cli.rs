@@ -466,13 +466,21 @@ fn excite_identify_direct_predict() {
         s(&d.join("validation")),
     ]);
     assert!(out.contains("rel. RMS") && out.contains("joint6"), "{out}");
+    assert!(
+        out.contains("model s.e. RMS") && out.contains("the model's own uncertainty"),
+        "{out}"
+    );
     let v: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(d.join("validation/validation.json")).unwrap(),
     )
     .unwrap();
     for j in v["joints"].as_array().unwrap() {
         assert!(j["rms"].as_f64().unwrap() < 1e-6, "{j}");
+        assert!(j["model_stderr_rms"].as_f64().unwrap() >= 0.0, "{j}");
     }
+    // the figure draws the predictions' band of +- 2 standard errors
+    let svg = std::fs::read_to_string(d.join("validation/validation.svg")).unwrap();
+    assert_eq!(svg.matches("<polygon").count(), 6, "one band a joint");
     let residuals = std::fs::read_to_string(d.join("validation/residuals.csv")).unwrap();
     assert!(
         residuals.starts_with("t,residual_joint1,"),

@@ -730,6 +730,10 @@ class Validation:
     @property
     def max(self) -> NDArray[np.float64]: ...
     @property
+    def model_stderr_rms(self) -> NDArray[np.float64]:
+        """Per joint, the RMS of the predictions' standard errors (N m): the model's own
+        uncertainty at these states; NaN where the model gives none."""
+    @property
     def residuals(self) -> NDArray[np.float64]: ...
     @property
     def samples(self) -> int: ...

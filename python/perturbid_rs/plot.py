@@ -27,22 +27,32 @@ def measured_and_predicted(
     measured: ArrayLike,
     predicted: ArrayLike,
     joints: Optional[Sequence[str]] = None,
+    stderr: Optional[ArrayLike] = None,
 ) -> Any:
     """One panel per joint: the measured torque (solid, grey), the predicted one (dashed, red)
     and their difference (dotted, blue). ``t`` (k,) in s; ``measured``, ``predicted`` (k, n) in
-    N m; ``joints`` names the panels."""
+    N m; ``joints`` names the panels. ``stderr`` (k, n) in N m, the predictions' standard errors
+    (a model's ``predict_stderr``), draws the band of +- 2 of them about the prediction (red,
+    shaded; a gap where one is unknown, NaN)."""
     plt = _pyplot()
     t = np.asarray(t, dtype=float)
     m = np.atleast_2d(np.asarray(measured, dtype=float))
     p = np.atleast_2d(np.asarray(predicted, dtype=float))
     if m.shape != p.shape or m.shape[0] != t.shape[0]:
         raise ValueError(f"t {t.shape}, measured {m.shape} and predicted {p.shape} disagree: expected (k,), (k, n), (k, n)")
+    se = None if stderr is None else np.atleast_2d(np.asarray(stderr, dtype=float))
+    if se is not None and se.shape != p.shape:
+        raise ValueError(f"stderr {se.shape} and predicted {p.shape} disagree: expected (k, n) for both")
+    if se is not None and (se < 0).any():
+        raise ValueError("stderr holds negative values: expected standard errors (>= 0, or NaN where unknown)")
     n = m.shape[1]
     names = list(joints) if joints is not None else [f"joint {j + 1}" for j in range(n)]
     fig, axes = plt.subplots(n, 1, figsize=(9, 2.0 * n), sharex=True, squeeze=False)
     for j, ax in enumerate(axes[:, 0]):
         ax.plot(t, m[:, j], "-", color="0.35", lw=1.5, label="measured")
         ax.plot(t, p[:, j], "--", color="tab:red", lw=1.2, label="predicted")
+        if se is not None:
+            ax.fill_between(t, p[:, j] - 2 * se[:, j], p[:, j] + 2 * se[:, j], color="tab:red", alpha=0.15, lw=0, label="predicted +- 2 s.e.")
         ax.plot(t, m[:, j] - p[:, j], ":", color="tab:blue", lw=1.0, label="residual")
         ax.set_ylabel(f"{names[j]}\n(N m)")
     axes[0, 0].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)

@@ -17,7 +17,7 @@ use crate::io::{OutputSet, Table};
 use crate::states::States;
 use crate::svg::{line_plot, Series};
 use crate::torque_model::{ModelFile, TorqueModel};
-use crate::validation::validate;
+use crate::validation::{stored_stderr, validate};
 
 #[derive(Args)]
 pub(crate) struct ValidateArgs {
@@ -84,7 +84,20 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
         ModelFile::Local(m) => m.predict(&states)?,
         ModelFile::GlobalLinear(m) => m.predict(&states)?,
     };
-    let v = validate(&joints, &predicted, &rec.tau)?;
+    progress.update("the predictions' standard errors");
+    let stderr = match &file {
+        ModelFile::Base(fit) => {
+            stored_stderr(fit.predict_stderr(robot.as_ref().expect("checked above"), &states))?
+        }
+        ModelFile::Local(m) => stored_stderr(m.predict_stderr(&states))?,
+        ModelFile::GlobalLinear(_) => {
+            Err("a globally linearised model stores no covariance of its coefficients".into())
+        }
+    };
+    let mut v = validate(&joints, &predicted, &rec.tau)?;
+    if let Ok(se) = &stderr {
+        v = v.with_model_stderr(se)?;
+    }
     // the log's torque columns against the robot's own model, as every direct fit checks
     // its own log: swapped columns, another sign or other units show here by name, not only
     // as large errors
@@ -151,7 +164,13 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     )?;
     set.add(
         "validation.svg",
-        figure(&joints, &rec.t, &rec.tau, &predicted),
+        figure(
+            &joints,
+            &rec.t,
+            &rec.tau,
+            &predicted,
+            stderr.as_deref().ok(),
+        ),
     )?;
     set.commit()?;
     let _ = writeln!(
@@ -163,18 +182,32 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     );
     let _ = writeln!(
         out,
-        "  {:<20} {:>12} {:>10} {:>12}",
-        "joint", "RMS (N m)", "rel. RMS", "max (N m)"
+        "  {:<20} {:>12} {:>10} {:>12} {:>14}",
+        "joint", "RMS (N m)", "rel. RMS", "max (N m)", "model s.e. RMS"
     );
     for j in &v.joints {
         let rel = j
             .relative_rms
             .map_or("-".to_string(), |r| format!("{:.2} %", 100.0 * r));
+        let se = j
+            .model_stderr_rms
+            .map_or("-".to_string(), |s| format!("{s:.4}"));
         let _ = writeln!(
             out,
-            "  {:<20} {:>12.4} {:>10} {:>12.4}",
-            j.joint, j.rms, rel, j.max
+            "  {:<20} {:>12.4} {:>10} {:>12.4} {:>14}",
+            j.joint, j.rms, rel, j.max, se
         );
+    }
+    match &stderr {
+        Ok(_) => {
+            let _ = writeln!(
+                out,
+                "  (model s.e.: the model's own uncertainty at these states; an RMS far beyond it and the torque noise is the model's error)"
+            );
+        }
+        Err(why) => {
+            let _ = writeln!(out, "  (no model s.e.: {why})");
+        }
     }
     let _ = writeln!(
         out,
@@ -185,8 +218,15 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
 }
 
 /// Measured and predicted torques per joint, one panel each (measured solid, predicted
-/// dashed over it), with the residual.
-fn figure(joints: &[String], t: &[f64], measured: &[f64], predicted: &[f64]) -> String {
+/// dashed over it, with the band of +- 2 standard errors where the model gives them), with
+/// the residual.
+fn figure(
+    joints: &[String],
+    t: &[f64],
+    measured: &[f64],
+    predicted: &[f64],
+    stderr: Option<&[f64]>,
+) -> String {
     let n = joints.len();
     let column =
         |v: &[f64], j: usize| -> Vec<f64> { v.iter().skip(j).step_by(n).copied().collect() };
@@ -194,6 +234,13 @@ fn figure(joints: &[String], t: &[f64], measured: &[f64], predicted: &[f64]) -> 
         .map(|j| {
             let (m, p) = (column(measured, j), column(predicted, j));
             let r: Vec<f64> = m.iter().zip(&p).map(|(a, b)| a - b).collect();
+            let se = stderr.map(|s| column(s, j));
+            let band = se.as_ref().map(|se| {
+                let side = |sign: f64| -> Vec<f64> {
+                    p.iter().zip(se).map(|(p, s)| p + sign * 2.0 * s).collect()
+                };
+                (side(-1.0), side(1.0))
+            });
             line_plot(
                 &format!("{}: measured and predicted torque", joints[j]),
                 "t (s)",
@@ -213,7 +260,7 @@ fn figure(joints: &[String], t: &[f64], measured: &[f64], predicted: &[f64]) -> 
                         dash: "6 4",
                         x: t,
                         y: &p,
-                        band: None,
+                        band: band.as_ref().map(|(lo, hi)| [&lo[..], &hi[..]]),
                     },
                     Series {
                         name: "residual",

@@ -11,13 +11,14 @@ use super::direct::{
     position_offsets_dict, position_range_dicts, torque_column_dicts, torque_lag_dict, PyBaseModel,
 };
 use super::errors::warn_all;
+use super::local_model::PyLocalModel;
 use super::tables::dataframe;
 use crate::direct::position_offsets::{check_position_offsets_in_validation, PositionOffsets};
 use crate::direct::position_range::{check_position_range, JointRange};
 use crate::direct::torque_columns::{check_torque_columns, TorqueColumn};
 use crate::direct::torque_lag::{check_torque_lag, log_findings, TorqueLag};
 use crate::states::States;
-use crate::validation::{validate as validate_rs, Validation};
+use crate::validation::{stored_stderr, validate as validate_rs, Validation};
 
 /// A model's torques against measured ones. Attributes: `joints` (names), `rms`,
 /// `relative_rms` (NaN where the measured torque is zero), `max` (n,) per joint (N m; fraction);
@@ -109,7 +110,21 @@ impl PyValidation {
             .map(|o| position_offsets_dict(py, o, o.validation_finding()))
             .transpose()
     }
-    /// The per-joint table: index `joint`, columns `rms`, `relative_rms`, `max`.
+    /// Per joint, the RMS of the predictions' standard errors (n,) (N m): the model's own
+    /// uncertainty at these states, to weigh `rms` against; NaN where the model gives none (a
+    /// GlobalLinearModel, a model saved before they were stored) or one is unknown.
+    #[getter]
+    fn model_stderr_rms<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_iter(
+            py,
+            self.v
+                .joints
+                .iter()
+                .map(|j| j.model_stderr_rms.unwrap_or(f64::NAN)),
+        )
+    }
+    /// The per-joint table: index `joint`, columns `rms`, `relative_rms`, `max`,
+    /// `model_stderr_rms`.
     fn to_dataframe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         dataframe(
             py,
@@ -117,6 +132,7 @@ impl PyValidation {
                 ("rms", self.rms(py).into_any()),
                 ("relative_rms", self.relative_rms(py).into_any()),
                 ("max", self.max(py).into_any()),
+                ("model_stderr_rms", self.model_stderr_rms(py).into_any()),
             ],
             Some(("joint", self.joints())),
         )
@@ -176,7 +192,29 @@ pub(crate) fn validate<'py>(
         Ok(j) => j.extract()?,
         Err(_) => (1..=n).map(|j| format!("joint{j}")).collect(),
     };
-    let v = validate_rs(&joints, &predicted, &measured)?;
+    let mut v = validate_rs(&joints, &predicted, &measured)?;
+    // the predictions' standard errors, where the model gives them
+    let stderr = if let Ok(local) = model.cast::<PyLocalModel>() {
+        let (q, qd, qdd): (ArrayLike, ArrayLike, ArrayLike) =
+            (q.extract()?, qd.extract()?, qdd.extract()?);
+        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
+        stored_stderr(local.get().model.predict_stderr(&batch.states(n)?))?.ok()
+    } else if let Ok(base) = model.cast::<PyBaseModel>() {
+        let base = base.get();
+        let (q, qd, qdd): (ArrayLike, ArrayLike, ArrayLike) =
+            (q.extract()?, qd.extract()?, qdd.extract()?);
+        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
+        let states = batch.states(n)?;
+        let se = detached(model.py(), "validate", || {
+            stored_stderr(base.fit.predict_stderr(&base.model, &states))
+        })?;
+        se.ok()
+    } else {
+        None
+    };
+    if let Some(se) = &stderr {
+        v = v.with_model_stderr(se)?;
+    }
     // the measured torque columns against the robot's own model, as a direct fit checks its
     // own data
     let (position_range, torque_columns, torque_lag, position_offsets) =

@@ -628,6 +628,8 @@ def test_validation_tables_and_figures():
     fit = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction=None)
     v = pr.validate(fit, q, qd, qdd, tau)
     r = tau - fit.predict(q, qd, qdd)
+    np.testing.assert_allclose(v.model_stderr_rms, np.sqrt(np.mean(fit.predict_stderr(q, qd, qdd) ** 2, axis=0)), rtol=1e-12)
+    assert (v.model_stderr_rms < 0.05).all()  # the model's uncertainty, far below the noise
     np.testing.assert_allclose(v.residuals, r, atol=1e-12)
     np.testing.assert_allclose(v.rms, np.sqrt(np.mean(r**2, axis=0)), rtol=1e-12)
     np.testing.assert_allclose(v.relative_rms, np.sqrt(np.sum(r**2, axis=0) / np.sum(tau**2, axis=0)), rtol=1e-12)
@@ -644,6 +646,17 @@ def test_validation_tables_and_figures():
     assert len(fig.axes) == 6 and fig.axes[0].get_legend() is not None
     assert [line.get_linestyle() for line in fig.axes[0].lines] == ["-", "--", ":"]
     assert len(plot.residuals(v, t).axes) == 6
+    # the predictions' standard errors as a band of +- 2 about the prediction
+    se = fit.predict_stderr(q, qd, qdd)
+    fig = plot.measured_and_predicted(t, tau, fit.predict(q, qd, qdd), robot.joint_names, stderr=se)
+    band = fig.axes[2].collections[0].get_paths()[0].vertices
+    p2 = fit.predict(q, qd, qdd)[:, 2]
+    np.testing.assert_allclose(band[:, 1].max(), (p2 + 2 * se[:, 2]).max(), rtol=1e-12)
+    np.testing.assert_allclose(band[:, 1].min(), (p2 - 2 * se[:, 2]).min(), rtol=1e-12)
+    with pytest.raises(ValueError, match="stderr"):
+        plot.measured_and_predicted(t, tau, tau, stderr=se[:-1])
+    with pytest.raises(ValueError, match="negative"):
+        plot.measured_and_predicted(t, tau, tau, stderr=-se)
     with pytest.raises(ValueError, match="disagree"):
         plot.measured_and_predicted(t[:-1], tau, tau)
     with pytest.raises(pr.InputError):

@@ -129,6 +129,12 @@ def test_workflow_shapes_uncertainty_and_json():
     np.testing.assert_allclose(model.predict_stderr(m.q, m.qd, m.qdd), model.stderr["torque"], rtol=1e-14)
     se = model.predict_stderr(np.tile(m.q, (3, 1)), np.tile(m.qd, (3, 1)), np.tile(m.qdd, (3, 1)) + [[0.0], [0.1], [0.2]])
     assert se.shape == (3, 6)
+    # a validation weighs the errors against the model's own uncertainty at the states
+    states = [np.tile(v, (3, 1)) for v in (m.q, m.qd, m.qdd)]
+    states[2] = states[2] + [[0.0], [0.1], [0.2]]
+    v = pr.validate(model, *states, model.predict(*states))
+    np.testing.assert_allclose(v.model_stderr_rms, np.sqrt(np.mean(se**2, axis=0)), rtol=1e-12)
+    assert "model_stderr_rms" in v.to_dataframe().columns
     x = np.full(6, 0.2)
     for j in range(6):
         r = np.array(doc["d"]["correlation"][j])
