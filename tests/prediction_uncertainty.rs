@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{table2, Rng};
+use common::{a465_excitation, table2, torques, Rng};
 use nalgebra::DMatrix;
 use perturbid_rs::direct::{
     identify_base_parameters, BaseModel, BaseOptions, FrictionTerms, Weighting,
@@ -16,10 +16,7 @@ use perturbid_rs::local::{
 };
 use perturbid_rs::regression::least_squares;
 use perturbid_rs::robots::a465;
-use perturbid_rs::trajectory::FourierTrajectory;
-use perturbid_rs::{
-    rnea, simulate_plan, Data, Document, Friction, Gravity, SimulationOptions, States,
-};
+use perturbid_rs::{simulate_plan, Document, Friction, Gravity, SimulationOptions, States};
 
 const NOISE: f64 = 0.3;
 
@@ -312,31 +309,10 @@ fn correlations_are_saved_and_checked_on_loading() {
 fn base_model_predicted_standard_errors_match_the_scatter_over_seeds() {
     let model = a465::model("kinsheel2010").unwrap();
     let n = model.nv;
-    let mut rng = Rng(21);
-    let a = DMatrix::from_fn(n, 5, |_, _| rng.uniform(-0.12, 0.12));
-    let b = DMatrix::from_fn(n, 5, |_, _| rng.uniform(-0.12, 0.12));
-    let start = vec![0.2, 0.3, -0.4, 0.1, 0.5, -0.2];
-    let traj = FourierTrajectory::new(2.0 * std::f64::consts::PI * 0.1, start, a, b).unwrap();
+    let traj = a465_excitation(&mut Rng(21));
     let s = traj.sample_periods(1.0, 100.0).unwrap();
-    let torques = |q: &[f64], qd: &[f64], qdd: &[f64]| -> Vec<f64> {
-        let mut data = Data::new(&model);
-        (0..q.len() / n)
-            .flat_map(|i| {
-                let r = i * n..(i + 1) * n;
-                rnea(
-                    &model,
-                    &mut data,
-                    &q[r.clone()],
-                    &qd[r.clone()],
-                    &qdd[r],
-                    Gravity::Included,
-                )
-                .unwrap();
-                data.tau.as_slice().to_vec()
-            })
-            .collect()
-    };
-    let exact = torques(&s.q, &s.qd, &s.qdd);
+    let mut rng = Rng(21);
+    let exact = torques(&model, &s.q, &s.qd, &s.qdd, Gravity::Included);
     let states = States::new(n, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
     // three samples of the trajectory and one off it
     let (mut q, mut qd, mut qdd) = (vec![], vec![], vec![]);

@@ -410,6 +410,22 @@ pub(crate) fn write_into_all<T, const N: usize>(
     f(slices)
 }
 
+/// `f` at the states `q`, `qd`, `qdd` ((n,) each or a batch (k, n)), run with the GIL released
+/// (`name` names it in a caught panic's report); its row-major result, n values a state, as an
+/// array of the states' shape.
+pub(crate) fn at_states<'py>(
+    py: Python<'py>,
+    n: usize,
+    [q, qd, qdd]: [&ArrayLike<'py>; 3],
+    name: &str,
+    f: impl FnOnce(&crate::states::States<'_>) -> Result<Vec<f64>> + Send,
+) -> PyResult<Bound<'py, PyAny>> {
+    let batch = read_batch(n, &[("q", q), ("qd", qd), ("qdd", qdd)])?;
+    let states = batch.states(n)?;
+    let out = super::detached(py, name, || f(&states))?;
+    to_numpy(py, out, batch.k, batch.single, &[n])
+}
+
 /// A numpy array of `values` with shape `dims` prefixed by `k` unless `single`.
 pub(crate) fn to_numpy<'py>(
     py: Python<'py>,

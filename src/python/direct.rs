@@ -13,7 +13,9 @@ use super::scalars;
 use super::detached;
 use pyo3::types::PyDict;
 
-use super::arrays::{expansion_dict, matrix_to_numpy as mat, read_batch, to_numpy, ArrayLike};
+use super::arrays::{
+    at_states, expansion_dict, matrix_to_numpy as mat, read_batch, to_numpy, ArrayLike,
+};
 use super::local::PyOperatingPoint;
 use super::robot::PyRobot;
 use super::trajectory::PyFourier;
@@ -388,16 +390,11 @@ impl PyBaseModel {
         qd: ArrayLike<'py>,
         qdd: ArrayLike<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let n = self.model.nv;
-        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
-        let c = &batch.columns;
-        let tau = detached(py, "BaseParameterModel.predict", || {
-            self.fit.predict(
-                &self.model,
-                &States::new(self.model.nv, &c[0], Some(&c[1]), Some(&c[2]))?,
-            )
-        })?;
-        to_numpy(py, tau, batch.k, batch.single, &[n])
+        let (fit, model) = (&self.fit, &self.model);
+        let name = "BaseParameterModel.predict";
+        at_states(py, model.nv, [&q, &qd, &qdd], name, |s| {
+            fit.predict(model, s)
+        })
     }
     /// The standard errors (N m) of the torques `predict` gives at `q`, `qd`, `qdd` (shapes as
     /// there): from the parameters' standard errors and their correlation; the uncertainty of
@@ -410,16 +407,11 @@ impl PyBaseModel {
         qd: ArrayLike<'py>,
         qdd: ArrayLike<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let n = self.model.nv;
-        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
-        let c = &batch.columns;
-        let se = detached(py, "BaseParameterModel.predict_stderr", || {
-            self.fit.predict_stderr(
-                &self.model,
-                &States::new(self.model.nv, &c[0], Some(&c[1]), Some(&c[2]))?,
-            )
-        })?;
-        to_numpy(py, se, batch.k, batch.single, &[n])
+        let (fit, model) = (&self.fit, &self.model);
+        let name = "BaseParameterModel.predict_stderr";
+        at_states(py, model.nv, [&q, &qd, &qdd], name, |s| {
+            fit.predict_stderr(model, s)
+        })
     }
     /// The model linearised exactly at `op` (an OperatingPoint): dict `torque` (n,), `D`, `H`,
     /// `G`, `G_static` (n, n; row = torque, column = joint), as a LocalModel answers it.
@@ -650,13 +642,11 @@ impl PyGlobalLinear {
         qd: ArrayLike<'py>,
         qdd: ArrayLike<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let n = self.fit.offset.len();
-        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
-        let c = &batch.columns;
-        let out = self
-            .fit
-            .predict(&States::new(n, &c[0], Some(&c[1]), Some(&c[2]))?)?;
-        to_numpy(py, out, batch.k, batch.single, &[n])
+        let fit = &self.fit;
+        let name = "GlobalLinearModel.predict";
+        at_states(py, fit.offset.len(), [&q, &qd, &qdd], name, |s| {
+            fit.predict(s)
+        })
     }
     fn to_json(&self) -> String {
         serde_json::to_string_pretty(&self.fit).expect("serialisable")

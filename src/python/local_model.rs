@@ -4,7 +4,7 @@
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use super::arrays::{matrix_to_numpy as mat, read_batch, to_numpy, vec1, ArrayLike};
+use super::arrays::{at_states, matrix_to_numpy as mat, vec1, ArrayLike};
 use super::local::PyOperatingPoint;
 use crate::document::Document;
 use crate::local::{Estimate, Estimator, LocalModel, ReversalHandling};
@@ -318,10 +318,10 @@ impl PyLocalModel {
         qd: ArrayLike<'py>,
         qdd: ArrayLike<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let n = self.model.n();
-        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
-        let out = self.model.predict(&batch.states(n)?)?;
-        to_numpy(py, out, batch.k, batch.single, &[n])
+        let m = &self.model;
+        at_states(py, m.n(), [&q, &qd, &qdd], "LocalModel.predict", |s| {
+            m.predict(s)
+        })
     }
     /// The standard errors (N m) of the torques `predict` gives at `q`, `qd`, `qdd` (shapes as
     /// there): from those of `T*` and of the matrices' entries with their correlation within
@@ -335,10 +335,9 @@ impl PyLocalModel {
         qd: ArrayLike<'py>,
         qdd: ArrayLike<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let n = self.model.n();
-        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
-        let out = self.model.predict_stderr(&batch.states(n)?)?;
-        to_numpy(py, out, batch.k, batch.single, &[n])
+        let m = &self.model;
+        let name = "LocalModel.predict_stderr";
+        at_states(py, m.n(), [&q, &qd, &qdd], name, |s| m.predict_stderr(s))
     }
     /// The torque noise of the nominal passes: a tuple of two `(n,)` arrays (N m, or N for a
     /// prismatic joint), the samples' standard deviation about their windows' fits and what

@@ -17,7 +17,6 @@ use crate::direct::position_offsets::{check_position_offsets_in_validation, Posi
 use crate::direct::position_range::{check_position_range, JointRange};
 use crate::direct::torque_columns::{check_torque_columns, TorqueColumn};
 use crate::direct::torque_lag::{check_torque_lag, log_findings, TorqueLag};
-use crate::states::States;
 use crate::validation::{stored_stderr, validate as validate_rs, Validation};
 
 /// A model's torques against measured ones. Attributes: `joints` (names), `rms`,
@@ -193,60 +192,48 @@ pub(crate) fn validate<'py>(
         Err(_) => (1..=n).map(|j| format!("joint{j}")).collect(),
     };
     let mut v = validate_rs(&joints, &predicted, &measured)?;
-    // the predictions' standard errors, where the model gives them
-    let stderr = if let Ok(local) = model.cast::<PyLocalModel>() {
-        let (q, qd, qdd): (ArrayLike, ArrayLike, ArrayLike) =
-            (q.extract()?, qd.extract()?, qdd.extract()?);
-        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
-        stored_stderr(local.get().model.predict_stderr(&batch.states(n)?))?.ok()
-    } else if let Ok(base) = model.cast::<PyBaseModel>() {
-        let base = base.get();
+    // the predictions' standard errors, where the model gives them, and the measured torque
+    // columns against a base-parameter model's robot, as a direct fit checks its own data
+    let (local, base) = (model.cast::<PyLocalModel>(), model.cast::<PyBaseModel>());
+    let mut stderr = None;
+    let (mut position_range, mut torque_columns) = (vec![], vec![]);
+    let (mut torque_lag, mut position_offsets) = (None, None);
+    if local.is_ok() || base.is_ok() {
         let (q, qd, qdd): (ArrayLike, ArrayLike, ArrayLike) =
             (q.extract()?, qd.extract()?, qdd.extract()?);
         let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
         let states = batch.states(n)?;
-        let se = detached(model.py(), "validate", || {
-            stored_stderr(base.fit.predict_stderr(&base.model, &states))
-        })?;
-        se.ok()
-    } else {
-        None
-    };
+        if let Ok(local) = &local {
+            stderr = stored_stderr(local.get().model.predict_stderr(&states))?.ok();
+        }
+        if let Ok(base) = &base {
+            let base = base.get();
+            let (se, ranges, columns, lag, offsets) = detached(model.py(), "validate", || {
+                let g = base.fit.gravity;
+                Ok((
+                    stored_stderr(base.fit.predict_stderr(&base.model, &states))?,
+                    check_position_range(&base.model, &states),
+                    check_torque_columns(&base.model, &states, &measured, g)?,
+                    check_torque_lag(&base.model, &states, &measured, g)?,
+                    check_position_offsets_in_validation(
+                        &base.model,
+                        &base.fit,
+                        &states,
+                        &measured,
+                    )?,
+                ))
+            })?;
+            let mut findings = log_findings(&ranges, &columns, lag.as_ref());
+            findings.extend(offsets.as_ref().and_then(|o| o.validation_finding()));
+            warn_all(model.py(), &findings)?;
+            stderr = se.ok();
+            (position_range, torque_columns) = (ranges, columns);
+            (torque_lag, position_offsets) = (lag, offsets);
+        }
+    }
     if let Some(se) = &stderr {
         v = v.with_model_stderr(se)?;
     }
-    // the measured torque columns against the robot's own model, as a direct fit checks its
-    // own data
-    let (position_range, torque_columns, torque_lag, position_offsets) =
-        match model.cast::<PyBaseModel>() {
-            Ok(base) => {
-                let base = base.get();
-                let (q, qd, qdd): (ArrayLike, ArrayLike, ArrayLike) =
-                    (q.extract()?, qd.extract()?, qdd.extract()?);
-                let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
-                let c = &batch.columns;
-                let (ranges, columns, lag, offsets) = detached(model.py(), "validate", || {
-                    let states = States::new(n, &c[0], Some(&c[1]), Some(&c[2]))?;
-                    let g = base.fit.gravity;
-                    Ok((
-                        check_position_range(&base.model, &states),
-                        check_torque_columns(&base.model, &states, &measured, g)?,
-                        check_torque_lag(&base.model, &states, &measured, g)?,
-                        check_position_offsets_in_validation(
-                            &base.model,
-                            &base.fit,
-                            &states,
-                            &measured,
-                        )?,
-                    ))
-                })?;
-                let mut findings = log_findings(&ranges, &columns, lag.as_ref());
-                findings.extend(offsets.as_ref().and_then(|o| o.validation_finding()));
-                warn_all(model.py(), &findings)?;
-                (ranges, columns, lag, offsets)
-            }
-            Err(_) => (vec![], vec![], None, None),
-        };
     Ok(PyValidation {
         v,
         n,

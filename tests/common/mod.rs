@@ -500,3 +500,30 @@ pub fn worst_in_stderr(
         })
         .fold(0.0, f64::max)
 }
+
+/// Inverse dynamics of every sample of row-major `k x n` states (row-major `k x n` torques).
+pub fn torques(
+    model: &perturbid_rs::Model,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    gravity: perturbid_rs::Gravity,
+) -> Vec<f64> {
+    let n = model.nv;
+    let mut data = perturbid_rs::Data::new(model);
+    (0..q.len() / n)
+        .flat_map(|s| {
+            let r = s * n..(s + 1) * n;
+            perturbid_rs::rnea(
+                model,
+                &mut data,
+                &q[r.clone()],
+                &qd[r.clone()],
+                &qdd[r],
+                gravity,
+            )
+            .unwrap();
+            data.tau.as_slice().to_vec()
+        })
+        .collect()
+}
