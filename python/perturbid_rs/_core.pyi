@@ -365,6 +365,10 @@ class LocalModel:
     @property
     def stderr(self) -> dict[str, NDArray[np.float64]]: ...
     @property
+    def correlation(self) -> dict[str, NDArray[np.float64]]:
+        """Per term ('D', 'H', 'G', 'G_static', 'combined'), the correlation of each row's
+        entries, (n, m, m): diag(se) R diag(se) is the row's covariance."""
+    @property
     def residual_rms(self) -> dict[str, NDArray[np.float64]]: ...
     @property
     def op(self) -> OperatingPoint: ...
@@ -566,6 +570,10 @@ class BaseParameterModel:
     def theta_base(self) -> NDArray[np.float64]: ...
     @property
     def stderr(self) -> NDArray[np.float64]: ...
+    @property
+    def correlation(self) -> Optional[NDArray[np.float64]]:
+        """The correlation of the base parameters' estimates (p, p); None in a model saved
+        before it was stored."""
     @property
     def names(self) -> list[str]: ...
     @property

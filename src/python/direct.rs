@@ -267,6 +267,14 @@ impl PyBaseModel {
     fn stderr<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_slice(py, &self.fit.stderr)
     }
+    /// The correlation of the base parameters' estimates (p, p): with `stderr`,
+    /// `diag(stderr) R diag(stderr)` is their covariance; None in a model saved before it was
+    /// stored.
+    #[getter]
+    fn correlation<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let r = &self.fit.correlation;
+        (!r.is_empty()).then(|| mat(py, r)).transpose()
+    }
     #[getter]
     fn names(&self) -> Vec<String> {
         self.fit.base.names()

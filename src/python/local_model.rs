@@ -4,7 +4,7 @@
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use super::arrays::{at_states, matrix_to_numpy as mat, vec1, ArrayLike};
+use super::arrays::{at_states, matrix_to_numpy as mat, to_numpy, vec1, ArrayLike};
 use super::local::PyOperatingPoint;
 use crate::document::Document;
 use crate::local::{Estimate, Estimator, LocalModel, ReversalHandling};
@@ -262,6 +262,29 @@ impl PyLocalModel {
             if let Some(e) = e {
                 d.set_item(k, mat(py, &e.stderr)?)?;
             }
+        }
+        Ok(d)
+    }
+    /// Per term ('D', 'H', 'G', 'G_static', and 'combined' where identified), the correlation
+    /// of each row's entries: an (n, m, m) array for m columns (n; 3 n for 'combined'); with
+    /// the row's standard errors `se` (`stderr`), `diag(se) R diag(se)` is its covariance. A
+    /// model saved before the correlations were stored has none.
+    #[getter]
+    fn correlation<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        let combined = ("combined", &self.model.combined);
+        for (k, e) in self.parts().into_iter().chain([combined]) {
+            let Some(e) = e.as_ref().filter(|e| !e.correlation.is_empty()) else {
+                continue;
+            };
+            let m = e.matrix.ncols();
+            let values: Vec<f64> = (e.correlation.iter())
+                .flat_map(|r| r.transpose().iter().copied().collect::<Vec<_>>())
+                .collect();
+            d.set_item(
+                k,
+                to_numpy(py, values, e.correlation.len(), false, &[m, m])?,
+            )?;
         }
         Ok(d)
     }

@@ -109,6 +109,7 @@ def test_base_parameters_on_simulated_a465_are_exact():
     se = fit.predict_stderr(qh[:5], qdh[:5], qddh[:5])
     assert se.shape == (5, 6) and (se > 0).all()
     r = np.array(json.loads(fit.to_json())["correlation"])
+    np.testing.assert_array_equal(fit.correlation, r)
     full = np.concatenate([robot.regressor(qh[:5], qdh[:5], qddh[:5]), qddh[:5, :, None] * np.eye(6)], axis=2)
     z = full[:, :, fit.kept] * fit.stderr
     np.testing.assert_allclose(se, np.sqrt(np.einsum("kja,ab,kjb->kj", z, r, z)), rtol=1e-9)

@@ -136,13 +136,17 @@ def test_workflow_shapes_uncertainty_and_json():
     np.testing.assert_allclose(v.model_stderr_rms, np.sqrt(np.mean(se**2, axis=0)), rtol=1e-12)
     assert "model_stderr_rms" in v.to_dataframe().columns
     x = np.full(6, 0.2)
+    for term, key in [("D", "d"), ("H", "h"), ("G", "g"), ("G_static", "g_static")]:
+        np.testing.assert_array_equal(model.correlation[term], np.array(doc[key]["correlation"]))
+    assert model.correlation["D"].shape == (6, 6, 6) and model.correlation["combined"].shape == (6, 18, 18)
     for j in range(6):
-        r = np.array(doc["d"]["correlation"][j])
+        r = model.correlation["D"][j]
         s = model.stderr["D"][j] * x
         expected = np.sqrt(model.stderr["torque"][j] ** 2 + s @ r @ s)
         np.testing.assert_allclose(se[2, j], expected, rtol=1e-12)
     combined = pr.identify_local(plan, recs, estimator="combined")
     assert combined.combined.shape == (6, 18) and combined.estimator == "combined"
+    np.testing.assert_array_equal(combined.correlation["D"], combined.correlation["combined"][:, :6, :6])
     # the model as a tidy table: every entry once, where the arrays have it
     df = model.to_dataframe()
     assert list(df.columns) == ["term", "torque", "joint", "value", "std"]
