@@ -571,14 +571,14 @@ impl BaseModel {
         let mut out = Vec::with_capacity(states.len() * model.nv);
         regressor_blocks(model, &self.base.layout, states, self.gravity, |_, phi| {
             let rows = self.base.select(phi);
-            for row in rows.row_iter() {
-                // a parameter of unknown standard error counts only where the row weights it
-                let z = DVector::from_fn(p, |a, _| match row[a] {
-                    0.0 => 0.0,
-                    x => x * self.stderr[a],
-                });
-                out.push(z.dot(&(&self.correlation * &z)).max(0.0).sqrt());
-            }
+            // a parameter of unknown standard error counts only where the row weights it
+            let z = DMatrix::from_fn(rows.nrows(), p, |r, a| match rows[(r, a)] {
+                0.0 => 0.0,
+                x => x * self.stderr[a],
+            });
+            // every row's z^T R z at once: one product for the block
+            let w = &z * &self.correlation;
+            out.extend((0..z.nrows()).map(|r| z.row(r).dot(&w.row(r)).max(0.0).sqrt()));
             Ok(())
         })?;
         if let Some(i) = out.iter().position(|v| v.is_infinite()) {
