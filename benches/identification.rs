@@ -1,6 +1,7 @@
-//! Throughput of the identification methods: `cargo bench --bench identification`.
+//! Throughput of the identification methods and of the identified models' predictions:
+//! `cargo bench --bench identification`.
 
-use criterion::{criterion_group, criterion_main, Criterion};
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use perturbid_rs::direct::{
     design_excitation, identify_base_parameters, BaseOptions, ExcitationOptions, Weighting,
 };
@@ -68,6 +69,28 @@ fn identification(c: &mut Criterion) {
     };
     g.bench_function("design_excitation/a465/L5-500evals", |b| {
         b.iter(|| design_excitation(&model, &ex, None).unwrap())
+    });
+    g.finish();
+
+    // predictions and their standard errors, per state, on 10,000 states of the log above:
+    // the standard errors' cost as a ratio to the prediction's
+    let fit = identify_base_parameters(&model, &batch, &tau, &ols).unwrap();
+    let local = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    let m = 10_000;
+    let states = batch.slice(0..m);
+    let mut g = c.benchmark_group("prediction");
+    g.throughput(Throughput::Elements(m as u64));
+    g.bench_function("base_model/predict", |b| {
+        b.iter(|| fit.predict(&model, &states).unwrap())
+    });
+    g.bench_function("base_model/predict_stderr", |b| {
+        b.iter(|| fit.predict_stderr(&model, &states).unwrap())
+    });
+    g.bench_function("local_model/predict", |b| {
+        b.iter(|| local.predict(&states).unwrap())
+    });
+    g.bench_function("local_model/predict_stderr", |b| {
+        b.iter(|| local.predict_stderr(&states).unwrap())
     });
     g.finish();
 }

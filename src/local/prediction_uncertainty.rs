@@ -11,7 +11,7 @@
 //! which the planned designs balance (+- pairs), and is counted once, in the prediction's own
 //! `T*`.
 
-use nalgebra::DVector;
+use nalgebra::DMatrix;
 
 use super::model::{Estimate, Estimator, LocalModel};
 use crate::document::{check_correlation, invalid};
@@ -41,25 +41,30 @@ pub(crate) fn predict_stderr(model: &LocalModel, states: &States<'_>) -> Result<
     let (qd, qdd) = (states.qd_or_zeros(), states.qdd_or_zeros());
     let op = &model.planned_op;
     let mut out = Vec::with_capacity(states.len() * n);
+    let (mut deltas, mut z) = (vec![0.0; 3 * n], vec![0.0; 3 * n]);
     for s in 0..states.len() {
         let r = s * n..(s + 1) * n;
         // the deltas in the columns' order: dqdd, dqd, dq
-        let deltas: Vec<f64> = [(&qdd[r.clone()], &op.qdd), (&qd[r.clone()], &op.qd)]
-            .into_iter()
-            .chain([(&states.q()[r], &op.q)])
-            .flat_map(|(x, x0)| x.iter().zip(x0.iter()).map(|(a, b)| a - b))
-            .collect();
+        let blocks = [(&qdd[r.clone()], &op.qdd), (&qd[r.clone()], &op.qd)];
+        let blocks = blocks.into_iter().chain([(&states.q()[r], &op.q)]);
+        for (d, (x, x0)) in deltas.chunks_mut(n).zip(blocks) {
+            for ((d, a), b) in d.iter_mut().zip(x).zip(x0) {
+                *d = a - b;
+            }
+        }
         for j in 0..n {
             let mut var = model.torque_stderr[j].powi(2);
             for &(e, block) in &parts {
                 let cols = e.matrix.ncols();
                 let x = &deltas[block * n..block * n + cols];
                 // an unknown standard error counts only where the state weights it
-                let z = DVector::from_fn(cols, |a, _| match x[a] {
-                    0.0 => 0.0,
-                    xa => xa * e.stderr[(j, a)],
-                });
-                var += z.dot(&(&e.correlation[j] * &z));
+                for (a, za) in z[..cols].iter_mut().enumerate() {
+                    *za = match x[a] {
+                        0.0 => 0.0,
+                        xa => xa * e.stderr[(j, a)],
+                    };
+                }
+                var += quadratic_form(&e.correlation[j], &z[..cols]);
             }
             out.push(var.max(0.0).sqrt());
         }
@@ -75,6 +80,14 @@ pub(crate) fn predict_stderr(model: &LocalModel, states: &States<'_>) -> Result<
         });
     }
     Ok(out)
+}
+
+/// `z^T R z` for a square `r` of `z.len()` columns, without forming `R z`.
+fn quadratic_form(r: &DMatrix<f64>, z: &[f64]) -> f64 {
+    // column by column: nalgebra stores them contiguously
+    (r.column_iter().zip(z))
+        .map(|(column, zb)| zb * column.iter().zip(z).map(|(r, za)| r * za).sum::<f64>())
+        .sum()
 }
 
 /// The estimate `name` of a model, with a correlation for each of its `n` rows.
