@@ -269,6 +269,24 @@ fn correlations_are_saved_and_checked_on_loading() {
         e.contains("holds no correlation") && e.contains("identify it again"),
         "{e}"
     );
+    // unknown standard errors (null): T*'s makes its joint's NaN everywhere; an entry's only
+    // where the state weights it
+    let unknown = edited(&|v| {
+        v["torque_stderr"][0] = serde_json::Value::Null;
+        v["d"]["stderr"][1][2] = serde_json::Value::Null;
+    })
+    .unwrap();
+    let se = unknown.predict_stderr(&states).unwrap();
+    assert!(
+        se[0].is_nan() && se[1..].iter().all(|v| v.is_finite()),
+        "{se:?}"
+    );
+    let mut qdd = op.qdd.clone();
+    qdd[2] += 0.1;
+    let off = States::new(n, &op.q, Some(&op.qd), Some(&qdd)).unwrap();
+    let se = unknown.predict_stderr(&off).unwrap();
+    assert!(se[0].is_nan() && se[1].is_nan(), "{se:?}");
+    assert!(se[2..].iter().all(|v| v.is_finite() && *v > 0.0), "{se:?}");
     let cases: [(&str, Edit); 5] = [
         (
             "matrix 2, row 1, column 3 is 1.5; expected a correlation in [-1, 1]",
@@ -383,6 +401,14 @@ fn base_model_predicted_standard_errors_match_the_scatter_over_seeds() {
         e.contains("holds no correlation") && e.contains("identify it again"),
         "{e}"
     );
+    // a parameter of unknown standard error: NaN for the joints whose rows weigh it, not 0
+    let unknown = edited(&|v| v["stderr"][0] = serde_json::Value::Null).unwrap();
+    let se = unknown.predict_stderr(&model, &test).unwrap();
+    let known = fit.predict_stderr(&model, &test).unwrap();
+    assert!(se.iter().any(|v| v.is_nan()), "{se:?}");
+    for (a, b) in se.iter().zip(&known) {
+        assert!(a.is_nan() || (a - b).abs() <= 1e-12 * b, "{a} against {b}");
+    }
     let e = edited(&|v| {
         v["correlation"][1][0] = 2.0.into();
         v["correlation"][0][1] = 2.0.into();

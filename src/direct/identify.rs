@@ -560,6 +560,7 @@ impl BaseModel {
     /// [`Self::on`] refuses, for a model saved before the correlation was stored, and where
     /// the arithmetic overflows.
     pub fn predict_stderr(&self, model: &Model, states: &States<'_>) -> Result<Vec<f64>> {
+        use crate::local::prediction_uncertainty::root;
         self.check(model)?;
         let p = self.theta.len();
         if self.correlation.shape() != (p, p) {
@@ -578,7 +579,7 @@ impl BaseModel {
             });
             // every row's z^T R z at once: one product for the block
             let w = &z * &self.correlation;
-            out.extend((0..z.nrows()).map(|r| z.row(r).dot(&w.row(r)).max(0.0).sqrt()));
+            out.extend((0..z.nrows()).map(|r| root(z.row(r).dot(&w.row(r)))));
             Ok(())
         })?;
         if let Some(i) = out.iter().position(|v| v.is_infinite()) {

@@ -51,7 +51,7 @@ mod plan_checks;
 mod plan_warnings;
 pub mod point_design;
 pub mod predicted_response;
-mod prediction_uncertainty;
+pub(crate) mod prediction_uncertainty;
 pub mod quantisation;
 pub mod response;
 pub mod reversals;

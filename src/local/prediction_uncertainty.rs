@@ -11,8 +11,6 @@
 //! which the planned designs balance (+- pairs), and is counted once, in the prediction's own
 //! `T*`.
 
-use nalgebra::DMatrix;
-
 use super::model::{Estimate, Estimator, LocalModel};
 use crate::document::{check_correlation, invalid};
 use crate::error::{Error, Result};
@@ -40,33 +38,57 @@ pub(crate) fn predict_stderr(model: &LocalModel, states: &States<'_>) -> Result<
     };
     let (qd, qdd) = (states.qd_or_zeros(), states.qdd_or_zeros());
     let op = &model.planned_op;
-    let mut out = Vec::with_capacity(states.len() * n);
-    let (mut deltas, mut z) = (vec![0.0; 3 * n], vec![0.0; 3 * n]);
-    for s in 0..states.len() {
-        let r = s * n..(s + 1) * n;
-        // the deltas in the columns' order: dqdd, dqd, dq
-        let blocks = [(&qdd[r.clone()], &op.qdd), (&qd[r.clone()], &op.qd)];
-        let blocks = blocks.into_iter().chain([(&states.q()[r], &op.q)]);
-        for (d, (x, x0)) in deltas.chunks_mut(n).zip(blocks) {
-            for ((d, a), b) in d.iter_mut().zip(x).zip(x0) {
-                *d = a - b;
+    let k = states.len();
+    let mut out = vec![0.0; k * n];
+    // blocks of samples, each delta a contiguous column over the block's samples (columns
+    // dqdd, dqd, dq, one a joint), so each term of the quadratic forms runs over the samples
+    let mut deltas = vec![0.0; 3 * n * BLOCK];
+    let mut var = [0.0; BLOCK];
+    for start in (0..k).step_by(BLOCK) {
+        let b = (k - start).min(BLOCK);
+        for s in 0..b {
+            let r = (start + s) * n..(start + s + 1) * n;
+            let blocks = [(&qdd[r.clone()], &op.qdd), (&qd[r.clone()], &op.qd)];
+            for (v, (x, x0)) in blocks
+                .into_iter()
+                .chain([(&states.q()[r], &op.q)])
+                .enumerate()
+            {
+                for j in 0..n {
+                    deltas[(v * n + j) * BLOCK + s] = x[j] - x0[j];
+                }
             }
         }
+        let column = |c: usize| &deltas[c * BLOCK..c * BLOCK + b];
         for j in 0..n {
-            let mut var = model.torque_stderr[j].powi(2);
-            for &(e, block) in &parts {
-                let cols = e.matrix.ncols();
-                let x = &deltas[block * n..block * n + cols];
-                // an unknown standard error counts only where the state weights it
-                for (a, za) in z[..cols].iter_mut().enumerate() {
-                    *za = match x[a] {
-                        0.0 => 0.0,
-                        xa => xa * e.stderr[(j, a)],
-                    };
+            var[..b].fill(model.torque_stderr[j].powi(2));
+            for &(e, first) in &parts {
+                let (cols, r) = (e.matrix.ncols(), &e.correlation[j]);
+                let se = |a: usize| e.stderr[(j, a)];
+                for a in 0..cols {
+                    let xa = column(first * n + a);
+                    if se(a).is_nan() {
+                        // an unknown standard error counts only where the state weights it
+                        for (v, x) in var[..b].iter_mut().zip(xa) {
+                            if *x != 0.0 {
+                                *v = f64::NAN;
+                            }
+                        }
+                        continue;
+                    }
+                    // the pairs (a, c) and (c, a) at once: R is symmetric
+                    for c in (a..cols).filter(|&c| !se(c).is_nan()) {
+                        let w = if c == a { 1.0 } else { 2.0 } * r[(a, c)] * se(a) * se(c);
+                        let xc = column(first * n + c);
+                        for ((v, x), y) in var[..b].iter_mut().zip(xa).zip(xc) {
+                            *v += w * x * y;
+                        }
+                    }
                 }
-                var += quadratic_form(&e.correlation[j], &z[..cols]);
             }
-            out.push(var.max(0.0).sqrt());
+            for (s, v) in var[..b].iter().enumerate() {
+                out[(start + s) * n + j] = root(*v);
+            }
         }
     }
     if let Some(i) = out.iter().position(|v| v.is_infinite()) {
@@ -82,12 +104,16 @@ pub(crate) fn predict_stderr(model: &LocalModel, states: &States<'_>) -> Result<
     Ok(out)
 }
 
-/// `z^T R z` for a square `r` of `z.len()` columns, without forming `R z`.
-fn quadratic_form(r: &DMatrix<f64>, z: &[f64]) -> f64 {
-    // column by column: nalgebra stores them contiguously
-    (r.column_iter().zip(z))
-        .map(|(column, zb)| zb * column.iter().zip(z).map(|(r, za)| r * za).sum::<f64>())
-        .sum()
+/// Samples whose deltas are laid out together ([`predict_stderr`]).
+const BLOCK: usize = 256;
+
+/// The standard error of a variance: NaN stays NaN (unknown), rounding below 0 is 0.
+pub(crate) fn root(var: f64) -> f64 {
+    if var.is_nan() {
+        f64::NAN
+    } else {
+        var.max(0.0).sqrt()
+    }
 }
 
 /// The estimate `name` of a model, with a correlation for each of its `n` rows.
