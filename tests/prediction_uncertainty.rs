@@ -287,6 +287,12 @@ fn correlations_are_saved_and_checked_on_loading() {
     let se = unknown.predict_stderr(&off).unwrap();
     assert!(se[0].is_nan() && se[1].is_nan(), "{se:?}");
     assert!(se[2..].iter().all(|v| v.is_finite() && *v > 0.0), "{se:?}");
+    // deltas whose squares overflow are refused, not reported as unknown
+    let mut qdd = op.qdd.clone();
+    (qdd[2], qdd[3]) = (1e200, -1e200);
+    let huge = States::new(n, &op.q, Some(&op.qd), Some(&qdd)).unwrap();
+    let e = local.predict_stderr(&huge).unwrap_err().to_string();
+    assert!(e.contains("overflows"), "{e}");
     let cases: [(&str, Edit); 5] = [
         (
             "matrix 2, row 1, column 3 is 1.5; expected a correlation in [-1, 1]",
@@ -409,6 +415,10 @@ fn base_model_predicted_standard_errors_match_the_scatter_over_seeds() {
     for (a, b) in se.iter().zip(&known) {
         assert!(a.is_nan() || (a - b).abs() <= 1e-12 * b, "{a} against {b}");
     }
+    let huge: Vec<f64> = qdd.iter().map(|v| v * 1e200).collect();
+    let huge = States::new(n, &q, Some(&qd), Some(&huge)).unwrap();
+    let e = fit.predict_stderr(&model, &huge).unwrap_err().to_string();
+    assert!(e.contains("overflows"), "{e}");
     let e = edited(&|v| {
         v["correlation"][1][0] = 2.0.into();
         v["correlation"][0][1] = 2.0.into();

@@ -572,14 +572,19 @@ impl BaseModel {
         let mut out = Vec::with_capacity(states.len() * model.nv);
         regressor_blocks(model, &self.base.layout, states, self.gravity, |_, phi| {
             let rows = self.base.select(phi);
-            // a parameter of unknown standard error counts only where the row weights it
-            let z = DMatrix::from_fn(rows.nrows(), p, |r, a| match rows[(r, a)] {
-                0.0 => 0.0,
-                x => x * self.stderr[a],
+            // a parameter of unknown standard error counts only where the row weights it, and
+            // apart from the sums, so that a sum which overflows is told from it
+            let z = DMatrix::from_fn(rows.nrows(), p, |r, a| match self.stderr[a] {
+                se if se.is_nan() => 0.0,
+                se => rows[(r, a)] * se,
             });
+            let unknown = |r: usize| (0..p).any(|a| self.stderr[a].is_nan() && rows[(r, a)] != 0.0);
             // every row's z^T R z at once: one product for the block
             let w = &z * &self.correlation;
-            out.extend((0..z.nrows()).map(|r| root(z.row(r).dot(&w.row(r)))));
+            out.extend((0..z.nrows()).map(|r| match unknown(r) {
+                true => f64::NAN,
+                false => root(z.row(r).dot(&w.row(r))),
+            }));
             Ok(())
         })?;
         if let Some(i) = out.iter().position(|v| v.is_infinite()) {

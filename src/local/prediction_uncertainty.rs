@@ -43,7 +43,7 @@ pub(crate) fn predict_stderr(model: &LocalModel, states: &States<'_>) -> Result<
     // blocks of samples, each delta a contiguous column over the block's samples (columns
     // dqdd, dqd, dq, one a joint), so each term of the quadratic forms runs over the samples
     let mut deltas = vec![0.0; 3 * n * BLOCK];
-    let mut var = [0.0; BLOCK];
+    let (mut var, mut unknown) = ([0.0; BLOCK], [false; BLOCK]);
     for start in (0..k).step_by(BLOCK) {
         let b = (k - start).min(BLOCK);
         for s in 0..b {
@@ -61,18 +61,23 @@ pub(crate) fn predict_stderr(model: &LocalModel, states: &States<'_>) -> Result<
         }
         let column = |c: usize| &deltas[c * BLOCK..c * BLOCK + b];
         for j in 0..n {
-            var[..b].fill(model.torque_stderr[j].powi(2));
+            // an unknown standard error counts only where the state weights it (T*'s always);
+            // kept apart from the sums, so that a sum which overflows is told from it
+            let t_star = model.torque_stderr[j];
+            unknown[..b].fill(t_star.is_nan());
+            var[..b].fill(if t_star.is_nan() {
+                0.0
+            } else {
+                t_star * t_star
+            });
             for &(e, first) in &parts {
                 let (cols, r) = (e.matrix.ncols(), &e.correlation[j]);
                 let se = |a: usize| e.stderr[(j, a)];
                 for a in 0..cols {
                     let xa = column(first * n + a);
                     if se(a).is_nan() {
-                        // an unknown standard error counts only where the state weights it
-                        for (v, x) in var[..b].iter_mut().zip(xa) {
-                            if *x != 0.0 {
-                                *v = f64::NAN;
-                            }
+                        for (u, x) in unknown[..b].iter_mut().zip(xa) {
+                            *u |= *x != 0.0;
                         }
                         continue;
                     }
@@ -86,8 +91,8 @@ pub(crate) fn predict_stderr(model: &LocalModel, states: &States<'_>) -> Result<
                     }
                 }
             }
-            for (s, v) in var[..b].iter().enumerate() {
-                out[(start + s) * n + j] = root(*v);
+            for s in 0..b {
+                out[(start + s) * n + j] = if unknown[s] { f64::NAN } else { root(var[s]) };
             }
         }
     }
@@ -107,12 +112,13 @@ pub(crate) fn predict_stderr(model: &LocalModel, states: &States<'_>) -> Result<
 /// Samples whose deltas are laid out together ([`predict_stderr`]).
 const BLOCK: usize = 256;
 
-/// The standard error of a variance: NaN stays NaN (unknown), rounding below 0 is 0.
+/// The standard error of a variance summed from known terms: rounding below 0 is 0, and a
+/// sum that overflowed (inf, or NaN from inf - inf) is inf, for the caller to refuse.
 pub(crate) fn root(var: f64) -> f64 {
-    if var.is_nan() {
-        f64::NAN
-    } else {
+    if var.is_finite() {
         var.max(0.0).sqrt()
+    } else {
+        f64::INFINITY
     }
 }
 
