@@ -67,16 +67,12 @@ pub trait Document: Serialize + DeserializeOwned {
             let inner = e.into_inner();
             Error::Json {
                 context: context.clone(),
-                message: format!(
-                    "line {}, column {}, at {path}: {inner}",
-                    inner.line(),
-                    inner.column()
-                ),
+                message: crate::json::describe_error_at(&inner, text, &path),
             }
         })?;
         reader.end().map_err(|e| Error::Json {
             context: context.clone(),
-            message: format!("line {}, column {}: {e}", e.line(), e.column()),
+            message: crate::json::describe_error(&e, text),
         })?;
         doc.validate().map_err(|e| match e {
             Error::Json { message, .. } => Error::Json { context, message },
@@ -108,7 +104,7 @@ pub(crate) fn format_tag(text: &str, context: &str) -> Result<String> {
     }
     let t: Tagged = serde_json::from_str(text).map_err(|e| Error::Json {
         context: context.into(),
-        message: format!("line {}, column {}: {e}", e.line(), e.column()),
+        message: crate::json::describe_error(&e, text),
     })?;
     t.format.ok_or_else(|| Error::Json {
         context: context.into(),
@@ -119,6 +115,28 @@ pub(crate) fn format_tag(text: &str, context: &str) -> Result<String> {
 /// Checks that every value of the field `field` of a document `what` is a magnitude (a
 /// standard error, a residual, a noise level): finite and `>= 0`, or with `unknown_ok` NaN
 /// (`null` in the file: no residual degree of freedom). Errors name the entry (`field[3]`).
+/// Checks a document's `joint_names`: each non-empty and named once, as the robot's joints are
+/// (a hand-edited copy that names a joint twice would read a log's columns twice).
+pub(crate) fn check_joint_names(what: &str, names: &[String]) -> Result<()> {
+    if let Some(j) = names.iter().position(|name| name.trim().is_empty()) {
+        return Err(invalid(
+            what,
+            format!("joint_names[{j}] is empty; expected the robot's joint names"),
+        ));
+    }
+    let mut seen = std::collections::HashSet::with_capacity(names.len());
+    if let Some(j) = names.iter().position(|name| !seen.insert(name.as_str())) {
+        return Err(invalid(
+            what,
+            format!(
+                "joint_names[{j}] '{}' is named twice; expected the robot's joint names, each once",
+                names[j]
+            ),
+        ));
+    }
+    Ok(())
+}
+
 pub(crate) fn check_magnitudes(
     what: &str,
     field: &str,

@@ -125,3 +125,46 @@ pub mod matrices {
             .collect()
     }
 }
+
+/// A serde_json error as `line L, column C: what` without serde's trailing repetition of the
+/// position, with a hint where the text holds a number JSON cannot spell (`NaN`, `Infinity`,
+/// as Python's `json` module writes them). `text` is the document that was parsed.
+pub(crate) fn describe_error(e: &serde_json::Error, text: &str) -> String {
+    describe_error_at(e, text, "")
+}
+
+/// [`describe_error`] with the JSON path of the culprit (`experiments[2].rate`; none if empty)
+/// after the position.
+pub(crate) fn describe_error_at(e: &serde_json::Error, text: &str, path: &str) -> String {
+    let full = e.to_string();
+    let suffix = format!(" at line {} column {}", e.line(), e.column());
+    let what = full.strip_suffix(&suffix).unwrap_or(&full);
+    let hint = if e.is_syntax() && non_json_number_at(text, e.line(), e.column()) {
+        " (JSON has no NaN or Infinity: write a finite number, or null where a value may be unknown)"
+    } else {
+        ""
+    };
+    let at = if path.is_empty() {
+        String::new()
+    } else {
+        format!(", at {path}")
+    };
+    format!("line {}, column {}{at}: {what}{hint}", e.line(), e.column())
+}
+
+/// Whether the text at 1-based `line` and `column` (serde_json's position of a syntax error:
+/// the first character it could not read) starts a `NaN` or `[-]Infinity` literal.
+fn non_json_number_at(text: &str, line: usize, column: usize) -> bool {
+    let Some(l) = text.lines().nth(line.saturating_sub(1)) else {
+        return false;
+    };
+    // from the character before the position (a minus sign), on character boundaries
+    let window: String = l
+        .chars()
+        .skip(column.saturating_sub(2))
+        .take(10)
+        .collect::<String>()
+        .to_ascii_lowercase();
+    let literal = window.trim_start_matches(|c: char| !c.is_ascii_alphabetic());
+    literal.starts_with("nan") || literal.starts_with("inf")
+}

@@ -478,6 +478,27 @@ fn a_hand_edited_plan_is_checked_on_load() {
         e.contains("at most 1e8 samples and 2^28 values (2 GiB) are made"),
         "{e}"
     );
+    // a joint named twice, or not at all: a log's columns would be read twice
+    let mut edited = plan.clone();
+    edited.joint_names[2] = edited.joint_names[0].clone();
+    let e = Plan::from_json(&edited.to_json()).unwrap_err().to_string();
+    assert!(e.contains("joint_names[2] 'joint1' is named twice"), "{e}");
+    let mut edited = plan.clone();
+    edited.joint_names[4] = " ".into();
+    let e = Plan::from_json(&edited.to_json()).unwrap_err().to_string();
+    assert!(e.contains("joint_names[4] is empty"), "{e}");
+    // NaN as Python's json module writes it: said so, with the position once
+    let text = plan
+        .to_json()
+        .replacen("\"rate\": 1000.0", "\"rate\": NaN", 1);
+    let e = Plan::from_json(&text).unwrap_err().to_string();
+    assert!(e.contains("JSON has no NaN or Infinity"), "{e}");
+    assert_eq!(e.matches("line ").count(), 1, "{e}");
+    let text = plan.to_json().replacen("\"random\"", "\"randm\"", 1);
+    let e = Plan::from_json(&text).unwrap_err().to_string();
+    assert!(e.contains("at design: unknown variant `randm`"), "{e}");
+    assert_eq!(e.matches("line ").count(), 1, "{e}");
+    assert!(!e.contains("JSON has no NaN"), "{e}");
     // no experiment at all
     let mut edited = plan;
     edited.experiments.clear();

@@ -122,9 +122,8 @@ fn load_op(arg: &Path) -> Result<OperatingPoint> {
         let op: OpFile = serde_json::from_str(text).map_err(|e| Error::Json {
             context: "operating point".into(),
             message: format!(
-                "line {}, column {}: {e}; expected {{\"q\": [...], \"qd\": [...], \"qdd\": [...]}}",
-                e.line(),
-                e.column()
+                "{}; expected {{\"q\": [...], \"qd\": [...], \"qdd\": [...]}}",
+                crate::json::describe_error(&e, text)
             ),
         })?;
         OperatingPoint::new(op.q, op.qd, op.qdd)
@@ -311,9 +310,8 @@ fn load_reference(path: &Path) -> Result<Reference> {
     let t: FourierTrajectory = serde_json::from_str(&text).map_err(|e| Error::Json {
         context: context.clone(),
         message: format!(
-            "neither a plan nor an excitation (line {}, column {}: {e})",
-            e.line(),
-            e.column()
+            "neither a plan nor an excitation ({})",
+            crate::json::describe_error(&e, &text)
         ),
     })?;
     let t = FourierTrajectory::new(t.w_f, t.q0, t.a, t.b).map_err(|e| Error::Json {

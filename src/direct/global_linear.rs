@@ -110,6 +110,7 @@ impl Document for GlobalLinearModel {
                 format!("its parts do not all have the {n} joints of the offset"),
             ));
         }
+        crate::document::check_joint_names(Self::WHAT, &self.joint_names)?;
         check_magnitude_rows(Self::WHAT, "stderr", &self.stderr, true)?;
         check_magnitudes(Self::WHAT, "residual_rms", &self.residual_rms, false)?;
         check_condition(Self::WHAT, "cond", self.cond)

@@ -358,6 +358,7 @@ impl Document for BaseModel {
                 ),
             ));
         }
+        crate::document::check_joint_names(Self::WHAT, &m.joint_names)?;
         // kept and dropped: each parameter once, in ascending order
         let ascending = |v: &[usize]| v.windows(2).all(|w| w[0] < w[1]);
         let mut seen = vec![false; layout.len()];

@@ -137,15 +137,14 @@ pub fn workspace_from_json(text: &str, context: &str) -> Result<Vec<CartesianCon
             Error::Json {
                 context: context.to_string(),
                 message: format!(
-                    "line {}, column {}, at {path}: {inner} (expected an array of {{\"frame\", \"point\", \"region\": {{\"above\": {{\"normal\", \"offset\"}}}} or {{\"inside\": {{\"min\", \"max\"}}}}, \"margin\"}})",
-                    inner.line(),
-                    inner.column()
+                    "{} (expected an array of {{\"frame\", \"point\", \"region\": {{\"above\": {{\"normal\", \"offset\"}}}} or {{\"inside\": {{\"min\", \"max\"}}}}, \"margin\"}})",
+                    crate::json::describe_error_at(&inner, text, &path)
                 ),
             }
         })?;
     reader.end().map_err(|e| Error::Json {
         context: context.to_string(),
-        message: format!("line {}, column {}: {e}", e.line(), e.column()),
+        message: crate::json::describe_error(&e, text),
     })?;
     crate::limits::check_count("workspace constraints", out.len(), 0, 1000)?;
     Ok(out)

@@ -323,6 +323,7 @@ impl Document for LocalModel {
         }
         // standard errors and residuals are magnitudes: unknown (NaN, `null`) or >= 0
         check_magnitudes(Self::WHAT, "torque_stderr", &m.torque_stderr, true)?;
+        crate::document::check_joint_names(Self::WHAT, &m.joint_names)?;
         // and no number beyond any robot's
         let kind = "a local model";
         for (field, v) in [

@@ -305,6 +305,7 @@ impl Document for Plan {
         if plan.experiments.is_empty() {
             return Err(bad("the plan has no experiment".into()));
         }
+        crate::document::check_joint_names(Self::WHAT, &plan.joint_names)?;
         for (k, e) in plan.experiments.iter().enumerate() {
             let at = |what: &str| format!("experiments[{k}] ('{}'): {what}", e.kind.name());
             // segments in time order, end to end, finite: what sampling walks through

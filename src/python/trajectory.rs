@@ -108,7 +108,7 @@ impl PyFourier {
     fn from_json(text: &str) -> PyResult<Self> {
         let t: FourierTrajectory = serde_json::from_str(text).map_err(|e| Error::Json {
             context: "Fourier trajectory".into(),
-            message: e.to_string(),
+            message: crate::json::describe_error(&e, text),
         })?;
         Ok(Self {
             traj: FourierTrajectory::new(t.w_f, t.q0, t.a, t.b)?,
