@@ -123,6 +123,48 @@ fn plan_simulate_identify_predict() {
     .unwrap();
     assert_eq!(with_se.columns.len(), 13);
     assert_eq!(with_se.columns[7], "tau1_stderr");
+    // states at the operating point and one with joint 2 half a radian off: predicted and
+    // validated, and the one beyond the perturbations the model was identified over said so
+    let mut far = String::from("t,q1,q2,q3,q4,q5,q6,qd1,qd2,qd3,qd4,qd5,qd6,qdd1,qdd2,qdd3,qdd4,qdd5,qdd6,tau1,tau2,tau3,tau4,tau5,tau6\n");
+    for (i, off) in [0.0, 0.0, 0.5].iter().enumerate() {
+        let mut q = a465::TABLE2_Q.to_vec();
+        q[1] += off;
+        let row: Vec<String> = [vec![i as f64 * 1e-3], q, a465::TABLE2_QD.to_vec()]
+            .into_iter()
+            .flatten()
+            .chain(a465::TABLE2_QDD)
+            .chain([0.1; 6])
+            .map(|x| x.to_string())
+            .collect();
+        far.push_str(&(row.join(",") + "\n"));
+    }
+    write(&d.join("far.csv"), &far);
+    for (command, out) in [("predict", "far_pred.csv"), ("validate", "far_validation")] {
+        let run = bin()
+            .args([command, s(&d.join("model.json")), s(&d.join("far.csv"))])
+            .args(["--out", s(&d.join(out))])
+            .output()
+            .unwrap();
+        let said = String::from_utf8_lossy(&run.stderr);
+        assert!(run.status.success(), "{said}");
+        assert!(
+            said.contains("1 of 3 states lie beyond the perturbations")
+                && said.contains("q of 'joint2' +0.5000 rad"),
+            "{said}"
+        );
+    }
+    let v: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(d.join("far_validation/validation.json")).unwrap(),
+    )
+    .unwrap();
+    let x = &v["extrapolation"];
+    assert_eq!(
+        (x["beyond"].as_u64(), x["joint"].as_str()),
+        (Some(1), Some("joint2"))
+    );
+    let reach = x["largest"].as_f64().unwrap();
+    let range = model.perturbations.as_ref().unwrap().q[1];
+    assert!((reach - 0.5 / range).abs() < 1e-9, "{x}");
     let model = LocalModel::load(d.join("model.json")).unwrap();
     let states =
         Table::parse("D", &std::fs::read_to_string(d.join("plan/D.csv")).unwrap()).unwrap();

@@ -399,12 +399,22 @@ class LocalModel:
     def linearize(self, op: OperatingPoint) -> dict[str, Any]:
         """torque (n,), D, H, G (n, n) and G_static (n, n) or None at op."""
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:
-        """Predicted torques (N m), shape (n,) or (k, n)."""
+        """Predicted torques (N m), shape (n,) or (k, n); a PerturbidWarning where states lie
+        beyond the perturbations the model was identified over (reach above 1.5)."""
     def predict_stderr(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:
         """Standard errors (N m) of predict's torques, shape (n,) or (k, n): T*'s and the
         matrices' entries' with their correlation within each row; NaN where the model holds
         an unknown standard error that the state weights. InputError for a model saved before
-        the correlations were stored."""
+        the correlations were stored. Warns as predict does."""
+    def reach(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> Any:
+        """Per state (a float, or (k,) for a batch) the largest deviation from the planned
+        operating point in units of the largest perturbation the experiments gave that joint's
+        q, qd or qdd: at most 1 inside the identified region. InputError for a model saved
+        before its perturbations were stored."""
+    @property
+    def perturbations(self) -> Optional[dict[str, NDArray[np.float64]]]:
+        """The largest perturbation per joint: q (rad, G experiment), qd (rad/s, H), qdd
+        (rad/s^2, D), (n,) each; None for a model saved before they were stored."""
     def nominal_noise(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The nominal passes' torque noise (n,) each: the samples' and what varied from pass
         to pass beyond it (N m), for plan_experiments(torque_noise=, torque_pass_noise=)."""
@@ -741,6 +751,11 @@ class Validation:
     def model_stderr_rms(self) -> NDArray[np.float64]:
         """Per joint, the RMS of the predictions' standard errors (N m): the model's own
         uncertainty at these states; NaN where the model gives none."""
+    @property
+    def extrapolation(self) -> Optional[dict[str, Any]]:
+        """For a LocalModel whose states go beyond the perturbations it was identified over:
+        beyond, states, largest (reach), joint, variable ('q', 'qd', 'qdd'), deviation,
+        perturbation; None otherwise."""
     @property
     def residuals(self) -> NDArray[np.float64]: ...
     @property

@@ -348,6 +348,10 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
             (tau, se.transpose()?)
         }
         ModelFile::Local(m) => {
+            // states beyond the perturbations it was identified over: predicted, and said
+            if let Some(x) = m.extrapolation(&states)? {
+                eprintln!("perturbid: warning: '{}': {}", a.data.display(), x.message());
+            }
             let se = a.stderr.then(|| m.predict_stderr(&states));
             (m.predict(&states)?, se.transpose()?)
         }

@@ -41,7 +41,9 @@ pub(crate) struct ValidateArgs {
     /// for a base-parameter model `torque_columns`, each torque column of the log against the
     /// robot's model, `torque_lag`, its torques shifted against its positions, and
     /// `position_range`, the joints whose positions leave their limits, and `position_offsets`,
-    /// the joints' zero offsets against the model's parameters, whose findings are warned of)
+    /// the joints' zero offsets against the model's parameters, whose findings are warned of;
+    /// for a local model `extrapolation`, where the log's states go beyond the perturbations it
+    /// was identified over, warned of too)
     /// and validation.svg (measured and predicted
     /// torques, and residuals).
     #[arg(long, default_value = "validation")]
@@ -94,6 +96,11 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
             Err("a globally linearised model stores no covariance of its coefficients".into())
         }
     };
+    // a local model at states beyond the perturbations it was identified over
+    let extrapolation = match &file {
+        ModelFile::Local(m) => m.extrapolation(&states)?,
+        _ => None,
+    };
     let mut v = validate(&joints, &predicted, &rec.tau)?;
     if let Ok(se) = &stderr {
         v = v.with_model_stderr(se)?;
@@ -120,6 +127,7 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
         .into_iter()
         .chain(offsets.as_ref().and_then(|o| o.validation_finding()))
         .chain(rounding)
+        .chain(extrapolation.as_ref().map(|x| x.message()))
     {
         eprintln!("perturbid: warning: log '{}': {w}", a.data.display());
     }
@@ -150,6 +158,9 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     }
     if !position_range.is_empty() {
         json["position_range"] = serde_json::to_value(&position_range).expect("serialisable");
+    }
+    if let Some(x) = &extrapolation {
+        json["extrapolation"] = serde_json::to_value(x).expect("serialisable");
     }
     if let Some(o) = &offsets {
         json["position_offsets"] = serde_json::to_value(o).expect("serialisable");

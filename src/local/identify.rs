@@ -778,6 +778,7 @@ pub fn identify_local(
         g_static,
         combined,
         coulomb,
+        perturbations: super::Perturbations::of_plan(plan),
         diagnostics,
     })
 }

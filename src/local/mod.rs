@@ -53,6 +53,7 @@ pub mod point_design;
 pub mod predicted_response;
 pub(crate) mod prediction_uncertainty;
 pub mod quantisation;
+pub mod reach;
 pub mod response;
 pub mod reversals;
 pub mod rounded_positions;
@@ -76,4 +77,5 @@ pub use parameters::{identify_parameters_from_local, FromLocalOptions, Parameter
 pub use perturbation::{Design, Size, Sizes};
 pub use plan::{plan_experiments, Crossing, Experiment, ExperimentKind, Plan, PlanOptions};
 pub use point_design::{suggest_operating_points, SuggestedPoint};
+pub use reach::{Extrapolation, Perturbations, REACH_LIMIT};
 pub use session::{repeated_runs, split_session, SplitOptions};

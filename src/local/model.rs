@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::diagnostics::Diagnostics;
 use super::operating_point::OperatingPoint;
+use super::reach::{Extrapolation, Perturbations};
 use crate::choice::choice;
 use crate::document::{
     check_bounded, check_bounded_rows, check_condition, check_magnitude, check_magnitude_rows,
@@ -133,6 +134,11 @@ pub struct LocalModel {
     /// ([`crate::local::IdentifyOptions::friction_aware_h`]), when it was used.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coulomb: Option<CoulombSteps>,
+    /// The largest perturbation of each joint's `q`, `qd` and `qdd` the experiments gave: the
+    /// region the linear expansion was identified over ([`Self::reach`]). `None` in a model
+    /// saved before it was stored.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub perturbations: Option<Perturbations>,
     /// What happened during the identification: clock offsets, velocity reversals near
     /// crossings, warnings (see [`Diagnostics`]).
     #[serde(default)]
@@ -177,6 +183,35 @@ impl LocalModel {
     /// were stored.
     pub fn predict_stderr(&self, states: &States<'_>) -> Result<Vec<f64>> {
         super::prediction_uncertainty::predict_stderr(self, states)
+    }
+
+    /// Per sample of `states` (`k` values), its largest deviation from the planned operating
+    /// point over the joints and `q`, `qd`, `qdd`, in units of the largest perturbation the
+    /// experiments gave that joint's variable ([`super::reach`]): at most 1 inside the region
+    /// the model was identified over. Refused for a model saved before its perturbations were
+    /// stored (identify it again).
+    pub fn reach(&self, states: &States<'_>) -> Result<Vec<f64>> {
+        let p = self
+            .perturbations
+            .as_ref()
+            .ok_or_else(|| Error::InvalidArgument {
+                argument: "reach".into(),
+                message:
+                    "the model was saved before its perturbations were stored: identify it again"
+                        .into(),
+            })?;
+        Ok(Extrapolation::of(p, &self.planned_op, &self.joint_names, states)?.0)
+    }
+
+    /// Where the samples of `states` leave the region the model was identified over (reach
+    /// above [`super::REACH_LIMIT`]): `None` when none does, or when the model does not store
+    /// its perturbations (saved before they were). What predictions there rest on is
+    /// [`Extrapolation::message`].
+    pub fn extrapolation(&self, states: &States<'_>) -> Result<Option<Extrapolation>> {
+        match &self.perturbations {
+            Some(p) => Ok(Extrapolation::of(p, &self.planned_op, &self.joint_names, states)?.1),
+            None => Ok(None),
+        }
     }
 
     /// The torque noise of the nominal passes, per joint in `joint_names`' order (N m, or N
@@ -324,6 +359,9 @@ impl Document for LocalModel {
         // standard errors and residuals are magnitudes: unknown (NaN, `null`) or >= 0
         check_magnitudes(Self::WHAT, "torque_stderr", &m.torque_stderr, true)?;
         crate::document::check_joint_names(Self::WHAT, &m.joint_names)?;
+        if let Some(p) = &m.perturbations {
+            p.check(Self::WHAT, n)?;
+        }
         // and no number beyond any robot's
         let kind = "a local model";
         for (field, v) in [

@@ -4,7 +4,8 @@
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use super::arrays::{at_states, matrix_to_numpy as mat, to_numpy, vec1, ArrayLike};
+use super::arrays::{at_states, matrix_to_numpy as mat, read_batch, to_numpy, vec1, ArrayLike};
+use super::errors::warn_all;
 use super::local::PyOperatingPoint;
 use crate::document::Document;
 use crate::local::{Estimate, Estimator, LocalModel, ReversalHandling};
@@ -342,9 +343,16 @@ impl PyLocalModel {
         qdd: ArrayLike<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let m = &self.model;
-        at_states(py, m.n(), [&q, &qd, &qdd], "LocalModel.predict", |s| {
+        let mut beyond = None;
+        let out = at_states(py, m.n(), [&q, &qd, &qdd], "LocalModel.predict", |s| {
+            beyond = m.extrapolation(s)?;
             m.predict(s)
-        })
+        })?;
+        warn_all(
+            py,
+            &beyond.map(|x| x.message()).into_iter().collect::<Vec<_>>(),
+        )?;
+        Ok(out)
     }
     /// The standard errors (N m) of the torques `predict` gives at `q`, `qd`, `qdd` (shapes as
     /// there): from those of `T*` and of the matrices' entries with their correlation within
@@ -360,7 +368,50 @@ impl PyLocalModel {
     ) -> PyResult<Bound<'py, PyAny>> {
         let m = &self.model;
         let name = "LocalModel.predict_stderr";
-        at_states(py, m.n(), [&q, &qd, &qdd], name, |s| m.predict_stderr(s))
+        let mut beyond = None;
+        let out = at_states(py, m.n(), [&q, &qd, &qdd], name, |s| {
+            beyond = m.extrapolation(s)?;
+            m.predict_stderr(s)
+        })?;
+        warn_all(
+            py,
+            &beyond.map(|x| x.message()).into_iter().collect::<Vec<_>>(),
+        )?;
+        Ok(out)
+    }
+    /// How far each state lies from the planned operating point in units of the perturbations
+    /// the model was identified over: per state (a float for `(n,)` inputs, `(k,)` for a
+    /// batch) the largest `|x_j - x*_j| / perturbations[x][j]` over the joints and `x` in `q`,
+    /// `qd`, `qdd` (inf where a joint's variable was never perturbed and the state moves it).
+    /// At most 1 inside the identified region; `predict` warns (PerturbidWarning) where states
+    /// exceed 1.5. Raises InputError for a model saved before its perturbations were stored.
+    fn reach<'py>(
+        &self,
+        py: Python<'py>,
+        q: ArrayLike<'py>,
+        qd: ArrayLike<'py>,
+        qdd: ArrayLike<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.model.n();
+        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
+        let states = batch.states(n)?;
+        let out = super::detached(py, "LocalModel.reach", || self.model.reach(&states))?;
+        to_numpy(py, out, batch.k, batch.single, &[])
+    }
+    /// The largest perturbation the experiments gave each joint: dict `q` (rad; of the G
+    /// experiment), `qd` (rad/s; H), `qdd` (rad/s^2; D), each `(n,)` (m, m/s, m/s^2 for a
+    /// prismatic joint): the region the model was identified over. None for a model saved
+    /// before they were stored.
+    #[getter]
+    fn perturbations<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(p) = &self.model.perturbations else {
+            return Ok(None);
+        };
+        let out = PyDict::new(py);
+        for (k, v) in [("q", &p.q), ("qd", &p.qd), ("qdd", &p.qdd)] {
+            out.set_item(k, vec1(py, v))?;
+        }
+        Ok(Some(out))
     }
     /// The torque noise of the nominal passes: a tuple of two `(n,)` arrays (N m, or N for a
     /// prismatic joint), the samples' standard deviation about their windows' fits and what

@@ -17,6 +17,7 @@ use crate::direct::position_offsets::{check_position_offsets_in_validation, Posi
 use crate::direct::position_range::{check_position_range, JointRange};
 use crate::direct::torque_columns::{check_torque_columns, TorqueColumn};
 use crate::direct::torque_lag::{check_torque_lag, log_findings, TorqueLag};
+use crate::local::Extrapolation;
 use crate::validation::{stored_stderr, validate as validate_rs, Validation};
 
 /// A model's torques against measured ones. Attributes: `joints` (names), `rms`,
@@ -27,7 +28,9 @@ use crate::validation::{stored_stderr, validate as validate_rs, Validation};
 /// `BaseParameterModel.torque_lag`; None otherwise), `position_range` (likewise, as
 /// `BaseParameterModel.position_range`; empty otherwise), `position_offsets` (for a
 /// BaseParameterModel: the joints' zero offsets of this data against its parameters, held; a
-/// dict as `BaseParameterModel.position_offsets`; None otherwise). `to_dataframe()`: the
+/// dict as `BaseParameterModel.position_offsets`; None otherwise), `extrapolation` (for a
+/// LocalModel, where the states go beyond the region it was identified over; None
+/// otherwise). `to_dataframe()`: the
 /// per-joint table (pandas).
 #[pyclass(name = "Validation", module = "perturbid_rs", frozen)]
 pub(crate) struct PyValidation {
@@ -37,6 +40,7 @@ pub(crate) struct PyValidation {
     torque_lag: Option<TorqueLag>,
     position_range: Vec<JointRange>,
     position_offsets: Option<PositionOffsets>,
+    extrapolation: Option<Extrapolation>,
 }
 
 #[pymethods]
@@ -108,6 +112,26 @@ impl PyValidation {
         (self.position_offsets.as_ref())
             .map(|o| position_offsets_dict(py, o, o.validation_finding()))
             .transpose()
+    }
+    /// For a LocalModel whose states go beyond the perturbations it was identified over
+    /// (reach above 1.5, `LocalModel.reach`; `predict` warned of it): dict `beyond` (states),
+    /// `states`, `largest` (the largest reach), `joint`, `variable` ('q', 'qd' or 'qdd'),
+    /// `deviation` (from the operating point) and `perturbation` (the largest the experiments
+    /// gave it) where it is; None otherwise.
+    #[getter]
+    fn extrapolation<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(x) = &self.extrapolation else {
+            return Ok(None);
+        };
+        let out = PyDict::new(py);
+        out.set_item("beyond", x.beyond)?;
+        out.set_item("states", x.states)?;
+        out.set_item("largest", x.largest)?;
+        out.set_item("joint", &x.joint)?;
+        out.set_item("variable", &x.variable)?;
+        out.set_item("deviation", x.deviation)?;
+        out.set_item("perturbation", x.perturbation)?;
+        Ok(Some(out))
     }
     /// Per joint, the RMS of the predictions' standard errors (n,) (N m): the model's own
     /// uncertainty at these states, to weigh `rms` against; NaN where the model gives none (a
@@ -198,13 +222,16 @@ pub(crate) fn validate<'py>(
     let mut stderr = None;
     let (mut position_range, mut torque_columns) = (vec![], vec![]);
     let (mut torque_lag, mut position_offsets) = (None, None);
+    let mut extrapolation = None;
     if local.is_ok() || base.is_ok() {
         let (q, qd, qdd): (ArrayLike, ArrayLike, ArrayLike) =
             (q.extract()?, qd.extract()?, qdd.extract()?);
         let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
         let states = batch.states(n)?;
         if let Ok(local) = &local {
-            stderr = stored_stderr(local.get().model.predict_stderr(&states))?.ok();
+            let m = &local.get().model;
+            stderr = stored_stderr(m.predict_stderr(&states))?.ok();
+            extrapolation = m.extrapolation(&states)?;
         }
         if let Ok(base) = &base {
             let base = base.get();
@@ -241,5 +268,6 @@ pub(crate) fn validate<'py>(
         torque_lag,
         position_range,
         position_offsets,
+        extrapolation,
     })
 }

@@ -280,6 +280,7 @@ pub fn exact_local(
         g_static: None,
         combined: None,
         coulomb: None,
+        perturbations: None,
         diagnostics: Default::default(),
     }
 }

@@ -163,6 +163,54 @@ def test_workflow_shapes_uncertainty_and_json():
         np.testing.assert_array_equal(part["std"].to_numpy(), model.stderr[term][i, j])
 
 
+def test_predictions_beyond_the_identified_perturbations_are_warned_of():
+    robot = pr.robots.a465()
+    op = pr.OperatingPoint(*TABLE2)
+    plan = pr.plan_experiments(robot, op, design="orthogonal", n=16, seed=1)
+    model = pr.identify_local(plan, pr.simulate(robot, plan, torque_noise=0.02, seed=4))
+    # the region: per joint the largest perturbation of G's q, H's qd, D's qdd in the plan
+    p = model.perturbations
+    for kind, key in [("G", "q"), ("H", "qd"), ("D", "qdd")]:
+        np.testing.assert_allclose(p[key], np.abs(plan.experiment(kind).deltas).max(axis=0), rtol=1e-15)
+    rng = np.random.default_rng(3)
+    x0 = [op.q, op.qd, op.qdd]
+    near = [np.asarray(x) + rng.uniform(-1, 1, (20, 6)) * p[k] for x, k in zip(x0, ["q", "qd", "qdd"])]
+    far = [x.copy() for x in near]
+    far[0][7, 4] = op.q[4] + 6 * p["q"][4]  # one state: joint 5 six times G's largest
+    expected = np.max([np.abs(x - np.asarray(c)) / p[k] for x, c, k in zip(far, x0, ["q", "qd", "qdd"])], axis=(0, 2))
+    np.testing.assert_allclose(model.reach(*far), expected, rtol=1e-12)
+    assert model.reach(*near).max() <= 1 and model.reach(op.q, op.qd, op.qdd) == 0.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", pr.PerturbidWarning)
+        model.predict(*near)
+        model.predict_stderr(*near)
+    with pytest.warns(pr.PerturbidWarning, match=r"1 of 20 states lie beyond the perturbations .* q of 'joint5'"):
+        model.predict(*far)
+    with pytest.warns(pr.PerturbidWarning, match="the state lies beyond"):
+        model.predict_stderr(far[0][7], far[1][7], far[2][7])
+    with pytest.warns(pr.PerturbidWarning, match="beyond the perturbations"):
+        v = pr.validate(model, *far, model.predict(*near))
+    x = v.extrapolation
+    assert (x["beyond"], x["states"], x["joint"], x["variable"]) == (1, 20, "joint5", "q")
+    assert x["largest"] == pytest.approx(6.0) and x["perturbation"] == p["q"][4]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pr.PerturbidWarning)
+        assert pr.validate(model, *near, model.predict(*near)).extrapolation is None
+    # a model saved before the perturbations were stored: predicts as before, no reach
+    doc = json.loads(model.to_json())
+    del doc["perturbations"]
+    old = pr.LocalModel.from_json(json.dumps(doc))
+    assert old.perturbations is None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pr.PerturbidWarning)
+        predicted = model.predict(*far)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", pr.PerturbidWarning)
+        np.testing.assert_array_equal(old.predict(*far), predicted)
+    with pytest.raises(pr.InputError, match="identify it again"):
+        old.reach(*far)
+
+
 def test_real_recording_from_arrays_and_shifted_clock():
     robot = pr.robots.a465()
     op = pr.OperatingPoint(*TABLE2)
