@@ -50,6 +50,7 @@ pub mod student_t;
 pub mod study;
 pub mod svg;
 pub mod torque_model;
+pub mod torque_saturation;
 pub mod trajectory;
 pub mod urdf;
 pub mod validation;

@@ -77,8 +77,13 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     // the grids of the positions as logged: a glitch replaced by its neighbours' fit is off
     // the grid, and would hide it
     let steps = crate::local::rounded_positions::position_steps(rec);
+    // clipped torques, as logged: screening could replace a short clipped run
+    let torque_saturation = crate::torque_saturation::find_torque_saturation(rec);
     if !options.screen_glitches {
-        return preprocess_screened(rec, options, &steps);
+        return preprocess_screened(rec, options, &steps).map(|out| Recording {
+            torque_saturation,
+            ..out
+        });
     }
     if !options.split_at_gaps {
         check_gaps(rec)?;
@@ -101,6 +106,7 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     Ok(Recording {
         glitches,
         dropouts,
+        torque_saturation,
         ..out
     })
 }

@@ -30,6 +30,9 @@ pub struct Recording {
     /// derived from them, the noise their rounding leaves in qd and qdd
     /// ([`crate::position_rounding`]); empty for a recording as logged.
     pub position_rounding: Vec<crate::position_rounding::PositionRounding>,
+    /// Per joint and side, the torques of the log this recording was preprocessed from that
+    /// read clipped ([`crate::torque_saturation`]); empty for a recording as logged.
+    pub torque_saturation: Vec<crate::torque_saturation::TorqueSaturation>,
 }
 
 impl Recording {
@@ -57,6 +60,7 @@ impl Recording {
             glitches: vec![],
             dropouts: vec![],
             position_rounding: vec![],
+            torque_saturation: vec![],
         };
         r.check()?;
         Ok(r)

@@ -649,6 +649,79 @@ fn excite_identify_direct_predict() {
         let (a, b) = (a["rms"].as_f64().unwrap(), b["rms"].as_f64().unwrap());
         assert!((a - b).abs() < 0.01 * b + 1e-9, "{a} against {b}");
     }
+    // joint 3's torque clipped 20 % below its largest value: warned of by name, kept in the
+    // model and in validation.json
+    let mut clipped = raw.clone();
+    let top = clipped
+        .tau
+        .iter()
+        .skip(2)
+        .step_by(6)
+        .copied()
+        .fold(f64::MIN, f64::max);
+    let bottom = clipped
+        .tau
+        .iter()
+        .skip(2)
+        .step_by(6)
+        .copied()
+        .fold(f64::MAX, f64::min);
+    let level = top - 0.2 * (top - bottom);
+    clipped
+        .tau
+        .iter_mut()
+        .skip(2)
+        .step_by(6)
+        .for_each(|v| *v = v.min(level));
+    write(
+        &d.join("clipped.csv"),
+        &recording_table(&clipped, "").to_csv(),
+    );
+    let (log, base_out) = (d.join("clipped.csv"), d.join("clipped_base.json"));
+    let (base_json, validation_out) = (d.join("base.json"), d.join("clipped_validation"));
+    for warned in [
+        run(&["identify-direct", "a465", s(&log), "--out", s(&base_out)]),
+        run(&[
+            "validate",
+            s(&base_json),
+            s(&log),
+            "--robot",
+            "a465",
+            "--out",
+            s(&validation_out),
+        ]),
+    ] {
+        assert!(
+            warned.contains("the torque of 'joint3' reads exactly")
+                && warned.contains("its largest value")
+                && warned.contains("clipped"),
+            "{warned}"
+        );
+    }
+    let base: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("clipped_base.json")).unwrap())
+            .unwrap();
+    let validation: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(d.join("clipped_validation/validation.json")).unwrap(),
+    )
+    .unwrap();
+    for listed in [
+        &base["log_torque_saturation"],
+        &validation["log_torque_saturation"],
+    ] {
+        assert_eq!(listed[0]["joint"], 2, "{listed}");
+        assert_eq!(listed[0]["level"].as_f64(), Some(level), "{listed}");
+    }
+    assert!(!run(&[
+        "validate",
+        s(&d.join("base.json")),
+        s(&d.join("spiked.csv")),
+        "--robot",
+        "a465",
+        "--out",
+        s(&d.join("spiked_validation_again")),
+    ])
+    .contains("clipped"));
     let warned = run(&[
         "identify-direct",
         "a465",

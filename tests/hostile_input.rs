@@ -283,7 +283,7 @@ fn sizes_from_input_are_bounded_before_allocation() {
                 count: Some(1_000_000_000_000),
                 ..PlanOptions::default()
             },
-            "count: 1000000000000; expected 2 to 100000",
+            "n (perturbations per experiment): 1000000000000; expected 2 to 100000",
         ),
         (
             PlanOptions {

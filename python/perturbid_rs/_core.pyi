@@ -339,6 +339,10 @@ class Recording:
         them, the noise their rounding left in the preprocessed qd and qdd: joint (0-based),
         step (rad or m), qd_ratio, qdd_ratio (RMS of the noise over RMS of the signal;
         preprocess warns from 0.1)."""
+    @property
+    def torque_saturation(self) -> list[dict[str, Any]]:
+        """The log's torques that read clipped (preprocess warns): joint (0-based), level
+        (N m), upper, runs, samples, longest, first_at (s), beyond (N m)."""
     def __len__(self) -> int: ...
 
 @final

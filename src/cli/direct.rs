@@ -222,6 +222,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     let fit = crate::direct::BaseModel {
         log_glitches: rec.glitches.clone(),
         log_dropouts: rec.dropouts.clone(),
+        log_torque_saturation: rec.torque_saturation.clone(),
         position_rounding: rec.position_rounding.clone(),
         ..fit
     };

@@ -140,7 +140,19 @@ impl PreprocessArgs {
         use std::fmt::Write;
         progress.update(&format!("reading {}", path.display()));
         let rec = crate::io::load_recording(path, joints)?;
+        let clipped = |rec: &crate::recording::Recording| {
+            let log = path.display().to_string();
+            if let Some(w) = crate::torque_saturation::warning(&rec.torque_saturation, joints, &log)
+            {
+                eprintln!("perturbid: warning: {w}");
+            }
+        };
         if rec.qdd.is_some() && !self.preprocess {
+            let rec = crate::recording::Recording {
+                torque_saturation: crate::torque_saturation::find_torque_saturation(&rec),
+                ..rec
+            };
+            clipped(&rec);
             return Ok(rec);
         }
         progress.update("preprocessing");
@@ -168,6 +180,7 @@ impl PreprocessArgs {
         ) {
             eprintln!("perturbid: warning: {w}");
         }
+        clipped(&rec);
         let _ = writeln!(
             out,
             "preprocessed: {} Hz, {} Hz zero-phase low-pass, every {}th sample, {} s trimmed: {} samples",

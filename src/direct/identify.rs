@@ -99,6 +99,10 @@ pub struct BaseModel {
     /// while the robot moved; [`crate::log_screening::find_dropouts`]), set likewise.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub log_dropouts: Vec<crate::log_screening::LogDropout>,
+    /// The torques of that log that read clipped ([`crate::torque_saturation`]; set likewise):
+    /// the fit took them for the robot's, and was warned of them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub log_torque_saturation: Vec<crate::torque_saturation::TorqueSaturation>,
     /// Per joint of that log whose positions lie on a grid and whose velocity was derived
     /// from them, the noise their rounding left in qd and qdd ([`crate::position_rounding`];
     /// set likewise): ratios of [`crate::position_rounding::NOISE_RATIO`] or more are warned
@@ -282,6 +286,7 @@ fn fit_with_factors(
         base,
         residual_correlation: vec![],
         log_glitches: vec![],
+        log_torque_saturation: vec![],
         log_dropouts: vec![],
         position_rounding: vec![],
         torque_columns: super::torque_columns::check_torque_columns(
@@ -439,6 +444,14 @@ impl Document for BaseModel {
             .find_map(|(i, d)| d.problem().map(|p| (i, p)))
         {
             return Err(invalid(Self::WHAT, format!("log_dropouts[{i}]: {problem}")));
+        }
+        if let Some((i, problem)) = (m.log_torque_saturation.iter().enumerate())
+            .find_map(|(i, c)| c.problem(n).map(|p| (i, p)))
+        {
+            return Err(invalid(
+                Self::WHAT,
+                format!("log_torque_saturation[{i}]: {problem}"),
+            ));
         }
         if let Some((i, problem)) = m
             .position_rounding

@@ -297,6 +297,7 @@ pub fn identify_parameters_from_local(
         residual_correlation: vec![],
         log_glitches: vec![],
         log_dropouts: vec![],
+        log_torque_saturation: vec![],
         position_rounding: vec![],
         // rows from local models: no log's torque columns
         torque_columns: vec![],

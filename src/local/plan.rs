@@ -420,7 +420,12 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
     check_range("dwell", o.dwell, 0.0, 3600.0)?;
     check_range("min_transition", o.min_transition, 0.0, 3600.0)?;
     if let Some(count) = o.count {
-        check_count("count", count, 2, MAX_PERTURBATIONS)?;
+        check_count(
+            "n (perturbations per experiment)",
+            count,
+            2,
+            MAX_PERTURBATIONS,
+        )?;
     }
     let per_joint = |name: &str, values: &Option<Vec<f64>>, largest: f64| -> Result<()> {
         let Some(values) = values else { return Ok(()) };

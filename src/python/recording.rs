@@ -287,6 +287,34 @@ impl PyRecording {
             })
             .collect()
     }
+    /// The torques of the log this recording was preprocessed from that read clipped (a run
+    /// of samples at exactly the column's largest or smallest value that the samples either
+    /// side head beyond; `preprocess` warns): a list of dicts `joint` (0-based column index),
+    /// `level` (N m, the value read), `upper` (its largest value, else its smallest), `runs`,
+    /// `samples`, `longest` (samples), `first_at` (s), `beyond` (N m, how far beyond `level`
+    /// estimated from the slopes either side). Empty for a recording as logged.
+    #[getter]
+    fn torque_saturation<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<Vec<Bound<'py, pyo3::types::PyDict>>> {
+        self.rec
+            .torque_saturation
+            .iter()
+            .map(|c| {
+                let e = pyo3::types::PyDict::new(py);
+                e.set_item("joint", c.joint)?;
+                e.set_item("level", c.level)?;
+                e.set_item("upper", c.upper)?;
+                e.set_item("runs", c.runs)?;
+                e.set_item("samples", c.samples)?;
+                e.set_item("longest", c.longest)?;
+                e.set_item("first_at", c.first_at)?;
+                e.set_item("beyond", c.beyond)?;
+                Ok(e)
+            })
+            .collect()
+    }
     fn __len__(&self) -> usize {
         self.rec.len()
     }

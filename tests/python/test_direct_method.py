@@ -664,6 +664,31 @@ def test_validation_tables_and_figures():
         pr.validate(fit, q, qd, qdd, tau[:-1])
 
 
+def test_preprocess_names_a_clipped_torque():
+    """Joint 2's torque clipped at 1.5 N m (its peaks reach 2): a PerturbidWarning names it and
+    the recording lists it with the level, the side and about how far the torque went beyond
+    it (a parabola through the clipped stretch's ends); the torques logged in 0.05 N m steps,
+    their tops held a while, are not taken for clipped."""
+    rng = np.random.default_rng(5)
+    t = np.arange(8000) * 1e-3
+    q = np.stack([0.3 * np.sin(2 * np.pi * 0.2 * t + k) for k in range(3)], axis=1)
+    tau = np.stack([2.0 * np.cos(2 * np.pi * 0.3 * t + k) for k in range(3)], axis=1)
+    tau += 0.01 * rng.standard_normal(tau.shape)
+    clipped = tau.copy()
+    clipped[:, 1] = np.minimum(clipped[:, 1], 1.5)
+    with pytest.warns(pr.PerturbidWarning, match=r"the torque of joint 2 reads exactly 1\.5000 N m, its largest value.*clipped"):
+        rec = pr.preprocess(t, q, clipped, name="clipped")
+    (found,) = rec.torque_saturation
+    assert (found["joint"], found["level"], found["upper"]) == (1, 1.5, True)
+    # the peaks the clip hid: 0.5 N m beyond it
+    assert 0.25 < found["beyond"] < 1.0, found
+    assert found["runs"] >= 1 and found["longest"] >= 300
+    stepped = np.round(tau / 0.05) * 0.05
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", pr.PerturbidWarning)
+        assert pr.preprocess(t, q, stepped, name="stepped").torque_saturation == []
+
+
 def test_preprocess_replaces_a_logs_glitches_and_says_so():
     """A torque spike and a row of zero positions in a log are replaced before filtering: a
     PerturbidWarning names them, the result's glitches list them, and the preprocessed
