@@ -55,6 +55,9 @@ pub struct TorqueSaturation {
     /// How far beyond `level` the torque went in a clipped run, at most, as the parabola
     /// through the run's ends at its sides' gentler slope estimates it (N m or N).
     pub beyond: f64,
+    /// Each clipped run's first and last sample's times (s, the log's clock); not saved.
+    #[serde(skip)]
+    pub spans: Vec<(f64, f64)>,
 }
 
 impl TorqueSaturation {
@@ -145,7 +148,9 @@ pub fn find_torque_saturation(rec: &Recording) -> Vec<TorqueSaturation> {
                         longest: 0,
                         first_at: rec.t[run.start],
                         beyond: 0.0,
+                        spans: vec![],
                     });
+                    h.spans.push((rec.t[run.start], rec.t[run.end - 1]));
                     h.runs += 1;
                     h.samples += run.len();
                     h.longest = h.longest.max(run.len());
@@ -250,4 +255,42 @@ pub fn warning(found: &[TorqueSaturation], joint_names: &[String], log: &str) ->
         "log '{log}': the torque of {}: clipped (a saturated sensor or drive, or a torque limit of the controller). The fit takes the clipped readings for the robot's torques and its parameters bend to them: log with a wider range, or excite the robot less",
         each.join("; ")
     ))
+}
+
+/// The warning for the clipped runs of `found` (in one experiment's recording) that reach into
+/// a crossing's window: `times`, the crossings' times in the recording's clock (s), `window`
+/// the windows' half-width (s). None where none does: clipping between the crossings leaves
+/// the fits alone.
+pub fn crossing_warning(
+    found: &[TorqueSaturation],
+    times: &[f64],
+    window: f64,
+    joint_names: &[String],
+) -> Option<String> {
+    let each: Vec<String> = found
+        .iter()
+        .filter_map(|s| {
+            let hit: Vec<String> = (times.iter().enumerate())
+                .filter(|(_, t)| (s.spans.iter()).any(|&(a, b)| a <= *t + window && b >= *t - window))
+                .map(|(i, _)| i.to_string())
+                .collect();
+            let name = joint_names
+                .get(s.joint)
+                .map_or(format!("joint {}", s.joint + 1), |n| format!("'{n}'"));
+            (!hit.is_empty()).then(|| {
+                format!(
+                    "{name} reads exactly {:.4} N m, its {} value, in the window(s) of crossing(s) {}",
+                    s.level,
+                    if s.upper { "largest" } else { "smallest" },
+                    hit.join(", ")
+                )
+            })
+        })
+        .collect();
+    (!each.is_empty()).then(|| {
+        format!(
+            "the torque of {}: clipped (a saturated sensor or drive, or a torque limit of the controller), so those crossings' torques are the clip's, not the robot's, and the fits bend to them: record with a wider range, or perturb less",
+            each.join("; ")
+        )
+    })
 }

@@ -149,3 +149,60 @@ fn a_clipped_torque_moves_the_fit_far_beyond_its_standard_errors() {
     // about 2,900 here
     assert!(moved > 100.0, "{moved}");
 }
+
+/// The local method: a torque clipped in a crossing's window is warned of with the crossing;
+/// clipping only between the crossings, where no fit reads the torque, is not.
+#[test]
+fn the_local_method_names_the_crossings_a_clipped_torque_reaches() {
+    use perturbid_rs::local::{identify_local, ExperimentKind, IdentifyOptions};
+    let (plan, recs) = common::a465_noisy_runs();
+    let clean = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    assert!(!clean
+        .diagnostics
+        .warnings
+        .iter()
+        .any(|w| w.contains("clipped")));
+    let e = (plan.experiments.iter())
+        .position(|e| e.kind == ExperimentKind::D)
+        .unwrap();
+    let rec = &recs[e];
+    let j = 1;
+    // joint 2's torque at each crossing, read at its nearest sample
+    let at = |t: f64| {
+        let s = rec.t.partition_point(|x| *x < t);
+        rec.tau[s * 6 + j]
+    };
+    let crossings = &plan.experiments[e].crossings;
+    let (k, top) = (crossings.iter().enumerate())
+        .map(|(i, c)| (i, at(c.time)))
+        .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a });
+    let column_top = rec
+        .tau
+        .iter()
+        .skip(j)
+        .step_by(6)
+        .copied()
+        .fold(f64::MIN, f64::max);
+    for (level, says) in [(top - 0.3, true), (0.5 * (top + column_top), false)] {
+        let mut clipped = recs.clone();
+        for v in clipped[e].tau.iter_mut().skip(j).step_by(6) {
+            *v = v.min(level);
+        }
+        let model = identify_local(&plan, &clipped, &IdentifyOptions::default()).unwrap();
+        let warned: Vec<&String> = (model.diagnostics.warnings.iter())
+            .filter(|w| w.contains("clipped"))
+            .collect();
+        if !says {
+            assert!(warned.is_empty(), "{level} above {top}: {warned:?}");
+            continue;
+        }
+        assert_eq!(warned.len(), 1, "{warned:?}");
+        assert!(
+            warned[0].starts_with("experiment 'D': the torque of 'joint2' reads exactly")
+                && (warned[0].contains(&format!("crossing(s) {k}"))
+                    || warned[0].contains(&format!(", {k}"))),
+            "crossing {k}: {}",
+            warned[0]
+        );
+    }
+}

@@ -363,6 +363,7 @@ pub fn identify_local(
         // one joint's held readings (a lost message logged as its last value or zeros) are
         // replaced, and rows of zeros while the robot moves removed, before the windows are
         // read; the samples the diagnostics name are counted in the recording as logged
+        let clipped = crate::torque_saturation::find_torque_saturation(r);
         let (repaired, held) = crate::log_screening::screen_held_readings(r)?;
         if let Some(w) = crate::log_screening::warning(
             &held,
@@ -391,6 +392,15 @@ pub fn identify_local(
             }
             v
         };
+        let times: Vec<f64> = v.crossings.iter().map(|c| c.time).collect();
+        if let Some(w) = crate::torque_saturation::crossing_warning(
+            &clipped,
+            &times,
+            e.window,
+            &plan.joint_names,
+        ) {
+            dropout_warnings.push(format!("experiment '{}': {w}", e.kind.name()));
+        }
         if let Some(w) = crate::log_screening::dropout_warning(
             &found,
             &r.name,
