@@ -54,6 +54,7 @@ pub mod torque_saturation;
 pub mod trajectory;
 pub mod urdf;
 pub mod validation;
+pub mod velocity_columns;
 
 #[cfg(feature = "python")]
 mod python;

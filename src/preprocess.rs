@@ -281,6 +281,19 @@ fn preprocess_part(
             ),
         });
     }
+    // logged velocities against the positions' derivative, filtered alike, where kept
+    if rec.qd.is_some() {
+        let mut derived = Vec::with_capacity(n);
+        for q in &cols[0] {
+            crate::interrupt::check("preprocessing")?;
+            derived.push(smooth(differentiate(q, dt))?[skip..count - skip].to_vec());
+        }
+        let logged: Vec<Vec<f64>> = cols[1]
+            .iter()
+            .map(|v| v[skip..count - skip].to_vec())
+            .collect();
+        crate::velocity_columns::check_velocity_columns(&rec.name, &logged, &derived)?;
+    }
     let keep: Vec<usize> = (skip..count - skip).step_by(o.decimate).collect();
     // positions in coarse counts under velocities derived from them: the noise of their
     // rounding, through the same chain (crate::position_rounding)

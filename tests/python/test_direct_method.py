@@ -689,6 +689,21 @@ def test_preprocess_names_a_clipped_torque():
         assert pr.preprocess(t, q, stepped, name="stepped").torque_saturation == []
 
 
+def test_preprocess_refuses_velocities_that_are_not_the_positions_derivative():
+    t = np.arange(6000) * 1e-3
+    q = np.stack([0.3 * np.sin(2 * np.pi * 0.2 * t + k) for k in range(3)], axis=1)
+    qd = np.stack([0.3 * 2 * np.pi * 0.2 * np.cos(2 * np.pi * 0.2 * t + k) for k in range(3)], axis=1)
+    tau = np.stack([2.0 * np.cos(2 * np.pi * 0.3 * t + k) for k in range(3)], axis=1)
+    rec = pr.preprocess(t, q, tau, qd=qd)
+    expected = np.stack([0.3 * 2 * np.pi * 0.2 * np.cos(2 * np.pi * 0.2 * rec.t + k) for k in range(3)], axis=1)
+    np.testing.assert_allclose(rec.qd, expected, atol=1e-4)  # the logged velocities, as they were
+    with pytest.raises(pr.InputError, match=r"joints 1, 2, 3: 57\.296 times its positions' derivative: degrees per second"):
+        pr.preprocess(t, q, tau, qd=np.degrees(qd))
+    swapped = qd[:, [0, 2, 1]]
+    with pytest.raises(pr.InputError, match=r"joint 2: follows the positions of joint 3"):
+        pr.preprocess(t, q, tau, qd=swapped)
+
+
 def test_preprocess_replaces_a_logs_glitches_and_says_so():
     """A torque spike and a row of zero positions in a log are replaced before filtering: a
     PerturbidWarning names them, the result's glitches list them, and the preprocessed
