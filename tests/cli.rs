@@ -323,6 +323,17 @@ fn excite_identify_direct_predict() {
         out.contains("base parameters from") && out.contains("validation"),
         "{out}"
     );
+    // the held-out table: RMS, relative RMS and the predictions' standard errors' RMS
+    let held_out: Vec<&str> = (out.lines())
+        .skip_while(|l| !l.starts_with("validation on the last"))
+        .skip(1)
+        .take(6)
+        .collect();
+    assert!(
+        held_out.iter().all(|l| l.split_whitespace().count() == 4
+            && l.split_whitespace().nth(3).unwrap().parse::<f64>().is_ok()),
+        "{out}"
+    );
     // the parameter table, in full, as CSV and JSON beside the model
     assert!(
         out.contains("rel. std") && out.contains("parameter table -> "),
@@ -373,7 +384,7 @@ fn excite_identify_direct_predict() {
         &["--robot"],
     );
     // --stderr: after the torques, the library's standard errors
-    ok(&[
+    let compared = ok(&[
         "predict",
         s(&d.join("base.json")),
         s(&d.join("log.csv")),
@@ -415,6 +426,24 @@ fn excite_identify_direct_predict() {
     let got = pick(&with_se, named("tau", "_stderr"));
     for (g, w) in got.iter().zip(&want) {
         assert!((g - w).abs() <= 1e-12 * w && *w > 0.0, "{g} against {w}");
+    }
+    // and the comparison with the log's torques weighs each joint's error against them
+    assert!(
+        compared.contains("the RMS of the predictions' standard errors"),
+        "{compared}"
+    );
+    for j in 0..6 {
+        let line = (compared.lines())
+            .find(|l| l.trim_start().starts_with(&format!("joint{} ", j + 1)))
+            .unwrap();
+        let fields: Vec<&str> = line.split_whitespace().collect();
+        let column: Vec<f64> = got.iter().skip(j).step_by(6).copied().collect();
+        let rms = (column.iter().map(|v| v * v).sum::<f64>() / column.len() as f64).sqrt();
+        let shown: f64 = fields[2].parse().unwrap();
+        assert!(
+            fields.len() == 3 && (shown - rms).abs() <= 5e-5,
+            "{line}: {rms}"
+        );
     }
     // a globally linearised model stores no covariance: refused, nothing written
     let op = perturbid_rs::OperatingPoint::new(vec![0.0; 6], vec![0.0; 6], vec![0.0; 6]).unwrap();

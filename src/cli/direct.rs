@@ -270,21 +270,26 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         json.display()
     );
     if split < k {
-        let p = fit.on(&model)?.predict(&states.slice(split..k))?;
+        let held_out = states.slice(split..k);
+        let p = fit.on(&model)?.predict(&held_out)?;
         let _ = writeln!(
             out,
-            "validation on the last {} samples: per joint RMS (N m) and relative RMS (%)",
+            "validation on the last {} samples: per joint RMS (N m), relative RMS (%) and the RMS of the predictions' standard errors (N m)",
             k - split
         );
-        let v = crate::validation::validate(&model.joint_names, &p, &rec.tau[split * n..])?;
+        let mut v = crate::validation::validate(&model.joint_names, &p, &rec.tau[split * n..])?;
+        if let Ok(se) = crate::validation::stored_stderr(fit.predict_stderr(&model, &held_out))? {
+            v = v.with_model_stderr(&se)?;
+        }
         for e in &v.joints {
             let _ = writeln!(
                 out,
-                "  {:<16} {:>10} {:>8}",
+                "  {:<16} {:>10} {:>8} {:>12}",
                 e.joint,
                 number(e.rms),
                 e.relative_rms
-                    .map_or("-".to_string(), |r| format!("{:.2}", 100.0 * r))
+                    .map_or("-".to_string(), |r| format!("{:.2}", 100.0 * r)),
+                e.model_stderr_rms.map_or("-".to_string(), number)
             );
         }
     }
@@ -390,12 +395,28 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
         a.out.display()
     );
     if let Some(meas) = &states.tau {
+        let mut v = crate::validation::validate(&joints, &tau, meas)?;
+        if let Some(se) = &stderr {
+            v = v.with_model_stderr(se)?;
+        }
         let _ = writeln!(
             out,
-            "against the measured torques: per joint RMS error (N m)"
+            "against the measured torques: per joint RMS error (N m){}",
+            if stderr.is_some() {
+                ", and the RMS of the predictions' standard errors (N m)"
+            } else {
+                ""
+            }
         );
-        for e in crate::validation::validate(&joints, &tau, meas)?.joints {
-            let _ = writeln!(out, "  {:<16} {:>10}", e.joint, number(e.rms));
+        for e in v.joints {
+            let se = match &stderr {
+                Some(_) => format!(
+                    " {:>12}",
+                    e.model_stderr_rms.map_or("-".to_string(), number)
+                ),
+                None => String::new(),
+            };
+            let _ = writeln!(out, "  {:<16} {:>10}{se}", e.joint, number(e.rms));
         }
     }
     Ok(out)
