@@ -419,13 +419,8 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
     check_range("window", o.window, 0.0, 60.0)?;
     check_range("dwell", o.dwell, 0.0, 3600.0)?;
     check_range("min_transition", o.min_transition, 0.0, 3600.0)?;
-    if let Some(count) = o.count {
-        check_count(
-            "n (perturbations per experiment)",
-            count,
-            2,
-            MAX_PERTURBATIONS,
-        )?;
+    if let Some(k) = o.count {
+        check_count("n (perturbations per experiment)", k, 2, MAX_PERTURBATIONS)?;
     }
     let per_joint = |name: &str, values: &Option<Vec<f64>>, largest: f64| -> Result<()> {
         let Some(values) = values else { return Ok(()) };
@@ -615,12 +610,9 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
             o.rate,
             1 + 4 * n,
         )?;
-        check_limits(
-            model,
-            &trajectory.sample(o.rate),
-            &context,
-            "; reduce the perturbation sizes or move the operating point away from the limit",
-        )?;
+        let sampled = trajectory.sample(o.rate);
+        check_limits(model, &sampled, &context, LIMITS_ADVICE)?;
+        plan_warnings::effort(model, op, kind, &sampled, &mut warnings)?;
         let experiment = Experiment {
             kind,
             deltas,
@@ -675,6 +667,10 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
         warnings,
     })
 }
+
+/// What a plan that breaks a limit is told to do.
+const LIMITS_ADVICE: &str =
+    "; reduce the perturbation sizes or move the operating point away from the limit";
 
 /// Builds one experiment's trajectory on the sampling grid (times are sample counts / rate).
 struct Builder<'a> {
