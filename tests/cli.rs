@@ -12,7 +12,9 @@ mod cli_support;
 
 use std::process::Command;
 
-use cli_support::{bin, fails, nothing_written, ok, plan_nominal_and_d, s, table2_op, tmp, write};
+use cli_support::{
+    bin, fails, nothing_written, ok, plan_nominal_and_d, s, table2_op, tmp, warnings_of, write,
+};
 
 #[test]
 fn plan_simulate_identify_predict() {
@@ -140,13 +142,8 @@ fn plan_simulate_identify_predict() {
     }
     write(&d.join("far.csv"), &far);
     for (command, out) in [("predict", "far_pred.csv"), ("validate", "far_validation")] {
-        let run = bin()
-            .args([command, s(&d.join("model.json")), s(&d.join("far.csv"))])
-            .args(["--out", s(&d.join(out))])
-            .output()
-            .unwrap();
-        let said = String::from_utf8_lossy(&run.stderr);
-        assert!(run.status.success(), "{said}");
+        let (model, far, out) = (d.join("model.json"), d.join("far.csv"), d.join(out));
+        let said = warnings_of(&[command, s(&model), s(&far), "--out", s(&out)]);
         assert!(
             said.contains("1 of 3 states lie beyond the perturbations")
                 && said.contains("q of 'joint2' +0.5000 rad"),
@@ -603,20 +600,15 @@ fn excite_identify_direct_predict() {
         row[2] += 0.1;
     }
     write(&d.join("moved.csv"), &recording_table(&moved, "").to_csv());
-    let o = bin()
-        .args([
-            "validate",
-            s(&d.join("base.json")),
-            s(&d.join("moved.csv")),
-            "--robot",
-            "a465",
-            "--out",
-            s(&d.join("moved_validation")),
-        ])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(o.status.success(), "{err}");
+    let err = warnings_of(&[
+        "validate",
+        s(&d.join("base.json")),
+        s(&d.join("moved.csv")),
+        "--robot",
+        "a465",
+        "--out",
+        s(&d.join("moved_validation")),
+    ]);
     assert!(
         err.contains("with the positions of joint(s) 'joint3' -0.")
             && err.contains("not those of the log the model was identified from"),
@@ -640,11 +632,7 @@ fn excite_identify_direct_predict() {
         &d.join("spiked.csv"),
         &recording_table(&spiked, "").to_csv(),
     );
-    let run = |args: &[&str]| {
-        let o = bin().args(args).output().unwrap();
-        assert!(o.status.success(), "{args:?}");
-        String::from_utf8_lossy(&o.stderr).into_owned()
-    };
+    let run = warnings_of;
     let warned = run(&[
         "validate",
         s(&d.join("base.json")),

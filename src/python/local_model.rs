@@ -45,6 +45,25 @@ impl PyLocalModel {
     ) -> PyResult<Option<Bound<'py, PyAny>>> {
         e.as_ref().map(|e| mat(py, &e.matrix)).transpose()
     }
+    /// `f` of the model at the states `q`, `qd`, `qdd` (as `at_states`), with a
+    /// PerturbidWarning where they reach beyond the perturbations it was identified over.
+    fn near_point<'py>(
+        &self,
+        py: Python<'py>,
+        states: [&ArrayLike<'py>; 3],
+        name: &str,
+        f: fn(&LocalModel, &crate::states::States<'_>) -> crate::error::Result<Vec<f64>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let m = &self.model;
+        let mut beyond = None;
+        let out = at_states(py, m.n(), states, name, |s| {
+            beyond = m.extrapolation(s)?;
+            f(m, s)
+        })?;
+        let warnings: Vec<String> = beyond.map(|x| x.message()).into_iter().collect();
+        warn_all(py, &warnings)?;
+        Ok(out)
+    }
 }
 
 #[pymethods]
@@ -342,17 +361,12 @@ impl PyLocalModel {
         qd: ArrayLike<'py>,
         qdd: ArrayLike<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let m = &self.model;
-        let mut beyond = None;
-        let out = at_states(py, m.n(), [&q, &qd, &qdd], "LocalModel.predict", |s| {
-            beyond = m.extrapolation(s)?;
-            m.predict(s)
-        })?;
-        warn_all(
+        self.near_point(
             py,
-            &beyond.map(|x| x.message()).into_iter().collect::<Vec<_>>(),
-        )?;
-        Ok(out)
+            [&q, &qd, &qdd],
+            "LocalModel.predict",
+            LocalModel::predict,
+        )
     }
     /// The standard errors (N m) of the torques `predict` gives at `q`, `qd`, `qdd` (shapes as
     /// there): from those of `T*` and of the matrices' entries with their correlation within
@@ -366,18 +380,8 @@ impl PyLocalModel {
         qd: ArrayLike<'py>,
         qdd: ArrayLike<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let m = &self.model;
         let name = "LocalModel.predict_stderr";
-        let mut beyond = None;
-        let out = at_states(py, m.n(), [&q, &qd, &qdd], name, |s| {
-            beyond = m.extrapolation(s)?;
-            m.predict_stderr(s)
-        })?;
-        warn_all(
-            py,
-            &beyond.map(|x| x.message()).into_iter().collect::<Vec<_>>(),
-        )?;
-        Ok(out)
+        self.near_point(py, [&q, &qd, &qdd], name, LocalModel::predict_stderr)
     }
     /// How far each state lies from the planned operating point in units of the perturbations
     /// the model was identified over: per state (a float for `(n,)` inputs, `(k,)` for a

@@ -26,6 +26,14 @@ pub fn ok(args: &[&str]) -> String {
     so.into_owned()
 }
 
+/// Runs and expects success; returns stderr (the warnings).
+pub fn warnings_of(args: &[&str]) -> String {
+    let out = bin().args(args).output().unwrap();
+    let se = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "perturbid {args:?} failed: {se}");
+    se
+}
+
 /// Runs and expects a one-line error containing every `needles`, no panic; returns stderr.
 pub fn fails(args: &[&str], needles: &[&str]) -> String {
     let out = bin().args(args).output().unwrap();
