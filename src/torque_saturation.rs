@@ -77,7 +77,7 @@ impl TorqueSaturation {
         }
         if self.runs == 0
             || self.longest < MIN_RUN
-            || self.samples < self.runs * MIN_RUN
+            || self.samples < self.runs.saturating_mul(MIN_RUN)
             || self.longest > self.samples
         {
             return Some(format!(

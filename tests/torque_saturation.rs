@@ -132,6 +132,10 @@ fn a_saved_finding_is_checked_on_load() {
     let mut bad = found[0].clone();
     bad.level = f64::NAN;
     assert!(bad.problem(6).is_some());
+    // counts at the end of their range: refused, no overflow
+    let mut bad = found[0].clone();
+    bad.runs = usize::MAX;
+    assert!(bad.problem(6).unwrap().contains("runs of at least 3"));
 }
 
 /// Why it is warned of: the fit takes the clipped readings for torques, and the base
