@@ -31,11 +31,12 @@
 //! of one column while its joint moves is judged as a whole against the cubic through the
 //! samples either side of it (`judge_run`), and replaced as a whole when off by more than
 //! [`NOISE_LEVELS`] (its farthest sample, or its mean against the standard error of that
-//! mean). Rows of zeros for every joint of a signal are left to [`find_dropouts`], and rows
+//! mean). Rows of zeros for every joint of a signal are left to [`crate::log_dropouts::find_dropouts`], and rows
 //! that repeat the whole row before to the rule for stale rows below.
 //!
 //! What is not found: other bursts of more than [`MAX_PER_WINDOW`] samples (masked: see
-//! docs/limits.md), held runs longer than [`MAX_HELD`], and a log's repeated rows (a logger that writes its last message again:
+//! docs/limits.md), held runs longer than [`MAX_HELD`] (those that end with a jump are
+//! frozen readings, removed with their rows: [`crate::frozen_readings`]), and a log's repeated rows (a logger that writes its last message again:
 //! the real Panda log of `../shared` repeats 6 % of its rows; replacing them moved the direct
 //! method's parameters by 0.02 standard errors, so they are left as logged unless a repeated
 //! position is itself far off, then it is a glitch like any other).
@@ -195,7 +196,7 @@ fn screen_log(rec: &Recording, held_only: bool) -> Result<(Recording, Vec<LogGli
 pub const SIGNALS: [&str; 4] = ["q", "qd", "qdd", "tau"];
 
 /// The signals `rec` has (its columns, row-major), by their column prefix.
-fn signals(rec: &Recording) -> Vec<(&'static str, &Vec<f64>)> {
+pub(crate) fn signals(rec: &Recording) -> Vec<(&'static str, &Vec<f64>)> {
     [
         Some(&rec.q),
         rec.qd.as_ref(),
@@ -209,7 +210,7 @@ fn signals(rec: &Recording) -> Vec<(&'static str, &Vec<f64>)> {
 }
 
 /// The stretches `[a, b)` of `rec`'s samples between gaps.
-fn segments(rec: &Recording) -> Vec<(usize, usize)> {
+pub(crate) fn segments(rec: &Recording) -> Vec<(usize, usize)> {
     let mut bounds = vec![0];
     bounds.extend(crate::preprocess::gap_positions(rec).iter().map(|&i| i + 1));
     bounds.push(rec.len());
@@ -225,7 +226,7 @@ struct Found {
 }
 
 /// The median of the finite values of `x` (None for none).
-fn median(mut x: Vec<f64>) -> Option<f64> {
+pub(crate) fn median(mut x: Vec<f64>) -> Option<f64> {
     x.retain(|v| v.is_finite());
     if x.is_empty() {
         return None;
@@ -235,7 +236,7 @@ fn median(mut x: Vec<f64>) -> Option<f64> {
 }
 
 /// The candidates of one column `y` sampled at `t` (see the module documentation).
-fn candidates(t: &[f64], y: &[f64]) -> Vec<bool> {
+pub(crate) fn candidates(t: &[f64], y: &[f64]) -> Vec<bool> {
     let k = y.len();
     let mut e = vec![0.0; k];
     for i in 1..k - 1 {
@@ -283,33 +284,7 @@ fn screen_segment(
         let a = i.saturating_sub(HALF_WINDOW).min(k - width);
         a..a + width
     };
-    // the floor of every window's level: the rounding of a grid, a tiny fraction of the
-    // column's size, and its median level over evenly spread windows
-    let spread = (k / LEVEL_WINDOWS).max(1);
-    let mut levels: Vec<Vec<f64>> = vec![vec![]; columns.len()];
-    for i in (HALF_WINDOW..k - HALF_WINDOW).step_by(spread) {
-        let r = window(i);
-        if let Some((v, w)) = basis(&t[r.clone()], t[i]) {
-            for (c, y) in columns.iter().enumerate() {
-                levels[c].push(crate::outliers::level(&v, &w, &y[r.clone()]));
-            }
-        }
-    }
-    let floors: Vec<f64> = columns
-        .iter()
-        .zip(&candidate)
-        .zip(levels)
-        .map(|((y, cand), levels)| {
-            let ordinary: Vec<f64> = (0..k).filter(|&i| !cand[i]).map(|i| y[i]).collect();
-            let size = ordinary.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            let step = crate::local::quantisation::grid_step(&ordinary).unwrap_or(0.0);
-            median(levels)
-                .unwrap_or(0.0)
-                .max(step / 12f64.sqrt())
-                .max(1e-8 * size)
-                .max(f64::MIN_POSITIVE)
-        })
-        .collect();
+    let floors = floors(t, columns, &candidate);
     // each candidate judged in its own window
     let mut found = vec![];
     for (done, &i) in judged.iter().enumerate() {
@@ -362,15 +337,60 @@ fn screen_segment(
     Ok(found)
 }
 
+/// Per column of `columns` (each sampled at `t`, one stretch between gaps, of at least one
+/// window), the floor of its windows' noise levels: the rounding of a grid it lies on, 1e-8 of
+/// its largest value, and its median level over [`LEVEL_WINDOWS`] evenly spread windows (each
+/// against its cubic). `candidate` marks, per column, the samples [`candidates`] found, left
+/// out of the grid and the size.
+pub(crate) fn floors(t: &[f64], columns: &[Vec<f64>], candidate: &[Vec<bool>]) -> Vec<f64> {
+    let k = t.len();
+    let width = 2 * HALF_WINDOW + 1;
+    if k < width {
+        return vec![f64::MIN_POSITIVE; columns.len()];
+    }
+    let window = |i: usize| {
+        let a = i.saturating_sub(HALF_WINDOW).min(k - width);
+        a..a + width
+    };
+    // the floor of every window's level: the rounding of a grid, a tiny fraction of the
+    // column's size, and its median level over evenly spread windows
+    let spread = (k / LEVEL_WINDOWS).max(1);
+    let mut levels: Vec<Vec<f64>> = vec![vec![]; columns.len()];
+    for i in (HALF_WINDOW..k - HALF_WINDOW).step_by(spread) {
+        let r = window(i);
+        if let Some((v, w)) = basis(&t[r.clone()], t[i]) {
+            for (c, y) in columns.iter().enumerate() {
+                levels[c].push(crate::outliers::level(&v, &w, &y[r.clone()]));
+            }
+        }
+    }
+    columns
+        .iter()
+        .zip(candidate)
+        .zip(levels)
+        .map(|((y, cand), levels)| {
+            let ordinary: Vec<f64> = (0..k).filter(|&i| !cand[i]).map(|i| y[i]).collect();
+            let size = ordinary.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let step = crate::local::quantisation::grid_step(&ordinary).unwrap_or(0.0);
+            median(levels)
+                .unwrap_or(0.0)
+                .max(step / 12f64.sqrt())
+                .max(1e-8 * size)
+                .max(f64::MIN_POSITIVE)
+        })
+        .collect()
+}
+
 /// The longest run of exactly repeated readings of one column that is judged as a held
 /// reading: a sensor or logger that wrote its last value again (or zeros) for up to 10 ms at
-/// 1 kHz. Longer runs are left as logged (docs/limits.md).
+/// 1 kHz. Longer runs are not bridged: those that end with a jump are frozen readings, removed
+/// with their rows ([`crate::frozen_readings`]).
 pub const MAX_HELD: usize = HALF_WINDOW;
 
 /// Fewest samples of the others on each side of a held run for its judgement: the cubic
 /// through them interpolates the run and never extrapolates (and twice as many after it, whose
 /// own cubic tells whether the run ends with a jump).
-const HELD_SIDE: usize = DEGREE + 1;
+pub(crate) const HELD_SIDE: usize = DEGREE + 1;
 
 /// The runs of 2 to [`MAX_HELD`] exactly repeated readings in each column (as (column, first
 /// index..end)) while its joint moves: for `qd`, `qdd` and `tau` the joint's position changes
@@ -487,23 +507,7 @@ fn judge_run(t: &[f64], y: &[f64], run: std::ops::Range<usize>, floor: f64) -> V
     // sample is off the cubic through the samples after it, extrapolated one sample back. A
     // signal that really levels off (a joint arriving at rest: a kink the two-sided cubic
     // cannot follow) continues from its last sample and is left alone.
-    let after: Vec<usize> = (run.end..(run.end + HALF_WINDOW).min(y.len())).collect();
-    let last = run.end - 1;
-    if after.len() < 2 * HELD_SIDE {
-        return vec![];
-    }
-    let t_after: Vec<f64> = after.iter().map(|&i| t[i]).collect();
-    let y_after: Vec<f64> = after.iter().map(|&i| y[i]).collect();
-    let Some((va, wa)) = basis(&t_after, t[last]) else {
-        return vec![];
-    };
-    // the basis is in powers of the time from t[last]: there the fit is the constant's
-    // coefficient, and its variance (in units of the noise's) that coefficient's
-    let back: f64 = (0..after.len()).map(|m| wa[(0, m)] * y_after[m]).sum();
-    let variance: f64 = (0..after.len()).map(|m| wa[(0, m)].powi(2)).sum();
-    let level_after = crate::outliers::level(&va, &wa, &y_after).max(level);
-    let jump = (y[last] - back).abs() / (level_after * (1.0 + variance).sqrt());
-    if jump.is_finite() && jump <= NOISE_LEVELS {
+    if end_jump(t, y, run.end - 1, level).is_none_or(|jump| jump <= NOISE_LEVELS) {
         return vec![];
     }
     let held = Some(run.len());
@@ -519,10 +523,33 @@ fn judge_run(t: &[f64], y: &[f64], run: std::ops::Range<usize>, floor: f64) -> V
         .collect()
 }
 
+/// How far the sample `y[last]` (sampled at `t`) is off the cubic through the samples after
+/// it (up to [`HALF_WINDOW`], at least `2 HELD_SIDE`), extrapolated one sample back: in noise
+/// levels (the fit's own, at least `level`), with the extrapolation's uncertainty; infinite
+/// where the difference overflows. None where fewer samples follow, or their times do not
+/// span a cubic. The last sample of a held or frozen reading is far off: the signal jumps
+/// back when the sensor reads again.
+pub(crate) fn end_jump(t: &[f64], y: &[f64], last: usize, level: f64) -> Option<f64> {
+    let after: Vec<usize> = (last + 1..(last + 1 + HALF_WINDOW).min(y.len())).collect();
+    if after.len() < 2 * HELD_SIDE {
+        return None;
+    }
+    let t_after: Vec<f64> = after.iter().map(|&i| t[i]).collect();
+    let y_after: Vec<f64> = after.iter().map(|&i| y[i]).collect();
+    let (va, wa) = basis(&t_after, t[last])?;
+    // the basis is in powers of the time from t[last]: there the fit is the constant's
+    // coefficient, and its variance (in units of the noise's) that coefficient's
+    let back: f64 = (0..after.len()).map(|m| wa[(0, m)] * y_after[m]).sum();
+    let variance: f64 = (0..after.len()).map(|m| wa[(0, m)].powi(2)).sum();
+    let level_after = crate::outliers::level(&va, &wa, &y_after).max(level);
+    let jump = (y[last] - back).abs() / (level_after * (1.0 + variance).sqrt());
+    Some(if jump.is_nan() { f64::INFINITY } else { jump })
+}
+
 /// The cubic basis of a window at times `t` about `tc`, scaled to [-1, 1], and its
 /// least-squares weights (`(V^T V)^-1 V^T` by Cholesky: the scaled cubic is well
 /// conditioned); None where the times do not span a cubic.
-fn basis(t: &[f64], tc: f64) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
+pub(crate) fn basis(t: &[f64], tc: f64) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
     let half = t.iter().fold(0.0f64, |m, x| m.max((x - tc).abs()));
     if !(half > 0.0 && half.is_finite()) {
         return None;
@@ -534,139 +561,25 @@ fn basis(t: &[f64], tc: f64) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
     w.iter().all(|x| x.is_finite()).then_some((v, w))
 }
 
-/// The fewest rows a dropout has: a single row read as zeros is judged by the glitch screening
-/// like any other sample.
-pub const MIN_DROPOUT: usize = 2;
-
-/// A run of rows of a log in which every joint of one signal reads exactly 0 while the robot
-/// moves (a lost message logged as zeros): removed before preprocessing.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct LogDropout {
-    /// The signal read as zeros: `q`, `qd`, `qdd` or `tau`.
-    pub signal: String,
-    /// Index of its first row in the log (0-based: data row `first_sample + 1` of a CSV file).
-    pub first_sample: usize,
-    /// How many rows (at least [`MIN_DROPOUT`]).
-    pub samples: usize,
-    /// Times of its first and last rows (s).
-    pub from: f64,
-    pub to: f64,
-    /// The experiment of a plan whose recording had it (local identification); absent for a
-    /// log preprocessed on its own.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub experiment: Option<String>,
+/// A joint in a warning: its name quoted, or `joint 3` for index 2 where `joint_names` has none.
+pub(crate) fn joint_called(joint_names: &[String], joint: usize) -> String {
+    joint_names
+        .get(joint)
+        .map_or_else(|| format!("joint {}", joint + 1), |j| format!("'{j}'"))
 }
 
-impl LogDropout {
-    /// What is wrong with a dropout read from a file, if anything: an unknown signal, fewer
-    /// than [`MIN_DROPOUT`] rows, times not finite and in order.
-    pub fn problem(&self) -> Option<String> {
-        if !SIGNALS.contains(&self.signal.as_str()) {
-            return Some(format!(
-                "signal '{}' is not one of q, qd, qdd, tau",
-                self.signal
-            ));
-        }
-        if self.samples < MIN_DROPOUT {
-            return Some(format!(
-                "{} samples; a dropout has at least {MIN_DROPOUT}",
-                self.samples
-            ));
-        }
-        if !(self.from.is_finite() && self.to.is_finite() && self.from <= self.to) {
-            return Some("from and to must be finite times, from <= to".into());
-        }
-        None
+/// The unit of a signal in messages.
+pub(crate) fn unit(signal: &str) -> &'static str {
+    match signal {
+        "q" => "rad",
+        "qd" => "rad/s",
+        "qdd" => "rad/s^2",
+        _ => "N m",
     }
-}
-
-/// The dropouts of `rec`: runs of at least [`MIN_DROPOUT`] rows in which every joint of a
-/// signal reads exactly 0, with a row on either side in which some joint of it does not. For
-/// `qd`, `qdd` and `tau` the positions must change within the run (from its first row to its
-/// last): a robot holding a posture reads zero velocities and accelerations, and with no
-/// gravity may read zero torques. In log order.
-pub fn find_dropouts(rec: &Recording) -> Vec<LogDropout> {
-    let n = rec.n;
-    let k = rec.len();
-    let mut found = vec![];
-    for (signal, values) in signals(rec) {
-        let zero = |i: usize| values[i * n..(i + 1) * n].iter().all(|&x| x == 0.0);
-        let mut i = 1;
-        while i < k {
-            if !zero(i) {
-                i += 1;
-                continue;
-            }
-            let a = i;
-            while i < k && zero(i) {
-                i += 1;
-            }
-            // rows a..i read zeros; a - 1 does not (a >= 1 and the run starts there)
-            if i == k || zero(a - 1) || i - a < MIN_DROPOUT {
-                continue;
-            }
-            // the robot moves during the run: its positions change from its first row to its
-            // last (a hold between two postures reads zero velocities and accelerations)
-            let moves = signal == "q" || rec.q[a * n..(a + 1) * n] != rec.q[(i - 1) * n..i * n];
-            if moves {
-                found.push(LogDropout {
-                    signal: signal.to_string(),
-                    first_sample: a,
-                    samples: i - a,
-                    from: rec.t[a],
-                    to: rec.t[i - 1],
-                    experiment: None,
-                });
-            }
-        }
-    }
-    found.sort_by_key(|d| d.first_sample);
-    found
-}
-
-/// The indices of the rows of a log of `len` rows that `dropouts` leave.
-pub fn kept_rows(len: usize, dropouts: &[LogDropout]) -> Vec<usize> {
-    let mut keep = vec![true; len];
-    for d in dropouts {
-        for k in keep.iter_mut().skip(d.first_sample).take(d.samples) {
-            *k = false;
-        }
-    }
-    (0..len).filter(|&i| keep[i]).collect()
-}
-
-/// `rec` without the rows of `dropouts` (a row in several is removed once).
-pub fn without_dropouts(rec: &Recording, dropouts: &[LogDropout]) -> Result<Recording> {
-    if dropouts.is_empty() {
-        return Ok(rec.clone());
-    }
-    let n = rec.n;
-    let keep = kept_rows(rec.len(), dropouts);
-    let rows = |x: &[f64]| -> Vec<f64> {
-        keep.iter()
-            .flat_map(|&i| x[i * n..(i + 1) * n].iter().copied())
-            .collect()
-    };
-    let out = Recording::new(
-        rec.name.clone(),
-        n,
-        keep.iter().map(|&i| rec.t[i]).collect(),
-        rows(&rec.q),
-        rows(&rec.tau),
-        rec.qd.as_deref().map(rows),
-        rec.qdd.as_deref().map(rows),
-    )?;
-    Ok(Recording {
-        experiment: rec.experiment.clone(),
-        glitches: rec.glitches.clone(),
-        dropouts: dropouts.to_vec(),
-        ..out
-    })
 }
 
 /// How many glitches a warning lists before "and N more".
-const LISTED: usize = 5;
+pub(crate) const LISTED: usize = 5;
 
 /// What [`warning`] says the glitches were replaced before, for a whole log.
 pub const BEFORE_PREPROCESSING: &str = "before preprocessing";
@@ -683,12 +596,6 @@ pub fn warning(
     if found.is_empty() {
         return None;
     }
-    let unit = |s: &str| match s {
-        "q" => "rad",
-        "qd" => "rad/s",
-        "qdd" => "rad/s^2",
-        _ => "N m",
-    };
     // a held reading is listed once, by its first sample
     let first_of_run = |g: &LogGlitch| {
         g.held.is_none()
@@ -703,9 +610,7 @@ pub fn warning(
         .iter()
         .take(LISTED)
         .map(|g| {
-            let joint = joint_names
-                .get(g.joint)
-                .map_or_else(|| format!("joint {}", g.joint + 1), |j| format!("'{j}'"));
+            let joint = joint_called(joint_names, g.joint);
             let off = g
                 .noise_levels
                 .map_or("off beyond any scale".to_string(), |z| {
@@ -757,35 +662,6 @@ pub fn warning(
     Some(format!(
         "log '{recording}': {} were taken for glitches of the log and replaced by that fit {before}: {}",
         kinds.join(", and "),
-        listed.join("; ")
-    ))
-}
-
-/// What [`dropout_warning`] says became of the rows removed before preprocessing.
-pub const BRIDGED_BY_PREPROCESSING: &str = "before preprocessing, which bridges them as it bridges irregular sampling (a stretch longer than 20 median sample intervals is a gap)";
-
-/// The warning that tells of the `dropouts` removed from the log `recording` (None for none);
-/// `removed` says when and with what consequence (such as [`BRIDGED_BY_PREPROCESSING`]).
-pub fn dropout_warning(dropouts: &[LogDropout], recording: &str, removed: &str) -> Option<String> {
-    if dropouts.is_empty() {
-        return None;
-    }
-    let mut listed: Vec<String> = dropouts
-        .iter()
-        .take(LISTED)
-        .map(|d| {
-            format!(
-                "{} rows from sample {} (t = {:.4} s to {:.4} s) read 0 for every joint's {}",
-                d.samples, d.first_sample, d.from, d.to, d.signal
-            )
-        })
-        .collect();
-    if dropouts.len() > LISTED {
-        listed.push(format!("and {} more", dropouts.len() - LISTED));
-    }
-    Some(format!(
-        "log '{recording}': {} dropout(s), rows in which every joint of a signal reads exactly 0 while the robot moves (a lost message logged as zeros), were removed {removed}: {}",
-        dropouts.len(),
         listed.join("; ")
     ))
 }

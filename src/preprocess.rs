@@ -89,20 +89,16 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
         check_gaps(rec)?;
     }
     let (screened, glitches) = crate::log_screening::screen_recording(rec)?;
-    let dropouts = crate::log_screening::find_dropouts(&screened);
-    let kept = crate::log_screening::without_dropouts(&screened, &dropouts)?;
-    let out = preprocess_screened(&kept, options, &steps).map_err(|e| match e {
-        Error::Recording { recording, message } if !dropouts.is_empty() => Error::Recording {
-            recording,
-            message: format!(
-                "{message} (after removing {} dropout(s), rows that read 0 for every joint of a signal, the first {} rows from t = {:.6} s)",
-                dropouts.len(),
-                dropouts[0].samples,
-                dropouts[0].from
-            ),
-        },
-        other => other,
-    })?;
+    let dropouts = crate::log_dropouts::find_removed_rows(rec, &screened)?;
+    // a glitch in rows removed is not told of: its row is gone
+    let kept_rows = crate::log_dropouts::kept_rows(rec.len(), &dropouts);
+    let glitches: Vec<_> = glitches
+        .into_iter()
+        .filter(|g| kept_rows.binary_search(&g.sample).is_ok())
+        .collect();
+    let kept = crate::log_dropouts::without_dropouts(&screened, &dropouts)?;
+    let out = preprocess_screened(&kept, options, &steps)
+        .map_err(|e| crate::log_dropouts::after_removing(e, &dropouts))?;
     Ok(Recording {
         glitches,
         dropouts,
@@ -275,7 +271,7 @@ fn preprocess_part(
         return Err(Error::Recording {
             recording: rec.name.clone(),
             message: format!(
-                "{:.3} s long; trimming {} s at both ends leaves nothing",
+                "{:.3} s long; trimming {} s at both ends leaves nothing (a shorter trim keeps more: trim, --trim; it drops the low-pass filter's transients at each end)",
                 t1 - t0,
                 o.trim
             ),

@@ -24,8 +24,8 @@ pub struct Recording {
     pub glitches: Vec<crate::log_screening::LogGlitch>,
     /// Runs of rows of the log this recording was preprocessed from in which every joint of a
     /// signal read exactly 0 while the robot moved, removed first
-    /// ([`crate::log_screening::find_dropouts`]); empty for a recording as logged.
-    pub dropouts: Vec<crate::log_screening::LogDropout>,
+    /// ([`crate::log_dropouts::find_dropouts`]); empty for a recording as logged.
+    pub dropouts: Vec<crate::log_dropouts::LogDropout>,
     /// Per joint whose logged positions lie on a grid and whose velocity the preprocessing
     /// derived from them, the noise their rounding leaves in qd and qdd
     /// ([`crate::position_rounding`]); empty for a recording as logged.

@@ -8,44 +8,15 @@
 
 mod common;
 
-use common::{
-    a465_excitation, panda_log, panda_model, refused_on_load, torques_with_friction, Rng,
-};
+use common::{a465_noisy_log, panda_log, panda_model, refused_on_load};
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
 use perturbid_rs::document::Document;
-use perturbid_rs::log_screening::{
-    find_dropouts, screen_recording, warning, LogGlitch, HALF_WINDOW,
-};
+use perturbid_rs::log_dropouts::find_dropouts;
+use perturbid_rs::log_screening::{screen_recording, warning, LogGlitch, HALF_WINDOW};
 use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::robots::a465;
 use perturbid_rs::{Recording, States};
-
-/// The A465 running a 5-harmonic excitation for 12 s at about 1 kHz (irregular steps), with
-/// viscous and Coulomb friction (steps at every velocity reversal), torque noise of 0.03 N m
-/// and positions on a grid of 2^20 counts a revolution.
-fn noisy_log() -> Recording {
-    let model = a465::model("physical").unwrap();
-    let n = 6;
-    let mut rng = Rng(5);
-    let traj = a465_excitation(&mut rng);
-    let mut t = vec![0.0];
-    while *t.last().unwrap() < 12.0 {
-        let last = *t.last().unwrap();
-        t.push(last + rng.uniform(0.0008, 0.0012));
-    }
-    let s = traj.sample(&t);
-    let tau = torques_with_friction(&model, &s, &mut rng, |r| 0.03 * normal(r));
-    let count = 2f64.powi(20) / (2.0 * std::f64::consts::PI);
-    let q = s.q.iter().map(|x| (x * count).round() / count).collect();
-    Recording::new("log", n, t, q, tau, None, None).unwrap()
-}
-
-/// A standard normal draw (Box-Muller).
-fn normal(rng: &mut Rng) -> f64 {
-    let (u, v) = (rng.uniform(1e-12, 1.0), rng.uniform(0.0, 1.0));
-    (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
-}
 
 fn identify(rec: &Recording, screen: bool) -> (Recording, BaseModel) {
     let options = PreprocessOptions {
@@ -98,7 +69,7 @@ fn replaced_near_clean(found: &[LogGlitch], screened: &Recording, clean: &Record
 
 #[test]
 fn a_clean_log_with_velocity_reversals_is_left_alone() {
-    let rec = noisy_log();
+    let rec = a465_noisy_log();
     // the torques step at velocity reversals (Coulomb friction of 0.8 N m, 27 noise levels)
     let reversals = (1..rec.len())
         .filter(|&i| {
@@ -116,7 +87,7 @@ fn a_clean_log_with_velocity_reversals_is_left_alone() {
 
 #[test]
 fn spikes_and_a_row_of_zeros_are_replaced_and_leave_the_parameters_alone() {
-    let clean = noisy_log();
+    let clean = a465_noisy_log();
     let (_, reference) = identify(&clean, true);
     let mut rec = clean.clone();
     let n = 6;
@@ -177,7 +148,7 @@ fn spikes_and_a_row_of_zeros_are_replaced_and_leave_the_parameters_alone() {
 /// the window test, judged as a run against the cubic through the samples either side.
 #[test]
 fn held_readings_of_one_joint_are_replaced() {
-    let clean = noisy_log();
+    let clean = a465_noisy_log();
     let n = 6;
     let (_, reference) = identify(&clean, true);
     let mut rec = clean.clone();
@@ -250,7 +221,7 @@ fn held_readings_of_one_joint_are_replaced() {
 
 #[test]
 fn dropouts_are_removed_and_zeros_at_rest_kept() {
-    let clean = noisy_log();
+    let clean = a465_noisy_log();
     let n = 6;
     let (_, reference) = identify(&clean, true);
     // fifteen rows of torques read as zeros while the robot moves (bridged: under 20 intervals)
@@ -339,7 +310,7 @@ fn dropouts_are_removed_and_zeros_at_rest_kept() {
 /// window (its glitch left out), computed here independently by an SVD solve.
 #[test]
 fn a_glitch_is_replaced_by_the_cubic_through_the_others() {
-    let mut rec = noisy_log();
+    let mut rec = a465_noisy_log();
     let (n, i, j) = (6, 3000, 3);
     rec.tau[i * n + j] -= 20.0;
     let (_, found) = screen_recording(&rec).unwrap();
@@ -364,7 +335,7 @@ fn a_glitch_is_replaced_by_the_cubic_through_the_others() {
 
 #[test]
 fn windows_stop_at_gaps_and_short_stretches_are_not_judged() {
-    let mut rec = noisy_log();
+    let mut rec = a465_noisy_log();
     let n = 6;
     // a gap of 1 s after sample 2000: every later time moves on
     for t in &mut rec.t[2001..] {
@@ -376,7 +347,7 @@ fn windows_stop_at_gaps_and_short_stretches_are_not_judged() {
     assert_eq!(found.len(), 1, "{found:?}");
     assert_eq!((found[0].sample, found[0].joint), (2002, 0));
     // a stretch shorter than a window between two gaps is not judged
-    let mut short = noisy_log();
+    let mut short = a465_noisy_log();
     for t in &mut short.t[2001..] {
         *t += 1.0;
     }
@@ -392,7 +363,7 @@ fn windows_stop_at_gaps_and_short_stretches_are_not_judged() {
 
 #[test]
 fn saved_log_glitches_are_checked_on_load() {
-    let mut rec = noisy_log();
+    let mut rec = a465_noisy_log();
     rec.tau[4000 * 6 + 1] += 50.0;
     for x in &mut rec.tau[7000 * 6..7004 * 6] {
         *x = 0.0;

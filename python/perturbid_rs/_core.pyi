@@ -331,8 +331,11 @@ class Recording:
         held: the length of the held reading it belongs to, or None)."""
     @property
     def dropouts(self) -> list[dict[str, Any]]:
-        """Runs of rows of the log this was preprocessed from removed as dropouts (every joint
-        of a signal read exactly 0 while the robot moved): signal, first_sample, samples, from, to."""
+        """Runs of rows of the log this was preprocessed from that were removed: dropouts (every
+        joint of a signal read exactly 0 while the robot moved) and frozen readings (one joint's
+        column held one value for more than 10 samples while it moved, then jumped back):
+        signal, first_sample, samples, from, to; a frozen reading's also joint (0-based), value
+        (the value held) and noise_levels (how far its end jumped; None beyond any scale)."""
     @property
     def position_rounding(self) -> list[dict[str, Any]]:
         """Per joint whose logged positions lie on a grid and whose velocity was derived from

@@ -173,10 +173,11 @@ impl PreprocessArgs {
         ) {
             eprintln!("perturbid: warning: {w}");
         }
-        if let Some(w) = crate::log_screening::dropout_warning(
+        if let Some(w) = crate::log_dropouts::dropout_warning(
             &rec.dropouts,
             &path.display().to_string(),
-            crate::log_screening::BRIDGED_BY_PREPROCESSING,
+            joints,
+            crate::log_dropouts::BRIDGED_BY_PREPROCESSING,
         ) {
             eprintln!("perturbid: warning: {w}");
         }

@@ -95,10 +95,11 @@ pub struct BaseModel {
     /// such as the command line); empty when none were, or the data came otherwise.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub log_glitches: Vec<crate::log_screening::LogGlitch>,
-    /// Rows of that log removed first as dropouts (every joint of a signal read exactly 0
-    /// while the robot moved; [`crate::log_screening::find_dropouts`]), set likewise.
+    /// Rows of that log removed first: dropouts (every joint of a signal read exactly 0 while
+    /// the robot moved) and frozen readings (one joint's column held one value too long;
+    /// [`crate::log_dropouts::find_removed_rows`]), set likewise.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub log_dropouts: Vec<crate::log_screening::LogDropout>,
+    pub log_dropouts: Vec<crate::log_dropouts::LogDropout>,
     /// The torques of that log that read clipped ([`crate::torque_saturation`]; set likewise):
     /// the fit took them for the robot's, and was warned of them.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -441,7 +442,7 @@ impl Document for BaseModel {
             .log_dropouts
             .iter()
             .enumerate()
-            .find_map(|(i, d)| d.problem().map(|p| (i, p)))
+            .find_map(|(i, d)| d.problem(n).map(|p| (i, p)))
         {
             return Err(invalid(Self::WHAT, format!("log_dropouts[{i}]: {problem}")));
         }

@@ -162,10 +162,10 @@ pub struct Diagnostics {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub glitches: Vec<Glitch>,
     /// Rows of the recordings removed before their windows were read: every joint of a
-    /// signal read exactly 0 while the robot moved ([`crate::log_screening::find_dropouts`];
-    /// each names its experiment).
+    /// signal read exactly 0 while the robot moved, or one joint's column frozen
+    /// ([`crate::log_dropouts::find_removed_rows`]; each names its experiment).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub dropouts: Vec<crate::log_screening::LogDropout>,
+    pub dropouts: Vec<crate::log_dropouts::LogDropout>,
     /// Samples of the recordings replaced before their windows were read: one joint's reading
     /// held (a run of one repeated value while it moved, off the curve either side; see
     /// [`crate::log_screening::screen_held_readings`]; each names its experiment).

@@ -360,58 +360,11 @@ pub fn identify_local(
                 ),
             });
         }
-        // one joint's held readings (a lost message logged as its last value or zeros) are
-        // replaced, and rows of zeros while the robot moves removed, before the windows are
-        // read; the samples the diagnostics name are counted in the recording as logged
-        let clipped = crate::torque_saturation::find_torque_saturation(r);
-        let (repaired, held) = crate::log_screening::screen_held_readings(r)?;
-        if let Some(w) = crate::log_screening::warning(
-            &held,
-            &r.name,
-            &plan.joint_names,
-            "before the crossing windows were read",
-        ) {
-            dropout_warnings.push(format!("experiment '{}': {w}", e.kind.name()));
-        }
-        held_readings.extend(held.into_iter().map(|g| crate::log_screening::LogGlitch {
-            experiment: Some(e.kind.name().to_string()),
-            ..g
-        }));
-        let r = &repaired;
-        let found = crate::log_screening::find_dropouts(r);
-        let v = if found.is_empty() {
-            experiment_values(e, r, &plan.joint_names, options)?
-        } else {
-            let kept = crate::log_screening::without_dropouts(r, &found)?;
-            let mut v = experiment_values(e, &kept, &plan.joint_names, options)?;
-            let rows = crate::log_screening::kept_rows(r.len(), &found);
-            for c in v.crossings.iter_mut().chain(v.reference.iter_mut()) {
-                for g in &mut c.glitches {
-                    g.sample = rows[g.sample];
-                }
-            }
-            v
-        };
-        let times: Vec<f64> = v.crossings.iter().map(|c| c.time).collect();
-        if let Some(w) = crate::torque_saturation::crossing_warning(
-            &clipped,
-            &times,
-            e.window,
-            &plan.joint_names,
-        ) {
-            dropout_warnings.push(format!("experiment '{}': {w}", e.kind.name()));
-        }
-        if let Some(w) = crate::log_screening::dropout_warning(
-            &found,
-            &r.name,
-            "before the crossing windows were read (their fits use the samples left)",
-        ) {
-            dropout_warnings.push(format!("experiment '{}': {w}", e.kind.name()));
-        }
-        dropouts.extend(found.into_iter().map(|d| crate::log_screening::LogDropout {
-            experiment: Some(e.kind.name().to_string()),
-            ..d
-        }));
+        let read = super::repaired_recording::read_experiment(e, r, &plan.joint_names, options)?;
+        dropout_warnings.extend(read.warnings);
+        held_readings.extend(read.held);
+        dropouts.extend(read.dropouts);
+        let v = read.values;
         values.push(v);
         recording_names.push(r.name.clone());
     }

@@ -54,6 +54,7 @@ pub mod predicted_response;
 pub(crate) mod prediction_uncertainty;
 pub mod quantisation;
 pub mod reach;
+mod repaired_recording;
 pub mod response;
 pub mod reversals;
 pub mod rounded_positions;

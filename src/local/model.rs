@@ -468,12 +468,14 @@ impl Document for LocalModel {
             check_magnitude(Self::WHAT, &format!("{what}.stderr"), t.stderr, false)?;
         }
         for (i, d) in m.diagnostics.dropouts.iter().enumerate() {
-            let problem = d.problem().or_else(|| match &d.experiment {
-                Some(e) if super::ExperimentKind::ALL.iter().any(|k| k.name() == e) => None,
-                other => Some(format!(
-                    "experiment {other:?} is not one of the plan's experiments"
-                )),
-            });
+            let problem = d
+                .problem(m.joint_names.len())
+                .or_else(|| match &d.experiment {
+                    Some(e) if super::ExperimentKind::ALL.iter().any(|k| k.name() == e) => None,
+                    other => Some(format!(
+                        "experiment {other:?} is not one of the plan's experiments"
+                    )),
+                });
             if let Some(p) = problem {
                 return Err(bad(format!("diagnostics.dropouts[{i}]: {p}")));
             }

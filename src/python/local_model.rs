@@ -88,9 +88,10 @@ impl PyLocalModel {
     /// times the spread of the window's values),
     /// `replaced` (True: an isolated glitch replaced by that fit; False: kept, one of more than
     /// 3 in its window)), `dropouts` (list of dicts: `experiment`, `signal`, `first_sample`
-    /// (0-based row of its recording), `samples`, `from`, `to` (s): rows in which every joint
-    /// of a signal read exactly 0 while the robot moved, removed before the windows were
-    /// read), `held_readings` (list of dicts: `experiment` and the keys of
+    /// (0-based row of its recording), `samples`, `from`, `to` (s), and for a frozen reading
+    /// `joint`, `value`, `noise_levels`: rows in which every joint of a signal read exactly 0
+    /// while the robot moved, or one joint's column held one value for more than 10 samples
+    /// and then jumped back, removed before the windows were read), `held_readings` (list of dicts: `experiment` and the keys of
     /// `Recording.glitches`: samples of one joint's reading held while it moved, replaced
     /// before the windows were read), `torque_offsets` (list of dicts: `experiment` ('D', 'G'
     /// or 'G_static'), `joint`, `offset` (N m) and `stderr` (N m): torques that do not return

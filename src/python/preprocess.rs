@@ -64,10 +64,11 @@ pub(crate) fn preprocess(
             &[],
             crate::log_screening::BEFORE_PREPROCESSING,
         ),
-        crate::log_screening::dropout_warning(
+        crate::log_dropouts::dropout_warning(
             &out.dropouts,
             name,
-            crate::log_screening::BRIDGED_BY_PREPROCESSING,
+            &[],
+            crate::log_dropouts::BRIDGED_BY_PREPROCESSING,
         ),
         crate::position_rounding::warning(&out.position_rounding, &[])
             .map(|w| format!("{name}: {w}{}", crate::position_rounding::IN_A_FIT)),

@@ -44,7 +44,7 @@ pub(crate) fn glitch_dict<'py>(
 
 pub(crate) fn dropout_dict<'py>(
     py: Python<'py>,
-    d: &crate::log_screening::LogDropout,
+    d: &crate::log_dropouts::LogDropout,
 ) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
     let e = pyo3::types::PyDict::new(py);
     if let Some(x) = &d.experiment {
@@ -55,6 +55,11 @@ pub(crate) fn dropout_dict<'py>(
     e.set_item("samples", d.samples)?;
     e.set_item("from", d.from)?;
     e.set_item("to", d.to)?;
+    if let Some(j) = d.joint {
+        e.set_item("joint", j)?;
+        e.set_item("value", d.value)?;
+        e.set_item("noise_levels", d.noise_levels)?;
+    }
     Ok(e)
 }
 
@@ -252,10 +257,13 @@ impl PyRecording {
             .map(|g| glitch_dict(py, g))
             .collect()
     }
-    /// The runs of rows of the log this recording was preprocessed from that were removed as
-    /// dropouts (every joint of a signal read exactly 0 while the robot moved): a list of
-    /// dicts `signal`, `first_sample` (0-based row of the log), `samples` (rows), `from`, `to`
-    /// (s). Empty for a recording as logged.
+    /// The runs of rows of the log this recording was preprocessed from that were removed:
+    /// dropouts (every joint of a signal read exactly 0 while the robot moved) and frozen
+    /// readings (one joint's column held one value for more than 10 samples while it moved,
+    /// then jumped back). A list of dicts `signal`, `first_sample` (0-based row of the log),
+    /// `samples` (rows), `from`, `to` (s); a frozen reading's also `joint` (0-based column
+    /// index), `value` (the value held, in the signal's unit) and `noise_levels` (how far its
+    /// end jumped; None beyond any scale). Empty for a recording as logged.
     #[getter]
     fn dropouts<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, pyo3::types::PyDict>>> {
         self.rec

@@ -528,3 +528,29 @@ pub fn torques(
         })
         .collect()
 }
+
+/// The A465 running a 5-harmonic excitation for 12 s at about 1 kHz (irregular steps), with
+/// viscous and Coulomb friction (steps at every velocity reversal), torque noise of 0.03 N m
+/// and positions on a grid of 2^20 counts a revolution.
+pub fn a465_noisy_log() -> perturbid_rs::Recording {
+    let model = perturbid_rs::robots::a465::model("physical").unwrap();
+    let n = 6;
+    let mut rng = Rng(5);
+    let traj = a465_excitation(&mut rng);
+    let mut t = vec![0.0];
+    while *t.last().unwrap() < 12.0 {
+        let last = *t.last().unwrap();
+        t.push(last + rng.uniform(0.0008, 0.0012));
+    }
+    let s = traj.sample(&t);
+    let tau = torques_with_friction(&model, &s, &mut rng, |r| 0.03 * normal(r));
+    let count = 2f64.powi(20) / (2.0 * std::f64::consts::PI);
+    let q = s.q.iter().map(|x| (x * count).round() / count).collect();
+    perturbid_rs::Recording::new("log", n, t, q, tau, None, None).unwrap()
+}
+
+/// A standard normal draw (Box-Muller).
+pub fn normal(rng: &mut Rng) -> f64 {
+    let (u, v) = (rng.uniform(1e-12, 1.0), rng.uniform(0.0, 1.0));
+    (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
+}

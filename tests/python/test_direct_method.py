@@ -709,7 +709,8 @@ def test_preprocess_replaces_a_logs_glitches_and_says_so():
     PerturbidWarning names them, the result's glitches list them, and the preprocessed
     signals equal those of the clean log to well within the noise-free filter's output;
     screen_glitches=False keeps them (and the spike then shows in the filtered torque). Rows
-    of zero torques while the robot moves are removed as a dropout, and listed."""
+    of zero torques while the robot moves are removed as a dropout, and one joint's position
+    frozen for 15 rows as a frozen reading; both are listed."""
     rng = np.random.default_rng(3)
     t = np.cumsum(rng.uniform(0.0008, 0.0012, 8000))
     q = np.stack([0.3 * np.sin(2 * np.pi * 0.2 * t + k) for k in range(3)], axis=1)
@@ -750,6 +751,18 @@ def test_preprocess_replaces_a_logs_glitches_and_says_so():
     assert [(g["joint"], g["sample"], g["held"]) for g in repaired.glitches] == [(0, i, 6) for i in range(3000, 3006)]
     assert all(g["held"] is None for g in screened.glitches)
     assert np.max(np.abs(repaired.tau - clean.tau)) < 0.01
+    # one joint's position frozen for 15 rows while it moves (a stalled stream): the rows are
+    # removed as a frozen reading, listed with its joint, the value held and its end's jump
+    stalled = q.copy()
+    stalled[2000:2015, 1] = q[2000, 1]
+    with pytest.warns(pr.PerturbidWarning, match=r"1 frozen reading\(s\).*q of joint 2 held .* for 15 rows from sample 2000"):
+        removed = pr.preprocess(t, stalled, tau, name="stalled")
+    [d] = removed.dropouts
+    assert (d["signal"], d["joint"], d["first_sample"], d["samples"]) == ("q", 1, 2000, 15)
+    assert d["value"] == q[2000, 1] and d["noise_levels"] > 10
+    assert "joint" not in bridged.dropouts[0]
+    assert removed.glitches == []
+    assert np.max(np.abs(removed.q - clean.q)) < 1e-4
 
 
 def test_positions_in_coarse_counts_under_derived_velocities_are_warned_of():

@@ -459,6 +459,28 @@ def test_a_glitch_in_a_log_is_replaced_and_reported():
         ("D", "tau", 1, s, 6) for s in range(first, first + 6)
     ]
     np.testing.assert_allclose(model.D, clean.D, atol=0.2 * np.max(clean.stderr["D"]))
+    # one joint's position frozen for 15 rows in a D window (a stalled encoder stream): a
+    # frozen reading, its rows removed before the windows are read; across a window's centre
+    # they leave it too few samples, and the error says what was removed
+    def stall(at: float) -> tuple[list, int]:
+        out, first = [], -1
+        for r in recs:
+            q = r.q.copy()
+            if r.experiment == "D":
+                first = int(np.searchsorted(r.t, at))
+                q[first : first + 15, 1] = q[first, 1]
+            out.append(pr.Recording(r.t, q, r.tau, name=r.name, experiment=r.experiment))
+        return out, first
+
+    stalled, first = stall(d.crossing_times[1] + 0.004)
+    with pytest.warns(pr.PerturbidWarning, match="experiment 'D'.*1 frozen reading.*q of 'joint2' held"):
+        model = pr.identify_local(plan, stalled)
+    (frozen,) = model.diagnostics["dropouts"]
+    assert (frozen["experiment"], frozen["signal"], frozen["joint"], frozen["first_sample"], frozen["samples"]) == ("D", "q", 1, first, 15)
+    np.testing.assert_allclose(model.D, clean.D, atol=0.2 * np.max(clean.stderr["D"]))
+    across, _ = stall(d.crossing_times[1] - 0.007)
+    with pytest.raises(pr.InputError, match=r"crossing 1 .* need at least .*after removing 1 frozen reading\(s\)"):
+        pr.identify_local(plan, across)
 
 
 def test_the_torque_noise_is_reported_per_experiment_and_joint():

@@ -1,0 +1,93 @@
+//! One experiment's recording made ready for its crossing windows: one joint's held readings
+//! (a lost message logged as its last value or zeros) replaced, rows of zeros and frozen
+//! readings while the robot moves removed ([`crate::log_dropouts`]), clipped torques found in
+//! the recording as logged, and each told of in warnings that name the experiment. The samples
+//! the diagnostics name are counted in the recording as logged.
+
+use super::identify::{experiment_values, ExperimentValues, IdentifyOptions};
+use super::plan::Experiment;
+use crate::error::Result;
+use crate::log_dropouts::LogDropout;
+use crate::log_screening::LogGlitch;
+use crate::recording::Recording;
+
+/// An experiment's recording read: its values, what was repaired or removed (each naming the
+/// experiment), and the warnings that tell of it.
+pub(super) struct ReadExperiment {
+    pub values: ExperimentValues,
+    pub dropouts: Vec<LogDropout>,
+    pub held: Vec<LogGlitch>,
+    pub warnings: Vec<String>,
+}
+
+/// The values of experiment `e` from its recording `r` (joints named `joint_names`), read as
+/// [`experiment_values`] reads them after the repairs of the module documentation. Errors:
+/// those of the screening and of [`experiment_values`] (where rows were removed, the error
+/// says which: a window may be short of samples for the removal).
+pub(super) fn read_experiment(
+    e: &Experiment,
+    r: &Recording,
+    joint_names: &[String],
+    options: &IdentifyOptions,
+) -> Result<ReadExperiment> {
+    let name = e.kind.name();
+    let mut warnings = vec![];
+    let clipped = crate::torque_saturation::find_torque_saturation(r);
+    let (repaired, held) = crate::log_screening::screen_held_readings(r)?;
+    if let Some(w) = crate::log_screening::warning(
+        &held,
+        &r.name,
+        joint_names,
+        "before the crossing windows were read",
+    ) {
+        warnings.push(format!("experiment '{name}': {w}"));
+    }
+    let found = crate::log_dropouts::find_removed_rows(r, &repaired)?;
+    let values = if found.is_empty() {
+        experiment_values(e, &repaired, joint_names, options)?
+    } else {
+        let kept = crate::log_dropouts::without_dropouts(&repaired, &found)?;
+        let mut v = experiment_values(e, &kept, joint_names, options)
+            .map_err(|error| crate::log_dropouts::after_removing(error, &found))?;
+        let rows = crate::log_dropouts::kept_rows(repaired.len(), &found);
+        for c in v.crossings.iter_mut().chain(v.reference.iter_mut()) {
+            for g in &mut c.glitches {
+                g.sample = rows[g.sample];
+            }
+        }
+        v
+    };
+    let times: Vec<f64> = values.crossings.iter().map(|c| c.time).collect();
+    if let Some(w) =
+        crate::torque_saturation::crossing_warning(&clipped, &times, e.window, joint_names)
+    {
+        warnings.push(format!("experiment '{name}': {w}"));
+    }
+    if let Some(w) = crate::log_dropouts::dropout_warning(
+        &found,
+        &r.name,
+        joint_names,
+        "before the crossing windows were read (their fits use the samples left)",
+    ) {
+        warnings.push(format!("experiment '{name}': {w}"));
+    }
+    let of_experiment = Some(name.to_string());
+    Ok(ReadExperiment {
+        values,
+        dropouts: found
+            .into_iter()
+            .map(|d| LogDropout {
+                experiment: of_experiment.clone(),
+                ..d
+            })
+            .collect(),
+        held: held
+            .into_iter()
+            .map(|g| LogGlitch {
+                experiment: of_experiment.clone(),
+                ..g
+            })
+            .collect(),
+        warnings,
+    })
+}

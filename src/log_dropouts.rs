@@ -1,0 +1,302 @@
+//! Rows removed from a log before preprocessing: runs of rows in which every joint of one
+//! signal reads exactly 0 while the robot moves (a lost message logged as zeros: a dropout),
+//! and runs in which one joint's reading holds one value too long to be replaced
+//! ([`crate::frozen_readings`]). What was logged there is not known, so the rows go; the
+//! preprocessing bridges them as it bridges irregular sampling, and a crossing window's fit
+//! uses the samples left.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::frozen_readings::MIN_FROZEN;
+use crate::log_screening::{signals, LISTED, SIGNALS};
+use crate::outliers::NOISE_LEVELS;
+use crate::recording::Recording;
+
+/// The fewest rows a dropout has: a single row read as zeros is judged by the glitch screening
+/// like any other sample.
+pub const MIN_DROPOUT: usize = 2;
+
+/// A run of rows of a log removed before preprocessing: rows in which every joint of one
+/// signal reads exactly 0 while the robot moves (a lost message logged as zeros; `joint` is
+/// None), or a frozen reading, in which one joint's column holds one value for more than
+/// [`MAX_HELD`](crate::log_screening::MAX_HELD) samples while the joint moves and then jumps
+/// back to the signal (`joint`, `value` and `noise_levels` say which, what and how far:
+/// [`crate::frozen_readings`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LogDropout {
+    /// The signal read as zeros, or frozen: `q`, `qd`, `qdd` or `tau`.
+    pub signal: String,
+    /// Index of its first row in the log (0-based: data row `first_sample + 1` of a CSV file).
+    pub first_sample: usize,
+    /// How many rows (at least [`MIN_DROPOUT`]; for a frozen reading, at least
+    /// [`MIN_FROZEN`]).
+    pub samples: usize,
+    /// Times of its first and last rows (s).
+    pub from: f64,
+    pub to: f64,
+    /// The experiment of a plan whose recording had it (local identification); absent for a
+    /// log preprocessed on its own.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub experiment: Option<String>,
+    /// A frozen reading's joint (0-based, in the recording's column order); absent for rows
+    /// of zeros in every joint.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint: Option<usize>,
+    /// The value a frozen reading holds (the signal's unit: rad, rad/s, rad/s^2 or N m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub value: Option<f64>,
+    /// How far a frozen reading's last sample is off the signal after it, in noise levels
+    /// (absent for rows of zeros, and for a jump beyond any scale).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise_levels: Option<f64>,
+}
+
+impl LogDropout {
+    /// What is wrong with a dropout read from a file, if anything: an unknown signal, fewer
+    /// than [`MIN_DROPOUT`] rows (a frozen reading: [`MIN_FROZEN`]), times not finite and in
+    /// order, a frozen reading's value not finite or its noise levels not beyond
+    /// [`NOISE_LEVELS`] or its joint not one of the `n`, or those given for rows of zeros.
+    pub fn problem(&self, n: usize) -> Option<String> {
+        if !SIGNALS.contains(&self.signal.as_str()) {
+            return Some(format!(
+                "signal '{}' is not one of q, qd, qdd, tau",
+                self.signal
+            ));
+        }
+        let fewest = if self.joint.is_some() {
+            MIN_FROZEN
+        } else {
+            MIN_DROPOUT
+        };
+        if self.samples < fewest {
+            return Some(format!(
+                "{} samples; {} has at least {fewest}",
+                self.samples,
+                self.what()
+            ));
+        }
+        match (self.joint, self.value, self.noise_levels) {
+            (None, None, None) => {}
+            (None, ..) => {
+                return Some("value and noise_levels belong to a frozen reading, which names its joint".into())
+            }
+            (Some(j), _, _) if j >= n => {
+                return Some(format!("joint {j}: expected a joint index below {n}"))
+            }
+            (Some(_), Some(v), z) if v.is_finite() && z.is_none_or(|z| z > NOISE_LEVELS) => {}
+            (Some(_), ..) => {
+                return Some(format!(
+                    "a frozen reading holds a finite value and is more than {NOISE_LEVELS} noise levels off (or beyond any scale: noise_levels absent)"
+                ))
+            }
+        }
+        if !(self.from.is_finite() && self.to.is_finite() && self.from <= self.to) {
+            return Some("from and to must be finite times, from <= to".into());
+        }
+        None
+    }
+
+    /// What it is, for messages: "a dropout" or "a frozen reading".
+    pub fn what(&self) -> &'static str {
+        if self.joint.is_some() {
+            "a frozen reading"
+        } else {
+            "a dropout"
+        }
+    }
+}
+
+/// The dropouts of `rec`: runs of at least [`MIN_DROPOUT`] rows in which every joint of a
+/// signal reads exactly 0, with a row on either side in which some joint of it does not. For
+/// `qd`, `qdd` and `tau` the positions must change within the run (from its first row to its
+/// last): a robot holding a posture reads zero velocities and accelerations, and with no
+/// gravity may read zero torques. In log order.
+pub fn find_dropouts(rec: &Recording) -> Vec<LogDropout> {
+    let n = rec.n;
+    let k = rec.len();
+    let mut found = vec![];
+    for (signal, values) in signals(rec) {
+        let zero = |i: usize| values[i * n..(i + 1) * n].iter().all(|&x| x == 0.0);
+        let mut i = 1;
+        while i < k {
+            if !zero(i) {
+                i += 1;
+                continue;
+            }
+            let a = i;
+            while i < k && zero(i) {
+                i += 1;
+            }
+            // rows a..i read zeros; a - 1 does not (a >= 1 and the run starts there)
+            if i == k || zero(a - 1) || i - a < MIN_DROPOUT {
+                continue;
+            }
+            // the robot moves during the run: its positions change from its first row to its
+            // last (a hold between two postures reads zero velocities and accelerations)
+            let moves = signal == "q" || rec.q[a * n..(a + 1) * n] != rec.q[(i - 1) * n..i * n];
+            if moves {
+                found.push(LogDropout {
+                    signal: signal.to_string(),
+                    first_sample: a,
+                    samples: i - a,
+                    from: rec.t[a],
+                    to: rec.t[i - 1],
+                    experiment: None,
+                    joint: None,
+                    value: None,
+                    noise_levels: None,
+                });
+            }
+        }
+    }
+    found.sort_by_key(|d| d.first_sample);
+    found
+}
+
+/// The rows to remove from a log before preprocessing: the frozen readings of `logged` (the
+/// log as logged: [`crate::frozen_readings::find_frozen_readings`]) and the dropouts of
+/// `screened` (the same log with its glitches or held readings replaced: [`find_dropouts`]),
+/// in log order. A frozen reading within a dropout of its signal (zeros held by every joint)
+/// is told of as the dropout.
+///
+/// Errors: those of [`crate::frozen_readings::find_frozen_readings`].
+pub fn find_removed_rows(logged: &Recording, screened: &Recording) -> Result<Vec<LogDropout>> {
+    let dropouts = find_dropouts(screened);
+    let mut rows: Vec<LogDropout> = crate::frozen_readings::find_frozen_readings(logged)?
+        .into_iter()
+        .filter(|f| {
+            !dropouts.iter().any(|d| {
+                d.signal == f.signal
+                    && d.first_sample <= f.first_sample
+                    && f.first_sample + f.samples <= d.first_sample + d.samples
+            })
+        })
+        .collect();
+    rows.extend(dropouts);
+    rows.sort_by_key(|d| d.first_sample);
+    Ok(rows)
+}
+
+/// `error` (a recording's, from the rows left after `removed`'s were removed) with what was
+/// removed appended: a gap or a window short of samples may be of the removal's making. Other
+/// errors, and any where nothing was removed, are returned as they are.
+pub fn after_removing(error: Error, removed: &[LogDropout]) -> Error {
+    match (error, removed.first()) {
+        (Error::Recording { recording, message }, Some(first)) => {
+            let frozen = removed.iter().filter(|d| d.joint.is_some()).count();
+            let zeros = removed.len() - frozen;
+            let mut what = vec![];
+            if zeros > 0 {
+                what.push(format!(
+                    "{zeros} dropout(s), rows that read 0 for every joint of a signal"
+                ));
+            }
+            if frozen > 0 {
+                what.push(format!(
+                    "{frozen} frozen reading(s), rows in which a joint's column held one value"
+                ));
+            }
+            Error::Recording {
+                recording,
+                message: format!(
+                    "{message} (after removing {}, the first {} rows from t = {:.6} s)",
+                    what.join(", and "),
+                    first.samples,
+                    first.from
+                ),
+            }
+        }
+        (other, _) => other,
+    }
+}
+
+/// The indices of the rows of a log of `len` rows that `dropouts` leave.
+pub fn kept_rows(len: usize, dropouts: &[LogDropout]) -> Vec<usize> {
+    let mut keep = vec![true; len];
+    for d in dropouts {
+        for k in keep.iter_mut().skip(d.first_sample).take(d.samples) {
+            *k = false;
+        }
+    }
+    (0..len).filter(|&i| keep[i]).collect()
+}
+
+/// `rec` without the rows of `dropouts` (a row in several is removed once).
+pub fn without_dropouts(rec: &Recording, dropouts: &[LogDropout]) -> Result<Recording> {
+    if dropouts.is_empty() {
+        return Ok(rec.clone());
+    }
+    let n = rec.n;
+    let keep = kept_rows(rec.len(), dropouts);
+    let rows = |x: &[f64]| -> Vec<f64> {
+        keep.iter()
+            .flat_map(|&i| x[i * n..(i + 1) * n].iter().copied())
+            .collect()
+    };
+    let out = Recording::new(
+        rec.name.clone(),
+        n,
+        keep.iter().map(|&i| rec.t[i]).collect(),
+        rows(&rec.q),
+        rows(&rec.tau),
+        rec.qd.as_deref().map(rows),
+        rec.qdd.as_deref().map(rows),
+    )?;
+    Ok(Recording {
+        experiment: rec.experiment.clone(),
+        glitches: rec.glitches.clone(),
+        dropouts: dropouts.to_vec(),
+        ..out
+    })
+}
+
+/// What [`dropout_warning`] says became of the rows removed before preprocessing.
+pub const BRIDGED_BY_PREPROCESSING: &str = "before preprocessing, which bridges them as it bridges irregular sampling (a stretch longer than 20 median sample intervals is a gap)";
+
+/// The warning that tells of the `dropouts` removed from the log `recording` (None for none):
+/// rows of zeros, and frozen readings ([`crate::frozen_readings::describe`]); `removed` says
+/// when and with what consequence (such as [`BRIDGED_BY_PREPROCESSING`]); `joint_names` name
+/// the joints by index (where it has none, `joint 3` names index 2).
+pub fn dropout_warning(
+    dropouts: &[LogDropout],
+    recording: &str,
+    joint_names: &[String],
+    removed: &str,
+) -> Option<String> {
+    let (frozen, zeros): (Vec<&LogDropout>, Vec<&LogDropout>) =
+        dropouts.iter().partition(|d| d.joint.is_some());
+    let mut parts = vec![];
+    if !zeros.is_empty() {
+        let mut listed: Vec<String> = zeros
+            .iter()
+            .take(LISTED)
+            .map(|d| {
+                format!(
+                    "{} rows from sample {} (t = {:.4} s to {:.4} s) read 0 for every joint's {}",
+                    d.samples, d.first_sample, d.from, d.to, d.signal
+                )
+            })
+            .collect();
+        if zeros.len() > LISTED {
+            listed.push(format!("and {} more", zeros.len() - LISTED));
+        }
+        parts.push(format!(
+            "{} dropout(s), rows in which every joint of a signal reads exactly 0 while the robot moves (a lost message logged as zeros), were removed {removed}: {}",
+            zeros.len(),
+            listed.join("; ")
+        ));
+    }
+    if !frozen.is_empty() {
+        parts.push(crate::frozen_readings::describe(
+            &frozen,
+            joint_names,
+            removed,
+        ));
+    }
+    if parts.is_empty() {
+        return None;
+    }
+    Some(format!("log '{recording}': {}", parts.join("; and ")))
+}
