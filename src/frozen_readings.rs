@@ -39,7 +39,7 @@
 use crate::error::{Error, Result};
 use crate::log_dropouts::LogDropout;
 use crate::log_screening::{
-    candidates, end_jump, floors, joint_called, median, segments, signals, unit, LISTED, MAX_HELD,
+    column_floor, end_jump, joint_called, median, segments, signals, unit, LISTED, MAX_HELD,
 };
 use crate::outliers::NOISE_LEVELS;
 use crate::recording::Recording;
@@ -66,7 +66,7 @@ pub fn find_frozen_readings(rec: &Recording) -> Result<Vec<LogDropout>> {
         let t = &rec.t[a..b];
         let column =
             |values: &[f64], j: usize| -> Vec<f64> { (a..b).map(|i| values[i * n + j]).collect() };
-        let floor = |y: &Vec<f64>| floors(t, std::slice::from_ref(y), &[candidates(t, y)])[0];
+        let floor = |y: &Vec<f64>| column_floor(t, y);
         // each joint's position floor, computed where a run asks for it
         let mut position_floor: Vec<Option<f64>> = vec![None; n];
         for &(signal, values) in &all {

@@ -20,6 +20,7 @@ mod choice;
 pub mod cli;
 pub mod data;
 pub mod decomposition;
+pub mod derivative_columns;
 pub mod direct;
 pub mod document;
 pub mod error;
@@ -56,7 +57,6 @@ pub mod torque_saturation;
 pub mod trajectory;
 pub mod urdf;
 pub mod validation;
-pub mod velocity_columns;
 
 #[cfg(feature = "python")]
 mod python;

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::frozen_readings::MIN_FROZEN;
-use crate::log_screening::{signals, LISTED, SIGNALS};
+use crate::log_screening::{column_floor, signals, LISTED, SIGNALS};
 use crate::outliers::NOISE_LEVELS;
 use crate::recording::Recording;
 
@@ -111,12 +111,15 @@ impl LogDropout {
 /// The dropouts of `rec`: runs of at least [`MIN_DROPOUT`] rows in which every joint of a
 /// signal reads exactly 0, with a row on either side in which some joint of it does not. For
 /// `qd`, `qdd` and `tau` the positions must change within the run (from its first row to its
-/// last): a robot holding a posture reads zero velocities and accelerations, and with no
+/// last, some joint's by more than [`NOISE_LEVELS`] noise levels of its column): a robot holding
+/// a posture reads zero velocities and accelerations (and noisy positions), and with no
 /// gravity may read zero torques. In log order.
 pub fn find_dropouts(rec: &Recording) -> Vec<LogDropout> {
     let n = rec.n;
     let k = rec.len();
     let mut found = vec![];
+    // each joint's position noise floor, computed where a run asks for it
+    let mut position_floors: Option<Vec<f64>> = None;
     for (signal, values) in signals(rec) {
         let zero = |i: usize| values[i * n..(i + 1) * n].iter().all(|&x| x == 0.0);
         let mut i = 1;
@@ -133,9 +136,22 @@ pub fn find_dropouts(rec: &Recording) -> Vec<LogDropout> {
             if i == k || zero(a - 1) || i - a < MIN_DROPOUT {
                 continue;
             }
-            // the robot moves during the run: its positions change from its first row to its
-            // last (a hold between two postures reads zero velocities and accelerations)
-            let moves = signal == "q" || rec.q[a * n..(a + 1) * n] != rec.q[(i - 1) * n..i * n];
+            // the robot moves during the run: some joint's position changes from its first row
+            // to its last by more than 10 noise levels of its column (a hold between two
+            // postures reads zero velocities and accelerations, and noisy positions)
+            let moves = signal == "q" || {
+                let floors = position_floors.get_or_insert_with(|| {
+                    (0..n)
+                        .map(|j| {
+                            let y: Vec<f64> = (0..k).map(|r| rec.q[r * n + j]).collect();
+                            column_floor(&rec.t, &y)
+                        })
+                        .collect()
+                });
+                (0..n).any(|j| {
+                    (rec.q[(i - 1) * n + j] - rec.q[a * n + j]).abs() > NOISE_LEVELS * floors[j]
+                })
+            };
             if moves {
                 found.push(LogDropout {
                     signal: signal.to_string(),

@@ -381,6 +381,11 @@ pub(crate) fn floors(t: &[f64], columns: &[Vec<f64>], candidate: &[Vec<bool>]) -
         .collect()
 }
 
+/// The floor of one column `y` sampled at `t` ([`floors`], its candidates found first).
+pub(crate) fn column_floor(t: &[f64], y: &[f64]) -> f64 {
+    floors(t, &[y.to_vec()], &[candidates(t, y)])[0]
+}
+
 /// The longest run of exactly repeated readings of one column that is judged as a held
 /// reading: a sensor or logger that wrote its last value again (or zeros) for up to 10 ms at
 /// 1 kHz. Longer runs are not bridged: those that end with a jump are frozen readings, removed

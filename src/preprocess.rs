@@ -288,7 +288,7 @@ fn preprocess_part(
             .iter()
             .map(|v| v[skip..count - skip].to_vec())
             .collect();
-        crate::velocity_columns::check_velocity_columns(&rec.name, &logged, &derived)?;
+        crate::derivative_columns::check_velocity_columns(&rec.name, &logged, &derived)?;
     }
     let keep: Vec<usize> = (skip..count - skip).step_by(o.decimate).collect();
     // positions in coarse counts under velocities derived from them: the noise of their

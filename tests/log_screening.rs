@@ -286,6 +286,15 @@ fn dropouts_are_removed_and_zeros_at_rest_kept() {
     hold.qd = Some(qd);
     assert_ne!(hold.q[6999 * n..7000 * n], hold.q[7010 * n..7011 * n]);
     assert!(find_dropouts(&hold).is_empty());
+    // the same hold read by noisy encoders (1e-5 rad, the whole log): the positions change
+    // within it, by their noise alone
+    let mut noisy = hold.clone();
+    let mut rng = common::Rng(3);
+    for x in &mut noisy.q {
+        *x += 1e-5 * common::normal(&mut rng);
+    }
+    assert_ne!(noisy.q[7000 * n..7001 * n], noisy.q[7009 * n..7010 * n]);
+    assert!(find_dropouts(&noisy).is_empty());
     // a row of zero positions is a dropout of positions; one row alone is no dropout
     let mut q = clean.clone();
     for x in &mut q.q[3000 * n..3002 * n] {

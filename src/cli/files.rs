@@ -148,6 +148,8 @@ impl PreprocessArgs {
             }
         };
         if rec.qdd.is_some() && !self.preprocess {
+            // taken as logged: its velocity and acceleration columns against the derivatives
+            crate::derivative_columns::check_logged_derivatives(&rec)?;
             let rec = crate::recording::Recording {
                 torque_saturation: crate::torque_saturation::find_torque_saturation(&rec),
                 ..rec

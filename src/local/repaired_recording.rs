@@ -1,4 +1,6 @@
-//! One experiment's recording made ready for its crossing windows: one joint's held readings
+//! One experiment's recording made ready for its crossing windows: its logged velocities and
+//! accelerations checked against the derivatives where they are to be used
+//! ([`crate::derivative_columns::check_logged_derivatives`]), one joint's held readings
 //! (a lost message logged as its last value or zeros) replaced, rows of zeros and frozen
 //! readings while the robot moves removed ([`crate::log_dropouts`]), clipped torques found in
 //! the recording as logged, and each told of in warnings that name the experiment. The samples
@@ -31,6 +33,9 @@ pub(super) fn read_experiment(
     options: &IdentifyOptions,
 ) -> Result<ReadExperiment> {
     let name = e.kind.name();
+    if options.fit.recorded_derivatives {
+        crate::derivative_columns::check_logged_derivatives(r)?;
+    }
     let mut warnings = vec![];
     let clipped = crate::torque_saturation::find_torque_saturation(r);
     let (repaired, held) = crate::log_screening::screen_held_readings(r)?;
