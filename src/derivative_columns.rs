@@ -220,7 +220,8 @@ fn check_columns(
 }
 
 /// Checks the logged velocities and accelerations of `rec`, a log used as logged (not
-/// preprocessed), against the derivatives of its positions and of its logged velocities: each
+/// preprocessed), against the derivatives of its positions (steps of whole turns taken out:
+/// [`crate::position_wraps`]) and of its logged velocities: each
 /// stretch between gaps (longer than 20 median sample intervals) resampled at its median rate,
 /// both sides filtered alike by the default preprocessing's low-pass
 /// ([`PreprocessOptions::default`]) and trimmed by its trim; stretches too short or sampled too
@@ -231,6 +232,9 @@ pub fn check_logged_derivatives(rec: &Recording) -> Result<()> {
     let Some(qd) = rec.qd.as_ref() else {
         return Ok(());
     };
+    // a joint angle logged within one turn steps by a turn where it wraps: not motion
+    let (unwrapped, _) = crate::position_wraps::unwrap_positions(rec);
+    let rec = &unwrapped;
     let options = PreprocessOptions::default();
     let n = rec.n;
     'parts: for (first, end) in crate::log_screening::segments(rec) {

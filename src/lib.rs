@@ -39,6 +39,7 @@ pub mod outliers;
 #[cfg(feature = "cli")]
 pub mod paper;
 pub mod position_rounding;
+pub mod position_wraps;
 pub mod preprocess;
 pub mod recording;
 pub mod regression;

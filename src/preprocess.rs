@@ -55,7 +55,9 @@ impl Default for PreprocessOptions {
     }
 }
 
-/// Preprocesses a recording: replaces its glitches and removes its dropouts (when
+/// Preprocesses a recording: takes steps of whole turns out of its positions
+/// ([`crate::position_wraps`], listed in the result's [`Recording::position_wraps`]),
+/// replaces its glitches and removes its dropouts (when
 /// `options.screen_glitches`: single samples far off the curve their neighbours follow, and
 /// rows in which every joint of a signal reads exactly 0 while the robot moves, see
 /// [`crate::log_screening`]; listed in the result's [`Recording::glitches`] and
@@ -75,13 +77,17 @@ impl Default for PreprocessOptions {
 /// [`MAX_GAP_INTERVALS`]: crate::limits::MAX_GAP_INTERVALS
 pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Recording> {
     // the grids of the positions as logged: a glitch replaced by its neighbours' fit is off
-    // the grid, and would hide it
+    // the grid, and would hide it (and whole turns taken out are no multiple of its step)
     let steps = crate::local::rounded_positions::position_steps(rec);
+    // steps of whole turns taken back out before anything reads the positions' motion
+    let (unwrapped, position_wraps) = crate::position_wraps::unwrap_positions(rec);
+    let rec = &unwrapped;
     // clipped torques, as logged: screening could replace a short clipped run
     let torque_saturation = crate::torque_saturation::find_torque_saturation(rec);
     if !options.screen_glitches {
         return preprocess_screened(rec, options, &steps).map(|out| Recording {
             torque_saturation,
+            position_wraps,
             ..out
         });
     }
@@ -103,6 +109,7 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
         glitches,
         dropouts,
         torque_saturation,
+        position_wraps,
         ..out
     })
 }

@@ -33,6 +33,9 @@ pub struct Recording {
     /// Per joint and side, the torques of the log this recording was preprocessed from that
     /// read clipped ([`crate::torque_saturation`]); empty for a recording as logged.
     pub torque_saturation: Vec<crate::torque_saturation::TorqueSaturation>,
+    /// Steps of whole turns in the positions of the log this recording was preprocessed from,
+    /// taken back out first ([`crate::position_wraps`]); empty for a recording as logged.
+    pub position_wraps: Vec<crate::position_wraps::PositionWrap>,
 }
 
 impl Recording {
@@ -61,6 +64,7 @@ impl Recording {
             dropouts: vec![],
             position_rounding: vec![],
             torque_saturation: vec![],
+            position_wraps: vec![],
         };
         r.check()?;
         Ok(r)

@@ -343,6 +343,11 @@ class Recording:
         step (rad or m), qd_ratio, qdd_ratio (RMS of the noise over RMS of the signal;
         preprocess warns from 0.1)."""
     @property
+    def position_wraps(self) -> list[dict[str, Any]]:
+        """Steps of whole turns in the positions of the log this was preprocessed from (a joint
+        angle logged within one turn that a continuous joint passes), taken back out first:
+        joint (0-based), sample (the first after the step), time (s), turns (added from there on)."""
+    @property
     def torque_saturation(self) -> list[dict[str, Any]]:
         """The log's torques that read clipped (preprocess warns): joint (0-based), level
         (N m), upper, runs, samples, longest, first_at (s), beyond (N m)."""

@@ -223,6 +223,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         log_glitches: rec.glitches.clone(),
         log_dropouts: rec.dropouts.clone(),
         log_torque_saturation: rec.torque_saturation.clone(),
+        log_position_wraps: rec.position_wraps.clone(),
         position_rounding: rec.position_rounding.clone(),
         ..fit
     };

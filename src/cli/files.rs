@@ -175,6 +175,14 @@ impl PreprocessArgs {
         ) {
             eprintln!("perturbid: warning: {w}");
         }
+        if let Some(w) = crate::position_wraps::warning(
+            &rec.position_wraps,
+            &path.display().to_string(),
+            joints,
+            "before preprocessing",
+        ) {
+            eprintln!("perturbid: warning: {w}");
+        }
         if let Some(w) = crate::log_dropouts::dropout_warning(
             &rec.dropouts,
             &path.display().to_string(),

@@ -104,6 +104,10 @@ pub struct BaseModel {
     /// the fit took them for the robot's, and was warned of them.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub log_torque_saturation: Vec<crate::torque_saturation::TorqueSaturation>,
+    /// Steps of whole turns in that log's positions, taken back out first
+    /// ([`crate::position_wraps`]; set likewise).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub log_position_wraps: Vec<crate::position_wraps::PositionWrap>,
     /// Per joint of that log whose positions lie on a grid and whose velocity was derived
     /// from them, the noise their rounding left in qd and qdd ([`crate::position_rounding`];
     /// set likewise): ratios of [`crate::position_rounding::NOISE_RATIO`] or more are warned
@@ -288,6 +292,7 @@ fn fit_with_factors(
         residual_correlation: vec![],
         log_glitches: vec![],
         log_torque_saturation: vec![],
+        log_position_wraps: vec![],
         log_dropouts: vec![],
         position_rounding: vec![],
         torque_columns: super::torque_columns::check_torque_columns(
@@ -445,6 +450,14 @@ impl Document for BaseModel {
             .find_map(|(i, d)| d.problem(n).map(|p| (i, p)))
         {
             return Err(invalid(Self::WHAT, format!("log_dropouts[{i}]: {problem}")));
+        }
+        if let Some((i, problem)) = (m.log_position_wraps.iter().enumerate())
+            .find_map(|(i, w)| w.problem(n).map(|p| (i, p)))
+        {
+            return Err(invalid(
+                Self::WHAT,
+                format!("log_position_wraps[{i}]: {problem}"),
+            ));
         }
         if let Some((i, problem)) = (m.log_torque_saturation.iter().enumerate())
             .find_map(|(i, c)| c.problem(n).map(|p| (i, p)))

@@ -1,4 +1,5 @@
-//! One experiment's recording made ready for its crossing windows: its logged velocities and
+//! One experiment's recording made ready for its crossing windows: steps of whole turns taken
+//! out of its positions ([`crate::position_wraps`]), its logged velocities and
 //! accelerations checked against the derivatives where they are to be used
 //! ([`crate::derivative_columns::check_logged_derivatives`]), one joint's held readings
 //! (a lost message logged as its last value or zeros) replaced, rows of zeros and frozen
@@ -33,10 +34,20 @@ pub(super) fn read_experiment(
     options: &IdentifyOptions,
 ) -> Result<ReadExperiment> {
     let name = e.kind.name();
+    let mut warnings = vec![];
+    let (unwrapped, wraps) = crate::position_wraps::unwrap_positions(r);
+    if let Some(w) = crate::position_wraps::warning(
+        &wraps,
+        &r.name,
+        joint_names,
+        "before the crossing windows were read",
+    ) {
+        warnings.push(format!("experiment '{name}': {w}"));
+    }
+    let r = &unwrapped;
     if options.fit.recorded_derivatives {
         crate::derivative_columns::check_logged_derivatives(r)?;
     }
-    let mut warnings = vec![];
     let clipped = crate::torque_saturation::find_torque_saturation(r);
     let (repaired, held) = crate::log_screening::screen_held_readings(r)?;
     if let Some(w) = crate::log_screening::warning(

@@ -73,6 +73,7 @@ pub(crate) fn preprocess(
         crate::position_rounding::warning(&out.position_rounding, &[])
             .map(|w| format!("{name}: {w}{}", crate::position_rounding::IN_A_FIT)),
         crate::torque_saturation::warning(&out.torque_saturation, &[], name),
+        crate::position_wraps::warning(&out.position_wraps, name, &[], "before preprocessing"),
     ]
     .into_iter()
     .flatten()

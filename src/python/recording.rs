@@ -295,6 +295,29 @@ impl PyRecording {
             })
             .collect()
     }
+    /// Steps of whole turns in the positions of the log this recording was preprocessed from
+    /// (a joint angle logged within one turn that a continuous joint passes), taken back out
+    /// first; `preprocess` warns: a list of dicts `joint` (0-based column index), `sample`
+    /// (0-based row of the log: the first after the step), `time` (s), `turns` (whole turns
+    /// added to the joint's positions from there on). Empty for a recording as logged.
+    #[getter]
+    fn position_wraps<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<Vec<Bound<'py, pyo3::types::PyDict>>> {
+        self.rec
+            .position_wraps
+            .iter()
+            .map(|w| {
+                let e = pyo3::types::PyDict::new(py);
+                e.set_item("joint", w.joint)?;
+                e.set_item("sample", w.sample)?;
+                e.set_item("time", w.time)?;
+                e.set_item("turns", w.turns)?;
+                Ok(e)
+            })
+            .collect()
+    }
     /// The torques of the log this recording was preprocessed from that read clipped (a run
     /// of samples at exactly the column's largest or smallest value that the samples either
     /// side head beyond; `preprocess` warns): a list of dicts `joint` (0-based column index),

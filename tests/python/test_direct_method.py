@@ -710,7 +710,8 @@ def test_preprocess_replaces_a_logs_glitches_and_says_so():
     signals equal those of the clean log to well within the noise-free filter's output;
     screen_glitches=False keeps them (and the spike then shows in the filtered torque). Rows
     of zero torques while the robot moves are removed as a dropout, and one joint's position
-    frozen for 15 rows as a frozen reading; both are listed."""
+    frozen for 15 rows as a frozen reading; both are listed. A joint logged within one turn has
+    its steps of a turn taken back out."""
     rng = np.random.default_rng(3)
     t = np.cumsum(rng.uniform(0.0008, 0.0012, 8000))
     q = np.stack([0.3 * np.sin(2 * np.pi * 0.2 * t + k) for k in range(3)], axis=1)
@@ -763,6 +764,23 @@ def test_preprocess_replaces_a_logs_glitches_and_says_so():
     assert "joint" not in bridged.dropouts[0]
     assert removed.glitches == []
     assert np.max(np.abs(removed.q - clean.q)) < 1e-4
+    # joint 3 logged within one turn, passing pi: each step of a turn is taken back out, and
+    # the preprocessed recording is the unwrapped log's, whole turns apart
+    shifted = q.copy()
+    shifted[:, 2] += np.pi - 0.5 * (q[:, 2].min() + q[:, 2].max())
+    logged = shifted.copy()
+    logged[:, 2] = np.angle(np.exp(1j * shifted[:, 2]))
+    steps = np.flatnonzero(np.abs(np.diff(logged[:, 2])) > np.pi) + 1
+    assert len(steps) >= 2
+    with pytest.warns(pr.PerturbidWarning, match=rf"{len(steps)} step\(s\) of a joint's positions by whole turns.*joint 3 at t = "):
+        unwrapped = pr.preprocess(t, logged, tau, name="wrapped")
+    assert [(w["joint"], w["sample"]) for w in unwrapped.position_wraps] == [(2, int(i)) for i in steps]
+    assert all(abs(w["turns"]) == 1 and w["time"] == t[w["sample"]] for w in unwrapped.position_wraps)
+    reference = pr.preprocess(t, shifted, tau)
+    turns = np.round((unwrapped.q - reference.q) / (2 * np.pi))
+    np.testing.assert_allclose(unwrapped.q - 2 * np.pi * turns, reference.q, atol=1e-9)
+    np.testing.assert_allclose(unwrapped.qd, reference.qd, atol=1e-9)
+    assert clean.position_wraps == []
 
 
 def test_positions_in_coarse_counts_under_derived_velocities_are_warned_of():
