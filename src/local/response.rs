@@ -65,9 +65,11 @@ impl PassNoise {
     }
 }
 
-/// The residual degrees of freedom below which the noise is read from the samples' scatter
-/// about their windows' fits (`u`, known rather than estimated): its F test is then taken with
-/// this many, close to the chi-square limit.
+/// The degrees of freedom given to the noise where it is read from the samples' scatter about
+/// their windows' fits (`u`: known rather than estimated), because the regression leaves no
+/// residual degrees of freedom of its own: the F test is then taken with this many, close to
+/// its chi-square limit. (Not a threshold: with any residual degrees of freedom, even 2, the
+/// regression's own residuals are the noise.)
 const KNOWN_NOISE_DOF: f64 = 1000.0;
 
 /// Each joint's response in the regression `y = x B` (`x`: k x N perturbations measured, `y`:
