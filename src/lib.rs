@@ -26,6 +26,7 @@ pub mod document;
 pub mod error;
 pub mod frozen_readings;
 pub mod gravity;
+pub mod held_columns;
 pub mod interrupt;
 pub mod io;
 pub mod json;

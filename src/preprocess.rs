@@ -56,7 +56,9 @@ impl Default for PreprocessOptions {
 }
 
 /// Preprocesses a recording: takes steps of whole turns out of its positions
-/// ([`crate::position_wraps`], listed in the result's [`Recording::position_wraps`]),
+/// ([`crate::position_wraps`], listed in the result's [`Recording::position_wraps`]), reads
+/// columns logged at a lower rate and held on its grid again at their values' arrivals
+/// ([`crate::held_columns`], [`Recording::held_columns`]),
 /// replaces its glitches and removes its dropouts (when
 /// `options.screen_glitches`: single samples far off the curve their neighbours follow, and
 /// rows in which every joint of a signal reads exactly 0 while the robot moves, see
@@ -81,13 +83,17 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     let steps = crate::local::rounded_positions::position_steps(rec);
     // steps of whole turns taken back out before anything reads the positions' motion
     let (unwrapped, position_wraps) = crate::position_wraps::unwrap_positions(rec);
-    let rec = &unwrapped;
+    // columns held at a lower rate read again at their values' arrivals, before anything
+    // reads their motion (their holds would otherwise end as frozen readings here and there)
+    let (reread, held_columns) = crate::held_columns::find_held_columns(&unwrapped)?;
+    let rec = &reread;
     // clipped torques, as logged: screening could replace a short clipped run
     let torque_saturation = crate::torque_saturation::find_torque_saturation(rec);
     if !options.screen_glitches {
         return preprocess_screened(rec, options, &steps).map(|out| Recording {
             torque_saturation,
             position_wraps,
+            held_columns,
             ..out
         });
     }
@@ -110,6 +116,7 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
         dropouts,
         torque_saturation,
         position_wraps,
+        held_columns,
         ..out
     })
 }

@@ -36,6 +36,10 @@ pub struct Recording {
     /// Steps of whole turns in the positions of the log this recording was preprocessed from,
     /// taken back out first ([`crate::position_wraps`]); empty for a recording as logged.
     pub position_wraps: Vec<crate::position_wraps::PositionWrap>,
+    /// Columns of the log this recording was preprocessed from that were logged at a lower
+    /// rate and held on its grid, read again at their values' arrivals first
+    /// ([`crate::held_columns`]); empty for a recording as logged.
+    pub held_columns: Vec<crate::held_columns::HeldColumn>,
 }
 
 impl Recording {
@@ -65,6 +69,7 @@ impl Recording {
             position_rounding: vec![],
             torque_saturation: vec![],
             position_wraps: vec![],
+            held_columns: vec![],
         };
         r.check()?;
         Ok(r)

@@ -343,6 +343,11 @@ class Recording:
         step (rad or m), qd_ratio, qdd_ratio (RMS of the noise over RMS of the signal;
         preprocess warns from 0.1)."""
     @property
+    def held_columns(self) -> list[dict[str, Any]]:
+        """Columns of the log this was preprocessed from logged at a lower rate and held on its
+        grid, read again at their values' arrivals first: signal, joint (0-based), repeated
+        (share of samples repeating the one before where the joint moves), held_for (samples)."""
+    @property
     def position_wraps(self) -> list[dict[str, Any]]:
         """Steps of whole turns in the positions of the log this was preprocessed from (a joint
         angle logged within one turn that a continuous joint passes), taken back out first:

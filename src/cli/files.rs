@@ -175,6 +175,11 @@ impl PreprocessArgs {
         ) {
             eprintln!("perturbid: warning: {w}");
         }
+        if let Some(w) =
+            crate::held_columns::warning(&rec.held_columns, &path.display().to_string(), joints)
+        {
+            eprintln!("perturbid: warning: {w}");
+        }
         if let Some(w) = crate::position_wraps::warning(
             &rec.position_wraps,
             &path.display().to_string(),

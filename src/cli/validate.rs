@@ -39,7 +39,8 @@ pub(crate) struct ValidateArgs {
     /// per-joint table, and `log_glitches` and `log_dropouts`: the samples of the log replaced
     /// as glitches and the rows removed as dropouts before preprocessing, when there were any;
     /// `log_torque_saturation`, its torques that read clipped, warned of; `log_position_wraps`,
-    /// steps of whole turns taken out of its positions;
+    /// steps of whole turns taken out of its positions; `log_held_columns`, its columns logged
+    /// at a lower rate and read again at their values' arrivals;
     /// for a base-parameter model `torque_columns`, each torque column of the log against the
     /// robot's model, `torque_lag`, its torques shifted against its positions, and
     /// `position_range`, the joints whose positions leave their limits, and `position_offsets`,
@@ -151,6 +152,9 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     }
     if !rec.dropouts.is_empty() {
         json["log_dropouts"] = serde_json::to_value(&rec.dropouts).expect("serialisable");
+    }
+    if !rec.held_columns.is_empty() {
+        json["log_held_columns"] = serde_json::to_value(&rec.held_columns).expect("serialisable");
     }
     if !rec.position_wraps.is_empty() {
         json["log_position_wraps"] =

@@ -108,6 +108,10 @@ pub struct BaseModel {
     /// ([`crate::position_wraps`]; set likewise).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub log_position_wraps: Vec<crate::position_wraps::PositionWrap>,
+    /// Columns of that log logged at a lower rate and held on its grid, read again at their
+    /// values' arrivals first ([`crate::held_columns`]; set likewise).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub log_held_columns: Vec<crate::held_columns::HeldColumn>,
     /// Per joint of that log whose positions lie on a grid and whose velocity was derived
     /// from them, the noise their rounding left in qd and qdd ([`crate::position_rounding`];
     /// set likewise): ratios of [`crate::position_rounding::NOISE_RATIO`] or more are warned
@@ -293,6 +297,7 @@ fn fit_with_factors(
         log_glitches: vec![],
         log_torque_saturation: vec![],
         log_position_wraps: vec![],
+        log_held_columns: vec![],
         log_dropouts: vec![],
         position_rounding: vec![],
         torque_columns: super::torque_columns::check_torque_columns(
@@ -450,6 +455,14 @@ impl Document for BaseModel {
             .find_map(|(i, d)| d.problem(n).map(|p| (i, p)))
         {
             return Err(invalid(Self::WHAT, format!("log_dropouts[{i}]: {problem}")));
+        }
+        if let Some((i, problem)) =
+            (m.log_held_columns.iter().enumerate()).find_map(|(i, h)| h.problem(n).map(|p| (i, p)))
+        {
+            return Err(invalid(
+                Self::WHAT,
+                format!("log_held_columns[{i}]: {problem}"),
+            ));
         }
         if let Some((i, problem)) = (m.log_position_wraps.iter().enumerate())
             .find_map(|(i, w)| w.problem(n).map(|p| (i, p)))

@@ -1,5 +1,6 @@
 //! One experiment's recording made ready for its crossing windows: steps of whole turns taken
-//! out of its positions ([`crate::position_wraps`]), its logged velocities and
+//! out of its positions ([`crate::position_wraps`]), columns held at a lower rate read again
+//! at their values' arrivals ([`crate::held_columns`]), its logged velocities and
 //! accelerations checked against the derivatives where they are to be used
 //! ([`crate::derivative_columns::check_logged_derivatives`]), one joint's held readings
 //! (a lost message logged as its last value or zeros) replaced, rows of zeros and frozen
@@ -44,7 +45,11 @@ pub(super) fn read_experiment(
     ) {
         warnings.push(format!("experiment '{name}': {w}"));
     }
-    let r = &unwrapped;
+    let (reread, held_columns) = crate::held_columns::find_held_columns(&unwrapped)?;
+    if let Some(w) = crate::held_columns::warning(&held_columns, &r.name, joint_names) {
+        warnings.push(format!("experiment '{name}': {w}"));
+    }
+    let r = &reread;
     if options.fit.recorded_derivatives {
         crate::derivative_columns::check_logged_derivatives(r)?;
     }

@@ -74,6 +74,7 @@ pub(crate) fn preprocess(
             .map(|w| format!("{name}: {w}{}", crate::position_rounding::IN_A_FIT)),
         crate::torque_saturation::warning(&out.torque_saturation, &[], name),
         crate::position_wraps::warning(&out.position_wraps, name, &[], "before preprocessing"),
+        crate::held_columns::warning(&out.held_columns, name, &[]),
     ]
     .into_iter()
     .flatten()

@@ -295,6 +295,27 @@ impl PyRecording {
             })
             .collect()
     }
+    /// Columns of the log this recording was preprocessed from that were logged at a lower
+    /// rate and held on its grid (a slower stream merged into a faster one), read again at
+    /// their values' arrivals first; `preprocess` warns: a list of dicts `signal`, `joint`
+    /// (0-based column index), `repeated` (share of its samples, where the joint moves, that
+    /// repeat the one before), `held_for` (median samples a value is held). Empty for a
+    /// recording as logged.
+    #[getter]
+    fn held_columns<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, pyo3::types::PyDict>>> {
+        self.rec
+            .held_columns
+            .iter()
+            .map(|h| {
+                let e = pyo3::types::PyDict::new(py);
+                e.set_item("signal", &h.signal)?;
+                e.set_item("joint", h.joint)?;
+                e.set_item("repeated", h.repeated)?;
+                e.set_item("held_for", h.held_for)?;
+                Ok(e)
+            })
+            .collect()
+    }
     /// Steps of whole turns in the positions of the log this recording was preprocessed from
     /// (a joint angle logged within one turn that a continuous joint passes), taken back out
     /// first; `preprocess` warns: a list of dicts `joint` (0-based column index), `sample`

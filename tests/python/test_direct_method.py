@@ -781,6 +781,20 @@ def test_preprocess_replaces_a_logs_glitches_and_says_so():
     np.testing.assert_allclose(unwrapped.q - 2 * np.pi * turns, reference.q, atol=1e-9)
     np.testing.assert_allclose(unwrapped.qd, reference.qd, atol=1e-9)
     assert clean.position_wraps == []
+    # joint 2's torque logged at 100 Hz and held on the 1 kHz grid: read again at its values'
+    # arrivals, and the preprocessed torque is the clean one's to well within what the
+    # staircase's half-hold lag (4.5 ms) would leave
+    exact = np.stack([2.0 * np.cos(2 * np.pi * 0.3 * t + k) for k in range(3)], axis=1)
+    stairs = exact.copy()
+    stairs[:, 1] = exact[np.arange(len(t)) // 10 * 10, 1]
+    with pytest.warns(pr.PerturbidWarning, match=r"1 column\(s\) logged at a lower rate.*tau of joint 2 repeats 9\d % .* held for 10 samples"):
+        reread = pr.preprocess(t, q, stairs, name="stairs")
+    [h] = reread.held_columns
+    assert (h["signal"], h["joint"], h["held_for"]) == ("tau", 1, 10.0) and h["repeated"] > 0.85
+    smooth = pr.preprocess(t, q, exact)
+    lag = 4.5e-3 * np.sqrt(np.mean(np.gradient(smooth.tau[:, 1], smooth.t) ** 2))
+    assert np.sqrt(np.mean((reread.tau[:, 1] - smooth.tau[:, 1]) ** 2)) < 0.1 * lag
+    assert clean.held_columns == [] and reread.dropouts == []
 
 
 def test_positions_in_coarse_counts_under_derived_velocities_are_warned_of():
