@@ -8,14 +8,13 @@
 
 mod common;
 
-use common::{a465_noisy_log, panda_log, refused_on_load};
-use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
+use common::{a465_noisy_log, fit_preprocessed, moved_in_stderr, panda_log, refused_on_load};
+use perturbid_rs::direct::BaseModel;
 use perturbid_rs::document::Document;
 use perturbid_rs::frozen_readings::{find_frozen_readings, MIN_FROZEN};
 use perturbid_rs::log_dropouts::{dropout_warning, BRIDGED_BY_PREPROCESSING};
 use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
-use perturbid_rs::robots::a465;
-use perturbid_rs::{Recording, States};
+use perturbid_rs::Recording;
 
 const N: usize = 6;
 
@@ -27,26 +26,7 @@ fn identify(rec: &Recording, screen: bool) -> (Recording, BaseModel) {
         split_at_gaps: true,
         ..PreprocessOptions::default()
     };
-    let p = preprocess(rec, &options).unwrap();
-    let states = States::new(N, &p.q, p.qd.as_deref(), p.qdd.as_deref()).unwrap();
-    let fit = identify_base_parameters(
-        &a465::model("physical").unwrap(),
-        &states,
-        &p.tau,
-        &BaseOptions::default(),
-    )
-    .unwrap();
-    (p, fit)
-}
-
-/// The largest difference of `a`'s parameters from `b`'s, in `b`'s standard errors.
-fn moved(a: &BaseModel, b: &BaseModel) -> f64 {
-    a.theta
-        .iter()
-        .zip(&b.theta)
-        .zip(&b.stderr)
-        .map(|((x, y), s)| (x - y).abs() / s)
-        .fold(0.0, f64::max)
+    fit_preprocessed(rec, &options)
 }
 
 /// `rec` without its rows `rows`.
@@ -97,14 +77,18 @@ fn a_frozen_position_is_removed_with_its_rows() {
     // unremoved, far off; removed, the clean log's fit without those rows, exactly
     let (_, unremoved) = identify(&rec, false);
     assert!(
-        moved(&unremoved, &reference) > 5.0,
+        moved_in_stderr(&unremoved, &reference) > 5.0,
         "{}",
-        moved(&unremoved, &reference)
+        moved_in_stderr(&unremoved, &reference)
     );
     let (p, fit) = identify(&rec, true);
     assert_eq!(p.dropouts, found);
     let (_, cut) = identify(&without_rows(&clean, 5000..5050), true);
-    assert!(moved(&fit, &cut) < 1e-6, "{}", moved(&fit, &cut));
+    assert!(
+        moved_in_stderr(&fit, &cut) < 1e-6,
+        "{}",
+        moved_in_stderr(&fit, &cut)
+    );
     // 50 rows are a gap: refused unless split, naming what was removed
     let e = preprocess(&rec, &PreprocessOptions::default())
         .unwrap_err()

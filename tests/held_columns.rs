@@ -6,36 +6,17 @@
 
 mod common;
 
-use common::{a465_noisy_log, panda_log, refused_on_load};
-use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
+use common::{a465_noisy_log, fit_preprocessed, moved_in_stderr, panda_log, refused_on_load};
+use perturbid_rs::direct::BaseModel;
 use perturbid_rs::document::Document;
 use perturbid_rs::held_columns::{find_held_columns, warning};
-use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
-use perturbid_rs::robots::a465;
-use perturbid_rs::{Recording, States};
+use perturbid_rs::preprocess::PreprocessOptions;
+use perturbid_rs::Recording;
 
 const N: usize = 6;
 
 fn identify(rec: &Recording) -> (Recording, BaseModel) {
-    let p = preprocess(rec, &PreprocessOptions::default()).unwrap();
-    let states = States::new(N, &p.q, p.qd.as_deref(), p.qdd.as_deref()).unwrap();
-    let fit = identify_base_parameters(
-        &a465::model("physical").unwrap(),
-        &states,
-        &p.tau,
-        &BaseOptions::default(),
-    )
-    .unwrap();
-    (p, fit)
-}
-
-fn moved(a: &BaseModel, b: &BaseModel) -> f64 {
-    a.theta
-        .iter()
-        .zip(&b.theta)
-        .zip(&b.stderr)
-        .map(|((x, y), s)| (x - y).abs() / s)
-        .fold(0.0, f64::max)
+    fit_preprocessed(rec, &PreprocessOptions::default())
 }
 
 /// `rec` with the column of `signal` ("q" or "tau") of joint `j` held for `every` samples.
@@ -119,13 +100,13 @@ fn columns_held_at_a_lower_rate_are_read_again() {
         let lag = 4.5e-3 * rms((0..c.len()).map(|i| rate[i * N + j]).collect());
         eprintln!(
             "{signal}: {error} against {lag}, moved {}",
-            moved(&fit, &reference)
+            moved_in_stderr(&fit, &reference)
         );
         assert!(error < 0.3 * lag, "{signal}: {error} against {lag}");
         assert!(
-            moved(&fit, &reference) < 3.0,
+            moved_in_stderr(&fit, &reference) < 3.0,
             "{signal}: {}",
-            moved(&fit, &reference)
+            moved_in_stderr(&fit, &reference)
         );
     }
     let names: Vec<String> = (1..=N).map(|j| format!("j{j}")).collect();

@@ -8,14 +8,15 @@
 
 mod common;
 
-use common::{a465_noisy_log, panda_log, panda_model, refused_on_load};
+use common::{
+    a465_noisy_log, fit_preprocessed, moved_in_stderr, panda_log, panda_model, refused_on_load,
+};
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
 use perturbid_rs::document::Document;
 use perturbid_rs::log_dropouts::find_dropouts;
 use perturbid_rs::log_screening::{screen_recording, warning, LogGlitch, HALF_WINDOW};
 use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
-use perturbid_rs::robots::a465;
 use perturbid_rs::{Recording, States};
 
 fn identify(rec: &Recording, screen: bool) -> (Recording, BaseModel) {
@@ -23,27 +24,7 @@ fn identify(rec: &Recording, screen: bool) -> (Recording, BaseModel) {
         screen_glitches: screen,
         ..PreprocessOptions::default()
     };
-    let p = preprocess(rec, &options).unwrap();
-    let states = States::new(6, &p.q, p.qd.as_deref(), p.qdd.as_deref()).unwrap();
-    let fit = identify_base_parameters(
-        &a465::model("physical").unwrap(),
-        &states,
-        &p.tau,
-        &BaseOptions::default(),
-    )
-    .unwrap();
-    (p, fit)
-}
-
-/// The largest difference of the parameters of `a` from `clean`'s, in `clean`'s standard
-/// errors.
-fn moved(a: &BaseModel, clean: &BaseModel) -> f64 {
-    a.theta
-        .iter()
-        .zip(&clean.theta)
-        .zip(&clean.stderr)
-        .map(|((x, y), s)| (x - y).abs() / s)
-        .fold(0.0, f64::max)
+    fit_preprocessed(rec, &options)
 }
 
 /// Each glitch `found` was replaced in `screened` near the `clean` log's value (its noise:
@@ -128,18 +109,18 @@ fn spikes_and_a_row_of_zeros_are_replaced_and_leave_the_parameters_alone() {
     let (p, screened_fit) = identify(&rec, true);
     assert_eq!(p.glitches, found);
     assert!(
-        moved(&screened_fit, &reference) < 0.05,
+        moved_in_stderr(&screened_fit, &reference) < 0.05,
         "{}",
-        moved(&screened_fit, &reference)
+        moved_in_stderr(&screened_fit, &reference)
     );
     let mut unscreened = clean.clone();
     unscreened.q[6000 * n + 2] += 0.05;
     let (p, unscreened_fit) = identify(&unscreened, false);
     assert!(p.glitches.is_empty());
     assert!(
-        moved(&unscreened_fit, &reference) > 3.0,
+        moved_in_stderr(&unscreened_fit, &reference) > 3.0,
         "{}",
-        moved(&unscreened_fit, &reference)
+        moved_in_stderr(&unscreened_fit, &reference)
     );
 }
 
@@ -165,9 +146,9 @@ fn held_readings_of_one_joint_are_replaced() {
     }
     let (_, unscreened) = identify(&rec, false);
     assert!(
-        moved(&unscreened, &reference) > 0.3,
+        moved_in_stderr(&unscreened, &reference) > 0.3,
         "{}",
-        moved(&unscreened, &reference)
+        moved_in_stderr(&unscreened, &reference)
     );
     let (screened, found) = screen_recording(&rec).unwrap();
     let at = |signal: &str, j: usize| -> Vec<usize> {
@@ -201,9 +182,9 @@ fn held_readings_of_one_joint_are_replaced() {
     );
     let (_, fit) = identify(&rec, true);
     assert!(
-        moved(&fit, &reference) < 0.05,
+        moved_in_stderr(&fit, &reference) < 0.05,
         "{}",
-        moved(&fit, &reference)
+        moved_in_stderr(&fit, &reference)
     );
     // readings that repeat legitimately are kept: a torque on a coarse grid (0.05 N m, its
     // noise 0.03 N m), repeated many times over while the joint moves, and a joint that holds
@@ -239,10 +220,18 @@ fn dropouts_are_removed_and_zeros_at_rest_kept() {
     assert_eq!((d.from, d.to), (rec.t[7000], rec.t[7014]));
     let (p, fit) = identify(&rec, true);
     assert_eq!(p.dropouts, found);
-    assert!(moved(&fit, &reference) < 0.1, "{}", moved(&fit, &reference));
+    assert!(
+        moved_in_stderr(&fit, &reference) < 0.1,
+        "{}",
+        moved_in_stderr(&fit, &reference)
+    );
     let (p, fit) = identify(&rec, false);
     assert!(p.dropouts.is_empty());
-    assert!(moved(&fit, &reference) > 1.0, "{}", moved(&fit, &reference));
+    assert!(
+        moved_in_stderr(&fit, &reference) > 1.0,
+        "{}",
+        moved_in_stderr(&fit, &reference)
+    );
     // a hundred rows leave a gap: refused naming it and the dropout, or split on request
     let mut long = clean.clone();
     for x in &mut long.tau[7000 * n..7100 * n] {
@@ -449,5 +438,9 @@ fn the_real_panda_log_loses_only_stale_positions() {
         identify_base_parameters(&model, &states, &p.tau, &BaseOptions::default()).unwrap()
     };
     let (with, without) = (fit(true), fit(false));
-    assert!(moved(&with, &without) < 0.01, "{}", moved(&with, &without));
+    assert!(
+        moved_in_stderr(&with, &without) < 0.01,
+        "{}",
+        moved_in_stderr(&with, &without)
+    );
 }

@@ -7,28 +7,18 @@
 
 mod common;
 
-use common::{a465_log, a465_noisy_log, refused_on_load};
-use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
+use common::{a465_log, a465_noisy_log, fit_preprocessed, moved_in_stderr, refused_on_load};
+use perturbid_rs::direct::BaseModel;
 use perturbid_rs::document::Document;
 use perturbid_rs::position_wraps::{unwrap_positions, warning};
-use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
-use perturbid_rs::robots::a465;
-use perturbid_rs::{Recording, States};
+use perturbid_rs::preprocess::PreprocessOptions;
+use perturbid_rs::Recording;
 use std::f64::consts::{PI, TAU};
 
 const N: usize = 6;
 
 fn identify(rec: &Recording) -> (Recording, BaseModel) {
-    let p = preprocess(rec, &PreprocessOptions::default()).unwrap();
-    let states = States::new(N, &p.q, p.qd.as_deref(), p.qdd.as_deref()).unwrap();
-    let fit = identify_base_parameters(
-        &a465::model("physical").unwrap(),
-        &states,
-        &p.tau,
-        &BaseOptions::default(),
-    )
-    .unwrap();
-    (p, fit)
+    fit_preprocessed(rec, &PreprocessOptions::default())
 }
 
 /// `q` wrapped into [-pi, pi).
@@ -77,13 +67,7 @@ fn a_joint_logged_within_one_turn_is_unwrapped() {
     let (p, fit) = identify(&rec);
     assert_eq!(p.position_wraps, wraps);
     let (_, reference) = identify(&shifted);
-    let moved = fit
-        .theta
-        .iter()
-        .zip(&reference.theta)
-        .zip(&reference.stderr)
-        .map(|((x, y), s)| (x - y).abs() / s)
-        .fold(0.0, f64::max);
+    let moved = moved_in_stderr(&fit, &reference);
     assert!(moved < 1e-6, "{moved}");
     let names: Vec<String> = (1..=N).map(|j| format!("j{j}")).collect();
     let w = warning(&wraps, "log", &names, "before preprocessing").unwrap();

@@ -554,3 +554,34 @@ pub fn normal(rng: &mut Rng) -> f64 {
     let (u, v) = (rng.uniform(1e-12, 1.0), rng.uniform(0.0, 1.0));
     (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
 }
+
+/// The A465's base parameters (its "physical" model) fitted to `rec` preprocessed with
+/// `options`, with the preprocessed recording.
+pub fn fit_preprocessed(
+    rec: &perturbid_rs::Recording,
+    options: &perturbid_rs::preprocess::PreprocessOptions,
+) -> (perturbid_rs::Recording, perturbid_rs::direct::BaseModel) {
+    let p = perturbid_rs::preprocess::preprocess(rec, options).unwrap();
+    let states = perturbid_rs::States::new(6, &p.q, p.qd.as_deref(), p.qdd.as_deref()).unwrap();
+    let fit = perturbid_rs::direct::identify_base_parameters(
+        &perturbid_rs::robots::a465::model("physical").unwrap(),
+        &states,
+        &p.tau,
+        &perturbid_rs::direct::BaseOptions::default(),
+    )
+    .unwrap();
+    (p, fit)
+}
+
+/// The largest difference of `a`'s parameters from `b`'s, in `b`'s standard errors.
+pub fn moved_in_stderr(
+    a: &perturbid_rs::direct::BaseModel,
+    b: &perturbid_rs::direct::BaseModel,
+) -> f64 {
+    a.theta
+        .iter()
+        .zip(&b.theta)
+        .zip(&b.stderr)
+        .map(|((x, y), s)| (x - y).abs() / s)
+        .fold(0.0, f64::max)
+}
