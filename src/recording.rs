@@ -102,6 +102,20 @@ impl Recording {
         }
     }
 
+    /// Why the time does not increase at sample `i` (the first where it does not), with how
+    /// often it does not in all and what a user can do ([`time_hint`]).
+    fn time_not_increasing(&self, i: usize) -> String {
+        let k = self.t.len();
+        let repeated = (1..k).filter(|&r| self.t[r] == self.t[r - 1]).count();
+        let back = (1..k).filter(|&r| self.t[r] < self.t[r - 1]).count();
+        format!(
+            "time is not increasing at sample {i}: t = {} after {}{} ({repeated} repeated time stamp(s) and {back} step(s) back in all)",
+            shown(self.t[i]),
+            shown(self.t[i - 1]),
+            time_hint(self.t[i], self.t[i - 1])
+        )
+    }
+
     fn check(&self) -> Result<()> {
         let k = self.t.len();
         if self.n == 0 {
@@ -117,11 +131,7 @@ impl Recording {
             )));
         }
         if let Some(i) = (1..k).find(|&i| self.t[i] <= self.t[i - 1]) {
-            return Err(self.error(format!(
-                "time is not increasing at sample {i}: t = {} after {}",
-                shown(self.t[i]),
-                shown(self.t[i - 1])
-            )));
+            return Err(self.error(self.time_not_increasing(i)));
         }
         let columns = [
             ("q", Some(&self.q)),
@@ -159,5 +169,16 @@ impl Recording {
 
     pub fn is_empty(&self) -> bool {
         self.t.is_empty()
+    }
+}
+
+/// What a time `now` that does not increase on `before` is likely to be, and what to do, for
+/// messages (it begins with ": "): a repeated stamp (a message logged twice, or a clock
+/// coarser than the rate) or a step back (logs joined end to end, rows out of order).
+pub(crate) fn time_hint(now: f64, before: f64) -> &'static str {
+    if now == before {
+        ": a repeated time stamp (a message logged twice, or a clock coarser than the sample rate); drop the repeated rows, or give each its own time"
+    } else {
+        ": a step back (logs joined end to end, or rows out of order); split the log there, or sort its rows by time"
     }
 }

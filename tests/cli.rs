@@ -917,7 +917,7 @@ fn bad_inputs_get_one_line_errors_and_no_output() {
         &["identify", s(&plan), &f, &f, "--out", s(&model)],
         &[
             "time.csv",
-            "line 4, column 't': time does not increase (t = 0.001 after 0.002 on line 3)",
+            "line 4, column 't': time does not increase (t = 0.001 after 0.002 on line 3): a step back (logs joined end to end, or rows out of order); split the log there, or sort its rows by time",
         ],
     );
     // ... after a huge time: the number in exponent form, not 301 digits

@@ -477,7 +477,32 @@ fn recordings_with_problems_get_clear_errors() {
         None,
     )
     .unwrap_err();
-    assert!(e.to_string().contains("not increasing at sample 2"), "{e}");
+    assert!(
+        e.to_string().contains("not increasing at sample 2")
+            && e.to_string()
+                .contains("a step back (logs joined end to end")
+            && e.to_string()
+                .contains("0 repeated time stamp(s) and 1 step(s) back in all"),
+        "{e}"
+    );
+    // a repeated stamp, twice: named as such, and counted
+    let e = Recording::new(
+        "r",
+        1,
+        vec![0.0, 0.001, 0.001, 0.002, 0.002],
+        vec![0.0; 5],
+        vec![0.0; 5],
+        None,
+        None,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("not increasing at sample 2: t = 0.001 after 0.001: a repeated time stamp")
+            && e.contains("drop the repeated rows")
+            && e.contains("2 repeated time stamp(s) and 0 step(s) back in all"),
+        "{e}"
+    );
     let e = Recording::new(
         "r",
         1,

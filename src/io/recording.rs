@@ -62,10 +62,11 @@ impl<'a> Columns<'a> {
             return Err(bad(
                 table,
                 format!(
-                    "time does not increase at data row {} (t = {} after {})",
+                    "time does not increase at data row {} (t = {} after {}){}",
                     i + 1,
                     shown(t[i]),
-                    shown(t[i - 1])
+                    shown(t[i - 1]),
+                    crate::recording::time_hint(t[i], t[i - 1])
                 ),
             ));
         }

@@ -155,10 +155,11 @@ impl Table {
                 let now = t.values[t.values.len() - t.columns.len() + c];
                 if now <= previous.0 {
                     return Err(t.error(format!(
-                        "line {line}, column 't': time does not increase (t = {} after {} on line {})",
+                        "line {line}, column 't': time does not increase (t = {} after {} on line {}){}",
                         crate::error::shown(now),
                         crate::error::shown(previous.0),
-                        previous.1
+                        previous.1,
+                        crate::recording::time_hint(now, previous.0)
                     )));
                 }
                 previous = (now, line);
@@ -310,7 +311,7 @@ mod tests {
         let e = Table::parse("x.csv", "t,q1\n# log\n0,1\n\n0.5,1\n0.5,2\n").unwrap_err();
         assert!(
             e.to_string().contains(
-                "line 6, column 't': time does not increase (t = 0.5 after 0.5 on line 5)"
+                "line 6, column 't': time does not increase (t = 0.5 after 0.5 on line 5): a repeated time stamp"
             ),
             "{e}"
         );
