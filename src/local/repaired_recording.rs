@@ -35,34 +35,33 @@ pub(super) fn read_experiment(
     options: &IdentifyOptions,
 ) -> Result<ReadExperiment> {
     let name = e.kind.name();
-    let mut warnings = vec![];
+    // what each step found, in words: each becomes a warning naming the experiment
+    let mut said: Vec<Option<String>> = vec![];
     let (unwrapped, wraps) = crate::position_wraps::unwrap_positions(r);
-    if let Some(w) = crate::position_wraps::warning(
+    said.push(crate::position_wraps::warning(
         &wraps,
         &r.name,
         joint_names,
         "before the crossing windows were read",
-    ) {
-        warnings.push(format!("experiment '{name}': {w}"));
-    }
+    ));
     let (reread, held_columns) = crate::held_columns::find_held_columns(&unwrapped)?;
-    if let Some(w) = crate::held_columns::warning(&held_columns, &r.name, joint_names) {
-        warnings.push(format!("experiment '{name}': {w}"));
-    }
+    said.push(crate::held_columns::warning(
+        &held_columns,
+        &r.name,
+        joint_names,
+    ));
     let r = &reread;
     if options.fit.recorded_derivatives {
         crate::derivative_columns::check_logged_derivatives(r)?;
     }
     let clipped = crate::torque_saturation::find_torque_saturation(r);
     let (repaired, held) = crate::log_screening::screen_held_readings(r)?;
-    if let Some(w) = crate::log_screening::warning(
+    said.push(crate::log_screening::warning(
         &held,
         &r.name,
         joint_names,
         "before the crossing windows were read",
-    ) {
-        warnings.push(format!("experiment '{name}': {w}"));
-    }
+    ));
     let found = crate::log_dropouts::find_removed_rows(r, &repaired)?;
     let values = if found.is_empty() {
         experiment_values(e, &repaired, joint_names, options)?
@@ -79,19 +78,18 @@ pub(super) fn read_experiment(
         v
     };
     let times: Vec<f64> = values.crossings.iter().map(|c| c.time).collect();
-    if let Some(w) =
-        crate::torque_saturation::crossing_warning(&clipped, &times, e.window, joint_names)
-    {
-        warnings.push(format!("experiment '{name}': {w}"));
-    }
-    if let Some(w) = crate::log_dropouts::dropout_warning(
+    said.push(crate::torque_saturation::crossing_warning(
+        &clipped,
+        &times,
+        e.window,
+        joint_names,
+    ));
+    said.push(crate::log_dropouts::dropout_warning(
         &found,
         &r.name,
         joint_names,
         "before the crossing windows were read (their fits use the samples left)",
-    ) {
-        warnings.push(format!("experiment '{name}': {w}"));
-    }
+    ));
     let of_experiment = Some(name.to_string());
     Ok(ReadExperiment {
         values,
@@ -109,6 +107,10 @@ pub(super) fn read_experiment(
                 ..g
             })
             .collect(),
-        warnings,
+        warnings: said
+            .into_iter()
+            .flatten()
+            .map(|w| format!("experiment '{name}': {w}"))
+            .collect(),
     })
 }
