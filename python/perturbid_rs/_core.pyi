@@ -708,6 +708,7 @@ def identify_base_parameters(
     gravity: bool = True,
     tolerance: float = 1e-8,
     seed: int = 0,
+    t: Optional[ArrayLike] = None,
 ) -> BaseParameterModel: ...
 
 @final
@@ -750,6 +751,7 @@ def identify_consistent_parameters(
     gravity: bool = True,
     prior_weight: float = 1e-6,
     max_iterations: int = 2000,
+    t: Optional[ArrayLike] = None,
 ) -> ConsistentFit:
     """Physically consistent least squares over the direct method's data (interior point)."""
 

@@ -136,9 +136,10 @@ impl PyConsistentFit {
 /// `identify_base_parameters` (same `friction`, `weighting`, `gravity`) over the parameter sets
 /// a real robot can have, solved by an interior-point (log-barrier Newton) method. The robot's own
 /// parameters are a weak prior (`prior_weight` relative to each column's norm) that decides
-/// what the data do not. Returns a ConsistentFit.
+/// what the data do not. `t` ((k,) s), when the samples are a log: its qd and qdd columns are
+/// checked first, as `identify_base_parameters` checks them. Returns a ConsistentFit.
 #[pyfunction]
-#[pyo3(signature = (robot, q, qd, qdd, tau, friction=None, weighting="wls", gravity=true, prior_weight=1e-6, max_iterations=2000))]
+#[pyo3(signature = (robot, q, qd, qdd, tau, friction=None, weighting="wls", gravity=true, prior_weight=1e-6, max_iterations=2000, t=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_consistent_parameters(
     py: Python<'_>,
@@ -152,6 +153,7 @@ pub(crate) fn identify_consistent_parameters(
     gravity: bool,
     #[pyo3(from_py_with = scalars::real)] prior_weight: f64,
     #[pyo3(from_py_with = scalars::count)] max_iterations: usize,
+    t: Option<ArrayLike<'_>>,
 ) -> PyResult<PyConsistentFit> {
     let options = base_options(friction, weighting, gravity)?;
     let consistent = ConsistentOptions {
@@ -161,7 +163,12 @@ pub(crate) fn identify_consistent_parameters(
     };
     let model = &robot.model;
     let c = states(model.nv, &q, &qd, &qdd, Some(&tau))?;
+    let t = (t.as_ref())
+        .map(|t| super::arrays::vector("t", t))
+        .transpose()?;
     let fit = detached(py, "identify_consistent_parameters", || {
+        let what = "identify_consistent_parameters' samples";
+        super::direct::check_sample_derivatives(what, model.nv, t, &c)?;
         consistent_rs(
             model,
             &States::new(model.nv, &c[0], Some(&c[1]), Some(&c[2]))?,

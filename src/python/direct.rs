@@ -14,7 +14,7 @@ use super::detached;
 use pyo3::types::PyDict;
 
 use super::arrays::{
-    at_states, expansion_dict, matrix_to_numpy as mat, read_batch, to_numpy, ArrayLike,
+    at_states, expansion_dict, matrix_to_numpy as mat, read_batch, to_numpy, vector, ArrayLike,
 };
 use super::local::PyOperatingPoint;
 use super::robot::PyRobot;
@@ -225,6 +225,41 @@ pub(crate) fn states<'a>(
         args.push(("tau", t));
     }
     Ok(read_batch(n, &args)?.columns)
+}
+
+/// With `t` given ((k,) s, read by the caller, strictly increasing, one per row of the samples `c`: q, qd, qdd,
+/// tau as [`states`] read them), the samples taken for a log: its velocity and acceleration
+/// columns are checked against the derivatives of its positions and velocities
+/// ([`crate::derivative_columns::check_logged_derivatives`]), so velocities in deg/s, swapped
+/// or negated columns are refused naming the joint. Without `t` nothing is checked: states
+/// need not be a trajectory. `what` names the samples in messages.
+pub(crate) fn check_sample_derivatives(
+    what: &str,
+    n: usize,
+    t: Option<Vec<f64>>,
+    c: &[Cow<'_, [f64]>],
+) -> Result<()> {
+    let Some(t) = t else {
+        return Ok(());
+    };
+    let k = c[0].len() / n;
+    if t.len() != k {
+        return Err(Error::Shape {
+            argument: "t".into(),
+            expected: format!("({k},): one time per row of q"),
+            got: format!("shape ({},)", t.len()),
+        });
+    }
+    let log = crate::recording::Recording::new(
+        what,
+        n,
+        t,
+        c[0].to_vec(),
+        c[3].to_vec(),
+        Some(c[1].to_vec()),
+        Some(c[2].to_vec()),
+    )?;
+    crate::derivative_columns::check_logged_derivatives(&log)
 }
 
 /// The options of the direct method from its Python arguments (`friction`, `weighting`,
@@ -463,9 +498,12 @@ impl PyBaseModel {
 /// Identifies the base parameters of `robot` from samples `q`, `qd`, `qdd`, `tau` (each (k, n);
 /// rad, rad/s, rad/s^2, N m). `friction`: True (viscous, Coulomb and offset per joint), False,
 /// or a list of those names; `weighting`: 'wls' (default) or 'ols'; `gravity`: whether `tau`
-/// includes gravity; `tolerance`: relative rank tolerance of the pivoted QR.
+/// includes gravity; `tolerance`: relative rank tolerance of the pivoted QR. `t` ((k,) s),
+/// when the samples are a log: its qd and qdd columns are checked against the derivatives of
+/// q and qd first (see `check_sample_derivatives`), refusing columns in other units, of
+/// another joint or of the opposite sign.
 #[pyfunction]
-#[pyo3(signature = (robot, q, qd, qdd, tau, friction=None, weighting="wls", gravity=true, tolerance=1e-8, seed=0))]
+#[pyo3(signature = (robot, q, qd, qdd, tau, friction=None, weighting="wls", gravity=true, tolerance=1e-8, seed=0, t=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_base_parameters(
     py: Python<'_>,
@@ -479,6 +517,7 @@ pub(crate) fn identify_base_parameters(
     gravity: bool,
     #[pyo3(from_py_with = scalars::real)] tolerance: f64,
     #[pyo3(from_py_with = scalars::seed)] seed: u64,
+    t: Option<ArrayLike<'_>>,
 ) -> PyResult<PyBaseModel> {
     let options = BaseOptions {
         tolerance,
@@ -487,7 +526,9 @@ pub(crate) fn identify_base_parameters(
     };
     let model = &robot.model;
     let c = states(model.nv, &q, &qd, &qdd, Some(&tau))?;
+    let t = t.as_ref().map(|t| vector("t", t)).transpose()?;
     let fit = detached(py, "identify_base_parameters", || {
+        check_sample_derivatives("identify_base_parameters' samples", model.nv, t, &c)?;
         base_rs(
             model,
             &States::new(model.nv, &c[0], Some(&c[1]), Some(&c[2]))?,

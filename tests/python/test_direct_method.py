@@ -826,3 +826,34 @@ def test_positions_in_coarse_counts_under_derived_velocities_are_warned_of():
         warnings.simplefilter("error")
         logged = pr.preprocess(t, np.round(q / step) * step, tau, qd=qd)
     assert logged.position_rounding == []
+
+
+def test_a_logs_derivative_columns_are_checked_when_its_time_is_given():
+    """With `t`, identify_base_parameters and identify_consistent_parameters take the samples
+    for a log and refuse velocity or acceleration columns that are not the derivatives of the
+    positions and velocities (other units, another joint's), naming the joint; the clean log
+    fits exactly as without `t`. Without `t` states need not be a trajectory: unchecked."""
+    robot = pr.robots.a465()
+    traj = excitation(robot, 5, 0.1, 0.12, 1)
+    t = np.arange(0, traj.period, 0.005)
+    q, qd, qdd = traj.sample(t)
+    tau = robot.rnea(q, qd, qdd)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", pr.PerturbidWarning)
+        checked = pr.identify_base_parameters(robot, q, qd, qdd, tau, weighting="ols", t=t)
+    plain = pr.identify_base_parameters(robot, q, qd, qdd, tau, weighting="ols")
+    np.testing.assert_array_equal(checked.theta_base, plain.theta_base)
+    degrees = qd.copy()
+    degrees[:, 3] = np.degrees(qd[:, 3])
+    with pytest.raises(pr.InputError, match=r"joint 4: 57\.29\d times its positions' derivative: degrees per second read as rad/s"):
+        pr.identify_base_parameters(robot, q, degrees, qdd, tau, weighting="ols", t=t)
+    with pytest.raises(pr.InputError, match=r"joint 4: 57\.29\d times"):
+        pr.identify_consistent_parameters(robot, q, degrees, qdd, tau, t=t)
+    pr.identify_base_parameters(robot, q, degrees, qdd, tau, weighting="ols")  # not checked
+    swapped = qdd[:, [0, 2, 1, 3, 4, 5]]
+    with pytest.raises(pr.InputError, match=r"joint 2: follows the velocities of joint 3"):
+        pr.identify_base_parameters(robot, q, qd, swapped, tau, weighting="ols", t=t)
+    with pytest.raises(pr.InputError, match=r"t: expected \(%d,\): one time per row of q, got shape \(%d,\)" % (len(t), len(t) - 1)):
+        pr.identify_base_parameters(robot, q, qd, qdd, tau, t=t[:-1])
+    with pytest.raises(pr.InputError, match="time is not increasing at sample 1"):
+        pr.identify_base_parameters(robot, q, qd, qdd, tau, t=np.zeros(len(t)))
