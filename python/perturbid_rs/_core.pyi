@@ -798,7 +798,9 @@ class Validation:
     def to_dataframe(self) -> Any:
         """The per-joint table as a pandas DataFrame (index joint; rms, relative_rms, max)."""
 
-def validate(model: Any, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, tau: ArrayLike) -> Validation:
+def validate(
+    model: Any, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, tau: ArrayLike, t: Optional[ArrayLike] = None
+) -> Validation:
     """Validates any model with predict(q, qd, qdd) on measured states and torques; for a
     BaseParameterModel also checks the torque columns against its robot's model (a
     PerturbidWarning per finding: swapped, the opposite sign, other units)."""

@@ -183,14 +183,18 @@ impl PyValidation {
 /// model (swapped columns, the opposite sign, other units: a PerturbidWarning each, and
 /// `Validation.torque_columns`), for a lag behind the positions (`Validation.torque_lag`) and
 /// for joints zeroed elsewhere than in the model's data (`Validation.position_offsets`).
-/// Returns a Validation.
+/// `t` ((k,) s), when the samples are a log: its qd and qdd columns are checked first against
+/// the derivatives of q and qd, as `identify_base_parameters` checks them. Returns a
+/// Validation.
 #[pyfunction]
+#[pyo3(signature = (model, q, qd, qdd, tau, t=None))]
 pub(crate) fn validate<'py>(
     model: Bound<'py, PyAny>,
     q: Bound<'py, PyAny>,
     qd: Bound<'py, PyAny>,
     qdd: Bound<'py, PyAny>,
     tau: ArrayLike<'py>,
+    t: Option<ArrayLike<'py>>,
 ) -> PyResult<PyValidation> {
     let measured = {
         let array = tau.as_array();
@@ -207,6 +211,16 @@ pub(crate) fn validate<'py>(
         (n, batch.columns[0].to_vec())
     };
     let (n, measured) = measured;
+    if let Some(t) = &t {
+        let (q, qd, qdd): (ArrayLike, ArrayLike, ArrayLike) =
+            (q.extract()?, qd.extract()?, qdd.extract()?);
+        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd), ("tau", &tau)])?;
+        let t = super::arrays::vector("t", t)?;
+        let samples = &batch.columns;
+        detached(model.py(), "validate", || {
+            super::direct::check_sample_derivatives("validate's samples", n, Some(t), samples)
+        })?;
+    }
     let predicted = model.call_method1("predict", (&q, &qd, &qdd))?;
     let predicted: Vec<f64> = predicted
         .extract::<Bound<'py, numpy::PyArrayDyn<f64>>>()?

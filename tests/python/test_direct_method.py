@@ -849,6 +849,9 @@ def test_a_logs_derivative_columns_are_checked_when_its_time_is_given():
         pr.identify_base_parameters(robot, q, degrees, qdd, tau, weighting="ols", t=t)
     with pytest.raises(pr.InputError, match=r"joint 4: 57\.29\d times"):
         pr.identify_consistent_parameters(robot, q, degrees, qdd, tau, t=t)
+    with pytest.raises(pr.InputError, match=r"validate's samples: .*joint 4: 57\.29\d times"):
+        pr.validate(plain, q, degrees, qdd, tau, t=t)
+    np.testing.assert_array_equal(pr.validate(plain, q, qd, qdd, tau, t=t).rms, pr.validate(plain, q, qd, qdd, tau).rms)
     pr.identify_base_parameters(robot, q, degrees, qdd, tau, weighting="ols")  # not checked
     swapped = qdd[:, [0, 2, 1, 3, 4, 5]]
     with pytest.raises(pr.InputError, match=r"joint 2: follows the velocities of joint 3"):
