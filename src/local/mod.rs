@@ -60,6 +60,7 @@ pub mod reversals;
 pub mod rounded_positions;
 pub mod session;
 pub mod torque_offsets;
+mod trajectory_builder;
 
 pub use clock::{check_clock, covering_offsets, overlap_offsets, position_misfit, PositionMisfit};
 pub use crossing::{
