@@ -634,6 +634,10 @@ class BaseParameterModel:
         to the logged positions, stderr, unexplained, unexplained_with_offsets, finding), or
         None where no joint's offset is determined; a finding is also a warning."""
     @property
+    def unmodelled_friction(self) -> list[dict[str, Any]]:
+        """Joints whose torques show friction terms the fit lacks: joint, explained,
+        residual_rms, remaining_rms, terms (dicts term, coefficient, stderr); also warnings."""
+    @property
     def position_range(self) -> list[dict[str, Any]]:
         """The joints whose positions in the data leave their URDF limits by more than 5 % of
         their range (joint, min, max, lower, upper in rad or m; degrees: True where, read as

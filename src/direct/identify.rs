@@ -139,6 +139,11 @@ pub struct BaseModel {
     /// joint's offset is determined (or in a model saved before it was checked).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub position_offsets: Option<super::position_offsets::PositionOffsets>,
+    /// The joints whose residuals friction terms the fit lacks explain
+    /// ([`super::unmodelled_friction`]): warned of ([`BaseModel::warnings`]). Empty where
+    /// none do, the fit has every friction term, or in a model saved before it was checked.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub unmodelled_friction: Vec<super::unmodelled_friction::UnmodelledFriction>,
     /// The correlation of the estimates in `theta` (p x p, unit diagonal): with `stderr`,
     /// `diag(stderr) R diag(stderr)` is their covariance, which [`BaseModel::predict_stderr`]
     /// needs. In a physically consistent model, the unconstrained fit's (with its standard
@@ -233,20 +238,26 @@ pub fn identify_consistent_parameters(
     })
 }
 
-/// [`identify_base_parameters`] with the reduced data it was computed from.
-fn fit_with_factors(
+/// A least-squares fit of the base parameters: OLS, or WLS weighted by the OLS residuals.
+pub(super) struct Solved {
+    pub base: BaseParameters,
+    pub factors: streaming::JointFactors,
+    pub ls: crate::regression::LeastSquares,
+    /// Per joint, the residual RMS (N m or N) and the weight's noise level.
+    pub rms: Vec<f64>,
+    pub sigma: Vec<f64>,
+}
+
+/// The base parameters of `model` with `options`' terms fitted to `tau` (row-major `k x nv`,
+/// N m) at `states`, checked already: one pass over the samples gives the OLS fit, the WLS
+/// weights (each joint's OLS residual RMS) and the WLS fit. Errors: residuals that overflow.
+pub(super) fn solve(
     model: &Model,
     states: &States<'_>,
     tau: &[f64],
     options: &BaseOptions,
-) -> Result<(BaseModel, streaming::JointFactors)> {
+) -> Result<Solved> {
     let nv = model.nv;
-    crate::torque_model::check_joints(states, nv)?;
-    states.check_companion("tau", tau, nv)?;
-    crate::limits::check_range("tolerance", options.tolerance, 1e-15, 0.1)?;
-    crate::limits::check_count("states", options.states, 1, 1_000_000)?;
-    crate::torque_model::refuse_flat_torques(states, tau, &model.joint_names)?;
-    let k = states.len();
     let layout = ParameterLayout::new(model, options.friction.for_model(model));
     let base = BaseParameters::from_random_states(
         model,
@@ -257,10 +268,8 @@ fn fit_with_factors(
         options.seed,
     )?;
     let names = base.names();
-    let g = options.gravity;
     let mut sigma = vec![1.0; nv];
-    // one pass over the samples; OLS, the WLS weights and the WLS fit all come from it
-    let factors = streaming::JointFactors::new(model, &base, states, tau, g)?;
+    let factors = streaming::JointFactors::new(model, &base, states, tau, options.gravity)?;
     let mut ls = factors.solve(&sigma, &names)?;
     let mut rms = factors.residual_rms(ls.coef.as_slice())?;
     // residuals past f64's range (torques or states near 1e300) can be neither weighted nor
@@ -279,6 +288,36 @@ fn fit_with_factors(
         ls = factors.solve(&sigma, &names)?;
         rms = factors.residual_rms(ls.coef.as_slice())?;
     }
+    Ok(Solved {
+        base,
+        factors,
+        ls,
+        rms,
+        sigma,
+    })
+}
+
+/// [`identify_base_parameters`] with the reduced data it was computed from.
+fn fit_with_factors(
+    model: &Model,
+    states: &States<'_>,
+    tau: &[f64],
+    options: &BaseOptions,
+) -> Result<(BaseModel, streaming::JointFactors)> {
+    let nv = model.nv;
+    crate::torque_model::check_joints(states, nv)?;
+    states.check_companion("tau", tau, nv)?;
+    crate::limits::check_range("tolerance", options.tolerance, 1e-15, 0.1)?;
+    crate::limits::check_count("states", options.states, 1, 1_000_000)?;
+    crate::torque_model::refuse_flat_torques(states, tau, &model.joint_names)?;
+    let k = states.len();
+    let Solved {
+        base,
+        factors,
+        ls,
+        rms,
+        sigma,
+    } = solve(model, states, tau, options)?;
     let mut fit = BaseModel {
         format: BaseModel::tag(),
         robot: model.name.clone(),
@@ -309,6 +348,7 @@ fn fit_with_factors(
         torque_lag: super::torque_lag::check_torque_lag(model, states, tau, options.gravity)?,
         position_range: super::position_range::check_position_range(model, states),
         position_offsets: None,
+        unmodelled_friction: vec![],
     };
     // residuals correlated from sample to sample (a filtered, lightly decimated log) carry less
     // information than their number says
@@ -322,6 +362,8 @@ fn fit_with_factors(
     }
     fit.position_offsets =
         super::position_offsets::check_position_offsets(model, &fit, states, tau)?;
+    fit.unmodelled_friction =
+        super::unmodelled_friction::check_unmodelled_friction(model, &fit, states, tau, options)?;
     Ok((fit, factors))
 }
 
@@ -521,6 +563,14 @@ impl Document for BaseModel {
         if let Some(problem) = (m.position_offsets.as_ref()).and_then(|o| o.problem(&m.joint_names))
         {
             return Err(invalid(Self::WHAT, format!("position_offsets: {problem}")));
+        }
+        if let Some((i, problem)) = (m.unmodelled_friction.iter().enumerate())
+            .find_map(|(i, f)| f.problem(&m.joint_names).map(|p| (i, p)))
+        {
+            return Err(invalid(
+                Self::WHAT,
+                format!("unmodelled_friction[{i}]: {problem}"),
+            ));
         }
         if let Some((i, problem)) = m.position_range.iter().enumerate().find_map(|(i, r)| {
             let unknown = (!m.joint_names.contains(&r.joint))

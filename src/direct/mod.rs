@@ -18,6 +18,7 @@ pub mod residual_correlation;
 pub mod streaming;
 pub mod torque_columns;
 pub mod torque_lag;
+pub mod unmodelled_friction;
 pub mod workspace;
 
 pub use base::BaseParameters;
@@ -37,4 +38,5 @@ pub use position_offsets::{
 };
 pub use torque_columns::{check_torque_columns, TorqueColumn};
 pub use torque_lag::{check_torque_lag, TorqueLag};
+pub use unmodelled_friction::{check_unmodelled_friction, MissingTerm, UnmodelledFriction};
 pub use workspace::{workspace_from_json, CartesianConstraint, Region};

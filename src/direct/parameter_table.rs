@@ -48,7 +48,8 @@ impl BaseModel {
     /// the robot's model says they should ([`super::torque_columns`]: swapped, of the opposite
     /// sign, in other units), torques out of step with their positions
     /// ([`super::torque_lag`]), joints whose zeros in the data look offset
-    /// ([`super::position_offsets`]), positions logged in counts so coarse that their rounding
+    /// ([`super::position_offsets`]), friction the fit leaves out that shows in its residuals
+    /// ([`super::unmodelled_friction`]), positions logged in counts so coarse that their rounding
     /// shows in the derived velocities ([`crate::position_rounding`]), and friction or armature coefficients identified on their own
     /// (not in a combination) and negative beyond three standard errors. No joint has them;
     /// the data hold an effect the model lacks, or are not what it assumes. A consistent fit
@@ -81,9 +82,14 @@ impl BaseModel {
             crate::position_rounding::warning(&self.position_rounding, &self.joint_names)
                 .map(|w| format!("{w}{}", crate::position_rounding::IN_A_FIT));
         let offsets = (self.position_offsets.as_ref()).and_then(|o| o.finding());
+        let friction = super::unmodelled_friction::finding(
+            &self.unmodelled_friction,
+            self.base.layout.friction,
+        );
         columns
             .into_iter()
             .chain(offsets)
+            .chain(friction)
             .chain(rounding)
             .chain(negative)
             .collect()

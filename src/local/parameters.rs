@@ -306,6 +306,7 @@ pub fn identify_parameters_from_local(
         torque_lag: None,
         position_range: vec![],
         position_offsets: None,
+        unmodelled_friction: vec![],
     };
     let consistent = match &options.consistent {
         None => None,

@@ -386,6 +386,35 @@ impl PyBaseModel {
             .map(|o| position_offsets_dict(py, o, o.finding()))
             .transpose()
     }
+    /// The joints whose torques show friction terms the fit lacks (the fit made again with
+    /// viscous, Coulomb and offset terms): dicts `joint`, `explained` (the fraction of its
+    /// residual sum of squares the terms take off), `residual_rms` and `remaining_rms` (N m,
+    /// without and with them), `terms` (dicts `term`: 'viscous', 'coulomb' or 'offset',
+    /// `coefficient` (N m s/rad, N m), `stderr`); their finding is also a warning. Empty where
+    /// none do or the fit has every term.
+    #[getter]
+    fn unmodelled_friction<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        (self.fit.unmodelled_friction.iter())
+            .map(|f| {
+                let e = PyDict::new(py);
+                e.set_item("joint", &f.joint)?;
+                e.set_item("explained", f.explained)?;
+                e.set_item("residual_rms", f.residual_rms)?;
+                e.set_item("remaining_rms", f.remaining_rms)?;
+                let terms = (f.terms.iter())
+                    .map(|t| {
+                        let d = PyDict::new(py);
+                        d.set_item("term", &t.term)?;
+                        d.set_item("coefficient", t.coefficient)?;
+                        d.set_item("stderr", t.stderr)?;
+                        Ok(d)
+                    })
+                    .collect::<PyResult<Vec<_>>>()?;
+                e.set_item("terms", terms)?;
+                Ok(e)
+            })
+            .collect()
+    }
     /// The joints whose positions in the data leave their URDF limits by more than 5 % of
     /// their range: dicts `joint`, `min`, `max` (the positions logged), `lower`, `upper` (the
     /// limits; rad or m) and `degrees` (True where, read as degrees, they lie within the

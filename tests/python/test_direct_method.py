@@ -860,3 +860,31 @@ def test_a_logs_derivative_columns_are_checked_when_its_time_is_given():
         pr.identify_base_parameters(robot, q, qd, qdd, tau, t=t[:-1])
     with pytest.raises(pr.InputError, match="time is not increasing at sample 1"):
         pr.identify_base_parameters(robot, q, qd, qdd, tau, t=np.zeros(len(t)))
+
+
+def test_friction_the_fit_leaves_out_is_named_with_its_coefficients():
+    """A log whose shoulder has 1 N m of Coulomb friction, fitted without friction, warns of it
+    and lists it in fit.unmodelled_friction with the coefficient the fit with every friction
+    term identifies; that fit, and a log without friction, raise nothing."""
+    robot = pr.robots.a465()
+    traj = excitation(robot, 5, 0.1, 0.12, 1)
+    t = np.arange(0, traj.period, 0.005)
+    q, qd, qdd = traj.sample(t)
+    rng = np.random.default_rng(3)
+    clean = robot.rnea(q, qd, qdd) + 0.05 * rng.standard_normal(q.shape)
+    tau = clean + np.sign(qd) * (np.arange(6) == 1)
+    with pytest.warns(pr.PerturbidWarning, match=r"friction the fit leaves out shows in the torques of 1 joint\(s\).*'joint2' \(coulomb [01]\.\d{3} \+- 0\.0\d\d N m.*friction=\['coulomb'\]"):
+        fit = pr.identify_base_parameters(robot, q, qd, qdd, tau)
+    [found] = fit.unmodelled_friction
+    assert found["joint"] == "joint2" and found["explained"] > 0.9
+    [coulomb] = found["terms"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", pr.PerturbidWarning)
+        every = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction="all")
+        pr.identify_base_parameters(robot, q, qd, qdd, clean)
+    assert every.unmodelled_friction == []
+    assert coulomb["term"] == "coulomb"
+    assert coulomb["coefficient"] == pytest.approx(every.theta_base[every.names.index("joint2.coulomb")], rel=1e-9)
+    assert abs(coulomb["coefficient"] - 1.0) < 4 * coulomb["stderr"]
+    rms = every.residual_rms[1] / fit.residual_rms[1]
+    assert found["explained"] == pytest.approx(1 - rms**2, abs=1e-9)

@@ -1,0 +1,254 @@
+//! Friction the direct fit left out, found by fitting it (docs/method.md, section 8).
+//!
+//! Every real joint has friction, but the direct method identifies it only where asked (Python's
+//! default is none). Left out, it went into the inertial parameters without a word: on the
+//! A465's test excitation, a Coulomb friction of 1 N m on the shoulder moved the base
+//! parameters by 215 of their standard errors, with the residual RMS on that joint 14 times the
+//! torque noise; on the real Franka Emika Panda log fitted without friction, viscous, Coulomb
+//! and offset terms explain 51 to 92 % of every joint's residual.
+//!
+//! So a fit that lacks some of the friction terms (viscous `qd_j`, Coulomb `sign(qd_j)`, a
+//! constant offset, each per joint) is fitted again with them, on at most [`SAMPLES`] samples
+//! spread evenly over the data, with the same weighting. A joint is a finding where the terms
+//! take at least [`EXPLAINED`] off its residual sum of squares there, and at least one of its
+//! own new terms is [`T_NAMED`] or more of its standard errors (inflated for residuals
+//! correlated from sample to sample, [`super::residual_correlation`]) from 0; those terms are
+//! named with their coefficients. A joint whose residual shrinks only because the other joints'
+//! friction no longer biases the shared parameters has no term of its own to name, and is no
+//! finding. What the data cannot tell from the rigid-body model is not found: an offset where
+//! gravity barely changes over a joint's motion is absorbed by the gravity parameters, and the
+//! terms are not judged where the refit's parameters are not determined.
+
+use serde::{Deserialize, Serialize};
+
+use super::identify::{BaseModel, BaseOptions};
+use super::parameters::FrictionTerms;
+use crate::error::Result;
+use crate::model::Model;
+use crate::states::States;
+
+/// The most samples the fit with the missing terms takes (spread evenly over the data).
+pub const SAMPLES: usize = 20_000;
+
+/// The fraction of a joint's residual sum of squares the missing terms must take off.
+pub const EXPLAINED: f64 = 0.25;
+
+/// How many standard errors from 0 a joint's own new term must be to be named.
+pub const T_NAMED: f64 = 5.0;
+
+/// The friction terms a joint can have.
+const TERMS: [&str; 3] = ["viscous", "coulomb", "offset"];
+
+/// A friction term of one joint, identified by the fit with the missing terms.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MissingTerm {
+    /// `viscous`, `coulomb` or `offset`.
+    pub term: String,
+    /// Its coefficient (N m s/rad, N m, N m; N s/m, N, N for a prismatic joint).
+    pub coefficient: f64,
+    /// Its standard error (same unit), inflated for residuals correlated from sample to sample.
+    pub stderr: f64,
+}
+
+/// A joint whose residual the friction terms the fit lacks take [`EXPLAINED`] or more off,
+/// with a term of its own [`T_NAMED`] standard errors from 0.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UnmodelledFriction {
+    pub joint: String,
+    /// The fraction of its residual sum of squares the terms take off.
+    pub explained: f64,
+    /// Its residual RMS without and with the terms (N m or N), over the samples refitted.
+    pub residual_rms: f64,
+    pub remaining_rms: f64,
+    /// Its new terms that are [`T_NAMED`] standard errors from 0.
+    pub terms: Vec<MissingTerm>,
+}
+
+impl UnmodelledFriction {
+    /// What is wrong with the entry of a saved model, if anything: an unknown joint or term,
+    /// no term, a fraction outside [0, 1], values that are not finite.
+    pub fn problem(&self, joints: &[String]) -> Option<String> {
+        let who = format!("joint '{}'", self.joint);
+        if !joints.contains(&self.joint) {
+            return Some(format!("{who} is not one of the model's"));
+        }
+        if !(0.0..=1.0).contains(&self.explained) {
+            return Some(format!(
+                "{who}: explained {}, expected a fraction in [0, 1]",
+                self.explained
+            ));
+        }
+        let values = [self.residual_rms, self.remaining_rms];
+        let terms = self.terms.iter().flat_map(|t| [t.coefficient, t.stderr]);
+        if values.into_iter().chain(terms).any(|v| !v.is_finite()) {
+            return Some(format!("{who}: a value that is not finite"));
+        }
+        if self.terms.is_empty() {
+            return Some(format!("{who}: no term, expected at least one"));
+        }
+        (self
+            .terms
+            .iter()
+            .find(|t| !TERMS.contains(&t.term.as_str())))
+        .map(|t| {
+            format!(
+                "{who}: term '{}', expected one of {}",
+                t.term,
+                TERMS.join(", ")
+            )
+        })
+    }
+
+    /// The joint's terms as `coulomb 0.43 +- 0.01 N m` items.
+    fn terms_said(&self) -> String {
+        let unit = |t: &str| if t == "viscous" { " N m s/rad" } else { " N m" };
+        (self.terms.iter())
+            .map(|t| {
+                let (c, se, u) = (t.coefficient, t.stderr, unit(&t.term));
+                format!("{} {c:.3} +- {se:.3}{u}", t.term)
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// The warning for `found` (none if empty) in a fit with the terms `fitted`: which joints,
+/// which terms, and the friction terms to identify with (those fitted and those found).
+pub fn finding(found: &[UnmodelledFriction], fitted: FrictionTerms) -> Option<String> {
+    if found.is_empty() {
+        return None;
+    }
+    let named = |t: &str| found.iter().any(|f| f.terms.iter().any(|x| x.term == t));
+    // the armature is added where the robot has one: not the user's to ask for
+    let with = FrictionTerms {
+        viscous: fitted.viscous || named("viscous"),
+        coulomb: fitted.coulomb || named("coulomb"),
+        offset: fitted.offset || named("offset"),
+        armature: false,
+    };
+    let names = with.names();
+    let joints: Vec<String> = (found.iter())
+        .map(|f| {
+            format!(
+                "'{}' ({}; residual RMS {:.3}, {:.3} with them: {:.0} % of its sum of squares)",
+                f.joint,
+                f.terms_said(),
+                f.residual_rms,
+                f.remaining_rms,
+                100.0 * f.explained
+            )
+        })
+        .collect();
+    Some(format!(
+        "friction the fit leaves out shows in the torques of {} joint(s), and the fit's parameters took up what they could of it: {}; identify with those terms (friction=[{}] in Python, --friction {} on the command line)",
+        found.len(),
+        joints.join("; "),
+        names.iter().map(|n| format!("'{n}'")).collect::<Vec<_>>().join(", "),
+        names.join(",")
+    ))
+}
+
+/// The joints of `model` whose torques `tau` (row-major `k x nv`, N m, at `states`, samples in
+/// time order) show friction terms `fit` (identified from them with `options`) lacks (see the
+/// module documentation). None where the fit has every term, the states have no velocities,
+/// or the refit is not determined. Stops on Ctrl-C.
+pub fn check_unmodelled_friction(
+    model: &Model,
+    fit: &BaseModel,
+    states: &States<'_>,
+    tau: &[f64],
+    options: &BaseOptions,
+) -> Result<Vec<UnmodelledFriction>> {
+    let fitted = fit.base.layout.friction;
+    let missing: Vec<&str> = (TERMS.iter().copied())
+        .filter(|t| match *t {
+            "viscous" => !fitted.viscous,
+            "coulomb" => !fitted.coulomb,
+            _ => !fitted.offset,
+        })
+        .collect();
+    let (n, k) = (model.nv, states.len());
+    let Some(qd) = states.qd() else {
+        return Ok(vec![]);
+    };
+    if missing.is_empty() || k == 0 {
+        return Ok(vec![]);
+    }
+    crate::interrupt::check("checking the fit for friction it leaves out")?;
+    // the samples refitted, spread evenly over the data and in time order
+    let count = k.min(SAMPLES);
+    let rows: Vec<usize> = (0..count).map(|i| i * k / count).collect();
+    let pick = |x: &[f64]| -> Vec<f64> {
+        (rows.iter())
+            .flat_map(|&s| x[s * n..(s + 1) * n].iter().copied())
+            .collect()
+    };
+    let (q, v, a, measured) = (
+        pick(states.q()),
+        pick(qd),
+        states.qdd().map(pick),
+        pick(tau),
+    );
+    let sub = States::new(n, &q, Some(&v), a.as_deref())?;
+    let all = FrictionTerms {
+        viscous: true,
+        coulomb: true,
+        offset: true,
+        ..fitted
+    };
+    let options = BaseOptions {
+        friction: all,
+        ..options.clone()
+    };
+    // fewer samples than parameters (or a refit the data do not determine): nothing to judge
+    let Ok(solved) = super::identify::solve(model, &sub, &measured, &options) else {
+        return Ok(vec![]);
+    };
+    let refit = BaseModel {
+        theta: solved.ls.coef.row(0).iter().copied().collect(),
+        stderr: solved.ls.stderr.row(0).iter().copied().collect(),
+        base: solved.base,
+        ..fit.clone()
+    };
+    let residual = |m: &BaseModel| -> Result<Vec<f64>> {
+        let p = m.predict(model, &sub)?;
+        Ok(measured.iter().zip(&p).map(|(t, p)| t - p).collect())
+    };
+    let (before, after) = (residual(fit)?, residual(&refit)?);
+    let long_run = super::residual_correlation::long_run_factors(&after, n);
+    let table = refit.parameter_table();
+    let sum_of_squares =
+        |r: &[f64], j: usize| (0..count).map(|i| r[i * n + j].powi(2)).sum::<f64>();
+    let mut found = vec![];
+    for (j, joint) in model.joint_names.iter().enumerate() {
+        let (was, is) = (sum_of_squares(&before, j), sum_of_squares(&after, j));
+        let explained = 1.0 - is / was;
+        if !(was > 0.0 && explained >= EXPLAINED) {
+            continue;
+        }
+        let inflation = long_run[j].sqrt();
+        let terms: Vec<MissingTerm> = (missing.iter())
+            .filter_map(|t| {
+                let row = table.iter().find(|r| r.name == format!("{joint}.{t}"))?;
+                let stderr = row.std? * inflation;
+                (!row.combination && row.value.abs() >= T_NAMED * stderr).then(|| MissingTerm {
+                    term: t.to_string(),
+                    coefficient: row.value,
+                    stderr,
+                })
+            })
+            .collect();
+        if !terms.is_empty() && explained.is_finite() {
+            found.push(UnmodelledFriction {
+                joint: joint.clone(),
+                explained: explained.min(1.0),
+                residual_rms: (was / count as f64).sqrt(),
+                remaining_rms: (is / count as f64).sqrt(),
+                terms,
+            });
+        }
+    }
+    Ok(found)
+}
