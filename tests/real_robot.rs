@@ -499,6 +499,7 @@ fn closed_loop_tracking_errors_favour_the_combined_estimate() {
             kd: vec![40.0; n],
             substeps: 2,
             feedforward: true,
+            effort: None,
         }),
         ..TrueRobot::default()
     };

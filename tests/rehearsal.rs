@@ -254,6 +254,7 @@ fn tracking_error_shrinks_as_gains_grow() {
                 kd: vec![2.0 * kp.sqrt(); n],
                 substeps: 4,
                 feedforward: true,
+                effort: None,
             }),
             ..TrueRobot::default()
         };
@@ -416,6 +417,7 @@ fn bad_true_robot_documents_are_refused_by_name() {
             kd: vec![0.0; 6],
             substeps: 1,
             feedforward: true,
+            effort: None,
         }),
         ..TrueRobot::default()
     };
@@ -559,4 +561,90 @@ fn friction_keeps_its_direction_where_a_joint_touches_zero_speed() {
     let noisy = rehearse(&model, &doc(&json), &s, 0, "excitation").unwrap();
     let (_, glitches) = perturbid_rs::log_screening::screen_recording(&noisy).unwrap();
     assert!(glitches.is_empty(), "{glitches:?}");
+}
+
+/// A drive's torque limit (`controller.effort`): the command is clipped there and logged so,
+/// the joint falls behind the reference, and the log's preprocessing names the clipped
+/// torques; the joints whose limits are not reached log what they would without one.
+#[test]
+fn a_saturated_drive_clips_its_command_and_the_log_shows_it() {
+    use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let r = reference(n, 4.0, 500.0);
+    let run = |effort: Option<Vec<f64>>| {
+        let robot = TrueRobot {
+            controller: Some(Controller {
+                kp: vec![400.0; n],
+                kd: vec![40.0; n],
+                substeps: 4,
+                feedforward: true,
+                effort,
+            }),
+            ..TrueRobot::default()
+        };
+        rehearse(&model, &robot, &r, 0, "tracked").unwrap()
+    };
+    let free = run(None);
+    let k = r.len();
+    let column = |x: &[f64], j: usize| -> Vec<f64> { (0..k).map(|i| x[i * n + j]).collect() };
+    let peak = column(&free.tau, 1)
+        .iter()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    let limit = 0.97 * peak;
+    let mut effort = vec![1e6; n];
+    effort[1] = limit;
+    let held = run(Some(effort));
+    let shoulder = column(&held.tau, 1);
+    assert!(shoulder.iter().all(|x| x.abs() <= limit));
+    let clipped = shoulder.iter().filter(|x| x.abs() == limit).count();
+    assert!(clipped > 20, "{clipped} samples at the limit");
+    // the shoulder falls behind where its drive saturates
+    let error = |rec: &perturbid_rs::Recording| {
+        (0..k)
+            .map(|i| (rec.q[i * n + 1] - r.q[i * n + 1]).abs())
+            .fold(0.0, f64::max)
+    };
+    assert!(
+        error(&held) > 10.0 * error(&free),
+        "{} vs {}",
+        error(&held),
+        error(&free)
+    );
+    // a limit no command reaches changes nothing
+    let loose = run(Some(vec![10.0 * peak.max(1.0); n]));
+    assert_eq!(loose.tau, free.tau);
+    // the log's preprocessing finds the shoulder's clipped torques, and only those
+    let p = preprocess(&held, &PreprocessOptions::default()).unwrap();
+    assert!(!p.torque_saturation.is_empty(), "nothing found");
+    assert!(
+        p.torque_saturation
+            .iter()
+            .all(|s| s.joint == 1 && (s.level.abs() - limit).abs() < 1e-12),
+        "{:?}",
+        p.torque_saturation
+    );
+    // a limit that is not positive, or one short, is refused by name
+    let bad = |effort: Vec<f64>| {
+        let robot = TrueRobot {
+            controller: Some(Controller {
+                kp: vec![400.0; n],
+                kd: vec![40.0; n],
+                substeps: 4,
+                feedforward: true,
+                effort: Some(effort),
+            }),
+            ..TrueRobot::default()
+        };
+        rehearse(&model, &robot, &r, 0, "tracked")
+            .unwrap_err()
+            .to_string()
+    };
+    let e = bad(vec![0.0; n]);
+    assert!(
+        e.contains("controller.effort[0] is 0, expected a positive torque limit"),
+        "{e}"
+    );
+    let e = bad(vec![100.0; n - 1]);
+    assert!(e.contains("controller.effort"), "{e}");
 }

@@ -72,7 +72,8 @@ pub fn follow_exactly(
 
 /// Closed-loop tracking of `reference` by the true robot `robot` under `controller`, the
 /// feed-forward computed on `nominal`; starts at the reference's first state (in true
-/// coordinates). Checks for Ctrl-C every 1000 samples.
+/// coordinates); a command beyond the controller's `effort` is clipped to it, applied and
+/// logged so. Checks for Ctrl-C every 1000 samples.
 ///
 /// Errors: a controller with the wrong number of gains; a state that leaves the finite range
 /// (an unstable controller), naming the time.
@@ -92,6 +93,9 @@ pub fn follow_closed_loop(
         ("controller.kd", &controller.kd),
     ] {
         crate::model::check_finite_vector(what, g, n)?;
+    }
+    if let Some(effort) = &controller.effort {
+        crate::model::check_finite_vector("controller.effort", effort, n)?;
     }
     let feedforward = if controller.feedforward {
         let states = States::new(n, &reference.q, Some(&reference.qd), Some(&reference.qdd))?;
@@ -142,6 +146,9 @@ pub fn follow_closed_loop(
             u[j] = feedforward[r]
                 + controller.kp[j] * (reference.q[r] - encoder)
                 + controller.kd[j] * (reference.qd[r] - qd[j]);
+            if let Some(effort) = &controller.effort {
+                u[j] = u[j].clamp(-effort[j], effort[j]);
+            }
         }
         out.encoder.extend((0..n).map(|j| q[j] + offsets[j]));
         out.qd.extend_from_slice(&qd);

@@ -121,6 +121,11 @@ pub struct Controller {
     pub substeps: usize,
     #[serde(default = "yes")]
     pub feedforward: bool,
+    /// The drives' torque limits (N m, or N for a prismatic joint; one positive value per
+    /// joint): the command is clipped to `+-effort`, applied and logged so, as a saturated
+    /// drive's is; the joints then fall behind the reference. Absent: no limit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub effort: Option<Vec<f64>>,
 }
 
 fn default_substeps() -> usize {
@@ -416,6 +421,15 @@ impl Document for TrueRobot {
             if c.kp.iter().chain(&c.kd).any(|&g| g < 0.0) {
                 return Err(bad("controller gains must be >= 0".into()));
             }
+            if let Some(effort) = &c.effort {
+                finite_all("controller.effort", effort)?;
+                if let Some(j) = effort.iter().position(|&e| e <= 0.0) {
+                    return Err(bad(format!(
+                        "controller.effort[{j}] is {}, expected a positive torque limit (N m)",
+                        effort[j]
+                    )));
+                }
+            }
             if !(1..=1000).contains(&c.substeps) {
                 return Err(bad(format!(
                     "controller.substeps is {}, expected 1 to 1000",
@@ -502,6 +516,7 @@ impl TrueRobot {
             for (what, g) in [("controller.kp", &c.kp), ("controller.kd", &c.kd)] {
                 per_joint(what, &Some(g.clone()), n, 0.0)?;
             }
+            per_joint("controller.effort", &c.effort, n, 0.0)?;
         }
         for link in self
             .payload
