@@ -261,6 +261,34 @@ fn a_tool_the_model_lacks_is_no_finding() {
     );
 }
 
+/// Joints that barely move (+-0.002 rad about a posture) leave gravity torques that change
+/// less than the noise: the columns cannot show the model, and the warning names that cause
+/// among the others.
+#[test]
+fn a_motion_too_small_to_show_gravity_is_named_among_the_causes() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let mut rng = Rng(1);
+    let a = DMatrix::from_fn(6, 5, |_, _| rng.uniform(-0.002, 0.002));
+    let b = DMatrix::from_fn(6, 5, |_, _| rng.uniform(-0.002, 0.002));
+    let traj = FourierTrajectory::new(
+        2.0 * std::f64::consts::PI * 0.1,
+        vec![0.2, 0.3, -0.4, 0.1, 0.5, -0.2],
+        a,
+        b,
+    )
+    .unwrap();
+    let s = traj.sample_periods(1.0, 200.0).unwrap();
+    let tau = common::torques_with_friction(&model, &s, &mut rng, |r| 0.05 * common::normal(r));
+    let states = States::new(6, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
+    let fit = identify_base_parameters(&model, &states, &tau, &BaseOptions::default()).unwrap();
+    let said = findings(&fit.torque_columns).join("\n");
+    assert!(
+        said.contains("does not match the robot")
+            && said.contains("joints moved too little for their gravity torque to change beyond the torque noise"),
+        "{said}"
+    );
+}
+
 /// The real Panda log (beside the repository; skipped when absent) against the URDF of
 /// example-robot-data: every judged column follows its own joint at a plausible scale.
 #[test]
