@@ -387,17 +387,42 @@ pub(crate) fn gap_positions(rec: &Recording) -> Vec<usize> {
 pub const SLOWEST_INTERVAL: f64 = 0.5;
 
 /// Refuses a log whose median sample interval is [`SLOWEST_INTERVAL`] or longer, asking
-/// whether its time is in milliseconds (it would otherwise be resampled into a log 1,000
+/// whether its time is in milliseconds, microseconds or nanoseconds where one of them gives a
+/// robot's logging rate (10 Hz to 100 kHz; it would otherwise be resampled into a log 1,000
 /// times slower than the robot moved, or refused for its size).
 fn check_sample_interval(rec: &Recording) -> Result<()> {
     let median = gaps(rec).0;
     if median < SLOWEST_INTERVAL {
         return Ok(());
     }
+    // the units a robot's logging rate (10 Hz to 100 kHz) would make of it, if any do
+    let rate = |scale: f64| {
+        let hz = 1.0 / (median * scale);
+        crate::error::shown(format!("{hz:.4e}").parse().unwrap_or(hz))
+    };
+    let units: Vec<String> = [
+        (1e-3, "milliseconds", "1,000"),
+        (1e-6, "microseconds", "1e6"),
+        (1e-9, "nanoseconds (a ROS stamp)", "1e9"),
+    ]
+    .into_iter()
+    .filter(|(scale, _, _)| (10.0..=1e5).contains(&(1.0 / (median * scale))))
+    .map(|(scale, unit, divisor)| {
+        format!(
+            "{unit} (the samples would come at {} Hz: divide it by {divisor})",
+            rate(scale)
+        )
+    })
+    .collect();
+    let question = if units.is_empty() {
+        "Is the time column in milliseconds or another unit?".to_string()
+    } else {
+        format!("Is the time column in {}?", units.join(" or "))
+    };
     Err(Error::Recording {
         recording: rec.name.clone(),
         message: format!(
-            "its samples are {} s apart (the median interval; {} Hz): too slow to identify a robot's dynamics from. Is the time column in milliseconds or another unit? It is read in seconds",
+            "its samples are {} s apart (the median interval; {} Hz): too slow to identify a robot's dynamics from. {question} It is read in seconds",
             crate::error::shown(median),
             crate::error::shown(format!("{:.4e}", 1.0 / median).parse().unwrap_or(1.0 / median))
         ),

@@ -423,7 +423,8 @@ fn a_gap_in_a_log_is_not_filled_with_invented_values() {
 
 /// A log whose time column is in milliseconds reads as samples 1 s apart: refused, asking
 /// about the unit, before it is resampled into a log 1,000 times slower than the robot moved
-/// (a short one) or refused for its size (a long one). 2.5 Hz passes this check.
+/// (a short one) or refused for its size (a long one); microseconds and nanoseconds likewise,
+/// each named where it gives a robot's logging rate. 2.5 Hz passes this check.
 #[test]
 fn a_log_timed_in_milliseconds_is_asked_about() {
     use perturbid_rs::preprocess::{preprocess, PreprocessOptions, SLOWEST_INTERVAL};
@@ -440,10 +441,25 @@ fn a_log_timed_in_milliseconds_is_asked_about() {
             .to_string();
         assert!(
             e.starts_with("arm.csv: its samples are 1 s apart (the median interval; 1 Hz)")
-                && e.contains("Is the time column in milliseconds"),
+                && e.contains("Is the time column in milliseconds (the samples would come at 1000 Hz: divide it by 1,000)? It is read in seconds"),
             "{e}"
         );
     }
+    // nanoseconds (a ROS stamp, here from 0) and a rate two units would make plausible
+    let e = preprocess(&log("bag.csv", 2_000, 1e6), &PreprocessOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("Is the time column in nanoseconds (a ROS stamp) (the samples would come at 1000 Hz: divide it by 1e9)?"),
+        "{e}"
+    );
+    let e = preprocess(&log("both.csv", 2_000, 50.0), &PreprocessOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("milliseconds (the samples would come at 20 Hz: divide it by 1,000) or microseconds (the samples would come at 20000 Hz: divide it by 1e6)?"),
+        "{e}"
+    );
     assert_eq!(SLOWEST_INTERVAL, 0.5);
     if let Err(e) = preprocess(&log("slow.csv", 200, 0.4), &PreprocessOptions::default()) {
         assert!(!e.to_string().contains("milliseconds"), "{e}");
