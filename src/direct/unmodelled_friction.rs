@@ -202,9 +202,12 @@ pub fn check_unmodelled_friction(
         friction: all,
         ..options.clone()
     };
-    // fewer samples than parameters (or a refit the data do not determine): nothing to judge
-    let Ok(solved) = super::identify::solve(model, &sub, &measured, &options) else {
-        return Ok(vec![]);
+    // fewer samples than parameters (or a refit the data do not determine): nothing to judge;
+    // Ctrl-C stops the fit it is part of
+    let solved = match super::identify::solve(model, &sub, &measured, &options) {
+        Ok(solved) => solved,
+        Err(e @ crate::error::Error::Interrupted { .. }) => return Err(e),
+        Err(_) => return Ok(vec![]),
     };
     let refit = BaseModel {
         theta: solved.ls.coef.row(0).iter().copied().collect(),
