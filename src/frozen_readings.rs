@@ -31,8 +31,15 @@
 //!    steps from its last value by one sample's motion, and a torque logged in steps coarser
 //!    than its noise by one step.
 //!
-//! A run that reaches the end of its stretch between gaps cannot be judged and is kept. A
-//! column whose frozen readings cover more than [`MAX_FROZEN_SHARE`] of a stretch is refused:
+//! A run that reaches the end of its stretch between gaps (a stream that stopped before the
+//! log did, its last value logged to the end) has no jump to judge. It is a frozen reading
+//! where its joint moves (as in 1.; for `q`, its logged velocity integrates over the run to
+//! more than [`NOISE_LEVELS`] noise levels and 2 grid steps: a joint at rest whose velocity
+//! reads noise is not taken, and without logged velocities it is kept) and it is more than
+//! twice as long as the column's longest run of repeated values before it in the stretch
+//! (positions printed coarsely, torques on a coarse grid repeat all along). A column that
+//! holds one value over its whole stretch is a flat channel, not a stall, and is kept. A column
+//! whose frozen readings cover more than [`MAX_FROZEN_SHARE`] of a stretch is refused:
 //! it is a signal logged at a lower rate and held on the log's grid (or a sensor that failed),
 //! not a stall, and removing its rows would leave little.
 
@@ -98,6 +105,42 @@ pub fn find_frozen_readings(rec: &Recording) -> Result<Vec<LogDropout>> {
                     if !moves {
                         continue;
                     }
+                    // a column that never changes in the stretch is a flat channel, not a stall
+                    // (crate::local::flat_channels warns of it)
+                    if run.start == 0 && run.end == y.len() {
+                        continue;
+                    }
+                    if run.end == y.len() {
+                        // a stream that stopped before the log did: no jump to judge, so the
+                        // run must stand out from the column's runs before it, and a position
+                        // must have moved by what its logged velocity says
+                        let moved = signal != "q" || {
+                            let travel = match &rec.qd {
+                                Some(qd) => run
+                                    .clone()
+                                    .skip(1)
+                                    .fold(0.0, |s, i| s + qd[(a + i) * n + j] * (t[i] - t[i - 1])),
+                                None => 0.0,
+                            };
+                            travel.abs() > NOISE_LEVELS * level + 2.0 * grid
+                        };
+                        if moved && run.len() > 2 * longest_run(&y[..run.start]) {
+                            covered += run.len();
+                            found.push(LogDropout {
+                                signal: signal.to_string(),
+                                first_sample: a + run.start,
+                                samples: run.len(),
+                                from: rec.t[a + run.start],
+                                to: rec.t[a + run.end - 1],
+                                experiment: None,
+                                joint: Some(j),
+                                value: Some(y[run.start]),
+                                noise_levels: None,
+                                to_end: true,
+                            });
+                        }
+                        continue;
+                    }
                     let Some(jump) = end_jump(t, &y, run.end - 1, level) else {
                         continue;
                     };
@@ -115,6 +158,7 @@ pub fn find_frozen_readings(rec: &Recording) -> Result<Vec<LogDropout>> {
                         joint: Some(j),
                         value: Some(y[run.start]),
                         noise_levels: Some(jump).filter(|z| z.is_finite()),
+                        to_end: false,
                     });
                 }
                 if covered as f64 > MAX_FROZEN_SHARE * (b - a) as f64 {
@@ -158,6 +202,21 @@ fn moved_on(y: &[f64], run: std::ops::Range<usize>, grid: f64) -> bool {
 /// How many samples' worth of the signal's own motion the first sample after a frozen
 /// reading must step from the value held (see the module documentation).
 pub const MOVED_ON: f64 = 3.0;
+
+/// The length of the longest run of bit-for-bit repeated values of `y` (0 if empty).
+fn longest_run(y: &[f64]) -> usize {
+    let mut longest = 0;
+    let mut a = 0;
+    while a < y.len() {
+        let b = a + y[a..]
+            .iter()
+            .take_while(|v| v.to_bits() == y[a].to_bits())
+            .count();
+        longest = longest.max(b - a);
+        a = b;
+    }
+    longest
+}
 
 /// The runs of at least [`MIN_FROZEN`] bit-for-bit repeated values of `y` (index ranges).
 fn long_runs(y: &[f64]) -> Vec<std::ops::Range<usize>> {
@@ -220,8 +279,14 @@ pub fn describe(frozen: &[&LogDropout], joint_names: &[String], removed: &str) -
             } else {
                 "beyond any scale".into()
             };
+            let then = if g.iter().all(|d| d.to_end) {
+                "to the end of its stretch of the log (the stream stopped before the log did)"
+                    .to_string()
+            } else {
+                format!("and then jumped {off} back to the signal")
+            };
             format!(
-                "{held} for {} rows from sample {} (t = {:.4} s to {:.4} s) and then jumped {off} back to the signal",
+                "{held} for {} rows from sample {} (t = {:.4} s to {:.4} s) {then}",
                 d.samples, d.first_sample, d.from, d.to
             )
         })

@@ -51,13 +51,18 @@ pub struct LogDropout {
     /// (absent for rows of zeros, and for a jump beyond any scale).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub noise_levels: Option<f64>,
+    /// A frozen reading that lasts to the end of its stretch between gaps: the stream stopped
+    /// before the log did, and there is no jump to judge (`noise_levels` absent).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub to_end: bool,
 }
 
 impl LogDropout {
     /// What is wrong with a dropout read from a file, if anything: an unknown signal, fewer
     /// than [`MIN_DROPOUT`] rows (a frozen reading: [`MIN_FROZEN`]), times not finite and in
     /// order, a frozen reading's value not finite or its noise levels not beyond
-    /// [`NOISE_LEVELS`] or its joint not one of the `n`, or those given for rows of zeros.
+    /// [`NOISE_LEVELS`] or its joint not one of the `n`, or those given for rows of zeros;
+    /// `to_end` with noise levels or without a joint.
     pub fn problem(&self, n: usize) -> Option<String> {
         if !SIGNALS.contains(&self.signal.as_str()) {
             return Some(format!(
@@ -91,6 +96,11 @@ impl LogDropout {
                     "a frozen reading holds a finite value and is more than {NOISE_LEVELS} noise levels off (or beyond any scale: noise_levels absent)"
                 ))
             }
+        }
+        if self.to_end && (self.joint.is_none() || self.noise_levels.is_some()) {
+            return Some(
+                "to_end belongs to a frozen reading that lasts to the end of its stretch, which names its joint and has no noise_levels".into(),
+            );
         }
         if !(self.from.is_finite() && self.to.is_finite() && self.from <= self.to) {
             return Some("from and to must be finite times, from <= to".into());
@@ -163,6 +173,7 @@ pub fn find_dropouts(rec: &Recording) -> Vec<LogDropout> {
                     joint: None,
                     value: None,
                     noise_levels: None,
+                    to_end: false,
                 });
             }
         }

@@ -137,8 +137,98 @@ fn a_whole_message_stalled_is_listed_once() {
             && w.contains("q of joint 1, joint 2, joint 3, joint 4, joint 5, joint 6 held their values for 40 rows from sample 8000"),
         "{w}"
     );
+    // a position run at the log's end, without logged velocities to say the joint moved, is kept
     let end = frozen(&clean, "q", 2, clean.len() - 60..clean.len());
     assert!(find_frozen_readings(&end).unwrap().is_empty());
+}
+
+/// `rec` with velocities logged: the central differences of its positions (one-sided at the
+/// ends), which move on where a position column is frozen.
+fn with_velocities(rec: &Recording) -> Recording {
+    let k = rec.len();
+    let qd = (0..k * N)
+        .map(|x| {
+            let (i, j) = (x / N, x % N);
+            let (a, b) = (i.saturating_sub(1), (i + 1).min(k - 1));
+            (rec.q[b * N + j] - rec.q[a * N + j]) / (rec.t[b] - rec.t[a])
+        })
+        .collect();
+    let mut out = rec.clone();
+    out.qd = Some(qd);
+    out
+}
+
+/// A stream that stops before the log does, its last value logged to the end: the torque of
+/// one joint over the last 60 rows is found (to the end, no jump), its rows removed, and the
+/// fit is the clean log's without them; so are positions whose logged velocities go on. A
+/// joint that comes to rest at the end, its positions printed with four decimals and its
+/// velocity reading noise, is kept.
+#[test]
+fn a_stream_that_stops_before_the_log_is_removed_from_the_end() {
+    let clean = a465_noisy_log();
+    let k = clean.len();
+    let rec = frozen(&clean, "tau", 3, k - 60..k);
+    let found = find_frozen_readings(&rec).unwrap();
+    assert_eq!(found.len(), 1, "{found:?}");
+    let f = &found[0];
+    assert_eq!(
+        (
+            f.signal.as_str(),
+            f.joint,
+            f.first_sample,
+            f.samples,
+            f.to_end
+        ),
+        ("tau", Some(3), k - 60, 60, true)
+    );
+    assert_eq!(
+        (f.noise_levels, f.value),
+        (None, Some(clean.tau[(k - 60) * N + 3]))
+    );
+    assert!(f.problem(N).is_none());
+    let (p, fit) = identify(&rec, true);
+    assert_eq!(p.dropouts, found);
+    let (_, cut) = identify(&without_rows(&clean, k - 60..k), true);
+    assert!(
+        moved_in_stderr(&fit, &cut) < 1e-6,
+        "{}",
+        moved_in_stderr(&fit, &cut)
+    );
+    let refs: Vec<_> = found.iter().collect();
+    let w = perturbid_rs::frozen_readings::describe(&refs, &[], "before preprocessing");
+    assert!(
+        w.contains("tau of joint 4 held")
+            && w.contains(
+                "to the end of its stretch of the log (the stream stopped before the log did)"
+            ),
+        "{w}"
+    );
+    // positions frozen while the logged velocities go on
+    let moving = with_velocities(&clean);
+    let mut rec = frozen(&moving, "q", 1, k - 40..k);
+    rec.qd = moving.qd.clone();
+    let found = find_frozen_readings(&rec).unwrap();
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!(
+        (found[0].signal.as_str(), found[0].joint, found[0].samples),
+        ("q", Some(1), 40)
+    );
+    // at rest at the end: positions printed coarsely repeat, velocities read noise about 0
+    let mut rest = with_velocities(&clean);
+    let mut rng = common::Rng(3);
+    let held = (clean.q[(k - 300) * N + 1] * 1e4).round() / 1e4;
+    for i in k - 300..k {
+        rest.q[i * N + 1] = held;
+        rest.qd.as_mut().unwrap()[i * N + 1] = 1e-3 * common::normal(&mut rng);
+    }
+    assert!(find_frozen_readings(&rest).unwrap().is_empty());
+    // a saved reading to the end with noise levels, or of rows of zeros, is refused
+    let mut bad = f.clone();
+    bad.noise_levels = Some(20.0);
+    assert!(bad
+        .problem(N)
+        .unwrap()
+        .contains("to_end belongs to a frozen reading"));
 }
 
 /// Repeats that are readings: a joint that stands still (its torque read on a coarse grid

@@ -335,7 +335,8 @@ class Recording:
         joint of a signal read exactly 0 while the robot moved) and frozen readings (one joint's
         column held one value for more than 10 samples while it moved, then jumped back):
         signal, first_sample, samples, from, to; a frozen reading's also joint (0-based), value
-        (the value held) and noise_levels (how far its end jumped; None beyond any scale)."""
+        (the value held), noise_levels (how far its end jumped; None beyond any scale or at
+        the end) and to_end (True where it lasts to the end of its stretch of the log)."""
     @property
     def position_rounding(self) -> list[dict[str, Any]]:
         """Per joint whose logged positions lie on a grid and whose velocity was derived from

@@ -59,6 +59,7 @@ pub(crate) fn dropout_dict<'py>(
         e.set_item("joint", j)?;
         e.set_item("value", d.value)?;
         e.set_item("noise_levels", d.noise_levels)?;
+        e.set_item("to_end", d.to_end)?;
     }
     Ok(e)
 }
@@ -262,8 +263,10 @@ impl PyRecording {
     /// readings (one joint's column held one value for more than 10 samples while it moved,
     /// then jumped back). A list of dicts `signal`, `first_sample` (0-based row of the log),
     /// `samples` (rows), `from`, `to` (s); a frozen reading's also `joint` (0-based column
-    /// index), `value` (the value held, in the signal's unit) and `noise_levels` (how far its
-    /// end jumped; None beyond any scale). Empty for a recording as logged.
+    /// index), `value` (the value held, in the signal's unit), `noise_levels` (how far its
+    /// end jumped; None beyond any scale or at the stretch's end) and `to_end` (True where it
+    /// lasts to the end of its stretch: a stream that stopped before the log did). Empty for
+    /// a recording as logged.
     #[getter]
     fn dropouts<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, pyo3::types::PyDict>>> {
         self.rec
