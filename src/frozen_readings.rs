@@ -74,6 +74,20 @@ pub fn find_frozen_readings(rec: &Recording) -> Result<Vec<LogDropout>> {
         let column =
             |values: &[f64], j: usize| -> Vec<f64> { (a..b).map(|i| values[i * n + j]).collect() };
         let floor = |y: &Vec<f64>| column_floor(t, y);
+        // the frozen reading of `signal`'s column `j` holding `value` over the stretch's rows `run`
+        let reading =
+            |signal: &str, j: usize, run: std::ops::Range<usize>, value, jump, to_end| LogDropout {
+                signal: signal.to_string(),
+                first_sample: a + run.start,
+                samples: run.len(),
+                from: rec.t[a + run.start],
+                to: rec.t[a + run.end - 1],
+                experiment: None,
+                joint: Some(j),
+                value: Some(value),
+                noise_levels: jump,
+                to_end,
+            };
         // each joint's position floor, computed where a run asks for it
         let mut position_floor: Vec<Option<f64>> = vec![None; n];
         for &(signal, values) in &all {
@@ -126,18 +140,7 @@ pub fn find_frozen_readings(rec: &Recording) -> Result<Vec<LogDropout>> {
                         };
                         if moved && run.len() > 2 * longest_run(&y[..run.start]) {
                             covered += run.len();
-                            found.push(LogDropout {
-                                signal: signal.to_string(),
-                                first_sample: a + run.start,
-                                samples: run.len(),
-                                from: rec.t[a + run.start],
-                                to: rec.t[a + run.end - 1],
-                                experiment: None,
-                                joint: Some(j),
-                                value: Some(y[run.start]),
-                                noise_levels: None,
-                                to_end: true,
-                            });
+                            found.push(reading(signal, j, run.clone(), y[run.start], None, true));
                         }
                         continue;
                     }
@@ -148,18 +151,8 @@ pub fn find_frozen_readings(rec: &Recording) -> Result<Vec<LogDropout>> {
                         continue;
                     }
                     covered += run.len();
-                    found.push(LogDropout {
-                        signal: signal.to_string(),
-                        first_sample: a + run.start,
-                        samples: run.len(),
-                        from: rec.t[a + run.start],
-                        to: rec.t[a + run.end - 1],
-                        experiment: None,
-                        joint: Some(j),
-                        value: Some(y[run.start]),
-                        noise_levels: Some(jump).filter(|z| z.is_finite()),
-                        to_end: false,
-                    });
+                    let jump = Some(jump).filter(|z| z.is_finite());
+                    found.push(reading(signal, j, run.clone(), y[run.start], jump, false));
                 }
                 if covered as f64 > MAX_FROZEN_SHARE * (b - a) as f64 {
                     return Err(Error::Recording {

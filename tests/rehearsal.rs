@@ -572,19 +572,17 @@ fn a_saturated_drive_clips_its_command_and_the_log_shows_it() {
     let model = a465::model("kinsheel2010").unwrap();
     let n = model.nv;
     let r = reference(n, 4.0, 500.0);
-    let run = |effort: Option<Vec<f64>>| {
-        let robot = TrueRobot {
-            controller: Some(Controller {
-                kp: vec![400.0; n],
-                kd: vec![40.0; n],
-                substeps: 4,
-                feedforward: true,
-                effort,
-            }),
-            ..TrueRobot::default()
-        };
-        rehearse(&model, &robot, &r, 0, "tracked").unwrap()
+    let with_limits = |effort: Option<Vec<f64>>| TrueRobot {
+        controller: Some(Controller {
+            kp: vec![400.0; n],
+            kd: vec![40.0; n],
+            substeps: 4,
+            feedforward: true,
+            effort,
+        }),
+        ..TrueRobot::default()
     };
+    let run = |effort| rehearse(&model, &with_limits(effort), &r, 0, "tracked").unwrap();
     let free = run(None);
     let k = r.len();
     let column = |x: &[f64], j: usize| -> Vec<f64> { (0..k).map(|i| x[i * n + j]).collect() };
@@ -626,17 +624,7 @@ fn a_saturated_drive_clips_its_command_and_the_log_shows_it() {
     );
     // a limit that is not positive, or one short, is refused by name
     let bad = |effort: Vec<f64>| {
-        let robot = TrueRobot {
-            controller: Some(Controller {
-                kp: vec![400.0; n],
-                kd: vec![40.0; n],
-                substeps: 4,
-                feedforward: true,
-                effort: Some(effort),
-            }),
-            ..TrueRobot::default()
-        };
-        rehearse(&model, &robot, &r, 0, "tracked")
+        rehearse(&model, &with_limits(Some(effort)), &r, 0, "tracked")
             .unwrap_err()
             .to_string()
     };
