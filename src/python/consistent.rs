@@ -137,7 +137,9 @@ impl PyConsistentFit {
 /// a real robot can have, solved by an interior-point (log-barrier Newton) method. The robot's own
 /// parameters are a weak prior (`prior_weight` relative to each column's norm) that decides
 /// what the data do not. `t` ((k,) s), when the samples are a log: its qd and qdd columns are
-/// checked first, as `identify_base_parameters` checks them. Returns a ConsistentFit.
+/// checked first, as `identify_base_parameters` checks them. What the checks of the data find
+/// (torque columns, a lag, zero offsets, friction left out) is warned of (PerturbidWarning).
+/// Returns a ConsistentFit.
 #[pyfunction]
 #[pyo3(signature = (robot, q, qd, qdd, tau, friction=None, weighting="wls", gravity=true, prior_weight=1e-6, max_iterations=2000, t=None))]
 #[allow(clippy::too_many_arguments)]
@@ -177,6 +179,9 @@ pub(crate) fn identify_consistent_parameters(
             &consistent,
         )
     })?;
+    // what the data's checks found (torque columns, lag, offsets, friction left out), as the
+    // command line and identify_base_parameters warn of it
+    super::errors::warn_all(py, &fit.model.warnings())?;
     Ok(PyConsistentFit {
         fit,
         model: Arc::new(model.clone()),

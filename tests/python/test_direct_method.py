@@ -888,3 +888,7 @@ def test_friction_the_fit_leaves_out_is_named_with_its_coefficients():
     assert abs(coulomb["coefficient"] - 1.0) < 4 * coulomb["stderr"]
     rms = every.residual_rms[1] / fit.residual_rms[1]
     assert found["explained"] == pytest.approx(1 - rms**2, abs=1e-9)
+    # the physically consistent fit checks the same data, and warns alike
+    with pytest.warns(pr.PerturbidWarning, match=r"friction the fit leaves out .*'joint2' \(coulomb"):
+        consistent = pr.identify_consistent_parameters(robot, q, qd, qdd, tau)
+    assert consistent.model.unmodelled_friction == fit.unmodelled_friction
