@@ -892,3 +892,23 @@ def test_friction_the_fit_leaves_out_is_named_with_its_coefficients():
     with pytest.warns(pr.PerturbidWarning, match=r"friction the fit leaves out .*'joint2' \(coulomb"):
         consistent = pr.identify_consistent_parameters(robot, q, qd, qdd, tau)
     assert consistent.model.unmodelled_friction == fit.unmodelled_friction
+
+
+def test_a_stream_that_stops_before_the_log_is_cut_from_its_end():
+    """One torque column logged at its last value over the log's last 50 ms while the joints
+    move (the stream stopped first): preprocess warns of it and removes those rows, which
+    Recording.dropouts lists with to_end; the clean log cut there preprocesses to the same."""
+    t = np.arange(6000) * 1e-3
+    q = np.stack([0.3 * np.sin(2 * np.pi * 0.2 * t + k) for k in range(3)], axis=1)
+    rng = np.random.default_rng(5)
+    tau = np.stack([2.0 * np.cos(2 * np.pi * 0.3 * t + k) for k in range(3)], axis=1) + 0.01 * rng.standard_normal((6000, 3))
+    stalled = tau.copy()
+    stalled[-50:, 1] = tau[-50, 1]
+    with pytest.warns(pr.PerturbidWarning, match=r"tau of joint 2 held .* for 50 rows from sample 5950 .* to the end of its stretch of the log"):
+        rec = pr.preprocess(t, q, stalled)
+    [d] = rec.dropouts
+    assert (d["signal"], d["joint"], d["first_sample"], d["samples"], d["to_end"]) == ("tau", 1, 5950, 50, True)
+    assert d["noise_levels"] is None and d["value"] == tau[-50, 1]
+    cut = pr.preprocess(t[:-50], q[:-50], tau[:-50])
+    np.testing.assert_array_equal(rec.t, cut.t)
+    np.testing.assert_array_equal(rec.tau, cut.tau)
