@@ -165,6 +165,36 @@ fn only_the_joint_with_friction_is_named_and_a_log_without_any_raises_nothing() 
     assert!(m.warnings().is_empty(), "{:?}", m.warnings());
 }
 
+/// A base joint that turns one way throughout (its Coulomb term is its offset in these data):
+/// the refit leaves the offset out, and every joint's Coulomb friction is still found.
+#[test]
+fn a_joint_that_never_reverses_does_not_stop_the_check() {
+    let model = physical();
+    let mut rng = Rng(6);
+    let t: Vec<f64> = (0..5000).map(|i| i as f64 * 2e-3).collect();
+    let mut s = a465_excitation(&mut rng).sample(&t);
+    for (i, &ti) in t.iter().enumerate() {
+        s.q[i * 6] += 0.5 * ti;
+        s.qd[i * 6] += 0.5;
+    }
+    assert!((0..t.len()).all(|i| s.qd[i * 6] > 0.0));
+    let states = States::new(6, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
+    let mut tau = vec![0.0; s.q.len()];
+    let mut ws = parallel::Workspace::new(&model);
+    parallel::rnea(&model, &mut ws, &states, Gravity::Included, &mut tau).unwrap();
+    for (i, x) in tau.iter_mut().enumerate() {
+        *x += 0.8 * s.qd[i].signum() + 0.03 * normal(&mut rng);
+    }
+    let m = fit(&model, &s.q, &s.qd, &s.qdd, &tau, FrictionTerms::NONE);
+    let found = &m.unmodelled_friction;
+    assert_eq!(found.len(), 6, "{found:?}");
+    for f in found {
+        let (c, se) = term(f, "coulomb").unwrap_or_else(|| panic!("{f:?}"));
+        assert!((c - 0.8).abs() < 4.0 * se, "{f:?}");
+        assert_eq!(term(f, "offset"), None, "{f:?}");
+    }
+}
+
 #[test]
 fn the_finding_is_saved_with_the_model_and_checked_on_load() {
     let log = a465_log();

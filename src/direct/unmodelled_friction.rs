@@ -9,7 +9,9 @@
 //!
 //! So a fit that lacks some of the friction terms (viscous `qd_j`, Coulomb `sign(qd_j)`, a
 //! constant offset, each per joint) is fitted again with them, on at most [`SAMPLES`] samples
-//! spread evenly over the data, with the same weighting. A joint is a finding where the terms
+//! spread evenly over the data, with the same weighting (where the data cannot tell two terms
+//! apart, as the Coulomb term and the offset of a joint that never reverses, without the
+//! offset, or else without the Coulomb term). A joint is a finding where the terms
 //! take at least [`EXPLAINED`] off its residual sum of squares there, and at least one of its
 //! own new terms is [`T_NAMED`] or more of its standard errors (inflated for residuals
 //! correlated from sample to sample, [`super::residual_correlation`]) from 0; those terms are
@@ -192,22 +194,33 @@ pub fn check_unmodelled_friction(
         pick(tau),
     );
     let sub = States::new(n, &q, Some(&v), a.as_deref())?;
-    let all = FrictionTerms {
-        viscous: true,
-        coulomb: true,
-        offset: true,
-        ..fitted
-    };
-    let options = BaseOptions {
-        friction: all,
-        ..options.clone()
-    };
-    // fewer samples than parameters (or a refit the data do not determine): nothing to judge;
-    // Ctrl-C stops the fit it is part of
-    let solved = match super::identify::solve(model, &sub, &measured, &options) {
-        Ok(solved) => solved,
-        Err(e @ crate::error::Error::Interrupted { .. }) => return Err(e),
-        Err(_) => return Ok(vec![]),
+    // every term; where the data cannot tell two apart (the Coulomb term of a joint that never
+    // reverses is its offset), without the offset, then without the Coulomb term. Fewer
+    // samples than parameters, or a refit the data do not determine: nothing to judge. Ctrl-C
+    // stops the fit it is part of
+    let mut solved = None;
+    for (coulomb, offset) in [(true, true), (true, false), (false, true)] {
+        let terms = FrictionTerms {
+            viscous: true,
+            coulomb: fitted.coulomb || coulomb,
+            offset: fitted.offset || offset,
+            ..fitted
+        };
+        let options = BaseOptions {
+            friction: terms,
+            ..options.clone()
+        };
+        match super::identify::solve(model, &sub, &measured, &options) {
+            Ok(s) => {
+                solved = Some(s);
+                break;
+            }
+            Err(e @ crate::error::Error::Interrupted { .. }) => return Err(e),
+            Err(_) => {}
+        }
+    }
+    let Some(solved) = solved else {
+        return Ok(vec![]);
     };
     let refit = BaseModel {
         theta: solved.ls.coef.row(0).iter().copied().collect(),
