@@ -282,3 +282,34 @@ pub(crate) fn first_non_finite_here(x: &[f64]) -> Option<usize> {
 fn any_non_finite(x: &[f64]) -> bool {
     x.iter().fold(0u64, |bits, v| bits | (v - v).to_bits()) != 0
 }
+
+/// At most `most` of `k` samples spread evenly over them, in order (rows `i k / m`, `m =
+/// min(k, most)`): the samples a check on a long log reads, at a bounded cost.
+pub(crate) struct SpreadRows {
+    rows: Vec<usize>,
+    n: usize,
+}
+
+impl SpreadRows {
+    /// The rows of `k` samples of `n` values each.
+    pub(crate) fn new(k: usize, most: usize, n: usize) -> Self {
+        let m = k.min(most);
+        Self {
+            rows: (0..m).map(|i| i * k / m).collect(),
+            n,
+        }
+    }
+
+    /// How many rows.
+    pub(crate) fn len(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// Those rows of `x` (row-major, `n` per sample).
+    pub(crate) fn pick(&self, x: &[f64]) -> Vec<f64> {
+        let n = self.n;
+        (self.rows.iter())
+            .flat_map(|&i| x[i * n..(i + 1) * n].iter().copied())
+            .collect()
+    }
+}

@@ -260,12 +260,8 @@ fn check(
     if m * n < 2 * (p + n) || fit.sigma.len() != n {
         return Ok(None);
     }
-    let rows: Vec<usize> = (0..m).map(|i| i * k / m).collect();
-    let pick = |x: &[f64]| -> Vec<f64> {
-        rows.iter()
-            .flat_map(|&i| x[i * n..(i + 1) * n].iter().copied())
-            .collect()
-    };
+    let rows = crate::states::SpreadRows::new(k, SAMPLES, n);
+    let pick = |x: &[f64]| rows.pick(x);
     let weight: Vec<f64> = fit.sigma.iter().map(|s| 1.0 / s).collect();
     let measured = pick(tau);
     let problem = Problem {

@@ -211,14 +211,8 @@ pub fn check_torque_columns(
         return Ok(vec![]);
     }
     states.check_companion("tau", tau, n)?;
-    let rows: Vec<usize> = (0..k.min(SAMPLES))
-        .map(|i| i * k / k.min(SAMPLES))
-        .collect();
-    let pick = |x: &[f64]| -> Vec<f64> {
-        rows.iter()
-            .flat_map(|&i| x[i * n..(i + 1) * n].iter().copied())
-            .collect()
-    };
+    let rows = crate::states::SpreadRows::new(k, SAMPLES, n);
+    let pick = |x: &[f64]| rows.pick(x);
     let (q, qd, qdd) = (
         pick(states.q()),
         pick(states.qd().unwrap_or_default()),

@@ -180,13 +180,8 @@ pub fn check_unmodelled_friction(
     }
     crate::interrupt::check("checking the fit for friction it leaves out")?;
     // the samples refitted, spread evenly over the data and in time order
-    let count = k.min(SAMPLES);
-    let rows: Vec<usize> = (0..count).map(|i| i * k / count).collect();
-    let pick = |x: &[f64]| -> Vec<f64> {
-        (rows.iter())
-            .flat_map(|&s| x[s * n..(s + 1) * n].iter().copied())
-            .collect()
-    };
+    let rows = crate::states::SpreadRows::new(k, SAMPLES, n);
+    let (count, pick) = (rows.len(), |x: &[f64]| rows.pick(x));
     let (q, v, a, measured) = (
         pick(states.q()),
         pick(qd),
