@@ -434,6 +434,12 @@ pub(crate) fn shown(v: f64) -> String {
     }
 }
 
+/// `v` rounded to 5 significant digits, written as [`shown`] writes it: a measured interval or
+/// rate in a message (0.009 s, not 0.009000000000000001 s).
+pub(crate) fn shown5(v: f64) -> String {
+    shown(format!("{v:.4e}").parse().unwrap_or(v))
+}
+
 /// `text` with every number of more than [`LONG_NUMBER`] characters written as [`shown`]
 /// writes it: the JSON and TOML readers' own messages print a float of 1e300 in 301 digits.
 pub(crate) fn short_numbers(text: &str) -> String {

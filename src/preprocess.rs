@@ -261,7 +261,11 @@ fn preprocess_part(
         match &filter {
             Some(f) => filtfilt(f, &x).map_err(|e| Error::Recording {
                 recording: rec.name.clone(),
-                message: format!("too short to filter: {e}"),
+                message: format!(
+                    "{} s long, {count} samples at {} Hz: too short to filter ({e})",
+                    crate::error::shown5(t1 - t0),
+                    crate::error::shown(o.rate)
+                ),
             }),
             None => Ok(x),
         }
@@ -386,45 +390,65 @@ pub(crate) fn gap_positions(rec: &Recording) -> Vec<usize> {
 /// as 1 Hz.
 pub const SLOWEST_INTERVAL: f64 = 0.5;
 
+/// The shortest median sample interval (s) of a log preprocessed: 1 MHz. No robot logs its
+/// joints faster (100 kHz is the fastest expected), and a 1 kHz log whose time column is in
+/// hours reads as 3.6 MHz.
+pub const FASTEST_INTERVAL: f64 = 1e-6;
+
 /// Refuses a log whose median sample interval is [`SLOWEST_INTERVAL`] or longer, asking
 /// whether its time is in milliseconds, microseconds or nanoseconds where one of them gives a
 /// robot's logging rate (10 Hz to 100 kHz; it would otherwise be resampled into a log 1,000
-/// times slower than the robot moved, or refused for its size).
+/// times slower than the robot moved, or refused for its size), and one whose median interval
+/// is below [`FASTEST_INTERVAL`], asking likewise about minutes and hours (it would otherwise
+/// be resampled into a handful of samples, or none).
 fn check_sample_interval(rec: &Recording) -> Result<()> {
     let median = gaps(rec).0;
-    if median < SLOWEST_INTERVAL {
-        return Ok(());
-    }
-    // the units a robot's logging rate (10 Hz to 100 kHz) would make of it, if any do
-    let rate = |scale: f64| {
-        let hz = 1.0 / (median * scale);
-        crate::error::shown(format!("{hz:.4e}").parse().unwrap_or(hz))
-    };
-    let units: Vec<String> = [
-        (1e-3, "milliseconds", "1,000"),
-        (1e-6, "microseconds", "1e6"),
-        (1e-9, "nanoseconds (a ROS stamp)", "1e9"),
-    ]
-    .into_iter()
-    .filter(|(scale, _, _)| (10.0..=1e5).contains(&(1.0 / (median * scale))))
-    .map(|(scale, unit, divisor)| {
-        format!(
-            "{unit} (the samples would come at {} Hz: divide it by {divisor})",
-            rate(scale)
+    // each unit the time might be in: seconds per its unit, its name, what turns it into s
+    type Unit = (f64, &'static str, &'static str);
+    let (candidates, verdict, otherwise): (&[Unit], &str, &str) = if median >= SLOWEST_INTERVAL {
+        (
+            &[
+                (1e-3, "milliseconds", "divide it by 1,000"),
+                (1e-6, "microseconds", "divide it by 1e6"),
+                (1e-9, "nanoseconds (a ROS stamp)", "divide it by 1e9"),
+            ],
+            "too slow to identify a robot's dynamics from",
+            "milliseconds or another unit",
         )
-    })
-    .collect();
+    } else if median > 0.0 && median < FASTEST_INTERVAL {
+        (
+            &[
+                (60.0, "minutes", "multiply it by 60"),
+                (3600.0, "hours", "multiply it by 3,600"),
+            ],
+            "faster than a robot logs its joints (at most 100 kHz is expected)",
+            "another unit than seconds",
+        )
+    } else {
+        return Ok(());
+    };
+    // the units a robot's logging rate (10 Hz to 100 kHz) would make of it, if any do
+    let units: Vec<String> = candidates
+        .iter()
+        .filter(|(scale, _, _)| (10.0..=1e5).contains(&(1.0 / (median * scale))))
+        .map(|(scale, unit, turn)| {
+            format!(
+                "{unit} (the samples would come at {} Hz: {turn})",
+                crate::error::shown5(1.0 / (median * scale))
+            )
+        })
+        .collect();
     let question = if units.is_empty() {
-        "Is the time column in milliseconds or another unit?".to_string()
+        format!("Is the time column in {otherwise}?")
     } else {
         format!("Is the time column in {}?", units.join(" or "))
     };
     Err(Error::Recording {
         recording: rec.name.clone(),
         message: format!(
-            "its samples are {} s apart (the median interval; {} Hz): too slow to identify a robot's dynamics from. {question} It is read in seconds",
-            crate::error::shown(median),
-            crate::error::shown(format!("{:.4e}", 1.0 / median).parse().unwrap_or(1.0 / median))
+            "its samples are {} s apart (the median interval; {} Hz): {verdict}. {question} It is read in seconds",
+            crate::error::shown5(median),
+            crate::error::shown5(1.0 / median)
         ),
     })
 }

@@ -59,16 +59,25 @@ pub(crate) fn check_joints(states: &States<'_>, nv: usize) -> Result<()> {
     Ok(())
 }
 
+/// What a fit would make of a flat torque column ([`refuse_flat_torques`]).
+pub(crate) const FOR_A_FIT: &str =
+    "a fit would take it for a torque that does not depend on the motion";
+/// What a validation would make of one.
+pub(crate) const FOR_A_VALIDATION: &str =
+    "a validation against it would report the model's whole torque as its error";
+
 /// Refuses torques (row-major `k x nv`, N m) in which a joint's column holds one value in
 /// every one of `k >= 2` samples, bit for bit, while the robot moves (some `qd` or `qdd` is
 /// not 0) or the value is not 0: a dead or saturated channel, or one far coarser than the
-/// motion's effect, from which a fit would take a row of zeros for certain. A torque of exactly
-/// 0 at rest throughout stays allowed (gravity compensated, a joint about a vertical axis).
-/// `names` name the joints.
+/// motion's effect, from which a fit would take a row of zeros for certain and against which
+/// a validation would measure nothing. A torque of exactly 0 at rest throughout stays allowed
+/// (gravity compensated, a joint about a vertical axis). `names` name the joints; `use_`
+/// says what the torques were for ([`FOR_A_FIT`], [`FOR_A_VALIDATION`]).
 pub(crate) fn refuse_flat_torques(
     states: &States<'_>,
     tau: &[f64],
     names: &[String],
+    use_: &str,
 ) -> Result<()> {
     let nv = states.nv();
     let k = states.len();
@@ -90,7 +99,7 @@ pub(crate) fn refuse_flat_torques(
             return Err(Error::InvalidArgument {
                 argument: "tau".into(),
                 message: format!(
-                    "the torque of joint '{name}' (column {}) is {} N m in all {k} samples{}: a dead or saturated channel, or one far coarser than the motion's effect; a fit would take it for a torque that does not depend on the motion",
+                    "the torque of joint '{name}' (column {}) is {} N m in all {k} samples{}: a dead or saturated channel, or one far coarser than the motion's effect; {use_}",
                     j + 1,
                     crate::error::shown(first),
                     if moving { " while the robot moves" } else { "" }

@@ -380,6 +380,38 @@ fn excite_identify_direct_predict() {
         &["predict", s(&d.join("base.json")), s(&d.join("log.csv"))],
         &["--robot"],
     );
+    // a dead torque channel (0 throughout while the robot moves) is refused by the fit and by
+    // a validation, each naming the file, the joint and what it would have done
+    let mut dead = rec.clone();
+    for s in 0..dead.len() {
+        dead.tau[s * 6 + 3] = 0.0;
+    }
+    write(&d.join("dead.csv"), &recording_table(&dead, "").to_csv());
+    let dead_csv = d.join("dead.csv").display().to_string();
+    let which = "tau: the torque of joint 'joint4' (column 4) is 0 N m in all";
+    fails(
+        &[
+            "identify-direct",
+            "a465",
+            &dead_csv,
+            "--out",
+            s(&d.join("dead.json")),
+        ],
+        &[&dead_csv, which, "a fit would take it for a torque"],
+    );
+    fails(
+        &[
+            "validate",
+            s(&d.join("base.json")),
+            &dead_csv,
+            "--robot",
+            "a465",
+            "--out",
+            s(&d.join("dead_validation")),
+        ],
+        &[&dead_csv, which, "a validation against it would report"],
+    );
+    assert!(!d.join("dead.json").exists() && !d.join("dead_validation").exists());
     // --stderr: after the torques, the library's standard errors
     let compared = ok(&[
         "predict",

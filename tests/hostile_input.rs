@@ -466,6 +466,58 @@ fn a_log_timed_in_milliseconds_is_asked_about() {
     }
 }
 
+/// A log timed in hours (1 kHz read as 3.6 MHz) is asked about, as one in milliseconds is:
+/// resampled at 1 kHz it would leave a handful of samples, refused as too short to filter.
+/// One faster still, which no unit makes a robot's rate, is refused without a guess; one at
+/// 100 kHz passes this check.
+#[test]
+fn a_log_timed_in_hours_is_asked_about() {
+    use perturbid_rs::preprocess::{preprocess, PreprocessOptions, FASTEST_INTERVAL};
+    use perturbid_rs::Recording;
+    let log = |name: &str, k: usize, dt: f64| {
+        let t: Vec<f64> = (0..k).map(|i| i as f64 * dt).collect();
+        let q: Vec<f64> = (0..k).map(|i| (0.3e-3 * i as f64).sin()).collect();
+        Recording::new(name, 1, t, q.clone(), q, None, None).unwrap()
+    };
+    assert_eq!(FASTEST_INTERVAL, 1e-6);
+    let e = preprocess(
+        &log("arm.csv", 20_000, 1e-3 / 3600.0),
+        &PreprocessOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.starts_with("arm.csv: its samples are 2.7778e-7 s apart (the median interval; 3600000 Hz): faster than a robot logs its joints")
+            && e.contains("minutes (the samples would come at 60000 Hz: multiply it by 60) or hours (the samples would come at 1000 Hz: multiply it by 3,600)? It is read in seconds"),
+        "{e}"
+    );
+    let e = preprocess(
+        &log("fast.csv", 20_000, 1e-12),
+        &PreprocessOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("1e-12 s apart")
+            && e.contains("Is the time column in another unit than seconds?"),
+        "{e}"
+    );
+    if let Err(e) = preprocess(
+        &log("quick.csv", 20_000, 1e-5),
+        &PreprocessOptions::default(),
+    ) {
+        assert!(!e.to_string().contains("faster than"), "{e}");
+    }
+    // a log too short to filter says how long it is and how many samples that made
+    let e = preprocess(&log("short.csv", 10, 1e-3), &PreprocessOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("short.csv: 0.009 s long, 10 samples at 1000 Hz: too short to filter"),
+        "{e}"
+    );
+}
+
 #[test]
 fn a_hand_edited_plan_is_checked_on_load() {
     let model = robots::builtin("a465").unwrap();

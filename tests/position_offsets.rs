@@ -258,3 +258,39 @@ fn an_a465_logs_offsets_are_found_against_its_saved_fit() {
     let w = o.validation_finding().unwrap_or_else(|| panic!("{o:?}"));
     assert!(w.contains("joint(s) 'joint3' "), "{w}");
 }
+
+/// A new log whose shoulder torque reads with the opposite sign, against the A465's saved fit:
+/// offsets of the shoulder and elbow fitted to it take up part of the column's error, so
+/// `validation_finding` alone would name them; the validation's findings name the column and
+/// not the offsets ([`PositionOffsets::finding_beside`]).
+#[test]
+fn offsets_are_not_named_beside_a_torque_column_found_wrong() {
+    use perturbid_rs::direct::torque_columns::check_torque_columns;
+    use perturbid_rs::direct::torque_lag::validation_findings;
+    let log = a465_log();
+    let fit = fit_physical(&log);
+    let model = perturbid_rs::robots::a465::model("physical").unwrap();
+    let negated: Vec<f64> = (log.tau.iter().enumerate())
+        .map(|(i, v)| if i % 6 == 1 { -v } else { *v })
+        .collect();
+    let states = States::new(6, &log.q, Some(&log.qd), Some(&log.qdd)).unwrap();
+    let o = check_position_offsets_in_validation(&model, &fit, &states, &negated)
+        .unwrap()
+        .expect("checked");
+    let raw = o.validation_finding().unwrap_or_else(|| panic!("{o:?}"));
+    assert!(raw.contains("joint(s) 'joint"), "{raw}");
+    let columns = check_torque_columns(&model, &states, &negated, fit.gravity).unwrap();
+    assert!(o.finding_beside(&columns, true).is_none());
+    let found = validation_findings(&[], &columns, None, Some(&o));
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!(
+        found[0].contains("joint 'joint2'") && found[0].contains("negate the column"),
+        "{found:?}"
+    );
+    // the log as it was: the offsets are judged (and find nothing)
+    let columns = check_torque_columns(&model, &states, &log.tau, fit.gravity).unwrap();
+    let o = check_position_offsets_in_validation(&model, &fit, &states, &log.tau)
+        .unwrap()
+        .expect("checked");
+    assert!(validation_findings(&[], &columns, None, Some(&o)).is_empty());
+}

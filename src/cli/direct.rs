@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::files::{load_robot, refuse_overwriting_inputs, PreprocessArgs, RobotArg};
+use super::files::{in_log, load_robot, refuse_overwriting_inputs, PreprocessArgs, RobotArg};
 use super::out_dir;
 use super::progress::Progress;
 use crate::direct::{
@@ -198,7 +198,8 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
             &rec.tau[..split * n],
             &options,
             &crate::direct::ConsistentOptions::default(),
-        )?;
+        )
+        .map_err(in_log(&a.data))?;
         let s = &c.solution;
         let _ = writeln!(
             out,
@@ -216,7 +217,8 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
             &states.slice(0..split),
             &rec.tau[..split * n],
             &options,
-        )?
+        )
+        .map_err(in_log(&a.data))?
     };
     progress.done();
     let fit = crate::direct::BaseModel {

@@ -86,6 +86,23 @@ pub(crate) fn is_inline_json(arg: &Path) -> bool {
         && !arg.exists()
 }
 
+/// The library's error about a log's columns (`q`, `qd`, `qdd`, `tau`: a dead torque
+/// channel, for one) as one about the file `path` it was read from, which the library's
+/// functions do not know.
+pub(crate) fn in_log(path: &Path) -> impl Fn(Error) -> Error + '_ {
+    move |e| match e {
+        Error::InvalidArgument { argument, message }
+            if ["q", "qd", "qdd", "tau"].contains(&argument.as_str()) =>
+        {
+            Error::Recording {
+                recording: path.display().to_string(),
+                message: format!("{argument}: {message}"),
+            }
+        }
+        e => e,
+    }
+}
+
 /// Refuses an output file that is one of the inputs (it would be destroyed before, or while,
 /// it is read): `--out` equal to an input, also through another spelling of the same path.
 pub(crate) fn refuse_overwriting_inputs(out: &Path, inputs: &[&Path]) -> Result<()> {

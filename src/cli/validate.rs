@@ -11,7 +11,7 @@ use super::progress::Progress;
 use crate::direct::position_offsets::check_position_offsets_in_validation;
 use crate::direct::position_range::check_position_range;
 use crate::direct::torque_columns::check_torque_columns;
-use crate::direct::torque_lag::{check_torque_lag, log_findings};
+use crate::direct::torque_lag::{check_torque_lag, validation_findings};
 use crate::error::{Error, Result};
 use crate::io::{OutputSet, Table};
 use crate::states::States;
@@ -81,6 +81,13 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
         _ => unreachable!("read() preprocesses a log without qdd"),
     };
     let states = States::new(n, &rec.q, Some(qd), Some(qdd))?;
+    crate::torque_model::refuse_flat_torques(
+        &states,
+        &rec.tau,
+        &joints,
+        crate::torque_model::FOR_A_VALIDATION,
+    )
+    .map_err(super::files::in_log(&a.data))?;
     progress.update("predicting");
     let predicted = match &file {
         ModelFile::Base(fit) => fit
@@ -126,11 +133,15 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     progress.done();
     let rounding = crate::position_rounding::warning(&rec.position_rounding, &joints)
         .map(|w| format!("{w}{}", crate::position_rounding::IN_A_VALIDATION));
-    for w in log_findings(&position_range, &torque_columns, torque_lag.as_ref())
-        .into_iter()
-        .chain(offsets.as_ref().and_then(|o| o.validation_finding()))
-        .chain(rounding)
-        .chain(extrapolation.as_ref().map(|x| x.message()))
+    for w in validation_findings(
+        &position_range,
+        &torque_columns,
+        torque_lag.as_ref(),
+        offsets.as_ref(),
+    )
+    .into_iter()
+    .chain(rounding)
+    .chain(extrapolation.as_ref().map(|x| x.message()))
     {
         eprintln!("perturbid: warning: log '{}': {w}", a.data.display());
     }

@@ -56,7 +56,12 @@ pub fn identify_global_linear(
     check_joints(states, nv)?;
     states.check_companion("tau", tau, nv)?;
     let joint_names: Vec<String> = (1..=nv).map(|j| format!("joint{j}")).collect();
-    crate::torque_model::refuse_flat_torques(states, tau, &joint_names)?;
+    crate::torque_model::refuse_flat_torques(
+        states,
+        tau,
+        &joint_names,
+        crate::torque_model::FOR_A_FIT,
+    )?;
     let k = states.len();
     let (q, qd, qdd) = (states.q(), states.qd_or_zeros(), states.qdd_or_zeros());
     let x = DMatrix::from_fn(k, 1 + 3 * nv, |s, c| match c {

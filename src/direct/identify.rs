@@ -309,7 +309,12 @@ fn fit_with_factors(
     states.check_companion("tau", tau, nv)?;
     crate::limits::check_range("tolerance", options.tolerance, 1e-15, 0.1)?;
     crate::limits::check_count("states", options.states, 1, 1_000_000)?;
-    crate::torque_model::refuse_flat_torques(states, tau, &model.joint_names)?;
+    crate::torque_model::refuse_flat_torques(
+        states,
+        tau,
+        &model.joint_names,
+        crate::torque_model::FOR_A_FIT,
+    )?;
     let k = states.len();
     let Solved {
         base,

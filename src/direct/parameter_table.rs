@@ -49,11 +49,13 @@ impl BaseModel {
     /// sign, in other units), torques out of step with their positions
     /// ([`super::torque_lag`]), joints whose zeros in the data look offset
     /// ([`super::position_offsets`]), friction the fit leaves out that shows in its residuals
-    /// ([`super::unmodelled_friction`]), positions logged in counts so coarse that their rounding
-    /// shows in the derived velocities ([`crate::position_rounding`]), and friction or armature coefficients identified on their own
-    /// (not in a combination) and negative beyond three standard errors. No joint has them;
-    /// the data hold an effect the model lacks, or are not what it assumes. A consistent fit
-    /// keeps them at zero.
+    /// ([`super::unmodelled_friction`]), positions logged in counts so coarse that their
+    /// rounding shows in the derived velocities ([`crate::position_rounding`]), and friction or
+    /// armature coefficients identified on their own (not in a combination) and negative
+    /// beyond three standard errors. No joint has them; the data hold an effect the model
+    /// lacks, or are not what it assumes. A consistent fit keeps them at zero. Where a torque
+    /// column is found wrong, offsets and friction are not named: fitted to such a log they
+    /// take up part of what is wrong with it.
     pub fn warnings(&self) -> Vec<String> {
         let columns = super::torque_lag::log_findings(
             &self.position_range,
@@ -81,11 +83,15 @@ impl BaseModel {
         let rounding =
             crate::position_rounding::warning(&self.position_rounding, &self.joint_names)
                 .map(|w| format!("{w}{}", crate::position_rounding::IN_A_FIT));
-        let offsets = (self.position_offsets.as_ref()).and_then(|o| o.finding());
+        let offsets = (self.position_offsets.as_ref())
+            .and_then(|o| o.finding_beside(&self.torque_columns, false));
+        // friction terms fitted to a log that does not read as the robot's model take up
+        // part of what is wrong with it, as offsets do: the columns first
         let friction = super::unmodelled_friction::finding(
             &self.unmodelled_friction,
             self.base.layout.friction,
-        );
+        )
+        .filter(|_| super::torque_columns::findings(&self.torque_columns).is_empty());
         columns
             .into_iter()
             .chain(offsets)

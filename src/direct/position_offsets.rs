@@ -28,6 +28,7 @@ use serde::{Deserialize, Serialize};
 
 use super::identify::BaseModel;
 use super::parameters::regressor_blocks;
+use super::torque_columns::TorqueColumn;
 use crate::error::{shown, Result};
 use crate::{Model, States};
 
@@ -108,7 +109,7 @@ pub enum WhyLeftOut {
 impl PositionOffsets {
     /// What is wrong, if the evidence is strong: the offsets leave at most [`FINDING_RATIO`]
     /// of the residual. Names the joints whose offsets exceed three standard errors, the
-    /// largest first.
+    /// largest first. What the library warns of is [`Self::finding_beside`].
     pub fn finding(&self) -> Option<String> {
         let (ratio, list) = self.named()?;
         Some(format!(
@@ -129,6 +130,23 @@ impl PositionOffsets {
 
     /// The residual's ratio and the joints beyond three standard errors, listed with their
     /// offsets (the largest first), where the offsets leave at most [`FINDING_RATIO`] of it.
+    /// [`Self::finding`] (`validation` false) or [`Self::validation_finding`] (true), unless
+    /// one of the log's torque `columns` is found wrong ([`super::torque_columns::findings`]):
+    /// offsets fitted to a negated, swapped or rescaled column take up part of its error and
+    /// would be named for it (the A465's shoulder column negated read as offsets of 1.7 rad of
+    /// the shoulder and the elbow against a saved model). What the fit and a validation warn
+    /// of, and their `finding`.
+    pub fn finding_beside(&self, columns: &[TorqueColumn], validation: bool) -> Option<String> {
+        if !super::torque_columns::findings(columns).is_empty() {
+            return None;
+        }
+        if validation {
+            self.validation_finding()
+        } else {
+            self.finding()
+        }
+    }
+
     fn named(&self) -> Option<(f64, String)> {
         let ratio = self.unexplained_with_offsets / self.unexplained;
         if !(ratio.is_finite() && ratio <= FINDING_RATIO) {

@@ -20,6 +20,7 @@
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
+use super::position_offsets::PositionOffsets;
 use super::position_range::JointRange;
 use super::torque_columns::{joint_regressors, model_torques, TorqueColumn, JUDGED};
 use crate::error::Result;
@@ -111,6 +112,20 @@ pub fn log_findings(
     let mut out: Vec<String> = super::position_range::finding(ranges).into_iter().collect();
     out.extend(super::torque_columns::findings(columns));
     out.extend(lag.and_then(TorqueLag::finding));
+    out
+}
+
+/// What looks wrong with a new log against a saved base-parameter model: its
+/// [`log_findings`], then the joints' zero offsets against the model's parameters
+/// ([`PositionOffsets::finding_beside`]: none where a torque column is found wrong).
+pub fn validation_findings(
+    ranges: &[JointRange],
+    columns: &[TorqueColumn],
+    lag: Option<&TorqueLag>,
+    offsets: Option<&PositionOffsets>,
+) -> Vec<String> {
+    let mut out = log_findings(ranges, columns, lag);
+    out.extend(offsets.and_then(|o| o.finding_beside(columns, true)));
     out
 }
 

@@ -383,7 +383,9 @@ impl PyBaseModel {
     #[getter]
     fn position_offsets<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
         (self.fit.position_offsets.as_ref())
-            .map(|o| position_offsets_dict(py, o, o.finding()))
+            .map(|o| {
+                position_offsets_dict(py, o, o.finding_beside(&self.fit.torque_columns, false))
+            })
             .transpose()
     }
     /// The joints whose torques show friction terms the fit lacks (the fit made again with

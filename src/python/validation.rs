@@ -16,7 +16,7 @@ use super::tables::dataframe;
 use crate::direct::position_offsets::{check_position_offsets_in_validation, PositionOffsets};
 use crate::direct::position_range::{check_position_range, JointRange};
 use crate::direct::torque_columns::{check_torque_columns, TorqueColumn};
-use crate::direct::torque_lag::{check_torque_lag, log_findings, TorqueLag};
+use crate::direct::torque_lag::{check_torque_lag, validation_findings, TorqueLag};
 use crate::local::Extrapolation;
 use crate::validation::{stored_stderr, validate as validate_rs, Validation};
 
@@ -110,7 +110,7 @@ impl PyValidation {
     #[getter]
     fn position_offsets<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
         (self.position_offsets.as_ref())
-            .map(|o| position_offsets_dict(py, o, o.validation_finding()))
+            .map(|o| position_offsets_dict(py, o, o.finding_beside(&self.torque_columns, true)))
             .transpose()
     }
     /// For a LocalModel whose states go beyond the perturbations it was identified over
@@ -182,8 +182,10 @@ impl PyValidation {
 /// them. For a BaseParameterModel the torque columns are also checked against its robot's
 /// model (swapped columns, the opposite sign, other units: a PerturbidWarning each, and
 /// `Validation.torque_columns`), for a lag behind the positions (`Validation.torque_lag`) and
-/// for joints zeroed elsewhere than in the model's data (`Validation.position_offsets`).
-/// `t` ((k,) s), when the samples are a log: its qd and qdd columns are checked first against
+/// for joints zeroed elsewhere than in the model's data (`Validation.position_offsets`;
+/// not judged where a torque column is found wrong). For a LocalModel or
+/// BaseParameterModel a torque column that holds one value throughout while the robot moves
+/// (a dead channel) is refused. `t` ((k,) s), when the samples are a log: its qd and qdd columns are checked first against
 /// the derivatives of q and qd, as `identify_base_parameters` checks them. Returns a
 /// Validation.
 #[pyfunction]
@@ -242,6 +244,12 @@ pub(crate) fn validate<'py>(
             (q.extract()?, qd.extract()?, qdd.extract()?);
         let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
         let states = batch.states(n)?;
+        crate::torque_model::refuse_flat_torques(
+            &states,
+            &measured,
+            &joints,
+            crate::torque_model::FOR_A_VALIDATION,
+        )?;
         if let Ok(local) = &local {
             let m = &local.get().model;
             stderr = stored_stderr(m.predict_stderr(&states))?.ok();
@@ -264,8 +272,7 @@ pub(crate) fn validate<'py>(
                     )?,
                 ))
             })?;
-            let mut findings = log_findings(&ranges, &columns, lag.as_ref());
-            findings.extend(offsets.as_ref().and_then(|o| o.validation_finding()));
+            let findings = validation_findings(&ranges, &columns, lag.as_ref(), offsets.as_ref());
             warn_all(model.py(), &findings)?;
             stderr = se.ok();
             (position_range, torque_columns) = (ranges, columns);

@@ -171,10 +171,14 @@ def test_torque_columns_are_checked_against_the_model():
     for r in v.position_range:
         j = robot.joint_names.index(r["joint"])
         assert (r["min"], r["max"]) == (np.degrees(q[:, j]).min(), np.degrees(q[:, j]).max())
-    with pytest.warns(pr.PerturbidWarning, match="look like degrees"):
+    with pytest.warns(pr.PerturbidWarning, match="look like degrees") as caught:
         fit = pr.identify_base_parameters(
             robot, np.degrees(q), np.degrees(qd), np.degrees(qdd), tau, friction=None, weighting="ols"
         )
+    # friction terms refitted to a log that does not match the robot take up part of what is
+    # wrong with it: measured, but not named while the columns are found wrong
+    assert fit.unmodelled_friction
+    assert not any("friction the fit leaves out" in str(w.message) for w in caught)
     assert [r["joint"] for r in fit.position_range] == [r["joint"] for r in v.position_range]
     assert clean.position_range == [] and pr.validate(clean, q, qd, qdd, tau).position_range == []
     negated = tau.copy()
@@ -315,6 +319,31 @@ def test_a_new_logs_offsets_are_found_against_a_saved_fit():
             return fit.predict(q, qd, qdd)
 
     assert pr.validate(Predictor(), logged, qd, qdd, new_tau).position_offsets is None
+
+
+def test_a_validation_log_with_a_wrong_or_dead_torque_column():
+    """Against a saved fit, a new log whose shoulder torque reads with the opposite sign is
+    named for that column only: the zero offsets that take up part of its error are estimated
+    but not named (no warning, `finding` None), though on their own they would be. A column
+    that reads 0 throughout while the robot moves is refused, naming its joint."""
+    robot, t, q, qd, qdd, tau, rng = noisy_log(0.005, 5)
+    fit = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction=None, weighting="ols")
+    negated = tau.copy()
+    negated[:, 1] *= -1.0
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        v = pr.validate(fit, q, qd, qdd, negated)
+    said = [str(w.message) for w in caught]
+    assert any("joint 'joint2' reads" in w and "negate the column" in w for w in said), said
+    assert not any("not those of the log the model was identified from" in w for w in said), said
+    assert v.position_offsets is not None and v.position_offsets["finding"] is None
+    # the offsets were fitted to the column's error all the same: they leave less of it
+    o = v.position_offsets
+    assert o["joints"] and o["unexplained_with_offsets"] < 0.9 * o["unexplained"], o
+    dead = tau.copy()
+    dead[:, 3] = 0.0
+    with pytest.raises(pr.InputError, match="the torque of joint 'joint4' \\(column 4\\) is 0 N m in all .* while the robot moves"):
+        pr.validate(fit, q, qd, qdd, dead)
 
 
 def test_standard_errors_count_residuals_correlated_by_the_filter():
