@@ -518,6 +518,74 @@ fn a_log_timed_in_hours_is_asked_about() {
     );
 }
 
+/// Text that is not UTF-8 is refused naming its line, its byte and what the file looks like:
+/// a header with a degree sign in Latin-1, UTF-16 as some Windows tools save, binary data. A
+/// document an editor saved with a UTF-8 byte-order mark first is read (RFC 8259 lets a
+/// reader ignore it).
+#[test]
+fn text_not_in_utf8_is_named_and_a_byte_order_mark_is_ignored() {
+    let d = std::env::temp_dir().join(format!("perturbid-utf8-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let joints = vec!["joint1".to_string()];
+    let cases: [(&str, Vec<u8>, &str); 3] = [
+        (
+            "latin1.csv",
+            b"t,q1,tau1\n0,1,2\n0.001,1,2 # 30\xb0\n".to_vec(),
+            "line 3, byte 15 of it: byte 0xb0 is not UTF-8; the file looks like text in another encoding",
+        ),
+        (
+            "utf16.csv",
+            [0xff, 0xfe, b't', 0, b',', 0].to_vec(),
+            "line 1, byte 1 of it: byte 0xff is not UTF-8; the file looks like UTF-16 text",
+        ),
+        (
+            "binary.csv",
+            [7, 1, 0, 0, 0x9f, 0x80, 0x41].to_vec(),
+            "byte 0x9f is not UTF-8; the file looks like binary data, not text",
+        ),
+    ];
+    for (name, bytes, expected) in cases {
+        let path = d.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let e = perturbid_rs::io::load_recording(&path, &joints)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(name) && e.contains(expected), "{e}");
+    }
+    // a saved model with a byte-order mark first loads as without it
+    let model = perturbid_rs::robots::a465::model("kinsheel2010").unwrap();
+    let mut rng = 7u64;
+    let mut next = || {
+        rng = rng.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (rng >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    let k = 200;
+    let (q, qd, qdd): (Vec<f64>, Vec<f64>, Vec<f64>) = (
+        (0..k * 6).map(|_| next()).collect(),
+        (0..k * 6).map(|_| next()).collect(),
+        (0..k * 6).map(|_| next()).collect(),
+    );
+    let states = perturbid_rs::States::new(6, &q, Some(&qd), Some(&qdd)).unwrap();
+    let mut ws = perturbid_rs::parallel::Workspace::new(&model);
+    let mut tau = vec![0.0; k * 6];
+    let gravity = perturbid_rs::Gravity::Included;
+    perturbid_rs::parallel::rnea(&model, &mut ws, &states, gravity, &mut tau).unwrap();
+    let fit = perturbid_rs::direct::identify_base_parameters(
+        &model,
+        &states,
+        &tau,
+        &perturbid_rs::direct::BaseOptions::default(),
+    )
+    .unwrap();
+    let path = d.join("model.json");
+    fit.save(&path).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::write(&path, format!("\u{feff}{text}")).unwrap();
+    let loaded = perturbid_rs::direct::BaseModel::load(&path).unwrap();
+    assert_eq!(loaded.theta, fit.theta);
+    std::fs::remove_dir_all(&d).ok();
+}
+
 #[test]
 fn a_hand_edited_plan_is_checked_on_load() {
     let model = robots::builtin("a465").unwrap();

@@ -29,9 +29,15 @@ pub fn read_text(path: impl AsRef<Path>) -> Result<String> {
 }
 
 /// The contents of a document (JSON, TOML, URDF: at most
-/// [`MAX_DOCUMENT_BYTES`](crate::limits::MAX_DOCUMENT_BYTES)), as [`read_text`].
+/// [`MAX_DOCUMENT_BYTES`](crate::limits::MAX_DOCUMENT_BYTES)), as [`read_text`], without the
+/// UTF-8 byte-order mark an editor may have put first (JSON and TOML do not allow it; RFC 8259
+/// lets a reader ignore it).
 pub fn read_document(path: impl AsRef<Path>) -> Result<String> {
-    read_bounded(path.as_ref(), crate::limits::MAX_DOCUMENT_BYTES, "document")
+    let text = read_bounded(path.as_ref(), crate::limits::MAX_DOCUMENT_BYTES, "document")?;
+    Ok(match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_string(),
+        None => text,
+    })
 }
 
 /// Reads at most `max` bytes of `path` (`what` it is, for the error): a regular file larger
@@ -54,14 +60,41 @@ fn read_bounded(path: &Path, max: u64, what: &str) -> Result<String> {
     if meta.is_file() && meta.len() > max {
         return Err(too_large());
     }
-    let mut text = String::new();
+    let mut bytes = Vec::new();
     file.take(max + 1)
-        .read_to_string(&mut text)
+        .read_to_end(&mut bytes)
         .map_err(|e| io_error(path, e))?;
-    if text.len() as u64 > max {
+    if bytes.len() as u64 > max {
         return Err(too_large());
     }
-    Ok(text)
+    String::from_utf8(bytes).map_err(|e| not_utf8(path, e.as_bytes(), e.utf8_error()))
+}
+
+/// The error for `bytes` of `path` that are not UTF-8 text: where (line and byte), what byte,
+/// and what the file might be instead.
+fn not_utf8(path: &Path, bytes: &[u8], e: std::str::Utf8Error) -> Error {
+    let at = e.valid_up_to();
+    let line = 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();
+    let column = at
+        - bytes[..at]
+            .iter()
+            .rposition(|&b| b == b'\n')
+            .map_or(0, |i| i + 1)
+        + 1;
+    let what = if bytes.starts_with(&[0xff, 0xfe]) || bytes.starts_with(&[0xfe, 0xff]) {
+        "UTF-16 text (a byte-order mark of 0xff 0xfe or 0xfe 0xff first): save it as UTF-8"
+    } else if bytes.iter().take(4096).any(|&b| b == 0) {
+        "binary data, not text"
+    } else {
+        "text in another encoding (Latin-1 or Windows-1252, a degree sign or an accent in a name): save it as UTF-8"
+    };
+    io_error(
+        path,
+        std::io::Error::other(format!(
+            "line {line}, byte {column} of it: byte 0x{:02x} is not UTF-8; the file looks like {what}",
+            bytes[at]
+        )),
+    )
 }
 
 /// Writes `bytes` to a temporary file beside `path` (hidden, named after this process so that
