@@ -35,6 +35,11 @@ pub struct LeastSquares {
     /// unit diagonal (the design's alone, the same for every output; with the standard errors
     /// of an output's row, `diag(se) R diag(se)` is its coefficients' covariance).
     pub correlation: DMatrix<f64>,
+    /// The right singular vector of `X`'s smallest singular value after scaling each column to
+    /// unit norm (p, unit norm, its largest entry positive): the combination of the scaled
+    /// coefficients the data determine least well, `cond / s_max` times less precisely than
+    /// an orthogonal design of the same column norms would.
+    pub weakest: Vec<f64>,
 }
 
 /// Relative singular-value threshold below which a design counts as rank deficient.
@@ -201,8 +206,18 @@ pub fn least_squares(
         let c: f64 = (0..p).map(|i| v[(a, i)] * v[(b, i)] / (s[i] * s[i])).sum();
         (c / (cov_scaled[a] * cov_scaled[b]).sqrt()).clamp(-1.0, 1.0)
     });
+    let least = (0..p).min_by(|&a, &b| s[a].total_cmp(&s[b])).unwrap_or(0);
+    let mut weakest: Vec<f64> = (0..p).map(|j| v[(j, least)]).collect();
+    let largest = weakest
+        .iter()
+        .copied()
+        .fold(0.0, |a: f64, w| if w.abs() > a.abs() { w } else { a });
+    if largest < 0.0 {
+        weakest.iter_mut().for_each(|w| *w = -*w);
+    }
     Ok(LeastSquares {
         coef,
+        weakest,
         cond: smax / smin,
         residual_rms,
         stderr,

@@ -556,7 +556,9 @@ fn text_not_in_utf8_is_named_and_a_byte_order_mark_is_ignored() {
     let model = perturbid_rs::robots::a465::model("kinsheel2010").unwrap();
     let mut rng = 7u64;
     let mut next = || {
-        rng = rng.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        rng = rng
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (rng >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
     };
     let k = 200;

@@ -639,6 +639,11 @@ class BaseParameterModel:
         """Joints whose torques show friction terms the fit lacks: joint, explained,
         residual_rms, remaining_rms, terms (dicts term, coefficient, stderr); also warnings."""
     @property
+    def weak_excitation(self) -> dict[str, Any] | None:
+        """Where the data excite the base parameters weakly (cond beyond 1000), else None:
+        cond, weakest (the least determined combination: dicts parameter, weight), motion
+        (dicts joint, extent, range in rad or m; range None without limits); also a warning."""
+    @property
     def position_range(self) -> list[dict[str, Any]]:
         """The joints whose positions in the data leave their URDF limits by more than 5 % of
         their range (joint, min, max, lower, upper in rad or m; degrees: True where, read as

@@ -144,6 +144,12 @@ pub struct BaseModel {
     /// none do, the fit has every friction term, or in a model saved before it was checked.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub unmodelled_friction: Vec<super::unmodelled_friction::UnmodelledFriction>,
+    /// Where the data excite the base parameters weakly (`cond` beyond
+    /// [`super::weak_excitation::WEAK_CONDITION`]): the least determined combination and how
+    /// far each joint moved ([`super::weak_excitation`]), warned of ([`BaseModel::warnings`]).
+    /// None otherwise, or in a model saved before it was checked.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weak_excitation: Option<super::weak_excitation::WeakExcitation>,
     /// The correlation of the estimates in `theta` (p x p, unit diagonal): with `stderr`,
     /// `diag(stderr) R diag(stderr)` is their covariance, which [`BaseModel::predict_stderr`]
     /// needs. In a physically consistent model, the unconstrained fit's (with its standard
@@ -354,7 +360,10 @@ fn fit_with_factors(
         position_range: super::position_range::check_position_range(model, states),
         position_offsets: None,
         unmodelled_friction: vec![],
+        weak_excitation: None,
     };
+    fit.weak_excitation =
+        super::weak_excitation::check_excitation(model, states, &fit.base, ls.cond, &ls.weakest);
     // residuals correlated from sample to sample (a filtered, lightly decimated log) carry less
     // information than their number says
     let head = states.slice(0..k.min(super::residual_correlation::SAMPLES));
@@ -564,6 +573,16 @@ impl Document for BaseModel {
             .and_then(|l| l.problem(&m.joint_names))
         {
             return Err(invalid(Self::WHAT, format!("torque_lag: {problem}")));
+        }
+        if let Some(w) = &m.weak_excitation {
+            let unknown = (w.motion.iter())
+                .find(|j| !m.joint_names.contains(&j.joint))
+                .map(|j| format!("joint '{}' is not one of the model's", j.joint));
+            let cond = (w.cond != m.cond)
+                .then(|| format!("cond {} is not the model's {}", w.cond, m.cond));
+            if let Some(problem) = unknown.or(cond).or_else(|| w.problem()) {
+                return Err(invalid(Self::WHAT, format!("weak_excitation: {problem}")));
+            }
         }
         if let Some(problem) = (m.position_offsets.as_ref()).and_then(|o| o.problem(&m.joint_names))
         {

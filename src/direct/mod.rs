@@ -19,6 +19,7 @@ pub mod streaming;
 pub mod torque_columns;
 pub mod torque_lag;
 pub mod unmodelled_friction;
+pub mod weak_excitation;
 pub mod workspace;
 
 pub use base::BaseParameters;
@@ -39,4 +40,5 @@ pub use position_offsets::{
 pub use torque_columns::{check_torque_columns, TorqueColumn};
 pub use torque_lag::{check_torque_lag, TorqueLag};
 pub use unmodelled_friction::{check_unmodelled_friction, MissingTerm, UnmodelledFriction};
+pub use weak_excitation::{check_excitation, WeakExcitation};
 pub use workspace::{workspace_from_json, CartesianConstraint, Region};

@@ -49,7 +49,8 @@ impl BaseModel {
     /// sign, in other units), torques out of step with their positions
     /// ([`super::torque_lag`]), joints whose zeros in the data look offset
     /// ([`super::position_offsets`]), friction the fit leaves out that shows in its residuals
-    /// ([`super::unmodelled_friction`]), positions logged in counts so coarse that their
+    /// ([`super::unmodelled_friction`]), data that excite the base parameters weakly
+    /// ([`super::weak_excitation`]), positions logged in counts so coarse that their
     /// rounding shows in the derived velocities ([`crate::position_rounding`]), and friction or
     /// armature coefficients identified on their own (not in a combination) and negative
     /// beyond three standard errors. No joint has them; the data hold an effect the model
@@ -92,10 +93,12 @@ impl BaseModel {
             self.base.layout.friction,
         )
         .filter(|_| super::torque_columns::findings(&self.torque_columns).is_empty());
+        let weak = (self.weak_excitation.as_ref()).map(|w| w.finding());
         columns
             .into_iter()
             .chain(offsets)
             .chain(friction)
+            .chain(weak)
             .chain(rounding)
             .chain(negative)
             .collect()

@@ -307,6 +307,8 @@ pub fn identify_parameters_from_local(
         position_range: vec![],
         position_offsets: None,
         unmodelled_friction: vec![],
+        // rows from local models: their own diagnostics say what they leave unidentified
+        weak_excitation: None,
     };
     let consistent = match &options.consistent {
         None => None,

@@ -417,6 +417,36 @@ impl PyBaseModel {
             })
             .collect()
     }
+    /// Where the data excite the base parameters weakly (cond beyond 1000), else None: dict
+    /// `cond`, `weakest` (the least determined combination of base parameters: dicts
+    /// `parameter`, the name it is kept as with ' (merged)' where others are merged into it,
+    /// and `weight`, in units of its regressor column's norm; at most 6, largest first) and
+    /// `motion` (dicts `joint`, `extent`: the largest position minus the smallest, `range`:
+    /// the URDF's upper limit minus its lower one or None; rad or m); also a warning.
+    #[getter]
+    fn weak_excitation<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(w) = &self.fit.weak_excitation else {
+            return Ok(None);
+        };
+        let e = PyDict::new(py);
+        e.set_item("cond", w.cond)?;
+        let weakest = (w.weakest.iter()).map(|t| {
+            let d = PyDict::new(py);
+            d.set_item("parameter", &t.parameter)?;
+            d.set_item("weight", t.weight)?;
+            Ok(d)
+        });
+        e.set_item("weakest", weakest.collect::<PyResult<Vec<_>>>()?)?;
+        let motion = (w.motion.iter()).map(|m| {
+            let d = PyDict::new(py);
+            d.set_item("joint", &m.joint)?;
+            d.set_item("extent", m.extent)?;
+            d.set_item("range", m.range)?;
+            Ok(d)
+        });
+        e.set_item("motion", motion.collect::<PyResult<Vec<_>>>()?)?;
+        Ok(Some(e))
+    }
     /// The joints whose positions in the data leave their URDF limits by more than 5 % of
     /// their range: dicts `joint`, `min`, `max` (the positions logged), `lower`, `upper` (the
     /// limits; rad or m) and `degrees` (True where, read as degrees, they lie within the

@@ -346,6 +346,57 @@ def test_a_validation_log_with_a_wrong_or_dead_torque_column():
         pr.validate(fit, q, qd, qdd, dead)
 
 
+def test_a_weakly_exciting_log_is_named():
+    """The test excitation scaled to +-0.05 rad excites the A465's base parameters weakly: the
+    fit's cond and least determined combination are numpy's SVD of the column-scaled base
+    regressor (Phi[:, kept] with the rotors' columns), each joint's extent numpy's, and the
+    warning names them; the same motion at +-0.3 rad is no finding. Saved and loaded with
+    the model; a hand-edited cond is refused on load."""
+    robot = pr.robots.a465()
+    traj = excitation(robot, 5, 0.1, 0.05, 1)
+    t = np.arange(0, traj.period, 0.01)
+    q, qd, qdd = traj.sample(t)
+    tau = robot.rnea(q, qd, qdd) + np.random.default_rng(0).normal(0.0, 0.05, q.shape)
+    with pytest.warns(pr.PerturbidWarning, match="the data excite the base parameters weakly") as caught:
+        fit = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction=None, weighting="ols")
+    w = fit.weak_excitation
+    assert w is not None and w["cond"] == fit.cond > 1000
+    # numpy: the base regressor, its columns scaled to unit norm, and its SVD
+    phi = robot.regressor(q, qd, qdd)
+    rotors = qdd[:, :, None] * np.eye(6)
+    full = np.concatenate([phi, rotors], axis=2).reshape(-1, 66)
+    base = full[:, fit.kept]
+    scaled = base / np.linalg.norm(base, axis=0)
+    _, sv, vt = np.linalg.svd(scaled, full_matrices=False)
+    assert w["cond"] == pytest.approx(sv[0] / sv[-1], rel=1e-6)
+    weakest = vt[-1] * np.sign(vt[-1][np.argmax(np.abs(vt[-1]))])
+    kept_names = [n.split(" ")[0] for n in fit.names]
+    order = np.argsort(-np.abs(weakest))
+    named = [t["parameter"].removesuffix(" (merged)") for t in w["weakest"]]
+    assert named == [kept_names[i] for i in order[: len(named)]]
+    for term, i in zip(w["weakest"], order):
+        assert term["weight"] == pytest.approx(weakest[i], abs=1e-6)
+        assert term["parameter"].endswith(" (merged)") == (" + " in fit.names[i] or " - " in fit.names[i])
+    assert [m["joint"] for m in w["motion"]] == robot.joint_names
+    for j, m in enumerate(w["motion"]):
+        assert m["extent"] == pytest.approx(np.ptp(q[:, j]), rel=1e-12)
+        assert m["range"] == pytest.approx(robot.upper[j] - robot.lower[j], rel=1e-12)
+    message = next(str(c.message) for c in caught if "weakly" in str(c.message))
+    least = min(range(6), key=lambda j: np.ptp(q[:, j]) / (robot.upper[j] - robot.lower[j]))
+    assert f"'{robot.joint_names[least]}'" in message and named[0] in message, message
+    saved = json.loads(fit.to_json())
+    assert saved["weak_excitation"]["cond"] == fit.cond
+    # the same motion over more of the joints' ranges is no finding
+    wide = excitation(robot, 5, 0.1, 0.3, 1)
+    q, qd, qdd = wide.sample(t)
+    tau = robot.rnea(q, qd, qdd) + np.random.default_rng(0).normal(0.0, 0.05, q.shape)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fit_wide = pr.identify_base_parameters(robot, q, qd, qdd, tau, friction=None, weighting="ols")
+    assert fit_wide.weak_excitation is None and fit_wide.cond < 1000
+    assert "weak_excitation" not in json.loads(fit_wide.to_json())
+
+
 def test_standard_errors_count_residuals_correlated_by_the_filter():
     # a log low-pass filtered at 10 Hz and kept at 100 Hz: about five correlated samples to
     # every independent one, which the standard errors now count
