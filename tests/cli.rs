@@ -135,7 +135,8 @@ fn plan_simulate_identify_predict() {
             .into_iter()
             .flatten()
             .chain(a465::TABLE2_QDD)
-            .chain([0.1; 6])
+            // torques that change (a column of one value while moving is a dead channel)
+            .chain((0..6).map(|j| 0.1 + 0.01 * (i + j) as f64))
             .map(|x| x.to_string())
             .collect();
         far.push_str(&(row.join(",") + "\n"));
