@@ -640,7 +640,7 @@ class BaseParameterModel:
         residual_rms, remaining_rms, terms (dicts term, coefficient, stderr); also warnings."""
     @property
     def weak_excitation(self) -> dict[str, Any] | None:
-        """Where the data excite the base parameters weakly (cond beyond 1000), else None:
+        """Where the data excite the base parameters weakly (cond beyond 2000), else None:
         cond, weakest (the least determined combination: dicts parameter, weight), motion
         (dicts joint, extent, range in rad or m; range None without limits); also a warning."""
     @property

@@ -417,7 +417,7 @@ impl PyBaseModel {
             })
             .collect()
     }
-    /// Where the data excite the base parameters weakly (cond beyond 1000), else None: dict
+    /// Where the data excite the base parameters weakly (cond beyond 2000), else None: dict
     /// `cond`, `weakest` (the least determined combination of base parameters: dicts
     /// `parameter`, the name it is kept as with ' (merged)' where others are merged into it,
     /// and `weight`, in units of its regressor column's norm; at most 6, largest first) and
