@@ -66,7 +66,9 @@ impl Default for PreprocessOptions {
 /// [`Recording::dropouts`]), resamples `q`, `tau` (and `qd` when logged; otherwise qd is the
 /// derivative of q) onto a uniform grid at `rate`, filters qd and tau (and q if asked) with a
 /// zero-phase Butterworth low-pass, differentiates the filtered qd into qdd, trims and
-/// decimates. The result is a recording with `qd` and `qdd`, named `<name> (preprocessed)`.
+/// decimates. The result is a recording with `qd` and `qdd`, named `<name> (preprocessed)`;
+/// where it filters, also with [`Recording::coulomb`]: the sign of the filtered qd, filtered
+/// again as tau is, the Coulomb friction term's column for a fit of the filtered torques.
 /// Where a joint's logged positions lie on a grid (encoder counts) and its velocity is derived
 /// from them, the noise their rounding leaves in qd and qdd is estimated and kept in
 /// [`Recording::position_rounding`] ([`crate::position_rounding`]).
@@ -178,6 +180,8 @@ fn preprocess_screened(
             done.iter()
                 .flat_map(|r| r.position_rounding.iter().cloned()),
         ),
+        coulomb: (done.iter().all(|r| r.coulomb.is_some()))
+            .then(|| cat(|r| r.coulomb.as_deref().unwrap_or(&[]))),
         ..out
     })
 }
@@ -270,7 +274,8 @@ fn preprocess_part(
             None => Ok(x),
         }
     };
-    let mut cols: [Vec<Vec<f64>>; 4] = Default::default(); // q, qd, qdd, tau per joint
+    // q, qd, qdd, tau per joint, and the Coulomb term's column: sign(qd) filtered as tau is
+    let mut cols: [Vec<Vec<f64>>; 5] = Default::default();
     for j in 0..n {
         crate::interrupt::check("preprocessing")?;
         let q = interpolate(&rec.t, &column(&rec.q, j), &grid);
@@ -279,6 +284,13 @@ fn preprocess_part(
             None => differentiate(&q, dt),
         };
         let qd = smooth(qd)?;
+        if filter.is_some() {
+            let sign: Vec<f64> = qd
+                .iter()
+                .map(|&v| crate::direct::parameters::sign0(v))
+                .collect();
+            cols[4].push(smooth(sign)?);
+        }
         cols[2].push(differentiate(&qd, dt));
         cols[1].push(qd);
         cols[0].push(if o.filter_position { smooth(q)? } else { q });
@@ -358,6 +370,7 @@ fn preprocess_part(
     .map(|out| Recording {
         experiment: rec.experiment.clone(),
         position_rounding: rounding,
+        coulomb: filter.is_some().then(|| rows(&cols[4])),
         ..out
     })
 }

@@ -35,6 +35,9 @@ pub struct States<'a> {
     q: &'a [f64],
     qd: Option<&'a [f64]>,
     qdd: Option<&'a [f64]>,
+    /// The Coulomb friction term's regressor column, where not `sign(qd)`
+    /// ([`States::with_coulomb`]).
+    coulomb: Option<&'a [f64]>,
 }
 
 /// One sample of [`States`]: slices of `nv` values, `None` for zeros.
@@ -119,6 +122,7 @@ impl<'a> States<'a> {
             q,
             qd,
             qdd,
+            coulomb: None,
         };
         states.check_finite()?;
         Ok(states)
@@ -224,7 +228,51 @@ impl<'a> States<'a> {
             single: self.single,
             q: &self.q[r.clone()],
             qd: self.qd.map(|x| &x[r.clone()]),
-            qdd: self.qdd.map(|x| &x[r]),
+            qdd: self.qdd.map(|x| &x[r.clone()]),
+            coulomb: self.coulomb.map(|x| &x[r]),
+        }
+    }
+
+    /// These states with `coulomb` (row-major `k x nv`, each within [-2, 2]) as the regressor
+    /// column of every joint's Coulomb friction term in place of `sign(qd)`: `sign(qd)`
+    /// low-pass filtered as the torques were ([`crate::Recording::coulomb`]), so that the
+    /// term follows the filtered torque's smoothed steps at velocity reversals (parallel
+    /// filtering; a low-pass filter's overshoot takes it past 1, by 14 % for the default
+    /// 4th-order Butterworth applied forwards and backwards). Errors: a shape unlike `q`'s, or
+    /// a value not finite or beyond +-2, which no filtered sign reaches.
+    pub fn with_coulomb(self, coulomb: &'a [f64]) -> Result<Self> {
+        self.check_companion("coulomb", coulomb, self.nv)?;
+        if let Some(i) = coulomb.iter().position(|v| v.abs() > 2.0) {
+            return Err(Error::InvalidArgument {
+                argument: "coulomb".into(),
+                message: format!(
+                    "sample {}, joint {}: {}, expected a value within [-2, 2] (sign(qd), filtered)",
+                    self.first + i / self.nv,
+                    i % self.nv + 1,
+                    crate::error::shown(coulomb[i])
+                ),
+            });
+        }
+        Ok(Self {
+            coulomb: Some(coulomb),
+            ..self
+        })
+    }
+
+    /// The Coulomb friction term's regressor column of every joint, row-major `k x nv`, where
+    /// given ([`Self::with_coulomb`]); `None` for `sign(qd)`.
+    pub fn coulomb(&self) -> Option<&'a [f64]> {
+        self.coulomb
+    }
+
+    /// The Coulomb term's column of joint `j` at sample `s`: the given one, or `sign(qd)`
+    /// (0 at rest or without velocities).
+    pub fn coulomb_at(&self, s: usize, j: usize) -> f64 {
+        let i = s * self.nv + j;
+        match (self.coulomb, self.qd) {
+            (Some(c), _) => c[i],
+            (None, Some(qd)) => crate::direct::parameters::sign0(qd[i]),
+            (None, None) => 0.0,
         }
     }
 

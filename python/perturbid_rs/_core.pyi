@@ -325,6 +325,10 @@ class Recording:
     @property
     def qdd(self) -> Optional[NDArray[np.float64]]: ...
     @property
+    def coulomb(self) -> Optional[NDArray[np.float64]]:
+        """The Coulomb friction term's column (k, n): sign(qd) filtered as tau was, for a
+        direct fit of these torques (coulomb=); None where preprocess did not filter."""
+    @property
     def glitches(self) -> list[dict[str, Any]]:
         """Samples of the log this was preprocessed from taken for glitches and replaced first
         (signal, joint, sample, time, value, noise_levels, replaced_by, repeats_previous,
@@ -656,8 +660,8 @@ class BaseParameterModel:
         """torque (n,), D, H, G (n, n) and G_static (n, n) or None at op."""
     def to_dataframe(self) -> Any:
         """The parameter table as a pandas DataFrame (index parameter; value, std, relative_std, combination)."""
-    def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]: ...
-    def predict_stderr(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]:
+    def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, coulomb: Optional[ArrayLike] = None) -> NDArray[np.float64]: ...
+    def predict_stderr(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, coulomb: Optional[ArrayLike] = None) -> NDArray[np.float64]:
         """Standard errors (N m) of predict's torques, shape (n,) or (k, n): from the parameters'
         standard errors and their correlation (the model's uncertainty, not a measured torque's
         scatter). InputError for a model saved before the correlation was stored."""
@@ -719,6 +723,7 @@ def identify_base_parameters(
     tolerance: float = 1e-8,
     seed: int = 0,
     t: Optional[ArrayLike] = None,
+    coulomb: Optional[ArrayLike] = None,
 ) -> BaseParameterModel: ...
 
 @final
@@ -762,6 +767,7 @@ def identify_consistent_parameters(
     prior_weight: float = 1e-6,
     max_iterations: int = 2000,
     t: Optional[ArrayLike] = None,
+    coulomb: Optional[ArrayLike] = None,
 ) -> ConsistentFit:
     """Physically consistent least squares over the direct method's data (interior point)."""
 
@@ -809,7 +815,13 @@ class Validation:
         """The per-joint table as a pandas DataFrame (index joint; rms, relative_rms, max)."""
 
 def validate(
-    model: Any, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, tau: ArrayLike, t: Optional[ArrayLike] = None
+    model: Any,
+    q: ArrayLike,
+    qd: ArrayLike,
+    qdd: ArrayLike,
+    tau: ArrayLike,
+    t: Optional[ArrayLike] = None,
+    coulomb: Optional[ArrayLike] = None,
 ) -> Validation:
     """Validates any model with predict(q, qd, qdd) on measured states and torques; for a
     BaseParameterModel also checks the torque columns against its robot's model (a

@@ -179,10 +179,6 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
             ),
         });
     }
-    let (qd, qdd) = (
-        rec.qd.clone().expect("preprocessed"),
-        rec.qdd.clone().expect("preprocessed"),
-    );
     let options = BaseOptions {
         friction: a.friction,
         weighting: a.weighting,
@@ -190,7 +186,8 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         ..BaseOptions::default()
     };
     progress.update(&format!("identifying on {split} samples"));
-    let states = States::new(n, &rec.q, Some(&qd), Some(&qdd))?;
+    // with the Coulomb term's column filtered as the torques were
+    let states = rec.states()?;
     let fit = if a.consistent {
         let c = crate::direct::identify_consistent_parameters(
             &model,

@@ -14,7 +14,6 @@ use crate::direct::torque_columns::check_torque_columns;
 use crate::direct::torque_lag::{check_torque_lag, validation_findings};
 use crate::error::{Error, Result};
 use crate::io::{OutputSet, Table};
-use crate::states::States;
 use crate::svg::{line_plot, Series};
 use crate::torque_model::{ModelFile, TorqueModel};
 use crate::validation::{stored_stderr, validate};
@@ -76,11 +75,8 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
         .preprocessing
         .read(&a.data, &joints, &progress, &mut out)?;
     let n = joints.len();
-    let (qd, qdd) = match (&rec.qd, &rec.qdd) {
-        (Some(v), Some(a)) => (v, a),
-        _ => unreachable!("read() preprocesses a log without qdd"),
-    };
-    let states = States::new(n, &rec.q, Some(qd), Some(qdd))?;
+    // with the Coulomb term's column filtered as the torques were
+    let states = rec.states()?;
     crate::torque_model::refuse_flat_torques(
         &states,
         &rec.tau,

@@ -244,7 +244,7 @@ pub(crate) fn fill_regressor(
             for (t, name) in terms.iter().enumerate() {
                 out[(base + j, ni + j * terms.len() + t)] = match *name {
                     "viscous" => qd[j],
-                    "coulomb" => sign0(qd[j]),
+                    "coulomb" => states.coulomb_at(s, j),
                     "armature" => qdd[j],
                     _ => 1.0,
                 };

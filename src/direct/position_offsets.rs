@@ -288,6 +288,7 @@ fn check(
         q: pick(states.q()),
         qd: pick(&states.qd_or_zeros()),
         qdd: pick(&states.qdd_or_zeros()),
+        coulomb: states.coulomb().map(pick),
         y: DVector::from_fn(m * n, |r, _| measured[r] * weight[r % n]),
         weight,
         parameters,
@@ -349,6 +350,8 @@ struct Problem<'a> {
     q: Vec<f64>,
     qd: Vec<f64>,
     qdd: Vec<f64>,
+    /// The Coulomb term's column where the states give one ([`States::with_coulomb`]).
+    coulomb: Option<Vec<f64>>,
     /// The torques (row-major), each joint's weighted by `weight`.
     y: DVector<f64>,
     /// `1 / sigma` per joint.
@@ -405,6 +408,10 @@ impl Problem<'_> {
             .map(|(i, v)| v + d[i % n])
             .collect();
         let s = States::new(n, &q, Some(&self.qd), Some(&self.qdd))?;
+        let s = match &self.coulomb {
+            Some(c) => s.with_coulomb(c)?,
+            None => s,
+        };
         let mut a = DMatrix::zeros(rows, p);
         regressor_blocks(
             self.model,

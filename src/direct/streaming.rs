@@ -153,7 +153,7 @@ impl Worker {
         &mut self,
         model: &Model,
         columns: &[JointColumns],
-        x: [&[f64]; 3],
+        x: [&[f64]; 4],
         tau: &[f64],
         gravity: Gravity,
         range: std::ops::Range<usize>,
@@ -179,14 +179,14 @@ impl Worker {
 }
 
 impl Worker {
-    /// Writes the rows of samples `range` of the states `[q, qd, qdd]` (row-major, the whole
-    /// batch) below the factors: the regressor [`LaneData::width`] samples at a time by the multi-sample
+    /// Writes the rows of samples `range` of the states `[q, qd, qdd, coulomb]` (row-major,
+    /// the whole batch; `coulomb` the Coulomb term's column, [`States::coulomb_at`]) below the factors: the regressor [`LaneData::width`] samples at a time by the multi-sample
     /// kernel ([`regressor_group`]), read in place.
     fn fill(
         &mut self,
         model: &Model,
         columns: &[JointColumns],
-        [q, qd, qdd]: [&[f64]; 3],
+        [q, qd, qdd, coulomb]: [&[f64]; 4],
         tau: &[f64],
         gravity: Gravity,
         range: std::ops::Range<usize>,
@@ -206,7 +206,8 @@ impl Worker {
             )?;
             for l in 0..used {
                 let s = first + l;
-                let (qd, qdd) = (&qd[s * nv..(s + 1) * nv], &qdd[s * nv..(s + 1) * nv]);
+                let row = s * nv..(s + 1) * nv;
+                let (qd, qdd, coulomb) = (&qd[row.clone()], &qdd[row.clone()], &coulomb[row]);
                 for (j, (a, cols)) in self.stacks.iter_mut().zip(columns).enumerate() {
                     let nj = cols.base.len();
                     let i = nj + 1 + s - range.start;
@@ -216,7 +217,7 @@ impl Worker {
                     for &(c, term) in &cols.friction {
                         a[(i, c)] = match term {
                             Term::Viscous => qd[j],
-                            Term::Coulomb => crate::direct::parameters::sign0(qd[j]),
+                            Term::Coulomb => coulomb[j],
                             Term::Offset => 1.0,
                             Term::Armature => qdd[j],
                         };
@@ -296,7 +297,14 @@ impl JointFactors {
         states.check_companion("tau", tau, nv)?;
         let k = states.len();
         let (qd, qdd) = (states.qd_or_zeros(), states.qdd_or_zeros());
-        let x = [states.q(), &qd[..], &qdd[..]];
+        let coulomb: Vec<f64> = match states.coulomb() {
+            Some(c) => c.to_vec(),
+            None => qd
+                .iter()
+                .map(|&v| crate::direct::parameters::sign0(v))
+                .collect(),
+        };
+        let x = [states.q(), &qd[..], &qdd[..], &coulomb[..]];
         let p = base.len();
         let columns = JointColumns::new(model, base);
         let chunks: Vec<std::ops::Range<usize>> = (0..k)

@@ -188,7 +188,12 @@ pub fn check_unmodelled_friction(
         states.qdd().map(pick),
         pick(tau),
     );
+    let c = states.coulomb().map(pick);
     let sub = States::new(n, &q, Some(&v), a.as_deref())?;
+    let sub = match &c {
+        Some(c) => sub.with_coulomb(c)?,
+        None => sub,
+    };
     // every term; where the data cannot tell two apart (the Coulomb term of a joint that never
     // reverses is its offset), without the offset, then without the Coulomb term. Fewer
     // samples than parameters, or a refit the data do not determine: nothing to judge. Ctrl-C

@@ -192,6 +192,9 @@ pub(crate) struct Batch<'a> {
     pub single: bool,
     /// One buffer per argument, `k * n` values each, sample after sample.
     pub columns: Vec<Cow<'a, [f64]>>,
+    /// Whether the fourth argument, after q, qd and qdd, is named `coulomb`: the Coulomb
+    /// friction term's column ([`Batch::states`]).
+    pub coulomb: bool,
 }
 
 /// Reads `args` (name, array-like), each of shape `(n,)` or `(k, n)`, all with the same `k`.
@@ -235,6 +238,7 @@ pub(crate) fn read_batch<'a, A: ArrayArg>(n: usize, args: &[(&str, &'a A)]) -> R
         k,
         single: !batched,
         columns,
+        coulomb: args.get(3).is_some_and(|(name, _)| *name == "coulomb"),
     })
 }
 
@@ -244,10 +248,15 @@ impl Batch<'_> {
     pub fn states(&self, nv: usize) -> Result<States<'_>> {
         let column = |i: usize| self.columns.get(i).map(|c| &c[..]);
         let q = column(0).unwrap_or(&[]);
-        if self.single {
+        let states = if self.single {
             States::single(nv, q, column(1), column(2))
         } else {
             States::new(nv, q, column(1), column(2))
+        }?;
+        // a fourth array named coulomb, after q, qd and qdd, is the Coulomb term's column
+        match column(3) {
+            Some(c) if self.coulomb => states.with_coulomb(c),
+            _ => Ok(states),
         }
     }
 
@@ -420,7 +429,22 @@ pub(crate) fn at_states<'py>(
     name: &str,
     f: impl FnOnce(&crate::states::States<'_>) -> Result<Vec<f64>> + Send,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let batch = read_batch(n, &[("q", q), ("qd", qd), ("qdd", qdd)])?;
+    at_states_with(py, n, [q, qd, qdd], None, name, f)
+}
+
+/// [`at_states`] with the Coulomb friction term's column (`coulomb`, shaped as `q`; see
+/// [`crate::States::with_coulomb`]) where given.
+pub(crate) fn at_states_with<'py>(
+    py: Python<'py>,
+    n: usize,
+    [q, qd, qdd]: [&ArrayLike<'py>; 3],
+    coulomb: Option<&ArrayLike<'py>>,
+    name: &str,
+    f: impl FnOnce(&crate::states::States<'_>) -> Result<Vec<f64>> + Send,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mut args = vec![("q", q), ("qd", qd), ("qdd", qdd)];
+    args.extend(coulomb.map(|c| ("coulomb", c)));
+    let batch = read_batch(n, &args)?;
     let states = batch.states(n)?;
     let out = super::detached(py, name, || f(&states))?;
     to_numpy(py, out, batch.k, batch.single, &[n])

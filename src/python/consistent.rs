@@ -16,7 +16,6 @@ use crate::direct::{
     identify_consistent_parameters as consistent_rs, ConsistentFit, ConsistentOptions,
 };
 use crate::model::Model;
-use crate::states::States;
 
 /// Physically consistent parameters: every body's pseudo-inertia positive semi-definite (a
 /// rigid body with a non-negative density can have them), viscous, Coulomb and armature
@@ -139,9 +138,10 @@ impl PyConsistentFit {
 /// what the data do not. `t` ((k,) s), when the samples are a log: its qd and qdd columns are
 /// checked first, as `identify_base_parameters` checks them. What the checks of the data find
 /// (torque columns, a lag, zero offsets, friction left out) is warned of (PerturbidWarning).
-/// Returns a ConsistentFit.
+/// `coulomb` ((k, n)): the Coulomb term's column for filtered torques, as in
+/// `identify_base_parameters`. Returns a ConsistentFit.
 #[pyfunction]
-#[pyo3(signature = (robot, q, qd, qdd, tau, friction=None, weighting="wls", gravity=true, prior_weight=1e-6, max_iterations=2000, t=None))]
+#[pyo3(signature = (robot, q, qd, qdd, tau, friction=None, weighting="wls", gravity=true, prior_weight=1e-6, max_iterations=2000, t=None, coulomb=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_consistent_parameters(
     py: Python<'_>,
@@ -156,6 +156,7 @@ pub(crate) fn identify_consistent_parameters(
     #[pyo3(from_py_with = scalars::real)] prior_weight: f64,
     #[pyo3(from_py_with = scalars::count)] max_iterations: usize,
     t: Option<ArrayLike<'_>>,
+    coulomb: Option<ArrayLike<'_>>,
 ) -> PyResult<PyConsistentFit> {
     let options = base_options(friction, weighting, gravity)?;
     let consistent = ConsistentOptions {
@@ -165,19 +166,15 @@ pub(crate) fn identify_consistent_parameters(
     };
     let model = &robot.model;
     let c = states(model.nv, &q, &qd, &qdd, Some(&tau))?;
+    let coulomb = super::direct::coulomb_column(model.nv, coulomb.as_ref())?;
     let t = (t.as_ref())
         .map(|t| super::arrays::vector("t", t))
         .transpose()?;
     let fit = detached(py, "identify_consistent_parameters", || {
         let what = "identify_consistent_parameters' samples";
         super::direct::check_sample_derivatives(what, model.nv, t, &c)?;
-        consistent_rs(
-            model,
-            &States::new(model.nv, &c[0], Some(&c[1]), Some(&c[2]))?,
-            &c[3],
-            &options,
-            &consistent,
-        )
+        let s = super::direct::fit_states(model.nv, &c, coulomb.as_deref())?;
+        consistent_rs(model, &s, &c[3], &options, &consistent)
     })?;
     // what the data's checks found (torque columns, lag, offsets, friction left out), as the
     // command line and identify_base_parameters warn of it

@@ -1,6 +1,6 @@
-//! The direct method in Python: `design_excitation` (`ExcitationDesign`),
-//! `identify_base_parameters` (`BaseParameterModel`) and `identify_global_linear`
-//! (`GlobalLinearModel`) (mirrors `crate::direct`).
+//! The direct method in Python: `identify_base_parameters` (`BaseParameterModel`) and
+//! `identify_global_linear` (`GlobalLinearModel`) (mirrors `crate::direct`; the excitation
+//! design is `super::excitation`).
 
 use std::borrow::Cow;
 use std::sync::Arc;
@@ -14,80 +14,21 @@ use super::detached;
 use pyo3::types::PyDict;
 
 use super::arrays::{
-    at_states, expansion_dict, matrix_to_numpy as mat, read_batch, to_numpy, vector, ArrayLike,
+    at_states, at_states_with, expansion_dict, matrix_to_numpy as mat, read_batch, to_numpy,
+    vector, ArrayLike,
 };
 use super::local::PyOperatingPoint;
 use super::robot::PyRobot;
-use super::trajectory::PyFourier;
-use crate::direct::excitation::ExcitationDesign;
 use crate::direct::position_offsets::PositionOffsets;
 use crate::direct::position_range::JointRange;
 use crate::direct::{
-    design_excitation as design_rs, identify_base_parameters as base_rs,
-    identify_global_linear as global_rs, BaseModel, BaseOptions, Criterion, ExcitationOptions,
-    FrictionTerms, GlobalLinearModel, TorqueColumn, TorqueLag, Weighting,
+    identify_base_parameters as base_rs, identify_global_linear as global_rs, BaseModel,
+    BaseOptions, FrictionTerms, GlobalLinearModel, TorqueColumn, TorqueLag, Weighting,
 };
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::states::States;
 use crate::torque_model::TorqueModel;
-use crate::trajectory::FourierTrajectory;
-
-/// A designed excitation: `trajectory` (a FourierTrajectory), `cond` (cond of the base
-/// regressor), `value` (the criterion) and `evaluations`.
-#[pyclass(name = "ExcitationDesign", module = "perturbid_rs", frozen)]
-pub(crate) struct PyExcitationDesign {
-    design: ExcitationDesign,
-}
-
-impl PyExcitationDesign {
-    /// The designed trajectory.
-    pub(crate) fn trajectory_ref(&self) -> &FourierTrajectory {
-        &self.design.trajectory
-    }
-}
-
-#[pymethods]
-impl PyExcitationDesign {
-    #[getter]
-    fn trajectory(&self) -> PyFourier {
-        PyFourier {
-            traj: self.design.trajectory.clone(),
-        }
-    }
-    #[getter]
-    fn cond(&self) -> f64 {
-        self.design.cond
-    }
-    #[getter]
-    fn value(&self) -> f64 {
-        self.design.value
-    }
-    /// The workspace and effort constraints with their smallest slack over a period (m beyond
-    /// each workspace margin; `1 - |tau| / (margin effort)` per joint), as a dict.
-    #[getter]
-    fn margins(&self) -> std::collections::BTreeMap<String, f64> {
-        self.design.margins.iter().cloned().collect()
-    }
-    #[getter]
-    fn evaluations(&self) -> usize {
-        self.design.evaluations
-    }
-    /// `trajectory.sample(t)`.
-    fn sample<'py>(
-        &self,
-        py: Python<'py>,
-        t: &Bound<'py, PyAny>,
-    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-        self.trajectory().sample(py, t)
-    }
-    fn __repr__(&self) -> String {
-        format!(
-            "ExcitationDesign(cond={:.4}, evaluations={})",
-            self.design.cond, self.design.evaluations
-        )
-    }
-}
 
 /// The `friction` argument of the direct method: a name or a list of names from 'viscous',
 /// 'coulomb', 'offset', 'armature' ('all' for the three friction terms, 'none' for none), or
@@ -100,7 +41,7 @@ pub(crate) enum FrictionNames<'py> {
 }
 
 /// The friction terms of a `friction` argument; `None` means none.
-fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<FrictionTerms> {
+pub(crate) fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<FrictionTerms> {
     Ok(match value {
         None => FrictionTerms::NONE,
         Some(FrictionNames::One(name)) => FrictionTerms::from_names(&[name])?,
@@ -115,74 +56,6 @@ fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<FrictionTerms> {
             .into())
         }
     })
-}
-
-/// Designs a Fourier excitation for `robot` minimising `criterion` ('cond' or 'logdet') of the
-/// base regressor subject to the limits (times `margin`), starting and ending at rest when
-/// `rest`. COBYLA, seeded; `progress=True` logs the progress every 100 evaluations to Python's
-/// `logging` (logger `perturbid_rs.excitation`, level INFO).
-#[pyfunction]
-#[pyo3(signature = (robot, harmonics=5, base_frequency=0.1, criterion="cond", seed=0, *, rest=true, samples=100, margin=0.9, max_evaluations=2000, friction=Some(FrictionNames::Many(vec!["viscous".into(), "coulomb".into()])), progress=false, workspace=None, effort_limits=true),
-    text_signature = "(robot, harmonics=5, base_frequency=0.1, criterion='cond', seed=0, *, rest=True, samples=100, margin=0.9, max_evaluations=2000, friction=('viscous', 'coulomb'), progress=False, workspace=None, effort_limits=True)")]
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn design_excitation(
-    py: Python<'_>,
-    robot: &PyRobot,
-    #[pyo3(from_py_with = scalars::count)] harmonics: usize,
-    #[pyo3(from_py_with = scalars::real)] base_frequency: f64,
-    criterion: &str,
-    #[pyo3(from_py_with = scalars::seed)] seed: u64,
-    rest: bool,
-    #[pyo3(from_py_with = scalars::count)] samples: usize,
-    #[pyo3(from_py_with = scalars::real)] margin: f64,
-    #[pyo3(from_py_with = scalars::count)] max_evaluations: usize,
-    friction: Option<FrictionNames<'_>>,
-    progress: bool,
-    workspace: Option<Bound<'_, PyAny>>,
-    effort_limits: bool,
-) -> PyResult<PyExcitationDesign> {
-    // workspace constraints: a list of dicts (or a JSON string), read as the JSON file is
-    let workspace = match workspace {
-        None => vec![],
-        Some(w) => {
-            let text: String = match w.extract::<String>() {
-                Ok(s) => s,
-                Err(_) => py.import("json")?.call_method1("dumps", (w,))?.extract()?,
-            };
-            crate::direct::workspace_from_json(&text, "workspace")?
-        }
-    };
-    let mut o = ExcitationOptions {
-        harmonics,
-        base_frequency,
-        criterion: criterion.parse::<Criterion>()?,
-        seed,
-        rest,
-        samples,
-        margin,
-        max_evaluations,
-        workspace,
-        effort: effort_limits,
-        ..ExcitationOptions::default()
-    };
-    o.friction = friction_terms(friction)?;
-    let design = detached(py, "design_excitation", || {
-        let mut report = |e: usize, best: f64| {
-            if e.is_multiple_of(100) {
-                log::info!(
-                    target: "perturbid_rs::excitation",
-                    "excitation design: {e} evaluations, best criterion {best:.4}"
-                )
-            }
-        };
-        design_rs(
-            &robot.model,
-            &o,
-            if progress { Some(&mut report) } else { None },
-        )
-    })?;
-    super::errors::warn_all(py, &design.warnings(&robot.model))?;
-    Ok(PyExcitationDesign { design })
 }
 
 /// The joints' zero offsets as a dict (`BaseParameterModel.position_offsets`,
@@ -225,6 +98,32 @@ pub(crate) fn states<'a>(
         args.push(("tau", t));
     }
     Ok(read_batch(n, &args)?.columns)
+}
+
+/// The Coulomb friction term's column a caller gave (`coulomb`, (k, n) or (n,): a
+/// preprocessed log's `Recording.coulomb`), read for `n` joints; None where not given.
+pub(crate) fn coulomb_column<'a>(
+    n: usize,
+    coulomb: Option<&'a ArrayLike<'_>>,
+) -> Result<Option<Cow<'a, [f64]>>> {
+    let Some(c) = coulomb else {
+        return Ok(None);
+    };
+    Ok(read_batch(n, &[("coulomb", c)])?.columns.pop())
+}
+
+/// The samples `c` (q, qd, qdd and tau as [`states`] read them) as the states of `n` joints,
+/// with the Coulomb term's column `coulomb` where given ([`States::with_coulomb`]).
+pub(crate) fn fit_states<'a>(
+    n: usize,
+    c: &'a [Cow<'_, [f64]>],
+    coulomb: Option<&'a [f64]>,
+) -> Result<States<'a>> {
+    let s = States::new(n, &c[0], Some(&c[1]), Some(&c[2]))?;
+    match coulomb {
+        Some(x) => s.with_coulomb(x),
+        None => Ok(s),
+    }
 }
 
 /// With `t` given ((k,) s, read by the caller, strictly increasing, one per row of the samples `c`: q, qd, qdd,
@@ -486,17 +385,21 @@ impl PyBaseModel {
             Some(("parameter", rows.iter().map(|r| r.name.clone()).collect())),
         )
     }
-    /// Predicted torques (N m) at `q`, `qd`, `qdd`: (n,) each or (k, n).
+    /// Predicted torques (N m) at `q`, `qd`, `qdd`: (n,) each or (k, n). `coulomb`, shaped
+    /// as `q`: the Coulomb term's column in place of sign(qd) (`Recording.coulomb` of a
+    /// preprocessed log, to compare with its filtered torques).
+    #[pyo3(signature = (q, qd, qdd, coulomb=None))]
     fn predict<'py>(
         &self,
         py: Python<'py>,
         q: ArrayLike<'py>,
         qd: ArrayLike<'py>,
         qdd: ArrayLike<'py>,
+        coulomb: Option<ArrayLike<'py>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (fit, model) = (&self.fit, &self.model);
         let name = "BaseParameterModel.predict";
-        at_states(py, model.nv, [&q, &qd, &qdd], name, |s| {
+        at_states_with(py, model.nv, [&q, &qd, &qdd], coulomb.as_ref(), name, |s| {
             fit.predict(model, s)
         })
     }
@@ -504,16 +407,18 @@ impl PyBaseModel {
     /// there): from the parameters' standard errors and their correlation; the uncertainty of
     /// the model's torque, not a measured one's scatter about it. Raises InputError for a
     /// model saved before the correlation was stored.
+    #[pyo3(signature = (q, qd, qdd, coulomb=None))]
     fn predict_stderr<'py>(
         &self,
         py: Python<'py>,
         q: ArrayLike<'py>,
         qd: ArrayLike<'py>,
         qdd: ArrayLike<'py>,
+        coulomb: Option<ArrayLike<'py>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (fit, model) = (&self.fit, &self.model);
         let name = "BaseParameterModel.predict_stderr";
-        at_states(py, model.nv, [&q, &qd, &qdd], name, |s| {
+        at_states_with(py, model.nv, [&q, &qd, &qdd], coulomb.as_ref(), name, |s| {
             fit.predict_stderr(model, s)
         })
     }
@@ -562,9 +467,11 @@ impl PyBaseModel {
 /// includes gravity; `tolerance`: relative rank tolerance of the pivoted QR. `t` ((k,) s),
 /// when the samples are a log: its qd and qdd columns are checked against the derivatives of
 /// q and qd first (see `check_sample_derivatives`), refusing columns in other units, of
-/// another joint or of the opposite sign.
+/// another joint or of the opposite sign. `coulomb` ((k, n)), for torques low-pass filtered:
+/// the Coulomb friction term's column filtered as they were (`Recording.coulomb` of
+/// `preprocess`), in place of sign(qd).
 #[pyfunction]
-#[pyo3(signature = (robot, q, qd, qdd, tau, friction=None, weighting="wls", gravity=true, tolerance=1e-8, seed=0, t=None))]
+#[pyo3(signature = (robot, q, qd, qdd, tau, friction=None, weighting="wls", gravity=true, tolerance=1e-8, seed=0, t=None, coulomb=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_base_parameters(
     py: Python<'_>,
@@ -579,6 +486,7 @@ pub(crate) fn identify_base_parameters(
     #[pyo3(from_py_with = scalars::real)] tolerance: f64,
     #[pyo3(from_py_with = scalars::seed)] seed: u64,
     t: Option<ArrayLike<'_>>,
+    coulomb: Option<ArrayLike<'_>>,
 ) -> PyResult<PyBaseModel> {
     let options = BaseOptions {
         tolerance,
@@ -587,15 +495,12 @@ pub(crate) fn identify_base_parameters(
     };
     let model = &robot.model;
     let c = states(model.nv, &q, &qd, &qdd, Some(&tau))?;
+    let coulomb = coulomb_column(model.nv, coulomb.as_ref())?;
     let t = t.as_ref().map(|t| vector("t", t)).transpose()?;
     let fit = detached(py, "identify_base_parameters", || {
         check_sample_derivatives("identify_base_parameters' samples", model.nv, t, &c)?;
-        base_rs(
-            model,
-            &States::new(model.nv, &c[0], Some(&c[1]), Some(&c[2]))?,
-            &c[3],
-            &options,
-        )
+        let s = fit_states(model.nv, &c, coulomb.as_deref())?;
+        base_rs(model, &s, &c[3], &options)
     })?;
     super::errors::warn_all(py, &fit.warnings())?;
     Ok(PyBaseModel {

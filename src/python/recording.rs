@@ -228,6 +228,16 @@ impl PyRecording {
     fn tau<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         rows(py, &self.rec.tau, self.rec.n)
     }
+    /// The Coulomb friction term's column of every joint ((k, n), within [-2, 2]): sign(qd)
+    /// low-pass filtered as `tau` was, for a direct fit of these torques (pass it as
+    /// `coulomb=` to identify_base_parameters, predict and validate); None where `preprocess`
+    /// did not filter, or for a recording as logged.
+    #[getter]
+    fn coulomb<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        (self.rec.coulomb.as_ref())
+            .map(|v| rows(py, v, self.rec.n))
+            .transpose()
+    }
     #[getter]
     fn qd<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         self.rec

@@ -10,7 +10,7 @@ use super::detached;
 use pyo3::types::PyDict;
 
 use super::arrays::{per_joint, vector, ArrayLike};
-use super::direct::PyExcitationDesign;
+use super::excitation::PyExcitationDesign;
 use super::local::PyPlan;
 use super::recording::{matrix_rows, PyRecording};
 use super::rehearsal::PyTrueRobot;

@@ -186,10 +186,12 @@ impl PyValidation {
 /// not judged where a torque column is found wrong). For a LocalModel or
 /// BaseParameterModel a torque column that holds one value throughout while the robot moves
 /// (a dead channel) is refused. `t` ((k,) s), when the samples are a log: its qd and qdd columns are checked first against
-/// the derivatives of q and qd, as `identify_base_parameters` checks them. Returns a
-/// Validation.
+/// the derivatives of q and qd, as `identify_base_parameters` checks them. `coulomb` ((k, n),
+/// a BaseParameterModel only): the Coulomb term's column for filtered torques
+/// (`Recording.coulomb`), given to its `predict`. Returns a Validation.
 #[pyfunction]
-#[pyo3(signature = (model, q, qd, qdd, tau, t=None))]
+#[pyo3(signature = (model, q, qd, qdd, tau, t=None, coulomb=None))]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn validate<'py>(
     model: Bound<'py, PyAny>,
     q: Bound<'py, PyAny>,
@@ -197,7 +199,15 @@ pub(crate) fn validate<'py>(
     qdd: Bound<'py, PyAny>,
     tau: ArrayLike<'py>,
     t: Option<ArrayLike<'py>>,
+    coulomb: Option<ArrayLike<'py>>,
 ) -> PyResult<PyValidation> {
+    if coulomb.is_some() && model.cast::<PyBaseModel>().is_err() {
+        return Err(crate::Error::InvalidArgument {
+            argument: "coulomb".into(),
+            message: "the Coulomb term's column is a BaseParameterModel's; this model has no Coulomb term to give it to".into(),
+        }
+        .into());
+    }
     let measured = {
         let array = tau.as_array();
         let n = *array.shape().last().unwrap_or(&0);
@@ -223,7 +233,14 @@ pub(crate) fn validate<'py>(
             super::direct::check_sample_derivatives("validate's samples", n, Some(t), samples)
         })?;
     }
-    let predicted = model.call_method1("predict", (&q, &qd, &qdd))?;
+    let predicted = match &coulomb {
+        Some(c) => {
+            let kwargs = pyo3::types::PyDict::new(model.py());
+            kwargs.set_item("coulomb", c.as_any())?;
+            model.call_method("predict", (&q, &qd, &qdd), Some(&kwargs))?
+        }
+        None => model.call_method1("predict", (&q, &qd, &qdd))?,
+    };
     let predicted: Vec<f64> = predicted
         .extract::<Bound<'py, numpy::PyArrayDyn<f64>>>()?
         .to_vec()?;
@@ -242,7 +259,9 @@ pub(crate) fn validate<'py>(
     if local.is_ok() || base.is_ok() {
         let (q, qd, qdd): (ArrayLike, ArrayLike, ArrayLike) =
             (q.extract()?, qd.extract()?, qdd.extract()?);
-        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd)])?;
+        let mut args = vec![("q", &q), ("qd", &qd), ("qdd", &qdd)];
+        args.extend(coulomb.as_ref().map(|c| ("coulomb", c)));
+        let batch = read_batch(n, &args)?;
         let states = batch.states(n)?;
         crate::torque_model::refuse_flat_torques(
             &states,

@@ -397,6 +397,62 @@ def test_a_weakly_exciting_log_is_named():
     assert "weak_excitation" not in json.loads(fit_wide.to_json())
 
 
+def test_filtered_torques_are_fitted_with_the_filtered_coulomb_column():
+    """preprocess filters sign(qd) as it filters the torques (Recording.coulomb); given to the
+    fit, it is the Coulomb term's column: the fit equals numpy's least squares on the
+    regressor, the rotors', viscous and that column, and finds the friction the log was made
+    with (0.3 N m s/rad, 0.5 N m), where sign(qd) gives the Coulomb terms low by many standard
+    errors. predict and validate take it too; validate refuses it for another model."""
+    robot = pr.robots.a465()
+    traj = excitation(robot, 5, 0.1, 0.12, 1)
+    t = np.arange(0, 20, 1e-3)
+    q, qd, qdd = traj.sample(t)
+    rng = np.random.default_rng(0)
+    tau = robot.rnea(q, qd, qdd) + 0.5 * np.sign(qd) + 0.3 * qd + rng.normal(0.0, 0.03, q.shape)
+    rec = pr.preprocess(t, q, tau)
+    c = rec.coulomb
+    assert c.shape == rec.q.shape and np.abs(c).max() <= 1.2 and np.abs(c).min() < 0.5
+    friction = ["viscous", "coulomb"]
+    fit = pr.identify_base_parameters(robot, rec.q, rec.qd, rec.qdd, rec.tau, friction=friction, weighting="ols", coulomb=c)
+    # numpy's columns in the fit's order of the full parameters: the 60 inertial ones, then
+    # each joint's terms (its own rows only)
+    phi = robot.regressor(rec.q, rec.qd, rec.qdd)
+    term = {"viscous": rec.qd, "coulomb": c, "armature": rec.qdd}
+    columns = []
+    for i, name in enumerate(fit.full_names):
+        if i < 60:
+            columns.append(phi[:, :, i])
+        else:
+            joint, kind = name.split(".")
+            own = np.zeros_like(rec.q)
+            j = robot.joint_names.index(joint)
+            own[:, j] = term[kind][:, j]
+            columns.append(own)
+    x = np.stack(columns, axis=2).reshape(-1, len(fit.full_names))
+    theta = np.linalg.lstsq(x[:, fit.kept], rec.tau.reshape(-1), rcond=None)[0]
+    np.testing.assert_allclose(fit.theta_base, theta, rtol=1e-6, atol=1e-9)
+    plain = pr.identify_base_parameters(robot, rec.q, rec.qd, rec.qdd, rec.tau, friction=friction, weighting="ols")
+    for j in range(1, 7):
+        i = fit.names.index(f"joint{j}.coulomb")
+        assert abs(fit.theta_base[i] - 0.5) < 4 * fit.stderr[i] + 0.005
+        assert 0.5 - plain.theta_base[i] > 5 * plain.stderr[i]
+        i = fit.names.index(f"joint{j}.viscous")
+        assert abs(fit.theta_base[i] - 0.3) < 4 * fit.stderr[i] + 0.005
+    np.testing.assert_allclose(fit.predict(rec.q, rec.qd, rec.qdd, coulomb=c), x[:, fit.kept].dot(fit.theta_base).reshape(-1, 6), rtol=1e-9, atol=1e-9)
+    v = pr.validate(fit, rec.q, rec.qd, rec.qdd, rec.tau, coulomb=c)
+    assert (v.rms < 0.01).all(), v.rms
+    assert (pr.validate(fit, rec.q, rec.qd, rec.qdd, rec.tau).rms > 3 * v.rms).any()
+
+    class Predictor:
+        def predict(self, q, qd, qdd):
+            return fit.predict(q, qd, qdd)
+
+    with pytest.raises(pr.InputError, match="coulomb"):
+        pr.validate(Predictor(), rec.q, rec.qd, rec.qdd, rec.tau, coulomb=c)
+    with pytest.raises(pr.InputError, match="expected a value within"):
+        pr.identify_base_parameters(robot, rec.q, rec.qd, rec.qdd, rec.tau, friction=friction, coulomb=3 * c)
+
+
 def test_standard_errors_count_residuals_correlated_by_the_filter():
     # a log low-pass filtered at 10 Hz and kept at 100 Hz: about five correlated samples to
     # every independent one, which the standard errors now count
