@@ -62,7 +62,8 @@ pub(crate) fn check_joints(states: &States<'_>, nv: usize) -> Result<()> {
 /// What a fit would make of a flat torque column ([`refuse_flat_torques`]).
 pub(crate) const FOR_A_FIT: &str =
     "a fit would take it for a torque that does not depend on the motion";
-/// What a validation would make of one.
+/// What a validation would make of one (the front ends validate).
+#[cfg(any(feature = "cli", feature = "python"))]
 pub(crate) const FOR_A_VALIDATION: &str =
     "a validation against it would report the model's whole torque as its error";
 
