@@ -1090,10 +1090,30 @@ fn torques_that_do_not_return_to_t_star_are_found() {
         "{:?}",
         m.diagnostics.warnings
     );
+    assert!(!says(&m, "minus twice"), "{:?}", m.diagnostics.warnings);
     let back = LocalModel::from_json(&m.to_json()).unwrap();
     assert_eq!(
         back.diagnostics.torque_offsets,
         m.diagnostics.torque_offsets
+    );
+    // the elbow's torque negated in D (another sign convention): off by -2 T*, and named so
+    let m = edited("D", &|r: &mut Recording| {
+        for i in 0..r.t.len() {
+            r.tau[i * n + 2] = -r.tau[i * n + 2];
+        }
+    });
+    assert_eq!(offsets(&m), pairs(&[("D", "joint3")]));
+    let t = &m.diagnostics.torque_offsets[0];
+    let opposite = -2.0 * clean.torque[2];
+    assert!(
+        (t.offset - opposite).abs() < 0.01 * opposite.abs(),
+        "{t:?} against {opposite}"
+    );
+    assert!(
+        says(&m, "'joint3' is off by minus twice its T*: its torque column looks negated in the D recording or in the nominal one")
+            && says(&m, "its row of D* is negated too"),
+        "{:?}",
+        m.diagnostics.warnings
     );
     // in H only swaps are findings (its velocity-squared terms give an intercept of their
     // own): joints 3 and 6 swapped there are found, the shoulder 0.5 N m higher is not

@@ -496,10 +496,12 @@ pub fn identify_local(
         }
         let found = torque_offsets::findings(kind, &plan.joint_names, &intercepts, base_tau);
         let swapped = torque_offsets::swapped_pairs(kind, &found, &plan.joint_names, base_tau);
+        let negated = torque_offsets::negated(kind, &found, &swapped, &plan.joint_names, base_tau);
         let planned = plan
             .experiment(kind)
             .expect("values of a planned experiment");
-        if let Some(w) = torque_offsets::warning(kind, &found, &swapped, planned.in_pairs()) {
+        let symmetric = planned.in_pairs();
+        if let Some(w) = torque_offsets::warning(kind, &found, &swapped, &negated, symmetric) {
             extra_warnings.borrow_mut().push(w);
         }
         offsets_found.borrow_mut().extend(found);

@@ -179,13 +179,42 @@ pub fn swapped_pairs<'a>(
     pairs
 }
 
+/// The findings of `found` (one experiment's) that read the opposite of their joint's base:
+/// each offset within a tenth (and three standard errors) of `-2 T*_j`, as a torque column
+/// negated in the recording or in the nominal one (another sign convention), and not in a
+/// swapped pair (`swapped`). None for G-static, whose base is in its own recording.
+pub fn negated<'a>(
+    kind: ExperimentKind,
+    found: &'a [TorqueOffset],
+    swapped: &[(&TorqueOffset, &TorqueOffset)],
+    joint_names: &[String],
+    base: &[f64],
+) -> Vec<&'a TorqueOffset> {
+    if kind == ExperimentKind::GStatic {
+        return vec![];
+    }
+    let paired = |t: &TorqueOffset| swapped.iter().any(|(a, b)| *a == t || *b == t);
+    (found.iter())
+        .filter(|t| !paired(t))
+        .filter(|t| {
+            let Some(j) = joint_names.iter().position(|n| *n == t.joint) else {
+                return false;
+            };
+            let opposite = -2.0 * base[j];
+            opposite != 0.0 && (t.offset - opposite).abs() <= 0.1 * opposite.abs() + 3.0 * t.stderr
+        })
+        .collect()
+}
+
 /// The warning for `found`, the findings of experiment `kind` (one or more joints), with the
-/// pairs among them that read each other's base; `symmetric` when the perturbations come in
-/// +- pairs (then the offset does not bias the estimate).
+/// pairs among them that read each other's base and those that read the opposite of their
+/// own ([`negated`]); `symmetric` when the perturbations come in +- pairs (then the offset
+/// does not bias the estimate).
 pub fn warning(
     kind: ExperimentKind,
     found: &[TorqueOffset],
     swapped: &[(&TorqueOffset, &TorqueOffset)],
+    negated: &[&TorqueOffset],
     symmetric: bool,
 ) -> Option<String> {
     if found.is_empty() {
@@ -221,12 +250,20 @@ pub fn warning(
             kind.estimate_name()
         ));
     }
+    for t in negated {
+        text.push_str(&format!(
+            ". '{}' is off by minus twice its T*: its torque column looks negated in the {} recording or in the nominal one (another sign convention), and then its row of {} is negated too",
+            t.joint,
+            kind.name(),
+            kind.estimate_name()
+        ));
+    }
     text.push_str(&format!(
         ". {} offset from each other (a torque sensor re-zeroed or drifting between the runs, a changed payload, friction changed as the robot warmed): the rows' standard errors include the offset, which {}",
-        if swapped.is_empty() {
+        if swapped.is_empty() && negated.is_empty() {
             "The recordings' torques look"
         } else {
-            "If not swapped, the recordings' torques are"
+            "If not so, the recordings' torques are"
         },
         if symmetric {
             "does not bias them (the perturbations come in +- pairs)"
