@@ -180,7 +180,8 @@ impl Worker {
 
 impl Worker {
     /// Writes the rows of samples `range` of the states `[q, qd, qdd, coulomb]` (row-major,
-    /// the whole batch; `coulomb` the Coulomb term's column, [`States::coulomb_at`]) below the factors: the regressor [`LaneData::width`] samples at a time by the multi-sample
+    /// the whole batch; `coulomb` the Coulomb term's column, [`States::coulomb_at`]) below
+    /// the factors: the regressor [`LaneData::width`] samples at a time by the multi-sample
     /// kernel ([`regressor_group`]), read in place.
     fn fill(
         &mut self,

@@ -185,10 +185,11 @@ impl PyValidation {
 /// for joints zeroed elsewhere than in the model's data (`Validation.position_offsets`;
 /// not judged where a torque column is found wrong). For a LocalModel or
 /// BaseParameterModel a torque column that holds one value throughout while the robot moves
-/// (a dead channel) is refused. `t` ((k,) s), when the samples are a log: its qd and qdd columns are checked first against
-/// the derivatives of q and qd, as `identify_base_parameters` checks them. `coulomb` ((k, n),
-/// a BaseParameterModel only): the Coulomb term's column for filtered torques
-/// (`Recording.coulomb`), given to its `predict`. Returns a Validation.
+/// (a dead channel) is refused. `t` ((k,) s), when the samples are a log: its qd and qdd
+/// columns are checked first against the derivatives of q and qd, as
+/// `identify_base_parameters` checks them. `coulomb` ((k, n), a BaseParameterModel only): the
+/// Coulomb term's column for filtered torques (`Recording.coulomb`), given to its `predict`.
+/// Returns a Validation.
 #[pyfunction]
 #[pyo3(signature = (model, q, qd, qdd, tau, t=None, coulomb=None))]
 #[allow(clippy::too_many_arguments)]
