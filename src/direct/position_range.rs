@@ -78,14 +78,7 @@ pub fn check_position_range(model: &Model, states: &States<'_>) -> Vec<JointRang
             if !(l.lower.is_finite() && l.upper.is_finite()) {
                 return None;
             }
-            let (min, max) = q
-                .iter()
-                .skip(j)
-                .step_by(n)
-                .filter(|v| v.is_finite())
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                    (a.min(v), b.max(v))
-                });
+            let (min, max) = extent(q, n, j);
             if min > max || within(min, max, l.lower, l.upper) {
                 return None;
             }
@@ -100,6 +93,16 @@ pub fn check_position_range(model: &Model, states: &States<'_>) -> Vec<JointRang
             })
         })
         .collect()
+}
+
+/// The smallest and largest finite value of joint `j` in `q` (row-major, `n` joints a row);
+/// `(inf, -inf)` where it has none.
+pub(crate) fn extent(q: &[f64], n: usize, j: usize) -> (f64, f64) {
+    (q.iter().skip(j).step_by(n))
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        })
 }
 
 /// The warning for `ranges` (from [`check_position_range`]), or None where there are none.

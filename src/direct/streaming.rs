@@ -298,10 +298,10 @@ impl JointFactors {
         states.check_companion("tau", tau, nv)?;
         let k = states.len();
         let (qd, qdd) = (states.qd_or_zeros(), states.qdd_or_zeros());
-        let coulomb: Vec<f64> = match states.coulomb() {
-            Some(c) => c.to_vec(),
-            None => qd
-                .iter()
+        // the Coulomb term's column: the states' own (filtered), or sign(qd)
+        let coulomb: std::borrow::Cow<[f64]> = match states.coulomb() {
+            Some(c) => c.into(),
+            None => (qd.iter())
                 .map(|&v| crate::direct::parameters::sign0(v))
                 .collect(),
         };

@@ -166,11 +166,7 @@ pub fn check_excitation(
     let q = states.q();
     let motion = (0..n)
         .map(|j| {
-            let (lo, hi) = (q.iter().skip(j).step_by(n))
-                .filter(|v| v.is_finite())
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                    (a.min(v), b.max(v))
-                });
+            let (lo, hi) = super::position_range::extent(q, n, j);
             let l = &model.limits[j];
             JointMotion {
                 joint: model.joint_names[j].clone(),
