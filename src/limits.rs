@@ -43,6 +43,10 @@ pub const MAX_EVALUATIONS: usize = 10_000_000;
 pub const MAX_TEXT_BYTES: u64 = 2 << 30;
 /// Bytes read from one document (JSON, TOML, URDF): 256 MiB, far past any plan, model or robot.
 pub const MAX_DOCUMENT_BYTES: u64 = 256 << 20;
+/// Bytes of one TOML configuration (a pipeline or a study): 1 MiB, hundreds of steps. The
+/// TOML parser holds about 250 bytes for each byte of small inline tables, so a document of
+/// [`MAX_DOCUMENT_BYTES`] would take tens of gigabytes; a pipeline is a few kilobytes.
+pub const MAX_CONFIG_BYTES: usize = 1 << 20;
 /// A number of a saved local model (a torque, an entry of D*, H*, G*, Gs or their standard
 /// errors, a state of its operating point): at most 10^9 in size, beyond any robot's. Larger
 /// ones are hand edits or corruption, and would overflow the fits that read them (their squares

@@ -13,7 +13,7 @@ use perturbid_rs::local::{
     plan_experiments, ExperimentKind, OperatingPoint, PlanOptions, Size, Sizes,
 };
 use perturbid_rs::robots::a465::{TABLE2_Q, TABLE2_QD, TABLE2_QDD};
-use perturbid_rs::urdf::MAX_XML_DEPTH;
+use perturbid_rs::urdf::{MAX_XML_DEPTH, MAX_XML_ELEMENTS};
 use perturbid_rs::{
     catch_panics, model_from_urdf_str, robots, Document, ErrorKind, LoadOptions, Plan,
 };
@@ -104,6 +104,29 @@ fn a_robot_without_a_moving_joint_is_refused() {
     };
     let e = model_from_urdf_str(&mimic_pair(true), "m.urdf", &options).unwrap_err();
     assert!(e.to_string().contains("has no moving joint"), "{e}");
+}
+
+#[test]
+fn a_urdf_of_too_many_elements_is_refused_before_parsing() {
+    // flat, within the document's byte bound, but the parsers would hold gigabytes of it
+    let gazebo = r#"<gazebo reference="a"><material>x</material></gazebo>"#;
+    let many = with_limit("", "continuous").replace(
+        "</robot>",
+        &format!("{}</robot>", gazebo.repeat(MAX_XML_ELEMENTS / 2)),
+    );
+    let e = load(&many).unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::Model);
+    assert!(
+        e.to_string()
+            .contains(&format!("more than {MAX_XML_ELEMENTS} elements")),
+        "{e}"
+    );
+    // self-closing elements count too; a few thousand load
+    let some = with_limit("", "continuous").replace(
+        "</robot>",
+        &format!("{}</robot>", "<gazebo/>".repeat(5_000)),
+    );
+    load(&some).unwrap();
 }
 
 #[test]

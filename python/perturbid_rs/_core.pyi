@@ -51,6 +51,7 @@ __all__ = [
     "study_pending",
     "study_record",
     "study_resolve",
+    "study_resolve_file",
     "study_run",
     "validate",
 ]
@@ -851,6 +852,10 @@ def cli(argv: list[str]) -> int:
 
 def study_resolve(text: str, format: str, base: str, source: str) -> str:
     """A study configuration (TOML or JSON text) resolved into its cases, as JSON."""
+
+def study_resolve_file(path: str) -> str:
+    """The study configuration in the TOML file `path` resolved into its cases, as JSON (the
+    file read size-bounded, as the command line reads it; relative files next to it)."""
 
 def study_len(study: str) -> int:
     """The number of cases of a resolved study."""

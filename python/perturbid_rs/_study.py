@@ -58,9 +58,7 @@ Config = Union[str, "os.PathLike[str]", Mapping[str, Any]]
 def _resolve(config: Config) -> str:
     if isinstance(config, Mapping):
         return _core.study_resolve(json.dumps(dict(config)), "json", str(Path.cwd()), "study")
-    path = Path(config)
-    text = path.read_text(encoding="utf-8")
-    return _core.study_resolve(text, "toml", str(path.parent), str(path))
+    return _core.study_resolve_file(str(Path(config)))
 
 
 def study(

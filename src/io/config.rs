@@ -26,8 +26,20 @@ pub fn location(source: &str, text: &str, offset: usize) -> String {
 }
 
 /// Parses TOML `text` (from `source`, for messages) into `T`; a syntax error, a missing or
-/// unknown key or a value of the wrong type names the line and column.
+/// unknown key or a value of the wrong type names the line and column. Text longer than
+/// [`MAX_CONFIG_BYTES`](crate::limits::MAX_CONFIG_BYTES) is refused before parsing.
 pub fn parse_toml<T: DeserializeOwned>(source: &str, text: &str) -> Result<T> {
+    let max = crate::limits::MAX_CONFIG_BYTES;
+    if text.len() > max {
+        return Err(Error::Config {
+            location: source.to_string(),
+            message: format!(
+                "{} bytes; a pipeline or study file is read up to {} KiB (a few kilobytes is usual; docs/limits.md)",
+                text.len(),
+                max >> 10
+            ),
+        });
+    }
     toml::from_str(text).map_err(|e| {
         let mut message = e.message().trim().to_string();
         // the parser's "duplicate key" says where, not which: the key is the span's text
@@ -83,6 +95,13 @@ mod tests {
         assert!(e.to_string().starts_with("p.toml:2:1: "), "{e}");
         assert!(e.to_string().contains("unknown field `b`"), "{e}");
         let e = parse_toml::<Doc>("p.toml", "a = [\n").unwrap_err();
+        assert!(e.to_string().starts_with("p.toml:1:"), "{e}");
+        let huge = format!(
+            "a = [{}1]\n",
+            "1,".repeat(crate::limits::MAX_CONFIG_BYTES / 2)
+        );
+        let e = parse_toml::<Doc>("p.toml", &huge).unwrap_err();
+        assert!(e.to_string().contains("read up to 1024 KiB"), "{e}");
         assert!(e.to_string().starts_with("p.toml:"), "{e}");
         assert_eq!(line_col("ab\ncd", 4), (2, 2));
         // a key given twice is named, as written

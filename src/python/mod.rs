@@ -60,6 +60,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simd_isa, m)?)?;
     m.add_class::<robot::PyRobot>()?;
     m.add_function(wrap_pyfunction!(study::study_resolve, m)?)?;
+    m.add_function(wrap_pyfunction!(study::study_resolve_file, m)?)?;
     m.add_function(wrap_pyfunction!(study::study_len, m)?)?;
     m.add_function(wrap_pyfunction!(study::study_pending, m)?)?;
     m.add_function(wrap_pyfunction!(study::study_case, m)?)?;

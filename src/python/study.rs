@@ -53,6 +53,14 @@ pub(crate) fn study_resolve(
     Ok(serde_json::to_string(&s).expect("serialisable"))
 }
 
+/// The study configuration in the TOML file `path` resolved into its cases, as JSON: read as
+/// the command line reads it (size-bounded; relative files next to it).
+#[pyfunction]
+pub(crate) fn study_resolve_file(path: PathBuf) -> PyResult<String> {
+    let s = Study::from_file(&path)?;
+    Ok(serde_json::to_string(&s).expect("serialisable"))
+}
+
 /// The number of cases of a resolved study.
 #[pyfunction]
 pub(crate) fn study_len(study: &str) -> PyResult<usize> {

@@ -10,6 +10,12 @@ use crate::error::{Error, Result};
 /// parser recursion can overflow the stack.
 pub const MAX_XML_DEPTH: usize = 64;
 
+/// The most XML elements accepted in a URDF. A 7-joint arm's URDF has about 150, a humanoid's
+/// with its visuals, collisions and Gazebo tags a few thousand; the parsers hold about 2 kB per
+/// element, so a document of [`MAX_DOCUMENT_BYTES`](crate::limits::MAX_DOCUMENT_BYTES) in
+/// small elements would take 18 GB. Refused before parsing, in the nesting check's pass.
+pub const MAX_XML_ELEMENTS: usize = 200_000;
+
 /// Lines of the URDF's joints and links, and which joints have a `<limit>`, from a light XML
 /// pass (urdf-rs keeps no positions).
 pub(super) struct LineIndex {
@@ -127,12 +133,18 @@ impl LineIndex {
     }
 }
 
-/// Refuses XML nested deeper than [`MAX_XML_DEPTH`], in one pass over the text that counts
-/// opening and closing tags (comments, processing instructions, CDATA and declarations are
+/// Refuses XML nested deeper than [`MAX_XML_DEPTH`] or with more than [`MAX_XML_ELEMENTS`]
+/// elements, in one pass over the text that counts opening and closing tags (comments, processing instructions, CDATA and declarations are
 /// skipped; quoted attribute values may hold `>`).
 pub(super) fn check_depth(text: &str, source: &str) -> Result<()> {
     let bytes = text.as_bytes();
-    let (mut depth, mut line, mut i) = (0usize, 1u32, 0usize);
+    let (mut depth, mut line, mut i, mut elements) = (0usize, 1u32, 0usize, 0usize);
+    let refuse = |message: String| {
+        Err(Error::UrdfSyntax {
+            source_name: source.to_string(),
+            message,
+        })
+    };
     let skip_to = |from: usize, end: &str| {
         text[from..]
             .find(end)
@@ -168,15 +180,20 @@ pub(super) fn check_depth(text: &str, source: &str) -> Result<()> {
                     }
                     if rest.starts_with("</") {
                         depth = depth.saturating_sub(1);
-                    } else if j == 0 || bytes.get(j - 1) != Some(&b'/') {
-                        depth += 1;
-                        if depth > MAX_XML_DEPTH {
-                            return Err(Error::UrdfSyntax {
-                                source_name: source.to_string(),
-                                message: format!(
+                    } else {
+                        elements += 1;
+                        if elements > MAX_XML_ELEMENTS {
+                            return refuse(format!(
+                                "line {line}: more than {MAX_XML_ELEMENTS} elements; a robot's URDF has a few thousand at most (docs/limits.md)"
+                            ));
+                        }
+                        if j == 0 || bytes.get(j - 1) != Some(&b'/') {
+                            depth += 1;
+                            if depth > MAX_XML_DEPTH {
+                                return refuse(format!(
                                     "line {line}: elements nested {depth} deep; at most {MAX_XML_DEPTH} levels are read"
-                                ),
-                            });
+                                ));
+                            }
                         }
                     }
                     j + 1

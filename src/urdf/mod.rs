@@ -30,7 +30,7 @@ mod graph;
 mod lines;
 mod roles;
 
-pub use lines::MAX_XML_DEPTH;
+pub use lines::{MAX_XML_DEPTH, MAX_XML_ELEMENTS};
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;

@@ -45,6 +45,12 @@ def test_study_errors_and_resume(tmp_path: Path):
     with pytest.raises(pr.InputError, match=r"s\.toml:13:1: unknown field `methods`"):
         pr.study(toml, tmp_path / "y")  # methods after [evaluation] belongs to that table
     toml.write_text(toml.read_text().replace('methods = ["local_separated"]\n', ""))
+    huge = tmp_path / "huge.toml"  # the TOML parser would hold gigabytes of it
+    huge.write_text(toml.read_text() + "junk = [" + "{a=1}," * 400_000 + "]\n")
+    with pytest.raises(pr.InputError, match=r"huge\.toml: \d+ bytes; a pipeline or study file is read up to 1024 KiB"):
+        pr.study(huge, tmp_path / "z")
+    with pytest.raises(pr.FileError, match=r"nowhere\.toml"):
+        pr.study(tmp_path / "nowhere.toml", tmp_path / "z")
     first = pr.study(toml, tmp_path / "y")
     journal = (tmp_path / "y" / "cases.jsonl").read_text()
     again = pr.study(toml, tmp_path / "y")
