@@ -102,6 +102,7 @@ pub(crate) fn format_tag(text: &str, context: &str) -> Result<String> {
     struct Tagged {
         format: Option<String>,
     }
+    crate::json::check_containers(text, context)?;
     let t: Tagged = serde_json::from_str(text).map_err(|e| Error::Json {
         context: context.into(),
         message: crate::json::describe_error(&e, text),

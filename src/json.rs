@@ -126,6 +126,44 @@ pub mod matrices {
     }
 }
 
+/// Refuses JSON `text` (from `context`, for the message) holding more than
+/// [`MAX_JSON_CONTAINERS`](crate::limits::MAX_JSON_CONTAINERS) arrays and objects, before any
+/// parser allocates them: each costs the parser about 80 bytes for its 4 of text (`[0],`), so a
+/// document of the byte bound in empty rows would take gigabytes. One pass; brackets inside
+/// strings are not counted.
+pub(crate) fn check_containers(text: &str, context: &str) -> crate::error::Result<()> {
+    let max = crate::limits::MAX_JSON_CONTAINERS;
+    let (mut count, mut in_string, mut escaped) = (0usize, false, false);
+    for (i, &b) in text.as_bytes().iter().enumerate() {
+        if in_string {
+            match b {
+                _ if escaped => escaped = false,
+                b'\\' => escaped = true,
+                b'"' => in_string = false,
+                _ => {}
+            }
+            continue;
+        }
+        match b {
+            b'"' => in_string = true,
+            b'[' | b'{' => {
+                count += 1;
+                if count > max {
+                    let line = 1 + text.as_bytes()[..i].iter().filter(|&&c| c == b'\n').count();
+                    return Err(crate::error::Error::Json {
+                        context: context.to_string(),
+                        message: format!(
+                            "line {line}: more than {max} arrays and objects; a document of the largest robot has some tens of thousands (docs/limits.md)"
+                        ),
+                    });
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 /// A serde_json error as `line L, column C: what` without serde's trailing repetition of the
 /// position, with a hint where the text holds a number JSON cannot spell (`NaN`, `Infinity`,
 /// as Python's `json` module writes them). `text` is the document that was parsed.

@@ -43,6 +43,11 @@ pub const MAX_EVALUATIONS: usize = 10_000_000;
 pub const MAX_TEXT_BYTES: u64 = 2 << 30;
 /// Bytes read from one document (JSON, TOML, URDF): 256 MiB, far past any plan, model or robot.
 pub const MAX_DOCUMENT_BYTES: u64 = 256 << 20;
+/// Arrays and objects in one JSON document (a plan, a model, a true robot, an excitation, a
+/// workspace): 1,000,000. A model of the largest robot (1,000 bodies) has some tens of
+/// thousands (its matrices' rows); a parser holds about 80 bytes for each, so 256 MiB of empty
+/// rows (`[0],`) would take 5 GB.
+pub const MAX_JSON_CONTAINERS: usize = 1_000_000;
 /// Bytes of one TOML configuration (a pipeline or a study): 1 MiB, hundreds of steps. The
 /// TOML parser holds about 250 bytes for each byte of small inline tables, so a document of
 /// [`MAX_DOCUMENT_BYTES`] would take tens of gigabytes; a pipeline is a few kilobytes.

@@ -235,6 +235,33 @@ fn documents_refuse_unknown_keys_with_their_path() {
 }
 
 #[test]
+fn a_document_of_too_many_arrays_is_refused_before_parsing() {
+    use perturbid_rs::limits::MAX_JSON_CONTAINERS;
+    let model = robots::builtin("a465").unwrap();
+    let op =
+        OperatingPoint::new(TABLE2_Q.to_vec(), TABLE2_QD.to_vec(), TABLE2_QDD.to_vec()).unwrap();
+    let text = plan_experiments(&model, &op, &PlanOptions::default())
+        .unwrap()
+        .to_json();
+    // empty rows past the bound: the parser would hold 80 bytes for each 4 of text
+    let rows = format!("[{}[0]]", "[0],".repeat(MAX_JSON_CONTAINERS));
+    let edited = text.replacen("\"rate\"", &format!("\"junk\": {rows}, \"rate\""), 1);
+    let e = Plan::from_json(&edited).unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::Input);
+    assert!(
+        e.to_string().contains(&format!(
+            "more than {MAX_JSON_CONTAINERS} arrays and objects"
+        )),
+        "{e}"
+    );
+    // brackets inside strings (escaped quotes too) are not counted
+    let brackets = format!("\"\\\"{}\"", "[".repeat(MAX_JSON_CONTAINERS + 1));
+    let edited = text.replacen("\"rate\"", &format!("\"junk\": {brackets}, \"rate\""), 1);
+    let e = Plan::from_json(&edited).unwrap_err().to_string();
+    assert!(e.contains("unknown field `junk`"), "{e}");
+}
+
+#[test]
 fn buffers_made_for_another_model_are_refused_not_indexed() {
     use perturbid_rs::{
         aba, forward_dynamics, gravity_torque, linearize, mass_matrix, rnea, rnea_derivatives,

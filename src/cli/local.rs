@@ -294,6 +294,7 @@ enum Reference {
 fn load_reference(path: &Path) -> Result<Reference> {
     let text = crate::io::read_document(path)?;
     let context = path.display().to_string();
+    crate::json::check_containers(&text, &context)?;
     if let Ok(tag) = crate::document::format_tag(&text, &context) {
         if tag.starts_with(Plan::FORMAT) {
             return Ok(Reference::Plan(Box::new(Plan::from_json_in(

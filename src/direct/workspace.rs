@@ -129,6 +129,7 @@ impl CartesianConstraint {
 /// [..]}}, "margin": m}`. `context` names the source in errors, which give the line, column
 /// and JSON path of the culprit. At most 1000 constraints.
 pub fn workspace_from_json(text: &str, context: &str) -> Result<Vec<CartesianConstraint>> {
+    crate::json::check_containers(text, context)?;
     let mut reader = serde_json::Deserializer::from_str(text);
     let out: Vec<CartesianConstraint> =
         serde_path_to_error::deserialize(&mut reader).map_err(|e| {

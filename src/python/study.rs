@@ -35,6 +35,7 @@ pub(crate) fn study_resolve(
     let config: StudyConfig = match format {
         "toml" => crate::io::config::parse_toml(source, text)?,
         "json" => {
+            crate::json::check_containers(text, source)?;
             let mut reader = serde_json::Deserializer::from_str(text);
             serde_path_to_error::deserialize(&mut reader).map_err(|e| Error::Config {
                 location: source.to_string(),

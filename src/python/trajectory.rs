@@ -106,6 +106,7 @@ impl PyFourier {
     }
     #[staticmethod]
     fn from_json(text: &str) -> PyResult<Self> {
+        crate::json::check_containers(text, "Fourier trajectory")?;
         let t: FourierTrajectory = serde_json::from_str(text).map_err(|e| Error::Json {
             context: "Fourier trajectory".into(),
             message: crate::json::describe_error(&e, text),
