@@ -47,20 +47,19 @@ def main() -> None:
     t, q, qd, tau = data[:, 0], data[:, 1:8], data[:, 8:15], data[:, 15:22]
     robot = pr.Robot.from_urdf(panda_urdf(), lock={"panda_finger_joint1": 0.0})
     rec = pr.preprocess(t, q, tau, qd)
-    k = len(rec.t)
+    k = len(rec)
     split = int(0.7 * k)
-    fit_part = (rec.q[:split], rec.qd[:split], rec.qdd[:split], rec.tau[:split])
-    held_out = (rec.q[split:], rec.qd[split:], rec.qdd[split:])
-    # the Coulomb term's column filtered as the torques were (parallel filtering)
-    fitted, unseen = {"coulomb": rec.coulomb[:split]}, {"coulomb": rec.coulomb[split:]}
-    base = pr.identify_base_parameters(robot, *fit_part, friction="all", **fitted)
-    consistent = pr.identify_consistent_parameters(robot, *fit_part, friction="all", **fitted)
+    # the recording given whole brings its time (the derivatives' check) and the Coulomb
+    # term's column filtered as its torques were (parallel filtering)
+    fit_part, held_out = rec[:split], rec[split:]
+    base = pr.identify_base_parameters(robot, fit_part, friction="all")
+    consistent = pr.identify_consistent_parameters(robot, fit_part, friction="all")
     np.set_printoptions(precision=1, suppress=True)
     print(f"{k} samples after preprocessing, {len(base.theta_base)} base parameters, cond {base.cond:.1f}")
     print(f"consistent fit: residual grows by {consistent.residual_growth:.3f}, {len(consistent.active)} constraints active")
-    measured = rec.tau[split:]
+    measured = held_out.tau
     for name, m in [("unconstrained", base), ("consistent", consistent.model)]:
-        print(f"held-out relative RMS error (%), {name}:", 100 * relative_rms(m.predict(*held_out, **unseen), measured))
+        print(f"held-out relative RMS error (%), {name}:", 100 * relative_rms(m.predict(held_out), measured))
     a.out.mkdir(parents=True, exist_ok=True)
     (a.out / "base_model.json").write_text(consistent.model.to_json())
     try:
@@ -71,11 +70,11 @@ def main() -> None:
     except ImportError:
         print("matplotlib is not installed: no figure")
         return
-    predicted = consistent.model.predict(*held_out, **unseen)
+    predicted = consistent.model.predict(held_out)
     fig, axes = plt.subplots(7, 1, figsize=(9, 14), sharex=True)
     for j, ax in enumerate(axes):
-        ax.plot(rec.t[split:], measured[:, j], color="0.3", label="measured")
-        ax.plot(rec.t[split:], predicted[:, j], "--", color="tab:red", label="predicted (consistent)")
+        ax.plot(held_out.t, measured[:, j], color="0.3", label="measured")
+        ax.plot(held_out.t, predicted[:, j], "--", color="tab:red", label="predicted (consistent)")
         ax.set_ylabel(f"joint {j + 1} (N m)")
     axes[0].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0))
     axes[-1].set_xlabel("t (s)")

@@ -181,6 +181,41 @@ impl Recording {
         Ok(())
     }
 
+    /// Samples `start..stop` (0-based, `stop` excluded) as a recording of their own, named
+    /// `name[start:stop]`: its time, positions, torques, velocities, accelerations and Coulomb
+    /// column. What was found in the log it was preprocessed from (glitches, dropouts, rounding,
+    /// clipping, wraps, held columns) is kept: it speaks of that log's samples. Errors where the
+    /// range leaves fewer than 2 samples or lies past the end.
+    pub fn rows(&self, start: usize, stop: usize) -> Result<Self> {
+        let k = self.len();
+        if start > stop || stop > k || stop - start < 2 {
+            return Err(self.error(format!(
+                "samples {start}..{stop} of {k}: expected at least 2 samples within the recording"
+            )));
+        }
+        let n = self.n;
+        let cut = |v: &Vec<f64>| v[start * n..stop * n].to_vec();
+        let r = Self {
+            name: format!("{}[{start}:{stop}]", self.name),
+            n,
+            t: self.t[start..stop].to_vec(),
+            q: cut(&self.q),
+            tau: cut(&self.tau),
+            qd: self.qd.as_ref().map(cut),
+            qdd: self.qdd.as_ref().map(cut),
+            coulomb: self.coulomb.as_ref().map(cut),
+            experiment: self.experiment.clone(),
+            glitches: self.glitches.clone(),
+            dropouts: self.dropouts.clone(),
+            position_rounding: self.position_rounding.clone(),
+            torque_saturation: self.torque_saturation.clone(),
+            position_wraps: self.position_wraps.clone(),
+            held_columns: self.held_columns.clone(),
+        };
+        r.check()?;
+        Ok(r)
+    }
+
     /// Number of samples.
     pub fn len(&self) -> usize {
         self.t.len()

@@ -328,7 +328,8 @@ class Recording:
     @property
     def coulomb(self) -> Optional[NDArray[np.float64]]:
         """The Coulomb friction term's column (k, n): sign(qd) filtered as tau was, for a
-        direct fit of these torques (coulomb=); None where preprocess did not filter."""
+        direct fit of these torques (brought by the recording given whole, or coulomb=); None
+        where preprocess did not filter."""
     @property
     def glitches(self) -> list[dict[str, Any]]:
         """Samples of the log this was preprocessed from taken for glitches and replaced first
@@ -363,6 +364,10 @@ class Recording:
         """The log's torques that read clipped (preprocess warns): joint (0-based), level
         (N m), upper, runs, samples, longest, first_at (s), beyond (N m)."""
     def __len__(self) -> int: ...
+    def __getitem__(self, key: slice, /) -> Recording:
+        """rec[a:b]: samples a..b (step 1, at least 2) as a Recording of their own, with the
+        Coulomb column and what was found in the log; for fitting one part and validating
+        on another."""
 
 @final
 class LocalModel:
@@ -661,8 +666,22 @@ class BaseParameterModel:
         """torque (n,), D, H, G (n, n) and G_static (n, n) or None at op."""
     def to_dataframe(self) -> Any:
         """The parameter table as a pandas DataFrame (index parameter; value, std, relative_std, combination)."""
-    def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, coulomb: Optional[ArrayLike] = None) -> NDArray[np.float64]: ...
-    def predict_stderr(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, coulomb: Optional[ArrayLike] = None) -> NDArray[np.float64]:
+    def predict(
+        self,
+        q: Union[ArrayLike, Recording],
+        qd: Optional[ArrayLike] = None,
+        qdd: Optional[ArrayLike] = None,
+        coulomb: Optional[ArrayLike] = None,
+    ) -> NDArray[np.float64]:
+        """Torques (N m) at q, qd, qdd ((n,) or (k, n)), with the Coulomb column where given; or
+        at a Recording's states, with its Coulomb column, given as q alone."""
+    def predict_stderr(
+        self,
+        q: Union[ArrayLike, Recording],
+        qd: Optional[ArrayLike] = None,
+        qdd: Optional[ArrayLike] = None,
+        coulomb: Optional[ArrayLike] = None,
+    ) -> NDArray[np.float64]:
         """Standard errors (N m) of predict's torques, shape (n,) or (k, n): from the parameters'
         standard errors and their correlation (the model's uncertainty, not a measured torque's
         scatter). InputError for a model saved before the correlation was stored."""
@@ -714,10 +733,10 @@ def design_excitation(
 
 def identify_base_parameters(
     robot: Robot,
-    q: ArrayLike,
-    qd: ArrayLike,
-    qdd: ArrayLike,
-    tau: ArrayLike,
+    q: Union[ArrayLike, Recording],
+    qd: Optional[ArrayLike] = None,
+    qdd: Optional[ArrayLike] = None,
+    tau: Optional[ArrayLike] = None,
     friction: Union[str, Sequence[str], None] = None,
     weighting: str = "wls",
     gravity: bool = True,
@@ -758,10 +777,10 @@ class ConsistentFit:
 
 def identify_consistent_parameters(
     robot: Robot,
-    q: ArrayLike,
-    qd: ArrayLike,
-    qdd: ArrayLike,
-    tau: ArrayLike,
+    q: Union[ArrayLike, Recording],
+    qd: Optional[ArrayLike] = None,
+    qdd: Optional[ArrayLike] = None,
+    tau: Optional[ArrayLike] = None,
     friction: Union[str, Sequence[str], None] = None,
     weighting: str = "wls",
     gravity: bool = True,
@@ -817,16 +836,17 @@ class Validation:
 
 def validate(
     model: Any,
-    q: ArrayLike,
-    qd: ArrayLike,
-    qdd: ArrayLike,
-    tau: ArrayLike,
+    q: Union[ArrayLike, Recording],
+    qd: Optional[ArrayLike] = None,
+    qdd: Optional[ArrayLike] = None,
+    tau: Optional[ArrayLike] = None,
     t: Optional[ArrayLike] = None,
     coulomb: Optional[ArrayLike] = None,
 ) -> Validation:
-    """Validates any model with predict(q, qd, qdd) on measured states and torques; for a
-    BaseParameterModel also checks the torque columns against its robot's model (a
-    PerturbidWarning per finding: swapped, the opposite sign, other units)."""
+    """Validates any model with predict(q, qd, qdd) on measured states and torques (arrays, or
+    a Recording as q alone: its states, torques, time and, for a BaseParameterModel, its
+    Coulomb column); for a BaseParameterModel also checks the torque columns against its
+    robot's model (a PerturbidWarning per finding: swapped, the opposite sign, other units)."""
 
 def identify_global_linear(op: OperatingPoint, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, tau: ArrayLike) -> GlobalLinearModel: ...
 

@@ -8,7 +8,6 @@ use pyo3::prelude::*;
 
 use super::scalars;
 
-use super::arrays::ArrayLike;
 use super::detached;
 use super::direct::{base_options, states, FrictionNames, PyBaseModel};
 use super::robot::PyRobot;
@@ -139,24 +138,25 @@ impl PyConsistentFit {
 /// checked first, as `identify_base_parameters` checks them. What the checks of the data find
 /// (torque columns, a lag, zero offsets, friction left out) is warned of (PerturbidWarning).
 /// `coulomb` ((k, n)): the Coulomb term's column for filtered torques, as in
-/// `identify_base_parameters`. Returns a ConsistentFit.
+/// `identify_base_parameters`; a Recording as `q`, alone, gives its own. Returns a
+/// ConsistentFit.
 #[pyfunction]
-#[pyo3(signature = (robot, q, qd, qdd, tau, friction=None, weighting="wls", gravity=true, prior_weight=1e-6, max_iterations=2000, t=None, coulomb=None))]
+#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, friction=None, weighting="wls", gravity=true, prior_weight=1e-6, max_iterations=2000, t=None, coulomb=None))]
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn identify_consistent_parameters(
-    py: Python<'_>,
+pub(crate) fn identify_consistent_parameters<'py>(
+    py: Python<'py>,
     robot: &PyRobot,
-    q: ArrayLike<'_>,
-    qd: ArrayLike<'_>,
-    qdd: ArrayLike<'_>,
-    tau: ArrayLike<'_>,
+    q: Bound<'py, PyAny>,
+    qd: Option<Bound<'py, PyAny>>,
+    qdd: Option<Bound<'py, PyAny>>,
+    tau: Option<Bound<'py, PyAny>>,
     friction: Option<FrictionNames<'_>>,
     weighting: &str,
     gravity: bool,
     #[pyo3(from_py_with = scalars::real)] prior_weight: f64,
     #[pyo3(from_py_with = scalars::count)] max_iterations: usize,
-    t: Option<ArrayLike<'_>>,
-    coulomb: Option<ArrayLike<'_>>,
+    t: Option<Bound<'py, PyAny>>,
+    coulomb: Option<Bound<'py, PyAny>>,
 ) -> PyResult<PyConsistentFit> {
     let options = base_options(friction, weighting, gravity)?;
     let consistent = ConsistentOptions {
@@ -165,9 +165,17 @@ pub(crate) fn identify_consistent_parameters(
         ..ConsistentOptions::default()
     };
     let model = &robot.model;
-    let c = states(model.nv, &q, &qd, &qdd, Some(&tau))?;
-    let coulomb = super::direct::coulomb_column(model.nv, coulomb.as_ref())?;
-    let t = (t.as_ref())
+    let given = super::samples::Given {
+        qd,
+        qdd,
+        tau,
+        t,
+        coulomb,
+    };
+    let a = super::samples::samples(q, given, true, true)?.arrays()?;
+    let c = states(model.nv, &a.q, &a.qd, &a.qdd, a.tau.as_ref())?;
+    let coulomb = super::direct::coulomb_column(model.nv, a.coulomb.as_ref())?;
+    let t = (a.t.as_ref())
         .map(|t| super::arrays::vector("t", t))
         .transpose()?;
     let fit = detached(py, "identify_consistent_parameters", || {

@@ -19,6 +19,7 @@ use super::arrays::{
 };
 use super::local::PyOperatingPoint;
 use super::robot::PyRobot;
+use super::samples::{samples, Given};
 use crate::direct::position_offsets::PositionOffsets;
 use crate::direct::position_range::JointRange;
 use crate::direct::{
@@ -98,6 +99,24 @@ pub(crate) fn states<'a>(
         args.push(("tau", t));
     }
     Ok(read_batch(n, &args)?.columns)
+}
+
+/// The states (`q`, `qd`, `qdd`, `coulomb` as a prediction takes them; or a Recording as `q`,
+/// alone) read as arrays.
+fn states_of<'py>(
+    q: Bound<'py, PyAny>,
+    qd: Option<Bound<'py, PyAny>>,
+    qdd: Option<Bound<'py, PyAny>>,
+    coulomb: Option<Bound<'py, PyAny>>,
+) -> PyResult<super::samples::SampleArrays<'py>> {
+    let given = Given {
+        qd,
+        qdd,
+        tau: None,
+        t: None,
+        coulomb,
+    };
+    samples(q, given, false, false)?.arrays()
 }
 
 /// The Coulomb friction term's column a caller gave (`coulomb`, (k, n) or (n,): a
@@ -387,40 +406,53 @@ impl PyBaseModel {
     }
     /// Predicted torques (N m) at `q`, `qd`, `qdd`: (n,) each or (k, n). `coulomb`, shaped
     /// as `q`: the Coulomb term's column in place of sign(qd) (`Recording.coulomb` of a
-    /// preprocessed log, to compare with its filtered torques).
-    #[pyo3(signature = (q, qd, qdd, coulomb=None))]
+    /// preprocessed log, to compare with its filtered torques). A Recording as `q`, alone:
+    /// its states and Coulomb column.
+    #[pyo3(signature = (q, qd=None, qdd=None, coulomb=None))]
     fn predict<'py>(
         &self,
         py: Python<'py>,
-        q: ArrayLike<'py>,
-        qd: ArrayLike<'py>,
-        qdd: ArrayLike<'py>,
-        coulomb: Option<ArrayLike<'py>>,
+        q: Bound<'py, PyAny>,
+        qd: Option<Bound<'py, PyAny>>,
+        qdd: Option<Bound<'py, PyAny>>,
+        coulomb: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (fit, model) = (&self.fit, &self.model);
         let name = "BaseParameterModel.predict";
-        at_states_with(py, model.nv, [&q, &qd, &qdd], coulomb.as_ref(), name, |s| {
-            fit.predict(model, s)
-        })
+        let a = states_of(q, qd, qdd, coulomb)?;
+        at_states_with(
+            py,
+            model.nv,
+            [&a.q, &a.qd, &a.qdd],
+            a.coulomb.as_ref(),
+            name,
+            |s| fit.predict(model, s),
+        )
     }
     /// The standard errors (N m) of the torques `predict` gives at `q`, `qd`, `qdd` (shapes as
     /// there): from the parameters' standard errors and their correlation; the uncertainty of
     /// the model's torque, not a measured one's scatter about it. Raises InputError for a
     /// model saved before the correlation was stored.
-    #[pyo3(signature = (q, qd, qdd, coulomb=None))]
+    #[pyo3(signature = (q, qd=None, qdd=None, coulomb=None))]
     fn predict_stderr<'py>(
         &self,
         py: Python<'py>,
-        q: ArrayLike<'py>,
-        qd: ArrayLike<'py>,
-        qdd: ArrayLike<'py>,
-        coulomb: Option<ArrayLike<'py>>,
+        q: Bound<'py, PyAny>,
+        qd: Option<Bound<'py, PyAny>>,
+        qdd: Option<Bound<'py, PyAny>>,
+        coulomb: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (fit, model) = (&self.fit, &self.model);
         let name = "BaseParameterModel.predict_stderr";
-        at_states_with(py, model.nv, [&q, &qd, &qdd], coulomb.as_ref(), name, |s| {
-            fit.predict_stderr(model, s)
-        })
+        let a = states_of(q, qd, qdd, coulomb)?;
+        at_states_with(
+            py,
+            model.nv,
+            [&a.q, &a.qd, &a.qdd],
+            a.coulomb.as_ref(),
+            name,
+            |s| fit.predict_stderr(model, s),
+        )
     }
     /// The model linearised exactly at `op` (an OperatingPoint): dict `torque` (n,), `D`, `H`,
     /// `G`, `G_static` (n, n; row = torque, column = joint), as a LocalModel answers it.
@@ -462,7 +494,8 @@ impl PyBaseModel {
 }
 
 /// Identifies the base parameters of `robot` from samples `q`, `qd`, `qdd`, `tau` (each (k, n);
-/// rad, rad/s, rad/s^2, N m). `friction`: True (viscous, Coulomb and offset per joint), False,
+/// rad, rad/s, rad/s^2, N m), or from a Recording given as `q` alone (`preprocess`'s: its
+/// states, torques, time and Coulomb column; see `samples`). `friction`: True (viscous, Coulomb and offset per joint), False,
 /// or a list of those names; `weighting`: 'wls' (default) or 'ols'; `gravity`: whether `tau`
 /// includes gravity; `tolerance`: relative rank tolerance of the pivoted QR. `t` ((k,) s),
 /// when the samples are a log: its qd and qdd columns are checked against the derivatives of
@@ -471,22 +504,22 @@ impl PyBaseModel {
 /// the Coulomb friction term's column filtered as they were (`Recording.coulomb` of
 /// `preprocess`), in place of sign(qd).
 #[pyfunction]
-#[pyo3(signature = (robot, q, qd, qdd, tau, friction=None, weighting="wls", gravity=true, tolerance=1e-8, seed=0, t=None, coulomb=None))]
+#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, friction=None, weighting="wls", gravity=true, tolerance=1e-8, seed=0, t=None, coulomb=None))]
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn identify_base_parameters(
-    py: Python<'_>,
+pub(crate) fn identify_base_parameters<'py>(
+    py: Python<'py>,
     robot: &PyRobot,
-    q: ArrayLike<'_>,
-    qd: ArrayLike<'_>,
-    qdd: ArrayLike<'_>,
-    tau: ArrayLike<'_>,
+    q: Bound<'py, PyAny>,
+    qd: Option<Bound<'py, PyAny>>,
+    qdd: Option<Bound<'py, PyAny>>,
+    tau: Option<Bound<'py, PyAny>>,
     friction: Option<FrictionNames<'_>>,
     weighting: &str,
     gravity: bool,
     #[pyo3(from_py_with = scalars::real)] tolerance: f64,
     #[pyo3(from_py_with = scalars::seed)] seed: u64,
-    t: Option<ArrayLike<'_>>,
-    coulomb: Option<ArrayLike<'_>>,
+    t: Option<Bound<'py, PyAny>>,
+    coulomb: Option<Bound<'py, PyAny>>,
 ) -> PyResult<PyBaseModel> {
     let options = BaseOptions {
         tolerance,
@@ -494,9 +527,17 @@ pub(crate) fn identify_base_parameters(
         ..base_options(friction, weighting, gravity)?
     };
     let model = &robot.model;
-    let c = states(model.nv, &q, &qd, &qdd, Some(&tau))?;
-    let coulomb = coulomb_column(model.nv, coulomb.as_ref())?;
-    let t = t.as_ref().map(|t| vector("t", t)).transpose()?;
+    let given = Given {
+        qd,
+        qdd,
+        tau,
+        t,
+        coulomb,
+    };
+    let a = samples(q, given, true, true)?.arrays()?;
+    let c = states(model.nv, &a.q, &a.qd, &a.qdd, a.tau.as_ref())?;
+    let coulomb = coulomb_column(model.nv, a.coulomb.as_ref())?;
+    let t = a.t.as_ref().map(|t| vector("t", t)).transpose()?;
     let fit = detached(py, "identify_base_parameters", || {
         check_sample_derivatives("identify_base_parameters' samples", model.nv, t, &c)?;
         let s = fit_states(model.nv, &c, coulomb.as_deref())?;

@@ -15,6 +15,7 @@ mod preprocess;
 mod recording;
 mod rehearsal;
 mod robot;
+mod samples;
 mod scalars;
 mod simulation;
 mod study;

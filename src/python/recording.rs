@@ -229,8 +229,9 @@ impl PyRecording {
         rows(py, &self.rec.tau, self.rec.n)
     }
     /// The Coulomb friction term's column of every joint ((k, n), within [-2, 2]): sign(qd)
-    /// low-pass filtered as `tau` was, for a direct fit of these torques (pass it as
-    /// `coulomb=` to identify_base_parameters, predict and validate); None where `preprocess`
+    /// low-pass filtered as `tau` was, for a direct fit of these torques (the recording given
+    /// whole to identify_base_parameters, predict and validate brings it; with arrays, pass it
+    /// as `coulomb=`); None where `preprocess`
     /// did not filter, or for a recording as logged.
     #[getter]
     fn coulomb<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
@@ -382,6 +383,37 @@ impl PyRecording {
     }
     fn __len__(&self) -> usize {
         self.rec.len()
+    }
+    /// `rec[a:b]`: samples a..b as a Recording of their own (a slice with step 1; at least 2
+    /// samples), with its Coulomb column and what was found in the log, for fitting one part
+    /// of a log and validating on another.
+    fn __getitem__(&self, index: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let Ok(slice) = index.cast::<pyo3::types::PySlice>() else {
+            return Err(Error::InvalidArgument {
+                argument: "index".into(),
+                message: format!(
+                    "{}; expected a slice of samples (rec[a:b]): a recording indexes rows by slices only",
+                    index.repr()?
+                ),
+            }
+            .into());
+        };
+        let k = self.rec.len();
+        let s = slice.indices(k as isize)?;
+        if s.step != 1 {
+            return Err(Error::InvalidArgument {
+                argument: "index".into(),
+                message: format!(
+                    "a slice of step {}; expected step 1 (a recording's samples stay evenly spaced and in order)",
+                    s.step
+                ),
+            }
+            .into());
+        }
+        let (start, stop) = (s.start as usize, (s.stop.max(s.start)) as usize);
+        Ok(Self {
+            rec: Arc::new(self.rec.rows(start, stop)?),
+        })
     }
     fn __repr__(&self) -> String {
         format!(

@@ -5,7 +5,7 @@ use pyo3::prelude::*;
 
 use pyo3::types::PyDict;
 
-use super::arrays::{read_batch, to_numpy, ArrayLike};
+use super::arrays::{read_batch, to_numpy};
 use super::detached;
 use super::direct::{
     position_offsets_dict, position_range_dicts, torque_column_dicts, torque_lag_dict, PyBaseModel,
@@ -189,26 +189,49 @@ impl PyValidation {
 /// columns are checked first against the derivatives of q and qd, as
 /// `identify_base_parameters` checks them. `coulomb` ((k, n), a BaseParameterModel only): the
 /// Coulomb term's column for filtered torques (`Recording.coulomb`), given to its `predict`.
+/// A Recording as `q`, alone: its states, torques and time, and its Coulomb column for a
+/// BaseParameterModel.
 /// Returns a Validation.
 #[pyfunction]
-#[pyo3(signature = (model, q, qd, qdd, tau, t=None, coulomb=None))]
+#[pyo3(signature = (model, q, qd=None, qdd=None, tau=None, t=None, coulomb=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn validate<'py>(
     model: Bound<'py, PyAny>,
     q: Bound<'py, PyAny>,
-    qd: Bound<'py, PyAny>,
-    qdd: Bound<'py, PyAny>,
-    tau: ArrayLike<'py>,
-    t: Option<ArrayLike<'py>>,
-    coulomb: Option<ArrayLike<'py>>,
+    qd: Option<Bound<'py, PyAny>>,
+    qdd: Option<Bound<'py, PyAny>>,
+    tau: Option<Bound<'py, PyAny>>,
+    t: Option<Bound<'py, PyAny>>,
+    coulomb: Option<Bound<'py, PyAny>>,
 ) -> PyResult<PyValidation> {
-    if coulomb.is_some() && model.cast::<PyBaseModel>().is_err() {
+    let base_model = model.cast::<PyBaseModel>().is_ok();
+    if coulomb.is_some() && !base_model {
         return Err(crate::Error::InvalidArgument {
             argument: "coulomb".into(),
             message: "the Coulomb term's column is a BaseParameterModel's; this model has no Coulomb term to give it to".into(),
         }
         .into());
     }
+    let given = super::samples::Given {
+        qd,
+        qdd,
+        tau,
+        t,
+        coulomb,
+    };
+    let s = super::samples::samples(q, given, true, true)?;
+    // a recording's own Coulomb column goes to a base-parameter model only
+    let s = super::samples::Samples {
+        coulomb: s.coulomb.filter(|_| base_model),
+        ..s
+    };
+    let a = s.arrays()?;
+    let (q, qd, qdd) = (&s.q, &s.qd, &s.qdd);
+    let tau = (a.tau.as_ref()).ok_or_else(|| crate::Error::InvalidArgument {
+        argument: "tau".into(),
+        message: "missing: the measured torques are what a model is validated against".into(),
+    })?;
+    let (t, coulomb) = (&a.t, &a.coulomb);
     let measured = {
         let array = tau.as_array();
         let n = *array.shape().last().unwrap_or(&0);
@@ -220,14 +243,13 @@ pub(crate) fn validate<'py>(
             }
             .into());
         }
-        let batch = read_batch(n, &[("tau", &tau)])?;
+        let batch = read_batch(n, &[("tau", tau)])?;
         (n, batch.columns[0].to_vec())
     };
     let (n, measured) = measured;
     if let Some(t) = &t {
-        let (q, qd, qdd): (ArrayLike, ArrayLike, ArrayLike) =
-            (q.extract()?, qd.extract()?, qdd.extract()?);
-        let batch = read_batch(n, &[("q", &q), ("qd", &qd), ("qdd", &qdd), ("tau", &tau)])?;
+        let args = [("q", &a.q), ("qd", &a.qd), ("qdd", &a.qdd), ("tau", tau)];
+        let batch = read_batch(n, &args)?;
         let t = super::arrays::vector("t", t)?;
         let samples = &batch.columns;
         detached(model.py(), "validate", || {
@@ -258,9 +280,7 @@ pub(crate) fn validate<'py>(
     let (mut torque_lag, mut position_offsets) = (None, None);
     let mut extrapolation = None;
     if local.is_ok() || base.is_ok() {
-        let (q, qd, qdd): (ArrayLike, ArrayLike, ArrayLike) =
-            (q.extract()?, qd.extract()?, qdd.extract()?);
-        let mut args = vec![("q", &q), ("qd", &qd), ("qdd", &qdd)];
+        let mut args = vec![("q", &a.q), ("qd", &a.qd), ("qdd", &a.qdd)];
         args.extend(coulomb.as_ref().map(|c| ("coulomb", c)));
         let batch = read_batch(n, &args)?;
         let states = batch.states(n)?;

@@ -453,6 +453,67 @@ def test_filtered_torques_are_fitted_with_the_filtered_coulomb_column():
         pr.identify_base_parameters(robot, rec.q, rec.qd, rec.qdd, rec.tau, friction=friction, coulomb=3 * c)
 
 
+def test_a_recording_given_whole_brings_its_coulomb_column_and_time():
+    """A preprocessed Recording as q, alone, is fitted, predicted at and validated with its
+    own Coulomb column and time: the same numbers as its arrays given with coulomb= and t=,
+    and not those of its arrays alone (the bias a forgotten coulomb= leaves). Slices of it
+    fit one part and validate another. Mixing a Recording with arrays, or giving one without
+    velocities, is refused by name."""
+    robot = pr.robots.a465()
+    traj = excitation(robot, 5, 0.1, 0.12, 1)
+    t = np.arange(0, 20, 1e-3)
+    q, qd, qdd = traj.sample(t)
+    rng = np.random.default_rng(1)
+    tau = robot.rnea(q, qd, qdd) + 0.5 * np.sign(qd) + 0.3 * qd + rng.normal(0.0, 0.03, q.shape)
+    rec = pr.preprocess(t, q, tau)
+    split = int(0.7 * len(rec))
+    part, rest = rec[:split], rec[split:]
+    assert len(part) == split and len(rest) == len(rec) - split and part.name.endswith(f"[0:{split}]")
+    np.testing.assert_array_equal(part.coulomb, rec.coulomb[:split])
+    np.testing.assert_array_equal(rest.t, rec.t[split:])
+    np.testing.assert_array_equal(rec[-100:].tau, rec.tau[-100:])
+    friction = ["viscous", "coulomb"]
+    whole = pr.identify_base_parameters(robot, part, friction=friction)
+    arrays = (part.q, part.qd, part.qdd, part.tau)
+    given = pr.identify_base_parameters(robot, *arrays, friction=friction, t=part.t, coulomb=part.coulomb)
+    np.testing.assert_array_equal(whole.theta_base, given.theta_base)
+    forgotten = pr.identify_base_parameters(robot, *arrays, friction=friction)
+    assert np.abs(forgotten.theta_base - whole.theta_base).max() > 0.01
+    consistent = pr.identify_consistent_parameters(robot, part, friction=friction, max_iterations=50)
+    consistent_given = pr.identify_consistent_parameters(robot, *arrays, friction=friction, max_iterations=50, coulomb=part.coulomb)
+    np.testing.assert_array_equal(consistent.theta, consistent_given.theta)
+    np.testing.assert_array_equal(whole.predict(rest), whole.predict(rest.q, rest.qd, rest.qdd, coulomb=rest.coulomb))
+    np.testing.assert_array_equal(whole.predict_stderr(rest), whole.predict_stderr(rest.q, rest.qd, rest.qdd, coulomb=rest.coulomb))
+    v = pr.validate(whole, rest)
+    np.testing.assert_array_equal(v.residuals, pr.validate(whole, rest.q, rest.qd, rest.qdd, rest.tau, coulomb=rest.coulomb).residuals)
+    assert (v.rms < 0.01).all(), v.rms
+
+    class Predictor:  # another model: the recording's Coulomb column is not given to it
+        def predict(self, q, qd, qdd):
+            return whole.predict(q, qd, qdd)
+
+    np.testing.assert_array_equal(pr.validate(Predictor(), rest).residuals, pr.validate(whole, rest.q, rest.qd, rest.qdd, rest.tau).residuals)
+    with pytest.raises(pr.InputError, match="coulomb: given with a Recording as q"):
+        pr.identify_base_parameters(robot, part, friction=friction, coulomb=part.coulomb)
+    with pytest.raises(pr.InputError, match="qd: given with a Recording as q"):
+        whole.predict(rest, rest.qd)
+    with pytest.raises(pr.InputError, match="tau: missing"):
+        pr.identify_base_parameters(robot, part.q, part.qd, part.qdd)
+    with pytest.raises(pr.InputError, match="qdd: missing"):
+        pr.validate(whole, rest.q, rest.qd, tau=rest.tau)
+    raw = pr.Recording(t, q, tau)
+    with pytest.raises(pr.InputError, match="no velocities and accelerations.*preprocess it first"):
+        pr.identify_base_parameters(robot, raw)
+    with pytest.raises(pr.InputError, match="step 1"):
+        rec[::2]
+    with pytest.raises(pr.InputError, match="a slice of samples"):
+        rec[3]
+    with pytest.raises(pr.InputError, match="at least 2 samples"):
+        rec[5:6]
+    with pytest.raises(TypeError, match="argument 'qd'"):
+        pr.identify_base_parameters(robot, part.q, "x", part.qdd, part.tau)
+
+
 def test_standard_errors_count_residuals_correlated_by_the_filter():
     # a log low-pass filtered at 10 Hz and kept at 100 Hz: about five correlated samples to
     # every independent one, which the standard errors now count
