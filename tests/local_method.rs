@@ -1014,6 +1014,45 @@ fn a_torque_channel_that_does_not_change_is_warned_about() {
     assert_eq!(from(&m).rows + 3 * n, from(&clean).rows);
 }
 
+/// A torque column logged with the opposite sign in every recording (another sign convention
+/// for that joint) leaves every experiment consistent with the nominal one, so no torque offset
+/// shows it; D* does: its row of that joint is a mass matrix's negated (a negative diagonal
+/// entry, symmetric and positive definite once negated), and the warning names the joint.
+#[test]
+fn a_torque_column_negated_in_every_recording_is_named_from_d_star() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
+    let mut sim = SimulationOptions::new(&model);
+    sim.torque_noise = vec![0.01; n];
+    let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    let run =
+        |recs: &[Recording]| identify_local(&plan, recs, &IdentifyOptions::default()).unwrap();
+    let d_warning = |m: &LocalModel| {
+        (m.diagnostics.warnings.iter())
+            .find(|w| w.starts_with("D* is"))
+            .cloned()
+    };
+    assert_eq!(d_warning(&run(&recs)), None);
+    for joint in [1, 4] {
+        let mut negated = recs.clone();
+        for r in &mut negated {
+            for i in 0..r.t.len() {
+                r.tau[i * n + joint] = -r.tau[i * n + joint];
+            }
+        }
+        let m = run(&negated);
+        let w = d_warning(&m).expect("a D* warning");
+        let name = format!("'joint{}' (D(joint{0},joint{0}) = -", joint + 1);
+        assert!(
+            w.contains(&format!("rows of joint(s) {name}"))
+                && w.contains("logged with the opposite sign to its position"),
+            "{w}"
+        );
+        assert!(m.diagnostics.torque_offsets.is_empty());
+    }
+}
+
 /// Torques that do not return to T* between an experiment's perturbations: torque columns
 /// swapped in one recording, or one offset, are found with the joints and named (a swap as
 /// such; one in the nominal recording by G and D alike; in H only a swap), listed in the

@@ -183,7 +183,9 @@ const FALSE_ALARM: f64 = 0.01;
 /// standard errors per pair warned on a quarter of sound A465 identifications with 6 degrees
 /// of freedom), and a negative eigenvalue of the symmetric part beyond [`SIGNIFICANT`] times
 /// the Frobenius norm of the standard errors (which bounds how far noise moves an
-/// eigenvalue).
+/// eigenvalue). Where the rows of the joints whose diagonal entry is negative beyond
+/// [`SIGNIFICANT`] standard errors, negated, leave a D* without either departure, those
+/// joints' torque columns are named as logged with the opposite sign.
 pub(super) fn mass_matrix_warning(d: &Estimate, joints: &[String]) -> Option<String> {
     let n = joints.len();
     let (m, se) = (&d.matrix, &d.stderr);
@@ -193,6 +195,63 @@ pub(super) fn mass_matrix_warning(d: &Estimate, joints: &[String]) -> Option<Str
     }
     let pairs = (n * (n - 1) / 2).max(1) as f64;
     let threshold = crate::student_t::upper_quantile(FALSE_ALARM / (2.0 * pairs), dof as f64);
+    let noise = se.norm();
+    let (asymmetric, smallest) = departures(m, se, threshold, joints);
+    let indefinite = smallest < -SIGNIFICANT * noise;
+    if asymmetric.is_empty() && !indefinite {
+        return None;
+    }
+    let negative: Vec<usize> = (0..n)
+        .filter(|&j| m[(j, j)] < -SIGNIFICANT * se[(j, j)])
+        .collect();
+    if !negative.is_empty() {
+        let mut flipped = m.clone();
+        for &j in &negative {
+            flipped.row_mut(j).neg_mut();
+        }
+        let (still, smallest) = departures(&flipped, se, threshold, joints);
+        if still.is_empty() && smallest >= -SIGNIFICANT * noise {
+            let named: Vec<String> = negative
+                .iter()
+                .map(|&j| format!("'{}' (D({0},{0}) = {:.4})", joints[j], m[(j, j)]))
+                .collect();
+            return Some(format!(
+                "D* is no mass matrix, but its rows of joint(s) {} are a mass matrix's negated: their diagonal entries are negative, and with those rows negated D* is symmetric and positive definite within its noise; the torque column of {} is logged with the opposite sign to its position (another sign convention, in every recording or in the D experiment's): negate it where the log is read, and identify again",
+                named.join(", "),
+                if negative.len() == 1 { "that joint" } else { "each" }
+            ));
+        }
+    }
+    let mut parts = vec![];
+    if !asymmetric.is_empty() {
+        parts.push(format!(
+            "not symmetric beyond {threshold:.1} standard errors, which noise passes once in {:.0} identifications ({})",
+            1.0 / FALSE_ALARM,
+            asymmetric.join("; ")
+        ));
+    }
+    if indefinite {
+        parts.push(format!(
+            "not positive definite: smallest eigenvalue {smallest:.4} where the standard errors allow {:.4}",
+            -SIGNIFICANT * noise
+        ));
+    }
+    Some(format!(
+        "D* is {}: no mass matrix is; the D experiment did not measure what the model assumes (tracking errors, a joint that slipped, unmodelled compliance), so do not trust D*",
+        parts.join(" and ")
+    ))
+}
+
+/// The pairs of `m` whose entries differ beyond `threshold` times their combined standard error
+/// (`se`), as text naming the `joints`, and the smallest eigenvalue of its symmetric part (NaN
+/// where it cannot be computed).
+fn departures(
+    m: &nalgebra::DMatrix<f64>,
+    se: &nalgebra::DMatrix<f64>,
+    threshold: f64,
+    joints: &[String],
+) -> (Vec<String>, f64) {
+    let n = joints.len();
     let mut asymmetric = vec![];
     for i in 0..n {
         for j in (i + 1)..n {
@@ -212,30 +271,10 @@ pub(super) fn mass_matrix_warning(d: &Estimate, joints: &[String]) -> Option<Str
         }
     }
     let symmetric = (m + m.transpose()) * 0.5;
-    let smallest = crate::decomposition::symmetric_eigen(symmetric.clone()).map_or(f64::NAN, |e| {
+    let smallest = crate::decomposition::symmetric_eigen(symmetric).map_or(f64::NAN, |e| {
         e.eigenvalues.iter().copied().fold(f64::INFINITY, f64::min)
     });
-    let noise = se.norm();
-    let mut parts = vec![];
-    if !asymmetric.is_empty() {
-        parts.push(format!(
-            "not symmetric beyond {threshold:.1} standard errors, which noise passes once in {:.0} identifications ({})",
-            1.0 / FALSE_ALARM,
-            asymmetric.join("; ")
-        ));
-    }
-    if smallest < -SIGNIFICANT * noise {
-        parts.push(format!(
-            "not positive definite: smallest eigenvalue {smallest:.4} where the standard errors allow {:.4}",
-            -SIGNIFICANT * noise
-        ));
-    }
-    (!parts.is_empty()).then(|| {
-        format!(
-            "D* is {}: no mass matrix is; the D experiment did not measure what the model assumes (tracking errors, a joint that slipped, unmodelled compliance), so do not trust D*",
-            parts.join(" and ")
-        )
-    })
+    (asymmetric, smallest)
 }
 
 #[cfg(test)]
@@ -297,6 +336,19 @@ mod tests {
             mass_matrix_warning(&estimate(indefinite, 0.2), &joints),
             None
         );
+        // a joint's row negated (its torque column of the opposite sign) is named as such
+        let mut negated = m.clone();
+        negated.row_mut(1).neg_mut();
+        let w = mass_matrix_warning(&estimate(negated.clone(), 0.01), &joints).unwrap();
+        assert!(
+            w.contains("rows of joint(s) 'j2' (D(j2,j2) = -1.0000) are a mass matrix's negated")
+                && w.contains("the torque column of that joint is logged with the opposite sign"),
+            "{w}"
+        );
+        // a negative diagonal whose row negated is still no mass matrix is not named so
+        negated[(1, 0)] = 0.0;
+        let w = mass_matrix_warning(&estimate(negated, 0.01), &joints).unwrap();
+        assert!(w.contains("did not measure what the model assumes"), "{w}");
         // without standard errors nothing is judged
         let mut unknown = estimate(m, 0.01);
         unknown.stderr[(0, 0)] = f64::NAN;
