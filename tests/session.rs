@@ -6,8 +6,8 @@ mod common;
 
 use common::{a465_noisy_runs, worst_in_stderr};
 use perturbid_rs::local::{
-    identify_local, position_misfit, repeated_runs, split_session, CrossingTimes, IdentifyOptions,
-    SplitOptions,
+    gaps_in_runs, identify_local, position_misfit, repeated_runs, split_session, CrossingTimes,
+    IdentifyOptions, SplitOptions,
 };
 use perturbid_rs::Recording;
 
@@ -83,6 +83,7 @@ fn a_session_log_splits_into_the_runs_that_identify_as_the_separate_recordings()
     // not taken for a second run of D)
     let repeated = repeated_runs(&plan, &log, &split).unwrap();
     assert!(repeated.is_empty(), "{repeated:?}");
+    assert!(gaps_in_runs(&plan, &log, &split).is_empty());
     // the first run starts after the 2 s homing move, at 1002 s of the log
     assert!((split[0].1 - 1002.0).abs() < 2e-3, "{}", split[0].1);
     for ((run, _), e) in split.iter().zip(&plan.experiments) {
@@ -307,4 +308,66 @@ fn an_experiment_run_twice_is_named_with_both_stretches() {
         "{}",
         repeated[0]
     );
+}
+
+/// A stretch of a run without samples, lost or skipped by a step of the log's clock, is named
+/// with the experiment, its length and where it lies in the log and on the plan's clock; a gap
+/// between the runs is none of a run's.
+#[test]
+fn a_gap_inside_a_run_is_named() {
+    let (plan, recs) = a465_noisy_runs();
+    let log = session(&recs.iter().collect::<Vec<_>>(), 1.5);
+    let split = split_session(&plan, &log, &SplitOptions::default()).unwrap();
+    let n = log.n;
+    let without = |from: f64, to: f64, step: f64| {
+        let keep: Vec<usize> = (0..log.len())
+            .filter(|&i| log.t[i] < from || log.t[i] >= to)
+            .collect();
+        let rows = |v: &[f64]| -> Vec<f64> {
+            keep.iter()
+                .flat_map(|&i| v[i * n..(i + 1) * n].to_vec())
+                .collect()
+        };
+        let t = keep
+            .iter()
+            .map(|&i| log.t[i] + if log.t[i] >= to { step } else { 0.0 })
+            .collect();
+        Recording::new(
+            "session.csv",
+            n,
+            t,
+            rows(&log.q),
+            rows(&log.tau),
+            None,
+            None,
+        )
+        .unwrap()
+    };
+    // 0.3 s lost in the middle of the third experiment's run
+    let (e, d) = (&plan.experiments[2], split[2].1);
+    let middle = d + 0.5 * (e.trajectory.start() + e.trajectory.end());
+    let lost = without(middle, middle + 0.3, 0.0);
+    let runs = split_session(&plan, &lost, &SplitOptions::default()).unwrap();
+    let w = gaps_in_runs(&plan, &lost, &runs);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with(&format!(
+            "experiment '{}': session.csv has no sample for 0.3",
+            e.kind.name()
+        )) && w[0].contains("samples were lost there, or the log's clock stepped"),
+        "{w:?}"
+    );
+    // the log's clock stepping 5 s forward there: named alike
+    let stepped = without(middle, middle + 0.001, 5.0);
+    let runs = split_session(&plan, &stepped, &SplitOptions::default()).unwrap();
+    let w = gaps_in_runs(&plan, &stepped, &runs);
+    assert!(
+        w.iter().any(|w| w.contains("has no sample for 5.00")),
+        "{w:?}"
+    );
+    // 0.3 s lost between the second and the third runs: no run's
+    let between = split[1].1 + plan.experiments[1].trajectory.end() + 0.5;
+    let outside = without(between, between + 0.3, 0.0);
+    let runs = split_session(&plan, &outside, &SplitOptions::default()).unwrap();
+    assert!(gaps_in_runs(&plan, &outside, &runs).is_empty());
 }

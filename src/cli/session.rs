@@ -11,7 +11,7 @@ use super::out_dir;
 use crate::document::Document;
 use crate::error::Result;
 use crate::io::{load_recording, recording_files};
-use crate::local::{repeated_runs, split_session, Plan, SplitOptions};
+use crate::local::{gaps_in_runs, repeated_runs, split_session, Plan, SplitOptions};
 
 #[derive(Args)]
 pub(crate) struct SplitArgs {
@@ -34,7 +34,9 @@ pub(crate) fn split(a: SplitArgs) -> Result<String> {
     let plan = Plan::load(&a.plan)?;
     let log = load_recording(&a.log, &plan.joint_names)?;
     let runs = split_session(&plan, &log, &SplitOptions { margin: a.margin })?;
-    for w in repeated_runs(&plan, &log, &runs)? {
+    let mut warnings = repeated_runs(&plan, &log, &runs)?;
+    warnings.extend(gaps_in_runs(&plan, &log, &runs));
+    for w in warnings {
         eprintln!("perturbid: warning: {w}");
     }
     let (recordings, offsets): (Vec<_>, Vec<f64>) = runs.into_iter().unzip();

@@ -80,4 +80,4 @@ pub use perturbation::{Design, Size, Sizes};
 pub use plan::{plan_experiments, Crossing, Experiment, ExperimentKind, Plan, PlanOptions};
 pub use point_design::{suggest_operating_points, SuggestedPoint};
 pub use reach::{Extrapolation, Perturbations, REACH_LIMIT};
-pub use session::{repeated_runs, split_session, SplitOptions};
+pub use session::{gaps_in_runs, repeated_runs, split_session, SplitOptions};

@@ -230,6 +230,49 @@ pub fn repeated_runs(
     Ok(out)
 }
 
+/// A warning for each run of `runs` (from [`split_session`] of `plan` on `log`) inside whose
+/// planned span the log has no sample for longer than
+/// [`MAX_GAP_INTERVALS`](crate::limits::MAX_GAP_INTERVALS) times its median interval: samples
+/// lost there (the identification names a crossing whose window they leave empty), or a step
+/// of the log's clock, after which the run is off the plan's clock by the step (and the
+/// recording ends early). Named with the experiment, the gap's length and where it lies in
+/// the log and on the plan's clock.
+pub fn gaps_in_runs(plan: &Plan, log: &Recording, runs: &[(Recording, f64)]) -> Vec<String> {
+    let intervals: Vec<f64> = log.t.windows(2).map(|w| w[1] - w[0]).collect();
+    let Some(median) = crate::log_screening::median(intervals) else {
+        return vec![];
+    };
+    let longest = crate::limits::MAX_GAP_INTERVALS * median;
+    let mut out = vec![];
+    for (e, (_, d)) in plan.experiments.iter().zip(runs) {
+        let (from, to) = (d + e.trajectory.start(), d + e.trajectory.end());
+        let i0 = log.t.partition_point(|&t| t < from).saturating_sub(1);
+        let i1 = log.t.partition_point(|&t| t <= to).min(log.len() - 1);
+        let gaps: Vec<(f64, f64)> = (i0..i1)
+            .map(|i| (log.t[i], log.t[i + 1]))
+            .filter(|(a, b)| b - a > longest && *b > from && *a < to)
+            .collect();
+        if let Some(&(a, b)) = gaps
+            .iter()
+            .max_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
+        {
+            out.push(format!(
+                "experiment '{}': {} has no sample for {} s inside its run, from {} to {} s of the log ({} to {} s on the plan's clock; {} such gap(s) in the run, the median interval {} s): samples were lost there, or the log's clock stepped, and then the rest of the run is off the plan's clock by the step; the identification needs the samples around each crossing",
+                e.kind.name(),
+                log.name,
+                shown_time(b - a),
+                shown_time(a),
+                shown_time(b),
+                shown_time(a - d),
+                shown_time(b - d),
+                gaps.len(),
+                crate::error::shown5(median)
+            ));
+        }
+    }
+    out
+}
+
 /// A time in the log (s), to the millisecond.
 fn shown_time(t: f64) -> String {
     crate::error::shown((t * 1e3).round() / 1e3)

@@ -165,7 +165,8 @@ impl PyPlan {
     /// InputError naming the experiment and the time in the log when a run does not fit where
     /// it must (out of order, missing, a log cut short) or its best stretch does not follow the
     /// plan; KeyboardInterrupt on Ctrl-C. An experiment that ran twice (its plan followed also
-    /// between the runs next to it) gets a PerturbidWarning naming both stretches.
+    /// between the runs next to it) gets a PerturbidWarning naming both stretches, and one
+    /// inside whose run the log has a gap (lost samples, or a step of its clock) one naming it.
     #[pyo3(signature = (log, margin=0.2))]
     fn split_session(
         &self,
@@ -177,7 +178,8 @@ impl PyPlan {
         let (runs, repeated) = detached(py, "Plan.split_session", || {
             let runs =
                 crate::local::split_session(&plan, &log, &crate::local::SplitOptions { margin })?;
-            let repeated = crate::local::repeated_runs(&plan, &log, &runs)?;
+            let mut repeated = crate::local::repeated_runs(&plan, &log, &runs)?;
+            repeated.extend(crate::local::gaps_in_runs(&plan, &log, &runs));
             Ok((runs, repeated))
         })?;
         super::errors::warn_all(py, &repeated)?;
