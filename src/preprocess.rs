@@ -71,7 +71,9 @@ impl Default for PreprocessOptions {
 /// again as tau is, the Coulomb friction term's column for a fit of the filtered torques.
 /// Where a joint's logged positions lie on a grid (encoder counts) and its velocity is derived
 /// from them, the noise their rounding leaves in qd and qdd is estimated and kept in
-/// [`Recording::position_rounding`] ([`crate::position_rounding`]).
+/// [`Recording::position_rounding`] ([`crate::position_rounding`]). Stamps that jitter while
+/// the samples were taken on a regular clock are found and kept in
+/// [`Recording::stamp_jitter`] ([`crate::stamp_jitter`]); the log is not changed.
 ///
 /// A gap in `t` longer than [`MAX_GAP_INTERVALS`] median sample intervals is an error naming
 /// its time, unless `options.split_at_gaps`: then each part between gaps is preprocessed on its
@@ -91,11 +93,14 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     let rec = &reread;
     // clipped torques, as logged: screening could replace a short clipped run
     let torque_saturation = crate::torque_saturation::find_torque_saturation(rec);
+    // the stamps against the positions, as logged: resampling reads them as the samples' times
+    let stamp_jitter = crate::stamp_jitter::find_stamp_jitter(rec);
     if !options.screen_glitches {
         return preprocess_screened(rec, options, &steps).map(|out| Recording {
             torque_saturation,
             position_wraps,
             held_columns,
+            stamp_jitter,
             ..out
         });
     }
@@ -119,6 +124,7 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
         torque_saturation,
         position_wraps,
         held_columns,
+        stamp_jitter,
         ..out
     })
 }

@@ -47,6 +47,10 @@ pub struct Recording {
     /// Coulomb coefficients came out 6 % low and the viscous ones 50 % high without it). Set
     /// by [`crate::preprocess::preprocess`] where it filters; None otherwise.
     pub coulomb: Option<Vec<f64>>,
+    /// The time stamps of the log this recording was preprocessed from, found jittering while
+    /// its samples were taken on a regular clock ([`crate::stamp_jitter`]); None for a
+    /// recording as logged, or stamps found sound.
+    pub stamp_jitter: Option<crate::stamp_jitter::StampJitter>,
 }
 
 impl Recording {
@@ -78,6 +82,7 @@ impl Recording {
             position_wraps: vec![],
             held_columns: vec![],
             coulomb: None,
+            stamp_jitter: None,
         };
         r.check()?;
         Ok(r)
@@ -184,7 +189,7 @@ impl Recording {
     /// Samples `start..stop` (0-based, `stop` excluded) as a recording of their own, named
     /// `name[start:stop]`: its time, positions, torques, velocities, accelerations and Coulomb
     /// column. What was found in the log it was preprocessed from (glitches, dropouts, rounding,
-    /// clipping, wraps, held columns) is kept: it speaks of that log's samples. Errors where the
+    /// clipping, wraps, held columns, jittering stamps) is kept: it speaks of that log's samples. Errors where the
     /// range leaves fewer than 2 samples or lies past the end.
     pub fn rows(&self, start: usize, stop: usize) -> Result<Self> {
         let k = self.len();
@@ -211,6 +216,7 @@ impl Recording {
             torque_saturation: self.torque_saturation.clone(),
             position_wraps: self.position_wraps.clone(),
             held_columns: self.held_columns.clone(),
+            stamp_jitter: self.stamp_jitter.clone(),
         };
         r.check()?;
         Ok(r)

@@ -350,6 +350,12 @@ class Recording:
         step (rad or m), qd_ratio, qdd_ratio (RMS of the noise over RMS of the signal;
         preprocess warns from 0.1)."""
     @property
+    def stamp_jitter(self) -> Optional[dict[str, Any]]:
+        """The time stamps of the log this was preprocessed from, found jittering while its
+        samples were taken on a regular clock: interval (median, s), scatter (s), joint
+        (0-based), rougher (its positions' distance from their neighbours' line against the
+        stamps over that against the sample count); None where sound."""
+    @property
     def held_columns(self) -> list[dict[str, Any]]:
         """Columns of the log this was preprocessed from logged at a lower rate and held on its
         grid, read again at their values' arrivals first: signal, joint (0-based), repeated

@@ -197,6 +197,11 @@ impl PreprocessArgs {
         {
             eprintln!("perturbid: warning: {w}");
         }
+        if let Some(w) =
+            crate::stamp_jitter::warning(&rec.stamp_jitter, &path.display().to_string(), joints)
+        {
+            eprintln!("perturbid: warning: {w}");
+        }
         if let Some(w) = crate::position_wraps::warning(
             &rec.position_wraps,
             &path.display().to_string(),

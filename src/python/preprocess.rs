@@ -75,6 +75,7 @@ pub(crate) fn preprocess(
         crate::torque_saturation::warning(&out.torque_saturation, &[], name),
         crate::position_wraps::warning(&out.position_wraps, name, &[], "before preprocessing"),
         crate::held_columns::warning(&out.held_columns, name, &[]),
+        crate::stamp_jitter::warning(&out.stamp_jitter, name, &[]),
     ]
     .into_iter()
     .flatten()

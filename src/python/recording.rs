@@ -330,6 +330,27 @@ impl PyRecording {
             })
             .collect()
     }
+    /// The time stamps of the log this recording was preprocessed from, found jittering while
+    /// its samples were taken on a regular clock (`preprocess` warns): a dict `interval` (the
+    /// median interval, s), `scatter` (how far the intervals scatter about it, s), `joint`
+    /// (0-based column index of the joint that tells it most clearly) and `rougher` (how many
+    /// times farther from their neighbours' line its positions lie against the stamps than
+    /// against the sample count); None where the stamps are sound, or for a recording as logged.
+    #[getter]
+    fn stamp_jitter<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<Option<Bound<'py, pyo3::types::PyDict>>> {
+        let Some(j) = &self.rec.stamp_jitter else {
+            return Ok(None);
+        };
+        let e = pyo3::types::PyDict::new(py);
+        e.set_item("interval", j.interval)?;
+        e.set_item("scatter", j.scatter)?;
+        e.set_item("joint", j.joint)?;
+        e.set_item("rougher", j.rougher)?;
+        Ok(Some(e))
+    }
     /// Steps of whole turns in the positions of the log this recording was preprocessed from
     /// (a joint angle logged within one turn that a continuous joint passes), taken back out
     /// first; `preprocess` warns: a list of dicts `joint` (0-based column index), `sample`

@@ -1109,3 +1109,31 @@ def test_a_stream_that_stops_before_the_log_is_cut_from_its_end():
     cut = pr.preprocess(t[:-50], q[:-50], tau[:-50])
     np.testing.assert_array_equal(rec.t, cut.t)
     np.testing.assert_array_equal(rec.tau, cut.tau)
+
+
+def test_stamps_that_jitter_over_a_regular_clock_are_found_and_warned_of():
+    """Samples taken every millisecond, stamped with 0.1 ms of white jitter (a ROS bag's
+    receive time): preprocess finds it from the positions (smooth against the sample count,
+    rough against the stamps; the ratio against numpy's) and warns; the harm it warns of holds
+    (the fit's residual many times the sound log's). Stamped right, nothing is found."""
+    robot = pr.robots.a465()
+    traj = excitation(robot, 5, 0.1, 0.3, 2)
+    t = np.arange(0, 20, 1e-3)
+    q, qd, qdd = traj.sample(t)
+    rng = np.random.default_rng(3)
+    tau = robot.rnea(q, qd, qdd) + 0.5 * np.sign(qd) + 0.3 * qd + rng.normal(0, 0.03, q.shape)
+    friction = ["viscous", "coulomb"]
+    sound = pr.preprocess(t, q, tau)
+    assert sound.stamp_jitter is None
+    stamps = t + rng.normal(0, 1e-4, t.shape)
+    with pytest.warns(pr.PerturbidWarning, match="its time stamps jitter while its samples were taken on a regular clock"):
+        jittered = pr.preprocess(stamps, q, tau)
+    found = jittered.stamp_jitter
+    line = q[:-2] + (q[2:] - q[:-2]) * ((stamps[1:-1] - stamps[:-2]) / (stamps[2:] - stamps[:-2]))[:, None]
+    ratios = np.abs(q[1:-1] - line).mean(0) / np.abs(q[1:-1] - 0.5 * (q[:-2] + q[2:])).mean(0)
+    assert found["joint"] == int(np.argmax(ratios))
+    np.testing.assert_allclose(found["rougher"], ratios.max(), rtol=1e-9)
+    assert abs(found["interval"] - 1e-3) < 2e-5 and abs(found["scatter"] - 1.41e-4) < 1.5e-5, found
+    good = pr.identify_base_parameters(robot, sound, friction=friction)
+    bad = pr.identify_base_parameters(robot, jittered, friction=friction)
+    assert bad.residual_rms.max() > 5 * good.residual_rms.max(), (bad.residual_rms, good.residual_rms)
