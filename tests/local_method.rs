@@ -1014,6 +1014,36 @@ fn a_torque_channel_that_does_not_change_is_warned_about() {
     assert_eq!(from(&m).rows + 3 * n, from(&clean).rows);
 }
 
+/// A recording whose stamps jitter over the regular clock its samples were taken on (a ROS
+/// bag's receive time) is named with its experiment; the clean rehearsal is not.
+#[test]
+fn a_recording_whose_stamps_jitter_is_named() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
+    let mut sim = SimulationOptions::new(&model);
+    sim.torque_noise = vec![0.01; model.nv];
+    let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    let says = |m: &LocalModel| {
+        (m.diagnostics.warnings.iter())
+            .filter(|w| w.contains("its time stamps jitter"))
+            .cloned()
+            .collect::<Vec<_>>()
+    };
+    let clean = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    assert!(says(&clean).is_empty(), "{:?}", says(&clean));
+    let mut jittered = recs.clone();
+    let d = (jittered.iter_mut())
+        .find(|r| r.experiment.as_deref() == Some("D"))
+        .unwrap();
+    let mut rng = common::Rng(3);
+    for t in &mut d.t {
+        *t += 1e-4 * common::normal(&mut rng);
+    }
+    let m = identify_local(&plan, &jittered, &IdentifyOptions::default()).unwrap();
+    let w = says(&m);
+    assert!(w.len() == 1 && w[0].starts_with("experiment 'D'"), "{w:?}");
+}
+
 /// A torque column logged with the opposite sign in every recording (another sign convention
 /// for that joint) leaves every experiment consistent with the nominal one, so no torque offset
 /// shows it; D* does: its row of that joint is a mass matrix's negated (a negative diagonal

@@ -1,6 +1,7 @@
 //! One experiment's recording made ready for its crossing windows: steps of whole turns taken
 //! out of its positions ([`crate::position_wraps`]), columns held at a lower rate read again
-//! at their values' arrivals ([`crate::held_columns`]), its logged velocities and
+//! at their values' arrivals ([`crate::held_columns`]), stamps that jitter over a regular
+//! clock found ([`crate::stamp_jitter`]), its logged velocities and
 //! accelerations checked against the derivatives where they are to be used
 //! ([`crate::derivative_columns::check_logged_derivatives`]), one joint's held readings
 //! (a lost message logged as its last value or zeros) replaced, rows of zeros and frozen
@@ -51,6 +52,12 @@ pub(super) fn read_experiment(
         joint_names,
     ));
     let r = &reread;
+    // the stamps against the positions: the windows' fits read the stamps as the samples' times
+    said.push(crate::stamp_jitter::warning(
+        &crate::stamp_jitter::find_stamp_jitter(r),
+        &r.name,
+        joint_names,
+    ));
     if options.fit.recorded_derivatives {
         crate::derivative_columns::check_logged_derivatives(r)?;
     }
