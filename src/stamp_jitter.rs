@@ -41,6 +41,39 @@ pub struct StampJitter {
     pub rougher: f64,
 }
 
+impl StampJitter {
+    /// What is wrong with a finding read from a file, if anything: a joint not one of the `n`,
+    /// an interval that is not a positive time, a scatter that is not a finite time of 0 or
+    /// more, a ratio below [`ROUGHER`] (no finding) or not finite.
+    pub fn problem(&self, n: usize) -> Option<String> {
+        if self.joint >= n {
+            return Some(format!(
+                "joint {}: expected a joint index below {n}",
+                self.joint
+            ));
+        }
+        if !(self.interval > 0.0 && self.interval.is_finite()) {
+            return Some(format!(
+                "interval {}: expected a positive time (s)",
+                self.interval
+            ));
+        }
+        if !(self.scatter >= 0.0 && self.scatter.is_finite()) {
+            return Some(format!(
+                "scatter {}: expected a finite time of 0 or more (s)",
+                self.scatter
+            ));
+        }
+        if !(self.rougher >= ROUGHER && self.rougher.is_finite()) {
+            return Some(format!(
+                "rougher {}: expected a finite ratio of {ROUGHER} or more (a finding)",
+                self.rougher
+            ));
+        }
+        None
+    }
+}
+
 /// The stamps of `rec` found jittering (see the module's documentation), or None. Triples of
 /// samples across a gap (an interval longer than
 /// [`MAX_GAP_INTERVALS`](crate::limits::MAX_GAP_INTERVALS) median intervals) are left out.

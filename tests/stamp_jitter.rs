@@ -111,3 +111,39 @@ fn the_real_panda_log_is_left_alone() {
     assert!(ratio(&panda) < 0.7 * ROUGHER, "{}", ratio(&panda));
     assert_eq!(find_stamp_jitter(&panda), None);
 }
+
+#[test]
+fn a_saved_finding_is_checked_on_load() {
+    use perturbid_rs::direct::BaseModel;
+    use perturbid_rs::document::Document;
+    let rec = log(1e-4);
+    let (p, fit) = common::fit_preprocessed(&rec, &PreprocessOptions::default());
+    let fit = BaseModel {
+        log_stamp_jitter: p.stamp_jitter,
+        ..fit
+    };
+    assert!(fit.log_stamp_jitter.is_some());
+    let text = fit.to_json();
+    assert_eq!(BaseModel::from_json(&text).unwrap(), fit);
+    let value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    type Edit = fn(&mut serde_json::Value);
+    let edits: [(Edit, &str); 4] = [
+        (
+            |v| v["log_stamp_jitter"]["joint"] = 6.into(),
+            "log_stamp_jitter: joint 6",
+        ),
+        (
+            |v| v["log_stamp_jitter"]["interval"] = 0.0.into(),
+            "log_stamp_jitter: interval 0",
+        ),
+        (
+            |v| v["log_stamp_jitter"]["scatter"] = (-1.0).into(),
+            "log_stamp_jitter: scatter -1",
+        ),
+        (
+            |v| v["log_stamp_jitter"]["rougher"] = 1.5.into(),
+            "log_stamp_jitter: rougher 1.5",
+        ),
+    ];
+    common::refused_on_load::<BaseModel>(&value, &edits);
+}

@@ -224,6 +224,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         log_torque_saturation: rec.torque_saturation.clone(),
         log_position_wraps: rec.position_wraps.clone(),
         log_held_columns: rec.held_columns.clone(),
+        log_stamp_jitter: rec.stamp_jitter.clone(),
         position_rounding: rec.position_rounding.clone(),
         ..fit
     };

@@ -39,7 +39,8 @@ pub(crate) struct ValidateArgs {
     /// as glitches and the rows removed as dropouts before preprocessing, when there were any;
     /// `log_torque_saturation`, its torques that read clipped, warned of; `log_position_wraps`,
     /// steps of whole turns taken out of its positions; `log_held_columns`, its columns logged
-    /// at a lower rate and read again at their values' arrivals;
+    /// at a lower rate and read again at their values' arrivals; `log_stamp_jitter`, its time
+    /// stamps found jittering over a regular clock;
     /// for a base-parameter model `torque_columns`, each torque column of the log against the
     /// robot's model, `torque_lag`, its torques shifted against its positions, and
     /// `position_range`, the joints whose positions leave their limits, and `position_offsets`,
@@ -162,6 +163,9 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     }
     if !rec.held_columns.is_empty() {
         json["log_held_columns"] = serde_json::to_value(&rec.held_columns).expect("serialisable");
+    }
+    if let Some(j) = &rec.stamp_jitter {
+        json["log_stamp_jitter"] = serde_json::to_value(j).expect("serialisable");
     }
     if !rec.position_wraps.is_empty() {
         json["log_position_wraps"] =

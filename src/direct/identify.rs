@@ -112,6 +112,10 @@ pub struct BaseModel {
     /// values' arrivals first ([`crate::held_columns`]; set likewise).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub log_held_columns: Vec<crate::held_columns::HeldColumn>,
+    /// That log's time stamps, found jittering over the regular clock its samples were taken
+    /// on ([`crate::stamp_jitter`]; set likewise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub log_stamp_jitter: Option<crate::stamp_jitter::StampJitter>,
     /// Per joint of that log whose positions lie on a grid and whose velocity was derived
     /// from them, the noise their rounding left in qd and qdd ([`crate::position_rounding`];
     /// set likewise): ratios of [`crate::position_rounding::NOISE_RATIO`] or more are warned
@@ -348,6 +352,7 @@ fn fit_with_factors(
         log_torque_saturation: vec![],
         log_position_wraps: vec![],
         log_held_columns: vec![],
+        log_stamp_jitter: None,
         log_dropouts: vec![],
         position_rounding: vec![],
         torque_columns: super::torque_columns::check_torque_columns(
@@ -519,6 +524,9 @@ impl Document for BaseModel {
                 Self::WHAT,
                 format!("log_held_columns[{i}]: {problem}"),
             ));
+        }
+        if let Some(problem) = m.log_stamp_jitter.as_ref().and_then(|j| j.problem(n)) {
+            return Err(invalid(Self::WHAT, format!("log_stamp_jitter: {problem}")));
         }
         if let Some((i, problem)) = (m.log_position_wraps.iter().enumerate())
             .find_map(|(i, w)| w.problem(n).map(|p| (i, p)))

@@ -300,6 +300,7 @@ pub fn identify_parameters_from_local(
         log_torque_saturation: vec![],
         log_position_wraps: vec![],
         log_held_columns: vec![],
+        log_stamp_jitter: None,
         position_rounding: vec![],
         // rows from local models: no log's torque columns
         torque_columns: vec![],
