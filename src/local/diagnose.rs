@@ -112,7 +112,7 @@ pub(super) fn disagreement_warning(
         )
     } else {
         format!(
-            "the variables an experiment did not perturb deviate only by their measurement noise ({deviation:.1} standard errors RMS), which the combined regression takes for motion (encoder quantisation reaches qdd through two derivatives and leaks D* into the smaller H* and G*); trust the separated estimate"
+            "the variables an experiment did not perturb deviate only by their measurement noise ({deviation:.1} standard errors RMS), which the combined regression takes for motion (encoder quantisation, or stamps that jitter, reach qdd through two derivatives and leak D* into the smaller H* and G*); trust the separated estimate"
         )
     };
     Some(format!(
