@@ -1014,15 +1014,22 @@ fn a_torque_channel_that_does_not_change_is_warned_about() {
     assert_eq!(from(&m).rows + 3 * n, from(&clean).rows);
 }
 
-/// A recording whose stamps jitter over the regular clock its samples were taken on (a ROS
-/// bag's receive time) is named with its experiment; the clean rehearsal is not.
-#[test]
-fn a_recording_whose_stamps_jitter_is_named() {
+/// The A465 ("kinsheel2010") planned at the paper's Table 2 point and rehearsed with 0.01 N m
+/// of torque noise: the model, the simulation's options, the plan and the recordings.
+fn noisy_rehearsal() -> (perturbid_rs::Model, SimulationOptions, Plan, Vec<Recording>) {
     let model = a465::model("kinsheel2010").unwrap();
     let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
     let mut sim = SimulationOptions::new(&model);
     sim.torque_noise = vec![0.01; model.nv];
     let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    (model, sim, plan, recs)
+}
+
+/// A recording whose stamps jitter over the regular clock its samples were taken on (a ROS
+/// bag's receive time) is named with its experiment; the clean rehearsal is not.
+#[test]
+fn a_recording_whose_stamps_jitter_is_named() {
+    let (_, _, plan, recs) = noisy_rehearsal();
     let says = |m: &LocalModel| {
         (m.diagnostics.warnings.iter())
             .filter(|w| w.contains("its time stamps jitter"))
@@ -1050,12 +1057,8 @@ fn a_recording_whose_stamps_jitter_is_named() {
 /// entry, symmetric and positive definite once negated), and the warning names the joint.
 #[test]
 fn a_torque_column_negated_in_every_recording_is_named_from_d_star() {
-    let model = a465::model("kinsheel2010").unwrap();
+    let (model, _, plan, recs) = noisy_rehearsal();
     let n = model.nv;
-    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
-    let mut sim = SimulationOptions::new(&model);
-    sim.torque_noise = vec![0.01; n];
-    let recs = simulate_plan(&model, &plan, &sim).unwrap();
     let run =
         |recs: &[Recording]| identify_local(&plan, recs, &IdentifyOptions::default()).unwrap();
     let d_warning = |m: &LocalModel| {
@@ -1090,12 +1093,8 @@ fn a_torque_column_negated_in_every_recording_is_named_from_d_star() {
 /// have none. Without +- pairs the warning says the offset biases the estimate.
 #[test]
 fn torques_that_do_not_return_to_t_star_are_found() {
-    let model = a465::model("kinsheel2010").unwrap();
+    let (model, sim, plan, recs) = noisy_rehearsal();
     let n = model.nv;
-    let plan = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
-    let mut sim = SimulationOptions::new(&model);
-    sim.torque_noise = vec![0.01; n];
-    let recs = simulate_plan(&model, &plan, &sim).unwrap();
     let run =
         |recs: &[Recording]| identify_local(&plan, recs, &IdentifyOptions::default()).unwrap();
     let offsets = |m: &LocalModel| -> Vec<(String, String)> {

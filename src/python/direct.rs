@@ -210,6 +210,26 @@ pub(crate) struct PyBaseModel {
     pub(crate) model: Arc<Model>,
 }
 
+impl PyBaseModel {
+    /// `f` of the fit and its robot at the states `q`, `qd`, `qdd` with `coulomb` (or a
+    /// Recording as `q`, alone), as `predict` takes them; `name` is the Python entry point.
+    fn at_states<'py>(
+        &self,
+        py: Python<'py>,
+        name: &str,
+        q: Bound<'py, PyAny>,
+        [qd, qdd, coulomb]: [Option<Bound<'py, PyAny>>; 3],
+        f: impl FnOnce(&BaseModel, &Model, &States<'_>) -> Result<Vec<f64>> + Send,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (fit, model) = (&self.fit, &self.model);
+        let a = states_of(q, qd, qdd, coulomb)?;
+        let columns = [&a.q, &a.qd, &a.qdd];
+        at_states_with(py, model.nv, columns, a.coulomb.as_ref(), name, |s| {
+            f(fit, model, s)
+        })
+    }
+}
+
 #[pymethods]
 impl PyBaseModel {
     #[getter]
@@ -417,17 +437,10 @@ impl PyBaseModel {
         qdd: Option<Bound<'py, PyAny>>,
         coulomb: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (fit, model) = (&self.fit, &self.model);
         let name = "BaseParameterModel.predict";
-        let a = states_of(q, qd, qdd, coulomb)?;
-        at_states_with(
-            py,
-            model.nv,
-            [&a.q, &a.qd, &a.qdd],
-            a.coulomb.as_ref(),
-            name,
-            |s| fit.predict(model, s),
-        )
+        self.at_states(py, name, q, [qd, qdd, coulomb], |fit, model, s| {
+            fit.predict(model, s)
+        })
     }
     /// The standard errors (N m) of the torques `predict` gives at `q`, `qd`, `qdd` (shapes as
     /// there): from the parameters' standard errors and their correlation; the uncertainty of
@@ -442,17 +455,10 @@ impl PyBaseModel {
         qdd: Option<Bound<'py, PyAny>>,
         coulomb: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (fit, model) = (&self.fit, &self.model);
         let name = "BaseParameterModel.predict_stderr";
-        let a = states_of(q, qd, qdd, coulomb)?;
-        at_states_with(
-            py,
-            model.nv,
-            [&a.q, &a.qd, &a.qdd],
-            a.coulomb.as_ref(),
-            name,
-            |s| fit.predict_stderr(model, s),
-        )
+        self.at_states(py, name, q, [qd, qdd, coulomb], |fit, model, s| {
+            fit.predict_stderr(model, s)
+        })
     }
     /// The model linearised exactly at `op` (an OperatingPoint): dict `torque` (n,), `D`, `H`,
     /// `G`, `G_static` (n, n; row = torque, column = joint), as a LocalModel answers it.

@@ -72,6 +72,19 @@ def excitation(robot, harmonics, frequency, amplitude, seed):
         base_frequency=frequency,
     )
 
+def log_with_friction(robot, amplitude, motion_seed, seed):
+    """20 s of a Fourier excitation (0.1 Hz, 5 harmonics of `amplitude` rad drawn with
+    `motion_seed`) sampled every millisecond, its torques with 0.3 N m s/rad viscous and 0.5 N m
+    Coulomb friction and 0.03 N m of noise (the generator of `seed`): t, q, qd, qdd, tau and the
+    generator."""
+    traj = excitation(robot, 5, 0.1, amplitude, motion_seed)
+    t = np.arange(0, 20, 1e-3)
+    q, qd, qdd = traj.sample(t)
+    rng = np.random.default_rng(seed)
+    tau = robot.rnea(q, qd, qdd) + 0.5 * np.sign(qd) + 0.3 * qd + rng.normal(0.0, 0.03, q.shape)
+    return t, q, qd, qdd, tau, rng
+
+
 
 def noisy_log(step, seed):
     """The A465 through one period of the test excitation sampled every `step` s, its torques
@@ -404,11 +417,7 @@ def test_filtered_torques_are_fitted_with_the_filtered_coulomb_column():
     with (0.3 N m s/rad, 0.5 N m), where sign(qd) gives the Coulomb terms low by many standard
     errors. predict and validate take it too; validate refuses it for another model."""
     robot = pr.robots.a465()
-    traj = excitation(robot, 5, 0.1, 0.12, 1)
-    t = np.arange(0, 20, 1e-3)
-    q, qd, qdd = traj.sample(t)
-    rng = np.random.default_rng(0)
-    tau = robot.rnea(q, qd, qdd) + 0.5 * np.sign(qd) + 0.3 * qd + rng.normal(0.0, 0.03, q.shape)
+    t, q, qd, qdd, tau, rng = log_with_friction(robot, 0.12, 1, 0)
     rec = pr.preprocess(t, q, tau)
     c = rec.coulomb
     assert c.shape == rec.q.shape and np.abs(c).max() <= 1.2 and np.abs(c).min() < 0.5
@@ -460,11 +469,7 @@ def test_a_recording_given_whole_brings_its_coulomb_column_and_time():
     fit one part and validate another. Mixing a Recording with arrays, or giving one without
     velocities, is refused by name."""
     robot = pr.robots.a465()
-    traj = excitation(robot, 5, 0.1, 0.12, 1)
-    t = np.arange(0, 20, 1e-3)
-    q, qd, qdd = traj.sample(t)
-    rng = np.random.default_rng(1)
-    tau = robot.rnea(q, qd, qdd) + 0.5 * np.sign(qd) + 0.3 * qd + rng.normal(0.0, 0.03, q.shape)
+    t, q, qd, qdd, tau, rng = log_with_friction(robot, 0.12, 1, 1)
     rec = pr.preprocess(t, q, tau)
     split = int(0.7 * len(rec))
     part, rest = rec[:split], rec[split:]
@@ -1117,11 +1122,7 @@ def test_stamps_that_jitter_over_a_regular_clock_are_found_and_warned_of():
     rough against the stamps; the ratio against numpy's) and warns; the harm it warns of holds
     (the fit's residual many times the sound log's). Stamped right, nothing is found."""
     robot = pr.robots.a465()
-    traj = excitation(robot, 5, 0.1, 0.3, 2)
-    t = np.arange(0, 20, 1e-3)
-    q, qd, qdd = traj.sample(t)
-    rng = np.random.default_rng(3)
-    tau = robot.rnea(q, qd, qdd) + 0.5 * np.sign(qd) + 0.3 * qd + rng.normal(0, 0.03, q.shape)
+    t, q, qd, qdd, tau, rng = log_with_friction(robot, 0.3, 2, 3)
     friction = ["viscous", "coulomb"]
     sound = pr.preprocess(t, q, tau)
     assert sound.stamp_jitter is None
