@@ -164,6 +164,11 @@ pub struct BaseModel {
         with = "crate::json::rows"
     )]
     pub correlation: DMatrix<f64>,
+    /// The joints' drive gains where the model was identified from logged motor currents with
+    /// them ([`super::drive_gains`]): the model's torques are the gains times the signal.
+    /// None for a model identified from torques.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drive_gains: Option<super::drive_gains::DriveGains>,
 }
 
 /// Identifies the base parameters of `model` from the samples of `states` (rad, rad/s,
@@ -258,6 +263,19 @@ pub(super) struct Solved {
     pub sigma: Vec<f64>,
 }
 
+/// The base parameters of `model` with `options`' joint terms, found from its random states.
+pub(super) fn base_parameters(model: &Model, options: &BaseOptions) -> Result<BaseParameters> {
+    let layout = ParameterLayout::new(model, options.friction.for_model(model));
+    BaseParameters::from_random_states(
+        model,
+        &layout,
+        options.gravity,
+        options.states.max(layout.len() / model.nv + 1),
+        options.tolerance,
+        options.seed,
+    )
+}
+
 /// The base parameters of `model` with `options`' terms fitted to `tau` (row-major `k x nv`,
 /// N m) at `states`, checked already: one pass over the samples gives the OLS fit, the WLS
 /// weights (each joint's OLS residual RMS) and the WLS fit. Errors: residuals that overflow.
@@ -267,18 +285,9 @@ pub(super) fn solve(
     tau: &[f64],
     options: &BaseOptions,
 ) -> Result<Solved> {
-    let nv = model.nv;
-    let layout = ParameterLayout::new(model, options.friction.for_model(model));
-    let base = BaseParameters::from_random_states(
-        model,
-        &layout,
-        options.gravity,
-        options.states.max(layout.len() / nv + 1),
-        options.tolerance,
-        options.seed,
-    )?;
+    let base = base_parameters(model, options)?;
     let names = base.names();
-    let mut sigma = vec![1.0; nv];
+    let mut sigma = vec![1.0; model.nv];
     let factors = streaming::JointFactors::new(model, &base, states, tau, options.gravity)?;
     let mut ls = factors.solve(&sigma, &names)?;
     let mut rms = factors.residual_rms(ls.coef.as_slice())?;
@@ -308,7 +317,7 @@ pub(super) fn solve(
 }
 
 /// [`identify_base_parameters`] with the reduced data it was computed from.
-fn fit_with_factors(
+pub(super) fn fit_with_factors(
     model: &Model,
     states: &States<'_>,
     tau: &[f64],
@@ -366,6 +375,7 @@ fn fit_with_factors(
         position_offsets: None,
         unmodelled_friction: vec![],
         weak_excitation: None,
+        drive_gains: None,
     };
     fit.weak_excitation =
         super::weak_excitation::check_excitation(model, states, &fit.base, ls.cond, &ls.weakest);
@@ -613,6 +623,9 @@ impl Document for BaseModel {
                 Self::WHAT,
                 format!("position_range[{i}]: {problem}"),
             ));
+        }
+        if let Some(problem) = (m.drive_gains.as_ref()).and_then(|g| g.problem(Self::WHAT, n)) {
+            return Err(invalid(Self::WHAT, problem));
         }
         check_magnitudes(Self::WHAT, "residual_rms", &m.residual_rms, false)?;
         check_magnitudes(Self::WHAT, "sigma", &m.sigma, false)?;

@@ -7,6 +7,7 @@ pub mod base;
 pub mod base_linearization;
 pub mod consistency;
 pub mod consistent;
+pub mod drive_gains;
 pub mod excitation;
 pub mod global_linear;
 pub mod identify;
@@ -27,6 +28,7 @@ pub use consistency::{check_physical_consistency, BodyConsistency, ConsistencyRe
 pub use consistent::{
     consistent_least_squares, ConsistentFit, ConsistentOptions, ConsistentSolution,
 };
+pub use drive_gains::{identify_drive_gains, DriveGainFit, DriveGains, GainRun};
 pub use excitation::{design_excitation, Criterion, ExcitationDesign, ExcitationOptions};
 pub use global_linear::{identify_global_linear, GlobalLinearModel};
 pub use identify::{

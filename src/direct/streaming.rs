@@ -9,6 +9,10 @@
 //!   stacked `R_j / sigma_j`, so OLS and then WLS need no second pass over the samples;
 //! - the per-joint residuals of any `theta`: `|tau_j - Phi_j theta| = |R_j [theta; -1]|`.
 //!
+//! Columns of data that a joint's rows alone carry (a drive gain's logged current,
+//! [`super::drive_gains`]) come in beside the base columns, `extra` of them a joint
+//! ([`JointFactors::with_columns`]): unknowns `p + nv extra` in all.
+//!
 //! QR keeps the conditioning of the regressor (normal equations would square it).
 //! Memory: per worker (about two per core), one chunk of every joint, at most `nv * (CHUNK + p +
 //! 1) * (p + 1)` values (1.9 MB for a 6-dof arm with 36 base parameters, 3.9 MB for a 7-dof
@@ -109,11 +113,15 @@ pub struct JointFactors {
     pub samples: usize,
     /// Number of base parameters `p`.
     pub parameters: usize,
+    /// Columns of data per joint beside the base columns (`e`; 0 for a plain fit): joint `j`'s
+    /// column `c` is unknown `p + j e + c`.
+    pub extra: usize,
     /// The base columns that joint `j`'s rows can have nonzero (`n_j` of them, ascending).
     pub active: Vec<Vec<usize>>,
-    /// `R_j`, `(n_j + 1) x (n_j + 1)` upper triangular, one per joint, over the columns
-    /// `active[j]` and then the torque: `R_j^T R_j = A_j^T A_j` for the rows
-    /// `A_j = [Phi_base[:, active[j]] | tau]` of joint `j`.
+    /// `R_j`, `(n_j + e + 1) x (n_j + e + 1)` upper triangular, one per joint, over the columns
+    /// `active[j]`, then the joint's `e` columns of data and then the torque:
+    /// `R_j^T R_j = A_j^T A_j` for the rows `A_j = [Phi_base[:, active[j]] | X_j | tau]` of
+    /// joint `j`.
     pub factors: Vec<DMatrix<f64>>,
 }
 
@@ -128,14 +136,21 @@ struct Worker {
 }
 
 impl Worker {
-    fn new(model: &Model, columns: &[JointColumns]) -> Self {
-        let widest = columns.iter().map(|c| c.base.len() + 1).max().unwrap_or(1);
+    fn new(model: &Model, columns: &[JointColumns], extra: usize) -> Self {
+        let widest = columns
+            .iter()
+            .map(|c| c.base.len() + extra + 1)
+            .max()
+            .unwrap_or(1);
         let block = recommended_block_size::<f64>(widest + CHUNK, widest);
         Self {
             lanes: LaneData::new(model),
             stacks: columns
                 .iter()
-                .map(|c| Mat::zeros(c.base.len() + 1 + CHUNK, c.base.len() + 1))
+                .map(|c| {
+                    let n = c.base.len() + extra + 1;
+                    Mat::zeros(n + CHUNK, n)
+                })
                 .collect(),
             q_coeff: Mat::zeros(block, widest),
             scratch: MemBuffer::new(qr_in_place_scratch::<f64>(
@@ -154,11 +169,12 @@ impl Worker {
         model: &Model,
         columns: &[JointColumns],
         x: [&[f64]; 4],
+        extra: &[&[f64]],
         tau: &[f64],
         gravity: Gravity,
         range: std::ops::Range<usize>,
     ) -> Result<()> {
-        self.fill(model, columns, x, tau, gravity, range.clone())?;
+        self.fill(model, columns, x, extra, tau, gravity, range.clone())?;
         for a in &mut self.stacks {
             let rows = a.ncols() + range.len();
             factor_top(
@@ -180,14 +196,17 @@ impl Worker {
 
 impl Worker {
     /// Writes the rows of samples `range` of the states `[q, qd, qdd, coulomb]` (row-major,
-    /// the whole batch; `coulomb` the Coulomb term's column, [`States::coulomb_at`]) below
-    /// the factors: the regressor [`LaneData::width`] samples at a time by the multi-sample
-    /// kernel ([`regressor_group`]), read in place.
+    /// the whole batch; `coulomb` the Coulomb term's column, [`States::coulomb_at`]) and of
+    /// the joints' columns of data `extra` (each row-major `k x nv`) below the factors: the
+    /// regressor [`LaneData::width`] samples at a time by the multi-sample kernel
+    /// ([`regressor_group`]), read in place.
+    #[allow(clippy::too_many_arguments)]
     fn fill(
         &mut self,
         model: &Model,
         columns: &[JointColumns],
         [q, qd, qdd, coulomb]: [&[f64]; 4],
+        extra: &[&[f64]],
         tau: &[f64],
         gravity: Gravity,
         range: std::ops::Range<usize>,
@@ -211,7 +230,7 @@ impl Worker {
                 let (qd, qdd, coulomb) = (&qd[row.clone()], &qdd[row.clone()], &coulomb[row]);
                 for (j, (a, cols)) in self.stacks.iter_mut().zip(columns).enumerate() {
                     let nj = cols.base.len();
-                    let i = nj + 1 + s - range.start;
+                    let i = a.ncols() + s - range.start;
                     for &(c, col) in &cols.inertial {
                         a[(i, c)] = self.lanes.regressor_entry(l, j, col);
                     }
@@ -223,7 +242,10 @@ impl Worker {
                             Term::Armature => qdd[j],
                         };
                     }
-                    a[(i, nj)] = tau[s * nv + j];
+                    for (c, x) in extra.iter().enumerate() {
+                        a[(i, nj + c)] = x[s * nv + j];
+                    }
+                    a[(i, nj + extra.len())] = tau[s * nv + j];
                 }
             }
             first += used;
@@ -294,8 +316,35 @@ impl JointFactors {
         tau: &[f64],
         gravity: Gravity,
     ) -> Result<Self> {
+        Self::with_columns(model, base, states, tau, &[], gravity)
+    }
+
+    /// [`JointFactors::new`] with `extra` columns of data per joint beside the base columns:
+    /// each row-major `k x nv`, joint `j`'s rows reading its entry `j` of each (`extra[c][s nv
+    /// + j]` at sample `s`), as unknowns `p + j e + c` (`e = extra.len()`, at most 4).
+    pub fn with_columns(
+        model: &Model,
+        base: &BaseParameters,
+        states: &States<'_>,
+        tau: &[f64],
+        extra: &[&[f64]],
+        gravity: Gravity,
+    ) -> Result<Self> {
         let nv = model.nv;
         states.check_companion("tau", tau, nv)?;
+        if extra.len() > 4 {
+            return Err(Error::InvalidArgument {
+                argument: "extra".into(),
+                message: format!(
+                    "{} columns of data a joint, expected at most 4",
+                    extra.len()
+                ),
+            });
+        }
+        for x in extra {
+            states.check_companion("a joint's column of data", x, nv)?;
+        }
+        let e = extra.len();
         let k = states.len();
         let (qd, qdd) = (states.qd_or_zeros(), states.qdd_or_zeros());
         // the Coulomb term's column: the states' own (filtered), or sign(qd)
@@ -319,17 +368,17 @@ impl JointFactors {
         let factors = chunks
             .par_chunks(per)
             .map(|run| -> Result<Vec<DMatrix<f64>>> {
-                let mut w = Worker::new(model, &columns);
+                let mut w = Worker::new(model, &columns, e);
                 for range in run {
                     crate::interrupt::check("identification")?;
-                    w.absorb(model, &columns, x, tau, gravity, range.clone())?;
+                    w.absorb(model, &columns, x, extra, tau, gravity, range.clone())?;
                 }
                 Ok(w.factors())
             })
             .try_reduce_with(|a, b| Ok(merge(a, b)))
             .transpose()?
             .unwrap_or_else(|| {
-                let size = |c: &JointColumns| c.base.len() + 1;
+                let size = |c: &JointColumns| c.base.len() + e + 1;
                 columns
                     .iter()
                     .map(|c| DMatrix::zeros(size(c), size(c)))
@@ -338,20 +387,28 @@ impl JointFactors {
         Ok(Self {
             samples: k,
             parameters: p,
+            extra: e,
             active: columns.into_iter().map(|c| c.base).collect(),
             factors,
         })
     }
 
-    /// The least-squares fit of the base parameters with the rows of joint `j` weighted by
-    /// `1 / sigma[j]` (`sigma`: `nv` values, N m; all 1 for OLS). `names` label the `p` base
-    /// columns for a rank-deficiency error. Returns the coefficients (`1 x p`), `cond` of the
-    /// column-scaled weighted regressor, `stderr` for the weighted problem
-    /// (`sigma_w^2 (W^T W)^-1`, `sigma_w^2` = weighted residual sum of squares / (K nv - p)) and
-    /// `residual_rms` left empty (see [`JointFactors::residual_rms`]).
+    /// The number of unknowns: the `p` base parameters and the joints' columns of data,
+    /// `p + nv e`.
+    pub fn unknowns(&self) -> usize {
+        self.parameters + self.factors.len() * self.extra
+    }
+
+    /// The least-squares fit of the base parameters (and the joints' columns of data) with the
+    /// rows of joint `j` weighted by `1 / sigma[j]` (`sigma`: `nv` values, N m; all 1 for OLS).
+    /// `names` label the [`JointFactors::unknowns`] columns for a rank-deficiency error.
+    /// Returns the coefficients (`1 x p`, `p` the unknowns), `cond` of the column-scaled
+    /// weighted regressor, `stderr` for the weighted problem (`sigma_w^2 (W^T W)^-1`,
+    /// `sigma_w^2` = weighted residual sum of squares / (K nv - p)) and `residual_rms` left
+    /// empty (see [`JointFactors::residual_rms`]).
     pub fn solve(&self, sigma: &[f64], names: &[String]) -> Result<LeastSquares> {
         let nv = self.factors.len();
-        let p = self.parameters;
+        let p = self.unknowns();
         let rows = self.samples * nv;
         if rows <= p {
             return Err(Error::RankDeficient {
@@ -360,7 +417,7 @@ impl JointFactors {
                 cols: p,
                 rank: rows,
                 missing: format!(
-                    "{} samples x {nv} joints cannot determine {p} base parameters; add samples",
+                    "{} samples x {nv} joints cannot determine {p} unknowns; add samples",
                     self.samples
                 ),
             });
@@ -374,12 +431,13 @@ impl JointFactors {
         Ok(ls)
     }
 
-    /// The weighted problem reduced to `p` rows: `|W (Phi_base theta - tau)|^2 = |R11 theta -
-    /// z|^2 + rho^2` for every `theta`, rows of joint `j` divided by `sigma[j]`. Returns
-    /// `(R11 (p x p, upper triangular), z (p x 1), rho)`.
+    /// The weighted problem reduced to `p` rows (`p` the [`JointFactors::unknowns`]):
+    /// `|W (Phi_base theta - tau)|^2 = |R11 theta - z|^2 + rho^2` for every `theta`, rows of
+    /// joint `j` divided by `sigma[j]`. Returns `(R11 (p x p, upper triangular), z (p x 1),
+    /// rho)`.
     pub fn reduced(&self, sigma: &[f64]) -> Result<(DMatrix<f64>, DMatrix<f64>, f64)> {
         let nv = self.factors.len();
-        let p = self.parameters;
+        let (p, e) = (self.unknowns(), self.extra);
         if sigma.len() != nv || sigma.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
             return Err(Error::InvalidArgument {
                 argument: "sigma".into(),
@@ -390,15 +448,18 @@ impl JointFactors {
         let height: usize = self.factors.iter().map(|r| r.nrows()).sum();
         let mut stacked = DMatrix::zeros(height, p + 1);
         let mut row = 0;
-        for ((r, active), s) in self.factors.iter().zip(&self.active).zip(sigma) {
+        for (j, ((r, active), s)) in self.factors.iter().zip(&self.active).zip(sigma).enumerate() {
             let nj = active.len();
-            for i in 0..=nj {
+            for i in 0..r.nrows() {
                 for (a, &c) in active.iter().enumerate() {
                     stacked[(row + i, c)] = r[(i, a)] / s;
                 }
-                stacked[(row + i, p)] = r[(i, nj)] / s;
+                for c in 0..e {
+                    stacked[(row + i, self.parameters + j * e + c)] = r[(i, nj + c)] / s;
+                }
+                stacked[(row + i, p)] = r[(i, nj + e)] / s;
             }
-            row += nj + 1;
+            row += r.nrows();
         }
         let r = triangular(&stacked);
         // [R11 z; 0 rho]: min |W theta - y| solves R11 theta = z with residual norm |rho|
@@ -408,9 +469,10 @@ impl JointFactors {
     }
 
     /// Per-joint RMS over the samples of the unweighted residuals `tau - Phi_base theta` (N m)
-    /// for base parameters `theta` (`p`): `|R_j [theta; -1]| / sqrt(K)`.
+    /// for base parameters `theta` (the [`JointFactors::unknowns`], the joints' columns of
+    /// data after the base parameters): `|R_j [theta; -1]| / sqrt(K)`.
     pub fn residual_rms(&self, theta: &[f64]) -> Result<Vec<f64>> {
-        let p = self.parameters;
+        let (p, e) = (self.unknowns(), self.extra);
         if theta.len() != p {
             return Err(Error::Shape {
                 argument: "theta".into(),
@@ -419,14 +481,18 @@ impl JointFactors {
             });
         }
         let k = self.samples.max(1) as f64;
+        let data = &theta[self.parameters..];
         Ok(self
             .factors
             .iter()
             .zip(&self.active)
-            .map(|(r, active)| {
+            .enumerate()
+            .map(|(j, (r, active))| {
                 let x = DVector::from_iterator(
-                    active.len() + 1,
-                    active.iter().map(|&c| theta[c]).chain([-1.0]),
+                    r.ncols(),
+                    (active.iter().map(|&c| theta[c]))
+                        .chain(data[j * e..(j + 1) * e].iter().copied())
+                        .chain([-1.0]),
                 );
                 (r * x).norm() / k.sqrt()
             })

@@ -310,6 +310,7 @@ pub fn identify_parameters_from_local(
         unmodelled_friction: vec![],
         // rows from local models: their own diagnostics say what they leave unidentified
         weak_excitation: None,
+        drive_gains: None,
     };
     let consistent = match &options.consistent {
         None => None,

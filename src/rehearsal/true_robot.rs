@@ -43,6 +43,56 @@ pub struct Payload {
     pub inertia: [f64; 6],
 }
 
+impl Payload {
+    /// What makes this payload one nobody could bolt on (a centre of mass beyond
+    /// [`MAX_COM_OFFSET`], a negative or non-finite mass, an inertia that is no rigid body's),
+    /// `what` naming it in the message; None where it is sound.
+    pub fn problem(&self, what: &str) -> Option<String> {
+        if let Some(i) = self.com.iter().position(|c| !c.is_finite()) {
+            return Some(format!(
+                "{what}.com[{i}] is {}, expected a finite number",
+                self.com[i]
+            ));
+        }
+        if let Some(i) = self.com.iter().position(|c| c.abs() > MAX_COM_OFFSET) {
+            return Some(format!(
+                "{what}.com[{i}] is {} m, expected at most {MAX_COM_OFFSET} m in magnitude",
+                crate::error::shown(self.com[i])
+            ));
+        }
+        if let Some(i) = self.inertia.iter().position(|c| !c.is_finite()) {
+            return Some(format!(
+                "{what}.inertia[{i}] is {}, expected a finite number",
+                self.inertia[i]
+            ));
+        }
+        if !(self.mass.is_finite() && self.mass >= 0.0) {
+            return Some(format!("{what}.mass is {}, expected >= 0 kg", self.mass));
+        }
+        // a body someone could bolt on: the simulation's mass matrix stays positive
+        let s = self.spatial_inertia();
+        crate::spatial::rigid_body_problem(self.mass, &s.inertia_com, Some("")).map(|reason| {
+            format!(
+                "{what} ([ixx, ixy, ixz, iyy, iyz, izz] = {:?}): {reason}",
+                self.inertia
+            )
+        })
+    }
+
+    /// Its spatial inertia in the frame of its link's body.
+    pub fn spatial_inertia(&self) -> crate::spatial::Inertia {
+        let [xx, xy, xz, yy, yz, zz] = self.inertia;
+        let inertia = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
+        crate::spatial::Inertia::new(self.mass, Vector3::from(self.com), inertia)
+    }
+
+    /// The index of the body of `model` that starts at its link; an error lists the moving
+    /// links.
+    pub fn body(&self, model: &Model) -> Result<usize> {
+        body_of(model, &self.link)
+    }
+}
+
 /// An error of one link's inertial parameters: its mass and rotational inertia scaled by
 /// `1 + mass` and `1 + inertia`, its centre of mass moved by `com` (m).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -390,21 +440,8 @@ impl Document for TrueRobot {
                 None => Ok(()),
             }
         };
-        if let Some(p) = &self.payload {
-            reach("payload.com", &p.com)?;
-            finite_all("payload.inertia", &p.inertia)?;
-            if !(p.mass.is_finite() && p.mass >= 0.0) {
-                return Err(bad(format!("payload.mass is {}, expected >= 0 kg", p.mass)));
-            }
-            // a body someone could bolt on: the simulation's mass matrix stays positive
-            let [xx, xy, xz, yy, yz, zz] = p.inertia;
-            let inertia = nalgebra::Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
-            if let Some(reason) = crate::spatial::rigid_body_problem(p.mass, &inertia, Some("")) {
-                return Err(bad(format!(
-                    "payload ([ixx, ixy, ixz, iyy, iyz, izz] = {:?}): {reason}",
-                    p.inertia
-                )));
-            }
+        if let Some(reason) = self.payload.as_ref().and_then(|p| p.problem("payload")) {
+            return Err(bad(reason));
         }
         for (i, e) in self.link_errors.iter().enumerate() {
             reach(&format!("link_errors[{i}].com"), &e.com)?;
@@ -556,11 +593,8 @@ impl TrueRobot {
             i.inertia_com *= 1.0 + e.inertia;
         }
         if let Some(p) = &self.payload {
-            let [xx, xy, xz, yy, yz, zz] = p.inertia;
-            let inertia = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
-            let b = body_of(nominal, &p.link)?;
-            let added = crate::spatial::Inertia::new(p.mass, Vector3::from(p.com), inertia);
-            m.bodies[b].inertia = m.bodies[b].inertia.add(&added);
+            let b = p.body(nominal)?;
+            m.bodies[b].inertia = m.bodies[b].inertia.add(&p.spatial_inertia());
         }
         m.refresh();
         m.name = format!("{} (true robot)", nominal.name);

@@ -1,0 +1,403 @@
+//! Joint drive gains identified with the base parameters, for robots that log their motors'
+//! currents (or torques computed from them with nominal gains) instead of joint torques
+//! (docs/method.md, section 8d; the approach of Gautier & Briot, "Global identification of joint
+//! drive gains and dynamic parameters of robots", 2014).
+//!
+//! Joint `j`'s logged signal `i_j` is its torque over a gain `K_j` (N m, or N for a prismatic
+//! joint, per unit of the signal: a torque constant times a gear ratio). In a run with a known
+//! payload bolted onto a link, the joint torques are the robot's and the payload's `tau_L`:
+//!
+//! ```text
+//! K_j i_j = Phi_base,j(q, qd, qdd) theta + tau_L,j     (tau_L = 0 in a run without it)
+//! ```
+//!
+//! linear in the base parameters `theta` and the gains `K`, so one least-squares problem over
+//! every run gives both: `Phi_base theta - diag(i) K = -tau_L`, reduced per joint as the plain
+//! fit is ([`super::streaming`], the signal a column of data of each joint's rows), OLS then
+//! WLS. The payload fixes the scale: with the same payload (or none) in every run, `theta` and
+//! `K` could be scaled together and the data would not tell, so such runs are refused.
+//!
+//! The signal's noise sits in a column of the regressor, where it biases the gains towards 0 by
+//! about `var(noise) / var(signal beyond the rest of the model)`: [`DriveGains::noise_bias`]
+//! bounds it, taking every residual for the signal's noise.
+
+use serde::{Deserialize, Serialize};
+
+use super::identify::{fit_with_factors, BaseModel, BaseOptions, Weighting};
+use super::streaming::JointFactors;
+use crate::document::{check_bounded, check_condition, check_magnitudes};
+use crate::error::{shown, Error, Result};
+use crate::model::Model;
+use crate::rehearsal::Payload;
+use crate::states::States;
+
+/// Runs at most in one identification.
+pub const MAX_RUNS: usize = 1000;
+
+/// A gain's standard error, relative to it, beyond which it is warned of as poorly determined.
+pub const LOOSE_GAIN: f64 = 0.05;
+
+/// [`DriveGains::noise_bias`] beyond which it is warned of.
+pub const NOISE_BIAS: f64 = 0.01;
+
+/// One run of the robot: its states, the joints' logged signal and the payload it carried.
+#[derive(Clone, Copy, Debug)]
+pub struct GainRun<'a> {
+    /// The samples (rad, rad/s, rad/s^2, or m for a prismatic joint), with velocities and
+    /// accelerations; a Coulomb column where the signal was filtered ([`States::with_coulomb`]).
+    pub states: States<'a>,
+    /// The joints' logged signal, row-major `k x nv` (A, or whatever unit the log counts in).
+    pub signal: &'a [f64],
+    /// The known payload bolted onto a link during the run (None: the robot alone). Its
+    /// inertial parameters are taken as exact.
+    pub payload: Option<&'a Payload>,
+}
+
+/// The drive gains identified with a base-parameter model ([`BaseModel::drive_gains`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriveGains {
+    /// Per joint, `K_j`: the joint's torque (N m, or N) per unit of its logged signal.
+    /// Negative for a signal that counts the other way from the torque.
+    pub gain: Vec<f64>,
+    /// Their standard errors (inflated for residuals correlated from sample to sample, as the
+    /// model's are).
+    pub stderr: Vec<f64>,
+    /// Per joint, an upper bound of the gain's relative bias towards 0 from noise in the
+    /// logged signal: `(rms / K)^2 / (|i_perp|^2 / k)`, with the joint's residual RMS `rms`
+    /// taken for the signal's noise and `i_perp` its signal beyond what every other column of
+    /// the (weighted) fit explains.
+    pub noise_bias: Vec<f64>,
+    /// Per joint, the RMS (N m, or N) of the payloads' torques over the runs that carried one:
+    /// what determined the gain's scale.
+    pub payload_torque_rms: Vec<f64>,
+    /// cond of the (weighted) regressor of base parameters and gains, columns scaled to unit
+    /// norm.
+    pub cond: f64,
+    /// Runs and samples identified from, and the runs that carried a payload.
+    pub runs: usize,
+    pub loaded_runs: usize,
+}
+
+impl DriveGains {
+    /// What is wrong with saved gains for `n` joints; None where nothing is.
+    pub(crate) fn problem(&self, what: &str, n: usize) -> Option<String> {
+        let lens = [
+            ("gain", self.gain.len()),
+            ("stderr", self.stderr.len()),
+            ("noise_bias", self.noise_bias.len()),
+            ("payload_torque_rms", self.payload_torque_rms.len()),
+        ];
+        if let Some((field, len)) = lens.iter().find(|(_, l)| *l != n) {
+            return Some(format!(
+                "drive_gains.{field} has {len} entries, expected one per joint ({n})"
+            ));
+        }
+        if let Some(j) = self.gain.iter().position(|g| !(g.is_finite() && *g != 0.0)) {
+            return Some(format!(
+                "drive_gains.gain[{j}] is {}, expected a finite gain other than 0",
+                shown(self.gain[j])
+            ));
+        }
+        if !(self.loaded_runs >= 1 && self.loaded_runs <= self.runs && self.runs <= MAX_RUNS) {
+            return Some(format!(
+                "drive_gains: {} runs of which {} loaded, expected 2 to {MAX_RUNS} runs and at least one loaded",
+                self.runs, self.loaded_runs
+            ));
+        }
+        let checks = [
+            check_bounded(what, "drive gains", "drive_gains.gain", &self.gain),
+            check_magnitudes(what, "drive_gains.stderr", &self.stderr, false),
+            check_magnitudes(what, "drive_gains.noise_bias", &self.noise_bias, false),
+            check_magnitudes(
+                what,
+                "drive_gains.payload_torque_rms",
+                &self.payload_torque_rms,
+                false,
+            ),
+            check_condition(what, "drive_gains.cond", self.cond),
+        ];
+        checks
+            .into_iter()
+            .find_map(|c| c.err())
+            .map(|e| e.to_string())
+    }
+
+    /// The findings about the gains, naming the joints (`names`): gains determined to worse
+    /// than [`LOOSE_GAIN`] of themselves, noise biases beyond [`NOISE_BIAS`], negative gains.
+    pub fn warnings(&self, names: &[String]) -> Vec<String> {
+        let mut out = Vec::new();
+        for (j, name) in names.iter().enumerate().take(self.gain.len()) {
+            let (g, se) = (self.gain[j], self.stderr[j]);
+            if g < 0.0 {
+                out.push(format!(
+                    "the drive gain of joint '{name}' is negative ({g:.5} +- {se:.5}): its logged signal counts the other way from its torque (the model takes it so)"
+                ));
+            }
+            if se > LOOSE_GAIN * g.abs() {
+                out.push(format!(
+                    "the drive gain of joint '{name}' is determined to +-{:.1} % only ({g:.5} +- {se:.5}): the payload's torque on it is {} RMS; bolt on a heavier payload, or move the joint more in the loaded run",
+                    100.0 * se / g.abs(),
+                    shown(self.payload_torque_rms[j])
+                ));
+            }
+            if self.noise_bias[j] > NOISE_BIAS {
+                out.push(format!(
+                    "the drive gain of joint '{name}' may be biased towards 0 by up to {:.1} %: its logged signal's noise is large against the part of it the rest of the model does not explain (filter the signal, preprocess, or use a heavier payload)",
+                    100.0 * self.noise_bias[j]
+                ));
+            }
+        }
+        out
+    }
+}
+
+/// An identification of drive gains: the base-parameter model of the robot alone (SI units:
+/// its predictions are torques), with the gains in [`BaseModel::drive_gains`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct DriveGainFit {
+    pub model: BaseModel,
+}
+
+impl DriveGainFit {
+    /// The gains (always present in a fit).
+    pub fn gains(&self) -> &DriveGains {
+        self.model
+            .drive_gains
+            .as_ref()
+            .expect("a drive-gain fit holds its gains")
+    }
+}
+
+/// The payload's torques alone (row-major `k x nv`, N m or N) at `states`: the robot's model
+/// with every body massless but the payload's link, which holds only the payload.
+fn payload_torques(
+    model: &Model,
+    payload: &Payload,
+    states: &States<'_>,
+    options: &BaseOptions,
+) -> Result<Vec<f64>> {
+    let b = payload.body(model)?;
+    let mut alone = model.clone();
+    for body in &mut alone.bodies {
+        body.inertia = crate::spatial::Inertia::zeros();
+    }
+    alone.bodies[b].inertia = payload.spatial_inertia();
+    alone.armature.iter_mut().for_each(|a| *a = 0.0);
+    alone.refresh();
+    let mut tau = vec![0.0; states.len() * model.nv];
+    let mut ws = crate::algorithms::parallel::Workspace::new(&alone);
+    crate::algorithms::parallel::rnea(&alone, &mut ws, states, options.gravity, &mut tau)?;
+    Ok(tau)
+}
+
+/// The payload as its link's body and ten inertial parameters (None: no payload, or one of no
+/// mass), for telling runs' payloads apart.
+fn load_of(model: &Model, payload: Option<&Payload>) -> Result<Option<(usize, [f64; 10])>> {
+    let Some(p) = payload.filter(|p| p.mass > 0.0) else {
+        return Ok(None);
+    };
+    let b = p.body(model)?;
+    let i = p.spatial_inertia();
+    let c = i.com * i.mass;
+    let r = i.inertia_origin();
+    Ok(Some((
+        b,
+        [
+            i.mass,
+            c.x,
+            c.y,
+            c.z,
+            r[(0, 0)],
+            r[(0, 1)],
+            r[(1, 1)],
+            r[(0, 2)],
+            r[(1, 2)],
+            r[(2, 2)],
+        ],
+    )))
+}
+
+/// Identifies the drive gains and the base parameters of `model` from `runs` (at least two, at
+/// most [`MAX_RUNS`], not all with the same payload): see the module docs. `options` as for
+/// [`super::identify_base_parameters`], whose checks of the data (torque columns, lag, offsets,
+/// friction, excitation) the model gets on the signal scaled by the gains.
+///
+/// Errors: runs of other joints or without velocities, signals of the wrong shape or flat,
+/// payloads that are no rigid body or on no moving link, every run with the same payload, and
+/// data that do not determine the gains (rank deficiency, naming them).
+pub fn identify_drive_gains(
+    model: &Model,
+    runs: &[GainRun<'_>],
+    options: &BaseOptions,
+) -> Result<DriveGainFit> {
+    let nv = model.nv;
+    let bad = |message: String| Error::InvalidArgument {
+        argument: "runs".into(),
+        message,
+    };
+    if !(2..=MAX_RUNS).contains(&runs.len()) {
+        return Err(bad(format!(
+            "{} runs given, expected 2 to {MAX_RUNS}: one without the payload (or with another) and one with it",
+            runs.len()
+        )));
+    }
+    let mut loads = Vec::with_capacity(runs.len());
+    for (r, run) in runs.iter().enumerate() {
+        let s = &run.states;
+        let at = |e: Error| bad(format!("run {r}: {e}"));
+        crate::torque_model::check_joints(s, nv).map_err(at)?;
+        if s.qd().is_none() || s.qdd().is_none() {
+            return Err(bad(format!(
+                "run {r} has no velocities and accelerations: preprocess its log first"
+            )));
+        }
+        s.check_companion("signal", run.signal, nv).map_err(at)?;
+        if let Some(problem) = run.payload.and_then(|p| p.problem("payload")) {
+            return Err(bad(format!("run {r}: {problem}")));
+        }
+        loads.push(load_of(model, run.payload).map_err(at)?);
+    }
+    if loads.iter().all(|l| *l == loads[0]) {
+        return Err(bad(format!(
+            "every run carries {}: the gains' scale is not determined (the parameters and the gains could grow together); run the motion once more with a known payload bolted on, and give it as that run's payload",
+            match &runs[0].payload {
+                Some(p) if p.mass > 0.0 => format!("the same payload ({} kg on '{}')", p.mass, p.link),
+                _ => "no payload".into(),
+            }
+        )));
+    }
+    // the runs one after the other: states, the signal's column (-i), the right-hand side
+    // (-tau_L) and the robot's own torque once the gains are known
+    let k: usize = runs.iter().map(|r| r.states.len()).sum();
+    let mut q = Vec::with_capacity(k * nv);
+    let mut qd = Vec::with_capacity(k * nv);
+    let mut qdd = Vec::with_capacity(k * nv);
+    let filtered = runs.iter().any(|r| r.states.coulomb().is_some());
+    let mut coulomb = Vec::with_capacity(if filtered { k * nv } else { 0 });
+    let mut column = Vec::with_capacity(k * nv);
+    let mut payload_tau = vec![0.0; k * nv];
+    let mut loaded = Vec::with_capacity(k * nv);
+    let mut first = 0;
+    for run in runs {
+        let s = &run.states;
+        q.extend_from_slice(s.q());
+        qd.extend_from_slice(s.qd().unwrap_or_default());
+        qdd.extend_from_slice(s.qdd().unwrap_or_default());
+        if filtered {
+            coulomb.extend((0..s.len() * nv).map(|x| s.coulomb_at(x / nv, x % nv)));
+        }
+        column.extend(run.signal.iter().map(|i| -i));
+        if let Some(p) = run.payload.filter(|p| p.mass > 0.0) {
+            let tau = payload_torques(model, p, s, options)?;
+            loaded.extend_from_slice(&tau);
+            payload_tau[first * nv..(first + s.len()) * nv].copy_from_slice(&tau);
+        }
+        first += s.len();
+    }
+    let states = States::new(nv, &q, Some(&qd), Some(&qdd))?;
+    let states = if filtered {
+        states.with_coulomb(&coulomb)?
+    } else {
+        states
+    };
+    let signal: Vec<f64> = column.iter().map(|c| -c).collect();
+    crate::torque_model::refuse_flat_torques(
+        &states,
+        &signal,
+        &model.joint_names,
+        "a fit would take it for a signal that does not follow the motion",
+    )?;
+    let rhs: Vec<f64> = payload_tau.iter().map(|t| -t).collect();
+
+    // the joint fit of base parameters and gains: OLS, then WLS on its residuals
+    let base = super::identify::base_parameters(model, options)?;
+    let factors =
+        JointFactors::with_columns(model, &base, &states, &rhs, &[&column], options.gravity)?;
+    let p = base.len();
+    let names: Vec<String> = base
+        .names()
+        .into_iter()
+        .chain(model.joint_names.iter().map(|j| format!("{j}.drive_gain")))
+        .collect();
+    let mut sigma = vec![1.0; nv];
+    let mut ls = factors.solve(&sigma, &names)?;
+    let mut rms = factors.residual_rms(ls.coef.as_slice())?;
+    if options.weighting == Weighting::Wls {
+        sigma = rms
+            .iter()
+            .map(|&s| if s.is_finite() && s > 0.0 { s } else { 1.0 })
+            .collect();
+        ls = factors.solve(&sigma, &names)?;
+        rms = factors.residual_rms(ls.coef.as_slice())?;
+    }
+    let coef: Vec<f64> = ls.coef.row(0).iter().copied().collect();
+    let gain = coef[p..].to_vec();
+    if let Some(j) =
+        (0..nv).find(|&j| !(gain[j].is_finite() && gain[j] != 0.0 && rms[j].is_finite()))
+    {
+        return Err(Error::Numerical {
+            operation: "drive-gain identification".into(),
+            message: format!(
+                "joint '{}': gain {} with residual RMS {}: the signal does not determine it (a signal of 0 or one too large for f64 arithmetic?)",
+                model.joint_names[j],
+                shown(gain[j]),
+                shown(rms[j])
+            ),
+        });
+    }
+
+    // the robot alone: its torques are the gains' times the signal less the payload's
+    let tau: Vec<f64> = (0..k * nv)
+        .map(|x| gain[x % nv] * signal[x] - payload_tau[x])
+        .collect();
+    let (mut model_fit, _) = fit_with_factors(model, &states, &tau, options)?;
+    let inflation = model_fit.stderr_inflation();
+    let stderr: Vec<f64> = ls.stderr.row(0).iter().map(|s| s * inflation).collect();
+    model_fit.theta = coef[..p].to_vec();
+    model_fit.stderr = stderr[..p].to_vec();
+    model_fit.correlation = ls.correlation.view((0, 0), (p, p)).into_owned();
+    model_fit.residual_rms = rms.clone();
+    model_fit.sigma = sigma;
+
+    // the gains' noise bias: joint j's weighted signal column beyond every other column has
+    // squared norm 1 / cov_diag (the unscaled covariance's diagonal), against k samples of
+    // noise of at most rms / (|K| sigma) each in the same weighted units
+    let noise_bias = (0..nv)
+        .map(|j| {
+            let noise = rms[j] / (gain[j].abs() * model_fit.sigma[j]);
+            let bias = noise * noise * k as f64 * ls.cov_diag[p + j];
+            if bias.is_finite() {
+                Ok(bias)
+            } else {
+                Err(Error::Numerical {
+                    operation: "drive-gain identification".into(),
+                    message: format!(
+                        "joint '{}': its signal is explained whole by the model's other columns, so its gain is not determined",
+                        model.joint_names[j]
+                    ),
+                })
+            }
+        })
+        .collect::<Result<Vec<f64>>>()?;
+    let loaded_rows = loaded.len() / nv;
+    let payload_torque_rms = (0..nv)
+        .map(|j| {
+            let sum: f64 = (0..loaded_rows).map(|s| loaded[s * nv + j].powi(2)).sum();
+            (sum / loaded_rows.max(1) as f64).sqrt()
+        })
+        .collect();
+    model_fit.drive_gains = Some(DriveGains {
+        gain,
+        stderr: stderr[p..].to_vec(),
+        noise_bias,
+        payload_torque_rms,
+        cond: ls.cond,
+        runs: runs.len(),
+        loaded_runs: runs
+            .iter()
+            .filter(|r| r.payload.is_some_and(|p| p.mass > 0.0))
+            .count(),
+    });
+    Ok(DriveGainFit { model: model_fit })
+}

@@ -1,0 +1,414 @@
+//! Drive gains identified with the base parameters from logged motor currents and a known
+//! payload (src/direct/drive_gains.rs): the gains and the robot's torques come back; the joint
+//! fit equals a dense least-squares solution of the same system (nalgebra's SVD); runs that do
+//! not fix the scale, and payloads no robot carries, are refused; a signal counting the other
+//! way is named; the noise bias bound holds; saved gains are checked on load. (Against numpy's
+//! least squares: tests/python/test_drive_gains.py.)
+
+mod common;
+
+use common::{a465_excitation, normal, refused_on_load, torques_with_friction, Rng};
+use nalgebra::{DMatrix, DVector};
+use perturbid_rs::direct::{
+    identify_drive_gains, regressor_matrix, BaseModel, BaseOptions, GainRun, Weighting,
+};
+use perturbid_rs::document::Document;
+use perturbid_rs::rehearsal::{Payload, TrueRobot};
+use perturbid_rs::trajectory::Samples;
+use perturbid_rs::{Gravity, Model, States, TorqueModel};
+
+/// N m per ampere of the A465's six drives (made up: a torque constant times a gear ratio).
+const GAINS: [f64; 6] = [42.0, 65.0, 38.0, 9.0, 7.5, 4.0];
+
+fn payload() -> Payload {
+    Payload {
+        link: "link6".into(),
+        mass: 2.0,
+        com: [0.02, -0.01, 0.08],
+        inertia: [0.004, 0.0, 0.0, 0.004, 0.0, 0.002],
+    }
+}
+
+/// 8 s at 500 Hz of the seeded excitation.
+fn motion(seed: u64) -> Samples {
+    let traj = a465_excitation(&mut Rng(seed));
+    let t: Vec<f64> = (0..4000).map(|i| i as f64 * 2e-3).collect();
+    traj.sample(&t)
+}
+
+/// The logged currents of `truth` (with the payload when given) along `s`: torques with
+/// friction over the gains, plus `noise` A of white noise.
+fn currents(
+    truth: &Model,
+    s: &Samples,
+    loaded: Option<&Payload>,
+    noise: f64,
+    seed: u64,
+) -> Vec<f64> {
+    let robot = match loaded {
+        Some(p) => TrueRobot {
+            payload: Some(p.clone()),
+            ..TrueRobot::default()
+        }
+        .rigid_body_model(truth)
+        .unwrap(),
+        None => truth.clone(),
+    };
+    let mut rng = Rng(seed);
+    let tau = torques_with_friction(&robot, s, &mut rng, |_| 0.0);
+    (tau.iter().enumerate())
+        .map(|(i, t)| t / GAINS[i % 6] + noise * normal(&mut rng))
+        .collect()
+}
+
+fn truth() -> Model {
+    perturbid_rs::robots::a465::model("kinsheel2010").unwrap()
+}
+
+fn states(s: &Samples) -> States<'_> {
+    States::new(6, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap()
+}
+
+#[test]
+fn the_gains_and_the_robots_torques_come_back_from_currents_with_a_known_payload() {
+    let truth = truth();
+    let (a, b) = (motion(3), motion(4));
+    let p = payload();
+    let (ia, ib) = (
+        currents(&truth, &a, None, 1e-4, 1),
+        currents(&truth, &b, Some(&p), 1e-4, 2),
+    );
+    let runs = [
+        GainRun {
+            states: states(&a),
+            signal: &ia,
+            payload: None,
+        },
+        GainRun {
+            states: states(&b),
+            signal: &ib,
+            payload: Some(&p),
+        },
+    ];
+    let fit = identify_drive_gains(&truth, &runs, &BaseOptions::default()).unwrap();
+    let g = fit.gains();
+    for j in 0..6 {
+        // within its standard errors of the truth, less the bias the noise can give it
+        let (k, se, bias) = (g.gain[j], g.stderr[j], g.noise_bias[j]);
+        assert!(
+            (k - GAINS[j]).abs() < 4.0 * se + bias * GAINS[j] && (k / GAINS[j] - 1.0).abs() < 1e-2,
+            "joint {j}: {k} +- {se} (bias up to {bias}), truth {}",
+            GAINS[j]
+        );
+        assert!(
+            g.noise_bias[j] < 1e-3 && g.payload_torque_rms[j] > 0.01,
+            "{g:?}"
+        );
+    }
+    assert_eq!((g.runs, g.loaded_runs), (2, 1));
+    assert!(
+        g.warnings(&truth.joint_names).is_empty(),
+        "{:?}",
+        g.warnings(&truth.joint_names)
+    );
+    // the model is the robot alone's, in torques: on a third motion, unloaded
+    let c = motion(5);
+    let tau = torques_with_friction(&truth, &c, &mut Rng(0), |_| 0.0);
+    let predicted = fit.model.on(&truth).unwrap().predict(&states(&c)).unwrap();
+    let rms = (tau
+        .iter()
+        .zip(&predicted)
+        .map(|(a, b)| (a - b).powi(2))
+        .sum::<f64>()
+        / tau.len() as f64)
+        .sqrt();
+    assert!(rms < 0.02, "RMS {rms} N m");
+    // its own residuals are those of the joint fit, in N m
+    for (j, r) in fit.model.residual_rms.iter().enumerate() {
+        assert!(
+            *r > 0.5 * 1e-4 * GAINS[j] && *r < 2.0 * 1e-4 * GAINS[j],
+            "{j}: {r}"
+        );
+    }
+    // saved with the model and read back whole
+    assert_eq!(
+        BaseModel::from_json(&fit.model.to_json()).unwrap(),
+        fit.model
+    );
+}
+
+#[test]
+fn the_joint_fit_is_the_dense_least_squares_solution() {
+    // OLS, so that the dense system is the one the streaming fit reduces
+    let truth = truth();
+    let (a, b) = (motion(6), motion(7));
+    let p = payload();
+    let (ia, ib) = (
+        currents(&truth, &a, None, 1e-3, 3),
+        currents(&truth, &b, Some(&p), 1e-3, 4),
+    );
+    let options = BaseOptions {
+        weighting: Weighting::Ols,
+        ..BaseOptions::default()
+    };
+    let runs = [
+        GainRun {
+            states: states(&a),
+            signal: &ia,
+            payload: None,
+        },
+        GainRun {
+            states: states(&b),
+            signal: &ib,
+            payload: Some(&p),
+        },
+    ];
+    let fit = identify_drive_gains(&truth, &runs, &options).unwrap();
+    // [Phi_base | -diag(i)] [theta; K] = -tau_L, built whole
+    let base = &fit.model.base;
+    let loaded = TrueRobot {
+        payload: Some(p.clone()),
+        ..TrueRobot::default()
+    }
+    .rigid_body_model(&truth)
+    .unwrap();
+    let mut rows = Vec::new();
+    let mut rhs = Vec::new();
+    for (s, i, with) in [(&a, &ia, false), (&b, &ib, true)] {
+        let phi = base.select(
+            &regressor_matrix(&truth, &base.layout, &states(s), Gravity::Included).unwrap(),
+        );
+        let payload_tau = if with {
+            let (l, r) = (
+                common::torques(&loaded, &s.q, &s.qd, &s.qdd, Gravity::Included),
+                common::torques(&truth, &s.q, &s.qd, &s.qdd, Gravity::Included),
+            );
+            l.iter().zip(&r).map(|(l, r)| l - r).collect()
+        } else {
+            vec![0.0; s.q.len()]
+        };
+        for r in 0..phi.nrows() {
+            let mut row: Vec<f64> = phi.row(r).iter().copied().collect();
+            row.extend((0..6).map(|j| if j == r % 6 { -i[r] } else { 0.0 }));
+            rows.push(row);
+            rhs.push(-payload_tau[r]);
+        }
+    }
+    let cols = rows[0].len();
+    let x = DMatrix::from_fn(rows.len(), cols, |r, c| rows[r][c]);
+    // columns scaled to unit norm, as the fit does, for the SVD's tolerance
+    let scale: Vec<f64> = (0..cols).map(|c| x.column(c).norm()).collect();
+    let xs = DMatrix::from_fn(x.nrows(), cols, |r, c| x[(r, c)] / scale[c]);
+    let sol = xs
+        .svd(true, true)
+        .solve(&DVector::from_vec(rhs), 1e-14)
+        .unwrap();
+    let theta: Vec<f64> = (0..cols).map(|c| sol[c] / scale[c]).collect();
+    let p_base = fit.model.theta.len();
+    let g = fit.gains();
+    for j in 0..6 {
+        let rel = (g.gain[j] - theta[p_base + j]).abs() / theta[p_base + j].abs();
+        assert!(
+            rel < 1e-8,
+            "gain {j}: {} against {}",
+            g.gain[j],
+            theta[p_base + j]
+        );
+    }
+    for (c, (t, d)) in fit.model.theta.iter().zip(&theta).enumerate() {
+        assert!(
+            (t - d).abs() < 1e-7 * d.abs().max(1.0),
+            "theta[{c}]: {t} against {d}"
+        );
+    }
+}
+
+#[test]
+fn runs_that_do_not_fix_the_scale_and_payloads_no_robot_carries_are_refused() {
+    let truth = truth();
+    let (a, b) = (motion(3), motion(4));
+    let p = payload();
+    let (ia, ib) = (
+        currents(&truth, &a, None, 0.0, 1),
+        currents(&truth, &b, Some(&p), 0.0, 2),
+    );
+    let o = BaseOptions::default();
+    let run = |s, i, payload| GainRun {
+        states: states(s),
+        signal: i,
+        payload,
+    };
+    let said = |runs: &[GainRun<'_>]| {
+        identify_drive_gains(&truth, runs, &o)
+            .unwrap_err()
+            .to_string()
+    };
+    let e = said(&[run(&a, &ia, None), run(&b, &ib, None)]);
+    assert!(
+        e.contains("every run carries no payload") && e.contains("not determined"),
+        "{e}"
+    );
+    let e = said(&[run(&a, &ia, Some(&p)), run(&b, &ib, Some(&p))]);
+    assert!(e.contains("the same payload (2 kg on 'link6')"), "{e}");
+    let e = said(&[run(&b, &ib, Some(&p))]);
+    assert!(e.contains("1 runs given, expected 2"), "{e}");
+    let nowhere = Payload {
+        link: "gripper".into(),
+        ..payload()
+    };
+    let e = said(&[run(&a, &ia, None), run(&b, &ib, Some(&nowhere))]);
+    assert!(
+        e.contains("run 1") && e.contains("'gripper' is not a moving link") && e.contains("link6"),
+        "{e}"
+    );
+    let negative = Payload {
+        mass: -1.0,
+        ..payload()
+    };
+    let e = said(&[run(&a, &ia, None), run(&b, &ib, Some(&negative))]);
+    assert!(e.contains("payload.mass is -1"), "{e}");
+    let flat = Payload {
+        inertia: [0.004, 0.0, 0.0, 0.004, 0.0, 0.009],
+        ..payload()
+    };
+    let e = said(&[run(&a, &ia, None), run(&b, &ib, Some(&flat))]);
+    assert!(e.contains("run 1: payload ([ixx"), "{e}");
+    let short = &ib[..ib.len() - 6];
+    let e = said(&[run(&a, &ia, None), run(&b, short, Some(&p))]);
+    assert!(e.contains("run 1") && e.contains("signal"), "{e}");
+    let no_velocity = GainRun {
+        states: States::new(6, &b.q, None, None).unwrap(),
+        signal: &ib,
+        payload: Some(&p),
+    };
+    let e = said(&[run(&a, &ia, None), no_velocity]);
+    assert!(e.contains("run 1 has no velocities"), "{e}");
+}
+
+#[test]
+fn a_signal_that_counts_the_other_way_gets_a_negative_gain_and_is_named() {
+    let truth = truth();
+    let (a, b) = (motion(3), motion(4));
+    let p = payload();
+    let mut ia = currents(&truth, &a, None, 1e-4, 1);
+    let mut ib = currents(&truth, &b, Some(&p), 1e-4, 2);
+    for i in ia.iter_mut().chain(ib.iter_mut()).skip(1).step_by(6) {
+        *i = -*i;
+    }
+    let runs = [
+        GainRun {
+            states: states(&a),
+            signal: &ia,
+            payload: None,
+        },
+        GainRun {
+            states: states(&b),
+            signal: &ib,
+            payload: Some(&p),
+        },
+    ];
+    let fit = identify_drive_gains(&truth, &runs, &BaseOptions::default()).unwrap();
+    let g = fit.gains();
+    assert!((g.gain[1] / -GAINS[1] - 1.0).abs() < 1e-2, "{g:?}");
+    let w = g.warnings(&truth.joint_names);
+    assert!(
+        w.len() == 1 && w[0].contains("'joint2' is negative"),
+        "{w:?}"
+    );
+}
+
+#[test]
+fn the_noise_bias_bounds_what_a_noisy_signal_does_to_the_gains() {
+    // a light payload and currents noisy against it: the gains come out low, within the bound
+    let truth = truth();
+    let (a, b) = (motion(3), motion(4));
+    let light = Payload {
+        mass: 0.3,
+        ..payload()
+    };
+    let noise = 0.05;
+    let (ia, ib) = (
+        currents(&truth, &a, None, noise, 1),
+        currents(&truth, &b, Some(&light), noise, 2),
+    );
+    let runs = [
+        GainRun {
+            states: states(&a),
+            signal: &ia,
+            payload: None,
+        },
+        GainRun {
+            states: states(&b),
+            signal: &ib,
+            payload: Some(&light),
+        },
+    ];
+    let fit = identify_drive_gains(&truth, &runs, &BaseOptions::default()).unwrap();
+    let g = fit.gains();
+    let mut warned = 0;
+    for j in 0..6 {
+        let low = 1.0 - g.gain[j] / GAINS[j];
+        assert!(
+            low < g.noise_bias[j] + 4.0 * g.stderr[j] / GAINS[j],
+            "joint {j}: {low} low, bound {} (s.e. {})",
+            g.noise_bias[j],
+            g.stderr[j] / GAINS[j]
+        );
+        warned += usize::from(g.noise_bias[j] > 0.01);
+    }
+    let w = g.warnings(&truth.joint_names);
+    assert!(
+        warned > 0 && w.iter().filter(|w| w.contains("biased towards 0")).count() == warned,
+        "{w:?}"
+    );
+}
+
+#[test]
+fn saved_gains_are_checked_on_load() {
+    let truth = truth();
+    let (a, b) = (motion(3), motion(4));
+    let p = payload();
+    let (ia, ib) = (
+        currents(&truth, &a, None, 1e-4, 1),
+        currents(&truth, &b, Some(&p), 1e-4, 2),
+    );
+    let runs = [
+        GainRun {
+            states: states(&a),
+            signal: &ia,
+            payload: None,
+        },
+        GainRun {
+            states: states(&b),
+            signal: &ib,
+            payload: Some(&p),
+        },
+    ];
+    let fit = identify_drive_gains(&truth, &runs, &BaseOptions::default()).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&fit.model.to_json()).unwrap();
+    refused_on_load::<BaseModel>(
+        &json,
+        &[
+            (
+                |v| v["drive_gains"]["gain"][2] = serde_json::json!(0.0),
+                "drive_gains.gain[2] is 0, expected a finite gain other than 0",
+            ),
+            (
+                |v| v["drive_gains"]["stderr"] = serde_json::json!([1.0]),
+                "drive_gains.stderr has 1 entries, expected one per joint (6)",
+            ),
+            (
+                |v| v["drive_gains"]["noise_bias"][0] = serde_json::json!(-1.0),
+                "drive_gains.noise_bias[0] is -1",
+            ),
+            (
+                |v| v["drive_gains"]["loaded_runs"] = serde_json::json!(0),
+                "at least one loaded",
+            ),
+            (
+                |v| v["drive_gains"]["gain"][0] = serde_json::json!(1e300),
+                "drive_gains.gain[0] is 1e300",
+            ),
+        ],
+    );
+}
