@@ -37,6 +37,7 @@ __all__ = [
     "design_excitation",
     "identify_base_parameters",
     "identify_consistent_parameters",
+    "identify_drive_gains",
     "identify_global_linear",
     "identify_local",
     "identify_parameters_from_local",
@@ -655,6 +656,12 @@ class BaseParameterModel:
         """Joints whose torques show friction terms the fit lacks: joint, explained,
         residual_rms, remaining_rms, terms (dicts term, coefficient, stderr); also warnings."""
     @property
+    def drive_gains(self) -> dict[str, Any] | None:
+        """Where the model was identified from logged motor currents (identify_drive_gains),
+        else None: gain, stderr, noise_bias (a bound on each gain's relative bias towards 0
+        from the signal's noise), payload_torque_rms (N m), each (n,); cond, runs,
+        loaded_runs. The model's torques are gain * signal."""
+    @property
     def weak_excitation(self) -> dict[str, Any] | None:
         """Where the data excite the base parameters weakly (cond beyond 2000), else None:
         cond, weakest (the least determined combination: dicts parameter, weight), motion
@@ -751,6 +758,22 @@ def identify_base_parameters(
     t: Optional[ArrayLike] = None,
     coulomb: Optional[ArrayLike] = None,
 ) -> BaseParameterModel: ...
+
+def identify_drive_gains(
+    robot: Robot,
+    runs: Sequence[Recording],
+    payloads: Sequence[Optional[dict[str, Any]]],
+    friction: Union[str, Sequence[str], None] = None,
+    weighting: str = "wls",
+    gravity: bool = True,
+    tolerance: float = 1e-8,
+    seed: int = 0,
+) -> BaseParameterModel:
+    """Drive gains (N m per unit of the logged signal) with the base parameters, from
+    preprocessed Recordings whose tau holds the motor currents, one payload a run: None or a
+    dict link, mass (kg), com (m), inertia ([ixx, ixy, ixz, iyy, iyz, izz] about the centre
+    of mass, kg m^2) in the link's frame. Not every run may carry the same payload."""
+    ...
 
 @final
 class ConsistentFit:

@@ -94,8 +94,10 @@ impl BaseModel {
         )
         .filter(|_| super::torque_columns::findings(&self.torque_columns).is_empty());
         let weak = (self.weak_excitation.as_ref()).map(|w| w.finding());
+        let gains = (self.drive_gains.iter()).flat_map(|g| g.warnings(&self.joint_names));
         columns
             .into_iter()
+            .chain(gains)
             .chain(offsets)
             .chain(friction)
             .chain(weak)

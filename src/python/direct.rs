@@ -355,6 +355,17 @@ impl PyBaseModel {
             })
             .collect()
     }
+    /// The joints' drive gains where the model was identified from logged motor currents
+    /// (`identify_drive_gains`), else None: dict `gain`, `stderr`, `noise_bias` (an upper
+    /// bound of each gain's relative bias towards 0 from the signal's noise) and
+    /// `payload_torque_rms` (N m), each (n,); `cond` of the joint fit, `runs`, `loaded_runs`.
+    /// The model's torques are `gain * signal`.
+    #[getter]
+    fn drive_gains<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        (self.fit.drive_gains.as_ref())
+            .map(|g| super::drive_gains::gains_dict(py, g))
+            .transpose()
+    }
     /// Where the data excite the base parameters weakly (cond beyond 2000), else None: dict
     /// `cond`, `weakest` (the least determined combination of base parameters: dicts
     /// `parameter`, the name it is kept as with ' (merged)' where others are merged into it,

@@ -6,6 +6,7 @@ mod arrays;
 mod cli;
 mod consistent;
 mod direct;
+mod drive_gains;
 mod errors;
 mod excitation;
 mod linearization;
@@ -86,6 +87,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<direct::PyGlobalLinear>()?;
     m.add_function(wrap_pyfunction!(excitation::design_excitation, m)?)?;
     m.add_function(wrap_pyfunction!(direct::identify_base_parameters, m)?)?;
+    m.add_function(wrap_pyfunction!(drive_gains::identify_drive_gains, m)?)?;
     m.add_function(wrap_pyfunction!(direct::identify_global_linear, m)?)?;
     m.add_class::<consistent::PyConsistentFit>()?;
     m.add_class::<validation::PyValidation>()?;

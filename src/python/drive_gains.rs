@@ -1,0 +1,252 @@
+//! Python: `identify_drive_gains` (mirrors `crate::direct::drive_gains`): the joints' drive
+//! gains and the base parameters from Recordings of logged motor currents, one of them with a
+//! known payload.
+
+use std::borrow::Cow;
+use std::sync::Arc;
+
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyTuple};
+
+use super::arrays::vec1;
+use super::detached;
+use super::direct::{base_options, check_sample_derivatives, FrictionNames, PyBaseModel};
+use super::recording::PyRecording;
+use super::robot::PyRobot;
+use super::scalars;
+use crate::direct::drive_gains::{identify_drive_gains as gains_rs, DriveGains, GainRun, MAX_RUNS};
+use crate::direct::BaseOptions;
+use crate::error::{Error, Result};
+use crate::recording::Recording;
+use crate::rehearsal::Payload;
+use crate::states::States;
+
+/// The payload a caller gave for run `r`: None, or a dict with the keys of the true robot's
+/// `payload` (`link`, `mass`, `com`, `inertia`); unknown keys, and values of another type or
+/// length, refused by key (values out of range by [`Payload::problem`]).
+fn payload_of(r: usize, value: &Bound<'_, PyAny>) -> PyResult<Option<Payload>> {
+    if value.is_none() {
+        return Ok(None);
+    }
+    let bad = |message: String| -> PyErr {
+        Error::InvalidArgument {
+            argument: format!("payloads[{r}]"),
+            message,
+        }
+        .into()
+    };
+    let Ok(dict) = value.cast::<PyDict>() else {
+        return Err(bad(format!(
+            "a {}, expected None or a dict with 'link', 'mass' (kg), 'com' (m) and 'inertia' ([ixx, ixy, ixz, iyy, iyz, izz] about the centre of mass, kg m^2)",
+            value.get_type().name()?
+        )));
+    };
+    let mut payload = Payload {
+        link: String::new(),
+        mass: f64::NAN,
+        com: [0.0; 3],
+        inertia: [0.0; 6],
+    };
+    let (mut link, mut mass) = (false, false);
+    for (key, v) in dict.iter() {
+        let key: String = key
+            .extract()
+            .map_err(|_| bad("its keys must be strings".into()))?;
+        let numbers = |len: usize| -> PyResult<Vec<f64>> {
+            let x: Vec<Bound<'_, PyAny>> = if v.cast::<pyo3::types::PyString>().is_ok() {
+                vec![]
+            } else {
+                v.extract().unwrap_or_default()
+            };
+            let x = (x.iter())
+                .map(scalars::real)
+                .collect::<PyResult<Vec<f64>>>();
+            match x {
+                Ok(x) if x.len() == len => Ok(x),
+                _ => Err(bad(format!("'{key}' must be {len} real numbers"))),
+            }
+        };
+        match key.as_str() {
+            "link" => {
+                payload.link = v
+                    .extract()
+                    .map_err(|_| bad("'link' must be a string".into()))?;
+                link = true;
+            }
+            "mass" => {
+                payload.mass = scalars::real(&v)
+                    .map_err(|_| bad("'mass' must be a real number (kg)".into()))?;
+                mass = true;
+            }
+            "com" => payload.com.copy_from_slice(&numbers(3)?),
+            "inertia" => payload.inertia.copy_from_slice(&numbers(6)?),
+            other => {
+                return Err(bad(format!(
+                    "unknown key '{other}', expected 'link', 'mass', 'com' and 'inertia'"
+                )))
+            }
+        }
+    }
+    if !(link && mass) {
+        return Err(bad("'link' and 'mass' are required".into()));
+    }
+    Ok(Some(payload))
+}
+
+/// The entries of a list or tuple argument `name`, at most [`MAX_RUNS`].
+fn entries<'py>(name: &str, v: &Bound<'py, PyAny>) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let items: Vec<Bound<'py, PyAny>> = if let Ok(l) = v.cast::<PyList>() {
+        l.iter().collect()
+    } else if let Ok(t) = v.cast::<PyTuple>() {
+        t.iter().collect()
+    } else {
+        return Err(Error::InvalidArgument {
+            argument: name.into(),
+            message: format!("a {}, expected a list", v.get_type().name()?),
+        }
+        .into());
+    };
+    if items.len() > MAX_RUNS {
+        return Err(Error::InvalidArgument {
+            argument: name.into(),
+            message: format!("{} entries, expected at most {MAX_RUNS}", items.len()),
+        }
+        .into());
+    }
+    Ok(items)
+}
+
+/// A recording's arrays for a run of a robot of `nv` joints: velocities and accelerations
+/// required.
+fn run_arrays(r: usize, rec: &Recording, nv: usize) -> Result<(&[f64], &[f64])> {
+    if rec.n != nv {
+        return Err(Error::InvalidArgument {
+            argument: format!("runs[{r}]"),
+            message: format!(
+                "the Recording '{}' has {} joints, expected the robot's {nv}",
+                rec.name, rec.n
+            ),
+        });
+    }
+    match (&rec.qd, &rec.qdd) {
+        (Some(qd), Some(qdd)) => Ok((qd, qdd)),
+        _ => Err(Error::InvalidArgument {
+            argument: format!("runs[{r}]"),
+            message: format!(
+                "the Recording '{}' has no velocities and accelerations (a log as read): preprocess it first (perturbid_rs.preprocess)",
+                rec.name
+            ),
+        }),
+    }
+}
+
+/// Identifies the joints' drive gains with the base parameters (docs/method.md, section 8d)
+/// from `runs`, Recordings of the robot whose `tau` holds each joint's logged signal (motor
+/// currents, A, or torques computed with nominal gains), preprocessed (with `qd` and `qdd`),
+/// and `payloads`, one a run: None for the robot alone, or the known payload bolted on during
+/// it, a dict `link` (a moving link of `robot`), `mass` (kg), `com` (m) and `inertia`
+/// (`[ixx, ixy, ixz, iyy, iyz, izz]` about the centre of mass, kg m^2), all in the link's
+/// frame. Not every run may carry the same payload: the payload fixes the gains' scale.
+///
+/// Returns a BaseParameterModel of the robot alone in SI units (its predictions are torques),
+/// with `drive_gains`: `gain` (n,) N m (or N) per unit of the signal, `stderr`, `noise_bias`
+/// (a bound on each gain's relative bias towards 0 from the signal's noise),
+/// `payload_torque_rms` (N m), `cond`, `runs`, `loaded_runs`. `friction`, `weighting`,
+/// `gravity`, `tolerance`, `seed` as for `identify_base_parameters`. Findings are warned of.
+#[pyfunction]
+#[pyo3(signature = (robot, runs, payloads, friction=None, weighting="wls", gravity=true, tolerance=1e-8, seed=0))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn identify_drive_gains(
+    py: Python<'_>,
+    robot: &PyRobot,
+    runs: Bound<'_, PyAny>,
+    payloads: Bound<'_, PyAny>,
+    friction: Option<FrictionNames<'_>>,
+    weighting: &str,
+    gravity: bool,
+    #[pyo3(from_py_with = scalars::real)] tolerance: f64,
+    #[pyo3(from_py_with = scalars::seed)] seed: u64,
+) -> PyResult<PyBaseModel> {
+    let options = BaseOptions {
+        tolerance,
+        seed,
+        ..base_options(friction, weighting, gravity)?
+    };
+    let model = &robot.model;
+    let (runs, payloads) = (entries("runs", &runs)?, entries("payloads", &payloads)?);
+    if runs.len() != payloads.len() {
+        return Err(Error::InvalidArgument {
+            argument: "payloads".into(),
+            message: format!(
+                "{} payloads for {} runs, expected one a run (None for a run without)",
+                payloads.len(),
+                runs.len()
+            ),
+        }
+        .into());
+    }
+    let mut recordings: Vec<Arc<Recording>> = Vec::with_capacity(runs.len());
+    for (r, run) in runs.iter().enumerate() {
+        let Ok(rec) = run.cast::<PyRecording>() else {
+            return Err(Error::InvalidArgument {
+                argument: format!("runs[{r}]"),
+                message: format!(
+                    "a {}, expected a Recording (perturbid_rs.Recording, preprocessed)",
+                    run.get_type().name()?
+                ),
+            }
+            .into());
+        };
+        recordings.push(rec.get().rec.clone());
+    }
+    let payloads = (payloads.iter().enumerate())
+        .map(|(r, p)| payload_of(r, &p))
+        .collect::<PyResult<Vec<_>>>()?;
+    let fit = detached(py, "identify_drive_gains", || {
+        let mut gain_runs = Vec::with_capacity(recordings.len());
+        for (r, (rec, payload)) in recordings.iter().zip(&payloads).enumerate() {
+            let (qd, qdd) = run_arrays(r, rec, model.nv)?;
+            let columns = [
+                Cow::Borrowed(&rec.q[..]),
+                Cow::Borrowed(qd),
+                Cow::Borrowed(qdd),
+                Cow::Borrowed(&rec.tau[..]),
+            ];
+            check_sample_derivatives(
+                &format!("runs[{r}] ('{}')", rec.name),
+                model.nv,
+                Some(rec.t.clone()),
+                &columns,
+            )?;
+            let states = States::new(rec.n, &rec.q, Some(qd), Some(qdd))?;
+            let states = match &rec.coulomb {
+                Some(c) => states.with_coulomb(c)?,
+                None => states,
+            };
+            gain_runs.push(GainRun {
+                states,
+                signal: &rec.tau,
+                payload: payload.as_ref(),
+            });
+        }
+        Ok(gains_rs(model, &gain_runs, &options)?.model)
+    })?;
+    super::errors::warn_all(py, &fit.warnings())?;
+    Ok(PyBaseModel {
+        fit,
+        model: Arc::new(model.clone()),
+    })
+}
+
+/// The gains as a dict (see `BaseParameterModel.drive_gains`).
+pub(crate) fn gains_dict<'py>(py: Python<'py>, g: &DriveGains) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("gain", vec1(py, &g.gain))?;
+    d.set_item("stderr", vec1(py, &g.stderr))?;
+    d.set_item("noise_bias", vec1(py, &g.noise_bias))?;
+    d.set_item("payload_torque_rms", vec1(py, &g.payload_torque_rms))?;
+    d.set_item("cond", g.cond)?;
+    d.set_item("runs", g.runs)?;
+    d.set_item("loaded_runs", g.loaded_runs)?;
+    Ok(d)
+}

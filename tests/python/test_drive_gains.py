@@ -1,0 +1,148 @@
+"""Drive gains from logged motor currents with a known payload (identify_drive_gains): the
+torques come from Pinocchio (the payload added to its link's inertia there), the gains are
+checked against numpy's least squares over Pinocchio's own regressor, the model of the robot
+alone against Pinocchio's torques on another motion; hostile arguments are refused by name."""
+
+import json
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import perturbid_rs as pr
+from conftest import pair_from_text
+
+GAINS = np.array([42.0, 65.0, 38.0, 9.0, 7.5, 4.0])  # N m per A (made up)
+PAYLOAD = {"link": "link6", "mass": 2.0, "com": [0.02, -0.01, 0.08],
+           "inertia": [0.004, 0.0, 0.0, 0.004, 0.0, 0.002]}
+VISCOUS = 0.3
+
+
+def motion(seed, seconds=8.0, rate=500.0):
+    """A sum of sines about a posture, analytic derivatives: t (k,), q, qd, qdd (k, 6)."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, seconds, 1.0 / rate)
+    w = 2 * np.pi * 0.125 * np.arange(1, 6)
+    a = rng.uniform(-0.12, 0.12, (5, 6))
+    b = rng.uniform(-0.12, 0.12, (5, 6))
+    q0 = np.array([0.2, 0.3, -0.4, 0.1, 0.5, -0.2])
+    s, c = np.sin(np.outer(t, w)), np.cos(np.outer(t, w))
+    q = q0 + s @ a + c @ b
+    qd = (c * w) @ a - (s * w) @ b
+    qdd = -(s * w**2) @ a - (c * w**2) @ b
+    return t, q, qd, qdd
+
+
+def pin_torques(model, q, qd, qdd):
+    data = model.createData()
+    return np.array([pin.rnea(model, data, *x) for x in zip(q, qd, qdd)])
+
+
+@pytest.fixture(scope="module")
+def setup():
+    pair = pair_from_text(pr.robots.a465_urdf("kinsheel2010"))
+    loaded = pair.model.copy()
+    jid = loaded.getJointId("joint6")
+    c = np.array(PAYLOAD["com"])
+    xx, xy, xz, yy, yz, zz = PAYLOAD["inertia"]
+    inertia = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    loaded.inertias[jid] = loaded.inertias[jid] + pin.Inertia(PAYLOAD["mass"], c, inertia)
+    rng = np.random.default_rng(0)
+    runs = []
+    for seed, model in [(3, pair.model), (4, loaded)]:
+        t, q, qd, qdd = motion(seed)
+        tau = pin_torques(model, q, qd, qdd) + VISCOUS * qd
+        current = tau / GAINS + 1e-4 * rng.standard_normal(tau.shape)
+        runs.append((t, q, qd, qdd, current))
+    return pair, loaded, runs
+
+
+def recordings(runs):
+    return [pr.Recording(t, q, i, qd=qd, qdd=qdd, name=f"run{r}")
+            for r, (t, q, qd, qdd, i) in enumerate(runs)]
+
+
+def test_gains_match_numpy_least_squares_over_pinocchios_regressor(setup):
+    pair, loaded, runs = setup
+    fit = pr.identify_drive_gains(pair.ours, recordings(runs), [None, PAYLOAD],
+                                  friction="viscous", weighting="ols")
+    g = fit.drive_gains
+    assert g is not None and g["runs"] == 2 and g["loaded_runs"] == 1
+    # [Y_pin | armature | viscous | -diag(i)] [theta; K] = -tau_payload, solved by numpy
+    data = pair.model.createData()
+    ids = [pair.model.getJointId(n) for n in pair.ours.joint_names]
+    cols = np.concatenate([np.arange(10 * (i - 1), 10 * i) for i in ids])
+    rows, rhs = [], []
+    for r, (t, q, qd, qdd, i) in enumerate(runs):
+        payload_tau = (pin_torques(loaded, q, qd, qdd) - pin_torques(pair.model, q, qd, qdd)
+                       if r == 1 else np.zeros_like(q))
+        for s in range(len(t)):
+            y = pin.computeJointTorqueRegressor(pair.model, data, q[s], qd[s], qdd[s])[:, cols]
+            rows.append(np.hstack([y, np.diag(qdd[s]), np.diag(qd[s]), -np.diag(i[s])]))
+            rhs.append(-payload_tau[s])
+    x = np.vstack(rows)
+    scale = np.linalg.norm(x, axis=0)
+    scale[scale == 0] = 1.0
+    sol = np.linalg.lstsq(x / scale, np.concatenate(rhs), rcond=1e-12)[0] / scale
+    np.testing.assert_allclose(g["gain"], sol[-6:], rtol=1e-8)
+    # and the truth, within the standard errors and the bound on the noise's bias
+    err = np.abs(g["gain"] - GAINS)
+    assert np.all(err < 4 * g["stderr"] + g["noise_bias"] * GAINS), (g, GAINS)
+    assert np.all(g["noise_bias"] < 1e-3) and np.all(g["payload_torque_rms"] > 0.01)
+
+
+def test_the_model_is_the_robot_alones_in_torques(setup):
+    pair, _, runs = setup
+    with_friction = pr.identify_drive_gains(pair.ours, recordings(runs), [None, PAYLOAD],
+                                            friction="viscous")
+    t, q, qd, qdd = motion(5)
+    truth = pin_torques(pair.model, q, qd, qdd) + VISCOUS * qd
+    predicted = with_friction.predict(q, qd, qdd)
+    assert np.sqrt(np.mean((predicted - truth) ** 2)) < 0.02
+    saved = json.loads(with_friction.to_json())
+    np.testing.assert_allclose(saved["drive_gains"]["gain"], with_friction.drive_gains["gain"])
+    # a model fitted to torques has none
+    plain = pr.identify_base_parameters(pair.ours, q, qd, qdd, truth, friction="viscous")
+    assert plain.drive_gains is None
+
+
+def test_a_signal_counting_the_other_way_is_named(setup):
+    pair, _, runs = setup
+    flipped = [(t, q, qd, qdd, i * np.array([1, -1, 1, 1, 1, 1])) for t, q, qd, qdd, i in runs]
+    with pytest.warns(pr.PerturbidWarning, match="'joint2' is negative"):
+        fit = pr.identify_drive_gains(pair.ours, recordings(flipped), [None, PAYLOAD],
+                                      friction="viscous")
+    assert fit.drive_gains["gain"][1] == pytest.approx(-GAINS[1], rel=1e-2)
+
+
+def test_hostile_arguments_are_refused_by_name(setup):
+    pair, _, runs = setup
+    recs = recordings(runs)
+    robot = pair.ours
+
+    def refused(runs_, payloads, says, error=pr.InputError):
+        with pytest.raises(error, match=says):
+            pr.identify_drive_gains(robot, runs_, payloads, friction="viscous")
+
+    refused(recs, [None, None], "every run carries no payload")
+    refused(recs, [PAYLOAD, PAYLOAD], "the same payload")
+    refused(recs, [None], "1 payloads for 2 runs")
+    refused(recs[:1], [PAYLOAD], "1 runs given, expected 2")
+    refused(recs, [None, {**PAYLOAD, "colour": "red"}], r"payloads\[1\].*unknown key 'colour'")
+    refused(recs, [None, {**PAYLOAD, "link": "tool0"}], "'tool0' is not a moving link")
+    refused(recs, [None, {**PAYLOAD, "mass": float("nan")}], "payload.mass is NaN")
+    refused(recs, [None, {**PAYLOAD, "com": [0, 0, 1e9]}], r"payload.com\[2\]")
+    refused(recs, [None, "2 kg"], r"payloads\[1\].*expected None or a dict")
+    refused(recs, [None, {**PAYLOAD, "com": [0, 0]}], "'com' must be 3 real numbers")
+    refused(recs, [None, {**PAYLOAD, "mass": True}], "'mass' must be a real number")
+    refused(recs, [None, {"mass": 2.0}], "'link' and 'mass' are required")
+    refused("runs", [None], "a str, expected a list")
+    refused([recs[0], "run"], [None, PAYLOAD], r"runs\[1\].*expected a Recording")
+    t, q, qd, qdd, i = runs[1]
+    raw = pr.Recording(t, q, i, name="raw")
+    refused([recs[0], raw], [None, PAYLOAD], "'raw' has no velocities")
+    # velocities in degrees per second are caught by the derivative check
+    deg = pr.Recording(t, q, i, qd=np.degrees(qd), qdd=qdd, name="deg")
+    refused([recs[0], deg], [None, PAYLOAD], "degrees per second")
+    other = pr.Recording(t, q[:, :5], i[:, :5], qd=qd[:, :5], qdd=qdd[:, :5], name="five")
+    refused([recs[0], other], [None, PAYLOAD], r"runs\[1\].*'five' has 5 joints, expected the robot's 6")
