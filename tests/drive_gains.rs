@@ -106,6 +106,12 @@ fn the_gains_and_the_robots_torques_come_back_from_currents_with_a_known_payload
         );
     }
     assert_eq!((g.runs, g.loaded_runs), (2, 1));
+    // the runs agree with one robot and the payload: the joint fit leaves what each run does
+    assert!(
+        g.agreement.iter().all(|a| (0.95..1.2).contains(a)),
+        "{:?}",
+        g.agreement
+    );
     assert!(
         g.warnings(&truth.joint_names).is_empty(),
         "{:?}",
@@ -318,6 +324,40 @@ fn a_signal_that_counts_the_other_way_gets_a_negative_gain_and_is_named() {
 }
 
 #[test]
+fn a_run_logged_without_the_payload_given_is_named() {
+    // both runs of the robot alone, the second given as loaded: the fit goes through, and the
+    // residuals say that the runs and the payload do not agree
+    let truth = truth();
+    let (a, b) = (motion(3), motion(4));
+    let p = payload();
+    let (ia, ib) = (
+        currents(&truth, &a, None, 1e-4, 1),
+        currents(&truth, &b, None, 1e-4, 2),
+    );
+    let runs = [
+        GainRun {
+            states: states(&a),
+            signal: &ia,
+            payload: None,
+        },
+        GainRun {
+            states: states(&b),
+            signal: &ib,
+            payload: Some(&p),
+        },
+    ];
+    let fit = identify_drive_gains(&truth, &runs, &BaseOptions::default()).unwrap();
+    let g = fit.gains();
+    assert!(g.agreement.iter().any(|a| *a > 10.0), "{:?}", g.agreement);
+    let w = fit.model.warnings();
+    assert!(
+        w.iter()
+            .any(|w| w.contains("the runs do not agree with the payload as given")),
+        "{w:?}"
+    );
+}
+
+#[test]
 fn the_noise_bias_bounds_what_a_noisy_signal_does_to_the_gains() {
     // a light payload and currents noisy against it: the gains come out low, within the bound
     let truth = truth();
@@ -408,6 +448,10 @@ fn saved_gains_are_checked_on_load() {
             (
                 |v| v["drive_gains"]["gain"][0] = serde_json::json!(1e300),
                 "drive_gains.gain[0] is 1e300",
+            ),
+            (
+                |v| v["drive_gains"]["agreement"][5] = serde_json::json!(null),
+                "drive_gains.agreement[5]",
             ),
         ],
     );

@@ -3,6 +3,7 @@
 
 mod direct;
 mod files;
+mod gains;
 mod info;
 mod local;
 mod paper;
@@ -54,6 +55,10 @@ enum Command {
     /// Identify base parameters (the direct method) from a recording CSV; writes the model
     /// (JSON) and prints the fit.
     IdentifyDirect(direct::IdentifyDirectArgs),
+    /// Identify the joints' drive gains with the base parameters from logs of motor currents,
+    /// some with a known payload bolted on; writes the base-parameter model with the gains
+    /// (JSON) and prints the gains.
+    IdentifyGains(gains::IdentifyGainsArgs),
     /// Torques predicted by a saved model (local or base-parameter) at the states of a CSV.
     Predict(direct::PredictArgs),
     /// A saved model against a log (positions and torques; preprocessed as for
@@ -90,6 +95,7 @@ fn run(cli: Cli) -> Result<String> {
         Command::Identify(a) => local::identify(a),
         Command::Excite(a) => direct::excite(a),
         Command::IdentifyDirect(a) => direct::identify_direct(a),
+        Command::IdentifyGains(a) => gains::identify_gains(a),
         Command::Predict(a) => direct::predict(a),
         Command::Parameters(a) => parameters::run(a),
         Command::Validate(a) => validate::run(a),

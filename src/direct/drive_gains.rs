@@ -40,6 +40,10 @@ pub const LOOSE_GAIN: f64 = 0.05;
 /// [`DriveGains::noise_bias`] beyond which it is warned of.
 pub const NOISE_BIAS: f64 = 0.01;
 
+/// [`DriveGains::agreement`] beyond which the runs are warned of as disagreeing with the
+/// payload given.
+pub const AGREEMENT: f64 = 2.0;
+
 /// One run of the robot: its states, the joints' logged signal and the payload it carried.
 #[derive(Clone, Copy, Debug)]
 pub struct GainRun<'a> {
@@ -71,6 +75,13 @@ pub struct DriveGains {
     /// Per joint, the RMS (N m, or N) of the payloads' torques over the runs that carried one:
     /// what determined the gain's scale.
     pub payload_torque_rms: Vec<f64>,
+    /// Per joint, the joint fit's residual RMS over the RMS each run's signal leaves when that
+    /// joint's row of the model is fitted to it alone, run by run (every coefficient free):
+    /// near 1 where the runs agree with one robot and the payload as given; far above where
+    /// a run did not carry the payload given, the payload's centre of mass or inertia is not
+    /// its own, or the robot changed between the runs. (A payload's mass off by a factor
+    /// scales the gains and the parameters by it, and no data can show that.)
+    pub agreement: Vec<f64>,
     /// cond of the (weighted) regressor of base parameters and gains, columns scaled to unit
     /// norm.
     pub cond: f64,
@@ -87,6 +98,7 @@ impl DriveGains {
             ("stderr", self.stderr.len()),
             ("noise_bias", self.noise_bias.len()),
             ("payload_torque_rms", self.payload_torque_rms.len()),
+            ("agreement", self.agreement.len()),
         ];
         if let Some((field, len)) = lens.iter().find(|(_, l)| *l != n) {
             return Some(format!(
@@ -115,6 +127,7 @@ impl DriveGains {
                 &self.payload_torque_rms,
                 false,
             ),
+            check_magnitudes(what, "drive_gains.agreement", &self.agreement, false),
             check_condition(what, "drive_gains.cond", self.cond),
         ];
         checks
@@ -127,6 +140,16 @@ impl DriveGains {
     /// than [`LOOSE_GAIN`] of themselves, noise biases beyond [`NOISE_BIAS`], negative gains.
     pub fn warnings(&self, names: &[String]) -> Vec<String> {
         let mut out = Vec::new();
+        let apart: Vec<String> = (names.iter().zip(&self.agreement))
+            .filter(|(_, a)| **a > AGREEMENT)
+            .map(|(n, a)| format!("'{n}' {a:.1} times"))
+            .collect();
+        if !apart.is_empty() {
+            out.push(format!(
+                "the runs do not agree with the payload as given: one robot with it leaves residuals larger than each run's signal fitted alone ({}); a run logged without the payload given, a payload's centre of mass or inertia not its own, or a robot that changed between the runs; the gains are not to be trusted",
+                apart.join(", ")
+            ));
+        }
         for (j, name) in names.iter().enumerate().take(self.gain.len()) {
             let (g, se) = (self.gain[j], self.stderr[j]);
             if g < 0.0 {
@@ -380,6 +403,29 @@ pub fn identify_drive_gains(
             }
         })
         .collect::<Result<Vec<f64>>>()?;
+    // each run's signal fitted alone, joint by joint, for the agreement
+    let mut alone = vec![0.0; nv];
+    for (r, run) in runs.iter().enumerate() {
+        if run.states.len() <= p {
+            return Err(bad(format!(
+                "run {r} has {} samples; at least {} are needed to read it against the others",
+                run.states.len(),
+                p + 1
+            )));
+        }
+        let f = JointFactors::new(model, &base, &run.states, run.signal, options.gravity)?;
+        for (a, r) in alone.iter_mut().zip(&f.factors) {
+            *a += beyond_the_rest(r).powi(2);
+        }
+    }
+    let agreement = (0..nv)
+        .map(|j| {
+            let scale: f64 = (0..k).map(|s| signal[s * nv + j].powi(2)).sum::<f64>() / k as f64;
+            let floor = 1e-9 * scale.sqrt();
+            let own = (alone[j] / k as f64).sqrt();
+            (rms[j] / gain[j].abs() + floor) / (own + floor)
+        })
+        .collect();
     let loaded_rows = loaded.len() / nv;
     let payload_torque_rms = (0..nv)
         .map(|j| {
@@ -392,6 +438,7 @@ pub fn identify_drive_gains(
         stderr: stderr[p..].to_vec(),
         noise_bias,
         payload_torque_rms,
+        agreement,
         cond: ls.cond,
         runs: runs.len(),
         loaded_runs: runs
@@ -400,4 +447,21 @@ pub fn identify_drive_gains(
             .count(),
     });
     Ok(DriveGainFit { model: model_fit })
+}
+
+/// The norm of the last column of the triangular factor `r` (`n x n`) beyond the span of the
+/// others: the residual of the least-squares fit of that column on them, by SVD (the others
+/// may be rank deficient: columns zero in a joint's rows).
+fn beyond_the_rest(r: &nalgebra::DMatrix<f64>) -> f64 {
+    let n = r.ncols();
+    let (a, b) = (
+        r.columns(0, n - 1).into_owned(),
+        r.column(n - 1).into_owned(),
+    );
+    let svd = a.clone().svd(true, true);
+    let tol = 1e-10 * svd.singular_values.max();
+    match svd.solve(&b, tol) {
+        Ok(x) => (b - a * x).norm(),
+        Err(_) => b.norm(),
+    }
 }

@@ -357,8 +357,9 @@ impl PyBaseModel {
     }
     /// The joints' drive gains where the model was identified from logged motor currents
     /// (`identify_drive_gains`), else None: dict `gain`, `stderr`, `noise_bias` (an upper
-    /// bound of each gain's relative bias towards 0 from the signal's noise) and
-    /// `payload_torque_rms` (N m), each (n,); `cond` of the joint fit, `runs`, `loaded_runs`.
+    /// bound of each gain's relative bias towards 0 from the signal's noise),
+    /// `payload_torque_rms` (N m) and `agreement` (near 1 where the runs agree with the
+    /// payload as given), each (n,); `cond` of the joint fit, `runs`, `loaded_runs`.
     /// The model's torques are `gain * signal`.
     #[getter]
     fn drive_gains<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {

@@ -151,7 +151,9 @@ fn run_arrays(r: usize, rec: &Recording, nv: usize) -> Result<(&[f64], &[f64])> 
 /// Returns a BaseParameterModel of the robot alone in SI units (its predictions are torques),
 /// with `drive_gains`: `gain` (n,) N m (or N) per unit of the signal, `stderr`, `noise_bias`
 /// (a bound on each gain's relative bias towards 0 from the signal's noise),
-/// `payload_torque_rms` (N m), `cond`, `runs`, `loaded_runs`. `friction`, `weighting`,
+/// `payload_torque_rms` (N m), `agreement` (the fit's residual over each run's signal fitted
+/// alone: near 1 where the runs agree with the payload as given), `cond`, `runs`,
+/// `loaded_runs`. `friction`, `weighting`,
 /// `gravity`, `tolerance`, `seed` as for `identify_base_parameters`. Findings are warned of.
 #[pyfunction]
 #[pyo3(signature = (robot, runs, payloads, friction=None, weighting="wls", gravity=true, tolerance=1e-8, seed=0))]
@@ -245,6 +247,7 @@ pub(crate) fn gains_dict<'py>(py: Python<'py>, g: &DriveGains) -> PyResult<Bound
     d.set_item("stderr", vec1(py, &g.stderr))?;
     d.set_item("noise_bias", vec1(py, &g.noise_bias))?;
     d.set_item("payload_torque_rms", vec1(py, &g.payload_torque_rms))?;
+    d.set_item("agreement", vec1(py, &g.agreement))?;
     d.set_item("cond", g.cond)?;
     d.set_item("runs", g.runs)?;
     d.set_item("loaded_runs", g.loaded_runs)?;

@@ -89,6 +89,7 @@ def test_gains_match_numpy_least_squares_over_pinocchios_regressor(setup):
     err = np.abs(g["gain"] - GAINS)
     assert np.all(err < 4 * g["stderr"] + g["noise_bias"] * GAINS), (g, GAINS)
     assert np.all(g["noise_bias"] < 1e-3) and np.all(g["payload_torque_rms"] > 0.01)
+    assert np.all((g["agreement"] > 0.95) & (g["agreement"] < 1.2))
 
 
 def test_the_model_is_the_robot_alones_in_torques(setup):

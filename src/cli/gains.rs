@@ -1,0 +1,178 @@
+//! `perturbid identify-gains`: drive gains and base parameters from logs of motor currents,
+//! some of them with a known payload ([`crate::direct::drive_gains`]).
+
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+
+use super::files::{
+    in_log, is_inline_json, load_json, refuse_overwriting_inputs, PreprocessArgs, RobotArg,
+};
+use super::progress::Progress;
+use crate::direct::{identify_drive_gains, BaseOptions, FrictionTerms, GainRun, Weighting};
+use crate::document::Document;
+use crate::error::{Error, Result};
+use crate::gravity::Gravity;
+use crate::recording::Recording;
+use crate::rehearsal::Payload;
+
+#[derive(Args)]
+pub(crate) struct IdentifyGainsArgs {
+    #[command(flatten)]
+    robot: RobotArg,
+    /// Recording CSVs of the robot alone: t, q1..qN, and in tau1..tauN each joint's logged
+    /// signal (motor current, A, or a torque computed with nominal gains); optional qd, qdd.
+    #[arg(required = true)]
+    runs: Vec<PathBuf>,
+    /// A recording CSV of a run with the payload bolted on (repeat for more).
+    #[arg(long, required = true)]
+    loaded: Vec<PathBuf>,
+    /// The payload of the --loaded runs: a JSON file, or the JSON itself, {"link": "link6",
+    /// "mass": 2.0, "com": [0, 0, 0.08], "inertia": [ixx, ixy, ixz, iyy, iyz, izz]} (kg, m,
+    /// kg m^2 about its centre of mass, in the link's frame).
+    #[arg(long)]
+    payload: PathBuf,
+    /// Where to write the base-parameter model with its drive gains (JSON).
+    #[arg(long, default_value = "base_model.json")]
+    out: PathBuf,
+    /// Joint terms, comma separated from viscous, coulomb, offset, armature; or none (the
+    /// armature is added when the robot has one).
+    #[arg(long, default_value = "viscous,coulomb,offset")]
+    friction: FrictionTerms,
+    /// wls (weights from the per-joint residuals) or ols.
+    #[arg(long, value_enum, default_value_t = Weighting::Wls)]
+    weighting: Weighting,
+    /// The torques exclude gravity (the robot's controller compensates it in the signal).
+    #[arg(long)]
+    no_gravity: bool,
+    #[command(flatten)]
+    preprocessing: PreprocessArgs,
+}
+
+/// The payload of `--payload`: a JSON file, or the JSON itself.
+fn load_payload(arg: &Path) -> Result<Payload> {
+    let parse = |text: &str| -> Result<Payload> {
+        let p: Payload = serde_json::from_str(text).map_err(|e| Error::Json {
+            context: "payload".into(),
+            message: format!(
+                "{}; expected {{\"link\": ..., \"mass\": kg, \"com\": [x, y, z], \"inertia\": [ixx, ixy, ixz, iyy, iyz, izz]}}",
+                crate::json::describe_error(&e, text)
+            ),
+        })?;
+        match p.problem("payload") {
+            Some(message) => Err(Error::Json {
+                context: "payload".into(),
+                message,
+            }),
+            None => Ok(p),
+        }
+    };
+    match arg.to_str() {
+        Some(text) if is_inline_json(arg) => parse(text).map_err(|e| match e {
+            Error::Json { message, .. } => Error::Json {
+                context: "--payload (given as JSON)".into(),
+                message,
+            },
+            other => other,
+        }),
+        _ => load_json(arg, parse),
+    }
+}
+
+pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
+    let logs: Vec<&PathBuf> = a.runs.iter().chain(&a.loaded).collect();
+    let mut inputs: Vec<&Path> = logs.iter().map(|p| p.as_path()).collect();
+    inputs.push(&a.payload);
+    inputs.push(a.robot.path());
+    refuse_overwriting_inputs(&a.out, &inputs)?;
+    let model = a.robot.load()?;
+    let payload = load_payload(&a.payload)?;
+    // a payload on a link the robot lacks is named before any log is read
+    payload.body(&model)?;
+    let progress = Progress::new();
+    let mut out = String::new();
+    let recordings = logs
+        .iter()
+        .map(|path| {
+            a.preprocessing
+                .read(path, &model.joint_names, &progress, &mut out)
+        })
+        .collect::<Result<Vec<Recording>>>()?;
+    let states = recordings
+        .iter()
+        .zip(&logs)
+        .map(|(r, path)| r.states().map_err(in_log(path)))
+        .collect::<Result<Vec<_>>>()?;
+    let runs: Vec<GainRun<'_>> = (states.into_iter().zip(&recordings).enumerate())
+        .map(|(i, (states, rec))| GainRun {
+            states,
+            signal: &rec.tau,
+            payload: (i >= a.runs.len()).then_some(&payload),
+        })
+        .collect();
+    let options = BaseOptions {
+        friction: a.friction,
+        weighting: a.weighting,
+        gravity: Gravity::from(!a.no_gravity),
+        ..BaseOptions::default()
+    };
+    let k: usize = runs.iter().map(|r| r.states.len()).sum();
+    progress.update(&format!(
+        "identifying on {k} samples of {} runs",
+        runs.len()
+    ));
+    let fit = identify_drive_gains(&model, &runs, &options).map_err(|e| match e {
+        // an error about one run's data names its file
+        Error::InvalidArgument { argument, message } if argument == "runs" => {
+            let file = (0..logs.len()).find(|r| {
+                message.starts_with(&format!("run {r}:"))
+                    || message.starts_with(&format!("run {r} "))
+            });
+            Error::InvalidArgument {
+                argument: file.map_or("runs".into(), |r| logs[r].display().to_string()),
+                message,
+            }
+        }
+        other => other,
+    })?;
+    progress.done();
+    let fit = fit.model;
+    for w in fit.warnings() {
+        eprintln!("perturbid: warning: {w}");
+    }
+    fit.save(&a.out)?;
+    let g = fit
+        .drive_gains
+        .as_ref()
+        .expect("a drive-gain fit holds its gains");
+    let _ = writeln!(
+        out,
+        "drive gains from {} runs ({} with {} kg on '{}'), {k} samples, cond {:.3e}:",
+        g.runs, g.loaded_runs, payload.mass, payload.link, g.cond
+    );
+    let _ = writeln!(
+        out,
+        "  {:<16} {:>14} {:>12} {:>12} {:>16}",
+        "joint", "gain", "std. error", "noise bias", "payload torque"
+    );
+    for (j, name) in model.joint_names.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "  {:<16} {:>14.6} {:>12.2e} {:>10.2} % {:>16.4}",
+            name,
+            g.gain[j],
+            g.stderr[j],
+            100.0 * g.noise_bias[j],
+            g.payload_torque_rms[j]
+        );
+    }
+    let _ = writeln!(
+        out,
+        "{} base parameters of the robot alone (torques: gain x signal), cond {:.3e} -> {}",
+        fit.theta.len(),
+        fit.cond,
+        a.out.display()
+    );
+    Ok(out)
+}

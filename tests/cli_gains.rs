@@ -1,0 +1,162 @@
+//! `perturbid identify-gains` end to end: logs of currents with and without a known payload
+//! give the gains and a model of the robot alone; bad payloads are refused by name with
+//! nothing written.
+
+mod cli_support;
+
+use cli_support::{fails, nothing_written, ok, s, tmp, warnings_of, write};
+use nalgebra::DMatrix;
+use perturbid_rs::direct::BaseModel;
+use perturbid_rs::io::recording_table;
+use perturbid_rs::rehearsal::{Payload, TrueRobot};
+use perturbid_rs::trajectory::FourierTrajectory;
+use perturbid_rs::{parallel, Document, Gravity, Recording, States};
+
+const GAINS: [f64; 6] = [42.0, 65.0, 38.0, 9.0, 7.5, 4.0];
+const PAYLOAD: &str = r#"{"link": "link6", "mass": 2.0, "com": [0.02, -0.01, 0.08], "inertia": [0.004, 0, 0, 0.004, 0, 0.002]}"#;
+
+/// A log of the A465's currents along a seeded excitation (8 s at 500 Hz), with viscous
+/// friction and a deterministic 1e-4 A of noise, with the payload where given.
+fn log(path: &std::path::Path, seed: u64, payload: Option<&Payload>) {
+    let truth = perturbid_rs::robots::a465::model("kinsheel2010").unwrap();
+    let robot = match payload {
+        Some(p) => TrueRobot {
+            payload: Some(p.clone()),
+            ..TrueRobot::default()
+        }
+        .rigid_body_model(&truth)
+        .unwrap(),
+        None => truth,
+    };
+    let c =
+        |r: usize, c: usize| (((seed as usize * 31 + r * 7 + c * 13) as f64) * 0.37).sin() * 0.12;
+    let traj = FourierTrajectory::new(
+        2.0 * std::f64::consts::PI * 0.125,
+        vec![0.2, 0.3, -0.4, 0.1, 0.5, -0.2],
+        DMatrix::from_fn(6, 5, c),
+        DMatrix::from_fn(6, 5, |r, k| c(r + 6, k)),
+    )
+    .unwrap();
+    let t: Vec<f64> = (0..4000).map(|i| i as f64 * 2e-3).collect();
+    let x = traj.sample(&t);
+    let states = States::new(6, &x.q, Some(&x.qd), Some(&x.qdd)).unwrap();
+    let mut tau = vec![0.0; x.q.len()];
+    parallel::rnea(
+        &robot,
+        &mut parallel::Workspace::new(&robot),
+        &states,
+        Gravity::Included,
+        &mut tau,
+    )
+    .unwrap();
+    let current: Vec<f64> = (tau.iter().enumerate())
+        .map(|(i, v)| {
+            (v + 0.3 * x.qd[i]) / GAINS[i % 6] + 1e-4 * ((i as f64 * 0.618_034).fract() - 0.5) * 3.4
+        })
+        .collect();
+    let rec = Recording::new("log", 6, t, x.q, current, Some(x.qd), Some(x.qdd)).unwrap();
+    write(path, &recording_table(&rec, "").to_csv());
+}
+
+#[test]
+fn gains_and_the_robot_alone_from_logs_of_currents() {
+    let d = tmp("gains");
+    let payload: Payload = serde_json::from_str(PAYLOAD).unwrap();
+    log(&d.join("alone.csv"), 1, None);
+    log(&d.join("loaded.csv"), 2, Some(&payload));
+    write(&d.join("payload.json"), PAYLOAD);
+    let out = ok(&[
+        "identify-gains",
+        "a465",
+        s(&d.join("alone.csv")),
+        "--loaded",
+        s(&d.join("loaded.csv")),
+        "--payload",
+        s(&d.join("payload.json")),
+        "--friction",
+        "viscous",
+        "--out",
+        s(&d.join("model.json")),
+    ]);
+    assert!(
+        out.contains("drive gains from 2 runs (1 with 2 kg on 'link6')"),
+        "{out}"
+    );
+    let model = BaseModel::load(d.join("model.json")).unwrap();
+    let g = model.drive_gains.as_ref().unwrap();
+    for j in 0..6 {
+        assert!((g.gain[j] / GAINS[j] - 1.0).abs() < 1e-2, "{out}");
+        assert!(out.contains(&format!("{:.6}", g.gain[j])), "{out}");
+    }
+    // the payload given inline, and the model predicts the robot's torques
+    let out = ok(&[
+        "identify-gains",
+        "a465",
+        s(&d.join("alone.csv")),
+        "--loaded",
+        s(&d.join("loaded.csv")),
+        "--payload",
+        PAYLOAD,
+        "--friction",
+        "viscous",
+        "--out",
+        s(&d.join("inline.json")),
+    ]);
+    assert!(out.contains("base parameters of the robot alone"), "{out}");
+    assert_eq!(BaseModel::load(d.join("inline.json")).unwrap(), model);
+}
+
+#[test]
+fn bad_payloads_and_runs_are_refused_by_name() {
+    let d = tmp("gains-bad");
+    log(&d.join("alone.csv"), 1, None);
+    let args = |payload: &str, out: &str| -> Vec<String> {
+        [
+            "identify-gains",
+            "a465",
+            s(&d.join("alone.csv")),
+            "--loaded",
+            s(&d.join("alone.csv")),
+            "--payload",
+            payload,
+            "--out",
+            out,
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    let out = d.join("model.json");
+    let run = |payload: &str, needles: &[&str]| {
+        let a = args(payload, s(&out));
+        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        fails(&a, needles);
+        nothing_written(&d, "model.json");
+    };
+    run(
+        r#"{"link": "tool0", "mass": 1.0}"#,
+        &["'tool0' is not a moving link", "link6"],
+    );
+    run(
+        r#"{"link": "link6", "mass": -1.0}"#,
+        &["--payload", "payload.mass is -1"],
+    );
+    run(
+        r#"{"link": "link6", "mass": 1.0, "colour": "red"}"#,
+        &["--payload", "unknown field `colour`"],
+    );
+    run(
+        &d.join("missing.json").display().to_string(),
+        &["missing.json"],
+    );
+    // a log without the payload given as loaded: fitted, and said
+    write(&d.join("p.json"), PAYLOAD);
+    log(&d.join("other.csv"), 2, None);
+    let mut a = args(s(&d.join("p.json")), s(&out));
+    a[4] = s(&d.join("other.csv")).into();
+    let a: Vec<&str> = a.iter().map(String::as_str).collect();
+    let e = warnings_of(&a);
+    assert!(
+        e.contains("the runs do not agree with the payload as given"),
+        "{e}"
+    );
+}
