@@ -65,43 +65,34 @@ fn gains_and_the_robot_alone_from_logs_of_currents() {
     log(&d.join("alone.csv"), 1, None);
     log(&d.join("loaded.csv"), 2, Some(&payload));
     write(&d.join("payload.json"), PAYLOAD);
-    let out = ok(&[
-        "identify-gains",
-        "a465",
-        s(&d.join("alone.csv")),
-        "--loaded",
-        s(&d.join("loaded.csv")),
-        "--payload",
-        s(&d.join("payload.json")),
-        "--friction",
-        "viscous",
-        "--out",
-        s(&d.join("model.json")),
-    ]);
+    let run = |payload: &str, out: &str| {
+        ok(&[
+            "identify-gains",
+            "a465",
+            s(&d.join("alone.csv")),
+            "--loaded",
+            s(&d.join("loaded.csv")),
+            "--payload",
+            payload,
+            "--friction",
+            "viscous",
+            "--out",
+            s(&d.join(out)),
+        ])
+    };
+    let out = run(s(&d.join("payload.json")), "model.json");
     assert!(
         out.contains("drive gains from 2 runs (1 with 2 kg on 'link6')"),
         "{out}"
     );
     let model = BaseModel::load(d.join("model.json")).unwrap();
     let g = model.drive_gains.as_ref().unwrap();
-    for j in 0..6 {
-        assert!((g.gain[j] / GAINS[j] - 1.0).abs() < 1e-2, "{out}");
-        assert!(out.contains(&format!("{:.6}", g.gain[j])), "{out}");
+    for (gain, truth) in g.gain.iter().zip(GAINS) {
+        assert!((gain / truth - 1.0).abs() < 1e-2, "{out}");
+        assert!(out.contains(&format!("{gain:.6}")), "{out}");
     }
-    // the payload given inline, and the model predicts the robot's torques
-    let out = ok(&[
-        "identify-gains",
-        "a465",
-        s(&d.join("alone.csv")),
-        "--loaded",
-        s(&d.join("loaded.csv")),
-        "--payload",
-        PAYLOAD,
-        "--friction",
-        "viscous",
-        "--out",
-        s(&d.join("inline.json")),
-    ]);
+    // the payload given inline: the same model
+    let out = run(PAYLOAD, "inline.json");
     assert!(out.contains("base parameters of the robot alone"), "{out}");
     assert_eq!(BaseModel::load(d.join("inline.json")).unwrap(), model);
 }

@@ -658,10 +658,10 @@ class BaseParameterModel:
     @property
     def drive_gains(self) -> dict[str, Any] | None:
         """Where the model was identified from logged motor currents (identify_drive_gains),
-        else None: gain, stderr, noise_bias (a bound on each gain's relative bias towards 0
-        from the signal's noise), payload_torque_rms (N m), agreement (near 1 where the
-        runs agree with the payload as given), each (n,); cond, runs, loaded_runs. The
-        model's torques are gain * signal."""
+        else None: gain, stderr, noise_bias (each gain's relative bias towards 0, were
+        every residual the signal's noise), payload_torque_rms (N m), agreement (near 1
+        where the runs agree with the payload as given), each (n,); cond, runs,
+        loaded_runs. The model's torques are gain * signal."""
     @property
     def weak_excitation(self) -> dict[str, Any] | None:
         """Where the data excite the base parameters weakly (cond beyond 2000), else None:

@@ -118,6 +118,32 @@ pub(crate) fn excite(a: ExciteArgs) -> Result<String> {
     Ok(out)
 }
 
+/// The terms and weighting of a direct fit (`identify-direct`, `identify-gains`).
+#[derive(Args)]
+pub(crate) struct FitArgs {
+    /// Joint terms, comma separated from viscous, coulomb, offset, armature; or none (the
+    /// armature is added when the robot has one).
+    #[arg(long, default_value = "viscous,coulomb,offset")]
+    friction: FrictionTerms,
+    /// wls (weights from the per-joint residuals) or ols.
+    #[arg(long, value_enum, default_value_t = Weighting::Wls)]
+    weighting: Weighting,
+    /// The torques exclude gravity (the robot's controller compensates it in what it logs).
+    #[arg(long)]
+    no_gravity: bool,
+}
+
+impl FitArgs {
+    pub(crate) fn options(&self) -> BaseOptions {
+        BaseOptions {
+            friction: self.friction,
+            weighting: self.weighting,
+            gravity: Gravity::from(!self.no_gravity),
+            ..BaseOptions::default()
+        }
+    }
+}
+
 #[derive(Args)]
 pub(crate) struct IdentifyDirectArgs {
     #[command(flatten)]
@@ -128,16 +154,8 @@ pub(crate) struct IdentifyDirectArgs {
     /// Where to write the base-parameter model (JSON).
     #[arg(long, default_value = "base_model.json")]
     out: PathBuf,
-    /// Joint terms, comma separated from viscous, coulomb, offset, armature; or none (the
-    /// armature is added when the robot has one).
-    #[arg(long, default_value = "viscous,coulomb,offset")]
-    friction: FrictionTerms,
-    /// wls (weights from the per-joint residuals) or ols.
-    #[arg(long, value_enum, default_value_t = Weighting::Wls)]
-    weighting: Weighting,
-    /// The torques exclude gravity.
-    #[arg(long)]
-    no_gravity: bool,
+    #[command(flatten)]
+    fit: FitArgs,
     #[command(flatten)]
     preprocessing: PreprocessArgs,
     /// Fit on the first (1 - FRACTION) of the samples and report the errors on the rest.
@@ -179,12 +197,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
             ),
         });
     }
-    let options = BaseOptions {
-        friction: a.friction,
-        weighting: a.weighting,
-        gravity: Gravity::from(!a.no_gravity),
-        ..BaseOptions::default()
-    };
+    let options = a.fit.options();
     progress.update(&format!("identifying on {split} samples"));
     // with the Coulomb term's column filtered as the torques were
     let states = rec.states()?;

@@ -6,14 +6,14 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 
+use super::direct::FitArgs;
 use super::files::{
     in_log, is_inline_json, load_json, refuse_overwriting_inputs, PreprocessArgs, RobotArg,
 };
 use super::progress::Progress;
-use crate::direct::{identify_drive_gains, BaseOptions, FrictionTerms, GainRun, Weighting};
+use crate::direct::{identify_drive_gains, GainRun};
 use crate::document::Document;
 use crate::error::{Error, Result};
-use crate::gravity::Gravity;
 use crate::recording::Recording;
 use crate::rehearsal::Payload;
 
@@ -36,16 +36,8 @@ pub(crate) struct IdentifyGainsArgs {
     /// Where to write the base-parameter model with its drive gains (JSON).
     #[arg(long, default_value = "base_model.json")]
     out: PathBuf,
-    /// Joint terms, comma separated from viscous, coulomb, offset, armature; or none (the
-    /// armature is added when the robot has one).
-    #[arg(long, default_value = "viscous,coulomb,offset")]
-    friction: FrictionTerms,
-    /// wls (weights from the per-joint residuals) or ols.
-    #[arg(long, value_enum, default_value_t = Weighting::Wls)]
-    weighting: Weighting,
-    /// The torques exclude gravity (the robot's controller compensates it in the signal).
-    #[arg(long)]
-    no_gravity: bool,
+    #[command(flatten)]
+    fit: FitArgs,
     #[command(flatten)]
     preprocessing: PreprocessArgs,
 }
@@ -111,12 +103,7 @@ pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
             payload: (i >= a.runs.len()).then_some(&payload),
         })
         .collect();
-    let options = BaseOptions {
-        friction: a.friction,
-        weighting: a.weighting,
-        gravity: Gravity::from(!a.no_gravity),
-        ..BaseOptions::default()
-    };
+    let options = a.fit.options();
     let k: usize = runs.iter().map(|r| r.states.len()).sum();
     progress.update(&format!(
         "identifying on {k} samples of {} runs",

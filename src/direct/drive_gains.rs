@@ -1,6 +1,6 @@
 //! Joint drive gains identified with the base parameters, for robots that log their motors'
 //! currents (or torques computed from them with nominal gains) instead of joint torques
-//! (docs/method.md, section 8d; the approach of Gautier & Briot, "Global identification of joint
+//! (docs/method.md, section 8c; the approach of Gautier & Briot, "Global identification of joint
 //! drive gains and dynamic parameters of robots", 2014).
 //!
 //! Joint `j`'s logged signal `i_j` is its torque over a gain `K_j` (N m, or N for a prismatic
@@ -17,9 +17,9 @@
 //! WLS. The payload fixes the scale: with the same payload (or none) in every run, `theta` and
 //! `K` could be scaled together and the data would not tell, so such runs are refused.
 //!
-//! The signal's noise sits in a column of the regressor, where it biases the gains towards 0 by
-//! about `var(noise) / var(signal beyond the rest of the model)`: [`DriveGains::noise_bias`]
-//! bounds it, taking every residual for the signal's noise.
+//! The signal's noise sits in columns of the regressor, where it biases the gains towards 0:
+//! [`DriveGains::noise_bias`] estimates by how much, taking every residual for the signal's
+//! noise.
 
 use serde::{Deserialize, Serialize};
 
@@ -67,10 +67,11 @@ pub struct DriveGains {
     /// Their standard errors (inflated for residuals correlated from sample to sample, as the
     /// model's are).
     pub stderr: Vec<f64>,
-    /// Per joint, an upper bound of the gain's relative bias towards 0 from noise in the
-    /// logged signal: `(rms / K)^2 / (|i_perp|^2 / k)`, with the joint's residual RMS `rms`
-    /// taken for the signal's noise and `i_perp` its signal beyond what every other column of
-    /// the (weighted) fit explains.
+    /// Per joint, the gain's relative bias towards 0 were every residual noise of the logged
+    /// signal (an upper estimate; 0 where the estimate points away from 0): the errors in the
+    /// signal's columns bias least squares by `-(X^T W^2 X)^-1 Sigma_uu theta`, `Sigma_uu`
+    /// holding `k (rms_j / (K_j sigma_j))^2` at joint `j`'s signal column. The gains share one
+    /// scale with each other and the parameters, so every joint's noise biases every gain.
     pub noise_bias: Vec<f64>,
     /// Per joint, the RMS (N m, or N) of the payloads' torques over the runs that carried one:
     /// what determined the gain's scale.
@@ -383,21 +384,30 @@ pub fn identify_drive_gains(
     model_fit.residual_rms = rms.clone();
     model_fit.sigma = sigma;
 
-    // the gains' noise bias: joint j's weighted signal column beyond every other column has
-    // squared norm 1 / cov_diag (the unscaled covariance's diagonal), against k samples of
-    // noise of at most rms / (|K| sigma) each in the same weighted units
+    // the gains' noise bias: errors in the columns bias least squares by -(X^T W^2 X)^-1
+    // Sigma_uu theta, Sigma_uu holding k (noise / sigma)^2 at each joint's signal column (its
+    // rows weighted by 1 / sigma); the gains share one scale with each other and the
+    // parameters, so every joint's noise biases every gain. The noise taken for the whole
+    // residual, rms / |K|.
+    let cov =
+        |a: usize, b: usize| ls.correlation[(a, b)] * (ls.cov_diag[a] * ls.cov_diag[b]).sqrt();
     let noise_bias = (0..nv)
-        .map(|j| {
-            let noise = rms[j] / (gain[j].abs() * model_fit.sigma[j]);
-            let bias = noise * noise * k as f64 * ls.cov_diag[p + j];
+        .map(|m| {
+            let sum: f64 = (0..nv)
+                .map(|j| {
+                    let w = rms[j] / model_fit.sigma[j];
+                    cov(p + m, p + j) * k as f64 * w * w / gain[j]
+                })
+                .sum();
+            let bias = sum / gain[m];
             if bias.is_finite() {
-                Ok(bias)
+                Ok(bias.max(0.0))
             } else {
                 Err(Error::Numerical {
                     operation: "drive-gain identification".into(),
                     message: format!(
                         "joint '{}': its signal is explained whole by the model's other columns, so its gain is not determined",
-                        model.joint_names[j]
+                        model.joint_names[m]
                     ),
                 })
             }

@@ -125,6 +125,17 @@ pub struct JointFactors {
     pub factors: Vec<DMatrix<f64>>,
 }
 
+/// The samples a fit reduces, row-major over the whole batch: the states `x` (`[q, qd, qdd,
+/// coulomb]`, `coulomb` the Coulomb term's column, [`States::coulomb_at`]), the joints'
+/// columns of data `extra` (each `k x nv`) and the torques `tau`; `gravity` in the regressor.
+#[derive(Clone, Copy)]
+struct Batch<'a> {
+    x: [&'a [f64]; 4],
+    extra: &'a [&'a [f64]],
+    tau: &'a [f64],
+    gravity: Gravity,
+}
+
 /// One worker's buffers: a `Data`, the regressor of one sample, and per joint a column-major
 /// `(n_j + 1 + CHUNK) x (n_j + 1)` matrix whose top rows carry the factor so far (zeros at
 /// first) and whose other rows take the next chunk.
@@ -163,18 +174,15 @@ impl Worker {
         }
     }
 
-    /// Reduces samples `range` into the factors.
+    /// Reduces samples `range` of `batch` into the factors.
     fn absorb(
         &mut self,
         model: &Model,
         columns: &[JointColumns],
-        x: [&[f64]; 4],
-        extra: &[&[f64]],
-        tau: &[f64],
-        gravity: Gravity,
+        batch: &Batch<'_>,
         range: std::ops::Range<usize>,
     ) -> Result<()> {
-        self.fill(model, columns, x, extra, tau, gravity, range.clone())?;
+        self.fill(model, columns, batch, range.clone())?;
         for a in &mut self.stacks {
             let rows = a.ncols() + range.len();
             factor_top(
@@ -195,22 +203,22 @@ impl Worker {
 }
 
 impl Worker {
-    /// Writes the rows of samples `range` of the states `[q, qd, qdd, coulomb]` (row-major,
-    /// the whole batch; `coulomb` the Coulomb term's column, [`States::coulomb_at`]) and of
-    /// the joints' columns of data `extra` (each row-major `k x nv`) below the factors: the
-    /// regressor [`LaneData::width`] samples at a time by the multi-sample kernel
-    /// ([`regressor_group`]), read in place.
-    #[allow(clippy::too_many_arguments)]
+    /// Writes the rows of samples `range` of `batch` below the factors: the regressor
+    /// [`LaneData::width`] samples at a time by the multi-sample kernel ([`regressor_group`]),
+    /// read in place.
     fn fill(
         &mut self,
         model: &Model,
         columns: &[JointColumns],
-        [q, qd, qdd, coulomb]: [&[f64]; 4],
-        extra: &[&[f64]],
-        tau: &[f64],
-        gravity: Gravity,
+        batch: &Batch<'_>,
         range: std::ops::Range<usize>,
     ) -> Result<()> {
+        let Batch {
+            x: [q, qd, qdd, coulomb],
+            extra,
+            tau,
+            gravity,
+        } = *batch;
         let nv = model.nv;
         let mut first = range.start;
         while first < range.end {
@@ -320,8 +328,9 @@ impl JointFactors {
     }
 
     /// [`JointFactors::new`] with `extra` columns of data per joint beside the base columns:
-    /// each row-major `k x nv`, joint `j`'s rows reading its entry `j` of each (`extra[c][s nv
-    /// + j]` at sample `s`), as unknowns `p + j e + c` (`e = extra.len()`, at most 4).
+    /// each row-major `k x nv`, joint `j`'s rows reading its entry `j` of each
+    /// (`extra[c][s * nv + j]` at sample `s`), as unknowns `p + j e + c` (`e = extra.len()`,
+    /// at most 4).
     pub fn with_columns(
         model: &Model,
         base: &BaseParameters,
@@ -354,7 +363,12 @@ impl JointFactors {
                 .map(|&v| crate::direct::parameters::sign0(v))
                 .collect(),
         };
-        let x = [states.q(), &qd[..], &qdd[..], &coulomb[..]];
+        let batch = Batch {
+            x: [states.q(), &qd[..], &qdd[..], &coulomb[..]],
+            extra,
+            tau,
+            gravity,
+        };
         let p = base.len();
         let columns = JointColumns::new(model, base);
         let chunks: Vec<std::ops::Range<usize>> = (0..k)
@@ -371,7 +385,7 @@ impl JointFactors {
                 let mut w = Worker::new(model, &columns, e);
                 for range in run {
                     crate::interrupt::check("identification")?;
-                    w.absorb(model, &columns, x, extra, tau, gravity, range.clone())?;
+                    w.absorb(model, &columns, &batch, range.clone())?;
                 }
                 Ok(w.factors())
             })

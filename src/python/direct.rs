@@ -195,6 +195,22 @@ pub(crate) fn base_options(
     })
 }
 
+/// [`base_options`] with the base parameters' rank `tolerance` and random states' `seed`, as
+/// the fits take them.
+pub(crate) fn fit_options(
+    friction: Option<FrictionNames<'_>>,
+    weighting: &str,
+    gravity: bool,
+    tolerance: f64,
+    seed: u64,
+) -> PyResult<BaseOptions> {
+    Ok(BaseOptions {
+        tolerance,
+        seed,
+        ..base_options(friction, weighting, gravity)?
+    })
+}
+
 /// An identified base-parameter model (the direct method).
 ///
 /// - `theta_base` (p,), `stderr` (p,), `names` (p,): the base parameters, each a kept full
@@ -357,7 +373,7 @@ impl PyBaseModel {
     }
     /// The joints' drive gains where the model was identified from logged motor currents
     /// (`identify_drive_gains`), else None: dict `gain`, `stderr`, `noise_bias` (an upper
-    /// bound of each gain's relative bias towards 0 from the signal's noise),
+    /// estimate of each gain's relative bias towards 0, were every residual the signal's noise),
     /// `payload_torque_rms` (N m) and `agreement` (near 1 where the runs agree with the
     /// payload as given), each (n,); `cond` of the joint fit, `runs`, `loaded_runs`.
     /// The model's torques are `gain * signal`.
@@ -539,11 +555,7 @@ pub(crate) fn identify_base_parameters<'py>(
     t: Option<Bound<'py, PyAny>>,
     coulomb: Option<Bound<'py, PyAny>>,
 ) -> PyResult<PyBaseModel> {
-    let options = BaseOptions {
-        tolerance,
-        seed,
-        ..base_options(friction, weighting, gravity)?
-    };
+    let options = fit_options(friction, weighting, gravity, tolerance, seed)?;
     let model = &robot.model;
     let given = Given {
         qd,

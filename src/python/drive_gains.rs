@@ -10,12 +10,11 @@ use pyo3::types::{PyDict, PyList, PyTuple};
 
 use super::arrays::vec1;
 use super::detached;
-use super::direct::{base_options, check_sample_derivatives, FrictionNames, PyBaseModel};
+use super::direct::{check_sample_derivatives, fit_options, FrictionNames, PyBaseModel};
 use super::recording::PyRecording;
 use super::robot::PyRobot;
 use super::scalars;
 use crate::direct::drive_gains::{identify_drive_gains as gains_rs, DriveGains, GainRun, MAX_RUNS};
-use crate::direct::BaseOptions;
 use crate::error::{Error, Result};
 use crate::recording::Recording;
 use crate::rehearsal::Payload;
@@ -140,7 +139,7 @@ fn run_arrays(r: usize, rec: &Recording, nv: usize) -> Result<(&[f64], &[f64])> 
     }
 }
 
-/// Identifies the joints' drive gains with the base parameters (docs/method.md, section 8d)
+/// Identifies the joints' drive gains with the base parameters (docs/method.md, section 8c)
 /// from `runs`, Recordings of the robot whose `tau` holds each joint's logged signal (motor
 /// currents, A, or torques computed with nominal gains), preprocessed (with `qd` and `qdd`),
 /// and `payloads`, one a run: None for the robot alone, or the known payload bolted on during
@@ -150,7 +149,7 @@ fn run_arrays(r: usize, rec: &Recording, nv: usize) -> Result<(&[f64], &[f64])> 
 ///
 /// Returns a BaseParameterModel of the robot alone in SI units (its predictions are torques),
 /// with `drive_gains`: `gain` (n,) N m (or N) per unit of the signal, `stderr`, `noise_bias`
-/// (a bound on each gain's relative bias towards 0 from the signal's noise),
+/// (each gain's relative bias towards 0 were every residual the signal's noise),
 /// `payload_torque_rms` (N m), `agreement` (the fit's residual over each run's signal fitted
 /// alone: near 1 where the runs agree with the payload as given), `cond`, `runs`,
 /// `loaded_runs`. `friction`, `weighting`,
@@ -169,11 +168,7 @@ pub(crate) fn identify_drive_gains(
     #[pyo3(from_py_with = scalars::real)] tolerance: f64,
     #[pyo3(from_py_with = scalars::seed)] seed: u64,
 ) -> PyResult<PyBaseModel> {
-    let options = BaseOptions {
-        tolerance,
-        seed,
-        ..base_options(friction, weighting, gravity)?
-    };
+    let options = fit_options(friction, weighting, gravity, tolerance, seed)?;
     let model = &robot.model;
     let (runs, payloads) = (entries("runs", &runs)?, entries("payloads", &payloads)?);
     if runs.len() != payloads.len() {
@@ -202,7 +197,7 @@ pub(crate) fn identify_drive_gains(
         recordings.push(rec.get().rec.clone());
     }
     let payloads = (payloads.iter().enumerate())
-        .map(|(r, p)| payload_of(r, &p))
+        .map(|(r, p)| payload_of(r, p))
         .collect::<PyResult<Vec<_>>>()?;
     let fit = detached(py, "identify_drive_gains", || {
         let mut gain_runs = Vec::with_capacity(recordings.len());

@@ -85,7 +85,7 @@ def test_gains_match_numpy_least_squares_over_pinocchios_regressor(setup):
     scale[scale == 0] = 1.0
     sol = np.linalg.lstsq(x / scale, np.concatenate(rhs), rcond=1e-12)[0] / scale
     np.testing.assert_allclose(g["gain"], sol[-6:], rtol=1e-8)
-    # and the truth, within the standard errors and the bound on the noise's bias
+    # and the truth, within the standard errors and the noise's estimated bias
     err = np.abs(g["gain"] - GAINS)
     assert np.all(err < 4 * g["stderr"] + g["noise_bias"] * GAINS), (g, GAINS)
     assert np.all(g["noise_bias"] < 1e-3) and np.all(g["payload_torque_rms"] > 0.01)
