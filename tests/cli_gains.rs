@@ -95,6 +95,75 @@ fn gains_and_the_robot_alone_from_logs_of_currents() {
     let out = run(PAYLOAD, "inline.json");
     assert!(out.contains("base parameters of the robot alone"), "{out}");
     assert_eq!(BaseModel::load(d.join("inline.json")).unwrap(), model);
+    // a third run of the robot alone: its currents predicted, and validated in torques
+    log(&d.join("third.csv"), 3, None);
+    let model_path = d.join("model.json");
+    let m = s(&model_path);
+    let out = ok(&[
+        "predict",
+        m,
+        s(&d.join("third.csv")),
+        "--robot",
+        "a465",
+        "--signal",
+        "--stderr",
+        "--out",
+        s(&d.join("currents.csv")),
+    ]);
+    assert!(
+        out.contains("predicted signals (torques over the drive gains)")
+            && out.contains("(signal units)"),
+        "{out}"
+    );
+    let predicted = perturbid_rs::io::Table::read(&d.join("currents.csv")).unwrap();
+    let logged = perturbid_rs::io::Table::read(&d.join("third.csv")).unwrap();
+    for j in 1..=6 {
+        let col = |t: &perturbid_rs::io::Table, name: String| t.column(t.index(&name).unwrap());
+        let (p, l) = (
+            col(&predicted, format!("signal{j}")),
+            col(&logged, format!("tau{j}")),
+        );
+        let rms =
+            (p.iter().zip(&l).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / p.len() as f64).sqrt();
+        assert!(rms < 1e-3, "joint {j}: {rms} A");
+        assert!(predicted.index(&format!("signal{j}_stderr")).is_some());
+    }
+    let out = ok(&[
+        "validate",
+        m,
+        s(&d.join("third.csv")),
+        "--robot",
+        "a465",
+        "--signal",
+        "--out",
+        s(&d.join("validation")),
+    ]);
+    assert!(
+        out.contains("the log's signal times the model's drive gains: torques"),
+        "{out}"
+    );
+    // a model without gains has no signal
+    ok(&[
+        "identify-direct",
+        "a465",
+        s(&d.join("third.csv")),
+        "--out",
+        s(&d.join("plain.json")),
+    ]);
+    fails(
+        &[
+            "predict",
+            s(&d.join("plain.json")),
+            s(&d.join("third.csv")),
+            "--robot",
+            "a465",
+            "--signal",
+            "--out",
+            s(&d.join("x.csv")),
+        ],
+        &["--signal", "plain.json' holds no drive gains"],
+    );
+    nothing_written(&d, "x.csv");
 }
 
 #[test]

@@ -341,12 +341,22 @@ pub(crate) struct PredictArgs {
     /// Joints of --robot held still, as when the model was identified (JOINT=VALUE, repeat).
     #[arg(long = "lock", value_name = "JOINT=VALUE", value_parser = super::files::parse_lock)]
     lock: Vec<(String, f64)>,
+    /// Predict the signal the model's drive gains were identified for (motor currents: a
+    /// model from identify-gains), each torque over its joint's gain: columns
+    /// signal1..signalN (and signal1_stderr..); tau1..tauN of the states CSV read as that
+    /// signal.
+    #[arg(long)]
+    signal: bool,
 }
 
 pub(crate) fn predict(a: PredictArgs) -> Result<String> {
     refuse_overwriting_inputs(&a.out, &[&a.model, &a.data])?;
     let file = ModelFile::load(&a.model)?;
     let joints = file.joint_names().to_vec();
+    let gains = a
+        .signal
+        .then(|| super::gains::model_gains(&file, &a.model))
+        .transpose()?;
     let rows = read_states(&crate::io::Table::read(&a.data)?, &joints)?;
     let states = States::new(joints.len(), &rows.q, Some(&rows.qd), Some(&rows.qdd))?;
     let (tau, stderr) = match &file {
@@ -387,12 +397,27 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
         }
         ModelFile::GlobalLinear(m) => (m.predict(&states)?, None),
     };
+    // the signal: each torque over its joint's gain (the standard errors over its size)
+    let (tau, stderr, name, unit) = match gains {
+        Some(g) => {
+            let inverse: Vec<f64> = g.iter().map(|k| 1.0 / k).collect();
+            let size: Vec<f64> = inverse.iter().map(|k| k.abs()).collect();
+            let se = stderr.map(|se| super::gains::scaled_columns(&se, &size));
+            (
+                super::gains::scaled_columns(&tau, &inverse),
+                se,
+                "signal",
+                "signal units",
+            )
+        }
+        None => (tau, stderr, "tau", "N m"),
+    };
     let states = rows;
     let n = joints.len();
     let mut columns = vec!["t".to_string()];
-    columns.extend((1..=n).map(|j| format!("tau{j}")));
+    columns.extend((1..=n).map(|j| format!("{name}{j}")));
     if stderr.is_some() {
-        columns.extend((1..=n).map(|j| format!("tau{j}_stderr")));
+        columns.extend((1..=n).map(|j| format!("{name}{j}_stderr")));
     }
     let mut table = Table::new("", columns);
     for (i, t) in states.t.iter().enumerate() {
@@ -405,8 +430,13 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
     }
     write_atomic(&a.out, table.to_csv().as_bytes())?;
     let mut out = format!(
-        "{} predicted torques -> {}\n",
+        "{} predicted {} -> {}\n",
         states.t.len(),
+        if gains.is_some() {
+            "signals (torques over the drive gains)"
+        } else {
+            "torques"
+        },
         a.out.display()
     );
     if let Some(meas) = &states.tau {
@@ -416,11 +446,12 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
         }
         let _ = writeln!(
             out,
-            "against the measured torques: per joint RMS error (N m){}",
+            "against the measured {}: per joint RMS error ({unit}){}",
+            if gains.is_some() { "signal" } else { "torques" },
             if stderr.is_some() {
-                ", and the RMS of the predictions' standard errors (N m)"
+                format!(", and the RMS of the predictions' standard errors ({unit})")
             } else {
-                ""
+                String::new()
             }
         );
         for e in v.joints {

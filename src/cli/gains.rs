@@ -16,6 +16,7 @@ use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::recording::Recording;
 use crate::rehearsal::Payload;
+use crate::torque_model::ModelFile;
 
 #[derive(Args)]
 pub(crate) struct IdentifyGainsArgs {
@@ -162,4 +163,28 @@ pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
         a.out.display()
     );
     Ok(out)
+}
+
+/// The drive gains of the saved model `file` (read from `path`) for `--signal`: refused for a
+/// model that holds none.
+pub(crate) fn model_gains<'a>(file: &'a ModelFile, path: &Path) -> Result<&'a [f64]> {
+    match file {
+        ModelFile::Base(fit) => fit.drive_gains.as_ref().map(|g| &g.gain[..]),
+        _ => None,
+    }
+    .ok_or_else(|| Error::InvalidArgument {
+        argument: "--signal".into(),
+        message: format!(
+            "'{}' holds no drive gains: only a model from identify-gains reads or gives its signal",
+            path.display()
+        ),
+    })
+}
+
+/// `values` (row-major `k x n`) with column `j` multiplied by `scale[j]`.
+pub(crate) fn scaled_columns(values: &[f64], scale: &[f64]) -> Vec<f64> {
+    let n = scale.len();
+    (values.iter().enumerate())
+        .map(|(i, v)| v * scale[i % n])
+        .collect()
 }

@@ -51,6 +51,11 @@ pub(crate) struct ValidateArgs {
     /// torques, and residuals).
     #[arg(long, default_value = "validation")]
     out: PathBuf,
+    /// The log's tau columns hold the signal the model's drive gains were identified for
+    /// (motor currents; a model from identify-gains): each is multiplied by its joint's gain,
+    /// and the validation is in torques.
+    #[arg(long)]
+    signal: bool,
 }
 
 pub(crate) fn run(a: ValidateArgs) -> Result<String> {
@@ -72,9 +77,26 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     };
     let progress = Progress::new();
     let mut out = String::new();
+    let gains = a
+        .signal
+        .then(|| super::gains::model_gains(&file, &a.model))
+        .transpose()?;
     let rec = a
         .preprocessing
         .read(&a.data, &joints, &progress, &mut out)?;
+    let rec = match gains {
+        Some(g) => {
+            let _ = writeln!(
+                out,
+                "the log's signal times the model's drive gains: torques"
+            );
+            crate::recording::Recording {
+                tau: super::gains::scaled_columns(&rec.tau, g),
+                ..rec
+            }
+        }
+        None => rec,
+    };
     let n = joints.len();
     // with the Coulomb term's column filtered as the torques were
     let states = rec.states()?;
