@@ -282,6 +282,14 @@ pub fn identify_drive_gains(
         }
         loads.push(load_of(model, run.payload).map_err(at)?);
     }
+    // the runs are held together, about ten values a joint and sample
+    let k: usize = runs.iter().map(|r| r.states.len()).sum();
+    if (k * nv) as f64 * 10.0 > crate::limits::MAX_VALUES {
+        return Err(bad(format!(
+            "{k} samples of {nv} joints in all: more than the {} values the fit may hold (about ten a joint and sample); decimate the logs (preprocess at a lower rate)",
+            crate::limits::MAX_VALUES
+        )));
+    }
     if loads.iter().all(|l| *l == loads[0]) {
         return Err(bad(format!(
             "every run carries {}: the gains' scale is not determined (the parameters and the gains could grow together); run the motion once more with a known payload bolted on, and give it as that run's payload",
@@ -293,7 +301,6 @@ pub fn identify_drive_gains(
     }
     // the runs one after the other: states, the signal's column (-i), the right-hand side
     // (-tau_L) and the robot's own torque once the gains are known
-    let k: usize = runs.iter().map(|r| r.states.len()).sum();
     let mut q = Vec::with_capacity(k * nv);
     let mut qd = Vec::with_capacity(k * nv);
     let mut qdd = Vec::with_capacity(k * nv);
