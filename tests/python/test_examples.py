@@ -43,6 +43,13 @@ def test_panda_direct_example(tmp_path):
         assert (tmp_path / "out/validation.png").stat().st_size > 10_000
 
 
+def test_drive_gains_example(tmp_path):
+    out = run("a465_drive_gains.py", "--quick", cwd=tmp_path)
+    assert "drive gains (N m per A):" in out and "feed-forward currents" in out
+    worst = float(out.split("largest gain error ")[1].split(" %")[0])
+    assert worst < 1.0, out
+
+
 def test_every_input_the_readme_names_is_in_examples():
     readme = (EXAMPLES.parent / "README.md").read_text()
     for name in ["op.json", "panda_drilling_op.json", "panda_true_robot.json", "panda_workspace.json", "a465_true_robot.json"]:
