@@ -220,3 +220,78 @@ fn bad_payloads_and_runs_are_refused_by_name() {
         "{e}"
     );
 }
+
+#[test]
+fn a_local_model_in_torques_from_recordings_of_currents() {
+    // the drive gains identified once, then the local method's recordings logged as currents
+    let d = tmp("gains-local");
+    let payload: Payload = serde_json::from_str(PAYLOAD).unwrap();
+    log(&d.join("alone.csv"), 1, None);
+    log(&d.join("loaded.csv"), 2, Some(&payload));
+    let gains = d.join("gains.json");
+    ok(&[
+        "identify-gains",
+        "a465",
+        s(&d.join("alone.csv")),
+        "--loaded",
+        s(&d.join("loaded.csv")),
+        "--payload",
+        PAYLOAD,
+        "--friction",
+        "viscous",
+        "--out",
+        s(&gains),
+    ]);
+    let plan = cli_support::plan_nominal_and_d(&d);
+    ok(&["simulate", "a465", s(&plan), "--out", s(&d.join("rec"))]);
+    std::fs::create_dir_all(d.join("currents")).unwrap();
+    let joints: Vec<String> = (1..=6).map(|j| format!("joint{j}")).collect();
+    for name in ["nominal", "D"] {
+        let file = format!("{name}.csv");
+        let rec = perturbid_rs::io::load_recording(&d.join("rec").join(&file), &joints).unwrap();
+        let current: Vec<f64> = (rec.tau.iter().enumerate())
+            .map(|(i, t)| t / GAINS[i % 6])
+            .collect();
+        let rec = Recording {
+            tau: current,
+            ..rec
+        };
+        write(
+            &d.join("currents").join(&file),
+            &recording_table(&rec, "").to_csv(),
+        );
+    }
+    let identify = |rec: &str, out: &str, extra: &[&str]| {
+        let mut args = vec!["identify", s(&plan), rec, "--out", out];
+        args.extend_from_slice(extra);
+        ok(&args)
+    };
+    identify(s(&d.join("rec")), s(&d.join("torques.json")), &[]);
+    let out = identify(
+        s(&d.join("currents")),
+        s(&d.join("from_currents.json")),
+        &["--gains-from", s(&gains)],
+    );
+    assert!(
+        out.contains("torques: the recordings' signal times the drive gains of"),
+        "{out}"
+    );
+    let load = |f: &str| perturbid_rs::local::LocalModel::load(d.join(f)).unwrap();
+    let (a, b) = (load("torques.json"), load("from_currents.json"));
+    let (da, db) = (&a.d.as_ref().unwrap().matrix, &b.d.as_ref().unwrap().matrix);
+    let rel = (da - db).abs().max() / da.abs().max();
+    assert!(rel < 2e-3, "D* from currents off by {rel}");
+    fails(
+        &[
+            "identify",
+            s(&plan),
+            s(&d.join("currents")),
+            "--out",
+            s(&d.join("x.json")),
+            "--gains-from",
+            s(&d.join("torques.json")),
+        ],
+        &["torques.json"],
+    );
+    nothing_written(&d, "x.json");
+}

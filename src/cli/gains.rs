@@ -188,3 +188,23 @@ pub(crate) fn scaled_columns(values: &[f64], scale: &[f64]) -> Vec<f64> {
         .map(|(i, v)| v * scale[i % n])
         .collect()
 }
+
+/// The drive gains saved in the base-parameter model at `path` (`--gains-from`), for a robot
+/// of joints `joints`: refused, naming the file, for a model of other joints or without gains.
+pub(crate) fn gains_from_file(path: &Path, joints: &[String]) -> Result<crate::direct::DriveGains> {
+    let refuse = |message: String| Error::InvalidArgument {
+        argument: "--gains-from".into(),
+        message: format!("{}: {message}", path.display()),
+    };
+    let model = crate::direct::BaseModel::load(path)?;
+    if model.joint_names != joints {
+        return Err(refuse(format!(
+            "a model of joints [{}]; the plan's are [{}]",
+            model.joint_names.join(", "),
+            joints.join(", ")
+        )));
+    }
+    model
+        .drive_gains
+        .ok_or_else(|| refuse("holds no drive gains: a model from identify-gains has them".into()))
+}

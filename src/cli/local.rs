@@ -455,6 +455,12 @@ pub(crate) struct IdentifyArgs {
     /// (`plan --friction-aware-h`).
     #[arg(long)]
     friction_aware_h: bool,
+    /// The recordings' tau columns hold the signal of a robot's drive gains identified before
+    /// (motor currents; a base-parameter model from identify-gains): each is multiplied by its
+    /// joint's gain, so the local model is in torques. The gains' own standard errors are not
+    /// in the local model's.
+    #[arg(long, value_name = "MODEL.json")]
+    gains_from: Option<PathBuf>,
 }
 
 fn fmt_matrix(
@@ -493,6 +499,7 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
     };
     let inputs: Vec<&std::path::Path> = std::iter::once(a.plan.as_path())
         .chain(files.iter().map(PathBuf::as_path))
+        .chain(a.gains_from.as_deref())
         .collect();
     super::files::refuse_overwriting_inputs(&a.out, &inputs)?;
     if files.len() != plan.experiments.len() {
@@ -506,9 +513,23 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
             ),
         });
     }
+    let gains = a
+        .gains_from
+        .as_deref()
+        .map(|path| super::gains::gains_from_file(path, &plan.joint_names))
+        .transpose()?;
     let recs: Vec<Recording> = files
         .iter()
-        .map(|f| load_recording(f, &plan.joint_names))
+        .map(|f| {
+            let rec = load_recording(f, &plan.joint_names)?;
+            Ok(match &gains {
+                Some(g) => Recording {
+                    tau: super::gains::scaled_columns(&rec.tau, &g.gain),
+                    ..rec
+                },
+                None => rec,
+            })
+        })
         .collect::<Result<_>>()?;
     let options = IdentifyOptions {
         times: if a.planned_times {
@@ -538,6 +559,17 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
         a.estimator,
         a.out.display()
     );
+    if let (Some(g), Some(path)) = (&gains, &a.gains_from) {
+        let worst = (g.gain.iter().zip(&g.stderr))
+            .map(|(k, se)| se / k.abs())
+            .fold(0.0, f64::max);
+        let _ = writeln!(
+            out,
+            "torques: the recordings' signal times the drive gains of {} (their relative standard errors, up to {:.2e}, are not in the model's)",
+            path.display(),
+            worst
+        );
+    }
     let offsets: Vec<String> = model
         .diagnostics
         .offsets
