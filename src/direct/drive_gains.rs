@@ -308,7 +308,8 @@ pub fn identify_drive_gains(
     let mut coulomb = Vec::with_capacity(if filtered { k * nv } else { 0 });
     let mut column = Vec::with_capacity(k * nv);
     let mut payload_tau = vec![0.0; k * nv];
-    let mut loaded = Vec::with_capacity(k * nv);
+    // per joint, the payloads' squared torques summed over the loaded runs' samples
+    let (mut loaded_squares, mut loaded_rows) = (vec![0.0; nv], 0);
     let mut first = 0;
     for run in runs {
         let s = &run.states;
@@ -321,7 +322,10 @@ pub fn identify_drive_gains(
         column.extend(run.signal.iter().map(|i| -i));
         if let Some(p) = run.payload.filter(|p| p.mass > 0.0) {
             let tau = payload_torques(model, p, s, options)?;
-            loaded.extend_from_slice(&tau);
+            for (x, t) in tau.iter().enumerate() {
+                loaded_squares[x % nv] += t * t;
+            }
+            loaded_rows += s.len();
             payload_tau[first * nv..(first + s.len()) * nv].copy_from_slice(&tau);
         }
         first += s.len();
@@ -443,12 +447,8 @@ pub fn identify_drive_gains(
             (rms[j] / gain[j].abs() + floor) / (own + floor)
         })
         .collect();
-    let loaded_rows = loaded.len() / nv;
-    let payload_torque_rms = (0..nv)
-        .map(|j| {
-            let sum: f64 = (0..loaded_rows).map(|s| loaded[s * nv + j].powi(2)).sum();
-            (sum / loaded_rows.max(1) as f64).sqrt()
-        })
+    let payload_torque_rms = (loaded_squares.iter())
+        .map(|sum| (sum / loaded_rows.max(1) as f64).sqrt())
         .collect();
     model_fit.drive_gains = Some(DriveGains {
         gain,
