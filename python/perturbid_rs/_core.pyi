@@ -878,7 +878,15 @@ def validate(
     Coulomb column); for a BaseParameterModel also checks the torque columns against its
     robot's model (a PerturbidWarning per finding: swapped, the opposite sign, other units)."""
 
-def identify_global_linear(op: OperatingPoint, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, tau: ArrayLike) -> GlobalLinearModel: ...
+def identify_global_linear(
+    op: OperatingPoint,
+    q: Union[ArrayLike, Recording],
+    qd: Optional[ArrayLike] = None,
+    qdd: Optional[ArrayLike] = None,
+    tau: Optional[ArrayLike] = None,
+) -> GlobalLinearModel:
+    """The paper's globally linearised model at op from samples (k, n) each, or a preprocessed
+    Recording given whole as q, alone."""
 
 def preprocess(
     t: ArrayLike,

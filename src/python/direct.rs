@@ -739,17 +739,28 @@ impl PyGlobalLinear {
     }
 }
 
-/// Fits the globally linearised model at `op` to samples `q`, `qd`, `qdd`, `tau` (each (k, n)).
+/// Fits the globally linearised model at `op` to samples `q`, `qd`, `qdd`, `tau` (each (k, n):
+/// rad, rad/s, rad/s^2, N m), or to a Recording given whole as `q` (preprocessed: with its
+/// velocities and accelerations), alone.
 #[pyfunction]
-pub(crate) fn identify_global_linear(
-    py: Python<'_>,
+#[pyo3(signature = (op, q, qd=None, qdd=None, tau=None))]
+pub(crate) fn identify_global_linear<'py>(
+    py: Python<'py>,
     op: &PyOperatingPoint,
-    q: ArrayLike<'_>,
-    qd: ArrayLike<'_>,
-    qdd: ArrayLike<'_>,
-    tau: ArrayLike<'_>,
+    q: Bound<'py, PyAny>,
+    qd: Option<Bound<'py, PyAny>>,
+    qdd: Option<Bound<'py, PyAny>>,
+    tau: Option<Bound<'py, PyAny>>,
 ) -> PyResult<PyGlobalLinear> {
-    let c = states(op.op.n(), &q, &qd, &qdd, Some(&tau))?;
+    let given = Given {
+        qd,
+        qdd,
+        tau,
+        t: None,
+        coulomb: None,
+    };
+    let a = samples(q, given, true, false)?.arrays()?;
+    let c = states(op.op.n(), &a.q, &a.qd, &a.qdd, a.tau.as_ref())?;
     let fit = detached(py, "identify_global_linear", || {
         global_rs(
             &op.op,

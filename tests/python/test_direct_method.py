@@ -549,6 +549,16 @@ def test_global_linear_model_is_a_workspace_average():
     assert np.abs(lin.D[[1, 2, 4], 0]).max() > 0.02
     assert set(lin.stderr) == {"torque", "D", "H", "G"} and lin.D.shape == (6, 6)
     np.testing.assert_allclose(lin.predict(op.q, op.qd, op.qdd), lin.torque, atol=1e-12)
+    # a Recording given whole: the same fit; mixed with arrays, or without velocities, refused
+    rec = pr.Recording(t, q, tau, qd=qd, qdd=qdd)
+    same = pr.identify_global_linear(op, rec)
+    np.testing.assert_array_equal(same.D, lin.D)
+    with pytest.raises(pr.InputError, match="given with a Recording"):
+        pr.identify_global_linear(op, rec, qd)
+    with pytest.raises(pr.InputError, match="no velocities and accelerations"):
+        pr.identify_global_linear(op, pr.Recording(t, q, tau))
+    with pytest.raises(pr.InputError, match="missing"):
+        pr.identify_global_linear(op, q, qd, qdd)
     # a 5-harmonic excitation cannot separate 19 columns: a clear error, not NaN
     q5, qd5, qdd5 = excitation(robot, 5, 0.1, 0.1, 1).sample(t[::2])
     with pytest.raises(pr.NumericalError, match="rank 11 < 19"):
