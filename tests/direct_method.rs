@@ -625,6 +625,41 @@ fn negative_friction_and_still_joints_are_warned_about() {
             && w[0].contains("negative beyond 3 standard errors"),
         "{w:?}"
     );
+    // a long log (100,000 samples) where joint 3 is pushed by a tiny fraction of its speed:
+    // many standard errors below 0, a torque a twentieth of the noise's, not warned of
+    let s = traj.sample_periods(1.0, 10_000.0).unwrap();
+    let states = States::new(6, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
+    let long: Vec<f64> = torques(&model, &s.q, &s.qd, &s.qdd, Gravity::Included)
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let c = if i % 6 == 2 { -0.01 } else { 0.3 };
+            t + c * s.qd[i] + rng.uniform(-0.05, 0.05)
+        })
+        .collect();
+    let fit = identify_base_parameters(&model, &states, &long, &options).unwrap();
+    let row = (fit.parameter_table().into_iter())
+        .find(|r| r.name == "joint3.viscous")
+        .unwrap();
+    let rms = fit.joint_term_rms[2];
+    assert!(row.value + 5.0 * row.std.unwrap() < 0.0, "{row:?}");
+    assert!(
+        row.value.abs() * rms < 0.1 * fit.residual_rms[2],
+        "{row:?} {rms}"
+    );
+    assert!(fit.warnings().is_empty(), "{:?}", fit.warnings());
+    // the same model without the columns' RMS (saved before they were stored) warns as before
+    let old = perturbid_rs::direct::BaseModel {
+        joint_term_rms: vec![],
+        ..fit.clone()
+    };
+    assert!(
+        old.warnings()
+            .iter()
+            .any(|w| w.starts_with("joint3.viscous")),
+        "{:?}",
+        old.warnings()
+    );
     // the excitation: joint 2 held still
     let sound = ExcitationDesign {
         trajectory: traj.clone(),

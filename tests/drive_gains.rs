@@ -407,6 +407,10 @@ fn saved_gains_are_checked_on_load() {
                 |v| v["drive_gains"]["agreement"][5] = serde_json::json!(null),
                 "drive_gains.agreement[5]",
             ),
+            (
+                |v| v["joint_term_rms"] = serde_json::json!([1.0]),
+                "joint_term_rms has 1 entries, expected one per joint and joint term",
+            ),
         ],
     );
 }

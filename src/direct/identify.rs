@@ -169,6 +169,13 @@ pub struct BaseModel {
     /// None for a model identified from torques.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub drive_gains: Option<super::drive_gains::DriveGains>,
+    /// Per joint and joint term of the layout (joint by joint, each joint's terms in the
+    /// layout's order), the RMS over the fit's samples of that term's regressor column (`qd`,
+    /// the Coulomb column, 1, `qdd`): the torque a coefficient of 1 gives, which tells a
+    /// coefficient negligible against the residuals from one that matters
+    /// ([`BaseModel::warnings`]). Empty in a model saved before it was stored.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub joint_term_rms: Vec<f64>,
 }
 
 /// Identifies the base parameters of `model` from the samples of `states` (rad, rad/s,
@@ -316,6 +323,27 @@ pub(super) fn solve(
     })
 }
 
+/// [`BaseModel::joint_term_rms`] of `states` for the joint terms `terms` (their names).
+fn joint_term_rms(states: &States<'_>, terms: Vec<&str>) -> Vec<f64> {
+    let (k, nv) = (states.len(), states.nv());
+    let (qd, qdd) = (states.qd_or_zeros(), states.qdd_or_zeros());
+    let mut sums = vec![0.0; nv * terms.len()];
+    for s in 0..k {
+        for j in 0..nv {
+            for (t, term) in terms.iter().enumerate() {
+                let x = match *term {
+                    "viscous" => qd[s * nv + j],
+                    "coulomb" => states.coulomb_at(s, j),
+                    "armature" => qdd[s * nv + j],
+                    _ => 1.0,
+                };
+                sums[j * terms.len() + t] += x * x;
+            }
+        }
+    }
+    sums.iter().map(|x| (x / k.max(1) as f64).sqrt()).collect()
+}
+
 /// [`identify_base_parameters`] with the reduced data it was computed from.
 pub(super) fn fit_with_factors(
     model: &Model,
@@ -376,6 +404,7 @@ pub(super) fn fit_with_factors(
         unmodelled_friction: vec![],
         weak_excitation: None,
         drive_gains: None,
+        joint_term_rms: joint_term_rms(states, options.friction.for_model(model).names()),
     };
     fit.weak_excitation =
         super::weak_excitation::check_excitation(model, states, &fit.base, ls.cond, &ls.weakest);
@@ -624,6 +653,17 @@ impl Document for BaseModel {
                 format!("position_range[{i}]: {problem}"),
             ));
         }
+        let terms = n * layout.friction.names().len();
+        if !(m.joint_term_rms.is_empty() || m.joint_term_rms.len() == terms) {
+            return Err(invalid(
+                Self::WHAT,
+                format!(
+                    "joint_term_rms has {} entries, expected one per joint and joint term ({terms}) or none",
+                    m.joint_term_rms.len()
+                ),
+            ));
+        }
+        check_magnitudes(Self::WHAT, "joint_term_rms", &m.joint_term_rms, false)?;
         if let Some(problem) = (m.drive_gains.as_ref()).and_then(|g| g.problem(Self::WHAT, n)) {
             return Err(invalid(Self::WHAT, problem));
         }

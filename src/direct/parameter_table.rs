@@ -43,6 +43,33 @@ impl BaseModel {
     }
 }
 
+/// A joint term's torque (its coefficient times its column's RMS) below this fraction of its
+/// joint's residual RMS is negligible: a negative one is not warned of however many standard
+/// errors it lies below 0 (on an hour's log, a model's small mismatches lie many below).
+pub const NEGLIGIBLE_TERM: f64 = 0.1;
+
+impl BaseModel {
+    /// Whether base parameter `i`, where it is a joint term, gives a torque below
+    /// [`NEGLIGIBLE_TERM`] of its joint's residual RMS ([`Self::joint_term_rms`]; false where
+    /// not stored).
+    fn negligible(&self, i: usize) -> bool {
+        let layout = &self.base.layout;
+        let (ni, terms) = (10 * layout.nbodies, layout.friction.names().len());
+        let Some(col) = self.base.kept.get(i).and_then(|c| c.checked_sub(ni)) else {
+            return false;
+        };
+        let (Some(rms), Some(residual)) = (
+            self.joint_term_rms
+                .get(col)
+                .filter(|_| self.joint_term_rms.len() == layout.nv * terms),
+            self.residual_rms.get(col / terms.max(1)),
+        ) else {
+            return false;
+        };
+        self.theta[i].abs() * rms < NEGLIGIBLE_TERM * residual
+    }
+}
+
 impl BaseModel {
     /// What a person should know before trusting the fit: torque columns that do not read as
     /// the robot's model says they should ([`super::torque_columns`]: swapped, of the opposite
@@ -52,9 +79,11 @@ impl BaseModel {
     /// ([`super::unmodelled_friction`]), data that excite the base parameters weakly
     /// ([`super::weak_excitation`]), positions logged in counts so coarse that their
     /// rounding shows in the derived velocities ([`crate::position_rounding`]), and friction or
-    /// armature coefficients identified on their own (not in a combination) and negative
-    /// beyond three standard errors. No joint has them; the data hold an effect the model
-    /// lacks, or are not what it assumes. A consistent fit keeps them at zero. Where a torque
+    /// armature coefficients identified on their own (not in a combination), negative beyond
+    /// three standard errors and not negligible (a torque at least [`NEGLIGIBLE_TERM`] of the
+    /// joint's residual RMS). No joint has them; the data hold an effect the model lacks, or
+    /// are not what it assumes. The drive gains' findings ([`super::drive_gains`]) where the
+    /// model has them. A consistent fit keeps them at zero. Where a torque
     /// column is found wrong, offsets and friction are not named: fitted to such a log they
     /// take up part of what is wrong with it.
     pub fn warnings(&self) -> Vec<String> {
@@ -66,13 +95,15 @@ impl BaseModel {
         let negative = self
             .parameter_table()
             .into_iter()
-            .filter(|r| {
+            .enumerate()
+            .filter(|(i, r)| {
                 !r.combination
                     && [".viscous", ".coulomb", ".armature"]
                         .iter()
                         .any(|t| r.name.ends_with(t))
+                    && !self.negligible(*i)
             })
-            .filter_map(|r| {
+            .filter_map(|(_, r)| {
                 let std = r.std?;
                 (r.value + 3.0 * std < 0.0).then(|| {
                     format!(

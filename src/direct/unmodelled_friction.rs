@@ -226,6 +226,8 @@ pub fn check_unmodelled_friction(
         theta: solved.ls.coef.row(0).iter().copied().collect(),
         stderr: solved.ls.stderr.row(0).iter().copied().collect(),
         base: solved.base,
+        // of the fit's layout, not the refit's
+        joint_term_rms: vec![],
         ..fit.clone()
     };
     let residual = |m: &BaseModel| -> Result<Vec<f64>> {

@@ -311,6 +311,7 @@ pub fn identify_parameters_from_local(
         // rows from local models: their own diagnostics say what they leave unidentified
         weak_excitation: None,
         drive_gains: None,
+        joint_term_rms: vec![],
     };
     let consistent = match &options.consistent {
         None => None,
