@@ -58,6 +58,24 @@ fn log(path: &std::path::Path, seed: u64, payload: Option<&Payload>) {
     write(path, &recording_table(&rec, "").to_csv());
 }
 
+/// `perturbid identify-gains` on `dir`'s alone.csv and loaded.csv with `payload`, viscous
+/// friction, into `dir/out`; its stdout.
+fn identify_gains(dir: &std::path::Path, payload: &str, out: &str) -> String {
+    ok(&[
+        "identify-gains",
+        "a465",
+        s(&dir.join("alone.csv")),
+        "--loaded",
+        s(&dir.join("loaded.csv")),
+        "--payload",
+        payload,
+        "--friction",
+        "viscous",
+        "--out",
+        s(&dir.join(out)),
+    ])
+}
+
 #[test]
 fn gains_and_the_robot_alone_from_logs_of_currents() {
     let d = tmp("gains");
@@ -65,21 +83,7 @@ fn gains_and_the_robot_alone_from_logs_of_currents() {
     log(&d.join("alone.csv"), 1, None);
     log(&d.join("loaded.csv"), 2, Some(&payload));
     write(&d.join("payload.json"), PAYLOAD);
-    let run = |payload: &str, out: &str| {
-        ok(&[
-            "identify-gains",
-            "a465",
-            s(&d.join("alone.csv")),
-            "--loaded",
-            s(&d.join("loaded.csv")),
-            "--payload",
-            payload,
-            "--friction",
-            "viscous",
-            "--out",
-            s(&d.join(out)),
-        ])
-    };
+    let run = |payload: &str, out: &str| identify_gains(&d, payload, out);
     let out = run(s(&d.join("payload.json")), "model.json");
     assert!(
         out.contains("drive gains from 2 runs (1 with 2 kg on 'link6')"),
@@ -229,19 +233,7 @@ fn a_local_model_in_torques_from_recordings_of_currents() {
     log(&d.join("alone.csv"), 1, None);
     log(&d.join("loaded.csv"), 2, Some(&payload));
     let gains = d.join("gains.json");
-    ok(&[
-        "identify-gains",
-        "a465",
-        s(&d.join("alone.csv")),
-        "--loaded",
-        s(&d.join("loaded.csv")),
-        "--payload",
-        PAYLOAD,
-        "--friction",
-        "viscous",
-        "--out",
-        s(&gains),
-    ]);
+    identify_gains(&d, PAYLOAD, "gains.json");
     let plan = cli_support::plan_nominal_and_d(&d);
     ok(&["simulate", "a465", s(&plan), "--out", s(&d.join("rec"))]);
     std::fs::create_dir_all(d.join("currents")).unwrap();

@@ -82,6 +82,39 @@ fn alone_then_loaded<'a>(
     ]
 }
 
+/// Two runs' logs: the robot alone along motion 3, and along motion 4 with the payload (or
+/// alone too, where `loaded` is false), their currents under `noise` A.
+struct Logs {
+    truth: Model,
+    a: Samples,
+    b: Samples,
+    ia: Vec<f64>,
+    ib: Vec<f64>,
+    p: Payload,
+}
+
+fn logs(noise: f64, loaded: bool) -> Logs {
+    let (truth, p) = (truth(), payload());
+    let (a, b) = (motion(3), motion(4));
+    let ia = currents(&truth, &a, None, noise, 1);
+    let ib = currents(&truth, &b, loaded.then_some(&p), noise, 2);
+    Logs {
+        truth,
+        a,
+        b,
+        ia,
+        ib,
+        p,
+    }
+}
+
+impl Logs {
+    /// The runs as identified: the second given as carrying the payload.
+    fn runs(&self) -> [GainRun<'_>; 2] {
+        alone_then_loaded([&self.a, &self.b], [&self.ia, &self.ib], &self.p)
+    }
+}
+
 fn truth() -> Model {
     perturbid_rs::robots::a465::model("kinsheel2010").unwrap()
 }
@@ -92,15 +125,9 @@ fn states(s: &Samples) -> States<'_> {
 
 #[test]
 fn the_gains_and_the_robots_torques_come_back_from_currents_with_a_known_payload() {
-    let truth = truth();
-    let (a, b) = (motion(3), motion(4));
-    let p = payload();
-    let (ia, ib) = (
-        currents(&truth, &a, None, 1e-4, 1),
-        currents(&truth, &b, Some(&p), 1e-4, 2),
-    );
-    let runs = alone_then_loaded([&a, &b], [&ia, &ib], &p);
-    let fit = identify_drive_gains(&truth, &runs, &BaseOptions::default()).unwrap();
+    let logs = logs(1e-4, true);
+    let truth = &logs.truth;
+    let fit = identify_drive_gains(truth, &logs.runs(), &BaseOptions::default()).unwrap();
     let g = fit.gains();
     for (j, truth) in GAINS.iter().enumerate() {
         // within its standard errors of the truth, less the bias the noise can give it
@@ -128,8 +155,8 @@ fn the_gains_and_the_robots_torques_come_back_from_currents_with_a_known_payload
     );
     // the model is the robot alone's, in torques: on a third motion, unloaded
     let c = motion(5);
-    let tau = torques_with_friction(&truth, &c, &mut Rng(0), |_| 0.0);
-    let predicted = fit.model.on(&truth).unwrap().predict(&states(&c)).unwrap();
+    let tau = torques_with_friction(truth, &c, &mut Rng(0), |_| 0.0);
+    let predicted = fit.model.on(truth).unwrap().predict(&states(&c)).unwrap();
     let rms = (tau
         .iter()
         .zip(&predicted)
@@ -291,16 +318,18 @@ fn runs_that_do_not_fix_the_scale_and_payloads_no_robot_carries_are_refused() {
 
 #[test]
 fn a_signal_that_counts_the_other_way_gets_a_negative_gain_and_is_named() {
-    let truth = truth();
-    let (a, b) = (motion(3), motion(4));
-    let p = payload();
-    let mut ia = currents(&truth, &a, None, 1e-4, 1);
-    let mut ib = currents(&truth, &b, Some(&p), 1e-4, 2);
-    for i in ia.iter_mut().chain(ib.iter_mut()).skip(1).step_by(6) {
+    let mut logs = logs(1e-4, true);
+    for i in logs
+        .ia
+        .iter_mut()
+        .chain(logs.ib.iter_mut())
+        .skip(1)
+        .step_by(6)
+    {
         *i = -*i;
     }
-    let runs = alone_then_loaded([&a, &b], [&ia, &ib], &p);
-    let fit = identify_drive_gains(&truth, &runs, &BaseOptions::default()).unwrap();
+    let truth = &logs.truth;
+    let fit = identify_drive_gains(truth, &logs.runs(), &BaseOptions::default()).unwrap();
     let g = fit.gains();
     assert!((g.gain[1] / -GAINS[1] - 1.0).abs() < 1e-2, "{g:?}");
     let w = g.warnings(&truth.joint_names);
@@ -314,15 +343,8 @@ fn a_signal_that_counts_the_other_way_gets_a_negative_gain_and_is_named() {
 fn a_run_logged_without_the_payload_given_is_named() {
     // both runs of the robot alone, the second given as loaded: the fit goes through, and the
     // residuals say that the runs and the payload do not agree
-    let truth = truth();
-    let (a, b) = (motion(3), motion(4));
-    let p = payload();
-    let (ia, ib) = (
-        currents(&truth, &a, None, 1e-4, 1),
-        currents(&truth, &b, None, 1e-4, 2),
-    );
-    let runs = alone_then_loaded([&a, &b], [&ia, &ib], &p);
-    let fit = identify_drive_gains(&truth, &runs, &BaseOptions::default()).unwrap();
+    let logs = logs(1e-4, false);
+    let fit = identify_drive_gains(&logs.truth, &logs.runs(), &BaseOptions::default()).unwrap();
     let g = fit.gains();
     assert!(g.agreement.iter().any(|a| *a > 10.0), "{:?}", g.agreement);
     let w = fit.model.warnings();
@@ -337,16 +359,9 @@ fn a_run_logged_without_the_payload_given_is_named() {
 fn the_noise_bias_says_what_a_noisy_signal_does_to_the_gains() {
     // currents noisy against the part the payload explains: the gains come out low by about
     // what the estimate says (every residual here is the signal's noise)
-    let truth = truth();
-    let (a, b) = (motion(3), motion(4));
-    let p = payload();
-    let noise = 5e-4;
-    let (ia, ib) = (
-        currents(&truth, &a, None, noise, 1),
-        currents(&truth, &b, Some(&p), noise, 2),
-    );
-    let runs = alone_then_loaded([&a, &b], [&ia, &ib], &p);
-    let fit = identify_drive_gains(&truth, &runs, &BaseOptions::default()).unwrap();
+    let logs = logs(5e-4, true);
+    let truth = &logs.truth;
+    let fit = identify_drive_gains(truth, &logs.runs(), &BaseOptions::default()).unwrap();
     let g = fit.gains();
     let mut warned = 0;
     for (j, truth) in GAINS.iter().enumerate() {
@@ -370,15 +385,9 @@ fn the_noise_bias_says_what_a_noisy_signal_does_to_the_gains() {
 
 #[test]
 fn saved_gains_are_checked_on_load() {
-    let truth = truth();
-    let (a, b) = (motion(3), motion(4));
-    let p = payload();
-    let (ia, ib) = (
-        currents(&truth, &a, None, 1e-4, 1),
-        currents(&truth, &b, Some(&p), 1e-4, 2),
-    );
-    let runs = alone_then_loaded([&a, &b], [&ia, &ib], &p);
-    let fit = identify_drive_gains(&truth, &runs, &BaseOptions::default()).unwrap();
+    let logs = logs(1e-4, true);
+    let truth = &logs.truth;
+    let fit = identify_drive_gains(truth, &logs.runs(), &BaseOptions::default()).unwrap();
     let json: serde_json::Value = serde_json::from_str(&fit.model.to_json()).unwrap();
     refused_on_load::<BaseModel>(
         &json,
