@@ -186,6 +186,58 @@ impl Recording {
         Ok(())
     }
 
+    /// This recording of a joint signal that is not a torque (motor currents) in torques: each
+    /// `tau` column times its joint's gain (`gains`: one a joint, finite and other than 0; N m
+    /// or N per unit of the signal, [`crate::direct::DriveGains`]). What was found in the log
+    /// is kept, the torques' clipping levels and glitches' values scaled alike (a negative gain
+    /// swaps a clipping's side). Errors on gains of the wrong number or value.
+    pub fn in_torques(&self, gains: &[f64]) -> Result<Self> {
+        if gains.len() != self.n {
+            return Err(self.error(format!(
+                "{} gains for {} joints, expected one a joint",
+                gains.len(),
+                self.n
+            )));
+        }
+        if let Some(j) = gains.iter().position(|g| !(g.is_finite() && *g != 0.0)) {
+            return Err(self.error(format!(
+                "the gain of joint {} is {}, expected a finite gain other than 0",
+                j + 1,
+                gains[j]
+            )));
+        }
+        let n = self.n;
+        let tau = (self.tau.iter().enumerate())
+            .map(|(i, t)| t * gains[i % n])
+            .collect();
+        let torque_saturation = (self.torque_saturation.iter())
+            .map(|c| crate::torque_saturation::TorqueSaturation {
+                level: c.level * gains[c.joint],
+                beyond: c.beyond * gains[c.joint].abs(),
+                upper: c.upper == (gains[c.joint] > 0.0),
+                ..c.clone()
+            })
+            .collect();
+        let glitches = (self.glitches.iter())
+            .map(|g| match g.signal.as_str() {
+                "tau" => crate::log_screening::LogGlitch {
+                    value: g.value * gains[g.joint],
+                    replaced_by: g.replaced_by * gains[g.joint],
+                    ..g.clone()
+                },
+                _ => g.clone(),
+            })
+            .collect();
+        let r = Self {
+            tau,
+            torque_saturation,
+            glitches,
+            ..self.clone()
+        };
+        r.check()?;
+        Ok(r)
+    }
+
     /// Samples `start..stop` (0-based, `stop` excluded) as a recording of their own, named
     /// `name[start:stop]`: its time, positions, torques, velocities, accelerations and Coulomb
     /// column. What was found in the log it was preprocessed from (glitches, dropouts, rounding,

@@ -423,3 +423,58 @@ fn saved_gains_are_checked_on_load() {
         ],
     );
 }
+
+#[test]
+fn a_recording_of_currents_in_torques_keeps_what_was_found() {
+    use perturbid_rs::log_screening::LogGlitch;
+    use perturbid_rs::torque_saturation::TorqueSaturation;
+    let t: Vec<f64> = (0..4).map(|i| i as f64 * 0.01).collect();
+    let q = vec![0.1; 8];
+    let current = vec![1.0, 2.0, -1.0, 0.5, 3.0, -2.0, 0.0, 1.0];
+    let mut rec =
+        perturbid_rs::Recording::new("log", 2, t, q, current, Some(vec![0.2; 8]), None).unwrap();
+    rec.torque_saturation = vec![TorqueSaturation {
+        joint: 1,
+        level: 2.0,
+        upper: true,
+        runs: 1,
+        samples: 2,
+        longest: 2,
+        first_at: 0.01,
+        beyond: 0.3,
+        spans: vec![],
+    }];
+    rec.glitches = vec![LogGlitch {
+        signal: "tau".into(),
+        joint: 0,
+        sample: 2,
+        time: 0.02,
+        value: 9.0,
+        noise_levels: Some(40.0),
+        replaced_by: 3.0,
+        repeats_previous: false,
+        held: None,
+        experiment: None,
+    }];
+    let torques = rec.in_torques(&[10.0, -4.0]).unwrap();
+    assert_eq!(
+        torques.tau,
+        vec![10.0, -8.0, -10.0, -2.0, 30.0, 8.0, 0.0, -4.0]
+    );
+    assert_eq!(torques.qd, rec.qd);
+    let c = &torques.torque_saturation[0];
+    assert_eq!((c.level, c.beyond, c.upper), (-8.0, 1.2, false));
+    let g = &torques.glitches[0];
+    assert_eq!(
+        (g.value, g.replaced_by, g.noise_levels),
+        (90.0, 30.0, Some(40.0))
+    );
+    for (gains, says) in [
+        (vec![1.0], "1 gains for 2 joints"),
+        (vec![1.0, 0.0], "the gain of joint 2 is 0"),
+        (vec![f64::NAN, 1.0], "the gain of joint 1 is NaN"),
+    ] {
+        let e = rec.in_torques(&gains).unwrap_err().to_string();
+        assert!(e.contains(says), "{e}");
+    }
+}

@@ -375,6 +375,10 @@ class Recording:
         """rec[a:b]: samples a..b (step 1, at least 2) as a Recording of their own, with the
         Coulomb column and what was found in the log; for fitting one part and validating
         on another."""
+    def in_torques(self, gains: ArrayLike) -> Recording:
+        """This recording of motor currents in torques: each tau column times its joint's
+        gain ((n,), e.g. BaseParameterModel.drive_gains["gain"]), keeping qd, qdd, the
+        Coulomb column and what was found in the log (clipping levels scaled alike)."""
 
 @final
 class LocalModel:

@@ -522,13 +522,10 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
         .iter()
         .map(|f| {
             let rec = load_recording(f, &plan.joint_names)?;
-            Ok(match &gains {
-                Some(g) => Recording {
-                    tau: super::gains::scaled_columns(&rec.tau, &g.gain),
-                    ..rec
-                },
-                None => rec,
-            })
+            match &gains {
+                Some(g) => rec.in_torques(&g.gain),
+                None => Ok(rec),
+            }
         })
         .collect::<Result<_>>()?;
     let options = IdentifyOptions {

@@ -90,10 +90,7 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
                 out,
                 "the log's signal times the model's drive gains: torques"
             );
-            crate::recording::Recording {
-                tau: super::gains::scaled_columns(&rec.tau, g),
-                ..rec
-            }
+            rec.in_torques(g)?
         }
         None => rec,
     };

@@ -436,6 +436,17 @@ impl PyRecording {
             rec: Arc::new(self.rec.rows(start, stop)?),
         })
     }
+    /// This recording of motor currents (or another signal) in torques: each `tau` column
+    /// times its joint's gain (`gains`: (n,) N m or N per unit of the signal, such as
+    /// `BaseParameterModel.drive_gains["gain"]`), with its velocities, accelerations, Coulomb
+    /// column and what was found in the log (the torques' clipping levels and glitches scaled
+    /// alike).
+    fn in_torques(&self, gains: ArrayLike<'_>) -> PyResult<Self> {
+        let gains = vector("gains", &gains)?;
+        Ok(Self {
+            rec: Arc::new(self.rec.in_torques(&gains)?),
+        })
+    }
     fn __repr__(&self) -> String {
         format!(
             "Recording('{}', samples={}, joints={})",

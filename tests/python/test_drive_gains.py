@@ -102,6 +102,17 @@ def test_the_model_is_the_robot_alones_in_torques(setup):
     assert np.sqrt(np.mean((predicted - truth) ** 2)) < 0.02
     saved = json.loads(with_friction.to_json())
     np.testing.assert_allclose(saved["drive_gains"]["gain"], with_friction.drive_gains["gain"])
+    # a log of currents in torques, validated: its velocities and accelerations kept
+    current = truth / with_friction.drive_gains["gain"]
+    rec = pr.Recording(t, q, current, qd=qd, qdd=qdd).in_torques(with_friction.drive_gains["gain"])
+    np.testing.assert_allclose(rec.tau, truth, rtol=1e-12)
+    assert rec.qd is not None and rec.qdd is not None
+    v = pr.validate(with_friction, rec)
+    assert v.rms.max() < 0.02, v.rms
+    with pytest.raises(pr.PerturbidError, match="5 gains for 6 joints"):
+        rec.in_torques(np.ones(5))
+    with pytest.raises(pr.PerturbidError, match="the gain of joint 2 is 0"):
+        rec.in_torques([1.0, 0.0, 1.0, 1.0, 1.0, 1.0])
     # a model fitted to torques has none
     plain = pr.identify_base_parameters(pair.ours, q, qd, qdd, truth, friction="viscous")
     assert plain.drive_gains is None
