@@ -299,17 +299,17 @@ pub fn identify_drive_gains(
             }
         )));
     }
-    // the runs one after the other: states, the signal's column (-i), the right-hand side
-    // (-tau_L) and the robot's own torque once the gains are known
+    // the runs one after the other: states, the signal (its column's coefficient is -K) and
+    // the right-hand side -tau_L
     let mut q = Vec::with_capacity(k * nv);
     let mut qd = Vec::with_capacity(k * nv);
     let mut qdd = Vec::with_capacity(k * nv);
     let filtered = runs.iter().any(|r| r.states.coulomb().is_some());
     let mut coulomb = Vec::with_capacity(if filtered { k * nv } else { 0 });
-    let mut column = Vec::with_capacity(k * nv);
-    let mut payload_tau = vec![0.0; k * nv];
+    let mut signal = Vec::with_capacity(k * nv);
+    let mut rhs = vec![0.0; k * nv];
     // per joint, the payloads' squared torques summed over the loaded runs' samples
-    let (mut loaded_squares, mut loaded_rows) = (vec![0.0; nv], 0);
+    let (mut loaded_squares, mut loaded_rows, mut loaded_runs) = (vec![0.0; nv], 0, 0);
     let mut first = 0;
     for run in runs {
         let s = &run.states;
@@ -319,14 +319,16 @@ pub fn identify_drive_gains(
         if filtered {
             coulomb.extend((0..s.len() * nv).map(|x| s.coulomb_at(x / nv, x % nv)));
         }
-        column.extend(run.signal.iter().map(|i| -i));
+        signal.extend_from_slice(run.signal);
         if let Some(p) = run.payload.filter(|p| p.mass > 0.0) {
             let tau = payload_torques(model, p, s, options)?;
-            for (x, t) in tau.iter().enumerate() {
+            let rows = &mut rhs[first * nv..(first + s.len()) * nv];
+            for (x, (t, r)) in tau.iter().zip(rows).enumerate() {
                 loaded_squares[x % nv] += t * t;
+                *r = -t;
             }
             loaded_rows += s.len();
-            payload_tau[first * nv..(first + s.len()) * nv].copy_from_slice(&tau);
+            loaded_runs += 1;
         }
         first += s.len();
     }
@@ -336,20 +338,26 @@ pub fn identify_drive_gains(
     } else {
         states
     };
-    let signal: Vec<f64> = column.iter().map(|c| -c).collect();
     crate::torque_model::refuse_flat_torques(
         &states,
         &signal,
         &model.joint_names,
         "a fit would take it for a signal that does not follow the motion",
     )?;
-    let rhs: Vec<f64> = payload_tau.iter().map(|t| -t).collect();
 
     // the joint fit of base parameters and gains: OLS, then WLS on its residuals
     let base = super::identify::base_parameters(model, options)?;
-    let factors =
-        JointFactors::with_columns(model, &base, &states, &rhs, &[&column], options.gravity)?;
     let p = base.len();
+    // each run is read alone too (the agreement), so each must determine the parameters
+    if let Some((r, run)) = (runs.iter().enumerate()).find(|(_, run)| run.states.len() <= p) {
+        return Err(bad(format!(
+            "run {r} has {} samples; at least {} are needed to read it against the others",
+            run.states.len(),
+            p + 1
+        )));
+    }
+    let factors =
+        JointFactors::with_columns(model, &base, &states, &rhs, &[&signal], options.gravity)?;
     let names: Vec<String> = base
         .names()
         .into_iter()
@@ -367,7 +375,7 @@ pub fn identify_drive_gains(
         rms = factors.residual_rms(ls.coef.as_slice())?;
     }
     let coef: Vec<f64> = ls.coef.row(0).iter().copied().collect();
-    let gain = coef[p..].to_vec();
+    let gain: Vec<f64> = coef[p..].iter().map(|c| -c).collect();
     if let Some(j) =
         (0..nv).find(|&j| !(gain[j].is_finite() && gain[j] != 0.0 && rms[j].is_finite()))
     {
@@ -384,7 +392,7 @@ pub fn identify_drive_gains(
 
     // the robot alone: its torques are the gains' times the signal less the payload's
     let tau: Vec<f64> = (0..k * nv)
-        .map(|x| gain[x % nv] * signal[x] - payload_tau[x])
+        .map(|x| gain[x % nv] * signal[x] + rhs[x])
         .collect();
     let (mut model_fit, _) = fit_with_factors(model, &states, &tau, options)?;
     let inflation = model_fit.stderr_inflation();
@@ -399,7 +407,7 @@ pub fn identify_drive_gains(
     // Sigma_uu theta, Sigma_uu holding k (noise / sigma)^2 at each joint's signal column (its
     // rows weighted by 1 / sigma); the gains share one scale with each other and the
     // parameters, so every joint's noise biases every gain. The noise taken for the whole
-    // residual, rms / |K|.
+    // residual, rms / |K|. (The fit's coefficients are -K: their covariance is K's.)
     let cov =
         |a: usize, b: usize| ls.correlation[(a, b)] * (ls.cov_diag[a] * ls.cov_diag[b]).sqrt();
     let noise_bias = (0..nv)
@@ -426,14 +434,7 @@ pub fn identify_drive_gains(
         .collect::<Result<Vec<f64>>>()?;
     // each run's signal fitted alone, joint by joint, for the agreement
     let mut alone = vec![0.0; nv];
-    for (r, run) in runs.iter().enumerate() {
-        if run.states.len() <= p {
-            return Err(bad(format!(
-                "run {r} has {} samples; at least {} are needed to read it against the others",
-                run.states.len(),
-                p + 1
-            )));
-        }
+    for run in runs {
         let f = JointFactors::new(model, &base, &run.states, run.signal, options.gravity)?;
         for (a, r) in alone.iter_mut().zip(&f.factors) {
             *a += beyond_the_rest(r).powi(2);
@@ -458,10 +459,7 @@ pub fn identify_drive_gains(
         agreement,
         cond: ls.cond,
         runs: runs.len(),
-        loaded_runs: runs
-            .iter()
-            .filter(|r| r.payload.is_some_and(|p| p.mass > 0.0))
-            .count(),
+        loaded_runs,
     });
     Ok(DriveGainFit { model: model_fit })
 }
