@@ -355,7 +355,7 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
     let joints = file.joint_names().to_vec();
     let gains = a
         .signal
-        .then(|| super::gains::model_gains(&file, &a.model))
+        .then(|| super::gains::model_gains(&file, &a.model, "--signal").map(|g| &g.gain[..]))
         .transpose()?;
     let rows = read_states(&crate::io::Table::read(&a.data)?, &joints)?;
     let states = States::new(joints.len(), &rows.q, Some(&rows.qd), Some(&rows.qdd))?;

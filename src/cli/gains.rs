@@ -165,17 +165,21 @@ pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
     Ok(out)
 }
 
-/// The drive gains of the saved model `file` (read from `path`) for `--signal`: refused for a
-/// model that holds none.
-pub(crate) fn model_gains<'a>(file: &'a ModelFile, path: &Path) -> Result<&'a [f64]> {
+/// The drive gains of the saved model `file` (read from `path`) for the option `argument`
+/// (`--signal`, `--gains-from`): refused for a model that holds none.
+pub(crate) fn model_gains<'a>(
+    file: &'a ModelFile,
+    path: &Path,
+    argument: &str,
+) -> Result<&'a crate::direct::DriveGains> {
     match file {
-        ModelFile::Base(fit) => fit.drive_gains.as_ref().map(|g| &g.gain[..]),
+        ModelFile::Base(fit) => fit.drive_gains.as_ref(),
         _ => None,
     }
     .ok_or_else(|| Error::InvalidArgument {
-        argument: "--signal".into(),
+        argument: argument.into(),
         message: format!(
-            "'{}' holds no drive gains: only a model from identify-gains reads or gives its signal",
+            "'{}' holds no drive gains: only a model from identify-gains has them",
             path.display()
         ),
     })
@@ -189,22 +193,20 @@ pub(crate) fn scaled_columns(values: &[f64], scale: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// The drive gains saved in the base-parameter model at `path` (`--gains-from`), for a robot
-/// of joints `joints`: refused, naming the file, for a model of other joints or without gains.
+/// The drive gains saved in the model at `path` (`--gains-from`), for a robot of joints
+/// `joints`: refused, naming the file, for a model of other joints or without gains.
 pub(crate) fn gains_from_file(path: &Path, joints: &[String]) -> Result<crate::direct::DriveGains> {
-    let refuse = |message: String| Error::InvalidArgument {
-        argument: "--gains-from".into(),
-        message: format!("{}: {message}", path.display()),
-    };
-    let model = crate::direct::BaseModel::load(path)?;
-    if model.joint_names != joints {
-        return Err(refuse(format!(
-            "a model of joints [{}]; the plan's are [{}]",
-            model.joint_names.join(", "),
-            joints.join(", ")
-        )));
+    let file = ModelFile::load(path)?;
+    if file.joint_names() != joints {
+        return Err(Error::InvalidArgument {
+            argument: "--gains-from".into(),
+            message: format!(
+                "{}: a model of joints [{}]; the plan's are [{}]",
+                path.display(),
+                file.joint_names().join(", "),
+                joints.join(", ")
+            ),
+        });
     }
-    model
-        .drive_gains
-        .ok_or_else(|| refuse("holds no drive gains: a model from identify-gains has them".into()))
+    Ok(model_gains(&file, path, "--gains-from")?.clone())
 }

@@ -79,7 +79,7 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     let mut out = String::new();
     let gains = a
         .signal
-        .then(|| super::gains::model_gains(&file, &a.model))
+        .then(|| super::gains::model_gains(&file, &a.model, "--signal").map(|g| &g.gain[..]))
         .transpose()?;
     let rec = a
         .preprocessing

@@ -323,27 +323,6 @@ pub(super) fn solve(
     })
 }
 
-/// [`BaseModel::joint_term_rms`] of `states` for the joint terms `terms` (their names).
-fn joint_term_rms(states: &States<'_>, terms: Vec<&str>) -> Vec<f64> {
-    let (k, nv) = (states.len(), states.nv());
-    let (qd, qdd) = (states.qd_or_zeros(), states.qdd_or_zeros());
-    let mut sums = vec![0.0; nv * terms.len()];
-    for s in 0..k {
-        for j in 0..nv {
-            for (t, term) in terms.iter().enumerate() {
-                let x = match *term {
-                    "viscous" => qd[s * nv + j],
-                    "coulomb" => states.coulomb_at(s, j),
-                    "armature" => qdd[s * nv + j],
-                    _ => 1.0,
-                };
-                sums[j * terms.len() + t] += x * x;
-            }
-        }
-    }
-    sums.iter().map(|x| (x / k.max(1) as f64).sqrt()).collect()
-}
-
 /// [`identify_base_parameters`] with the reduced data it was computed from.
 pub(super) fn fit_with_factors(
     model: &Model,
@@ -404,7 +383,10 @@ pub(super) fn fit_with_factors(
         unmodelled_friction: vec![],
         weak_excitation: None,
         drive_gains: None,
-        joint_term_rms: joint_term_rms(states, options.friction.for_model(model).names()),
+        joint_term_rms: super::parameter_table::joint_term_rms(
+            states,
+            options.friction.for_model(model).names(),
+        ),
     };
     fit.weak_excitation =
         super::weak_excitation::check_excitation(model, states, &fit.base, ls.cond, &ls.weakest);
@@ -653,17 +635,7 @@ impl Document for BaseModel {
                 format!("position_range[{i}]: {problem}"),
             ));
         }
-        let terms = n * layout.friction.names().len();
-        if !(m.joint_term_rms.is_empty() || m.joint_term_rms.len() == terms) {
-            return Err(invalid(
-                Self::WHAT,
-                format!(
-                    "joint_term_rms has {} entries, expected one per joint and joint term ({terms}) or none",
-                    m.joint_term_rms.len()
-                ),
-            ));
-        }
-        check_magnitudes(Self::WHAT, "joint_term_rms", &m.joint_term_rms, false)?;
+        m.check_joint_term_rms()?;
         if let Some(problem) = (m.drive_gains.as_ref()).and_then(|g| g.problem(Self::WHAT, n)) {
             return Err(invalid(Self::WHAT, problem));
         }

@@ -5,6 +5,7 @@
 use serde::Serialize;
 
 use super::identify::BaseModel;
+use crate::states::States;
 
 /// One base parameter.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -43,12 +44,51 @@ impl BaseModel {
     }
 }
 
+/// [`BaseModel::joint_term_rms`] of `states` for the joint terms `terms` (their names).
+pub(super) fn joint_term_rms(states: &States<'_>, terms: Vec<&str>) -> Vec<f64> {
+    let (k, nv) = (states.len(), states.nv());
+    let (qd, qdd) = (states.qd_or_zeros(), states.qdd_or_zeros());
+    let mut sums = vec![0.0; nv * terms.len()];
+    for s in 0..k {
+        for j in 0..nv {
+            for (t, term) in terms.iter().enumerate() {
+                let x = match *term {
+                    "viscous" => qd[s * nv + j],
+                    "coulomb" => states.coulomb_at(s, j),
+                    "armature" => qdd[s * nv + j],
+                    _ => 1.0,
+                };
+                sums[j * terms.len() + t] += x * x;
+            }
+        }
+    }
+    sums.iter().map(|x| (x / k.max(1) as f64).sqrt()).collect()
+}
+
 /// A joint term's torque (its coefficient times its column's RMS) below this fraction of its
 /// joint's residual RMS is negligible: a negative one is not warned of however many standard
 /// errors it lies below 0 (on an hour's log, a model's small mismatches lie many below).
 pub const NEGLIGIBLE_TERM: f64 = 0.1;
 
 impl BaseModel {
+    /// Checks a saved [`Self::joint_term_rms`]: one per joint and joint term of the layout,
+    /// or none; finite and >= 0.
+    pub(super) fn check_joint_term_rms(&self) -> crate::error::Result<()> {
+        use crate::document::{check_magnitudes, invalid, Document};
+        let terms = self.joint_names.len() * self.base.layout.friction.names().len();
+        let rms = &self.joint_term_rms;
+        if !(rms.is_empty() || rms.len() == terms) {
+            return Err(invalid(
+                Self::WHAT,
+                format!(
+                    "joint_term_rms has {} entries, expected one per joint and joint term ({terms}) or none",
+                    rms.len()
+                ),
+            ));
+        }
+        check_magnitudes(Self::WHAT, "joint_term_rms", rms, false)
+    }
+
     /// Whether base parameter `i`, where it is a joint term, gives a torque below
     /// [`NEGLIGIBLE_TERM`] of its joint's residual RMS ([`Self::joint_term_rms`]; false where
     /// not stored).
