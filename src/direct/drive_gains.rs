@@ -17,9 +17,10 @@
 //! WLS. The payload fixes the scale: with the same payload (or none) in every run, `theta` and
 //! `K` could be scaled together and the data would not tell, so such runs are refused.
 //!
-//! The signal's noise sits in columns of the regressor, where it biases the gains towards 0:
-//! [`DriveGains::noise_bias`] estimates by how much, taking every residual for the signal's
-//! noise.
+//! The signal's noise sits in columns of the regressor, where it biases the least-squares
+//! gains towards 0: [`DriveGains::noise_bias`] estimates by how much, taking every residual
+//! for the signal's noise. [`GainEstimator::Instrumental`] removes the bias, by instrumental
+//! variables ([`super::instrumental`]).
 
 use serde::{Deserialize, Serialize};
 
@@ -44,6 +45,43 @@ pub const NOISE_BIAS: f64 = 0.01;
 /// payload given.
 pub const AGREEMENT: f64 = 2.0;
 
+/// How the gains and the base parameters are estimated ([`identify_drive_gains_with`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GainEstimator {
+    /// Least squares (OLS, then WLS where the options say): the smallest variance, biased
+    /// towards 0 by the signal's noise ([`DriveGains::noise_bias`] says by how much).
+    #[default]
+    LeastSquares,
+    /// Instrumental variables, the signal predicted by the least-squares fit for its
+    /// instrument (weighted as the least-squares fit was): consistent under the signal's
+    /// noise, at a larger variance. For logs whose noise is not small against what the
+    /// payload explains.
+    Instrumental,
+}
+
+impl GainEstimator {
+    /// Its name in files and on the command line: `least_squares`, `instrumental`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::LeastSquares => "least_squares",
+            Self::Instrumental => "instrumental",
+        }
+    }
+
+    /// The estimator of `name` ([`GainEstimator::name`]).
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "least_squares" => Ok(Self::LeastSquares),
+            "instrumental" => Ok(Self::Instrumental),
+            other => Err(Error::InvalidArgument {
+                argument: "estimator".into(),
+                message: format!("'{other}', expected 'least_squares' or 'instrumental'"),
+            }),
+        }
+    }
+}
+
 /// One run of the robot: its states, the joints' logged signal and the payload it carried.
 #[derive(Clone, Copy, Debug)]
 pub struct GainRun<'a> {
@@ -67,8 +105,8 @@ pub struct DriveGains {
     /// Their standard errors (inflated for residuals correlated from sample to sample, as the
     /// model's are).
     pub stderr: Vec<f64>,
-    /// Per joint, the gain's relative bias towards 0 were every residual noise of the logged
-    /// signal (an upper estimate; 0 where the estimate points away from 0): the errors in the
+    /// Per joint, the least-squares gain's relative bias towards 0 were every residual noise
+    /// of the logged signal (an upper estimate; 0 where the estimate points away from 0): the errors in the
     /// signal's columns bias least squares by `-(X^T W^2 X)^-1 Sigma_uu theta`, `Sigma_uu`
     /// holding `k (rms_j / (K_j sigma_j))^2` at joint `j`'s signal column. The gains share one
     /// scale with each other and the parameters, so every joint's noise biases every gain.
@@ -89,6 +127,14 @@ pub struct DriveGains {
     /// Runs and samples identified from, and the runs that carried a payload.
     pub runs: usize,
     pub loaded_runs: usize,
+    /// How the gains were estimated (models saved before it: least squares).
+    #[serde(default)]
+    pub estimator: GainEstimator,
+    /// The least-squares gains, where the gains are by instrumental variables (else empty):
+    /// `1 - least_squares_gain / gain` is the bias the signal's noise gave least squares,
+    /// [`DriveGains::noise_bias`] its estimate.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub least_squares_gain: Vec<f64>,
 }
 
 impl DriveGains {
@@ -101,6 +147,20 @@ impl DriveGains {
             ("payload_torque_rms", self.payload_torque_rms.len()),
             ("agreement", self.agreement.len()),
         ];
+        let least_squares = self.least_squares_gain.len();
+        match self.estimator {
+            GainEstimator::LeastSquares if least_squares != 0 => {
+                return Some(format!(
+                    "drive_gains.least_squares_gain has {least_squares} entries for gains by least squares, expected none"
+                ))
+            }
+            GainEstimator::Instrumental if least_squares != n => {
+                return Some(format!(
+                    "drive_gains.least_squares_gain has {least_squares} entries, expected one per joint ({n}) for gains by instrumental variables"
+                ))
+            }
+            _ => {}
+        }
         if let Some((field, len)) = lens.iter().find(|(_, l)| *l != n) {
             return Some(format!(
                 "drive_gains.{field} has {len} entries, expected one per joint ({n})"
@@ -120,6 +180,12 @@ impl DriveGains {
         }
         let checks = [
             check_bounded(what, "drive gains", "drive_gains.gain", &self.gain),
+            check_bounded(
+                what,
+                "drive gains",
+                "drive_gains.least_squares_gain",
+                &self.least_squares_gain,
+            ),
             check_magnitudes(what, "drive_gains.stderr", &self.stderr, false),
             check_magnitudes(what, "drive_gains.noise_bias", &self.noise_bias, false),
             check_magnitudes(
@@ -165,9 +231,9 @@ impl DriveGains {
                     shown(self.payload_torque_rms[j])
                 ));
             }
-            if self.noise_bias[j] > NOISE_BIAS {
+            if self.noise_bias[j] > NOISE_BIAS && self.estimator == GainEstimator::LeastSquares {
                 out.push(format!(
-                    "the drive gain of joint '{name}' may be biased towards 0 by up to {:.1} %: its logged signal's noise is large against the part of it the rest of the model does not explain (filter the signal, preprocess, or use a heavier payload)",
+                    "the drive gain of joint '{name}' may be biased towards 0 by up to {:.1} %: its logged signal's noise is large against the part of it the rest of the model does not explain (estimate by instrumental variables, filter the signal, or use a heavier payload)",
                     100.0 * self.noise_bias[j]
                 ));
             }
@@ -254,6 +320,20 @@ pub fn identify_drive_gains(
     model: &Model,
     runs: &[GainRun<'_>],
     options: &BaseOptions,
+) -> Result<DriveGainFit> {
+    identify_drive_gains_with(model, runs, options, GainEstimator::LeastSquares)
+}
+
+/// [`identify_drive_gains`] by `estimator`: by instrumental variables, the least-squares fit
+/// comes first (its gains kept in [`DriveGains::least_squares_gain`], its bias estimate in
+/// [`DriveGains::noise_bias`]) and predicts the instruments; the model's parameters, standard
+/// errors, correlation, residuals and every check of the data are then the instrumental
+/// estimate's.
+pub fn identify_drive_gains_with(
+    model: &Model,
+    runs: &[GainRun<'_>],
+    options: &BaseOptions,
+    estimator: GainEstimator,
 ) -> Result<DriveGainFit> {
     let nv = model.nv;
     let bad = |message: String| Error::InvalidArgument {
@@ -374,21 +454,36 @@ pub fn identify_drive_gains(
         ls = factors.solve(&sigma, &names)?;
         rms = factors.residual_rms(ls.coef.as_slice())?;
     }
-    let coef: Vec<f64> = ls.coef.row(0).iter().copied().collect();
+    let undetermined = |gain: &[f64], rms: &[f64]| -> Result<()> {
+        match (0..nv).find(|&j| !(gain[j].is_finite() && gain[j] != 0.0 && rms[j].is_finite())) {
+            Some(j) => Err(Error::Numerical {
+                operation: "drive-gain identification".into(),
+                message: format!(
+                    "joint '{}': gain {} with residual RMS {}: the signal does not determine it (a signal of 0 or one too large for f64 arithmetic?)",
+                    model.joint_names[j],
+                    shown(gain[j]),
+                    shown(rms[j])
+                ),
+            }),
+            None => Ok(()),
+        }
+    };
+    let ls_coef: Vec<f64> = ls.coef.row(0).iter().copied().collect();
+    let ls_gain: Vec<f64> = ls_coef[p..].iter().map(|c| -c).collect();
+    undetermined(&ls_gain, &rms)?;
+    // the least-squares gains' noise bias, from the least-squares fit (below)
+    let ls_rms = rms.clone();
+    let (fit, coef) = match estimator {
+        GainEstimator::LeastSquares => (ls.clone(), ls_coef),
+        GainEstimator::Instrumental => {
+            let iv = super::instrumental::instrumental(&factors, &sigma, &ls_coef, &names)?;
+            let coef: Vec<f64> = iv.coef.row(0).iter().copied().collect();
+            rms = factors.residual_rms(&coef)?;
+            (iv, coef)
+        }
+    };
     let gain: Vec<f64> = coef[p..].iter().map(|c| -c).collect();
-    if let Some(j) =
-        (0..nv).find(|&j| !(gain[j].is_finite() && gain[j] != 0.0 && rms[j].is_finite()))
-    {
-        return Err(Error::Numerical {
-            operation: "drive-gain identification".into(),
-            message: format!(
-                "joint '{}': gain {} with residual RMS {}: the signal does not determine it (a signal of 0 or one too large for f64 arithmetic?)",
-                model.joint_names[j],
-                shown(gain[j]),
-                shown(rms[j])
-            ),
-        });
-    }
+    undetermined(&gain, &rms)?;
 
     // the robot alone: its torques are the gains' times the signal less the payload's
     let tau: Vec<f64> = (0..k * nv)
@@ -396,10 +491,10 @@ pub fn identify_drive_gains(
         .collect();
     let (mut model_fit, _) = fit_with_factors(model, &states, &tau, options)?;
     let inflation = model_fit.stderr_inflation();
-    let stderr: Vec<f64> = ls.stderr.row(0).iter().map(|s| s * inflation).collect();
+    let stderr: Vec<f64> = fit.stderr.row(0).iter().map(|s| s * inflation).collect();
     model_fit.theta = coef[..p].to_vec();
     model_fit.stderr = stderr[..p].to_vec();
-    model_fit.correlation = ls.correlation.view((0, 0), (p, p)).into_owned();
+    model_fit.correlation = fit.correlation.view((0, 0), (p, p)).into_owned();
     model_fit.residual_rms = rms.clone();
     model_fit.sigma = sigma;
 
@@ -414,11 +509,11 @@ pub fn identify_drive_gains(
         .map(|m| {
             let sum: f64 = (0..nv)
                 .map(|j| {
-                    let w = rms[j] / model_fit.sigma[j];
-                    cov(p + m, p + j) * k as f64 * w * w / gain[j]
+                    let w = ls_rms[j] / model_fit.sigma[j];
+                    cov(p + m, p + j) * k as f64 * w * w / ls_gain[j]
                 })
                 .sum();
-            let bias = sum / gain[m];
+            let bias = sum / ls_gain[m];
             if bias.is_finite() {
                 Ok(bias.max(0.0))
             } else {
@@ -460,6 +555,11 @@ pub fn identify_drive_gains(
         cond: ls.cond,
         runs: runs.len(),
         loaded_runs,
+        estimator,
+        least_squares_gain: match estimator {
+            GainEstimator::LeastSquares => Vec::new(),
+            GainEstimator::Instrumental => ls_gain,
+        },
     });
     Ok(DriveGainFit { model: model_fit })
 }

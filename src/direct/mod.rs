@@ -11,6 +11,7 @@ pub mod drive_gains;
 pub mod excitation;
 pub mod global_linear;
 pub mod identify;
+pub mod instrumental;
 pub mod parameter_table;
 pub mod parameters;
 pub mod position_offsets;
@@ -28,7 +29,10 @@ pub use consistency::{check_physical_consistency, BodyConsistency, ConsistencyRe
 pub use consistent::{
     consistent_least_squares, ConsistentFit, ConsistentOptions, ConsistentSolution,
 };
-pub use drive_gains::{identify_drive_gains, DriveGainFit, DriveGains, GainRun};
+pub use drive_gains::{
+    identify_drive_gains, identify_drive_gains_with, DriveGainFit, DriveGains, GainEstimator,
+    GainRun,
+};
 pub use excitation::{design_excitation, Criterion, ExcitationDesign, ExcitationOptions};
 pub use global_linear::{identify_global_linear, GlobalLinearModel};
 pub use identify::{

@@ -299,6 +299,31 @@ fn triangular(a: &DMatrix<f64>) -> DMatrix<f64> {
     DMatrix::from_fn(n, n, |i, j| f[(i, j)])
 }
 
+/// The upper-triangular factor (`width x width`) of every joint's factor `factors[j]` (any
+/// number of rows) stacked, its rows divided by `sigma[j]` and its column `c` placed in column
+/// `column(j, c)` (`< width`) of the stack: `R^T R = sum_j F_j^T F_j / sigma_j^2` over the
+/// scattered columns.
+pub(super) fn triangular_of_stacked(
+    factors: &[DMatrix<f64>],
+    sigma: &[f64],
+    width: usize,
+    column: impl Fn(usize, usize) -> usize,
+) -> DMatrix<f64> {
+    let height: usize = factors.iter().map(|r| r.nrows()).sum();
+    let mut stacked = DMatrix::zeros(height, width);
+    let mut row = 0;
+    for (j, (r, s)) in factors.iter().zip(sigma).enumerate() {
+        for c in 0..r.ncols() {
+            let to = column(j, c);
+            for i in 0..r.nrows() {
+                stacked[(row + i, to)] = r[(i, c)] / s;
+            }
+        }
+        row += r.nrows();
+    }
+    triangular(&stacked)
+}
+
 /// Merges two sets of per-joint factors (QR of each stacked pair).
 fn merge(a: Vec<DMatrix<f64>>, b: Vec<DMatrix<f64>>) -> Vec<DMatrix<f64>> {
     a.into_iter()
@@ -459,23 +484,14 @@ impl JointFactors {
             });
         }
         // every joint's factor, weighted and scattered onto the p base columns and the torque
-        let height: usize = self.factors.iter().map(|r| r.nrows()).sum();
-        let mut stacked = DMatrix::zeros(height, p + 1);
-        let mut row = 0;
-        for (j, ((r, active), s)) in self.factors.iter().zip(&self.active).zip(sigma).enumerate() {
-            let nj = active.len();
-            for i in 0..r.nrows() {
-                for (a, &c) in active.iter().enumerate() {
-                    stacked[(row + i, c)] = r[(i, a)] / s;
-                }
-                for c in 0..e {
-                    stacked[(row + i, self.parameters + j * e + c)] = r[(i, nj + c)] / s;
-                }
-                stacked[(row + i, p)] = r[(i, nj + e)] / s;
+        let r = triangular_of_stacked(&self.factors, sigma, p + 1, |j, c| {
+            let nj = self.active[j].len();
+            match c {
+                c if c < nj => self.active[j][c],
+                c if c < nj + e => self.parameters + j * e + c - nj,
+                _ => p,
             }
-            row += r.nrows();
-        }
-        let r = triangular(&stacked);
+        });
         // [R11 z; 0 rho]: min |W theta - y| solves R11 theta = z with residual norm |rho|
         let r11 = r.view((0, 0), (p, p)).into_owned();
         let z = r.view((0, p), (p, 1)).into_owned();

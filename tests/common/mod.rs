@@ -3,6 +3,8 @@
 
 use nalgebra::DMatrix;
 
+pub mod gain_logs;
+
 /// A deterministic pseudo-random generator (splitmix64) so helpers need no extra crate.
 pub struct Rng(pub u64);
 
