@@ -61,8 +61,15 @@ fn log(path: &std::path::Path, seed: u64, payload: Option<&Payload>) {
 /// `perturbid identify-gains` on `dir`'s alone.csv and loaded.csv with `payload`, viscous
 /// friction, into `dir/out`; its stdout.
 fn identify_gains(dir: &std::path::Path, payload: &str, out: &str) -> String {
+    identify_gains_by(dir, payload, out, "least_squares")
+}
+
+/// [`identify_gains`] by `estimator`.
+fn identify_gains_by(dir: &std::path::Path, payload: &str, out: &str, estimator: &str) -> String {
     ok(&[
         "identify-gains",
+        "--estimator",
+        estimator,
         "a465",
         s(&dir.join("alone.csv")),
         "--loaded",
@@ -86,7 +93,7 @@ fn gains_and_the_robot_alone_from_logs_of_currents() {
     let run = |payload: &str, out: &str| identify_gains(&d, payload, out);
     let out = run(s(&d.join("payload.json")), "model.json");
     assert!(
-        out.contains("drive gains from 2 runs (1 with 2 kg on 'link6')"),
+        out.contains("drive gains by least squares from 2 runs (1 with 2 kg on 'link6')"),
         "{out}"
     );
     let model = BaseModel::load(d.join("model.json")).unwrap();
@@ -95,6 +102,34 @@ fn gains_and_the_robot_alone_from_logs_of_currents() {
         assert!((gain / truth - 1.0).abs() < 1e-2, "{out}");
         assert!(out.contains(&format!("{gain:.6}")), "{out}");
     }
+    // by instrumental variables: the least-squares gains beside them
+    let out = identify_gains_by(&d, s(&d.join("payload.json")), "iv.json", "instrumental");
+    assert!(
+        out.contains("drive gains by instrumental variables") && out.contains("least squares\n"),
+        "{out}"
+    );
+    let iv = BaseModel::load(d.join("iv.json")).unwrap();
+    let ivg = iv.drive_gains.as_ref().unwrap();
+    assert_eq!(ivg.least_squares_gain, g.gain);
+    for ((gain, ls), truth) in ivg.gain.iter().zip(&g.gain).zip(GAINS) {
+        assert!((gain / truth - 1.0).abs() < 1e-2, "{out}");
+        assert!(out.contains(&format!("{gain:.6} ")), "{out}");
+        assert!(out.contains(&format!("{ls:.6}\n")), "{out}");
+    }
+    fails(
+        &[
+            "identify-gains",
+            "a465",
+            s(&d.join("alone.csv")),
+            "--loaded",
+            s(&d.join("loaded.csv")),
+            "--payload",
+            PAYLOAD,
+            "--estimator",
+            "bayes",
+        ],
+        &["'bayes'", "instrumental"],
+    );
     // the payload given inline: the same model
     let out = run(PAYLOAD, "inline.json");
     assert!(out.contains("base parameters of the robot alone"), "{out}");

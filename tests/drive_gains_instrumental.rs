@@ -114,7 +114,7 @@ fn the_instrumental_estimate_is_the_dense_one() {
     let (n, cols) = (6, x.ncols());
     let pb = cols - n;
     // Z: the signal's columns replaced by the signal the first fit predicts
-    let predicted = &x.columns(0, pb) * nalgebra::DVector::from_column_slice(&first[..pb]) - &y;
+    let predicted = x.columns(0, pb) * nalgebra::DVector::from_column_slice(&first[..pb]) - &y;
     let z = DMatrix::from_fn(x.nrows(), cols, |r, c| {
         if c < pb {
             x[(r, c)]

@@ -662,10 +662,12 @@ class BaseParameterModel:
     @property
     def drive_gains(self) -> dict[str, Any] | None:
         """Where the model was identified from logged motor currents (identify_drive_gains),
-        else None: gain, stderr, noise_bias (each gain's relative bias towards 0, were
+        else None: gain, stderr, noise_bias (each least-squares gain's relative bias towards 0, were
         every residual the signal's noise), payload_torque_rms (N m), agreement (near 1
         where the runs agree with the payload as given), each (n,); cond, runs,
-        loaded_runs. The model's torques are gain * signal."""
+        loaded_runs, estimator ("least_squares" or "instrumental"), least_squares_gain
+        (None, or by instrumental variables the least-squares gains, (n,)). The model's
+        torques are gain * signal."""
     @property
     def weak_excitation(self) -> dict[str, Any] | None:
         """Where the data excite the base parameters weakly (cond beyond 2000), else None:
@@ -773,11 +775,14 @@ def identify_drive_gains(
     gravity: bool = True,
     tolerance: float = 1e-8,
     seed: int = 0,
+    estimator: Literal["least_squares", "instrumental"] = "least_squares",
 ) -> BaseParameterModel:
     """Drive gains (N m per unit of the logged signal) with the base parameters, from
     preprocessed Recordings whose tau holds the motor currents, one payload a run: None or a
     dict link, mass (kg), com (m), inertia ([ixx, ixy, ixz, iyy, iyz, izz] about the centre
-    of mass, kg m^2) in the link's frame. Not every run may carry the same payload."""
+    of mass, kg m^2) in the link's frame. Not every run may carry the same payload.
+    estimator "instrumental": instrumental variables, unbiased by the signal's noise (least
+    squares is biased towards 0 by it, as drive_gains["noise_bias"] says)."""
     ...
 
 @final

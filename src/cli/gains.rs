@@ -11,7 +11,7 @@ use super::files::{
     in_log, is_inline_json, load_json, refuse_overwriting_inputs, PreprocessArgs, RobotArg,
 };
 use super::progress::Progress;
-use crate::direct::{identify_drive_gains, GainRun};
+use crate::direct::{identify_drive_gains_with, GainEstimator, GainRun};
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::recording::Recording;
@@ -37,6 +37,12 @@ pub(crate) struct IdentifyGainsArgs {
     /// Where to write the base-parameter model with its drive gains (JSON).
     #[arg(long, default_value = "base_model.json")]
     out: PathBuf,
+    /// How the gains are estimated: least_squares (the smallest variance, biased towards 0 by
+    /// the signal's noise, as the table's noise bias says) or instrumental (instrumental
+    /// variables, the signal predicted by the least-squares fit for instrument: unbiased by
+    /// the signal's noise, at a larger variance).
+    #[arg(long, default_value = "least_squares", value_parser = ["least_squares", "instrumental"])]
+    estimator: String,
     #[command(flatten)]
     fit: FitArgs,
     #[command(flatten)]
@@ -110,20 +116,22 @@ pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
         "identifying on {k} samples of {} runs",
         runs.len()
     ));
-    let fit = identify_drive_gains(&model, &runs, &options).map_err(|e| match e {
-        // an error about one run's data names its file
-        Error::InvalidArgument { argument, message } if argument == "runs" => {
-            let file = (0..logs.len()).find(|r| {
-                message.starts_with(&format!("run {r}:"))
-                    || message.starts_with(&format!("run {r} "))
-            });
-            Error::InvalidArgument {
-                argument: file.map_or("runs".into(), |r| logs[r].display().to_string()),
-                message,
+    let estimator = GainEstimator::parse(&a.estimator)?;
+    let fit =
+        identify_drive_gains_with(&model, &runs, &options, estimator).map_err(|e| match e {
+            // an error about one run's data names its file
+            Error::InvalidArgument { argument, message } if argument == "runs" => {
+                let file = (0..logs.len()).find(|r| {
+                    message.starts_with(&format!("run {r}:"))
+                        || message.starts_with(&format!("run {r} "))
+                });
+                Error::InvalidArgument {
+                    argument: file.map_or("runs".into(), |r| logs[r].display().to_string()),
+                    message,
+                }
             }
-        }
-        other => other,
-    })?;
+            other => other,
+        })?;
     progress.done();
     let fit = fit.model;
     for w in fit.warnings() {
@@ -134,18 +142,29 @@ pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
         .drive_gains
         .as_ref()
         .expect("a drive-gain fit holds its gains");
+    let instrumental = estimator == GainEstimator::Instrumental;
     let _ = writeln!(
         out,
-        "drive gains from {} runs ({} with {} kg on '{}'), {k} samples, cond {:.3e}:",
-        g.runs, g.loaded_runs, payload.mass, payload.link, g.cond
+        "drive gains by {} from {} runs ({} with {} kg on '{}'), {k} samples, cond {:.3e}:",
+        if instrumental {
+            "instrumental variables"
+        } else {
+            "least squares"
+        },
+        g.runs,
+        g.loaded_runs,
+        payload.mass,
+        payload.link,
+        g.cond
     );
-    let _ = writeln!(
+    let _ = write!(
         out,
         "  {:<16} {:>14} {:>12} {:>12} {:>16}",
         "joint", "gain", "std. error", "noise bias", "payload torque"
     );
+    let _ = writeln!(out, "{}", if instrumental { "  least squares" } else { "" });
     for (j, name) in model.joint_names.iter().enumerate() {
-        let _ = writeln!(
+        let _ = write!(
             out,
             "  {:<16} {:>14.6} {:>12.2e} {:>10.2} % {:>16.4}",
             name,
@@ -153,6 +172,17 @@ pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
             g.stderr[j],
             100.0 * g.noise_bias[j],
             g.payload_torque_rms[j]
+        );
+        match g.least_squares_gain.get(j) {
+            Some(l) => writeln!(out, " {l:>14.6}"),
+            None => writeln!(out),
+        }
+        .ok();
+    }
+    if instrumental {
+        let _ = writeln!(
+            out,
+            "  (noise bias: of the least-squares gains, the last column; the gains are unbiased by the signal's noise)"
         );
     }
     let _ = writeln!(

@@ -373,10 +373,12 @@ impl PyBaseModel {
     }
     /// The joints' drive gains where the model was identified from logged motor currents
     /// (`identify_drive_gains`), else None: dict `gain`, `stderr`, `noise_bias` (an upper
-    /// estimate of each gain's relative bias towards 0, were every residual the signal's noise),
+    /// estimate of each least-squares gain's relative bias towards 0, were every residual the signal's noise),
     /// `payload_torque_rms` (N m) and `agreement` (near 1 where the runs agree with the
-    /// payload as given), each (n,); `cond` of the joint fit, `runs`, `loaded_runs`.
-    /// The model's torques are `gain * signal`.
+    /// payload as given), each (n,); `cond` of the joint fit, `runs`, `loaded_runs`,
+    /// `estimator` ("least_squares" or "instrumental") and `least_squares_gain` (None, or by
+    /// instrumental variables the least-squares gains, (n,)). The model's torques are
+    /// `gain * signal`.
     #[getter]
     fn drive_gains<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
         (self.fit.drive_gains.as_ref())

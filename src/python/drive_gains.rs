@@ -14,7 +14,9 @@ use super::direct::{check_sample_derivatives, fit_options, FrictionNames, PyBase
 use super::recording::PyRecording;
 use super::robot::PyRobot;
 use super::scalars;
-use crate::direct::drive_gains::{identify_drive_gains as gains_rs, DriveGains, GainRun, MAX_RUNS};
+use crate::direct::drive_gains::{
+    identify_drive_gains_with as gains_rs, DriveGains, GainEstimator, GainRun, MAX_RUNS,
+};
 use crate::error::{Error, Result};
 use crate::recording::Recording;
 use crate::rehearsal::Payload;
@@ -149,13 +151,17 @@ fn run_arrays(r: usize, rec: &Recording, nv: usize) -> Result<(&[f64], &[f64])> 
 ///
 /// Returns a BaseParameterModel of the robot alone in SI units (its predictions are torques),
 /// with `drive_gains`: `gain` (n,) N m (or N) per unit of the signal, `stderr`, `noise_bias`
-/// (each gain's relative bias towards 0 were every residual the signal's noise),
+/// (each least-squares gain's relative bias towards 0 were every residual the signal's noise),
 /// `payload_torque_rms` (N m), `agreement` (the fit's residual over each run's signal fitted
 /// alone: near 1 where the runs agree with the payload as given), `cond`, `runs`,
-/// `loaded_runs`. `friction`, `weighting`,
-/// `gravity`, `tolerance`, `seed` as for `identify_base_parameters`. Findings are warned of.
+/// `loaded_runs`, `estimator` and `least_squares_gain` (None, or by instrumental variables
+/// the least-squares gains). `estimator`: "least_squares" (the smallest variance, biased
+/// towards 0 by the signal's noise as `noise_bias` says) or "instrumental" (instrumental
+/// variables, the signal predicted by the least-squares fit for instrument: consistent under
+/// the signal's noise). `friction`, `weighting`, `gravity`, `tolerance`, `seed` as for
+/// `identify_base_parameters`. Findings are warned of.
 #[pyfunction]
-#[pyo3(signature = (robot, runs, payloads, friction=None, weighting="wls", gravity=true, tolerance=1e-8, seed=0))]
+#[pyo3(signature = (robot, runs, payloads, friction=None, weighting="wls", gravity=true, tolerance=1e-8, seed=0, estimator="least_squares"))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_drive_gains(
     py: Python<'_>,
@@ -167,8 +173,10 @@ pub(crate) fn identify_drive_gains(
     gravity: bool,
     #[pyo3(from_py_with = scalars::real)] tolerance: f64,
     #[pyo3(from_py_with = scalars::seed)] seed: u64,
+    estimator: &str,
 ) -> PyResult<PyBaseModel> {
     let options = fit_options(friction, weighting, gravity, tolerance, seed)?;
+    let estimator = GainEstimator::parse(estimator)?;
     let model = &robot.model;
     let (runs, payloads) = (entries("runs", &runs)?, entries("payloads", &payloads)?);
     if runs.len() != payloads.len() {
@@ -226,7 +234,7 @@ pub(crate) fn identify_drive_gains(
                 payload: payload.as_ref(),
             });
         }
-        Ok(gains_rs(model, &gain_runs, &options)?.model)
+        Ok(gains_rs(model, &gain_runs, &options, estimator)?.model)
     })?;
     super::errors::warn_all(py, &fit.warnings())?;
     Ok(PyBaseModel {
@@ -246,5 +254,10 @@ pub(crate) fn gains_dict<'py>(py: Python<'py>, g: &DriveGains) -> PyResult<Bound
     d.set_item("cond", g.cond)?;
     d.set_item("runs", g.runs)?;
     d.set_item("loaded_runs", g.loaded_runs)?;
+    d.set_item("estimator", g.estimator.name())?;
+    match g.least_squares_gain.is_empty() {
+        true => d.set_item("least_squares_gain", py.None())?,
+        false => d.set_item("least_squares_gain", vec1(py, &g.least_squares_gain))?,
+    }
     Ok(d)
 }

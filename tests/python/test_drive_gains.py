@@ -4,6 +4,7 @@ checked against numpy's least squares over Pinocchio's own regressor, the model 
 alone against Pinocchio's torques on another motion; hostile arguments are refused by name."""
 
 import json
+import warnings
 
 import numpy as np
 import pinocchio as pin
@@ -38,8 +39,9 @@ def pin_torques(model, q, qd, qdd):
     return np.array([pin.rnea(model, data, *x) for x in zip(q, qd, qdd)])
 
 
-@pytest.fixture(scope="module")
-def setup():
+def logs(noise):
+    """The A465 (Pinocchio), alone and with the payload on link 6 along two motions: the
+    pair, the loaded Pinocchio model, and the runs (t, q, qd, qdd, currents under `noise` A)."""
     pair = pair_from_text(pr.robots.a465_urdf("kinsheel2010"))
     loaded = pair.model.copy()
     jid = loaded.getJointId("joint6")
@@ -52,9 +54,38 @@ def setup():
     for seed, model in [(3, pair.model), (4, loaded)]:
         t, q, qd, qdd = motion(seed)
         tau = pin_torques(model, q, qd, qdd) + VISCOUS * qd
-        current = tau / GAINS + 1e-4 * rng.standard_normal(tau.shape)
+        current = tau / GAINS + noise * rng.standard_normal(tau.shape)
         runs.append((t, q, qd, qdd, current))
     return pair, loaded, runs
+
+
+@pytest.fixture(scope="module")
+def setup():
+    return logs(1e-4)
+
+
+def dense_system(pair, loaded, runs):
+    """[Y_pin | armature | viscous | -diag(i)] [theta; K] = -tau_payload over the runs (the
+    second loaded), Pinocchio's regressor and torques: x (6k, 10 nb + 18), rhs (6k,)."""
+    data = pair.model.createData()
+    ids = [pair.model.getJointId(n) for n in pair.ours.joint_names]
+    cols = np.concatenate([np.arange(10 * (i - 1), 10 * i) for i in ids])
+    rows, rhs = [], []
+    for r, (t, q, qd, qdd, i) in enumerate(runs):
+        payload_tau = (pin_torques(loaded, q, qd, qdd) - pin_torques(pair.model, q, qd, qdd)
+                       if r == 1 else np.zeros_like(q))
+        for s in range(len(t)):
+            y = pin.computeJointTorqueRegressor(pair.model, data, q[s], qd[s], qdd[s])[:, cols]
+            rows.append(np.hstack([y, np.diag(qdd[s]), np.diag(qd[s]), -np.diag(i[s])]))
+            rhs.append(-payload_tau[s])
+    return np.vstack(rows), np.concatenate(rhs)
+
+
+def lstsq(x, y):
+    """numpy's least squares, columns scaled to unit norm (zero columns left)."""
+    scale = np.linalg.norm(x, axis=0)
+    scale[scale == 0] = 1.0
+    return np.linalg.lstsq(x / scale, y, rcond=1e-12)[0] / scale
 
 
 def recordings(runs):
@@ -68,28 +99,57 @@ def test_gains_match_numpy_least_squares_over_pinocchios_regressor(setup):
                                   friction="viscous", weighting="ols")
     g = fit.drive_gains
     assert g is not None and g["runs"] == 2 and g["loaded_runs"] == 1
-    # [Y_pin | armature | viscous | -diag(i)] [theta; K] = -tau_payload, solved by numpy
-    data = pair.model.createData()
-    ids = [pair.model.getJointId(n) for n in pair.ours.joint_names]
-    cols = np.concatenate([np.arange(10 * (i - 1), 10 * i) for i in ids])
-    rows, rhs = [], []
-    for r, (t, q, qd, qdd, i) in enumerate(runs):
-        payload_tau = (pin_torques(loaded, q, qd, qdd) - pin_torques(pair.model, q, qd, qdd)
-                       if r == 1 else np.zeros_like(q))
-        for s in range(len(t)):
-            y = pin.computeJointTorqueRegressor(pair.model, data, q[s], qd[s], qdd[s])[:, cols]
-            rows.append(np.hstack([y, np.diag(qdd[s]), np.diag(qd[s]), -np.diag(i[s])]))
-            rhs.append(-payload_tau[s])
-    x = np.vstack(rows)
-    scale = np.linalg.norm(x, axis=0)
-    scale[scale == 0] = 1.0
-    sol = np.linalg.lstsq(x / scale, np.concatenate(rhs), rcond=1e-12)[0] / scale
+    # solved by numpy over Pinocchio's regressor
+    sol = lstsq(*dense_system(pair, loaded, runs))
     np.testing.assert_allclose(g["gain"], sol[-6:], rtol=1e-8)
+    assert g["estimator"] == "least_squares" and g["least_squares_gain"] is None
     # and the truth, within the standard errors and the noise's estimated bias
     err = np.abs(g["gain"] - GAINS)
     assert np.all(err < 4 * g["stderr"] + g["noise_bias"] * GAINS), (g, GAINS)
     assert np.all(g["noise_bias"] < 1e-3) and np.all(g["payload_torque_rms"] > 0.01)
     assert np.all((g["agreement"] > 0.95) & (g["agreement"] < 1.2))
+
+
+def test_instrumental_gains_match_numpy_and_lose_the_noise_bias():
+    """On currents noisy enough to bias least squares by several per cent: the instrumental
+    estimate (Z^T X) beta = Z^T y solved by numpy over Pinocchio's regressor, Z the signal
+    predicted by numpy's least-squares fit."""
+    pair, loaded, runs = logs(5e-4)
+    recs = recordings(runs)
+    kw = dict(friction="viscous", weighting="ols")
+    ls = pr.identify_drive_gains(pair.ours, recs, [None, PAYLOAD], **kw)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        iv = pr.identify_drive_gains(pair.ours, recs, [None, PAYLOAD], estimator="instrumental",
+                                     **kw).drive_gains
+    x, y = dense_system(pair, loaded, runs)
+    first = lstsq(x, y)
+    # Pinocchio's regressor has more columns than the data determine: an orthonormal basis
+    # of their span instead (the fitted torques and the gains do not depend on the basis)
+    phi = x[:, :-6]
+    u, sv, _ = np.linalg.svd(phi / np.maximum(np.linalg.norm(phi, axis=0), 1e-300),
+                             full_matrices=False)
+    basis = u[:, sv > 1e-10 * sv[0]]
+    joint = np.arange(len(y)) % 6
+    predicted = (phi @ first[:-6] - y) / first[-6:][joint]
+    signal = x[:, -6:]
+    instrument = np.zeros_like(signal)
+    instrument[np.arange(len(y)), joint] = -predicted
+    xb, zb = np.hstack([basis, signal]), np.hstack([basis, instrument])
+    scale = np.linalg.norm(xb, axis=0)
+    beta = np.linalg.solve((zb / scale).T @ (xb / scale), (zb / scale).T @ y) / scale
+    np.testing.assert_allclose(iv["gain"], beta[-6:], rtol=1e-7)
+    # (to 1e-8 on the quieter currents above; numpy's rank-deficient solve is looser here)
+    np.testing.assert_allclose(iv["least_squares_gain"], first[-6:], rtol=1e-6)
+    assert iv["estimator"] == "instrumental"
+    # within their standard errors of the truth; least squares is not, where biased
+    assert np.all(np.abs(iv["gain"] - GAINS) < 3.5 * iv["stderr"]), (iv, GAINS)
+    biased = iv["noise_bias"] > 0.01
+    assert biased.sum() >= 2, iv["noise_bias"]
+    lost = np.abs(ls.drive_gains["gain"] - GAINS)
+    assert np.all(lost[biased] > 3 * np.abs(iv["gain"] - GAINS)[biased]), (lost, iv["gain"])
+    with pytest.raises(pr.InputError, match="estimator.*'bayes'"):
+        pr.identify_drive_gains(pair.ours, recs, [None, PAYLOAD], estimator="bayes")
 
 
 def test_the_model_is_the_robot_alones_in_torques(setup):
