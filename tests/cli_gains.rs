@@ -134,6 +134,13 @@ fn gains_and_the_robot_alone_from_logs_of_currents() {
     let out = run(PAYLOAD, "inline.json");
     assert!(out.contains("base parameters of the robot alone"), "{out}");
     assert_eq!(BaseModel::load(d.join("inline.json")).unwrap(), model);
+    // and in a pipeline, written out as a table (it was taken for a string)
+    write(
+        &d.join("p.toml"),
+        "[[step]]\nrun = \"identify-gains\"\nrobot = \"a465\"\nruns = [\"alone.csv\"]\nloaded = [\"loaded.csv\"]\nfriction = \"viscous\"\nout = \"table.json\"\npayload = { link = \"link6\", mass = 2.0, com = [0.02, -0.01, 0.08], inertia = [0.004, 0, 0, 0.004, 0, 0.002] }\n",
+    );
+    ok(&["run", s(&d.join("p.toml"))]);
+    assert_eq!(BaseModel::load(d.join("table.json")).unwrap(), model);
     // a third run of the robot alone: its currents predicted, and validated in torques
     log(&d.join("third.csv"), 3, None);
     let model_path = d.join("model.json");

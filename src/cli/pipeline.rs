@@ -307,9 +307,9 @@ fn words(key: &str, value: &Value, arg: &clap::Arg, base: &Path, at: &str) -> Re
                 .map(|(joint, v)| Ok(format!("{joint}={}", scalar(v)?)))
                 .collect::<Result<Vec<_>>>()?
         }
-        // `op = { q = [...], qd = [...], qdd = [...] }`: the operating point written out, given
-        // to `--op` as its JSON
-        Value::Table(t) if arg.get_id().as_str() == "op" => {
+        // `op = { q = [...], qd = [...], qdd = [...] }`: the operating point written out, and
+        // `payload = { link = "link6", mass = 2.0, ... }` the payload, given as their JSON
+        Value::Table(t) if ["op", "payload"].contains(&arg.get_id().as_str()) => {
             return serde_json::to_string(t)
                 .map(|json| vec![json])
                 .map_err(|e| bad(format!("'{key}': {e}")))
