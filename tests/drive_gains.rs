@@ -12,10 +12,13 @@ use common::gain_logs::{
     truth, GAINS,
 };
 use common::{refused_on_load, torques_with_friction, Rng};
-use perturbid_rs::direct::{identify_drive_gains, BaseModel, BaseOptions, GainRun, Weighting};
+use nalgebra::{DMatrix, DVector};
+use perturbid_rs::direct::{
+    identify_drive_gains, regressor_matrix, BaseModel, BaseOptions, GainRun, Weighting,
+};
 use perturbid_rs::document::Document;
 use perturbid_rs::rehearsal::Payload;
-use perturbid_rs::{States, TorqueModel};
+use perturbid_rs::{Gravity, States, TorqueModel};
 
 #[test]
 fn the_gains_and_the_robots_torques_come_back_from_currents_with_a_known_payload() {
@@ -114,6 +117,48 @@ fn the_joint_fit_is_the_dense_least_squares_solution() {
             "theta[{c}]: {t} against {d}"
         );
     }
+    // the predicted signal and its standard error on a third motion, from the dense
+    // covariance s^2 (X^T X)^-1 of [theta; K] (inflated as the model's) and the gradient of
+    // i_j = Phi_j theta / K_j
+    let cols = x.ncols();
+    let scale: Vec<f64> = (0..cols).map(|c| x.column(c).norm()).collect();
+    let xs = DMatrix::from_fn(x.nrows(), cols, |r, c| x[(r, c)] / scale[c]);
+    let residual = &rhs - &x * DVector::from_column_slice(&theta);
+    let s2 = residual.norm_squared() / (x.nrows() - cols) as f64;
+    let inverse = (xs.transpose() * &xs).try_inverse().unwrap();
+    let inflation = fit.model.stderr_inflation().powi(2);
+    let cov = DMatrix::from_fn(cols, cols, |a, b| {
+        inverse[(a, b)] / (scale[a] * scale[b]) * s2 * inflation
+    });
+    let c = motion(8);
+    let third = states(&c);
+    let signal = fit.model.predict_signal(&truth, &third).unwrap();
+    let tau = fit.model.predict(&truth, &third).unwrap();
+    let se = fit.model.predict_signal_stderr(&truth, &third).unwrap();
+    let phi = fit.model.base.select(
+        &regressor_matrix(&truth, &fit.model.base.layout, &third, Gravity::Included).unwrap(),
+    );
+    for r in (0..phi.nrows()).step_by(397) {
+        let j = r % 6;
+        assert_eq!(signal[r], tau[r] / g.gain[j]);
+        let mut grad = DVector::zeros(cols);
+        for a in 0..p_base {
+            grad[a] = phi[(r, a)] / g.gain[j];
+        }
+        grad[p_base + j] = -tau[r] / g.gain[j].powi(2);
+        let dense = grad.dot(&(&cov * &grad)).sqrt();
+        assert!(
+            (se[r] / dense - 1.0).abs() < 1e-6,
+            "row {r}: {} against {dense}",
+            se[r]
+        );
+    }
+    // torques alone, the gains' covariance left out, would say otherwise
+    let naive = fit.model.predict_stderr(&truth, &third).unwrap();
+    let apart = (0..se.len())
+        .map(|r| naive[r] / g.gain[r % 6].abs() / se[r])
+        .fold(1.0f64, |m, v| m.max(v.max(1.0 / v)));
+    assert!(apart > 1.05, "{apart}");
 }
 
 #[test]
@@ -282,8 +327,48 @@ fn saved_gains_are_checked_on_load() {
                 |v| v["joint_term_rms"] = serde_json::json!([1.0]),
                 "joint_term_rms has 1 entries, expected one per joint and joint term",
             ),
+            (
+                |v| v["drive_gains"]["correlation"] = serde_json::json!([[1.0]]),
+                "drive_gains.correlation is 1 x 1, expected one row per joint (6)",
+            ),
+            (
+                |v| v["drive_gains"]["correlation"][2][0] = serde_json::json!(1.5),
+                "correlation with drive_gains.correlation, row",
+            ),
+            (
+                |v| v["correlation"] = serde_json::json!([]),
+                "a column for each of the model's 0 parameters",
+            ),
         ],
     );
+    // a model saved before the gains' correlation was: its signal predicted, without
+    // standard errors
+    let mut old = json.clone();
+    old["drive_gains"]
+        .as_object_mut()
+        .unwrap()
+        .remove("correlation");
+    let old = BaseModel::from_json(&old.to_string()).unwrap();
+    let s = states(&logs.a);
+    assert_eq!(
+        old.predict_signal(truth, &s).unwrap(),
+        fit.model.predict_signal(truth, &s).unwrap()
+    );
+    let e = old
+        .predict_signal_stderr(truth, &s)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("a model saved before it was stored"), "{e}");
+    // and a model fitted to torques has no signal
+    let plain = perturbid_rs::direct::identify_base_parameters(
+        truth,
+        &s,
+        &fit.model.predict(truth, &s).unwrap(),
+        &BaseOptions::default(),
+    )
+    .unwrap();
+    let e = plain.predict_signal(truth, &s).unwrap_err().to_string();
+    assert!(e.contains("holds no drive gains"), "{e}");
 }
 
 #[test]

@@ -692,19 +692,24 @@ class BaseParameterModel:
         qd: Optional[ArrayLike] = None,
         qdd: Optional[ArrayLike] = None,
         coulomb: Optional[ArrayLike] = None,
+        signal: bool = False,
     ) -> NDArray[np.float64]:
         """Torques (N m) at q, qd, qdd ((n,) or (k, n)), with the Coulomb column where given; or
-        at a Recording's states, with its Coulomb column, given as q alone."""
+        at a Recording's states, with its Coulomb column, given as q alone. signal=True: the
+        logged signal the drive gains were identified for (motor currents: torque / gain)."""
     def predict_stderr(
         self,
         q: Union[ArrayLike, Recording],
         qd: Optional[ArrayLike] = None,
         qdd: Optional[ArrayLike] = None,
         coulomb: Optional[ArrayLike] = None,
+        signal: bool = False,
     ) -> NDArray[np.float64]:
         """Standard errors (N m) of predict's torques, shape (n,) or (k, n): from the parameters'
         standard errors and their correlation (the model's uncertainty, not a measured torque's
-        scatter). InputError for a model saved before the correlation was stored."""
+        scatter). signal=True: of the predicted signal, from the parameters' and the drive
+        gains' covariance together. InputError for a model saved before the correlation was
+        stored."""
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]: ...
     def to_json(self) -> str: ...
 

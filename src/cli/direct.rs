@@ -343,8 +343,8 @@ pub(crate) struct PredictArgs {
     lock: Vec<(String, f64)>,
     /// Predict the signal the model's drive gains were identified for (motor currents: a
     /// model from identify-gains), each torque over its joint's gain: columns
-    /// signal1..signalN (and signal1_stderr..); tau1..tauN of the states CSV read as that
-    /// signal.
+    /// signal1..signalN (and signal1_stderr.., from the covariance of the parameters and the
+    /// gains together); tau1..tauN of the states CSV read as that signal.
     #[arg(long)]
     signal: bool,
 }
@@ -374,9 +374,15 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
             if let Some(w) = crate::direct::position_range::finding(&ranges) {
                 eprintln!("perturbid: warning: '{}': {w}", a.data.display());
             }
-            let tau = fit.on(&robot)?.predict(&states)?;
-            let se = a.stderr.then(|| fit.predict_stderr(&robot, &states));
-            (tau, se.transpose()?)
+            if gains.is_some() {
+                // the signal, its standard errors from the parameters' and gains' covariance
+                let se = a.stderr.then(|| fit.predict_signal_stderr(&robot, &states));
+                (fit.predict_signal(&robot, &states)?, se.transpose()?)
+            } else {
+                let tau = fit.on(&robot)?.predict(&states)?;
+                let se = a.stderr.then(|| fit.predict_stderr(&robot, &states));
+                (tau, se.transpose()?)
+            }
         }
         ModelFile::Local(m) => {
             // states beyond the perturbations it was identified over: predicted, and said
@@ -397,20 +403,9 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
         }
         ModelFile::GlobalLinear(m) => (m.predict(&states)?, None),
     };
-    // the signal: each torque over its joint's gain (the standard errors over its size)
-    let (tau, stderr, name, unit) = match gains {
-        Some(g) => {
-            let inverse: Vec<f64> = g.iter().map(|k| 1.0 / k).collect();
-            let size: Vec<f64> = inverse.iter().map(|k| k.abs()).collect();
-            let se = stderr.map(|se| super::gains::scaled_columns(&se, &size));
-            (
-                super::gains::scaled_columns(&tau, &inverse),
-                se,
-                "signal",
-                "signal units",
-            )
-        }
-        None => (tau, stderr, "tau", "N m"),
+    let (name, unit) = match gains {
+        Some(_) => ("signal", "signal units"),
+        None => ("tau", "N m"),
     };
     let states = rows;
     let n = joints.len();

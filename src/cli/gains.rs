@@ -215,14 +215,6 @@ pub(crate) fn model_gains<'a>(
     })
 }
 
-/// `values` (row-major `k x n`) with column `j` multiplied by `scale[j]`.
-pub(crate) fn scaled_columns(values: &[f64], scale: &[f64]) -> Vec<f64> {
-    let n = scale.len();
-    (values.iter().enumerate())
-        .map(|(i, v)| v * scale[i % n])
-        .collect()
-}
-
 /// The drive gains saved in the model at `path` (`--gains-from`), for a robot of joints
 /// `joints`: refused, naming the file, for a model of other joints or without gains.
 pub(crate) fn gains_from_file(path: &Path, joints: &[String]) -> Result<crate::direct::DriveGains> {

@@ -130,6 +130,18 @@ pub struct DriveGains {
     /// How the gains were estimated (models saved before it: least squares).
     #[serde(default)]
     pub estimator: GainEstimator,
+    /// The correlation of each gain's estimate with the base parameters' and the gains'
+    /// (`nv x (p + nv)`: row `j` gain `j`'s, columns the base parameters in the model's order
+    /// and then the gains): with [`BaseModel::correlation`], the correlation of every estimate
+    /// of the joint fit, which the predicted signal's standard errors need
+    /// ([`BaseModel::predict_signal_stderr`]). Empty (0 x 0) in a model saved before it was
+    /// stored.
+    #[serde(
+        default = "crate::json::empty_matrix",
+        skip_serializing_if = "crate::json::is_empty_matrix",
+        with = "crate::json::rows"
+    )]
+    pub correlation: nalgebra::DMatrix<f64>,
     /// The least-squares gains, where the gains are by instrumental variables (else empty):
     /// `1 - least_squares_gain / gain` is the bias the signal's noise gave least squares,
     /// [`DriveGains::noise_bias`] its estimate.
@@ -138,8 +150,14 @@ pub struct DriveGains {
 }
 
 impl DriveGains {
-    /// What is wrong with saved gains for `n` joints; None where nothing is.
-    pub(crate) fn problem(&self, what: &str, n: usize) -> Option<String> {
+    /// What is wrong with saved gains for `n` joints beside the parameters' correlation
+    /// `theta` ([`BaseModel::correlation`]); None where nothing is.
+    pub(crate) fn problem(
+        &self,
+        what: &str,
+        n: usize,
+        theta: &nalgebra::DMatrix<f64>,
+    ) -> Option<String> {
         let lens = [
             ("gain", self.gain.len()),
             ("stderr", self.stderr.len()),
@@ -196,11 +214,43 @@ impl DriveGains {
             ),
             check_magnitudes(what, "drive_gains.agreement", &self.agreement, false),
             check_condition(what, "drive_gains.cond", self.cond),
+            self.check_correlation(what, n, theta),
         ];
         checks
             .into_iter()
             .find_map(|c| c.err())
             .map(|e| e.to_string())
+    }
+
+    /// [`DriveGains::correlation`], where saved, against the parameters' `theta`: with it, a
+    /// correlation of `p + n` estimates.
+    fn check_correlation(
+        &self,
+        what: &str,
+        n: usize,
+        theta: &nalgebra::DMatrix<f64>,
+    ) -> Result<()> {
+        let r = &self.correlation;
+        if r.is_empty() {
+            return Ok(());
+        }
+        let p = theta.nrows();
+        if theta.is_empty() || r.shape() != (n, p + n) {
+            return Err(crate::document::invalid(
+                what,
+                format!(
+                    "drive_gains.correlation is {} x {}, expected one row per joint ({n}) and a column for each of the model's {p} parameters (its correlation) and {n} gains",
+                    r.nrows(),
+                    r.ncols()
+                ),
+            ));
+        }
+        crate::document::check_correlation(
+            what,
+            "correlation with drive_gains.correlation",
+            &super::signal_prediction::joint_correlation(theta, r),
+            p + n,
+        )
     }
 
     /// The findings about the gains, naming the joints (`names`): gains determined to worse
@@ -556,6 +606,16 @@ pub fn identify_drive_gains_with(
         runs: runs.len(),
         loaded_runs,
         estimator,
+        // the fit's coefficients are -K: the gains' correlation with the parameters is the
+        // negated one
+        correlation: nalgebra::DMatrix::from_fn(nv, p + nv, |j, a| {
+            let r = fit.correlation[(p + j, a)];
+            if a < p {
+                -r
+            } else {
+                r
+            }
+        }),
         least_squares_gain: match estimator {
             GainEstimator::LeastSquares => Vec::new(),
             GainEstimator::Instrumental => ls_gain,

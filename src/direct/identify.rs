@@ -636,7 +636,9 @@ impl Document for BaseModel {
             ));
         }
         m.check_joint_term_rms()?;
-        if let Some(problem) = (m.drive_gains.as_ref()).and_then(|g| g.problem(Self::WHAT, n)) {
+        if let Some(problem) =
+            (m.drive_gains.as_ref()).and_then(|g| g.problem(Self::WHAT, n, &m.correlation))
+        {
             return Err(invalid(Self::WHAT, problem));
         }
         check_magnitudes(Self::WHAT, "residual_rms", &m.residual_rms, false)?;
@@ -659,7 +661,7 @@ impl BaseModel {
         Ok(BaseModelOn { fit: self, robot })
     }
 
-    fn check(&self, model: &Model) -> Result<()> {
+    pub(super) fn check(&self, model: &Model) -> Result<()> {
         if model.joint_names != self.joint_names || model.nbodies() != self.base.layout.nbodies {
             return Err(Error::InvalidArgument {
                 argument: "robot".into(),

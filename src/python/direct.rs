@@ -457,8 +457,10 @@ impl PyBaseModel {
     /// Predicted torques (N m) at `q`, `qd`, `qdd`: (n,) each or (k, n). `coulomb`, shaped
     /// as `q`: the Coulomb term's column in place of sign(qd) (`Recording.coulomb` of a
     /// preprocessed log, to compare with its filtered torques). A Recording as `q`, alone:
-    /// its states and Coulomb column.
-    #[pyo3(signature = (q, qd=None, qdd=None, coulomb=None))]
+    /// its states and Coulomb column. `signal=True`: the logged signal the model's drive
+    /// gains were identified for instead (motor currents, A: each torque over its gain; the
+    /// feed-forward a motion needs), for a model from `identify_drive_gains`.
+    #[pyo3(signature = (q, qd=None, qdd=None, coulomb=None, signal=false))]
     fn predict<'py>(
         &self,
         py: Python<'py>,
@@ -466,17 +468,27 @@ impl PyBaseModel {
         qd: Option<Bound<'py, PyAny>>,
         qdd: Option<Bound<'py, PyAny>>,
         coulomb: Option<Bound<'py, PyAny>>,
+        signal: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let name = "BaseParameterModel.predict";
-        self.at_states(py, name, q, [qd, qdd, coulomb], |fit, model, s| {
-            fit.predict(model, s)
-        })
+        self.at_states(
+            py,
+            name,
+            q,
+            [qd, qdd, coulomb],
+            |fit, model, s| match signal {
+                true => fit.predict_signal(model, s),
+                false => fit.predict(model, s),
+            },
+        )
     }
     /// The standard errors (N m) of the torques `predict` gives at `q`, `qd`, `qdd` (shapes as
     /// there): from the parameters' standard errors and their correlation; the uncertainty of
-    /// the model's torque, not a measured one's scatter about it. Raises InputError for a
-    /// model saved before the correlation was stored.
-    #[pyo3(signature = (q, qd=None, qdd=None, coulomb=None))]
+    /// the model's torque, not a measured one's scatter about it. `signal=True`: of the
+    /// signal `predict(..., signal=True)` gives (signal units), from the covariance of the
+    /// parameters and the drive gains together (fitted together, their errors are
+    /// correlated). Raises InputError for a model saved before the correlation was stored.
+    #[pyo3(signature = (q, qd=None, qdd=None, coulomb=None, signal=false))]
     fn predict_stderr<'py>(
         &self,
         py: Python<'py>,
@@ -484,11 +496,19 @@ impl PyBaseModel {
         qd: Option<Bound<'py, PyAny>>,
         qdd: Option<Bound<'py, PyAny>>,
         coulomb: Option<Bound<'py, PyAny>>,
+        signal: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let name = "BaseParameterModel.predict_stderr";
-        self.at_states(py, name, q, [qd, qdd, coulomb], |fit, model, s| {
-            fit.predict_stderr(model, s)
-        })
+        self.at_states(
+            py,
+            name,
+            q,
+            [qd, qdd, coulomb],
+            |fit, model, s| match signal {
+                true => fit.predict_signal_stderr(model, s),
+                false => fit.predict_stderr(model, s),
+            },
+        )
     }
     /// The model linearised exactly at `op` (an OperatingPoint): dict `torque` (n,), `D`, `H`,
     /// `G`, `G_static` (n, n; row = torque, column = joint), as a LocalModel answers it.

@@ -173,9 +173,19 @@ def test_the_model_is_the_robot_alones_in_torques(setup):
         rec.in_torques(np.ones(5))
     with pytest.raises(pr.PerturbidError, match="the gain of joint 2 is 0"):
         rec.in_torques([1.0, 0.0, 1.0, 1.0, 1.0, 1.0])
+    # the currents the motion needs, with their standard errors (from the parameters' and
+    # gains' covariance: tests/drive_gains.rs checks them against the dense one)
+    gain = with_friction.drive_gains["gain"]
+    np.testing.assert_array_equal(with_friction.predict(q, qd, qdd, signal=True),
+                                  predicted / gain)
+    se = with_friction.predict_stderr(q, qd, qdd, signal=True)
+    assert se.shape == q.shape and np.all(np.isfinite(se)) and np.all(se > 0)
+    assert np.all(se < 0.01 * np.abs(predicted / gain).max(axis=0))
     # a model fitted to torques has none
     plain = pr.identify_base_parameters(pair.ours, q, qd, qdd, truth, friction="viscous")
     assert plain.drive_gains is None
+    with pytest.raises(pr.InputError, match="holds no drive gains"):
+        plain.predict(q, qd, qdd, signal=True)
 
 
 def test_a_signal_counting_the_other_way_is_named(setup):

@@ -1,0 +1,114 @@
+//! The signal a model with drive gains predicts (motor currents: the feed-forward a motion
+//! needs), with its standard error from the joint fit of base parameters and gains
+//! ([`super::drive_gains`]).
+//!
+//! Joint `j`'s signal is `i_j = Phi_j theta / K_j`. The parameters and the gains were fitted
+//! together and share one scale (the payload's), so their errors are correlated: a payload
+//! that loads a joint weakly leaves `theta` and `K` free to grow together, which leaves `i`
+//! well determined although each of them is not. The standard error takes the whole
+//! covariance of `[theta, K_j]`: `sqrt(z^T C z)`, `z = [Phi_j / K_j, -Phi_j theta / K_j^2]`
+//! times the standard errors, `C` their correlation ([`BaseModel::correlation`] and
+//! [`super::DriveGains::correlation`]).
+
+use nalgebra::{DMatrix, DVector};
+
+use super::identify::BaseModel;
+use super::parameters::regressor_blocks;
+use crate::error::{Error, Result};
+use crate::local::prediction_uncertainty::root;
+use crate::model::Model;
+use crate::states::States;
+
+impl BaseModel {
+    /// The logged signal (row-major `k x nv`, in the unit the gains were identified for: A
+    /// for motor currents) the model predicts at the samples of `states`: each joint's torque
+    /// ([`Self::predict`]) over its drive gain. Refused for a model without drive gains, and
+    /// as [`Self::predict`] refuses.
+    pub fn predict_signal(&self, model: &Model, states: &States<'_>) -> Result<Vec<f64>> {
+        let gains = self.gains_for("predict_signal")?;
+        let mut tau = self.predict(model, states)?;
+        for (x, t) in tau.iter_mut().enumerate() {
+            *t /= gains.gain[x % model.nv];
+        }
+        Ok(tau)
+    }
+
+    /// The standard errors (row-major `k x nv`, signal units) of the signal
+    /// [`Self::predict_signal`] gives at the samples of `states`, from the covariance of the
+    /// parameters and the gains together (see the module docs): the uncertainty of the
+    /// model's signal, not a measured one's scatter about it. NaN for a joint whose row weights
+    /// a parameter of unknown standard error. Refused for a model without drive gains, or
+    /// saved before their correlation with the parameters was stored, as
+    /// [`Self::predict_stderr`] refuses, and where the arithmetic overflows.
+    pub fn predict_signal_stderr(&self, model: &Model, states: &States<'_>) -> Result<Vec<f64>> {
+        let gains = self.gains_for("predict_signal_stderr")?;
+        let (p, nv) = (self.theta.len(), model.nv);
+        self.check(model)?;
+        if self.correlation.shape() != (p, p) || gains.correlation.shape() != (nv, p + nv) {
+            return Err(Error::InvalidArgument {
+                argument: "predict_signal_stderr".into(),
+                message: "the model holds no correlation of its parameters' and gains' estimates (a model saved before it was stored): identify it again from its logs".into(),
+            });
+        }
+        let theta = DVector::from_column_slice(&self.theta);
+        let mut out = Vec::with_capacity(states.len() * nv);
+        regressor_blocks(model, &self.base.layout, states, self.gravity, |_, phi| {
+            let rows = self.base.select(phi);
+            let tau = &rows * &theta;
+            // the block's rows: its samples' joints, sample after sample
+            for (r, row) in rows.row_iter().enumerate() {
+                let j = r % nv;
+                let (k, se_k) = (gains.gain[j], gains.stderr[j]);
+                if (0..p).any(|a| self.stderr[a].is_nan() && row[a] != 0.0) || se_k.is_nan() {
+                    out.push(f64::NAN);
+                    continue;
+                }
+                let z = DVector::from_fn(p, |a, _| match self.stderr[a] {
+                    se if se.is_nan() => 0.0,
+                    se => row[a] * se / k,
+                });
+                let zk = -tau[r] / (k * k) * se_k;
+                let cross: f64 = (0..p).map(|a| gains.correlation[(j, a)] * z[a]).sum();
+                let var = z.dot(&(&self.correlation * &z)) + 2.0 * zk * cross + zk * zk;
+                out.push(root(var));
+            }
+            Ok(())
+        })?;
+        if let Some(i) = out.iter().position(|v| v.is_infinite()) {
+            return Err(Error::Numerical {
+                operation: "predicted signal's standard error".into(),
+                message: format!(
+                    "the standard error of joint {} at sample {} overflows: the state is too large to compute with",
+                    i % nv + 1,
+                    i / nv
+                ),
+            });
+        }
+        Ok(out)
+    }
+
+    /// The drive gains, for `operation`; refused for a model identified from torques.
+    fn gains_for(&self, operation: &str) -> Result<&super::DriveGains> {
+        self.drive_gains
+            .as_ref()
+            .ok_or_else(|| Error::InvalidArgument {
+                argument: operation.into(),
+                message: format!(
+                    "the model of '{}' holds no drive gains: it was identified from torques, not from a logged signal (identify_drive_gains)",
+                    self.robot
+                ),
+            })
+    }
+}
+
+/// The correlation of the joint fit's estimates, `(p + nv)` square: the parameters' (`theta`,
+/// `p x p`) and the gains' rows (`gains`, `nv x (p + nv)`).
+pub(crate) fn joint_correlation(theta: &DMatrix<f64>, gains: &DMatrix<f64>) -> DMatrix<f64> {
+    let p = theta.nrows();
+    let n = gains.ncols();
+    DMatrix::from_fn(n, n, |a, b| match (a < p, b < p) {
+        (true, true) => theta[(a, b)],
+        (false, _) => gains[(a - p, b)],
+        (true, false) => gains[(b - p, a)],
+    })
+}
