@@ -50,20 +50,28 @@ def main() -> None:
         log = pr.simulate(robot, design, true_robot=true_robot(payload), rate=1000.0, periods=2.0)
         current = log.tau / GAINS  # what the robot logs (A)
         runs.append(pr.preprocess(log.t, log.q, current, name="loaded" if payload else "alone"))
-    fit = pr.identify_drive_gains(robot, runs, [None, PAYLOAD], friction=["viscous", "coulomb"])
+    friction = ["viscous", "coulomb"]
+    fit = pr.identify_drive_gains(robot, runs, [None, PAYLOAD], friction=friction)
     g = fit.drive_gains
+    # by instrumental variables too: unbiased by the currents' noise, at a larger variance
+    iv = pr.identify_drive_gains(robot, runs, [None, PAYLOAD], friction=friction,
+                                 estimator="instrumental").drive_gains
     print("drive gains (N m per A):")
-    print(f"  {'joint':<8} {'true':>8} {'identified':>12} {'std. error':>11} {'noise bias':>11} {'agreement':>10}")
+    print(f"  {'joint':<8} {'true':>8} {'identified':>12} {'std. error':>11} {'noise bias':>11}"
+          f" {'agreement':>10} {'instrumental':>13}")
     for j, name in enumerate(robot.joint_names):
         print(f"  {name:<8} {GAINS[j]:8.3f} {g['gain'][j]:12.4f} {g['stderr'][j]:11.4f}"
-              f" {100 * g['noise_bias'][j]:9.3f} % {g['agreement'][j]:10.3f}")
+              f" {100 * g['noise_bias'][j]:9.3f} % {g['agreement'][j]:10.3f} {iv['gain'][j]:13.4f}")
     worst = np.max(np.abs(g["gain"] / GAINS - 1))
     print(f"largest gain error {100 * worst:.2f} %; {len(fit.theta_base)} base parameters, cond {fit.cond:.1f}")
-    # the currents another motion needs: the model's torques over the gains
+    print(f"largest gain error by instrumental variables {100 * np.max(np.abs(iv['gain'] / GAINS - 1)):.2f} %")
+    # the currents another motion needs, with their standard errors
     t = np.linspace(0.0, 2.0, 5)
     q, qd, qdd = design.trajectory.sample(t)
+    current = fit.predict(q, qd, qdd, signal=True)[:, 1]
+    se = fit.predict_stderr(q, qd, qdd, signal=True)[:, 1]
     print("feed-forward currents (A) along the excitation's first 2 s, joint 2:",
-          np.round(fit.predict(q, qd, qdd)[:, 1] / g["gain"][1], 4))
+          " ".join(f"{c:.4f}+-{s:.1e}" for c, s in zip(current, se)))
 
 
 if __name__ == "__main__":

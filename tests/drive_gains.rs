@@ -8,13 +8,12 @@
 mod common;
 
 use common::gain_logs::{
-    alone_then_loaded, currents, dense_least_squares, dense_system, logs, motion, payload, states,
-    truth, GAINS,
+    currents, dense_least_squares, dense_logs, logs, motion, payload, states, truth, GAINS,
 };
 use common::{refused_on_load, torques_with_friction, Rng};
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::direct::{
-    identify_drive_gains, regressor_matrix, BaseModel, BaseOptions, GainRun, Weighting,
+    identify_drive_gains, regressor_matrix, BaseModel, BaseOptions, GainEstimator, GainRun,
 };
 use perturbid_rs::document::Document;
 use perturbid_rs::rehearsal::Payload;
@@ -78,27 +77,10 @@ fn the_gains_and_the_robots_torques_come_back_from_currents_with_a_known_payload
 
 #[test]
 fn the_joint_fit_is_the_dense_least_squares_solution() {
-    // OLS, so that the dense system is the one the streaming fit reduces
-    let truth = truth();
-    let (a, b) = (motion(6), motion(7));
-    let p = payload();
-    let (ia, ib) = (
-        currents(&truth, &a, None, 1e-3, 3),
-        currents(&truth, &b, Some(&p), 1e-3, 4),
-    );
-    let options = BaseOptions {
-        weighting: Weighting::Ols,
-        ..BaseOptions::default()
-    };
-    let runs = alone_then_loaded([&a, &b], [&ia, &ib], &p);
-    let fit = identify_drive_gains(&truth, &runs, &options).unwrap();
     // [Phi_base | -diag(i)] [theta; K] = -tau_L, built whole
-    let (x, rhs) = dense_system(
-        &truth,
-        &fit.model.base,
-        &p,
-        [(&a, &ia, false), (&b, &ib, true)],
-    );
+    let logs = dense_logs();
+    let truth = &logs.truth;
+    let (fit, x, rhs) = logs.ols_and_dense(GainEstimator::LeastSquares);
     let theta = dense_least_squares(&x, &rhs);
     let p_base = fit.model.theta.len();
     let g = fit.gains();

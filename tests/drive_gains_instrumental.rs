@@ -8,14 +8,11 @@
 
 mod common;
 
-use common::gain_logs::{
-    alone_then_loaded, currents, dense_least_squares, dense_system, logs, motion, payload, GAINS,
-};
+use common::gain_logs::{dense_least_squares, dense_logs, logs, GAINS};
 use common::refused_on_load;
 use nalgebra::DMatrix;
 use perturbid_rs::direct::{
     identify_drive_gains, identify_drive_gains_with, BaseModel, BaseOptions, GainEstimator,
-    Weighting,
 };
 use perturbid_rs::document::Document;
 
@@ -89,27 +86,8 @@ fn instrumental_variables_remove_the_bias_the_noise_gives_least_squares() {
 
 #[test]
 fn the_instrumental_estimate_is_the_dense_one() {
-    let truth = common::gain_logs::truth();
-    let (a, b) = (motion(6), motion(7));
-    let p = payload();
-    let (ia, ib) = (
-        currents(&truth, &a, None, 1e-3, 3),
-        currents(&truth, &b, Some(&p), 1e-3, 4),
-    );
     // OLS: the instruments come from the unweighted least-squares fit
-    let options = BaseOptions {
-        weighting: Weighting::Ols,
-        ..BaseOptions::default()
-    };
-    let runs = alone_then_loaded([&a, &b], [&ia, &ib], &p);
-    let fit =
-        identify_drive_gains_with(&truth, &runs, &options, GainEstimator::Instrumental).unwrap();
-    let (x, y) = dense_system(
-        &truth,
-        &fit.model.base,
-        &p,
-        [(&a, &ia, false), (&b, &ib, true)],
-    );
+    let (fit, x, y) = dense_logs().ols_and_dense(GainEstimator::Instrumental);
     let first = dense_least_squares(&x, &y);
     let (n, cols) = (6, x.ncols());
     let pb = cols - n;

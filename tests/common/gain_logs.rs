@@ -4,7 +4,10 @@
 
 use super::{a465_excitation, normal, torques_with_friction, Rng};
 use nalgebra::{DMatrix, DVector};
-use perturbid_rs::direct::{regressor_matrix, BaseParameters, GainRun};
+use perturbid_rs::direct::{
+    identify_drive_gains_with, regressor_matrix, BaseOptions, BaseParameters, DriveGainFit,
+    GainEstimator, GainRun, Weighting,
+};
 use perturbid_rs::rehearsal::{Payload, TrueRobot};
 use perturbid_rs::trajectory::Samples;
 use perturbid_rs::{Gravity, Model, States};
@@ -100,10 +103,48 @@ pub fn logs(noise: f64, loaded: bool) -> Logs {
     }
 }
 
+/// The logs the dense comparisons use: motions 6 and 7 (the second loaded), 1e-3 A of noise.
+pub fn dense_logs() -> Logs {
+    let (truth, p) = (truth(), payload());
+    let (a, b) = (motion(6), motion(7));
+    let ia = currents(&truth, &a, None, 1e-3, 3);
+    let ib = currents(&truth, &b, Some(&p), 1e-3, 4);
+    Logs {
+        truth,
+        a,
+        b,
+        ia,
+        ib,
+        p,
+    }
+}
+
 impl Logs {
     /// The runs as identified: the second given as carrying the payload.
     pub fn runs(&self) -> [GainRun<'_>; 2] {
         alone_then_loaded([&self.a, &self.b], [&self.ia, &self.ib], &self.p)
+    }
+
+    /// The runs identified by OLS (so that the dense system is the one the streaming fit
+    /// reduces) with `estimator`, and the system built whole ([`dense_system`]) over the
+    /// fit's base parameters.
+    pub fn ols_and_dense(
+        &self,
+        estimator: GainEstimator,
+    ) -> (DriveGainFit, DMatrix<f64>, DVector<f64>) {
+        let options = BaseOptions {
+            weighting: Weighting::Ols,
+            ..BaseOptions::default()
+        };
+        let fit =
+            identify_drive_gains_with(&self.truth, &self.runs(), &options, estimator).unwrap();
+        let (x, y) = dense_system(
+            &self.truth,
+            &fit.model.base,
+            &self.p,
+            [(&self.a, &self.ia, false), (&self.b, &self.ib, true)],
+        );
+        (fit, x, y)
     }
 }
 

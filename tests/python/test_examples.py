@@ -48,6 +48,8 @@ def test_drive_gains_example(tmp_path):
     assert "drive gains (N m per A):" in out and "feed-forward currents" in out
     worst = float(out.split("largest gain error ")[1].split(" %")[0])
     assert worst < 1.0, out
+    worst = float(out.split("largest gain error by instrumental variables ")[1].split(" %")[0])
+    assert worst < 1.0, out
 
 
 def test_every_input_the_readme_names_is_in_examples():
