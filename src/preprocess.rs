@@ -90,6 +90,9 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     // columns held at a lower rate read again at their values' arrivals, before anything
     // reads their motion (their holds would otherwise end as frozen readings here and there)
     let (reread, held_columns) = crate::held_columns::find_held_columns(&unwrapped)?;
+    // each step's copy of the log is let go as soon as the next holds it (a long log's
+    // copies are what a preprocessing holds most of)
+    drop(unwrapped);
     let rec = &reread;
     // clipped torques, as logged: screening could replace a short clipped run
     let torque_saturation = crate::torque_saturation::find_torque_saturation(rec);
@@ -111,11 +114,14 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     let dropouts = crate::log_dropouts::find_removed_rows(rec, &screened)?;
     // a glitch in rows removed is not told of: its row is gone
     let kept_rows = crate::log_dropouts::kept_rows(rec.len(), &dropouts);
+    drop(reread);
     let glitches: Vec<_> = glitches
         .into_iter()
         .filter(|g| kept_rows.binary_search(&g.sample).is_ok())
         .collect();
+    drop(kept_rows);
     let kept = crate::log_dropouts::without_dropouts(&screened, &dropouts)?;
+    drop(screened);
     let out = preprocess_screened(&kept, options, &steps)
         .map_err(|e| crate::log_dropouts::after_removing(e, &dropouts))?;
     Ok(Recording {
