@@ -51,6 +51,9 @@ pub(super) fn read_experiment(
         &r.name,
         joint_names,
     ));
+    // the unwrapped copy let go as soon as the reread one holds it (a long log's copies are
+    // what the reading holds most of)
+    drop(unwrapped);
     let r = &reread;
     // the stamps against the positions: the windows' fits read the stamps as the samples' times
     said.push(crate::stamp_jitter::warning(
