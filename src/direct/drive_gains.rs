@@ -106,10 +106,11 @@ pub struct DriveGains {
     /// model's are).
     pub stderr: Vec<f64>,
     /// Per joint, the least-squares gain's relative bias towards 0 were every residual noise
-    /// of the logged signal (an upper estimate; 0 where the estimate points away from 0): the errors in the
-    /// signal's columns bias least squares by `-(X^T W^2 X)^-1 Sigma_uu theta`, `Sigma_uu`
-    /// holding `k (rms_j / (K_j sigma_j))^2` at joint `j`'s signal column. The gains share one
-    /// scale with each other and the parameters, so every joint's noise biases every gain.
+    /// of the logged signal (an upper estimate; 0 where the estimate points away from 0): the
+    /// errors in the signal's columns bias least squares by `-(X^T W^2 X)^-1 Sigma_uu theta`,
+    /// `Sigma_uu` holding `k (rms_j / (K_j sigma_j))^2` at joint `j`'s signal column. The
+    /// gains share one scale with each other and the parameters, so every joint's noise
+    /// biases every gain.
     pub noise_bias: Vec<f64>,
     /// Per joint, the RMS (N m, or N) of the payloads' torques over the runs that carried one:
     /// what determined the gain's scale.
