@@ -265,6 +265,87 @@ fn bad_payloads_and_runs_are_refused_by_name() {
         e.contains("the runs do not agree with the payload as given"),
         "{e}"
     );
+    // payloads neither one for all the loaded runs nor one for each
+    let mut a = args(s(&d.join("p.json")), s(&d.join("mismatch.json")));
+    a.extend(["--payload".into(), s(&d.join("p.json")).into()]);
+    a.extend(["--loaded".into(), s(&d.join("other.csv")).into()]);
+    a.extend(["--loaded".into(), s(&d.join("other.csv")).into()]);
+    let a: Vec<&str> = a.iter().map(String::as_str).collect();
+    fails(&a, &["--payload", "2 payloads for 3 --loaded runs"]);
+    nothing_written(&d, "mismatch.json");
+}
+
+#[test]
+fn two_loaded_runs_with_payloads_of_their_own() {
+    let d = tmp("gains-two");
+    let light: Payload = serde_json::from_str(PAYLOAD).unwrap();
+    let heavy = Payload {
+        mass: 5.0,
+        com: [0.0, 0.03, 0.1],
+        ..light.clone()
+    };
+    log(&d.join("alone.csv"), 1, None);
+    log(&d.join("light.csv"), 2, Some(&light));
+    log(&d.join("heavy.csv"), 3, Some(&heavy));
+    let heavy_json = serde_json::to_string(&heavy).unwrap();
+    let out = ok(&[
+        "identify-gains",
+        "a465",
+        s(&d.join("alone.csv")),
+        "--loaded",
+        s(&d.join("light.csv")),
+        "--loaded",
+        s(&d.join("heavy.csv")),
+        "--payload",
+        PAYLOAD,
+        "--payload",
+        &heavy_json,
+        "--friction",
+        "viscous",
+        "--out",
+        s(&d.join("model.json")),
+    ]);
+    assert!(
+        out.contains("from 3 runs (2 with 2 kg on 'link6', 5 kg on 'link6')"),
+        "{out}"
+    );
+    let model = BaseModel::load(d.join("model.json")).unwrap();
+    let g = model.drive_gains.as_ref().unwrap();
+    assert_eq!((g.runs, g.loaded_runs), (3, 2));
+    for (gain, truth) in g.gain.iter().zip(GAINS) {
+        assert!((gain / truth - 1.0).abs() < 1e-2, "{out}");
+    }
+    assert!(g.agreement.iter().all(|a| *a < 1.2), "{:?}", g.agreement);
+    // in a pipeline, a list: one written out as a table, the other a file beside it
+    write(&d.join("heavy.json"), &heavy_json);
+    write(
+        &d.join("p.toml"),
+        "[[step]]\nrun = \"identify-gains\"\nrobot = \"a465\"\nruns = [\"alone.csv\"]\nloaded = [\"light.csv\", \"heavy.csv\"]\nfriction = \"viscous\"\nout = \"pipeline.json\"\npayload = [{ link = \"link6\", mass = 2.0, com = [0.02, -0.01, 0.08], inertia = [0.004, 0, 0, 0.004, 0, 0.002] }, \"heavy.json\"]\n",
+    );
+    ok(&["run", s(&d.join("p.toml"))]);
+    assert_eq!(BaseModel::load(d.join("pipeline.json")).unwrap(), model);
+    // the payloads swapped: the runs do not agree with them, and it is said
+    let e = warnings_of(&[
+        "identify-gains",
+        "a465",
+        s(&d.join("alone.csv")),
+        "--loaded",
+        s(&d.join("light.csv")),
+        "--loaded",
+        s(&d.join("heavy.csv")),
+        "--payload",
+        &heavy_json,
+        "--payload",
+        PAYLOAD,
+        "--friction",
+        "viscous",
+        "--out",
+        s(&d.join("swapped.json")),
+    ]);
+    assert!(
+        e.contains("the runs do not agree with the payload as given"),
+        "{e}"
+    );
 }
 
 #[test]

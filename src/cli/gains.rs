@@ -26,14 +26,16 @@ pub(crate) struct IdentifyGainsArgs {
     /// signal (motor current, A, or a torque computed with nominal gains); optional qd, qdd.
     #[arg(required = true)]
     runs: Vec<PathBuf>,
-    /// A recording CSV of a run with the payload bolted on (repeat for more).
+    /// A recording CSV of a run with a payload bolted on (repeat for more).
     #[arg(long, required = true)]
     loaded: Vec<PathBuf>,
     /// The payload of the --loaded runs: a JSON file, or the JSON itself, {"link": "link6",
     /// "mass": 2.0, "com": [0, 0, 0.08], "inertia": [ixx, ixy, ixz, iyy, iyz, izz]} (kg, m,
     /// kg m^2 about its centre of mass, in the link's frame).
-    #[arg(long)]
-    payload: PathBuf,
+    /// Once for every --loaded run, or once for each in their order (a heavier payload in
+    /// one run and a lighter one in another determine the gains better).
+    #[arg(long, required = true)]
+    payload: Vec<PathBuf>,
     /// Where to write the base-parameter model with its drive gains (JSON).
     #[arg(long, default_value = "base_model.json")]
     out: PathBuf,
@@ -82,13 +84,29 @@ fn load_payload(arg: &Path) -> Result<Payload> {
 pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
     let logs: Vec<&PathBuf> = a.runs.iter().chain(&a.loaded).collect();
     let mut inputs: Vec<&Path> = logs.iter().map(|p| p.as_path()).collect();
-    inputs.push(&a.payload);
+    inputs.extend(a.payload.iter().map(PathBuf::as_path));
     inputs.push(a.robot.path());
     refuse_overwriting_inputs(&a.out, &inputs)?;
     let model = a.robot.load()?;
-    let payload = load_payload(&a.payload)?;
-    // a payload on a link the robot lacks is named before any log is read
-    payload.body(&model)?;
+    if !(a.payload.len() == 1 || a.payload.len() == a.loaded.len()) {
+        return Err(Error::InvalidArgument {
+            argument: "--payload".into(),
+            message: format!(
+                "{} payloads for {} --loaded runs: give one for them all, or one for each in their order",
+                a.payload.len(),
+                a.loaded.len()
+            ),
+        });
+    }
+    let payloads = (a.payload.iter())
+        .map(|arg| {
+            let p = load_payload(arg)?;
+            // a payload on a link the robot lacks is named before any log is read
+            p.body(&model)?;
+            Ok(p)
+        })
+        .collect::<Result<Vec<Payload>>>()?;
+    let payload_of = |loaded: usize| &payloads[loaded.min(payloads.len() - 1)];
     let progress = Progress::new();
     let mut out = String::new();
     let recordings = logs
@@ -107,7 +125,7 @@ pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
         .map(|(i, (states, rec))| GainRun {
             states,
             signal: &rec.tau,
-            payload: (i >= a.runs.len()).then_some(&payload),
+            payload: (i >= a.runs.len()).then(|| payload_of(i - a.runs.len())),
         })
         .collect();
     let options = a.fit.options();
@@ -145,7 +163,7 @@ pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
     let instrumental = estimator == GainEstimator::Instrumental;
     let _ = writeln!(
         out,
-        "drive gains by {} from {} runs ({} with {} kg on '{}'), {k} samples, cond {:.3e}:",
+        "drive gains by {} from {} runs ({} with {}), {k} samples, cond {:.3e}:",
         if instrumental {
             "instrumental variables"
         } else {
@@ -153,8 +171,10 @@ pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
         },
         g.runs,
         g.loaded_runs,
-        payload.mass,
-        payload.link,
+        (payloads.iter())
+            .map(|p| format!("{} kg on '{}'", p.mass, p.link))
+            .collect::<Vec<_>>()
+            .join(", "),
         g.cond
     );
     let _ = write!(

@@ -270,6 +270,13 @@ fn words(key: &str, value: &Value, arg: &clap::Arg, base: &Path, at: &str) -> Re
     let flag = matches!(arg.get_action(), ArgAction::SetTrue | ArgAction::SetFalse);
     let many = matches!(arg.get_action(), ArgAction::Append)
         || arg.get_num_args().is_some_and(|n| n.max_values() > 1);
+    // `op = { q = [...], qd = [...], qdd = [...] }`: the operating point written out, and
+    // `payload = { link = "link6", mass = 2.0, ... }` a payload (or a list of them), given as
+    // their JSON
+    let written_out = ["op", "payload"].contains(&arg.get_id().as_str());
+    let table_json = |t: &toml::Table| -> Result<String> {
+        serde_json::to_string(t).map_err(|e| bad(format!("'{key}': {e}")))
+    };
     let scalar = |v: &Value| -> Result<String> {
         match v {
             Value::String(s) => Ok(s.clone()),
@@ -295,7 +302,12 @@ fn words(key: &str, value: &Value, arg: &clap::Arg, base: &Path, at: &str) -> Re
         }
         Value::Boolean(b) => return Ok(vec![b.to_string()]),
         _ if flag => return Err(bad(format!("'{key}' is a switch: write {key} = true"))),
-        Value::Array(items) if many => items.iter().map(scalar).collect::<Result<Vec<_>>>()?,
+        Value::Array(items) if many => (items.iter())
+            .map(|v| match v {
+                Value::Table(t) if written_out => table_json(t),
+                v => scalar(v),
+            })
+            .collect::<Result<Vec<_>>>()?,
         Value::Array(_) => return Err(bad(format!("'{key}' takes one value, not a list"))),
         Value::Table(t)
             if many
@@ -307,13 +319,7 @@ fn words(key: &str, value: &Value, arg: &clap::Arg, base: &Path, at: &str) -> Re
                 .map(|(joint, v)| Ok(format!("{joint}={}", scalar(v)?)))
                 .collect::<Result<Vec<_>>>()?
         }
-        // `op = { q = [...], qd = [...], qdd = [...] }`: the operating point written out, and
-        // `payload = { link = "link6", mass = 2.0, ... }` the payload, given as their JSON
-        Value::Table(t) if ["op", "payload"].contains(&arg.get_id().as_str()) => {
-            return serde_json::to_string(t)
-                .map(|json| vec![json])
-                .map_err(|e| bad(format!("'{key}': {e}")))
-        }
+        Value::Table(t) if written_out => return Ok(vec![table_json(t)?]),
         v => vec![scalar(v)?],
     };
     for w in &mut words {
