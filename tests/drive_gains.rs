@@ -114,11 +114,11 @@ fn the_joint_fit_is_the_dense_least_squares_solution() {
     });
     let c = motion(8);
     let third = states(&c);
-    let signal = fit.model.predict_signal(&truth, &third).unwrap();
-    let tau = fit.model.predict(&truth, &third).unwrap();
-    let se = fit.model.predict_signal_stderr(&truth, &third).unwrap();
+    let signal = fit.model.predict_signal(truth, &third).unwrap();
+    let tau = fit.model.predict(truth, &third).unwrap();
+    let se = fit.model.predict_signal_stderr(truth, &third).unwrap();
     let phi = fit.model.base.select(
-        &regressor_matrix(&truth, &fit.model.base.layout, &third, Gravity::Included).unwrap(),
+        &regressor_matrix(truth, &fit.model.base.layout, &third, Gravity::Included).unwrap(),
     );
     for r in (0..phi.nrows()).step_by(397) {
         let j = r % 6;
@@ -136,7 +136,7 @@ fn the_joint_fit_is_the_dense_least_squares_solution() {
         );
     }
     // torques alone, the gains' covariance left out, would say otherwise
-    let naive = fit.model.predict_stderr(&truth, &third).unwrap();
+    let naive = fit.model.predict_stderr(truth, &third).unwrap();
     let apart = (0..se.len())
         .map(|r| naive[r] / g.gain[r % 6].abs() / se[r])
         .fold(1.0f64, |m, v| m.max(v.max(1.0 / v)));
