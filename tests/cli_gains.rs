@@ -234,7 +234,7 @@ fn bad_payloads_and_runs_are_refused_by_name() {
     let out = d.join("model.json");
     let run = |payload: &str, needles: &[&str]| {
         let a = args(payload, s(&out));
-        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        let a = strs(&a);
         fails(&a, needles);
         nothing_written(&d, "model.json");
     };
@@ -259,7 +259,7 @@ fn bad_payloads_and_runs_are_refused_by_name() {
     log(&d.join("other.csv"), 2, None);
     let mut a = args(s(&d.join("p.json")), s(&out));
     a[4] = s(&d.join("other.csv")).into();
-    let a: Vec<&str> = a.iter().map(String::as_str).collect();
+    let a = strs(&a);
     let e = warnings_of(&a);
     assert!(
         e.contains("the runs do not agree with the payload as given"),
@@ -270,9 +270,14 @@ fn bad_payloads_and_runs_are_refused_by_name() {
     a.extend(["--payload".into(), s(&d.join("p.json")).into()]);
     a.extend(["--loaded".into(), s(&d.join("other.csv")).into()]);
     a.extend(["--loaded".into(), s(&d.join("other.csv")).into()]);
-    let a: Vec<&str> = a.iter().map(String::as_str).collect();
+    let a = strs(&a);
     fails(&a, &["--payload", "2 payloads for 3 --loaded runs"]);
     nothing_written(&d, "mismatch.json");
+}
+
+/// `a` as the command line's words.
+fn strs(a: &[String]) -> Vec<&str> {
+    a.iter().map(String::as_str).collect()
 }
 
 #[test]
@@ -288,23 +293,29 @@ fn two_loaded_runs_with_payloads_of_their_own() {
     log(&d.join("light.csv"), 2, Some(&light));
     log(&d.join("heavy.csv"), 3, Some(&heavy));
     let heavy_json = serde_json::to_string(&heavy).unwrap();
-    let out = ok(&[
-        "identify-gains",
-        "a465",
-        s(&d.join("alone.csv")),
-        "--loaded",
-        s(&d.join("light.csv")),
-        "--loaded",
-        s(&d.join("heavy.csv")),
-        "--payload",
-        PAYLOAD,
-        "--payload",
-        &heavy_json,
-        "--friction",
-        "viscous",
-        "--out",
-        s(&d.join("model.json")),
-    ]);
+    // the light run and then the heavy one, given the payloads `first` and `second`
+    let args = |first: &str, second: &str, out: &str| -> Vec<String> {
+        [
+            "identify-gains",
+            "a465",
+            s(&d.join("alone.csv")),
+            "--loaded",
+            s(&d.join("light.csv")),
+            "--loaded",
+            s(&d.join("heavy.csv")),
+            "--payload",
+            first,
+            "--payload",
+            second,
+            "--friction",
+            "viscous",
+            "--out",
+            s(&d.join(out)),
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    let out = ok(&strs(&args(PAYLOAD, &heavy_json, "model.json")));
     assert!(
         out.contains("from 3 runs (2 with 2 kg on 'link6', 5 kg on 'link6')"),
         "{out}"
@@ -325,23 +336,7 @@ fn two_loaded_runs_with_payloads_of_their_own() {
     ok(&["run", s(&d.join("p.toml"))]);
     assert_eq!(BaseModel::load(d.join("pipeline.json")).unwrap(), model);
     // the payloads swapped: the runs do not agree with them, and it is said
-    let e = warnings_of(&[
-        "identify-gains",
-        "a465",
-        s(&d.join("alone.csv")),
-        "--loaded",
-        s(&d.join("light.csv")),
-        "--loaded",
-        s(&d.join("heavy.csv")),
-        "--payload",
-        &heavy_json,
-        "--payload",
-        PAYLOAD,
-        "--friction",
-        "viscous",
-        "--out",
-        s(&d.join("swapped.json")),
-    ]);
+    let e = warnings_of(&strs(&args(&heavy_json, PAYLOAD, "swapped.json")));
     assert!(
         e.contains("the runs do not agree with the payload as given"),
         "{e}"
