@@ -141,6 +141,14 @@ fn the_joint_fit_is_the_dense_least_squares_solution() {
         .map(|r| naive[r] / g.gain[r % 6].abs() / se[r])
         .fold(1.0f64, |m, v| m.max(v.max(1.0 / v)));
     assert!(apart > 1.05, "{apart}");
+    // a state too large to compute with is refused, naming the joint and sample
+    let huge = vec![1e160; 6];
+    let zeros = vec![0.0; 6];
+    let far = States::new(6, &zeros, Some(&huge), Some(&zeros)).unwrap();
+    let e = (fit.model.predict_signal_stderr(truth, &far))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("at sample 0 overflows"), "{e}");
 }
 
 #[test]

@@ -737,17 +737,11 @@ impl BaseModel {
             }));
             Ok(())
         })?;
-        if let Some(i) = out.iter().position(|v| v.is_infinite()) {
-            return Err(Error::Numerical {
-                operation: "prediction's standard error".into(),
-                message: format!(
-                    "the standard error of joint {} at sample {} overflows: the state is too large to compute with",
-                    i % model.nv + 1,
-                    i / model.nv
-                ),
-            });
-        }
-        Ok(out)
+        crate::local::prediction_uncertainty::refuse_overflow(
+            out,
+            model.nv,
+            "prediction's standard error",
+        )
     }
 
     /// [`Self::predict`] on a robot [`Self::check`] accepted.

@@ -15,7 +15,7 @@ use nalgebra::{DMatrix, DVector};
 use super::identify::BaseModel;
 use super::parameters::regressor_blocks;
 use crate::error::{Error, Result};
-use crate::local::prediction_uncertainty::root;
+use crate::local::prediction_uncertainty::{refuse_overflow, root};
 use crate::model::Model;
 use crate::states::States;
 
@@ -74,17 +74,7 @@ impl BaseModel {
             }
             Ok(())
         })?;
-        if let Some(i) = out.iter().position(|v| v.is_infinite()) {
-            return Err(Error::Numerical {
-                operation: "predicted signal's standard error".into(),
-                message: format!(
-                    "the standard error of joint {} at sample {} overflows: the state is too large to compute with",
-                    i % nv + 1,
-                    i / nv
-                ),
-            });
-        }
-        Ok(out)
+        refuse_overflow(out, nv, "predicted signal's standard error")
     }
 
     /// The drive gains, for `operation`; refused for a model identified from torques.

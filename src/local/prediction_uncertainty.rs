@@ -122,6 +122,22 @@ pub(crate) fn root(var: f64) -> f64 {
     }
 }
 
+/// `stderr` (row-major `k x n`) returned, or refused naming the first joint and sample whose
+/// standard error overflowed (inf: [`root`]) for `operation`.
+pub(crate) fn refuse_overflow(stderr: Vec<f64>, n: usize, operation: &str) -> Result<Vec<f64>> {
+    match stderr.iter().position(|v| v.is_infinite()) {
+        Some(i) => Err(Error::Numerical {
+            operation: operation.into(),
+            message: format!(
+                "the standard error of joint {} at sample {} overflows: the state is too large to compute with",
+                i % n + 1,
+                i / n
+            ),
+        }),
+        None => Ok(stderr),
+    }
+}
+
 /// The estimate `name` of a model, with a correlation for each of its `n` rows.
 fn part<'a>(e: &'a Option<Estimate>, name: &str, n: usize) -> Result<&'a Estimate> {
     let refuse = |message: String| Error::InvalidArgument {
