@@ -391,6 +391,11 @@ fn a_local_model_in_torques_from_recordings_of_currents() {
     let (da, db) = (&a.d.as_ref().unwrap().matrix, &b.d.as_ref().unwrap().matrix);
     let rel = (da - db).abs().max() / da.abs().max();
     assert!(rel < 2e-3, "D* from currents off by {rel}");
+    // the model keeps the gains it was put in torques by (their errors enter its predictions')
+    let g = BaseModel::load(&gains).unwrap().drive_gains.unwrap();
+    let kept = b.drive_gains.as_ref().unwrap();
+    assert_eq!((&kept.gain, &kept.stderr), (&g.gain, &g.stderr));
+    assert!(a.drive_gains.is_none());
     fails(
         &[
             "identify",

@@ -440,3 +440,81 @@ fn base_model_predicted_standard_errors_match_the_scatter_over_seeds() {
         "{e}"
     );
 }
+
+/// A local model identified from currents put in torques by drive gains
+/// (`identify --gains-from`): the gains' standard errors enter its predictions' as the
+/// prediction's change with each gain (by finite differences: every coefficient of joint j's
+/// row scaled by the gain) times the gain's standard error, independent of the local fit's;
+/// saved, and checked on loading.
+#[test]
+fn the_drive_gains_standard_errors_enter_a_local_models_predictions() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let n = model.nv;
+    let op = table2();
+    let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+    let mut sim = SimulationOptions::new(&model);
+    sim.torque_noise = vec![0.01; n];
+    let recs = simulate_plan(&model, &plan, &sim).unwrap();
+    let plain = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    let gain = vec![42.0, 65.0, 38.0, 9.0, 7.5, -4.0];
+    let stderr = vec![0.05, 0.02, 0.03, 0.01, 0.02, 0.004];
+    let with = LocalModel {
+        drive_gains: Some(perturbid_rs::local::SignalGains {
+            gain: gain.clone(),
+            stderr: stderr.clone(),
+        }),
+        ..plain.clone()
+    };
+    let (mut q, mut qd, mut qdd) = (op.q.clone(), op.qd.clone(), op.qdd.clone());
+    q[1] += 0.01;
+    qd[2] -= 0.05;
+    qdd[0] += 0.2;
+    let states = States::new(n, &q, Some(&qd), Some(&qdd)).unwrap();
+    let (se0, se) = (
+        plain.predict_stderr(&states).unwrap(),
+        with.predict_stderr(&states).unwrap(),
+    );
+    let tau = plain.predict(&states).unwrap();
+    for j in 0..n {
+        // the model with joint j's gain moved by h: its row's T*, D*, H*, G* scale with it
+        let h = 1e-6 * gain[j].abs();
+        let mut moved = plain.clone();
+        let scale = (gain[j] + h) / gain[j];
+        moved.torque[j] *= scale;
+        for e in [&mut moved.d, &mut moved.h, &mut moved.g] {
+            let e = e.as_mut().unwrap();
+            for c in 0..n {
+                e.matrix[(j, c)] *= scale;
+            }
+        }
+        let slope = (moved.predict(&states).unwrap()[j] - tau[j]) / h;
+        let expected = se0[j].hypot(slope * stderr[j]);
+        assert!(
+            (se[j] / expected - 1.0).abs() < 1e-6,
+            "joint {j}: {} against {expected} (without the gains {})",
+            se[j],
+            se0[j]
+        );
+        assert!(se[j] > se0[j], "joint {j}");
+    }
+    let text = with.to_json();
+    assert_eq!(LocalModel::from_json(&text).unwrap(), with);
+    let edited = |f: &dyn Fn(&mut serde_json::Value)| -> String {
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        f(&mut v);
+        LocalModel::from_json(&v.to_string())
+            .unwrap_err()
+            .to_string()
+    };
+    let e = edited(&|v| v["drive_gains"]["gain"][4] = 0.0.into());
+    assert!(e.contains("drive_gains.gain[4] is 0"), "{e}");
+    let e = edited(&|v| v["drive_gains"]["stderr"] = serde_json::json!([0.1]));
+    assert!(
+        e.contains("drive_gains.stderr has 1 entries, expected one per joint (6)"),
+        "{e}"
+    );
+    let e = edited(&|v| v["drive_gains"]["stderr"][0] = (-1.0).into());
+    assert!(e.contains("drive_gains.stderr[0]"), "{e}");
+    let e = edited(&|v| v["drive_gains"]["offset"] = 1.0.into());
+    assert!(e.contains("unknown field `offset`"), "{e}");
+}

@@ -397,6 +397,10 @@ class LocalModel:
     @property
     def G_static(self) -> Optional[NDArray[np.float64]]: ...
     @property
+    def drive_gains(self) -> dict[str, Any] | None:
+        """The drive gains its recordings of currents were put in torques by (identify
+        --gains-from), else None: gain, stderr (n,); their errors are in predict_stderr's."""
+    @property
     def combined(self) -> Optional[NDArray[np.float64]]:
         """The combined estimate [D H G], shape (n, 3n)."""
     @property

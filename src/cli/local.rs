@@ -543,7 +543,11 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
         estimator: a.estimator,
         friction_aware_h: a.friction_aware_h,
     };
-    let model: LocalModel = identify_local(&plan, &recs, &options)?;
+    let mut model: LocalModel = identify_local(&plan, &recs, &options)?;
+    model.drive_gains = gains.as_ref().map(|g| crate::local::SignalGains {
+        gain: g.gain.clone(),
+        stderr: g.stderr.clone(),
+    });
     model.save(&a.out)?;
     for w in &model.diagnostics.warnings {
         eprintln!("perturbid: warning: {w}");
@@ -562,7 +566,7 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
             .fold(0.0, f64::max);
         let _ = writeln!(
             out,
-            "torques: the recordings' signal times the drive gains of {} (their relative standard errors, up to {:.2e}, are not in the model's)",
+            "torques: the recordings' signal times the drive gains of {} (their relative standard errors, up to {:.2e}, are in the model's predictions' standard errors, not in the coefficients' below)",
             path.display(),
             worst
         );

@@ -745,5 +745,6 @@ pub fn identify_local(
         coulomb,
         perturbations: super::Perturbations::of_plan(plan),
         diagnostics,
+        drive_gains: None,
     })
 }

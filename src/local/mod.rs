@@ -72,7 +72,7 @@ pub use diagnostics::{
     Unmeasured,
 };
 pub use identify::{identify_local, CrossingTimes, IdentifyOptions};
-pub use model::{Estimate, Estimator, LocalModel};
+pub use model::{Estimate, Estimator, LocalModel, SignalGains};
 pub use offset_search::{detect_offset, detect_offset_in};
 pub use operating_point::OperatingPoint;
 pub use parameters::{identify_parameters_from_local, FromLocalOptions, ParametersFromLocal};

@@ -143,6 +143,45 @@ pub struct LocalModel {
     /// crossings, warnings (see [`Diagnostics`]).
     #[serde(default)]
     pub diagnostics: Diagnostics,
+    /// The drive gains the recordings' signal was multiplied by, where they logged motor
+    /// currents (`perturbid identify --gains-from`): the model is in torques, and the gains'
+    /// standard errors enter its predictions' ([`Self::predict_stderr`]), not its
+    /// coefficients'. None for recordings of torques.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drive_gains: Option<SignalGains>,
+}
+
+/// The drive gains a local model's recordings were put in torques by ([`LocalModel::drive_gains`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SignalGains {
+    /// Per joint, N m (or N) per unit of the signal (`crate::direct::DriveGains::gain`).
+    pub gain: Vec<f64>,
+    /// Their standard errors.
+    pub stderr: Vec<f64>,
+}
+
+impl SignalGains {
+    /// Checks `n` gains, finite, other than 0 and bounded, and their standard errors.
+    fn check(&self, what: &str, n: usize) -> Result<()> {
+        for (field, len) in [("gain", self.gain.len()), ("stderr", self.stderr.len())] {
+            if len != n {
+                return Err(invalid(
+                    what,
+                    format!("drive_gains.{field} has {len} entries, expected one per joint ({n})"),
+                ));
+            }
+        }
+        if let Some(j) = self.gain.iter().position(|g| *g == 0.0) {
+            return Err(invalid(
+                what,
+                format!("drive_gains.gain[{j}] is 0, expected a gain other than 0"),
+            ));
+        }
+        check_bounded(what, "drive gains", "drive_gains.gain", &self.gain)?;
+        check_magnitudes(what, "drive_gains.stderr", &self.stderr, false)?;
+        check_bounded(what, "drive gains", "drive_gains.stderr", &self.stderr)
+    }
 }
 
 impl LocalModel {
@@ -181,8 +220,27 @@ impl LocalModel {
     /// NaN for a joint where the model holds an unknown standard error that the state weights.
     /// Refused for a model without the D, H or G experiment, or saved before the correlations
     /// were stored.
+    ///
+    /// A model whose recordings were currents put in torques ([`Self::drive_gains`]) adds the
+    /// gains' relative standard errors: joint `j`'s every coefficient is `K_j` times the
+    /// signal's, so its prediction `tau_j` varies by `tau_j se_K_j / |K_j|` more, independent
+    /// of the local fit (the gains came from other data).
     pub fn predict_stderr(&self, states: &States<'_>) -> Result<Vec<f64>> {
-        super::prediction_uncertainty::predict_stderr(self, states)
+        let mut out = super::prediction_uncertainty::predict_stderr(self, states)?;
+        if let Some(g) = &self.drive_gains {
+            let n = self.n();
+            let tau = self.predict(states)?;
+            for (x, (se, t)) in out.iter_mut().zip(&tau).enumerate() {
+                let relative = g.stderr[x % n] / g.gain[x % n].abs();
+                *se = se.hypot(t * relative);
+            }
+            return super::prediction_uncertainty::refuse_overflow(
+                out,
+                n,
+                "prediction's standard error",
+            );
+        }
+        Ok(out)
     }
 
     /// Per sample of `states` (`k` values), its largest deviation from the planned operating
@@ -361,6 +419,9 @@ impl Document for LocalModel {
         crate::document::check_joint_names(Self::WHAT, &m.joint_names)?;
         if let Some(p) = &m.perturbations {
             p.check(Self::WHAT, n)?;
+        }
+        if let Some(g) = &m.drive_gains {
+            g.check(Self::WHAT, n)?;
         }
         // and no number beyond any robot's
         let kind = "a local model";

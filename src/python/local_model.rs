@@ -260,6 +260,21 @@ impl PyLocalModel {
     fn g_static<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         self.get(py, &self.model.g_static)
     }
+    /// The drive gains the recordings' signal was put in torques by, where they logged motor
+    /// currents (`perturbid identify --gains-from`), else None: dict `gain` and `stderr`,
+    /// (n,) each (N m or N per unit of the signal). Their standard errors are in
+    /// `predict_stderr`'s, not in the coefficients'.
+    #[getter]
+    fn drive_gains<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        (self.model.drive_gains.as_ref())
+            .map(|g| {
+                let d = PyDict::new(py);
+                d.set_item("gain", vec1(py, &g.gain))?;
+                d.set_item("stderr", vec1(py, &g.stderr))?;
+                Ok(d)
+            })
+            .transpose()
+    }
     /// The combined estimate `[D H G]`, shape `(n, 3n)`, or None.
     #[getter]
     fn combined<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {

@@ -284,6 +284,7 @@ pub fn exact_local(
         coulomb: None,
         perturbations: None,
         diagnostics: Default::default(),
+        drive_gains: None,
     }
 }
 

@@ -129,6 +129,17 @@ def test_workflow_shapes_uncertainty_and_json():
     np.testing.assert_allclose(model.predict_stderr(m.q, m.qd, m.qdd), model.stderr["torque"], rtol=1e-14)
     se = model.predict_stderr(np.tile(m.q, (3, 1)), np.tile(m.qd, (3, 1)), np.tile(m.qdd, (3, 1)) + [[0.0], [0.1], [0.2]])
     assert se.shape == (3, 6)
+    # recordings of currents put in torques by drive gains (identify --gains-from): the gains'
+    # relative standard errors scale each joint's whole prediction
+    assert model.drive_gains is None
+    gains = {"gain": [42.0, 65.0, 38.0, 9.0, 7.5, -4.0], "stderr": [0.05, 0.02, 0.03, 0.01, 0.02, 0.004]}
+    scaled = pr.LocalModel.from_json(json.dumps({**doc, "drive_gains": gains}))
+    np.testing.assert_array_equal(scaled.drive_gains["gain"], gains["gain"])
+    off = [np.tile(v, (3, 1)) for v in (m.q, m.qd, m.qdd)]
+    off[2] = off[2] + [[0.0], [0.1], [0.2]]
+    rel = np.array(gains["stderr"]) / np.abs(gains["gain"])
+    np.testing.assert_allclose(scaled.predict_stderr(*off),
+                               np.hypot(se, model.predict(*off) * rel), rtol=1e-12)
     # a validation weighs the errors against the model's own uncertainty at the states
     states = [np.tile(v, (3, 1)) for v in (m.q, m.qd, m.qdd)]
     states[2] = states[2] + [[0.0], [0.1], [0.2]]
