@@ -552,8 +552,11 @@ def identify_local(
     recorded_derivatives: bool = False,
     estimator: str = "separated",
     friction_aware_h: bool = False,
+    drive_gains: Optional[BaseParameterModel] = None,
 ) -> LocalModel:
-    """The local model from a plan and one recording per experiment."""
+    """The local model from a plan and one recording per experiment. drive_gains: a model
+    from identify_drive_gains, for recordings of motor currents (put in torques by its
+    gains, which the local model keeps)."""
 
 def identify_parameters_from_local(
     robot: Robot,

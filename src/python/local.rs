@@ -424,9 +424,13 @@ pub(crate) fn plan_experiments(
 /// - `friction_aware_h`: H* from the differences of the H passes' +- pairs with each joint's
 ///   Coulomb step as its own column (exact for viscous and Coulomb friction that reverses
 ///   between passes; the plan needs `friction_aware_h=True`); the steps are in
-///   `LocalModel.coulomb`.
+///   `LocalModel.coulomb`;
+/// - `drive_gains`: a BaseParameterModel from `identify_drive_gains`, for recordings whose
+///   `tau` holds motor currents: each is put in torques by its gains (as
+///   `Recording.in_torques`), the model keeps them (`LocalModel.drive_gains`) and their
+///   standard errors enter its predictions' (as `perturbid identify --gains-from`).
 #[pyfunction]
-#[pyo3(signature = (plan, recordings, crossing_times="detected", max_shift=0.5, window=None, torque_degree=6, recorded_derivatives=false, estimator="separated", friction_aware_h=false))]
+#[pyo3(signature = (plan, recordings, crossing_times="detected", max_shift=0.5, window=None, torque_degree=6, recorded_derivatives=false, estimator="separated", friction_aware_h=false, drive_gains=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_local(
     py: Python<'_>,
@@ -439,6 +443,7 @@ pub(crate) fn identify_local(
     recorded_derivatives: bool,
     estimator: &str,
     friction_aware_h: bool,
+    drive_gains: Option<PyRef<'_, super::direct::PyBaseModel>>,
 ) -> PyResult<PyLocalModel> {
     let times = match crossing_times {
         "planned" => CrossingTimes::Planned,
@@ -461,9 +466,41 @@ pub(crate) fn identify_local(
         estimator: estimator.parse::<Estimator>()?,
         friction_aware_h,
     };
-    let recs: Vec<Recording> = recordings.iter().map(|r| (*r.get().rec).clone()).collect();
+    let gains = match &drive_gains {
+        None => None,
+        Some(m) => {
+            let refuse = |message: String| Error::InvalidArgument {
+                argument: "drive_gains".into(),
+                message,
+            };
+            let g = (m.fit.drive_gains.as_ref()).ok_or_else(|| {
+                refuse(
+                    "the model holds no drive gains: give a model from identify_drive_gains".into(),
+                )
+            })?;
+            if m.fit.joint_names != plan.plan.joint_names {
+                return Err(refuse(format!(
+                    "the model's joints [{}] are not the plan's [{}]",
+                    m.fit.joint_names.join(", "),
+                    plan.plan.joint_names.join(", ")
+                ))
+                .into());
+            }
+            Some(crate::local::SignalGains {
+                gain: g.gain.clone(),
+                stderr: g.stderr.clone(),
+            })
+        }
+    };
+    let recs: Vec<Recording> = (recordings.iter())
+        .map(|r| match &gains {
+            Some(g) => r.get().rec.in_torques(&g.gain),
+            None => Ok((*r.get().rec).clone()),
+        })
+        .collect::<Result<_>>()?;
     let plan = plan.plan.clone();
-    let model = detached(py, "identify_local", || identify_rs(&plan, &recs, &options))?;
+    let mut model = detached(py, "identify_local", || identify_rs(&plan, &recs, &options))?;
+    model.drive_gains = gains;
     super::errors::warn_all(py, &model.diagnostics.warnings)?;
     Ok(PyLocalModel { model })
 }

@@ -188,6 +188,33 @@ def test_the_model_is_the_robot_alones_in_torques(setup):
         plain.predict(q, qd, qdd, signal=True)
 
 
+def test_a_local_model_from_recordings_of_currents(setup):
+    """identify_local(..., drive_gains=fit): the local method's recordings logged as currents
+    give the local model of the same recordings in torques, keeping the gains."""
+    pair, _, runs = setup
+    fit = pr.identify_drive_gains(pair.ours, recordings(runs), [None, PAYLOAD], friction="viscous")
+    op = pr.OperatingPoint([0.7854, 0.3927, -0.5236, 0.0, 1.0472, 0.0],
+                           [0.089, -0.106, 0.022, 0.056, 0.011, 0.014],
+                           [-0.155, -0.5, 0.034, -0.291, -0.008, 0.171])
+    plan = pr.plan_experiments(pair.ours, op)
+    recs = pr.simulate(pair.ours, plan, torque_noise=0.01, seed=2)
+    currents = [pr.Recording(r.t, r.q, r.tau / GAINS, name=r.name, experiment=r.experiment)
+                for r in recs]
+    torques = pr.identify_local(plan, recs)
+    local = pr.identify_local(plan, currents, drive_gains=fit)
+    np.testing.assert_array_equal(local.drive_gains["gain"], fit.drive_gains["gain"])
+    assert torques.drive_gains is None
+    # the gains are the identified ones, off the truth by their errors: so is the model
+    worst = np.max(np.abs(fit.drive_gains["gain"] / GAINS - 1))
+    np.testing.assert_allclose(local.D, torques.D, rtol=0, atol=2 * worst * np.abs(torques.D).max())
+    np.testing.assert_allclose(local.torque, torques.torque, rtol=2 * worst, atol=1e-6)
+    _, q, qd, qdd = motion(5)
+    plain = pr.identify_base_parameters(pair.ours, q, qd, qdd, fit.predict(q, qd, qdd),
+                                        friction="viscous")
+    with pytest.raises(pr.InputError, match="holds no drive gains"):
+        pr.identify_local(plan, currents, drive_gains=plain)
+
+
 def test_a_signal_counting_the_other_way_is_named(setup):
     pair, _, runs = setup
     flipped = [(t, q, qd, qdd, i * np.array([1, -1, 1, 1, 1, 1])) for t, q, qd, qdd, i in runs]
