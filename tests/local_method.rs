@@ -929,14 +929,14 @@ fn a_sound_d_star_raises_no_mass_matrix_warning() {
 /// value, and the other rows keep their values. Without it, no warning.
 #[test]
 fn a_torque_channel_that_does_not_change_is_warned_about() {
-    let model = a465::model("kinsheel2010").unwrap();
+    let common::Table2Local {
+        model,
+        plan,
+        recs,
+        local: clean,
+        ..
+    } = common::table2_local();
     let n = model.nv;
-    let op = table2();
-    let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
-    let mut sim = SimulationOptions::new(&model);
-    sim.torque_noise = vec![0.01; n];
-    let recs = simulate_plan(&model, &plan, &sim).unwrap();
-    let clean = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
     assert!(
         !clean
             .diagnostics

@@ -216,14 +216,10 @@ type Edit<'a> = &'a dyn Fn(&mut serde_json::Value);
 /// refused on loading, naming the estimate, matrix, row and column.
 #[test]
 fn correlations_are_saved_and_checked_on_loading() {
-    let model = a465::model("kinsheel2010").unwrap();
+    let common::Table2Local {
+        model, op, local, ..
+    } = common::table2_local();
     let n = model.nv;
-    let op = table2();
-    let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
-    let mut sim = SimulationOptions::new(&model);
-    sim.torque_noise = vec![0.01; n];
-    let recs = simulate_plan(&model, &plan, &sim).unwrap();
-    let local = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
     for e in [
         &local.d,
         &local.h,
@@ -448,14 +444,13 @@ fn base_model_predicted_standard_errors_match_the_scatter_over_seeds() {
 /// saved, and checked on loading.
 #[test]
 fn the_drive_gains_standard_errors_enter_a_local_models_predictions() {
-    let model = a465::model("kinsheel2010").unwrap();
+    let common::Table2Local {
+        model,
+        op,
+        local: plain,
+        ..
+    } = common::table2_local();
     let n = model.nv;
-    let op = table2();
-    let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
-    let mut sim = SimulationOptions::new(&model);
-    sim.torque_noise = vec![0.01; n];
-    let recs = simulate_plan(&model, &plan, &sim).unwrap();
-    let plain = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
     let gain = vec![42.0, 65.0, 38.0, 9.0, 7.5, -4.0];
     let stderr = vec![0.05, 0.02, 0.03, 0.01, 0.02, 0.004];
     let with = LocalModel {

@@ -129,6 +129,35 @@ pub fn table2() -> perturbid_rs::OperatingPoint {
     .unwrap()
 }
 
+/// The A465 at Table 2's point, planned by default and simulated with 0.01 N m of torque
+/// noise: the robot, the point, the plan, the recordings and the local model identified from
+/// them by default.
+pub struct Table2Local {
+    pub model: perturbid_rs::Model,
+    pub op: perturbid_rs::OperatingPoint,
+    pub plan: perturbid_rs::local::Plan,
+    pub recs: Vec<perturbid_rs::Recording>,
+    pub local: perturbid_rs::local::LocalModel,
+}
+
+pub fn table2_local() -> Table2Local {
+    use perturbid_rs::local::{identify_local, plan_experiments, IdentifyOptions, PlanOptions};
+    let model = perturbid_rs::robots::a465::model("kinsheel2010").unwrap();
+    let op = table2();
+    let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+    let mut sim = perturbid_rs::SimulationOptions::new(&model);
+    sim.torque_noise = vec![0.01; model.nv];
+    let recs = perturbid_rs::simulate_plan(&model, &plan, &sim).unwrap();
+    let local = identify_local(&plan, &recs, &IdentifyOptions::default()).unwrap();
+    Table2Local {
+        model,
+        op,
+        plan,
+        recs,
+        local,
+    }
+}
+
 /// The robot's own linearisation at `op`, gravity included.
 pub fn linearized(
     model: &perturbid_rs::Model,
