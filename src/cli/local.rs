@@ -544,10 +544,7 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
         friction_aware_h: a.friction_aware_h,
     };
     let mut model: LocalModel = identify_local(&plan, &recs, &options)?;
-    model.drive_gains = gains.as_ref().map(|g| crate::local::SignalGains {
-        gain: g.gain.clone(),
-        stderr: g.stderr.clone(),
-    });
+    model.drive_gains = gains.as_ref().map(crate::local::SignalGains::from);
     model.save(&a.out)?;
     for w in &model.diagnostics.warnings {
         eprintln!("perturbid: warning: {w}");

@@ -522,19 +522,22 @@ pub fn identify_drive_gains_with(
     let ls_coef: Vec<f64> = ls.coef.row(0).iter().copied().collect();
     let ls_gain: Vec<f64> = ls_coef[p..].iter().map(|c| -c).collect();
     undetermined(&ls_gain, &rms)?;
-    // the least-squares gains' noise bias, from the least-squares fit (below)
-    let ls_rms = rms.clone();
-    let (fit, coef) = match estimator {
-        GainEstimator::LeastSquares => (ls.clone(), ls_coef),
-        GainEstimator::Instrumental => {
-            let iv = super::instrumental::instrumental(&factors, &sigma, &ls_coef, &names)?;
-            let coef: Vec<f64> = iv.coef.row(0).iter().copied().collect();
-            rms = factors.residual_rms(&coef)?;
-            (iv, coef)
-        }
+    // by instrumental variables the model is theirs; the least-squares fit keeps the gains'
+    // noise bias (below)
+    let iv = match estimator {
+        GainEstimator::LeastSquares => None,
+        GainEstimator::Instrumental => Some(super::instrumental::instrumental(
+            &factors, &sigma, &ls_coef, &names,
+        )?),
+    };
+    let fit = iv.as_ref().unwrap_or(&ls);
+    let coef: Vec<f64> = fit.coef.row(0).iter().copied().collect();
+    let fit_rms: Vec<f64> = match &iv {
+        Some(iv) => iv.residual_rms.iter().copied().collect(),
+        None => rms.clone(),
     };
     let gain: Vec<f64> = coef[p..].iter().map(|c| -c).collect();
-    undetermined(&gain, &rms)?;
+    undetermined(&gain, &fit_rms)?;
 
     // the robot alone: its torques are the gains' times the signal less the payload's
     let tau: Vec<f64> = (0..k * nv)
@@ -546,7 +549,7 @@ pub fn identify_drive_gains_with(
     model_fit.theta = coef[..p].to_vec();
     model_fit.stderr = stderr[..p].to_vec();
     model_fit.correlation = fit.correlation.view((0, 0), (p, p)).into_owned();
-    model_fit.residual_rms = rms.clone();
+    model_fit.residual_rms = fit_rms.clone();
     model_fit.sigma = sigma;
 
     // the gains' noise bias: errors in the columns bias least squares by -(X^T W^2 X)^-1
@@ -560,7 +563,7 @@ pub fn identify_drive_gains_with(
         .map(|m| {
             let sum: f64 = (0..nv)
                 .map(|j| {
-                    let w = ls_rms[j] / model_fit.sigma[j];
+                    let w = rms[j] / model_fit.sigma[j];
                     cov(p + m, p + j) * k as f64 * w * w / ls_gain[j]
                 })
                 .sum();
@@ -591,7 +594,7 @@ pub fn identify_drive_gains_with(
             let scale: f64 = (0..k).map(|s| signal[s * nv + j].powi(2)).sum::<f64>() / k as f64;
             let floor = 1e-9 * scale.sqrt();
             let own = (alone[j] / k as f64).sqrt();
-            (rms[j] / gain[j].abs() + floor) / (own + floor)
+            (fit_rms[j] / gain[j].abs() + floor) / (own + floor)
         })
         .collect();
     let payload_torque_rms = (loaded_squares.iter())

@@ -31,8 +31,9 @@ use crate::regression::{least_squares, LeastSquares};
 ///
 /// Returns the estimate as a [`LeastSquares`]: `coef` (`1 x (p + nv)`), `stderr` from the
 /// weighted residuals of the estimate (`sigma_w^2 = |W (y - X beta)|^2 / (K nv - p - nv)`),
-/// `cov_diag` and `correlation` of `M^-1 M^-T`, `cond` of the column-scaled `M`, `rows`;
-/// `residual_rms`, `leverage` and `weakest` as the square solve leaves them.
+/// `residual_rms` per joint, unweighted (N m, [`JointFactors::residual_rms`]), `cov_diag`
+/// and `correlation` of `M^-1 M^-T`, `cond` of the column-scaled `M`, `rows`; `leverage`
+/// and `weakest` as the square solve leaves them.
 pub(super) fn instrumental(
     factors: &JointFactors,
     sigma: &[f64],
@@ -106,5 +107,6 @@ pub(super) fn instrumental(
     let s = (weighted / rows.saturating_sub(unknowns).max(1) as f64).sqrt();
     iv.stderr = DMatrix::from_fn(1, unknowns, |_, c| s * iv.cov_diag[c].sqrt());
     iv.rows = rows;
+    iv.residual_rms = DVector::from_vec(rms);
     Ok(iv)
 }

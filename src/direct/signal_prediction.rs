@@ -51,25 +51,30 @@ impl BaseModel {
             });
         }
         let theta = DVector::from_column_slice(&self.theta);
+        // the correlation of the gains with the parameters: row j gain j's
+        let cross = gains.correlation.columns(0, p);
         let mut out = Vec::with_capacity(states.len() * nv);
         regressor_blocks(model, &self.base.layout, states, self.gravity, |_, phi| {
             let rows = self.base.select(phi);
             let tau = &rows * &theta;
-            // the block's rows: its samples' joints, sample after sample
-            for (r, row) in rows.row_iter().enumerate() {
+            // the block's rows (its samples' joints, sample after sample) over the gains, in
+            // standard errors; every row's z^T R z at once: one product for the block
+            let z = DMatrix::from_fn(rows.nrows(), p, |r, a| match self.stderr[a] {
+                se if se.is_nan() => 0.0,
+                se => rows[(r, a)] * se / gains.gain[r % nv],
+            });
+            let w = &z * &self.correlation;
+            for r in 0..rows.nrows() {
                 let j = r % nv;
                 let (k, se_k) = (gains.gain[j], gains.stderr[j]);
-                if (0..p).any(|a| self.stderr[a].is_nan() && row[a] != 0.0) || se_k.is_nan() {
+                let unknown = (0..p).any(|a| self.stderr[a].is_nan() && rows[(r, a)] != 0.0);
+                if unknown || se_k.is_nan() {
                     out.push(f64::NAN);
                     continue;
                 }
-                let z = DVector::from_fn(p, |a, _| match self.stderr[a] {
-                    se if se.is_nan() => 0.0,
-                    se => row[a] * se / k,
-                });
                 let zk = -tau[r] / (k * k) * se_k;
-                let cross: f64 = (0..p).map(|a| gains.correlation[(j, a)] * z[a]).sum();
-                let var = z.dot(&(&self.correlation * &z)) + 2.0 * zk * cross + zk * zk;
+                let var =
+                    z.row(r).dot(&w.row(r)) + 2.0 * zk * z.row(r).dot(&cross.row(j)) + zk * zk;
                 out.push(root(var));
             }
             Ok(())

@@ -161,6 +161,16 @@ pub struct SignalGains {
     pub stderr: Vec<f64>,
 }
 
+impl From<&crate::direct::DriveGains> for SignalGains {
+    /// The gains of a drive-gain identification and their standard errors.
+    fn from(g: &crate::direct::DriveGains) -> Self {
+        Self {
+            gain: g.gain.clone(),
+            stderr: g.stderr.clone(),
+        }
+    }
+}
+
 impl SignalGains {
     /// Checks `n` gains, finite, other than 0 and bounded, and their standard errors.
     fn check(&self, what: &str, n: usize) -> Result<()> {

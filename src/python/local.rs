@@ -486,10 +486,7 @@ pub(crate) fn identify_local(
                 ))
                 .into());
             }
-            Some(crate::local::SignalGains {
-                gain: g.gain.clone(),
-                stderr: g.stderr.clone(),
-            })
+            Some(crate::local::SignalGains::from(g))
         }
     };
     let recs: Vec<Recording> = (recordings.iter())
