@@ -200,7 +200,7 @@ fn csv_headers_are_checked_in_one_pass() {
     let t = Table::parse("wide.csv", &format!("{}\n{zeros}\n", wide.join(","))).unwrap();
     assert_eq!(t.columns.len(), 200_000);
     // a table written with another separator reads as one column: said so
-    for (sep, name) in [(";", "semicolons"), ("\t", "tabs")] {
+    for (sep, name) in [(";", "semicolons"), ("\t", "tabs"), (" ", "spaces")] {
         let text = format!("t{sep}q1{sep}tau1\n0{sep}1,5{sep}2\n");
         let e = Table::parse("log.csv", &text).unwrap_err().to_string();
         assert!(

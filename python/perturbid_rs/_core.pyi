@@ -293,9 +293,15 @@ class Recording:
         path: Union[str, PathLike[str]],
         joints: Sequence[str],
         experiment: Optional[str] = None,
+        *,
+        columns: Optional[Union[Mapping[str, str], Sequence[str]]] = None,
+        ignore_columns: Optional[Sequence[str]] = None,
     ) -> "Recording":
         """Reads a recording CSV (t, q1..qN, [qd, qdd,] tau1..tauN, or q_<joint>, ...) of
-        the robot's ``joints``, as the command line does; named by its path."""
+        the robot's ``joints``, as the command line does; named by its path. A log from
+        another tool: ``columns`` reads its names as these ({"t": "timestamp*ms", "q":
+        "actual_q_{i}"} or ["t=timestamp*ms", ...]), ``ignore_columns`` leaves columns out
+        (names, or starts of names ending in ``*``), as ``--column`` and ``--ignore-columns``."""
     def save(self, path: Union[str, PathLike[str]]) -> None:
         """Writes the recording as CSV (atomically), read back exactly by ``load``."""
     @staticmethod
@@ -304,9 +310,13 @@ class Recording:
         joints: Sequence[str],
         name: str = "dataframe",
         experiment: Optional[str] = None,
+        *,
+        columns: Optional[Union[Mapping[str, str], Sequence[str]]] = None,
+        ignore_columns: Optional[Sequence[str]] = None,
     ) -> "Recording":
         """A pandas DataFrame read by the CSV files' rules; ``t`` in s, datetimes or
-        timedeltas, as a column or the index named ``t``."""
+        timedeltas, as a column or the index named ``t``; ``columns`` and ``ignore_columns``
+        as for ``load`` (columns left out may hold text)."""
     def to_dataframe(self) -> Any:
         """The recording as a DataFrame with its CSV file's columns (t, q1.., tau1..)."""
     @property

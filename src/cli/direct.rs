@@ -347,6 +347,8 @@ pub(crate) struct PredictArgs {
     /// gains together); tau1..tauN of the states CSV read as that signal.
     #[arg(long)]
     signal: bool,
+    #[command(flatten)]
+    columns: super::files::ColumnArgs,
 }
 
 pub(crate) fn predict(a: PredictArgs) -> Result<String> {
@@ -357,7 +359,8 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
         .signal
         .then(|| super::gains::model_gains(&file, &a.model, "--signal").map(|g| &g.gain[..]))
         .transpose()?;
-    let rows = read_states(&crate::io::Table::read(&a.data)?, &joints)?;
+    let mut notes = String::new();
+    let rows = read_states(&a.columns.table(&a.data, &joints, &mut notes)?, &joints)?;
     let states = States::new(joints.len(), &rows.q, Some(&rows.qd), Some(&rows.qdd))?;
     let (tau, stderr) = match &file {
         ModelFile::Base(fit) => {
@@ -424,8 +427,10 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
         table.push(&row);
     }
     write_atomic(&a.out, table.to_csv().as_bytes())?;
-    let mut out = format!(
-        "{} predicted {} -> {}\n",
+    let mut out = notes;
+    let _ = writeln!(
+        out,
+        "{} predicted {} -> {}",
         states.t.len(),
         if gains.is_some() {
             "signals (torques over the drive gains)"

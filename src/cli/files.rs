@@ -123,9 +123,61 @@ pub(crate) fn refuse_overwriting_inputs(out: &Path, inputs: &[&Path]) -> Result<
     }
 }
 
+/// How a log from another tool is read ([`crate::io::column_map`]).
+#[derive(clap::Args, Clone, Debug, Default)]
+pub(crate) struct ColumnArgs {
+    /// A log from another tool: read its column SOURCE as TARGET (t; q, qd, qdd or tau for
+    /// every joint, SOURCE then holding {i} for the joint's index from 0, {j} for its number
+    /// from 1 or {joint} for its name; or one joint's, q3), its values times SCALE (a number,
+    /// -1 for a signal counting the other way, or deg, ms, us, ns): --column
+    /// t=timestamp*ms --column q=actual_q_{i}. Repeat for each.
+    #[arg(long = "column", value_name = "TARGET=SOURCE[*SCALE]")]
+    column: Vec<String>,
+    /// Columns of the log to leave out (currents, temperatures, states in words: they need
+    /// not hold numbers): names, or the start of names followed by '*', separated by commas;
+    /// the output lists those left out. A column --column names is read all the same.
+    #[arg(long = "ignore-columns", value_name = "NAME[,NAME...]")]
+    ignore_columns: Vec<String>,
+}
+
+impl ColumnArgs {
+    /// The map the options give.
+    pub(crate) fn map(&self) -> Result<crate::io::ColumnMap> {
+        crate::io::ColumnMap::new(&self.column, &self.ignore_columns)
+    }
+
+    /// The table of the log `path` for the joints `joints`, its columns read by the map; the
+    /// columns left out are listed in `out`.
+    pub(crate) fn table(
+        &self,
+        path: &Path,
+        joints: &[String],
+        out: &mut String,
+    ) -> Result<crate::io::Table> {
+        let (table, left_out) = self.map()?.read(path, joints)?;
+        if let Some(note) = crate::io::column_map::left_out_note(path, &left_out) {
+            out.push_str(&note);
+            out.push('\n');
+        }
+        Ok(table)
+    }
+
+    /// [`Self::table`] read as a recording.
+    pub(crate) fn load(
+        &self,
+        path: &Path,
+        joints: &[String],
+        out: &mut String,
+    ) -> Result<crate::recording::Recording> {
+        crate::io::read_recording(&self.table(path, joints, out)?, joints)
+    }
+}
+
 /// How a recording is preprocessed (the same for identification and validation).
 #[derive(clap::Args)]
 pub(crate) struct PreprocessArgs {
+    #[command(flatten)]
+    pub(crate) columns: ColumnArgs,
     /// Preprocess even when the file has qdd columns.
     #[arg(long)]
     preprocess: bool,
@@ -156,7 +208,7 @@ impl PreprocessArgs {
     ) -> Result<crate::recording::Recording> {
         use std::fmt::Write;
         progress.update(&format!("reading {}", path.display()));
-        let rec = crate::io::load_recording(path, joints)?;
+        let rec = self.columns.load(path, joints, out)?;
         let clipped = |rec: &crate::recording::Recording| {
             let log = path.display().to_string();
             if let Some(w) = crate::torque_saturation::warning(&rec.torque_saturation, joints, &log)

@@ -11,7 +11,7 @@ use super::out_dir;
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
-use crate::io::{load_recording, plan_files, recording_files, save_recording};
+use crate::io::{plan_files, recording_files, save_recording};
 use crate::local::{
     identify_local, plan_experiments, CrossingTimes, Design, Estimator, ExperimentKind,
     IdentifyOptions, LocalModel, OperatingPoint, Plan, PlanOptions, Size,
@@ -461,6 +461,8 @@ pub(crate) struct IdentifyArgs {
     /// in the local model's.
     #[arg(long, value_name = "MODEL.json")]
     gains_from: Option<PathBuf>,
+    #[command(flatten)]
+    columns: super::files::ColumnArgs,
 }
 
 fn fmt_matrix(
@@ -518,10 +520,11 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
         .as_deref()
         .map(|path| super::gains::gains_from_file(path, &plan.joint_names))
         .transpose()?;
+    let mut notes = String::new();
     let recs: Vec<Recording> = files
         .iter()
         .map(|f| {
-            let rec = load_recording(f, &plan.joint_names)?;
+            let rec = a.columns.load(f, &plan.joint_names, &mut notes)?;
             match &gains {
                 Some(g) => rec.in_torques(&g.gain),
                 None => Ok(rec),
@@ -549,7 +552,7 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
     for w in &model.diagnostics.warnings {
         eprintln!("perturbid: warning: {w}");
     }
-    let mut out = String::new();
+    let mut out = notes;
     let _ = writeln!(
         out,
         "local model of '{}' ({} estimator) -> {}",

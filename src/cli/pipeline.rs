@@ -311,10 +311,12 @@ fn words(key: &str, value: &Value, arg: &clap::Arg, base: &Path, at: &str) -> Re
         Value::Array(_) => return Err(bad(format!("'{key}' takes one value, not a list"))),
         Value::Table(t)
             if many
-                && arg
-                    .get_value_names()
-                    .is_some_and(|n| n.iter().any(|n| n.as_str() == "JOINT=VALUE")) =>
+                && arg.get_value_names().is_some_and(|n| {
+                    n.iter()
+                        .any(|n| ["JOINT=VALUE", "TARGET=SOURCE[*SCALE]"].contains(&n.as_str()))
+                }) =>
         {
+            // `lock = { joint = value }`, `column = { t = "timestamp*ms" }`
             t.iter()
                 .map(|(joint, v)| Ok(format!("{joint}={}", scalar(v)?)))
                 .collect::<Result<Vec<_>>>()?

@@ -10,7 +10,7 @@ use super::files::refuse_overwriting_inputs;
 use super::out_dir;
 use crate::document::Document;
 use crate::error::Result;
-use crate::io::{load_recording, recording_files};
+use crate::io::recording_files;
 use crate::local::{gaps_in_runs, repeated_runs, split_session, Plan, SplitOptions};
 
 #[derive(Args)]
@@ -28,11 +28,14 @@ pub(crate) struct SplitArgs {
     /// Seconds of log kept before and after each run.
     #[arg(long, default_value_t = 0.2)]
     margin: f64,
+    #[command(flatten)]
+    columns: super::files::ColumnArgs,
 }
 
 pub(crate) fn split(a: SplitArgs) -> Result<String> {
     let plan = Plan::load(&a.plan)?;
-    let log = load_recording(&a.log, &plan.joint_names)?;
+    let mut out = String::new();
+    let log = a.columns.load(&a.log, &plan.joint_names, &mut out)?;
     let runs = split_session(&plan, &log, &SplitOptions { margin: a.margin })?;
     let mut warnings = repeated_runs(&plan, &log, &runs)?;
     warnings.extend(gaps_in_runs(&plan, &log, &runs));
@@ -41,7 +44,6 @@ pub(crate) fn split(a: SplitArgs) -> Result<String> {
     }
     let (recordings, offsets): (Vec<_>, Vec<f64>) = runs.into_iter().unzip();
     let set = recording_files(&plan, &recordings, &out_dir(&a.out))?;
-    let mut out = String::new();
     for ((e, run), offset) in plan.experiments.iter().zip(&recordings).zip(&offsets) {
         let name = format!("{}.csv", e.kind.name());
         refuse_overwriting_inputs(&set.path_of(&name), &[a.log.as_path(), a.plan.as_path()])?;

@@ -4,6 +4,7 @@
 //! reader sees whole or not at all.
 
 pub mod atomic;
+pub mod column_map;
 pub mod config;
 pub(crate) mod foreign;
 pub mod output_set;
@@ -12,6 +13,7 @@ pub mod recording;
 pub mod table;
 
 pub use atomic::{read_document, read_text, write_atomic};
+pub use column_map::ColumnMap;
 pub use output_set::{check_not_partial, OutputSet};
 pub use plan_files::{plan_files, recording_files};
 pub use recording::{

@@ -50,8 +50,8 @@ impl<'a> Columns<'a> {
             bad(
                 table,
                 format!(
-                    "no column 't' (time, s){case}; the columns are: {}",
-                    table.columns.join(", ")
+                    "no column 't' (time, s){case}; the columns are: {}; a log from another tool: read its time as t with --column t=NAME (*ms, *us or *ns for a time in those units; Python columns=, docs/data.md)",
+                    listed(&table.columns)
                 ),
             )
         })?;
@@ -96,7 +96,7 @@ impl<'a> Columns<'a> {
             return Err(bad(
                 table,
                 format!(
-                    "missing column(s) {}: the robot has {n} joints ({})",
+                    "missing column(s) {}: the robot has {n} joints ({}); a log from another tool: read its own names as these with --column {var}=NAME_{{i}} ({{i}} the joint's index from 0, {{j}} its number, {{joint}} its name; Python columns=, docs/data.md)",
                     missing.join(", "),
                     joints.join(", ")
                 ),
@@ -121,13 +121,22 @@ impl<'a> Columns<'a> {
             Some(c) => Err(bad(
                 self.table,
                 format!(
-                    "unexpected column '{}': expected t, q1..q{n}, optional qd1..qd{n} and qdd1..qdd{n}, tau1..tau{n} (or the same named after the joints, e.g. q_{})",
-                    self.table.columns[c], self.joints[0]
+                    "unexpected column '{}': expected t, q1..q{n}, optional qd1..qd{n} and qdd1..qdd{n}, tau1..tau{n} (or the same named after the joints, e.g. q_{}); a log from another tool: leave its other columns out (command line --ignore-columns '{}', Python ignore_columns=) and read its own names as these (--column, columns=; docs/data.md)",
+                    self.table.columns[c], self.joints[0], self.table.columns[c]
                 ),
             )),
             None => Ok(()),
         }
     }
+}
+
+/// A header's names for a message: the first 40, then "...".
+pub(super) fn listed(columns: &[String]) -> String {
+    let mut names: Vec<&str> = columns.iter().take(40).map(String::as_str).collect();
+    if columns.len() > 40 {
+        names.push("...");
+    }
+    names.join(", ")
 }
 
 fn bad(table: &Table, message: String) -> Error {

@@ -45,6 +45,18 @@ impl Table {
     /// non-number, NaN or inf is an error naming the line (1-based) and the column, and so is
     /// a time (column `t`) that does not increase from one row to the next.
     pub fn parse(source: &str, text: &str) -> Result<Self> {
+        Self::parse_selected(source, text, |columns| Ok(Selection::all(columns)))
+    }
+
+    /// [`Self::parse`] keeping the columns `select` picks from the header (after the header's
+    /// own checks), under the names it gives them and scaled as it says: a column it leaves
+    /// out is not read (it may hold text), a kept one must hold numbers whose scaled values are
+    /// finite; the time that must increase is the kept column named `t`.
+    pub fn parse_selected(
+        source: &str,
+        text: &str,
+        select: impl FnOnce(&[String]) -> Result<Selection>,
+    ) -> Result<Self> {
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let mut reader = csv::ReaderBuilder::new()
             .has_headers(false)
@@ -98,6 +110,7 @@ impl Table {
         };
         let (header_line, header) = first.map_err(csv_error)?;
         let columns: Vec<String> = header.iter().map(str::to_string).collect();
+        let width = columns.len();
         let mut t = Table::new(source, columns);
         if t.columns.len() > 1 && t.columns.last().is_some_and(String::is_empty) {
             // a logger that ends every line with a comma
@@ -111,7 +124,7 @@ impl Table {
         }
         // a table written with another separator reads as one column
         if let [only] = t.columns.as_slice() {
-            if let Some((sep, name)) = [(';', "semicolons"), ('\t', "tabs"), ('|', "bars")]
+            if let Some((sep, name)) = [(';', "semicolons"), ('\t', "tabs"), ('|', "bars"), (' ', "spaces")]
                 .into_iter()
                 .find(|(c, _)| only.contains(*c))
             {
@@ -123,33 +136,64 @@ impl Table {
                 )));
             }
         }
+        let selection = select(&t.columns)?;
+        let original = std::mem::take(&mut t.columns);
+        t.columns = selection.keep.iter().map(|k| k.name.clone()).collect();
+        if let Some(problem) = t.header_problem() {
+            return Err(t.error(format!(
+                "line {header_line}, as the columns are renamed: {problem}"
+            )));
+        }
+        // a column by its name in the file, and by the one it is read as where that differs
+        let named = |k: &Kept| match &original[k.source] {
+            name if *name == k.name => format!("'{name}'"),
+            name => format!("'{name}' (read as {})", k.name),
+        };
         // time must increase: checked here, where the line is known (a log whose clock
         // stepped back was named by its data row, which blank and comment lines shift)
         let time = t.index("t");
         let mut previous = (f64::NEG_INFINITY, 0);
         for record in records {
             let (line, fields) = record.map_err(csv_error)?;
-            if fields.len() != t.columns.len() {
+            if fields.len() != width {
                 return Err(t.error(format!(
-                    "line {line}: {} fields, the header has {} columns",
+                    "line {line}: {} fields, the header has {width} columns",
                     fields.len(),
-                    t.columns.len()
                 )));
             }
-            for (c, f) in fields.iter().enumerate() {
+            for k in &selection.keep {
+                let f = &fields[k.source];
                 let v: f64 = f.parse().map_err(|_| {
+                    // a column of words (a robot's mode, a date) is no recording's
+                    let words = if f.chars().any(|c| c.is_ascii_digit()) {
+                        String::new()
+                    } else {
+                        format!(
+                            " (a column that holds no numbers is left out with --ignore-columns '{}', Python ignore_columns=)",
+                            original[k.source]
+                        )
+                    };
                     t.error(format!(
-                        "line {line}, column '{}': '{f}' is not a number",
-                        t.columns[c]
+                        "line {line}, column {}: '{f}' is not a number{words}",
+                        named(k)
                     ))
                 })?;
                 if !v.is_finite() {
                     return Err(t.error(format!(
-                        "line {line}, column '{}': {v} is not a finite number",
-                        t.columns[c]
+                        "line {line}, column {}: {v} is not a finite number",
+                        named(k)
                     )));
                 }
-                t.values.push(v);
+                let scaled = v * k.scale;
+                if !scaled.is_finite() {
+                    return Err(t.error(format!(
+                        "line {line}, column {}: {} times {} is beyond the largest number",
+                        named(k),
+                        crate::error::shown(v),
+                        crate::error::shown(k.scale)
+                    )));
+                }
+                t.values.push(scaled);
             }
             if let Some(c) = time {
                 let now = t.values[t.values.len() - t.columns.len() + c];
@@ -248,6 +292,36 @@ impl Table {
                     .map(|v| format!("{v}"))
             }),
         )
+    }
+}
+
+/// A column [`Table::parse_selected`] keeps: its index in the file's header, the name it is
+/// read as and the factor its values are multiplied by.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Kept {
+    pub source: usize,
+    pub name: String,
+    pub scale: f64,
+}
+
+/// The columns [`Table::parse_selected`] keeps, in the order the table holds them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Selection {
+    pub keep: Vec<Kept>,
+}
+
+impl Selection {
+    /// Every column of `columns`, under its own name and unscaled.
+    pub fn all(columns: &[String]) -> Self {
+        Self {
+            keep: (columns.iter().enumerate())
+                .map(|(source, name)| Kept {
+                    source,
+                    name: name.clone(),
+                    scale: 1.0,
+                })
+                .collect(),
+        }
     }
 }
 

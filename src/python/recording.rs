@@ -136,19 +136,31 @@ impl PyRecording {
     /// (`q_<joint>`, ...); `joints` are the robot's joint names in order (e.g.
     /// `robot.joint_names` or `plan.joint_names`), N of them. t in s, positions in rad or m,
     /// torques in N m or N. Named by its path, so `D.csv` pairs with experiment D in
-    /// `identify_local`; `experiment` marks it explicitly. Raises FileError for a file that
-    /// cannot be read (or larger than 2 GiB), InputError naming the file, line and column of
-    /// a bad value, a missing or unexpected column, or time that does not increase.
+    /// `identify_local`; `experiment` marks it explicitly. A log from another tool:
+    /// `columns` reads its own names as these, a dict `{TARGET: "SOURCE[*SCALE]"}` or a list
+    /// of `"TARGET=SOURCE[*SCALE]"` (TARGET `t`; `q`, `qd`, `qdd` or `tau` for every joint,
+    /// SOURCE then holding `{i}` (index from 0), `{j}` (number from 1) or `{joint}` (name); or
+    /// one joint's, `q3`; SCALE a number or `deg`, `ms`, `us`, `ns`), and `ignore_columns`
+    /// leaves columns out (names, or starts of names ending in `*`; they need not hold
+    /// numbers), as the command line's `--column` and `--ignore-columns` (docs/data.md).
+    /// Raises FileError for a file that cannot be read (or larger than 2 GiB), InputError
+    /// naming the file, line and column of a bad value, a missing or unexpected column, a
+    /// map that does not fit the log, or time that does not increase; TypeError for a
+    /// `columns` that is neither a dict nor a list of strings.
     #[staticmethod]
-    #[pyo3(signature = (path, joints, experiment=None))]
+    #[pyo3(signature = (path, joints, experiment=None, *, columns=None, ignore_columns=None))]
     fn load(
         py: Python<'_>,
         path: PathBuf,
         joints: Vec<String>,
         experiment: Option<String>,
+        columns: Option<&Bound<'_, PyAny>>,
+        ignore_columns: Option<Vec<String>>,
     ) -> PyResult<Self> {
+        let map = column_map(columns, ignore_columns)?;
         let mut rec = super::detached(py, "Recording.load", || {
-            crate::io::load_recording(&path, &joints)
+            let (table, _) = map.read(&path, &joints)?;
+            crate::io::read_recording(&table, &joints)
         })?;
         if experiment.is_some() {
             rec.experiment = experiment;
@@ -175,16 +187,21 @@ impl PyRecording {
     /// time column, a missing, repeated or unexpected column, a non-finite value (row and
     /// column), time that does not increase; TypeError for what is not a DataFrame. Parquet
     /// logs read through `pandas.read_parquet` (pyarrow).
+    /// `columns` and `ignore_columns` as for `Recording.load` (a column left out is not
+    /// converted: it may hold text).
     #[staticmethod]
-    #[pyo3(signature = (frame, joints, name="dataframe", experiment=None))]
+    #[pyo3(signature = (frame, joints, name="dataframe", experiment=None, *, columns=None, ignore_columns=None))]
     fn from_dataframe(
         py: Python<'_>,
         frame: &Bound<'_, PyAny>,
         joints: Vec<String>,
         name: &str,
         experiment: Option<String>,
+        columns: Option<&Bound<'_, PyAny>>,
+        ignore_columns: Option<Vec<String>>,
     ) -> PyResult<Self> {
-        let columns = super::tables::frame_columns(frame, name)?;
+        let map = column_map(columns, ignore_columns)?;
+        let columns = super::tables::frame_columns(frame, name, &map, &joints)?;
         let mut rec = super::detached(py, "Recording.from_dataframe", || {
             crate::io::read_recording(&crate::io::Table::from_columns(name, columns)?, &joints)
         })?;
@@ -455,4 +472,36 @@ impl PyRecording {
             self.rec.n
         )
     }
+}
+
+/// The column map of `Recording.load`'s and `from_dataframe`'s `columns` (a dict `{TARGET:
+/// "SOURCE[*SCALE]"}` or a list of `"TARGET=SOURCE[*SCALE]"`) and `ignore_columns`.
+fn column_map(
+    columns: Option<&Bound<'_, PyAny>>,
+    ignore_columns: Option<Vec<String>>,
+) -> PyResult<crate::io::ColumnMap> {
+    let expected = || {
+        pyo3::exceptions::PyTypeError::new_err(
+            "columns: expected a dict {TARGET: 'SOURCE[*SCALE]'} or a list of 'TARGET=SOURCE[*SCALE]' strings",
+        )
+    };
+    let entries = match columns {
+        None => Vec::new(),
+        Some(c) => match c.cast::<pyo3::types::PyDict>() {
+            Ok(d) => (d.iter())
+                .map(
+                    |(k, v)| match (k.extract::<String>(), v.extract::<String>()) {
+                        (Ok(k), Ok(v)) => Ok(format!("{k}={v}")),
+                        _ => Err(expected()),
+                    },
+                )
+                .collect::<PyResult<Vec<String>>>()?,
+            Err(_) if c.is_instance_of::<pyo3::types::PyString>() => return Err(expected()),
+            Err(_) => c.extract::<Vec<String>>().map_err(|_| expected())?,
+        },
+    };
+    Ok(crate::io::ColumnMap::new(
+        &entries,
+        &ignore_columns.unwrap_or_default(),
+    )?)
 }

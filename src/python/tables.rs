@@ -15,9 +15,13 @@ use crate::error::Error;
 /// the index when named `t` and no column is. A column named by anything but a string, or
 /// holding booleans, text, categories or times (other than `t`), is refused by name; so is a
 /// frame of more than [`crate::limits::MAX_VALUES`] values. TypeError for what is not a frame.
+/// The columns are those `map` reads for the joints `joints`, renamed and scaled as it says
+/// ([`crate::io::ColumnMap::select`]): those it leaves out are not converted.
 pub(crate) fn frame_columns(
     frame: &Bound<'_, PyAny>,
     source: &str,
+    map: &crate::io::ColumnMap,
+    joints: &[String],
 ) -> PyResult<Vec<(String, Vec<f64>)>> {
     let py = frame.py();
     let bad = |message: String| -> PyErr {
@@ -75,12 +79,18 @@ pub(crate) fn frame_columns(
             columns.insert(0, ("t".into(), index.call_method0("to_series")?));
         }
     }
+    // the columns `map` reads, under the names it gives them (those it leaves out are not
+    // converted: they may hold text)
+    let names: Vec<String> = columns.iter().map(|c| c.0.clone()).collect();
+    let (selection, _) = map.select(source, &names, joints)?;
     let numbers = PyDict::new(py);
     numbers.set_item("dtype", "float64")?;
     numbers.set_item("na_value", f64::NAN)?;
-    columns
+    selection
+        .keep
         .into_iter()
-        .map(|(name, series)| {
+        .map(|k| {
+            let (name, series) = (k.name, &columns[k.source].1);
             let dtype = series.getattr("dtype")?;
             let kind: String = dtype.getattr("kind")?.extract()?;
             let values = match kind.as_str() {
@@ -101,15 +111,24 @@ pub(crate) fn frame_columns(
                     } else {
                         ""
                     };
+                    let own = &columns[k.source].0;
+                    let words = if kind == "O" {
+                        format!(" (a column of words is left out with ignore_columns=['{own}'])")
+                    } else {
+                        String::new()
+                    };
                     return Err(bad(format!(
-                        "column '{name}' holds {} values: expected numbers{times}",
+                        "column '{own}' holds {} values: expected numbers{times}{words}",
                         dtype.str()?
                     )));
                 }
             };
             let values: PyReadonlyArray1<'_, f64> = values.extract()?;
             debug_assert_eq!(values.len(), rows);
-            Ok((name, values.as_array().to_vec()))
+            Ok((
+                name,
+                values.as_array().iter().map(|v| v * k.scale).collect(),
+            ))
         })
         .collect()
 }

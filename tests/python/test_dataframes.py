@@ -75,3 +75,39 @@ def test_a_bad_frame_is_named(change, expected):
 def test_something_not_a_frame_is_a_type_error():
     with pytest.raises(TypeError, match="a pandas DataFrame"):
         pr.Recording.from_dataframe({"t": [0.0]}, ["a"])
+
+
+def test_another_tool_s_log_reads_with_a_column_map_from_a_file_and_a_frame(tmp_path):
+    """A UR-style log (stamps in ms, positions in degrees as actual_q_<i>, currents counting
+    the other way, target positions and a mode in words beside them) read with columns= and
+    ignore_columns= gives the recording it was made from, from a CSV file and from a DataFrame
+    alike (src/io/column_map.rs)."""
+    t, q, tau = frame_of()
+    joints = ["shoulder", "elbow"]
+    rec = pr.Recording(t, q, tau)
+    df = pd.DataFrame({"timestamp": 1e3 * t, "actual_q_0": np.degrees(q[:, 0]), "actual_q_1": np.degrees(q[:, 1]),
+                       "target_q_0": q[:, 0], "target_q_1": q[:, 1],
+                       "current_shoulder": -tau[:, 0] / 10, "current_elbow": -tau[:, 1] / 10, "mode": ["RUNNING"] * len(t)})
+    path = tmp_path / "ur.csv"
+    df.to_csv(path, index=False)
+    columns = {"t": "timestamp*ms", "q": "actual_q_{i}*deg", "tau": "current_{joint}*-10"}
+    for back in (
+        pr.Recording.load(path, joints, columns=columns, ignore_columns=["target_q_*", "mode"]),
+        pr.Recording.load(path, joints, columns=[f"{k}={v}" for k, v in columns.items()], ignore_columns=["target_q_*,mode"]),
+        pr.Recording.from_dataframe(df, joints, columns=columns, ignore_columns=["target_q_*", "mode"]),
+    ):
+        for field in ("t", "q", "tau"):
+            np.testing.assert_allclose(getattr(back, field), getattr(rec, field), rtol=1e-13, atol=1e-15)
+    # without the mode left out: named, with the way out
+    with pytest.raises(pr.InputError, match=r"column 'mode'.*ignore_columns"):
+        pr.Recording.load(path, joints, columns=columns, ignore_columns=["target_q_*"])
+    with pytest.raises(pr.InputError, match=r"column 'mode' holds .* values: expected numbers"):
+        pr.Recording.from_dataframe(df, joints, columns=columns, ignore_columns=["target_q_*"])
+    # a map that does not fit: the entry named
+    with pytest.raises(pr.InputError, match=r"'q=actual_pos_\{i\}': no column 'actual_pos_0' for q1"):
+        pr.Recording.load(path, joints, columns={"t": "timestamp*ms", "q": "actual_pos_{i}"})
+    with pytest.raises(pr.InputError, match="the scale 'furlong' is no factor"):
+        pr.Recording.from_dataframe(df, joints, columns={"q": "actual_q_{i}*furlong"})
+    for wrong in ("t=timestamp", {"t": 1.0}, [1, 2]):
+        with pytest.raises(TypeError, match="columns: expected a dict"):
+            pr.Recording.load(path, joints, columns=wrong)
