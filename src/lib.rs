@@ -50,6 +50,7 @@ pub mod signal;
 pub mod simd;
 pub mod simulation;
 pub mod spatial;
+pub mod stacked_states;
 pub mod stamp_jitter;
 pub mod states;
 pub mod student_t;

@@ -97,6 +97,9 @@ fn gains_and_the_robot_alone_from_logs_of_currents() {
         "{out}"
     );
     let model = BaseModel::load(d.join("model.json")).unwrap();
+    // each run's log named with what its preprocessing found
+    let logs: Vec<&str> = model.logs.iter().map(|l| l.log.as_str()).collect();
+    assert_eq!(logs, [s(&d.join("alone.csv")), s(&d.join("loaded.csv"))]);
     let g = model.drive_gains.as_ref().unwrap();
     for (gain, truth) in g.gain.iter().zip(GAINS) {
         assert!((gain / truth - 1.0).abs() < 1e-2, "{out}");

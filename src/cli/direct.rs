@@ -149,8 +149,11 @@ pub(crate) struct IdentifyDirectArgs {
     #[command(flatten)]
     robot: RobotArg,
     /// The recording CSV: t, q1..qN, tau1..tauN, optional qd1..qN (and qdd1..qN, which skips
-    /// preprocessing unless --preprocess is given).
-    data: PathBuf,
+    /// preprocessing unless --preprocess is given). Several: the logs of several runs (other
+    /// excitations, other days), each read and preprocessed alone and fitted together; each
+    /// one's findings are kept in the model's `logs`.
+    #[arg(required = true)]
+    data: Vec<PathBuf>,
     /// Where to write the base-parameter model (JSON).
     #[arg(long, default_value = "base_model.json")]
     out: PathBuf,
@@ -158,7 +161,8 @@ pub(crate) struct IdentifyDirectArgs {
     fit: FitArgs,
     #[command(flatten)]
     preprocessing: PreprocessArgs,
-    /// Fit on the first (1 - FRACTION) of the samples and report the errors on the rest.
+    /// Fit on the first (1 - FRACTION) of the samples (of each log) and report the errors on
+    /// the rest.
     #[arg(long, default_value_t = 0.3)]
     validate: f64,
     /// Physically consistent parameters (every link a possible rigid body, friction and
@@ -169,13 +173,22 @@ pub(crate) struct IdentifyDirectArgs {
 }
 
 pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
-    refuse_overwriting_inputs(&a.out, &[&a.data, a.robot.path()])?;
+    let mut inputs: Vec<&std::path::Path> = a.data.iter().map(PathBuf::as_path).collect();
+    inputs.push(a.robot.path());
+    refuse_overwriting_inputs(&a.out, &inputs)?;
+    if a.data.len() > crate::direct::drive_gains::MAX_RUNS {
+        return Err(Error::InvalidArgument {
+            argument: "DATA".into(),
+            message: format!(
+                "{} logs, expected at most {}",
+                a.data.len(),
+                crate::direct::drive_gains::MAX_RUNS
+            ),
+        });
+    }
     let model = a.robot.load()?;
     let progress = Progress::new();
     let mut out = String::new();
-    let rec = a
-        .preprocessing
-        .read(&a.data, &model.joint_names, &progress, &mut out)?;
     if !(0.0..1.0).contains(&a.validate) {
         return Err(Error::InvalidArgument {
             argument: "--validate".into(),
@@ -185,31 +198,77 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
             ),
         });
     }
+    let recs = (a.data.iter())
+        .map(|path| {
+            a.preprocessing
+                .read(path, &model.joint_names, &progress, &mut out)
+        })
+        .collect::<Result<Vec<_>>>()?;
     let n = model.nv;
-    let k = rec.len();
-    let split = ((1.0 - a.validate) * k as f64).round() as usize;
-    if a.validate > 0.0 && split >= k {
-        return Err(Error::InvalidArgument {
-            argument: "--validate".into(),
-            message: format!(
-                "{} of {k} samples leaves none to validate on; give a larger fraction, or 0 for none",
-                crate::error::shown(a.validate)
-            ),
-        });
+    // each log's first samples are fitted to, its last validated on
+    let mut splits = Vec::with_capacity(recs.len());
+    for (rec, path) in recs.iter().zip(&a.data) {
+        let k = rec.len();
+        let split = ((1.0 - a.validate) * k as f64).round() as usize;
+        if a.validate > 0.0 && split >= k {
+            return Err(Error::InvalidArgument {
+                argument: "--validate".into(),
+                message: format!(
+                    "{} of {k} samples{} leaves none to validate on; give a larger fraction, or 0 for none",
+                    crate::error::shown(a.validate),
+                    if recs.len() > 1 { format!(" of {}", path.display()) } else { String::new() }
+                ),
+            });
+        }
+        splits.push(split);
     }
+    let logs_states = (recs.iter().zip(&a.data))
+        .map(|(r, path)| r.states().map_err(in_log(path)))
+        .collect::<Result<Vec<_>>>()?;
+    // several logs are stacked, their parts to fit to and to validate on; one is read in place
+    // (a long log is not copied)
+    let stack = |range: &dyn Fn(usize, usize) -> std::ops::Range<usize>| {
+        let parts: Vec<(States<'_>, &[f64])> = (logs_states.iter().zip(&recs).zip(&splits))
+            .map(|((s, r), &split)| {
+                let rows = range(split, r.len());
+                (s.slice(rows.clone()), &r.tau[rows.start * n..rows.end * n])
+            })
+            .collect();
+        crate::stacked_states::StackedStates::of(&parts)
+    };
+    let stacked = match recs.len() {
+        1 => None,
+        _ => Some((stack(&|split, _| 0..split)?, stack(&|split, k| split..k)?)),
+    };
+    type Part<'a> = (States<'a>, &'a [f64]);
+    let (train, held): (Part<'_>, Part<'_>) = match &stacked {
+        None => {
+            let (s, r, split) = (&logs_states[0], &recs[0], splits[0]);
+            (
+                (s.slice(0..split), &r.tau[..split * n]),
+                (s.slice(split..r.len()), &r.tau[split * n..]),
+            )
+        }
+        Some((t, h)) => ((t.states()?, &t.data[..]), (h.states()?, &h.data[..])),
+    };
+    let (split, k) = (train.0.len(), train.0.len() + held.0.len());
+    // one log: the errors name it
+    let in_data = |e: Error| match recs.len() {
+        1 => in_log(&a.data[0])(e),
+        _ => e,
+    };
     let options = a.fit.options();
     progress.update(&format!("identifying on {split} samples"));
     // with the Coulomb term's column filtered as the torques were
-    let states = rec.states()?;
     let fit = if a.consistent {
         let c = crate::direct::identify_consistent_parameters(
             &model,
-            &states.slice(0..split),
-            &rec.tau[..split * n],
+            &train.0,
+            train.1,
             &options,
             &crate::direct::ConsistentOptions::default(),
         )
-        .map_err(in_log(&a.data))?;
+        .map_err(in_data)?;
         let s = &c.solution;
         let _ = writeln!(
             out,
@@ -222,24 +281,26 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         );
         c.model
     } else {
-        identify_base_parameters(
-            &model,
-            &states.slice(0..split),
-            &rec.tau[..split * n],
-            &options,
-        )
-        .map_err(in_log(&a.data))?
+        identify_base_parameters(&model, &train.0, train.1, &options).map_err(in_data)?
     };
     progress.done();
-    let fit = crate::direct::BaseModel {
-        log_glitches: rec.glitches.clone(),
-        log_dropouts: rec.dropouts.clone(),
-        log_torque_saturation: rec.torque_saturation.clone(),
-        log_position_wraps: rec.position_wraps.clone(),
-        log_held_columns: rec.held_columns.clone(),
-        log_stamp_jitter: rec.stamp_jitter.clone(),
-        position_rounding: rec.position_rounding.clone(),
-        ..fit
+    let fit = match recs.as_slice() {
+        [rec] => crate::direct::BaseModel {
+            log_glitches: rec.glitches.clone(),
+            log_dropouts: rec.dropouts.clone(),
+            log_torque_saturation: rec.torque_saturation.clone(),
+            log_position_wraps: rec.position_wraps.clone(),
+            log_held_columns: rec.held_columns.clone(),
+            log_stamp_jitter: rec.stamp_jitter.clone(),
+            position_rounding: rec.position_rounding.clone(),
+            ..fit
+        },
+        recs => crate::direct::BaseModel {
+            logs: (recs.iter().zip(&a.data))
+                .map(|(r, path)| crate::direct::LogFindings::of(&path.display().to_string(), r))
+                .collect(),
+            ..fit
+        },
     };
     for w in fit.warnings() {
         eprintln!("perturbid: warning: {w}");
@@ -247,9 +308,13 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     fit.save(&a.out)?;
     let _ = writeln!(
         out,
-        "{} base parameters from {} samples, cond {:.3e} -> {}",
+        "{} base parameters from {} samples{}, cond {:.3e} -> {}",
         fit.theta.len(),
         split,
+        match recs.len() {
+            1 => String::new(),
+            logs => format!(" of {logs} logs"),
+        },
         fit.cond,
         a.out.display()
     );
@@ -285,14 +350,15 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         json.display()
     );
     if split < k {
-        let held_out = states.slice(split..k);
+        let held_out = held.0;
         let p = fit.on(&model)?.predict(&held_out)?;
         let _ = writeln!(
             out,
-            "validation on the last {} samples: per joint RMS (N m), relative RMS (%) and the RMS of the predictions' standard errors (N m)",
-            k - split
+            "validation on the last {} samples{}: per joint RMS (N m), relative RMS (%) and the RMS of the predictions' standard errors (N m)",
+            k - split,
+            if recs.len() > 1 { " of each log" } else { "" }
         );
-        let mut v = crate::validation::validate(&model.joint_names, &p, &rec.tau[split * n..])?;
+        let mut v = crate::validation::validate(&model.joint_names, &p, held.1)?;
         if let Ok(se) = crate::validation::stored_stderr(fit.predict_stderr(&model, &held_out))? {
             v = v.with_model_stderr(&se)?;
         }

@@ -151,7 +151,13 @@ pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
             other => other,
         })?;
     progress.done();
-    let fit = fit.model;
+    // what the preprocessing found in each run's log, kept with the model
+    let fit = crate::direct::BaseModel {
+        logs: (recordings.iter().zip(&logs))
+            .map(|(r, path)| crate::direct::LogFindings::of(&path.display().to_string(), r))
+            .collect(),
+        ..fit.model
+    };
     for w in fit.warnings() {
         eprintln!("perturbid: warning: {w}");
     }

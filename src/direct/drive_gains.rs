@@ -432,25 +432,15 @@ pub fn identify_drive_gains_with(
     }
     // the runs one after the other: states, the signal (its column's coefficient is -K) and
     // the right-hand side -tau_L
-    let mut q = Vec::with_capacity(k * nv);
-    let mut qd = Vec::with_capacity(k * nv);
-    let mut qdd = Vec::with_capacity(k * nv);
-    let filtered = runs.iter().any(|r| r.states.coulomb().is_some());
-    let mut coulomb = Vec::with_capacity(if filtered { k * nv } else { 0 });
-    let mut signal = Vec::with_capacity(k * nv);
+    let parts: Vec<(States<'_>, &[f64])> = runs.iter().map(|r| (r.states, r.signal)).collect();
+    let stacked = crate::stacked_states::StackedStates::of(&parts)?;
+    let signal = &stacked.data;
     let mut rhs = vec![0.0; k * nv];
     // per joint, the payloads' squared torques summed over the loaded runs' samples
     let (mut loaded_squares, mut loaded_rows, mut loaded_runs) = (vec![0.0; nv], 0, 0);
     let mut first = 0;
     for run in runs {
         let s = &run.states;
-        q.extend_from_slice(s.q());
-        qd.extend_from_slice(s.qd().unwrap_or_default());
-        qdd.extend_from_slice(s.qdd().unwrap_or_default());
-        if filtered {
-            coulomb.extend((0..s.len() * nv).map(|x| s.coulomb_at(x / nv, x % nv)));
-        }
-        signal.extend_from_slice(run.signal);
         if let Some(p) = run.payload.filter(|p| p.mass > 0.0) {
             let tau = payload_torques(model, p, s, options)?;
             let rows = &mut rhs[first * nv..(first + s.len()) * nv];
@@ -463,15 +453,10 @@ pub fn identify_drive_gains_with(
         }
         first += s.len();
     }
-    let states = States::new(nv, &q, Some(&qd), Some(&qdd))?;
-    let states = if filtered {
-        states.with_coulomb(&coulomb)?
-    } else {
-        states
-    };
+    let states = stacked.states()?;
     crate::torque_model::refuse_flat_torques(
         &states,
-        &signal,
+        signal,
         &model.joint_names,
         "a fit would take it for a signal that does not follow the motion",
     )?;
@@ -488,7 +473,7 @@ pub fn identify_drive_gains_with(
         )));
     }
     let factors =
-        JointFactors::with_columns(model, &base, &states, &rhs, &[&signal], options.gravity)?;
+        JointFactors::with_columns(model, &base, &states, &rhs, &[signal], options.gravity)?;
     let names: Vec<String> = base
         .names()
         .into_iter()

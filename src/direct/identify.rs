@@ -122,6 +122,11 @@ pub struct BaseModel {
     /// of ([`BaseModel::warnings`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub position_rounding: Vec<crate::position_rounding::PositionRounding>,
+    /// Where the model was fitted to several logs (excitation runs, or drive-gain runs), what
+    /// the preprocessing found in each, named by the log ([`super::log_findings`]); the
+    /// `log_*` fields and `position_rounding` are then empty. Empty for a model of one log.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub logs: Vec<super::log_findings::LogFindings>,
     /// The data's torque columns against the robot's own model, one a joint
     /// ([`super::torque_columns`]): swapped columns, the opposite sign convention or other
     /// units are warned of ([`BaseModel::warnings`]). Empty in a model saved before it was
@@ -371,6 +376,7 @@ pub(super) fn fit_with_factors(
         log_stamp_jitter: None,
         log_dropouts: vec![],
         position_rounding: vec![],
+        logs: vec![],
         torque_columns: super::torque_columns::check_torque_columns(
             model,
             states,
@@ -522,59 +528,39 @@ impl Document for BaseModel {
                 ),
             ));
         }
-        if let Some((i, problem)) = m
-            .log_glitches
-            .iter()
-            .enumerate()
-            .find_map(|(i, g)| g.problem(n).map(|p| (i, p)))
-        {
-            return Err(invalid(Self::WHAT, format!("log_glitches[{i}]: {problem}")));
+        // the findings of the one log fitted to, or of each of several
+        let flat = super::log_findings::LogFindings {
+            log: "the log".into(),
+            glitches: m.log_glitches.clone(),
+            dropouts: m.log_dropouts.clone(),
+            torque_saturation: m.log_torque_saturation.clone(),
+            position_wraps: m.log_position_wraps.clone(),
+            held_columns: m.log_held_columns.clone(),
+            stamp_jitter: m.log_stamp_jitter.clone(),
+            position_rounding: m.position_rounding.clone(),
+        };
+        let flat_name = |f: &str| match f {
+            "position_rounding" => f.to_string(),
+            f => format!("log_{f}"),
+        };
+        if let Some(problem) = flat.problem(n, flat_name) {
+            return Err(invalid(Self::WHAT, problem));
         }
-        if let Some((i, problem)) = m
-            .log_dropouts
-            .iter()
-            .enumerate()
-            .find_map(|(i, d)| d.problem(n).map(|p| (i, p)))
-        {
-            return Err(invalid(Self::WHAT, format!("log_dropouts[{i}]: {problem}")));
-        }
-        if let Some((i, problem)) =
-            (m.log_held_columns.iter().enumerate()).find_map(|(i, h)| h.problem(n).map(|p| (i, p)))
-        {
+        if m.logs.len() > super::drive_gains::MAX_RUNS || (!m.logs.is_empty() && !flat.is_empty()) {
             return Err(invalid(
                 Self::WHAT,
-                format!("log_held_columns[{i}]: {problem}"),
+                format!(
+                    "logs: {} logs' findings{}; expected at most {} logs, and a model of several logs keeps each one's findings there, none in the log_* fields",
+                    m.logs.len(),
+                    if flat.is_empty() { "" } else { " beside findings in the log_* fields" },
+                    super::drive_gains::MAX_RUNS
+                ),
             ));
         }
-        if let Some(problem) = m.log_stamp_jitter.as_ref().and_then(|j| j.problem(n)) {
-            return Err(invalid(Self::WHAT, format!("log_stamp_jitter: {problem}")));
-        }
-        if let Some((i, problem)) = (m.log_position_wraps.iter().enumerate())
-            .find_map(|(i, w)| w.problem(n).map(|p| (i, p)))
+        if let Some(problem) = (m.logs.iter().enumerate())
+            .find_map(|(k, l)| l.problem(n, |f| format!("logs[{k}].{f}")))
         {
-            return Err(invalid(
-                Self::WHAT,
-                format!("log_position_wraps[{i}]: {problem}"),
-            ));
-        }
-        if let Some((i, problem)) = (m.log_torque_saturation.iter().enumerate())
-            .find_map(|(i, c)| c.problem(n).map(|p| (i, p)))
-        {
-            return Err(invalid(
-                Self::WHAT,
-                format!("log_torque_saturation[{i}]: {problem}"),
-            ));
-        }
-        if let Some((i, problem)) = m
-            .position_rounding
-            .iter()
-            .enumerate()
-            .find_map(|(i, r)| r.problem(n).map(|p| (i, p)))
-        {
-            return Err(invalid(
-                Self::WHAT,
-                format!("position_rounding[{i}]: {problem}"),
-            ));
+            return Err(invalid(Self::WHAT, problem));
         }
         if !m.torque_columns.is_empty() && m.torque_columns.len() != n {
             return Err(invalid(

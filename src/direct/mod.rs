@@ -12,6 +12,7 @@ pub mod excitation;
 pub mod global_linear;
 pub mod identify;
 pub mod instrumental;
+pub mod log_findings;
 pub mod parameter_table;
 pub mod parameters;
 pub mod position_offsets;
@@ -39,6 +40,7 @@ pub use global_linear::{identify_global_linear, GlobalLinearModel};
 pub use identify::{
     identify_base_parameters, identify_consistent_parameters, BaseModel, BaseOptions, Weighting,
 };
+pub use log_findings::LogFindings;
 pub use parameter_table::ParameterRow;
 pub use parameters::{regressor_blocks, regressor_matrix, FrictionTerms, ParameterLayout};
 pub use position_offsets::{

@@ -118,7 +118,8 @@ impl BaseModel {
     /// ([`super::position_offsets`]), friction the fit leaves out that shows in its residuals
     /// ([`super::unmodelled_friction`]), data that excite the base parameters weakly
     /// ([`super::weak_excitation`]), positions logged in counts so coarse that their
-    /// rounding shows in the derived velocities ([`crate::position_rounding`]), and friction or
+    /// rounding shows in the derived velocities ([`crate::position_rounding`]; in each log of
+    /// several, named), and friction or
     /// armature coefficients identified on their own (not in a combination), negative beyond
     /// three standard errors and not negligible (a torque at least [`NEGLIGIBLE_TERM`] of the
     /// joint's residual RMS). No joint has them; the data hold an effect the model lacks, or
@@ -155,6 +156,11 @@ impl BaseModel {
         let rounding =
             crate::position_rounding::warning(&self.position_rounding, &self.joint_names)
                 .map(|w| format!("{w}{}", crate::position_rounding::IN_A_FIT));
+        // of each of several logs, named
+        let rounding = rounding.into_iter().chain(self.logs.iter().filter_map(|l| {
+            crate::position_rounding::warning(&l.position_rounding, &self.joint_names)
+                .map(|w| format!("'{}': {w}{}", l.log, crate::position_rounding::IN_A_FIT))
+        }));
         let offsets = (self.position_offsets.as_ref())
             .and_then(|o| o.finding_beside(&self.torque_columns, false));
         // friction terms fitted to a log that does not read as the robot's model take up

@@ -124,9 +124,14 @@ impl Table {
         }
         // a table written with another separator reads as one column
         if let [only] = t.columns.as_slice() {
-            if let Some((sep, name)) = [(';', "semicolons"), ('\t', "tabs"), ('|', "bars"), (' ', "spaces")]
-                .into_iter()
-                .find(|(c, _)| only.contains(*c))
+            if let Some((sep, name)) = [
+                (';', "semicolons"),
+                ('\t', "tabs"),
+                ('|', "bars"),
+                (' ', "spaces"),
+            ]
+            .into_iter()
+            .find(|(c, _)| only.contains(*c))
             {
                 let shown: String = only.chars().take(60).collect();
                 return Err(t.error(format!(

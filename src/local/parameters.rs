@@ -302,6 +302,7 @@ pub fn identify_parameters_from_local(
         log_held_columns: vec![],
         log_stamp_jitter: None,
         position_rounding: vec![],
+        logs: vec![],
         // rows from local models: no log's torque columns
         torque_columns: vec![],
         torque_lag: None,

@@ -1,0 +1,163 @@
+//! `identify-direct` over several logs (runs of two excitations): each log preprocessed alone
+//! and the fit over them all, equal to the library's fit of the preprocessed recordings one
+//! after the other; each log's first samples fitted and its last validated on; what the
+//! preprocessing found in each kept in the model's `logs`, named by the log and checked on
+//! load; drive gains keep their runs' findings alike.
+
+mod cli_support;
+
+use cli_support::{fails, ok, s, tmp};
+use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
+use perturbid_rs::document::Document;
+use perturbid_rs::io::load_recording;
+use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+use perturbid_rs::stacked_states::StackedStates;
+use std::path::{Path, PathBuf};
+
+/// Two logs of the A465, each along its own excitation, with torque noise.
+fn two_logs(d: &Path) -> [PathBuf; 2] {
+    [1, 2].map(|seed| {
+        let dir = d.join(format!("exc{seed}"));
+        let seed = seed.to_string();
+        ok(&[
+            "excite",
+            "a465",
+            "--out",
+            s(&dir),
+            "--max-evaluations",
+            "30",
+            "--rate",
+            "100",
+            "--seed",
+            &seed,
+        ]);
+        let log = d.join(format!("log{seed}.csv"));
+        ok(&[
+            "simulate",
+            "a465",
+            s(&dir.join("excitation.json")),
+            "--out",
+            s(&log),
+            "--rate",
+            "200",
+            "--torque-noise",
+            "0.01",
+            "--seed",
+            &seed,
+        ]);
+        log
+    })
+}
+
+#[test]
+fn several_logs_are_fitted_together_each_preprocessed_alone() {
+    let d = tmp("several-logs");
+    let logs = two_logs(&d);
+    let model_path = d.join("both.json");
+    let out = ok(&[
+        "identify-direct",
+        "a465",
+        s(&logs[0]),
+        s(&logs[1]),
+        "--out",
+        s(&model_path),
+        "--validate",
+        "0",
+    ]);
+    assert!(
+        out.matches("preprocessed: ").count() == 2 && out.contains("samples of 2 logs"),
+        "{out}"
+    );
+    let fit = BaseModel::load(&model_path).unwrap();
+    // the library's fit of the two preprocessed recordings, one after the other
+    let robot = perturbid_rs::robots::builtin("a465").unwrap();
+    let recs: Vec<_> = (logs.iter())
+        .map(|l| {
+            preprocess(
+                &load_recording(l, &robot.joint_names).unwrap(),
+                &PreprocessOptions::default(),
+            )
+            .unwrap()
+        })
+        .collect();
+    let states: Vec<_> = recs.iter().map(|r| r.states().unwrap()).collect();
+    let parts: Vec<_> = states
+        .iter()
+        .zip(&recs)
+        .map(|(s, r)| (*s, &r.tau[..]))
+        .collect();
+    let stacked = StackedStates::of(&parts).unwrap();
+    let expected = identify_base_parameters(
+        &robot,
+        &stacked.states().unwrap(),
+        &stacked.data,
+        &BaseOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(fit.samples, recs[0].len() + recs[1].len());
+    let scale = expected.theta.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for (a, b) in fit.theta.iter().zip(&expected.theta) {
+        assert!((a - b).abs() <= 1e-9 * scale, "{a} against {b}");
+    }
+    // each log's findings, named by it; none in the one-log fields
+    assert_eq!(fit.logs.len(), 2);
+    assert_eq!(fit.logs[1].log, s(&logs[1]));
+    assert!(fit.log_glitches.is_empty() && fit.position_rounding.is_empty());
+    // checked on load: a finding of a joint the robot lacks, findings in both places
+    let text = fit.to_json();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["logs"][1]["glitches"] = serde_json::json!([{"signal": "tau", "joint": 9, "sample": 3, "time": 0.03, "value": 1.0, "noise_levels": 20.0, "replaced_by": 0.0, "repeats_previous": false, "held": null, "experiment": null}]);
+    let e = BaseModel::from_json(&v.to_string())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("logs[1].glitches[0]"), "{e}");
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["log_glitches"] = serde_json::json!([{"signal": "tau", "joint": 0, "sample": 3, "time": 0.03, "value": 1.0, "noise_levels": 20.0, "replaced_by": 0.0, "repeats_previous": false, "held": null, "experiment": null}]);
+    let e = BaseModel::from_json(&v.to_string())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("keeps each one's findings there, none in the log_* fields"),
+        "{e}"
+    );
+    // validation on each log's last samples
+    let out = ok(&[
+        "identify-direct",
+        "a465",
+        s(&logs[0]),
+        s(&logs[1]),
+        "--out",
+        s(&d.join("v.json")),
+        "--validate",
+        "0.3",
+    ]);
+    let held: usize = recs
+        .iter()
+        .map(|r| r.len() - ((0.7 * r.len() as f64).round() as usize))
+        .sum();
+    assert!(
+        out.contains(&format!(
+            "validation on the last {held} samples of each log"
+        )),
+        "{out}"
+    );
+    // a log that fails is named
+    let bad = d.join("bad.csv");
+    std::fs::write(
+        &bad,
+        "t,q1,q2,q3,q4,q5,q6,tau1,tau2,tau3,tau4,tau5,tau6\n0,0,0,0,0,0,0,0,0,0,0,0,0\n",
+    )
+    .unwrap();
+    fails(
+        &[
+            "identify-direct",
+            "a465",
+            s(&logs[0]),
+            s(&bad),
+            "--out",
+            s(&d.join("x.json")),
+        ],
+        &["bad.csv"],
+    );
+    assert!(!d.join("x.json").exists());
+}
