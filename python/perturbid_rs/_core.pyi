@@ -775,7 +775,7 @@ def design_excitation(
 
 def identify_base_parameters(
     robot: Robot,
-    q: Union[ArrayLike, Recording],
+    q: Union[ArrayLike, Recording, Sequence[Recording]],
     qd: Optional[ArrayLike] = None,
     qdd: Optional[ArrayLike] = None,
     tau: Optional[ArrayLike] = None,
@@ -786,7 +786,10 @@ def identify_base_parameters(
     seed: int = 0,
     t: Optional[ArrayLike] = None,
     coulomb: Optional[ArrayLike] = None,
-) -> BaseParameterModel: ...
+) -> BaseParameterModel:
+    """Base parameters from arrays (q, qd, qdd, tau), a preprocessed Recording as q alone,
+    or a list of them as q (runs fitted together, one after the other; what each one's
+    preprocessing found kept in the model's logs)."""
 
 def identify_drive_gains(
     robot: Robot,

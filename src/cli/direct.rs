@@ -285,16 +285,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     };
     progress.done();
     let fit = match recs.as_slice() {
-        [rec] => crate::direct::BaseModel {
-            log_glitches: rec.glitches.clone(),
-            log_dropouts: rec.dropouts.clone(),
-            log_torque_saturation: rec.torque_saturation.clone(),
-            log_position_wraps: rec.position_wraps.clone(),
-            log_held_columns: rec.held_columns.clone(),
-            log_stamp_jitter: rec.stamp_jitter.clone(),
-            position_rounding: rec.position_rounding.clone(),
-            ..fit
-        },
+        [rec] => fit.with_findings_of(rec),
         recs => crate::direct::BaseModel {
             logs: (recs.iter().zip(&a.data))
                 .map(|(r, path)| crate::direct::LogFindings::of(&path.display().to_string(), r))

@@ -6,6 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::BaseModel;
 use crate::recording::Recording;
 
 /// One log's findings, named by the log (its path as given).
@@ -106,5 +107,22 @@ impl LogFindings {
             && self.held_columns.is_empty()
             && self.stamp_jitter.is_none()
             && self.position_rounding.is_empty()
+    }
+}
+
+impl BaseModel {
+    /// The model with what the preprocessing found in `rec`, the one log it was fitted to, in
+    /// its `log_*` fields and `position_rounding`.
+    pub fn with_findings_of(self, rec: &Recording) -> Self {
+        Self {
+            log_glitches: rec.glitches.clone(),
+            log_dropouts: rec.dropouts.clone(),
+            log_torque_saturation: rec.torque_saturation.clone(),
+            log_position_wraps: rec.position_wraps.clone(),
+            log_held_columns: rec.held_columns.clone(),
+            log_stamp_jitter: rec.stamp_jitter.clone(),
+            position_rounding: rec.position_rounding.clone(),
+            ..self
+        }
     }
 }

@@ -551,7 +551,9 @@ impl PyBaseModel {
 
 /// Identifies the base parameters of `robot` from samples `q`, `qd`, `qdd`, `tau` (each (k, n);
 /// rad, rad/s, rad/s^2, N m), or from a Recording given as `q` alone (`preprocess`'s: its
-/// states, torques, time and Coulomb column; see `samples`). `friction`: True (viscous, Coulomb and offset per joint), False,
+/// states, torques, time and Coulomb column; see `samples`), or from a list of them (runs
+/// fitted together, one after the other; what each one's preprocessing found kept in the
+/// model's `logs`). `friction`: True (viscous, Coulomb and offset per joint), False,
 /// or a list of those names; `weighting`: 'wls' (default) or 'ols'; `gravity`: whether `tau`
 /// includes gravity; `tolerance`: relative rank tolerance of the pivoted QR. `t` ((k,) s),
 /// when the samples are a log: its qd and qdd columns are checked against the derivatives of
@@ -579,6 +581,32 @@ pub(crate) fn identify_base_parameters<'py>(
 ) -> PyResult<PyBaseModel> {
     let options = fit_options(friction, weighting, gravity, tolerance, seed)?;
     let model = &robot.model;
+    if let Some(recs) = recordings_of(&q)? {
+        let named = [
+            ("qd", &qd),
+            ("qdd", &qdd),
+            ("tau", &tau),
+            ("t", &t),
+            ("coulomb", &coulomb),
+        ];
+        if let Some((name, _)) = named.iter().find(|(_, v)| v.is_some()) {
+            return Err(Error::InvalidArgument {
+                argument: (*name).into(),
+                message: "given with a list of Recordings as q, which carry their own: pass the list alone".into(),
+            }
+            .into());
+        }
+        let fit = detached(py, "identify_base_parameters", || {
+            fit_recordings(model, &recs, &options)
+        })?;
+        super::errors::warn_all(py, &fit.warnings())?;
+        return Ok(PyBaseModel {
+            fit,
+            model: Arc::new(model.clone()),
+        });
+    }
+    // a Recording's findings are kept with the model, as the command line keeps its log's
+    let recording = (q.cast::<super::recording::PyRecording>().ok()).map(|r| r.get().rec.clone());
     let given = Given {
         qd,
         qdd,
@@ -593,12 +621,96 @@ pub(crate) fn identify_base_parameters<'py>(
     let fit = detached(py, "identify_base_parameters", || {
         check_sample_derivatives("identify_base_parameters' samples", model.nv, t, &c)?;
         let s = fit_states(model.nv, &c, coulomb.as_deref())?;
-        base_rs(model, &s, &c[3], &options)
+        let fit = base_rs(model, &s, &c[3], &options)?;
+        Ok::<_, Error>(match &recording {
+            Some(rec) => fit.with_findings_of(rec),
+            None => fit,
+        })
     })?;
     super::errors::warn_all(py, &fit.warnings())?;
     Ok(PyBaseModel {
         fit,
         model: Arc::new(model.clone()),
+    })
+}
+
+/// The Recordings of `q` where it is a list or tuple of them (None where it is anything else:
+/// an array of numbers); a list of which some are Recordings and some not is a TypeError.
+fn recordings_of(q: &Bound<'_, PyAny>) -> PyResult<Option<Vec<Arc<crate::recording::Recording>>>> {
+    let items: Vec<Bound<'_, PyAny>> = match (
+        q.cast::<pyo3::types::PyList>(),
+        q.cast::<pyo3::types::PyTuple>(),
+    ) {
+        (Ok(l), _) => l.iter().collect(),
+        (_, Ok(t)) => t.iter().collect(),
+        _ => return Ok(None),
+    };
+    let recs: Vec<Option<Arc<crate::recording::Recording>>> = (items.iter())
+        .map(|x| {
+            x.cast::<super::recording::PyRecording>()
+                .ok()
+                .map(|r| r.get().rec.clone())
+        })
+        .collect();
+    match recs.iter().filter(|r| r.is_some()).count() {
+        0 => Ok(None),
+        k if k == recs.len() => Ok(Some(recs.into_iter().flatten().collect())),
+        _ => Err(pyo3::exceptions::PyTypeError::new_err(
+            "q: a list of Recordings (runs to fit together) or an array of positions, not a mix",
+        )),
+    }
+}
+
+/// The base parameters of `model` fitted to the Recordings `recs` (preprocessed: with
+/// velocities and accelerations) one after the other, each one's logged derivatives checked
+/// as a log's, what its preprocessing found kept in the model's `logs` (named by it).
+fn fit_recordings(
+    model: &crate::model::Model,
+    recs: &[Arc<crate::recording::Recording>],
+    options: &crate::direct::BaseOptions,
+) -> Result<crate::direct::BaseModel> {
+    if recs.is_empty() || recs.len() > crate::direct::drive_gains::MAX_RUNS {
+        return Err(Error::InvalidArgument {
+            argument: "q".into(),
+            message: format!(
+                "{} Recordings, expected 1 to {}",
+                recs.len(),
+                crate::direct::drive_gains::MAX_RUNS
+            ),
+        });
+    }
+    let mut states = Vec::with_capacity(recs.len());
+    for (i, r) in recs.iter().enumerate() {
+        let at = |e: Error| Error::InvalidArgument {
+            argument: "q".into(),
+            message: format!("Recording {i} ('{}'): {e}", r.name),
+        };
+        if r.n != model.nv || r.qd.is_none() || r.qdd.is_none() {
+            return Err(at(Error::InvalidArgument {
+                argument: "q".into(),
+                message: format!(
+                    "{} joints{}, expected the robot's {} with velocities and accelerations: preprocess it first (perturbid_rs.preprocess)",
+                    r.n,
+                    if r.qdd.is_none() { " without velocities and accelerations" } else { "" },
+                    model.nv
+                ),
+            }));
+        }
+        crate::derivative_columns::check_logged_derivatives(r).map_err(at)?;
+        states.push(r.states().map_err(at)?);
+    }
+    let parts: Vec<(States<'_>, &[f64])> = states
+        .iter()
+        .zip(recs)
+        .map(|(s, r)| (*s, &r.tau[..]))
+        .collect();
+    let stacked = crate::stacked_states::StackedStates::of(&parts)?;
+    let fit = base_rs(model, &stacked.states()?, &stacked.data, options)?;
+    Ok(crate::direct::BaseModel {
+        logs: (recs.iter())
+            .map(|r| crate::direct::LogFindings::of(&r.name, r))
+            .collect(),
+        ..fit
     })
 }
 

@@ -519,6 +519,35 @@ def test_a_recording_given_whole_brings_its_coulomb_column_and_time():
         pr.identify_base_parameters(robot, part.q, "x", part.qdd, part.tau)
 
 
+def test_several_recordings_are_fitted_together():
+    """A list of preprocessed Recordings (two runs of other excitations) is fitted as their
+    arrays stacked with their Coulomb columns are; the model keeps each one's findings in
+    `logs`, named by it; a list mixed with arrays, or holding a Recording without velocities,
+    is refused."""
+    robot = pr.robots.a465()
+    recs = []
+    for motion, seed in [(1, 1), (2, 2)]:
+        t, q, qd, qdd, tau, _ = log_with_friction(robot, 0.1, motion, seed)
+        recs.append(pr.preprocess(t, q, tau, name=f"run{motion}.csv"))
+    friction = ["viscous", "coulomb"]
+    both = pr.identify_base_parameters(robot, recs, friction=friction)
+    stack = lambda field: np.vstack([getattr(r, field) for r in recs])
+    arrays = pr.identify_base_parameters(robot, stack("q"), stack("qd"), stack("qdd"), stack("tau"), friction=friction, coulomb=stack("coulomb"))
+    np.testing.assert_allclose(both.theta_base, arrays.theta_base, rtol=1e-10, atol=1e-12)
+    assert both.samples == len(recs[0]) + len(recs[1])
+    logs = json.loads(both.to_json())["logs"]
+    assert [l["log"] for l in logs] == ["run1.csv (preprocessed)", "run2.csv (preprocessed)"], logs
+    # a tuple reads as a list; one Recording alone is the one-log fit
+    np.testing.assert_array_equal(pr.identify_base_parameters(robot, tuple(recs), friction=friction).theta_base, both.theta_base)
+    with pytest.raises(TypeError, match="not a mix"):
+        pr.identify_base_parameters(robot, [recs[0], recs[1].q], friction=friction)
+    with pytest.raises(pr.InputError, match="tau: given with a list of Recordings"):
+        pr.identify_base_parameters(robot, recs, tau=stack("tau"))
+    raw = pr.Recording(t, q, tau, name="raw.csv")
+    with pytest.raises(pr.InputError, match=r"Recording 1 \('raw.csv'\).*without velocities and accelerations.*preprocess it first"):
+        pr.identify_base_parameters(robot, [recs[0], raw])
+
+
 def test_standard_errors_count_residuals_correlated_by_the_filter():
     # a log low-pass filtered at 10 Hz and kept at 100 Hz: about five correlated samples to
     # every independent one, which the standard errors now count
