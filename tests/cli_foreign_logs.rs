@@ -7,7 +7,7 @@
 
 mod cli_support;
 
-use cli_support::{fails, ok, plan_nominal_and_d, s, tmp, write};
+use cli_support::{excitation_log, fails, ok, plan_nominal_and_d, s, tmp, write};
 use perturbid_rs::io::Table;
 use std::path::Path;
 
@@ -92,28 +92,7 @@ fn close(a: &[f64], b: &[f64]) {
 #[test]
 fn a_foreign_log_gives_the_models_its_recording_gives() {
     let d = tmp("foreign-direct");
-    ok(&[
-        "excite",
-        "a465",
-        "--out",
-        s(&d),
-        "--max-evaluations",
-        "40",
-        "--rate",
-        "100",
-    ]);
-    let (exc, log) = (d.join("excitation.json"), d.join("log.csv"));
-    ok(&[
-        "simulate",
-        "a465",
-        s(&exc),
-        "--out",
-        s(&log),
-        "--rate",
-        "200",
-        "--torque-noise",
-        "0.01",
-    ]);
+    let log = excitation_log(&d, 1);
     let ur = d.join("ur.csv");
     foreign(&log, &ur);
     let plain = d.join("plain.json");
@@ -176,7 +155,7 @@ fn a_foreign_log_gives_the_models_its_recording_gives() {
     let residuals = |dir: &Path| Table::read(&dir.join("residuals.csv")).unwrap().values;
     close(&residuals(&v_mapped), &residuals(&v_plain));
     // predict: states with velocities and accelerations (the excitation's samples)
-    let states = d.join("excitation.csv");
+    let states = d.join("exc1/excitation.csv");
     let ur_states = d.join("ur_states.csv");
     foreign(&states, &ur_states);
     let (p_plain, p_mapped) = (d.join("p_plain.csv"), d.join("p_mapped.csv"));

@@ -6,64 +6,33 @@
 
 mod cli_support;
 
-use cli_support::{fails, ok, s, tmp};
+use cli_support::{excitation_log, fails, ok, s, tmp};
 use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
 use perturbid_rs::document::Document;
 use perturbid_rs::io::load_recording;
 use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::stacked_states::StackedStates;
-use std::path::{Path, PathBuf};
-
-/// Two logs of the A465, each along its own excitation, with torque noise.
-fn two_logs(d: &Path) -> [PathBuf; 2] {
-    [1, 2].map(|seed| {
-        let dir = d.join(format!("exc{seed}"));
-        let seed = seed.to_string();
-        ok(&[
-            "excite",
-            "a465",
-            "--out",
-            s(&dir),
-            "--max-evaluations",
-            "30",
-            "--rate",
-            "100",
-            "--seed",
-            &seed,
-        ]);
-        let log = d.join(format!("log{seed}.csv"));
-        ok(&[
-            "simulate",
-            "a465",
-            s(&dir.join("excitation.json")),
-            "--out",
-            s(&log),
-            "--rate",
-            "200",
-            "--torque-noise",
-            "0.01",
-            "--seed",
-            &seed,
-        ]);
-        log
-    })
-}
+use std::path::Path;
 
 #[test]
 fn several_logs_are_fitted_together_each_preprocessed_alone() {
     let d = tmp("several-logs");
-    let logs = two_logs(&d);
+    let logs = [1, 2].map(|seed| excitation_log(&d, seed));
+    // both logs into `out`, validated on the last `fraction` of each
+    let both = |out: &Path, fraction: &str| {
+        ok(&[
+            "identify-direct",
+            "a465",
+            s(&logs[0]),
+            s(&logs[1]),
+            "--out",
+            s(out),
+            "--validate",
+            fraction,
+        ])
+    };
     let model_path = d.join("both.json");
-    let out = ok(&[
-        "identify-direct",
-        "a465",
-        s(&logs[0]),
-        s(&logs[1]),
-        "--out",
-        s(&model_path),
-        "--validate",
-        "0",
-    ]);
+    let out = both(&model_path, "0");
     assert!(
         out.matches("preprocessed: ").count() == 2 && out.contains("samples of 2 logs"),
         "{out}"
@@ -121,16 +90,7 @@ fn several_logs_are_fitted_together_each_preprocessed_alone() {
         "{e}"
     );
     // validation on each log's last samples
-    let out = ok(&[
-        "identify-direct",
-        "a465",
-        s(&logs[0]),
-        s(&logs[1]),
-        "--out",
-        s(&d.join("v.json")),
-        "--validate",
-        "0.3",
-    ]);
+    let out = both(&d.join("v.json"), "0.3");
     let held: usize = recs
         .iter()
         .map(|r| r.len() - ((0.7 * r.len() as f64).round() as usize))

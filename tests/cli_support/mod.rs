@@ -109,3 +109,38 @@ pub const ARM_WITH_FINGER: &str = r#"<robot name="arm">
   <joint name="finger_joint" type="prismatic"><parent link="upper"/><child link="finger"/><origin xyz="0.3 0 0"/><axis xyz="0 1 0"/>
     <limit lower="0" upper="0.04" velocity="0.2" effort="20"/></joint>
 </robot>"#;
+
+/// An excitation of the A465 designed with `seed` (30 evaluations, sampled at 100 Hz) into
+/// `dir/exc<seed>/`, and its log simulated at 200 Hz with 0.01 N m of torque noise into
+/// `dir/log<seed>.csv`; returns the log's path.
+pub fn excitation_log(dir: &Path, seed: u64) -> PathBuf {
+    let exc = dir.join(format!("exc{seed}"));
+    let seed = seed.to_string();
+    ok(&[
+        "excite",
+        "a465",
+        "--out",
+        s(&exc),
+        "--max-evaluations",
+        "30",
+        "--rate",
+        "100",
+        "--seed",
+        &seed,
+    ]);
+    let log = dir.join(format!("log{seed}.csv"));
+    ok(&[
+        "simulate",
+        "a465",
+        s(&exc.join("excitation.json")),
+        "--out",
+        s(&log),
+        "--rate",
+        "200",
+        "--torque-noise",
+        "0.01",
+        "--seed",
+        &seed,
+    ]);
+    log
+}
