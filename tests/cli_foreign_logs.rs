@@ -120,6 +120,24 @@ fn a_foreign_log_gives_the_models_its_recording_gives() {
         ],
         &["ur.csv", "no column 't' (time, s)", "--column t=NAME"],
     );
+    // `columns` shows how the map reads the log, before any command reads it so
+    let mut args = vec!["columns", "a465", s(&ur)];
+    args.extend(LOG_MAP);
+    let shown = ok(&args);
+    for line in [
+        "ur.csv: 20 columns, 2001 rows; read as a recording of 6 joints (joint1, joint2",
+        "  t          <- timestamp x 0.001\n",
+        "  q6         <- actual_q_5 x 0.017453292519943295\n",
+        "  tau1       <- actual_current_0 x -10\n",
+        "t from 0 s to 10 s; q, tau (preprocessed by the commands that fit)",
+        "ur.csv: 7 column(s) left out (--ignore-columns): target_q_0",
+    ] {
+        assert!(shown.contains(line), "'{line}' not in {shown}");
+    }
+    fails(
+        &["columns", "a465", s(&ur)],
+        &["column 'robot_mode': 'RUNNING' is not a number"],
+    );
     let mapped = d.join("mapped.json");
     let mut args = vec!["identify-direct", "a465", s(&ur), "--out", s(&mapped)];
     args.extend(LOG_MAP);

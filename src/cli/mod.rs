@@ -1,6 +1,7 @@
 //! The `perturbid` command line: the same program whether built with cargo (`src/bin`) or
 //! installed by pip (a console script calling [`main_with_args`] through the extension module).
 
+mod columns;
 mod direct;
 mod files;
 mod gains;
@@ -52,6 +53,10 @@ enum Command {
     /// Design a Fourier excitation for the direct method (COBYLA): writes excitation.json and
     /// the sampled trajectory CSV.
     Excite(direct::ExciteArgs),
+    /// How a log's columns are read as a recording's (with --column and --ignore-columns, as
+    /// every command that reads a log takes them): each column read with its source and scale,
+    /// those left out; refused as those commands would refuse it.
+    Columns(columns::ColumnsArgs),
     /// Identify base parameters (the direct method) from a recording CSV; writes the model
     /// (JSON) and prints the fit.
     IdentifyDirect(direct::IdentifyDirectArgs),
@@ -94,6 +99,7 @@ fn run(cli: Cli) -> Result<String> {
         Command::Split(a) => session::split(a),
         Command::Identify(a) => local::identify(a),
         Command::Excite(a) => direct::excite(a),
+        Command::Columns(a) => columns::run(a),
         Command::IdentifyDirect(a) => direct::identify_direct(a),
         Command::IdentifyGains(a) => gains::identify_gains(a),
         Command::Predict(a) => direct::predict(a),

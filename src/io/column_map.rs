@@ -258,16 +258,39 @@ impl ColumnMap {
     /// The table in the CSV file at `path`, its columns selected for the joints `joints`
     /// ([`Self::select`]), and the names of those left out.
     pub fn read(&self, path: &std::path::Path, joints: &[String]) -> Result<(Table, Vec<String>)> {
+        let (table, read) = self.read_explained(path, joints)?;
+        Ok((table, read.left_out))
+    }
+
+    /// [`Self::read`], with how each column was read ([`ReadColumns`]).
+    pub fn read_explained(
+        &self,
+        path: &std::path::Path,
+        joints: &[String],
+    ) -> Result<(Table, ReadColumns)> {
         let source = path.display().to_string();
         let text = super::read_text(path)?;
-        let mut left_out = Vec::new();
+        let mut read = ReadColumns::default();
         let table = Table::parse_selected(&source, &text, |columns| {
-            let (selection, out) = self.select(&source, columns, joints)?;
-            left_out = out;
+            let (selection, left_out) = self.select(&source, columns, joints)?;
+            read = ReadColumns {
+                header: columns.to_vec(),
+                selection: selection.clone(),
+                left_out,
+            };
             Ok(selection)
         })?;
-        Ok((table, left_out))
+        Ok((table, read))
     }
+}
+
+/// How a log's columns were read ([`ColumnMap::read_explained`]): its header, the columns
+/// kept (the name each is read as and its scale) and those left out.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ReadColumns {
+    pub header: Vec<String>,
+    pub selection: Selection,
+    pub left_out: Vec<String>,
 }
 
 /// What a map left out of the log `path`, as a line for a command's output (None where

@@ -310,7 +310,7 @@ pub struct Kept {
 }
 
 /// The columns [`Table::parse_selected`] keeps, in the order the table holds them.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Selection {
     pub keep: Vec<Kept>,
 }
