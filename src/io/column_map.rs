@@ -16,6 +16,8 @@
 //! column may give one target only; the log's columns a map leaves alone keep their names (and
 //! a recording refuses those it has no place for, as without a map).
 
+use std::collections::HashMap;
+
 use super::table::{Kept, Selection, Table};
 use crate::error::{Error, Result};
 
@@ -185,9 +187,14 @@ impl ColumnMap {
             recording: source.into(),
             message,
         };
-        let listed = || super::recording::listed(columns);
-        // the target each mapped column is read as
+        let listed = || super::recording::listed(columns, 40);
+        // by name: a header of a hundred thousand columns is read in linear time
+        let index: HashMap<&str, usize> = (columns.iter().enumerate())
+            .map(|(c, name)| (name.as_str(), c))
+            .collect();
+        // the target each mapped column is read as, and the column of each target
         let mut mapped: Vec<Option<(String, f64, &str)>> = vec![None; columns.len()];
+        let mut source_of: HashMap<String, usize> = HashMap::new();
         for e in &self.entries {
             let targets: Vec<(String, String)> = match (e.var.as_str(), e.joint) {
                 ("t", _) => vec![("t".into(), e.source.clone())],
@@ -202,7 +209,7 @@ impl ColumnMap {
                     .collect(),
             };
             for (target, from) in targets {
-                let c = columns.iter().position(|c| *c == from).ok_or_else(|| {
+                let c = *index.get(from.as_str()).ok_or_else(|| {
                     bad(format!(
                         "--column '{}': no column '{from}' for {target}; the columns are: {}",
                         e.given,
@@ -215,6 +222,7 @@ impl ColumnMap {
                         e.given
                     )));
                 }
+                source_of.insert(target.clone(), c);
                 mapped[c] = Some((target, e.scale, &e.given));
             }
         }
@@ -234,22 +242,21 @@ impl ColumnMap {
                     scale: *scale,
                 }),
                 None if ignored(name) => left_out.push(name.clone()),
-                None => keep.push(Kept {
-                    source: c,
-                    name: name.clone(),
-                    scale: 1.0,
-                }),
-            }
-        }
-        // a column the log names as a target a map entry also gives
-        for k in (keep.iter()).filter(|k| mapped[k.source].is_none()) {
-            if let Some((c, (_, _, given))) = (mapped.iter().enumerate())
-                .find_map(|(c, m)| m.as_ref().filter(|m| m.0 == k.name).map(|m| (c, m)))
-            {
-                return Err(bad(format!(
-                    "column '{}' and column '{}' (by --column '{given}') are both read as {}: leave one out (--ignore-columns {})",
-                    k.name, columns[c], k.name, k.name
-                )));
+                // a column the log names as a target a map entry also gives
+                None => match source_of.get(name) {
+                    Some(&m) => {
+                        let given = mapped[m].as_ref().map_or("", |m| m.2);
+                        return Err(bad(format!(
+                            "column '{name}' and column '{}' (by --column '{given}') are both read as {name}: leave one out (--ignore-columns {name})",
+                            columns[m]
+                        )));
+                    }
+                    None => keep.push(Kept {
+                        source: c,
+                        name: name.clone(),
+                        scale: 1.0,
+                    }),
+                },
             }
         }
         Ok((Selection { keep }, left_out))
@@ -299,15 +306,11 @@ pub fn left_out_note(path: &std::path::Path, left_out: &[String]) -> Option<Stri
     if left_out.is_empty() {
         return None;
     }
-    let mut names: Vec<&str> = left_out.iter().take(12).map(String::as_str).collect();
-    if left_out.len() > 12 {
-        names.push("...");
-    }
     Some(format!(
         "{}: {} column(s) left out (--ignore-columns): {}",
         path.display(),
         left_out.len(),
-        names.join(", ")
+        super::recording::listed(left_out, 12)
     ))
 }
 

@@ -51,7 +51,7 @@ impl<'a> Columns<'a> {
                 table,
                 format!(
                     "no column 't' (time, s){case}; the columns are: {}; a log from another tool: read its time as t with --column t=NAME (*ms, *us or *ns for a time in those units; Python columns=, docs/data.md)",
-                    listed(&table.columns)
+                    listed(&table.columns, 40)
                 ),
             )
         })?;
@@ -130,10 +130,10 @@ impl<'a> Columns<'a> {
     }
 }
 
-/// A header's names for a message: the first 40, then "...".
-pub(super) fn listed(columns: &[String]) -> String {
-    let mut names: Vec<&str> = columns.iter().take(40).map(String::as_str).collect();
-    if columns.len() > 40 {
+/// Names for a message: the first `most`, then "...".
+pub(super) fn listed(columns: &[String], most: usize) -> String {
+    let mut names: Vec<&str> = columns.iter().take(most).map(String::as_str).collect();
+    if columns.len() > most {
         names.push("...");
     }
     names.join(", ")
