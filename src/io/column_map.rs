@@ -1,6 +1,6 @@
 //! Logs written by other tools, read as recordings: their columns renamed to `t`, `q1..qN`,
 //! `qd1..qN`, `qdd1..qN`, `tau1..tauN`, scaled to SI units, and the columns a recording has no
-//! place for left out by name (docs/data.md, "Logs from other tools").
+//! place for left out by name (docs/logs.md).
 //!
 //! A map is given as `TARGET=SOURCE[*SCALE]` entries and `IGNORE` patterns:
 //! - `TARGET` is `t`, or one of `q`, `qd`, `qdd`, `tau` for every joint (then `SOURCE` holds

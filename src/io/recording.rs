@@ -50,7 +50,7 @@ impl<'a> Columns<'a> {
             bad(
                 table,
                 format!(
-                    "no column 't' (time, s){case}; the columns are: {}; a log from another tool: read its time as t with --column t=NAME (*ms, *us or *ns for a time in those units; Python columns=, docs/data.md)",
+                    "no column 't' (time, s){case}; the columns are: {}; a log from another tool: read its time as t with --column t=NAME (*ms, *us or *ns for a time in those units; Python columns=, docs/logs.md)",
                     listed(&table.columns, 40)
                 ),
             )
@@ -96,7 +96,7 @@ impl<'a> Columns<'a> {
             return Err(bad(
                 table,
                 format!(
-                    "missing column(s) {}: the robot has {n} joints ({}); a log from another tool: read its own names as these with --column {var}=NAME_{{i}} ({{i}} the joint's index from 0, {{j}} its number, {{joint}} its name; Python columns=, docs/data.md)",
+                    "missing column(s) {}: the robot has {n} joints ({}); a log from another tool: read its own names as these with --column {var}=NAME_{{i}} ({{i}} the joint's index from 0, {{j}} its number, {{joint}} its name; Python columns=, docs/logs.md)",
                     missing.join(", "),
                     joints.join(", ")
                 ),
@@ -121,7 +121,7 @@ impl<'a> Columns<'a> {
             Some(c) => Err(bad(
                 self.table,
                 format!(
-                    "unexpected column '{}': expected t, q1..q{n}, optional qd1..qd{n} and qdd1..qdd{n}, tau1..tau{n} (or the same named after the joints, e.g. q_{}); a log from another tool: leave its other columns out (command line --ignore-columns '{}', Python ignore_columns=) and read its own names as these (--column, columns=; docs/data.md)",
+                    "unexpected column '{}': expected t, q1..q{n}, optional qd1..qd{n} and qdd1..qdd{n}, tau1..tau{n} (or the same named after the joints, e.g. q_{}); a log from another tool: leave its other columns out (command line --ignore-columns '{}', Python ignore_columns=) and read its own names as these (--column, columns=; docs/logs.md)",
                     self.table.columns[c], self.joints[0], self.table.columns[c]
                 ),
             )),

@@ -142,7 +142,7 @@ impl PyRecording {
     /// SOURCE then holding `{i}` (index from 0), `{j}` (number from 1) or `{joint}` (name); or
     /// one joint's, `q3`; SCALE a number or `deg`, `ms`, `us`, `ns`), and `ignore_columns`
     /// leaves columns out (names, or starts of names ending in `*`; they need not hold
-    /// numbers), as the command line's `--column` and `--ignore-columns` (docs/data.md).
+    /// numbers), as the command line's `--column` and `--ignore-columns` (docs/logs.md).
     /// Raises FileError for a file that cannot be read (or larger than 2 GiB), InputError
     /// naming the file, line and column of a bad value, a missing or unexpected column, a
     /// map that does not fit the log, or time that does not increase; TypeError for a
