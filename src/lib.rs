@@ -45,6 +45,7 @@ pub mod preprocess;
 pub mod recording;
 pub mod regression;
 pub mod rehearsal;
+pub mod repeated_samples;
 pub mod robots;
 pub mod signal;
 pub mod simd;

@@ -22,14 +22,26 @@ impl StackedStates {
     /// `parts` (each a run's states, with velocities and accelerations, and its data, `nv`
     /// values a sample) one after the other. Errors: no part, parts of other joints than the
     /// first's, a part without velocities or accelerations (naming it, from 0), data of
-    /// another shape.
+    /// another shape, two parts that share samples (positions and data alike, bit for bit,
+    /// over [`crate::repeated_samples::RUN`] samples or more: a run given twice).
     pub fn of(parts: &[(States<'_>, &[f64])]) -> Result<Self> {
+        Self::of_named(parts, &[], "runs")
+    }
+
+    /// [`Self::of`] with the parts named in its errors by `names` (`run r` where none is given)
+    /// and those errors' argument `argument`.
+    pub fn of_named(
+        parts: &[(States<'_>, &[f64])],
+        names: &[String],
+        argument: &str,
+    ) -> Result<Self> {
         let Some((first, _)) = parts.first() else {
             return Err(Error::InvalidArgument {
-                argument: "runs".into(),
+                argument: argument.into(),
                 message: "no run to stack".into(),
             });
         };
+        let name = |r: usize| names.get(r).cloned().unwrap_or_else(|| format!("run {r}"));
         let nv = first.nv();
         let k: usize = parts.iter().map(|(s, _)| s.len()).sum();
         let filtered = parts.iter().any(|(s, _)| s.coulomb().is_some());
@@ -44,16 +56,17 @@ impl StackedStates {
         for (r, (s, data)) in parts.iter().enumerate() {
             let (Some(qd), Some(qdd)) = (s.qd(), s.qdd()) else {
                 return Err(Error::InvalidArgument {
-                    argument: "runs".into(),
+                    argument: argument.into(),
                     message: format!(
-                        "run {r} has no velocities and accelerations: preprocess its log first"
+                        "{} has no velocities and accelerations: preprocess its log first",
+                        name(r)
                     ),
                 });
             };
             if s.nv() != nv {
                 return Err(Error::InvalidArgument {
-                    argument: "runs".into(),
-                    message: format!("run {r} has {} joints, run 0 {nv}", s.nv()),
+                    argument: argument.into(),
+                    message: format!("{} has {} joints, {} {nv}", name(r), s.nv(), name(0)),
                 });
             }
             s.check_companion("data", data, nv)?;
@@ -65,6 +78,11 @@ impl StackedStates {
             }
             out.data.extend_from_slice(data);
         }
+        let prints = (parts.iter())
+            .map(|(s, data)| crate::repeated_samples::SamplePrints::of(nv, &[s.q(), data]))
+            .collect::<Result<Vec<_>>>()?;
+        let names: Vec<String> = (0..parts.len()).map(name).collect();
+        crate::repeated_samples::refuse_shared_samples(&prints, &names, argument, "samples")?;
         Ok(out)
     }
 

@@ -121,3 +121,105 @@ fn several_logs_are_fitted_together_each_preprocessed_alone() {
     );
     assert!(!d.join("x.json").exists());
 }
+
+/// The same samples given twice to one fit are refused, naming the logs and where they agree:
+/// one path twice, the same file under another path, a copy, a part of a log given again;
+/// among `identify-gains`'s runs too. Nothing is written.
+#[test]
+fn a_log_given_twice_is_refused() {
+    let d = tmp("log-twice");
+    let logs = [3, 4].map(|seed| excitation_log(&d, seed));
+    let out = d.join("m.json");
+    let direct = |a: &Path, b: &Path, needles: &[&str]| {
+        fails(
+            &[
+                "identify-direct",
+                "a465",
+                s(&logs[1]),
+                s(a),
+                s(b),
+                "--out",
+                s(&out),
+            ],
+            needles,
+        );
+        assert!(!out.exists());
+    };
+    direct(
+        &logs[0],
+        &logs[0],
+        &["log3.csv is given twice: each log once"],
+    );
+    let dotted = d.join(".").join("log3.csv");
+    direct(
+        &logs[0],
+        &dotted,
+        &["log3.csv is given twice (again as ", "/./log3.csv)"],
+    );
+    // a copy, its stamps shifted by 100 s
+    let text = std::fs::read_to_string(&logs[0]).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    let rows: Vec<&str> = lines.collect();
+    let shifted: Vec<String> = (rows.iter())
+        .map(|r| {
+            let (t, rest) = r.split_once(',').unwrap();
+            format!("{},{rest}", t.parse::<f64>().unwrap() + 100.0)
+        })
+        .collect();
+    let copy = d.join("copy.csv");
+    std::fs::write(&copy, format!("{header}\n{}\n", shifted.join("\n"))).unwrap();
+    direct(
+        &logs[0],
+        &copy,
+        &[
+            &format!(
+                "log3.csv and {} hold the same {} data rows, bit for bit",
+                s(&copy),
+                rows.len()
+            ),
+            "give each run's samples once",
+        ],
+    );
+    // data rows 501-1500 of the log as a log of their own
+    let part = d.join("part.csv");
+    std::fs::write(&part, format!("{header}\n{}\n", rows[500..1500].join("\n"))).unwrap();
+    direct(
+        &part,
+        &logs[0],
+        &[&format!(
+            "data rows 501 to 1500 of {} (of {}) are data rows 1 to 1000 of {} (of 1000), bit for bit",
+            s(&logs[0]),
+            rows.len(),
+            s(&part)
+        )],
+    );
+    // a run among the unloaded and the loaded
+    fails(
+        &[
+            "identify-gains",
+            "a465",
+            s(&logs[0]),
+            s(&logs[1]),
+            "--loaded",
+            s(&copy),
+            "--payload",
+            r#"{"link": "link6", "mass": 2.0, "com": [0, 0, 0.05], "inertia": [0.002, 0, 0, 0.002, 0, 0.002]}"#,
+            "--out",
+            s(&out),
+        ],
+        &["RUNS", "hold the same"],
+    );
+    assert!(!out.exists());
+    // two different runs of one excitation pass
+    ok(&[
+        "identify-direct",
+        "a465",
+        s(&logs[0]),
+        s(&logs[1]),
+        "--out",
+        s(&out),
+        "--validate",
+        "0",
+    ]);
+}

@@ -198,12 +198,9 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
             ),
         });
     }
-    let recs = (a.data.iter())
-        .map(|path| {
-            a.preprocessing
-                .read(path, &model.joint_names, &progress, &mut out)
-        })
-        .collect::<Result<Vec<_>>>()?;
+    let paths: Vec<&std::path::Path> = a.data.iter().map(PathBuf::as_path).collect();
+    let recs =
+        (a.preprocessing).read_logs(&paths, &model.joint_names, "DATA", &progress, &mut out)?;
     let n = model.nv;
     // each log's first samples are fitted to, its last validated on
     let mut splits = Vec::with_capacity(recs.len());

@@ -1,6 +1,6 @@
 //! Loading robots, CSV and JSON files for the subcommands.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -206,9 +206,69 @@ impl PreprocessArgs {
         progress: &super::progress::Progress,
         out: &mut String,
     ) -> Result<crate::recording::Recording> {
-        use std::fmt::Write;
         progress.update(&format!("reading {}", path.display()));
         let rec = self.columns.load(path, joints, out)?;
+        self.prepare(rec, path, joints, progress, out)
+    }
+
+    /// [`Self::read`] of every log of `paths`, the logs of one fit. Refused, as `argument`: a
+    /// file given twice (the same file under two paths; before any is read), and two logs
+    /// that share samples as read, positions and torques bit for bit
+    /// ([`crate::repeated_samples`]: a copy, or a part of a log given again).
+    pub(crate) fn read_logs(
+        &self,
+        paths: &[&Path],
+        joints: &[String],
+        argument: &str,
+        progress: &super::progress::Progress,
+        out: &mut String,
+    ) -> Result<Vec<crate::recording::Recording>> {
+        // the same file under two names: refused before it is read
+        let files: Vec<Option<PathBuf>> = paths.iter().map(|p| p.canonicalize().ok()).collect();
+        for (b, file) in files.iter().enumerate() {
+            if let Some(a) = (0..b).find(|&a| file.is_some() && files[a] == *file) {
+                return Err(Error::InvalidArgument {
+                    argument: argument.into(),
+                    message: format!(
+                        "{} is given twice{}: each log once (its noise would count as independent twice)",
+                        paths[a].display(),
+                        match paths[a].as_os_str() == paths[b].as_os_str() {
+                            true => String::new(),
+                            false => format!(" (again as {})", paths[b].display()),
+                        }
+                    ),
+                });
+            }
+        }
+        // each log preprocessed as it is read (one log as read is held at a time), its
+        // samples as read printed for the comparison
+        let mut recs = Vec::with_capacity(paths.len());
+        let mut prints = Vec::with_capacity(paths.len());
+        for path in paths {
+            progress.update(&format!("reading {}", path.display()));
+            let rec = self.columns.load(path, joints, out)?;
+            prints.push(crate::repeated_samples::SamplePrints::of(
+                rec.n,
+                &[&rec.q, &rec.tau],
+            )?);
+            recs.push(self.prepare(rec, path, joints, progress, out)?);
+        }
+        let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+        crate::repeated_samples::refuse_shared_samples(&prints, &names, argument, "data rows")?;
+        Ok(recs)
+    }
+
+    /// The recording `rec` as read from `path`, preprocessed when it has no qdd columns (or
+    /// `--preprocess` asks); says so in `out`.
+    fn prepare(
+        &self,
+        rec: crate::recording::Recording,
+        path: &Path,
+        joints: &[String],
+        progress: &super::progress::Progress,
+        out: &mut String,
+    ) -> Result<crate::recording::Recording> {
+        use std::fmt::Write;
         let clipped = |rec: &crate::recording::Recording| {
             let log = path.display().to_string();
             if let Some(w) = crate::torque_saturation::warning(&rec.torque_saturation, joints, &log)

@@ -109,13 +109,9 @@ pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
     let payload_of = |loaded: usize| &payloads[loaded.min(payloads.len() - 1)];
     let progress = Progress::new();
     let mut out = String::new();
-    let recordings = logs
-        .iter()
-        .map(|path| {
-            a.preprocessing
-                .read(path, &model.joint_names, &progress, &mut out)
-        })
-        .collect::<Result<Vec<Recording>>>()?;
+    let paths: Vec<&Path> = logs.iter().map(|p| p.as_path()).collect();
+    let recordings: Vec<Recording> =
+        (a.preprocessing).read_logs(&paths, &model.joint_names, "RUNS", &progress, &mut out)?;
     let states = recordings
         .iter()
         .zip(&logs)

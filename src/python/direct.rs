@@ -703,7 +703,10 @@ fn fit_recordings(
         .zip(recs)
         .map(|(s, r)| (*s, &r.tau[..]))
         .collect();
-    let stacked = crate::stacked_states::StackedStates::of(&parts)?;
+    let names: Vec<String> = (recs.iter().enumerate())
+        .map(|(i, r)| format!("Recording {i} ('{}')", r.name))
+        .collect();
+    let stacked = crate::stacked_states::StackedStates::of_named(&parts, &names, "q")?;
     let fit = base_rs(model, &stacked.states()?, &stacked.data, options)?;
     Ok(crate::direct::BaseModel {
         logs: (recs.iter())

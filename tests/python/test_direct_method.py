@@ -546,6 +546,11 @@ def test_several_recordings_are_fitted_together():
     raw = pr.Recording(t, q, tau, name="raw.csv")
     with pytest.raises(pr.InputError, match=r"Recording 1 \('raw.csv'\).*without velocities and accelerations.*preprocess it first"):
         pr.identify_base_parameters(robot, [recs[0], raw])
+    # the same samples twice: one Recording given twice, or a part of one given again
+    with pytest.raises(pr.InputError, match=r"q: Recording 0 \('run1.csv \(preprocessed\)'\) and Recording 2 \('run1.csv \(preprocessed\)'\) hold the same \d+ samples, bit for bit.*give each run's samples once"):
+        pr.identify_base_parameters(robot, [recs[0], recs[1], recs[0]], friction=friction)
+    with pytest.raises(pr.InputError, match=r"samples 1 to 300 of Recording 1 .* are samples 101 to 400 of Recording 0"):
+        pr.identify_base_parameters(robot, [recs[1], recs[1][100:400]], friction=friction)
 
 
 def test_standard_errors_count_residuals_correlated_by_the_filter():

@@ -255,3 +255,5 @@ def test_hostile_arguments_are_refused_by_name(setup):
     refused([recs[0], deg], [None, PAYLOAD], "degrees per second")
     other = pr.Recording(t, q[:, :5], i[:, :5], qd=qd[:, :5], qdd=qdd[:, :5], name="five")
     refused([recs[0], other], [None, PAYLOAD], r"runs\[1\].*'five' has 5 joints, expected the robot's 6")
+    # the same run twice, once loaded: the same samples given twice
+    refused([recs[0], recs[0]], [None, PAYLOAD], r"run 0 and run 1 hold the same \d+ samples, bit for bit")
