@@ -91,4 +91,64 @@ fn parameters_from_local_models() {
         &["parameters", "a465", s(&d.join("nope.json"))],
         &["nope.json"],
     );
+    // a model given twice (one path twice, or a copy) is refused; a second model at the first
+    // point, from other recordings, is counted as such
+    let out_path = d.join("twice.json");
+    let twice = |a: &std::path::Path, needles: &[&str]| {
+        fails(
+            &[
+                "parameters",
+                "a465",
+                s(&models[0]),
+                s(&models[1]),
+                s(a),
+                "--out",
+                s(&out_path),
+            ],
+            needles,
+        );
+        assert!(!out_path.exists());
+    };
+    twice(
+        &models[0],
+        &["MODELS: ", "m0.json is given twice: each local model once"],
+    );
+    let copy = d.join("copy.json");
+    std::fs::copy(&models[0], &copy).unwrap();
+    twice(
+        &copy,
+        &[&format!(
+            "{}: the same local model as {} (the same estimates at the same operating point)",
+            s(&copy),
+            s(&models[0])
+        )],
+    );
+    let (rec, again) = (d.join("rec0b"), d.join("m0b.json"));
+    let plan = d.join("plan0").join("plan.json");
+    ok(&[
+        "simulate",
+        "a465",
+        s(&plan),
+        "--out",
+        s(&rec),
+        "--no-friction",
+        "--torque-noise",
+        "0.001",
+        "--seed",
+        "7",
+    ]);
+    ok(&["identify", s(&plan), s(&rec), "--out", s(&again)]);
+    let out = ok(&[
+        "parameters",
+        "a465",
+        s(&models[0]),
+        s(&models[1]),
+        s(&again),
+        "--out",
+        s(&out_path),
+    ]);
+    assert!(
+        out.contains("identified from 3 local models at 2 operating point(s)"),
+        "{out}"
+    );
 }

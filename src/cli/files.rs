@@ -123,6 +123,32 @@ pub(crate) fn refuse_overwriting_inputs(out: &Path, inputs: &[&Path]) -> Result<
     }
 }
 
+/// Refuses a file of `paths` given twice (under any two paths to it: `a.csv`, `./a.csv`, a
+/// link), as `argument`, naming it; `what` is what each file is (`log`, `local model`). Paths
+/// that do not resolve (a missing file) are left to the reading to name.
+pub(crate) fn refuse_repeated_paths(paths: &[&Path], argument: &str, what: &str) -> Result<()> {
+    let files: Vec<Option<PathBuf>> = paths.iter().map(|p| p.canonicalize().ok()).collect();
+    let mut seen: std::collections::HashMap<&PathBuf, usize> = std::collections::HashMap::new();
+    for (b, file) in files.iter().enumerate() {
+        let Some(file) = file else { continue };
+        if let Some(&a) = seen.get(file) {
+            return Err(Error::InvalidArgument {
+                argument: argument.into(),
+                message: format!(
+                    "{} is given twice{}: each {what} once (its noise would count as independent twice)",
+                    paths[a].display(),
+                    match paths[a].as_os_str() == paths[b].as_os_str() {
+                        true => String::new(),
+                        false => format!(" (again as {})", paths[b].display()),
+                    }
+                ),
+            });
+        }
+        seen.insert(file, b);
+    }
+    Ok(())
+}
+
 /// How a log from another tool is read ([`crate::io::column_map`]).
 #[derive(clap::Args, Clone, Debug, Default)]
 pub(crate) struct ColumnArgs {
@@ -223,23 +249,7 @@ impl PreprocessArgs {
         progress: &super::progress::Progress,
         out: &mut String,
     ) -> Result<Vec<crate::recording::Recording>> {
-        // the same file under two names: refused before it is read
-        let files: Vec<Option<PathBuf>> = paths.iter().map(|p| p.canonicalize().ok()).collect();
-        for (b, file) in files.iter().enumerate() {
-            if let Some(a) = (0..b).find(|&a| file.is_some() && files[a] == *file) {
-                return Err(Error::InvalidArgument {
-                    argument: argument.into(),
-                    message: format!(
-                        "{} is given twice{}: each log once (its noise would count as independent twice)",
-                        paths[a].display(),
-                        match paths[a].as_os_str() == paths[b].as_os_str() {
-                            true => String::new(),
-                            false => format!(" (again as {})", paths[b].display()),
-                        }
-                    ),
-                });
-            }
-        }
+        refuse_repeated_paths(paths, argument, "log")?;
         // each log preprocessed as it is read (one log as read is held at a time), its
         // samples as read printed for the comparison
         let mut recs = Vec::with_capacity(paths.len());

@@ -8,7 +8,7 @@ use clap::Args;
 use super::files::{refuse_overwriting_inputs, RobotArg};
 use crate::direct::FrictionTerms;
 use crate::document::Document;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::local::{identify_parameters_from_local, FromLocalOptions, LocalModel};
 
@@ -40,6 +40,8 @@ pub(crate) fn run(a: ParametersArgs) -> Result<String> {
     let mut inputs: Vec<&std::path::Path> = a.models.iter().map(PathBuf::as_path).collect();
     inputs.push(a.robot.path());
     refuse_overwriting_inputs(&a.out, &inputs)?;
+    let paths: Vec<&std::path::Path> = a.models.iter().map(PathBuf::as_path).collect();
+    super::files::refuse_repeated_paths(&paths, "MODELS", "local model")?;
     let robot = a.robot.load()?;
     let models: Vec<LocalModel> = a
         .models
@@ -52,7 +54,27 @@ pub(crate) fn run(a: ParametersArgs) -> Result<String> {
         consistent: a.consistent.then(crate::direct::ConsistentOptions::default),
         ..FromLocalOptions::default()
     };
-    let fit = identify_parameters_from_local(&robot, &models, &options)?;
+    // an error about one model names its file
+    let fit = identify_parameters_from_local(&robot, &models, &options).map_err(|e| match e {
+        Error::InvalidArgument { argument, message } => {
+            let file = |arg: &str| {
+                (arg.strip_prefix("models["))
+                    .and_then(|r| r.strip_suffix(']'))
+                    .and_then(|i| i.parse::<usize>().ok())
+                    .and_then(|i| a.models.get(i))
+                    .map(|p| p.display().to_string())
+            };
+            // "models[a]" in the message too
+            let message = (0..a.models.len()).rev().fold(message, |m, i| {
+                m.replace(&format!("models[{i}]"), &a.models[i].display().to_string())
+            });
+            Error::InvalidArgument {
+                argument: file(&argument).unwrap_or(argument),
+                message,
+            }
+        }
+        other => other,
+    })?;
     let mut out = String::new();
     match &fit.consistent {
         Some(c) => {
@@ -67,12 +89,16 @@ pub(crate) fn run(a: ParametersArgs) -> Result<String> {
         }
         None => fit.model.save(&a.out)?,
     }
-    let _ = writeln!(
+    let _ =
+        writeln!(
         out,
-        "{} of the robot's {} base parameters identified from {} operating point(s), {} equations, cond {:.3e} -> {}",
+        "{} of the robot's {} base parameters identified from {}, {} equations, cond {:.3e} -> {}",
         fit.rank,
         fit.robot_rank,
-        models.len(),
+        match (models.len(), crate::local::parameters::operating_points(&models)) {
+            (m, p) if m == p => format!("{p} operating point(s)"),
+            (m, p) => format!("{m} local models at {p} operating point(s)"),
+        },
         fit.rows,
         fit.model.cond,
         a.out.display()

@@ -109,6 +109,38 @@ fn push_block(
     }
 }
 
+/// Refuses a model of `models` that is another one again (the same document: estimates,
+/// standard errors and operating point, bit for bit), naming both: its estimates' noise would
+/// count as independent twice. Two models identified at one point from other recordings pass.
+fn refuse_repeated_models(models: &[LocalModel]) -> Result<()> {
+    let texts: Vec<String> = models.iter().map(|m| m.to_json()).collect();
+    let mut seen: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
+    for (b, text) in texts.iter().enumerate() {
+        if let Some(&a) = seen.get(text.as_str()) {
+            return Err(Error::InvalidArgument {
+                argument: format!("models[{b}]"),
+                message: format!(
+                    "the same local model as models[{a}] (the same estimates at the same operating point): give each model once (its noise would count as independent twice)"
+                ),
+            });
+        }
+        seen.insert(text, b);
+    }
+    Ok(())
+}
+
+/// How many operating points `models` were identified at (planned points that differ in any
+/// value).
+pub fn operating_points(models: &[LocalModel]) -> usize {
+    let mut points: Vec<&super::OperatingPoint> = vec![];
+    for m in models {
+        if !points.iter().any(|p| **p == m.planned_op) {
+            points.push(&m.planned_op);
+        }
+    }
+    points.len()
+}
+
 /// Row-major entries of a matrix (entry `(i, j)` at `i * n + j`).
 fn entries(m: &DMatrix<f64>) -> Vec<f64> {
     (0..m.nrows())
@@ -124,7 +156,8 @@ fn entries(m: &DMatrix<f64>) -> Vec<f64> {
 /// marks as not measured (`diagnostics.unmeasured`: a torque that did not change) are left
 /// out.
 ///
-/// Errors: no model, a model for other joints than `robot`'s.
+/// Errors: no model, a model for other joints than `robot`'s, a model given twice (the same
+/// document again).
 pub fn identify_parameters_from_local(
     robot: &Model,
     models: &[LocalModel],
@@ -137,6 +170,7 @@ pub fn identify_parameters_from_local(
             message: "no local model given".into(),
         });
     }
+    refuse_repeated_models(models)?;
     let layout = ParameterLayout::new(robot, options.friction.for_model(robot));
     let (mut x, mut y, mut w, mut joint) = (vec![], vec![], vec![], vec![]);
     for (i, m) in models.iter().enumerate() {

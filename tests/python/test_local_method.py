@@ -349,6 +349,9 @@ def test_parameters_from_identified_local_models():
         np.testing.assert_allclose(c.model.predict(op.q, op.qd, op.qdd), m.torque, atol=1e-3)
     with pytest.raises(pr.InputError, match="'Q'"):
         pr.identify_parameters_from_local(robot, models, use=["Q"])
+    # a model given twice counts its noise twice
+    with pytest.raises(pr.InputError, match=r"models\[3\]: the same local model as models\[1\]"):
+        pr.identify_parameters_from_local(robot, models + [models[1]], use=["torque", "D", "H"])
 
 
 def test_suggested_operating_points_reach_every_base_parameter():
