@@ -789,7 +789,8 @@ def identify_base_parameters(
 ) -> BaseParameterModel:
     """Base parameters from arrays (q, qd, qdd, tau), a preprocessed Recording as q alone,
     or a list of them as q (runs fitted together, one after the other; what each one's
-    preprocessing found kept in the model's logs)."""
+    preprocessing found kept in the model's logs, and not warned of again; Recordings that
+    share samples, one given twice, refused)."""
 
 def identify_drive_gains(
     robot: Robot,
@@ -807,7 +808,9 @@ def identify_drive_gains(
     dict link, mass (kg), com (m), inertia ([ixx, ixy, ixz, iyy, iyz, izz] about the centre
     of mass, kg m^2) in the link's frame. Not every run may carry the same payload.
     estimator "instrumental": instrumental variables, unbiased by the signal's noise (least
-    squares is biased towards 0 by it, as drive_gains["noise_bias"] says)."""
+    squares is biased towards 0 by it, as drive_gains["noise_bias"] says). What each run's
+    preprocessing found is kept in the model's JSON ``logs``, named by its Recording; runs
+    that share samples (one given twice) are refused."""
     ...
 
 @final

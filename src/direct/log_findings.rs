@@ -40,11 +40,21 @@ pub struct LogFindings {
     pub position_rounding: Vec<crate::position_rounding::PositionRounding>,
 }
 
+/// The longest name of a log kept (characters): a path, or a Recording's name.
+pub const MAX_NAME: usize = 4096;
+
 impl LogFindings {
-    /// What the preprocessing of `rec` found, named `log`.
+    /// What the preprocessing of `rec` found, named `log`: a name kept as given, but that an
+    /// empty one reads `(unnamed)` and one past [`MAX_NAME`] characters is cut to its first
+    /// `MAX_NAME - 1` and `…` (a Recording may be named anything; the model must load again).
     pub fn of(log: &str, rec: &Recording) -> Self {
+        let log = match log.chars().count() {
+            0 => "(unnamed)".to_string(),
+            c if c > MAX_NAME => log.chars().take(MAX_NAME - 1).chain(['…']).collect(),
+            _ => log.to_string(),
+        };
         Self {
-            log: log.into(),
+            log,
             glitches: rec.glitches.clone(),
             dropouts: rec.dropouts.clone(),
             torque_saturation: rec.torque_saturation.clone(),
@@ -66,11 +76,11 @@ impl LogFindings {
             (items.iter().enumerate())
                 .find_map(|(i, x)| problem(x).map(|p| format!("{name}[{i}]: {p}")))
         }
-        if self.log.is_empty() || self.log.len() > 4096 {
+        let chars = self.log.chars().count();
+        if chars == 0 || chars > MAX_NAME {
             return Some(format!(
-                "{}: {} characters, expected a log's name of 1 to 4096",
+                "{}: {chars} characters, expected a log's name of 1 to {MAX_NAME}",
                 field("log"),
-                self.log.len()
             ));
         }
         first(&self.glitches, field("glitches"), |g| g.problem(n))
@@ -124,5 +134,44 @@ impl BaseModel {
             position_rounding: rec.position_rounding.clone(),
             ..self
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_name_past_the_limit_or_empty_still_loads() {
+        let rec = Recording::new(
+            "r",
+            1,
+            vec![0.0, 1.0],
+            vec![0.0, 1.0],
+            vec![0.0, 1.0],
+            None,
+            None,
+        )
+        .unwrap();
+        let long = "é".repeat(MAX_NAME + 10);
+        let f = LogFindings::of(&long, &rec);
+        assert_eq!(f.log.chars().count(), MAX_NAME);
+        assert!(f.log.ends_with('…') && f.log.starts_with("éé"));
+        assert_eq!(f.problem(1, |x| x.to_string()), None);
+        let f = LogFindings::of("", &rec);
+        assert_eq!(f.log, "(unnamed)");
+        assert_eq!(f.problem(1, |x| x.to_string()), None);
+        // as given where it fits; past the limit refused on load
+        let f = LogFindings::of(&"é".repeat(MAX_NAME), &rec);
+        assert_eq!(f.log.chars().count(), MAX_NAME);
+        let bad = LogFindings {
+            log: "a".repeat(MAX_NAME + 1),
+            ..f
+        };
+        let p = bad.problem(1, |x| x.to_string()).unwrap();
+        assert!(
+            p.contains("4097 characters, expected a log's name of 1 to 4096"),
+            "{p}"
+        );
     }
 }

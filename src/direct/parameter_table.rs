@@ -128,6 +128,18 @@ impl BaseModel {
     /// column is found wrong, offsets and friction are not named: fitted to such a log they
     /// take up part of what is wrong with it.
     pub fn warnings(&self) -> Vec<String> {
+        self.warnings_with(true)
+    }
+
+    /// [`Self::warnings`] without those of the logs' own findings (position rounding) that
+    /// the preprocessing of the fitted Recordings gave already: what Python's fit of
+    /// Recordings warns of (the model's `warnings` still lists them all).
+    pub fn fit_warnings(&self) -> Vec<String> {
+        self.warnings_with(false)
+    }
+
+    /// The warnings, with the logs' findings or without.
+    fn warnings_with(&self, log_findings: bool) -> Vec<String> {
         let columns = super::torque_lag::log_findings(
             &self.position_range,
             &self.torque_columns,
@@ -178,7 +190,7 @@ impl BaseModel {
             .chain(offsets)
             .chain(friction)
             .chain(weak)
-            .chain(rounding)
+            .chain(rounding.filter(|_| log_findings))
             .chain(negative)
             .collect()
     }

@@ -552,7 +552,9 @@ impl PyBaseModel {
 /// rad, rad/s, rad/s^2, N m), or from a Recording given as `q` alone (`preprocess`'s: its
 /// states, torques, time and Coulomb column; see `samples`), or from a list of them (runs
 /// fitted together, one after the other; what each one's preprocessing found kept in the
-/// model's `logs`). `friction`: True (viscous, Coulomb and offset per joint), False,
+/// model's `logs`; Recordings that share samples, one given twice, refused). A Recording's own
+/// findings (position rounding) were warned of by `preprocess` and are not warned of again.
+/// `friction`: True (viscous, Coulomb and offset per joint), False,
 /// or a list of those names; `weighting`: 'wls' (default) or 'ols'; `gravity`: whether `tau`
 /// includes gravity; `tolerance`: relative rank tolerance of the pivoted QR. `t` ((k,) s),
 /// when the samples are a log: its qd and qdd columns are checked against the derivatives of
@@ -598,7 +600,8 @@ pub(crate) fn identify_base_parameters<'py>(
         let fit = detached(py, "identify_base_parameters", || {
             fit_recordings(model, &recs, &options)
         })?;
-        super::errors::warn_all(py, &fit.warnings())?;
+        // the Recordings' own findings were warned of by the preprocessing that made them
+        super::errors::warn_all(py, &fit.fit_warnings())?;
         return Ok(PyBaseModel {
             fit,
             model: Arc::new(model.clone()),
@@ -626,7 +629,11 @@ pub(crate) fn identify_base_parameters<'py>(
             None => fit,
         })
     })?;
-    super::errors::warn_all(py, &fit.warnings())?;
+    match recording {
+        // its findings were warned of by the preprocessing that made it
+        Some(_) => super::errors::warn_all(py, &fit.fit_warnings())?,
+        None => super::errors::warn_all(py, &fit.warnings())?,
+    }
     Ok(PyBaseModel {
         fit,
         model: Arc::new(model.clone()),

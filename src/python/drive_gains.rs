@@ -159,7 +159,9 @@ fn run_arrays(r: usize, rec: &Recording, nv: usize) -> Result<(&[f64], &[f64])> 
 /// towards 0 by the signal's noise as `noise_bias` says) or "instrumental" (instrumental
 /// variables, the signal predicted by the least-squares fit for instrument: consistent under
 /// the signal's noise). `friction`, `weighting`, `gravity`, `tolerance`, `seed` as for
-/// `identify_base_parameters`. Findings are warned of.
+/// `identify_base_parameters`. Findings are warned of. What each run's preprocessing found
+/// (glitches, dropouts, position rounding, ...) is kept in the model's `logs`, named by the
+/// Recording, as `perturbid identify-gains` keeps its logs'.
 #[pyfunction]
 #[pyo3(signature = (robot, runs, payloads, friction=None, weighting="wls", gravity=true, tolerance=1e-8, seed=0, estimator="least_squares"))]
 #[allow(clippy::too_many_arguments)]
@@ -234,9 +236,18 @@ pub(crate) fn identify_drive_gains(
                 payload: payload.as_ref(),
             });
         }
-        Ok(gains_rs(model, &gain_runs, &options, estimator)?.model)
+        let fit = gains_rs(model, &gain_runs, &options, estimator)?.model;
+        // what each run's preprocessing found, kept with the model as the command line keeps
+        // its logs'
+        Ok::<_, Error>(crate::direct::BaseModel {
+            logs: (recordings.iter())
+                .map(|r| crate::direct::LogFindings::of(&r.name, r))
+                .collect(),
+            ..fit
+        })
     })?;
-    super::errors::warn_all(py, &fit.warnings())?;
+    // the runs' own findings were warned of by the preprocessing that made them
+    super::errors::warn_all(py, &fit.fit_warnings())?;
     Ok(PyBaseModel {
         fit,
         model: Arc::new(model.clone()),

@@ -1074,6 +1074,33 @@ def test_positions_in_coarse_counts_under_derived_velocities_are_warned_of():
     assert logged.position_rounding == []
 
 
+def test_a_fit_of_recordings_does_not_warn_again_of_their_rounding():
+    """The preprocessing warns of positions in coarse counts once, naming the log; a fit of the
+    Recording (or a list of them) keeps the finding in the model but does not warn of it a
+    second time. A Recording's name of any length is kept so that the model loads again."""
+    robot = pr.robots.a465()
+    t = np.arange(0, 20, 0.001)
+    q = np.stack([0.5 * np.sin(2 * np.pi * 0.1 * (j + 1) * t + j) for j in range(6)], 1)
+    qd = np.gradient(q, t, axis=0)
+    tau = robot.rnea(q, qd, np.gradient(qd, t, axis=0)) + np.random.default_rng(0).normal(0, 0.01, q.shape)
+    coarse = np.round(q / 2e-3) * 2e-3
+    with pytest.warns(pr.PerturbidWarning, match="a.csv: positions logged in coarse counts"):
+        a = pr.preprocess(t, coarse, tau, name="a.csv")
+    with pytest.warns(pr.PerturbidWarning, match="coarse counts"):
+        b = pr.preprocess(t[:15000], coarse[:15000] * 1.01, tau[:15000], name="b" * 5000)
+    for given in [a, [a, b]]:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            fit = pr.identify_base_parameters(robot, given, friction=None)
+        assert not any("coarse counts" in str(w.message) for w in caught), [str(w.message)[:80] for w in caught]
+        saved = json.loads(fit.to_json())
+        found = saved["position_rounding"] if given is a else saved["logs"][0]["position_rounding"]
+        assert [r["joint"] for r in found if r["qdd_ratio"] >= 0.1] == [0, 1], found
+    # the longest name is cut to 4,096 characters, ending in an ellipsis
+    long = saved["logs"][1]["log"]
+    assert len(long) == 4096 and long.endswith("\u2026") and long.startswith("bbb")
+
+
 def test_a_logs_derivative_columns_are_checked_when_its_time_is_given():
     """With `t`, identify_base_parameters and identify_consistent_parameters take the samples
     for a log and refuse velocity or acceleration columns that are not the derivatives of the

@@ -108,6 +108,8 @@ def test_gains_match_numpy_least_squares_over_pinocchios_regressor(setup):
     assert np.all(err < 4 * g["stderr"] + g["noise_bias"] * GAINS), (g, GAINS)
     assert np.all(g["noise_bias"] < 1e-3) and np.all(g["payload_torque_rms"] > 0.01)
     assert np.all((g["agreement"] > 0.95) & (g["agreement"] < 1.2))
+    # each run's findings kept in `logs`, named by its Recording, as identify-gains keeps its logs'
+    assert [l["log"] for l in json.loads(fit.to_json())["logs"]] == ["run0", "run1"]
 
 
 def test_instrumental_gains_match_numpy_and_lose_the_noise_bias():
