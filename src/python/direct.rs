@@ -16,14 +16,14 @@ use pyo3::types::PyDict;
 use super::arrays::{
     at_states_with, expansion_dict, matrix_to_numpy as mat, read_batch, to_numpy, vector, ArrayLike,
 };
+use super::findings::{
+    position_offsets_dict, position_range_dicts, torque_column_dicts, torque_lag_dict,
+};
 use super::local::PyOperatingPoint;
 use super::robot::PyRobot;
 use super::samples::{samples, Given};
-use crate::direct::position_offsets::PositionOffsets;
-use crate::direct::position_range::JointRange;
 use crate::direct::{
-    identify_base_parameters as base_rs, BaseModel, BaseOptions, FrictionTerms, TorqueColumn,
-    TorqueLag, Weighting,
+    identify_base_parameters as base_rs, BaseModel, BaseOptions, FrictionTerms, Weighting,
 };
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -56,33 +56,6 @@ pub(crate) fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<Frict
             .into())
         }
     })
-}
-
-/// The joints' zero offsets as a dict (`BaseParameterModel.position_offsets`,
-/// `Validation.position_offsets`), with its `finding`.
-pub(crate) fn position_offsets_dict<'py>(
-    py: Python<'py>,
-    o: &PositionOffsets,
-    finding: Option<String>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let e = PyDict::new(py);
-    e.set_item("joints", &o.joints)?;
-    e.set_item("offsets", &o.offsets)?;
-    e.set_item("stderr", &o.stderr)?;
-    e.set_item("unexplained", o.unexplained)?;
-    e.set_item("unexplained_with_offsets", o.unexplained_with_offsets)?;
-    let left_out = (o.left_out.iter())
-        .map(|l| {
-            let d = PyDict::new(py);
-            d.set_item("joint", &l.joint)?;
-            d.set_item("why", serde_json::to_value(l.why).expect("a name").as_str())?;
-            d.set_item("stderr", l.stderr)?;
-            Ok(d)
-        })
-        .collect::<PyResult<Vec<_>>>()?;
-    e.set_item("left_out", left_out)?;
-    e.set_item("finding", finding)?;
-    Ok(e)
 }
 
 /// Row-major (k, n) samples of three arrays and optionally a fourth.
@@ -721,61 +694,4 @@ fn fit_recordings(
             .collect(),
         ..fit
     })
-}
-
-/// The torque columns' checks as dicts (see `BaseParameterModel.torque_columns`), each with
-/// its `finding` among `columns`.
-pub(crate) fn torque_column_dicts<'py>(
-    py: Python<'py>,
-    columns: &[TorqueColumn],
-) -> PyResult<Vec<Bound<'py, PyDict>>> {
-    columns
-        .iter()
-        .map(|c| {
-            let e = PyDict::new(py);
-            e.set_item("joint", &c.joint)?;
-            e.set_item("scale", c.scale)?;
-            e.set_item("explained", c.explained)?;
-            e.set_item("follows", &c.follows)?;
-            e.set_item("follows_explained", c.follows_explained)?;
-            e.set_item("gravity_rms", c.gravity_rms)?;
-            e.set_item("finding", c.finding(columns))?;
-            Ok(e)
-        })
-        .collect()
-}
-
-/// Joints whose positions leave their limits as dicts (see
-/// `BaseParameterModel.position_range`).
-pub(crate) fn position_range_dicts<'py>(
-    py: Python<'py>,
-    ranges: &[JointRange],
-) -> PyResult<Vec<Bound<'py, PyDict>>> {
-    ranges
-        .iter()
-        .map(|r| {
-            let e = PyDict::new(py);
-            e.set_item("joint", &r.joint)?;
-            e.set_item("min", r.min)?;
-            e.set_item("max", r.max)?;
-            e.set_item("lower", r.lower)?;
-            e.set_item("upper", r.upper)?;
-            e.set_item("degrees", r.degrees)?;
-            Ok(e)
-        })
-        .collect()
-}
-
-/// The torques' lag as a dict (see `BaseParameterModel.torque_lag`).
-pub(crate) fn torque_lag_dict<'py>(
-    py: Python<'py>,
-    lag: &TorqueLag,
-) -> PyResult<Bound<'py, PyDict>> {
-    let e = PyDict::new(py);
-    e.set_item("samples", lag.samples)?;
-    e.set_item("joints", &lag.joints)?;
-    e.set_item("unexplained", lag.unexplained)?;
-    e.set_item("unexplained_at_lag", lag.unexplained_at_lag)?;
-    e.set_item("finding", lag.finding())?;
-    Ok(e)
 }

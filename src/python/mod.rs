@@ -9,6 +9,7 @@ mod direct;
 mod drive_gains;
 mod errors;
 mod excitation;
+mod findings;
 mod global_linear;
 mod linearization;
 mod local;

@@ -7,10 +7,11 @@ use pyo3::types::PyDict;
 
 use super::arrays::{read_batch, to_numpy};
 use super::detached;
-use super::direct::{
-    position_offsets_dict, position_range_dicts, torque_column_dicts, torque_lag_dict, PyBaseModel,
-};
+use super::direct::PyBaseModel;
 use super::errors::warn_all;
+use super::findings::{
+    position_offsets_dict, position_range_dicts, torque_column_dicts, torque_lag_dict,
+};
 use super::local_model::PyLocalModel;
 use super::tables::dataframe;
 use crate::direct::position_offsets::{check_position_offsets_in_validation, PositionOffsets};
