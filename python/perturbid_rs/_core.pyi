@@ -481,6 +481,12 @@ class LocalModel:
     def to_json(self) -> str: ...
     @staticmethod
     def from_json(text: str) -> "LocalModel": ...
+    def save(self, path: Union[str, PathLike[str]]) -> None:
+        """Writes the model as JSON (atomically), the local_model.json of ``perturbid identify``."""
+    @staticmethod
+    def load(path: Union[str, PathLike[str]]) -> "LocalModel":
+        """A model saved by ``save`` or ``perturbid identify``; FileError, or InputError naming
+        the file and field."""
 
 def plan_experiments(
     robot: Robot,
@@ -729,6 +735,16 @@ class BaseParameterModel:
         stored."""
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]: ...
     def to_json(self) -> str: ...
+    @staticmethod
+    def from_json(text: str, robot: Robot) -> "BaseParameterModel": ...
+    def save(self, path: Union[str, PathLike[str]]) -> None:
+        """Writes the model as JSON (atomically), the base_model.json of ``perturbid
+        identify-direct``."""
+    @staticmethod
+    def load(path: Union[str, PathLike[str]], robot: Robot) -> "BaseParameterModel":
+        """A model saved by ``save``, ``perturbid identify-direct`` or ``identify-gains``, for
+        the robot it was identified for; FileError, or InputError naming the file and field, or
+        the robot it does not fit."""
 
 @final
 class GlobalLinearModel:

@@ -3,6 +3,7 @@
 //! design `super::excitation`).
 
 use std::borrow::Cow;
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use numpy::PyArray1;
@@ -25,6 +26,7 @@ use super::samples::{samples, Given};
 use crate::direct::{
     identify_base_parameters as base_rs, BaseModel, BaseOptions, FrictionTerms, Weighting,
 };
+use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::states::States;
@@ -56,6 +58,19 @@ pub(crate) fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<Frict
             .into())
         }
     })
+}
+
+/// `fit` (read from `source`) checked against the robot `model` it is to predict for: errors
+/// name the source.
+fn fitted_to(fit: BaseModel, model: &Model, source: &str) -> Result<BaseModel> {
+    match fit.on(model) {
+        Ok(_) => Ok(fit),
+        Err(Error::InvalidArgument { argument, message }) => Err(Error::InvalidArgument {
+            argument,
+            message: format!("{source}: {message}; give the robot it was identified for"),
+        }),
+        Err(e) => Err(e),
+    }
 }
 
 /// Row-major (k, n) samples of three arrays and optionally a fourth.
@@ -507,8 +522,43 @@ impl PyBaseModel {
         }
         to_numpy(py, out, batch.k, batch.single, &[n, n])
     }
+    /// The model as JSON text: the document `perturbid identify-direct` writes, read back by
+    /// `from_json` (and by `perturbid predict`).
     fn to_json(&self) -> String {
-        serde_json::to_string_pretty(&self.fit).expect("serialisable")
+        Document::to_json(&self.fit)
+    }
+    /// Writes the model to `path` as JSON (atomically: a temporary file renamed into place),
+    /// the document `perturbid identify-direct` writes. Raises FileError when it cannot be
+    /// written.
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        Ok(detached(py, "BaseParameterModel.save", || {
+            self.fit.save(&path)
+        })?)
+    }
+    /// A model saved by `save` or by `perturbid identify-direct` / `identify-gains`
+    /// (`base_model.json`), for `robot`, the one it was identified for (the same joints,
+    /// bodies and parameter names: a URDF of the same robot with other inertias is fine).
+    /// Checked as `perturbid predict` checks it: every field, its shapes and ranges. Raises
+    /// FileError for a file that cannot be read, InputError naming the file and field of a
+    /// document that is not such a model (another kind of document, a hand-edited value out
+    /// of range), or the robot it does not fit.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf, robot: &PyRobot) -> PyResult<Self> {
+        let model = Arc::new(robot.model.clone());
+        let fit = detached(py, "BaseParameterModel.load", || {
+            let fit = BaseModel::load(&path)?;
+            fitted_to(fit, &model, &path.display().to_string())
+        })?;
+        Ok(Self { fit, model })
+    }
+    /// `load` from the JSON text `text` (of `to_json`).
+    #[staticmethod]
+    fn from_json(text: &str, robot: &PyRobot) -> PyResult<Self> {
+        let fit = fitted_to(BaseModel::from_json(text)?, &robot.model, "the model")?;
+        Ok(Self {
+            fit,
+            model: Arc::new(robot.model.clone()),
+        })
     }
     fn __repr__(&self) -> String {
         format!(

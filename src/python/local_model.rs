@@ -1,6 +1,8 @@
 //! Python: `LocalModel`, the paper's local model at an operating point with its uncertainty and
 //! diagnostics (mirrors `crate::local::LocalModel`).
 
+use std::path::PathBuf;
+
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -471,6 +473,22 @@ impl PyLocalModel {
         Ok(Self {
             model: <LocalModel as Document>::from_json(text)?,
         })
+    }
+    /// Writes the model to `path` as JSON (atomically: a temporary file renamed into place),
+    /// the document `perturbid identify` writes (`local_model.json`). Raises FileError when it
+    /// cannot be written.
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        Ok(super::detached(py, "LocalModel.save", || {
+            Document::save(&self.model, &path)
+        })?)
+    }
+    /// A model saved by `save` or by `perturbid identify`, checked as `from_json` checks it.
+    /// Raises FileError for a file that cannot be read, InputError naming the file and field
+    /// of a document that is not a local model.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let model = super::detached(py, "LocalModel.load", || LocalModel::load(&path))?;
+        Ok(Self { model })
     }
     fn __repr__(&self) -> String {
         let parts: Vec<String> = self

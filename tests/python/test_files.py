@@ -153,3 +153,57 @@ def test_a_session_log_splits_into_its_experiments(tmp_path):
     # a log cut short: the first run that no longer fits is named
     with pytest.raises(pr.InputError, match=r"experiment '\w+': its run \(\d+\.\d+ s\) does not fit in the log between .* \(the log's end\)"):
         plan.split_session(pr.Recording(log.t[: len(log) // 2], log.q[: len(log) // 2], log.tau[: len(log) // 2]))
+
+
+def cli(*args):
+    """`perturbid ARGS`, which must succeed; returns its stdout."""
+    run = subprocess.run([sys.executable, "-m", "perturbid_rs", *map(str, args)], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    return run.stdout
+
+
+def test_models_through_files_as_the_command_line_writes_them(tmp_path):
+    """BaseParameterModel.save / load and LocalModel.save / load: what the command line writes
+    loads in Python and predicts what `perturbid predict` predicts; a model saved from Python
+    is the command line's document; a file that is not such a model, or a robot the model does
+    not fit, is refused by name."""
+    robot = pr.robots.a465()
+    traj = pr.design_excitation(robot, harmonics=3, base_frequency=0.2, max_evaluations=20, seed=1).trajectory
+    t = np.arange(0, traj.period, 0.005)
+    q, qd, qdd = traj.sample(t)
+    tau = robot.rnea(q, qd, qdd) + np.random.default_rng(4).normal(0, 0.01, q.shape)
+    pr.Recording(t, q, tau, qd=qd, qdd=qdd, name="log").save(tmp_path / "log.csv")
+    cli("identify-direct", "a465", tmp_path / "log.csv", "--out", tmp_path / "base.json", "--validate", "0")
+    cli("predict", tmp_path / "base.json", tmp_path / "log.csv", "--robot", "a465", "--stderr", "--out", tmp_path / "p.csv")
+    fit = pr.BaseParameterModel.load(tmp_path / "base.json", robot)
+    predicted = np.loadtxt(tmp_path / "p.csv", delimiter=",", skiprows=1)
+    np.testing.assert_allclose(fit.predict(q, qd, qdd), predicted[:, 1:7], rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(fit.predict_stderr(q, qd, qdd), predicted[:, 7:13], rtol=1e-12, atol=1e-15)
+    # saved from Python: the same document, which the command line reads
+    fit.save(tmp_path / "again.json")
+    assert (tmp_path / "again.json").read_text() == (tmp_path / "base.json").read_text()
+    back = pr.BaseParameterModel.from_json(fit.to_json(), robot)
+    np.testing.assert_array_equal(back.theta_base, fit.theta_base)
+    # refused by name: another robot, another document, a hand-edited value, no file
+    other = pr.Robot.from_urdf_string(pr.robots.a465_urdf(), lock={"joint6": 0.0})
+    with pytest.raises(pr.InputError, match=r"robot: .*base.json: the model was identified for 'a465\w*' with joints \[joint1, .*joint6\]; give the robot"):
+        pr.BaseParameterModel.load(tmp_path / "base.json", other)
+    text = (tmp_path / "base.json").read_text()
+    (tmp_path / "nan.json").write_text(text.replace('"cond": ', '"cond": -', 1))
+    with pytest.raises(pr.InputError, match="nan.json"):
+        pr.BaseParameterModel.load(tmp_path / "nan.json", robot)
+    with pytest.raises(pr.FileError, match="missing.json"):
+        pr.BaseParameterModel.load(tmp_path / "missing.json", robot)
+    # a local model, through its files
+    plan = pr.plan_experiments(robot, pr.OperatingPoint(*TABLE2), seed=1, keep_velocity_sign=True)
+    local = pr.identify_local(plan, pr.simulate(robot, plan, torque_noise=0.05, seed=2))
+    local.save(tmp_path / "local.json")
+    loaded = pr.LocalModel.load(tmp_path / "local.json")
+    assert loaded.to_json() == local.to_json()
+    np.testing.assert_array_equal(loaded.predict(q[:5], qd[:5], qdd[:5]), local.predict(q[:5], qd[:5], qdd[:5]))
+    with pytest.raises(pr.InputError, match="local.json"):
+        pr.BaseParameterModel.load(tmp_path / "local.json", robot)
+    with pytest.raises(pr.InputError, match="base.json"):
+        pr.LocalModel.load(tmp_path / "base.json")
+    with pytest.raises(pr.FileError):
+        local.save(tmp_path / "local.json" / "m.json")  # under a file
