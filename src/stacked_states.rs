@@ -16,6 +16,9 @@ pub struct StackedStates {
     pub qdd: Vec<f64>,
     pub coulomb: Option<Vec<f64>>,
     pub data: Vec<f64>,
+    /// The samples of each run, in their order: a fit's [`crate::direct::BaseOptions::runs`],
+    /// so that each run's residuals are read as a time series of their own.
+    pub runs: Vec<usize>,
 }
 
 impl StackedStates {
@@ -52,6 +55,7 @@ impl StackedStates {
             qdd: Vec::with_capacity(k * nv),
             coulomb: filtered.then(|| Vec::with_capacity(k * nv)),
             data: Vec::with_capacity(k * nv),
+            runs: parts.iter().map(|(s, _)| s.len()).collect(),
         };
         for (r, (s, data)) in parts.iter().enumerate() {
             let (Some(qd), Some(qdd)) = (s.qd(), s.qdd()) else {

@@ -353,6 +353,21 @@ impl SpreadRows {
         self.rows.len()
     }
 
+    /// How many of the rows fall in each of consecutive runs of `runs` samples (of the `k`
+    /// spread over; empty for one run): the picked rows' runs, in order.
+    pub(crate) fn counts_in(&self, runs: &[usize]) -> Vec<usize> {
+        let mut end = 0;
+        (runs.iter())
+            .map(|&len| {
+                let start = end;
+                end += len;
+                (self.rows.iter())
+                    .filter(|&&i| (start..end).contains(&i))
+                    .count()
+            })
+            .collect()
+    }
+
     /// Those rows of `x` (row-major, `n` per sample).
     pub(crate) fn pick(&self, x: &[f64]) -> Vec<f64> {
         let n = self.n;

@@ -792,6 +792,19 @@ fn options_that_mean_nothing_are_refused() {
         let e = identify_base_parameters(&model, &states, &q, &options).unwrap_err();
         assert!(e.to_string().starts_with("tolerance: "), "{e}");
     }
+    // runs that are not the samples' (10 of them)
+    for (runs, says) in [
+        (vec![4, 5], "runs: runs of 9 samples in all, for 10 samples"),
+        (vec![0, 10], "runs: run 0 has no samples"),
+        (vec![1; 1001], "runs: 1001 runs, expected at most 1000"),
+    ] {
+        let options = BaseOptions {
+            runs,
+            ..BaseOptions::default()
+        };
+        let e = identify_base_parameters(&model, &states, &q, &options).unwrap_err();
+        assert!(e.to_string().starts_with(says), "{e}");
+    }
 }
 
 mod fuzz {

@@ -254,7 +254,11 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         1 => in_log(&a.data[0])(e),
         _ => e,
     };
-    let options = a.fit.options();
+    // each log's residuals a time series of their own
+    let options = crate::direct::BaseOptions {
+        runs: stacked.as_ref().map_or(vec![], |(t, _)| t.runs.clone()),
+        ..a.fit.options()
+    };
     progress.update(&format!("identifying on {split} samples"));
     // with the Coulomb term's column filtered as the torques were
     let fit = if a.consistent {

@@ -528,6 +528,11 @@ pub fn identify_drive_gains_with(
     let tau: Vec<f64> = (0..k * nv)
         .map(|x| gain[x % nv] * signal[x] + rhs[x])
         .collect();
+    // each run's residuals a time series of their own
+    let options = &BaseOptions {
+        runs: stacked.runs.clone(),
+        ..options.clone()
+    };
     let (mut model_fit, _) = fit_with_factors(model, &states, &tau, options)?;
     let inflation = model_fit.stderr_inflation();
     let stderr: Vec<f64> = fit.stderr.row(0).iter().map(|s| s * inflation).collect();

@@ -45,6 +45,15 @@ pub struct BaseOptions {
     /// Random states used to find the base parameters (default 200) and their seed.
     pub states: usize,
     pub seed: u64,
+    /// The samples as several runs one after the other (logs of other excitations, other
+    /// days): the number of samples of each, adding up to all of them
+    /// ([`crate::stacked_states::StackedStates::runs`]). Each run's residuals are a time
+    /// series of their own: their correlation from sample to sample is estimated within each
+    /// run, not across the joins, where two logs' residuals may differ in mean (a torque
+    /// offset that drifted between them read as correlation at every lag, and inflated the
+    /// standard errors six times for 0.02 N m). Empty (default): one run. At most
+    /// [`super::drive_gains::MAX_RUNS`].
+    pub runs: Vec<usize>,
 }
 
 impl Default for BaseOptions {
@@ -56,6 +65,7 @@ impl Default for BaseOptions {
             tolerance: BASE_TOLERANCE,
             states: 200,
             seed: 0,
+            runs: vec![],
         }
     }
 }
@@ -340,6 +350,7 @@ pub(super) fn fit_with_factors(
     states.check_companion("tau", tau, nv)?;
     crate::limits::check_range("tolerance", options.tolerance, 1e-15, 0.1)?;
     crate::limits::check_count("states", options.states, 1, 1_000_000)?;
+    check_runs(&options.runs, states.len())?;
     crate::torque_model::refuse_flat_torques(
         states,
         tau,
@@ -397,11 +408,8 @@ pub(super) fn fit_with_factors(
     fit.weak_excitation =
         super::weak_excitation::check_excitation(model, states, &fit.base, ls.cond, &ls.weakest);
     // residuals correlated from sample to sample (a filtered, lightly decimated log) carry less
-    // information than their number says
-    let head = states.slice(0..k.min(super::residual_correlation::SAMPLES));
-    let predicted = fit.predict(model, &head)?;
-    let residuals: Vec<f64> = tau.iter().zip(&predicted).map(|(t, p)| t - p).collect();
-    fit.residual_correlation = super::residual_correlation::long_run_factors(&residuals, nv);
+    // information than their number says: estimated from the first samples of each run
+    fit.residual_correlation = run_factors(model, &fit, states, tau, &options.runs)?;
     let inflation = fit.stderr_inflation();
     for se in &mut fit.stderr {
         *se *= inflation;
@@ -411,6 +419,62 @@ pub(super) fn fit_with_factors(
     fit.unmodelled_friction =
         super::unmodelled_friction::check_unmodelled_friction(model, &fit, states, tau, options)?;
     Ok((fit, factors))
+}
+
+/// Refuses `runs` ([`BaseOptions::runs`]) that are not the lengths of consecutive runs of `k`
+/// samples: none of 0, adding up to `k`, at most [`super::drive_gains::MAX_RUNS`].
+fn check_runs(runs: &[usize], k: usize) -> Result<()> {
+    let most = super::drive_gains::MAX_RUNS;
+    let problem = if runs.len() > most {
+        Some(format!("{} runs, expected at most {most}", runs.len()))
+    } else if let Some(r) = runs.iter().position(|&len| len == 0) {
+        Some(format!("run {r} has no samples"))
+    } else if !runs.is_empty() && runs.iter().sum::<usize>() != k {
+        Some(format!(
+            "runs of {} samples in all, for {k} samples",
+            runs.iter().sum::<usize>()
+        ))
+    } else {
+        None
+    };
+    match problem {
+        Some(message) => Err(Error::InvalidArgument {
+            argument: "runs".into(),
+            message,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Per joint, the residuals' long-run variance factor of `fit` on the samples `states`, `tau`
+/// (row-major `k x nv`), in runs of `runs` samples (empty: one): from each run's first samples
+/// ([`super::residual_correlation::SAMPLES`] shared among them, at least
+/// [`super::residual_correlation::SAMPLES_A_RUN`] each), combined as their information is.
+fn run_factors(
+    model: &Model,
+    fit: &BaseModel,
+    states: &States<'_>,
+    tau: &[f64],
+    runs: &[usize],
+) -> Result<Vec<f64>> {
+    use super::residual_correlation::{combine, long_run_factors, SAMPLES, SAMPLES_A_RUN};
+    let (nv, k) = (model.nv, states.len());
+    let whole = [k];
+    let runs = if runs.is_empty() { &whole[..] } else { runs };
+    let head = (SAMPLES / runs.len()).max(SAMPLES_A_RUN);
+    let mut start = 0;
+    let mut factors = Vec::with_capacity(runs.len());
+    for &len in runs {
+        let rows = start..start + len.min(head);
+        let predicted = fit.predict(model, &states.slice(rows.clone()))?;
+        let residuals: Vec<f64> = (tau[rows.start * nv..rows.end * nv].iter())
+            .zip(&predicted)
+            .map(|(t, p)| t - p)
+            .collect();
+        factors.push((long_run_factors(&residuals, nv), len));
+        start += len;
+    }
+    Ok(combine(&factors, nv))
 }
 
 impl BaseModel {

@@ -73,6 +73,52 @@ pub fn long_run_factors(r: &[f64], n: usize) -> Vec<f64> {
         .collect()
 }
 
+/// The samples (the first ones) of each of several runs whose residuals estimate its
+/// autocorrelation, at the least: [`SAMPLES`] are shared among the runs, but none reads fewer
+/// than this.
+pub const SAMPLES_A_RUN: usize = 1_000;
+
+/// [`long_run_factors`] of residuals `r` (row-major, `k x n`) that are several runs one after
+/// the other, of `runs` samples each (they add up to `k`; empty for one run): each run is a
+/// time series of its own (a join between two logs is no lag, and two logs' residuals may
+/// differ in mean: a torque offset that drifted between them would read as correlation at
+/// every lag), its factor `f_ij` estimated within it. Per joint the factors combine as the
+/// samples' information does: `f_j = sum_i k_i / sum_i (k_i / f_ij)`, `k_i` the run's
+/// samples.
+pub fn long_run_factors_over_runs(r: &[f64], n: usize, runs: &[usize]) -> Vec<f64> {
+    let k = r.len().checked_div(n).unwrap_or(0);
+    if runs.len() <= 1 || runs.iter().sum::<usize>() != k {
+        return long_run_factors(r, n);
+    }
+    let mut start = 0;
+    let factors: Vec<(Vec<f64>, usize)> = (runs.iter())
+        .map(|&len| {
+            let f = long_run_factors(&r[start * n..(start + len) * n], n);
+            start += len;
+            (f, len)
+        })
+        .collect();
+    combine(&factors, n)
+}
+
+/// Per joint, the factors `(f_i, k_i)` of runs of `k_i` samples combined as their
+/// information is: `sum k_i / sum (k_i / f_ij)` (1 for no samples).
+pub fn combine(factors: &[(Vec<f64>, usize)], n: usize) -> Vec<f64> {
+    if let [(f, _)] = factors {
+        return f.clone();
+    }
+    let total: usize = factors.iter().map(|(_, k)| k).sum();
+    (0..n)
+        .map(|j| {
+            let information: f64 = (factors.iter()).map(|(f, k)| *k as f64 / f[j]).sum();
+            match total {
+                0 => 1.0,
+                _ => (total as f64 / information).max(1.0),
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -123,5 +169,33 @@ mod tests {
         // too few samples, zeros: 1
         assert_eq!(long_run_factors(&[1.0, 2.0, 3.0], 1), vec![1.0]);
         assert_eq!(long_run_factors(&vec![0.0; 100], 2), vec![1.0, 1.0]);
+    }
+
+    #[test]
+    fn runs_are_series_of_their_own_and_their_factors_combine_as_information() {
+        // two runs of white noise whose means differ: read across the join the step is
+        // correlation at every lag; run by run there is none
+        let k = 20_000;
+        let e = white(2 * k, 5);
+        let r: Vec<f64> = (0..2 * k)
+            .map(|i| e[i] + if i < k { 0.3 } else { -0.3 })
+            .collect();
+        let across = long_run_factors(&r, 1)[0];
+        let within = long_run_factors_over_runs(&r, 1, &[k, k])[0];
+        assert!(across > 50.0, "{across}");
+        assert!((within - 1.0).abs() < 0.15, "{within}");
+        // a white run and a moving average of 5 (factor 5), of k and 3k samples:
+        // 4k / (k / 1 + 3k / 5) = 2.5
+        let e = white(4 * k + 4, 7);
+        let mut r: Vec<f64> = e[..k].to_vec();
+        r.extend((k..4 * k).map(|i| e[i..i + 5].iter().sum::<f64>() / 5.0));
+        let f = long_run_factors_over_runs(&r, 1, &[k, 3 * k])[0];
+        assert!((f / 2.5 - 1.0).abs() < 0.1, "{f}");
+        // runs that do not add up to the samples are one run
+        assert_eq!(
+            long_run_factors_over_runs(&r, 1, &[k, k]),
+            long_run_factors(&r, 1)
+        );
+        assert_eq!(combine(&[], 2), vec![1.0, 1.0]);
     }
 }

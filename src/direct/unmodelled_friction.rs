@@ -235,7 +235,12 @@ pub fn check_unmodelled_friction(
         Ok(measured.iter().zip(&p).map(|(t, p)| t - p).collect())
     };
     let (before, after) = (residual(fit)?, residual(&refit)?);
-    let long_run = super::residual_correlation::long_run_factors(&after, n);
+    // each run's rows a time series of their own
+    let long_run = super::residual_correlation::long_run_factors_over_runs(
+        &after,
+        n,
+        &rows.counts_in(&options.runs),
+    );
     let table = refit.parameter_table();
     let sum_of_squares =
         |r: &[f64], j: usize| (0..count).map(|i| r[i * n + j].powi(2)).sum::<f64>();

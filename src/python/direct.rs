@@ -737,7 +737,12 @@ fn fit_recordings(
         .map(|(i, r)| format!("Recording {i} ('{}')", r.name))
         .collect();
     let stacked = crate::stacked_states::StackedStates::of_named(&parts, &names, "q")?;
-    let fit = base_rs(model, &stacked.states()?, &stacked.data, options)?;
+    // each Recording's residuals a time series of their own
+    let options = BaseOptions {
+        runs: stacked.runs.clone(),
+        ..options.clone()
+    };
+    let fit = base_rs(model, &stacked.states()?, &stacked.data, &options)?;
     Ok(crate::direct::BaseModel {
         logs: (recs.iter())
             .map(|r| crate::direct::LogFindings::of(&r.name, r))
