@@ -6,7 +6,7 @@
 
 mod cli_support;
 
-use cli_support::{excitation_log, fails, ok, s, tmp};
+use cli_support::{excitation_log, fails, ok, s, tmp, warnings_of};
 use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
 use perturbid_rs::document::Document;
 use perturbid_rs::io::load_recording;
@@ -222,4 +222,60 @@ fn a_log_given_twice_is_refused() {
         "--validate",
         "0",
     ]);
+}
+
+/// Two logs whose torque offsets differ (0.1 N m added to the second's): the joints whose
+/// residuals differ in mean from log to log are warned of, naming both logs, and kept in the
+/// model; the same two logs as they were are not.
+#[test]
+fn an_offset_that_drifted_between_logs_is_named() {
+    let d = tmp("offset-drift");
+    let logs = [5, 6].map(|seed| excitation_log(&d, seed));
+    let text = std::fs::read_to_string(&logs[1]).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    let shifted: Vec<String> = lines
+        .map(|row| {
+            let values: Vec<String> = (row.split(',').enumerate())
+                .map(|(c, v)| match c {
+                    7.. => format!("{}", v.parse::<f64>().unwrap() + 0.1),
+                    _ => v.to_string(),
+                })
+                .collect();
+            values.join(",")
+        })
+        .collect();
+    let drifted = d.join("drifted.csv");
+    std::fs::write(&drifted, format!("{header}\n{}\n", shifted.join("\n"))).unwrap();
+    let out = d.join("m.json");
+    let fit = |b: &Path| {
+        let args = [
+            "identify-direct",
+            "a465",
+            s(&logs[0]),
+            s(b),
+            "--out",
+            s(&out),
+            "--validate",
+            "0",
+        ];
+        (warnings_of(&args), BaseModel::load(&out).unwrap())
+    };
+    let (warned, model) = fit(&drifted);
+    assert!(
+        warned.contains("differ in mean from log to log, from -0.")
+            && warned.contains(s(&drifted))
+            && warned.contains(s(&logs[0])),
+        "{warned}"
+    );
+    assert!(!model.run_offsets.is_empty());
+    for o in &model.run_offsets {
+        // the second log's residuals sit above the first's
+        assert!(o.means[1] > o.means[0] + 5.0 * o.stderr[0], "{o:?}");
+    }
+    let (warned, model) = fit(&logs[1]);
+    assert!(
+        model.run_offsets.is_empty() && !warned.contains("differ in mean"),
+        "{warned}"
+    );
 }

@@ -679,6 +679,11 @@ class BaseParameterModel:
         to the logged positions, stderr, unexplained, unexplained_with_offsets, finding), or
         None where no joint's offset is determined; a finding is also a warning."""
     @property
+    def run_offsets(self) -> list[dict[str, Any]]:
+        """Fitted over several Recordings: joints whose residuals differ in mean from run to
+        run (a torque offset that drifted), dicts joint, means, stderr ((runs,) N m),
+        residual_rms, finding (also a warning)."""
+    @property
     def unmodelled_friction(self) -> list[dict[str, Any]]:
         """Joints whose torques show friction terms the fit lacks: joint, explained,
         residual_rms, remaining_rms, terms (dicts term, coefficient, stderr); also warnings."""

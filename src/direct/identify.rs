@@ -163,6 +163,12 @@ pub struct BaseModel {
     /// none do, the fit has every friction term, or in a model saved before it was checked.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub unmodelled_friction: Vec<super::unmodelled_friction::UnmodelledFriction>,
+    /// In a fit over several runs ([`BaseOptions::runs`]), the joints whose residuals differ in
+    /// mean from run to run ([`super::runs`]: a torque offset that drifted between the logs),
+    /// warned of ([`BaseModel::warnings`]). Empty otherwise, or in a model saved before it was
+    /// checked.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub run_offsets: Vec<super::runs::RunOffsets>,
     /// Where the data excite the base parameters weakly (`cond` beyond
     /// [`super::weak_excitation::WEAK_CONDITION`]): the least determined combination and how
     /// far each joint moved ([`super::weak_excitation`]), warned of ([`BaseModel::warnings`]).
@@ -350,7 +356,7 @@ pub(super) fn fit_with_factors(
     states.check_companion("tau", tau, nv)?;
     crate::limits::check_range("tolerance", options.tolerance, 1e-15, 0.1)?;
     crate::limits::check_count("states", options.states, 1, 1_000_000)?;
-    check_runs(&options.runs, states.len())?;
+    super::runs::check_runs(&options.runs, states.len())?;
     crate::torque_model::refuse_flat_torques(
         states,
         tau,
@@ -398,6 +404,7 @@ pub(super) fn fit_with_factors(
         position_range: super::position_range::check_position_range(model, states),
         position_offsets: None,
         unmodelled_friction: vec![],
+        run_offsets: vec![],
         weak_excitation: None,
         drive_gains: None,
         joint_term_rms: super::parameter_table::joint_term_rms(
@@ -409,7 +416,9 @@ pub(super) fn fit_with_factors(
         super::weak_excitation::check_excitation(model, states, &fit.base, ls.cond, &ls.weakest);
     // residuals correlated from sample to sample (a filtered, lightly decimated log) carry less
     // information than their number says: estimated from the first samples of each run
-    fit.residual_correlation = run_factors(model, &fit, states, tau, &options.runs)?;
+    // (and each run's mean: a torque offset that drifted between runs)
+    (fit.residual_correlation, fit.run_offsets) =
+        super::runs::run_residuals(model, &fit, states, tau, &options.runs)?;
     let inflation = fit.stderr_inflation();
     for se in &mut fit.stderr {
         *se *= inflation;
@@ -419,62 +428,6 @@ pub(super) fn fit_with_factors(
     fit.unmodelled_friction =
         super::unmodelled_friction::check_unmodelled_friction(model, &fit, states, tau, options)?;
     Ok((fit, factors))
-}
-
-/// Refuses `runs` ([`BaseOptions::runs`]) that are not the lengths of consecutive runs of `k`
-/// samples: none of 0, adding up to `k`, at most [`super::drive_gains::MAX_RUNS`].
-fn check_runs(runs: &[usize], k: usize) -> Result<()> {
-    let most = super::drive_gains::MAX_RUNS;
-    let problem = if runs.len() > most {
-        Some(format!("{} runs, expected at most {most}", runs.len()))
-    } else if let Some(r) = runs.iter().position(|&len| len == 0) {
-        Some(format!("run {r} has no samples"))
-    } else if !runs.is_empty() && runs.iter().sum::<usize>() != k {
-        Some(format!(
-            "runs of {} samples in all, for {k} samples",
-            runs.iter().sum::<usize>()
-        ))
-    } else {
-        None
-    };
-    match problem {
-        Some(message) => Err(Error::InvalidArgument {
-            argument: "runs".into(),
-            message,
-        }),
-        None => Ok(()),
-    }
-}
-
-/// Per joint, the residuals' long-run variance factor of `fit` on the samples `states`, `tau`
-/// (row-major `k x nv`), in runs of `runs` samples (empty: one): from each run's first samples
-/// ([`super::residual_correlation::SAMPLES`] shared among them, at least
-/// [`super::residual_correlation::SAMPLES_A_RUN`] each), combined as their information is.
-fn run_factors(
-    model: &Model,
-    fit: &BaseModel,
-    states: &States<'_>,
-    tau: &[f64],
-    runs: &[usize],
-) -> Result<Vec<f64>> {
-    use super::residual_correlation::{combine, long_run_factors, SAMPLES, SAMPLES_A_RUN};
-    let (nv, k) = (model.nv, states.len());
-    let whole = [k];
-    let runs = if runs.is_empty() { &whole[..] } else { runs };
-    let head = (SAMPLES / runs.len()).max(SAMPLES_A_RUN);
-    let mut start = 0;
-    let mut factors = Vec::with_capacity(runs.len());
-    for &len in runs {
-        let rows = start..start + len.min(head);
-        let predicted = fit.predict(model, &states.slice(rows.clone()))?;
-        let residuals: Vec<f64> = (tau[rows.start * nv..rows.end * nv].iter())
-            .zip(&predicted)
-            .map(|(t, p)| t - p)
-            .collect();
-        factors.push((long_run_factors(&residuals, nv), len));
-        start += len;
-    }
-    Ok(combine(&factors, nv))
 }
 
 impl BaseModel {
@@ -674,6 +627,11 @@ impl Document for BaseModel {
                 Self::WHAT,
                 format!("unmodelled_friction[{i}]: {problem}"),
             ));
+        }
+        if let Some((i, problem)) = (m.run_offsets.iter().enumerate())
+            .find_map(|(i, o)| o.problem(&m.joint_names, m.logs.len()).map(|p| (i, p)))
+        {
+            return Err(invalid(Self::WHAT, format!("run_offsets[{i}]: {problem}")));
         }
         if let Some((i, problem)) = m.position_range.iter().enumerate().find_map(|(i, r)| {
             let unknown = (!m.joint_names.contains(&r.joint))

@@ -18,6 +18,7 @@ pub mod parameters;
 pub mod position_offsets;
 pub mod position_range;
 pub mod residual_correlation;
+pub mod runs;
 pub mod signal_prediction;
 pub mod streaming;
 pub mod torque_columns;

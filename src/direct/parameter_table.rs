@@ -117,7 +117,8 @@ impl BaseModel {
     /// ([`super::torque_lag`]), joints whose zeros in the data look offset
     /// ([`super::position_offsets`]), friction the fit leaves out that shows in its residuals
     /// ([`super::unmodelled_friction`]), data that excite the base parameters weakly
-    /// ([`super::weak_excitation`]), positions logged in counts so coarse that their
+    /// ([`super::weak_excitation`]), runs of a fit over several logs whose residuals differ in
+    /// mean ([`super::runs`]: a torque offset that drifted), positions logged in counts so coarse that their
     /// rounding shows in the derived velocities ([`crate::position_rounding`]; in each log of
     /// several, named), and friction or
     /// armature coefficients identified on their own (not in a combination), negative beyond
@@ -183,6 +184,8 @@ impl BaseModel {
         )
         .filter(|_| super::torque_columns::findings(&self.torque_columns).is_empty());
         let weak = (self.weak_excitation.as_ref()).map(|w| w.finding());
+        let log_names: Vec<String> = self.logs.iter().map(|l| l.log.clone()).collect();
+        let drifted = (self.run_offsets.iter()).map(|o| o.finding(&log_names));
         let gains = (self.drive_gains.iter()).flat_map(|g| g.warnings(&self.joint_names));
         columns
             .into_iter()
@@ -190,6 +193,7 @@ impl BaseModel {
             .chain(offsets)
             .chain(friction)
             .chain(weak)
+            .chain(drifted)
             .chain(rounding.filter(|_| log_findings))
             .chain(negative)
             .collect()

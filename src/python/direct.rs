@@ -329,6 +329,25 @@ impl PyBaseModel {
             })
             .transpose()
     }
+    /// In a fit of several Recordings (or runs), the joints whose residuals differ in mean from
+    /// run to run (a torque offset that drifted between the logs): dicts `joint`, `means` and
+    /// `stderr` ((runs,) N m: each run's mean residual over its first samples and its standard
+    /// error), `residual_rms` (N m) and `finding` (also a warning). Empty where none do.
+    #[getter]
+    fn run_offsets<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let names: Vec<String> = self.fit.logs.iter().map(|l| l.log.clone()).collect();
+        (self.fit.run_offsets.iter())
+            .map(|o| {
+                let e = PyDict::new(py);
+                e.set_item("joint", &o.joint)?;
+                e.set_item("means", PyArray1::from_slice(py, &o.means))?;
+                e.set_item("stderr", PyArray1::from_slice(py, &o.stderr))?;
+                e.set_item("residual_rms", o.residual_rms)?;
+                e.set_item("finding", o.finding(&names))?;
+                Ok(e)
+            })
+            .collect()
+    }
     /// The joints whose torques show friction terms the fit lacks (the fit made again with
     /// viscous, Coulomb and offset terms): dicts `joint`, `explained` (the fraction of its
     /// residual sum of squares the terms take off), `residual_rms` and `remaining_rms` (N m,

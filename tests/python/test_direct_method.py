@@ -558,7 +558,7 @@ def test_each_recordings_residuals_are_a_time_series_of_their_own():
     them; the offset term takes their mean): fitted as a list, each run's white residuals give
     a long-run factor of 1; the same samples as one array read the step at the join as
     correlation at every lag (a factor near 190, standard errors 14 times too large), with
-    the same parameters."""
+    the same parameters. The runs' differing means are named (`run_offsets`, a warning)."""
     robot = pr.robots.a465()
     d = pr.design_excitation(robot, harmonics=4, base_frequency=0.1, max_evaluations=30, seed=1).trajectory
     t = np.arange(0, d.period, 0.01)
@@ -566,13 +566,31 @@ def test_each_recordings_residuals_are_a_time_series_of_their_own():
     tau = robot.rnea(q, qd, qdd)
     rng = np.random.default_rng(3)
     runs = [pr.Recording(t, q, tau + rng.normal(0, 0.01, q.shape) + s * 0.01, qd=qd, qdd=qdd, name=f"run{i}") for i, s in enumerate([1, -1])]
-    fit = pr.identify_base_parameters(robot, runs, friction="all")
+    with pytest.warns(pr.PerturbidWarning, match=r"the residuals of joint 'joint1' differ in mean from log to log, from -0.0\d+ \('run1'\) to 0.0\d+ \('run0'\)"):
+        fit = pr.identify_base_parameters(robot, runs, friction="all")
     stack = lambda f: np.vstack([getattr(r, f) for r in runs])
     flat = pr.identify_base_parameters(robot, stack("q"), stack("qd"), stack("qdd"), stack("tau"), friction="all")
     assert (fit.residual_correlation < 1.2).all(), fit.residual_correlation
     assert (flat.residual_correlation > 50).all(), flat.residual_correlation
     np.testing.assert_allclose(fit.theta_base, flat.theta_base, rtol=1e-12, atol=1e-12)
     assert (flat.stderr > 5 * fit.stderr).all()
+    # the drift is named: each run's mean residual, +-0.01 N m on every joint, with its
+    # standard error (white noise of 0.01 N m about it, 1,000 samples: 0.00032)
+    found = fit.run_offsets
+    assert [o["joint"] for o in found] == robot.joint_names and flat.run_offsets == []
+    for o in found:
+        np.testing.assert_allclose(o["means"], [0.01, -0.01], atol=0.002)
+        np.testing.assert_allclose(o["stderr"], 0.01 / np.sqrt(1000), rtol=0.2)
+    # kept in the model and checked on load
+    back = pr.BaseParameterModel.from_json(fit.to_json(), robot)
+    assert [o["finding"] for o in back.run_offsets] == [o["finding"] for o in found]
+    bad = json.loads(fit.to_json())
+    bad["run_offsets"][0]["stderr"][1] = -1.0
+    with pytest.raises(pr.InputError, match=r"run_offsets\[0\]: stderr\[1\] is -1, expected a positive standard error"):
+        pr.BaseParameterModel.from_json(json.dumps(bad), robot)
+    # runs without a drift: nothing named
+    same = [pr.Recording(t, q, tau + rng.normal(0, 0.01, q.shape), qd=qd, qdd=qdd, name=f"run{i}") for i in range(2)]
+    assert pr.identify_base_parameters(robot, same, friction="all").run_offsets == []
 
 
 def test_standard_errors_count_residuals_correlated_by_the_filter():
