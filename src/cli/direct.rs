@@ -231,7 +231,8 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
                 (s.slice(rows.clone()), &r.tau[rows.start * n..rows.end * n])
             })
             .collect();
-        crate::stacked_states::StackedStates::of(&parts)
+        let names: Vec<String> = a.data.iter().map(|p| p.display().to_string()).collect();
+        crate::stacked_states::StackedStates::of_named(&parts, &names, "DATA")
     };
     let stacked = match recs.len() {
         1 => None,

@@ -232,9 +232,8 @@ impl PreprocessArgs {
         progress: &super::progress::Progress,
         out: &mut String,
     ) -> Result<crate::recording::Recording> {
-        progress.update(&format!("reading {}", path.display()));
-        let rec = self.columns.load(path, joints, out)?;
-        self.prepare(rec, path, joints, progress, out)
+        let mut recs = self.read_logs(&[path], joints, "DATA", progress, out)?;
+        Ok(recs.pop().expect("one log read"))
     }
 
     /// [`Self::read`] of every log of `paths`, the logs of one fit. Refused, as `argument`: a
@@ -257,10 +256,12 @@ impl PreprocessArgs {
         for path in paths {
             progress.update(&format!("reading {}", path.display()));
             let rec = self.columns.load(path, joints, out)?;
-            prints.push(crate::repeated_samples::SamplePrints::of(
-                rec.n,
-                &[&rec.q, &rec.tau],
-            )?);
+            if paths.len() > 1 {
+                prints.push(crate::repeated_samples::SamplePrints::of(
+                    rec.n,
+                    &[&rec.q, &rec.tau],
+                )?);
+            }
             recs.push(self.prepare(rec, path, joints, progress, out)?);
         }
         let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
