@@ -877,7 +877,9 @@ def identify_consistent_parameters(
     t: Optional[ArrayLike] = None,
     coulomb: Optional[ArrayLike] = None,
 ) -> ConsistentFit:
-    """Physically consistent least squares over the direct method's data (interior point)."""
+    """Physically consistent least squares over the direct method's data (interior point):
+    arrays, a preprocessed Recording as q alone, or a list of them (runs fitted together, as
+    identify_base_parameters takes them)."""
 
 @final
 class Validation:

@@ -138,8 +138,10 @@ impl PyConsistentFit {
 /// checked first, as `identify_base_parameters` checks them. What the checks of the data find
 /// (torque columns, a lag, zero offsets, friction left out) is warned of (PerturbidWarning).
 /// `coulomb` ((k, n)): the Coulomb term's column for filtered torques, as in
-/// `identify_base_parameters`; a Recording as `q`, alone, gives its own. Returns a
-/// ConsistentFit.
+/// `identify_base_parameters`; a Recording as `q`, alone, gives its own, and a list of them
+/// is fitted as runs one after the other, as `identify_base_parameters` fits them (what each
+/// one's preprocessing found kept in the models' `logs`; one Recording's in the one-log
+/// fields). Returns a ConsistentFit.
 #[pyfunction]
 #[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, friction=None, weighting="wls", gravity=true, prior_weight=1e-6, max_iterations=2000, t=None, coulomb=None))]
 #[allow(clippy::too_many_arguments)]
@@ -172,6 +174,45 @@ pub(crate) fn identify_consistent_parameters<'py>(
         t,
         coulomb,
     };
+    // several Recordings, fitted together; one Recording's findings are kept with the model
+    let listed = super::direct::recordings_given(&q, &given)?;
+    let recs = match &listed {
+        Some(recs) => recs.clone(),
+        None => (q.cast::<super::recording::PyRecording>().ok())
+            .map(|r| vec![r.get().rec.clone()])
+            .unwrap_or_default(),
+    };
+    let findings = |c: ConsistentFit| -> ConsistentFit {
+        let keep = |m: crate::direct::BaseModel| match recs.as_slice() {
+            [] => m,
+            [rec] => m.with_findings_of(rec),
+            recs => super::direct::with_logs(m, recs),
+        };
+        ConsistentFit {
+            model: keep(c.model),
+            unconstrained: keep(c.unconstrained),
+            ..c
+        }
+    };
+    if listed.is_some() {
+        let fit = detached(py, "identify_consistent_parameters", || {
+            let (stacked, options) = super::direct::stacked_recordings(model, &recs, &options)?;
+            let c = consistent_rs(
+                model,
+                &stacked.states()?,
+                &stacked.data,
+                &options,
+                &consistent,
+            )?;
+            Ok::<_, crate::error::Error>(findings(c))
+        })?;
+        // the Recordings' own findings were warned of by the preprocessing that made them
+        super::errors::warn_all(py, &fit.model.fit_warnings())?;
+        return Ok(PyConsistentFit {
+            fit,
+            model: Arc::new(model.clone()),
+        });
+    }
     let a = super::samples::samples(q, given, true, true)?.arrays()?;
     let c = states(model.nv, &a.q, &a.qd, &a.qdd, a.tau.as_ref())?;
     let coulomb = super::direct::coulomb_column(model.nv, a.coulomb.as_ref())?;
@@ -182,11 +223,21 @@ pub(crate) fn identify_consistent_parameters<'py>(
         let what = "identify_consistent_parameters' samples";
         super::direct::check_sample_derivatives(what, model.nv, t, &c)?;
         let s = super::direct::fit_states(model.nv, &c, coulomb.as_deref())?;
-        consistent_rs(model, &s, &c[3], &options, &consistent)
+        Ok::<_, crate::error::Error>(findings(consistent_rs(
+            model,
+            &s,
+            &c[3],
+            &options,
+            &consistent,
+        )?))
     })?;
     // what the data's checks found (torque columns, lag, offsets, friction left out), as the
-    // command line and identify_base_parameters warn of it
-    super::errors::warn_all(py, &fit.model.warnings())?;
+    // command line and identify_base_parameters warn of it (a Recording's own findings were
+    // warned of by its preprocessing)
+    match recs.is_empty() {
+        true => super::errors::warn_all(py, &fit.model.warnings())?,
+        false => super::errors::warn_all(py, &fit.model.fit_warnings())?,
+    }
     Ok(PyConsistentFit {
         fit,
         model: Arc::new(model.clone()),

@@ -624,23 +624,18 @@ pub(crate) fn identify_base_parameters<'py>(
 ) -> PyResult<PyBaseModel> {
     let options = fit_options(friction, weighting, gravity, tolerance, seed)?;
     let model = &robot.model;
-    if let Some(recs) = recordings_of(&q)? {
-        let named = [
-            ("qd", &qd),
-            ("qdd", &qdd),
-            ("tau", &tau),
-            ("t", &t),
-            ("coulomb", &coulomb),
-        ];
-        if let Some((name, _)) = named.iter().find(|(_, v)| v.is_some()) {
-            return Err(Error::InvalidArgument {
-                argument: (*name).into(),
-                message: "given with a list of Recordings as q, which carry their own: pass the list alone".into(),
-            }
-            .into());
-        }
+    let given = Given {
+        qd,
+        qdd,
+        tau,
+        t,
+        coulomb,
+    };
+    if let Some(recs) = recordings_given(&q, &given)? {
         let fit = detached(py, "identify_base_parameters", || {
-            fit_recordings(model, &recs, &options)
+            let (stacked, options) = stacked_recordings(model, &recs, &options)?;
+            let fit = base_rs(model, &stacked.states()?, &stacked.data, &options)?;
+            Ok::<_, Error>(with_logs(fit, &recs))
         })?;
         // the Recordings' own findings were warned of by the preprocessing that made them
         super::errors::warn_all(py, &fit.fit_warnings())?;
@@ -651,13 +646,6 @@ pub(crate) fn identify_base_parameters<'py>(
     }
     // a Recording's findings are kept with the model, as the command line keeps its log's
     let recording = (q.cast::<super::recording::PyRecording>().ok()).map(|r| r.get().rec.clone());
-    let given = Given {
-        qd,
-        qdd,
-        tau,
-        t,
-        coulomb,
-    };
     let a = samples(q, given, true, true)?.arrays()?;
     let c = states(model.nv, &a.q, &a.qd, &a.qdd, a.tau.as_ref())?;
     let coulomb = coulomb_column(model.nv, a.coulomb.as_ref())?;
@@ -684,7 +672,9 @@ pub(crate) fn identify_base_parameters<'py>(
 
 /// The Recordings of `q` where it is a list or tuple of them (None where it is anything else:
 /// an array of numbers); a list of which some are Recordings and some not is a TypeError.
-fn recordings_of(q: &Bound<'_, PyAny>) -> PyResult<Option<Vec<Arc<crate::recording::Recording>>>> {
+pub(crate) fn recordings_of(
+    q: &Bound<'_, PyAny>,
+) -> PyResult<Option<Vec<Arc<crate::recording::Recording>>>> {
     let items: Vec<Bound<'_, PyAny>> = match (
         q.cast::<pyo3::types::PyList>(),
         q.cast::<pyo3::types::PyTuple>(),
@@ -709,14 +699,42 @@ fn recordings_of(q: &Bound<'_, PyAny>) -> PyResult<Option<Vec<Arc<crate::recordi
     }
 }
 
-/// The base parameters of `model` fitted to the Recordings `recs` (preprocessed: with
-/// velocities and accelerations) one after the other, each one's logged derivatives checked
-/// as a log's, what its preprocessing found kept in the model's `logs` (named by it).
-fn fit_recordings(
+/// The Recordings given as `q` (a list or tuple of them: runs to fit together), with nothing
+/// else given beside them (they carry their own); None for arrays or one Recording.
+pub(crate) fn recordings_given(
+    q: &Bound<'_, PyAny>,
+    given: &Given<'_>,
+) -> PyResult<Option<Vec<Arc<crate::recording::Recording>>>> {
+    let Some(recs) = recordings_of(q)? else {
+        return Ok(None);
+    };
+    let named = [
+        ("qd", &given.qd),
+        ("qdd", &given.qdd),
+        ("tau", &given.tau),
+        ("t", &given.t),
+        ("coulomb", &given.coulomb),
+    ];
+    if let Some((name, _)) = named.iter().find(|(_, v)| v.is_some()) {
+        return Err(Error::InvalidArgument {
+            argument: (*name).into(),
+            message:
+                "given with a list of Recordings as q, which carry their own: pass the list alone"
+                    .into(),
+        }
+        .into());
+    }
+    Ok(Some(recs))
+}
+
+/// The Recordings `recs` (preprocessed: with velocities and accelerations) one after the
+/// other, each one's logged derivatives checked as a log's, and `options` with their runs
+/// (each one's residuals a time series of their own). Errors name the Recording.
+pub(crate) fn stacked_recordings(
     model: &crate::model::Model,
     recs: &[Arc<crate::recording::Recording>],
-    options: &crate::direct::BaseOptions,
-) -> Result<crate::direct::BaseModel> {
+    options: &BaseOptions,
+) -> Result<(crate::stacked_states::StackedStates, BaseOptions)> {
     if recs.is_empty() || recs.len() > crate::direct::drive_gains::MAX_RUNS {
         return Err(Error::InvalidArgument {
             argument: "q".into(),
@@ -761,11 +779,16 @@ fn fit_recordings(
         runs: stacked.runs.clone(),
         ..options.clone()
     };
-    let fit = base_rs(model, &stacked.states()?, &stacked.data, &options)?;
-    Ok(crate::direct::BaseModel {
+    Ok((stacked, options))
+}
+
+/// `fit` with what each of the Recordings `recs` it was fitted to found in its preprocessing,
+/// in its `logs` (named by it).
+pub(crate) fn with_logs(fit: BaseModel, recs: &[Arc<crate::recording::Recording>]) -> BaseModel {
+    BaseModel {
         logs: (recs.iter())
             .map(|r| crate::direct::LogFindings::of(&r.name, r))
             .collect(),
         ..fit
-    })
+    }
 }

@@ -546,6 +546,18 @@ def test_several_recordings_are_fitted_together():
     raw = pr.Recording(t, q, tau, name="raw.csv")
     with pytest.raises(pr.InputError, match=r"Recording 1 \('raw.csv'\).*without velocities and accelerations.*preprocess it first"):
         pr.identify_base_parameters(robot, [recs[0], raw])
+    # physically consistent alike: the same parameters as from the arrays, each log's findings kept
+    consistent = pr.identify_consistent_parameters(robot, recs, friction=friction, max_iterations=50)
+    flat = pr.identify_consistent_parameters(robot, stack("q"), stack("qd"), stack("qdd"), stack("tau"), friction=friction, coulomb=stack("coulomb"), max_iterations=50)
+    np.testing.assert_allclose(consistent.theta, flat.theta, rtol=1e-9, atol=1e-12)
+    for m in (consistent.model, consistent.unconstrained):
+        assert [l["log"] for l in json.loads(m.to_json())["logs"]] == ["run1.csv (preprocessed)", "run2.csv (preprocessed)"]
+    assert "logs" not in json.loads(pr.identify_consistent_parameters(robot, recs[0], friction=friction, max_iterations=50).model.to_json())
+    # what takes one Recording says so of a list
+    with pytest.raises(pr.InputError, match="q: a list of Recordings, which only the fits take"):
+        pr.validate(both, recs)
+    with pytest.raises(pr.InputError, match="q: a list of Recordings, which only the fits take"):
+        both.predict(recs)
     # the same samples twice: one Recording given twice, or a part of one given again
     with pytest.raises(pr.InputError, match=r"q: Recording 0 \('run1.csv \(preprocessed\)'\) and Recording 2 \('run1.csv \(preprocessed\)'\) hold the same \d+ samples, bit for bit.*give each run's samples once"):
         pr.identify_base_parameters(robot, [recs[0], recs[1], recs[0]], friction=friction)
