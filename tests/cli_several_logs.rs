@@ -101,6 +101,21 @@ fn several_logs_are_fitted_together_each_preprocessed_alone() {
         )),
         "{out}"
     );
+    // and each log's own RMS, of its held-out samples
+    assert!(out.contains("per log, per joint RMS (N m):"), "{out}");
+    for log in &logs {
+        let line = (out.lines())
+            .find(|l| l.starts_with(&format!("  {}: ", s(log))))
+            .unwrap_or_else(|| panic!("{out}"));
+        let rms: Vec<f64> = (line.rsplit(": ").next().unwrap().split(' '))
+            .map(|x| x.parse().unwrap())
+            .collect();
+        // 0.01 N m of noise, filtered
+        assert!(
+            rms.len() == 6 && rms.iter().all(|&r| r > 0.0 && r < 0.05),
+            "{line}"
+        );
+    }
     // a log that fails is named
     let bad = d.join("bad.csv");
     std::fs::write(

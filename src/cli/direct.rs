@@ -366,6 +366,25 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
                 e.model_stderr_rms.map_or("-".to_string(), number)
             );
         }
+        // several logs: each one's own, to tell a log the model fits worse
+        if recs.len() > 1 {
+            let _ = writeln!(out, "per log, per joint RMS (N m):");
+            let mut start = 0;
+            for ((rec, &split), path) in recs.iter().zip(&splits).zip(&a.data) {
+                let rows = start * n..(start + rec.len() - split) * n;
+                start += rec.len() - split;
+                if rows.is_empty() {
+                    continue;
+                }
+                let v = crate::validation::validate(
+                    &model.joint_names,
+                    &p[rows.clone()],
+                    &held.1[rows],
+                )?;
+                let rms: Vec<String> = v.joints.iter().map(|e| number(e.rms)).collect();
+                let _ = writeln!(out, "  {}: {}", path.display(), rms.join(" "));
+            }
+        }
     }
     Ok(out)
 }
