@@ -183,10 +183,11 @@ pub(crate) fn identify_consistent_parameters<'py>(
             .unwrap_or_default(),
     };
     let findings = |c: ConsistentFit| -> ConsistentFit {
-        let keep = |m: crate::direct::BaseModel| match recs.as_slice() {
-            [] => m,
-            [rec] => m.with_findings_of(rec),
-            recs => super::direct::with_logs(m, recs),
+        // a list's in `logs`, as identify_base_parameters keeps them
+        let keep = |m: crate::direct::BaseModel| match (&listed, recs.as_slice()) {
+            (Some(_), recs) => super::direct::with_logs(m, recs),
+            (None, [rec]) => m.with_findings_of(rec),
+            (None, _) => m,
         };
         ConsistentFit {
             model: keep(c.model),
