@@ -708,16 +708,9 @@ pub(crate) fn recordings_given(
     let Some(recs) = recordings_of(q)? else {
         return Ok(None);
     };
-    let named = [
-        ("qd", &given.qd),
-        ("qdd", &given.qdd),
-        ("tau", &given.tau),
-        ("t", &given.t),
-        ("coulomb", &given.coulomb),
-    ];
-    if let Some((name, _)) = named.iter().find(|(_, v)| v.is_some()) {
+    if let Some(name) = given.first_given() {
         return Err(Error::InvalidArgument {
-            argument: (*name).into(),
+            argument: name.into(),
             message:
                 "given with a list of Recordings as q, which carry their own: pass the list alone"
                     .into(),

@@ -70,6 +70,22 @@ pub(crate) struct Given<'py> {
     pub coulomb: Option<Bound<'py, PyAny>>,
 }
 
+impl Given<'_> {
+    /// The name of the first of them given (a caller that takes a Recording, which carries
+    /// its own, refuses it); None where none is.
+    pub(crate) fn first_given(&self) -> Option<&'static str> {
+        [
+            ("qd", &self.qd),
+            ("qdd", &self.qdd),
+            ("tau", &self.tau),
+            ("t", &self.t),
+            ("coulomb", &self.coulomb),
+        ]
+        .into_iter()
+        .find_map(|(name, v)| v.is_some().then_some(name))
+    }
+}
+
 /// The samples of `q` (arrays, or a Recording) and `given`: with a Recording, nothing else
 /// may be given (it carries its own) and it must have velocities and accelerations; with
 /// arrays, `qd` and `qdd` are required, and `tau` where `wants_tau`. `wants_t`: whether the
@@ -108,16 +124,9 @@ pub(crate) fn samples<'py>(
             coulomb: given.coulomb,
         });
     };
-    let named = [
-        ("qd", &given.qd),
-        ("qdd", &given.qdd),
-        ("tau", &given.tau),
-        ("t", &given.t),
-        ("coulomb", &given.coulomb),
-    ];
-    if let Some((name, _)) = named.iter().find(|(_, v)| v.is_some()) {
+    if let Some(name) = given.first_given() {
         return Err(Error::InvalidArgument {
-            argument: (*name).into(),
+            argument: name.into(),
             message: "given with a Recording as q, which carries its own: pass the Recording alone, or arrays for all".into(),
         }
         .into());
