@@ -356,14 +356,14 @@ impl SpreadRows {
     /// How many of the rows fall in each of consecutive runs of `runs` samples (of the `k`
     /// spread over; empty for one run): the picked rows' runs, in order.
     pub(crate) fn counts_in(&self, runs: &[usize]) -> Vec<usize> {
+        // the rows are in order: a run's are those before its end less those before its start
+        let before = |i: usize| self.rows.partition_point(|&r| r < i);
         let mut end = 0;
         (runs.iter())
             .map(|&len| {
                 let start = end;
                 end += len;
-                (self.rows.iter())
-                    .filter(|&&i| (start..end).contains(&i))
-                    .count()
+                before(end) - before(start)
             })
             .collect()
     }
@@ -374,5 +374,30 @@ impl SpreadRows {
         (self.rows.iter())
             .flat_map(|&i| x[i * n..(i + 1) * n].iter().copied())
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::SpreadRows;
+
+    #[test]
+    fn spread_rows_are_counted_run_by_run() {
+        // 10 of 100 samples: rows 0, 10, ..., 90
+        let rows = SpreadRows::new(100, 10, 1);
+        assert_eq!(rows.counts_in(&[5, 30, 65]), vec![1, 3, 6]);
+        assert_eq!(rows.counts_in(&[100]), vec![10]);
+        assert_eq!(rows.counts_in(&[]), Vec::<usize>::new());
+        // against the rows counted one by one
+        let rows = SpreadRows::new(1000, 37, 2);
+        let runs = [1, 200, 3, 500, 296];
+        let mut start = 0;
+        for (&len, count) in runs.iter().zip(rows.counts_in(&runs)) {
+            let by_hand = (rows.rows.iter())
+                .filter(|&&i| (start..start + len).contains(&i))
+                .count();
+            assert_eq!(count, by_hand);
+            start += len;
+        }
     }
 }
