@@ -684,6 +684,12 @@ class BaseParameterModel:
         run (a torque offset that drifted), dicts joint, means, stderr ((runs,) N m),
         residual_rms, finding (also a warning)."""
     @property
+    def run_checks(self) -> list[dict[str, Any]]:
+        """Fitted over several Recordings: each run's data checked alone against the robot's
+        model, in order: dicts log, samples, torque_columns, torque_lag, position_range (as
+        the model's own, of that run alone) and findings (each also a warning naming the
+        run). Empty for one run; the model's torque_lag is then None."""
+    @property
     def unmodelled_friction(self) -> list[dict[str, Any]]:
         """Joints whose torques show friction terms the fit lacks: joint, explained,
         residual_rms, remaining_rms, terms (dicts term, coefficient, stderr); also warnings."""

@@ -169,6 +169,12 @@ pub struct BaseModel {
     /// checked.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub run_offsets: Vec<super::runs::RunOffsets>,
+    /// In a fit over several runs, each run's data checked alone against the robot's model
+    /// ([`super::run_checks`]: its torque columns, lag and position range), in the runs'
+    /// order; the top-level `torque_lag` is then None (a shift would read across the joins).
+    /// Empty for one run, or in a model saved before they were checked.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub run_checks: Vec<super::run_checks::RunChecks>,
     /// Where the data excite the base parameters weakly (`cond` beyond
     /// [`super::weak_excitation::WEAK_CONDITION`]): the least determined combination and how
     /// far each joint moved ([`super::weak_excitation`]), warned of ([`BaseModel::warnings`]).
@@ -400,11 +406,22 @@ pub(super) fn fit_with_factors(
             tau,
             options.gravity,
         )?,
-        torque_lag: super::torque_lag::check_torque_lag(model, states, tau, options.gravity)?,
+        // over several runs each run's lag (a shift of the stacked samples reads across joins)
+        torque_lag: match options.runs.len() {
+            0 | 1 => super::torque_lag::check_torque_lag(model, states, tau, options.gravity)?,
+            _ => None,
+        },
         position_range: super::position_range::check_position_range(model, states),
         position_offsets: None,
         unmodelled_friction: vec![],
         run_offsets: vec![],
+        run_checks: super::run_checks::check_runs_against_model(
+            model,
+            states,
+            tau,
+            &options.runs,
+            options.gravity,
+        )?,
         weak_excitation: None,
         drive_gains: None,
         joint_term_rms: super::parameter_table::joint_term_rms(
@@ -579,32 +596,17 @@ impl Document for BaseModel {
         {
             return Err(invalid(Self::WHAT, problem));
         }
-        if !m.torque_columns.is_empty() && m.torque_columns.len() != n {
-            return Err(invalid(
-                Self::WHAT,
-                format!(
-                    "torque_columns: {} entries, expected one per joint ({n}) or none",
-                    m.torque_columns.len()
-                ),
-            ));
-        }
-        if let Some((i, problem)) = m
-            .torque_columns
-            .iter()
-            .enumerate()
-            .find_map(|(i, c)| c.problem(&m.joint_names).map(|p| (i, p)))
-        {
-            return Err(invalid(
-                Self::WHAT,
-                format!("torque_columns[{i}]: {problem}"),
-            ));
-        }
-        if let Some(problem) = m
-            .torque_lag
-            .as_ref()
-            .and_then(|l| l.problem(&m.joint_names))
-        {
-            return Err(invalid(Self::WHAT, format!("torque_lag: {problem}")));
+        if let Some(problem) = super::run_checks::data_checks_problem(
+            &m.torque_columns,
+            m.torque_lag.as_ref(),
+            &m.position_range,
+            &m.joint_names,
+            str::to_string,
+        )
+        .or_else(|| {
+            super::run_checks::problem(&m.run_checks, &m.joint_names, m.samples, m.logs.len())
+        }) {
+            return Err(invalid(Self::WHAT, problem));
         }
         if let Some(w) = &m.weak_excitation {
             let unknown = (w.motion.iter())
@@ -632,16 +634,6 @@ impl Document for BaseModel {
             .find_map(|(i, o)| o.problem(&m.joint_names, m.logs.len()).map(|p| (i, p)))
         {
             return Err(invalid(Self::WHAT, format!("run_offsets[{i}]: {problem}")));
-        }
-        if let Some((i, problem)) = m.position_range.iter().enumerate().find_map(|(i, r)| {
-            let unknown = (!m.joint_names.contains(&r.joint))
-                .then(|| format!("joint '{}' is not one of the model's", r.joint));
-            unknown.or_else(|| r.problem()).map(|p| (i, p))
-        }) {
-            return Err(invalid(
-                Self::WHAT,
-                format!("position_range[{i}]: {problem}"),
-            ));
         }
         m.check_joint_term_rms()?;
         if let Some(problem) =

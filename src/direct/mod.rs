@@ -18,6 +18,7 @@ pub mod parameters;
 pub mod position_offsets;
 pub mod position_range;
 pub mod residual_correlation;
+pub mod run_checks;
 pub mod runs;
 pub mod signal_prediction;
 pub mod streaming;
@@ -47,6 +48,7 @@ pub use parameters::{regressor_blocks, regressor_matrix, FrictionTerms, Paramete
 pub use position_offsets::{
     check_position_offsets, check_position_offsets_in_validation, PositionOffsets,
 };
+pub use run_checks::{check_runs_against_model, RunChecks};
 pub use torque_columns::{check_torque_columns, TorqueColumn};
 pub use torque_lag::{check_torque_lag, TorqueLag};
 pub use unmodelled_friction::{check_unmodelled_friction, MissingTerm, UnmodelledFriction};

@@ -125,11 +125,30 @@ impl BaseModel {
     /// three standard errors and not negligible (a torque at least [`NEGLIGIBLE_TERM`] of the
     /// joint's residual RMS). No joint has them; the data hold an effect the model lacks, or
     /// are not what it assumes. The drive gains' findings ([`super::drive_gains`]) where the
-    /// model has them. A consistent fit keeps them at zero. Where a torque
-    /// column is found wrong, offsets and friction are not named: fitted to such a log they
-    /// take up part of what is wrong with it.
+    /// model has them. A consistent fit keeps them at zero. Over several runs, each run's
+    /// torque columns, lag and position range are checked alone and named by its log
+    /// ([`super::run_checks`]). Where a torque column is found wrong (of the whole data or of
+    /// a run), offsets, friction and the runs' differing means are not named: fitted to such
+    /// a log they take up part of what is wrong with it.
     pub fn warnings(&self) -> Vec<String> {
         self.warnings_with(true)
+    }
+
+    /// Whether a torque column is found wrong, of the whole data or of a run of several
+    /// ([`super::torque_columns::findings`]): the offsets', friction's and runs' means'
+    /// findings are then not named.
+    pub fn columns_found_wrong(&self) -> bool {
+        self.run_checks.iter().any(|c| c.columns_wrong())
+            || !super::torque_columns::findings(&self.torque_columns).is_empty()
+    }
+
+    /// The joints' zero offsets' finding ([`super::position_offsets`]), if any: none where a
+    /// torque column is found wrong, of the whole data or of a run (fitted to such a log,
+    /// offsets take up part of what is wrong with it).
+    pub fn position_offsets_finding(&self) -> Option<String> {
+        (self.position_offsets.as_ref())
+            .filter(|_| !self.run_checks.iter().any(|c| c.columns_wrong()))
+            .and_then(|o| o.finding_beside(&self.torque_columns, false))
     }
 
     /// [`Self::warnings`] without those of the logs' own findings (position rounding) that
@@ -141,11 +160,24 @@ impl BaseModel {
 
     /// The warnings, with the logs' findings or without.
     fn warnings_with(&self, log_findings: bool) -> Vec<String> {
-        let columns = super::torque_lag::log_findings(
-            &self.position_range,
-            &self.torque_columns,
-            self.torque_lag.as_ref(),
-        );
+        let log_names: Vec<String> = self.logs.iter().map(|l| l.log.clone()).collect();
+        // over several runs each run's, named; the whole data's columns besides only where no
+        // run's is found wrong (a wrong column in every log is named log by log)
+        let each = super::run_checks::findings(&self.run_checks, &log_names);
+        let runs_wrong = self.run_checks.iter().any(|c| c.columns_wrong());
+        let columns = match self.run_checks.is_empty() {
+            true => super::torque_lag::log_findings(
+                &self.position_range,
+                &self.torque_columns,
+                self.torque_lag.as_ref(),
+            ),
+            false if runs_wrong => each,
+            false => each
+                .into_iter()
+                .chain(super::torque_columns::findings(&self.torque_columns))
+                .collect(),
+        };
+        let columns_wrong = self.columns_found_wrong();
         let negative = self
             .parameter_table()
             .into_iter()
@@ -174,18 +206,18 @@ impl BaseModel {
             crate::position_rounding::warning(&l.position_rounding, &self.joint_names)
                 .map(|w| format!("'{}': {w}{}", l.log, crate::position_rounding::IN_A_FIT))
         }));
-        let offsets = (self.position_offsets.as_ref())
-            .and_then(|o| o.finding_beside(&self.torque_columns, false));
+        let offsets = self.position_offsets_finding();
         // friction terms fitted to a log that does not read as the robot's model take up
         // part of what is wrong with it, as offsets do: the columns first
         let friction = super::unmodelled_friction::finding(
             &self.unmodelled_friction,
             self.base.layout.friction,
         )
-        .filter(|_| super::torque_columns::findings(&self.torque_columns).is_empty());
+        .filter(|_| !columns_wrong);
         let weak = (self.weak_excitation.as_ref()).map(|w| w.finding());
-        let log_names: Vec<String> = self.logs.iter().map(|l| l.log.clone()).collect();
-        let drifted = (self.run_offsets.iter()).map(|o| o.finding(&log_names));
+        let drifted = (self.run_offsets.iter())
+            .filter(|_| !columns_wrong)
+            .map(|o| o.finding(&log_names));
         let gains = (self.drive_gains.iter()).flat_map(|g| g.warnings(&self.joint_names));
         columns
             .into_iter()

@@ -344,6 +344,7 @@ pub fn identify_parameters_from_local(
         position_offsets: None,
         unmodelled_friction: vec![],
         run_offsets: vec![],
+        run_checks: vec![],
         // rows from local models: their own diagnostics say what they leave unidentified
         weak_excitation: None,
         drive_gains: None,

@@ -18,7 +18,8 @@ use super::arrays::{
     at_states_with, expansion_dict, matrix_to_numpy as mat, read_batch, to_numpy, vector, ArrayLike,
 };
 use super::findings::{
-    position_offsets_dict, position_range_dicts, torque_column_dicts, torque_lag_dict,
+    position_offsets_dict, position_range_dicts, run_check_dicts, torque_column_dicts,
+    torque_lag_dict,
 };
 use super::local::PyOperatingPoint;
 use super::robot::PyRobot;
@@ -324,15 +325,14 @@ impl PyBaseModel {
     #[getter]
     fn position_offsets<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
         (self.fit.position_offsets.as_ref())
-            .map(|o| {
-                position_offsets_dict(py, o, o.finding_beside(&self.fit.torque_columns, false))
-            })
+            .map(|o| position_offsets_dict(py, o, self.fit.position_offsets_finding()))
             .transpose()
     }
     /// In a fit of several Recordings (or runs), the joints whose residuals differ in mean from
     /// run to run (a torque offset that drifted between the logs): dicts `joint`, `means` and
     /// `stderr` ((runs,) N m: each run's mean residual over its first samples and its standard
-    /// error), `residual_rms` (N m) and `finding` (also a warning). Empty where none do.
+    /// error), `residual_rms` (N m) and `finding` (also a warning; None where a torque
+    /// column is found wrong, which takes it up). Empty where none do.
     #[getter]
     fn run_offsets<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         let names: Vec<String> = self.fit.logs.iter().map(|l| l.log.clone()).collect();
@@ -343,10 +343,21 @@ impl PyBaseModel {
                 e.set_item("means", PyArray1::from_slice(py, &o.means))?;
                 e.set_item("stderr", PyArray1::from_slice(py, &o.stderr))?;
                 e.set_item("residual_rms", o.residual_rms)?;
-                e.set_item("finding", o.finding(&names))?;
+                let found = !self.fit.columns_found_wrong();
+                e.set_item("finding", found.then(|| o.finding(&names)))?;
                 Ok(e)
             })
             .collect()
+    }
+    /// In a fit of several Recordings (or runs), each run's data checked alone against the
+    /// robot's model, in the runs' order: dicts `log` (its name), `samples` (fitted),
+    /// `torque_columns`, `torque_lag` and `position_range` (as the model's own, of that run's
+    /// samples alone) and `findings` (what looks wrong with the run, each also a warning
+    /// naming it). Empty for a fit of one run; the model's `torque_lag` is then None.
+    #[getter]
+    fn run_checks<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let names: Vec<String> = self.fit.logs.iter().map(|l| l.log.clone()).collect();
+        run_check_dicts(py, &self.fit.run_checks, &names)
     }
     /// The joints whose torques show friction terms the fit lacks (the fit made again with
     /// viscous, Coulomb and offset terms): dicts `joint`, `explained` (the fraction of its

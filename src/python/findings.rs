@@ -92,3 +92,32 @@ pub(crate) fn torque_lag_dict<'py>(
     e.set_item("finding", lag.finding())?;
     Ok(e)
 }
+
+/// Each run's checks as dicts (see `BaseParameterModel.run_checks`), each named by `names`
+/// (`run r` where none is given).
+pub(crate) fn run_check_dicts<'py>(
+    py: Python<'py>,
+    checks: &[crate::direct::RunChecks],
+    names: &[String],
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    (checks.iter().enumerate())
+        .map(|(r, c)| {
+            let name = names.get(r).cloned().unwrap_or_else(|| format!("run {r}"));
+            let e = PyDict::new(py);
+            e.set_item("log", &name)?;
+            e.set_item("samples", c.samples)?;
+            e.set_item(
+                "torque_columns",
+                torque_column_dicts(py, &c.torque_columns)?,
+            )?;
+            let lag = c.torque_lag.as_ref().map(|l| torque_lag_dict(py, l));
+            e.set_item("torque_lag", lag.transpose()?)?;
+            e.set_item(
+                "position_range",
+                position_range_dicts(py, &c.position_range)?,
+            )?;
+            e.set_item("findings", c.findings(&name))?;
+            Ok(e)
+        })
+        .collect()
+}

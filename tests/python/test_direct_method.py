@@ -605,6 +605,33 @@ def test_each_recordings_residuals_are_a_time_series_of_their_own():
     assert pr.identify_base_parameters(robot, same, friction="all").run_offsets == []
 
 
+def test_each_recording_of_a_list_is_checked_against_the_model_alone():
+    """A list of two Recordings, the second's shoulder torque in mN m: over the stacked
+    samples the column's gain is too low to judge, so only the second run checked alone names
+    it (`run_checks`, a warning naming the Recording); the first run has no finding, the
+    model no lag read across the join, and the checks are kept through a save."""
+    robot = pr.robots.a465()
+    recs = []
+    for motion, seed in [(1, 1), (2, 2)]:
+        t, q, qd, qdd, tau, _ = log_with_friction(robot, 0.1, motion, seed)
+        if motion == 2:
+            tau[:, 1] *= 1000.0
+        recs.append(pr.Recording(t[::10], q[::10], tau[::10], qd=qd[::10], qdd=qdd[::10], name=f"run{motion}"))
+    with pytest.warns(pr.PerturbidWarning, match=r"log 'run2': the torque of joint 'joint2' reads 1000\.\d+ times the robot's model torque"):
+        fit = pr.identify_base_parameters(robot, recs, friction=["viscous", "coulomb"])
+    checks = fit.run_checks
+    assert [c["log"] for c in checks] == ["run1", "run2"] and [c["samples"] for c in checks] == [2000, 2000]
+    assert checks[0]["findings"] == [] and len(checks[1]["findings"]) == 1
+    assert checks[1]["torque_columns"][1]["scale"] == pytest.approx(1000.0, rel=0.01)
+    assert fit.torque_columns[1]["finding"] is None and fit.torque_lag is None
+    assert all(c["torque_lag"]["samples"] == 0 for c in checks)
+    back = pr.BaseParameterModel.from_json(fit.to_json(), robot)
+    assert back.run_checks == checks
+    # one Recording is checked as the model's own, with no checks of runs
+    single = pr.identify_base_parameters(robot, recs[0], friction=["viscous", "coulomb"])
+    assert single.run_checks == [] and single.torque_lag["samples"] == 0
+
+
 def test_standard_errors_count_residuals_correlated_by_the_filter():
     # a log low-pass filtered at 10 Hz and kept at 100 Hz: about five correlated samples to
     # every independent one, which the standard errors now count
