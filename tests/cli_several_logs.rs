@@ -293,4 +293,67 @@ fn an_offset_that_drifted_between_logs_is_named() {
         model.run_offsets.is_empty() && !warned.contains("differ in mean"),
         "{warned}"
     );
+
+    // with an offset of each log's own: the drift fitted (+-0.05 about the logs' mean, each
+    // joint), not named, and each log validated with its own offset
+    let offsets = |extra: &[&str]| {
+        let mut args = vec![
+            "identify-direct",
+            "a465",
+            s(&logs[0]),
+            s(&drifted),
+            "--out",
+            s(&out),
+        ];
+        args.extend_from_slice(extra);
+        let printed = ok(&args);
+        (printed, BaseModel::load(&out).unwrap())
+    };
+    let (printed, model) = offsets(&["--offset-per-log"]);
+    let found = model.log_offsets.as_ref().expect("the logs' offsets");
+    for (d, se) in found.deviations.iter().zip(&found.stderr) {
+        assert!(
+            (d[1] - 0.05).abs() < 5.0 * se[1] && (d[0] + 0.05).abs() < 5.0 * se[0],
+            "{d:?} {se:?}"
+        );
+    }
+    assert!(model.run_offsets.is_empty(), "{:?}", model.run_offsets);
+    assert!(
+        printed.contains("each log's torque offset less the logs' mean")
+            && printed.contains("each with its own offset"),
+        "{printed}"
+    );
+    // checked on load: deviations that do not sum to 0
+    let mut v: serde_json::Value = serde_json::from_str(&model.to_json()).unwrap();
+    v["log_offsets"]["deviations"][2][0] = 1.0.into();
+    let e = BaseModel::from_json(&v.to_string())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("log_offsets.deviations[2] sum to"), "{e}");
+    // refused: one log, no offset term
+    fails(
+        &[
+            "identify-direct",
+            "a465",
+            s(&logs[0]),
+            "--out",
+            s(&out),
+            "--offset-per-log",
+        ],
+        &["--offset-per-log", "one log given"],
+    );
+    fails(
+        &[
+            "identify-direct",
+            "a465",
+            s(&logs[0]),
+            s(&drifted),
+            "--out",
+            s(&out),
+            "--offset-per-log",
+            "--friction",
+            "viscous,coulomb",
+        ],
+        &["--offset-per-log", "needs the offset among --friction"],
+    );
 }

@@ -684,6 +684,10 @@ class BaseParameterModel:
         run (a torque offset that drifted), dicts joint, means, stderr ((runs,) N m),
         residual_rms, finding (also a warning)."""
     @property
+    def log_offsets(self) -> Optional[dict[str, Any]]:
+        """Fitted with offset_per_log: logs (names), deviations and stderr ((logs, n) N m:
+        each log's torque offset less the logs' mean, the model's offset term); else None."""
+    @property
     def run_checks(self) -> list[dict[str, Any]]:
         """Fitted over several Recordings: each run's data checked alone against the robot's
         model, in order: dicts log, samples, torque_columns, torque_lag, position_range (as
@@ -813,6 +817,7 @@ def identify_base_parameters(
     seed: int = 0,
     t: Optional[ArrayLike] = None,
     coulomb: Optional[ArrayLike] = None,
+    offset_per_log: bool = False,
 ) -> BaseParameterModel:
     """Base parameters from arrays (q, qd, qdd, tau), a preprocessed Recording as q alone,
     or a list of them as q (runs fitted together, one after the other; what each one's
@@ -882,6 +887,7 @@ def identify_consistent_parameters(
     max_iterations: int = 2000,
     t: Optional[ArrayLike] = None,
     coulomb: Optional[ArrayLike] = None,
+    offset_per_log: bool = False,
 ) -> ConsistentFit:
     """Physically consistent least squares over the direct method's data (interior point):
     arrays, a preprocessed Recording as q alone, or a list of them (runs fitted together, as

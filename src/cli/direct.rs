@@ -170,6 +170,11 @@ pub(crate) struct IdentifyDirectArgs {
     /// model is saved, and the residual growth over the unconstrained fit is reported.
     #[arg(long)]
     consistent: bool,
+    /// Several logs: fit a torque offset of each log's own (a sensor zeroed anew, a drive
+    /// warmed up between them) beside the parameters, whose offset terms are then the logs'
+    /// mean; needs the offset among --friction. Each log is validated with its own offset.
+    #[arg(long)]
+    offset_per_log: bool,
 }
 
 pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
@@ -258,8 +263,26 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     // each log's residuals a time series of their own
     let options = crate::direct::BaseOptions {
         runs: stacked.as_ref().map_or(vec![], |(t, _)| t.runs.clone()),
+        offset_per_run: a.offset_per_log,
         ..a.fit.options()
     };
+    let most = crate::direct::streaming::MAX_OFFSET_RUNS;
+    let refused = match (recs.len(), options.friction.offset) {
+        (1, _) => Some("one log given: an offset of each log's own needs two or more".to_string()),
+        (k, _) if k > most => Some(format!(
+            "{k} logs, expected at most {most} for an offset of each log's own"
+        )),
+        (_, false) => {
+            Some("an offset of each log's own needs the offset among --friction".to_string())
+        }
+        _ => None,
+    };
+    if let Some(message) = refused.filter(|_| a.offset_per_log) {
+        return Err(Error::InvalidArgument {
+            argument: "--offset-per-log".into(),
+            message,
+        });
+    }
     progress.update(&format!("identifying on {split} samples"));
     // with the Coulomb term's column filtered as the torques were
     let fit = if a.consistent {
@@ -342,14 +365,36 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         csv.display(),
         json.display()
     );
+    if let Some(o) = &fit.log_offsets {
+        let _ = writeln!(
+            out,
+            "each log's torque offset less the logs' mean (the model's offset terms), per joint (N m, +- standard error):"
+        );
+        for (r, path) in a.data.iter().enumerate() {
+            let each: Vec<String> = (o.deviations.iter().zip(&o.stderr))
+                .map(|(d, s)| format!("{:.4} +- {:.4}", d[r], s[r]))
+                .collect();
+            let _ = writeln!(out, "  {}: {}", path.display(), each.join(", "));
+        }
+    }
     if split < k {
         let held_out = held.0;
-        let p = fit.on(&model)?.predict(&held_out)?;
+        let mut p = fit.on(&model)?.predict(&held_out)?;
+        // each log's held-out samples with its own offset, where one was fitted
+        if let Some(o) = &fit.log_offsets {
+            let held_runs: Vec<usize> =
+                recs.iter().zip(&splits).map(|(r, s)| r.len() - s).collect();
+            p = o.added(&p, &held_runs);
+        }
         let _ = writeln!(
             out,
             "validation on the last {} samples{}: per joint RMS (N m), relative RMS (%) and the RMS of the predictions' standard errors (N m)",
             k - split,
-            if recs.len() > 1 { " of each log" } else { "" }
+            match (recs.len(), &fit.log_offsets) {
+                (1, _) => "",
+                (_, None) => " of each log",
+                (_, Some(_)) => " of each log, each with its own offset",
+            }
         );
         let mut v = crate::validation::validate(&model.joint_names, &p, held.1)?;
         if let Ok(se) = crate::validation::stored_stderr(fit.predict_stderr(&model, &held_out))? {

@@ -476,3 +476,68 @@ fn solve_svd(a: DMatrix<f64>, b: &DVector<f64>, relative: f64) -> Result<DVector
         message: m.to_string(),
     })
 }
+
+/// Identifies physically consistent parameters of `model` from the same data as
+/// [`super::identify_base_parameters`] (same arguments, same weighting): the weighted least squares
+/// over parameter sets whose every body has a positive definite pseudo-inertia and whose
+/// friction and armature coefficients are non-negative (see [this module](self)). The
+/// robot's own parameters serve as the weak prior that decides what the data do not.
+///
+/// Returns the consistent fit with the unconstrained one beside it.
+pub fn identify_consistent_parameters(
+    model: &crate::Model,
+    states: &crate::States<'_>,
+    tau: &[f64],
+    options: &super::BaseOptions,
+    consistent: &ConsistentOptions,
+) -> Result<ConsistentFit> {
+    let (fit, factors) = super::identify::fit_with_factors(model, states, tau, options)?;
+    // the runs' offsets (where fitted) minimised over for every set of parameters
+    let profiled = factors.profiled(&fit.sigma)?;
+    let (r11, z, rho) = (&profiled.r, &profiled.z, profiled.rho);
+    let base = &fit.base;
+    let layout = &base.layout;
+    // theta_base = B theta: B[i, kept[i]] = 1, B[i, dropped[d]] = K[i, d]
+    let mut b = DMatrix::zeros(base.len(), layout.len());
+    for (i, &c) in base.kept.iter().enumerate() {
+        b[(i, c)] = 1.0;
+        for (d, &dc) in base.dropped.iter().enumerate() {
+            b[(i, dc)] = base.k[(i, d)];
+        }
+    }
+    let prior = layout.model_parameters(model);
+    let solution = consistent_least_squares(
+        layout,
+        &(r11 * b),
+        &DVector::from_column_slice(z.as_slice()),
+        rho * rho,
+        prior.as_slice(),
+        consistent,
+    )?;
+    let theta = base.from_full(&DVector::from_column_slice(&solution.theta))?;
+    let theta: Vec<f64> = theta.iter().copied().collect();
+    // the runs' offsets that go with the consistent parameters
+    let others = profiled.others(&theta)?;
+    let unknowns: Vec<f64> = theta.iter().chain(&others).copied().collect();
+    let log_offsets = (fit.log_offsets.as_ref()).map(|o| super::log_offsets::LogOffsets {
+        deviations: super::log_offsets::LogOffsets::deviations_of(
+            &unknowns,
+            theta.len(),
+            model.nv,
+            o.runs(),
+        ),
+        stderr: o.stderr.clone(),
+    });
+    let consistent_model = super::BaseModel {
+        residual_rms: factors.residual_rms(&unknowns)?,
+        theta,
+        log_offsets,
+        ..fit.clone()
+    };
+    Ok(ConsistentFit {
+        layout: layout.clone(),
+        solution,
+        model: consistent_model,
+        unconstrained: fit,
+    })
+}

@@ -391,6 +391,14 @@ pub fn identify_drive_gains_with(
         argument: "runs".into(),
         message,
     };
+    if options.offset_per_run {
+        // each loaded run's mean payload torque, part of what sets the gains' scale, would
+        // go into that run's offset
+        return Err(Error::InvalidArgument {
+            argument: "offset_per_run".into(),
+            message: "not taken with drive gains: an offset of each run's own would take up each loaded run's mean payload torque, part of what sets the gains' scale".into(),
+        });
+    }
     if !(2..=MAX_RUNS).contains(&runs.len()) {
         return Err(bad(format!(
             "{} runs given, expected 2 to {MAX_RUNS}: one without the payload (or with another) and one with it",

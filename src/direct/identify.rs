@@ -54,6 +54,12 @@ pub struct BaseOptions {
     /// standard errors six times for 0.02 N m). Empty (default): one run. At most
     /// [`super::drive_gains::MAX_RUNS`].
     pub runs: Vec<usize>,
+    /// An offset a run beside the base parameters, whose offset terms are then the runs'
+    /// mean ([`super::log_offsets`], [`BaseModel::log_offsets`]): for logs between which a
+    /// torque sensor was zeroed anew or a drive warmed up. Needs 2 to
+    /// [`super::streaming::MAX_OFFSET_RUNS`] `runs` and the offset among `friction`. Default
+    /// false.
+    pub offset_per_run: bool,
 }
 
 impl Default for BaseOptions {
@@ -66,6 +72,7 @@ impl Default for BaseOptions {
             states: 200,
             seed: 0,
             runs: vec![],
+            offset_per_run: false,
         }
     }
 }
@@ -175,6 +182,10 @@ pub struct BaseModel {
     /// Empty for one run, or in a model saved before they were checked.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub run_checks: Vec<super::run_checks::RunChecks>,
+    /// Where an offset a run was fitted ([`BaseOptions::offset_per_run`]), each run's offset
+    /// less the runs' mean (the model's offset terms), per joint; None otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub log_offsets: Option<super::log_offsets::LogOffsets>,
     /// Where the data excite the base parameters weakly (`cond` beyond
     /// [`super::weak_excitation::WEAK_CONDITION`]): the least determined combination and how
     /// far each joint moved ([`super::weak_excitation`]), warned of ([`BaseModel::warnings`]).
@@ -237,56 +248,6 @@ pub fn identify_base_parameters(
     Ok(fit_with_factors(model, states, tau, options)?.0)
 }
 
-/// Identifies physically consistent parameters of `model` from the same data as
-/// [`identify_base_parameters`] (same arguments, same weighting): the weighted least squares
-/// over parameter sets whose every body has a positive definite pseudo-inertia and whose
-/// friction and armature coefficients are non-negative (see [`super::consistent`]). The
-/// robot's own parameters serve as the weak prior that decides what the data do not.
-///
-/// Returns the consistent fit with the unconstrained one beside it.
-pub fn identify_consistent_parameters(
-    model: &Model,
-    states: &States<'_>,
-    tau: &[f64],
-    options: &BaseOptions,
-    consistent: &super::consistent::ConsistentOptions,
-) -> Result<super::consistent::ConsistentFit> {
-    let (fit, factors) = fit_with_factors(model, states, tau, options)?;
-    let (r11, z, rho) = factors.reduced(&fit.sigma)?;
-    let base = &fit.base;
-    let layout = &base.layout;
-    // theta_base = B theta: B[i, kept[i]] = 1, B[i, dropped[d]] = K[i, d]
-    let mut b = DMatrix::zeros(base.len(), layout.len());
-    for (i, &c) in base.kept.iter().enumerate() {
-        b[(i, c)] = 1.0;
-        for (d, &dc) in base.dropped.iter().enumerate() {
-            b[(i, dc)] = base.k[(i, d)];
-        }
-    }
-    let prior = layout.model_parameters(model);
-    let solution = super::consistent::consistent_least_squares(
-        layout,
-        &(r11 * b),
-        &DVector::from_column_slice(z.as_slice()),
-        rho * rho,
-        prior.as_slice(),
-        consistent,
-    )?;
-    let theta = base.from_full(&DVector::from_column_slice(&solution.theta))?;
-    let theta: Vec<f64> = theta.iter().copied().collect();
-    let consistent_model = BaseModel {
-        residual_rms: factors.residual_rms(&theta)?,
-        theta,
-        ..fit.clone()
-    };
-    Ok(super::consistent::ConsistentFit {
-        layout: layout.clone(),
-        solution,
-        model: consistent_model,
-        unconstrained: fit,
-    })
-}
-
 /// A least-squares fit of the base parameters: OLS, or WLS weighted by the OLS residuals.
 pub(super) struct Solved {
     pub base: BaseParameters,
@@ -320,9 +281,20 @@ pub(super) fn solve(
     options: &BaseOptions,
 ) -> Result<Solved> {
     let base = base_parameters(model, options)?;
-    let names = base.names();
+    let mut names = base.names();
     let mut sigma = vec![1.0; model.nv];
-    let factors = streaming::JointFactors::new(model, &base, states, tau, options.gravity)?;
+    let runs: &[usize] = match options.offset_per_run {
+        true => {
+            super::log_offsets::check_options(options)?;
+            for j in &model.joint_names {
+                names.extend((1..options.runs.len()).map(|r| format!("{j}.offset of run {r}")));
+            }
+            &options.runs
+        }
+        false => &[],
+    };
+    let factors =
+        streaming::JointFactors::with_runs(model, &base, states, tau, &[], runs, options.gravity)?;
     let mut ls = factors.solve(&sigma, &names)?;
     let mut rms = factors.residual_rms(ls.coef.as_slice())?;
     // residuals past f64's range (torques or states near 1e300) can be neither weighted nor
@@ -377,15 +349,29 @@ pub(super) fn fit_with_factors(
         rms,
         sigma,
     } = solve(model, states, tau, options)?;
+    let p = base.len();
+    let (coef, se) = (ls.coef.row(0), ls.stderr.row(0));
+    let log_offsets = options.offset_per_run.then(|| {
+        let (coef, se): (Vec<f64>, Vec<f64>) =
+            (coef.iter().copied().collect(), se.iter().copied().collect());
+        super::log_offsets::LogOffsets::of_fit(
+            &coef,
+            &se,
+            &ls.correlation,
+            p,
+            nv,
+            options.runs.len(),
+        )
+    });
     let mut fit = BaseModel {
         format: BaseModel::tag(),
         robot: model.name.clone(),
         joint_names: model.joint_names.clone(),
         gravity: options.gravity,
         weighting: options.weighting,
-        theta: ls.coef.row(0).iter().copied().collect(),
-        stderr: ls.stderr.row(0).iter().copied().collect(),
-        correlation: ls.correlation.clone(),
+        theta: coef.iter().take(p).copied().collect(),
+        stderr: se.iter().take(p).copied().collect(),
+        correlation: ls.correlation.view((0, 0), (p, p)).into_owned(),
         residual_rms: rms,
         sigma,
         cond: ls.cond,
@@ -422,6 +408,7 @@ pub(super) fn fit_with_factors(
             &options.runs,
             options.gravity,
         )?,
+        log_offsets: None,
         weak_excitation: None,
         drive_gains: None,
         joint_term_rms: super::parameter_table::joint_term_rms(
@@ -431,6 +418,14 @@ pub(super) fn fit_with_factors(
     };
     fit.weak_excitation =
         super::weak_excitation::check_excitation(model, states, &fit.base, ls.cond, &ls.weakest);
+    // what follows reads the torques as the model with the runs' mean offset fits them: each
+    // run's own offset taken out where one was fitted
+    let adjusted = (log_offsets.as_ref()).map(|o| o.taken_out(tau, &options.runs));
+    let tau = adjusted.as_deref().unwrap_or(tau);
+    let options = &BaseOptions {
+        offset_per_run: false,
+        ..options.clone()
+    };
     // residuals correlated from sample to sample (a filtered, lightly decimated log) carry less
     // information than their number says: estimated from the first samples of each run
     // (and each run's mean: a torque offset that drifted between runs)
@@ -440,6 +435,10 @@ pub(super) fn fit_with_factors(
     for se in &mut fit.stderr {
         *se *= inflation;
     }
+    fit.log_offsets = log_offsets.map(|mut o| {
+        o.inflate(inflation);
+        o
+    });
     fit.position_offsets =
         super::position_offsets::check_position_offsets(model, &fit, states, tau)?;
     fit.unmodelled_friction =
@@ -605,6 +604,10 @@ impl Document for BaseModel {
         )
         .or_else(|| {
             super::run_checks::problem(&m.run_checks, &m.joint_names, m.samples, m.logs.len())
+        })
+        .or_else(|| {
+            let offset = m.base.layout.friction.offset;
+            (m.log_offsets.as_ref()).and_then(|o| o.problem(n, m.logs.len(), offset))
         }) {
             return Err(invalid(Self::WHAT, problem));
         }

@@ -13,6 +13,7 @@ pub mod global_linear;
 pub mod identify;
 pub mod instrumental;
 pub mod log_findings;
+pub mod log_offsets;
 pub mod parameter_table;
 pub mod parameters;
 pub mod position_offsets;
@@ -31,7 +32,8 @@ pub mod workspace;
 pub use base::BaseParameters;
 pub use consistency::{check_physical_consistency, BodyConsistency, ConsistencyReport};
 pub use consistent::{
-    consistent_least_squares, ConsistentFit, ConsistentOptions, ConsistentSolution,
+    consistent_least_squares, identify_consistent_parameters, ConsistentFit, ConsistentOptions,
+    ConsistentSolution,
 };
 pub use drive_gains::{
     identify_drive_gains, identify_drive_gains_with, DriveGainFit, DriveGains, GainEstimator,
@@ -39,10 +41,9 @@ pub use drive_gains::{
 };
 pub use excitation::{design_excitation, Criterion, ExcitationDesign, ExcitationOptions};
 pub use global_linear::{identify_global_linear, GlobalLinearModel};
-pub use identify::{
-    identify_base_parameters, identify_consistent_parameters, BaseModel, BaseOptions, Weighting,
-};
+pub use identify::{identify_base_parameters, BaseModel, BaseOptions, Weighting};
 pub use log_findings::LogFindings;
+pub use log_offsets::LogOffsets;
 pub use parameter_table::ParameterRow;
 pub use parameters::{regressor_blocks, regressor_matrix, FrictionTerms, ParameterLayout};
 pub use position_offsets::{

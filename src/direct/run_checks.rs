@@ -63,7 +63,7 @@ impl RunChecks {
 /// without gravity as the logs were recorded; empty for fewer than two runs (a single run is
 /// the fit's own checks). Each run's checks read at most their own sample counts
 /// ([`super::torque_columns::SAMPLES`], [`super::torque_lag::SAMPLES`]): about 1 ms a run
-/// of a 6-joint arm. The caller checks `runs` first ([`super::runs::check_runs`]).
+/// of a 6-joint arm. The caller checks `runs` first.
 pub fn check_runs_against_model(
     model: &Model,
     states: &States<'_>,

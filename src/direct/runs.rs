@@ -92,7 +92,7 @@ impl RunOffsets {
         let apart = (self.means[hi] - self.means[lo])
             / (self.stderr[hi].powi(2) + self.stderr[lo].powi(2)).sqrt();
         format!(
-            "the residuals of joint '{}' differ in mean from log to log, from {:.4} ('{}') to {:.4} ('{}'), {:.0} standard errors apart, {:.0} % of its residual RMS {:.4}: a torque offset that drifted between the logs (a sensor zeroed anew, a drive warmed up), which one offset a joint cannot fit, or an effect the model lacks that the logs' motions excite unlike; it bends the other parameters and widens their standard errors. Compare the logs fitted one by one, or take each log's offset out of its torques before fitting them together",
+            "the residuals of joint '{}' differ in mean from log to log, from {:.4} ('{}') to {:.4} ('{}'), {:.0} standard errors apart, {:.0} % of its residual RMS {:.4}: a torque offset that drifted between the logs (a sensor zeroed anew, a drive warmed up), which one offset a joint cannot fit, or an effect the model lacks that the logs' motions excite unlike; it bends the other parameters and widens their standard errors. Fit an offset of each log's own (identify-direct --offset-per-log, Python offset_per_log=True), or compare the logs fitted one by one",
             self.joint,
             self.means[lo],
             name(lo),

@@ -38,6 +38,10 @@ use crate::states::States;
 /// Samples per chunk.
 pub const CHUNK: usize = 1024;
 
+/// The most runs whose offsets one fit takes ([`JointFactors::with_runs`]): each adds a column
+/// to every joint's factor (50 runs make a 6-joint arm's fit about 4 times as costly).
+pub const MAX_OFFSET_RUNS: usize = 50;
+
 /// A friction term of a joint: `qd`, `sign(qd)` or 1, on that joint's rows only.
 #[derive(Clone, Copy, Debug)]
 enum Term {
@@ -113,8 +117,9 @@ pub struct JointFactors {
     pub samples: usize,
     /// Number of base parameters `p`.
     pub parameters: usize,
-    /// Columns of data per joint beside the base columns (`e`; 0 for a plain fit): joint `j`'s
-    /// column `c` is unknown `p + j e + c`.
+    /// Columns per joint beside the base columns (`e`; 0 for a plain fit): its columns of data,
+    /// then its runs' offsets ([`JointFactors::with_runs`]); joint `j`'s column `c` is unknown
+    /// `p + j e + c`.
     pub extra: usize,
     /// The base columns that joint `j`'s rows can have nonzero (`n_j` of them, ascending).
     pub active: Vec<Vec<usize>>,
@@ -128,12 +133,22 @@ pub struct JointFactors {
 /// The samples a fit reduces, row-major over the whole batch: the states `x` (`[q, qd, qdd,
 /// coulomb]`, `coulomb` the Coulomb term's column, [`States::coulomb_at`]), the joints'
 /// columns of data `extra` (each `k x nv`) and the torques `tau`; `gravity` in the regressor.
+/// Where the runs' offsets are fitted ([`JointFactors::with_runs`]), `starts` holds each run's
+/// first sample (the first 0), and each joint's rows carry one column a run after the first.
 #[derive(Clone, Copy)]
 struct Batch<'a> {
     x: [&'a [f64]; 4],
     extra: &'a [&'a [f64]],
+    starts: &'a [usize],
     tau: &'a [f64],
     gravity: Gravity,
+}
+
+impl Batch<'_> {
+    /// The runs' offset columns a joint: one a run after the first (0 without runs).
+    fn run_columns(&self) -> usize {
+        self.starts.len().saturating_sub(1)
+    }
 }
 
 /// One worker's buffers: a `Data`, the regressor of one sample, and per joint a column-major
@@ -216,10 +231,16 @@ impl Worker {
         let Batch {
             x: [q, qd, qdd, coulomb],
             extra,
+            starts,
             tau,
             gravity,
         } = *batch;
         let nv = model.nv;
+        let (e, runs) = (extra.len(), batch.run_columns());
+        // the run of the chunk's first sample, advanced as its samples pass the next start
+        let mut run = starts
+            .partition_point(|&f| f <= range.start)
+            .saturating_sub(1);
         let mut first = range.start;
         while first < range.end {
             let used = (range.end - first).min(self.lanes.width());
@@ -234,6 +255,9 @@ impl Worker {
             )?;
             for l in 0..used {
                 let s = first + l;
+                while run + 1 < starts.len() && starts[run + 1] <= s {
+                    run += 1;
+                }
                 let row = s * nv..(s + 1) * nv;
                 let (qd, qdd, coulomb) = (&qd[row.clone()], &qdd[row.clone()], &coulomb[row]);
                 for (j, (a, cols)) in self.stacks.iter_mut().zip(columns).enumerate() {
@@ -253,7 +277,16 @@ impl Worker {
                     for (c, x) in extra.iter().enumerate() {
                         a[(i, nj + c)] = x[s * nv + j];
                     }
-                    a[(i, nj + extra.len())] = tau[s * nv + j];
+                    // run r's offset less the runs' mean (the first run's the others' sum,
+                    // negated): the base offset term is then the runs' mean offset
+                    for c in 0..runs {
+                        a[(i, nj + e + c)] = match run {
+                            0 => -1.0,
+                            r if r == c + 1 => 1.0,
+                            _ => 0.0,
+                        };
+                    }
+                    a[(i, nj + e + runs)] = tau[s * nv + j];
                 }
             }
             first += used;
@@ -364,7 +397,51 @@ impl JointFactors {
         extra: &[&[f64]],
         gravity: Gravity,
     ) -> Result<Self> {
+        Self::with_runs(model, base, states, tau, extra, &[], gravity)
+    }
+
+    /// [`JointFactors::with_columns`] with an offset a joint for each of the `runs` (the
+    /// samples of each, in order, adding up to all; none or two to [`MAX_OFFSET_RUNS`]) beside
+    /// the offset term the base parameters hold: joint `j`'s unknowns `p + j e + c` after its
+    /// `extra.len()` columns of data are, for `c = extra.len() + r - 1`, run `r`'s offset less
+    /// the runs' mean (`r = 1 ..`; the first run's is minus their sum), so that the base
+    /// offset term is the runs' mean offset. `e = extra.len() + runs.len() - 1`.
+    pub fn with_runs(
+        model: &Model,
+        base: &BaseParameters,
+        states: &States<'_>,
+        tau: &[f64],
+        extra: &[&[f64]],
+        runs: &[usize],
+        gravity: Gravity,
+    ) -> Result<Self> {
         let nv = model.nv;
+        if runs.len() == 1 || runs.len() > MAX_OFFSET_RUNS {
+            return Err(Error::InvalidArgument {
+                argument: "runs".into(),
+                message: format!(
+                    "{} runs, expected 2 to {MAX_OFFSET_RUNS} for an offset a run",
+                    runs.len()
+                ),
+            });
+        }
+        if !runs.is_empty() && (runs.contains(&0) || runs.iter().sum::<usize>() != states.len()) {
+            return Err(Error::InvalidArgument {
+                argument: "runs".into(),
+                message: format!(
+                    "runs of {} samples in all (none of 0 expected), for {} samples",
+                    runs.iter().sum::<usize>(),
+                    states.len()
+                ),
+            });
+        }
+        let starts: Vec<usize> = (runs.iter())
+            .scan(0, |first, &len| {
+                let at = *first;
+                *first += len;
+                Some(at)
+            })
+            .collect();
         states.check_companion("tau", tau, nv)?;
         if extra.len() > 4 {
             return Err(Error::InvalidArgument {
@@ -378,7 +455,7 @@ impl JointFactors {
         for x in extra {
             states.check_companion("a joint's column of data", x, nv)?;
         }
-        let e = extra.len();
+        let e = extra.len() + runs.len().saturating_sub(1);
         let k = states.len();
         let (qd, qdd) = (states.qd_or_zeros(), states.qdd_or_zeros());
         // the Coulomb term's column: the states' own (filtered), or sign(qd)
@@ -391,6 +468,7 @@ impl JointFactors {
         let batch = Batch {
             x: [states.q(), &qd[..], &qdd[..], &coulomb[..]],
             extra,
+            starts: &starts,
             tau,
             gravity,
         };
@@ -498,6 +576,49 @@ impl JointFactors {
         Ok((r11, z, r[(p, p)]))
     }
 
+    /// [`JointFactors::reduced`] with the joints' other unknowns (columns of data, runs'
+    /// offsets) minimised over for every `theta` of the `p` base parameters alone:
+    /// `min_d |W (Phi theta + X d - tau)|^2 = |R theta - z|^2 + rho^2` (the same as
+    /// [`JointFactors::reduced`] where there are none). [`Profiled::others`] gives the `d`
+    /// that minimises for a `theta`.
+    pub fn profiled(&self, sigma: &[f64]) -> Result<Profiled> {
+        let (r11, z, rho) = self.reduced(sigma)?;
+        let (p, m) = (self.parameters, self.unknowns() - self.parameters);
+        if m == 0 {
+            return Ok(Profiled {
+                r: r11,
+                z,
+                rho,
+                others: DMatrix::zeros(0, 0),
+                coupling: DMatrix::zeros(0, p),
+                others_z: DMatrix::zeros(0, 1),
+            });
+        }
+        // [R11 | z] with the others' columns first, and the residual's row: its QR's last
+        // p + 1 rows are the problem in theta alone
+        let n = p + m;
+        let mut a = DMatrix::zeros(n + 1, n + 1);
+        for i in 0..n {
+            for c in 0..m {
+                a[(i, c)] = r11[(i, p + c)];
+            }
+            for c in 0..p {
+                a[(i, m + c)] = r11[(i, c)];
+            }
+            a[(i, n)] = z[(i, 0)];
+        }
+        a[(n, n)] = rho;
+        let t = triangular(&a);
+        Ok(Profiled {
+            r: t.view((m, m), (p, p)).into_owned(),
+            z: t.view((m, n), (p, 1)).into_owned(),
+            rho: t[(n, n)].abs(),
+            others: t.view((0, 0), (m, m)).into_owned(),
+            coupling: t.view((0, m), (m, p)).into_owned(),
+            others_z: t.view((0, n), (m, 1)).into_owned(),
+        })
+    }
+
     /// Per-joint RMS over the samples of the unweighted residuals `tau - Phi_base theta` (N m)
     /// for base parameters `theta` (the [`JointFactors::unknowns`], the joints' columns of
     /// data after the base parameters): `|R_j [theta; -1]| / sqrt(K)`.
@@ -527,5 +648,45 @@ impl JointFactors {
                 (r * x).norm() / k.sqrt()
             })
             .collect())
+    }
+}
+
+/// The weighted problem in the base parameters alone, the joints' other unknowns minimised
+/// over ([`JointFactors::profiled`]).
+#[derive(Clone, Debug)]
+pub struct Profiled {
+    /// `R` (p x p, upper triangular), `z` (p x 1) and `rho`: `|R theta - z|^2 + rho^2`.
+    pub r: DMatrix<f64>,
+    pub z: DMatrix<f64>,
+    pub rho: f64,
+    /// The others' block (m x m, upper triangular), their coupling to theta (m x p) and their
+    /// right-hand side (m x 1): `others d + coupling theta = others_z` at the minimum.
+    others: DMatrix<f64>,
+    coupling: DMatrix<f64>,
+    others_z: DMatrix<f64>,
+}
+
+impl Profiled {
+    /// The joints' other unknowns (`m`, in the order of [`JointFactors::unknowns`] after the
+    /// base parameters) that minimise the residual for the base parameters `theta` (`p`).
+    /// Errors: a `theta` of another length, or others the data do not determine.
+    pub fn others(&self, theta: &[f64]) -> Result<Vec<f64>> {
+        let p = self.coupling.ncols();
+        if theta.len() != p {
+            return Err(Error::Shape {
+                argument: "theta".into(),
+                expected: format!("{p} base parameters"),
+                got: format!("{} values", theta.len()),
+            });
+        }
+        let rhs = &self.others_z - &self.coupling * DMatrix::from_column_slice(p, 1, theta);
+        let d = (self.others.rows(0, self.others.nrows()))
+            .solve_upper_triangular(&rhs)
+            .filter(|d| d.iter().all(|v| v.is_finite()))
+            .ok_or_else(|| Error::Numerical {
+                operation: "base-parameter identification".into(),
+                message: "the data do not determine the joints' other unknowns (runs' offsets, columns of data)".into(),
+            })?;
+        Ok(d.iter().copied().collect())
     }
 }

@@ -345,6 +345,7 @@ pub fn identify_parameters_from_local(
         unmodelled_friction: vec![],
         run_offsets: vec![],
         run_checks: vec![],
+        log_offsets: None,
         // rows from local models: their own diagnostics say what they leave unidentified
         weak_excitation: None,
         drive_gains: None,

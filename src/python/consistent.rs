@@ -141,9 +141,10 @@ impl PyConsistentFit {
 /// `identify_base_parameters`; a Recording as `q`, alone, gives its own, and a list of them
 /// is fitted as runs one after the other, as `identify_base_parameters` fits them (what each
 /// one's preprocessing found kept in the models' `logs`; one Recording's in the one-log
-/// fields). Returns a ConsistentFit.
+/// fields); `offset_per_log` fits each one's own torque offset, as `identify_base_parameters`
+/// does. Returns a ConsistentFit.
 #[pyfunction]
-#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, friction=None, weighting="wls", gravity=true, prior_weight=1e-6, max_iterations=2000, t=None, coulomb=None))]
+#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, friction=None, weighting="wls", gravity=true, prior_weight=1e-6, max_iterations=2000, t=None, coulomb=None, offset_per_log=false))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_consistent_parameters<'py>(
     py: Python<'py>,
@@ -159,6 +160,7 @@ pub(crate) fn identify_consistent_parameters<'py>(
     #[pyo3(from_py_with = scalars::count)] max_iterations: usize,
     t: Option<Bound<'py, PyAny>>,
     coulomb: Option<Bound<'py, PyAny>>,
+    offset_per_log: bool,
 ) -> PyResult<PyConsistentFit> {
     let options = base_options(friction, weighting, gravity)?;
     let consistent = ConsistentOptions {
@@ -175,7 +177,12 @@ pub(crate) fn identify_consistent_parameters<'py>(
         coulomb,
     };
     // several Recordings, fitted together; one Recording's findings are kept with the model
-    let listed = super::direct::recordings_given(&q, &given)?;
+    let listed = super::recording_list::recordings_given(&q, &given)?;
+    let options = super::recording_list::with_offset_per_log(
+        options,
+        offset_per_log,
+        listed.as_ref().map(Vec::len),
+    )?;
     let recs = match &listed {
         Some(recs) => recs.clone(),
         None => (q.cast::<super::recording::PyRecording>().ok())
@@ -185,7 +192,7 @@ pub(crate) fn identify_consistent_parameters<'py>(
     let findings = |c: ConsistentFit| -> ConsistentFit {
         // a list's in `logs`, as identify_base_parameters keeps them
         let keep = |m: crate::direct::BaseModel| match (&listed, recs.as_slice()) {
-            (Some(_), recs) => super::direct::with_logs(m, recs),
+            (Some(_), recs) => super::recording_list::with_logs(m, recs),
             (None, [rec]) => m.with_findings_of(rec),
             (None, _) => m,
         };
@@ -197,7 +204,8 @@ pub(crate) fn identify_consistent_parameters<'py>(
     };
     if listed.is_some() {
         let fit = detached(py, "identify_consistent_parameters", || {
-            let (stacked, options) = super::direct::stacked_recordings(model, &recs, &options)?;
+            let (stacked, options) =
+                super::recording_list::stacked_recordings(model, &recs, &options)?;
             let c = consistent_rs(
                 model,
                 &stacked.states()?,

@@ -6,6 +6,7 @@ use std::borrow::Cow;
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use nalgebra::DMatrix;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 
@@ -22,6 +23,7 @@ use super::findings::{
     torque_lag_dict,
 };
 use super::local::PyOperatingPoint;
+use super::recording_list::{recordings_given, stacked_recordings, with_logs, with_offset_per_log};
 use super::robot::PyRobot;
 use super::samples::{samples, Given};
 use crate::direct::{
@@ -349,6 +351,24 @@ impl PyBaseModel {
             })
             .collect()
     }
+    /// Where an offset of each log's own was fitted (`offset_per_log`), dict `logs` (their
+    /// names, in order), `deviations` and `stderr` ((logs, n) N m: each log's torque offset
+    /// less the logs' mean, which is the model's offset term, and its standard error); None
+    /// otherwise. A log's own offset of joint j is the model's offset term plus its deviation.
+    #[getter]
+    fn log_offsets<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(o) = &self.fit.log_offsets else {
+            return Ok(None);
+        };
+        let e = PyDict::new(py);
+        let names: Vec<String> = self.fit.logs.iter().map(|l| l.log.clone()).collect();
+        let (runs, n) = (o.runs(), o.deviations.len());
+        let by_log = |m: &[Vec<f64>]| DMatrix::from_fn(runs, n, |r, j| m[j][r]);
+        e.set_item("logs", names)?;
+        e.set_item("deviations", mat(py, &by_log(&o.deviations))?)?;
+        e.set_item("stderr", mat(py, &by_log(&o.stderr))?)?;
+        Ok(Some(e))
+    }
     /// In a fit of several Recordings (or runs), each run's data checked alone against the
     /// robot's model, in the runs' order: dicts `log` (its name), `samples` (fitted),
     /// `torque_columns`, `torque_lag` and `position_range` (as the model's own, of that run's
@@ -614,9 +634,11 @@ impl PyBaseModel {
 /// q and qd first (see `check_sample_derivatives`), refusing columns in other units, of
 /// another joint or of the opposite sign. `coulomb` ((k, n)), for torques low-pass filtered:
 /// the Coulomb friction term's column filtered as they were (`Recording.coulomb` of
-/// `preprocess`), in place of sign(qd).
+/// `preprocess`), in place of sign(qd). `offset_per_log`, for a list of Recordings: a torque
+/// offset of each one's own fitted beside the parameters (a sensor zeroed anew between logs),
+/// whose offset terms are then the logs' mean (`log_offsets`); needs the offset term.
 #[pyfunction]
-#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, friction=None, weighting="wls", gravity=true, tolerance=1e-8, seed=0, t=None, coulomb=None))]
+#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, friction=None, weighting="wls", gravity=true, tolerance=1e-8, seed=0, t=None, coulomb=None, offset_per_log=false))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_base_parameters<'py>(
     py: Python<'py>,
@@ -632,8 +654,8 @@ pub(crate) fn identify_base_parameters<'py>(
     #[pyo3(from_py_with = scalars::seed)] seed: u64,
     t: Option<Bound<'py, PyAny>>,
     coulomb: Option<Bound<'py, PyAny>>,
+    offset_per_log: bool,
 ) -> PyResult<PyBaseModel> {
-    let options = fit_options(friction, weighting, gravity, tolerance, seed)?;
     let model = &robot.model;
     let given = Given {
         qd,
@@ -642,7 +664,13 @@ pub(crate) fn identify_base_parameters<'py>(
         t,
         coulomb,
     };
-    if let Some(recs) = recordings_given(&q, &given)? {
+    let listed = recordings_given(&q, &given)?;
+    let options = with_offset_per_log(
+        fit_options(friction, weighting, gravity, tolerance, seed)?,
+        offset_per_log,
+        listed.as_ref().map(Vec::len),
+    )?;
+    if let Some(recs) = listed {
         let fit = detached(py, "identify_base_parameters", || {
             let (stacked, options) = stacked_recordings(model, &recs, &options)?;
             let fit = base_rs(model, &stacked.states()?, &stacked.data, &options)?;
@@ -679,120 +707,4 @@ pub(crate) fn identify_base_parameters<'py>(
         fit,
         model: Arc::new(model.clone()),
     })
-}
-
-/// The Recordings of `q` where it is a list or tuple of them (None where it is anything else:
-/// an array of numbers); a list of which some are Recordings and some not is a TypeError.
-pub(crate) fn recordings_of(
-    q: &Bound<'_, PyAny>,
-) -> PyResult<Option<Vec<Arc<crate::recording::Recording>>>> {
-    let items: Vec<Bound<'_, PyAny>> = match (
-        q.cast::<pyo3::types::PyList>(),
-        q.cast::<pyo3::types::PyTuple>(),
-    ) {
-        (Ok(l), _) => l.iter().collect(),
-        (_, Ok(t)) => t.iter().collect(),
-        _ => return Ok(None),
-    };
-    let recs: Vec<Option<Arc<crate::recording::Recording>>> = (items.iter())
-        .map(|x| {
-            x.cast::<super::recording::PyRecording>()
-                .ok()
-                .map(|r| r.get().rec.clone())
-        })
-        .collect();
-    match recs.iter().filter(|r| r.is_some()).count() {
-        0 => Ok(None),
-        k if k == recs.len() => Ok(Some(recs.into_iter().flatten().collect())),
-        _ => Err(pyo3::exceptions::PyTypeError::new_err(
-            "q: a list of Recordings (runs to fit together) or an array of positions, not a mix",
-        )),
-    }
-}
-
-/// The Recordings given as `q` (a list or tuple of them: runs to fit together), with nothing
-/// else given beside them (they carry their own); None for arrays or one Recording.
-pub(crate) fn recordings_given(
-    q: &Bound<'_, PyAny>,
-    given: &Given<'_>,
-) -> PyResult<Option<Vec<Arc<crate::recording::Recording>>>> {
-    let Some(recs) = recordings_of(q)? else {
-        return Ok(None);
-    };
-    if let Some(name) = given.first_given() {
-        return Err(Error::InvalidArgument {
-            argument: name.into(),
-            message:
-                "given with a list of Recordings as q, which carry their own: pass the list alone"
-                    .into(),
-        }
-        .into());
-    }
-    Ok(Some(recs))
-}
-
-/// The Recordings `recs` (preprocessed: with velocities and accelerations) one after the
-/// other, each one's logged derivatives checked as a log's, and `options` with their runs
-/// (each one's residuals a time series of their own). Errors name the Recording.
-pub(crate) fn stacked_recordings(
-    model: &crate::model::Model,
-    recs: &[Arc<crate::recording::Recording>],
-    options: &BaseOptions,
-) -> Result<(crate::stacked_states::StackedStates, BaseOptions)> {
-    if recs.is_empty() || recs.len() > crate::direct::drive_gains::MAX_RUNS {
-        return Err(Error::InvalidArgument {
-            argument: "q".into(),
-            message: format!(
-                "{} Recordings, expected 1 to {}",
-                recs.len(),
-                crate::direct::drive_gains::MAX_RUNS
-            ),
-        });
-    }
-    let mut states = Vec::with_capacity(recs.len());
-    for (i, r) in recs.iter().enumerate() {
-        let at = |e: Error| Error::InvalidArgument {
-            argument: "q".into(),
-            message: format!("Recording {i} ('{}'): {e}", r.name),
-        };
-        if r.n != model.nv || r.qd.is_none() || r.qdd.is_none() {
-            return Err(at(Error::InvalidArgument {
-                argument: "q".into(),
-                message: format!(
-                    "{} joints{}, expected the robot's {} with velocities and accelerations: preprocess it first (perturbid_rs.preprocess)",
-                    r.n,
-                    if r.qdd.is_none() { " without velocities and accelerations" } else { "" },
-                    model.nv
-                ),
-            }));
-        }
-        crate::derivative_columns::check_logged_derivatives(r).map_err(at)?;
-        states.push(r.states().map_err(at)?);
-    }
-    let parts: Vec<(States<'_>, &[f64])> = states
-        .iter()
-        .zip(recs)
-        .map(|(s, r)| (*s, &r.tau[..]))
-        .collect();
-    let names: Vec<String> = (recs.iter().enumerate())
-        .map(|(i, r)| format!("Recording {i} ('{}')", r.name))
-        .collect();
-    let stacked = crate::stacked_states::StackedStates::of_named(&parts, &names, "q")?;
-    // each Recording's residuals a time series of their own
-    let options = BaseOptions {
-        runs: stacked.runs.clone(),
-        ..options.clone()
-    };
-    Ok((stacked, options))
-}
-
-/// `fit` with what each of the Recordings `recs` it was fitted to found in its preprocessing,
-/// in its `logs` (named by it).
-pub(crate) fn with_logs(fit: BaseModel, recs: &[Arc<crate::recording::Recording>]) -> BaseModel {
-    BaseModel {
-        logs: (recs.iter())
-            .map(|r| crate::direct::LogFindings::of(&r.name, r))
-            .collect(),
-        ..fit
-    }
 }

@@ -16,6 +16,7 @@ mod local;
 mod local_model;
 mod preprocess;
 mod recording;
+mod recording_list;
 mod rehearsal;
 mod robot;
 mod samples;

@@ -1,0 +1,163 @@
+//! Several Recordings fitted together (runs one after the other: `identify_base_parameters`,
+//! `identify_consistent_parameters`): the list read, its Recordings stacked with their runs,
+//! the fit's option of an offset a log, and what each one's preprocessing found kept in the
+//! model's `logs`.
+
+use std::sync::Arc;
+
+use pyo3::prelude::*;
+
+use super::samples::Given;
+use crate::direct::{BaseModel, BaseOptions};
+use crate::error::{Error, Result};
+use crate::states::States;
+
+/// `options` with an offset a log where `offset_per_log` asks for one: refused unless the
+/// data are a list of two or more Recordings (`listed`, their number) and the joint terms have
+/// the offset, named as Python's argument.
+pub(crate) fn with_offset_per_log(
+    options: BaseOptions,
+    offset_per_log: bool,
+    listed: Option<usize>,
+) -> Result<BaseOptions> {
+    if !offset_per_log {
+        return Ok(options);
+    }
+    let most = crate::direct::streaming::MAX_OFFSET_RUNS;
+    let problem = match listed {
+        Some(k) if !(2..=most).contains(&k) => Some(format!(
+            "an offset of each log's own needs 2 to {most} Recordings, got {k}"
+        )),
+        None => Some("an offset of each log's own needs a list of Recordings (logs) as q".into()),
+        _ if !options.friction.offset => Some(
+            "an offset of each log's own needs the offset among the joint terms (friction='all', or a list with 'offset')".into(),
+        ),
+        _ => None,
+    };
+    match problem {
+        Some(message) => Err(Error::InvalidArgument {
+            argument: "offset_per_log".into(),
+            message,
+        }),
+        None => Ok(BaseOptions {
+            offset_per_run: true,
+            ..options
+        }),
+    }
+}
+
+/// The Recordings of `q` where it is a list or tuple of them (None where it is anything else:
+/// an array of numbers); a list of which some are Recordings and some not is a TypeError.
+pub(crate) fn recordings_of(
+    q: &Bound<'_, PyAny>,
+) -> PyResult<Option<Vec<Arc<crate::recording::Recording>>>> {
+    let items: Vec<Bound<'_, PyAny>> = match (
+        q.cast::<pyo3::types::PyList>(),
+        q.cast::<pyo3::types::PyTuple>(),
+    ) {
+        (Ok(l), _) => l.iter().collect(),
+        (_, Ok(t)) => t.iter().collect(),
+        _ => return Ok(None),
+    };
+    let recs: Vec<Option<Arc<crate::recording::Recording>>> = (items.iter())
+        .map(|x| {
+            x.cast::<super::recording::PyRecording>()
+                .ok()
+                .map(|r| r.get().rec.clone())
+        })
+        .collect();
+    match recs.iter().filter(|r| r.is_some()).count() {
+        0 => Ok(None),
+        k if k == recs.len() => Ok(Some(recs.into_iter().flatten().collect())),
+        _ => Err(pyo3::exceptions::PyTypeError::new_err(
+            "q: a list of Recordings (runs to fit together) or an array of positions, not a mix",
+        )),
+    }
+}
+
+/// The Recordings given as `q` (a list or tuple of them: runs to fit together), with nothing
+/// else given beside them (they carry their own); None for arrays or one Recording.
+pub(crate) fn recordings_given(
+    q: &Bound<'_, PyAny>,
+    given: &Given<'_>,
+) -> PyResult<Option<Vec<Arc<crate::recording::Recording>>>> {
+    let Some(recs) = recordings_of(q)? else {
+        return Ok(None);
+    };
+    if let Some(name) = given.first_given() {
+        return Err(Error::InvalidArgument {
+            argument: name.into(),
+            message:
+                "given with a list of Recordings as q, which carry their own: pass the list alone"
+                    .into(),
+        }
+        .into());
+    }
+    Ok(Some(recs))
+}
+
+/// The Recordings `recs` (preprocessed: with velocities and accelerations) one after the
+/// other, each one's logged derivatives checked as a log's, and `options` with their runs
+/// (each one's residuals a time series of their own). Errors name the Recording.
+pub(crate) fn stacked_recordings(
+    model: &crate::model::Model,
+    recs: &[Arc<crate::recording::Recording>],
+    options: &BaseOptions,
+) -> Result<(crate::stacked_states::StackedStates, BaseOptions)> {
+    if recs.is_empty() || recs.len() > crate::direct::drive_gains::MAX_RUNS {
+        return Err(Error::InvalidArgument {
+            argument: "q".into(),
+            message: format!(
+                "{} Recordings, expected 1 to {}",
+                recs.len(),
+                crate::direct::drive_gains::MAX_RUNS
+            ),
+        });
+    }
+    let mut states = Vec::with_capacity(recs.len());
+    for (i, r) in recs.iter().enumerate() {
+        let at = |e: Error| Error::InvalidArgument {
+            argument: "q".into(),
+            message: format!("Recording {i} ('{}'): {e}", r.name),
+        };
+        if r.n != model.nv || r.qd.is_none() || r.qdd.is_none() {
+            return Err(at(Error::InvalidArgument {
+                argument: "q".into(),
+                message: format!(
+                    "{} joints{}, expected the robot's {} with velocities and accelerations: preprocess it first (perturbid_rs.preprocess)",
+                    r.n,
+                    if r.qdd.is_none() { " without velocities and accelerations" } else { "" },
+                    model.nv
+                ),
+            }));
+        }
+        crate::derivative_columns::check_logged_derivatives(r).map_err(at)?;
+        states.push(r.states().map_err(at)?);
+    }
+    let parts: Vec<(States<'_>, &[f64])> = states
+        .iter()
+        .zip(recs)
+        .map(|(s, r)| (*s, &r.tau[..]))
+        .collect();
+    let names: Vec<String> = (recs.iter().enumerate())
+        .map(|(i, r)| format!("Recording {i} ('{}')", r.name))
+        .collect();
+    let stacked = crate::stacked_states::StackedStates::of_named(&parts, &names, "q")?;
+    // each Recording's residuals a time series of their own
+    let options = BaseOptions {
+        runs: stacked.runs.clone(),
+        ..options.clone()
+    };
+    Ok((stacked, options))
+}
+
+/// `fit` with what each of the Recordings `recs` it was fitted to found in its preprocessing,
+/// in its `logs` (named by it).
+pub(crate) fn with_logs(fit: BaseModel, recs: &[Arc<crate::recording::Recording>]) -> BaseModel {
+    BaseModel {
+        logs: (recs.iter())
+            .map(|r| crate::direct::LogFindings::of(&r.name, r))
+            .collect(),
+        ..fit
+    }
+}
