@@ -296,7 +296,7 @@ fn an_offset_that_drifted_between_logs_is_named() {
 
     // with an offset of each log's own: the drift fitted (+-0.05 about the logs' mean, each
     // joint), not named, and each log validated with its own offset
-    let offsets = |extra: &[&str]| {
+    let both = |extra: &[&'static str]| {
         let mut args = vec![
             "identify-direct",
             "a465",
@@ -306,10 +306,10 @@ fn an_offset_that_drifted_between_logs_is_named() {
             s(&out),
         ];
         args.extend_from_slice(extra);
-        let printed = ok(&args);
-        (printed, BaseModel::load(&out).unwrap())
+        args
     };
-    let (printed, model) = offsets(&["--offset-per-log"]);
+    let printed = ok(&both(&["--offset-per-log"]));
+    let model = BaseModel::load(&out).unwrap();
     let found = model.log_offsets.as_ref().expect("the logs' offsets");
     for (d, se) in found.deviations.iter().zip(&found.stderr) {
         assert!(
@@ -343,17 +343,7 @@ fn an_offset_that_drifted_between_logs_is_named() {
         &["--offset-per-log", "one log given"],
     );
     fails(
-        &[
-            "identify-direct",
-            "a465",
-            s(&logs[0]),
-            s(&drifted),
-            "--out",
-            s(&out),
-            "--offset-per-log",
-            "--friction",
-            "viscous,coulomb",
-        ],
+        &both(&["--offset-per-log", "--friction", "viscous,coulomb"]),
         &["--offset-per-log", "needs the offset among --friction"],
     );
 }

@@ -606,8 +606,12 @@ impl Document for BaseModel {
             super::run_checks::problem(&m.run_checks, &m.joint_names, m.samples, m.logs.len())
         })
         .or_else(|| {
-            let offset = m.base.layout.friction.offset;
-            (m.log_offsets.as_ref()).and_then(|o| o.problem(n, m.logs.len(), offset))
+            // as many runs as the model names by its logs, or checks
+            let (offset, runs) = (
+                m.base.layout.friction.offset,
+                m.logs.len().max(m.run_checks.len()),
+            );
+            (m.log_offsets.as_ref()).and_then(|o| o.problem(n, runs, offset))
         }) {
             return Err(invalid(Self::WHAT, problem));
         }

@@ -119,7 +119,7 @@ impl LogOffsets {
     }
 
     /// What is wrong with the offsets of a model read from a file, for `nv` joints and `logs`
-    /// logs (0 where the model names none), whose layout has the offset term (`has_offset`):
+    /// runs (its logs or its runs' checks; 0 where the model names none), whose layout has the offset term (`has_offset`):
     /// a model without it, other shapes, runs beyond
     /// [`super::streaming::MAX_OFFSET_RUNS`], values not finite or beyond 1e9, standard errors
     /// not positive, a joint's deviations that do not sum to 0.
