@@ -14,6 +14,13 @@ pub struct JointError {
     pub relative_rms: Option<f64>,
     /// Largest `|measured - predicted|` (N m or N).
     pub max: f64,
+    /// Mean of `measured - predicted` (N m or N): the constant part of the error. Near `rms`
+    /// it is most of it: the log's torque offset is not the model's (a sensor zeroed anew
+    /// since the model was identified; a model fitted with an offset of each log's own
+    /// predicts with their mean), or a misfit of a constant torque such as gravity at a
+    /// posture held. 0 in a file written before it was stored.
+    #[serde(default)]
+    pub mean: f64,
     /// RMS over the samples of the prediction's standard error (N m or N): the model's own
     /// uncertainty at these states ([`Validation::with_model_stderr`]). A model that holds there
     /// errs by about `sqrt(model_stderr_rms^2 + noise^2)` for the log's torque noise; an `rms`
@@ -46,6 +53,17 @@ pub fn rms(values: impl Iterator<Item = f64> + Clone) -> f64 {
         (s + (v / largest).powi(2), c + 1)
     });
     largest * (sum / count as f64).sqrt()
+}
+
+/// The mean of finite `values` (0 for none), scaled by the largest as [`rms`] is, so that a
+/// sum past f64's range still gives it.
+pub fn mean(values: impl Iterator<Item = f64> + Clone) -> f64 {
+    let largest = values.clone().fold(0.0, |a: f64, v| a.max(v.abs()));
+    if largest == 0.0 {
+        return 0.0;
+    }
+    let (sum, count) = values.fold((0.0, 0usize), |(s, c), v| (s + v / largest, c + 1));
+    largest * (sum / count as f64)
 }
 
 /// Compares `predicted` with `measured` torques (both row-major `k x n`, `n =
@@ -107,6 +125,7 @@ pub fn validate(joint_names: &[String], predicted: &[f64], measured: &[f64]) -> 
                 max: (0..k)
                     .map(|s| residuals[s * n + j].abs())
                     .fold(0.0, f64::max),
+                mean: mean((0..k).map(|s| residuals[s * n + j])),
                 model_stderr_rms: None,
             }
         })
@@ -181,6 +200,11 @@ mod tests {
         let v = validate(&joints, &[0.0, 0.0, 0.0, 0.0], &[0.0, 1e308, 0.0, 1e308]).unwrap();
         assert_eq!(v.joints[1].max, 1e308);
         assert!((v.joints[1].rms / 1e308 - 1.0).abs() < 1e-12);
+        // and its mean, whose plain sum would overflow
+        assert!((v.joints[1].mean / 1e308 - 1.0).abs() < 1e-12);
+        assert_eq!(v.joints[0].mean, 0.0);
+        let v = validate(&joints, &[0.0; 4], &[1.0, -2.0, 4.0, 1.0]).unwrap();
+        assert_eq!((v.joints[0].mean, v.joints[1].mean), (2.5, -0.5));
     }
 
     #[test]

@@ -566,7 +566,10 @@ fn excite_identify_direct_predict() {
         "--out",
         s(&d.join("validation")),
     ]);
-    assert!(out.contains("rel. RMS") && out.contains("joint6"), "{out}");
+    assert!(
+        out.contains("rel. RMS") && out.contains("mean (N m)") && out.contains("joint6"),
+        "{out}"
+    );
     assert!(
         out.contains("model s.e. RMS") && out.contains("the model's own uncertainty"),
         "{out}"

@@ -905,6 +905,10 @@ class Validation:
     @property
     def max(self) -> NDArray[np.float64]: ...
     @property
+    def mean(self) -> NDArray[np.float64]:
+        """Per joint, the mean of measured - predicted (N m): the error's constant part (a
+        torque offset the log does not share with the model, or a constant misfit)."""
+    @property
     def model_stderr_rms(self) -> NDArray[np.float64]:
         """Per joint, the RMS of the predictions' standard errors (N m): the model's own
         uncertainty at these states; NaN where the model gives none."""

@@ -237,8 +237,8 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     );
     let _ = writeln!(
         out,
-        "  {:<20} {:>12} {:>10} {:>12} {:>14}",
-        "joint", "RMS (N m)", "rel. RMS", "max (N m)", "model s.e. RMS"
+        "  {:<20} {:>12} {:>10} {:>12} {:>12} {:>14}",
+        "joint", "RMS (N m)", "rel. RMS", "mean (N m)", "max (N m)", "model s.e. RMS"
     );
     for j in &v.joints {
         let rel = j
@@ -249,8 +249,8 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
             .map_or("-".to_string(), |s| format!("{s:.4}"));
         let _ = writeln!(
             out,
-            "  {:<20} {:>12.4} {:>10} {:>12.4} {:>14}",
-            j.joint, j.rms, rel, j.max, se
+            "  {:<20} {:>12.4} {:>10} {:>12.4} {:>12.4} {:>14}",
+            j.joint, j.rms, rel, j.mean, j.max, se
         );
     }
     match &stderr {

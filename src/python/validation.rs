@@ -22,7 +22,8 @@ use crate::local::Extrapolation;
 use crate::validation::{stored_stderr, validate as validate_rs, Validation};
 
 /// A model's torques against measured ones. Attributes: `joints` (names), `rms`,
-/// `relative_rms` (NaN where the measured torque is zero), `max` (n,) per joint (N m; fraction);
+/// `relative_rms` (NaN where the measured torque is zero), `mean`, `max` (n,) per joint (N m;
+/// fraction);
 /// `residuals` (k, n): measured - predicted (N m); `samples`; `torque_columns` (for a
 /// BaseParameterModel: the measured torque columns against its robot's model, as
 /// `BaseParameterModel.torque_columns`; empty otherwise), `torque_lag` (likewise, as
@@ -67,6 +68,12 @@ impl PyValidation {
     #[getter]
     fn max<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_iter(py, self.v.joints.iter().map(|j| j.max))
+    }
+    /// Per joint, the mean of measured - predicted (N m): the constant part of the error (a
+    /// torque offset the log does not share with the model, or a constant misfit).
+    #[getter]
+    fn mean<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_iter(py, self.v.joints.iter().map(|j| j.mean))
     }
     #[getter]
     fn residuals<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
@@ -147,7 +154,7 @@ impl PyValidation {
                 .map(|j| j.model_stderr_rms.unwrap_or(f64::NAN)),
         )
     }
-    /// The per-joint table: index `joint`, columns `rms`, `relative_rms`, `max`,
+    /// The per-joint table: index `joint`, columns `rms`, `relative_rms`, `mean`, `max`,
     /// `model_stderr_rms`.
     fn to_dataframe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         dataframe(
@@ -155,6 +162,7 @@ impl PyValidation {
             vec![
                 ("rms", self.rms(py).into_any()),
                 ("relative_rms", self.relative_rms(py).into_any()),
+                ("mean", self.mean(py).into_any()),
                 ("max", self.max(py).into_any()),
                 ("model_stderr_rms", self.model_stderr_rms(py).into_any()),
             ],

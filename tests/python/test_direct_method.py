@@ -1024,7 +1024,12 @@ def test_validation_tables_and_figures():
     np.testing.assert_allclose(v.rms, np.sqrt(np.mean(r**2, axis=0)), rtol=1e-12)
     np.testing.assert_allclose(v.relative_rms, np.sqrt(np.sum(r**2, axis=0) / np.sum(tau**2, axis=0)), rtol=1e-12)
     np.testing.assert_allclose(v.max, np.abs(r).max(axis=0), rtol=1e-12)
+    np.testing.assert_allclose(v.mean, r.mean(axis=0), rtol=1e-9, atol=1e-15)
+    # a log whose shoulder torque reads 0.3 N m higher: the error's mean shows it
+    shifted = pr.validate(fit, q, qd, qdd, tau + np.array([0, 0.3, 0, 0, 0, 0]))
+    np.testing.assert_allclose(shifted.mean - v.mean, [0, 0.3, 0, 0, 0, 0], atol=1e-12)
     df = v.to_dataframe()
+    np.testing.assert_allclose(df["mean"].to_numpy(), v.mean)
     assert isinstance(df, pd.DataFrame) and list(df.index) == robot.joint_names and df.index.name == "joint"
     np.testing.assert_allclose(df["rms"].to_numpy(), v.rms)
     table = fit.to_dataframe()
