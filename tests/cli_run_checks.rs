@@ -211,3 +211,66 @@ fn a_models_run_checks_are_checked_on_load() {
         "unknown field `extra`",
     );
 }
+
+/// A log with a payload of 0.5 kg at the flange beside one without: the logs do not agree
+/// with one robot, and the warning says so, naming joints and a log; two logs of one robot
+/// agree (ratios near 1, no warning).
+#[test]
+fn logs_of_another_payload_do_not_agree_with_one_robot() {
+    let d = tmp("log-agreement");
+    let logs = [11, 12].map(|seed| excitation_log(&d, seed));
+    let (warned, model) = fit(&d, &logs[0], &logs[1]);
+    let agreement = model.log_agreement.as_ref().expect("checked");
+    assert!(!warned.contains("do not agree"), "{warned}");
+    for r in &agreement.ratio {
+        assert!(
+            r.is_some_and(|r| (0.95..1.2).contains(&r)),
+            "{:?}",
+            agreement.ratio
+        );
+    }
+    // the second excitation again, on a robot carrying a payload
+    let robot = d.join("payload.json");
+    std::fs::write(
+        &robot,
+        r#"{"format": "perturbid-true-robot/1", "seed": 3,
+            "payload": {"link": "link6", "mass": 0.5, "com": [0.0, 0.0, 0.06], "inertia": [0.001, 0, 0, 0.001, 0, 0.0005]},
+            "sensors": {"torque_noise": [0.01, 0.01, 0.01, 0.01, 0.01, 0.01]}}"#,
+    )
+    .unwrap();
+    let loaded = d.join("loaded.csv");
+    cli_support::ok(&[
+        "simulate",
+        "a465",
+        s(&d.join("exc12").join("excitation.json")),
+        "--true-robot",
+        s(&robot),
+        "--out",
+        s(&loaded),
+        "--rate",
+        "200",
+    ]);
+    let (warned, model) = fit(&d, &logs[0], &loaded);
+    assert!(
+        warned.contains("the logs do not agree with one robot") && warned.contains("'joint2' "),
+        "{warned}"
+    );
+    let agreement = model.log_agreement.as_ref().unwrap();
+    assert!(
+        agreement.ratio[1].is_some_and(|r| r > 5.0),
+        "{:?}",
+        agreement.ratio
+    );
+    // kept and checked on load
+    let mut v: serde_json::Value = serde_json::from_str(&model.to_json()).unwrap();
+    v["log_agreement"]["ratio"][0] = (-1.0).into();
+    let e = BaseModel::from_json(&v.to_string())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("log_agreement: -1, expected a magnitude"), "{e}");
+    v["log_agreement"]["fitted_rms"] = serde_json::json!([[0.1]]);
+    let e = BaseModel::from_json(&v.to_string())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("log_agreement: expected a ratio a joint"), "{e}");
+}

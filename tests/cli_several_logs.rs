@@ -318,6 +318,12 @@ fn an_offset_that_drifted_between_logs_is_named() {
         );
     }
     assert!(model.run_offsets.is_empty(), "{:?}", model.run_offsets);
+    // and the logs agree with one robot once each has its own offset
+    let ratio = &model.log_agreement.as_ref().unwrap().ratio;
+    assert!(
+        ratio.iter().flatten().all(|r| *r < 1.2) && ratio.iter().any(Option::is_some),
+        "{ratio:?}"
+    );
     assert!(
         printed.contains("each log's torque offset less the logs' mean")
             && printed.contains("each with its own offset"),

@@ -688,6 +688,11 @@ class BaseParameterModel:
         """Fitted with offset_per_log: logs (names), deviations and stderr ((logs, n) N m:
         each log's torque offset less the logs' mean, the model's offset term); else None."""
     @property
+    def log_agreement(self) -> Optional[dict[str, Any]]:
+        """Fitted over several Recordings: whether they agree with one robot: ratio ((n,),
+        near 1 where they agree, NaN where not judged), fitted_rms and own_rms ((logs, n) N m),
+        finding (also a warning, or None); None for one run."""
+    @property
     def run_checks(self) -> list[dict[str, Any]]:
         """Fitted over several Recordings: each run's data checked alone against the robot's
         model, in order: dicts log, samples, torque_columns, torque_lag, position_range (as

@@ -4,10 +4,9 @@
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
-use super::base::{BaseParameters, BASE_TOLERANCE};
-use super::parameters::{regressor_blocks, FrictionTerms, ParameterLayout};
+use super::base::BaseParameters;
+use super::parameters::{regressor_blocks, ParameterLayout};
 use super::streaming;
-use crate::choice::choice;
 use crate::document::{
     check_bounded, check_bounded_rows, check_condition, check_magnitudes, invalid, Document,
 };
@@ -17,65 +16,7 @@ use crate::model::Model;
 use crate::states::States;
 use crate::torque_model::BaseModelOn;
 
-choice! {
-    /// Ordinary or weighted least squares.
-    #[derive(Serialize, Deserialize)]
-    #[serde(rename_all = "snake_case")]
-    pub enum Weighting ("weighting") {
-        /// Ordinary least squares: every row weighs the same.
-        Ols = "ols",
-        /// Rows of joint `j` divided by `sigma_j`, the RMS of joint `j`'s OLS residuals (Swevers
-        /// et al.: the maximum-likelihood estimate for independent per-joint noise).
-        Wls = "wls",
-    }
-}
-
-/// Options of [`identify_base_parameters`].
-#[derive(Clone, Debug, PartialEq)]
-pub struct BaseOptions {
-    /// Joint terms identified with the inertial parameters (default viscous, Coulomb and
-    /// offset); the armature is added when the robot model has one
-    /// ([`FrictionTerms::for_model`]).
-    pub friction: FrictionTerms,
-    pub weighting: Weighting,
-    /// Whether the torques include gravity (default true).
-    pub gravity: Gravity,
-    /// Relative rank tolerance of the pivoted QR (default 1e-8).
-    pub tolerance: f64,
-    /// Random states used to find the base parameters (default 200) and their seed.
-    pub states: usize,
-    pub seed: u64,
-    /// The samples as several runs one after the other (logs of other excitations, other
-    /// days): the number of samples of each, adding up to all of them
-    /// ([`crate::stacked_states::StackedStates::runs`]). Each run's residuals are a time
-    /// series of their own: their correlation from sample to sample is estimated within each
-    /// run, not across the joins, where two logs' residuals may differ in mean (a torque
-    /// offset that drifted between them read as correlation at every lag, and inflated the
-    /// standard errors six times for 0.02 N m). Empty (default): one run. At most
-    /// [`super::drive_gains::MAX_RUNS`].
-    pub runs: Vec<usize>,
-    /// An offset a run beside the base parameters, whose offset terms are then the runs'
-    /// mean ([`super::log_offsets`], [`BaseModel::log_offsets`]): for logs between which a
-    /// torque sensor was zeroed anew or a drive warmed up. Needs 2 to
-    /// [`super::streaming::MAX_OFFSET_RUNS`] `runs` and the offset among `friction`. Default
-    /// false.
-    pub offset_per_run: bool,
-}
-
-impl Default for BaseOptions {
-    fn default() -> Self {
-        Self {
-            friction: FrictionTerms::ALL,
-            weighting: Weighting::Wls,
-            gravity: Gravity::Included,
-            tolerance: BASE_TOLERANCE,
-            states: 200,
-            seed: 0,
-            runs: vec![],
-            offset_per_run: false,
-        }
-    }
-}
+pub use super::base_options::{BaseOptions, Weighting};
 
 /// An identified base-parameter model.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -186,6 +127,11 @@ pub struct BaseModel {
     /// less the runs' mean (the model's offset terms), per joint; None otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub log_offsets: Option<super::log_offsets::LogOffsets>,
+    /// In a fit over several runs, whether they agree with one robot ([`super::log_agreement`]:
+    /// each run fitted alone against the fit); None for one run, or in a model saved before it
+    /// was checked.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub log_agreement: Option<super::log_agreement::LogAgreement>,
     /// Where the data excite the base parameters weakly (`cond` beyond
     /// [`super::weak_excitation::WEAK_CONDITION`]): the least determined combination and how
     /// far each joint moved ([`super::weak_excitation`]), warned of ([`BaseModel::warnings`]).
@@ -409,6 +355,7 @@ pub(super) fn fit_with_factors(
             options.gravity,
         )?,
         log_offsets: None,
+        log_agreement: None,
         weak_excitation: None,
         drive_gains: None,
         joint_term_rms: super::parameter_table::joint_term_rms(
@@ -439,6 +386,8 @@ pub(super) fn fit_with_factors(
         o.inflate(inflation);
         o
     });
+    fit.log_agreement =
+        super::log_agreement::check_log_agreement(model, &fit, states, tau, &options.runs)?;
     fit.position_offsets =
         super::position_offsets::check_position_offsets(model, &fit, states, tau)?;
     fit.unmodelled_friction =
@@ -611,7 +560,9 @@ impl Document for BaseModel {
                 m.base.layout.friction.offset,
                 m.logs.len().max(m.run_checks.len()),
             );
-            (m.log_offsets.as_ref()).and_then(|o| o.problem(n, runs, offset))
+            (m.log_offsets.as_ref())
+                .and_then(|o| o.problem(n, runs, offset))
+                .or_else(|| m.log_agreement.as_ref().and_then(|a| a.problem(n, runs)))
         }) {
             return Err(invalid(Self::WHAT, problem));
         }

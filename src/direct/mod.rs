@@ -5,6 +5,7 @@
 
 pub mod base;
 pub mod base_linearization;
+pub mod base_options;
 pub mod consistency;
 pub mod consistent;
 pub mod drive_gains;
@@ -12,6 +13,7 @@ pub mod excitation;
 pub mod global_linear;
 pub mod identify;
 pub mod instrumental;
+pub mod log_agreement;
 pub mod log_findings;
 pub mod log_offsets;
 pub mod parameter_table;
@@ -42,6 +44,7 @@ pub use drive_gains::{
 pub use excitation::{design_excitation, Criterion, ExcitationDesign, ExcitationOptions};
 pub use global_linear::{identify_global_linear, GlobalLinearModel};
 pub use identify::{identify_base_parameters, BaseModel, BaseOptions, Weighting};
+pub use log_agreement::LogAgreement;
 pub use log_findings::LogFindings;
 pub use log_offsets::LogOffsets;
 pub use parameter_table::ParameterRow;

@@ -219,12 +219,18 @@ impl BaseModel {
             .filter(|_| !columns_wrong)
             .map(|o| o.finding(&log_names));
         let gains = (self.drive_gains.iter()).flat_map(|g| g.warnings(&self.joint_names));
+        // the drive gains' runs differ by a payload and have their own agreement; a log whose
+        // column is wrong disagrees by that
+        let disagree = (self.log_agreement.as_ref())
+            .filter(|_| self.drive_gains.is_none() && !columns_wrong)
+            .and_then(|a| a.finding(&log_names, &self.joint_names, self.log_offsets.is_some()));
         columns
             .into_iter()
             .chain(gains)
             .chain(offsets)
             .chain(friction)
             .chain(weak)
+            .chain(disagree)
             .chain(drifted)
             .chain(rounding.filter(|_| log_findings))
             .chain(negative)

@@ -346,6 +346,7 @@ pub fn identify_parameters_from_local(
         run_offsets: vec![],
         run_checks: vec![],
         log_offsets: None,
+        log_agreement: None,
         // rows from local models: their own diagnostics say what they leave unidentified
         weak_excitation: None,
         drive_gains: None,

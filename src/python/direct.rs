@@ -369,6 +369,30 @@ impl PyBaseModel {
         e.set_item("stderr", mat(py, &by_log(&o.stderr))?)?;
         Ok(Some(e))
     }
+    /// In a fit of several Recordings (or runs), whether they agree with one robot (each fitted
+    /// alone against the fit; a payload in some and not others makes them disagree): dict
+    /// `ratio` ((n,): the fit's residual RMS over the logs, less each one's mean, over their
+    /// own fits'; near 1 where they agree, NaN where not judged), `fitted_rms` and `own_rms`
+    /// ((logs, n) N m; NaN for a log its samples do not determine), `finding` (also a
+    /// warning, or None). None for one run.
+    #[getter]
+    fn log_agreement<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(a) = &self.fit.log_agreement else {
+            return Ok(None);
+        };
+        let names: Vec<String> = self.fit.logs.iter().map(|l| l.log.clone()).collect();
+        let (logs, n) = (a.fitted_rms.len(), self.fit.joint_names.len());
+        let own = |r: usize, j: usize| a.own_rms[r].as_ref().map_or(f64::NAN, |o| o[j]);
+        let e = PyDict::new(py);
+        let ratio: Vec<f64> = a.ratio.iter().map(|r| r.unwrap_or(f64::NAN)).collect();
+        e.set_item("ratio", PyArray1::from_slice(py, &ratio))?;
+        let fitted = DMatrix::from_fn(logs, n, |r, j| a.fitted_rms[r][j]);
+        e.set_item("fitted_rms", mat(py, &fitted)?)?;
+        e.set_item("own_rms", mat(py, &DMatrix::from_fn(logs, n, own))?)?;
+        let offsets = self.fit.log_offsets.is_some();
+        e.set_item("finding", a.finding(&names, &self.fit.joint_names, offsets))?;
+        Ok(Some(e))
+    }
     /// In a fit of several Recordings (or runs), each run's data checked alone against the
     /// robot's model, in the runs' order: dicts `log` (its name), `samples` (fitted),
     /// `torque_columns`, `torque_lag` and `position_range` (as the model's own, of that run's

@@ -658,6 +658,10 @@ def test_an_offset_of_each_logs_own_is_fitted():
     # about the noise over each run's samples
     np.testing.assert_allclose(found["stderr"], 0.01 * np.sqrt(2 / 3 / len(t)), rtol=0.3)
     assert fit.run_offsets == [] and (fit.residual_correlation < 1.2).all()
+    # with their own offsets the runs agree with one robot
+    agreement = fit.log_agreement
+    assert agreement["finding"] is None and agreement["own_rms"].shape == (3, n)
+    assert ((agreement["ratio"] > 0.99) & (agreement["ratio"] < 1.1)).all(), agreement["ratio"]
     for j, name in enumerate(robot.joint_names):
         i = fit.names.index(f"{name}.offset")
         assert abs(fit.theta_base[i] - offsets[:, j].mean()) < 4 * fit.stderr[i]
