@@ -9,13 +9,12 @@
 //! compared with those the log's own fit leaves: [`LogAgreement::ratio`], the RMS of the one
 //! over the RMS of the other, summed over the logs. Where the logs agree, each own fit only
 //! takes up a little more of the noise: the ratio is near 1 (two simulated A465 logs of one
-//! robot, 1.003-1.026; two halves of the real Panda log, 1.02-1.07). A payload of 0.1 kg at the
-//! A465's flange in one of two logs made it 1.4 to 9.7, of 1 kg 10 to 95. A joint is judged
+//! robot, 1.002-1.03; two halves of the real Panda log, 1.02-1.07). A payload of 0.1 kg at the
+//! A465's flange in one of two logs made it 1.5 to 7.3, of 1 kg 10 to 71. A joint is judged
 //! where the logs' samples, counted as independent ones by the own fits' residuals'
 //! correlation ([`super::residual_correlation`]), are at least [`JUDGED_SAMPLES`] times the
 //! logs' parameters: under that the own fits take up much
-//! of the noise and the ratio says little (the real Panda log in thirds: its wrist's residuals
-//! correlated over 25 samples, ratio 1.43). Beyond [`AGREEMENT`] it is a finding.
+//! of the noise and the ratio says little (the real Panda log in thirds leaves its wrist unjudged). Beyond [`AGREEMENT`] it is a finding.
 
 use serde::{Deserialize, Serialize};
 
