@@ -142,6 +142,17 @@ impl BaseModel {
             || !super::torque_columns::findings(&self.torque_columns).is_empty()
     }
 
+    /// Whether the logs agree with one robot: the finding of [`Self::log_agreement`], if any;
+    /// none for drive gains (their runs differ by a payload, and have their own agreement) and
+    /// where a torque column is found wrong (a log that does not read as the robot disagrees
+    /// by that).
+    pub fn log_agreement_finding(&self) -> Option<String> {
+        let names: Vec<String> = self.logs.iter().map(|l| l.log.clone()).collect();
+        (self.log_agreement.as_ref())
+            .filter(|_| self.drive_gains.is_none() && !self.columns_found_wrong())
+            .and_then(|a| a.finding(&names, &self.joint_names, self.log_offsets.is_some()))
+    }
+
     /// The joints' zero offsets' finding ([`super::position_offsets`]), if any: none where a
     /// torque column is found wrong, of the whole data or of a run (fitted to such a log,
     /// offsets take up part of what is wrong with it).
@@ -219,11 +230,7 @@ impl BaseModel {
             .filter(|_| !columns_wrong)
             .map(|o| o.finding(&log_names));
         let gains = (self.drive_gains.iter()).flat_map(|g| g.warnings(&self.joint_names));
-        // the drive gains' runs differ by a payload and have their own agreement; a log whose
-        // column is wrong disagrees by that
-        let disagree = (self.log_agreement.as_ref())
-            .filter(|_| self.drive_gains.is_none() && !columns_wrong)
-            .and_then(|a| a.finding(&log_names, &self.joint_names, self.log_offsets.is_some()));
+        let disagree = self.log_agreement_finding();
         columns
             .into_iter()
             .chain(gains)

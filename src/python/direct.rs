@@ -380,7 +380,6 @@ impl PyBaseModel {
         let Some(a) = &self.fit.log_agreement else {
             return Ok(None);
         };
-        let names: Vec<String> = self.fit.logs.iter().map(|l| l.log.clone()).collect();
         let (logs, n) = (a.fitted_rms.len(), self.fit.joint_names.len());
         let own = |r: usize, j: usize| a.own_rms[r].as_ref().map_or(f64::NAN, |o| o[j]);
         let e = PyDict::new(py);
@@ -389,8 +388,7 @@ impl PyBaseModel {
         let fitted = DMatrix::from_fn(logs, n, |r, j| a.fitted_rms[r][j]);
         e.set_item("fitted_rms", mat(py, &fitted)?)?;
         e.set_item("own_rms", mat(py, &DMatrix::from_fn(logs, n, own))?)?;
-        let offsets = self.fit.log_offsets.is_some();
-        e.set_item("finding", a.finding(&names, &self.fit.joint_names, offsets))?;
+        e.set_item("finding", self.fit.log_agreement_finding())?;
         Ok(Some(e))
     }
     /// In a fit of several Recordings (or runs), each run's data checked alone against the
