@@ -320,6 +320,10 @@ class Recording:
     def to_dataframe(self) -> Any:
         """The recording as a DataFrame with its CSV file's columns (t, q1.., tau1..)."""
     @property
+    def left_out_columns(self) -> list[str]:
+        """The log's columns ignore_columns left out (load, from_dataframe), in its order;
+        empty for a Recording made otherwise."""
+    @property
     def experiment(self) -> Optional[str]:
         """The experiment of a plan this is a run of (nominal, G_static, G, H, D), or None."""
     @property

@@ -185,7 +185,7 @@ impl PyPlan {
         super::errors::warn_all(py, &repeated)?;
         Ok(runs
             .into_iter()
-            .map(|(rec, _)| PyRecording { rec: Arc::new(rec) })
+            .map(|(rec, _)| PyRecording::from(rec))
             .collect())
     }
     /// Reads a plan from `path` (the plan.json of `Plan.save` or `perturbid plan`), checked

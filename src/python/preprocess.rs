@@ -9,7 +9,6 @@ use super::detached;
 
 use super::arrays::ArrayLike;
 use super::recording::PyRecording;
-use std::sync::Arc;
 
 use crate::preprocess::{preprocess as preprocess_rs, PreprocessOptions};
 use crate::recording::Recording;
@@ -81,5 +80,5 @@ pub(crate) fn preprocess(
     .flatten()
     .collect();
     super::errors::warn_all(py, &warnings)?;
-    Ok(PyRecording { rec: Arc::new(out) })
+    Ok(PyRecording::from(out))
 }

@@ -16,6 +16,18 @@ use crate::recording::Recording;
 #[derive(Clone)]
 pub(crate) struct PyRecording {
     pub rec: Arc<Recording>,
+    /// The columns of the log that `ignore_columns` left out (`Recording.load`,
+    /// `from_dataframe`); empty otherwise.
+    pub left_out: Vec<String>,
+}
+
+impl From<Recording> for PyRecording {
+    fn from(rec: Recording) -> Self {
+        Self {
+            rec: Arc::new(rec),
+            left_out: vec![],
+        }
+    }
 }
 
 /// A dropout as a Python dict: `experiment` (when it has one), `signal`, `first_sample`,
@@ -129,7 +141,7 @@ impl PyRecording {
     ) -> PyResult<Self> {
         let mut rec = Self::build(t, q, tau, qd, qdd, name)?;
         rec.experiment = experiment;
-        Ok(Self { rec: Arc::new(rec) })
+        Ok(rec.into())
     }
     /// Reads a recording from the CSV file at `path`, as the command line does: a header
     /// `t, q1..qN, [qd1..qN, qdd1..qN,] tau1..tauN`, or the same named after the joints
@@ -158,14 +170,17 @@ impl PyRecording {
         ignore_columns: Option<Vec<String>>,
     ) -> PyResult<Self> {
         let map = column_map(columns, ignore_columns)?;
-        let mut rec = super::detached(py, "Recording.load", || {
-            let (table, _) = map.read(&path, &joints)?;
-            crate::io::read_recording(&table, &joints)
+        let (mut rec, left_out) = super::detached(py, "Recording.load", || {
+            let (table, left_out) = map.read(&path, &joints)?;
+            crate::io::read_recording(&table, &joints).map(|rec| (rec, left_out))
         })?;
         if experiment.is_some() {
             rec.experiment = experiment;
         }
-        Ok(Self { rec: Arc::new(rec) })
+        Ok(Self {
+            rec: Arc::new(rec),
+            left_out,
+        })
     }
     /// Writes the recording to the CSV file at `path` (atomically: a temporary file renamed
     /// into place) with the header `t, q1..qN, [qd1..qN, qdd1..qN,] tau1..tauN`; numbers
@@ -201,12 +216,15 @@ impl PyRecording {
         ignore_columns: Option<Vec<String>>,
     ) -> PyResult<Self> {
         let map = column_map(columns, ignore_columns)?;
-        let columns = super::tables::frame_columns(frame, name, &map, &joints)?;
+        let (columns, left_out) = super::tables::frame_columns(frame, name, &map, &joints)?;
         let mut rec = super::detached(py, "Recording.from_dataframe", || {
             crate::io::read_recording(&crate::io::Table::from_columns(name, columns)?, &joints)
         })?;
         rec.experiment = experiment;
-        Ok(Self { rec: Arc::new(rec) })
+        Ok(Self {
+            rec: Arc::new(rec),
+            left_out,
+        })
     }
     /// The recording as a pandas DataFrame with the columns of its CSV file: `t` (s), `q1..qN`,
     /// `qd1..qN` and `qdd1..qN` when present, `tau1..tauN`; `from_dataframe` reads it back.
@@ -223,6 +241,13 @@ impl PyRecording {
     #[getter]
     fn name(&self) -> String {
         self.rec.name.clone()
+    }
+    /// The columns of the log `ignore_columns` left out, in the log's order (`load`,
+    /// `from_dataframe`; as the command line lists them); empty for a Recording made
+    /// otherwise.
+    #[getter]
+    fn left_out_columns(&self) -> Vec<String> {
+        self.left_out.clone()
     }
     /// The experiment this recording is marked as a run of, or None.
     #[getter]
@@ -451,6 +476,7 @@ impl PyRecording {
         let (start, stop) = (s.start as usize, (s.stop.max(s.start)) as usize);
         Ok(Self {
             rec: Arc::new(self.rec.rows(start, stop)?),
+            left_out: self.left_out.clone(),
         })
     }
     /// This recording of motor currents (or another signal) in torques: each `tau` column
@@ -462,6 +488,7 @@ impl PyRecording {
         let gains = vector("gains", &gains)?;
         Ok(Self {
             rec: Arc::new(self.rec.in_torques(&gains)?),
+            left_out: self.left_out.clone(),
         })
     }
     fn __repr__(&self) -> String {

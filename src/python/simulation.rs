@@ -1,7 +1,5 @@
 //! `simulate` in Python: rehearsal of a plan on the model (mirrors `crate::simulation`).
 
-use std::sync::Arc;
-
 use pyo3::prelude::*;
 
 use super::scalars;
@@ -156,13 +154,10 @@ pub(crate) fn simulate<'py>(
         }
     };
     let one = |rec: Recording| -> PyResult<Bound<'py, PyAny>> {
-        Ok(Bound::new(py, PyRecording { rec: Arc::new(rec) })?.into_any())
+        Ok(Bound::new(py, PyRecording::from(rec))?.into_any())
     };
     let many = |recs: Vec<Recording>| -> PyResult<Bound<'py, PyAny>> {
-        let list: Vec<PyRecording> = recs
-            .into_iter()
-            .map(|r| PyRecording { rec: Arc::new(r) })
-            .collect();
+        let list: Vec<PyRecording> = recs.into_iter().map(PyRecording::from).collect();
         Ok(list.into_pyobject(py)?.into_any())
     };
     if let Some(t) = &true_robot {

@@ -8,6 +8,9 @@ use pyo3::types::PyDict;
 
 use crate::error::Error;
 
+/// A column read from a frame: its name (as the map reads it) and its values.
+type Column = (String, Vec<f64>);
+
 /// The columns of the pandas DataFrame `frame` as named `f64` columns for
 /// [`crate::io::Table::from_columns`], `source` naming it in errors: numbers (floats, integers,
 /// pandas' nullable types, whose missing values become NaN and are refused there); the time
@@ -16,13 +19,14 @@ use crate::error::Error;
 /// holding booleans, text, categories or times (other than `t`), is refused by name; so is a
 /// frame of more than [`crate::limits::MAX_VALUES`] values. TypeError for what is not a frame.
 /// The columns are those `map` reads for the joints `joints`, renamed and scaled as it says
-/// ([`crate::io::ColumnMap::select`]): those it leaves out are not converted.
+/// ([`crate::io::ColumnMap::select`]): those it leaves out are not converted, and their names
+/// are returned beside the columns read.
 pub(crate) fn frame_columns(
     frame: &Bound<'_, PyAny>,
     source: &str,
     map: &crate::io::ColumnMap,
     joints: &[String],
-) -> PyResult<Vec<(String, Vec<f64>)>> {
+) -> PyResult<(Vec<Column>, Vec<String>)> {
     let py = frame.py();
     let bad = |message: String| -> PyErr {
         Error::Recording {
@@ -82,7 +86,7 @@ pub(crate) fn frame_columns(
     // the columns `map` reads, under the names it gives them (those it leaves out are not
     // converted: they may hold text)
     let names: Vec<String> = columns.iter().map(|c| c.0.clone()).collect();
-    let (selection, _) = map.select(source, &names, joints)?;
+    let (selection, left_out) = map.select(source, &names, joints)?;
     let numbers = PyDict::new(py);
     numbers.set_item("dtype", "float64")?;
     numbers.set_item("na_value", f64::NAN)?;
@@ -130,7 +134,8 @@ pub(crate) fn frame_columns(
                 values.as_array().iter().map(|v| v * k.scale).collect(),
             ))
         })
-        .collect()
+        .collect::<PyResult<Vec<_>>>()
+        .map(|read| (read, left_out))
 }
 
 /// A `pandas.DataFrame` of `columns` (name, values), in order, with `index` as its index when

@@ -98,6 +98,10 @@ def test_another_tool_s_log_reads_with_a_column_map_from_a_file_and_a_frame(tmp_
     ):
         for field in ("t", "q", "tau"):
             np.testing.assert_allclose(getattr(back, field), getattr(rec, field), rtol=1e-13, atol=1e-15)
+        # the columns left out, in the log's order, as the command line lists them; kept by a slice
+        assert back.left_out_columns == ["target_q_0", "target_q_1", "mode"]
+        assert back[2:10].left_out_columns == back.left_out_columns
+    assert rec.left_out_columns == [] and pr.Recording.load(path, joints, columns=columns, ignore_columns=["target_q_*", "mode", "nothing_*"]).left_out_columns == ["target_q_0", "target_q_1", "mode"]
     # without the mode left out: named, with the way out
     with pytest.raises(pr.InputError, match=r"column 'mode'.*ignore_columns"):
         pr.Recording.load(path, joints, columns=columns, ignore_columns=["target_q_*"])
