@@ -183,7 +183,7 @@ pub fn refuse_shared_samples(
     let Some(s) = find_shared_samples(runs) else {
         return Ok(());
     };
-    let name = |r: usize| names.get(r).cloned().unwrap_or_else(|| format!("run {r}"));
+    let name = |r: usize| crate::stacked_states::run_name(names, r);
     let span = |at: usize| format!("{} to {}", at + 1, at + s.len);
     let whole = s.len == runs[s.first].len() && s.len == runs[s.second].len();
     let what = if whole {

@@ -44,7 +44,7 @@ impl StackedStates {
                 message: "no run to stack".into(),
             });
         };
-        let name = |r: usize| names.get(r).cloned().unwrap_or_else(|| format!("run {r}"));
+        let name = |r: usize| run_name(names, r);
         let nv = first.nv();
         let k: usize = parts.iter().map(|(s, _)| s.len()).sum();
         let filtered = parts.iter().any(|(s, _)| s.coulomb().is_some());
@@ -98,4 +98,10 @@ impl StackedStates {
             None => Ok(states),
         }
     }
+}
+
+/// Run `r`'s name among `names` (a log's path, a Recording's name), or `run r` (from 0) where
+/// none is given.
+pub fn run_name(names: &[String], r: usize) -> String {
+    names.get(r).cloned().unwrap_or_else(|| format!("run {r}"))
 }

@@ -135,6 +135,12 @@ impl BaseModel {
             ..self
         }
     }
+
+    /// The names of the logs the model was fitted to, in the fit's order (their paths or
+    /// Recordings' names; empty for a model of one log).
+    pub fn log_names(&self) -> Vec<String> {
+        self.logs.iter().map(|l| l.log.clone()).collect()
+    }
 }
 
 #[cfg(test)]

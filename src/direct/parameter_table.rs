@@ -147,7 +147,7 @@ impl BaseModel {
     /// where a torque column is found wrong (a log that does not read as the robot disagrees
     /// by that).
     pub fn log_agreement_finding(&self) -> Option<String> {
-        let names: Vec<String> = self.logs.iter().map(|l| l.log.clone()).collect();
+        let names = self.log_names();
         (self.log_agreement.as_ref())
             .filter(|_| self.drive_gains.is_none() && !self.columns_found_wrong())
             .and_then(|a| a.finding(&names, &self.joint_names, self.log_offsets.is_some()))
@@ -171,7 +171,7 @@ impl BaseModel {
 
     /// The warnings, with the logs' findings or without.
     fn warnings_with(&self, log_findings: bool) -> Vec<String> {
-        let log_names: Vec<String> = self.logs.iter().map(|l| l.log.clone()).collect();
+        let log_names = self.log_names();
         // over several runs each run's, named; the whole data's columns besides only where no
         // run's is found wrong (a wrong column in every log is named log by log)
         let each = super::run_checks::findings(&self.run_checks, &log_names);

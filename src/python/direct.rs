@@ -337,7 +337,7 @@ impl PyBaseModel {
     /// column is found wrong, which takes it up). Empty where none do.
     #[getter]
     fn run_offsets<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        let names: Vec<String> = self.fit.logs.iter().map(|l| l.log.clone()).collect();
+        let names = self.fit.log_names();
         (self.fit.run_offsets.iter())
             .map(|o| {
                 let e = PyDict::new(py);
@@ -361,7 +361,7 @@ impl PyBaseModel {
             return Ok(None);
         };
         let e = PyDict::new(py);
-        let names: Vec<String> = self.fit.logs.iter().map(|l| l.log.clone()).collect();
+        let names = self.fit.log_names();
         let (runs, n) = (o.runs(), o.deviations.len());
         let by_log = |m: &[Vec<f64>]| DMatrix::from_fn(runs, n, |r, j| m[j][r]);
         e.set_item("logs", names)?;
@@ -398,7 +398,7 @@ impl PyBaseModel {
     /// naming it). Empty for a fit of one run; the model's `torque_lag` is then None.
     #[getter]
     fn run_checks<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        let names: Vec<String> = self.fit.logs.iter().map(|l| l.log.clone()).collect();
+        let names = self.fit.log_names();
         run_check_dicts(py, &self.fit.run_checks, &names)
     }
     /// The joints whose torques show friction terms the fit lacks (the fit made again with
