@@ -18,6 +18,7 @@ pub mod log_findings;
 pub mod log_offsets;
 pub mod parameter_table;
 pub mod parameters;
+pub mod payload;
 pub mod position_offsets;
 pub mod position_range;
 pub mod residual_correlation;
@@ -49,6 +50,7 @@ pub use log_findings::LogFindings;
 pub use log_offsets::LogOffsets;
 pub use parameter_table::ParameterRow;
 pub use parameters::{regressor_blocks, regressor_matrix, FrictionTerms, ParameterLayout};
+pub use payload::{identify_payload, PayloadFit, PayloadOptions, PayloadStderr, Reference};
 pub use position_offsets::{
     check_position_offsets, check_position_offsets_in_validation, PositionOffsets,
 };

@@ -316,7 +316,7 @@ fn factor_top(mut a: MatMut<'_, f64>, q_coeff: MatMut<'_, f64>, scratch: &mut Me
 
 /// The upper-triangular factor (`ncols x ncols`, zero rows added when `a` is short) of a QR of
 /// `a`.
-fn triangular(a: &DMatrix<f64>) -> DMatrix<f64> {
+pub(crate) fn triangular(a: &DMatrix<f64>) -> DMatrix<f64> {
     let (m, n) = a.shape();
     let mut f = Mat::<f64>::from_fn(m.max(n), n, |i, j| if i < m { a[(i, j)] } else { 0.0 });
     let block = recommended_block_size::<f64>(m.max(n), n);

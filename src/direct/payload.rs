@@ -1,0 +1,749 @@
+//! A payload's inertial parameters identified from a log of the robot carrying it, against a
+//! model of the robot without it (docs/method.md, section 8d).
+//!
+//! A payload rigidly fixed to one moving body `b` adds its ten inertial parameters `pi` (mass,
+//! first moment and rotational inertia about the body's joint frame, Pinocchio's order: `m,
+//! mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz`) to that body's, and the joint torques change by
+//! that body's ten columns of the regressor:
+//!
+//! ```text
+//! tau - tau_ref(q, qd, qdd) = Phi_b(q, qd, qdd) pi + F(qd) phi + e
+//! ```
+//!
+//! `tau_ref` the robot's torques without the payload ([`Reference`]: a base-parameter model
+//! identified from the robot alone, or the URDF's own parameters), `F phi` the joint terms
+//! fitted beside it (each joint's viscous, Coulomb and offset terms, as far as asked for: a
+//! sensor zeroed anew, friction the reference does not hold). One least-squares problem,
+//! reduced per joint in one pass over the samples as the base parameters' is
+//! ([`super::streaming`]), gives `pi` and `phi`, OLS and then WLS. Its standard errors are
+//! inflated for residuals correlated from sample to sample ([`super::residual_correlation`]),
+//! and a base-parameter reference's own uncertainty is carried into them:
+//! `Cov(pi) += G Phi_base Cov(theta) Phi_base^T G^T`, `G` the weighted least-squares operator.
+//! The payload's mass, centre of mass and inertia about it follow from `pi`, with standard
+//! errors by the exact first-order (delta) rule.
+
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+use super::base::{BaseParameters, BASE_TOLERANCE};
+use super::identify::{BaseModel, Weighting};
+use super::parameters::{regressor_blocks, FrictionTerms, ParameterLayout};
+use super::residual_correlation::{long_run_factors, SAMPLES};
+use super::streaming::JointFactors;
+use crate::algorithms::regressor::PARAMS_PER_BODY;
+use crate::error::{shown, Error, Result};
+use crate::gravity::Gravity;
+use crate::model::Model;
+use crate::rehearsal::Payload;
+use crate::states::States;
+
+/// Standard errors a mass must lie above 0 by for the payload to count as seen (below it the
+/// centre of mass, a first moment over the mass, is not determined).
+pub const SEEN: f64 = 3.0;
+
+/// The mass's standard error, relative to it, beyond which it is named as loosely determined.
+pub const LOOSE_MASS: f64 = 0.05;
+
+/// A centre of mass coordinate's standard error beyond which it is named as loosely
+/// determined: this fraction of the centre's distance from the joint frame, or [`LOOSE_COM`]
+/// metres where that is larger.
+pub const LOOSE_COM_FRACTION: f64 = 0.1;
+
+/// See [`LOOSE_COM_FRACTION`] (m).
+pub const LOOSE_COM: f64 = 0.005;
+
+/// An inertia entry's standard error, relative to the payload's largest principal moment,
+/// beyond which the inertia is named as loosely determined.
+pub const LOOSE_INERTIA: f64 = 0.25;
+
+/// What the payload's torques are measured against.
+#[derive(Clone, Copy, Debug)]
+pub enum Reference<'a> {
+    /// The URDF's own inertial parameters (and armature), taken as exact: their errors go into
+    /// the payload unseen. No friction: fit the joint terms beside the payload.
+    Urdf,
+    /// A base-parameter model of the robot without the payload (its friction and offsets
+    /// included), whose parameters' uncertainty is carried into the payload's.
+    Model(&'a BaseModel),
+}
+
+/// How a payload is identified ([`identify_payload`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PayloadOptions {
+    /// The URDF link the payload is fixed to: a moving body's own link (the body that starts
+    /// at it), in whose joint frame the payload is expressed.
+    pub link: String,
+    /// Each joint's terms fitted beside the payload (viscous, Coulomb, offset, armature): on a
+    /// base-parameter reference a change of them (a sensor zeroed anew), on the URDF the terms
+    /// themselves.
+    pub terms: FrictionTerms,
+    /// OLS, or WLS with weights from the per-joint residuals of the OLS fit (default).
+    pub weighting: Weighting,
+    /// Gravity in the torques (default on); a base-parameter reference must agree.
+    pub gravity: Gravity,
+    /// A physically consistent payload: the least squares over the ten parameters whose
+    /// pseudo-inertia is positive semi-definite (a rigid body), the joint terms free
+    /// (default false: the plain least squares, which can leave a loosely determined inertia
+    /// no rigid body's).
+    pub consistent: bool,
+}
+
+impl PayloadOptions {
+    /// The defaults for `link` and `reference`: WLS, gravity on, and the joint terms the
+    /// reference lacks: an offset a joint on a base-parameter model (a torque sensor zeroed
+    /// anew between the logs), viscous, Coulomb and offset on the URDF.
+    pub fn new(link: &str, reference: &Reference<'_>) -> Self {
+        Self {
+            link: link.to_string(),
+            terms: match reference {
+                Reference::Urdf => FrictionTerms::ALL,
+                Reference::Model(_) => FrictionTerms {
+                    offset: true,
+                    ..FrictionTerms::NONE
+                },
+            },
+            weighting: Weighting::Wls,
+            gravity: Gravity::Included,
+            consistent: false,
+        }
+    }
+}
+
+/// Standard errors of a payload's mass (kg), centre of mass (m) and inertia about it (kg m^2,
+/// `[ixx, ixy, ixz, iyy, iyz, izz]`), as [`Payload`] holds them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PayloadStderr {
+    pub mass: f64,
+    pub com: [f64; 3],
+    pub inertia: [f64; 6],
+}
+
+/// An identified payload ([`identify_payload`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PayloadFit {
+    pub robot: String,
+    pub joint_names: Vec<String>,
+    /// The link the payload is fixed to.
+    pub link: String,
+    /// `urdf` or `base_model`: what the torques were measured against ([`Reference`]).
+    pub reference: String,
+    /// The unknowns: the payload's ten parameters (`payload.m`, `payload.mcx`, ... `payload.Izz`)
+    /// and then each joint's terms (`joint1.offset`, ...).
+    pub names: Vec<String>,
+    /// Their estimates: kg, kg m, kg m^2 about the link's joint frame; the joint terms in N m
+    /// s/rad, N m, N m and kg m^2 (N s/m, N, N and kg for a prismatic joint).
+    pub theta: Vec<f64>,
+    /// Their standard errors, with the reference model's share ([`Self::stderr_of_reference`]).
+    pub stderr: Vec<f64>,
+    /// The reference model's share of the standard errors alone: its parameters' uncertainty
+    /// carried through the fit (0 for the URDF, taken as exact; NaN for a base-parameter model
+    /// that stores no correlation of its parameters).
+    pub stderr_of_reference: Vec<f64>,
+    /// The correlation of the estimates (with [`Self::stderr`], their covariance).
+    #[serde(with = "crate::json::rows")]
+    pub correlation: DMatrix<f64>,
+    /// The payload: mass, centre of mass and inertia about it in the link's joint frame (the
+    /// document `identify-gains --payload` and true robots read). None where the mass is not
+    /// above 0 by [`SEEN`] standard errors (no payload seen; its centre of mass would be a
+    /// ratio of noise).
+    pub payload: Option<Payload>,
+    /// The payload's standard errors (with it).
+    pub payload_stderr: Option<PayloadStderr>,
+    /// Why the least-squares estimate is no rigid body anyone could bolt on (a negative
+    /// principal moment, the triangle inequality broken), None where it is one: the data
+    /// determine its inertia too loosely, or the model errs. Of the unconstrained estimate
+    /// also where the consistent one is given ([`Self::consistent`]).
+    pub not_a_rigid_body: Option<String>,
+    /// Whether [`Self::theta`] and [`Self::payload`] are the physically consistent estimate
+    /// ([`PayloadOptions::consistent`]); its standard errors are the unconstrained fit's,
+    /// which hold where no constraint is active.
+    pub consistent: bool,
+    /// For a consistent estimate, the weighted residual sum of squares over the unconstrained
+    /// fit's (1: the constraint cost nothing; None for a plain fit).
+    pub residual_growth: Option<f64>,
+    /// Per joint, the RMS (N m, or N) of the torques less the reference's: what the payload
+    /// and the joint terms are fitted to.
+    pub reference_rms: Vec<f64>,
+    /// Per joint, the RMS of the payload's torques alone over the log (N m, or N).
+    pub payload_torque_rms: Vec<f64>,
+    /// Per joint, the RMS of the residuals the fit leaves (N m, or N).
+    pub residual_rms: Vec<f64>,
+    /// The per-joint noise levels the rows were weighted by (N m; all 1 for OLS).
+    pub sigma: Vec<f64>,
+    /// cond of the weighted regressor of the unknowns, columns scaled to unit norm.
+    pub cond: f64,
+    /// Samples fitted.
+    pub samples: usize,
+    /// Per joint, the residuals' long-run variance factor ([`super::residual_correlation`]);
+    /// the fit's standard errors are inflated by the square root of the largest.
+    pub residual_correlation: Vec<f64>,
+    /// What the fit cannot vouch for, in words (each also warned of by the front ends).
+    pub findings: Vec<String>,
+}
+
+/// The payload's quantities `[m, cx, cy, cz, ixx, ixy, ixz, iyy, iyz, izz]` (inertia about the
+/// centre of mass) of its ten parameters `pi` (Pinocchio's order, about the joint frame), and
+/// their Jacobian (`10 x 10`, row per quantity). `pi[0]` must not be 0.
+pub fn payload_of_parameters(pi: &[f64; 10]) -> ([f64; 10], DMatrix<f64>) {
+    let m = pi[0];
+    let h = [pi[1], pi[2], pi[3]];
+    // Io as (a, b) -> index into pi
+    let io = |a: usize, b: usize| -> usize {
+        match (a.min(b), a.max(b)) {
+            (0, 0) => 4,
+            (0, 1) => 5,
+            (1, 1) => 6,
+            (0, 2) => 7,
+            (1, 2) => 8,
+            _ => 9,
+        }
+    };
+    let entries = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+    let hh: f64 = h.iter().map(|v| v * v).sum();
+    let delta = |a: usize, b: usize| if a == b { 1.0 } else { 0.0 };
+    let mut out = [0.0; 10];
+    let mut jac = DMatrix::zeros(10, 10);
+    out[0] = m;
+    jac[(0, 0)] = 1.0;
+    for i in 0..3 {
+        out[1 + i] = h[i] / m;
+        jac[(1 + i, 0)] = -h[i] / (m * m);
+        jac[(1 + i, 1 + i)] = 1.0 / m;
+    }
+    // Ic = Io - (|h|^2 / m) 1 + h h^T / m
+    for (e, &(a, b)) in entries.iter().enumerate() {
+        let row = 4 + e;
+        out[row] = pi[io(a, b)] - hh / m * delta(a, b) + h[a] * h[b] / m;
+        jac[(row, io(a, b))] = 1.0;
+        jac[(row, 0)] = hh / (m * m) * delta(a, b) - h[a] * h[b] / (m * m);
+        for k in 0..3 {
+            jac[(row, 1 + k)] =
+                -2.0 * h[k] / m * delta(a, b) + (delta(a, k) * h[b] + h[a] * delta(b, k)) / m;
+        }
+    }
+    (out, jac)
+}
+
+/// The ten parameters `pi` (Pinocchio's order, about the link's joint frame) of `payload`.
+pub fn parameters_of_payload(payload: &Payload) -> [f64; 10] {
+    let i = payload.spatial_inertia();
+    let h = i.com * i.mass;
+    let r = i.inertia_origin();
+    [
+        i.mass,
+        h.x,
+        h.y,
+        h.z,
+        r[(0, 0)],
+        r[(0, 1)],
+        r[(1, 1)],
+        r[(0, 2)],
+        r[(1, 2)],
+        r[(2, 2)],
+    ]
+}
+
+/// The unknowns' regression problem: the columns of the payload's body and of the joint terms.
+fn unknowns(model: &Model, body: usize, terms: FrictionTerms) -> BaseParameters {
+    let layout = ParameterLayout::new(model, terms);
+    let ni = PARAMS_PER_BODY * model.nbodies();
+    let kept: Vec<usize> = (body * PARAMS_PER_BODY..(body + 1) * PARAMS_PER_BODY)
+        .chain(ni..layout.len())
+        .collect();
+    BaseParameters {
+        layout,
+        k: DMatrix::zeros(kept.len(), 0),
+        kept,
+        dropped: vec![],
+        tolerance: BASE_TOLERANCE,
+        structural: false,
+    }
+}
+
+/// The unknowns' columns: the payload body's ten and each joint's terms.
+struct Columns {
+    body: usize,
+    terms: Vec<&'static str>,
+}
+
+impl Columns {
+    /// Row `s * nv + j` (`row` of the block `phi`, sample `sample` of `states`, joint `joint`)
+    /// into `out`: the payload body's ten regressor columns of the reference's regressor block
+    /// (inertial columns come first in every layout) and joint `j`'s own terms.
+    fn row(
+        &self,
+        phi: &DMatrix<f64>,
+        row: usize,
+        states: &States<'_>,
+        sample: usize,
+        joint: usize,
+        out: &mut [f64],
+    ) {
+        let (nv, terms) = (states.nv(), &self.terms);
+        for c in 0..PARAMS_PER_BODY {
+            out[c] = phi[(row, self.body * PARAMS_PER_BODY + c)];
+        }
+        out[PARAMS_PER_BODY..].iter_mut().for_each(|v| *v = 0.0);
+        let (qd, qdd) = (states.qd_or_zeros(), states.qdd_or_zeros());
+        for (t, name) in terms.iter().enumerate() {
+            out[PARAMS_PER_BODY + joint * terms.len() + t] = match *name {
+                "viscous" => qd[sample * nv + joint],
+                "coulomb" => states.coulomb_at(sample, joint),
+                "armature" => qdd[sample * nv + joint],
+                _ => 1.0,
+            };
+        }
+    }
+}
+
+/// Identifies the payload fixed to `options.link` from `states` (rad, rad/s, rad/s^2, with
+/// velocities and accelerations; a Coulomb column where the torques were filtered,
+/// [`States::with_coulomb`]) and the torques `tau` measured with it (row-major `k x nv`, N m,
+/// or N for a prismatic joint), against `reference`: see the module documentation.
+///
+/// Errors: states of other joints or without velocities, torques of another shape or flat, a
+/// link that is no moving body's, a reference identified for another robot or with gravity
+/// the other way, and data that do not determine the payload (a rank deficiency naming the
+/// parameters: a payload on a link whose motion the joints' torques cannot tell apart, or a
+/// log that moves too little).
+pub fn identify_payload(
+    model: &Model,
+    reference: Reference<'_>,
+    states: &States<'_>,
+    tau: &[f64],
+    options: &PayloadOptions,
+) -> Result<PayloadFit> {
+    let nv = model.nv;
+    crate::torque_model::check_joints(states, nv)?;
+    states.check_companion("tau", tau, nv)?;
+    if states.qd().is_none() || states.qdd().is_none() {
+        return Err(Error::InvalidArgument {
+            argument: "states".into(),
+            message: "the log has no velocities and accelerations: preprocess it first".into(),
+        });
+    }
+    crate::torque_model::refuse_flat_torques(
+        states,
+        tau,
+        &model.joint_names,
+        crate::torque_model::FOR_A_FIT,
+    )?;
+    let link = Payload {
+        link: options.link.clone(),
+        mass: 0.0,
+        com: [0.0; 3],
+        inertia: [0.0; 6],
+    };
+    let body = link.body(model).map_err(|e| match e {
+        Error::InvalidArgument { message, .. } => Error::InvalidArgument {
+            argument: "link".into(),
+            message,
+        },
+        other => other,
+    })?;
+    // the reference's regressor layout and parameters
+    let (ref_layout, ref_theta) = match reference {
+        Reference::Urdf => {
+            let layout = ParameterLayout::new(model, FrictionTerms::NONE.for_model(model));
+            let theta = layout.model_parameters(model);
+            (layout, theta)
+        }
+        Reference::Model(fit) => {
+            fit.check(model)?;
+            if fit.gravity != options.gravity {
+                return Err(Error::InvalidArgument {
+                    argument: "gravity".into(),
+                    message: format!(
+                        "the reference model was identified with gravity {} of its torques, the payload's log is read with it {}: both must agree",
+                        if fit.gravity.is_included() { "in" } else { "out" },
+                        if options.gravity.is_included() { "in" } else { "out" }
+                    ),
+                });
+            }
+            (
+                fit.base.layout.clone(),
+                DVector::from_column_slice(&fit.theta),
+            )
+        }
+    };
+    let base_of_reference = match reference {
+        Reference::Model(fit) => Some(&fit.base),
+        Reference::Urdf => None,
+    };
+    let problem = unknowns(model, body, options.terms);
+    let columns = Columns {
+        body,
+        terms: options.terms.names(),
+    };
+    let m = problem.len();
+    let p_ref = base_of_reference.map_or(0, |b| b.len());
+    // pass 1: the torques less the reference's, and per joint the cross products of the
+    // unknowns' columns with the reference's base columns (for its share of the errors)
+    let k = states.len();
+    let mut y = Vec::with_capacity(k * nv);
+    let mut cross = vec![DMatrix::<f64>::zeros(m, p_ref); nv];
+    let mut row = vec![0.0; m];
+    regressor_blocks(model, &ref_layout, states, options.gravity, |range, phi| {
+        let predicted = match base_of_reference {
+            Some(b) => b.select(phi) * &ref_theta,
+            None => phi * &ref_theta,
+        };
+        let rows_ref = base_of_reference.map(|b| b.select(phi));
+        for (i, s) in range.clone().enumerate() {
+            for j in 0..nv {
+                let r = i * nv + j;
+                y.push(tau[s * nv + j] - predicted[r]);
+                if let Some(f) = &rows_ref {
+                    columns.row(phi, r, states, s, j, &mut row);
+                    let a = DVector::from_column_slice(&row);
+                    cross[j].ger(1.0, &a, &f.row(r).transpose(), 1.0);
+                }
+            }
+        }
+        Ok(())
+    })?;
+    if let Some(j) = (0..nv).find(|&j| y.iter().skip(j).step_by(nv).any(|v| !v.is_finite())) {
+        return Err(Error::Numerical {
+            operation: "payload identification".into(),
+            message: format!(
+                "the torques of joint '{}' less the reference's overflow: the torques or states are too large for f64 arithmetic; rescale the log to SI units",
+                model.joint_names[j]
+            ),
+        });
+    }
+    // pass 2: the unknowns' least squares, OLS then WLS
+    let factors = JointFactors::new(model, &problem, states, &y, options.gravity)?;
+    let names: Vec<String> = (crate::algorithms::regressor::PARAMETER_NAMES.iter())
+        .map(|n| format!("payload.{n}"))
+        .chain(problem.names().into_iter().skip(PARAMS_PER_BODY))
+        .collect();
+    let in_context = |e: Error| match e {
+        Error::RankDeficient {
+            rows,
+            cols,
+            rank,
+            missing,
+            ..
+        } => Error::RankDeficient {
+            context: format!("payload identification on '{}'", options.link),
+            rows,
+            cols,
+            rank,
+            missing,
+        },
+        other => other,
+    };
+    let mut sigma = vec![1.0; nv];
+    let mut ls = factors.solve(&sigma, &names).map_err(in_context)?;
+    let mut rms = factors.residual_rms(ls.coef.as_slice())?;
+    if options.weighting == Weighting::Wls {
+        sigma = rms.iter().map(|&s| if s > 0.0 { s } else { 1.0 }).collect();
+        ls = factors.solve(&sigma, &names).map_err(in_context)?;
+        rms = factors.residual_rms(ls.coef.as_slice())?;
+    }
+    let unconstrained: Vec<f64> = ls.coef.iter().copied().collect();
+    let not_a_rigid_body = rigid_body_problem(&options.link, &unconstrained);
+    let (theta, residual_growth) = match options.consistent {
+        true => {
+            let (theta, growth) = consistent_payload(&factors, &sigma, &unconstrained)?;
+            rms = factors.residual_rms(&theta)?;
+            (theta, Some(growth))
+        }
+        false => (unconstrained, None),
+    };
+    let pi = DVector::from_column_slice(&theta);
+    // the residuals' correlation from sample to sample, and the payload's torques, over the
+    // first samples
+    let head = k.min(SAMPLES);
+    let mut residuals = Vec::with_capacity(head * nv);
+    let mut payload_squares = vec![0.0; nv];
+    let pi_payload = pi.rows(0, PARAMS_PER_BODY).into_owned();
+    regressor_blocks(
+        model,
+        &ref_layout,
+        &states.slice(0..head),
+        options.gravity,
+        |range, phi| {
+            let local = states.slice(0..head);
+            for (i, s) in range.clone().enumerate() {
+                for j in 0..nv {
+                    let r = i * nv + j;
+                    columns.row(phi, r, &local, s, j, &mut row);
+                    let fitted: f64 = row.iter().zip(pi.iter()).map(|(a, b)| a * b).sum();
+                    residuals.push(y[s * nv + j] - fitted);
+                    let own: f64 = (0..PARAMS_PER_BODY).map(|c| row[c] * pi_payload[c]).sum();
+                    payload_squares[j] += own * own;
+                }
+            }
+            Ok(())
+        },
+    )?;
+    let residual_correlation = long_run_factors(&residuals, nv);
+    let inflation = residual_correlation
+        .iter()
+        .fold(1.0f64, |a, &f| a.max(f))
+        .sqrt();
+    // covariance: the fit's (inflated), and the reference's carried through
+    let se_fit: Vec<f64> = ls.stderr.iter().map(|s| s * inflation).collect();
+    let corr = &ls.correlation;
+    let mut cov = DMatrix::from_fn(m, m, |a, b| se_fit[a] * corr[(a, b)] * se_fit[b]);
+    let stderr_of_reference = match reference {
+        Reference::Urdf => vec![0.0; m],
+        Reference::Model(fit) if fit.correlation.shape() != (p_ref, p_ref) => vec![f64::NAN; m],
+        Reference::Model(fit) => {
+            // (A^T W A)^-1 = corr scaled by sqrt(cov_diag)
+            let unscaled = DMatrix::from_fn(m, m, |a, b| {
+                corr[(a, b)] * (ls.cov_diag[a] * ls.cov_diag[b]).sqrt()
+            });
+            let mut weighted = DMatrix::<f64>::zeros(m, p_ref);
+            for (j, c) in cross.iter().enumerate() {
+                weighted += c / (sigma[j] * sigma[j]);
+            }
+            let g = &unscaled * weighted;
+            let ref_cov = DMatrix::from_fn(p_ref, p_ref, |a, b| {
+                fit.stderr[a] * fit.correlation[(a, b)] * fit.stderr[b]
+            });
+            let carried = &g * ref_cov * g.transpose();
+            cov += &carried;
+            (0..m).map(|a| carried[(a, a)].max(0.0).sqrt()).collect()
+        }
+    };
+    let stderr: Vec<f64> = (0..m).map(|a| cov[(a, a)].max(0.0).sqrt()).collect();
+    let correlation = DMatrix::from_fn(m, m, |a, b| {
+        let d = stderr[a] * stderr[b];
+        match (a == b, d > 0.0 && d.is_finite()) {
+            (true, _) => 1.0,
+            (false, true) => cov[(a, b)] / d,
+            (false, false) => 0.0,
+        }
+    });
+    let reference_rms: Vec<f64> = (0..nv)
+        .map(|j| {
+            let s: f64 = y.iter().skip(j).step_by(nv).map(|v| v * v).sum();
+            (s / k.max(1) as f64).sqrt()
+        })
+        .collect();
+    let payload_torque_rms: Vec<f64> = payload_squares
+        .iter()
+        .map(|s| (s / head.max(1) as f64).sqrt())
+        .collect();
+    let mut fit = PayloadFit {
+        robot: model.name.clone(),
+        joint_names: model.joint_names.clone(),
+        link: options.link.clone(),
+        reference: match reference {
+            Reference::Urdf => "urdf".into(),
+            Reference::Model(_) => "base_model".into(),
+        },
+        names,
+        theta,
+        stderr,
+        stderr_of_reference,
+        correlation,
+        payload: None,
+        payload_stderr: None,
+        not_a_rigid_body,
+        consistent: options.consistent,
+        residual_growth,
+        reference_rms,
+        payload_torque_rms,
+        residual_rms: rms,
+        sigma,
+        cond: ls.cond,
+        samples: k,
+        residual_correlation,
+        findings: vec![],
+    };
+    fit.judge(&cov);
+    Ok(fit)
+}
+
+impl PayloadFit {
+    /// The payload's ten parameters (Pinocchio's order, about the link's joint frame).
+    pub fn parameters(&self) -> [f64; 10] {
+        std::array::from_fn(|i| self.theta[i])
+    }
+
+    /// The payload, its standard errors and the findings, from the estimates and their
+    /// covariance `cov` (over [`Self::names`]).
+    fn judge(&mut self, cov: &DMatrix<f64>) {
+        let pi = self.parameters();
+        let (m, se_m) = (pi[0], self.stderr[0]);
+        if !(m > SEEN * se_m && m > 0.0) {
+            self.findings.push(format!(
+                "no payload on '{}' is seen: its mass comes out {} +- {} kg (not above 0 by {SEEN} standard errors), so its centre of mass and inertia are not determined; was it mounted while the log was taken, on this link?",
+                self.link,
+                shown(m),
+                shown(se_m)
+            ));
+            return;
+        }
+        let (u, jac) = payload_of_parameters(&pi);
+        let block = cov.view((0, 0), (PARAMS_PER_BODY, PARAMS_PER_BODY));
+        let cu = &jac * block * jac.transpose();
+        let se = |i: usize| cu[(i, i)].max(0.0).sqrt();
+        let payload = Payload {
+            link: self.link.clone(),
+            mass: u[0],
+            com: [u[1], u[2], u[3]],
+            inertia: [u[4], u[5], u[6], u[7], u[8], u[9]],
+        };
+        let stderr = PayloadStderr {
+            mass: se(0),
+            com: [se(1), se(2), se(3)],
+            inertia: std::array::from_fn(|i| se(4 + i)),
+        };
+        if stderr.mass > LOOSE_MASS * payload.mass {
+            self.findings.push(format!(
+                "the payload's mass is loosely determined: {} +- {} kg",
+                shown(payload.mass),
+                shown(stderr.mass)
+            ));
+        }
+        let distance = payload.com.iter().map(|c| c * c).sum::<f64>().sqrt();
+        let com_bound = (LOOSE_COM_FRACTION * distance).max(LOOSE_COM);
+        if stderr.com.iter().any(|s| s.is_nan() || *s > com_bound) {
+            self.findings.push(format!(
+                "the payload's centre of mass is loosely determined: [{}] +- [{}] m; a motion that turns the link about more axes, and faster, determines it better",
+                payload.com.map(shown).join(", "),
+                stderr.com.map(shown).join(", ")
+            ));
+        }
+        let s = payload.spatial_inertia().inertia_com;
+        let largest = crate::decomposition::symmetric_eigen(s).map_or(f64::NAN, |e| {
+            (e.eigenvalues.iter()).fold(0.0f64, |a, v| a.max(v.abs()))
+        });
+        if stderr
+            .inertia
+            .iter()
+            .any(|v| v.is_nan() || largest.is_nan() || *v > LOOSE_INERTIA * largest)
+        {
+            self.findings.push(format!(
+                "the payload's inertia about its centre of mass is loosely determined: standard errors up to {} kg m^2 against a largest principal moment of {} kg m^2 (a small payload's inertia moves the joint torques little; a motion that turns the link faster about each axis determines it better)",
+                shown(stderr.inertia.iter().fold(0.0f64, |a, v| a.max(*v))),
+                shown(largest)
+            ));
+        }
+        match (&self.not_a_rigid_body, self.consistent) {
+            (Some(reason), false) => self.findings.push(format!(
+                "the estimate is no rigid body: {reason}; the data determine its inertia too loosely (or the reference model errs), and the estimate is not to be used as it is: identify it consistent (a rigid body by construction)"
+            )),
+            (Some(reason), true) => self.findings.push(format!(
+                "the least-squares estimate is no rigid body ({reason}): the consistent one given lies on the boundary of rigid bodies, its inertia what the data allow more than what they determine"
+            )),
+            (None, _) => {}
+        }
+        // a consistent estimate is a rigid body by construction; checked all the same
+        if self.consistent {
+            if let Some(reason) = payload.problem("the consistent payload") {
+                self.findings.push(reason.clone());
+                self.not_a_rigid_body = Some(reason);
+                self.consistent = false;
+            }
+        }
+        self.payload = Some(payload);
+        self.payload_stderr = Some(stderr);
+    }
+
+    /// The payload ready to use: present, and a rigid body (None otherwise; see
+    /// [`Self::findings`]).
+    pub fn usable_payload(&self) -> Option<&Payload> {
+        self.payload
+            .as_ref()
+            .filter(|_| self.consistent || self.not_a_rigid_body.is_none())
+    }
+}
+
+/// Why the payload of the estimates `theta` (its ten parameters first) is no rigid body, None
+/// where it is one (or where its mass is not positive: no payload to judge).
+fn rigid_body_problem(link: &str, theta: &[f64]) -> Option<String> {
+    let pi: [f64; 10] = std::array::from_fn(|i| theta[i]);
+    if pi[0].is_nan() || pi[0] <= 0.0 {
+        return None;
+    }
+    let (u, _) = payload_of_parameters(&pi);
+    Payload {
+        link: link.to_string(),
+        mass: u[0],
+        com: [u[1], u[2], u[3]],
+        inertia: [u[4], u[5], u[6], u[7], u[8], u[9]],
+    }
+    .problem("the payload")
+}
+
+/// The consistent estimates (the payload's ten parameters a rigid body's, the joint terms
+/// free) of the weighted problem `factors` reduces with weights `sigma`, and the growth of
+/// its residual sum of squares over the unconstrained minimum. The joint terms are minimised
+/// over for every payload (a QR of `[R11 | z]` with their columns first), so that the
+/// constrained problem is in the ten parameters alone ([`super::consistent_least_squares`]).
+fn consistent_payload(
+    factors: &JointFactors,
+    sigma: &[f64],
+    unconstrained: &[f64],
+) -> Result<(Vec<f64>, f64)> {
+    let (r11, z, rho) = factors.reduced(sigma)?;
+    let n = r11.ncols();
+    let (b, f) = (PARAMS_PER_BODY, n - PARAMS_PER_BODY);
+    let mut a = DMatrix::zeros(n + 1, n + 1);
+    for i in 0..n {
+        for c in 0..f {
+            a[(i, c)] = r11[(i, b + c)];
+        }
+        for c in 0..b {
+            a[(i, f + c)] = r11[(i, c)];
+        }
+        a[(i, n)] = z[(i, 0)];
+    }
+    a[(n, n)] = rho;
+    let t = super::streaming::triangular(&a);
+    let r = t.view((f, f), (b, b)).into_owned();
+    let zp = DVector::from_iterator(b, (0..b).map(|i| t[(f + i, n)]));
+    let rest = t[(n, n)];
+    let layout = ParameterLayout {
+        nv: 0,
+        nbodies: 1,
+        friction: FrictionTerms::NONE,
+        names: (crate::algorithms::regressor::PARAMETER_NAMES.iter())
+            .map(|n| format!("payload.{n}"))
+            .collect(),
+    };
+    let solution = super::consistent_least_squares(
+        &layout,
+        &r,
+        &zp,
+        rest * rest,
+        &[0.0; PARAMS_PER_BODY],
+        // the data determine all ten (a rank deficiency was refused): the prior only keeps
+        // the solver's systems regular
+        &super::ConsistentOptions {
+            prior_weight: 1e-12,
+            ..super::ConsistentOptions::default()
+        },
+    )?;
+    let pi = &solution.theta;
+    // the joint terms that go with it: others d = others_z - coupling pi
+    let mut theta = pi.clone();
+    if f > 0 {
+        let others = t.view((0, 0), (f, f)).into_owned();
+        let coupling = t.view((0, f), (f, b)).into_owned();
+        let rhs = DVector::from_iterator(f, (0..f).map(|i| t[(i, n)]))
+            - coupling * DVector::from_column_slice(pi);
+        let d = others
+            .solve_upper_triangular(&rhs)
+            .filter(|d| d.iter().all(|v| v.is_finite()))
+            .ok_or_else(|| Error::Numerical {
+                operation: "payload identification".into(),
+                message: "the data do not determine the joint terms beside the payload".into(),
+            })?;
+        theta.extend(d.iter());
+    }
+    debug_assert_eq!(theta.len(), unconstrained.len());
+    let growth = match (solution.unconstrained_cost, solution.cost) {
+        (u, c) if u > 0.0 => c / u,
+        (_, 0.0) => 1.0,
+        _ => f64::INFINITY,
+    };
+    Ok((theta, growth))
+}

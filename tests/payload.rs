@@ -1,0 +1,335 @@
+//! A payload identified from a log of the robot carrying it (src/direct/payload.rs): exact
+//! on noise-free torques against the URDF, within its standard errors against a model
+//! identified from a log without it (whose own uncertainty it carries), the delta rule's
+//! Jacobian against finite differences, no payload named as none, a payload the joints cannot
+//! see refused naming its parameters, and references that disagree with the log refused.
+//! (Against Pinocchio's torques: tests/python/test_payload.py.)
+
+mod common;
+
+use common::gain_logs::{motion, payload, states, truth};
+use common::{torques_with_friction, Rng};
+use perturbid_rs::direct::payload::{parameters_of_payload, payload_of_parameters};
+use perturbid_rs::direct::{
+    identify_base_parameters, identify_payload, BaseOptions, FrictionTerms, PayloadOptions,
+    Reference,
+};
+use perturbid_rs::rehearsal::{Payload, TrueRobot};
+use perturbid_rs::{Error, Gravity, Model};
+
+/// The torques of `truth` with `p` fixed on (none where None) along motion `seed`, with the
+/// common friction and `noise` N m of white noise.
+fn loaded_torques(truth: &Model, p: Option<&Payload>, seed: u64, noise: f64) -> Vec<f64> {
+    let robot = match p {
+        Some(p) => TrueRobot {
+            payload: Some(p.clone()),
+            ..TrueRobot::default()
+        }
+        .rigid_body_model(truth)
+        .unwrap(),
+        None => truth.clone(),
+    };
+    let s = motion(seed);
+    torques_with_friction(&robot, &s, &mut Rng(seed + 100), |r| {
+        noise * common::normal(r)
+    })
+}
+
+#[test]
+fn a_payload_comes_back_exactly_from_noise_free_torques_against_the_urdf() {
+    let (truth, p) = (truth(), payload());
+    let s = motion(4);
+    let tau = loaded_torques(&truth, Some(&p), 4, 0.0);
+    let reference = Reference::Urdf;
+    let options = PayloadOptions::new("link6", &reference);
+    assert_eq!(options.terms, FrictionTerms::ALL);
+    let fit = identify_payload(&truth, reference, &states(&s), &tau, &options).unwrap();
+    let want = parameters_of_payload(&p);
+    for (i, (a, b)) in fit.parameters().iter().zip(&want).enumerate() {
+        assert!(
+            (a - b).abs() < 1e-8 * (1.0 + b.abs()),
+            "{}: {a} vs {b}",
+            fit.names[i]
+        );
+    }
+    let got = fit.usable_payload().expect("a payload");
+    assert!((got.mass - p.mass).abs() < 1e-8);
+    for i in 0..3 {
+        assert!((got.com[i] - p.com[i]).abs() < 1e-8, "{:?}", got.com);
+    }
+    for i in 0..6 {
+        assert!(
+            (got.inertia[i] - p.inertia[i]).abs() < 1e-8,
+            "{:?}",
+            got.inertia
+        );
+    }
+    // the friction the truth has (0.3 N m s/rad, 0.8 N m), fitted beside it
+    for j in 0..6 {
+        let at = |t: &str| {
+            fit.names
+                .iter()
+                .position(|n| *n == format!("joint{}.{t}", j + 1))
+        };
+        assert!((fit.theta[at("viscous").unwrap()] - 0.3).abs() < 1e-8);
+        assert!((fit.theta[at("coulomb").unwrap()] - 0.8).abs() < 1e-8);
+    }
+    assert!(fit.findings.is_empty(), "{:?}", fit.findings);
+    assert_eq!(fit.reference, "urdf");
+    assert!(fit.stderr_of_reference.iter().all(|s| *s == 0.0));
+}
+
+#[test]
+fn against_a_model_of_the_robot_alone_the_payload_lies_within_its_standard_errors() {
+    let (truth, p) = (truth(), payload());
+    let (a, b) = (motion(3), motion(4));
+    let noise = 0.02;
+    let alone = loaded_torques(&truth, None, 3, noise);
+    let model =
+        identify_base_parameters(&truth, &states(&a), &alone, &BaseOptions::default()).unwrap();
+    let loaded = loaded_torques(&truth, Some(&p), 4, noise);
+    let reference = Reference::Model(&model);
+    let options = PayloadOptions::new("link6", &reference);
+    let fit = identify_payload(&truth, reference, &states(&b), &loaded, &options).unwrap();
+    let want = parameters_of_payload(&p);
+    let mut worst: f64 = 0.0;
+    for (i, want) in want.iter().enumerate() {
+        let z = (fit.theta[i] - want) / fit.stderr[i];
+        worst = worst.max(z.abs());
+        // the reference's share is part of the whole, and not nothing
+        assert!(fit.stderr_of_reference[i] > 0.0 && fit.stderr_of_reference[i] <= fit.stderr[i]);
+    }
+    assert!(
+        worst < 4.0,
+        "{worst} standard errors: {:?} vs {want:?}",
+        fit.theta
+    );
+    let got = fit.payload.as_ref().unwrap();
+    let se = fit.payload_stderr.as_ref().unwrap();
+    assert!(
+        (got.mass - p.mass).abs() < 4.0 * se.mass && se.mass < 0.02,
+        "{got:?} {se:?}"
+    );
+    for i in 0..3 {
+        assert!(
+            (got.com[i] - p.com[i]).abs() < 4.0 * se.com[i],
+            "{got:?} {se:?}"
+        );
+    }
+    // the residuals are the noise's
+    for r in &fit.residual_rms {
+        assert!(
+            (0.8 * noise..1.3 * noise).contains(r),
+            "{:?}",
+            fit.residual_rms
+        );
+    }
+    assert!(
+        fit.payload_torque_rms[1] > 1.0,
+        "{:?}",
+        fit.payload_torque_rms
+    );
+    // 0.02 N m of noise leave its small inertia (0.004 kg m^2) undetermined: the least-squares
+    // estimate is no rigid body, and is said not to be usable
+    assert!(fit.not_a_rigid_body.is_some() && fit.usable_payload().is_none());
+    assert!(
+        fit.findings.iter().any(|f| f
+            .starts_with("the payload's inertia about its centre of mass is loosely determined")),
+        "{:?}",
+        fit.findings
+    );
+    assert!(
+        fit.findings
+            .iter()
+            .any(|f| f.contains("identify it consistent")),
+        "{:?}",
+        fit.findings
+    );
+
+    // the consistent estimate is a rigid body, costs little more, and keeps the mass and centre
+    let consistent = PayloadOptions {
+        consistent: true,
+        ..options
+    };
+    let c = identify_payload(&truth, reference, &states(&b), &loaded, &consistent).unwrap();
+    let cp = c.usable_payload().expect("a rigid body");
+    assert!(cp.problem("payload").is_none(), "{cp:?}");
+    let growth = c.residual_growth.unwrap();
+    assert!((1.0..1.01).contains(&growth), "{growth}");
+    assert!((cp.mass - p.mass).abs() < 4.0 * se.mass, "{cp:?}");
+    for i in 0..3 {
+        assert!(
+            (cp.com[i] - p.com[i]).abs() < 4.0 * se.com[i] + 1e-3,
+            "{cp:?} {se:?}"
+        );
+    }
+    assert!(
+        c.findings
+            .iter()
+            .any(|f| f.starts_with("the least-squares estimate is no rigid body")),
+        "{:?}",
+        c.findings
+    );
+    // its residuals are the fit's own for its parameters: weighted, no lower than the
+    // unconstrained fit's, and higher by the growth
+    let weighted =
+        |r: &[f64]| -> f64 { r.iter().zip(&fit.sigma).map(|(r, s)| (r / s).powi(2)).sum() };
+    let (wc, wu) = (weighted(&c.residual_rms), weighted(&fit.residual_rms));
+    assert!(
+        wc >= wu * (1.0 - 1e-9) && (wc / wu - growth).abs() < 1e-6,
+        "{wc} vs {wu}, growth {growth}"
+    );
+}
+
+#[test]
+fn where_least_squares_gives_a_rigid_body_the_consistent_estimate_is_the_same() {
+    let (truth, p) = (truth(), payload());
+    let s = motion(4);
+    let tau = loaded_torques(&truth, Some(&p), 4, 1e-4);
+    let reference = Reference::Urdf;
+    let plain = PayloadOptions::new("link6", &reference);
+    let consistent = PayloadOptions {
+        consistent: true,
+        ..plain.clone()
+    };
+    let a = identify_payload(&truth, reference, &states(&s), &tau, &plain).unwrap();
+    let b = identify_payload(&truth, reference, &states(&s), &tau, &consistent).unwrap();
+    assert!(a.not_a_rigid_body.is_none(), "{:?}", a.not_a_rigid_body);
+    for i in 0..a.theta.len() {
+        assert!(
+            (a.theta[i] - b.theta[i]).abs() < 1e-6 * (1.0 + a.theta[i].abs()),
+            "{}: {} vs {}",
+            a.names[i],
+            a.theta[i],
+            b.theta[i]
+        );
+    }
+    assert!((b.residual_growth.unwrap() - 1.0).abs() < 1e-6);
+}
+
+#[test]
+fn the_delta_rules_jacobian_is_the_finite_differences_of_the_payloads_quantities() {
+    let pi = parameters_of_payload(&payload());
+    let (u, jac) = payload_of_parameters(&pi);
+    assert!((u[0] - 2.0).abs() < 1e-15 && (u[3] - 0.08).abs() < 1e-15);
+    for c in 0..10 {
+        let h = 1e-6 * (1.0 + pi[c].abs());
+        let (mut up, mut down) = (pi, pi);
+        up[c] += h;
+        down[c] -= h;
+        let (a, b) = (payload_of_parameters(&up).0, payload_of_parameters(&down).0);
+        for r in 0..10 {
+            let fd = (a[r] - b[r]) / (2.0 * h);
+            assert!(
+                (fd - jac[(r, c)]).abs() < 1e-7 * (1.0 + fd.abs()),
+                "d{r}/d{c}: {fd} vs {}",
+                jac[(r, c)]
+            );
+        }
+    }
+}
+
+#[test]
+fn a_log_without_the_payload_says_no_payload_is_seen() {
+    let truth = truth();
+    let s = motion(4);
+    let tau = loaded_torques(&truth, None, 4, 0.02);
+    let reference = Reference::Urdf;
+    let fit = identify_payload(
+        &truth,
+        reference,
+        &states(&s),
+        &tau,
+        &PayloadOptions::new("link6", &reference),
+    )
+    .unwrap();
+    assert!(fit.payload.is_none() && fit.usable_payload().is_none());
+    assert!(
+        fit.findings
+            .iter()
+            .any(|f| f.starts_with("no payload on 'link6' is seen")),
+        "{:?}",
+        fit.findings
+    );
+}
+
+#[test]
+fn payloads_the_joints_cannot_see_and_references_that_disagree_are_refused() {
+    let (truth, p) = (truth(), payload());
+    let s = motion(4);
+    let tau = loaded_torques(&truth, Some(&p), 4, 0.0);
+    let reference = Reference::Urdf;
+    let fit = |link: &str| {
+        identify_payload(
+            &truth,
+            reference,
+            &states(&s),
+            &tau,
+            &PayloadOptions::new(link, &reference),
+        )
+    };
+    // on the first link only the first joint's torque sees it: its mass and most moments
+    // are not determined
+    match fit("link1") {
+        Err(Error::RankDeficient {
+            context, missing, ..
+        }) => {
+            assert!(
+                context.contains("payload identification on 'link1'"),
+                "{context}"
+            );
+            assert!(missing.contains("payload.m"), "{missing}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let e = fit("base_link").unwrap_err().to_string();
+    assert!(
+        e.contains("not a moving link") && e.contains("link6"),
+        "{e}"
+    );
+    // a reference identified with gravity left out of the torques
+    let a = motion(3);
+    let alone = loaded_torques(&truth, None, 3, 0.01);
+    let model =
+        identify_base_parameters(&truth, &states(&a), &alone, &BaseOptions::default()).unwrap();
+    let options = PayloadOptions {
+        gravity: Gravity::Excluded,
+        ..PayloadOptions::new("link6", &Reference::Model(&model))
+    };
+    let e = identify_payload(
+        &truth,
+        Reference::Model(&model),
+        &states(&s),
+        &tau,
+        &options,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("gravity") && e.contains("must agree"), "{e}");
+    // a reference of another robot
+    let panda_like = perturbid_rs::robots::a465::model("physical").unwrap();
+    let mut other = panda_like.clone();
+    other.joint_names[0] = "waist".into();
+    let e = identify_payload(
+        &other,
+        Reference::Model(&model),
+        &states(&s),
+        &tau,
+        &PayloadOptions::new("link6", &Reference::Model(&model)),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("identified for"), "{e}");
+    // states without accelerations
+    let q_only = perturbid_rs::States::new(6, &s.q, Some(&s.qd), None).unwrap();
+    let e = identify_payload(
+        &truth,
+        reference,
+        &q_only,
+        &tau,
+        &PayloadOptions::new("link6", &reference),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("preprocess"), "{e}");
+}
