@@ -9,6 +9,7 @@ mod info;
 mod local;
 mod paper;
 mod parameters;
+mod payload;
 mod pipeline;
 mod progress;
 mod session;
@@ -64,6 +65,10 @@ enum Command {
     /// some with a known payload bolted on; writes the base-parameter model with the gains
     /// (JSON) and prints the gains.
     IdentifyGains(gains::IdentifyGainsArgs),
+    /// Identify a payload's mass, centre of mass and inertia from a log of the robot carrying
+    /// it, against a model of the robot alone (identify-direct) or its URDF: writes
+    /// payload.json (as identify-gains --payload reads it) and payload_fit.json.
+    IdentifyPayload(payload::IdentifyPayloadArgs),
     /// Torques predicted by a saved model (local or base-parameter) at the states of a CSV.
     Predict(direct::PredictArgs),
     /// A saved model against a log (positions and torques; preprocessed as for
@@ -102,6 +107,7 @@ fn run(cli: Cli) -> Result<String> {
         Command::Columns(a) => columns::run(a),
         Command::IdentifyDirect(a) => direct::identify_direct(a),
         Command::IdentifyGains(a) => gains::identify_gains(a),
+        Command::IdentifyPayload(a) => payload::run(a),
         Command::Predict(a) => direct::predict(a),
         Command::Parameters(a) => parameters::run(a),
         Command::Validate(a) => validate::run(a),

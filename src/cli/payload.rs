@@ -1,0 +1,227 @@
+//! `perturbid identify-payload`: a payload's mass, centre of mass and inertia from a log of
+//! the robot carrying it, against a model of the robot alone or its URDF.
+
+use std::fmt::Write;
+use std::path::PathBuf;
+
+use clap::Args;
+
+use super::files::{in_log, refuse_overwriting_inputs, PreprocessArgs, RobotArg};
+use super::progress::Progress;
+use crate::direct::{
+    identify_payload, FrictionTerms, PayloadFit, PayloadOptions, Reference, Weighting,
+};
+use crate::error::{shown, Error, Result};
+use crate::gravity::Gravity;
+use crate::io::OutputSet;
+use crate::torque_model::ModelFile;
+
+#[derive(Args)]
+pub(crate) struct IdentifyPayloadArgs {
+    #[command(flatten)]
+    robot: RobotArg,
+    /// The log CSV of the robot carrying the payload: t, q1..qN, tau1..tauN (qd, qdd
+    /// optional; preprocessed as for identify-direct).
+    data: PathBuf,
+    /// The URDF link the payload is fixed to (a moving link: the body that starts at it); the
+    /// payload is given in its joint frame.
+    #[arg(long)]
+    link: String,
+    /// A base-parameter model of the robot without the payload (identify-direct, or
+    /// identify-gains with --signal): the torques are measured against its prediction, and
+    /// its parameters' uncertainty is carried into the payload's. Without it, against the
+    /// URDF's own parameters, taken as exact.
+    #[arg(long)]
+    model: Option<PathBuf>,
+    /// Joint terms fitted beside the payload, comma separated from viscous, coulomb, offset,
+    /// armature; or none. Default: offset with --model (a sensor zeroed anew), viscous,
+    /// coulomb and offset without it (the URDF holds no friction to measure against).
+    #[arg(long)]
+    terms: Option<FrictionTerms>,
+    /// wls (weights from the per-joint residuals) or ols.
+    #[arg(long, value_enum, default_value_t = Weighting::Wls)]
+    weighting: Weighting,
+    /// The torques exclude gravity (the robot's controller compensates it in what it logs).
+    #[arg(long)]
+    no_gravity: bool,
+    /// A physically consistent payload (a rigid body by construction): for a payload whose
+    /// inertia the log determines loosely.
+    #[arg(long)]
+    consistent: bool,
+    /// The log's tau columns hold the signal the model's drive gains were identified for
+    /// (motor currents; --model from identify-gains): each is multiplied by its joint's gain.
+    #[arg(long)]
+    signal: bool,
+    /// Output folder: payload.json (the payload as identify-gains --payload and true robots
+    /// read it; written only where the fit can vouch for it: a payload seen, a rigid body)
+    /// and payload_fit.json (every estimate with its standard error, the reference's share,
+    /// the residuals and the findings).
+    #[arg(long, default_value = "payload")]
+    out: PathBuf,
+    #[command(flatten)]
+    preprocessing: PreprocessArgs,
+}
+
+pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
+    let mut inputs = vec![a.data.as_path(), a.robot.path()];
+    inputs.extend(a.model.as_deref());
+    refuse_overwriting_inputs(&a.out, &inputs)?;
+    let model = a.robot.load()?;
+    let file = a.model.as_ref().map(|p| ModelFile::load(p)).transpose()?;
+    let base = match (&file, &a.model) {
+        (Some(ModelFile::Base(fit)), _) => Some(fit),
+        (Some(_), Some(path)) => {
+            return Err(Error::InvalidArgument {
+                argument: "--model".into(),
+                message: format!(
+                    "{} is not a base-parameter model (identify-direct, identify-gains): a local or globally linearised model holds near its operating point, not along the log's motion",
+                    path.display()
+                ),
+            })
+        }
+        _ => None,
+    };
+    let gains = match (a.signal, &file, &a.model) {
+        (false, ..) => None,
+        (true, Some(f), Some(path)) => {
+            Some(super::gains::model_gains(f, path, "--signal")?.gain.clone())
+        }
+        (true, ..) => {
+            return Err(Error::InvalidArgument {
+                argument: "--signal".into(),
+                message: "needs --model: the drive gains come from a model of identify-gains"
+                    .into(),
+            })
+        }
+    };
+    let reference = match base {
+        Some(fit) => Reference::Model(fit),
+        None => Reference::Urdf,
+    };
+    let mut options = PayloadOptions::new(&a.link, &reference);
+    options.terms = a.terms.unwrap_or(options.terms);
+    options.weighting = a.weighting;
+    options.gravity = Gravity::from(!a.no_gravity);
+    options.consistent = a.consistent;
+    // a link the robot lacks is named before the log is read
+    crate::rehearsal::Payload {
+        link: a.link.clone(),
+        mass: 0.0,
+        com: [0.0; 3],
+        inertia: [0.0; 6],
+    }
+    .body(&model)?;
+    let progress = Progress::new();
+    let mut out = String::new();
+    let rec = (a.preprocessing).read(&a.data, &model.joint_names, &progress, &mut out)?;
+    let rec = match &gains {
+        Some(g) => {
+            let _ = writeln!(
+                out,
+                "the log's signal times the model's drive gains: torques"
+            );
+            rec.in_torques(g)?
+        }
+        None => rec,
+    };
+    let states = rec.states().map_err(in_log(&a.data))?;
+    progress.update(&format!("identifying on {} samples", states.len()));
+    let fit = identify_payload(&model, reference, &states, &rec.tau, &options)
+        .map_err(in_log(&a.data))?;
+    progress.done();
+    for w in &fit.findings {
+        eprintln!("perturbid: warning: log '{}': {w}", a.data.display());
+    }
+    let mut set = OutputSet::new(&a.out, "payload");
+    if let Some(p) = fit.usable_payload() {
+        set.add(
+            "payload.json",
+            serde_json::to_string_pretty(p).expect("serialisable") + "\n",
+        )?;
+    }
+    set.add(
+        "payload_fit.json",
+        serde_json::to_string_pretty(&fit).expect("serialisable") + "\n",
+    )?;
+    set.commit()?;
+    out.push_str(&report(&fit, &a.out));
+    Ok(out)
+}
+
+/// The fit in words: the payload with its standard errors, the joint terms, the residuals.
+fn report(fit: &PayloadFit, out: &std::path::Path) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "payload on '{}' from {} samples against {}{}, cond {:.3e}:",
+        fit.link,
+        fit.samples,
+        match fit.reference.as_str() {
+            "urdf" => "the URDF's parameters",
+            _ => "the model of the robot alone",
+        },
+        if fit.consistent { ", consistent" } else { "" },
+        fit.cond
+    );
+    match (&fit.payload, &fit.payload_stderr) {
+        (Some(p), Some(se)) => {
+            let _ = writeln!(s, "  mass      {:>12.6} +- {:.2e} kg", p.mass, se.mass);
+            for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+                let _ = writeln!(
+                    s,
+                    "  com {axis}     {:>12.6} +- {:.2e} m",
+                    p.com[i], se.com[i]
+                );
+            }
+            for (i, name) in ["ixx", "ixy", "ixz", "iyy", "iyz", "izz"]
+                .iter()
+                .enumerate()
+            {
+                let _ = writeln!(
+                    s,
+                    "  {name}       {:>12.6} +- {:.2e} kg m^2 (about the centre of mass)",
+                    p.inertia[i], se.inertia[i]
+                );
+            }
+        }
+        _ => {
+            let _ = writeln!(
+                s,
+                "  no payload seen: mass {} +- {} kg",
+                shown(fit.theta[0]),
+                shown(fit.stderr[0])
+            );
+        }
+    }
+    if fit.names.len() > 10 {
+        let _ = writeln!(s, "  joint terms fitted beside it:");
+        for (i, name) in fit.names.iter().enumerate().skip(10) {
+            let _ = writeln!(
+                s,
+                "    {name:<24} {:>12.6} +- {:.2e}",
+                fit.theta[i], fit.stderr[i]
+            );
+        }
+    }
+    let _ = writeln!(
+        s,
+        "  {:<16} {:>16} {:>16} {:>14}",
+        "joint", "reference RMS", "payload RMS", "residual RMS"
+    );
+    for (j, name) in fit.joint_names.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "  {name:<16} {:>16.4} {:>16.4} {:>14.4}",
+            fit.reference_rms[j], fit.payload_torque_rms[j], fit.residual_rms[j]
+        );
+    }
+    let written = match fit.usable_payload() {
+        Some(_) => format!("{0}/payload.json and {0}/payload_fit.json", out.display()),
+        None => format!(
+            "{}/payload_fit.json (no payload.json: the fit cannot vouch for one, see the warnings)",
+            out.display()
+        ),
+    };
+    let _ = writeln!(s, "wrote {written}");
+    s
+}

@@ -1,0 +1,196 @@
+//! `perturbid identify-payload` end to end: a payload comes back from a simulated log of the
+//! A465 carrying it, against a model identified from a log without it and against the URDF;
+//! the payload.json it writes is the document true robots and `identify-gains --payload`
+//! read; a log without a payload writes none and says why; bad arguments are refused by name
+//! with nothing written.
+
+mod cli_support;
+
+use cli_support::{fails, nothing_written, ok, s, tmp, warnings_of, write};
+use perturbid_rs::rehearsal::Payload;
+
+const TRUE_PAYLOAD: &str = r#"{"link": "link6", "mass": 1.5, "com": [0.01, 0.0, 0.06], "inertia": [0.004, 0, 0, 0.004, 0, 0.002]}"#;
+
+/// The excitation of seed 1 (designed with 30 evaluations at 100 Hz) simulated at 500 Hz for
+/// two periods on a true A465 with friction, 0.02 N m of torque noise and `payload` (JSON, or
+/// none) into `dir/name`.
+fn log(dir: &std::path::Path, name: &str, payload: Option<&str>, seed: u64) -> std::path::PathBuf {
+    let exc = dir.join("exc");
+    if !exc.join("excitation.json").exists() {
+        ok(&[
+            "excite",
+            "a465",
+            "--out",
+            s(&exc),
+            "--max-evaluations",
+            "30",
+            "--rate",
+            "100",
+            "--seed",
+            "1",
+        ]);
+    }
+    let truth = dir.join(format!("{name}.true.json"));
+    let payload = payload.map_or(String::new(), |p| format!(r#""payload": {p},"#));
+    write(
+        &truth,
+        &format!(
+            r#"{{"format": "perturbid-true-robot/1", "seed": {seed}, {payload}
+ "friction": {{"viscous": [0.5, 0.4, 0.3, 0.2, 0.1, 0.05], "coulomb": [1.0, 0.8, 0.6, 0.4, 0.2, 0.1]}},
+ "sensors": {{"torque_noise": [0.02, 0.02, 0.02, 0.01, 0.01, 0.01]}}}}"#
+        ),
+    );
+    let out = dir.join(name);
+    ok(&[
+        "simulate",
+        "a465",
+        s(&exc.join("excitation.json")),
+        "--true-robot",
+        s(&truth),
+        "--rate",
+        "500",
+        "--periods",
+        "2",
+        "--out",
+        s(&out),
+    ]);
+    out
+}
+
+fn payload_in(dir: &std::path::Path) -> Payload {
+    let text = std::fs::read_to_string(dir.join("payload.json")).unwrap();
+    serde_json::from_str(&text).unwrap()
+}
+
+#[test]
+fn a_payload_comes_back_against_a_model_of_the_robot_alone_and_against_the_urdf() {
+    let d = tmp("payload");
+    let alone = log(&d, "alone.csv", None, 2);
+    let loaded = log(&d, "loaded.csv", Some(TRUE_PAYLOAD), 3);
+    let model = d.join("base.json");
+    ok(&["identify-direct", "a465", s(&alone), "--out", s(&model)]);
+    let out = ok(&[
+        "identify-payload",
+        "a465",
+        s(&loaded),
+        "--link",
+        "link6",
+        "--model",
+        s(&model),
+        "--out",
+        s(&d.join("p1")),
+    ]);
+    assert!(
+        out.contains("payload on 'link6' from")
+            && out.contains("against the model of the robot alone"),
+        "{out}"
+    );
+    assert!(out.contains("joint1.offset"), "{out}");
+    let p = payload_in(&d.join("p1"));
+    let truth: Payload = serde_json::from_str(TRUE_PAYLOAD).unwrap();
+    assert!((p.mass - truth.mass).abs() < 0.01, "{p:?}");
+    for i in 0..3 {
+        assert!((p.com[i] - truth.com[i]).abs() < 2e-3, "{p:?}");
+    }
+    assert!(p.problem("payload").is_none());
+    // the fit's document: every estimate with its standard error and the reference's share
+    let fit: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("p1/payload_fit.json")).unwrap())
+            .unwrap();
+    assert_eq!(fit["reference"], "base_model");
+    let share = fit["stderr_of_reference"][0].as_f64().unwrap();
+    assert!(
+        share > 0.0 && share <= fit["stderr"][0].as_f64().unwrap(),
+        "{fit}"
+    );
+    // what identify-gains reads as a known payload
+    let as_given = std::fs::read_to_string(d.join("p1/payload.json")).unwrap();
+    let inline: Payload = serde_json::from_str(&as_given).unwrap();
+    assert_eq!(inline, p);
+
+    // against the URDF (the simulation's own robot), consistent: friction fitted beside it
+    let out = ok(&[
+        "identify-payload",
+        "a465",
+        s(&loaded),
+        "--link",
+        "link6",
+        "--consistent",
+        "--out",
+        s(&d.join("p2")),
+    ]);
+    assert!(
+        out.contains("against the URDF's parameters, consistent"),
+        "{out}"
+    );
+    assert!(
+        out.contains("joint2.viscous") && out.contains("joint2.coulomb"),
+        "{out}"
+    );
+    let q = payload_in(&d.join("p2"));
+    assert!((q.mass - truth.mass).abs() < 0.01, "{q:?}");
+
+    // a log without the payload: none is seen, none written, and said so
+    let none = d.join("none");
+    let warned = warnings_of(&[
+        "identify-payload",
+        "a465",
+        s(&alone),
+        "--link",
+        "link6",
+        "--model",
+        s(&model),
+        "--out",
+        s(&none),
+    ]);
+    assert!(warned.contains("no payload on 'link6' is seen"), "{warned}");
+    assert!(!none.join("payload.json").exists() && none.join("payload_fit.json").exists());
+    // and a fresh fit into a folder that held a payload removes it
+    let warned = warnings_of(&[
+        "identify-payload",
+        "a465",
+        s(&alone),
+        "--link",
+        "link6",
+        "--model",
+        s(&model),
+        "--out",
+        s(&d.join("p1")),
+    ]);
+    assert!(warned.contains("no payload"), "{warned}");
+    assert!(!d.join("p1/payload.json").exists());
+}
+
+#[test]
+fn bad_arguments_are_refused_by_name_with_nothing_written() {
+    let d = tmp("payload-bad");
+    let loaded = log(&d, "loaded.csv", Some(TRUE_PAYLOAD), 3);
+    let out = d.join("out");
+    let run = |extra: &[&str], needles: &[&str]| {
+        let mut args = vec!["identify-payload", "a465", s(&loaded), "--out", s(&out)];
+        args.extend_from_slice(extra);
+        fails(&args, needles);
+        nothing_written(&d, "out");
+    };
+    run(
+        &["--link", "base_link"],
+        &["'base_link' is not a moving link", "link6"],
+    );
+    run(
+        &["--link", "link6", "--signal"],
+        &["--signal", "needs --model"],
+    );
+    run(&["--link", "link6", "--terms", "sticky"], &["sticky"]);
+    // a model that is not a base-parameter model
+    let local = d.join("local.json");
+    std::fs::copy(d.join("loaded.csv.true.json"), &local).unwrap();
+    run(&["--link", "link6", "--model", s(&local)], &[s(&local)]);
+    // a model without drive gains for --signal
+    let alone = log(&d, "alone.csv", None, 2);
+    let model = d.join("base.json");
+    ok(&["identify-direct", "a465", s(&alone), "--out", s(&model)]);
+    run(
+        &["--link", "link6", "--model", s(&model), "--signal"],
+        &["holds no drive gains"],
+    );
+}
