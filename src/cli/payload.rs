@@ -67,7 +67,7 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
     inputs.extend(a.model.as_deref());
     refuse_overwriting_inputs(&a.out, &inputs)?;
     let model = a.robot.load()?;
-    let file = a.model.as_ref().map(|p| ModelFile::load(p)).transpose()?;
+    let file = a.model.as_ref().map(ModelFile::load).transpose()?;
     let base = match (&file, &a.model) {
         (Some(ModelFile::Base(fit)), _) => Some(fit),
         (Some(_), Some(path)) => {
