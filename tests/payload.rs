@@ -333,3 +333,31 @@ fn payloads_the_joints_cannot_see_and_references_that_disagree_are_refused() {
     .to_string();
     assert!(e.contains("preprocess"), "{e}");
 }
+
+#[test]
+fn a_torque_column_in_other_units_is_named_before_the_payload_made_of_it() {
+    let (truth, p) = (truth(), payload());
+    let s = motion(4);
+    let mut tau = loaded_torques(&truth, Some(&p), 4, 0.01);
+    // the shoulder's torque logged in mN m
+    for v in tau.iter_mut().skip(1).step_by(6) {
+        *v *= 1000.0;
+    }
+    let reference = Reference::Urdf;
+    let fit = identify_payload(
+        &truth,
+        reference,
+        &states(&s),
+        &tau,
+        &PayloadOptions::new("link6", &reference),
+    )
+    .unwrap();
+    assert!(
+        fit.findings[0].starts_with("the torque of joint 'joint2' reads")
+            && fit.findings[0].contains("units"),
+        "{:?}",
+        fit.findings
+    );
+    // and what the fit made of it is not to be used
+    assert!(fit.payload.is_some() && fit.usable_payload().is_none());
+}

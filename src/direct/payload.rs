@@ -179,6 +179,12 @@ pub struct PayloadFit {
     /// Per joint, the residuals' long-run variance factor ([`super::residual_correlation`]);
     /// the fit's standard errors are inflated by the square root of the largest.
     pub residual_correlation: Vec<f64>,
+    /// Each torque column of the log against the robot's model, as every direct fit checks
+    /// its log ([`super::check_torque_columns`]): where one reads wrong (other units, sign or
+    /// joint) the payload is not vouched for.
+    pub torque_columns: Vec<super::TorqueColumn>,
+    /// The joints whose positions leave their limits ([`super::position_range`]).
+    pub position_range: Vec<super::position_range::JointRange>,
     /// What the fit cannot vouch for, in words (each also warned of by the front ends).
     pub findings: Vec<String>,
 }
@@ -386,11 +392,11 @@ pub fn identify_payload(
     let mut cross = vec![DMatrix::<f64>::zeros(m, p_ref); nv];
     let mut row = vec![0.0; m];
     regressor_blocks(model, &ref_layout, states, options.gravity, |range, phi| {
-        let predicted = match base_of_reference {
-            Some(b) => b.select(phi) * &ref_theta,
+        let rows_ref = base_of_reference.map(|b| b.select(phi));
+        let predicted = match &rows_ref {
+            Some(rows) => rows * &ref_theta,
             None => phi * &ref_theta,
         };
-        let rows_ref = base_of_reference.map(|b| b.select(phi));
         for (i, s) in range.clone().enumerate() {
             for j in 0..nv {
                 let r = i * nv + j;
@@ -554,8 +560,19 @@ pub fn identify_payload(
         cond: ls.cond,
         samples: k,
         residual_correlation,
+        torque_columns: vec![],
+        position_range: vec![],
         findings: vec![],
     };
+    // the log against the robot's model, as every direct fit checks its log: a torque column
+    // in other units, of another sign or joint, and positions beyond the limits (a log in
+    // degrees) are named before what the payload makes of them
+    fit.torque_columns =
+        super::torque_columns::check_torque_columns(model, states, tau, options.gravity)?;
+    fit.position_range = super::position_range::check_position_range(model, states);
+    fit.findings = super::torque_columns::findings(&fit.torque_columns);
+    fit.findings
+        .extend(super::position_range::finding(&fit.position_range));
     fit.judge(&cov);
     Ok(fit)
 }
@@ -647,12 +664,13 @@ impl PayloadFit {
         self.payload_stderr = Some(stderr);
     }
 
-    /// The payload ready to use: present, and a rigid body (None otherwise; see
-    /// [`Self::findings`]).
+    /// The payload ready to use: present, a rigid body, and from a log whose torque columns
+    /// read as the robot's (None otherwise; see [`Self::findings`]).
     pub fn usable_payload(&self) -> Option<&Payload> {
+        let columns_right = super::torque_columns::findings(&self.torque_columns).is_empty();
         self.payload
             .as_ref()
-            .filter(|_| self.consistent || self.not_a_rigid_body.is_none())
+            .filter(|_| (self.consistent || self.not_a_rigid_body.is_none()) && columns_right)
     }
 }
 
