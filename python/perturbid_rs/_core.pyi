@@ -24,6 +24,7 @@ __all__ = [
     "ModelError",
     "NumericalError",
     "OperatingPoint",
+    "PayloadFit",
     "PerturbidError",
     "PerturbidWarning",
     "Plan",
@@ -41,6 +42,7 @@ __all__ = [
     "identify_global_linear",
     "identify_local",
     "identify_parameters_from_local",
+    "identify_payload",
     "suggest_operating_points",
     "plan_experiments",
     "preprocess",
@@ -852,6 +854,104 @@ def identify_drive_gains(
     squares is biased towards 0 by it, as drive_gains["noise_bias"] says). What each run's
     preprocessing found is kept in the model's JSON ``logs``, named by its Recording; runs
     that share samples (one given twice) are refused."""
+    ...
+
+@final
+class PayloadFit:
+    """A payload identified from a log of the robot carrying it (identify_payload): its mass
+    (kg), centre of mass (m) and inertia about it (kg m^2, [ixx, ixy, ixz, iyy, iyz, izz]) in
+    the link's joint frame, with standard errors, and what the fit cannot vouch for."""
+    @property
+    def payload(self) -> Optional[dict[str, Any]]:
+        """link, mass, com, inertia: the dict identify_drive_gains and TrueRobot take; None
+        where no payload is seen or the fit cannot vouch for it (see findings)."""
+        ...
+    @property
+    def estimate(self) -> Optional[dict[str, Any]]:
+        """The estimate whether or not the fit vouches for it (None where no payload is seen)."""
+        ...
+    @property
+    def usable(self) -> bool: ...
+    @property
+    def payload_stderr(self) -> Optional[dict[str, Any]]:
+        """mass (kg), com ((3,) m), inertia ((6,) kg m^2): standard errors by the delta rule."""
+        ...
+    @property
+    def link(self) -> str: ...
+    @property
+    def reference(self) -> Literal["urdf", "base_model"]: ...
+    @property
+    def names(self) -> list[str]:
+        """payload.m, payload.mcx, ... payload.Izz, then the joint terms (joint1.offset, ...)."""
+        ...
+    @property
+    def theta(self) -> NDArray[np.float64]:
+        """(m,) the payload's ten parameters (Pinocchio's order, about the joint frame) and the
+        joint terms."""
+        ...
+    @property
+    def stderr(self) -> NDArray[np.float64]:
+        """(m,) with the reference model's share (stderr_of_reference)."""
+        ...
+    @property
+    def stderr_of_reference(self) -> NDArray[np.float64]: ...
+    @property
+    def correlation(self) -> NDArray[np.float64]:
+        """(m, m)."""
+        ...
+    @property
+    def reference_rms(self) -> NDArray[np.float64]:
+        """(n,) N m: the torques less the reference's, per joint."""
+        ...
+    @property
+    def payload_torque_rms(self) -> NDArray[np.float64]:
+        """(n,) N m: the payload's torques alone."""
+        ...
+    @property
+    def residual_rms(self) -> NDArray[np.float64]:
+        """(n,) N m."""
+        ...
+    @property
+    def sigma(self) -> NDArray[np.float64]:
+        """(n,) N m: the per-joint weights."""
+        ...
+    @property
+    def cond(self) -> float: ...
+    @property
+    def samples(self) -> int: ...
+    @property
+    def consistent(self) -> bool: ...
+    @property
+    def residual_growth(self) -> Optional[float]: ...
+    @property
+    def not_a_rigid_body(self) -> Optional[str]: ...
+    @property
+    def findings(self) -> list[str]: ...
+    def to_json(self) -> str:
+        """The document `perturbid identify-payload` writes as payload_fit.json."""
+        ...
+
+def identify_payload(
+    robot: Robot,
+    q: Union[ArrayLike, Recording],
+    qd: Optional[ArrayLike] = None,
+    qdd: Optional[ArrayLike] = None,
+    tau: Optional[ArrayLike] = None,
+    *,
+    link: str,
+    model: Optional[BaseParameterModel] = None,
+    terms: Union[str, Sequence[str], None] = None,
+    weighting: str = "wls",
+    gravity: bool = True,
+    consistent: bool = False,
+    t: Optional[ArrayLike] = None,
+    coulomb: Optional[ArrayLike] = None,
+) -> PayloadFit:
+    """The payload fixed to `link` from a log of the robot carrying it ((k, n) arrays, rad,
+    rad/s, rad/s^2, N m, or a preprocessed Recording as q), against `model` (the robot alone,
+    its uncertainty carried into the payload's) or the URDF's own parameters (None). terms:
+    the joint terms fitted beside it (None: an offset with a model, viscous, Coulomb and
+    offset without)."""
     ...
 
 @final

@@ -14,6 +14,7 @@ mod global_linear;
 mod linearization;
 mod local;
 mod local_model;
+mod payload;
 mod preprocess;
 mod recording;
 mod recording_list;
@@ -91,6 +92,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(excitation::design_excitation, m)?)?;
     m.add_function(wrap_pyfunction!(direct::identify_base_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(drive_gains::identify_drive_gains, m)?)?;
+    m.add_class::<payload::PyPayloadFit>()?;
+    m.add_function(wrap_pyfunction!(payload::identify_payload, m)?)?;
     m.add_function(wrap_pyfunction!(global_linear::identify_global_linear, m)?)?;
     m.add_class::<consistent::PyConsistentFit>()?;
     m.add_class::<validation::PyValidation>()?;

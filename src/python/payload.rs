@@ -1,0 +1,253 @@
+//! Python: `identify_payload` (`PayloadFit`; mirrors `crate::direct::payload`): a payload's
+//! mass, centre of mass and inertia from a log of the robot carrying it, against a model of
+//! the robot alone or its URDF.
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use super::arrays::{matrix_to_numpy as mat, vec1, vector};
+use super::detached;
+use super::direct::{
+    check_sample_derivatives, coulomb_column, fit_states, friction_terms, states, FrictionNames,
+    PyBaseModel,
+};
+use super::robot::PyRobot;
+use super::samples::{samples, Given};
+use crate::direct::{
+    identify_payload as payload_rs, PayloadFit, PayloadOptions, Reference, Weighting,
+};
+use crate::error::Error;
+use crate::gravity::Gravity;
+use crate::rehearsal::Payload;
+
+/// A payload identified from a log of the robot carrying it (`identify_payload`).
+///
+/// - `payload`: dict `link`, `mass` (kg), `com` ((3,) m), `inertia` ((6,) `[ixx, ixy, ixz,
+///   iyy, iyz, izz]` kg m^2 about the centre of mass), in the link's joint frame: the dict
+///   `identify_drive_gains` takes as a known payload and `TrueRobot` as its `payload`; None
+///   where no payload is seen (its mass not above 0 by 3 standard errors), or where the fit
+///   cannot vouch for it (`usable` False: no rigid body, a torque column read wrong; see
+///   `findings`);
+/// - `payload_stderr`: dict `mass`, `com`, `inertia`, their standard errors (delta rule);
+/// - `names`, `theta`, `stderr` (m,): the payload's ten parameters (Pinocchio's order, about
+///   the joint frame: kg, kg m, kg m^2) and the joint terms fitted beside it, with standard
+///   errors (inflated for correlated residuals, and with the reference model's share,
+///   `stderr_of_reference`); `correlation` (m, m);
+/// - `reference_rms`, `payload_torque_rms`, `residual_rms`, `sigma` (n,): per joint, the
+///   torques less the reference's, the payload's torques, the fit's residuals, the weights
+///   (N m); `cond`, `samples`; `consistent`, `residual_growth`, `not_a_rigid_body`;
+/// - `findings`: what the fit cannot vouch for, each also warned of.
+#[pyclass(name = "PayloadFit", module = "perturbid_rs", frozen)]
+pub(crate) struct PyPayloadFit {
+    pub(crate) fit: PayloadFit,
+}
+
+fn payload_dict<'py>(py: Python<'py>, p: &Payload) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("link", &p.link)?;
+    d.set_item("mass", p.mass)?;
+    d.set_item("com", p.com.to_vec())?;
+    d.set_item("inertia", p.inertia.to_vec())?;
+    Ok(d)
+}
+
+#[pymethods]
+impl PyPayloadFit {
+    /// The payload, where the fit vouches for it (see the class docs), else None.
+    #[getter]
+    fn payload<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        self.fit
+            .usable_payload()
+            .map(|p| payload_dict(py, p))
+            .transpose()
+    }
+    /// The estimate whether or not the fit vouches for it (None only where no payload is
+    /// seen): for a look at what a refused fit made of the log.
+    #[getter]
+    fn estimate<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        (self.fit.payload.as_ref())
+            .map(|p| payload_dict(py, p))
+            .transpose()
+    }
+    /// Whether `payload` is given (a payload seen, a rigid body, the log's columns right).
+    #[getter]
+    fn usable(&self) -> bool {
+        self.fit.usable_payload().is_some()
+    }
+    #[getter]
+    fn payload_stderr<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        (self.fit.payload_stderr.as_ref())
+            .map(|s| {
+                let d = PyDict::new(py);
+                d.set_item("mass", s.mass)?;
+                d.set_item("com", s.com.to_vec())?;
+                d.set_item("inertia", s.inertia.to_vec())?;
+                Ok(d)
+            })
+            .transpose()
+    }
+    #[getter]
+    fn link(&self) -> &str {
+        &self.fit.link
+    }
+    /// 'urdf' or 'base_model'.
+    #[getter]
+    fn reference(&self) -> &str {
+        &self.fit.reference
+    }
+    #[getter]
+    fn names(&self) -> Vec<String> {
+        self.fit.names.clone()
+    }
+    #[getter]
+    fn theta<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        vec1(py, &self.fit.theta)
+    }
+    #[getter]
+    fn stderr<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        vec1(py, &self.fit.stderr)
+    }
+    #[getter]
+    fn stderr_of_reference<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        vec1(py, &self.fit.stderr_of_reference)
+    }
+    #[getter]
+    fn correlation<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        mat(py, &self.fit.correlation)
+    }
+    #[getter]
+    fn reference_rms<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        vec1(py, &self.fit.reference_rms)
+    }
+    #[getter]
+    fn payload_torque_rms<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        vec1(py, &self.fit.payload_torque_rms)
+    }
+    #[getter]
+    fn residual_rms<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        vec1(py, &self.fit.residual_rms)
+    }
+    #[getter]
+    fn sigma<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        vec1(py, &self.fit.sigma)
+    }
+    #[getter]
+    fn cond(&self) -> f64 {
+        self.fit.cond
+    }
+    #[getter]
+    fn samples(&self) -> usize {
+        self.fit.samples
+    }
+    #[getter]
+    fn consistent(&self) -> bool {
+        self.fit.consistent
+    }
+    #[getter]
+    fn residual_growth(&self) -> Option<f64> {
+        self.fit.residual_growth
+    }
+    #[getter]
+    fn not_a_rigid_body(&self) -> Option<String> {
+        self.fit.not_a_rigid_body.clone()
+    }
+    #[getter]
+    fn findings(&self) -> Vec<String> {
+        self.fit.findings.clone()
+    }
+    /// The fit as the JSON document `perturbid identify-payload` writes as payload_fit.json.
+    fn to_json(&self) -> String {
+        serde_json::to_string_pretty(&self.fit).expect("serialisable")
+    }
+    fn __repr__(&self) -> String {
+        match &self.fit.payload {
+            Some(p) => format!(
+                "PayloadFit(link='{}', mass={:.6} kg, com={:?} m, usable={})",
+                self.fit.link,
+                p.mass,
+                p.com,
+                self.fit.usable_payload().is_some()
+            ),
+            None => format!("PayloadFit(link='{}', no payload seen)", self.fit.link),
+        }
+    }
+}
+
+/// Identifies the payload fixed to `link` (a moving link of `robot`; the payload in its joint
+/// frame) from a log of the robot carrying it: `q`, `qd`, `qdd`, `tau` (each (k, n); rad,
+/// rad/s, rad/s^2, N m), or a Recording as `q` alone (`preprocess`'s: its states, torques,
+/// time and Coulomb column).
+///
+/// `model`: a BaseParameterModel of the robot without the payload, identified with
+/// `identify_base_parameters` (or `identify_drive_gains`: then give the Recording in torques,
+/// `rec.in_torques(model.drive_gains['gain'])`), whose prediction the torques are measured
+/// against and whose parameters' uncertainty is carried into the payload's; None (default):
+/// against the URDF's own parameters, taken as exact. `terms`: the joint terms fitted beside
+/// the payload (None: an offset a joint with a model, viscous, Coulomb and offset without;
+/// or 'all', 'none', a list of 'viscous', 'coulomb', 'offset', 'armature'); `weighting`
+/// 'wls' or 'ols'; `gravity`: whether `tau` includes gravity (as the model's must);
+/// `consistent`: a rigid body by construction. `t` ((k,) s) checks a log's own qd and qdd
+/// columns against the derivatives of q and qd; `coulomb` ((k, n)) the Coulomb column of
+/// torques low-pass filtered. Findings are warned of (`PerturbidWarning`) and kept in
+/// `findings`.
+#[pyfunction]
+#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, *, link, model=None, terms=None, weighting="wls", gravity=true, consistent=false, t=None, coulomb=None))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn identify_payload<'py>(
+    py: Python<'py>,
+    robot: &PyRobot,
+    q: Bound<'py, PyAny>,
+    qd: Option<Bound<'py, PyAny>>,
+    qdd: Option<Bound<'py, PyAny>>,
+    tau: Option<Bound<'py, PyAny>>,
+    link: &str,
+    model: Option<PyRef<'py, PyBaseModel>>,
+    terms: Option<FrictionNames<'_>>,
+    weighting: &str,
+    gravity: bool,
+    consistent: bool,
+    t: Option<Bound<'py, PyAny>>,
+    coulomb: Option<Bound<'py, PyAny>>,
+) -> PyResult<PyPayloadFit> {
+    let robot_model = &robot.model;
+    let n = robot_model.nv;
+    let reference = match &model {
+        Some(m) => Reference::Model(&m.fit),
+        None => Reference::Urdf,
+    };
+    let mut options = PayloadOptions::new(link, &reference);
+    if terms.is_some() {
+        options.terms = friction_terms(terms)?;
+    }
+    options.weighting = match weighting {
+        "wls" => Weighting::Wls,
+        "ols" => Weighting::Ols,
+        other => {
+            return Err(Error::InvalidArgument {
+                argument: "weighting".into(),
+                message: format!("'{other}', expected 'wls' or 'ols'"),
+            }
+            .into())
+        }
+    };
+    options.gravity = Gravity::from(gravity);
+    options.consistent = consistent;
+    let given = Given {
+        qd,
+        qdd,
+        tau,
+        t,
+        coulomb,
+    };
+    let a = samples(q, given, true, true)?.arrays()?;
+    let c = states(n, &a.q, &a.qd, &a.qdd, a.tau.as_ref())?;
+    let coulomb = coulomb_column(n, a.coulomb.as_ref())?;
+    let t = a.t.as_ref().map(|t| vector("t", t)).transpose()?;
+    let fit = detached(py, "identify_payload", || {
+        check_sample_derivatives("identify_payload's samples", n, t, &c)?;
+        let s = fit_states(n, &c, coulomb.as_deref())?;
+        payload_rs(robot_model, reference, &s, &c[3], &options)
+    })?;
+    super::errors::warn_all(py, &fit.findings)?;
+    Ok(PyPayloadFit { fit })
+}

@@ -1,0 +1,167 @@
+"""A payload identified from a log of the robot carrying it (identify_payload): the torques
+come from Pinocchio with the payload added to its link's inertia there; the ten parameters are
+checked against Pinocchio's own dynamic parameters of the payload, the fit against numpy's
+least squares over Pinocchio's regressor, and the standard errors against the scatter over
+repeated noisy logs; hostile arguments are refused by name."""
+
+import json
+import warnings
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import perturbid_rs as pr
+from conftest import pair_from_text
+from test_drive_gains import motion, pin_torques
+
+PAYLOAD = {"link": "link6", "mass": 1.5, "com": [0.01, -0.02, 0.07],
+           "inertia": [0.004, 0.0005, 0.0, 0.005, 0.0, 0.002]}
+VISCOUS = 0.3
+
+
+def pin_payload():
+    xx, xy, xz, yy, yz, zz = PAYLOAD["inertia"]
+    inertia = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    return pin.Inertia(PAYLOAD["mass"], np.array(PAYLOAD["com"]), inertia)
+
+
+@pytest.fixture(scope="module")
+def a465():
+    """The A465 in both libraries, and Pinocchio's model with the payload on joint 6's body."""
+    pair = pair_from_text(pr.robots.a465_urdf("kinsheel2010"))
+    loaded = pair.model.copy()
+    jid = loaded.getJointId("joint6")
+    loaded.inertias[jid] = loaded.inertias[jid] + pin_payload()
+    return pair, loaded
+
+
+def log(model, seed, noise=0.0):
+    t, q, qd, qdd = motion(seed)
+    tau = pin_torques(model, q, qd, qdd) + VISCOUS * qd
+    tau = tau + noise * np.random.default_rng(seed).standard_normal(tau.shape)
+    return t, q, qd, qdd, tau
+
+
+def test_the_ten_parameters_are_pinocchios_of_the_payload(a465):
+    pair, loaded = a465
+    t, q, qd, qdd, tau = log(loaded, 4)
+    fit = pr.identify_payload(pair.ours, q, qd, qdd, tau, link="link6", terms="viscous")
+    # Pinocchio's dynamic parameters: m, m c, the inertia about the joint frame
+    want = pin_payload().toDynamicParameters()
+    assert np.allclose(fit.theta[:10], want, rtol=1e-8, atol=1e-10)
+    assert fit.names[:2] == ["payload.m", "payload.mcx"] and fit.names[10] == "joint1.viscous"
+    assert np.allclose(fit.theta[10:], VISCOUS, atol=1e-8)
+    p = fit.payload
+    assert p["link"] == "link6" and abs(p["mass"] - 1.5) < 1e-9
+    assert np.allclose(p["com"], PAYLOAD["com"], atol=1e-9)
+    assert np.allclose(p["inertia"], PAYLOAD["inertia"], atol=1e-9)
+    assert fit.usable and fit.findings == [] and fit.reference == "urdf"
+    # the payload is what a true robot and the drive gains take
+    pr.TrueRobot({"payload": p})
+    doc = json.loads(fit.to_json())
+    assert doc["payload"]["mass"] == p["mass"]
+
+
+def test_the_fit_is_numpys_least_squares_over_pinocchios_regressor(a465):
+    """OLS over [Y_payload | viscous] of the torques less the robot alone's, built whole."""
+    pair, loaded = a465
+    t, q, qd, qdd, tau = log(loaded, 5, noise=0.05)
+    fit = pr.identify_payload(pair.ours, q, qd, qdd, tau, link="link6", terms="viscous",
+                              weighting="ols")
+    data = pair.model.createData()
+    jid = pair.model.getJointId("joint6")
+    rows, rhs = [], []
+    alone = pin_torques(pair.model, q, qd, qdd)
+    for s in range(len(t)):
+        y = pin.computeJointTorqueRegressor(pair.model, data, q[s], qd[s], qdd[s])
+        x = np.zeros((6, 16))
+        x[:, :10] = y[:, 10 * (jid - 1):10 * jid]
+        x[:, 10:] = np.diag(qd[s])
+        rows.append(x)
+        rhs.append(tau[s] - alone[s])
+    x, b = np.vstack(rows), np.concatenate(rhs)
+    theta, *_ = np.linalg.lstsq(x, b, rcond=None)
+    assert np.allclose(fit.theta, theta, rtol=1e-8, atol=1e-10)
+    r = (b - x @ theta).reshape(-1, 6)
+    assert np.allclose(fit.residual_rms, np.sqrt((r**2).mean(axis=0)), rtol=1e-8)
+
+
+def test_against_a_model_of_the_robot_alone_the_errors_are_the_scatter_of_repeated_logs(a465):
+    pair, loaded = a465
+    t, q, qd, qdd, tau = log(pair.model, 3, noise=0.02)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pr.PerturbidWarning)
+        model = pr.identify_base_parameters(pair.ours, q, qd, qdd, tau, friction="viscous")
+    masses, coms, errors = [], [], []
+    for seed in range(20):
+        t, q, qd, qdd, tau = log(loaded, 4)
+        tau = tau + 0.02 * np.random.default_rng(100 + seed).standard_normal(tau.shape)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", pr.PerturbidWarning)
+            fit = pr.identify_payload(pair.ours, q, qd, qdd, tau, link="link6", model=model)
+        assert fit.reference == "base_model"
+        e = fit.estimate
+        masses.append(e["mass"])
+        coms.append(e["com"])
+        errors.append((fit.payload_stderr["mass"], fit.stderr_of_reference[0],
+                       fit.payload_stderr["com"]))
+    # the same reference every time: its share is a bias common to all, the rest scatters
+    own = np.sqrt(np.mean([m**2 - r**2 for m, r, _ in errors]))
+    assert 0.6 < np.std(masses) / own < 1.6, (np.std(masses), own)
+    # the whole error covers the truth
+    se = np.mean([m for m, _, _ in errors])
+    assert abs(np.mean(masses) - 1.5) < 4 * se
+    assert np.all(np.abs(np.mean(coms, axis=0) - PAYLOAD["com"])
+                  < 4 * np.mean([c for _, _, c in errors], axis=0) + 1e-4)
+
+
+def test_a_recording_and_a_consistent_estimate(a465):
+    pair, loaded = a465
+    t, q, qd, qdd, tau = log(loaded, 4, noise=0.05)
+    rec = pr.Recording(t, q, tau, qd=qd, qdd=qdd)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        plain = pr.identify_payload(pair.ours, rec, link="link6", terms="viscous")
+        fit = pr.identify_payload(pair.ours, rec, link="link6", terms="viscous", consistent=True)
+    assert fit.consistent and fit.residual_growth >= 1.0 and fit.usable
+    # the consistent payload is a rigid body
+    xx, xy, xz, yy, yz, zz = fit.payload["inertia"]
+    moments = np.linalg.eigvalsh([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    assert moments.min() >= -1e-12 and 2 * moments.max() <= moments.sum() + 1e-9
+    if plain.not_a_rigid_body is None:
+        assert np.allclose(plain.theta, fit.theta, rtol=1e-5, atol=1e-8)
+    else:
+        assert not plain.usable and plain.payload is None and plain.estimate is not None
+        assert any("no rigid body" in str(w.message) for w in caught)
+
+
+def test_no_payload_is_named_and_hostile_arguments_are_refused(a465):
+    pair, loaded = a465
+    t, q, qd, qdd, tau = log(pair.model, 4, noise=0.02)
+    with pytest.warns(pr.PerturbidWarning, match="no payload on 'link6' is seen"):
+        fit = pr.identify_payload(pair.ours, q, qd, qdd, tau, link="link6")
+    assert fit.payload is None and fit.estimate is None and not fit.usable
+    with pytest.raises(pr.InputError, match="'base_link' is not a moving link"):
+        pr.identify_payload(pair.ours, q, qd, qdd, tau, link="base_link")
+    with pytest.raises(pr.InputError, match="weighting"):
+        pr.identify_payload(pair.ours, q, qd, qdd, tau, link="link6", weighting="gls")
+    with pytest.raises(pr.InputError, match="sticky"):
+        pr.identify_payload(pair.ours, q, qd, qdd, tau, link="link6", terms=["sticky"])
+    with pytest.raises(pr.PerturbidError):
+        pr.identify_payload(pair.ours, q, qd, qdd, tau[:, :5], link="link6")
+    with pytest.raises(TypeError):
+        pr.identify_payload(pair.ours, q, qd, qdd, tau, "link6")  # link is keyword-only
+    with pytest.raises(pr.InputError):
+        pr.identify_payload(pair.ours, q, qd, qdd, np.full_like(tau, np.nan), link="link6")
+    # a model of the robot alone identified with gravity out of its torques
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pr.PerturbidWarning)
+        model = pr.identify_base_parameters(pair.ours, q, qd, qdd, tau, friction="viscous",
+                                            gravity=False)
+    with pytest.raises(pr.InputError, match="must agree"):
+        pr.identify_payload(pair.ours, q, qd, qdd, tau, link="link6", model=model)
+    # on the first link only the first joint's torque sees a payload: refused, named
+    t, q, qd, qdd, tau = log(loaded, 4)
+    with pytest.raises(pr.NumericalError, match="payload identification on 'link1'"):
+        pr.identify_payload(pair.ours, q, qd, qdd, tau, link="link1")
