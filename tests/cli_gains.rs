@@ -243,7 +243,7 @@ fn bad_payloads_and_runs_are_refused_by_name() {
     };
     run(
         r#"{"link": "tool0", "mass": 1.0}"#,
-        &["'tool0' is not a moving link", "link6"],
+        &["'tool0' is not a link of", "link6"],
     );
     run(
         r#"{"link": "link6", "mass": -1.0}"#,

@@ -174,7 +174,7 @@ fn bad_arguments_are_refused_by_name_with_nothing_written() {
     };
     run(
         &["--link", "base_link"],
-        &["'base_link' is not a moving link", "link6"],
+        &["'base_link' is fixed to the base", "link6"],
     );
     run(
         &["--link", "link6", "--signal"],

@@ -187,7 +187,7 @@ fn runs_that_do_not_fix_the_scale_and_payloads_no_robot_carries_are_refused() {
     };
     let e = said(&[run(&a, &ia, None), run(&b, &ib, Some(&nowhere))]);
     assert!(
-        e.contains("run 1") && e.contains("'gripper' is not a moving link") && e.contains("link6"),
+        e.contains("run 1") && e.contains("'gripper' is not a link of") && e.contains("link6"),
         "{e}"
     );
     let negative = Payload {

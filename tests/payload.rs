@@ -284,7 +284,7 @@ fn payloads_the_joints_cannot_see_and_references_that_disagree_are_refused() {
     }
     let e = fit("base_link").unwrap_err().to_string();
     assert!(
-        e.contains("not a moving link") && e.contains("link6"),
+        e.contains("'base_link' is fixed to the base") && e.contains("link6"),
         "{e}"
     );
     // a reference identified with gravity left out of the torques
@@ -360,4 +360,81 @@ fn a_torque_column_in_other_units_is_named_before_the_payload_made_of_it() {
     );
     // and what the fit made of it is not to be used
     assert!(fit.payload.is_some() && fit.usable_payload().is_none());
+}
+
+/// The A465 with a tool frame `tool0` fixed to link 6, turned and offset.
+fn a465_with_tool_frame() -> Model {
+    let urdf = perturbid_rs::robots::a465::urdf("kinsheel2010").unwrap();
+    let tool = r#"<joint name="tool_joint" type="fixed"><parent link="link6"/><child link="tool0"/>
+<origin xyz="0.01 -0.02 0.1" rpy="0.3 -0.2 0.5"/></joint><link name="tool0"/></robot>"#;
+    let urdf = urdf.replace("</robot>", tool);
+    perturbid_rs::urdf::model_from_urdf_str(&urdf, "a465 with tool0", &Default::default()).unwrap()
+}
+
+#[test]
+fn a_payload_on_a_tool_frame_is_given_in_that_frame() {
+    let truth = a465_with_tool_frame();
+    // the payload given in the tool frame: its com 5 cm along the tool's z
+    let on_tool = Payload {
+        link: "tool0".into(),
+        mass: 1.2,
+        com: [0.0, 0.01, 0.05],
+        inertia: [0.003, 0.0002, 0.0, 0.004, 0.0, 0.002],
+    };
+    let s = motion(4);
+    let fit = |link: &str, noise: f64| {
+        let tau = loaded_torques(&truth, Some(&on_tool), 4, noise);
+        let reference = Reference::Urdf;
+        identify_payload(
+            &truth,
+            reference,
+            &states(&s),
+            &tau,
+            &PayloadOptions::new(link, &reference),
+        )
+        .unwrap()
+    };
+    // noise-free: the payload as given, in the tool's frame
+    let exact = fit("tool0", 0.0);
+    assert_eq!(
+        (exact.link.as_str(), exact.body.as_str()),
+        ("tool0", "link6")
+    );
+    let p = exact.usable_payload().unwrap();
+    assert!((p.mass - 1.2).abs() < 1e-8);
+    for i in 0..3 {
+        assert!((p.com[i] - on_tool.com[i]).abs() < 1e-8, "{p:?}");
+    }
+    for i in 0..6 {
+        assert!((p.inertia[i] - on_tool.inertia[i]).abs() < 1e-8, "{p:?}");
+    }
+    // noisy: one regression (the body's ten parameters), given in either frame
+    let (tool, six) = (fit("tool0", 0.02), fit("link6", 0.02));
+    for (a, b) in tool.theta.iter().zip(&six.theta) {
+        assert!((a - b).abs() < 1e-12 * (1.0 + b.abs()));
+    }
+    let pose = perturbid_rs::spatial::Se3::from_xyz_rpy([0.01, -0.02, 0.1], [0.3, -0.2, 0.5]);
+    let (pt, ps) = (
+        tool.payload.as_ref().unwrap(),
+        six.payload.as_ref().unwrap(),
+    );
+    let c = pose.rotation * nalgebra::Vector3::from(pt.com) + pose.translation;
+    let r = pose.rotation;
+    let sym =
+        |v: &[f64; 6]| nalgebra::Matrix3::new(v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5]);
+    let turned = r * sym(&pt.inertia) * r.transpose();
+    for i in 0..3 {
+        assert!((ps.com[i] - c[i]).abs() < 1e-12, "{ps:?} vs {c:?}");
+    }
+    assert!((turned - sym(&ps.inertia)).norm() < 1e-12);
+    // the standard errors turn with the frame: the mass's alike, the total variance of the
+    // centre and the inertia's trace alike
+    let (st, ss) = (tool.payload_stderr.unwrap(), six.payload_stderr.unwrap());
+    assert!((st.mass - ss.mass).abs() < 1e-12);
+    let total = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>();
+    assert!(
+        (total(&st.com) / total(&ss.com) - 1.0).abs() < 1e-9,
+        "{st:?} {ss:?}"
+    );
+    assert!(((pt.mass - 1.2) / st.mass).abs() < 4.0);
 }

@@ -156,7 +156,7 @@ fn a_payload_is_the_urdf_with_the_payload_attached() {
     };
     let e = wrong.rigid_body_model(&model).unwrap_err().to_string();
     assert!(
-        e.contains("'gripper' is not a moving link") && e.contains("link6"),
+        e.contains("'gripper' is not a link of") && e.contains("link6"),
         "{e}"
     );
 }

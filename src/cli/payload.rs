@@ -23,8 +23,8 @@ pub(crate) struct IdentifyPayloadArgs {
     /// The log CSV of the robot carrying the payload: t, q1..qN, tau1..tauN (qd, qdd
     /// optional; preprocessed as for identify-direct).
     data: PathBuf,
-    /// The URDF link the payload is fixed to (a moving link: the body that starts at it); the
-    /// payload is given in its joint frame.
+    /// The URDF link the payload is fixed to (a moving link, or one behind fixed joints such
+    /// as a flange or tool frame); the payload is given in its frame.
     #[arg(long)]
     link: String,
     /// A base-parameter model of the robot without the payload (identify-direct, or

@@ -318,12 +318,12 @@ fn payload_torques(
     states: &States<'_>,
     options: &BaseOptions,
 ) -> Result<Vec<f64>> {
-    let b = payload.body(model)?;
+    let (b, inertia) = payload.in_body(model)?;
     let mut alone = model.clone();
     for body in &mut alone.bodies {
         body.inertia = crate::spatial::Inertia::zeros();
     }
-    alone.bodies[b].inertia = payload.spatial_inertia();
+    alone.bodies[b].inertia = inertia;
     alone.armature.iter_mut().for_each(|a| *a = 0.0);
     alone.refresh();
     let mut tau = vec![0.0; states.len() * model.nv];
@@ -338,8 +338,7 @@ fn load_of(model: &Model, payload: Option<&Payload>) -> Result<Option<(usize, [f
     let Some(p) = payload.filter(|p| p.mass > 0.0) else {
         return Ok(None);
     };
-    let b = p.body(model)?;
-    let i = p.spatial_inertia();
+    let (b, i) = p.in_body(model)?;
     let c = i.com * i.mass;
     let r = i.inertia_origin();
     Ok(Some((

@@ -35,7 +35,9 @@ use crate::error::{shown, Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
 use crate::rehearsal::Payload;
+use crate::spatial::Se3;
 use crate::states::States;
+use nalgebra::{Matrix3, Vector3};
 
 /// Standard errors a mass must lie above 0 by for the payload to count as seen (below it the
 /// centre of mass, a first moment over the mass, is not determined).
@@ -70,8 +72,8 @@ pub enum Reference<'a> {
 /// How a payload is identified ([`identify_payload`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PayloadOptions {
-    /// The URDF link the payload is fixed to: a moving body's own link (the body that starts
-    /// at it), in whose joint frame the payload is expressed.
+    /// The URDF link the payload is fixed to (a moving body's own, or one behind fixed joints
+    /// such as a flange or tool frame), in whose frame the payload is given.
     pub link: String,
     /// Each joint's terms fitted beside the payload (viscous, Coulomb, offset, armature): on a
     /// base-parameter reference a change of them (a sensor zeroed anew), on the URDF the terms
@@ -125,8 +127,12 @@ pub struct PayloadStderr {
 pub struct PayloadFit {
     pub robot: String,
     pub joint_names: Vec<String>,
-    /// The link the payload is fixed to.
+    /// The link the payload is fixed to, in whose frame [`Self::payload`] is given.
     pub link: String,
+    /// The link of the body it moves with (`link` itself, or for a link behind fixed joints,
+    /// such as a flange or tool frame, its parent body's), in whose joint frame
+    /// [`Self::theta`]'s ten parameters are.
+    pub body: String,
     /// `urdf` or `base_model`: what the torques were measured against ([`Reference`]).
     pub reference: String,
     /// The unknowns: the payload's ten parameters (`payload.m`, `payload.mcx`, ... `payload.Izz`)
@@ -230,6 +236,40 @@ pub fn payload_of_parameters(pi: &[f64; 10]) -> ([f64; 10], DMatrix<f64>) {
         }
     }
     (out, jac)
+}
+
+/// The payload's quantities `u` (`[m, c, I_c]` as [`payload_of_parameters`] gives them) and
+/// their covariance `cu` (`10 x 10`), given in a body's frame, in the frame of a link at
+/// `pose` in it: `c' = R^T (c - p)`, `I_c' = R^T I_c R` (the covariance by the same linear map).
+pub fn in_link_frame(u: &[f64; 10], cu: &DMatrix<f64>, pose: &Se3) -> ([f64; 10], DMatrix<f64>) {
+    let rt = pose.rotation.transpose();
+    let entries = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+    let sym = |v: &[f64]| Matrix3::new(v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5]);
+    // the linear map of the quantities: 1, R^T on the centre, R^T . R on the inertia's entries
+    let mut a = DMatrix::zeros(10, 10);
+    a[(0, 0)] = 1.0;
+    for i in 0..3 {
+        for j in 0..3 {
+            a[(1 + i, 1 + j)] = rt[(i, j)];
+        }
+    }
+    for (e, _) in entries.iter().enumerate() {
+        let mut basis = [0.0; 6];
+        basis[e] = 1.0;
+        let image = rt * sym(&basis) * pose.rotation;
+        for (f, &(r, c)) in entries.iter().enumerate() {
+            a[(4 + f, 4 + e)] = image[(r, c)];
+        }
+    }
+    let c = rt * (Vector3::new(u[1], u[2], u[3]) - pose.translation);
+    let i = rt * sym(&u[4..]) * pose.rotation;
+    let mut out = [0.0; 10];
+    out[0] = u[0];
+    out[1..4].copy_from_slice(c.as_slice());
+    for (f, &(r, col)) in entries.iter().enumerate() {
+        out[4 + f] = i[(r, col)];
+    }
+    (out, &a * cu * a.transpose())
 }
 
 /// The ten parameters `pi` (Pinocchio's order, about the link's joint frame) of `payload`.
@@ -336,19 +376,14 @@ pub fn identify_payload(
         &model.joint_names,
         crate::torque_model::FOR_A_FIT,
     )?;
-    let link = Payload {
-        link: options.link.clone(),
-        mass: 0.0,
-        com: [0.0; 3],
-        inertia: [0.0; 6],
-    };
-    let body = link.body(model).map_err(|e| match e {
-        Error::InvalidArgument { message, .. } => Error::InvalidArgument {
-            argument: "link".into(),
-            message,
-        },
-        other => other,
-    })?;
+    let (body, pose) =
+        crate::rehearsal::link_in_body(model, &options.link).map_err(|e| match e {
+            Error::InvalidArgument { message, .. } => Error::InvalidArgument {
+                argument: "link".into(),
+                message,
+            },
+            other => other,
+        })?;
     // the reference's regressor layout and parameters
     let (ref_layout, ref_theta) = match reference {
         Reference::Urdf => {
@@ -539,6 +574,7 @@ pub fn identify_payload(
         robot: model.name.clone(),
         joint_names: model.joint_names.clone(),
         link: options.link.clone(),
+        body: model.bodies[body].link.clone(),
         reference: match reference {
             Reference::Urdf => "urdf".into(),
             Reference::Model(_) => "base_model".into(),
@@ -573,7 +609,7 @@ pub fn identify_payload(
     fit.findings = super::torque_columns::findings(&fit.torque_columns);
     fit.findings
         .extend(super::position_range::finding(&fit.position_range));
-    fit.judge(&cov);
+    fit.judge(&cov, &pose);
     Ok(fit)
 }
 
@@ -585,7 +621,8 @@ impl PayloadFit {
 
     /// The payload, its standard errors and the findings, from the estimates and their
     /// covariance `cov` (over [`Self::names`]).
-    fn judge(&mut self, cov: &DMatrix<f64>) {
+    /// `pose`: the link's in the frame of the body it moves with.
+    fn judge(&mut self, cov: &DMatrix<f64>, pose: &Se3) {
         let pi = self.parameters();
         let (m, se_m) = (pi[0], self.stderr[0]);
         if !(m > SEEN * se_m && m > 0.0) {
@@ -599,7 +636,7 @@ impl PayloadFit {
         }
         let (u, jac) = payload_of_parameters(&pi);
         let block = cov.view((0, 0), (PARAMS_PER_BODY, PARAMS_PER_BODY));
-        let cu = &jac * block * jac.transpose();
+        let (u, cu) = in_link_frame(&u, &(&jac * block * jac.transpose()), pose);
         let se = |i: usize| cu[(i, i)].max(0.0).sqrt();
         let payload = Payload {
             link: self.link.clone(),

@@ -145,7 +145,7 @@ fn run_arrays(r: usize, rec: &Recording, nv: usize) -> Result<(&[f64], &[f64])> 
 /// from `runs`, Recordings of the robot whose `tau` holds each joint's logged signal (motor
 /// currents, A, or torques computed with nominal gains), preprocessed (with `qd` and `qdd`),
 /// and `payloads`, one a run: None for the robot alone, or the known payload bolted on during
-/// it, a dict `link` (a moving link of `robot`), `mass` (kg), `com` (m) and `inertia`
+/// it, a dict `link` (a link of `robot` that moves: a body's own, or a flange or tool frame behind fixed joints), `mass` (kg), `com` (m) and `inertia`
 /// (`[ixx, ixy, ixz, iyy, iyz, izz]` about the centre of mass, kg m^2), all in the link's
 /// frame. Not every run may carry the same payload: the payload fixes the gains' scale.
 ///

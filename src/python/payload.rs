@@ -173,8 +173,8 @@ impl PyPayloadFit {
     }
 }
 
-/// Identifies the payload fixed to `link` (a moving link of `robot`; the payload in its joint
-/// frame) from a log of the robot carrying it: `q`, `qd`, `qdd`, `tau` (each (k, n); rad,
+/// Identifies the payload fixed to `link` (a link of `robot` that moves: a body's own, or one
+/// behind fixed joints such as a flange or tool frame; the payload in its frame) from a log of the robot carrying it: `q`, `qd`, `qdd`, `tau` (each (k, n); rad,
 /// rad/s, rad/s^2, N m), or a Recording as `q` alone (`preprocess`'s: its states, torques,
 /// time and Coulomb column).
 ///

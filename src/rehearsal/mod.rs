@@ -15,7 +15,9 @@ pub mod tracking;
 pub mod true_robot;
 
 pub use joint_effects::JointEffects;
-pub use true_robot::{Controller, FrictionSpec, Harmonic, LinkError, Payload, Sensors, TrueRobot};
+pub use true_robot::{
+    link_in_body, Controller, FrictionSpec, Harmonic, LinkError, Payload, Sensors, TrueRobot,
+};
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

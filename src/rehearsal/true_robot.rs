@@ -79,17 +79,55 @@ impl Payload {
         })
     }
 
-    /// Its spatial inertia in the frame of its link's body.
+    /// Its spatial inertia in its link's frame (kg, m, kg m^2).
     pub fn spatial_inertia(&self) -> crate::spatial::Inertia {
         let [xx, xy, xz, yy, yz, zz] = self.inertia;
         let inertia = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
         crate::spatial::Inertia::new(self.mass, Vector3::from(self.com), inertia)
     }
 
-    /// The index of the body of `model` that starts at its link; an error lists the moving
-    /// links.
+    /// The index of the body of `model` its link moves with (the body that starts at it, or,
+    /// for a link behind fixed joints such as a flange or tool frame, its parent's); an
+    /// error lists the links a payload can be fixed to.
     pub fn body(&self, model: &Model) -> Result<usize> {
-        body_of(model, &self.link)
+        Ok(link_in_body(model, &self.link)?.0)
+    }
+
+    /// The body of `model` its link moves with ([`Self::body`]) and its spatial inertia in
+    /// that body's frame: the link's pose in the body applied.
+    pub fn in_body(&self, model: &Model) -> Result<(usize, crate::spatial::Inertia)> {
+        let (b, pose) = link_in_body(model, &self.link)?;
+        Ok((b, pose.act_inertia(&self.spatial_inertia())))
+    }
+}
+
+/// The body of `model` URDF link `link` moves with and the link's pose in that body's frame
+/// (the identity for the body's own link): a payload's. Refused for a link fixed to the base
+/// (it moves no joint) and a link the robot lacks, listing those a payload can be fixed to.
+pub fn link_in_body(model: &Model, link: &str) -> Result<(usize, crate::spatial::Se3)> {
+    match model.frame(link) {
+        Some(crate::model::Frame {
+            body: Some(b),
+            pose,
+            ..
+        }) => Ok((*b, *pose)),
+        found => Err(Error::InvalidArgument {
+            argument: "true robot: link".into(),
+            message: format!(
+                "'{link}' {} '{}'; links that move: {}",
+                if found.is_some() {
+                    "is fixed to the base (a payload there moves no joint) of"
+                } else {
+                    "is not a link of"
+                },
+                model.name,
+                (model.frames.iter())
+                    .filter(|f| f.body.is_some())
+                    .map(|f| f.link.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        }),
     }
 }
 
@@ -555,13 +593,11 @@ impl TrueRobot {
             }
             per_joint("controller.effort", &c.effort, n, 0.0)?;
         }
-        for link in self
-            .payload
-            .iter()
-            .map(|p| &p.link)
-            .chain(self.link_errors.iter().map(|e| &e.link))
-        {
-            body_of(model, link)?;
+        if let Some(p) = &self.payload {
+            p.body(model)?;
+        }
+        for e in &self.link_errors {
+            body_of(model, &e.link)?;
         }
         Ok(())
     }
@@ -593,8 +629,8 @@ impl TrueRobot {
             i.inertia_com *= 1.0 + e.inertia;
         }
         if let Some(p) = &self.payload {
-            let b = p.body(nominal)?;
-            m.bodies[b].inertia = m.bodies[b].inertia.add(&p.spatial_inertia());
+            let (b, inertia) = p.in_body(nominal)?;
+            m.bodies[b].inertia = m.bodies[b].inertia.add(&inertia);
         }
         m.refresh();
         m.name = format!("{} (true robot)", nominal.name);

@@ -240,7 +240,7 @@ def test_hostile_arguments_are_refused_by_name(setup):
     refused(recs, [None], "1 payloads for 2 runs")
     refused(recs[:1], [PAYLOAD], "1 runs given, expected 2")
     refused(recs, [None, {**PAYLOAD, "colour": "red"}], r"payloads\[1\].*unknown key 'colour'")
-    refused(recs, [None, {**PAYLOAD, "link": "tool0"}], "'tool0' is not a moving link")
+    refused(recs, [None, {**PAYLOAD, "link": "tool0"}], "'tool0' is not a link of")
     refused(recs, [None, {**PAYLOAD, "mass": float("nan")}], "payload.mass is NaN")
     refused(recs, [None, {**PAYLOAD, "com": [0, 0, 1e9]}], r"payload.com\[2\]")
     refused(recs, [None, "2 kg"], r"payloads\[1\].*expected None or a dict")

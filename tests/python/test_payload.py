@@ -142,7 +142,7 @@ def test_no_payload_is_named_and_hostile_arguments_are_refused(a465):
     with pytest.warns(pr.PerturbidWarning, match="no payload on 'link6' is seen"):
         fit = pr.identify_payload(pair.ours, q, qd, qdd, tau, link="link6")
     assert fit.payload is None and fit.estimate is None and not fit.usable
-    with pytest.raises(pr.InputError, match="'base_link' is not a moving link"):
+    with pytest.raises(pr.InputError, match="'base_link' is fixed to the base"):
         pr.identify_payload(pair.ours, q, qd, qdd, tau, link="base_link")
     with pytest.raises(pr.InputError, match="weighting"):
         pr.identify_payload(pair.ours, q, qd, qdd, tau, link="link6", weighting="gls")
@@ -165,3 +165,25 @@ def test_no_payload_is_named_and_hostile_arguments_are_refused(a465):
     t, q, qd, qdd, tau = log(loaded, 4)
     with pytest.raises(pr.NumericalError, match="payload identification on 'link1'"):
         pr.identify_payload(pair.ours, q, qd, qdd, tau, link="link1")
+
+
+def test_a_payload_on_a_tool_frame_is_pinocchios_in_that_frame():
+    """A tool frame fixed to link 6, turned and offset: Pinocchio places the payload on joint
+    6's body through the frame's placement; the payload comes back in the tool's frame."""
+    tool = ('<joint name="tool_joint" type="fixed"><parent link="link6"/><child link="tool0"/>'
+            '<origin xyz="0.01 -0.02 0.1" rpy="0.3 -0.2 0.5"/></joint><link name="tool0"/></robot>')
+    pair = pair_from_text(pr.robots.a465_urdf("kinsheel2010").replace("</robot>", tool))
+    loaded = pair.model.copy()
+    placement = loaded.frames[loaded.getFrameId("tool0")].placement
+    jid = loaded.getJointId("joint6")
+    loaded.inertias[jid] = loaded.inertias[jid] + placement.act(pin_payload())
+    t, q, qd, qdd, tau = log(loaded, 4)
+    fit = pr.identify_payload(pair.ours, q, qd, qdd, tau, link="tool0", terms="viscous")
+    p = fit.payload
+    assert p["link"] == "tool0" and abs(p["mass"] - PAYLOAD["mass"]) < 1e-8
+    assert np.allclose(p["com"], PAYLOAD["com"], atol=1e-8)
+    assert np.allclose(p["inertia"], PAYLOAD["inertia"], atol=1e-8)
+    # the ten parameters are the body's: Pinocchio's of the payload placed on it
+    assert np.allclose(fit.theta[:10], placement.act(pin_payload()).toDynamicParameters(),
+                       rtol=1e-8, atol=1e-10)
+    assert json.loads(fit.to_json())["body"] == "link6"
