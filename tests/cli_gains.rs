@@ -413,3 +413,65 @@ fn a_local_model_in_torques_from_recordings_of_currents() {
     );
     nothing_written(&d, "x.json");
 }
+
+#[test]
+fn an_unknown_payload_from_a_log_of_currents_against_the_gains_model() {
+    let d = tmp("gains-payload");
+    let payload: Payload = serde_json::from_str(PAYLOAD).unwrap();
+    log(&d.join("alone.csv"), 1, None);
+    log(&d.join("loaded.csv"), 2, Some(&payload));
+    identify_gains(&d, PAYLOAD, "model.json");
+    // a tool the gains' runs did not carry, on a later motion
+    let tool = Payload {
+        link: "link6".into(),
+        mass: 0.8,
+        com: [0.0, 0.03, 0.05],
+        inertia: [0.002, 0.0, 0.0, 0.002, 0.0, 0.001],
+    };
+    log(&d.join("tool.csv"), 5, Some(&tool));
+    let out = ok(&[
+        "identify-payload",
+        "a465",
+        s(&d.join("tool.csv")),
+        "--link",
+        "link6",
+        "--model",
+        s(&d.join("model.json")),
+        "--signal",
+        "--out",
+        s(&d.join("tool")),
+    ]);
+    assert!(
+        out.contains("signal times the model's drive gains"),
+        "{out}"
+    );
+    let found: Payload =
+        serde_json::from_str(&std::fs::read_to_string(d.join("tool/payload.json")).unwrap())
+            .unwrap();
+    assert!((found.mass - 0.8).abs() < 5e-3, "{found:?}\n{out}");
+    for i in 0..3 {
+        assert!((found.com[i] - tool.com[i]).abs() < 2e-3, "{found:?}");
+    }
+    // and it is a payload identify-gains takes
+    let again = ok(&[
+        "identify-gains",
+        "a465",
+        s(&d.join("alone.csv")),
+        "--loaded",
+        s(&d.join("tool.csv")),
+        "--payload",
+        s(&d.join("tool/payload.json")),
+        "--friction",
+        "viscous",
+        "--out",
+        s(&d.join("again.json")),
+    ]);
+    assert!(
+        again.contains("(1 with 0.799") && again.contains("kg on 'link6')"),
+        "{again}"
+    );
+    let g = BaseModel::load(d.join("again.json")).unwrap();
+    for (gain, truth) in g.drive_gains.unwrap().gain.iter().zip(GAINS) {
+        assert!((gain / truth - 1.0).abs() < 1e-2, "{again}");
+    }
+}
