@@ -129,6 +129,24 @@ fn a_payload_comes_back_against_a_model_of_the_robot_alone_and_against_the_urdf(
     );
     let q = payload_in(&d.join("p2"));
     assert!((q.mass - truth.mass).abs() < 0.01, "{q:?}");
+    // as a point mass
+    let out = ok(&[
+        "identify-payload",
+        "a465",
+        s(&loaded),
+        "--link",
+        "link6",
+        "--model",
+        s(&model),
+        "--inertia",
+        "point_mass",
+        "--out",
+        s(&d.join("p3")),
+    ]);
+    assert!(out.contains("inertia about the centre of mass: 0 (a point mass)"), "{out}");
+    assert!(!out.contains("ixx"), "{out}");
+    let r = payload_in(&d.join("p3"));
+    assert!((r.mass - truth.mass).abs() < 0.01 && r.inertia == [0.0; 6], "{r:?}");
 
     // a log without the payload: none is seen, none written, and said so
     let none = d.join("none");
@@ -181,6 +199,7 @@ fn bad_arguments_are_refused_by_name_with_nothing_written() {
         &["--signal", "needs --model"],
     );
     run(&["--link", "link6", "--terms", "sticky"], &["sticky"]);
+    run(&["--link", "link6", "--inertia", "sphere"], &["sphere", "point_mass"]);
     // a model that is not a base-parameter model
     let local = d.join("local.json");
     std::fs::copy(d.join("loaded.csv.true.json"), &local).unwrap();

@@ -438,3 +438,144 @@ fn a_payload_on_a_tool_frame_is_given_in_that_frame() {
     );
     assert!(((pt.mass - 1.2) / st.mass).abs() < 4.0);
 }
+
+#[test]
+fn a_point_mass_comes_back_exactly_and_from_poses_held_still() {
+    use perturbid_rs::direct::PayloadInertia;
+    let truth = truth();
+    // a point mass 8 cm out: its inertia about the joint frame is not 0, and follows from it
+    let point = Payload {
+        link: "link6".into(),
+        mass: 1.1,
+        com: [0.02, -0.01, 0.08],
+        inertia: [0.0; 6],
+    };
+    let s = motion(4);
+    let tau = loaded_torques(&truth, Some(&point), 4, 0.0);
+    let reference = Reference::Urdf;
+    let options = PayloadOptions {
+        inertia: PayloadInertia::PointMass,
+        ..PayloadOptions::new("link6", &reference)
+    };
+    let fit = identify_payload(&truth, reference, &states(&s), &tau, &options).unwrap();
+    let p = fit.usable_payload().unwrap();
+    assert!((p.mass - 1.1).abs() < 1e-9, "{p:?}");
+    for i in 0..3 {
+        assert!((p.com[i] - point.com[i]).abs() < 1e-9, "{p:?}");
+    }
+    assert_eq!(p.inertia, [0.0; 6]);
+    assert_eq!(fit.inertia, PayloadInertia::PointMass);
+    assert!(fit.findings.is_empty(), "{:?}", fit.findings);
+    let want = parameters_of_payload(&point);
+    for (a, b) in fit.theta.iter().zip(&want) {
+        assert!(
+            (a - b).abs() < 1e-9 * (1.0 + b.abs()),
+            "{:?} vs {want:?}",
+            fit.theta
+        );
+    }
+
+    // poses held still: only gravity, so the inertia is not determined at all; the point
+    // mass's mass and centre are, with an offset a joint beside them
+    let mut rng = Rng(7);
+    let poses = 40;
+    let q: Vec<f64> = (0..poses)
+        .flat_map(|_| {
+            truth
+                .limits
+                .iter()
+                .map(|l| rng.uniform(0.8 * l.lower, 0.8 * l.upper))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let zeros = vec![0.0; q.len()];
+    let held = perturbid_rs::States::new(6, &q, Some(&zeros), Some(&zeros)).unwrap();
+    let loaded = TrueRobot {
+        payload: Some(point.clone()),
+        ..TrueRobot::default()
+    }
+    .rigid_body_model(&truth)
+    .unwrap();
+    let mut tau = vec![0.0; q.len()];
+    perturbid_rs::parallel::rnea(
+        &loaded,
+        &mut perturbid_rs::parallel::Workspace::new(&loaded),
+        &held,
+        Gravity::Included,
+        &mut tau,
+    )
+    .unwrap();
+    let offsets = PayloadOptions {
+        terms: FrictionTerms {
+            offset: true,
+            ..FrictionTerms::NONE
+        },
+        ..options.clone()
+    };
+    let fitted = PayloadOptions {
+        inertia: PayloadInertia::Fitted,
+        ..offsets.clone()
+    };
+    match identify_payload(&truth, reference, &held, &tau, &fitted) {
+        Err(Error::RankDeficient { missing, .. }) => {
+            assert!(missing.contains("payload.I"), "{missing}")
+        }
+        other => panic!("{other:?}"),
+    }
+    let fit = identify_payload(&truth, reference, &held, &tau, &offsets).unwrap();
+    let p = fit.usable_payload().unwrap();
+    assert!(
+        (p.mass - 1.1).abs() < 1e-9 && (p.com[2] - 0.08).abs() < 1e-9,
+        "{p:?}"
+    );
+
+    // and a point mass is a rigid body already
+    let both = PayloadOptions {
+        consistent: true,
+        ..options
+    };
+    let e = identify_payload(
+        &truth,
+        reference,
+        &states(&s),
+        &tau_of(&truth, &point),
+        &both,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("point mass"), "{e}");
+}
+
+fn tau_of(truth: &Model, p: &Payload) -> Vec<f64> {
+    loaded_torques(truth, Some(p), 4, 0.0)
+}
+
+#[test]
+fn a_point_mass_determines_a_small_payloads_mass_and_centre_better() {
+    use perturbid_rs::direct::PayloadInertia;
+    let (truth, p) = (truth(), payload());
+    let s = motion(4);
+    let tau = loaded_torques(&truth, Some(&p), 4, 0.05);
+    let reference = Reference::Urdf;
+    let fitted = PayloadOptions::new("link6", &reference);
+    let point = PayloadOptions {
+        inertia: PayloadInertia::PointMass,
+        ..fitted.clone()
+    };
+    let a = identify_payload(&truth, reference, &states(&s), &tau, &fitted).unwrap();
+    let b = identify_payload(&truth, reference, &states(&s), &tau, &point).unwrap();
+    let (sa, sb) = (a.payload_stderr.unwrap(), b.payload_stderr.unwrap());
+    assert!(sb.mass < sa.mass && sb.com[2] < sa.com[2], "{sa:?} {sb:?}");
+    // its inertia (0.002-0.004 kg m^2, small beside a 2 kg mass 8 cm out) biases it little
+    let q = b.payload.as_ref().unwrap();
+    assert!(
+        (q.mass - p.mass).abs() < 4.0 * sb.mass + 0.01,
+        "{q:?} {sb:?}"
+    );
+    for i in 0..3 {
+        assert!(
+            (q.com[i] - p.com[i]).abs() < 4.0 * sb.com[i] + 2e-3,
+            "{q:?} {sb:?}"
+        );
+    }
+}

@@ -920,6 +920,8 @@ class PayloadFit:
     @property
     def samples(self) -> int: ...
     @property
+    def inertia(self) -> Literal["fitted", "point_mass"]: ...
+    @property
     def consistent(self) -> bool: ...
     @property
     def residual_growth(self) -> Optional[float]: ...
@@ -943,6 +945,7 @@ def identify_payload(
     terms: Union[str, Sequence[str], None] = None,
     weighting: str = "wls",
     gravity: bool = True,
+    inertia: Literal["fitted", "point_mass"] = "fitted",
     consistent: bool = False,
     t: Optional[ArrayLike] = None,
     coulomb: Optional[ArrayLike] = None,

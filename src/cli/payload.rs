@@ -48,6 +48,11 @@ pub(crate) struct IdentifyPayloadArgs {
     /// inertia the log determines loosely.
     #[arg(long)]
     consistent: bool,
+    /// How the payload's inertia about its centre of mass is taken: fitted (all ten
+    /// parameters), or point_mass (0: the mass and centre of mass alone fitted, for a log that
+    /// determines a small payload's inertia loosely or not at all, as poses held still do).
+    #[arg(long, default_value = "fitted", value_parser = ["fitted", "point_mass"])]
+    inertia: String,
     /// The log's tau columns hold the signal the model's drive gains were identified for
     /// (motor currents; --model from identify-gains): each is multiplied by its joint's gain.
     #[arg(long)]
@@ -103,6 +108,7 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
     options.weighting = a.weighting;
     options.gravity = Gravity::from(!a.no_gravity);
     options.consistent = a.consistent;
+    options.inertia = crate::direct::PayloadInertia::parse(&a.inertia)?;
     // a link the robot lacks is named before the log is read
     crate::rehearsal::Payload {
         link: a.link.clone(),
@@ -173,10 +179,12 @@ fn report(fit: &PayloadFit, out: &std::path::Path) -> String {
                     p.com[i], se.com[i]
                 );
             }
-            for (i, name) in ["ixx", "ixy", "ixz", "iyy", "iyz", "izz"]
-                .iter()
-                .enumerate()
-            {
+            let point_mass = fit.inertia == crate::direct::PayloadInertia::PointMass;
+            if point_mass {
+                let _ = writeln!(s, "  inertia about the centre of mass: 0 (a point mass)");
+            }
+            let names = ["ixx", "ixy", "ixz", "iyy", "iyz", "izz"];
+            for (i, name) in names.iter().enumerate().filter(|_| !point_mass) {
                 let _ = writeln!(
                     s,
                     "  {name}       {:>12.6} +- {:.2e} kg m^2 (about the centre of mass)",

@@ -19,6 +19,8 @@ pub mod log_offsets;
 pub mod parameter_table;
 pub mod parameters;
 pub mod payload;
+pub mod payload_estimate;
+pub mod payload_quantities;
 pub mod position_offsets;
 pub mod position_range;
 pub mod residual_correlation;
@@ -50,7 +52,9 @@ pub use log_findings::LogFindings;
 pub use log_offsets::LogOffsets;
 pub use parameter_table::ParameterRow;
 pub use parameters::{regressor_blocks, regressor_matrix, FrictionTerms, ParameterLayout};
-pub use payload::{identify_payload, PayloadFit, PayloadOptions, PayloadStderr, Reference};
+pub use payload::{
+    identify_payload, PayloadFit, PayloadInertia, PayloadOptions, PayloadStderr, Reference,
+};
 pub use position_offsets::{
     check_position_offsets, check_position_offsets_in_validation, PositionOffsets,
 };

@@ -28,6 +28,8 @@ use serde::{Deserialize, Serialize};
 use super::base::{BaseParameters, BASE_TOLERANCE};
 use super::identify::{BaseModel, Weighting};
 use super::parameters::{regressor_blocks, FrictionTerms, ParameterLayout};
+use super::payload_estimate as estimate;
+pub use super::payload_quantities::{in_link_frame, parameters_of_payload, payload_of_parameters};
 use super::residual_correlation::{long_run_factors, SAMPLES};
 use super::streaming::JointFactors;
 use crate::algorithms::regressor::PARAMS_PER_BODY;
@@ -37,7 +39,6 @@ use crate::model::Model;
 use crate::rehearsal::Payload;
 use crate::spatial::Se3;
 use crate::states::States;
-use nalgebra::{Matrix3, Vector3};
 
 /// Standard errors a mass must lie above 0 by for the payload to count as seen (below it the
 /// centre of mass, a first moment over the mass, is not determined).
@@ -69,6 +70,41 @@ pub enum Reference<'a> {
     Model(&'a BaseModel),
 }
 
+/// How a payload's inertia about its centre of mass is taken ([`PayloadOptions::inertia`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PayloadInertia {
+    /// Fitted with the mass and the centre of mass: all ten parameters.
+    #[default]
+    Fitted,
+    /// Taken as 0 (a point mass): the mass and centre of mass alone are fitted, for logs that
+    /// determine a small payload's inertia loosely or not at all (slow motion, or poses held
+    /// still), and the payload given has no inertia about its centre.
+    PointMass,
+}
+
+impl PayloadInertia {
+    /// Its name on the command line and in files: `fitted`, `point_mass`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Fitted => "fitted",
+            Self::PointMass => "point_mass",
+        }
+    }
+
+    /// The choice of `name` ([`Self::name`]).
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "fitted" => Ok(Self::Fitted),
+            "point_mass" => Ok(Self::PointMass),
+            other => Err(Error::InvalidArgument {
+                argument: "inertia".into(),
+                message: format!("'{other}', expected 'fitted' or 'point_mass'"),
+            }),
+        }
+    }
+}
+
 /// How a payload is identified ([`identify_payload`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PayloadOptions {
@@ -83,6 +119,8 @@ pub struct PayloadOptions {
     pub weighting: Weighting,
     /// Gravity in the torques (default on); a base-parameter reference must agree.
     pub gravity: Gravity,
+    /// How the payload's inertia about its centre of mass is taken (default: fitted).
+    pub inertia: PayloadInertia,
     /// A physically consistent payload: the least squares over the ten parameters whose
     /// pseudo-inertia is positive semi-definite (a rigid body), the joint terms free
     /// (default false: the plain least squares, which can leave a loosely determined inertia
@@ -106,6 +144,7 @@ impl PayloadOptions {
             },
             weighting: Weighting::Wls,
             gravity: Gravity::Included,
+            inertia: PayloadInertia::Fitted,
             consistent: false,
         }
     }
@@ -162,6 +201,9 @@ pub struct PayloadFit {
     /// determine its inertia too loosely, or the model errs. Of the unconstrained estimate
     /// also where the consistent one is given ([`Self::consistent`]).
     pub not_a_rigid_body: Option<String>,
+    /// How the inertia about the centre of mass was taken: fitted, or 0 for a point mass
+    /// (then its standard errors are 0: it was not estimated).
+    pub inertia: PayloadInertia,
     /// Whether [`Self::theta`] and [`Self::payload`] are the physically consistent estimate
     /// ([`PayloadOptions::consistent`]); its standard errors are the unconstrained fit's,
     /// which hold where no constraint is active.
@@ -193,102 +235,6 @@ pub struct PayloadFit {
     pub position_range: Vec<super::position_range::JointRange>,
     /// What the fit cannot vouch for, in words (each also warned of by the front ends).
     pub findings: Vec<String>,
-}
-
-/// The payload's quantities `[m, cx, cy, cz, ixx, ixy, ixz, iyy, iyz, izz]` (inertia about the
-/// centre of mass) of its ten parameters `pi` (Pinocchio's order, about the joint frame), and
-/// their Jacobian (`10 x 10`, row per quantity). `pi[0]` must not be 0.
-pub fn payload_of_parameters(pi: &[f64; 10]) -> ([f64; 10], DMatrix<f64>) {
-    let m = pi[0];
-    let h = [pi[1], pi[2], pi[3]];
-    // Io as (a, b) -> index into pi
-    let io = |a: usize, b: usize| -> usize {
-        match (a.min(b), a.max(b)) {
-            (0, 0) => 4,
-            (0, 1) => 5,
-            (1, 1) => 6,
-            (0, 2) => 7,
-            (1, 2) => 8,
-            _ => 9,
-        }
-    };
-    let entries = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
-    let hh: f64 = h.iter().map(|v| v * v).sum();
-    let delta = |a: usize, b: usize| if a == b { 1.0 } else { 0.0 };
-    let mut out = [0.0; 10];
-    let mut jac = DMatrix::zeros(10, 10);
-    out[0] = m;
-    jac[(0, 0)] = 1.0;
-    for i in 0..3 {
-        out[1 + i] = h[i] / m;
-        jac[(1 + i, 0)] = -h[i] / (m * m);
-        jac[(1 + i, 1 + i)] = 1.0 / m;
-    }
-    // Ic = Io - (|h|^2 / m) 1 + h h^T / m
-    for (e, &(a, b)) in entries.iter().enumerate() {
-        let row = 4 + e;
-        out[row] = pi[io(a, b)] - hh / m * delta(a, b) + h[a] * h[b] / m;
-        jac[(row, io(a, b))] = 1.0;
-        jac[(row, 0)] = hh / (m * m) * delta(a, b) - h[a] * h[b] / (m * m);
-        for k in 0..3 {
-            jac[(row, 1 + k)] =
-                -2.0 * h[k] / m * delta(a, b) + (delta(a, k) * h[b] + h[a] * delta(b, k)) / m;
-        }
-    }
-    (out, jac)
-}
-
-/// The payload's quantities `u` (`[m, c, I_c]` as [`payload_of_parameters`] gives them) and
-/// their covariance `cu` (`10 x 10`), given in a body's frame, in the frame of a link at
-/// `pose` in it: `c' = R^T (c - p)`, `I_c' = R^T I_c R` (the covariance by the same linear map).
-pub fn in_link_frame(u: &[f64; 10], cu: &DMatrix<f64>, pose: &Se3) -> ([f64; 10], DMatrix<f64>) {
-    let rt = pose.rotation.transpose();
-    let entries = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
-    let sym = |v: &[f64]| Matrix3::new(v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5]);
-    // the linear map of the quantities: 1, R^T on the centre, R^T . R on the inertia's entries
-    let mut a = DMatrix::zeros(10, 10);
-    a[(0, 0)] = 1.0;
-    for i in 0..3 {
-        for j in 0..3 {
-            a[(1 + i, 1 + j)] = rt[(i, j)];
-        }
-    }
-    for (e, _) in entries.iter().enumerate() {
-        let mut basis = [0.0; 6];
-        basis[e] = 1.0;
-        let image = rt * sym(&basis) * pose.rotation;
-        for (f, &(r, c)) in entries.iter().enumerate() {
-            a[(4 + f, 4 + e)] = image[(r, c)];
-        }
-    }
-    let c = rt * (Vector3::new(u[1], u[2], u[3]) - pose.translation);
-    let i = rt * sym(&u[4..]) * pose.rotation;
-    let mut out = [0.0; 10];
-    out[0] = u[0];
-    out[1..4].copy_from_slice(c.as_slice());
-    for (f, &(r, col)) in entries.iter().enumerate() {
-        out[4 + f] = i[(r, col)];
-    }
-    (out, &a * cu * a.transpose())
-}
-
-/// The ten parameters `pi` (Pinocchio's order, about the link's joint frame) of `payload`.
-pub fn parameters_of_payload(payload: &Payload) -> [f64; 10] {
-    let i = payload.spatial_inertia();
-    let h = i.com * i.mass;
-    let r = i.inertia_origin();
-    [
-        i.mass,
-        h.x,
-        h.y,
-        h.z,
-        r[(0, 0)],
-        r[(0, 1)],
-        r[(1, 1)],
-        r[(0, 2)],
-        r[(1, 2)],
-        r[(2, 2)],
-    ]
 }
 
 /// The unknowns' regression problem: the columns of the payload's body and of the joint terms.
@@ -476,24 +422,30 @@ pub fn identify_payload(
         },
         other => other,
     };
+    if options.consistent && options.inertia == PayloadInertia::PointMass {
+        return Err(Error::InvalidArgument {
+            argument: "consistent".into(),
+            message: "not with a point mass, which is a rigid body already".into(),
+        });
+    }
+    let estimate = |sigma: &[f64]| match options.inertia {
+        PayloadInertia::Fitted => estimate::least_squares_estimate(&factors, sigma, &names),
+        PayloadInertia::PointMass => estimate::point_mass_estimate(&factors, sigma, &names),
+    };
     let mut sigma = vec![1.0; nv];
-    let mut ls = factors.solve(&sigma, &names).map_err(in_context)?;
-    let mut rms = factors.residual_rms(ls.coef.as_slice())?;
+    let mut e = estimate(&sigma).map_err(in_context)?;
+    let mut rms = factors.residual_rms(&e.theta)?;
     if options.weighting == Weighting::Wls {
         sigma = rms.iter().map(|&s| if s > 0.0 { s } else { 1.0 }).collect();
-        ls = factors.solve(&sigma, &names).map_err(in_context)?;
-        rms = factors.residual_rms(ls.coef.as_slice())?;
+        e = estimate(&sigma).map_err(in_context)?;
+        rms = factors.residual_rms(&e.theta)?;
     }
-    let unconstrained: Vec<f64> = ls.coef.iter().copied().collect();
-    let not_a_rigid_body = rigid_body_problem(&options.link, &unconstrained);
-    let (theta, residual_growth) = match options.consistent {
-        true => {
-            let (theta, growth) = consistent_payload(&factors, &sigma, &unconstrained)?;
-            rms = factors.residual_rms(&theta)?;
-            (theta, Some(growth))
-        }
-        false => (unconstrained, None),
-    };
+    let not_a_rigid_body = rigid_body_problem(&options.link, &e.theta);
+    if options.consistent {
+        e = estimate::rigid_body_estimate(&factors, &sigma, &e)?;
+        rms = factors.residual_rms(&e.theta)?;
+    }
+    let theta = e.theta.clone();
     let pi = DVector::from_column_slice(&theta);
     // the residuals' correlation from sample to sample, and the payload's torques, over the
     // first samples
@@ -527,22 +479,17 @@ pub fn identify_payload(
         .fold(1.0f64, |a, &f| a.max(f))
         .sqrt();
     // covariance: the fit's (inflated), and the reference's carried through
-    let se_fit: Vec<f64> = ls.stderr.iter().map(|s| s * inflation).collect();
-    let corr = &ls.correlation;
-    let mut cov = DMatrix::from_fn(m, m, |a, b| se_fit[a] * corr[(a, b)] * se_fit[b]);
+    let mut cov = &e.unit_covariance * (e.variance * inflation * inflation);
     let stderr_of_reference = match reference {
         Reference::Urdf => vec![0.0; m],
         Reference::Model(fit) if fit.correlation.shape() != (p_ref, p_ref) => vec![f64::NAN; m],
         Reference::Model(fit) => {
-            // (A^T W A)^-1 = corr scaled by sqrt(cov_diag)
-            let unscaled = DMatrix::from_fn(m, m, |a, b| {
-                corr[(a, b)] * (ls.cov_diag[a] * ls.cov_diag[b]).sqrt()
-            });
+            // the estimator's linearised operator on the torques: unit covariance A^T W
             let mut weighted = DMatrix::<f64>::zeros(m, p_ref);
             for (j, c) in cross.iter().enumerate() {
                 weighted += c / (sigma[j] * sigma[j]);
             }
-            let g = &unscaled * weighted;
+            let g = &e.unit_covariance * weighted;
             let ref_cov = DMatrix::from_fn(p_ref, p_ref, |a, b| {
                 fit.stderr[a] * fit.correlation[(a, b)] * fit.stderr[b]
             });
@@ -587,13 +534,14 @@ pub fn identify_payload(
         payload: None,
         payload_stderr: None,
         not_a_rigid_body,
+        inertia: options.inertia,
         consistent: options.consistent,
-        residual_growth,
+        residual_growth: e.residual_growth,
         reference_rms,
         payload_torque_rms,
         residual_rms: rms,
         sigma,
-        cond: ls.cond,
+        cond: e.cond,
         samples: k,
         residual_correlation,
         torque_columns: vec![],
@@ -638,17 +586,23 @@ impl PayloadFit {
         let block = cov.view((0, 0), (PARAMS_PER_BODY, PARAMS_PER_BODY));
         let (u, cu) = in_link_frame(&u, &(&jac * block * jac.transpose()), pose);
         let se = |i: usize| cu[(i, i)].max(0.0).sqrt();
-        let payload = Payload {
+        let mut payload = Payload {
             link: self.link.clone(),
             mass: u[0],
             com: [u[1], u[2], u[3]],
             inertia: [u[4], u[5], u[6], u[7], u[8], u[9]],
         };
-        let stderr = PayloadStderr {
+        let mut stderr = PayloadStderr {
             mass: se(0),
             com: [se(1), se(2), se(3)],
             inertia: std::array::from_fn(|i| se(4 + i)),
         };
+        let point_mass = self.inertia == PayloadInertia::PointMass;
+        if point_mass {
+            // 0 by assumption, not estimated (what is left is rounding)
+            payload.inertia = [0.0; 6];
+            stderr.inertia = [0.0; 6];
+        }
         if stderr.mass > LOOSE_MASS * payload.mass {
             self.findings.push(format!(
                 "the payload's mass is loosely determined: {} +- {} kg",
@@ -669,10 +623,9 @@ impl PayloadFit {
         let largest = crate::decomposition::symmetric_eigen(s).map_or(f64::NAN, |e| {
             (e.eigenvalues.iter()).fold(0.0f64, |a, v| a.max(v.abs()))
         });
-        if stderr
-            .inertia
-            .iter()
-            .any(|v| v.is_nan() || largest.is_nan() || *v > LOOSE_INERTIA * largest)
+        if !point_mass
+            && (stderr.inertia.iter())
+                .any(|v| v.is_nan() || largest.is_nan() || *v > LOOSE_INERTIA * largest)
         {
             self.findings.push(format!(
                 "the payload's inertia about its centre of mass is loosely determined: standard errors up to {} kg m^2 against a largest principal moment of {} kg m^2 (a small payload's inertia moves the joint torques little; a motion that turns the link faster about each axis determines it better)",
@@ -726,79 +679,4 @@ fn rigid_body_problem(link: &str, theta: &[f64]) -> Option<String> {
         inertia: [u[4], u[5], u[6], u[7], u[8], u[9]],
     }
     .problem("the payload")
-}
-
-/// The consistent estimates (the payload's ten parameters a rigid body's, the joint terms
-/// free) of the weighted problem `factors` reduces with weights `sigma`, and the growth of
-/// its residual sum of squares over the unconstrained minimum. The joint terms are minimised
-/// over for every payload (a QR of `[R11 | z]` with their columns first), so that the
-/// constrained problem is in the ten parameters alone ([`super::consistent_least_squares`]).
-fn consistent_payload(
-    factors: &JointFactors,
-    sigma: &[f64],
-    unconstrained: &[f64],
-) -> Result<(Vec<f64>, f64)> {
-    let (r11, z, rho) = factors.reduced(sigma)?;
-    let n = r11.ncols();
-    let (b, f) = (PARAMS_PER_BODY, n - PARAMS_PER_BODY);
-    let mut a = DMatrix::zeros(n + 1, n + 1);
-    for i in 0..n {
-        for c in 0..f {
-            a[(i, c)] = r11[(i, b + c)];
-        }
-        for c in 0..b {
-            a[(i, f + c)] = r11[(i, c)];
-        }
-        a[(i, n)] = z[(i, 0)];
-    }
-    a[(n, n)] = rho;
-    let t = super::streaming::triangular(&a);
-    let r = t.view((f, f), (b, b)).into_owned();
-    let zp = DVector::from_iterator(b, (0..b).map(|i| t[(f + i, n)]));
-    let rest = t[(n, n)];
-    let layout = ParameterLayout {
-        nv: 0,
-        nbodies: 1,
-        friction: FrictionTerms::NONE,
-        names: (crate::algorithms::regressor::PARAMETER_NAMES.iter())
-            .map(|n| format!("payload.{n}"))
-            .collect(),
-    };
-    let solution = super::consistent_least_squares(
-        &layout,
-        &r,
-        &zp,
-        rest * rest,
-        &[0.0; PARAMS_PER_BODY],
-        // the data determine all ten (a rank deficiency was refused): the prior only keeps
-        // the solver's systems regular
-        &super::ConsistentOptions {
-            prior_weight: 1e-12,
-            ..super::ConsistentOptions::default()
-        },
-    )?;
-    let pi = &solution.theta;
-    // the joint terms that go with it: others d = others_z - coupling pi
-    let mut theta = pi.clone();
-    if f > 0 {
-        let others = t.view((0, 0), (f, f)).into_owned();
-        let coupling = t.view((0, f), (f, b)).into_owned();
-        let rhs = DVector::from_iterator(f, (0..f).map(|i| t[(i, n)]))
-            - coupling * DVector::from_column_slice(pi);
-        let d = others
-            .solve_upper_triangular(&rhs)
-            .filter(|d| d.iter().all(|v| v.is_finite()))
-            .ok_or_else(|| Error::Numerical {
-                operation: "payload identification".into(),
-                message: "the data do not determine the joint terms beside the payload".into(),
-            })?;
-        theta.extend(d.iter());
-    }
-    debug_assert_eq!(theta.len(), unconstrained.len());
-    let growth = match (solution.unconstrained_cost, solution.cost) {
-        (u, c) if u > 0.0 => c / u,
-        (_, 0.0) => 1.0,
-        _ => f64::INFINITY,
-    };
-    Ok((theta, growth))
 }

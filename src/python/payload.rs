@@ -139,6 +139,11 @@ impl PyPayloadFit {
     fn samples(&self) -> usize {
         self.fit.samples
     }
+    /// 'fitted', or 'point_mass' (the inertia about the centre of mass 0 by assumption).
+    #[getter]
+    fn inertia(&self) -> &'static str {
+        self.fit.inertia.name()
+    }
     #[getter]
     fn consistent(&self) -> bool {
         self.fit.consistent
@@ -186,12 +191,15 @@ impl PyPayloadFit {
 /// the payload (None: an offset a joint with a model, viscous, Coulomb and offset without;
 /// or 'all', 'none', a list of 'viscous', 'coulomb', 'offset', 'armature'); `weighting`
 /// 'wls' or 'ols'; `gravity`: whether `tau` includes gravity (as the model's must);
-/// `consistent`: a rigid body by construction. `t` ((k,) s) checks a log's own qd and qdd
+/// `inertia`: 'fitted' (all ten parameters) or 'point_mass' (the inertia about the centre of
+/// mass taken as 0, the mass and centre alone fitted: for a log that determines a small
+/// payload's inertia loosely or not at all, as poses held still do); `consistent`: a rigid
+/// body by construction. `t` ((k,) s) checks a log's own qd and qdd
 /// columns against the derivatives of q and qd; `coulomb` ((k, n)) the Coulomb column of
 /// torques low-pass filtered. Findings are warned of (`PerturbidWarning`) and kept in
 /// `findings`.
 #[pyfunction]
-#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, *, link, model=None, terms=None, weighting="wls", gravity=true, consistent=false, t=None, coulomb=None))]
+#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, *, link, model=None, terms=None, weighting="wls", gravity=true, inertia="fitted", consistent=false, t=None, coulomb=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_payload<'py>(
     py: Python<'py>,
@@ -205,6 +213,7 @@ pub(crate) fn identify_payload<'py>(
     terms: Option<FrictionNames<'_>>,
     weighting: &str,
     gravity: bool,
+    inertia: &str,
     consistent: bool,
     t: Option<Bound<'py, PyAny>>,
     coulomb: Option<Bound<'py, PyAny>>,
@@ -232,6 +241,7 @@ pub(crate) fn identify_payload<'py>(
     };
     options.gravity = Gravity::from(gravity);
     options.consistent = consistent;
+    options.inertia = crate::direct::PayloadInertia::parse(inertia)?;
     let given = Given {
         qd,
         qdd,

@@ -187,3 +187,33 @@ def test_a_payload_on_a_tool_frame_is_pinocchios_in_that_frame():
     assert np.allclose(fit.theta[:10], placement.act(pin_payload()).toDynamicParameters(),
                        rtol=1e-8, atol=1e-10)
     assert json.loads(fit.to_json())["body"] == "link6"
+
+
+def test_a_point_mass_from_poses_held_still(a465):
+    """Only gravity at poses held still: the inertia is not determined (refused, named), the
+    point mass's mass and centre are, exactly, Pinocchio's."""
+    pair, _ = a465
+    point = pin.Inertia(0.9, np.array([0.03, 0.0, 0.06]), np.zeros((3, 3)))
+    loaded = pair.model.copy()
+    jid = loaded.getJointId("joint6")
+    loaded.inertias[jid] = loaded.inertias[jid] + point
+    rng = np.random.default_rng(3)
+    lo, hi = pair.model.lowerPositionLimit, pair.model.upperPositionLimit
+    q = rng.uniform(0.8 * lo, 0.8 * hi, (30, 6))
+    zero = np.zeros_like(q)
+    tau = pin_torques(loaded, q, zero, zero) + 0.2  # a sensor offset on every joint
+    with pytest.raises(pr.NumericalError, match="payload.I"):
+        pr.identify_payload(pair.ours, q, zero, zero, tau, link="link6", terms="offset")
+    fit = pr.identify_payload(pair.ours, q, zero, zero, tau, link="link6", terms="offset",
+                              inertia="point_mass")
+    assert fit.inertia == "point_mass" and fit.usable
+    assert abs(fit.payload["mass"] - 0.9) < 1e-9
+    assert np.allclose(fit.payload["com"], [0.03, 0.0, 0.06], atol=1e-9)
+    assert fit.payload["inertia"] == [0.0] * 6 and fit.payload_stderr["inertia"] == [0.0] * 6
+    assert np.allclose(fit.theta[:10], point.toDynamicParameters(), atol=1e-9)
+    assert np.allclose(fit.theta[10:], 0.2, atol=1e-9)
+    with pytest.raises(pr.InputError, match="point_mass"):
+        pr.identify_payload(pair.ours, q, zero, zero, tau, link="link6", inertia="sphere")
+    with pytest.raises(pr.InputError, match="rigid body already"):
+        pr.identify_payload(pair.ours, q, zero, zero, tau, link="link6", terms="offset",
+                            inertia="point_mass", consistent=True)
