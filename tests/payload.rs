@@ -77,6 +77,29 @@ fn a_payload_comes_back_exactly_from_noise_free_torques_against_the_urdf() {
     assert!(fit.findings.is_empty(), "{:?}", fit.findings);
     assert_eq!(fit.reference, "urdf");
     assert!(fit.stderr_of_reference.iter().all(|s| *s == 0.0));
+    // the robot carrying it, on another motion: its torques
+    let other = motion(5);
+    let predicted = fit.predict(&truth, reference, &states(&other)).unwrap();
+    let want = loaded_torques(&truth, Some(&p), 5, 0.0);
+    for (a, b) in predicted.iter().zip(&want) {
+        assert!((a - b).abs() < 1e-8 * (1.0 + b.abs()), "{a} vs {b}");
+    }
+    // against the kind of reference it was identified against only
+    let alone = identify_base_parameters(
+        &truth,
+        &states(&other),
+        &loaded_torques(&truth, None, 5, 0.01),
+        &BaseOptions::default(),
+    )
+    .unwrap();
+    let e = fit
+        .predict(&truth, Reference::Model(&alone), &states(&other))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("identified against the URDF's parameters"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -929,6 +929,16 @@ class PayloadFit:
     def not_a_rigid_body(self) -> Optional[str]: ...
     @property
     def findings(self) -> list[str]: ...
+    def predict(
+        self,
+        q: Union[ArrayLike, Recording],
+        qd: Optional[ArrayLike] = None,
+        qdd: Optional[ArrayLike] = None,
+        coulomb: Optional[ArrayLike] = None,
+    ) -> NDArray[np.float64]:
+        """Torques (N m, (n,) or (k, n)) of the robot carrying the payload: the reference's,
+        the payload's and the joint terms fitted beside it."""
+        ...
     def to_json(self) -> str:
         """The document `perturbid identify-payload` writes as payload_fit.json."""
         ...

@@ -57,6 +57,10 @@ pub(crate) struct IdentifyPayloadArgs {
     /// (motor currents; --model from identify-gains): each is multiplied by its joint's gain.
     #[arg(long)]
     signal: bool,
+    /// Fit on the first (1 - FRACTION) of the samples and report the errors of the robot
+    /// carrying the payload on the rest.
+    #[arg(long, default_value_t = 0.3)]
+    validate: f64,
     /// Output folder: payload.json (the payload as identify-gains --payload and true robots
     /// read it; written only where the fit can vouch for it: a payload seen, a rigid body)
     /// and payload_fit.json (every estimate with its standard error, the reference's share,
@@ -109,6 +113,12 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
     options.gravity = Gravity::from(!a.no_gravity);
     options.consistent = a.consistent;
     options.inertia = crate::direct::PayloadInertia::parse(&a.inertia)?;
+    if !(0.0..1.0).contains(&a.validate) {
+        return Err(Error::InvalidArgument {
+            argument: "--validate".into(),
+            message: format!("{}; expected a fraction in [0, 1)", shown(a.validate)),
+        });
+    }
     // a link the robot lacks is named before the log is read
     crate::rehearsal::Payload {
         link: a.link.clone(),
@@ -131,9 +141,35 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
         None => rec,
     };
     let states = rec.states().map_err(in_log(&a.data))?;
-    progress.update(&format!("identifying on {} samples", states.len()));
-    let fit = identify_payload(&model, reference, &states, &rec.tau, &options)
-        .map_err(in_log(&a.data))?;
+    let k = states.len();
+    let split = ((1.0 - a.validate) * k as f64).round() as usize;
+    if a.validate > 0.0 && split >= k {
+        return Err(Error::InvalidArgument {
+            argument: "--validate".into(),
+            message: format!(
+                "{} of {k} samples leaves none to validate on; give a larger fraction, or 0 for none",
+                shown(a.validate)
+            ),
+        });
+    }
+    let n = model.nv;
+    progress.update(&format!("identifying on {split} samples"));
+    let fit = identify_payload(
+        &model,
+        reference,
+        &states.slice(0..split),
+        &rec.tau[..split * n],
+        &options,
+    )
+    .map_err(in_log(&a.data))?;
+    let validation = (split < k)
+        .then(|| -> Result<_> {
+            progress.update("validating");
+            let held = states.slice(split..k);
+            let predicted = fit.predict(&model, reference, &held)?;
+            crate::validation::validate(&model.joint_names, &predicted, &rec.tau[split * n..])
+        })
+        .transpose()?;
     progress.done();
     for w in &fit.findings {
         eprintln!("perturbid: warning: log '{}': {w}", a.data.display());
@@ -151,6 +187,23 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
     )?;
     set.commit()?;
     out.push_str(&report(&fit, &a.out));
+    if let Some(v) = validation {
+        let _ = writeln!(
+            out,
+            "validation of the robot carrying the payload on the last {} samples: per joint RMS (N m) and relative RMS (%)",
+            v.samples
+        );
+        for e in &v.joints {
+            let _ = writeln!(
+                out,
+                "  {:<16} {:>10.4} {:>8}",
+                e.joint,
+                e.rms,
+                e.relative_rms
+                    .map_or("-".to_string(), |r| format!("{:.2}", 100.0 * r))
+            );
+        }
+    }
     Ok(out)
 }
 

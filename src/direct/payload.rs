@@ -174,6 +174,10 @@ pub struct PayloadFit {
     pub body: String,
     /// `urdf` or `base_model`: what the torques were measured against ([`Reference`]).
     pub reference: String,
+    /// Whether the torques included gravity.
+    pub gravity: Gravity,
+    /// The joint terms fitted beside the payload.
+    pub terms: FrictionTerms,
     /// The unknowns: the payload's ten parameters (`payload.m`, `payload.mcx`, ... `payload.Izz`)
     /// and then each joint's terms (`joint1.offset`, ...).
     pub names: Vec<String>,
@@ -235,6 +239,58 @@ pub struct PayloadFit {
     pub position_range: Vec<super::position_range::JointRange>,
     /// What the fit cannot vouch for, in words (each also warned of by the front ends).
     pub findings: Vec<String>,
+}
+
+/// The reference's regressor layout, its parameters over it, and for a base-parameter model
+/// its base parameters (whose columns of that layout it keeps).
+struct ReferenceParts<'a> {
+    layout: ParameterLayout,
+    theta: DVector<f64>,
+    base: Option<&'a BaseParameters>,
+}
+
+impl<'a> ReferenceParts<'a> {
+    /// Of `reference` for `model`, read with `gravity`: refused for a model of another robot or
+    /// identified with gravity the other way.
+    fn of(model: &Model, reference: &Reference<'a>, gravity: Gravity) -> Result<Self> {
+        Ok(match *reference {
+            Reference::Urdf => {
+                let layout = ParameterLayout::new(model, FrictionTerms::NONE.for_model(model));
+                let theta = layout.model_parameters(model);
+                Self {
+                    layout,
+                    theta,
+                    base: None,
+                }
+            }
+            Reference::Model(fit) => {
+                fit.check(model)?;
+                if fit.gravity != gravity {
+                    return Err(Error::InvalidArgument {
+                        argument: "gravity".into(),
+                        message: format!(
+                            "the reference model was identified with gravity {} of its torques, the payload's log is read with it {}: both must agree",
+                            if fit.gravity.is_included() { "in" } else { "out" },
+                            if gravity.is_included() { "in" } else { "out" }
+                        ),
+                    });
+                }
+                Self {
+                    layout: fit.base.layout.clone(),
+                    theta: DVector::from_column_slice(&fit.theta),
+                    base: Some(&fit.base),
+                }
+            }
+        })
+    }
+
+    /// The reference's torques of the regressor block `phi` (of [`Self::layout`]).
+    fn torques(&self, phi: &DMatrix<f64>) -> DVector<f64> {
+        match self.base {
+            Some(b) => b.select(phi) * &self.theta,
+            None => phi * &self.theta,
+        }
+    }
 }
 
 /// The unknowns' regression problem: the columns of the payload's body and of the joint terms.
@@ -330,35 +386,8 @@ pub fn identify_payload(
             },
             other => other,
         })?;
-    // the reference's regressor layout and parameters
-    let (ref_layout, ref_theta) = match reference {
-        Reference::Urdf => {
-            let layout = ParameterLayout::new(model, FrictionTerms::NONE.for_model(model));
-            let theta = layout.model_parameters(model);
-            (layout, theta)
-        }
-        Reference::Model(fit) => {
-            fit.check(model)?;
-            if fit.gravity != options.gravity {
-                return Err(Error::InvalidArgument {
-                    argument: "gravity".into(),
-                    message: format!(
-                        "the reference model was identified with gravity {} of its torques, the payload's log is read with it {}: both must agree",
-                        if fit.gravity.is_included() { "in" } else { "out" },
-                        if options.gravity.is_included() { "in" } else { "out" }
-                    ),
-                });
-            }
-            (
-                fit.base.layout.clone(),
-                DVector::from_column_slice(&fit.theta),
-            )
-        }
-    };
-    let base_of_reference = match reference {
-        Reference::Model(fit) => Some(&fit.base),
-        Reference::Urdf => None,
-    };
+    let parts = ReferenceParts::of(model, &reference, options.gravity)?;
+    let (ref_layout, ref_theta, base_of_reference) = (&parts.layout, &parts.theta, parts.base);
     let problem = unknowns(model, body, options.terms);
     let columns = Columns {
         body,
@@ -372,11 +401,11 @@ pub fn identify_payload(
     let mut y = Vec::with_capacity(k * nv);
     let mut cross = vec![DMatrix::<f64>::zeros(m, p_ref); nv];
     let mut row = vec![0.0; m];
-    regressor_blocks(model, &ref_layout, states, options.gravity, |range, phi| {
+    regressor_blocks(model, ref_layout, states, options.gravity, |range, phi| {
         let rows_ref = base_of_reference.map(|b| b.select(phi));
         let predicted = match &rows_ref {
-            Some(rows) => rows * &ref_theta,
-            None => phi * &ref_theta,
+            Some(rows) => rows * ref_theta,
+            None => phi * ref_theta,
         };
         for (i, s) in range.clone().enumerate() {
             for j in 0..nv {
@@ -455,7 +484,7 @@ pub fn identify_payload(
     let pi_payload = pi.rows(0, PARAMS_PER_BODY).into_owned();
     regressor_blocks(
         model,
-        &ref_layout,
+        ref_layout,
         &states.slice(0..head),
         options.gravity,
         |range, phi| {
@@ -526,6 +555,8 @@ pub fn identify_payload(
             Reference::Urdf => "urdf".into(),
             Reference::Model(_) => "base_model".into(),
         },
+        gravity: options.gravity,
+        terms: options.terms,
         names,
         theta,
         stderr,
@@ -562,6 +593,74 @@ pub fn identify_payload(
 }
 
 impl PayloadFit {
+    /// The torques (row-major `k x nv`, N m, or N for a prismatic joint) of the robot
+    /// carrying the payload at `states` (rad, rad/s, rad/s^2; a Coulomb column where the
+    /// torques are filtered): `reference`'s (the one the payload was identified against), the
+    /// payload's and the joint terms fitted beside it. Refused for a robot of other joints or
+    /// without the payload's body, and a reference of another kind than the fit's.
+    pub fn predict(
+        &self,
+        model: &Model,
+        reference: Reference<'_>,
+        states: &States<'_>,
+    ) -> Result<Vec<f64>> {
+        let nv = model.nv;
+        let bad = |message: String| Error::InvalidArgument {
+            argument: "payload fit".into(),
+            message,
+        };
+        if model.joint_names != self.joint_names {
+            return Err(bad(format!(
+                "identified for joints [{}], not '{}''s",
+                self.joint_names.join(", "),
+                model.name
+            )));
+        }
+        let kind = match reference {
+            Reference::Urdf => "urdf",
+            Reference::Model(_) => "base_model",
+        };
+        if kind != self.reference {
+            return Err(bad(format!(
+                "identified against the {}, not against the {}: predict with the reference it was identified against",
+                describe(&self.reference),
+                describe(kind)
+            )));
+        }
+        let body = (model.bodies.iter())
+            .position(|b| b.link == self.body)
+            .ok_or_else(|| bad(format!("the robot has no body '{}'", self.body)))?;
+        let columns = Columns {
+            body,
+            terms: self.terms.names(),
+        };
+        if PARAMS_PER_BODY + columns.terms.len() * nv != self.theta.len() {
+            return Err(bad(format!(
+                "{} estimates, not the {} of the payload and its joint terms on this robot",
+                self.theta.len(),
+                PARAMS_PER_BODY + columns.terms.len() * nv
+            )));
+        }
+        crate::torque_model::check_joints(states, nv)?;
+        let parts = ReferenceParts::of(model, &reference, self.gravity)?;
+        let mut row = vec![0.0; self.theta.len()];
+        let mut out = Vec::with_capacity(states.len() * nv);
+        regressor_blocks(model, &parts.layout, states, self.gravity, |range, phi| {
+            let base = parts.torques(phi);
+            for (i, s) in range.clone().enumerate() {
+                for j in 0..nv {
+                    let r = i * nv + j;
+                    columns.row(phi, r, states, s, j, &mut row);
+                    let own: f64 = row.iter().zip(&self.theta).map(|(a, b)| a * b).sum();
+                    out.push(base[r] + own);
+                }
+            }
+            Ok(())
+        })?;
+        crate::torque_model::check_prediction(&out, nv)?;
+        Ok(out)
+    }
+
     /// The payload's ten parameters (Pinocchio's order, about the link's joint frame).
     pub fn parameters(&self) -> [f64; 10] {
         std::array::from_fn(|i| self.theta[i])
@@ -679,4 +778,12 @@ fn rigid_body_problem(link: &str, theta: &[f64]) -> Option<String> {
         inertia: [u[4], u[5], u[6], u[7], u[8], u[9]],
     }
     .problem("the payload")
+}
+
+/// A reference's kind in words.
+fn describe(kind: &str) -> &'static str {
+    match kind {
+        "urdf" => "URDF's parameters",
+        _ => "model of the robot alone",
+    }
 }

@@ -93,7 +93,7 @@ pub(crate) fn states<'a>(
 
 /// The states (`q`, `qd`, `qdd`, `coulomb` as a prediction takes them; or a Recording as `q`,
 /// alone) read as arrays.
-fn states_of<'py>(
+pub(crate) fn states_of<'py>(
     q: Bound<'py, PyAny>,
     qd: Option<Bound<'py, PyAny>>,
     qdd: Option<Bound<'py, PyAny>>,

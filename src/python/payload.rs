@@ -5,19 +5,23 @@
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::arrays::{matrix_to_numpy as mat, vec1, vector};
+use std::sync::Arc;
+
+use super::arrays::{at_states_with, matrix_to_numpy as mat, vec1, vector};
 use super::detached;
 use super::direct::{
-    check_sample_derivatives, coulomb_column, fit_states, friction_terms, states, FrictionNames,
-    PyBaseModel,
+    check_sample_derivatives, coulomb_column, fit_states, friction_terms, states, states_of,
+    FrictionNames, PyBaseModel,
 };
 use super::robot::PyRobot;
 use super::samples::{samples, Given};
+use crate::direct::BaseModel;
 use crate::direct::{
     identify_payload as payload_rs, PayloadFit, PayloadOptions, Reference, Weighting,
 };
 use crate::error::Error;
 use crate::gravity::Gravity;
+use crate::model::Model;
 use crate::rehearsal::Payload;
 
 /// A payload identified from a log of the robot carrying it (`identify_payload`).
@@ -40,6 +44,10 @@ use crate::rehearsal::Payload;
 #[pyclass(name = "PayloadFit", module = "perturbid_rs", frozen)]
 pub(crate) struct PyPayloadFit {
     pub(crate) fit: PayloadFit,
+    /// The robot and the model of it alone (None: its URDF) the payload was identified
+    /// against, for `predict`.
+    robot: Arc<Model>,
+    reference: Option<BaseModel>,
 }
 
 fn payload_dict<'py>(py: Python<'py>, p: &Payload) -> PyResult<Bound<'py, PyDict>> {
@@ -160,6 +168,34 @@ impl PyPayloadFit {
     fn findings(&self) -> Vec<String> {
         self.fit.findings.clone()
     }
+    /// The torques (N m) of the robot carrying the payload at `q`, `qd`, `qdd` ((n,) each or
+    /// (k, n); or a Recording as `q`, alone, with its Coulomb column): the reference's (the
+    /// model of the robot alone, or the URDF), the payload's and the joint terms fitted beside
+    /// it. `coulomb`, shaped as `q`: the Coulomb term's column in place of sign(qd).
+    #[pyo3(signature = (q, qd=None, qdd=None, coulomb=None))]
+    fn predict<'py>(
+        &self,
+        py: Python<'py>,
+        q: Bound<'py, PyAny>,
+        qd: Option<Bound<'py, PyAny>>,
+        qdd: Option<Bound<'py, PyAny>>,
+        coulomb: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let a = states_of(q, qd, qdd, coulomb)?;
+        let reference = match &self.reference {
+            Some(m) => Reference::Model(m),
+            None => Reference::Urdf,
+        };
+        let (fit, robot) = (&self.fit, &self.robot);
+        at_states_with(
+            py,
+            robot.nv,
+            [&a.q, &a.qd, &a.qdd],
+            a.coulomb.as_ref(),
+            "PayloadFit.predict",
+            |s| fit.predict(robot, reference, s),
+        )
+    }
     /// The fit as the JSON document `perturbid identify-payload` writes as payload_fit.json.
     fn to_json(&self) -> String {
         serde_json::to_string_pretty(&self.fit).expect("serialisable")
@@ -259,5 +295,9 @@ pub(crate) fn identify_payload<'py>(
         payload_rs(robot_model, reference, &s, &c[3], &options)
     })?;
     super::errors::warn_all(py, &fit.findings)?;
-    Ok(PyPayloadFit { fit })
+    Ok(PyPayloadFit {
+        fit,
+        robot: Arc::new(robot_model.clone()),
+        reference: model.as_ref().map(|m| m.fit.clone()),
+    })
 }

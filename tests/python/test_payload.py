@@ -57,6 +57,10 @@ def test_the_ten_parameters_are_pinocchios_of_the_payload(a465):
     assert np.allclose(p["com"], PAYLOAD["com"], atol=1e-9)
     assert np.allclose(p["inertia"], PAYLOAD["inertia"], atol=1e-9)
     assert fit.usable and fit.findings == [] and fit.reference == "urdf"
+    # the robot carrying it, on another motion: Pinocchio's torques
+    t2, q2, qd2, qdd2, tau2 = log(loaded, 6)
+    assert np.allclose(fit.predict(q2, qd2, qdd2), tau2, rtol=1e-8, atol=1e-8)
+    assert fit.predict(q2[0], qd2[0], qdd2[0]).shape == (6,)
     # the payload is what a true robot and the drive gains take
     pr.TrueRobot({"payload": p})
     doc = json.loads(fit.to_json())
