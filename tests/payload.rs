@@ -274,6 +274,27 @@ fn a_log_without_the_payload_says_no_payload_is_seen() {
         "{:?}",
         fit.findings
     );
+    // a URDF heavier than the robot at the link: a negative mass, named as the reference's
+    let mut heavy = truth.clone();
+    let b = heavy.bodies.iter().position(|b| b.link == "link6").unwrap();
+    heavy.bodies[b].inertia.mass += 0.5;
+    heavy.refresh();
+    let fit = identify_payload(
+        &heavy,
+        reference,
+        &states(&s),
+        &tau,
+        &PayloadOptions::new("link6", &reference),
+    )
+    .unwrap();
+    assert!(fit.payload.is_none());
+    assert!(
+        fit.findings.iter().any(|f| f.contains("negative mass")
+            && f.contains("the URDF's parameters is heavier")
+            && f.contains("identify a model of the robot alone")),
+        "{:?}",
+        fit.findings
+    );
 }
 
 #[test]
@@ -601,4 +622,47 @@ fn a_point_mass_determines_a_small_payloads_mass_and_centre_better() {
             "{q:?} {sb:?}"
         );
     }
+}
+
+#[test]
+fn the_real_panda_log_holds_no_payload_against_a_model_of_its_first_half() {
+    // the real Franka Emika Panda log (docs/data.md): a model of the robot from its first
+    // half, the payload on the hand looked for in its second half, where there is none
+    let Some((model, rec)) = common::panda_preprocessed() else {
+        return;
+    };
+    let (k, n) = (rec.len(), model.nv);
+    let half = k / 2;
+    let states = rec.states().unwrap();
+    let options = BaseOptions {
+        friction: FrictionTerms::ALL,
+        ..BaseOptions::default()
+    };
+    let alone = identify_base_parameters(
+        &model,
+        &states.slice(0..half),
+        &rec.tau[..half * n],
+        &options,
+    )
+    .unwrap();
+    let reference = Reference::Model(&alone);
+    let fit = identify_payload(
+        &model,
+        reference,
+        &states.slice(half..k),
+        &rec.tau[half * n..],
+        &PayloadOptions::new("panda_hand", &reference),
+    )
+    .unwrap();
+    assert_eq!(fit.body, "panda_link7");
+    let (m, se) = (fit.theta[0], fit.stderr[0]);
+    assert!(m.abs() < 3.0 * se && se < 0.05, "{m} +- {se} kg");
+    assert!(fit.payload.is_none(), "{:?}", fit.payload);
+    assert!(
+        fit.findings
+            .iter()
+            .any(|f| f.starts_with("no payload on 'panda_hand' is seen")),
+        "{:?}",
+        fit.findings
+    );
 }

@@ -672,6 +672,20 @@ impl PayloadFit {
     fn judge(&mut self, cov: &DMatrix<f64>, pose: &Se3) {
         let pi = self.parameters();
         let (m, se_m) = (pi[0], self.stderr[0]);
+        if m < -SEEN * se_m {
+            self.findings.push(format!(
+                "the payload on '{}' comes out with a negative mass, {} +- {} kg (below 0 by more than {SEEN} standard errors): the {} is heavier at this link than the robot that made the log; {}",
+                self.link,
+                shown(m),
+                shown(se_m),
+                describe(&self.reference),
+                match self.reference.as_str() {
+                    "urdf" => "identify a model of the robot alone from a log without the payload, and give it as the reference",
+                    _ => "was the model identified on this robot, with the same tool flange, and the log taken with the payload on?",
+                }
+            ));
+            return;
+        }
         if !(m > SEEN * se_m && m > 0.0) {
             self.findings.push(format!(
                 "no payload on '{}' is seen: its mass comes out {} +- {} kg (not above 0 by {SEEN} standard errors), so its centre of mass and inertia are not determined; was it mounted while the log was taken, on this link?",
