@@ -339,22 +339,9 @@ fn load_of(model: &Model, payload: Option<&Payload>) -> Result<Option<(usize, [f
         return Ok(None);
     };
     let (b, i) = p.in_body(model)?;
-    let c = i.com * i.mass;
-    let r = i.inertia_origin();
     Ok(Some((
         b,
-        [
-            i.mass,
-            c.x,
-            c.y,
-            c.z,
-            r[(0, 0)],
-            r[(0, 1)],
-            r[(1, 1)],
-            r[(0, 2)],
-            r[(1, 2)],
-            r[(2, 2)],
-        ],
+        crate::algorithms::regressor::dynamic_parameters(&i),
     )))
 }
 

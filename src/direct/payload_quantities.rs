@@ -85,21 +85,7 @@ pub fn in_link_frame(u: &[f64; 10], cu: &DMatrix<f64>, pose: &Se3) -> ([f64; 10]
     (out, &a * cu * a.transpose())
 }
 
-/// The ten parameters `pi` (Pinocchio's order, about the link's joint frame) of `payload`.
+/// The ten parameters `pi` (Pinocchio's order, about its link's frame) of `payload`.
 pub fn parameters_of_payload(payload: &Payload) -> [f64; 10] {
-    let i = payload.spatial_inertia();
-    let h = i.com * i.mass;
-    let r = i.inertia_origin();
-    [
-        i.mass,
-        h.x,
-        h.y,
-        h.z,
-        r[(0, 0)],
-        r[(0, 1)],
-        r[(1, 1)],
-        r[(0, 2)],
-        r[(1, 2)],
-        r[(2, 2)],
-    ]
+    crate::algorithms::regressor::dynamic_parameters(&payload.spatial_inertia())
 }
