@@ -234,3 +234,61 @@ fn bad_arguments_are_refused_by_name_with_nothing_written() {
         &["holds no drive gains"],
     );
 }
+
+#[test]
+fn several_logs_are_fitted_together_and_each_is_checked_alone() {
+    let d = tmp("payload-several");
+    let a = log(&d, "a.csv", Some(TRUE_PAYLOAD), 3);
+    let b = log(&d, "b.csv", Some(TRUE_PAYLOAD), 4);
+    let out = ok(&[
+        "identify-payload",
+        "a465",
+        s(&a),
+        s(&b),
+        "--link",
+        "link6",
+        "--out",
+        s(&d.join("p")),
+    ]);
+    assert!(out.contains("of each log"), "{out}");
+    let p = payload_in(&d.join("p"));
+    assert!((p.mass - 1.5).abs() < 0.01, "{p:?}");
+    let fit: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("p/payload_fit.json")).unwrap())
+            .unwrap();
+    assert_eq!(fit["logs"][1], s(&b));
+    assert_eq!(fit["run_checks"].as_array().unwrap().len(), 2);
+    // the second log's shoulder torque in mN m: named by its log, and no payload written
+    let text = std::fs::read_to_string(&b).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    let col = header.split(',').position(|c| c.trim() == "tau2").unwrap();
+    let mut scaled = vec![header.to_string()];
+    for line in lines {
+        let mut cells: Vec<String> = line.split(',').map(str::to_string).collect();
+        let v: f64 = cells[col].trim().parse().unwrap();
+        cells[col] = format!("{}", v * 1000.0);
+        scaled.push(cells.join(","));
+    }
+    let units = d.join("units.csv");
+    write(&units, &(scaled.join("\n") + "\n"));
+    let warned = warnings_of(&[
+        "identify-payload",
+        "a465",
+        s(&a),
+        s(&units),
+        "--link",
+        "link6",
+        "--out",
+        s(&d.join("q")),
+    ]);
+    assert!(
+        warned.contains(&format!(
+            "log '{}': the torque of joint 'joint2' reads",
+            s(&units)
+        )),
+        "{warned}"
+    );
+    assert!(!warned.contains(&format!("log '{}'", s(&a))), "{warned}");
+    assert!(!d.join("q/payload.json").exists());
+}

@@ -945,7 +945,7 @@ class PayloadFit:
 
 def identify_payload(
     robot: Robot,
-    q: Union[ArrayLike, Recording],
+    q: Union[ArrayLike, Recording, Sequence[Recording]],
     qd: Optional[ArrayLike] = None,
     qdd: Optional[ArrayLike] = None,
     tau: Optional[ArrayLike] = None,

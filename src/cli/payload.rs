@@ -21,8 +21,10 @@ pub(crate) struct IdentifyPayloadArgs {
     #[command(flatten)]
     robot: RobotArg,
     /// The log CSV of the robot carrying the payload: t, q1..qN, tau1..tauN (qd, qdd
-    /// optional; preprocessed as for identify-direct).
-    data: PathBuf,
+    /// optional; preprocessed as for identify-direct). Several: logs of other motions with
+    /// the same payload, each read, preprocessed and checked alone and fitted together.
+    #[arg(required = true)]
+    data: Vec<PathBuf>,
     /// The URDF link the payload is fixed to (a moving link, or one behind fixed joints such
     /// as a flange or tool frame); the payload is given in its frame.
     #[arg(long)]
@@ -72,7 +74,8 @@ pub(crate) struct IdentifyPayloadArgs {
 }
 
 pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
-    let mut inputs = vec![a.data.as_path(), a.robot.path()];
+    let mut inputs: Vec<&std::path::Path> = a.data.iter().map(PathBuf::as_path).collect();
+    inputs.push(a.robot.path());
     inputs.extend(a.model.as_deref());
     refuse_overwriting_inputs(&a.out, &inputs)?;
     let model = a.robot.load()?;
@@ -129,50 +132,103 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
     .body(&model)?;
     let progress = Progress::new();
     let mut out = String::new();
-    let rec = (a.preprocessing).read(&a.data, &model.joint_names, &progress, &mut out)?;
-    let rec = match &gains {
-        Some(g) => {
-            let _ = writeln!(
-                out,
-                "the log's signal times the model's drive gains: torques"
-            );
-            rec.in_torques(g)?
-        }
-        None => rec,
-    };
-    let states = rec.states().map_err(in_log(&a.data))?;
-    let k = states.len();
-    let split = ((1.0 - a.validate) * k as f64).round() as usize;
-    if a.validate > 0.0 && split >= k {
-        return Err(Error::InvalidArgument {
-            argument: "--validate".into(),
-            message: format!(
-                "{} of {k} samples leaves none to validate on; give a larger fraction, or 0 for none",
-                shown(a.validate)
-            ),
-        });
+    let paths: Vec<&std::path::Path> = a.data.iter().map(PathBuf::as_path).collect();
+    let mut recs =
+        (a.preprocessing).read_logs(&paths, &model.joint_names, "DATA", &progress, &mut out)?;
+    if let Some(g) = &gains {
+        let _ = writeln!(
+            out,
+            "the log's signal times the model's drive gains: torques"
+        );
+        recs = recs
+            .into_iter()
+            .map(|r| r.in_torques(g))
+            .collect::<Result<_>>()?;
     }
     let n = model.nv;
-    progress.update(&format!("identifying on {split} samples"));
-    let fit = identify_payload(
-        &model,
-        reference,
-        &states.slice(0..split),
-        &rec.tau[..split * n],
-        &options,
-    )
-    .map_err(in_log(&a.data))?;
-    let validation = (split < k)
+    // each log's first samples are fitted to, its last validated on
+    let mut splits = Vec::with_capacity(recs.len());
+    for (rec, path) in recs.iter().zip(&a.data) {
+        let k = rec.len();
+        let split = ((1.0 - a.validate) * k as f64).round() as usize;
+        if a.validate > 0.0 && split >= k {
+            return Err(Error::InvalidArgument {
+                argument: "--validate".into(),
+                message: format!(
+                    "{} of {k} samples of {} leaves none to validate on; give a larger fraction, or 0 for none",
+                    shown(a.validate),
+                    path.display()
+                ),
+            });
+        }
+        splits.push(split);
+    }
+    let states = (recs.iter().zip(&a.data))
+        .map(|(r, path)| r.states().map_err(in_log(path)))
+        .collect::<Result<Vec<_>>>()?;
+    let names: Vec<String> = a.data.iter().map(|p| p.display().to_string()).collect();
+    let part = |held: bool| -> Result<crate::stacked_states::StackedStates> {
+        let parts: Vec<(crate::states::States<'_>, &[f64])> = (states.iter().zip(&recs))
+            .zip(&splits)
+            .map(|((s, r), &split)| {
+                let rows = if held { split..r.len() } else { 0..split };
+                (s.slice(rows.clone()), &r.tau[rows.start * n..rows.end * n])
+            })
+            .filter(|(s, _)| !s.is_empty())
+            .collect();
+        crate::stacked_states::StackedStates::of_named(&parts, &names, "DATA")
+    };
+    // several logs are stacked; one is read in place (a long log is not copied)
+    let stacked = match recs.len() {
+        1 => None,
+        _ => Some((
+            part(false)?,
+            (a.validate > 0.0).then(|| part(true)).transpose()?,
+        )),
+    };
+    type Part<'a> = (crate::states::States<'a>, &'a [f64]);
+    let (train, held): (Part<'_>, Part<'_>) = match &stacked {
+        None => {
+            let (s, r, split) = (&states[0], &recs[0], splits[0]);
+            (
+                (s.slice(0..split), &r.tau[..split * n]),
+                (s.slice(split..r.len()), &r.tau[split * n..]),
+            )
+        }
+        Some((t, h)) => {
+            let train = t.states()?;
+            let held = match h {
+                Some(h) => (h.states()?, &h.data[..]),
+                None => (train.slice(0..0), &[][..]),
+            };
+            ((train, &t.data[..]), held)
+        }
+    };
+    if let Some((t, _)) = &stacked {
+        options.runs = t.runs.clone();
+        options.log_names = names.clone();
+    }
+    // one log: the errors name it
+    let in_data = |e: Error| match recs.len() {
+        1 => in_log(&a.data[0])(e),
+        _ => e,
+    };
+    progress.update(&format!("identifying on {} samples", train.0.len()));
+    let fit = identify_payload(&model, reference, &train.0, train.1, &options).map_err(in_data)?;
+    let validation = (!held.0.is_empty())
         .then(|| -> Result<_> {
             progress.update("validating");
-            let held = states.slice(split..k);
-            let predicted = fit.predict(&model, reference, &held)?;
-            crate::validation::validate(&model.joint_names, &predicted, &rec.tau[split * n..])
+            let predicted = fit.predict(&model, reference, &held.0)?;
+            crate::validation::validate(&model.joint_names, &predicted, held.1)
         })
         .transpose()?;
     progress.done();
     for w in &fit.findings {
-        eprintln!("perturbid: warning: log '{}': {w}", a.data.display());
+        match recs.len() {
+            1 => eprintln!("perturbid: warning: log '{}': {w}", a.data[0].display()),
+            // each log's findings name it
+            _ => eprintln!("perturbid: warning: {w}"),
+        }
     }
     let mut set = OutputSet::new(&a.out, "payload");
     if let Some(p) = fit.usable_payload() {
@@ -190,8 +246,9 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
     if let Some(v) = validation {
         let _ = writeln!(
             out,
-            "validation of the robot carrying the payload on the last {} samples: per joint RMS (N m) and relative RMS (%)",
-            v.samples
+            "validation of the robot carrying the payload on the last {} samples{}: per joint RMS (N m) and relative RMS (%)",
+            v.samples,
+            if a.data.len() > 1 { " of each log" } else { "" }
         );
         for e in &v.joints {
             let _ = writeln!(

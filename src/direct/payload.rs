@@ -30,7 +30,7 @@ use super::identify::{BaseModel, Weighting};
 use super::parameters::{regressor_blocks, FrictionTerms, ParameterLayout};
 use super::payload_estimate as estimate;
 pub use super::payload_quantities::{in_link_frame, parameters_of_payload, payload_of_parameters};
-use super::residual_correlation::{long_run_factors, SAMPLES};
+use super::residual_correlation::{combine, long_run_factors, SAMPLES, SAMPLES_A_RUN};
 use super::streaming::JointFactors;
 use crate::algorithms::regressor::PARAMS_PER_BODY;
 use crate::error::{shown, Error, Result};
@@ -121,6 +121,12 @@ pub struct PayloadOptions {
     pub gravity: Gravity,
     /// How the payload's inertia about its centre of mass is taken (default: fitted).
     pub inertia: PayloadInertia,
+    /// Several logs one after the other: the samples of each, in order, adding up to all
+    /// (empty for one log). Each log is checked alone against the robot's model, and its
+    /// residuals are read as a time series of their own.
+    pub runs: Vec<usize>,
+    /// The logs' names for the findings (one a log, or none: `run r`).
+    pub log_names: Vec<String>,
     /// A physically consistent payload: the least squares over the ten parameters whose
     /// pseudo-inertia is positive semi-definite (a rigid body), the joint terms free
     /// (default false: the plain least squares, which can leave a loosely determined inertia
@@ -145,6 +151,8 @@ impl PayloadOptions {
             weighting: Weighting::Wls,
             gravity: Gravity::Included,
             inertia: PayloadInertia::Fitted,
+            runs: vec![],
+            log_names: vec![],
             consistent: false,
         }
     }
@@ -237,6 +245,11 @@ pub struct PayloadFit {
     pub torque_columns: Vec<super::TorqueColumn>,
     /// The joints whose positions leave their limits ([`super::position_range`]).
     pub position_range: Vec<super::position_range::JointRange>,
+    /// Over several logs, their names (`run r` where none was given) and each one's checks
+    /// alone against the robot's model (empty for one log): where one log's torque column
+    /// reads wrong, the payload is not vouched for.
+    pub logs: Vec<String>,
+    pub run_checks: Vec<super::RunChecks>,
     /// What the fit cannot vouch for, in words (each also warned of by the front ends).
     pub findings: Vec<String>,
 }
@@ -378,6 +391,17 @@ pub fn identify_payload(
         &model.joint_names,
         crate::torque_model::FOR_A_FIT,
     )?;
+    super::runs::check_runs(&options.runs, states.len())?;
+    if !(options.log_names.is_empty() || options.log_names.len() == options.runs.len()) {
+        return Err(Error::InvalidArgument {
+            argument: "log_names".into(),
+            message: format!(
+                "{} names for {} logs, expected one a log or none",
+                options.log_names.len(),
+                options.runs.len()
+            ),
+        });
+    }
     let (body, pose) =
         crate::rehearsal::link_in_body(model, &options.link).map_err(|e| match e {
             Error::InvalidArgument { message, .. } => Error::InvalidArgument {
@@ -477,32 +501,40 @@ pub fn identify_payload(
     let theta = e.theta.clone();
     let pi = DVector::from_column_slice(&theta);
     // the residuals' correlation from sample to sample, and the payload's torques, over the
-    // first samples
-    let head = k.min(SAMPLES);
-    let mut residuals = Vec::with_capacity(head * nv);
-    let mut payload_squares = vec![0.0; nv];
+    // first samples of each log (each log's residuals a time series of its own)
+    let whole = [k];
+    let runs: &[usize] = if options.runs.len() > 1 {
+        &options.runs
+    } else {
+        &whole
+    };
+    let head = (SAMPLES / runs.len()).max(SAMPLES_A_RUN);
+    let (mut factors_of_runs, mut payload_squares, mut heads) = (vec![], vec![0.0; nv], 0);
     let pi_payload = pi.rows(0, PARAMS_PER_BODY).into_owned();
-    regressor_blocks(
-        model,
-        ref_layout,
-        &states.slice(0..head),
-        options.gravity,
-        |range, phi| {
-            let local = states.slice(0..head);
+    let mut first = 0;
+    for &len in runs {
+        let rows = first..first + len.min(head);
+        let part = states.slice(rows.clone());
+        let mut residuals = Vec::with_capacity(rows.len() * nv);
+        regressor_blocks(model, ref_layout, &part, options.gravity, |range, phi| {
             for (i, s) in range.clone().enumerate() {
                 for j in 0..nv {
                     let r = i * nv + j;
-                    columns.row(phi, r, &local, s, j, &mut row);
+                    columns.row(phi, r, &part, s, j, &mut row);
                     let fitted: f64 = row.iter().zip(pi.iter()).map(|(a, b)| a * b).sum();
-                    residuals.push(y[s * nv + j] - fitted);
+                    residuals.push(y[(rows.start + s) * nv + j] - fitted);
                     let own: f64 = (0..PARAMS_PER_BODY).map(|c| row[c] * pi_payload[c]).sum();
                     payload_squares[j] += own * own;
                 }
             }
             Ok(())
-        },
-    )?;
-    let residual_correlation = long_run_factors(&residuals, nv);
+        })?;
+        factors_of_runs.push((long_run_factors(&residuals, nv), len));
+        heads += rows.len();
+        first += len;
+    }
+    let head = heads;
+    let residual_correlation = combine(&factors_of_runs, nv);
     let inflation = residual_correlation
         .iter()
         .fold(1.0f64, |a, &f| a.max(f))
@@ -577,6 +609,13 @@ pub fn identify_payload(
         residual_correlation,
         torque_columns: vec![],
         position_range: vec![],
+        logs: match options.runs.len() {
+            0 | 1 => vec![],
+            n => (0..n)
+                .map(|r| crate::stacked_states::run_name(&options.log_names, r))
+                .collect(),
+        },
+        run_checks: vec![],
         findings: vec![],
     };
     // the log against the robot's model, as every direct fit checks its log: a torque column
@@ -585,9 +624,24 @@ pub fn identify_payload(
     fit.torque_columns =
         super::torque_columns::check_torque_columns(model, states, tau, options.gravity)?;
     fit.position_range = super::position_range::check_position_range(model, states);
-    fit.findings = super::torque_columns::findings(&fit.torque_columns);
-    fit.findings
-        .extend(super::position_range::finding(&fit.position_range));
+    fit.run_checks =
+        super::check_runs_against_model(model, states, tau, &options.runs, options.gravity)?;
+    fit.findings = match fit.run_checks.is_empty() {
+        true => {
+            let mut f = super::torque_columns::findings(&fit.torque_columns);
+            f.extend(super::position_range::finding(&fit.position_range));
+            f
+        }
+        // each log named by its own findings; the stacked samples' columns where no log's
+        // are named (what makes the payload not vouched for is always said)
+        false => {
+            let mut f = super::run_checks::findings(&fit.run_checks, &fit.logs);
+            if !fit.run_checks.iter().any(|c| c.columns_wrong()) {
+                f.extend(super::torque_columns::findings(&fit.torque_columns));
+            }
+            f
+        }
+    };
     fit.judge(&cov, &pose);
     Ok(fit)
 }
@@ -770,7 +824,8 @@ impl PayloadFit {
     /// The payload ready to use: present, a rigid body, and from a log whose torque columns
     /// read as the robot's (None otherwise; see [`Self::findings`]).
     pub fn usable_payload(&self) -> Option<&Payload> {
-        let columns_right = super::torque_columns::findings(&self.torque_columns).is_empty();
+        let columns_right = super::torque_columns::findings(&self.torque_columns).is_empty()
+            && !self.run_checks.iter().any(|c| c.columns_wrong());
         self.payload
             .as_ref()
             .filter(|_| (self.consistent || self.not_a_rigid_body.is_none()) && columns_right)

@@ -13,6 +13,7 @@ use super::direct::{
     check_sample_derivatives, coulomb_column, fit_states, friction_terms, states, states_of,
     FrictionNames, PyBaseModel,
 };
+use super::recording_list::{recordings_given, stacked_recordings};
 use super::robot::PyRobot;
 use super::samples::{samples, Given};
 use crate::direct::BaseModel;
@@ -217,7 +218,8 @@ impl PyPayloadFit {
 /// Identifies the payload fixed to `link` (a link of `robot` that moves: a body's own, or one
 /// behind fixed joints such as a flange or tool frame; the payload in its frame) from a log of the robot carrying it: `q`, `qd`, `qdd`, `tau` (each (k, n); rad,
 /// rad/s, rad/s^2, N m), or a Recording as `q` alone (`preprocess`'s: its states, torques,
-/// time and Coulomb column).
+/// time and Coulomb column), or a list of them (logs of other motions with the same payload,
+/// fitted together, each checked alone against the robot's model and named in its findings).
 ///
 /// `model`: a BaseParameterModel of the robot without the payload, identified with
 /// `identify_base_parameters` (or `identify_drive_gains`: then give the Recording in torques,
@@ -285,6 +287,30 @@ pub(crate) fn identify_payload<'py>(
         t,
         coulomb,
     };
+    // a list of Recordings: logs fitted together, each checked alone
+    if let Some(recs) = recordings_given(&q, &given)? {
+        let fit = detached(py, "identify_payload", || {
+            let (stacked, stacked_options) =
+                stacked_recordings(robot_model, &recs, &Default::default())?;
+            if recs.len() > 1 {
+                options.runs = stacked_options.runs;
+                options.log_names = recs.iter().map(|r| r.name.clone()).collect();
+            }
+            payload_rs(
+                robot_model,
+                reference,
+                &stacked.states()?,
+                &stacked.data,
+                &options,
+            )
+        })?;
+        super::errors::warn_all(py, &fit.findings)?;
+        return Ok(PyPayloadFit {
+            fit,
+            robot: Arc::new(robot_model.clone()),
+            reference: model.as_ref().map(|m| m.fit.clone()),
+        });
+    }
     let a = samples(q, given, true, true)?.arrays()?;
     let c = states(n, &a.q, &a.qd, &a.qdd, a.tau.as_ref())?;
     let coulomb = coulomb_column(n, a.coulomb.as_ref())?;

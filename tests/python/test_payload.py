@@ -221,3 +221,27 @@ def test_a_point_mass_from_poses_held_still(a465):
     with pytest.raises(pr.InputError, match="rigid body already"):
         pr.identify_payload(pair.ours, q, zero, zero, tau, link="link6", terms="offset",
                             inertia="point_mass", consistent=True)
+
+
+def test_several_recordings_are_fitted_together_and_each_checked_alone(a465):
+    pair, loaded = a465
+    recs = []
+    for seed in (4, 5):
+        t, q, qd, qdd, tau = log(loaded, seed, noise=0.01)
+        recs.append(pr.Recording(t, q, tau, qd=qd, qdd=qdd, name=f"day{seed}.csv"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pr.PerturbidWarning)
+        fit = pr.identify_payload(pair.ours, recs, link="link6", terms="viscous")
+    assert fit.usable and abs(fit.payload["mass"] - 1.5) < 4 * fit.payload_stderr["mass"]
+    doc = json.loads(fit.to_json())
+    assert doc["logs"] == ["day4.csv", "day5.csv"] and len(doc["run_checks"]) == 2
+    assert fit.samples == sum(len(r.t) for r in recs)
+    # the second day's shoulder torque in mN m: named by it, the payload not vouched for
+    t, q, qd, qdd, tau = log(loaded, 5, noise=0.01)
+    tau[:, 1] *= 1000.0
+    bad = pr.Recording(t, q, tau, qd=qd, qdd=qdd, name="units.csv")
+    with pytest.warns(pr.PerturbidWarning, match="log 'units.csv': the torque of joint 'joint2'"):
+        fit = pr.identify_payload(pair.ours, [recs[0], bad], link="link6", terms="viscous")
+    assert not fit.usable and fit.payload is None
+    with pytest.raises(pr.InputError, match="pass the list alone"):
+        pr.identify_payload(pair.ours, recs, q, link="link6")
