@@ -666,3 +666,58 @@ fn the_real_panda_log_holds_no_payload_against_a_model_of_its_first_half() {
         fit.findings
     );
 }
+
+#[test]
+fn the_references_share_of_the_errors_is_the_dense_propagation() {
+    // G Phi_base Cov(theta) Phi_base^T G^T, G = (A^T W A)^-1 A^T W, built whole
+    use nalgebra::{DMatrix, DVector};
+    use perturbid_rs::direct::{regressor_matrix, ParameterLayout};
+    let (truth, p) = (truth(), payload());
+    let (a, b) = (motion(3), motion(4));
+    let alone = loaded_torques(&truth, None, 3, 0.02);
+    let model =
+        identify_base_parameters(&truth, &states(&a), &alone, &BaseOptions::default()).unwrap();
+    let k = 600;
+    let sub = states(&b).slice(0..k);
+    let loaded = loaded_torques(&truth, Some(&p), 4, 0.02);
+    let reference = Reference::Model(&model);
+    let fit = identify_payload(
+        &truth,
+        reference,
+        &sub,
+        &loaded[..k * 6],
+        &PayloadOptions::new("link6", &reference),
+    )
+    .unwrap();
+    let layout = ParameterLayout::new(&truth, FrictionTerms::NONE);
+    let phi_full = regressor_matrix(&truth, &layout, &sub, Gravity::Included).unwrap();
+    let body = truth.bodies.iter().position(|x| x.link == "link6").unwrap();
+    // the unknowns: the payload's ten columns and an offset a joint
+    let m = 16;
+    let x = DMatrix::from_fn(6 * k, m, |r, c| match c {
+        c if c < 10 => phi_full[(r, 10 * body + c)],
+        c => f64::from(r % 6 == c - 10),
+    });
+    let ref_layout = &model.base.layout;
+    let phi_ref = model
+        .base
+        .select(&regressor_matrix(&truth, ref_layout, &sub, Gravity::Included).unwrap());
+    let w = DVector::from_fn(6 * k, |r, _| 1.0 / fit.sigma[r % 6].powi(2));
+    let xtw = x.transpose() * DMatrix::from_diagonal(&w);
+    let g = (&xtw * &x).try_inverse().unwrap() * xtw;
+    let pr = model.theta.len();
+    let cov = DMatrix::from_fn(pr, pr, |a, b| {
+        model.stderr[a] * model.correlation[(a, b)] * model.stderr[b]
+    });
+    let gp = g * phi_ref;
+    let carried = &gp * cov * gp.transpose();
+    for i in 0..m {
+        let want = carried[(i, i)].sqrt();
+        let got = fit.stderr_of_reference[i];
+        assert!(
+            (got - want).abs() < 1e-8 * want,
+            "{}: {got} vs {want}",
+            fit.names[i]
+        );
+    }
+}

@@ -433,13 +433,21 @@ pub fn identify_payload(
         };
         for (i, s) in range.clone().enumerate() {
             for j in 0..nv {
-                let r = i * nv + j;
-                y.push(tau[s * nv + j] - predicted[r]);
-                if let Some(f) = &rows_ref {
-                    columns.row(phi, r, states, s, j, &mut row);
-                    let a = DVector::from_column_slice(&row);
-                    cross[j].ger(1.0, &a, &f.row(r).transpose(), 1.0);
+                y.push(tau[s * nv + j] - predicted[i * nv + j]);
+            }
+        }
+        // per joint, the block's rows of the unknowns' and the reference's columns: one
+        // product each
+        if let Some(f) = &rows_ref {
+            let len = range.len();
+            for (j, cross) in cross.iter_mut().enumerate() {
+                let mut a = DMatrix::zeros(len, m);
+                for (i, s) in range.clone().enumerate() {
+                    columns.row(phi, i * nv + j, states, s, j, &mut row);
+                    a.row_mut(i).copy_from_slice(&row);
                 }
+                let b = DMatrix::from_fn(len, p_ref, |i, c| f[(i * nv + j, c)]);
+                cross.gemm_tr(1.0, &a, &b, 1.0);
             }
         }
         Ok(())
