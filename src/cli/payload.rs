@@ -161,6 +161,16 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
                 ),
             });
         }
+        if split == 0 {
+            return Err(Error::InvalidArgument {
+                argument: "--validate".into(),
+                message: format!(
+                    "{} of {k} samples of {} leaves none to fit to; give a smaller fraction",
+                    shown(a.validate),
+                    path.display()
+                ),
+            });
+        }
         splits.push(split);
     }
     let states = (recs.iter().zip(&a.data))
