@@ -194,36 +194,13 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     let model = a.robot.load()?;
     let progress = Progress::new();
     let mut out = String::new();
-    if !(0.0..1.0).contains(&a.validate) {
-        return Err(Error::InvalidArgument {
-            argument: "--validate".into(),
-            message: format!(
-                "{}; expected a fraction in [0, 1)",
-                crate::error::shown(a.validate)
-            ),
-        });
-    }
+    super::files::check_validate_fraction(a.validate)?;
     let paths: Vec<&std::path::Path> = a.data.iter().map(PathBuf::as_path).collect();
     let recs =
         (a.preprocessing).read_logs(&paths, &model.joint_names, "DATA", &progress, &mut out)?;
     let n = model.nv;
     // each log's first samples are fitted to, its last validated on
-    let mut splits = Vec::with_capacity(recs.len());
-    for (rec, path) in recs.iter().zip(&a.data) {
-        let k = rec.len();
-        let split = ((1.0 - a.validate) * k as f64).round() as usize;
-        if a.validate > 0.0 && split >= k {
-            return Err(Error::InvalidArgument {
-                argument: "--validate".into(),
-                message: format!(
-                    "{} of {k} samples{} leaves none to validate on; give a larger fraction, or 0 for none",
-                    crate::error::shown(a.validate),
-                    if recs.len() > 1 { format!(" of {}", path.display()) } else { String::new() }
-                ),
-            });
-        }
-        splits.push(split);
-    }
+    let splits = super::files::fit_splits(a.validate, &recs, &a.data)?;
     let logs_states = (recs.iter().zip(&a.data))
         .map(|(r, path)| r.states().map_err(in_log(path)))
         .collect::<Result<Vec<_>>>()?;

@@ -350,3 +350,54 @@ impl PreprocessArgs {
         Ok(rec)
     }
 }
+
+/// `--validate FRACTION` of `identify-direct` and `identify-payload`: refused outside [0, 1).
+pub(crate) fn check_validate_fraction(fraction: f64) -> Result<()> {
+    if (0.0..1.0).contains(&fraction) {
+        return Ok(());
+    }
+    Err(Error::InvalidArgument {
+        argument: "--validate".into(),
+        message: format!(
+            "{}; expected a fraction in [0, 1)",
+            crate::error::shown(fraction)
+        ),
+    })
+}
+
+/// Each log's samples to fit to, its first (1 - `fraction`); the rest are validated on.
+/// Refused where the fraction leaves a log none to validate on, or none to fit to (naming the
+/// log where there are several).
+pub(crate) fn fit_splits(
+    fraction: f64,
+    recs: &[crate::recording::Recording],
+    paths: &[PathBuf],
+) -> Result<Vec<usize>> {
+    let mut splits = Vec::with_capacity(recs.len());
+    for (rec, path) in recs.iter().zip(paths) {
+        let k = rec.len();
+        let split = ((1.0 - fraction) * k as f64).round() as usize;
+        let of = match recs.len() {
+            1 => String::new(),
+            _ => format!(" of {}", path.display()),
+        };
+        let problem = match split {
+            s if fraction > 0.0 && s >= k => {
+                Some("leaves none to validate on; give a larger fraction, or 0 for none")
+            }
+            0 => Some("leaves none to fit to; give a smaller fraction"),
+            _ => None,
+        };
+        if let Some(problem) = problem {
+            return Err(Error::InvalidArgument {
+                argument: "--validate".into(),
+                message: format!(
+                    "{} of {k} samples{of} {problem}",
+                    crate::error::shown(fraction)
+                ),
+            });
+        }
+        splits.push(split);
+    }
+    Ok(splits)
+}

@@ -116,12 +116,7 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
     options.gravity = Gravity::from(!a.no_gravity);
     options.consistent = a.consistent;
     options.inertia = crate::direct::PayloadInertia::parse(&a.inertia)?;
-    if !(0.0..1.0).contains(&a.validate) {
-        return Err(Error::InvalidArgument {
-            argument: "--validate".into(),
-            message: format!("{}; expected a fraction in [0, 1)", shown(a.validate)),
-        });
-    }
+    super::files::check_validate_fraction(a.validate)?;
     // a link the robot lacks is named before the log is read
     crate::rehearsal::Payload {
         link: a.link.clone(),
@@ -147,32 +142,7 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
     }
     let n = model.nv;
     // each log's first samples are fitted to, its last validated on
-    let mut splits = Vec::with_capacity(recs.len());
-    for (rec, path) in recs.iter().zip(&a.data) {
-        let k = rec.len();
-        let split = ((1.0 - a.validate) * k as f64).round() as usize;
-        if a.validate > 0.0 && split >= k {
-            return Err(Error::InvalidArgument {
-                argument: "--validate".into(),
-                message: format!(
-                    "{} of {k} samples of {} leaves none to validate on; give a larger fraction, or 0 for none",
-                    shown(a.validate),
-                    path.display()
-                ),
-            });
-        }
-        if split == 0 {
-            return Err(Error::InvalidArgument {
-                argument: "--validate".into(),
-                message: format!(
-                    "{} of {k} samples of {} leaves none to fit to; give a smaller fraction",
-                    shown(a.validate),
-                    path.display()
-                ),
-            });
-        }
-        splits.push(split);
-    }
+    let splits = super::files::fit_splits(a.validate, &recs, &a.data)?;
     let states = (recs.iter().zip(&a.data))
         .map(|(r, path)| r.states().map_err(in_log(path)))
         .collect::<Result<Vec<_>>>()?;

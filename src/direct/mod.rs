@@ -20,6 +20,7 @@ pub mod parameter_table;
 pub mod parameters;
 pub mod payload;
 pub mod payload_estimate;
+pub mod payload_fit;
 pub mod payload_quantities;
 pub mod position_offsets;
 pub mod position_range;
