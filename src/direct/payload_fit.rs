@@ -45,7 +45,7 @@ pub struct PayloadStderr {
     pub inertia: [f64; 6],
 }
 
-/// An identified payload ([`identify_payload`]).
+/// An identified payload ([`super::payload::identify_payload`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PayloadFit {
@@ -94,7 +94,7 @@ pub struct PayloadFit {
     /// (then its standard errors are 0: it was not estimated).
     pub inertia: PayloadInertia,
     /// Whether [`Self::theta`] and [`Self::payload`] are the physically consistent estimate
-    /// ([`PayloadOptions::consistent`]); its standard errors are the unconstrained fit's,
+    /// ([`super::PayloadOptions::consistent`]); its standard errors are the unconstrained fit's,
     /// which hold where no constraint is active.
     pub consistent: bool,
     /// For a consistent estimate, the weighted residual sum of squares over the unconstrained
