@@ -7,28 +7,20 @@
 
 mod common;
 
-use common::gain_logs::{motion, payload, states, truth};
+use common::gain_logs::{carrying, motion, payload, states, truth};
 use common::{torques_with_friction, Rng};
 use perturbid_rs::direct::payload::{parameters_of_payload, payload_of_parameters};
 use perturbid_rs::direct::{
     identify_base_parameters, identify_payload, BaseOptions, FrictionTerms, PayloadOptions,
     Reference,
 };
-use perturbid_rs::rehearsal::{Payload, TrueRobot};
+use perturbid_rs::rehearsal::Payload;
 use perturbid_rs::{Error, Gravity, Model};
 
 /// The torques of `truth` with `p` fixed on (none where None) along motion `seed`, with the
 /// common friction and `noise` N m of white noise.
 fn loaded_torques(truth: &Model, p: Option<&Payload>, seed: u64, noise: f64) -> Vec<f64> {
-    let robot = match p {
-        Some(p) => TrueRobot {
-            payload: Some(p.clone()),
-            ..TrueRobot::default()
-        }
-        .rigid_body_model(truth)
-        .unwrap(),
-        None => truth.clone(),
-    };
+    let robot = carrying(truth, p);
     let s = motion(seed);
     torques_with_friction(&robot, &s, &mut Rng(seed + 100), |r| {
         noise * common::normal(r)
@@ -534,12 +526,7 @@ fn a_point_mass_comes_back_exactly_and_from_poses_held_still() {
         .collect();
     let zeros = vec![0.0; q.len()];
     let held = perturbid_rs::States::new(6, &q, Some(&zeros), Some(&zeros)).unwrap();
-    let loaded = TrueRobot {
-        payload: Some(point.clone()),
-        ..TrueRobot::default()
-    }
-    .rigid_body_model(&truth)
-    .unwrap();
+    let loaded = carrying(&truth, Some(&point));
     let mut tau = vec![0.0; q.len()];
     perturbid_rs::parallel::rnea(
         &loaded,

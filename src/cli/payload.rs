@@ -9,7 +9,8 @@ use clap::Args;
 use super::files::{in_log, refuse_overwriting_inputs, PreprocessArgs, RobotArg};
 use super::progress::Progress;
 use crate::direct::{
-    identify_payload, FrictionTerms, PayloadFit, PayloadOptions, Reference, Weighting,
+    identify_payload, FrictionTerms, PayloadFit, PayloadInertia, PayloadOptions, Reference,
+    Weighting,
 };
 use crate::error::{shown, Error, Result};
 use crate::gravity::Gravity;
@@ -53,8 +54,8 @@ pub(crate) struct IdentifyPayloadArgs {
     /// How the payload's inertia about its centre of mass is taken: fitted (all ten
     /// parameters), or point_mass (0: the mass and centre of mass alone fitted, for a log that
     /// determines a small payload's inertia loosely or not at all, as poses held still do).
-    #[arg(long, default_value = "fitted", value_parser = ["fitted", "point_mass"])]
-    inertia: String,
+    #[arg(long, value_enum, default_value_t = PayloadInertia::Fitted)]
+    inertia: PayloadInertia,
     /// The log's tau columns hold the signal the model's drive gains were identified for
     /// (motor currents; --model from identify-gains): each is multiplied by its joint's gain.
     #[arg(long)]
@@ -115,7 +116,7 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
     options.weighting = a.weighting;
     options.gravity = Gravity::from(!a.no_gravity);
     options.consistent = a.consistent;
-    options.inertia = crate::direct::PayloadInertia::parse(&a.inertia)?;
+    options.inertia = a.inertia;
     super::files::check_validate_fraction(a.validate)?;
     // a link the robot lacks is named before the log is read
     crate::rehearsal::Payload {
@@ -269,7 +270,7 @@ fn report(fit: &PayloadFit, out: &std::path::Path) -> String {
                     p.com[i], se.com[i]
                 );
             }
-            let point_mass = fit.inertia == crate::direct::PayloadInertia::PointMass;
+            let point_mass = fit.inertia == PayloadInertia::PointMass;
             if point_mass {
                 let _ = writeln!(s, "  inertia about the centre of mass: 0 (a point mass)");
             }

@@ -37,6 +37,7 @@ pub use super::payload_quantities::{in_link_frame, parameters_of_payload, payloa
 use super::residual_correlation::{combine, long_run_factors, SAMPLES, SAMPLES_A_RUN};
 use super::streaming::JointFactors;
 use crate::algorithms::regressor::PARAMS_PER_BODY;
+use crate::choice::choice;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
@@ -53,38 +54,17 @@ pub enum Reference<'a> {
     Model(&'a BaseModel),
 }
 
-/// How a payload's inertia about its centre of mass is taken ([`PayloadOptions::inertia`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum PayloadInertia {
-    /// Fitted with the mass and the centre of mass: all ten parameters.
-    #[default]
-    Fitted,
-    /// Taken as 0 (a point mass): the mass and centre of mass alone are fitted, for logs that
-    /// determine a small payload's inertia loosely or not at all (slow motion, or poses held
-    /// still), and the payload given has no inertia about its centre.
-    PointMass,
-}
-
-impl PayloadInertia {
-    /// Its name on the command line and in files: `fitted`, `point_mass`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Fitted => "fitted",
-            Self::PointMass => "point_mass",
-        }
-    }
-
-    /// The choice of `name` ([`Self::name`]).
-    pub fn parse(name: &str) -> Result<Self> {
-        match name {
-            "fitted" => Ok(Self::Fitted),
-            "point_mass" => Ok(Self::PointMass),
-            other => Err(Error::InvalidArgument {
-                argument: "inertia".into(),
-                message: format!("'{other}', expected 'fitted' or 'point_mass'"),
-            }),
-        }
+choice! {
+    /// How a payload's inertia about its centre of mass is taken ([`PayloadOptions::inertia`]).
+    #[derive(Serialize, Deserialize)]
+    #[serde(rename_all = "snake_case")]
+    pub enum PayloadInertia ("inertia") {
+        /// Fitted with the mass and the centre of mass: all ten parameters.
+        Fitted = "fitted",
+        /// Taken as 0 (a point mass): the mass and centre of mass alone are fitted, for logs
+        /// that determine a small payload's inertia loosely or not at all (slow motion, or
+        /// poses held still), and the payload given has no inertia about its centre.
+        PointMass = "point_mass",
     }
 }
 
@@ -313,11 +293,9 @@ pub fn identify_payload(
     let mut cross = vec![DMatrix::<f64>::zeros(m, p_ref); nv];
     let mut row = vec![0.0; m];
     regressor_blocks(model, ref_layout, states, options.gravity, |range, phi| {
+        // the reference's columns of the block: its base parameters', or the URDF's all
         let rows_ref = base_of_reference.map(|b| b.select(phi));
-        let predicted = match &rows_ref {
-            Some(rows) => rows * ref_theta,
-            None => phi * ref_theta,
-        };
+        let predicted = rows_ref.as_ref().unwrap_or(phi) * ref_theta;
         for (i, s) in range.clone().enumerate() {
             for j in 0..nv {
                 y.push(tau[s * nv + j] - predicted[i * nv + j]);

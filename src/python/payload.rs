@@ -20,7 +20,6 @@ use crate::direct::BaseModel;
 use crate::direct::{
     identify_payload as payload_rs, PayloadFit, PayloadOptions, Reference, Weighting,
 };
-use crate::error::Error;
 use crate::gravity::Gravity;
 use crate::model::Model;
 use crate::rehearsal::Payload;
@@ -266,20 +265,10 @@ pub(crate) fn identify_payload<'py>(
     if terms.is_some() {
         options.terms = friction_terms(terms)?;
     }
-    options.weighting = match weighting {
-        "wls" => Weighting::Wls,
-        "ols" => Weighting::Ols,
-        other => {
-            return Err(Error::InvalidArgument {
-                argument: "weighting".into(),
-                message: format!("'{other}', expected 'wls' or 'ols'"),
-            }
-            .into())
-        }
-    };
+    options.weighting = weighting.parse::<Weighting>()?;
     options.gravity = Gravity::from(gravity);
     options.consistent = consistent;
-    options.inertia = crate::direct::PayloadInertia::parse(inertia)?;
+    options.inertia = inertia.parse()?;
     let given = Given {
         qd,
         qdd,

@@ -31,6 +31,19 @@ pub fn motion(seed: u64) -> Samples {
     traj.sample(&t)
 }
 
+/// `truth` with `payload` fixed on (itself where None).
+pub fn carrying(truth: &Model, payload: Option<&Payload>) -> Model {
+    match payload {
+        Some(p) => TrueRobot {
+            payload: Some(p.clone()),
+            ..TrueRobot::default()
+        }
+        .rigid_body_model(truth)
+        .unwrap(),
+        None => truth.clone(),
+    }
+}
+
 /// The logged currents of `truth` (with the payload when given) along `s`: torques with
 /// friction over the gains, plus `noise` A of white noise.
 pub fn currents(
@@ -40,15 +53,7 @@ pub fn currents(
     noise: f64,
     seed: u64,
 ) -> Vec<f64> {
-    let robot = match loaded {
-        Some(p) => TrueRobot {
-            payload: Some(p.clone()),
-            ..TrueRobot::default()
-        }
-        .rigid_body_model(truth)
-        .unwrap(),
-        None => truth.clone(),
-    };
+    let robot = carrying(truth, loaded);
     let mut rng = Rng(seed);
     let tau = torques_with_friction(&robot, s, &mut rng, |_| 0.0);
     (tau.iter().enumerate())
@@ -165,12 +170,7 @@ pub fn dense_system(
     payload: &Payload,
     runs: [(&Samples, &[f64], bool); 2],
 ) -> (DMatrix<f64>, DVector<f64>) {
-    let loaded = TrueRobot {
-        payload: Some(payload.clone()),
-        ..TrueRobot::default()
-    }
-    .rigid_body_model(truth)
-    .unwrap();
+    let loaded = carrying(truth, Some(payload));
     let mut rows = Vec::new();
     let mut rhs = Vec::new();
     for (s, i, with) in runs {
