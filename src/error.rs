@@ -328,6 +328,14 @@ pub enum Error {
     #[error("{context}: interrupted")]
     Interrupted { context: String },
 
+    /// A model that cannot be written as URDF (see `crate::urdf::write_urdf`).
+    #[error("cannot write a URDF of '{robot}': {element}: {message}")]
+    UrdfExport {
+        robot: String,
+        element: String,
+        message: String,
+    },
+
     /// A bug of this library (a panic), caught at its boundary.
     #[error("internal error in {context}: {message} (a bug in perturbid_rs: please report it)")]
     Internal { context: String, message: String },
@@ -381,6 +389,7 @@ impl Error {
             | Error::InvalidDynamics { .. }
             | Error::NoDegreeOfFreedom { .. }
             | Error::TooManyBodies { .. }
+            | Error::UrdfExport { .. }
             | Error::UnknownRobot { .. } => ErrorKind::Model,
             Error::Interrupted { .. } => ErrorKind::Interrupted,
             Error::Internal { .. } => ErrorKind::Internal,

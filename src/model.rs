@@ -279,6 +279,9 @@ pub struct Model {
     pub coupled: bool,
     /// Line of each moving joint in its URDF source, by body index (for error messages).
     pub(crate) joint_lines: Vec<Option<u32>>,
+    /// The URDF text the model was built from, with the options it was built with: what
+    /// [`crate::urdf::write_urdf`] writes the model's parameters into.
+    pub(crate) urdf: std::sync::Arc<crate::urdf::UrdfSource>,
 }
 
 impl Model {

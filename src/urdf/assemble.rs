@@ -95,6 +95,10 @@ impl Builder<'_> {
             base_mass: base_inertia.mass,
             coupled,
             joint_lines,
+            urdf: std::sync::Arc::new(super::UrdfSource {
+                text: self.text.to_string(),
+                options: self.options.clone(),
+            }),
         };
         // (every body's own terms again, and those that depend on several bodies)
         model.refresh();

@@ -19,7 +19,8 @@
 //! `checks` refuses what no robot can have, `graph` links joints and links into a tree,
 //! `roles` resolves mimic couplings and locks, `bodies` merges links into moving bodies and
 //! `assemble` numbers the degrees of freedom into a [`Model`]; `convert` turns urdf-rs values
-//! into ours.
+//! into ours. `write` writes a model back as URDF, its changed parameters in the file it came
+//! from.
 
 mod armature;
 mod assemble;
@@ -29,8 +30,10 @@ mod convert;
 mod graph;
 mod lines;
 mod roles;
+mod write;
 
 pub use lines::{MAX_XML_DEPTH, MAX_XML_ELEMENTS};
+pub use write::{write_urdf, UrdfSource, WriteOptions, WrittenUrdf};
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
@@ -78,6 +81,7 @@ pub fn model_from_urdf_str(text: &str, source_name: &str, options: &LoadOptions)
         message: e.to_string(),
     })?;
     Builder {
+        text,
         robot: &robot,
         source: source_name,
         lines: &lines,
@@ -89,6 +93,7 @@ pub fn model_from_urdf_str(text: &str, source_name: &str, options: &LoadOptions)
 
 /// The URDF being read, with where it came from and how to read it.
 struct Builder<'a> {
+    text: &'a str,
     robot: &'a urdf_rs::Robot,
     source: &'a str,
     lines: &'a LineIndex,
