@@ -170,6 +170,13 @@ pub(crate) struct IdentifyDirectArgs {
     /// model is saved, and the residual growth over the unconstrained fit is reported.
     #[arg(long)]
     consistent: bool,
+    /// With --consistent: also write the identified robot as URDF here, the robot's own file
+    /// with every link's new inertial and every joint's new friction and armature
+    /// (`<dynamics damping friction armature>`), the rest kept as that file has it. A link
+    /// moving with another's body (behind a fixed joint) keeps its inertial where the body
+    /// allows it. Torque offsets have no place in a URDF and stay in the model.
+    #[arg(long, value_name = "PATH")]
+    urdf: Option<PathBuf>,
     /// Several logs: fit a torque offset of each log's own (a sensor zeroed anew, a drive
     /// warmed up between them) beside the parameters, whose offset terms are then the logs'
     /// mean; needs the offset among --friction. Each log is validated with its own offset.
@@ -181,6 +188,16 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     let mut inputs: Vec<&std::path::Path> = a.data.iter().map(PathBuf::as_path).collect();
     inputs.push(a.robot.path());
     refuse_overwriting_inputs(&a.out, &inputs)?;
+    if let Some(urdf) = &a.urdf {
+        if !a.consistent {
+            return Err(Error::InvalidArgument {
+                argument: "--urdf".into(),
+                message: "needs --consistent: base parameters are sums of several links' parameters and give no link its own".into(),
+            });
+        }
+        inputs.push(&a.out);
+        refuse_overwriting_inputs(urdf, &inputs)?;
+    }
     if a.data.len() > crate::direct::drive_gains::MAX_RUNS {
         return Err(Error::InvalidArgument {
             argument: "DATA".into(),
@@ -262,6 +279,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     }
     progress.update(&format!("identifying on {split} samples"));
     // with the Coulomb term's column filtered as the torques were
+    let mut urdf = None;
     let fit = if a.consistent {
         let c = crate::direct::identify_consistent_parameters(
             &model,
@@ -281,6 +299,18 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
             s.active.len(),
             if s.active.is_empty() { String::new() } else { format!(": {}", s.active.join("; ")) }
         );
+        if a.urdf.is_some() {
+            let logs: Vec<String> = a.data.iter().map(|p| p.display().to_string()).collect();
+            let note = format!(
+                "Identified by `perturbid identify-direct --consistent` from {}.",
+                logs.join(", ")
+            );
+            let options = crate::urdf::WriteOptions {
+                note: &note,
+                ..Default::default()
+            };
+            urdf = Some(crate::urdf::write_urdf(&c.robot(&model)?, &options)?);
+        }
         c.model
     } else {
         identify_base_parameters(&model, &train.0, train.1, &options).map_err(in_data)?
@@ -299,6 +329,16 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         eprintln!("perturbid: warning: {w}");
     }
     fit.save(&a.out)?;
+    if let (Some(path), Some(written)) = (&a.urdf, &urdf) {
+        crate::io::write_atomic(path, written.text.as_bytes())?;
+        let _ = writeln!(out, "the identified robot as URDF -> {}", path.display());
+        for note in &written.notes {
+            let _ = writeln!(out, "  {note}");
+        }
+        for w in &written.warnings {
+            eprintln!("perturbid: warning: {}: {w}", path.display());
+        }
+    }
     let _ = writeln!(
         out,
         "{} base parameters from {} samples{}, cond {:.3e} -> {}",

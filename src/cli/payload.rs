@@ -70,6 +70,15 @@ pub(crate) struct IdentifyPayloadArgs {
     /// the residuals and the findings).
     #[arg(long, default_value = "payload")]
     out: PathBuf,
+    /// Also write robot_with_payload.urdf into the output folder, where payload.json is
+    /// written: ROBOT's own file (its links as it gives them) with the payload attached as a
+    /// link of its own (--payload-link), fixed to --link at its origin, for a simulator or a
+    /// controller's model; remove that link and its joint to take the payload off.
+    #[arg(long)]
+    urdf: bool,
+    /// The name of the payload's link in robot_with_payload.urdf (its joint is NAME_joint).
+    #[arg(long, default_value = "payload", value_name = "NAME")]
+    payload_link: String,
     #[command(flatten)]
     preprocessing: PreprocessArgs,
 }
@@ -217,13 +226,30 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
             "payload.json",
             serde_json::to_string_pretty(p).expect("serialisable") + "\n",
         )?;
+        if a.urdf {
+            let note = format!(
+                "The payload identified by `perturbid identify-payload` from {}.",
+                (a.data.iter().map(|p| p.display().to_string()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+            let options = crate::urdf::WriteOptions {
+                payload: Some(p),
+                payload_link: &a.payload_link,
+                note: &note,
+            };
+            set.add(
+                "robot_with_payload.urdf",
+                crate::urdf::write_urdf(&model, &options)?.text,
+            )?;
+        }
     }
     set.add(
         "payload_fit.json",
         serde_json::to_string_pretty(&fit).expect("serialisable") + "\n",
     )?;
     set.commit()?;
-    out.push_str(&report(&fit, &a.out));
+    out.push_str(&report(&fit, &a.out, a.urdf));
     if let Some(v) = validation {
         let _ = writeln!(
             out,
@@ -246,7 +272,7 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
 }
 
 /// The fit in words: the payload with its standard errors, the joint terms, the residuals.
-fn report(fit: &PayloadFit, out: &std::path::Path) -> String {
+fn report(fit: &PayloadFit, out: &std::path::Path, urdf: bool) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -315,6 +341,10 @@ fn report(fit: &PayloadFit, out: &std::path::Path) -> String {
         );
     }
     let written = match fit.usable_payload() {
+        Some(_) if urdf => format!(
+            "{0}/payload.json, {0}/payload_fit.json and {0}/robot_with_payload.urdf",
+            out.display()
+        ),
         Some(_) => format!("{0}/payload.json and {0}/payload_fit.json", out.display()),
         None => format!(
             "{}/payload_fit.json (no payload.json: the fit cannot vouch for one, see the warnings)",

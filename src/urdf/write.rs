@@ -76,9 +76,12 @@ pub struct WrittenUrdf {
     /// The URDF text (UTF-8).
     pub text: String,
     /// What was written, one sentence each: the links given new inertials, the joints new
-    /// dynamics, inertials moved onto a body's own link, the payload's link, and what a URDF
-    /// has no place for (a gravity other than the standard one's direction).
+    /// dynamics, the payload's link.
     pub notes: Vec<String>,
+    /// What the file does not hold as the model does, one sentence each: a link's inertial
+    /// moved onto its body's own link (the link then has none of its own), a gravity other
+    /// than straight down the base's z axis (a URDF has no place for it).
+    pub warnings: Vec<String>,
 }
 
 /// One replacement of the source text.
@@ -116,6 +119,7 @@ pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUr
     let elements = Elements::of(&doc);
     let mut edits = Vec::new();
     let mut notes = Vec::new();
+    let mut warnings = Vec::new();
     let triangle = source.options.check_triangle_inequality.then_some("");
     for (b, body) in model.bodies.iter().enumerate() {
         if same_inertia(&body.inertia, &original.bodies[b].inertia) {
@@ -192,7 +196,7 @@ pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUr
             {
                 edits.push(edit);
             }
-            notes.push(format!(
+            warnings.push(format!(
                 "link '{}': its <inertial> ({} kg) moved into link '{}' (the identified body less it is no rigid body)",
                 o.link,
                 number(o.inertia.mass),
@@ -269,7 +273,7 @@ pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUr
     }
     let standard = nalgebra::Vector3::new(0.0, 0.0, -1.0);
     if (model.gravity.normalize() - standard).norm() > 1e-12 {
-        notes.push(format!(
+        warnings.push(format!(
             "gravity ({}, {}, {}) m/s^2 in the base frame: a URDF has no place for it",
             number(model.gravity.x),
             number(model.gravity.y),
@@ -282,6 +286,7 @@ pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUr
     Ok(WrittenUrdf {
         text: written,
         notes,
+        warnings,
     })
 }
 

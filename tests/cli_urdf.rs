@@ -1,0 +1,201 @@
+//! The identified robot as URDF from the command line: `identify-direct --consistent --urdf`
+//! writes a file whose torques, friction and armature are the saved model's, and
+//! `identify-payload --urdf` the robot carrying the payload it found; what cannot be written
+//! is refused by name with nothing written.
+
+mod cli_support;
+
+use cli_support::{excitation_log, fails, nothing_written, ok, s, tmp};
+use perturbid_rs::direct::BaseModel;
+use perturbid_rs::{model_from_urdf_file, robots, Data, Document, Gravity, LoadOptions, States};
+
+#[test]
+fn the_consistent_robot_written_as_urdf_predicts_what_its_model_does() {
+    let d = tmp("urdf-direct");
+    let log = excitation_log(&d, 4);
+    let urdf = d.join("identified.urdf");
+    let out = ok(&[
+        "identify-direct",
+        "a465",
+        s(&log),
+        "--friction",
+        "viscous,coulomb",
+        "--consistent",
+        "--out",
+        s(&d.join("consistent.json")),
+        "--urdf",
+        s(&urdf),
+    ]);
+    assert!(out.contains("the identified robot as URDF ->"), "{out}");
+    assert!(out.contains("link 'link3': a new <inertial>"), "{out}");
+    assert!(out.contains("joint 'joint2': <dynamics> damping="), "{out}");
+    let model = BaseModel::load(d.join("consistent.json")).unwrap();
+    let written = model_from_urdf_file(&urdf, &LoadOptions::default()).unwrap();
+    let nominal = robots::a465::model("kinsheel2010").unwrap();
+    // at random states: the URDF's rigid bodies, armature and friction are the model's
+    let n = 6;
+    let mut seed = 5u64;
+    let mut next = |scale: f64| {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        scale * (2.0 * ((seed >> 11) as f64 / (1u64 << 53) as f64) - 1.0)
+    };
+    let k = 50;
+    let q: Vec<f64> = (0..k * n).map(|_| next(1.5)).collect();
+    let qd: Vec<f64> = (0..k * n).map(|_| next(2.0)).collect();
+    let qdd: Vec<f64> = (0..k * n).map(|_| next(4.0)).collect();
+    let states = States::new(n, &q, Some(&qd), Some(&qdd)).unwrap();
+    let predicted = model.predict(&nominal, &states).unwrap();
+    let mut data = Data::new(&written);
+    for r in 0..k {
+        let rows = r * n..(r + 1) * n;
+        perturbid_rs::rnea(
+            &written,
+            &mut data,
+            &q[rows.clone()],
+            &qd[rows.clone()],
+            &qdd[rows.clone()],
+            Gravity::Included,
+        )
+        .unwrap();
+        for j in 0..n {
+            let l = &written.limits[j];
+            let v = qd[r * n + j];
+            let tau = data.tau[j] + l.damping * v + l.friction * v.signum();
+            let p = predicted[r * n + j];
+            assert!(
+                (tau - p).abs() <= 1e-8 * p.abs().max(1.0),
+                "sample {r} joint {j}: {tau} vs {p}"
+            );
+        }
+    }
+    // everything but the inertials and dynamics as the built-in file has it
+    let text = std::fs::read_to_string(&urdf).unwrap();
+    let source = robots::a465::urdf("kinsheel2010").unwrap();
+    assert_eq!(
+        text.matches("<limit").count(),
+        source.matches("<limit").count()
+    );
+    assert!(text.contains(&format!("from {}", s(&log))), "{text}");
+
+    // refused: base parameters name no link's own, and the robot's file is not overwritten
+    fails(
+        &[
+            "identify-direct",
+            "a465",
+            s(&log),
+            "--out",
+            s(&d.join("b.json")),
+            "--urdf",
+            s(&d.join("b.urdf")),
+        ],
+        &["--urdf", "needs --consistent"],
+    );
+    assert!(!d.join("b.json").exists() && !d.join("b.urdf").exists());
+    let robot = d.join("robot.urdf");
+    std::fs::write(&robot, source).unwrap();
+    fails(
+        &[
+            "identify-direct",
+            s(&robot),
+            s(&log),
+            "--consistent",
+            "--out",
+            s(&d.join("c.json")),
+            "--urdf",
+            s(&robot),
+        ],
+        &[s(&robot)],
+    );
+    assert_eq!(std::fs::read_to_string(&robot).unwrap(), source);
+}
+
+#[test]
+fn identify_payload_writes_the_robot_carrying_it() {
+    let d = tmp("urdf-payload");
+    let truth = d.join("true.json");
+    std::fs::write(
+        &truth,
+        r#"{"format": "perturbid-true-robot/1", "seed": 3,
+ "payload": {"link": "link6", "mass": 1.5, "com": [0.01, 0.0, 0.06], "inertia": [0.004, 0, 0, 0.004, 0, 0.002]},
+ "sensors": {"torque_noise": [0.02, 0.02, 0.02, 0.01, 0.01, 0.01]}}"#,
+    )
+    .unwrap();
+    ok(&[
+        "excite",
+        "a465",
+        "--out",
+        s(&d.join("exc")),
+        "--max-evaluations",
+        "30",
+        "--rate",
+        "100",
+        "--seed",
+        "1",
+    ]);
+    let log = d.join("loaded.csv");
+    ok(&[
+        "simulate",
+        "a465",
+        s(&d.join("exc/excitation.json")),
+        "--true-robot",
+        s(&truth),
+        "--rate",
+        "500",
+        "--periods",
+        "2",
+        "--out",
+        s(&log),
+    ]);
+    let out_dir = d.join("p");
+    let out = ok(&[
+        "identify-payload",
+        "a465",
+        s(&log),
+        "--link",
+        "link6",
+        "--urdf",
+        "--payload-link",
+        "drill",
+        "--out",
+        s(&out_dir),
+    ]);
+    assert!(out.contains("robot_with_payload.urdf"), "{out}");
+    let written = model_from_urdf_file(
+        out_dir.join("robot_with_payload.urdf"),
+        &LoadOptions::default(),
+    )
+    .unwrap();
+    let nominal = robots::a465::model("kinsheel2010").unwrap();
+    let payload: perturbid_rs::rehearsal::Payload =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("payload.json")).unwrap())
+            .unwrap();
+    let (b, inertia) = payload.in_body(&nominal).unwrap();
+    let moved = written.bodies[b].inertia;
+    let expected = nominal.bodies[b].inertia.add(&inertia);
+    assert!(
+        (moved.mass - expected.mass).abs() < 1e-12,
+        "{moved:?} vs {expected:?}"
+    );
+    assert!((moved.com - expected.com).norm() < 1e-12);
+    assert!((moved.inertia_com - expected.inertia_com).norm() < 1e-12);
+    assert_eq!(written.frame("drill").unwrap().body, Some(b));
+    // a link name the robot has: refused before anything is written
+    fails(
+        &[
+            "identify-payload",
+            "a465",
+            s(&log),
+            "--link",
+            "link6",
+            "--urdf",
+            "--payload-link",
+            "link2",
+            "--out",
+            s(&d.join("q")),
+        ],
+        &["payload link 'link2'", "a link of the robot has this name"],
+    );
+    nothing_written(&d, "q");
+}
