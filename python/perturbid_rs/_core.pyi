@@ -179,6 +179,11 @@ class Robot:
         """(tau, dtau_dq, dtau_dv, M): inverse dynamics and its analytic derivatives, shapes (n,) and (n, n) or with a leading k; `out` a tuple of four such arrays."""
     def physical_consistency(self, theta: Optional[ArrayLike] = None, friction: Union[str, Sequence[str], None] = None) -> tuple[bool, list[dict[str, Any]], list[tuple[str, float]]]:
         """Per-body pseudo-inertia check of a full parameter vector (default: the model's)."""
+    def to_urdf(self, path: Union[str, PathLike[str], None] = None, *, payload: Optional[Mapping[str, Any]] = None, payload_link: str = "payload", note: str = "") -> str:
+        """The robot as URDF text (also written to `path`, atomically): the file it was loaded
+        from with every changed link inertial and joint <dynamics damping friction armature>
+        written anew, the rest kept; `payload` (identify_payload's dict) attached as a link
+        `payload_link` fixed to its link. Read back and checked before it is returned."""
     @property
     def parameters(self) -> NDArray[np.float64]:
         """The model's inertial parameters (10 per moving body, Pinocchio's order), shape (10 b,)."""

@@ -26,12 +26,20 @@ use crate::states::States;
 /// `payload` (`link`, `mass`, `com`, `inertia`); unknown keys, and values of another type or
 /// length, refused by key (values out of range by [`Payload::problem`]).
 fn payload_of(r: usize, value: &Bound<'_, PyAny>) -> PyResult<Option<Payload>> {
+    payload_argument(&format!("payloads[{r}]"), value)
+}
+
+/// A payload given as argument `argument`: None, or a dict as [`payload_of`] reads it.
+pub(crate) fn payload_argument(
+    argument: &str,
+    value: &Bound<'_, PyAny>,
+) -> PyResult<Option<Payload>> {
     if value.is_none() {
         return Ok(None);
     }
     let bad = |message: String| -> PyErr {
         Error::InvalidArgument {
-            argument: format!("payloads[{r}]"),
+            argument: argument.to_string(),
             message,
         }
         .into()

@@ -160,6 +160,56 @@ impl PyRobot {
         Ok(Self::new(robots::builtin(name)?))
     }
 
+    /// The robot as URDF text (str), also written to `path` where given (atomically: a
+    /// temporary file renamed into place).
+    ///
+    /// The text is the file the robot was loaded from (a built-in's own), with every link's
+    /// `<inertial>` whose body's inertia differs from that file's written anew (in the link's
+    /// frame: `rpy="0 0 0"`, centre of mass in m, inertia about it in kg m^2) and every
+    /// joint's `<dynamics damping friction armature>` whose viscous (N m s/rad) or Coulomb
+    /// (N m) friction or armature (kg m^2) differs; everything else (visuals, collisions,
+    /// transmissions, comments) is kept as written. This is how an identified robot
+    /// (`ConsistentFit.robot()`) goes to a simulator or a controller. Links moving with
+    /// another's body keep their own inertials where the body allows it; where it does not,
+    /// a fixed link's inertial moves onto the body's own link, with a warning.
+    ///
+    /// `payload` (a dict as `identify_payload` gives it: `link`, `mass` kg, `com` m,
+    /// `inertia` [ixx, ixy, ixz, iyy, iyz, izz] kg m^2 about the centre of mass, in the
+    /// link's frame) is attached as a link `payload_link` of its own, fixed to its link at
+    /// the link's origin by joint `<payload_link>_joint`. `note` goes into the comment the
+    /// file opens with. Raises `ModelError` where the robot's kinematics or limits differ
+    /// from its file's (only inertias, friction and armature are written), where a body
+    /// leaves its own link no rigid body, or where the payload's link name is taken; the text
+    /// is read back and checked before it is returned.
+    #[pyo3(signature = (path=None, *, payload=None, payload_link="payload", note=""))]
+    fn to_urdf(
+        &self,
+        py: Python<'_>,
+        path: Option<PathBuf>,
+        payload: Option<Bound<'_, PyAny>>,
+        payload_link: &str,
+        note: &str,
+    ) -> PyResult<String> {
+        let payload = match &payload {
+            Some(p) => super::drive_gains::payload_argument("payload", p)?,
+            None => None,
+        };
+        let written = detached(py, "Robot.to_urdf", || {
+            let options = urdf::WriteOptions {
+                payload: payload.as_ref(),
+                payload_link,
+                note,
+            };
+            let written = urdf::write_urdf(&self.model, &options)?;
+            if let Some(path) = &path {
+                crate::io::write_atomic(path, written.text.as_bytes())?;
+            }
+            Ok::<_, crate::error::Error>(written)
+        })?;
+        super::errors::warn_all(py, &written.warnings)?;
+        Ok(written.text)
+    }
+
     /// Robot name from the URDF.
     #[getter]
     fn name(&self) -> &str {
