@@ -20,13 +20,14 @@
 //! `roles` resolves mimic couplings and locks, `bodies` merges links into moving bodies and
 //! `assemble` numbers the degrees of freedom into a [`Model`]; `convert` turns urdf-rs values
 //! into ours. `write` writes a model back as URDF, its changed parameters in the file it came
-//! from.
+//! from, through the text edits of `edits`.
 
 mod armature;
 mod assemble;
 mod bodies;
 mod checks;
 mod convert;
+mod edits;
 mod graph;
 mod lines;
 mod roles;
