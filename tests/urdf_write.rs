@@ -356,6 +356,40 @@ fn what_a_urdf_written_here_could_not_hold_is_refused() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("damping -1 is not a finite number >= 0"), "{e}");
+    // an armature given by a transmission is not rewritten
+    let text = robots::a465::urdf("physical").unwrap().replace(
+        "</robot>",
+        "<transmission name=\"t\"><joint name=\"joint2\"/><actuator name=\"m\"><rotor_inertia value=\"0.5\"/></actuator></transmission></robot>",
+    );
+    let mut geared = model_from_urdf_str(&text, "geared", &LoadOptions::default()).unwrap();
+    assert_eq!(geared.armature[1], 0.5);
+    geared.limits[1].damping = 0.2; // friction is written beside it
+    let written = write_urdf(&geared, &WriteOptions::default()).unwrap();
+    assert_eq!(
+        model_from_urdf_str(&written.text, "w", &LoadOptions::default())
+            .unwrap()
+            .armature[1],
+        0.5
+    );
+    geared.armature[1] = 0.6;
+    let e = write_urdf(&geared, &WriteOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("joint 'joint2'") && e.contains("<transmission>"),
+        "{e}"
+    );
+    // a gravity a URDF cannot hold is warned of
+    let mut tilted = model.clone();
+    tilted.gravity = Vector3::new(0.0, -9.81, 0.0);
+    let written = write_urdf(&tilted, &WriteOptions::default()).unwrap();
+    assert!(
+        written
+            .warnings
+            .iter()
+            .any(|w| w.contains("gravity (0, -9.81, 0)")),
+        "{written:?}"
+    );
     let mut broken = model.clone();
     broken.bodies[0].inertia.inertia_com = Matrix3::from_diagonal(&Vector3::new(0.01, 0.01, 1.0));
     broken.refresh();
@@ -363,4 +397,66 @@ fn what_a_urdf_written_here_could_not_hold_is_refused() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("link 'link1'") && e.contains("triangle"), "{e}");
+}
+
+#[test]
+fn files_written_in_other_hands_keep_their_form() {
+    let source = robots::a465::urdf("physical").unwrap();
+    let variants: Vec<(&str, String)> = vec![
+        ("CRLF line ends", source.replace('\n', "\r\n")),
+        ("tabs", source.replace("  ", "\t")),
+        ("single quotes", source.replace('"', "'")),
+        (
+            "a comment and a named visual with '>' inside a link",
+            source.replace(
+                "<link name=\"link2\">",
+                "<link name=\"link2\"><!-- <inertial> in a comment --><visual name=\"a>b\"><geometry><box size=\"1 1 1\"/></geometry></visual>",
+            ),
+        ),
+        (
+            "an inertial written on one line",
+            source.replace("<link name=\"link3\">\n    <inertial>", "<link name=\"link3\"><inertial>"),
+        ),
+        ("no declaration", source.replace("<?xml version=\"1.0\"?>", "")),
+    ];
+    let payload = Payload {
+        link: "link6".into(),
+        mass: 0.5,
+        com: [0.0, 0.0, 0.05],
+        inertia: [1e-3, 0.0, 0.0, 1e-3, 0.0, 1e-3],
+    };
+    for (what, text) in variants {
+        let mut model = model_from_urdf_str(&text, "odd -- name-", &LoadOptions::default())
+            .unwrap_or_else(|e| panic!("{what}: {e}"));
+        let mut rng = Rng(5);
+        for b in &mut model.bodies {
+            b.inertia = changed(&b.inertia, &mut rng);
+        }
+        model.refresh();
+        model.limits[3].damping = 0.7;
+        let options = WriteOptions {
+            payload: Some(&payload),
+            payload_link: "tool \"<&>\" é",
+            note: "a note --> that tries to close the comment",
+        };
+        let written = write_urdf(&model, &options).unwrap_or_else(|e| panic!("{what}: {e}"));
+        let back = model_from_urdf_str(&written.text, "back", &LoadOptions::default())
+            .unwrap_or_else(|e| panic!("{what}: {e}\n{}", written.text));
+        assert!(back.frame("tool \"<&>\" é").is_some(), "{what}");
+        let mut carrying = model.clone();
+        let (b, inertia) = payload.in_body(&model).unwrap();
+        carrying.bodies[b].inertia = carrying.bodies[b].inertia.add(&inertia);
+        carrying.refresh();
+        same_torques(&carrying, &back, 1e-12);
+        if what == "CRLF line ends" {
+            assert_eq!(
+                written.text.matches('\n').count(),
+                written.text.matches("\r\n").count()
+            );
+        }
+        assert!(!written.text.contains("a note -->"), "{what}");
+        if what.starts_with("a comment") {
+            assert!(written.text.contains("<visual name=\"a>b\">"), "{what}");
+        }
+    }
 }

@@ -183,11 +183,13 @@ pub(super) fn remove_inertial(
     };
     let mut range = old.range();
     let indent = indent_at(text, range.start);
-    if text[range.end..].starts_with('\n')
-        && range.start - indent.len() > 0
-        && text[..range.start - indent.len()].ends_with('\n')
-    {
-        range = range.start - indent.len()..range.end + 1;
+    // the line too, where the element stands alone on it
+    let line_end = ["\r\n", "\n"]
+        .into_iter()
+        .find(|e| text[range.end..].starts_with(e));
+    let line_start = range.start - indent.len();
+    if let Some(end) = line_end.filter(|_| line_start > 0 && text[..line_start].ends_with('\n')) {
+        range = line_start..range.end + end.len();
     }
     Ok(Some(Edit {
         range,
@@ -340,9 +342,15 @@ pub(super) fn header(text: &str, doc: &roxmltree::Document<'_>, source: &str, no
     }
 }
 
-/// The source text with the edits made (they do not overlap).
+/// The source text with the edits made (they do not overlap), their lines ended as the
+/// source's are (`\r\n` where it has them).
 pub(super) fn apply(text: &str, mut edits: Vec<Edit>) -> String {
     edits.sort_by_key(|e| (e.range.start, e.range.end));
+    if text.contains("\r\n") {
+        for e in &mut edits {
+            e.text = e.text.replace('\n', "\r\n");
+        }
+    }
     let mut out =
         String::with_capacity(text.len() + edits.iter().map(|e| e.text.len()).sum::<usize>());
     let mut at = 0;

@@ -239,7 +239,7 @@ pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUr
             ));
         }
         let mut values = vec![("damping", l.damping), ("friction", l.friction)];
-        if model.armature[j] != 0.0 || armature_in_dynamics {
+        if armature_in_dynamics || model.armature[j] != original.armature[j] {
             values.push(("armature", model.armature[j]));
         }
         edits.push(set_dynamics(text, node, dynamics, &values));
