@@ -560,11 +560,10 @@ pub(crate) fn friction_terms(
     let Some(value) = value else {
         return Ok(crate::direct::FrictionTerms::NONE);
     };
-    let names: Vec<String> = match value.extract::<String>() {
-        Ok(text) => text.split(',').map(|t| t.trim().to_string()).collect(),
-        Err(_) => value.extract()?,
-    };
-    Ok(crate::direct::FrictionTerms::from_names(&names)?)
+    Ok(match value.extract::<String>() {
+        Ok(text) => text.parse()?,
+        Err(_) => crate::direct::FrictionTerms::from_names(&value.extract::<Vec<String>>()?)?,
+    })
 }
 
 /// The parts of local models to use, from Python's `use` (a subset of 'torque', 'D', 'H',

@@ -35,9 +35,9 @@ use crate::model::Model;
 use crate::states::States;
 use crate::torque_model::TorqueModel;
 
-/// The `friction` argument of the direct method: a name or a list of names from 'viscous',
-/// 'coulomb', 'offset', 'armature' ('all' for the three friction terms, 'none' for none), or
-/// anything else (refused).
+/// The `friction` argument of the direct method: a name, names comma separated or a list of
+/// names from 'viscous', 'coulomb', 'offset', 'armature' ('all' for the three friction terms,
+/// 'none' for none), or anything else (refused).
 #[derive(FromPyObject)]
 pub(crate) enum FrictionNames<'py> {
     One(String),
@@ -49,7 +49,8 @@ pub(crate) enum FrictionNames<'py> {
 pub(crate) fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<FrictionTerms> {
     Ok(match value {
         None => FrictionTerms::NONE,
-        Some(FrictionNames::One(name)) => FrictionTerms::from_names(&[name])?,
+        // a name, or names comma separated as the command line's --friction takes them
+        Some(FrictionNames::One(names)) => names.parse()?,
         Some(FrictionNames::Many(names)) => FrictionTerms::from_names(&names)?,
         Some(FrictionNames::Other(v)) => {
             return Err(Error::InvalidArgument {

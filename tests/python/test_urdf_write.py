@@ -34,8 +34,9 @@ def test_pinocchio_reads_the_identified_robot_as_it_predicts(tmp_path):
     t, q, qd, qdd = motion(1)
     tau = pin_torques(truth, q, qd, qdd) + 0.3 * qd + 0.5 * np.sign(qd)
     nominal = pr.Robot.from_urdf_string(source)
-    fit = pr.identify_consistent_parameters(nominal, q, qd, qdd, tau, friction=["viscous", "coulomb"],
+    fit = pr.identify_consistent_parameters(nominal, q, qd, qdd, tau, friction="viscous,coulomb",
                                             weighting="ols")
+    assert "joint1.coulomb" in fit.names  # names comma separated, as the command line's
     robot = fit.robot()
     path = tmp_path / "identified.urdf"
     text = robot.to_urdf(path, note="from a test")
