@@ -79,6 +79,71 @@ fn the_consistent_robot_written_as_urdf_predicts_what_its_model_does() {
     );
     assert!(text.contains(&format!("from {}", s(&log))), "{text}");
 
+    // the URDF validated against the log as a model: as good as the saved model, and the
+    // built-in robot the log came from as good; another robot's parameters worse
+    let rms = |dir: &str| -> Vec<f64> {
+        let v: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(d.join(dir).join("validation.json")).unwrap(),
+        )
+        .unwrap();
+        v["joints"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|j| j["rms"].as_f64().unwrap())
+            .collect()
+    };
+    ok(&["validate", s(&urdf), s(&log), "--out", s(&d.join("v_urdf"))]);
+    ok(&[
+        "validate",
+        s(&d.join("consistent.json")),
+        s(&log),
+        "--robot",
+        "a465",
+        "--out",
+        s(&d.join("v_model")),
+    ]);
+    let warned =
+        cli_support::warnings_of(&["validate", "a465", s(&log), "--out", s(&d.join("v_a465"))]);
+    assert!(warned.contains("gives its joints no friction"), "{warned}");
+    ok(&[
+        "validate",
+        "a465:physical",
+        s(&log),
+        "--out",
+        s(&d.join("v_physical")),
+    ]);
+    let (by_urdf, by_model, by_a465, by_physical) = (
+        rms("v_urdf"),
+        rms("v_model"),
+        rms("v_a465"),
+        rms("v_physical"),
+    );
+    for j in 0..6 {
+        assert!(
+            (by_urdf[j] - by_model[j]).abs() < 1e-6 * by_model[j].max(1e-3),
+            "{by_urdf:?} vs {by_model:?}"
+        );
+        assert!(by_a465[j] < 0.05, "{by_a465:?}");
+    }
+    assert!(
+        by_physical.iter().sum::<f64>() > 10.0 * by_a465.iter().sum::<f64>(),
+        "{by_physical:?}"
+    );
+    fails(
+        &[
+            "validate",
+            "a465",
+            s(&log),
+            "--robot",
+            "a465",
+            "--out",
+            s(&d.join("v_bad")),
+        ],
+        &["--robot", "is a robot, validated with its own parameters"],
+    );
+    nothing_written(&d, "v_bad");
+
     // refused: base parameters name no link's own, and the robot's file is not overwritten
     fails(
         &[

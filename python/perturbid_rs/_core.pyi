@@ -179,6 +179,10 @@ class Robot:
         """(tau, dtau_dq, dtau_dv, M): inverse dynamics and its analytic derivatives, shapes (n,) and (n, n) or with a leading k; `out` a tuple of four such arrays."""
     def physical_consistency(self, theta: Optional[ArrayLike] = None, friction: Union[str, Sequence[str], None] = None) -> tuple[bool, list[dict[str, Any]], list[tuple[str, float]]]:
         """Per-body pseudo-inertia check of a full parameter vector (default: the model's)."""
+    def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, out: Optional[NDArray[np.float64]] = None) -> NDArray[np.float64]:
+        """The torques its own parameters give, as validate compares them with a log's: rnea
+        (gravity, armature) plus each joint's URDF friction damping * qd + friction * sign(qd);
+        shape (n,) or (k, n)."""
     def to_urdf(self, path: Union[str, PathLike[str], None] = None, *, payload: Optional[Mapping[str, Any]] = None, payload_link: str = "payload", note: str = "") -> str:
         """The robot as URDF text (also written to `path`, atomically): the file it was loaded
         from with every changed link inertial and joint <dynamics damping friction armature>
@@ -1076,7 +1080,8 @@ def validate(
     t: Optional[ArrayLike] = None,
     coulomb: Optional[ArrayLike] = None,
 ) -> Validation:
-    """Validates any model with predict(q, qd, qdd) on measured states and torques (arrays, or
+    """Validates any model with predict(q, qd, qdd) (a Robot: its own parameters and URDF
+    friction) on measured states and torques (arrays, or
     a Recording as q alone: its states, torques, time and, for a BaseParameterModel, its
     Coulomb column); for a BaseParameterModel also checks the torque columns against its
     robot's model (a PerturbidWarning per finding: swapped, the opposite sign, other units)."""

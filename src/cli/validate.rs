@@ -18,10 +18,43 @@ use crate::svg::{line_plot, Series};
 use crate::torque_model::{ModelFile, TorqueModel};
 use crate::validation::{stored_stderr, validate};
 
+/// What is validated: a saved model, or a robot's own parameters.
+enum Subject {
+    File(ModelFile),
+    Robot(Box<crate::model::Model>),
+}
+
+/// Whether MODEL names a robot (a URDF file: its first character `<`; or a built-in robot's
+/// name where no such file exists) rather than a saved model (JSON).
+fn is_a_robot(model: &std::path::Path) -> Result<bool> {
+    if !model.exists() {
+        return Ok(crate::robots::builtin(&model.display().to_string()).is_ok());
+    }
+    use std::io::Read;
+    let io = |source| Error::Io {
+        path: model.display().to_string(),
+        source,
+    };
+    // the first bytes tell: a model file is read whole later
+    let mut head = Vec::new();
+    (std::fs::File::open(model).map_err(io)?)
+        .take(4096)
+        .read_to_end(&mut head)
+        .map_err(io)?;
+    let text = String::from_utf8_lossy(&head);
+    Ok(text
+        .trim_start_matches('\u{feff}')
+        .trim_start()
+        .starts_with('<'))
+}
+
 #[derive(Args)]
 pub(crate) struct ValidateArgs {
     /// A saved model: local (perturbid identify), base-parameter (perturbid identify-direct,
-    /// perturbid parameters) or globally linearised.
+    /// perturbid parameters) or globally linearised; or a robot (a URDF file or a built-in
+    /// name), whose own parameters are validated: its links' inertials and armature through
+    /// inverse dynamics, and its joints' <dynamics> friction (damping * qd + friction *
+    /// sign(qd)), with gravity (a vendor's URDF, or one identify-direct --urdf wrote).
     model: PathBuf,
     /// The log CSV: t, q1..qN, tau1..tauN (qd, qdd optional: without qdd the log is
     /// preprocessed as for identification).
@@ -29,7 +62,8 @@ pub(crate) struct ValidateArgs {
     /// The robot, for a base-parameter model (URDF file or built-in name).
     #[arg(long)]
     robot: Option<String>,
-    /// Joints of --robot held still, as when the model was identified (JOINT=VALUE, repeat).
+    /// Joints of --robot (or of MODEL, a robot) held still, as when the model was identified
+    /// (JOINT=VALUE, repeat).
     #[arg(long = "lock", value_name = "JOINT=VALUE", value_parser = super::files::parse_lock)]
     lock: Vec<(String, f64)>,
     #[command(flatten)]
@@ -60,10 +94,32 @@ pub(crate) struct ValidateArgs {
 
 pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     refuse_overwriting_inputs(&a.out, &[&a.model, &a.data])?;
-    let file = ModelFile::load(&a.model)?;
-    let joints = file.joint_names().to_vec();
+    let file = if is_a_robot(&a.model)? {
+        for (given, option) in [(a.robot.is_some(), "--robot"), (a.signal, "--signal")] {
+            if given {
+                return Err(Error::InvalidArgument {
+                    argument: option.into(),
+                    message: format!(
+                        "{} is a robot, validated with its own parameters: {option} is for a saved model",
+                        a.model.display()
+                    ),
+                });
+            }
+        }
+        Subject::Robot(Box::new(load_robot(
+            &a.model.display().to_string(),
+            &a.lock,
+        )?))
+    } else {
+        Subject::File(ModelFile::load(&a.model)?)
+    };
+    let joints = match &file {
+        Subject::File(f) => f.joint_names().to_vec(),
+        Subject::Robot(r) => r.joint_names.clone(),
+    };
     let robot = match (&file, &a.robot) {
-        (ModelFile::Base(_), None) => {
+        (Subject::Robot(r), _) => Some((**r).clone()),
+        (Subject::File(ModelFile::Base(_)), None) => {
             return Err(Error::InvalidArgument {
                 argument: "--robot".into(),
                 message: format!(
@@ -77,10 +133,12 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     };
     let progress = Progress::new();
     let mut out = String::new();
-    let gains = a
-        .signal
-        .then(|| super::gains::model_gains(&file, &a.model, "--signal").map(|g| &g.gain[..]))
-        .transpose()?;
+    let gains = match &file {
+        Subject::File(f) if a.signal => {
+            Some(super::gains::model_gains(f, &a.model, "--signal").map(|g| &g.gain[..])?)
+        }
+        _ => None,
+    };
     let rec = a
         .preprocessing
         .read(&a.data, &joints, &progress, &mut out)?;
@@ -106,25 +164,27 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     .map_err(super::files::in_log(&a.data))?;
     progress.update("predicting");
     let predicted = match &file {
-        ModelFile::Base(fit) => fit
+        Subject::File(ModelFile::Base(fit)) => fit
             .on(robot.as_ref().expect("checked above"))?
             .predict(&states)?,
-        ModelFile::Local(m) => m.predict(&states)?,
-        ModelFile::GlobalLinear(m) => m.predict(&states)?,
+        Subject::File(ModelFile::Local(m)) => m.predict(&states)?,
+        Subject::File(ModelFile::GlobalLinear(m)) => m.predict(&states)?,
+        Subject::Robot(r) => crate::robot_torques::RobotTorques::new(r).predict(&states)?,
     };
     progress.update("the predictions' standard errors");
     let stderr = match &file {
-        ModelFile::Base(fit) => {
+        Subject::File(ModelFile::Base(fit)) => {
             stored_stderr(fit.predict_stderr(robot.as_ref().expect("checked above"), &states))?
         }
-        ModelFile::Local(m) => stored_stderr(m.predict_stderr(&states))?,
-        ModelFile::GlobalLinear(_) => {
+        Subject::File(ModelFile::Local(m)) => stored_stderr(m.predict_stderr(&states))?,
+        Subject::File(ModelFile::GlobalLinear(_)) => {
             Err("a globally linearised model stores no covariance of its coefficients".into())
         }
+        Subject::Robot(_) => Err("a robot's own parameters come with no standard errors".into()),
     };
     // a local model at states beyond the perturbations it was identified over
     let extrapolation = match &file {
-        ModelFile::Local(m) => m.extrapolation(&states)?,
+        Subject::File(ModelFile::Local(m)) => m.extrapolation(&states)?,
         _ => None,
     };
     let mut v = validate(&joints, &predicted, &rec.tau)?;
@@ -135,13 +195,24 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     // its own log: swapped columns, another sign or other units show here by name, not only
     // as large errors
     let (position_range, torque_columns, torque_lag, offsets) = match (&file, &robot) {
-        (ModelFile::Base(fit), Some(r)) => {
+        (Subject::File(ModelFile::Base(fit)), Some(r)) => {
             progress.update("checking the torque columns");
             (
                 check_position_range(r, &states),
                 check_torque_columns(r, &states, &rec.tau, fit.gravity)?,
                 check_torque_lag(r, &states, &rec.tau, fit.gravity)?,
                 check_position_offsets_in_validation(r, fit, &states, &rec.tau)?,
+            )
+        }
+        // a robot's own: its columns, lag and range as a base-parameter model's; the zero
+        // offsets are estimated against a fit's parameters, which a robot has not
+        (Subject::Robot(r), _) => {
+            progress.update("checking the torque columns");
+            (
+                check_position_range(r, &states),
+                check_torque_columns(r, &states, &rec.tau, crate::gravity::Gravity::Included)?,
+                check_torque_lag(r, &states, &rec.tau, crate::gravity::Gravity::Included)?,
+                None,
             )
         }
         _ => (vec![], vec![], None, None),
@@ -157,6 +228,12 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     )
     .into_iter()
     .chain(rounding)
+    .chain(match &file {
+        Subject::Robot(r) if !crate::robot_torques::RobotTorques::new(r).has_friction() => {
+            Some(crate::robot_torques::NO_FRICTION.to_string())
+        }
+        _ => None,
+    })
     .chain(extrapolation.as_ref().map(|x| x.message()))
     {
         eprintln!("perturbid: warning: log '{}': {w}", a.data.display());

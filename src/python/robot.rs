@@ -304,6 +304,29 @@ impl PyRobot {
         })
     }
 
+    /// The torques the robot's own parameters give, as `validate` compares them with a log's:
+    /// `rnea(q, qd, qdd)` (with gravity and each joint's armature) plus each joint's URDF
+    /// friction, `damping * qd + friction * sign(qd)` (`sign(0) = 0`). q, qd, qdd: (n,) or
+    /// (k, n) (rad, rad/s, rad/s^2); returns N m (N for a prismatic joint), shaped alike.
+    #[pyo3(signature = (q, qd, qdd, out=None))]
+    fn predict<'py>(
+        &self,
+        py: Python<'py>,
+        q: Samples<'py>,
+        qd: Samples<'py>,
+        qdd: Samples<'py>,
+        out: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.model.nv;
+        let args = [("q", &q), ("qd", &qd), ("qdd", &qdd)];
+        self.batch(py, "Robot.predict", &args, &[n], out, |m, _, s, out| {
+            use crate::torque_model::TorqueModel;
+            let tau = crate::robot_torques::RobotTorques::new(m).predict(s)?;
+            out.copy_from_slice(&tau);
+            Ok(())
+        })
+    }
+
     /// Gravity torque g(q): the torque holding the robot at rest. q: (n,) or (k, n).
     #[pyo3(signature = (q, out=None))]
     fn gravity<'py>(

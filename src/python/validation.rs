@@ -186,7 +186,7 @@ impl PyValidation {
 }
 
 /// Validates `model` (anything with `predict(q, qd, qdd)`: a LocalModel, BaseParameterModel,
-/// GlobalLinearModel) on measured states and torques `q`, `qd`, `qdd`, `tau` ((k, n) each;
+/// GlobalLinearModel, or a Robot: its own parameters and URDF friction, `Robot.predict`) on measured states and torques `q`, `qd`, `qdd`, `tau` ((k, n) each;
 /// rad, rad/s, rad/s^2, N m). The joints are named after `model.joint_names` where it has
 /// them. For a BaseParameterModel the torque columns are also checked against its robot's
 /// model (swapped columns, the opposite sign, other units: a PerturbidWarning each, and
@@ -194,7 +194,9 @@ impl PyValidation {
 /// for joints zeroed elsewhere than in the model's data (`Validation.position_offsets`;
 /// not judged where a torque column is found wrong). For a LocalModel or
 /// BaseParameterModel a torque column that holds one value throughout while the robot moves
-/// (a dead channel) is refused. `t` ((k,) s), when the samples are a log: its qd and qdd
+/// (a dead channel) is refused. A Robot's log is checked as a BaseParameterModel's (its
+/// columns, lag and range, with gravity; not its zero offsets), and a robot whose file gives
+/// no friction is warned of. `t` ((k,) s), when the samples are a log: its qd and qdd
 /// columns are checked first against the derivatives of q and qd, as
 /// `identify_base_parameters` checks them. `coulomb` ((k, n), a BaseParameterModel only): the
 /// Coulomb term's column for filtered torques (`Recording.coulomb`), given to its `predict`.
@@ -284,11 +286,12 @@ pub(crate) fn validate<'py>(
     // the predictions' standard errors, where the model gives them, and the measured torque
     // columns against a base-parameter model's robot, as a direct fit checks its own data
     let (local, base) = (model.cast::<PyLocalModel>(), model.cast::<PyBaseModel>());
+    let robot = model.cast::<super::robot::PyRobot>();
     let mut stderr = None;
     let (mut position_range, mut torque_columns) = (vec![], vec![]);
     let (mut torque_lag, mut position_offsets) = (None, None);
     let mut extrapolation = None;
-    if local.is_ok() || base.is_ok() {
+    if local.is_ok() || base.is_ok() || robot.is_ok() {
         let mut args = vec![("q", &a.q), ("qd", &a.qd), ("qdd", &a.qdd)];
         args.extend(coulomb.as_ref().map(|c| ("coulomb", c)));
         let batch = read_batch(n, &args)?;
@@ -303,6 +306,25 @@ pub(crate) fn validate<'py>(
             let m = &local.get().model;
             stderr = stored_stderr(m.predict_stderr(&states))?.ok();
             extrapolation = m.extrapolation(&states)?;
+        }
+        // a robot's own parameters: its torque columns, lag and range checked as a
+        // base-parameter model's robot (the zero offsets need a fit's parameters)
+        if let Ok(robot) = &robot {
+            let r = &robot.get().model;
+            let (ranges, columns, lag) = detached(model.py(), "validate", || {
+                let g = crate::gravity::Gravity::Included;
+                Ok((
+                    check_position_range(r, &states),
+                    check_torque_columns(r, &states, &measured, g)?,
+                    check_torque_lag(r, &states, &measured, g)?,
+                ))
+            })?;
+            let mut findings = validation_findings(&ranges, &columns, lag.as_ref(), None);
+            if !crate::robot_torques::RobotTorques::new(r).has_friction() {
+                findings.push(crate::robot_torques::NO_FRICTION.to_string());
+            }
+            warn_all(model.py(), &findings)?;
+            (position_range, torque_columns, torque_lag) = (ranges, columns, lag);
         }
         if let Ok(base) = &base {
             let base = base.get();

@@ -98,3 +98,23 @@ def test_bad_arguments_are_refused_by_name(tmp_path):
     with pytest.raises(pr.FileError):
         robot.to_urdf(tmp_path)  # a folder
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_robot_validated_as_a_model_is_pinocchios_torques_and_friction(tmp_path):
+    """Robot.predict is Pinocchio's rnea plus the URDF's <dynamics> friction; validate takes a
+    Robot as a model and warns where its file gives no friction."""
+    text = pr.robots.a465_urdf("physical").replace(
+        '<axis xyz="0 1.0 0"/>', '<axis xyz="0 1.0 0"/>\n    <dynamics damping="0.4" friction="0.7"/>')
+    robot = pr.Robot.from_urdf_string(text)
+    assert np.count_nonzero(robot.damping) >= 1
+    model = pin.buildModelFromXML(text)
+    t, q, qd, qdd = motion(3)
+    want = pin_torques(model, q, qd, qdd) + model.damping * qd + model.friction * np.sign(qd)
+    assert np.allclose(robot.predict(q, qd, qdd), want, rtol=1e-10, atol=1e-10)
+    assert robot.predict(q[0], qd[0], qdd[0]).shape == (6,)
+    v = pr.validate(robot, q, qd, qdd, want + 0.01, t=t)
+    assert np.allclose(v.rms, 0.01) and np.allclose(v.mean, 0.01)
+    bare = pr.Robot.from_urdf_string(pr.robots.a465_urdf("physical"))
+    with pytest.warns(pr.PerturbidWarning, match="gives its joints no friction"):
+        v = pr.validate(bare, q, qd, qdd, want, t=t)
+    assert v.rms.max() > 0.1
