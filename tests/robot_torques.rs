@@ -39,8 +39,8 @@ fn the_expansion_is_the_derivative_of_the_predictions() {
         let op = OperatingPoint::new(q.clone(), qd.clone(), qdd.clone()).unwrap();
         let e = model.linearize(&op).unwrap();
         let at = predict_one(&model, &q, &qd, &qdd);
-        for j in 0..n {
-            assert!((e.torque[j] - at[j]).abs() < 1e-12 * at[j].abs().max(1.0));
+        for (t, a) in e.torque.iter().zip(&at) {
+            assert!((t - a).abs() < 1e-12 * a.abs().max(1.0));
         }
         let h = 1e-6;
         for c in 0..n {
