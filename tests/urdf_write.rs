@@ -356,6 +356,26 @@ fn what_a_urdf_written_here_could_not_hold_is_refused() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("damping -1 is not a finite number >= 0"), "{e}");
+    // notes and names past their bounds
+    let long = "x".repeat(65_537);
+    let options = WriteOptions {
+        note: &long,
+        ..WriteOptions::default()
+    };
+    let e = write_urdf(&model, &options).unwrap_err().to_string();
+    assert!(
+        e.contains("note") && e.contains("65537 characters, expected at most 65536"),
+        "{e}"
+    );
+    let options = WriteOptions {
+        payload_link: &long[..4097],
+        ..WriteOptions::default()
+    };
+    let e = write_urdf(&model, &options).unwrap_err().to_string();
+    assert!(
+        e.contains("payload_link") && e.contains("4097 characters"),
+        "{e}"
+    );
     // an armature given by a transmission is not rewritten
     let text = robots::a465::urdf("physical").unwrap().replace(
         "</robot>",

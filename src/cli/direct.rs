@@ -300,10 +300,9 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
             if s.active.is_empty() { String::new() } else { format!(": {}", s.active.join("; ")) }
         );
         if a.urdf.is_some() {
-            let logs: Vec<String> = a.data.iter().map(|p| p.display().to_string()).collect();
             let note = format!(
                 "Identified by `perturbid identify-direct --consistent` from {}.",
-                logs.join(", ")
+                super::files::logs_named(&a.data)
             );
             let options = crate::urdf::WriteOptions {
                 note: &note,

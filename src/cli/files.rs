@@ -401,3 +401,17 @@ pub(crate) fn fit_splits(
     }
     Ok(splits)
 }
+
+/// The logs given, for a note in a file written from them: their paths, or where they are
+/// many or long, their count and the first.
+pub(crate) fn logs_named(paths: &[PathBuf]) -> String {
+    let all: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    let joined = all.join(", ");
+    match all.first() {
+        Some(first) if joined.chars().count() > 2000 => {
+            let first: String = first.chars().take(1000).collect();
+            format!("{} logs, the first {first}", all.len())
+        }
+        _ => joined,
+    }
+}

@@ -229,9 +229,7 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
         if a.urdf {
             let note = format!(
                 "The payload identified by `perturbid identify-payload` from {}.",
-                (a.data.iter().map(|p| p.display().to_string()))
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                super::files::logs_named(&a.data)
             );
             let options = crate::urdf::WriteOptions {
                 payload: Some(p),

@@ -47,6 +47,12 @@ impl std::fmt::Debug for UrdfSource {
     }
 }
 
+/// The longest note [`WriteOptions::note`] takes, in characters (a comment, not a log).
+pub const MAX_NOTE: usize = 65_536;
+
+/// The longest name of a payload's link [`WriteOptions::payload_link`] takes, in characters.
+pub const MAX_LINK_NAME: usize = 4096;
+
 /// What to write besides the model's own parameters.
 #[derive(Clone, Debug)]
 pub struct WriteOptions<'a> {
@@ -96,6 +102,18 @@ pub struct WrittenUrdf {
 /// where a body's inertia leaves no rigid body for its own link, and where the payload's link
 /// name is taken or the payload is no rigid body of positive mass.
 pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUrdf> {
+    for (argument, value, most) in [
+        ("note", options.note, MAX_NOTE),
+        ("payload_link", options.payload_link, MAX_LINK_NAME),
+    ] {
+        let length = value.chars().count();
+        if length > most {
+            return Err(Error::InvalidArgument {
+                argument: argument.into(),
+                message: format!("{length} characters, expected at most {most}"),
+            });
+        }
+    }
     let source = &model.urdf;
     let text = source.text.as_str();
     let original = model_from_urdf_str(text, &model.source, &source.options)?;
