@@ -92,9 +92,13 @@ pub struct WrittenUrdf {
 
 /// The URDF of `model`: the file it was built from with its changed inertias, friction
 /// (`<dynamics damping friction>`: viscous N m s/rad or N s/m, Coulomb N m or N) and armature
-/// (`<dynamics armature>`, kg m^2 or kg) written in, and `options.payload` attached (see [this
-/// module](self)). Inertials are written in the link's frame (`rpy="0 0 0"`, the centre of
-/// mass in m, the inertia about it in kg m^2, numbers that read back exactly).
+/// (`<dynamics armature>`, kg m^2 or kg) written in, and `options.payload` attached as a link
+/// of its own; every other byte of the file kept. Inertials are written in the link's frame
+/// (`rpy="0 0 0"`, the centre of mass in m, the inertia about it in kg m^2, numbers that read
+/// back exactly). A link moving with another's body (behind a fixed or locked joint) keeps
+/// the file's inertial and the body's own link gets the rest, where that is a rigid body;
+/// otherwise the links behind fixed joints give theirs up to it (a warning each). The text
+/// is read back and compared with the model before it is returned (docs/urdf.md).
 ///
 /// Refused (a `ModelError` naming the joint, link or field) where the model's kinematics or
 /// limits differ from its file's (only inertias, friction and armature are written), where a
