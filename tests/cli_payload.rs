@@ -6,56 +6,12 @@
 
 mod cli_support;
 
-use cli_support::{fails, nothing_written, ok, s, tmp, warnings_of, write};
+use cli_support::{
+    a465_log_carrying as log, fails, nothing_written, ok, s, tmp, warnings_of, write,
+};
 use perturbid_rs::rehearsal::Payload;
 
-const TRUE_PAYLOAD: &str = r#"{"link": "link6", "mass": 1.5, "com": [0.01, 0.0, 0.06], "inertia": [0.004, 0, 0, 0.004, 0, 0.002]}"#;
-
-/// The excitation of seed 1 (designed with 30 evaluations at 100 Hz) simulated at 500 Hz for
-/// two periods on a true A465 with friction, 0.02 N m of torque noise and `payload` (JSON, or
-/// none) into `dir/name`.
-fn log(dir: &std::path::Path, name: &str, payload: Option<&str>, seed: u64) -> std::path::PathBuf {
-    let exc = dir.join("exc");
-    if !exc.join("excitation.json").exists() {
-        ok(&[
-            "excite",
-            "a465",
-            "--out",
-            s(&exc),
-            "--max-evaluations",
-            "30",
-            "--rate",
-            "100",
-            "--seed",
-            "1",
-        ]);
-    }
-    let truth = dir.join(format!("{name}.true.json"));
-    let payload = payload.map_or(String::new(), |p| format!(r#""payload": {p},"#));
-    write(
-        &truth,
-        &format!(
-            r#"{{"format": "perturbid-true-robot/1", "seed": {seed}, {payload}
- "friction": {{"viscous": [0.5, 0.4, 0.3, 0.2, 0.1, 0.05], "coulomb": [1.0, 0.8, 0.6, 0.4, 0.2, 0.1]}},
- "sensors": {{"torque_noise": [0.02, 0.02, 0.02, 0.01, 0.01, 0.01]}}}}"#
-        ),
-    );
-    let out = dir.join(name);
-    ok(&[
-        "simulate",
-        "a465",
-        s(&exc.join("excitation.json")),
-        "--true-robot",
-        s(&truth),
-        "--rate",
-        "500",
-        "--periods",
-        "2",
-        "--out",
-        s(&out),
-    ]);
-    out
-}
+use cli_support::TRUE_PAYLOAD;
 
 fn payload_in(dir: &std::path::Path) -> Payload {
     let text = std::fs::read_to_string(dir.join("payload.json")).unwrap();

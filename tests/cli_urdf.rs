@@ -179,40 +179,7 @@ fn the_consistent_robot_written_as_urdf_predicts_what_its_model_does() {
 #[test]
 fn identify_payload_writes_the_robot_carrying_it() {
     let d = tmp("urdf-payload");
-    let truth = d.join("true.json");
-    std::fs::write(
-        &truth,
-        r#"{"format": "perturbid-true-robot/1", "seed": 3,
- "payload": {"link": "link6", "mass": 1.5, "com": [0.01, 0.0, 0.06], "inertia": [0.004, 0, 0, 0.004, 0, 0.002]},
- "sensors": {"torque_noise": [0.02, 0.02, 0.02, 0.01, 0.01, 0.01]}}"#,
-    )
-    .unwrap();
-    ok(&[
-        "excite",
-        "a465",
-        "--out",
-        s(&d.join("exc")),
-        "--max-evaluations",
-        "30",
-        "--rate",
-        "100",
-        "--seed",
-        "1",
-    ]);
-    let log = d.join("loaded.csv");
-    ok(&[
-        "simulate",
-        "a465",
-        s(&d.join("exc/excitation.json")),
-        "--true-robot",
-        s(&truth),
-        "--rate",
-        "500",
-        "--periods",
-        "2",
-        "--out",
-        s(&log),
-    ]);
+    let log = cli_support::a465_log_carrying(&d, "loaded.csv", Some(cli_support::TRUE_PAYLOAD), 3);
     let out_dir = d.join("p");
     let out = ok(&[
         "identify-payload",

@@ -144,3 +144,52 @@ pub fn excitation_log(dir: &Path, seed: u64) -> PathBuf {
     ]);
     log
 }
+
+/// A 1.5 kg payload on the A465's last link, as a true robot's `payload` (JSON).
+pub const TRUE_PAYLOAD: &str = r#"{"link": "link6", "mass": 1.5, "com": [0.01, 0.0, 0.06], "inertia": [0.004, 0, 0, 0.004, 0, 0.002]}"#;
+
+/// The excitation of seed 1 (designed with 30 evaluations at 100 Hz) simulated at 500 Hz for
+/// two periods on a true A465 with friction, 0.02 N m of torque noise and `payload` (JSON, or
+/// none) into `dir/name`.
+pub fn a465_log_carrying(dir: &Path, name: &str, payload: Option<&str>, seed: u64) -> PathBuf {
+    let exc = dir.join("exc");
+    if !exc.join("excitation.json").exists() {
+        ok(&[
+            "excite",
+            "a465",
+            "--out",
+            s(&exc),
+            "--max-evaluations",
+            "30",
+            "--rate",
+            "100",
+            "--seed",
+            "1",
+        ]);
+    }
+    let truth = dir.join(format!("{name}.true.json"));
+    let payload = payload.map_or(String::new(), |p| format!(r#""payload": {p},"#));
+    write(
+        &truth,
+        &format!(
+            r#"{{"format": "perturbid-true-robot/1", "seed": {seed}, {payload}
+ "friction": {{"viscous": [0.5, 0.4, 0.3, 0.2, 0.1, 0.05], "coulomb": [1.0, 0.8, 0.6, 0.4, 0.2, 0.1]}},
+ "sensors": {{"torque_noise": [0.02, 0.02, 0.02, 0.01, 0.01, 0.01]}}}}"#
+        ),
+    );
+    let out = dir.join(name);
+    ok(&[
+        "simulate",
+        "a465",
+        s(&exc.join("excitation.json")),
+        "--true-robot",
+        s(&truth),
+        "--rate",
+        "500",
+        "--periods",
+        "2",
+        "--out",
+        s(&out),
+    ]);
+    out
+}
