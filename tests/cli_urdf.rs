@@ -130,17 +130,47 @@ fn the_consistent_robot_written_as_urdf_predicts_what_its_model_does() {
         by_physical.iter().sum::<f64>() > 10.0 * by_a465.iter().sum::<f64>(),
         "{by_physical:?}"
     );
+    // --robot beside a robot (a pipeline's defaults): the same robot's joints, or refused
+    ok(&[
+        "validate",
+        s(&urdf),
+        s(&log),
+        "--robot",
+        "a465",
+        "--out",
+        s(&d.join("v_same")),
+    ]);
+    assert_eq!(rms("v_same"), by_urdf);
+    let arm = d.join("arm.urdf");
+    cli_support::write(
+        &arm,
+        r#"<robot name="arm"><link name="base"/>
+  <link name="upper"><inertial><mass value="5"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
+    <limit lower="-2" upper="2" velocity="2" effort="50"/></joint></robot>"#,
+    );
     fails(
         &[
             "validate",
             "a465",
             s(&log),
             "--robot",
-            "a465",
+            s(&arm),
             "--out",
             s(&d.join("v_bad")),
         ],
-        &["--robot", "is a robot, validated with its own parameters"],
+        &["--robot", "must be the same robot", "shoulder"],
+    );
+    fails(
+        &[
+            "validate",
+            "a465",
+            s(&log),
+            "--signal",
+            "--out",
+            s(&d.join("v_bad")),
+        ],
+        &["--signal", "is a robot, validated with its own parameters"],
     );
     nothing_written(&d, "v_bad");
 

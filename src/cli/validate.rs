@@ -59,7 +59,8 @@ pub(crate) struct ValidateArgs {
     /// The log CSV: t, q1..qN, tau1..tauN (qd, qdd optional: without qdd the log is
     /// preprocessed as for identification).
     data: PathBuf,
-    /// The robot, for a base-parameter model (URDF file or built-in name).
+    /// The robot, for a base-parameter model (URDF file or built-in name). With a robot as
+    /// MODEL it may be given (as a pipeline's defaults give it) and must have MODEL's joints.
     #[arg(long)]
     robot: Option<String>,
     /// Joints of --robot (or of MODEL, a robot) held still, as when the model was identified
@@ -95,21 +96,32 @@ pub(crate) struct ValidateArgs {
 pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     refuse_overwriting_inputs(&a.out, &[&a.model, &a.data])?;
     let file = if is_a_robot(&a.model)? {
-        for (given, option) in [(a.robot.is_some(), "--robot"), (a.signal, "--signal")] {
-            if given {
+        if a.signal {
+            return Err(Error::InvalidArgument {
+                argument: "--signal".into(),
+                message: format!(
+                    "{} is a robot, validated with its own parameters: --signal is for a saved model with drive gains",
+                    a.model.display()
+                ),
+            });
+        }
+        let own = load_robot(&a.model.display().to_string(), &a.lock)?;
+        // --robot (a pipeline's defaults give it to every step) must be the same robot
+        if let Some(r) = &a.robot {
+            let other = load_robot(r, &a.lock)?;
+            if other.joint_names != own.joint_names {
                 return Err(Error::InvalidArgument {
-                    argument: option.into(),
+                    argument: "--robot".into(),
                     message: format!(
-                        "{} is a robot, validated with its own parameters: {option} is for a saved model",
-                        a.model.display()
+                        "'{r}' has joints {:?}, MODEL {} {:?}: a robot given as MODEL is validated with its own parameters, and --robot, where given, must be the same robot",
+                        other.joint_names,
+                        a.model.display(),
+                        own.joint_names
                     ),
                 });
             }
         }
-        Subject::Robot(Box::new(load_robot(
-            &a.model.display().to_string(),
-            &a.lock,
-        )?))
+        Subject::Robot(Box::new(own))
     } else {
         Subject::File(ModelFile::load(&a.model)?)
     };
