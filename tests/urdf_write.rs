@@ -245,15 +245,35 @@ fn the_panda_hand_and_fingers_keep_theirs_where_the_body_allows_it() {
         }
         Err(e) => panic!("{e}"),
     }
-    // lighter than the fingers: nothing is written
+    // lighter than the fingers: every link's inertial moves into link 7, and the fingers'
+    // joints are said to move no mass in this file
     let mut lightest = model.clone();
     lightest.bodies[last].inertia = Inertia::new(0.01, i.com, i.inertia_com * 0.01);
     lightest.refresh();
-    let e = write_urdf(&lightest, &WriteOptions::default())
+    let written = write_urdf(&lightest, &WriteOptions::default()).unwrap();
+    assert_eq!(written.warnings.len(), 3, "{:?}", written.warnings);
+    assert!(
+        written.warnings[1].contains("'panda_leftfinger'")
+            && written.warnings[1].contains("carries no mass"),
+        "{:?}",
+        written.warnings
+    );
+    same_torques(&lightest, &reread(&lightest, &written.text), 1e-11);
+    let e = model_from_urdf_str(&written.text, "w", &LoadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("panda_finger_joint1"), "{e}");
+    // a body that is no rigid body itself: nothing is written
+    let mut broken = model.clone();
+    broken.bodies[last].inertia = Inertia::new(1.5, i.com, -i.inertia_com);
+    broken.refresh();
+    let e = write_urdf(&broken, &WriteOptions::default())
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("link 'panda_link7'") && e.contains("panda_leftfinger"),
+        e.contains("link 'panda_link7'")
+            && e.contains("panda_leftfinger")
+            && e.contains("no rigid body"),
         "{e}"
     );
 }
@@ -479,4 +499,70 @@ fn files_written_in_other_hands_keep_their_form() {
             assert!(written.text.contains("<visual name=\"a>b\">"), "{what}");
         }
     }
+}
+
+#[test]
+fn the_real_pandas_identified_urdf_predicts_its_second_half_better_than_the_vendors() {
+    let Some((model, rec)) = common::panda_preprocessed() else {
+        return;
+    };
+    use perturbid_rs::direct::{
+        identify_consistent_parameters, BaseOptions, ConsistentOptions, FrictionTerms,
+    };
+    use perturbid_rs::{RobotTorques, TorqueModel};
+    let n = model.nv;
+    let k = rec.len() / 2;
+    let states = rec.states().unwrap();
+    let (first, held) = (states.slice(0..k), states.slice(k..rec.len()));
+    let (tau_first, tau_held) = (&rec.tau[..k * n], &rec.tau[k * n..]);
+    let options = BaseOptions {
+        friction: FrictionTerms {
+            viscous: true,
+            coulomb: true,
+            ..FrictionTerms::NONE
+        },
+        ..BaseOptions::default()
+    };
+    let fit = identify_consistent_parameters(
+        &model,
+        &first,
+        tau_first,
+        &options,
+        &ConsistentOptions::default(),
+    )
+    .unwrap();
+    let written = write_urdf(&fit.robot(&model).unwrap(), &WriteOptions::default()).unwrap();
+    for w in &written.warnings {
+        println!("warning: {w}");
+    }
+    let identified = reread(&model, &written.text);
+    let rms = |m: &Model| -> Vec<f64> {
+        let p = RobotTorques::new(m).predict(&held).unwrap();
+        let rows = held.len();
+        (0..n)
+            .map(|j| {
+                let s: f64 = (0..rows)
+                    .map(|i| (p[i * n + j] - tau_held[i * n + j]).powi(2))
+                    .sum();
+                (s / rows as f64).sqrt()
+            })
+            .collect()
+    };
+    let (vendor, ours) = (rms(&model), rms(&identified));
+    println!(
+        "second half, RMS a joint (N m): vendor's URDF {vendor:.3?}, identified URDF {ours:.3?}"
+    );
+    // the identified file, read as any tool reads it, predicts motion it was not fitted to
+    assert!(
+        ours.iter().sum::<f64>() < 0.5 * vendor.iter().sum::<f64>(),
+        "{ours:?} vs {vendor:?}"
+    );
+    // and it is the consistent model's own prediction there
+    let by_model = fit.model.predict(&model, &held).unwrap();
+    let by_file = RobotTorques::new(&identified).predict(&held).unwrap();
+    let scale = by_model.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+    assert!(by_model
+        .iter()
+        .zip(&by_file)
+        .all(|(a, b)| (a - b).abs() < 1e-8 * scale));
 }

@@ -9,8 +9,10 @@
 //! moves with it; an identification determines the body's sum only. The other links keep the
 //! URDF's inertials and the body's own link gets the rest, where that is a rigid body. Where
 //! it is not, the links behind fixed joints give their inertials up to the body's own link
-//! (removed, and said in the notes); a locked joint's link keeps its own, as it moves once
-//! the joint is unlocked. Where even that leaves no rigid body, nothing is written.
+//! (removed, and said in the warnings); a locked joint's link keeps its own, as it moves once
+//! the joint is unlocked. Where even that leaves no rigid body, every link of the body gives
+//! its inertial up (the body's own link holds the identified body; a locked joint's link then
+//! carries no mass, warned of). Where the body is no rigid body itself, nothing is written.
 //!
 //! The text written is read again with the same options, and every body's inertia, joint's
 //! friction and armature must come back as the model has them (to 1e-9 of their size), or
@@ -153,43 +155,36 @@ pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUr
                 }
             })
             .collect();
-        let all = rest(&body.inertia, others.iter().map(|o| &o.inertia));
-        let (own, moved) = match all
-            .filter(|r| rigid_body_problem(r.mass, &r.inertia_com, triangle).is_none())
-        {
-            Some(r) => (r, Vec::new()),
-            None => {
-                let locked = others
-                    .iter()
-                    .filter(|o| o.behind_locked)
-                    .map(|o| &o.inertia);
-                let fixed: Vec<&Other> = (others.iter())
-                    .filter(|o| !o.behind_locked && o.inertia.mass > 0.0)
-                    .collect();
-                let r = rest(&body.inertia, locked).filter(|r| {
-                    !fixed.is_empty()
-                        && rigid_body_problem(r.mass, &r.inertia_com, triangle).is_none()
+        // the allocations tried in turn: the other links keep theirs; those behind fixed
+        // joints give theirs up; all of them do (a locked joint's link then carries no mass)
+        let rigid = |r: &Inertia| rigid_body_problem(r.mass, &r.inertia_com, triangle).is_none();
+        let allocations: [&dyn Fn(&Other) -> bool; 3] =
+            [&|_| false, &|o| !o.behind_locked, &|_| true];
+        let chosen = allocations.iter().find_map(|gives_up| {
+            let kept = others.iter().filter(|o| !gives_up(o)).map(|o| &o.inertia);
+            let moved: Vec<&Other> = (others.iter())
+                .filter(|o| gives_up(o) && o.inertia.mass > 0.0)
+                .collect();
+            rest(&body.inertia, kept).filter(rigid).map(|r| (r, moved))
+        });
+        let Some((own, moved)) = chosen else {
+            let problem = rest(&body.inertia, others.iter().map(|o| &o.inertia))
+                .map_or("its mass is not above theirs".to_string(), |r| {
+                    rigid_body_problem(r.mass, &r.inertia_com, triangle).unwrap_or_default()
                 });
-                match r {
-                    Some(r) => (r, fixed),
-                    None => {
-                        return Err(refuse(
-                            format!("link '{}'", body.link),
-                            format!(
-                                "body '{}' (joint '{}', mass {} kg) leaves its own link no rigid body beside the URDF's inertials of the links that move with it ({}): {}",
-                                body.link,
-                                body.joint,
-                                number(body.inertia.mass),
-                                if others.is_empty() { "none".to_string() } else { others.iter().map(|o| o.link.as_str()).collect::<Vec<_>>().join(", ") },
-                                match all {
-                                    Some(r) => rigid_body_problem(r.mass, &r.inertia_com, triangle).unwrap_or_default(),
-                                    None => "its mass is not above theirs".into(),
-                                }
-                            ),
-                        ))
-                    }
-                }
-            }
+            return Err(refuse(
+                format!("link '{}'", body.link),
+                format!(
+                    "body '{}' (joint '{}', mass {} kg) is no rigid body, nor is it less the URDF's inertials of the links that move with it ({}): {problem}",
+                    body.link,
+                    body.joint,
+                    number(body.inertia.mass),
+                    match others.is_empty() {
+                        true => "none".to_string(),
+                        false => (others.iter().map(|o| o.link.as_str())).collect::<Vec<_>>().join(", "),
+                    },
+                ),
+            ));
         };
         let node = elements
             .link(&body.link)
@@ -213,10 +208,14 @@ pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUr
                 edits.push(edit);
             }
             warnings.push(format!(
-                "link '{}': its <inertial> ({} kg) moved into link '{}' (the identified body less it is no rigid body)",
+                "link '{}': its <inertial> ({} kg) moved into link '{}' (the identified body less it is no rigid body){}",
                 o.link,
                 number(o.inertia.mass),
-                body.link
+                body.link,
+                match o.behind_locked {
+                    true => "; the locked joint before it carries no mass in this file (unlocked, this library refuses it as massless)",
+                    false => "",
+                }
             ));
         }
     }
