@@ -11,6 +11,7 @@ use super::direct::states;
 use super::local::PyOperatingPoint;
 use super::samples::{samples, Given};
 use crate::direct::{identify_global_linear as global_rs, GlobalLinearModel};
+use crate::document::Document;
 use crate::states::States;
 use crate::torque_model::TorqueModel;
 
@@ -111,8 +112,32 @@ impl PyGlobalLinear {
             fit.predict(s)
         })
     }
+    /// The model as JSON (`perturbid-global-linear-model/1`), as `save` writes it.
     fn to_json(&self) -> String {
-        serde_json::to_string_pretty(&self.fit).expect("serialisable")
+        Document::to_json(&self.fit)
+    }
+    /// A model from the JSON of `to_json`, checked: every shape against the joints, standard
+    /// errors and residuals >= 0. Raises InputError naming the field.
+    #[staticmethod]
+    fn from_json(text: &str) -> PyResult<Self> {
+        Ok(Self {
+            fit: <GlobalLinearModel as Document>::from_json(text)?,
+        })
+    }
+    /// Writes the model to `path` as JSON (atomically: a temporary file renamed into place);
+    /// `perturbid validate` and `predict` read it. Raises FileError when it cannot be written.
+    fn save(&self, py: Python<'_>, path: std::path::PathBuf) -> PyResult<()> {
+        Ok(detached(py, "GlobalLinearModel.save", || {
+            Document::save(&self.fit, &path)
+        })?)
+    }
+    /// A model saved by `save`, checked as `from_json` checks it. Raises FileError for a file
+    /// that cannot be read, InputError naming the file and field of a document that is not a
+    /// globally linearised model.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Self> {
+        let fit = detached(py, "GlobalLinearModel.load", || GlobalLinearModel::load(&path))?;
+        Ok(Self { fit })
     }
 }
 

@@ -715,7 +715,7 @@ def test_standard_errors_count_residuals_correlated_by_the_filter():
     assert json.loads(fit.to_json())["residual_correlation"] == pytest.approx(list(f))
 
 
-def test_global_linear_model_is_a_workspace_average():
+def test_global_linear_model_is_a_workspace_average(tmp_path):
     robot = pr.robots.a465()
     op = pr.OperatingPoint(TABLE2_Q, [0.089, -0.106, 0.022, 0.056, 0.011, 0.014], [-0.155, -0.5, 0.034, -0.291, -0.008, 0.171])
     traj = excitation(robot, 10, 0.05, 0.06, 3)  # 21 > 19 functions of time: all columns excited
@@ -730,6 +730,14 @@ def test_global_linear_model_is_a_workspace_average():
     assert np.abs(lin.D[[1, 2, 4], 0]).max() > 0.02
     assert set(lin.stderr) == {"torque", "D", "H", "G"} and lin.D.shape == (6, 6)
     np.testing.assert_allclose(lin.predict(op.q, op.qd, op.qdd), lin.torque, atol=1e-12)
+    # saved and loaded: the same model, and the document perturbid validate reads
+    path = tmp_path / "global.json"
+    lin.save(path)
+    again = pr.GlobalLinearModel.load(path)
+    np.testing.assert_array_equal(again.D, lin.D)
+    assert pr.GlobalLinearModel.from_json(lin.to_json()).to_json() == lin.to_json()
+    with pytest.raises(pr.InputError, match="global"):
+        pr.GlobalLinearModel.from_json(json.dumps({"format": "perturbid-local-model/1"}))
     # a Recording given whole: the same fit; mixed with arrays, or without velocities, refused
     rec = pr.Recording(t, q, tau, qd=qd, qdd=qdd)
     same = pr.identify_global_linear(op, rec)
