@@ -243,6 +243,48 @@ fn identify_payload_writes_the_robot_carrying_it() {
     assert!((moved.com - expected.com).norm() < 1e-12);
     assert!((moved.inertia_com - expected.inertia_com).norm() < 1e-12);
     assert_eq!(written.frame("drill").unwrap().body, Some(b));
+    // perturbid urdf with that payload.json writes the same robot
+    let again = d.join("again.urdf");
+    let out = ok(&[
+        "urdf",
+        "a465",
+        "--payload",
+        s(&out_dir.join("payload.json")),
+        "--payload-link",
+        "drill",
+        "--out",
+        s(&again),
+    ]);
+    assert!(out.contains("link 'drill': the payload"), "{out}");
+    let strip = |t: String| {
+        t.lines()
+            .filter(|l| !l.contains("<!-- Written by"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    assert_eq!(
+        strip(std::fs::read_to_string(&again).unwrap()),
+        strip(std::fs::read_to_string(out_dir.join("robot_with_payload.urdf")).unwrap())
+    );
+    // and a built-in robot's own file, with nothing attached
+    let own = d.join("physical.urdf");
+    ok(&["urdf", "a465:physical", "--out", s(&own)]);
+    assert_eq!(
+        strip(std::fs::read_to_string(&own).unwrap()) + "\n",
+        robots::a465::urdf("physical").unwrap()
+    );
+    fails(
+        &[
+            "urdf",
+            "a465",
+            "--payload",
+            r#"{"link": "link9", "mass": 1}"#,
+            "--out",
+            s(&d.join("bad.urdf")),
+        ],
+        &["'link9' is not a link of"],
+    );
+    assert!(!d.join("bad.urdf").exists());
     // a link name the robot has: refused before anything is written
     fails(
         &[

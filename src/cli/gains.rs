@@ -52,7 +52,7 @@ pub(crate) struct IdentifyGainsArgs {
 }
 
 /// The payload of `--payload`: a JSON file, or the JSON itself.
-fn load_payload(arg: &Path) -> Result<Payload> {
+pub(crate) fn load_payload(arg: &Path) -> Result<Payload> {
     let parse = |text: &str| -> Result<Payload> {
         let p: Payload = serde_json::from_str(text).map_err(|e| Error::Json {
             context: "payload".into(),

@@ -14,6 +14,7 @@ mod pipeline;
 mod progress;
 mod session;
 mod study;
+mod urdf;
 mod validate;
 
 use std::ffi::OsString;
@@ -69,6 +70,9 @@ enum Command {
     /// it, against a model of the robot alone (identify-direct) or its URDF: writes
     /// payload.json (as identify-gains --payload reads it) and payload_fit.json.
     IdentifyPayload(payload::IdentifyPayloadArgs),
+    /// The robot as URDF (a built-in robot's own file), with a payload attached as a link of
+    /// its own where --payload gives one (payload.json of identify-payload).
+    Urdf(urdf::UrdfArgs),
     /// Torques predicted by a saved model (local or base-parameter) at the states of a CSV.
     Predict(direct::PredictArgs),
     /// A saved model against a log (positions and torques; preprocessed as for
@@ -99,6 +103,7 @@ pub(crate) fn out_dir(out: &Option<PathBuf>) -> PathBuf {
 fn run(cli: Cli) -> Result<String> {
     match cli.command {
         Command::Info(a) => info::run(a),
+        Command::Urdf(a) => urdf::run(a),
         Command::Plan(a) => local::plan(a),
         Command::Simulate(a) => local::simulate(a),
         Command::Split(a) => session::split(a),

@@ -136,7 +136,9 @@ impl PyGlobalLinear {
     /// globally linearised model.
     #[staticmethod]
     fn load(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Self> {
-        let fit = detached(py, "GlobalLinearModel.load", || GlobalLinearModel::load(&path))?;
+        let fit = detached(py, "GlobalLinearModel.load", || {
+            GlobalLinearModel::load(&path)
+        })?;
         Ok(Self { fit })
     }
 }
