@@ -139,6 +139,18 @@ fn links_without_an_inertial_and_one_line_links_get_one() {
         let back = model_from_urdf_str(&written.text, "tree", &LoadOptions::default()).unwrap();
         same_torques(&model, &back, 1e-11);
     }
+    // a tree of 400 links, some behind fixed joints: written and read back alike
+    let text = common::random_tree_urdf(42, 400);
+    let mut model = model_from_urdf_str(&text, "tree", &LoadOptions::default()).unwrap();
+    for b in &mut model.bodies {
+        b.inertia = changed(&b.inertia, &mut rng);
+    }
+    model.refresh();
+    let started = std::time::Instant::now();
+    let written = write_urdf(&model, &WriteOptions::default()).unwrap();
+    println!("{} bodies written in {:?}", model.nbodies(), started.elapsed());
+    let back = model_from_urdf_str(&written.text, "tree", &LoadOptions::default()).unwrap();
+    same_torques(&model, &back, 1e-10);
     // a massless link of its own (its mass on a fixed child) and one written <link/>
     let text = r#"<robot name="two">
   <link name="base"/>

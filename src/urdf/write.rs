@@ -18,6 +18,8 @@
 //! friction and armature must come back as the model has them (to 1e-9 of their size), or
 //! nothing is returned.
 
+use std::collections::HashMap;
+
 use super::convert::link_inertia;
 use super::edits::{
     apply, child, header, number, payload_edit, remove_inertial, set_dynamics, set_inertial,
@@ -99,14 +101,15 @@ pub struct WrittenUrdf {
 /// (`rpy="0 0 0"`, the centre of mass in m, the inertia about it in kg m^2, numbers that read
 /// back exactly). A link moving with another's body (behind a fixed or locked joint) keeps
 /// the file's inertial and the body's own link gets the rest, where that is a rigid body;
-/// otherwise the links behind fixed joints give theirs up to it (a warning each). The text
+/// otherwise the links behind fixed joints, and then all of them, give theirs up to it (a
+/// warning each). The text
 /// is read back and compared with the model before it is returned (docs/urdf.md).
 ///
 /// Refused (a `ModelError` naming the joint, link or field) where the model's kinematics or
 /// limits differ from its file's (only inertias, friction and armature are written), where a
 /// changed friction or armature is negative or an armature comes from a `<transmission>`,
-/// where a body's inertia leaves no rigid body for its own link, and where the payload's link
-/// name is taken or the payload is no rigid body of positive mass.
+/// where a body is no rigid body (nor is it less its other links' inertials), and where the
+/// payload's link name is taken or the payload is no rigid body of positive mass.
 pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUrdf> {
     for (argument, value, most) in [
         ("note", options.note, MAX_NOTE),
@@ -135,6 +138,12 @@ pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUr
         message: e.to_string(),
     })?;
     let elements = Elements::of(&doc);
+    // each link by name, and the joint each link hangs from
+    let links: HashMap<&str, &urdf_rs::Link> =
+        robot.links.iter().map(|l| (l.name.as_str(), l)).collect();
+    let parent_joint: HashMap<&str, &urdf_rs::Joint> = (robot.joints.iter())
+        .map(|j| (j.child.link.as_str(), j))
+        .collect();
     let mut edits = Vec::new();
     let mut notes = Vec::new();
     let mut warnings = Vec::new();
@@ -145,14 +154,11 @@ pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUr
         }
         let others: Vec<Other> = (model.frames.iter())
             .filter(|f| f.body == Some(b) && f.link != body.link)
-            .map(|f| {
-                let link = robot.links.iter().find(|l| l.name == f.link);
-                Other {
-                    link: f.link.clone(),
-                    inertia: link
-                        .map_or(Inertia::zeros(), |l| f.pose.act_inertia(&link_inertia(l))),
-                    behind_locked: behind_locked(&robot, &body.link, &f.link),
-                }
+            .map(|f| Other {
+                link: f.link.clone(),
+                inertia: (links.get(f.link.as_str()))
+                    .map_or(Inertia::zeros(), |l| f.pose.act_inertia(&link_inertia(l))),
+                behind_locked: behind_locked(&parent_joint, &body.link, &f.link),
             })
             .collect();
         // the allocations tried in turn: the other links keep theirs; those behind fixed
@@ -313,12 +319,13 @@ struct Other {
     behind_locked: bool,
 }
 
-/// Whether a joint other than a fixed one lies on the path from link `from` down to `to`.
-fn behind_locked(robot: &urdf_rs::Robot, from: &str, to: &str) -> bool {
+/// Whether a joint other than a fixed one lies on the path from link `from` down to `to`
+/// (`parent_joint`: the joint each link hangs from).
+fn behind_locked(parent_joint: &HashMap<&str, &urdf_rs::Joint>, from: &str, to: &str) -> bool {
     let mut link = to;
     let mut locked = false;
     while link != from {
-        let Some(j) = robot.joints.iter().find(|j| j.child.link == link) else {
+        let Some(j) = parent_joint.get(link) else {
             return false;
         };
         locked |= j.joint_type != urdf_rs::JointType::Fixed;
