@@ -148,7 +148,11 @@ fn links_without_an_inertial_and_one_line_links_get_one() {
     model.refresh();
     let started = std::time::Instant::now();
     let written = write_urdf(&model, &WriteOptions::default()).unwrap();
-    println!("{} bodies written in {:?}", model.nbodies(), started.elapsed());
+    println!(
+        "{} bodies written in {:?}",
+        model.nbodies(),
+        started.elapsed()
+    );
     let back = model_from_urdf_str(&written.text, "tree", &LoadOptions::default()).unwrap();
     same_torques(&model, &back, 1e-10);
     // a massless link of its own (its mass on a fixed child) and one written <link/>
@@ -470,6 +474,13 @@ fn files_written_in_other_hands_keep_their_form() {
             source.replace("<link name=\"link3\">\n    <inertial>", "<link name=\"link3\"><inertial>"),
         ),
         ("no declaration", source.replace("<?xml version=\"1.0\"?>", "")),
+        (
+            "a <dynamics> with a namespace of its own",
+            source.replace(
+                "<child link=\"link4\"/>",
+                "<child link=\"link4\"/><dynamics xmlns:g=\"urn:g\" g:spring='1' friction=\"0.1\"></dynamics>",
+            ),
+        ),
     ];
     let payload = Payload {
         link: "link6".into(),
@@ -507,6 +518,13 @@ fn files_written_in_other_hands_keep_their_form() {
             );
         }
         assert!(!written.text.contains("a note -->"), "{what}");
+        if what.starts_with("a <dynamics>") {
+            assert!(
+                written.text.contains("<dynamics xmlns:g=\"urn:g\" g:spring='1' friction=\"0.1\" damping=\"0.7\"></dynamics>"),
+                "{}",
+                written.text
+            );
+        }
         if what.starts_with("a comment") {
             assert!(written.text.contains("<visual name=\"a>b\">"), "{what}");
         }

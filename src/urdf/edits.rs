@@ -205,49 +205,50 @@ pub(super) fn escape(value: &str) -> String {
         .replace('"', "&quot;")
 }
 
-/// The edit that gives joint element `joint` a `<dynamics>` with `values`: those attributes
-/// of its own replaced (the others kept), or a new element before the joint's end tag.
+/// The edits that give joint element `joint` a `<dynamics>` with `values`: the values of those
+/// attributes of its own replaced and the missing ones added to its start tag (every other
+/// byte kept), or a new element before the joint's end tag.
 pub(super) fn set_dynamics(
     text: &str,
     joint: roxmltree::Node<'_, '_>,
     dynamics: Option<roxmltree::Node<'_, '_>>,
     values: &[(&str, f64)],
-) -> Edit {
-    let attributes = |kept: &mut String| {
-        for (k, v) in values {
-            let _ = write!(kept, " {k}=\"{}\"", number(*v));
-        }
-    };
+) -> Vec<Edit> {
     if let Some(d) = dynamics {
         let (end, closed) = start_tag_end(text, d);
-        let mut tag = String::from("<dynamics");
-        for a in d
-            .attributes()
-            .filter(|a| !values.iter().any(|(k, _)| *k == a.name()))
-        {
-            let _ = write!(tag, " {}=\"{}\"", &text[a.range_qname()], escape(a.value()));
-        }
-        attributes(&mut tag);
-        tag.push_str(if closed { "/>" } else { ">" });
-        let start = d.range().start;
-        return Edit {
-            range: start..end + 1,
-            text: tag,
-        };
+        // added before "/>" or ">"
+        let at = if closed { end - 1 } else { end };
+        return (values.iter())
+            .map(|(k, v)| {
+                let own = (d.attributes()).find(|a| a.namespace().is_none() && a.name() == *k);
+                match own {
+                    Some(a) => Edit {
+                        range: a.range_value(),
+                        text: number(*v),
+                    },
+                    None => Edit {
+                        range: at..at,
+                        text: format!(" {k}=\"{}\"", number(*v)),
+                    },
+                }
+            })
+            .collect();
     }
     let indent = indent_at(text, joint.range().start);
     let mut tag = String::from("<dynamics");
-    attributes(&mut tag);
+    for (k, v) in values {
+        let _ = write!(tag, " {k}=\"{}\"", number(*v));
+    }
     tag.push_str("/>");
     // before the end tag </joint>
     let close = text[..joint.range().end]
         .rfind("</")
         .unwrap_or(joint.range().end);
     let line_start = close - indent_at(text, close).len();
-    Edit {
+    vec![Edit {
         range: line_start..line_start,
         text: format!("{indent}  {tag}\n"),
-    }
+    }]
 }
 
 /// The edit that attaches payload `p`: a link `name` and its fixed joint before `</robot>`.

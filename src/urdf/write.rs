@@ -269,7 +269,7 @@ pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUr
         if armature_in_dynamics || model.armature[j] != original.armature[j] {
             values.push(("armature", model.armature[j]));
         }
-        edits.push(set_dynamics(text, node, dynamics, &values));
+        edits.extend(set_dynamics(text, node, dynamics, &values));
         notes.push(format!(
             "joint '{name}': <dynamics> {}",
             values
