@@ -214,6 +214,69 @@ fn several_logs_are_fitted_together_and_each_is_checked_alone() {
             .unwrap();
     assert_eq!(fit["logs"][1], s(&b));
     assert_eq!(fit["run_checks"].as_array().unwrap().len(), 2);
+    // the second log's torques read 0.2 N m high (its sensors zeroed anew): an offset each,
+    // against a model of the robot alone, validated each with its own
+    let text = std::fs::read_to_string(&b).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    let taus: Vec<usize> = (header.split(',').enumerate())
+        .filter(|(_, c)| c.trim().starts_with("tau"))
+        .map(|(i, _)| i)
+        .collect();
+    let mut shifted = vec![header.to_string()];
+    for line in lines {
+        let mut cells: Vec<String> = line.split(',').map(str::to_string).collect();
+        for &c in &taus {
+            let v: f64 = cells[c].trim().parse().unwrap();
+            cells[c] = format!("{}", v + 0.2);
+        }
+        shifted.push(cells.join(","));
+    }
+    let zeroed = d.join("zeroed.csv");
+    write(&zeroed, &(shifted.join("\n") + "\n"));
+    let alone = log(&d, "alone.csv", None, 2);
+    let model = d.join("base.json");
+    ok(&["identify-direct", "a465", s(&alone), "--out", s(&model)]);
+    let out = ok(&[
+        "identify-payload",
+        "a465",
+        s(&a),
+        s(&zeroed),
+        "--link",
+        "link6",
+        "--model",
+        s(&model),
+        "--offset-per-log",
+        "--out",
+        s(&d.join("z")),
+    ]);
+    let at = out
+        .find("each log's torque offset less the logs' mean")
+        .expect(&out);
+    let row = out[at..].lines().nth(2).unwrap();
+    assert!(row.starts_with(&format!("  {}: 0.1", s(&zeroed))), "{out}");
+    let p = payload_in(&d.join("z"));
+    assert!((p.mass - 1.5).abs() < 0.01, "{p:?}");
+    let fit: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("z/payload_fit.json")).unwrap())
+            .unwrap();
+    assert!(
+        fit["log_offsets"]["deviations"][0][1].as_f64().unwrap() > 0.09,
+        "{fit}"
+    );
+    fails(
+        &[
+            "identify-payload",
+            "a465",
+            s(&a),
+            "--link",
+            "link6",
+            "--offset-per-log",
+            "--out",
+            s(&d.join("y")),
+        ],
+        &["--offset-per-log", "2 to 50 logs"],
+    );
     // the second log's shoulder torque in mN m: named by its log, and no payload written
     let text = std::fs::read_to_string(&b).unwrap();
     let mut lines = text.lines();

@@ -878,6 +878,9 @@ class PayloadFit:
     (kg), centre of mass (m) and inertia about it (kg m^2, [ixx, ixy, ixz, iyy, iyz, izz]) in
     the link's joint frame, with standard errors, and what the fit cannot vouch for."""
     @property
+    def log_offsets(self) -> Optional[dict[str, Any]]:
+        """With offset_per_log: logs, deviations and stderr ((logs, n), N m)."""
+    @property
     def payload(self) -> Optional[dict[str, Any]]:
         """link, mass, com, inertia: the dict identify_drive_gains and TrueRobot take; None
         where no payload is seen or the fit cannot vouch for it (see findings)."""
@@ -975,6 +978,7 @@ def identify_payload(
     consistent: bool = False,
     t: Optional[ArrayLike] = None,
     coulomb: Optional[ArrayLike] = None,
+    offset_per_log: bool = False,
 ) -> PayloadFit:
     """The payload fixed to `link` from a log of the robot carrying it ((k, n) arrays, rad,
     rad/s, rad/s^2, N m, or a preprocessed Recording as q), against `model` (the robot alone,

@@ -382,16 +382,11 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         json.display()
     );
     if let Some(o) = &fit.log_offsets {
-        let _ = writeln!(
-            out,
-            "each log's torque offset less the logs' mean (the model's offset terms), per joint (N m, +- standard error):"
-        );
-        for (r, path) in a.data.iter().enumerate() {
-            let each: Vec<String> = (o.deviations.iter().zip(&o.stderr))
-                .map(|(d, s)| format!("{:.4} +- {:.4}", d[r], s[r]))
-                .collect();
-            let _ = writeln!(out, "  {}: {}", path.display(), each.join(", "));
-        }
+        out.push_str(&super::files::log_offsets_table(
+            o,
+            &a.data,
+            "the model's offset terms",
+        ));
     }
     if split < k {
         let held_out = held.0;

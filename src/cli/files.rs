@@ -415,3 +415,22 @@ pub(crate) fn logs_named(paths: &[PathBuf]) -> String {
         _ => joined,
     }
 }
+
+/// Each log's torque offset less the logs' mean (`mean` says what holds the mean), a line a
+/// log (`paths`, in the fit's order) with each joint's deviation and standard error.
+pub(crate) fn log_offsets_table(
+    o: &crate::direct::LogOffsets,
+    paths: &[PathBuf],
+    mean: &str,
+) -> String {
+    let mut out = format!(
+        "each log's torque offset less the logs' mean ({mean}), per joint (N m, +- standard error):\n"
+    );
+    for (r, path) in paths.iter().enumerate() {
+        let each: Vec<String> = (o.deviations.iter().zip(&o.stderr))
+            .map(|(d, s)| format!("{:.4} +- {:.4}", d[r], s[r]))
+            .collect();
+        out.push_str(&format!("  {}: {}\n", path.display(), each.join(", ")));
+    }
+    out
+}

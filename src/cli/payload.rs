@@ -76,6 +76,11 @@ pub(crate) struct IdentifyPayloadArgs {
     /// controller's model; remove that link and its joint to take the payload off.
     #[arg(long)]
     urdf: bool,
+    /// Several logs: fit a torque offset of each log's own (a sensor zeroed anew between
+    /// them) beside the joint terms' offset, which is then the logs' mean; needs the offset
+    /// among --terms. Each log is validated with its own offset.
+    #[arg(long)]
+    offset_per_log: bool,
     /// The name of the payload's link in robot_with_payload.urdf (its joint is NAME_joint).
     #[arg(long, default_value = "payload", value_name = "NAME")]
     payload_link: String,
@@ -126,6 +131,7 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
     options.gravity = Gravity::from(!a.no_gravity);
     options.consistent = a.consistent;
     options.inertia = a.inertia;
+    options.offset_per_run = a.offset_per_log;
     super::files::check_validate_fraction(a.validate)?;
     // a link the robot lacks is named before the log is read
     crate::rehearsal::Payload {
@@ -204,11 +210,19 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
         _ => e,
     };
     progress.update(&format!("identifying on {} samples", train.0.len()));
-    let fit = identify_payload(&model, reference, &train.0, train.1, &options).map_err(in_data)?;
+    let fit = identify_payload(&model, reference, &train.0, train.1, &options)
+        .map_err(|e| crate::direct::log_offsets::as_argument(e, "--offset-per-log"))
+        .map_err(in_data)?;
     let validation = (!held.0.is_empty())
         .then(|| -> Result<_> {
             progress.update("validating");
-            let predicted = fit.predict(&model, reference, &held.0)?;
+            let mut predicted = fit.predict(&model, reference, &held.0)?;
+            // each log's held-out samples with its own offset, where one was fitted
+            if let Some(o) = &fit.log_offsets {
+                let held_runs: Vec<usize> =
+                    recs.iter().zip(&splits).map(|(r, s)| r.len() - s).collect();
+                predicted = o.added(&predicted, &held_runs);
+            }
             crate::validation::validate(&model.joint_names, &predicted, held.1)
         })
         .transpose()?;
@@ -248,6 +262,13 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
     )?;
     set.commit()?;
     out.push_str(&report(&fit, &a.out, a.urdf));
+    if let Some(o) = &fit.log_offsets {
+        out.push_str(&super::files::log_offsets_table(
+            o,
+            &a.data,
+            "the joint terms' offset",
+        ));
+    }
     if let Some(v) = validation {
         let _ = writeln!(
             out,

@@ -168,6 +168,22 @@ impl LogOffsets {
     }
 }
 
+/// `e` with the argument `offset_per_run` named as a front end calls it (`--offset-per-log`,
+/// `offset_per_log`); other errors as they are.
+pub fn as_argument(e: crate::error::Error, name: &str) -> crate::error::Error {
+    match e {
+        crate::error::Error::InvalidArgument { argument, message }
+            if argument == "offset_per_run" =>
+        {
+            crate::error::Error::InvalidArgument {
+                argument: name.into(),
+                message,
+            }
+        }
+        other => other,
+    }
+}
+
 /// Refuses an offset a run ([`super::BaseOptions::offset_per_run`]) that `options` cannot
 /// take: fewer than two runs or more than [`super::streaming::MAX_OFFSET_RUNS`], or joint
 /// terms without the offset (the runs' offsets are deviations from it).

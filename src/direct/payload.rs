@@ -95,6 +95,11 @@ pub struct PayloadOptions {
     /// (default false: the plain least squares, which can leave a loosely determined inertia
     /// no rigid body's).
     pub consistent: bool,
+    /// Several logs: an offset of each log's own a joint (a sensor zeroed anew between them)
+    /// beside the joint terms' offset, which is then the logs' mean (default false: one
+    /// offset for all). Needs 2 to [`super::streaming::MAX_OFFSET_RUNS`] logs and the offset
+    /// among `terms`.
+    pub offset_per_run: bool,
 }
 
 impl PayloadOptions {
@@ -117,6 +122,7 @@ impl PayloadOptions {
             runs: vec![],
             log_names: vec![],
             consistent: false,
+            offset_per_run: false,
         }
     }
 }
@@ -190,10 +196,13 @@ fn unknowns(model: &Model, body: usize, terms: FrictionTerms) -> BaseParameters 
     }
 }
 
-/// The unknowns' columns: the payload body's ten and each joint's terms.
+/// The unknowns' columns: the payload body's ten, each joint's terms and, with an offset a
+/// log, each joint's deviations of the logs after the first.
 pub(super) struct Columns {
     pub(super) body: usize,
     pub(super) terms: Vec<&'static str>,
+    /// The logs with an offset each (0 without).
+    pub(super) runs: usize,
 }
 
 impl Columns {
@@ -223,6 +232,30 @@ impl Columns {
                 _ => 1.0,
             };
         }
+    }
+
+    /// The columns of a log's own offset of `joint` in a row of log `run` (as
+    /// [`super::streaming::JointFactors::with_runs`] has them: 1 in the log's own after the
+    /// first, -1 in all for the first), into `out` after [`Self::row`]'s; nothing without
+    /// them or for `None` (states of no log fitted: the logs' mean offset).
+    pub(super) fn run_offsets(&self, nv: usize, joint: usize, run: Option<usize>, out: &mut [f64]) {
+        let (Some(run), true) = (run, self.runs > 1) else {
+            return;
+        };
+        let e = self.runs - 1;
+        let first = PARAMS_PER_BODY + nv * self.terms.len() + joint * e;
+        for (c, v) in out[first..first + e].iter_mut().enumerate() {
+            *v = match run {
+                0 => -1.0,
+                r if r == c + 1 => 1.0,
+                _ => 0.0,
+            };
+        }
+    }
+
+    /// The number of unknowns for `nv` joints.
+    pub(super) fn len(&self, nv: usize) -> usize {
+        PARAMS_PER_BODY + nv * (self.terms.len() + self.runs.saturating_sub(1))
     }
 }
 
@@ -280,11 +313,31 @@ pub fn identify_payload(
     let parts = ReferenceParts::of(model, &reference, options.gravity)?;
     let (ref_layout, ref_theta, base_of_reference) = (&parts.layout, &parts.theta, parts.base);
     let problem = unknowns(model, body, options.terms);
+    let offset_runs: &[usize] = match options.offset_per_run {
+        true => {
+            super::log_offsets::check_options(&super::BaseOptions {
+                runs: options.runs.clone(),
+                friction: options.terms,
+                ..Default::default()
+            })?;
+            &options.runs
+        }
+        false => &[],
+    };
     let columns = Columns {
         body,
         terms: options.terms.names(),
+        runs: offset_runs.len(),
     };
-    let m = problem.len();
+    let m = columns.len(nv);
+    // the log of every sample, for its own offset's columns
+    let run_of = |s: usize| -> Option<usize> {
+        let mut first = 0;
+        offset_runs.iter().position(|&len| {
+            first += len;
+            s < first
+        })
+    };
     let p_ref = base_of_reference.map_or(0, |b| b.len());
     // pass 1: the torques less the reference's, and per joint the cross products of the
     // unknowns' columns with the reference's base columns (for its share of the errors)
@@ -309,6 +362,7 @@ pub fn identify_payload(
                 let mut a = DMatrix::zeros(len, m);
                 for (i, s) in range.clone().enumerate() {
                     columns.row(phi, i * nv + j, states, s, j, &mut row);
+                    columns.run_offsets(nv, j, run_of(s), &mut row);
                     a.row_mut(i).copy_from_slice(&row);
                 }
                 let b = DMatrix::from_fn(len, p_ref, |i, c| f[(i * nv + j, c)]);
@@ -327,11 +381,22 @@ pub fn identify_payload(
         });
     }
     // pass 2: the unknowns' least squares, OLS then WLS
-    let factors = JointFactors::new(model, &problem, states, &y, options.gravity)?;
-    let names: Vec<String> = (crate::algorithms::regressor::PARAMETER_NAMES.iter())
+    let factors = JointFactors::with_runs(
+        model,
+        &problem,
+        states,
+        &y,
+        &[],
+        offset_runs,
+        options.gravity,
+    )?;
+    let mut names: Vec<String> = (crate::algorithms::regressor::PARAMETER_NAMES.iter())
         .map(|n| format!("payload.{n}"))
         .chain(problem.names().into_iter().skip(PARAMS_PER_BODY))
         .collect();
+    for j in &model.joint_names {
+        names.extend((1..offset_runs.len()).map(|r| format!("{j}.offset of run {r}")));
+    }
     let in_context = |e: Error| match e {
         Error::RankDeficient {
             rows,
@@ -394,6 +459,7 @@ pub fn identify_payload(
                 for j in 0..nv {
                     let r = i * nv + j;
                     columns.row(phi, r, &part, s, j, &mut row);
+                    columns.run_offsets(nv, j, run_of(rows.start + s), &mut row);
                     let fitted: f64 = row.iter().zip(pi.iter()).map(|(a, b)| a * b).sum();
                     residuals.push(y[(rows.start + s) * nv + j] - fitted);
                     let own: f64 = (0..PARAMS_PER_BODY).map(|c| row[c] * pi_payload[c]).sum();
@@ -451,6 +517,17 @@ pub fn identify_payload(
         .iter()
         .map(|s| (s / head.max(1) as f64).sqrt())
         .collect();
+    // each log's offset less the logs' mean, where each has its own
+    let log_offsets = (offset_runs.len() > 1).then(|| {
+        super::log_offsets::LogOffsets::of_fit(
+            &theta,
+            &stderr,
+            &correlation,
+            problem.len(),
+            nv,
+            offset_runs.len(),
+        )
+    });
     let mut fit = PayloadFit {
         robot: model.name.clone(),
         joint_names: model.joint_names.clone(),
@@ -490,6 +567,7 @@ pub fn identify_payload(
         },
         run_checks: vec![],
         findings: vec![],
+        log_offsets,
     };
     // the log against the robot's model, as every direct fit checks its log: a torque column
     // in other units, of another sign or joint, and positions beyond the limits (a log in

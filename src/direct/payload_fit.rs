@@ -129,6 +129,10 @@ pub struct PayloadFit {
     pub run_checks: Vec<super::RunChecks>,
     /// What the fit cannot vouch for, in words (each also warned of by the front ends).
     pub findings: Vec<String>,
+    /// With an offset of each log's own ([`super::PayloadOptions::offset_per_run`]): each
+    /// log's offset less the logs' mean, per joint, with standard errors (the joint terms'
+    /// offset is the mean); None otherwise.
+    pub log_offsets: Option<super::log_offsets::LogOffsets>,
 }
 
 impl PayloadFit {
@@ -169,15 +173,18 @@ impl PayloadFit {
         let body = (model.bodies.iter())
             .position(|b| b.link == self.body)
             .ok_or_else(|| bad(format!("the robot has no body '{}'", self.body)))?;
+        // states of no log fitted: each joint's offset the logs' mean
         let columns = Columns {
             body,
             terms: self.terms.names(),
+            runs: (self.log_offsets.as_ref())
+                .map_or(0, |o| o.deviations.first().map_or(0, Vec::len)),
         };
-        if PARAMS_PER_BODY + columns.terms.len() * nv != self.theta.len() {
+        if columns.len(nv) != self.theta.len() {
             return Err(bad(format!(
                 "{} estimates, not the {} of the payload and its joint terms on this robot",
                 self.theta.len(),
-                PARAMS_PER_BODY + columns.terms.len() * nv
+                columns.len(nv)
             )));
         }
         crate::torque_model::check_joints(states, nv)?;

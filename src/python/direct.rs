@@ -361,14 +361,7 @@ impl PyBaseModel {
         let Some(o) = &self.fit.log_offsets else {
             return Ok(None);
         };
-        let e = PyDict::new(py);
-        let names = self.fit.log_names();
-        let (runs, n) = (o.runs(), o.deviations.len());
-        let by_log = |m: &[Vec<f64>]| DMatrix::from_fn(runs, n, |r, j| m[j][r]);
-        e.set_item("logs", names)?;
-        e.set_item("deviations", mat(py, &by_log(&o.deviations))?)?;
-        e.set_item("stderr", mat(py, &by_log(&o.stderr))?)?;
-        Ok(Some(e))
+        log_offsets_dict(py, o, self.fit.log_names()).map(Some)
     }
     /// In a fit of several Recordings (or runs), whether they agree with one robot (each fitted
     /// alone against the fit; a payload in some and not others makes them disagree): dict
@@ -730,4 +723,20 @@ pub(crate) fn identify_base_parameters<'py>(
         fit,
         model: Arc::new(model.clone()),
     })
+}
+
+/// Each log's offset as Python sees it: `logs` (names), `deviations` and `stderr`, each
+/// (logs, n) (N m), a log's offset less the logs' mean.
+pub(crate) fn log_offsets_dict<'py>(
+    py: Python<'py>,
+    o: &crate::direct::LogOffsets,
+    names: Vec<String>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let e = PyDict::new(py);
+    let (runs, n) = (o.runs(), o.deviations.len());
+    let by_log = |m: &[Vec<f64>]| DMatrix::from_fn(runs, n, |r, j| m[j][r]);
+    e.set_item("logs", names)?;
+    e.set_item("deviations", mat(py, &by_log(&o.deviations))?)?;
+    e.set_item("stderr", mat(py, &by_log(&o.stderr))?)?;
+    Ok(e)
 }

@@ -156,6 +156,15 @@ impl PyPayloadFit {
     fn consistent(&self) -> bool {
         self.fit.consistent
     }
+    /// With `offset_per_log`: `logs`, and `deviations` and `stderr` ((logs, n), N m), each
+    /// log's torque offset less the logs' mean; None otherwise.
+    #[getter]
+    fn log_offsets<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(o) = &self.fit.log_offsets else {
+            return Ok(None);
+        };
+        super::direct::log_offsets_dict(py, o, self.fit.logs.clone()).map(Some)
+    }
     #[getter]
     fn residual_growth(&self) -> Option<f64> {
         self.fit.residual_growth
@@ -231,12 +240,14 @@ impl PyPayloadFit {
 /// `inertia`: 'fitted' (all ten parameters) or 'point_mass' (the inertia about the centre of
 /// mass taken as 0, the mass and centre alone fitted: for a log that determines a small
 /// payload's inertia loosely or not at all, as poses held still do); `consistent`: a rigid
-/// body by construction. `t` ((k,) s) checks a log's own qd and qdd
+/// body by construction; `offset_per_log` (a list of Recordings): a torque offset of each
+/// log's own beside the joint terms' offset, then their mean (`PayloadFit.log_offsets`).
+/// `t` ((k,) s) checks a log's own qd and qdd
 /// columns against the derivatives of q and qd; `coulomb` ((k, n)) the Coulomb column of
 /// torques low-pass filtered. Findings are warned of (`PerturbidWarning`) and kept in
 /// `findings`.
 #[pyfunction]
-#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, *, link, model=None, terms=None, weighting="wls", gravity=true, inertia="fitted", consistent=false, t=None, coulomb=None))]
+#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, *, link, model=None, terms=None, weighting="wls", gravity=true, inertia="fitted", consistent=false, t=None, coulomb=None, offset_per_log=false))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_payload<'py>(
     py: Python<'py>,
@@ -254,6 +265,7 @@ pub(crate) fn identify_payload<'py>(
     consistent: bool,
     t: Option<Bound<'py, PyAny>>,
     coulomb: Option<Bound<'py, PyAny>>,
+    offset_per_log: bool,
 ) -> PyResult<PyPayloadFit> {
     let robot_model = &robot.model;
     let n = robot_model.nv;
@@ -269,6 +281,7 @@ pub(crate) fn identify_payload<'py>(
     options.gravity = Gravity::from(gravity);
     options.consistent = consistent;
     options.inertia = inertia.parse()?;
+    options.offset_per_run = offset_per_log;
     let given = Given {
         qd,
         qdd,
@@ -292,6 +305,7 @@ pub(crate) fn identify_payload<'py>(
                 &stacked.data,
                 &options,
             )
+            .map_err(|e| crate::direct::log_offsets::as_argument(e, "offset_per_log"))
         })?;
         super::errors::warn_all(py, &fit.findings)?;
         return Ok(PyPayloadFit {
@@ -308,6 +322,7 @@ pub(crate) fn identify_payload<'py>(
         check_sample_derivatives("identify_payload's samples", n, t, &c)?;
         let s = fit_states(n, &c, coulomb.as_deref())?;
         payload_rs(robot_model, reference, &s, &c[3], &options)
+            .map_err(|e| crate::direct::log_offsets::as_argument(e, "offset_per_log"))
     })?;
     super::errors::warn_all(py, &fit.findings)?;
     Ok(PyPayloadFit {

@@ -245,3 +245,26 @@ def test_several_recordings_are_fitted_together_and_each_checked_alone(a465):
     assert not fit.usable and fit.payload is None
     with pytest.raises(pr.InputError, match="pass the list alone"):
         pr.identify_payload(pair.ours, recs, q, link="link6")
+
+
+def test_each_logs_own_offset_is_fitted_beside_the_payload(a465):
+    """Two logs, the second's sensors zeroed anew (Pinocchio's torques plus an offset)."""
+    pair, loaded = a465
+    offsets = np.array([0.3, -0.2, 0.1, 0.05, -0.1, 0.02])
+    recs = []
+    for seed, shift in [(4, 0.0), (6, 1.0)]:
+        t, q, qd, qdd, tau = log(loaded, seed)
+        recs.append(pr.Recording(t, q, tau + shift * offsets, qd=qd, qdd=qdd, name=f"day{seed}.csv"))
+    fit = pr.identify_payload(pair.ours, recs, link="link6", terms=["viscous", "offset"],
+                              offset_per_log=True)
+    assert np.allclose(fit.theta[:10], pin_payload().toDynamicParameters(), rtol=1e-7, atol=1e-9)
+    o = fit.log_offsets
+    assert o["logs"] == ["day4.csv", "day6.csv"]
+    assert np.allclose(o["deviations"], np.outer([-0.5, 0.5], offsets), atol=1e-8)
+    assert o["stderr"].shape == (2, 6)
+    with pytest.warns(pr.PerturbidWarning):  # one offset for both: the payload takes the rest
+        shared = pr.identify_payload(pair.ours, recs, link="link6", terms=["viscous", "offset"])
+    assert shared.log_offsets is None
+    assert abs(shared.payload_stderr["mass"]) > 1e3 * abs(fit.payload_stderr["mass"])
+    with pytest.raises(pr.InputError, match="needs the offset among the joint terms"):
+        pr.identify_payload(pair.ours, recs, link="link6", terms="viscous", offset_per_log=True)
