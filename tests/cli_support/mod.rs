@@ -115,19 +115,7 @@ pub const ARM_WITH_FINGER: &str = r#"<robot name="arm">
 /// `dir/log<seed>.csv`; returns the log's path.
 pub fn excitation_log(dir: &Path, seed: u64) -> PathBuf {
     let exc = dir.join(format!("exc{seed}"));
-    let seed = seed.to_string();
-    ok(&[
-        "excite",
-        "a465",
-        "--out",
-        s(&exc),
-        "--max-evaluations",
-        "30",
-        "--rate",
-        "100",
-        "--seed",
-        &seed,
-    ]);
+    excite_a465(&exc, seed);
     let log = dir.join(format!("log{seed}.csv"));
     ok(&[
         "simulate",
@@ -140,7 +128,7 @@ pub fn excitation_log(dir: &Path, seed: u64) -> PathBuf {
         "--torque-noise",
         "0.01",
         "--seed",
-        &seed,
+        &seed.to_string(),
     ]);
     log
 }
@@ -154,18 +142,7 @@ pub const TRUE_PAYLOAD: &str = r#"{"link": "link6", "mass": 1.5, "com": [0.01, 0
 pub fn a465_log_carrying(dir: &Path, name: &str, payload: Option<&str>, seed: u64) -> PathBuf {
     let exc = dir.join("exc");
     if !exc.join("excitation.json").exists() {
-        ok(&[
-            "excite",
-            "a465",
-            "--out",
-            s(&exc),
-            "--max-evaluations",
-            "30",
-            "--rate",
-            "100",
-            "--seed",
-            "1",
-        ]);
+        excite_a465(&exc, 1);
     }
     let truth = dir.join(format!("{name}.true.json"));
     let payload = payload.map_or(String::new(), |p| format!(r#""payload": {p},"#));
@@ -192,4 +169,22 @@ pub fn a465_log_carrying(dir: &Path, name: &str, payload: Option<&str>, seed: u6
         s(&out),
     ]);
     out
+}
+
+/// An excitation of the A465 designed with `seed` (30 evaluations, sampled at 100 Hz) into
+/// the folder `exc`.
+pub fn excite_a465(exc: &Path, seed: u64) {
+    let seed = seed.to_string();
+    ok(&[
+        "excite",
+        "a465",
+        "--out",
+        s(exc),
+        "--max-evaluations",
+        "30",
+        "--rate",
+        "100",
+        "--seed",
+        &seed,
+    ]);
 }
