@@ -812,7 +812,6 @@ class GlobalLinearModel:
     def linearize(self, op: OperatingPoint) -> dict[str, Any]:
         """torque (n,), D, H, G (n, n) and G_static (n, n) or None at op."""
     def predict(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> NDArray[np.float64]: ...
-    def to_json(self) -> str: ...
 
 def design_excitation(
     robot: Robot,
