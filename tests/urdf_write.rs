@@ -446,6 +446,17 @@ fn what_a_urdf_written_here_could_not_hold_is_refused() {
             .any(|w| w.contains("gravity (0, -9.81, 0)")),
         "{written:?}"
     );
+    tilted.gravity = Vector3::zeros();
+    let written = write_urdf(&tilted, &WriteOptions::default()).unwrap();
+    assert!(
+        written
+            .warnings
+            .iter()
+            .any(|w| w.contains("gravity (0, 0, 0)")),
+        "{written:?}"
+    );
+    let plain = write_urdf(&model, &WriteOptions::default()).unwrap();
+    assert!(plain.warnings.is_empty(), "{plain:?}");
     let mut broken = model.clone();
     broken.bodies[0].inertia.inertia_com = Matrix3::from_diagonal(&Vector3::new(0.01, 0.01, 1.0));
     broken.refresh();

@@ -90,7 +90,7 @@ pub struct WrittenUrdf {
     pub notes: Vec<String>,
     /// What the file does not hold as the model does, one sentence each: a link's inertial
     /// moved onto its body's own link (the link then has none of its own), a gravity other
-    /// than straight down the base's z axis (a URDF has no place for it).
+    /// than the standard 9.81 m/s^2 down the base's z axis (a URDF has no place for it).
     pub warnings: Vec<String>,
 }
 
@@ -292,8 +292,8 @@ pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUr
             options.payload_link
         ));
     }
-    let standard = nalgebra::Vector3::new(0.0, 0.0, -1.0);
-    if (model.gravity.normalize() - standard).norm() > 1e-12 {
+    // a URDF holds neither gravity's direction nor its size (readers take 9.81 m/s^2 down z)
+    if model.gravity != nalgebra::Vector3::new(0.0, 0.0, -crate::model::STANDARD_GRAVITY) {
         warnings.push(format!(
             "gravity ({}, {}, {}) m/s^2 in the base frame: a URDF has no place for it",
             number(model.gravity.x),
