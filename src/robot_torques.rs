@@ -37,6 +37,27 @@ impl<'a> RobotTorques<'a> {
         }
     }
 
+    /// [`TorqueModel::predict`] into `tau` (row-major `k x nv`, checked by the batch engine)
+    /// with the engine's workspace `ws` (of this robot), for callers that hold one.
+    pub fn predict_into(
+        &self,
+        ws: &mut Workspace,
+        states: &States<'_>,
+        tau: &mut [f64],
+    ) -> Result<()> {
+        let (robot, n) = (self.robot, self.robot.nv);
+        parallel::rnea(robot, ws, states, self.gravity, tau)?;
+        if let Some(qd) = states.qd() {
+            for s in 0..states.len() {
+                for (j, l) in robot.limits.iter().enumerate() {
+                    let i = s * n + j;
+                    tau[i] += l.damping * qd[i] + l.friction * states.coulomb_at(s, j);
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Whether the robot's file gives any friction (some joint's `damping` or `friction`
     /// above 0): without it, a log's friction shows in the residuals.
     pub fn has_friction(&self) -> bool {
@@ -52,25 +73,9 @@ impl TorqueModel for RobotTorques<'_> {
     /// Row-major `k x nv` torques (N m, or N for a prismatic joint) at the samples of
     /// `states` (rad, rad/s, rad/s^2; missing velocities or accelerations are zeros).
     fn predict(&self, states: &States<'_>) -> Result<Vec<f64>> {
-        let robot = self.robot;
-        crate::torque_model::check_joints(states, robot.nv)?;
-        let n = robot.nv;
-        let mut tau = vec![0.0; states.len() * n];
-        parallel::rnea(
-            robot,
-            &mut Workspace::new(robot),
-            states,
-            self.gravity,
-            &mut tau,
-        )?;
-        if let Some(qd) = states.qd() {
-            for s in 0..states.len() {
-                for (j, l) in robot.limits.iter().enumerate() {
-                    let i = s * n + j;
-                    tau[i] += l.damping * qd[i] + l.friction * states.coulomb_at(s, j);
-                }
-            }
-        }
+        crate::torque_model::check_joints(states, self.robot.nv)?;
+        let mut tau = vec![0.0; states.len() * self.robot.nv];
+        self.predict_into(&mut Workspace::new(self.robot), states, &mut tau)?;
         Ok(tau)
     }
 

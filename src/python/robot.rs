@@ -319,11 +319,8 @@ impl PyRobot {
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.model.nv;
         let args = [("q", &q), ("qd", &qd), ("qdd", &qdd)];
-        self.batch(py, "Robot.predict", &args, &[n], out, |m, _, s, out| {
-            use crate::torque_model::TorqueModel;
-            let tau = crate::robot_torques::RobotTorques::new(m).predict(s)?;
-            out.copy_from_slice(&tau);
-            Ok(())
+        self.batch(py, "Robot.predict", &args, &[n], out, |m, w, s, out| {
+            crate::robot_torques::RobotTorques::new(m).predict_into(w, s, out)
         })
     }
 
