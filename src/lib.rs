@@ -24,6 +24,7 @@ pub mod derivative_columns;
 pub mod direct;
 pub mod document;
 pub mod error;
+pub mod excitation_start;
 pub mod frozen_readings;
 pub mod gravity;
 pub mod held_columns;
@@ -39,6 +40,7 @@ pub mod model;
 pub mod outliers;
 #[cfg(feature = "cli")]
 pub mod paper;
+pub mod period_average;
 pub mod position_rounding;
 pub mod position_wraps;
 pub mod preprocess;

@@ -38,6 +38,13 @@ pub struct PreprocessOptions {
     /// (default true; [`crate::log_screening`]). They are listed in the result's
     /// [`Recording::glitches`] and [`Recording::dropouts`].
     pub screen_glitches: bool,
+    /// Average the log over the periods of its excitation in place of the low-pass filter
+    /// and numerical derivatives (Swevers et al. 2007; [`crate::period_average`]): after the
+    /// screening, the result is one period, `q`, `qd`, `qdd` from the positions' first
+    /// harmonics and `tau` from the torques' up to `cutoff`, sampled at `rate` and decimated;
+    /// `trim`, `order` and `split_at_gaps` do not apply (a period holding a gap is left out),
+    /// and `filter_position` is refused. None (the default): the filter.
+    pub periods: Option<crate::period_average::PeriodOptions>,
 }
 
 impl Default for PreprocessOptions {
@@ -51,6 +58,7 @@ impl Default for PreprocessOptions {
             decimate: 10,
             split_at_gaps: false,
             screen_glitches: true,
+            periods: None,
         }
     }
 }
@@ -98,6 +106,12 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     let torque_saturation = crate::torque_saturation::find_torque_saturation(rec);
     // the stamps against the positions, as logged: resampling reads them as the samples' times
     let stamp_jitter = crate::stamp_jitter::find_stamp_jitter(rec);
+    if options.periods.is_some() && options.filter_position {
+        return Err(Error::InvalidArgument {
+            argument: "filter_position".into(),
+            message: "averaging over periods takes the positions' first harmonics, which filters them: filter_position does not apply".into(),
+        });
+    }
     if !options.screen_glitches {
         return preprocess_screened(rec, options, &steps).map(|out| Recording {
             torque_saturation,
@@ -107,7 +121,7 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
             ..out
         });
     }
-    if !options.split_at_gaps {
+    if !options.split_at_gaps && options.periods.is_none() {
         check_gaps(rec)?;
     }
     let (screened, glitches) = crate::log_screening::screen_recording(rec)?;
@@ -142,6 +156,16 @@ fn preprocess_screened(
     options: &PreprocessOptions,
     steps: &[Option<f64>],
 ) -> Result<Recording> {
+    if let Some(p) = &options.periods {
+        check_sample_interval(rec)?;
+        return crate::period_average::average_periods(
+            rec,
+            options.rate,
+            options.cutoff,
+            options.decimate,
+            p,
+        );
+    }
     if !options.split_at_gaps {
         return preprocess_part(rec, options, steps);
     }

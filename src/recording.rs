@@ -51,6 +51,10 @@ pub struct Recording {
     /// its samples were taken on a regular clock ([`crate::stamp_jitter`]); None for a
     /// recording as logged, or stamps found sound.
     pub stamp_jitter: Option<crate::stamp_jitter::StampJitter>,
+    /// What averaging the log over the periods of its excitation found (the periods averaged
+    /// and left out, each signal's noise from their spread; [`crate::period_average`]); None
+    /// for a recording as logged, or one preprocessed by the filter.
+    pub period_average: Option<crate::period_average::PeriodAverage>,
 }
 
 impl Recording {
@@ -83,6 +87,7 @@ impl Recording {
             held_columns: vec![],
             coulomb: None,
             stamp_jitter: None,
+            period_average: None,
         };
         r.check()?;
         Ok(r)
@@ -269,6 +274,7 @@ impl Recording {
             position_wraps: self.position_wraps.clone(),
             held_columns: self.held_columns.clone(),
             stamp_jitter: self.stamp_jitter.clone(),
+            period_average: self.period_average.clone(),
         };
         r.check()?;
         Ok(r)

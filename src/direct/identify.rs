@@ -74,6 +74,11 @@ pub struct BaseModel {
     /// on ([`crate::stamp_jitter`]; set likewise).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub log_stamp_jitter: Option<crate::stamp_jitter::StampJitter>,
+    /// What averaging that log over its excitation's periods found, where it was averaged
+    /// (`--period`, `--excitation`; [`crate::period_average`]; set likewise): the periods
+    /// averaged and left out, and each signal's noise from their spread.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub log_period_average: Option<crate::period_average::PeriodAverage>,
     /// Per joint of that log whose positions lie on a grid and whose velocity was derived
     /// from them, the noise their rounding left in qd and qdd ([`crate::position_rounding`];
     /// set likewise): ratios of [`crate::position_rounding::NOISE_RATIO`] or more are warned
@@ -329,6 +334,7 @@ pub(super) fn fit_with_factors(
         log_position_wraps: vec![],
         log_held_columns: vec![],
         log_stamp_jitter: None,
+        log_period_average: None,
         log_dropouts: vec![],
         position_rounding: vec![],
         logs: vec![],
@@ -520,6 +526,7 @@ impl Document for BaseModel {
             held_columns: m.log_held_columns.clone(),
             stamp_jitter: m.log_stamp_jitter.clone(),
             position_rounding: m.position_rounding.clone(),
+            period_average: m.log_period_average.clone(),
         };
         let flat_name = |f: &str| match f {
             "position_rounding" => f.to_string(),

@@ -38,6 +38,10 @@ pub struct LogFindings {
     /// ([`crate::position_rounding`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub position_rounding: Vec<crate::position_rounding::PositionRounding>,
+    /// What averaging over the excitation's periods found: the periods averaged and left
+    /// out, each signal's noise ([`crate::period_average`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub period_average: Option<crate::period_average::PeriodAverage>,
 }
 
 /// The longest name of a log kept (characters): a path, or a Recording's name.
@@ -62,6 +66,7 @@ impl LogFindings {
             held_columns: rec.held_columns.clone(),
             stamp_jitter: rec.stamp_jitter.clone(),
             position_rounding: rec.position_rounding.clone(),
+            period_average: rec.period_average.clone(),
         }
     }
 
@@ -106,6 +111,11 @@ impl LogFindings {
                     r.problem(n)
                 })
             })
+            .or_else(|| {
+                (self.period_average.as_ref())
+                    .and_then(|a| a.problem(n))
+                    .map(|p| format!("{}: {p}", field("period_average")))
+            })
     }
 
     /// Whether nothing was found.
@@ -117,6 +127,7 @@ impl LogFindings {
             && self.held_columns.is_empty()
             && self.stamp_jitter.is_none()
             && self.position_rounding.is_empty()
+            && self.period_average.is_none()
     }
 }
 
@@ -131,6 +142,7 @@ impl BaseModel {
             log_position_wraps: rec.position_wraps.clone(),
             log_held_columns: rec.held_columns.clone(),
             log_stamp_jitter: rec.stamp_jitter.clone(),
+            log_period_average: rec.period_average.clone(),
             position_rounding: rec.position_rounding.clone(),
             ..self
         }

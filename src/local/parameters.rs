@@ -335,6 +335,7 @@ pub fn identify_parameters_from_local(
         log_position_wraps: vec![],
         log_held_columns: vec![],
         log_stamp_jitter: None,
+        log_period_average: None,
         position_rounding: vec![],
         logs: vec![],
         // rows from local models: no log's torque columns

@@ -54,6 +54,7 @@ pub(crate) fn preprocess(
         decimate,
         split_at_gaps,
         screen_glitches,
+        periods: None,
     };
     let out: Recording = detached(py, "preprocess", || preprocess_rs(&rec, &options))?;
     let warnings: Vec<String> = [

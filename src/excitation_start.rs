@@ -1,0 +1,245 @@
+//! Where in a log the robot runs its Fourier excitation: the time of a period's start, and the
+//! run of whole periods it follows the excitation through, for averaging over them
+//! ([`crate::period_average`]).
+//!
+//! A log of an excitation rarely starts at the excitation's `t = 0`: the logger runs before
+//! the motion starts and after it ends, at rest. The excitation repeats every period `T`, so
+//! its start is a shift `s` in `[0, T)`: the one whose excitation, `q_e(t - s)`, is nearest the
+//! logged positions, by the median over the samples of the squared distance (robust to the
+//! half of the log that may be at rest), refined by Gauss-Newton over the periods that follow
+//! it. A period follows the excitation where its positions' RMS distance from it, each
+//! joint's mean distance taken off (a zero offset), is below a fifth of the excitation's motion.
+
+use crate::error::{shown5, Error, Result};
+use crate::recording::Recording;
+use crate::trajectory::FourierTrajectory;
+
+/// Where a log runs its excitation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExcitationStart {
+    /// The log's time (s) at which the first whole period it follows the excitation through
+    /// starts (the excitation's `t = 0`, modulo its period).
+    pub start: f64,
+    /// The whole periods, one after another from `start`, that follow the excitation.
+    pub periods: usize,
+    /// Per joint, the RMS distance (rad, or m) of the logged positions from the excitation
+    /// over those periods, each joint's mean distance (its offset) taken off.
+    pub tracking_rms: Vec<f64>,
+}
+
+/// A period follows the excitation where its positions' distance from it is below this
+/// fraction of the excitation's motion (RMS).
+pub const MAX_TRACKING: f64 = 0.2;
+
+/// The samples of the log the coarse search reads (evenly spread).
+const SEARCH_SAMPLES: usize = 20_000;
+/// Shifts of the coarse search over a period.
+const SHIFTS: usize = 1_000;
+
+/// Finds where `rec` runs the excitation `traj` (the same joints, in the same order).
+///
+/// Errors: joints that differ in number; a log shorter than one period; a log none of whose
+/// whole periods follows the excitation (naming the best alignment's distance against the
+/// motion); Ctrl-C.
+pub fn excitation_start(rec: &Recording, traj: &FourierTrajectory) -> Result<ExcitationStart> {
+    let n = rec.n;
+    if traj.n() != n {
+        return Err(Error::Shape {
+            argument: "excitation".into(),
+            expected: format!("{n} joints, the log's"),
+            got: format!("{} joints", traj.n()),
+        });
+    }
+    let period = traj.period();
+    let (t0, t1) = (rec.t[0], rec.t[rec.len() - 1]);
+    if !(t1 - t0 >= period * (1.0 - 1e-9)) {
+        return Err(Error::Recording {
+            recording: rec.name.clone(),
+            message: format!(
+                "{} s long, shorter than one period of the excitation ({} s)",
+                shown5(t1 - t0),
+                shown5(period)
+            ),
+        });
+    }
+    // the excitation's positions over a period, for the coarse search, and its motion
+    const GRID: usize = 4096;
+    let table: Vec<Vec<f64>> = (0..n)
+        .map(|j| {
+            (0..=GRID)
+                .map(|i| traj.eval(j, period * i as f64 / GRID as f64).0)
+                .collect()
+        })
+        .collect();
+    let motion = (0..n)
+        .map(|j| {
+            let x = &table[j][..GRID];
+            let mean = x.iter().sum::<f64>() / GRID as f64;
+            x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / GRID as f64
+        })
+        .sum::<f64>()
+        .sqrt();
+    let at = |j: usize, t: f64| -> f64 {
+        let phase = (t / period).rem_euclid(1.0) * GRID as f64;
+        let i = (phase.floor() as usize).min(GRID - 1);
+        let w = phase - i as f64;
+        table[j][i] + w * (table[j][i + 1] - table[j][i])
+    };
+    // the median sample interval: a period is whole where its last sample before the next
+    // period's first lies in the log
+    let dt = {
+        let mut d: Vec<f64> = rec.t.windows(2).map(|w| w[1] - w[0]).collect();
+        let mid = d.len() / 2;
+        *d.select_nth_unstable_by(mid, f64::total_cmp).1
+    };
+    let stride = rec.len().div_ceil(SEARCH_SAMPLES).max(1);
+    let samples: Vec<usize> = (0..rec.len()).step_by(stride).collect();
+    let mut best = (f64::INFINITY, 0.0);
+    let mut squares = vec![0.0; samples.len()];
+    for k in 0..SHIFTS {
+        if k % 100 == 0 {
+            crate::interrupt::check("finding the excitation's start")?;
+        }
+        let s = period * k as f64 / SHIFTS as f64;
+        for (d, &i) in squares.iter_mut().zip(&samples) {
+            *d = (0..n)
+                .map(|j| (rec.q[i * n + j] - at(j, rec.t[i] - s)).powi(2))
+                .sum();
+        }
+        let mid = squares.len() / 2;
+        let median = *squares.select_nth_unstable_by(mid, f64::total_cmp).1;
+        if median < best.0 {
+            best = (median, s);
+        }
+    }
+    let mut shift = best.1;
+    // the whole periods within the log for a shift, and which follow the excitation
+    let boundaries = |s: f64| -> Vec<f64> {
+        let first = ((t0 - s) / period - 1e-9).ceil();
+        (0..)
+            .map(|k| s + (first + k as f64) * period)
+            .take_while(|b| b + period <= t1 + 1.01 * dt)
+            .collect()
+    };
+    // the samples of the period from `a`
+    let in_period =
+        |a: f64| rec.t.partition_point(|&t| t < a)..rec.t.partition_point(|&t| t < a + period);
+    let distance = |s: f64, a: f64| -> Vec<f64> {
+        let rows = in_period(a);
+        (0..n)
+            .map(|j| {
+                let r: Vec<f64> = rows
+                    .clone()
+                    .map(|i| rec.q[i * n + j] - at(j, rec.t[i] - s))
+                    .collect();
+                let mean = r.iter().sum::<f64>() / r.len().max(1) as f64;
+                (r.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / r.len().max(1) as f64).sqrt()
+            })
+            .collect()
+    };
+    let follows = |d: &[f64]| d.iter().map(|x| x * x).sum::<f64>().sqrt() < MAX_TRACKING * motion;
+    let matched = |s: f64| -> Vec<(f64, bool)> {
+        boundaries(s)
+            .into_iter()
+            .map(|a| (a, follows(&distance(s, a))))
+            .collect()
+    };
+    // Gauss-Newton on the shift over the samples of the periods that follow it, each joint's
+    // offset taken off
+    for _ in 0..8 {
+        crate::interrupt::check("finding the excitation's start")?;
+        let periods: Vec<f64> = matched(shift)
+            .into_iter()
+            .filter(|p| p.1)
+            .map(|p| p.0)
+            .collect();
+        let rows: Vec<usize> = periods
+            .iter()
+            .flat_map(|&a| in_period(a))
+            .step_by(stride)
+            .collect();
+        if rows.is_empty() {
+            break;
+        }
+        let (mut num, mut den) = (0.0, 0.0);
+        for j in 0..n {
+            let r: Vec<(f64, f64)> = rows
+                .iter()
+                .map(|&i| {
+                    let (q, v, _) = traj.eval(j, rec.t[i] - shift);
+                    (rec.q[i * n + j] - q, v)
+                })
+                .collect();
+            let count = r.len() as f64;
+            let (mr, mv) = r
+                .iter()
+                .fold((0.0, 0.0), |a, x| (a.0 + x.0 / count, a.1 + x.1 / count));
+            // d r / d s = +v: the step that zeroes the linearised residual
+            for (ri, vi) in r {
+                num += (ri - mr) * (vi - mv);
+                den += (vi - mv).powi(2);
+            }
+        }
+        if den <= 0.0 {
+            break;
+        }
+        let step = -num / den;
+        shift = (shift + step.clamp(-0.05 * period, 0.05 * period)).rem_euclid(period);
+        if step.abs() < 1e-9 * period {
+            break;
+        }
+    }
+    let periods = matched(shift);
+    // the longest run of consecutive periods that follow it
+    let (mut run, mut best_run) = ((0, 0), (0, 0));
+    for (k, p) in periods.iter().enumerate() {
+        if p.1 {
+            run = if run.1 > 0 && run.0 + run.1 == k {
+                (run.0, run.1 + 1)
+            } else {
+                (k, 1)
+            };
+            if run.1 > best_run.1 {
+                best_run = run;
+            }
+        }
+    }
+    if best_run.1 == 0 {
+        let nearest = periods
+            .iter()
+            .map(|p| {
+                distance(shift, p.0)
+                    .iter()
+                    .map(|x| x * x)
+                    .sum::<f64>()
+                    .sqrt()
+            })
+            .fold(f64::INFINITY, f64::min);
+        return Err(Error::Recording {
+            recording: rec.name.clone(),
+            message: format!(
+                "none of its {} whole periods of {} s follows the excitation: the nearest is {} rad RMS from it (offsets taken off), against the excitation's motion of {} rad RMS (at most {} of it is taken as following). Is it a log of this excitation, with the joints in its order?",
+                periods.len(),
+                shown5(period),
+                shown5(nearest),
+                shown5(motion),
+                MAX_TRACKING
+            ),
+        });
+    }
+    let start = periods[best_run.0].0;
+    let mut tracking = vec![0.0; n];
+    for k in 0..best_run.1 {
+        for (t, d) in tracking
+            .iter_mut()
+            .zip(distance(shift, periods[best_run.0 + k].0))
+        {
+            *t += d * d / best_run.1 as f64;
+        }
+    }
+    Ok(ExcitationStart {
+        start,
+        periods: best_run.1,
+        tracking_rms: tracking.into_iter().map(f64::sqrt).collect(),
+    })
+}
