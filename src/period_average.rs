@@ -121,6 +121,17 @@ impl PeriodAverage {
         self.torque_noise.iter().map(|x| x / s).collect()
     }
 
+    /// Per joint, a fit's residual RMS (N m, of the averaged torques) against the averaged
+    /// torques' noise: their ratio (1 where the fit leaves only noise), and the model's own
+    /// error `sqrt(max(residual^2 - noise^2, 0))` (N m). The fit's parameters take up a small
+    /// share of the noise (their count over the `2 H + 1` values a period and joint holds), so
+    /// a ratio a little below 1 is noise too.
+    pub fn model_error(&self, residual_rms: &[f64]) -> Vec<(f64, f64)> {
+        (residual_rms.iter().zip(self.averaged_torque_noise()))
+            .map(|(r, n)| (r / n, (r * r - n * n).max(0.0).sqrt()))
+            .collect()
+    }
+
     /// What is wrong with it for `n` joints (a document edited by hand); None where nothing.
     pub(crate) fn problem(&self, n: usize) -> Option<String> {
         let lists = [

@@ -214,12 +214,38 @@ pub(crate) struct PreprocessArgs {
     cutoff: f64,
     #[arg(long, default_value_t = 10)]
     decimate: usize,
-    #[arg(long, default_value_t = 0.5)]
-    trim: f64,
+    /// Seconds dropped at both ends of a filtered log (default 0.5; not with periods).
+    #[arg(long)]
+    trim: Option<f64>,
     /// At a gap in the log (longer than 20 median sample intervals), preprocess the parts on
     /// either side separately instead of refusing the log; nothing is interpolated across it.
     #[arg(long)]
     split_at_gaps: bool,
+    /// Average each log over the periods of this excitation (excitation.json from `perturbid
+    /// excite`) in place of the low-pass filter: its period and harmonics, its start in each
+    /// log found from the positions (docs/method.md, section 8e).
+    #[arg(long, value_name = "EXCITATION")]
+    average_periods: Option<PathBuf>,
+    /// Average each log over periods of this many seconds (with --period-harmonics), from its
+    /// first sample or --period-start, in place of the low-pass filter.
+    #[arg(long, value_name = "SECONDS")]
+    period: Option<f64>,
+    /// The harmonics of the excitation's base frequency the positions hold (with --period).
+    #[arg(long, value_name = "L")]
+    period_harmonics: Option<usize>,
+    /// The log's time (s) at which a period starts (with --period; default its first sample).
+    #[arg(long, value_name = "T")]
+    period_start: Option<f64>,
+    /// Whole periods left out at the start of each log before averaging (a transient).
+    #[arg(long, default_value_t = 0, value_name = "K")]
+    skip_periods: usize,
+}
+
+/// How a log is averaged over periods, from the command line.
+enum Periods {
+    None,
+    Given(crate::period_average::PeriodOptions),
+    Excitation(Box<crate::trajectory::FourierTrajectory>, PathBuf),
 }
 
 impl PreprocessArgs {
@@ -269,6 +295,49 @@ impl PreprocessArgs {
         Ok(recs)
     }
 
+    /// How the logs are averaged over periods, the options checked against each other.
+    fn periods(&self) -> Result<Periods> {
+        let refuse = |message: &str| {
+            Err(Error::InvalidArgument {
+                argument: "--average-periods, --period".into(),
+                message: message.into(),
+            })
+        };
+        let periodic = self.average_periods.is_some() || self.period.is_some();
+        if !periodic {
+            if self.period_harmonics.is_some()
+                || self.period_start.is_some()
+                || self.skip_periods > 0
+            {
+                return refuse("--period-harmonics, --period-start and --skip-periods average over periods: give --period or --average-periods EXCITATION too");
+            }
+            return Ok(Periods::None);
+        }
+        if self.trim.is_some() {
+            return refuse("--trim drops a filter's transients, and averaging over periods has none: leave it out");
+        }
+        let options = |period: f64, harmonics: usize| crate::period_average::PeriodOptions {
+            skip: self.skip_periods,
+            start: self.period_start,
+            ..crate::period_average::PeriodOptions::new(period, harmonics)
+        };
+        match (&self.average_periods, self.period, self.period_harmonics) {
+            (Some(_), Some(_), _) | (Some(_), _, Some(_)) => refuse(
+                "--average-periods EXCITATION brings its own period and harmonics: give it, or --period and --period-harmonics, not both",
+            ),
+            (Some(_), _, _) if self.period_start.is_some() => refuse(
+                "--average-periods EXCITATION finds each log's start from its positions: --period-start does not apply (give --period and --period-harmonics instead to set it)",
+            ),
+            (Some(path), None, None) => Ok(Periods::Excitation(
+                Box::new(load_excitation(path)?),
+                path.clone(),
+            )),
+            (None, Some(period), Some(h)) => Ok(Periods::Given(options(period, h))),
+            (None, Some(_), None) => refuse("--period needs --period-harmonics L, the harmonics the excitation's positions hold"),
+            (None, None, _) => unreachable!("periodic"),
+        }
+    }
+
     /// The recording `rec` as read from `path`, preprocessed when it has no qdd columns (or
     /// `--preprocess` asks); says so in `out`.
     fn prepare(
@@ -287,7 +356,8 @@ impl PreprocessArgs {
                 eprintln!("perturbid: warning: {w}");
             }
         };
-        if rec.qdd.is_some() && !self.preprocess {
+        let periods = self.periods()?;
+        if rec.qdd.is_some() && !self.preprocess && matches!(periods, Periods::None) {
             // taken as logged: its velocity and acceleration columns against the derivatives
             crate::derivative_columns::check_logged_derivatives(&rec)?;
             let rec = crate::recording::Recording {
@@ -298,15 +368,43 @@ impl PreprocessArgs {
             return Ok(rec);
         }
         progress.update("preprocessing");
+        let periods = match periods {
+            Periods::None => None,
+            Periods::Given(o) => Some(o),
+            Periods::Excitation(traj, source) => {
+                let found = crate::excitation_start::excitation_start(&rec, &traj).map_err(
+                    |e| match e {
+                        Error::Recording { recording, message } => Error::Recording {
+                            recording,
+                            message: format!("against {}: {message}", source.display()),
+                        },
+                        e => e,
+                    },
+                )?;
+                Some(crate::period_average::PeriodOptions {
+                    start: Some(found.start),
+                    count: Some(found.periods),
+                    skip: self.skip_periods,
+                    ..crate::period_average::PeriodOptions::new(traj.period(), traj.harmonics())
+                })
+            }
+        };
+        let periodic = periods.is_some();
         let o = crate::preprocess::PreprocessOptions {
             rate: self.rate,
             cutoff: Some(self.cutoff),
             decimate: self.decimate,
-            trim: self.trim,
+            trim: self.trim.unwrap_or(0.5),
             split_at_gaps: self.split_at_gaps,
+            periods,
             ..crate::preprocess::PreprocessOptions::default()
         };
         let rec = crate::preprocess::preprocess(&rec, &o)?;
+        if let Some(w) =
+            crate::period_average::warning(&rec.period_average, &path.display().to_string(), joints)
+        {
+            eprintln!("perturbid: warning: {w}");
+        }
         if let Some(w) = crate::log_screening::warning(
             &rec.glitches,
             &path.display().to_string(),
@@ -342,13 +440,67 @@ impl PreprocessArgs {
             eprintln!("perturbid: warning: {w}");
         }
         clipped(&rec);
-        let _ = writeln!(
-            out,
-            "preprocessed: {} Hz, {} Hz zero-phase low-pass, every {}th sample, {} s trimmed: {} samples",
-            self.rate, self.cutoff, self.decimate, self.trim, rec.len()
-        );
+        match (&rec.period_average, periodic) {
+            (Some(a), true) => {
+                let noise: Vec<String> = (a.averaged_torque_noise().iter())
+                    .map(|x| crate::error::shown5(*x))
+                    .collect();
+                let _ = writeln!(
+                    out,
+                    "averaged over {} periods of {} s from t = {} s ({} left out): positions' {} harmonics, torques' {} (to {} Hz), {} samples every {}th kept: {} samples; the averaged torques' noise (N m) {}",
+                    a.periods,
+                    crate::error::shown5(a.period),
+                    crate::error::shown5(a.start),
+                    a.left_out.len(),
+                    a.harmonics,
+                    a.torque_harmonics,
+                    self.cutoff,
+                    a.samples,
+                    self.decimate,
+                    rec.len(),
+                    noise.join(", ")
+                );
+            }
+            _ => {
+                let _ = writeln!(
+                    out,
+                    "preprocessed: {} Hz, {} Hz zero-phase low-pass, every {}th sample, {} s trimmed: {} samples",
+                    self.rate, self.cutoff, self.decimate, o.trim, rec.len()
+                );
+            }
+        }
         Ok(rec)
     }
+}
+
+/// The Fourier excitation of `path` (excitation.json from `perturbid excite`), checked.
+pub(crate) fn load_excitation(path: &Path) -> Result<crate::trajectory::FourierTrajectory> {
+    let text = crate::io::read_document(path)?;
+    let context = path.display().to_string();
+    crate::json::check_containers(&text, &context)?;
+    excitation_of(
+        &text,
+        context,
+        "not an excitation (perturbid excite writes one)",
+    )
+}
+
+/// The Fourier excitation of the JSON `text` read from `context`, checked; an error says
+/// `otherwise` where it is none.
+pub(crate) fn excitation_of(
+    text: &str,
+    context: String,
+    otherwise: &str,
+) -> Result<crate::trajectory::FourierTrajectory> {
+    use crate::trajectory::FourierTrajectory;
+    let t: FourierTrajectory = serde_json::from_str(text).map_err(|e| Error::Json {
+        context: context.clone(),
+        message: format!("{otherwise} ({})", crate::json::describe_error(&e, text)),
+    })?;
+    FourierTrajectory::new(t.w_f, t.q0, t.a, t.b).map_err(|e| Error::Json {
+        context,
+        message: e.to_string(),
+    })
 }
 
 /// `--validate FRACTION` of `identify-direct` and `identify-payload`: refused outside [0, 1).

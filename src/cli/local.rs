@@ -308,17 +308,7 @@ fn load_reference(path: &Path) -> Result<Reference> {
             ),
         });
     }
-    let t: FourierTrajectory = serde_json::from_str(&text).map_err(|e| Error::Json {
-        context: context.clone(),
-        message: format!(
-            "neither a plan nor an excitation ({})",
-            crate::json::describe_error(&e, &text)
-        ),
-    })?;
-    let t = FourierTrajectory::new(t.w_f, t.q0, t.a, t.b).map_err(|e| Error::Json {
-        context,
-        message: e.to_string(),
-    })?;
+    let t = super::files::excitation_of(&text, context, "neither a plan nor an excitation")?;
     Ok(Reference::Excitation(t))
 }
 
