@@ -376,6 +376,12 @@ class Recording:
         step (rad or m), qd_ratio, qdd_ratio (RMS of the noise over RMS of the signal;
         preprocess warns from 0.1)."""
     @property
+    def period_average(self) -> Optional[dict[str, Any]]:
+        """What averaging over the excitation's periods found: period, start (s), periods,
+        harmonics, torque_harmonics, samples, per joint position_noise, velocity_noise,
+        acceleration_noise, torque_noise (one period's), averaged_torque_noise, position_beyond,
+        and left_out (dicts period, t0, t1, reason); None where not averaged."""
+    @property
     def stamp_jitter(self) -> Optional[dict[str, Any]]:
         """The time stamps of the log this was preprocessed from, found jittering while its
         samples were taken on a regular clock: interval (median, s), scatter (s), joint
@@ -1116,12 +1122,21 @@ def preprocess(
     cutoff: Optional[float] = 10.0,
     order: int = 4,
     decimate: int = 10,
-    trim: float = 0.5,
+    trim: Optional[float] = None,
     filter_position: bool = False,
     split_at_gaps: bool = False,
     screen_glitches: bool = True,
+    excitation: Optional[Union[FourierTrajectory, ExcitationDesign]] = None,
+    period: Optional[float] = None,
+    harmonics: Optional[int] = None,
+    period_start: Optional[float] = None,
+    skip_periods: int = 0,
     name: str = "recording",
-) -> Recording: ...
+) -> Recording:
+    """A log resampled, filtered and differentiated (trim default 0.5 s), or averaged over
+    its excitation's periods (excitation, or period with harmonics): one period, q, qd, qdd
+    from the positions' harmonics, tau from the torques' up to cutoff, period_average saying
+    what was found."""
 
 def cli(argv: list[str]) -> int:
     """Runs the perturbid command line (argv[0] is the program name); returns the exit status."""

@@ -13,6 +13,23 @@ use super::recording::PyRecording;
 use crate::preprocess::{preprocess as preprocess_rs, PreprocessOptions};
 use crate::recording::Recording;
 
+/// Excitation, periods and harmonics of `preprocess`'s averaging over periods: an excitation
+/// (FourierTrajectory or ExcitationDesign) brings its period and harmonics.
+#[derive(FromPyObject)]
+pub(crate) enum ExcitationArg<'py> {
+    Fourier(PyRef<'py, super::trajectory::PyFourier>),
+    Design(PyRef<'py, super::excitation::PyExcitationDesign>),
+}
+
+impl ExcitationArg<'_> {
+    fn trajectory(&self) -> crate::trajectory::FourierTrajectory {
+        match self {
+            Self::Fourier(f) => f.traj.clone(),
+            Self::Design(d) => d.trajectory_ref().clone(),
+        }
+    }
+}
+
 /// Preprocesses a real recording: resample `t`, `q`, `tau` (and `qd` when logged) onto a
 /// uniform grid at `rate` Hz, zero-phase Butterworth low-pass (`order`, `cutoff` Hz; None = no
 /// filter) on qd and tau (and q with `filter_position`), qdd by differentiating the filtered
@@ -24,9 +41,20 @@ use crate::recording::Recording;
 /// follow (glitches of the log) are replaced by the fit of their neighbours, and rows in which
 /// every joint of a signal reads exactly 0 while the robot moves (dropouts) are removed: a
 /// PerturbidWarning lists them, and the result's `glitches` and `dropouts` hold them.
+///
+/// Averaging over periods in place of the filter (Swevers et al. 2007; docs/method.md, section
+/// 8e): `excitation` (a FourierTrajectory or ExcitationDesign; its start and whole periods are
+/// found in the log from its positions), or `period` (s) with `harmonics` (the excitation's
+/// L) from `period_start` (the log's time of a period's start; default its first sample);
+/// `skip_periods` whole periods left out first. The result is one period sampled at `rate`,
+/// every `decimate`-th kept: `q`, `qd`, `qdd` from the positions' first `harmonics`
+/// harmonics (their exact derivatives), `tau` and `coulomb` from the torques' harmonics up to
+/// `cutoff`; periods with a gap or far off the others are left out and warned of; the result's
+/// `period_average` says what was found, with each signal's noise measured from the periods.
+/// `trim` (default 0.5 s, for the filter) is refused with it.
 #[pyfunction]
-#[pyo3(signature = (t, q, tau, qd=None, *, rate=1000.0, cutoff=Some(10.0), order=4, decimate=10, trim=0.5, filter_position=false, split_at_gaps=false, screen_glitches=true, name="recording"),
-    text_signature = "(t, q, tau, qd=None, *, rate=1000.0, cutoff=10.0, order=4, decimate=10, trim=0.5, filter_position=False, split_at_gaps=False, screen_glitches=True, name='recording')")]
+#[pyo3(signature = (t, q, tau, qd=None, *, rate=1000.0, cutoff=Some(10.0), order=4, decimate=10, trim=None, filter_position=false, split_at_gaps=false, screen_glitches=true, excitation=None, period=None, harmonics=None, period_start=None, skip_periods=0, name="recording"),
+    text_signature = "(t, q, tau, qd=None, *, rate=1000.0, cutoff=10.0, order=4, decimate=10, trim=None, filter_position=False, split_at_gaps=False, screen_glitches=True, excitation=None, period=None, harmonics=None, period_start=None, skip_periods=0, name='recording')")]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn preprocess(
     py: Python<'_>,
@@ -38,25 +66,100 @@ pub(crate) fn preprocess(
     #[pyo3(from_py_with = scalars::real_or_none)] cutoff: Option<f64>,
     #[pyo3(from_py_with = scalars::count)] order: usize,
     #[pyo3(from_py_with = scalars::count)] decimate: usize,
-    #[pyo3(from_py_with = scalars::real)] trim: f64,
+    #[pyo3(from_py_with = scalars::real_or_none)] trim: Option<f64>,
     filter_position: bool,
     split_at_gaps: bool,
     screen_glitches: bool,
+    excitation: Option<ExcitationArg<'_>>,
+    #[pyo3(from_py_with = scalars::real_or_none)] period: Option<f64>,
+    harmonics: Option<usize>,
+    #[pyo3(from_py_with = scalars::real_or_none)] period_start: Option<f64>,
+    #[pyo3(from_py_with = scalars::count)] skip_periods: usize,
     name: &str,
 ) -> PyResult<PyRecording> {
     let rec = PyRecording::build(t, q, tau, qd, None, name)?;
+    let invalid = |argument: &str, message: &str| -> PyErr {
+        crate::error::Error::InvalidArgument {
+            argument: argument.into(),
+            message: message.into(),
+        }
+        .into()
+    };
+    let periodic = excitation.is_some() || period.is_some();
+    if !periodic && (harmonics.is_some() || period_start.is_some() || skip_periods > 0) {
+        return Err(invalid(
+            "harmonics, period_start, skip_periods",
+            "they average over periods: give period or excitation too",
+        ));
+    }
+    if periodic && trim.is_some() {
+        return Err(invalid(
+            "trim",
+            "it drops a filter's transients, and averaging over periods has none: leave it out",
+        ));
+    }
+    let traj = excitation.as_ref().map(ExcitationArg::trajectory);
+    let periods = match (&traj, period, harmonics) {
+        (None, None, _) => None,
+        (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
+            return Err(invalid(
+                "excitation",
+                "it brings its own period and harmonics: give it, or period and harmonics, not both",
+            ))
+        }
+        (Some(_), None, None) if period_start.is_some() => {
+            return Err(invalid(
+                "period_start",
+                "the excitation's start is found in the log from its positions: give period and harmonics instead to set it",
+            ))
+        }
+        (Some(traj), None, None) => Some(crate::period_average::PeriodOptions {
+            skip: skip_periods,
+            ..crate::period_average::PeriodOptions::new(traj.period(), traj.harmonics())
+        }),
+        (None, Some(p), Some(h)) => Some(crate::period_average::PeriodOptions {
+            start: period_start,
+            skip: skip_periods,
+            ..crate::period_average::PeriodOptions::new(p, h)
+        }),
+        (None, Some(_), None) => {
+            return Err(invalid(
+                "period",
+                "it needs harmonics, the harmonics of the excitation's base frequency its positions hold",
+            ))
+        }
+    };
     let options = PreprocessOptions {
         rate,
         cutoff,
         order,
         filter_position,
-        trim,
+        trim: trim.unwrap_or(0.5),
         decimate,
         split_at_gaps,
         screen_glitches,
-        periods: None,
+        periods,
     };
-    let out: Recording = detached(py, "preprocess", || preprocess_rs(&rec, &options))?;
+    let out: Recording = detached(py, "preprocess", || {
+        let options = match &traj {
+            // the excitation's start and periods found in the log first
+            Some(traj) => {
+                let found = crate::excitation_start::excitation_start(&rec, traj)?;
+                PreprocessOptions {
+                    periods: options.periods.clone().map(|p| {
+                        crate::period_average::PeriodOptions {
+                            start: Some(found.start),
+                            count: Some(found.periods),
+                            ..p
+                        }
+                    }),
+                    ..options.clone()
+                }
+            }
+            None => options.clone(),
+        };
+        preprocess_rs(&rec, &options)
+    })?;
     let warnings: Vec<String> = [
         crate::log_screening::warning(
             &out.glitches,
@@ -76,6 +179,7 @@ pub(crate) fn preprocess(
         crate::position_wraps::warning(&out.position_wraps, name, &[], "before preprocessing"),
         crate::held_columns::warning(&out.held_columns, name, &[]),
         crate::stamp_jitter::warning(&out.stamp_jitter, name, &[]),
+        crate::period_average::warning(&out.period_average, name, &[]),
     ]
     .into_iter()
     .flatten()

@@ -393,6 +393,48 @@ impl PyRecording {
         e.set_item("rougher", j.rougher)?;
         Ok(Some(e))
     }
+    /// What averaging the log over its excitation's periods found (`preprocess(...,
+    /// excitation=...)` or `period=`): a dict with `period` (s), `start` (the log's time of the
+    /// first period used, s), `periods` (averaged), `harmonics` (the positions'),
+    /// `torque_harmonics`, `samples` (a period, before decimation), per joint
+    /// `position_noise` (rad), `velocity_noise` (rad/s), `acceleration_noise` (rad/s^2) and
+    /// `torque_noise` (N m) of one period's samples within their band (the average's are these
+    /// over sqrt(periods): `averaged_torque_noise`), `position_beyond` (rad RMS of the averaged
+    /// positions beyond the harmonics kept), and `left_out`, a list of dicts `period` (0-based),
+    /// `t0`, `t1` (s) and `reason`. None for a recording not averaged so.
+    #[getter]
+    fn period_average<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<Option<Bound<'py, pyo3::types::PyDict>>> {
+        let Some(a) = &self.rec.period_average else {
+            return Ok(None);
+        };
+        let e = pyo3::types::PyDict::new(py);
+        e.set_item("period", a.period)?;
+        e.set_item("start", a.start)?;
+        e.set_item("periods", a.periods)?;
+        e.set_item("harmonics", a.harmonics)?;
+        e.set_item("torque_harmonics", a.torque_harmonics)?;
+        e.set_item("samples", a.samples)?;
+        e.set_item("position_noise", a.position_noise.clone())?;
+        e.set_item("velocity_noise", a.velocity_noise.clone())?;
+        e.set_item("acceleration_noise", a.acceleration_noise.clone())?;
+        e.set_item("torque_noise", a.torque_noise.clone())?;
+        e.set_item("averaged_torque_noise", a.averaged_torque_noise())?;
+        e.set_item("position_beyond", a.position_beyond.clone())?;
+        let left = pyo3::types::PyList::empty(py);
+        for l in &a.left_out {
+            let d = pyo3::types::PyDict::new(py);
+            d.set_item("period", l.period)?;
+            d.set_item("t0", l.t0)?;
+            d.set_item("t1", l.t1)?;
+            d.set_item("reason", &l.reason)?;
+            left.append(d)?;
+        }
+        e.set_item("left_out", left)?;
+        Ok(Some(e))
+    }
     /// Steps of whole turns in the positions of the log this recording was preprocessed from
     /// (a joint angle logged within one turn that a continuous joint passes), taken back out
     /// first; `preprocess` warns: a list of dicts `joint` (0-based column index), `sample`
