@@ -52,7 +52,7 @@ pub fn excitation_start(rec: &Recording, traj: &FourierTrajectory) -> Result<Exc
     }
     let period = traj.period();
     let (t0, t1) = (rec.t[0], rec.t[rec.len() - 1]);
-    if !(t1 - t0 >= period * (1.0 - 1e-9)) {
+    if t1 - t0 < period * (1.0 - 1e-9) || (t1 - t0).is_nan() {
         return Err(Error::Recording {
             recording: rec.name.clone(),
             message: format!(

@@ -155,8 +155,9 @@ impl PeriodAverage {
             return Some(format!("{name}: {x}, expected finite and >= 0"));
         }
         let (low, high) = PERIOD_RANGE;
-        if !(self.period.is_finite() && (low..=high).contains(&self.period))
-            || !self.start.is_finite()
+        if !(self.period.is_finite()
+            && (low..=high).contains(&self.period)
+            && self.start.is_finite())
         {
             return Some(format!(
                 "period {} s from t = {} s; expected a period of {low} to {high} s, a finite start",
