@@ -128,8 +128,8 @@ pub fn excitation_start(rec: &Recording, traj: &FourierTrajectory) -> Result<Exc
         let rows = in_period(a);
         (0..n)
             .map(|j| {
-                let r: Vec<f64> = rows
-                    .clone()
+                // at most about 2,000 samples a period
+                let r: Vec<f64> = (rows.clone().step_by(rows.len().div_ceil(2000).max(1)))
                     .map(|i| rec.q[i * n + j] - at(j, rec.t[i] - s))
                     .collect();
                 let mean = r.iter().sum::<f64>() / r.len().max(1) as f64;

@@ -72,7 +72,7 @@ pub(crate) fn preprocess(
     screen_glitches: bool,
     excitation: Option<ExcitationArg<'_>>,
     #[pyo3(from_py_with = scalars::real_or_none)] period: Option<f64>,
-    harmonics: Option<usize>,
+    #[pyo3(from_py_with = scalars::count_or_none)] harmonics: Option<usize>,
     #[pyo3(from_py_with = scalars::real_or_none)] period_start: Option<f64>,
     #[pyo3(from_py_with = scalars::count)] skip_periods: usize,
     name: &str,

@@ -1,0 +1,366 @@
+//! Averaging a log over the periods of a periodic excitation (Swevers et al. 2007), in place
+//! of the low-pass filter and numerical derivatives of [`crate::preprocess`].
+//!
+//! A Fourier excitation repeats every period `T`, and so does everything the robot does while
+//! it runs one; only the noise differs from period to period. Each whole period of the log is
+//! resampled onto `M = round(T rate)` points and projected onto the harmonics `k / T` (a
+//! discrete Fourier series, exact on the grid):
+//! - the positions onto the excitation's own `L` harmonics, from which the velocities and
+//!   accelerations are the series' exact derivatives (`i k w` and `-(k w)^2` a harmonic), free
+//!   of the lag and noise gain of numerical differences;
+//! - the torques onto the harmonics up to the cutoff (`floor(cutoff T)`, at least `L`): a
+//!   low-pass without a transient, whose Coulomb column is `sign(qd)` projected alike.
+//!
+//! The mean of the periods' coefficients is the averaged period (the noise's variance divided
+//! by the periods averaged); their spread about it is the noise itself, measured from the
+//! data and not from a model's residuals: each signal's noise a sample within its band
+//! (Parseval: `d_0^2 + 1/2 sum_k (da_k^2 + db_k^2)` a period, summed over the periods and
+//! divided by `P - 1`). A model's residual beyond the averaged noise is the model's error.
+//!
+//! Refused or left out, never averaged in (docs/method.md, section 8e):
+//! - fewer than two whole periods (nothing tells noise from motion);
+//! - a period holding a gap of the log (left out, said);
+//! - a period far off the others (from 3 periods: a signal's deviation from the
+//!   coefficient-wise median of the periods beyond 3 times the median period's in RMS, as a
+//!   run's lead-in at rest, a collision or a stop gives): left out, said;
+//! - positions that differ from period to period by more than a tenth of their motion: the
+//!   log does not repeat with that period (a wrong period, or not the excitation), an error
+//!   naming the joint.
+
+mod finding;
+mod layout;
+mod series;
+
+pub use finding::{LeftOutPeriod, PeriodAverage};
+
+use crate::error::{shown5, Error, Result};
+use crate::recording::Recording;
+use layout::{too_few, Layout};
+use series::{energy, median_coefficients, median_of, weighted_energy, Table};
+
+/// What [`average_periods`] averages: the excitation's period and harmonics, and where in the
+/// log its periods lie.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PeriodOptions {
+    /// The excitation's period (s): `1 / base frequency`, within 0.001 to 1,000 s.
+    pub period: f64,
+    /// The harmonics of the base frequency the positions hold (the excitation's `L`, 1 to
+    /// [`crate::limits::MAX_HARMONICS`]): the positions are projected onto harmonics 0 to `L`.
+    pub harmonics: usize,
+    /// The log's time (s) at which a period starts (the excitation's `t = 0`, modulo the
+    /// period); None: the log's first sample. [`crate::excitation_start`] finds it from the
+    /// excitation.
+    pub start: Option<f64>,
+    /// Whole periods left out after `start` (a lead-in, the first period's transient).
+    pub skip: usize,
+    /// At most this many periods averaged (None: every whole period in the log).
+    pub count: Option<usize>,
+}
+
+impl PeriodOptions {
+    /// Periods of `period` s with `harmonics` harmonics, from the log's first sample, every
+    /// whole period averaged.
+    pub fn new(period: f64, harmonics: usize) -> Self {
+        Self {
+            period,
+            harmonics,
+            start: None,
+            skip: 0,
+            count: None,
+        }
+    }
+}
+
+/// The periods averaged may last 0.001 to 1,000 s (base frequencies of 1 kHz to 1 mHz, as
+/// [`crate::limits::BASE_FREQUENCY`]).
+pub const PERIOD_RANGE: (f64, f64) = (1e-3, 1e3);
+
+/// The most multiply-adds the projections may take (samples of the log's periods times
+/// harmonics): about ten seconds' work. A 10 s period at 1 kHz with 10 Hz of torque band
+/// takes 10^6 for each period and joint.
+pub const MAX_PROJECTION_WORK: f64 = 2e10;
+
+/// The most periods averaged (a 10 s period: 11 days of a log).
+pub const MAX_PERIODS: usize = 100_000;
+
+/// A period's deviation from the periods' median beyond this many times the median period's
+/// (in RMS) leaves it out.
+pub const OUTLIER_RATIO: f64 = 3.0;
+
+/// Positions that differ from period to period by more than this fraction of their motion
+/// (RMS) do not repeat with the period.
+pub const MAX_POSITION_SPREAD: f64 = 0.1;
+
+/// The averaged period of `rec` (screened as [`crate::preprocess::preprocess`] screens, at
+/// least two whole periods long): `M = round(period rate)` samples from the first period's
+/// start, every `decimate`-th kept (`rate`, `cutoff` and `decimate` from `options`; `cutoff`
+/// None keeps every harmonic the grid holds), `q`, `qd`, `qdd` from the positions' first
+/// `harmonics` harmonics, `tau` and [`Recording::coulomb`] from the torques' harmonics up to
+/// the cutoff, and [`Recording::period_average`] saying what was found. The time `t` is the
+/// log's over the first period used.
+///
+/// Errors: options out of range, naming them; fewer than 2 whole periods left (naming the
+/// log's span and the periods left out); positions that do not repeat (naming the joint and
+/// their spread against their motion); work beyond [`MAX_PROJECTION_WORK`]; Ctrl-C.
+pub fn average_periods(
+    rec: &Recording,
+    rate: f64,
+    cutoff: Option<f64>,
+    decimate: usize,
+    p: &PeriodOptions,
+) -> Result<Recording> {
+    let n = rec.n;
+    let layout = Layout::of(rec, rate, cutoff, decimate, p)?;
+    let (m, h_q, h_tau) = (layout.samples, p.harmonics, layout.torque_harmonics);
+    let table = Table::new(m);
+    let column =
+        |x: &[f64], j: usize| -> Vec<f64> { (0..rec.len()).map(|i| x[i * n + j]).collect() };
+    let q_cols: Vec<Vec<f64>> = (0..n).map(|j| column(&rec.q, j)).collect();
+    let tau_cols: Vec<Vec<f64>> = (0..n).map(|j| column(&rec.tau, j)).collect();
+    // each period's coefficients: [period][joint] -> positions (to h_tau, to see beyond L) and torques
+    let mut coef_q = Vec::with_capacity(layout.periods.len());
+    let mut coef_tau = Vec::with_capacity(layout.periods.len());
+    for &(_, a) in &layout.periods {
+        crate::interrupt::check("period averaging")?;
+        let grid: Vec<f64> = (0..m).map(|i| a + i as f64 * p.period / m as f64).collect();
+        let project = |cols: &[Vec<f64>], h: usize| -> Vec<Vec<f64>> {
+            cols.iter()
+                .map(|x| table.project(&crate::signal::interpolate(&rec.t, x, &grid), h))
+                .collect()
+        };
+        coef_q.push(project(&q_cols, h_tau));
+        coef_tau.push(project(&tau_cols, h_tau));
+    }
+    // periods far off the others, from the coefficient-wise median
+    let mut left_out = layout.left_out.clone();
+    let mut keep: Vec<usize> = (0..layout.periods.len()).collect();
+    if keep.len() >= 3 {
+        let names = ["positions", "torques"];
+        let mut far: Vec<(usize, String)> = Vec::new();
+        for (signal, coefs) in [&coef_q, &coef_tau].into_iter().enumerate() {
+            for j in 0..n {
+                let per: Vec<&[f64]> = coefs.iter().map(|c| c[j].as_slice()).collect();
+                let median = median_coefficients(&per);
+                let dev: Vec<f64> = per.iter().map(|c| energy(c, &median).sqrt()).collect();
+                let scale = energy(&median, &vec![0.0; median.len()]).sqrt();
+                let typical = median_of(&dev);
+                for (k, &d) in dev.iter().enumerate() {
+                    if d > OUTLIER_RATIO * typical
+                        && d > 1e-9 * scale
+                        && !far.iter().any(|f| f.0 == k)
+                    {
+                        far.push((
+                            k,
+                            format!(
+                                "joint {}'s {} {} RMS off the periods' median, {} times the median period's",
+                                j + 1,
+                                names[signal],
+                                shown5(d),
+                                shown5(d / typical.max(f64::MIN_POSITIVE))
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+        far.sort_by_key(|f| f.0);
+        for (k, reason) in far {
+            let (index, a) = layout.periods[k];
+            left_out.push(LeftOutPeriod {
+                period: index,
+                t0: a,
+                t1: a + p.period,
+                reason,
+            });
+            keep.retain(|&x| x != k);
+        }
+        left_out.sort_by_key(|l| l.period);
+    }
+    if keep.len() < 2 {
+        return Err(too_few(rec, &layout, &left_out, p));
+    }
+    let count = keep.len();
+    let mean = |coefs: &[Vec<Vec<f64>>], j: usize| -> Vec<f64> {
+        let len = coefs[0][j].len();
+        (0..len)
+            .map(|c| keep.iter().map(|&k| coefs[k][j][c]).sum::<f64>() / count as f64)
+            .collect()
+    };
+    // each signal's noise a sample of one period within its band, from the periods' spread
+    // about their mean, weighted a harmonic by `weight(k)` (a derivative's `(k w)^2`)
+    let noise = |coefs: &[Vec<Vec<f64>>],
+                 j: usize,
+                 h: usize,
+                 mean: &[f64],
+                 weight: &dyn Fn(usize) -> f64|
+     -> f64 {
+        let sum: f64 = keep
+            .iter()
+            .map(|&k| weighted_energy(&coefs[k][j][..2 * h + 1], &mean[..2 * h + 1], weight))
+            .sum();
+        (sum / (count - 1) as f64).sqrt()
+    };
+    let w = std::f64::consts::TAU / p.period;
+    let one = |_k: usize| 1.0;
+    let (mut pos_noise, mut vel_noise, mut acc_noise, mut tau_noise, mut beyond) = (
+        vec![0.0; n],
+        vec![0.0; n],
+        vec![0.0; n],
+        vec![0.0; n],
+        vec![0.0; n],
+    );
+    let mut q_mean = Vec::with_capacity(n);
+    let mut tau_mean = Vec::with_capacity(n);
+    for j in 0..n {
+        let qm = mean(&coef_q, j);
+        let tm = mean(&coef_tau, j);
+        pos_noise[j] = noise(&coef_q, j, h_q, &qm, &one);
+        vel_noise[j] = noise(&coef_q, j, h_q, &qm, &|k| (k as f64 * w).powi(2));
+        acc_noise[j] = noise(&coef_q, j, h_q, &qm, &|k| (k as f64 * w).powi(4));
+        tau_noise[j] = noise(&coef_tau, j, h_tau, &tm, &one);
+        let zero = vec![0.0; qm.len()];
+        beyond[j] = weighted_energy(&qm, &zero, &|k| if k > h_q { 1.0 } else { 0.0 }).sqrt();
+        // the positions' motion (without their mean) against their spread from period to period
+        let motion = weighted_energy(&qm[..2 * h_q + 1], &zero[..2 * h_q + 1], &|k| {
+            if k > 0 {
+                1.0
+            } else {
+                0.0
+            }
+        })
+        .sqrt();
+        let spread = noise(&coef_q, j, h_tau, &qm, &one);
+        if motion > 0.0 && spread > MAX_POSITION_SPREAD * motion {
+            return Err(Error::Recording {
+                recording: rec.name.clone(),
+                message: format!(
+                    "joint {}'s positions differ from period to period by {} RMS, {:.0} % of their motion ({} RMS) over the {count} periods of {} s from t = {} s: the log does not repeat with that period. Is the period the excitation's (its base frequency's inverse), and did the robot run the excitation through these periods (a start, skip_periods or --skip-periods past a lead-in)?",
+                    j + 1,
+                    shown5(spread),
+                    100.0 * spread / motion,
+                    shown5(motion),
+                    shown5(p.period),
+                    shown5(layout.periods[keep[0]].1)
+                ),
+            });
+        }
+        q_mean.push(qm);
+        tau_mean.push(tm);
+    }
+    // the averaged period, from its coefficients
+    let rows: Vec<usize> = (0..m).step_by(decimate).collect();
+    let k_out = rows.len();
+    let (mut q, mut qd, mut qdd, mut tau, mut coulomb) = (
+        vec![0.0; k_out * n],
+        vec![0.0; k_out * n],
+        vec![0.0; k_out * n],
+        vec![0.0; k_out * n],
+        vec![0.0; k_out * n],
+    );
+    for j in 0..n {
+        crate::interrupt::check("period averaging")?;
+        let (x, v, acc) = table.series(&q_mean[j], h_q, w);
+        let sign: Vec<f64> = v
+            .iter()
+            .map(|&v| crate::direct::parameters::sign0(v))
+            .collect();
+        let c = table.project(&sign, h_tau);
+        let c = table.series(&c, h_tau, w).0;
+        let t = table.series(&tau_mean[j], h_tau, w).0;
+        for (r, &i) in rows.iter().enumerate() {
+            q[r * n + j] = x[i];
+            qd[r * n + j] = v[i];
+            qdd[r * n + j] = acc[i];
+            tau[r * n + j] = t[i];
+            coulomb[r * n + j] = c[i];
+        }
+    }
+    let first = layout.periods[keep[0]].1;
+    let t: Vec<f64> = rows
+        .iter()
+        .map(|&i| first + i as f64 * p.period / m as f64)
+        .collect();
+    let out = Recording::new(
+        format!("{} (averaged over {count} periods)", rec.name),
+        n,
+        t,
+        q,
+        tau,
+        Some(qd),
+        Some(qdd),
+    )?;
+    Ok(Recording {
+        experiment: rec.experiment.clone(),
+        coulomb: Some(coulomb),
+        period_average: Some(PeriodAverage {
+            period: p.period,
+            start: first,
+            periods: count,
+            harmonics: h_q,
+            torque_harmonics: h_tau,
+            samples: m,
+            position_noise: pos_noise,
+            velocity_noise: vel_noise,
+            acceleration_noise: acc_noise,
+            torque_noise: tau_noise,
+            position_beyond: beyond,
+            left_out,
+        }),
+        ..out
+    })
+}
+
+/// The warning for what averaging found in the log `log` (joints named `joints`, or numbered
+/// where empty): periods left out, and positions with motion beyond the harmonics kept. None
+/// where neither.
+pub fn warning(average: &Option<PeriodAverage>, log: &str, joints: &[String]) -> Option<String> {
+    let a = average.as_ref()?;
+    let name = |j: usize| {
+        joints
+            .get(j)
+            .cloned()
+            .unwrap_or_else(|| format!("joint {}", j + 1))
+    };
+    let mut said = Vec::new();
+    if !a.left_out.is_empty() {
+        let list: Vec<String> = (a.left_out.iter().take(5))
+            .map(|l| {
+                format!(
+                    "period {} (t = {} to {} s): {}",
+                    l.period + 1,
+                    shown5(l.t0),
+                    shown5(l.t1),
+                    l.reason
+                )
+            })
+            .collect();
+        let more = a.left_out.len().saturating_sub(5);
+        said.push(format!(
+            "{} of its periods left out of the average ({}{}); {} averaged",
+            a.left_out.len(),
+            list.join("; "),
+            if more > 0 {
+                format!("; {more} more")
+            } else {
+                String::new()
+            },
+            a.periods
+        ));
+    }
+    // content beyond the harmonics kept: a twentieth of the noise's or more, and 1e-4 rad
+    let beyond: Vec<String> = (0..a.position_beyond.len())
+        .filter(|&j| {
+            a.position_beyond[j] > 1e-4 && a.position_beyond[j] > 5.0 * a.position_noise[j]
+        })
+        .map(|j| format!("{} {} rad RMS", name(j), shown5(a.position_beyond[j])))
+        .collect();
+    if !beyond.is_empty() {
+        said.push(format!(
+            "the averaged positions move beyond the {} harmonics kept ({}): the regressor is computed from the positions' first {} harmonics and does not see that motion (the robot's tracking error at higher frequencies, or an excitation of more harmonics than given)",
+            a.harmonics,
+            beyond.join(", "),
+            a.harmonics
+        ));
+    }
+    (!said.is_empty()).then(|| format!("{log}: {}", said.join("; ")))
+}
