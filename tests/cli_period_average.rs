@@ -37,26 +37,21 @@ fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_f
     let rows: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
         .collect();
+    let row = |r: &[f64], shift: f64| -> String {
+        let mut r = r.to_vec();
+        r[0] += shift;
+        r.iter()
+            .map(|x| x.to_string())
+            .collect::<Vec<_>>()
+            .join(",")
+            + "\n"
+    };
     let mut log = format!("{header}\n");
     for i in 0..1250 {
-        let mut r = rows[0].clone();
-        r[0] = i as f64 / 500.0;
-        log += &(r
-            .iter()
-            .map(|x| x.to_string())
-            .collect::<Vec<_>>()
-            .join(",")
-            + "\n");
+        log += &row(&rows[0], i as f64 / 500.0);
     }
     for r in &rows {
-        let mut r = r.clone();
-        r[0] += 2.5;
-        log += &(r
-            .iter()
-            .map(|x| x.to_string())
-            .collect::<Vec<_>>()
-            .join(",")
-            + "\n");
+        log += &row(r, 2.5);
     }
     let path = d.join("log.csv");
     write(&path, &log);
@@ -111,6 +106,10 @@ fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_f
         "5",
     ]);
     assert!(out.contains("averaged over 4 periods"), "{out}");
+    assert!(
+        out.contains("RMS over the averaged torques' noise, a joint: "),
+        "{out}"
+    );
     // periods given by hand, from the start found
     let out = ok(&[
         "validate",

@@ -352,19 +352,10 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     );
     // averaged over periods, the residual against the noise the periods measured
     if let (Some(avg), [_]) = (&fit.log_period_average, recs.as_slice()) {
-        let errors = avg.model_error(&fit.residual_rms);
-        let list = |f: &dyn Fn(&(f64, f64)) -> f64| -> String {
-            errors
-                .iter()
-                .map(|e| crate::error::shown5(f(e)))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
         let _ = writeln!(
             out,
-            "residual RMS over the averaged torques' noise, a joint: {} (1: the model leaves only noise); the model's own error (N m): {}",
-            list(&|e| e.0),
-            list(&|e| e.1)
+            "{}",
+            avg.model_error_line(&fit.residual_rms, "residual RMS")
         );
     }
     // the parameter table: printed in full and saved as CSV and JSON beside the model; the

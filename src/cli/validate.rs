@@ -75,7 +75,8 @@ pub(crate) struct ValidateArgs {
     /// `log_torque_saturation`, its torques that read clipped, warned of; `log_position_wraps`,
     /// steps of whole turns taken out of its positions; `log_held_columns`, its columns logged
     /// at a lower rate and read again at their values' arrivals; `log_stamp_jitter`, its time
-    /// stamps found jittering over a regular clock;
+    /// stamps found jittering over a regular clock; `log_period_average`, what averaging it
+    /// over its excitation's periods found (`--average-periods`, `--period`);
     /// for a base-parameter model `torque_columns`, each torque column of the log against the
     /// robot's model, `torque_lag`, its torques shifted against its positions, and
     /// `position_range`, the joints whose positions leave their limits, and `position_offsets`,
@@ -298,6 +299,9 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     if let Some(o) = &offsets {
         json["position_offsets"] = serde_json::to_value(o).expect("serialisable");
     }
+    if let Some(a) = &rec.period_average {
+        json["log_period_average"] = serde_json::to_value(a).expect("serialisable");
+    }
     if !rec.position_rounding.is_empty() {
         json["position_rounding"] =
             serde_json::to_value(&rec.position_rounding).expect("serialisable");
@@ -341,6 +345,10 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
             "  {:<20} {:>12.4} {:>10} {:>12.4} {:>12.4} {:>14}",
             j.joint, j.rms, rel, j.mean, j.max, se
         );
+    }
+    if let Some(avg) = &rec.period_average {
+        let rms: Vec<f64> = v.joints.iter().map(|j| j.rms).collect();
+        let _ = writeln!(out, "  {}", avg.model_error_line(&rms, "RMS"));
     }
     match &stderr {
         Ok(_) => {

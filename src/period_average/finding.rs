@@ -73,6 +73,22 @@ impl PeriodAverage {
             .collect()
     }
 
+    /// [`Self::model_error`] of the RMS `rms` (N m a joint, of a fit's residuals or a
+    /// validation's errors: `what`) in words, a joint each.
+    pub fn model_error_line(&self, rms: &[f64], what: &str) -> String {
+        let errors = self.model_error(rms);
+        let list = |f: &dyn Fn(&(f64, f64)) -> f64| -> String {
+            (errors.iter().map(|e| crate::error::shown5(f(e))))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        format!(
+            "{what} over the averaged torques' noise, a joint: {} (1: the model leaves only noise); the model's own error (N m): {}",
+            list(&|e| e.0),
+            list(&|e| e.1)
+        )
+    }
+
     /// What is wrong with it for `n` joints (a document edited by hand); None where nothing.
     pub(crate) fn problem(&self, n: usize) -> Option<String> {
         let lists = [
