@@ -327,6 +327,22 @@ fn gaps_short_logs_wrong_periods_and_bad_options() {
         ..averaged(PeriodOptions::new(PERIOD, 5))
     };
     assert!(refused(&rec, &o).contains("filter_position does not apply"));
+    // values past f64's range in their squares
+    let huge = Recording::new(
+        "huge",
+        6,
+        rec.t.clone(),
+        rec.q.clone(),
+        rec.tau.iter().map(|x| x * 1e300).collect(),
+        None,
+        None,
+    )
+    .unwrap();
+    let e = refused(&huge, &averaged(PeriodOptions::new(PERIOD, 5)));
+    assert!(
+        e.contains("joint 1's torques") && e.contains("past f64's range"),
+        "{e}"
+    );
     // the excitation of another robot, or a log that is none of it
     let other = FourierTrajectory::new(
         traj.w_f,

@@ -244,6 +244,24 @@ pub fn average_periods(
                 ),
             });
         }
+        // sums of squares past f64's range (values near 1e300) cannot be vouched for
+        let levels = [
+            ("positions", pos_noise[j]),
+            ("velocities", vel_noise[j]),
+            ("accelerations", acc_noise[j]),
+            ("torques", tau_noise[j]),
+            ("positions beyond the harmonics kept", beyond[j]),
+            ("positions' motion", motion),
+        ];
+        if let Some((what, x)) = levels.iter().find(|(_, x)| !x.is_finite()) {
+            return Err(Error::Numerical {
+                operation: "period averaging".into(),
+                message: format!(
+                    "joint {}'s {what}: their spread from period to period is {x}, past f64's range: the log's values are too large for f64 arithmetic (near 1e300?); rescale the log to SI units",
+                    j + 1
+                ),
+            });
+        }
         q_mean.push(qm);
         tau_mean.push(tm);
     }
