@@ -135,7 +135,7 @@ pub fn average_periods(
     let mut left_out = layout.left_out.clone();
     let mut keep: Vec<usize> = (0..layout.periods.len()).collect();
     if keep.len() >= 3 {
-        let names = ["positions", "torques"];
+        let names = [("positions", "rad"), ("torques", "N m")];
         let mut far: Vec<(usize, String)> = Vec::new();
         for (signal, coefs) in [&coef_q, &coef_tau].into_iter().enumerate() {
             for j in 0..n {
@@ -152,10 +152,11 @@ pub fn average_periods(
                         far.push((
                             k,
                             format!(
-                                "joint {}'s {} {} RMS off the periods' median, {} times the median period's",
+                                "joint {}'s {} {} {} RMS off the periods' median, {} times the median period's",
                                 j + 1,
-                                names[signal],
+                                names[signal].0,
                                 shown5(d),
+                                names[signal].1,
                                 shown5(d / typical.max(f64::MIN_POSITIVE))
                             ),
                         ));
@@ -234,7 +235,7 @@ pub fn average_periods(
             return Err(Error::Recording {
                 recording: rec.name.clone(),
                 message: format!(
-                    "joint {}'s positions differ from period to period by {} RMS, {:.0} % of their motion ({} RMS) over the {count} periods of {} s from t = {} s: the log does not repeat with that period. Is the period the excitation's (its base frequency's inverse), and did the robot run the excitation through these periods (a start, skip_periods or --skip-periods past a lead-in)?",
+                    "joint {}'s positions differ from period to period by {} rad RMS, {:.0} % of their motion ({} rad RMS) over the {count} periods of {} s from t = {} s: the log does not repeat with that period. Is the period the excitation's (its base frequency's inverse), and did the robot run the excitation through these periods (a start, skip_periods or --skip-periods past a lead-in)?",
                     j + 1,
                     shown5(spread),
                     100.0 * spread / motion,
