@@ -65,6 +65,18 @@ fn averaged(periods: PeriodOptions) -> PreprocessOptions {
     }
 }
 
+/// A direct fit with viscous and Coulomb friction, the terms the logs are made with.
+fn viscous_and_coulomb() -> BaseOptions {
+    BaseOptions {
+        friction: FrictionTerms {
+            viscous: true,
+            coulomb: true,
+            ..FrictionTerms::NONE
+        },
+        ..BaseOptions::default()
+    }
+}
+
 fn max_error(a: &[f64], b: &[f64]) -> f64 {
     a.iter()
         .zip(b)
@@ -129,6 +141,12 @@ fn the_noise_is_measured_from_the_periods_and_the_fit_leaves_only_it() {
     let rec = log(&s, 0.05, 7);
     let out = preprocess(&rec, &averaged(PeriodOptions::new(PERIOD, 5))).unwrap();
     let a = out.period_average.as_ref().unwrap();
+    // noise alone does not drift
+    assert!(
+        a.torque_drift.iter().all(|f| f.is_some_and(|f| f < 2.0)),
+        "{:?}",
+        a.torque_drift
+    );
     let expected = 0.05 * (201.0f64 / 5000.0).sqrt();
     for (j, x) in a.torque_noise.iter().enumerate() {
         assert!(
@@ -138,14 +156,7 @@ fn the_noise_is_measured_from_the_periods_and_the_fit_leaves_only_it() {
         );
     }
     let model = a465::model("kinsheel2010").unwrap();
-    let options = BaseOptions {
-        friction: FrictionTerms {
-            viscous: true,
-            coulomb: true,
-            ..FrictionTerms::NONE
-        },
-        ..BaseOptions::default()
-    };
+    let options = viscous_and_coulomb();
     let fit = identify_base_parameters(&model, &out.states().unwrap(), &out.tau, &options).unwrap();
     for (j, (r, n)) in fit
         .residual_rms
@@ -427,4 +438,46 @@ fn jittered_stamps_and_coarse_counts_average_out() {
         "{:?} against {most}",
         a.position_noise
     );
+}
+
+/// Friction that grows over the run (a joint warming): the drift is found on that joint and
+/// said, the others' torques judged steady.
+#[test]
+fn torques_that_drift_over_the_periods_are_said() {
+    let traj = a465_excitation(&mut Rng(21));
+    let s = samples(&traj, 0.0, 6.0);
+    let mut rec = log(&s, 0.02, 11);
+    // joint 3's Coulomb friction from 0.8 to 1.1 N m over the minute
+    let end = rec.t[rec.len() - 1];
+    for i in 0..rec.len() {
+        rec.tau[i * 6 + 2] += 0.3 * rec.t[i] / end * s.qd[i * 6 + 2].signum();
+    }
+    let out = preprocess(&rec, &averaged(PeriodOptions::new(PERIOD, 5))).unwrap();
+    let a = out.period_average.as_ref().unwrap();
+    let drift: Vec<f64> = a.torque_drift.iter().map(|f| f.unwrap()).collect();
+    assert!(drift[2] > 10.0, "{drift:?}");
+    assert!(
+        (0..6).filter(|&j| j != 2).all(|j| drift[j] < 2.0),
+        "{drift:?}"
+    );
+    let w = perturbid_rs::period_average::warning(&out.period_average, "log.csv", &[]).unwrap();
+    assert!(
+        w.contains("its torques drift from period to period (joint 3 (F = "),
+        "{w}"
+    );
+    // a saved finding is checked on load
+    use perturbid_rs::Document;
+    let model = a465::model("kinsheel2010").unwrap();
+    let options = viscous_and_coulomb();
+    let fit = identify_base_parameters(&model, &out.states().unwrap(), &out.tau, &options)
+        .unwrap()
+        .with_findings_of(&out);
+    let text = fit.to_json();
+    assert!(perturbid_rs::direct::BaseModel::from_json(&text).is_ok());
+    let mut doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+    doc["log_period_average"]["torque_drift"][0] = serde_json::json!(-1.0);
+    let e = perturbid_rs::direct::BaseModel::from_json(&doc.to_string())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("log_period_average: torque_drift"), "{e}");
 }

@@ -380,6 +380,7 @@ class Recording:
         """What averaging over the excitation's periods found: period, start (s), periods,
         harmonics, torque_harmonics, samples, per joint position_noise, velocity_noise,
         acceleration_noise, torque_noise (one period's), averaged_torque_noise, position_beyond,
+        torque_drift (F ratios of a trend over the periods, beyond 3 a drift; None unjudged),
         and left_out (dicts period, t0, t1, reason); None where not averaged."""
     @property
     def stamp_jitter(self) -> Optional[dict[str, Any]]:

@@ -49,6 +49,13 @@ pub struct PeriodAverage {
     /// the torques' band (rad): motion the harmonics kept leave out (tracking errors at
     /// higher frequencies), which the regressor then does not see.
     pub position_beyond: Vec<f64>,
+    /// Per joint, the F ratio of a linear trend of its torques over the periods against the
+    /// spread it leaves (near 1 for noise alone; beyond [`super::DRIFT_RATIO`] the torques
+    /// drift, as a warming joint's friction does, and the noise measured holds the drift);
+    /// None where not judged (fewer than 3 periods, or fewer than
+    /// [`super::MIN_COEFFICIENTS`] coefficients in the torques' band).
+    #[serde(default)]
+    pub torque_drift: Vec<Option<f64>>,
     /// Periods left out, in order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub left_out: Vec<LeftOutPeriod>,
@@ -130,6 +137,14 @@ impl PeriodAverage {
             return Some(format!(
                 "{} periods, {} and {} harmonics over {} samples; expected at least 2 periods, harmonics >= 1 and torque harmonics no fewer, below half the samples",
                 self.periods, self.harmonics, self.torque_harmonics, self.samples
+            ));
+        }
+        if !(self.torque_drift.is_empty() || self.torque_drift.len() == n)
+            || (self.torque_drift.iter().flatten()).any(|f| !(f.is_finite() && *f >= 0.0))
+        {
+            return Some(format!(
+                "torque_drift: {} values, expected one a joint ({n}), each finite and >= 0 or null",
+                self.torque_drift.len()
             ));
         }
         (self.left_out.iter().enumerate())

@@ -27,10 +27,12 @@
 //!   log does not repeat with that period (a wrong period, or not the excitation), an error
 //!   naming the joint.
 
+mod drift;
 mod finding;
 mod layout;
 mod series;
 
+pub use drift::{DRIFT_RATIO, MIN_COEFFICIENTS};
 pub use finding::{LeftOutPeriod, PeriodAverage};
 
 use crate::error::{shown5, Error, Result};
@@ -210,6 +212,7 @@ pub fn average_periods(
         vec![0.0; n],
         vec![0.0; n],
     );
+    let mut drift = vec![None; n];
     let mut q_mean = Vec::with_capacity(n);
     let mut tau_mean = Vec::with_capacity(n);
     for j in 0..n {
@@ -219,6 +222,9 @@ pub fn average_periods(
         vel_noise[j] = noise(&coef_q, j, h_q, &qm, &|k| (k as f64 * w).powi(2));
         acc_noise[j] = noise(&coef_q, j, h_q, &qm, &|k| (k as f64 * w).powi(4));
         tau_noise[j] = noise(&coef_tau, j, h_tau, &tm, &one);
+        let per: Vec<&[f64]> = keep.iter().map(|&k| coef_tau[k][j].as_slice()).collect();
+        let place: Vec<f64> = keep.iter().map(|&k| layout.periods[k].0 as f64).collect();
+        drift[j] = drift::trend_ratio(&per, &place);
         let zero = vec![0.0; qm.len()];
         beyond[j] = weighted_energy(&qm, &zero, &|k| if k > h_q { 1.0 } else { 0.0 }).sqrt();
         // the positions' motion (without their mean) against their spread from period to period
@@ -323,6 +329,7 @@ pub fn average_periods(
             acceleration_noise: acc_noise,
             torque_noise: tau_noise,
             position_beyond: beyond,
+            torque_drift: drift,
             left_out,
         }),
         ..out
@@ -364,6 +371,18 @@ pub fn warning(average: &Option<PeriodAverage>, log: &str, joints: &[String]) ->
                 String::new()
             },
             a.periods
+        ));
+    }
+    let drifting: Vec<String> = (a.torque_drift.iter().enumerate())
+        .filter_map(|(j, f)| {
+            f.filter(|f| *f > DRIFT_RATIO)
+                .map(|f| format!("{} (F = {})", name(j), shown5(f)))
+        })
+        .collect();
+    if !drifting.is_empty() {
+        said.push(format!(
+            "its torques drift from period to period ({}: a straight line over the periods explains more of their spread than noise would): a joint warming over the run, whose friction changes, or a payload or controller that changed; the noise measured holds the drift, and the average is the periods' mean. Fewer periods, after the robot warmed up (skip_periods, --skip-periods), drift less",
+            drifting.join(", ")
         ));
     }
     // content beyond the harmonics kept: a twentieth of the noise's or more, and 1e-4 rad

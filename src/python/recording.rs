@@ -400,7 +400,9 @@ impl PyRecording {
     /// `position_noise` (rad), `velocity_noise` (rad/s), `acceleration_noise` (rad/s^2) and
     /// `torque_noise` (N m) of one period's samples within their band (the average's are these
     /// over sqrt(periods): `averaged_torque_noise`), `position_beyond` (rad RMS of the averaged
-    /// positions beyond the harmonics kept), and `left_out`, a list of dicts `period` (0-based),
+    /// positions beyond the harmonics kept), `torque_drift` (per joint the F ratio of a linear
+    /// trend of its torques over the periods, near 1 for noise, beyond 3 a drift; None where
+    /// not judged), and `left_out`, a list of dicts `period` (0-based),
     /// `t0`, `t1` (s) and `reason`. None for a recording not averaged so.
     #[getter]
     fn period_average<'py>(
@@ -423,6 +425,7 @@ impl PyRecording {
         e.set_item("torque_noise", a.torque_noise.clone())?;
         e.set_item("averaged_torque_noise", a.averaged_torque_noise())?;
         e.set_item("position_beyond", a.position_beyond.clone())?;
+        e.set_item("torque_drift", a.torque_drift.clone())?;
         let left = pyo3::types::PyList::empty(py);
         for l in &a.left_out {
             let d = pyo3::types::PyDict::new(py);
