@@ -21,7 +21,7 @@ pub struct LeftOutPeriod {
 }
 
 /// What averaging over the periods found, kept with the recording it made
-/// ([`Recording::period_average`]) and with a model fitted to it.
+/// ([`crate::Recording::period_average`]) and with a model fitted to it.
 ///
 /// Noise levels are per joint, of one period's samples within the band kept (rad, rad/s,
 /// rad/s^2, N m; m and N for a prismatic joint); the averaged recording's are these over
