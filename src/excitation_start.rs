@@ -87,11 +87,7 @@ pub fn excitation_start(rec: &Recording, traj: &FourierTrajectory) -> Result<Exc
     };
     // the median sample interval: a period is whole where its last sample before the next
     // period's first lies in the log
-    let dt = {
-        let mut d: Vec<f64> = rec.t.windows(2).map(|w| w[1] - w[0]).collect();
-        let mid = d.len() / 2;
-        *d.select_nth_unstable_by(mid, f64::total_cmp).1
-    };
+    let dt = crate::preprocess::gaps(rec).0;
     let stride = rec.len().div_ceil(SEARCH_SAMPLES).max(1);
     let samples: Vec<usize> = (0..rec.len()).step_by(stride).collect();
     let mut best = (f64::INFINITY, 0.0);
@@ -241,5 +237,24 @@ pub fn excitation_start(rec: &Recording, traj: &FourierTrajectory) -> Result<Exc
         start,
         periods: best_run.1,
         tracking_rms: tracking.into_iter().map(f64::sqrt).collect(),
+    })
+}
+
+/// The periods of `rec` to average for the excitation `traj` ([`crate::period_average`]): its
+/// period and harmonics, from the start [`excitation_start`] finds, over the whole periods
+/// that follow it, `skip` of them left out first.
+///
+/// Errors: those of [`excitation_start`].
+pub fn excitation_periods(
+    rec: &Recording,
+    traj: &FourierTrajectory,
+    skip: usize,
+) -> Result<crate::period_average::PeriodOptions> {
+    let found = excitation_start(rec, traj)?;
+    Ok(crate::period_average::PeriodOptions {
+        start: Some(found.start),
+        count: Some(found.periods),
+        skip,
+        ..crate::period_average::PeriodOptions::new(traj.period(), traj.harmonics())
     })
 }

@@ -415,7 +415,7 @@ fn preprocess_part(
 /// longer than [`MAX_GAP_INTERVALS`] medians.
 ///
 /// [`MAX_GAP_INTERVALS`]: crate::limits::MAX_GAP_INTERVALS
-fn gaps(rec: &Recording) -> (f64, Vec<usize>) {
+pub(crate) fn gaps(rec: &Recording) -> (f64, Vec<usize>) {
     let dt: Vec<f64> = rec.t.windows(2).map(|w| w[1] - w[0]).collect();
     if dt.is_empty() {
         return (0.0, vec![]);

@@ -275,6 +275,8 @@ impl PreprocessArgs {
         out: &mut String,
     ) -> Result<Vec<crate::recording::Recording>> {
         refuse_repeated_paths(paths, argument, "log")?;
+        // the options checked, and an excitation read, once for all the logs
+        let periods = self.periods()?;
         // each log preprocessed as it is read (one log as read is held at a time), its
         // samples as read printed for the comparison
         let mut recs = Vec::with_capacity(paths.len());
@@ -288,7 +290,7 @@ impl PreprocessArgs {
                     &[&rec.q, &rec.tau],
                 )?);
             }
-            recs.push(self.prepare(rec, path, joints, progress, out)?);
+            recs.push(self.prepare(rec, path, &periods, joints, progress, out)?);
         }
         let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
         crate::repeated_samples::refuse_shared_samples(&prints, &names, argument, "data rows")?;
@@ -339,11 +341,12 @@ impl PreprocessArgs {
     }
 
     /// The recording `rec` as read from `path`, preprocessed when it has no qdd columns (or
-    /// `--preprocess` asks); says so in `out`.
+    /// `--preprocess` asks), averaged over `periods` where given; says so in `out`.
     fn prepare(
         &self,
         rec: crate::recording::Recording,
         path: &Path,
+        periods: &Periods,
         joints: &[String],
         progress: &super::progress::Progress,
         out: &mut String,
@@ -356,7 +359,6 @@ impl PreprocessArgs {
                 eprintln!("perturbid: warning: {w}");
             }
         };
-        let periods = self.periods()?;
         if rec.qdd.is_some() && !self.preprocess && matches!(periods, Periods::None) {
             // taken as logged: its velocity and acceleration columns against the derivatives
             crate::derivative_columns::check_logged_derivatives(&rec)?;
@@ -370,24 +372,17 @@ impl PreprocessArgs {
         progress.update("preprocessing");
         let periods = match periods {
             Periods::None => None,
-            Periods::Given(o) => Some(o),
-            Periods::Excitation(traj, source) => {
-                let found = crate::excitation_start::excitation_start(&rec, &traj).map_err(
-                    |e| match e {
+            Periods::Given(o) => Some(o.clone()),
+            Periods::Excitation(traj, source) => Some(
+                crate::excitation_start::excitation_periods(&rec, traj, self.skip_periods)
+                    .map_err(|e| match e {
                         Error::Recording { recording, message } => Error::Recording {
                             recording,
                             message: format!("against {}: {message}", source.display()),
                         },
                         e => e,
-                    },
-                )?;
-                Some(crate::period_average::PeriodOptions {
-                    start: Some(found.start),
-                    count: Some(found.periods),
-                    skip: self.skip_periods,
-                    ..crate::period_average::PeriodOptions::new(traj.period(), traj.harmonics())
-                })
-            }
+                    })?,
+            ),
         };
         let periodic = periods.is_some();
         let o = crate::preprocess::PreprocessOptions {

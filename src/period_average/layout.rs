@@ -1,6 +1,5 @@
 //! Where the periods of a log lie, how they are sampled, and which a gap leaves out.
 
-use super::series::median_of_mut;
 use super::{LeftOutPeriod, PeriodOptions, MAX_PROJECTION_WORK, PERIOD_RANGE};
 use crate::error::{shown, shown5, Error, Result};
 use crate::recording::Recording;
@@ -88,7 +87,7 @@ impl Layout {
         }
         let (t0, t1) = (rec.t[0], rec.t[rec.len() - 1]);
         let start = p.start.unwrap_or(t0);
-        let dt = median_interval(rec);
+        let (dt, gaps) = crate::preprocess::gaps(rec);
         let from = start + p.skip as f64 * p.period;
         if start < t0 - 0.5 * dt {
             return Err(Error::Recording {
@@ -131,7 +130,6 @@ impl Layout {
         crate::limits::check_values("period averaging", (m * (1 + 4 * rec.n)) as f64, || {
             format!("a period of {m} samples")
         })?;
-        let gaps = crate::preprocess::gap_positions(rec);
         let mut periods = Vec::new();
         let mut left_out = Vec::new();
         for k in 0..wanted {
@@ -193,9 +191,4 @@ pub(super) fn too_few(
             }
         ),
     }
-}
-
-fn median_interval(rec: &Recording) -> f64 {
-    let mut dt: Vec<f64> = rec.t.windows(2).map(|w| w[1] - w[0]).collect();
-    median_of_mut(&mut dt)
 }

@@ -38,7 +38,7 @@ pub use finding::{LeftOutPeriod, PeriodAverage};
 use crate::error::{shown5, Error, Result};
 use crate::recording::Recording;
 use layout::{too_few, Layout};
-use series::{energy, median_coefficients, median_of, weighted_energy, Table};
+use series::{energy, median_coefficients, median_of, weighted_energy, weighted_power, Table};
 
 /// What [`average_periods`] averages: the excitation's period and harmonics, and where in the
 /// log its periods lie.
@@ -144,7 +144,7 @@ pub fn average_periods(
                 let per: Vec<&[f64]> = coefs.iter().map(|c| c[j].as_slice()).collect();
                 let median = median_coefficients(&per);
                 let dev: Vec<f64> = per.iter().map(|c| energy(c, &median).sqrt()).collect();
-                let scale = energy(&median, &vec![0.0; median.len()]).sqrt();
+                let scale = weighted_power(&median, &|_| 1.0).sqrt();
                 let typical = median_of(&dev);
                 for (k, &d) in dev.iter().enumerate() {
                     if d > OUTLIER_RATIO * typical
@@ -225,17 +225,9 @@ pub fn average_periods(
         let per: Vec<&[f64]> = keep.iter().map(|&k| coef_tau[k][j].as_slice()).collect();
         let place: Vec<f64> = keep.iter().map(|&k| layout.periods[k].0 as f64).collect();
         drift[j] = drift::trend_ratio(&per, &place);
-        let zero = vec![0.0; qm.len()];
-        beyond[j] = weighted_energy(&qm, &zero, &|k| if k > h_q { 1.0 } else { 0.0 }).sqrt();
+        beyond[j] = weighted_power(&qm, &|k| if k > h_q { 1.0 } else { 0.0 }).sqrt();
         // the positions' motion (without their mean) against their spread from period to period
-        let motion = weighted_energy(&qm[..2 * h_q + 1], &zero[..2 * h_q + 1], &|k| {
-            if k > 0 {
-                1.0
-            } else {
-                0.0
-            }
-        })
-        .sqrt();
+        let motion = weighted_power(&qm[..2 * h_q + 1], &|k| if k > 0 { 1.0 } else { 0.0 }).sqrt();
         let spread = noise(&coef_q, j, h_tau, &qm, &one);
         if motion > 0.0 && spread > MAX_POSITION_SPREAD * motion {
             return Err(Error::Recording {
@@ -289,9 +281,8 @@ pub fn average_periods(
             .iter()
             .map(|&v| crate::direct::parameters::sign0(v))
             .collect();
-        let c = table.project(&sign, h_tau);
-        let c = table.series(&c, h_tau, w).0;
-        let t = table.series(&tau_mean[j], h_tau, w).0;
+        let c = table.values(&table.project(&sign, h_tau), h_tau);
+        let t = table.values(&tau_mean[j], h_tau);
         for (r, &i) in rows.iter().enumerate() {
             q[r * n + j] = x[i];
             qd[r * n + j] = v[i];

@@ -31,6 +31,16 @@ pub(super) fn energy(x: &[f64], y: &[f64]) -> f64 {
     weighted_energy(x, y, &|_| 1.0)
 }
 
+/// The mean square over a period of the series `x` with harmonic `k`'s share weighted by
+/// `weight(k)` (its power; [`weighted_energy`] against nothing).
+pub(super) fn weighted_power(x: &[f64], weight: &dyn Fn(usize) -> f64) -> f64 {
+    let mut e = weight(0) * x[0].powi(2);
+    for k in 1..=(x.len() - 1) / 2 {
+        e += 0.5 * weight(k) * (x[2 * k - 1].powi(2) + x[2 * k].powi(2));
+    }
+    e
+}
+
 /// [`energy`] with harmonic `k`'s share weighted by `weight(k)`.
 pub(super) fn weighted_energy(x: &[f64], y: &[f64], weight: &dyn Fn(usize) -> f64) -> f64 {
     let mut e = weight(0) * (x[0] - y[0]).powi(2);
@@ -76,6 +86,24 @@ impl Table {
             c.push(2.0 * b / m as f64);
         }
         c
+    }
+
+    /// The series of coefficients `c` (its first `h` harmonics) on the grid.
+    pub(super) fn values(&self, c: &[f64], h: usize) -> Vec<f64> {
+        let m = self.cos.len();
+        let mut x = vec![c[0]; m];
+        for k in 1..=h {
+            let (a, b) = (c[2 * k - 1], c[2 * k]);
+            let mut idx = 0usize;
+            for xi in x.iter_mut() {
+                *xi += a * self.cos[idx] + b * self.sin[idx];
+                idx += k;
+                if idx >= m {
+                    idx -= m;
+                }
+            }
+        }
+        x
     }
 
     /// The series of coefficients `c` (its first `h` harmonics) on the grid, with its first

@@ -113,10 +113,8 @@ pub(crate) fn preprocess(
                 "the excitation's start is found in the log from its positions: give period and harmonics instead to set it",
             ))
         }
-        (Some(traj), None, None) => Some(crate::period_average::PeriodOptions {
-            skip: skip_periods,
-            ..crate::period_average::PeriodOptions::new(traj.period(), traj.harmonics())
-        }),
+        // found in the log, below
+        (Some(_), None, None) => None,
         (None, Some(p), Some(h)) => Some(crate::period_average::PeriodOptions {
             start: period_start,
             skip: skip_periods,
@@ -140,25 +138,19 @@ pub(crate) fn preprocess(
         screen_glitches,
         periods,
     };
-    let out: Recording = detached(py, "preprocess", || {
-        let options = match &traj {
-            // the excitation's start and periods found in the log first
-            Some(traj) => {
-                let found = crate::excitation_start::excitation_start(&rec, traj)?;
-                PreprocessOptions {
-                    periods: options.periods.clone().map(|p| {
-                        crate::period_average::PeriodOptions {
-                            start: Some(found.start),
-                            count: Some(found.periods),
-                            ..p
-                        }
-                    }),
+    let out: Recording = detached(py, "preprocess", || match &traj {
+        // the excitation's start and periods found in the log first
+        Some(traj) => {
+            let periods = crate::excitation_start::excitation_periods(&rec, traj, skip_periods)?;
+            preprocess_rs(
+                &rec,
+                &PreprocessOptions {
+                    periods: Some(periods),
                     ..options.clone()
-                }
-            }
-            None => options.clone(),
-        };
-        preprocess_rs(&rec, &options)
+                },
+            )
+        }
+        None => preprocess_rs(&rec, &options),
     })?;
     let warnings: Vec<String> = [
         crate::log_screening::warning(
