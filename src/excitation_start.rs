@@ -133,20 +133,26 @@ pub fn excitation_start(rec: &Recording, traj: &FourierTrajectory) -> Result<Exc
             })
             .collect()
     };
-    let follows = |d: &[f64]| d.iter().map(|x| x * x).sum::<f64>().sqrt() < MAX_TRACKING * motion;
-    let matched = |s: f64| -> Vec<(f64, bool)> {
+    // each whole period's start, its joints' distances and their norm (rad RMS)
+    type Period = (f64, Vec<f64>, f64);
+    let matched = |s: f64| -> Vec<Period> {
         boundaries(s)
             .into_iter()
-            .map(|a| (a, follows(&distance(s, a))))
+            .map(|a| {
+                let d = distance(s, a);
+                let norm = d.iter().map(|x| x * x).sum::<f64>().sqrt();
+                (a, d, norm)
+            })
             .collect()
     };
+    let follows = |p: &Period| p.2 < MAX_TRACKING * motion;
     // Gauss-Newton on the shift over the samples of the periods that follow it, each joint's
     // offset taken off
     for _ in 0..8 {
         crate::interrupt::check("finding the excitation's start")?;
         let periods: Vec<f64> = matched(shift)
             .into_iter()
-            .filter(|p| p.1)
+            .filter(follows)
             .map(|p| p.0)
             .collect();
         let rows: Vec<usize> = periods
@@ -189,7 +195,7 @@ pub fn excitation_start(rec: &Recording, traj: &FourierTrajectory) -> Result<Exc
     // the longest run of consecutive periods that follow it
     let (mut run, mut best_run) = ((0, 0), (0, 0));
     for (k, p) in periods.iter().enumerate() {
-        if p.1 {
+        if follows(p) {
             run = if run.1 > 0 && run.0 + run.1 == k {
                 (run.0, run.1 + 1)
             } else {
@@ -201,16 +207,7 @@ pub fn excitation_start(rec: &Recording, traj: &FourierTrajectory) -> Result<Exc
         }
     }
     if best_run.1 == 0 {
-        let nearest = periods
-            .iter()
-            .map(|p| {
-                distance(shift, p.0)
-                    .iter()
-                    .map(|x| x * x)
-                    .sum::<f64>()
-                    .sqrt()
-            })
-            .fold(f64::INFINITY, f64::min);
+        let nearest = periods.iter().map(|p| p.2).fold(f64::INFINITY, f64::min);
         return Err(Error::Recording {
             recording: rec.name.clone(),
             message: format!(
@@ -225,11 +222,8 @@ pub fn excitation_start(rec: &Recording, traj: &FourierTrajectory) -> Result<Exc
     }
     let start = periods[best_run.0].0;
     let mut tracking = vec![0.0; n];
-    for k in 0..best_run.1 {
-        for (t, d) in tracking
-            .iter_mut()
-            .zip(distance(shift, periods[best_run.0 + k].0))
-        {
+    for p in &periods[best_run.0..best_run.0 + best_run.1] {
+        for (t, d) in tracking.iter_mut().zip(&p.1) {
             *t += d * d / best_run.1 as f64;
         }
     }
