@@ -75,7 +75,10 @@ impl PeriodOptions {
 
 /// The periods averaged may last 0.001 to 1,000 s (base frequencies of 1 kHz to 1 mHz, as
 /// [`crate::limits::BASE_FREQUENCY`]).
-pub const PERIOD_RANGE: (f64, f64) = (1e-3, 1e3);
+pub const PERIOD_RANGE: (f64, f64) = (
+    1.0 / crate::limits::BASE_FREQUENCY.1,
+    1.0 / crate::limits::BASE_FREQUENCY.0,
+);
 
 /// The most multiply-adds the projections may take (samples of the log's periods times
 /// harmonics): about ten seconds' work. A 10 s period at 1 kHz with 10 Hz of torque band
