@@ -19,6 +19,11 @@ choice! {
         /// Rows of joint `j` divided by `sigma_j`, the RMS of joint `j`'s OLS residuals (Swevers
         /// et al.: the maximum-likelihood estimate for independent per-joint noise).
         Wls = "wls",
+        /// Rows of joint `j` divided by `sigma_j`, the noise measured apart from the fit
+        /// ([`BaseOptions::noise`]: from the spread of an excitation's periods, or given):
+        /// the maximum-likelihood estimate whose weights no model error biases, its standard
+        /// errors from the noise ([`super::noise_fit`]).
+        Noise = "noise",
     }
 }
 
@@ -52,6 +57,11 @@ pub struct BaseOptions {
     /// [`super::streaming::MAX_OFFSET_RUNS`] `runs` and the offset among `friction`. Default
     /// false.
     pub offset_per_run: bool,
+    /// The torques' noise measured apart from the fit ([`super::TorqueNoise`]): the weights
+    /// of [`Weighting::Noise`] (which needs it), and for any weighting the yardstick the
+    /// fit's residuals are judged against ([`super::NoiseFit`], [`super::BaseModel::noise_fit`]).
+    /// Default None.
+    pub noise: Option<super::TorqueNoise>,
 }
 
 impl Default for BaseOptions {
@@ -65,6 +75,27 @@ impl Default for BaseOptions {
             seed: 0,
             runs: vec![],
             offset_per_run: false,
+            noise: None,
+        }
+    }
+}
+
+impl BaseOptions {
+    /// The noise levels a joint (N m) that weight the rows of a fit with these options:
+    /// [`BaseOptions::noise`]'s for [`Weighting::Noise`], None for the other weightings (OLS,
+    /// or WLS weighted from its residuals). Errors: the noise weighting without a noise, or a
+    /// noise that is not one positive level a joint of `joints`.
+    pub fn noise_weights(&self, joints: &[String]) -> crate::error::Result<Option<Vec<f64>>> {
+        if let Some(noise) = &self.noise {
+            noise.check(joints)?;
+        }
+        match (self.weighting, &self.noise) {
+            (Weighting::Noise, Some(noise)) => Ok(Some(noise.sigma.clone())),
+            (Weighting::Noise, None) => Err(crate::error::Error::InvalidArgument {
+                argument: "weighting".into(),
+                message: "the noise weighting needs the torques' noise measured apart from the fit: average the log over its excitation's periods (--average-periods, --period; preprocess(excitation=..., period=...)), or give the noise a joint (noise=)".into(),
+            }),
+            _ => Ok(None),
         }
     }
 }

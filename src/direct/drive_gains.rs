@@ -377,6 +377,14 @@ pub fn identify_drive_gains_with(
         argument: "runs".into(),
         message,
     };
+    if options.weighting == Weighting::Noise || options.noise.is_some() {
+        // the torques are the gains times the signal: a noise in its units is not known
+        // before the gains are
+        return Err(Error::InvalidArgument {
+            argument: "weighting".into(),
+            message: "the noise weighting is not taken with drive gains: the torques are the gains times the logged signal, so their noise is not known before the gains are; weight from the residuals (wls) or not (ols)".into(),
+        });
+    }
     if options.offset_per_run {
         // each loaded run's mean payload torque, part of what sets the gains' scale, would
         // go into that run's offset

@@ -36,7 +36,8 @@ pub struct BaseModel {
     pub stderr: Vec<f64>,
     /// Per joint, the RMS of the torque residuals of the fit (N m).
     pub residual_rms: Vec<f64>,
-    /// Per joint, the noise level used as weight (N m; 1 for OLS).
+    /// Per joint, the noise level used as weight (N m; 1 for OLS; the residual RMS of the OLS
+    /// fit for WLS; the noise measured apart for [`Weighting::Noise`]).
     pub sigma: Vec<f64>,
     /// cond(Phi_base) of the (weighted) fit, columns scaled to unit norm.
     pub cond: f64,
@@ -165,6 +166,14 @@ pub struct BaseModel {
     /// ([`BaseModel::warnings`]). Empty in a model saved before it was stored.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub joint_term_rms: Vec<f64>,
+    /// The fit's residuals judged against the torques' noise measured apart from it
+    /// ([`super::noise_fit`], [`BaseOptions::noise`]; set where it was given, as it is for a
+    /// log averaged over its excitation's periods): the cost, its degrees of freedom and the
+    /// chance of it from noise alone, warned of ([`BaseModel::warnings`]) beyond
+    /// [`super::noise_fit::FALSE_ALARM`]. For [`Weighting::Noise`] the standard errors come
+    /// from it. None otherwise, or where the noise holds no more values than the unknowns.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise_fit: Option<super::NoiseFit>,
 }
 
 /// Identifies the base parameters of `model` from the samples of `states` (rad, rad/s,
@@ -199,7 +208,8 @@ pub fn identify_base_parameters(
     Ok(fit_with_factors(model, states, tau, options)?.0)
 }
 
-/// A least-squares fit of the base parameters: OLS, or WLS weighted by the OLS residuals.
+/// A least-squares fit of the base parameters: OLS, WLS weighted by the OLS residuals, or
+/// weighted by the noise measured apart.
 pub(super) struct Solved {
     pub base: BaseParameters,
     pub factors: streaming::JointFactors,
@@ -224,13 +234,16 @@ pub(super) fn base_parameters(model: &Model, options: &BaseOptions) -> Result<Ba
 
 /// The base parameters of `model` with `options`' terms fitted to `tau` (row-major `k x nv`,
 /// N m) at `states`, checked already: one pass over the samples gives the OLS fit, the WLS
-/// weights (each joint's OLS residual RMS) and the WLS fit. Errors: residuals that overflow.
+/// weights (each joint's OLS residual RMS) and the WLS fit, or the fit weighted by
+/// [`BaseOptions::noise`]. Errors: residuals that overflow, the noise weighting without a
+/// noise of one positive level a joint.
 pub(super) fn solve(
     model: &Model,
     states: &States<'_>,
     tau: &[f64],
     options: &BaseOptions,
 ) -> Result<Solved> {
+    let fixed = options.noise_weights(&model.joint_names)?;
     let base = base_parameters(model, options)?;
     let mut names = base.names();
     let mut sigma = vec![1.0; model.nv];
@@ -259,8 +272,12 @@ pub(super) fn solve(
             ),
         });
     }
-    if options.weighting == Weighting::Wls {
-        sigma = rms.iter().map(|&s| if s > 0.0 { s } else { 1.0 }).collect();
+    let weights = match (options.weighting, fixed) {
+        (Weighting::Wls, _) => Some(rms.iter().map(|&s| if s > 0.0 { s } else { 1.0 }).collect()),
+        (_, fixed) => fixed,
+    };
+    if let Some(weights) = weights {
+        sigma = weights;
         ls = factors.solve(&sigma, &names)?;
         rms = factors.residual_rms(ls.coef.as_slice())?;
     }
@@ -296,10 +313,11 @@ pub(super) fn fit_with_factors(
     let Solved {
         base,
         factors,
-        ls,
+        mut ls,
         rms,
         sigma,
     } = solve(model, states, tau, options)?;
+    let noise_fit = noise_fit(&mut ls, options, &rms, k, nv)?;
     let p = base.len();
     let (coef, se) = (ls.coef.row(0), ls.stderr.row(0));
     let log_offsets = options.offset_per_run.then(|| {
@@ -368,6 +386,7 @@ pub(super) fn fit_with_factors(
             states,
             options.friction.for_model(model).names(),
         ),
+        noise_fit,
     };
     fit.weak_excitation =
         super::weak_excitation::check_excitation(model, states, &fit.base, ls.cond, &ls.weakest);
@@ -384,7 +403,11 @@ pub(super) fn fit_with_factors(
     // (and each run's mean: a torque offset that drifted between runs)
     (fit.residual_correlation, fit.run_offsets) =
         super::runs::run_residuals(model, &fit, states, tau, &options.runs)?;
-    let inflation = fit.stderr_inflation();
+    // the noise weighting's standard errors are the noise's already
+    let inflation = match options.weighting {
+        Weighting::Noise => 1.0,
+        _ => fit.stderr_inflation(),
+    };
     for se in &mut fit.stderr {
         *se *= inflation;
     }
@@ -399,6 +422,42 @@ pub(super) fn fit_with_factors(
     fit.unmodelled_friction =
         super::unmodelled_friction::check_unmodelled_friction(model, &fit, states, tau, options)?;
     Ok((fit, factors))
+}
+
+/// The fit's residuals (RMS `rms` a joint over `k` samples of `nv` joints) against
+/// [`BaseOptions::noise`] where given; for [`Weighting::Noise`], `ls`'s standard errors
+/// replaced by the noise's, `sqrt(c cov_diag)` scaled by [`super::NoiseFit::scale`]. Errors:
+/// the noise weighting where the noise holds no more independent values than the unknowns.
+fn noise_fit(
+    ls: &mut crate::regression::LeastSquares,
+    options: &BaseOptions,
+    rms: &[f64],
+    k: usize,
+    nv: usize,
+) -> Result<Option<super::NoiseFit>> {
+    let Some(noise) = &options.noise else {
+        return Ok(None);
+    };
+    let unknowns = ls.coef.ncols();
+    let found = super::NoiseFit::of(noise, rms, k, unknowns);
+    if options.weighting != Weighting::Noise {
+        return Ok(found);
+    }
+    let Some(n) = found else {
+        return Err(Error::InvalidArgument {
+            argument: "noise".into(),
+            message: format!(
+                "the noise holds {} independent values ({k} samples x {nv} joints over a correlation of {} samples), no more than the {unknowns} unknowns: standard errors cannot be had from it; give more samples, or weight otherwise (wls)",
+                crate::error::shown5((k * nv) as f64 / noise.correlation),
+                crate::error::shown5(noise.correlation),
+            ),
+        });
+    };
+    let scale = n.scale();
+    ls.stderr = DMatrix::from_fn(1, unknowns, |_, j| {
+        (noise.correlation * ls.cov_diag[j]).sqrt() * scale
+    });
+    Ok(Some(n))
 }
 
 impl BaseModel {
@@ -582,6 +641,20 @@ impl Document for BaseModel {
             if let Some(problem) = unknown.or(cond).or_else(|| w.problem()) {
                 return Err(invalid(Self::WHAT, format!("weak_excitation: {problem}")));
             }
+        }
+        let noise = match (&m.noise_fit, m.weighting) {
+            (None, Weighting::Noise) => Some(
+                "the noise weighting without its noise_fit: the noise the rows were weighted by"
+                    .to_string(),
+            ),
+            (Some(f), w) => f.problem(&m.joint_names).or_else(|| {
+                (w == Weighting::Noise && f.noise.sigma != m.sigma)
+                    .then(|| "the noise weighting with a sigma other than its noise's".to_string())
+            }),
+            (None, _) => None,
+        };
+        if let Some(problem) = noise {
+            return Err(invalid(Self::WHAT, format!("noise_fit: {problem}")));
         }
         if let Some(problem) = (m.position_offsets.as_ref()).and_then(|o| o.problem(&m.joint_names))
         {

@@ -117,7 +117,8 @@ impl BaseModel {
     /// ([`super::torque_lag`]), joints whose zeros in the data look offset
     /// ([`super::position_offsets`]), friction the fit leaves out that shows in its residuals
     /// ([`super::unmodelled_friction`]), data that excite the base parameters weakly
-    /// ([`super::weak_excitation`]), runs of a fit over several logs whose residuals differ in
+    /// ([`super::weak_excitation`]), residuals beyond or below the torques' noise measured apart
+    /// ([`super::noise_fit`]), runs of a fit over several logs whose residuals differ in
     /// mean ([`super::runs`]: a torque offset that drifted), positions logged in counts so coarse that their
     /// rounding shows in the derived velocities ([`crate::position_rounding`]; in each log of
     /// several, named), and friction or
@@ -226,6 +227,8 @@ impl BaseModel {
         )
         .filter(|_| !columns_wrong);
         let weak = (self.weak_excitation.as_ref()).map(|w| w.finding());
+        // residuals against the noise measured apart: a model error, or an overstated noise
+        let noise = (self.noise_fit.as_ref()).and_then(|f| f.finding(&self.joint_names));
         let drifted = (self.run_offsets.iter())
             .filter(|_| !columns_wrong)
             .map(|o| o.finding(&log_names));
@@ -237,6 +240,7 @@ impl BaseModel {
             .chain(offsets)
             .chain(friction)
             .chain(weak)
+            .chain(noise)
             .chain(disagree)
             .chain(drifted)
             .chain(rounding.filter(|_| log_findings))

@@ -78,7 +78,8 @@ pub struct PayloadOptions {
     /// base-parameter reference a change of them (a sensor zeroed anew), on the URDF the terms
     /// themselves.
     pub terms: FrictionTerms,
-    /// OLS, or WLS with weights from the per-joint residuals of the OLS fit (default).
+    /// OLS, or WLS with weights from the per-joint residuals of the OLS fit (default); the
+    /// noise weighting is refused.
     pub weighting: Weighting,
     /// Gravity in the torques (default on); a base-parameter reference must agree.
     pub gravity: Gravity,
@@ -292,6 +293,12 @@ pub fn identify_payload(
         crate::torque_model::FOR_A_FIT,
     )?;
     super::runs::check_runs(&options.runs, states.len())?;
+    if options.weighting == Weighting::Noise {
+        return Err(Error::InvalidArgument {
+            argument: "weighting".into(),
+            message: "the noise weighting is not taken by the payload's fit yet: weight from the residuals (wls) or not (ols)".into(),
+        });
+    }
     if !(options.log_names.is_empty() || options.log_names.len() == options.runs.len()) {
         return Err(Error::InvalidArgument {
             argument: "log_names".into(),

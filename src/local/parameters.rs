@@ -336,6 +336,7 @@ pub fn identify_parameters_from_local(
         log_held_columns: vec![],
         log_stamp_jitter: None,
         log_period_average: None,
+        noise_fit: None,
         position_rounding: vec![],
         logs: vec![],
         // rows from local models: no log's torque columns

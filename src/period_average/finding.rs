@@ -41,6 +41,10 @@ pub struct PeriodAverage {
     pub torque_harmonics: usize,
     /// Samples of the averaged period (before decimation).
     pub samples: usize,
+    /// Samples of the averaged recording: every `decimate`-th of `samples` (0 in a finding
+    /// saved before it was kept).
+    #[serde(default)]
+    pub kept_samples: usize,
     pub position_noise: Vec<f64>,
     pub velocity_noise: Vec<f64>,
     pub acceleration_noise: Vec<f64>,
@@ -67,6 +71,46 @@ impl PeriodAverage {
     pub fn averaged_torque_noise(&self) -> Vec<f64> {
         let s = (self.periods as f64).sqrt();
         self.torque_noise.iter().map(|x| x / s).collect()
+    }
+
+    /// The averaged torques' noise, for the noise weighting and the judgement of a fit's
+    /// residuals ([`crate::direct::TorqueNoise`], [`crate::direct::noise_fit`]):
+    /// [`Self::averaged_torque_noise`] a joint (N m), correlated over `kept_samples / (2 H +
+    /// 1)` samples (at least 1; `H` the torque harmonics: the noise lies in their span), its
+    /// levels estimated with `(periods - 1) (2 H + 1)` degrees of freedom a joint. Errors
+    /// naming the joint whose torques' noise measured 0 (a log without noise, such as a
+    /// simulated one), or a finding saved without `kept_samples`.
+    pub fn torque_noise(
+        &self,
+        joints: &[String],
+    ) -> crate::error::Result<crate::direct::TorqueNoise> {
+        let bad = |message: String| crate::error::Error::InvalidArgument {
+            argument: "noise".into(),
+            message,
+        };
+        if self.kept_samples == 0 {
+            return Err(bad("the log's period average was kept without its samples (saved by an older version): average the log anew".into()));
+        }
+        let sigma = self.averaged_torque_noise();
+        if let Some(j) = sigma.iter().position(|s| !(*s > 0.0)) {
+            let name = joints
+                .get(j)
+                .cloned()
+                .unwrap_or_else(|| format!("joint {}", j + 1));
+            return Err(bad(format!(
+                "the {} periods averaged measured no noise in {name}'s torques ({}): identical periods (a simulated log without noise) give no noise to weight by or judge against",
+                self.periods,
+                shown(sigma[j])
+            )));
+        }
+        let values = (2 * self.torque_harmonics + 1) as f64;
+        Ok(crate::direct::TorqueNoise {
+            sigma,
+            correlation: (self.kept_samples as f64 / values).max(1.0),
+            degrees_of_freedom: Some(
+                (self.periods - 1) as f64 * values * self.torque_noise.len() as f64,
+            ),
+        })
     }
 
     /// Per joint, a fit's residual RMS (N m, of the averaged torques) against the averaged
@@ -133,10 +177,11 @@ impl PeriodAverage {
             || self.harmonics == 0
             || self.torque_harmonics < self.harmonics
             || self.samples <= 2 * self.torque_harmonics
+            || self.kept_samples > self.samples
         {
             return Some(format!(
-                "{} periods, {} and {} harmonics over {} samples; expected at least 2 periods, harmonics >= 1 and torque harmonics no fewer, below half the samples",
-                self.periods, self.harmonics, self.torque_harmonics, self.samples
+                "{} periods, {} and {} harmonics over {} samples, {} kept; expected at least 2 periods, harmonics >= 1 and torque harmonics no fewer, below half the samples, and no more kept than there are",
+                self.periods, self.harmonics, self.torque_harmonics, self.samples, self.kept_samples
             ));
         }
         if !(self.torque_drift.is_empty() || self.torque_drift.len() == n)

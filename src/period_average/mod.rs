@@ -318,6 +318,7 @@ pub fn average_periods(
             harmonics: h_q,
             torque_harmonics: h_tau,
             samples: m,
+            kept_samples: k_out,
             position_noise: pos_noise,
             velocity_noise: vel_noise,
             acceleration_noise: acc_noise,

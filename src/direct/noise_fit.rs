@@ -1,0 +1,137 @@
+//! A fit's residuals judged against the torques' noise measured apart from it
+//! ([`super::TorqueNoise`]; docs/method.md, section 8f).
+//!
+//! Where the noise is known, the residuals tell whether the model holds what the robot does:
+//! a model that does leaves only noise, and the cost `V = sum_j sum_k (r_jk / sigma_j)^2 / c`
+//! (`c` the noise's [`super::TorqueNoise::correlation`]) is then chi-square distributed with
+//! `K n / c - p` degrees of freedom (`K` samples, `n` joints, `p` unknowns; Swevers et al.
+//! 2007, the maximum-likelihood cost). Where the noise was itself estimated (from an
+//! excitation's periods), `V / dof` is F distributed with the noise's degrees of freedom
+//! beside. A cost far above its degrees of freedom is a model error (friction the model lacks,
+//! a flexible joint, a torque lag), below them an overstated noise or a fit that follows
+//! noise.
+//!
+//! For the noise weighting ([`super::Weighting::Noise`]) the standard errors come from the
+//! noise, `sqrt(c)` times the weighted regressor's `(W Phi)^T (W Phi)` inverse's diagonal,
+//! scaled by `sqrt(V / dof)` where that exceeds 1 (the residuals then say more than the noise
+//! does; the usual convention for a model error of unknown form). For another weighting the
+//! cost is at least the noise-weighted fit's, so the test reads model errors a little more
+//! readily, and the standard errors are the fit's own.
+
+use serde::{Deserialize, Serialize};
+
+use super::torque_noise::TorqueNoise;
+use crate::error::shown5;
+
+/// The chance the noise alone gives a cost beyond which (or below which) a finding is made.
+pub const FALSE_ALARM: f64 = 1e-3;
+
+/// A fit's residuals against the noise.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoiseFit {
+    /// The noise judged against.
+    pub noise: TorqueNoise,
+    /// Per joint, the fit's residual RMS over its noise level (1 where only noise is left; the
+    /// parameters take up a share `p c / (K n)` of the noise, so a little below 1 is noise too).
+    pub ratio: Vec<f64>,
+    /// Per joint, the model's own error `sqrt(max(residual^2 - sigma^2, 0))` (N m).
+    pub model_error: Vec<f64>,
+    /// The cost `V` (see the module docs).
+    pub cost: f64,
+    /// Its degrees of freedom, `K n / c - p`.
+    pub degrees_of_freedom: f64,
+    /// The chance the noise alone gives a cost of `V` or more.
+    pub p_value: f64,
+}
+
+impl NoiseFit {
+    /// The residuals of a fit of `unknowns` unknowns to `samples` samples, their RMS `rms` a
+    /// joint (N m), against `noise` (checked already: one level a joint). None where the noise
+    /// holds no more independent values than there are unknowns.
+    pub fn of(noise: &TorqueNoise, rms: &[f64], samples: usize, unknowns: usize) -> Option<Self> {
+        let c = noise.correlation;
+        let dof = (samples * rms.len()) as f64 / c - unknowns as f64;
+        if dof < 1.0 {
+            return None;
+        }
+        let ratio: Vec<f64> = (rms.iter().zip(&noise.sigma)).map(|(r, s)| r / s).collect();
+        let cost = ratio.iter().map(|x| x * x).sum::<f64>() * samples as f64 / c;
+        let p_value = match noise.degrees_of_freedom {
+            Some(d2) => crate::student_t::f_upper_tail(cost / dof, dof, d2),
+            None => crate::student_t::chi_square_upper_tail(cost, dof),
+        };
+        Some(Self {
+            model_error: (rms.iter().zip(&noise.sigma))
+                .map(|(r, s)| (r * r - s * s).max(0.0).sqrt())
+                .collect(),
+            noise: noise.clone(),
+            ratio,
+            cost,
+            degrees_of_freedom: dof,
+            p_value,
+        })
+    }
+
+    /// `sqrt(max(V / dof, 1))`: what the noise's standard errors are scaled by.
+    pub fn scale(&self) -> f64 {
+        (self.cost / self.degrees_of_freedom).max(1.0).sqrt()
+    }
+
+    /// The finding in words, for the joints `joints`: residuals beyond the noise (a model
+    /// error), or below it; None where the cost is within what the noise gives.
+    pub fn finding(&self, joints: &[String]) -> Option<String> {
+        let reduced = shown5(self.cost / self.degrees_of_freedom);
+        let list = |x: &[f64]| -> String {
+            (joints.iter().zip(x))
+                .map(|(j, v)| format!("{j} {}", shown5(*v)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        if self.p_value < FALSE_ALARM {
+            return Some(format!(
+                "the residuals exceed the torques' noise (cost over its {} degrees of freedom {reduced}, a chance of {} from noise alone): the model lacks an effect the robot has (friction of another form, a flexible joint or drive, a torque lag, a payload), or the noise measured is too low. Residual over noise, a joint: {}; the model's own error (N m): {}",
+                shown5(self.degrees_of_freedom),
+                shown5(self.p_value),
+                list(&self.ratio),
+                list(&self.model_error)
+            ));
+        }
+        (self.p_value > 1.0 - FALSE_ALARM).then(|| {
+            format!(
+                "the residuals are below the torques' noise (cost over its {} degrees of freedom {reduced}, residual over noise, a joint: {}): the noise given is too high, or too correlated for the correlation given, or the fit follows the noise with too many parameters for its data; the standard errors from that noise are too large",
+                shown5(self.degrees_of_freedom),
+                list(&self.ratio)
+            )
+        })
+    }
+
+    /// What is wrong with it for the joints `joints` (a document edited by hand); None where
+    /// nothing.
+    pub fn problem(&self, joints: &[String]) -> Option<String> {
+        let n = joints.len();
+        self.noise.problem(joints).or_else(|| {
+            if self.ratio.len() != n || self.model_error.len() != n {
+                return Some(format!(
+                    "{} ratios and {} model errors, expected one a joint ({n})",
+                    self.ratio.len(),
+                    self.model_error.len()
+                ));
+            }
+            let bad = |x: f64| !(x.is_finite() && x >= 0.0);
+            if self.ratio.iter().chain(&self.model_error).any(|&x| bad(x))
+                || bad(self.cost)
+                || !(self.degrees_of_freedom.is_finite() && self.degrees_of_freedom >= 1.0)
+                || !(0.0..=1.0).contains(&self.p_value)
+            {
+                return Some(format!(
+                    "cost {}, {} degrees of freedom, p {}; expected finite ratios and errors >= 0, a cost >= 0, at least 1 degree of freedom and p in [0, 1]",
+                    shown5(self.cost),
+                    shown5(self.degrees_of_freedom),
+                    shown5(self.p_value)
+                ));
+            }
+            None
+        })
+    }
+}

@@ -1,0 +1,328 @@
+//! The noise weighting and a fit's residuals judged against the noise measured apart
+//! (src/direct/noise_fit.rs, src/direct/torque_noise.rs; docs/method.md, section 8f): the
+//! standard errors against the spread of estimates over many noise draws, the cost against
+//! its chi-square or F distribution, on white noise and on logs averaged over their periods.
+
+mod common;
+
+use common::{a465_excitation, normal, torques_with_friction, Rng};
+use perturbid_rs::direct::{
+    identify_base_parameters, BaseModel, BaseOptions, FrictionTerms, TorqueNoise, Weighting,
+};
+use perturbid_rs::period_average::PeriodOptions;
+use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+use perturbid_rs::robots::a465;
+use perturbid_rs::trajectory::{FourierTrajectory, Samples};
+use perturbid_rs::{Document, Error, Recording, States};
+
+/// A different noise level on each joint (N m), so that the weighting matters.
+const SIGMA: [f64; 6] = [0.05, 0.2, 0.1, 0.02, 0.03, 0.01];
+
+fn viscous_and_coulomb(weighting: Weighting, noise: Option<TorqueNoise>) -> BaseOptions {
+    BaseOptions {
+        friction: FrictionTerms {
+            viscous: true,
+            coulomb: true,
+            ..FrictionTerms::NONE
+        },
+        weighting,
+        noise,
+        ..BaseOptions::default()
+    }
+}
+
+/// The excitation sampled at `rate` for `seconds`, its torques with friction, and Gaussian
+/// noise of [`SIGMA`] a joint added to them (seeded by `seed`).
+fn noisy(traj: &FourierTrajectory, rate: f64, seconds: f64, seed: u64) -> (Samples, Vec<f64>) {
+    let model = a465::model("kinsheel2010").unwrap();
+    let t: Vec<f64> = (0..(seconds * rate).round() as usize)
+        .map(|i| i as f64 / rate)
+        .collect();
+    let s = traj.sample(&t);
+    let mut tau = torques_with_friction(&model, &s, &mut Rng(0), |_| 0.0);
+    let mut rng = Rng(seed);
+    for (i, x) in tau.iter_mut().enumerate() {
+        *x += SIGMA[i % 6] * normal(&mut rng);
+    }
+    (s, tau)
+}
+
+/// Over the draws, each parameter's spread of estimates over the mean standard error the
+/// fits gave it: the median over the parameters, and the largest.
+fn spread_over_stderr(fits: &[BaseModel]) -> (f64, f64) {
+    let n = fits.len() as f64;
+    let mut ratios: Vec<f64> = (0..fits[0].theta.len())
+        .map(|i| {
+            let mean = fits.iter().map(|f| f.theta[i]).sum::<f64>() / n;
+            let var = fits
+                .iter()
+                .map(|f| (f.theta[i] - mean).powi(2))
+                .sum::<f64>()
+                / (n - 1.0);
+            let se = fits.iter().map(|f| f.stderr[i]).sum::<f64>() / n;
+            var.sqrt() / se
+        })
+        .collect();
+    ratios.sort_by(f64::total_cmp);
+    (ratios[ratios.len() / 2], ratios[ratios.len() - 1])
+}
+
+fn reduced_cost(f: &BaseModel) -> f64 {
+    let n = f.noise_fit.as_ref().unwrap();
+    n.cost / n.degrees_of_freedom
+}
+
+/// White noise of known levels: the fit weighted by them has standard errors that match the
+/// spread of its estimates over 40 draws, a cost whose mean over the draws is its degrees of
+/// freedom, and no finding; a third of the noise's level is found beyond the noise, three
+/// times it below.
+#[test]
+fn with_the_noise_known_the_standard_errors_are_the_spread_of_the_estimates() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let traj = a465_excitation(&mut Rng(21));
+    let noise = TorqueNoise::white(SIGMA.to_vec());
+    let options = viscous_and_coulomb(Weighting::Noise, Some(noise.clone()));
+    let fits: Vec<BaseModel> = (0..40)
+        .map(|d| {
+            let (s, tau) = noisy(&traj, 100.0, 10.0, 100 + d);
+            let states = States::new(6, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
+            identify_base_parameters(&model, &states, &tau, &options).unwrap()
+        })
+        .collect();
+    let (median, largest) = spread_over_stderr(&fits);
+    assert!(
+        (0.85..1.15).contains(&median),
+        "median spread over stderr {median}"
+    );
+    assert!(largest < 1.5, "largest spread over stderr {largest}");
+    let f = &fits[0];
+    assert_eq!(f.sigma, SIGMA.to_vec());
+    let dof = f.noise_fit.as_ref().unwrap().degrees_of_freedom;
+    assert_eq!(dof, (1000 * 6 - f.theta.len()) as f64);
+    // the cost's mean over the draws: its degrees of freedom, within 4 standard errors
+    let mean = fits.iter().map(reduced_cost).sum::<f64>() / 40.0;
+    assert!(
+        (mean - 1.0).abs() < 4.0 * (2.0 / dof / 40.0).sqrt(),
+        "{mean}"
+    );
+    let alarms = fits
+        .iter()
+        .filter(|f| f.noise_fit.as_ref().unwrap().p_value < 0.01)
+        .count();
+    assert!(alarms <= 3, "{alarms} of 40 draws below p = 0.01");
+    assert!(fits
+        .iter()
+        .all(|f| !f.warnings().iter().any(|w| w.contains("noise"))));
+
+    // the noise stated wrong is found, either way
+    let (s, tau) = noisy(&traj, 100.0, 10.0, 7);
+    let states = States::new(6, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
+    for (scale, said) in [
+        (1.0 / 3.0, "exceed the torques' noise"),
+        (3.0, "below the torques' noise"),
+    ] {
+        let stated = TorqueNoise::white(SIGMA.iter().map(|s| s * scale).collect());
+        let f = identify_base_parameters(
+            &model,
+            &states,
+            &tau,
+            &viscous_and_coulomb(Weighting::Noise, Some(stated)),
+        )
+        .unwrap();
+        assert!(
+            f.warnings().iter().any(|w| w.contains(said)),
+            "{:?}",
+            f.warnings()
+        );
+        // beyond the noise the standard errors are scaled up to the residuals; below it the
+        // noise's stand, too large by its scale
+        let ls = identify_base_parameters(&model, &states, &tau, &options).unwrap();
+        let ratio = f.stderr[0] / ls.stderr[0];
+        let expected = scale * (reduced_cost(&f)).max(1.0).sqrt();
+        assert!(
+            (ratio / expected - 1.0).abs() < 0.05,
+            "{ratio} against {expected}"
+        );
+    }
+}
+
+/// A model without the friction the robot has leaves residuals beyond the noise: found with
+/// every weighting, its own error named a joint, and its standard errors scaled up to its
+/// residuals' (within 10 % of the residual-weighted fit's).
+#[test]
+fn a_model_error_is_found_beyond_the_noise() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let traj = a465_excitation(&mut Rng(21));
+    let (s, tau) = noisy(&traj, 100.0, 10.0, 3);
+    let states = States::new(6, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
+    let noise = TorqueNoise::white(SIGMA.to_vec());
+    for weighting in [Weighting::Noise, Weighting::Wls, Weighting::Ols] {
+        let options = BaseOptions {
+            friction: FrictionTerms::NONE,
+            ..viscous_and_coulomb(weighting, Some(noise.clone()))
+        };
+        let f = identify_base_parameters(&model, &states, &tau, &options).unwrap();
+        let n = f.noise_fit.as_ref().unwrap();
+        assert!(
+            n.p_value < 1e-10 && reduced_cost(&f) > 10.0,
+            "{weighting:?}: {n:?}"
+        );
+        assert!(
+            n.model_error.iter().all(|e| *e > 0.1),
+            "{:?}",
+            n.model_error
+        );
+        let w = f.warnings().join("\n");
+        assert!(
+            w.contains("exceed the torques' noise") && w.contains("joint3 "),
+            "{w}"
+        );
+    }
+}
+
+/// The noise weighting without a noise, with one of another length or a zero level, and
+/// with too few samples for its correlation, is refused by name; drive gains refuse it.
+#[test]
+fn a_noise_that_cannot_weight_is_refused() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let traj = a465_excitation(&mut Rng(21));
+    let (s, tau) = noisy(&traj, 100.0, 10.0, 3);
+    let states = States::new(6, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
+    let fails = |noise: Option<TorqueNoise>, said: &str| {
+        let options = viscous_and_coulomb(Weighting::Noise, noise);
+        match identify_base_parameters(&model, &states, &tau, &options) {
+            Err(Error::InvalidArgument { message, .. }) => {
+                assert!(message.contains(said), "{message}")
+            }
+            other => panic!(
+                "expected a refusal saying '{said}', got {:?}",
+                other.map(|f| f.theta)
+            ),
+        }
+    };
+    fails(None, "needs the torques' noise");
+    fails(
+        Some(TorqueNoise::white(vec![0.1; 5])),
+        "5 noise levels, expected one a joint (6)",
+    );
+    let mut zero = SIGMA.to_vec();
+    zero[2] = 0.0;
+    fails(
+        Some(TorqueNoise::white(zero)),
+        "joint 'joint3': a noise level of 0",
+    );
+    fails(
+        Some(TorqueNoise {
+            correlation: 0.5,
+            ..TorqueNoise::white(SIGMA.to_vec())
+        }),
+        "a correlation of 0.5 samples",
+    );
+    fails(
+        Some(TorqueNoise {
+            correlation: 500.0,
+            ..TorqueNoise::white(SIGMA.to_vec())
+        }),
+        "12 independent values",
+    );
+}
+
+/// Logs of 4 periods with white noise, averaged: the noise the periods measured weights the
+/// fit, and its band-limited correlation (the noise lies in the torques' 201 harmonics' span
+/// of the period's 2,000 samples) gives standard errors that match the spread of the
+/// estimates over 24 logs, and a cost whose mean is its degrees of freedom (`6 x 201 - p`).
+#[test]
+fn an_averaged_log_weights_by_the_noise_its_periods_measured() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let traj = a465_excitation(&mut Rng(21));
+    let options = PreprocessOptions {
+        rate: 200.0,
+        decimate: 1,
+        periods: Some(PeriodOptions::new(10.0, 5)),
+        ..PreprocessOptions::default()
+    };
+    let fits: Vec<BaseModel> = (0..24)
+        .map(|d| {
+            let (s, tau) = noisy(&traj, 200.0, 40.0, 500 + d);
+            let rec = Recording::new("log", 6, s.t, s.q, tau, None, None).unwrap();
+            let out = preprocess(&rec, &options).unwrap();
+            let a = out.period_average.as_ref().unwrap();
+            assert_eq!(
+                (a.samples, a.kept_samples, a.torque_harmonics),
+                (2000, 2000, 100)
+            );
+            let noise = a.torque_noise(&model.joint_names).unwrap();
+            assert!((noise.correlation - 2000.0 / 201.0).abs() < 1e-12);
+            assert_eq!(noise.degrees_of_freedom, Some(3.0 * 201.0 * 6.0));
+            // the levels measured: the noise put in, the band's share of it, over sqrt(4)
+            for (j, x) in noise.sigma.iter().enumerate() {
+                let expected = SIGMA[j] * (201.0f64 / 2000.0).sqrt() / 2.0;
+                assert!(
+                    (x / expected - 1.0).abs() < 0.2,
+                    "joint {j}: {x} against {expected}"
+                );
+            }
+            let options = viscous_and_coulomb(Weighting::Noise, Some(noise));
+            identify_base_parameters(&model, &out.states().unwrap(), &out.tau, &options).unwrap()
+        })
+        .collect();
+    let dof = fits[0].noise_fit.as_ref().unwrap().degrees_of_freedom;
+    assert!(
+        (dof - (6.0 * 201.0 - fits[0].theta.len() as f64)).abs() < 1e-9,
+        "{dof}"
+    );
+    let (median, largest) = spread_over_stderr(&fits);
+    assert!(
+        (0.8..1.2).contains(&median),
+        "median spread over stderr {median}"
+    );
+    assert!(largest < 1.6, "largest spread over stderr {largest}");
+    // the cost over its degrees of freedom is F-distributed about 1 (the noise estimated
+    // with 3 x 201 x 6 degrees of freedom): its mean over the logs within 4 standard errors
+    let mean = fits.iter().map(reduced_cost).sum::<f64>() / 24.0;
+    let spread = (2.0 / dof + 2.0 / 3618.0).sqrt() / 24f64.sqrt();
+    assert!((mean - 1.0).abs() < 4.0 * spread, "{mean} +- {spread}");
+    assert!(
+        fits.iter()
+            .filter(|f| f.noise_fit.as_ref().unwrap().p_value < 0.01)
+            .count()
+            <= 2
+    );
+}
+
+/// A model of the noise weighting is saved with its noise's judgement and read back the same;
+/// a document edited to drop it, or to weight by other levels than its noise's, is refused.
+#[test]
+fn the_noise_fit_is_kept_with_the_model_and_checked_on_load() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let traj = a465_excitation(&mut Rng(21));
+    let (s, tau) = noisy(&traj, 100.0, 10.0, 3);
+    let states = States::new(6, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
+    let options = viscous_and_coulomb(Weighting::Noise, Some(TorqueNoise::white(SIGMA.to_vec())));
+    let fit = identify_base_parameters(&model, &states, &tau, &options).unwrap();
+    let text = fit.to_json();
+    assert_eq!(BaseModel::from_json(&text).unwrap(), fit);
+    let mut doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+    doc["sigma"][1] = serde_json::json!(0.3);
+    let edited = BaseModel::from_json(&doc.to_string())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        edited.contains("a sigma other than its noise's"),
+        "{edited}"
+    );
+    doc.as_object_mut().unwrap().remove("noise_fit");
+    let edited = BaseModel::from_json(&doc.to_string())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        edited.contains("the noise weighting without its noise_fit"),
+        "{edited}"
+    );
+    let mut doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+    doc["noise_fit"]["p_value"] = serde_json::json!(1.5);
+    let edited = BaseModel::from_json(&doc.to_string())
+        .unwrap_err()
+        .to_string();
+    assert!(edited.contains("p in [0, 1]"), "{edited}");
+}
