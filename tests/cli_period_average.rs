@@ -8,19 +8,15 @@ use cli_support::{excite_a465, fails, ok, s, tmp, write};
 use perturbid_rs::direct::BaseModel;
 use perturbid_rs::Document;
 
-#[test]
-fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_found() {
-    let d = tmp("cli-periods");
-    let exc = d.join("exc");
-    excite_a465(&exc, 2);
-    let excitation = exc.join("excitation.json");
-    let raw = d.join("raw.csv");
+/// A log of 4 periods of `excitation` simulated on the A465 at 500 Hz with torque noise of
+/// 0.02 N m, at `out`.
+fn simulated(excitation: &std::path::Path, out: &std::path::Path, seed: &str) {
     ok(&[
         "simulate",
         "a465",
-        s(&excitation),
+        s(excitation),
         "--out",
-        s(&raw),
+        s(out),
         "--rate",
         "500",
         "--periods",
@@ -28,8 +24,18 @@ fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_f
         "--torque-noise",
         "0.02",
         "--seed",
-        "3",
+        seed,
     ]);
+}
+
+#[test]
+fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_found() {
+    let d = tmp("cli-periods");
+    let exc = d.join("exc");
+    excite_a465(&exc, 2);
+    let excitation = exc.join("excitation.json");
+    let raw = d.join("raw.csv");
+    simulated(&excitation, &raw, "3");
     // 2.5 s at rest where the excitation starts, before it: the logger ran first
     let text = std::fs::read_to_string(&raw).unwrap();
     let mut lines = text.lines();
@@ -159,4 +165,58 @@ fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_f
         let args: Vec<&str> = base.iter().copied().chain(extra).collect();
         fails(&args, &[says]);
     }
+}
+
+/// `--weighting noise`: the averaged log's rows weighted by the noise its periods measured,
+/// the residuals judged against it and kept with the model; refused for a log not averaged
+/// and for several logs, by name.
+#[test]
+fn an_averaged_log_is_weighted_by_its_noise() {
+    let d = tmp("cli-noise-weighting");
+    let exc = d.join("exc");
+    excite_a465(&exc, 2);
+    let excitation = exc.join("excitation.json");
+    let log = d.join("log.csv");
+    simulated(&excitation, &log, "5");
+    let model = d.join("model.json");
+    let fit = |extra: &[&str]| -> Vec<String> {
+        let mut args = vec!["identify-direct", "a465", s(&log)];
+        args.extend_from_slice(extra);
+        args.extend(["--friction", "none", "--decimate", "5", "--out", s(&model)]);
+        args.into_iter().map(String::from).collect()
+    };
+    let averaged = ["--period", "10", "--period-harmonics", "5"];
+    let args = fit(&[&averaged[..], &["--weighting", "noise"]].concat());
+    let out = ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(
+        out.contains("the residuals against the torques' noise measured apart: a cost of "),
+        "{out}"
+    );
+    let m = BaseModel::load(&model).unwrap();
+    let n = m.noise_fit.as_ref().expect("kept with the model");
+    let a = m.log_period_average.as_ref().unwrap();
+    assert_eq!(m.sigma, a.averaged_torque_noise());
+    // the kept samples: the period's 10,000 on the 1 kHz grid, every 5th (70 % fitted to)
+    assert_eq!((a.samples, a.kept_samples), (10000, 2000));
+    assert!((n.noise.correlation - 2000.0 / 201.0).abs() < 1e-9);
+    assert!(n.p_value > 1e-3, "{n:?}");
+    // with the residuals' weighting the noise still judges them
+    let args = fit(&averaged);
+    ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let m = BaseModel::load(&model).unwrap();
+    assert!(m.noise_fit.is_some() && m.sigma != a.averaged_torque_noise());
+    // no noise to weight by
+    let args = fit(&["--weighting", "noise"]);
+    fails(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        &["the noise weighting needs the torques' noise measured apart"],
+    );
+    let second = d.join("second.csv");
+    simulated(&excitation, &second, "6");
+    let mut args = fit(&[&averaged[..], &["--weighting", "noise"]].concat());
+    args.insert(3, s(&second).to_string());
+    fails(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        &["noise takes one log, 2 given"],
+    );
 }

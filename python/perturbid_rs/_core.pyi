@@ -734,6 +734,12 @@ class BaseParameterModel:
         (None, or by instrumental variables the least-squares gains, (n,)). The model's
         torques are gain * signal."""
     @property
+    def noise_fit(self) -> dict[str, Any] | None:
+        """The residuals against the torques' noise measured apart (noise=, or a Recording's
+        periods), else None: noise, correlation, noise_degrees_of_freedom, ratio, model_error
+        (a joint), cost, degrees_of_freedom and p_value (below 1e-3 a model error is warned
+        of)."""
+    @property
     def weak_excitation(self) -> dict[str, Any] | None:
         """Where the data excite the base parameters weakly (cond beyond 2000), else None:
         cond, weakest (the least determined combination: dicts parameter, weight), motion
@@ -851,11 +857,15 @@ def identify_base_parameters(
     t: Optional[ArrayLike] = None,
     coulomb: Optional[ArrayLike] = None,
     offset_per_log: bool = False,
+    noise: Optional[ArrayLike] = None,
+    noise_correlation: float = 1.0,
 ) -> BaseParameterModel:
     """Base parameters from arrays (q, qd, qdd, tau), a preprocessed Recording as q alone,
     or a list of them as q (runs fitted together, one after the other; what each one's
     preprocessing found kept in the model's logs, and not warned of again; Recordings that
-    share samples, one given twice, refused)."""
+    share samples, one given twice, refused). weighting 'noise' weights by the torques' noise
+    measured apart (noise=, (n,) N m, noise_correlation samples an independent value; or a
+    Recording's periods); with a noise the residuals are judged against it (noise_fit)."""
 
 def identify_drive_gains(
     robot: Robot,
@@ -1036,6 +1046,8 @@ def identify_consistent_parameters(
     t: Optional[ArrayLike] = None,
     coulomb: Optional[ArrayLike] = None,
     offset_per_log: bool = False,
+    noise: Optional[ArrayLike] = None,
+    noise_correlation: float = 1.0,
 ) -> ConsistentFit:
     """Physically consistent least squares over the direct method's data (interior point):
     arrays, a preprocessed Recording as q alone, or a list of them (runs fitted together, as

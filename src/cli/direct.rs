@@ -125,7 +125,10 @@ pub(crate) struct FitArgs {
     /// armature is added when the robot has one).
     #[arg(long, default_value = "viscous,coulomb,offset")]
     friction: FrictionTerms,
-    /// wls (weights from the per-joint residuals) or ols.
+    /// wls (weights from the per-joint residuals), ols, or noise: weights from the torques'
+    /// noise the periods of a log averaged over them measured (--average-periods, --period;
+    /// one log), the standard errors from that noise. An averaged log's residuals are judged
+    /// against its noise with any weighting.
     #[arg(long, value_enum, default_value_t = Weighting::Wls)]
     weighting: Weighting,
     /// The torques exclude gravity (the robot's controller compensates it in what it logs).
@@ -258,6 +261,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     let options = crate::direct::BaseOptions {
         runs: stacked.as_ref().map_or(vec![], |(t, _)| t.runs.clone()),
         offset_per_run: a.offset_per_log,
+        noise: super::files::averaged_noise(&recs, &a.data, &model.joint_names, a.fit.weighting)?,
         ..a.fit.options()
     };
     let most = crate::direct::streaming::MAX_OFFSET_RUNS;
@@ -357,6 +361,9 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
             "{}",
             avg.model_error_line(&fit.residual_rms, "residual RMS")
         );
+    }
+    if let Some(n) = &fit.noise_fit {
+        let _ = writeln!(out, "{}", n.summary());
     }
     // the parameter table: printed in full and saved as CSV and JSON beside the model; the
     // names last, as a base parameter's combination of a robot's parameters runs to hundreds

@@ -499,6 +499,35 @@ pub(crate) fn excitation_of(
 }
 
 /// `--validate FRACTION` of `identify-direct` and `identify-payload`: refused outside [0, 1).
+/// The torques' noise the periods of the log `recs` holds measured, where it was averaged over
+/// them: the noise of the direct fit's [`crate::direct::BaseOptions::noise`] (its weights for
+/// `--weighting noise`, and the yardstick of its residuals with any weighting). None for a
+/// log not averaged, or several logs. Errors, for `--weighting noise` only: several logs, a
+/// log averaged whose periods measured no noise, naming it.
+pub(crate) fn averaged_noise(
+    recs: &[crate::Recording],
+    paths: &[PathBuf],
+    joints: &[String],
+    weighting: crate::direct::Weighting,
+) -> Result<Option<crate::direct::TorqueNoise>> {
+    let weighted = weighting == crate::direct::Weighting::Noise;
+    match (recs, weighted) {
+        ([rec], _) => match (&rec.period_average, weighted) {
+            (Some(a), true) => a.torque_noise(joints).map(Some).map_err(in_log(&paths[0])),
+            (Some(a), false) => Ok(a.torque_noise(joints).ok()),
+            (None, _) => Ok(None),
+        },
+        (_, true) => Err(Error::InvalidArgument {
+            argument: "--weighting".into(),
+            message: format!(
+                "noise takes one log, {} given: each log's periods measure a noise of its own, which one weight a joint cannot hold; weight from the residuals (wls)",
+                recs.len()
+            ),
+        }),
+        (_, false) => Ok(None),
+    }
+}
+
 pub(crate) fn check_validate_fraction(fraction: f64) -> Result<()> {
     if (0.0..1.0).contains(&fraction) {
         return Ok(());

@@ -528,8 +528,13 @@ pub fn identify_consistent_parameters(
         ),
         stderr: o.stderr.clone(),
     });
+    let residual_rms = factors.residual_rms(&unknowns)?;
+    // its residuals against the noise, as the unconstrained fit's were
+    let noise_fit = (fit.noise_fit.as_ref())
+        .and_then(|n| super::NoiseFit::of(&n.noise, &residual_rms, fit.samples, unknowns.len()));
     let consistent_model = super::BaseModel {
-        residual_rms: factors.residual_rms(&unknowns)?,
+        residual_rms,
+        noise_fit,
         theta,
         log_offsets,
         ..fit.clone()

@@ -78,6 +78,16 @@ impl NoiseFit {
         (self.cost / self.degrees_of_freedom).max(1.0).sqrt()
     }
 
+    /// One line on it: the cost over its degrees of freedom and its chance from noise alone.
+    pub fn summary(&self) -> String {
+        format!(
+            "the residuals against the torques' noise measured apart: a cost of {} over its {} degrees of freedom (1 for noise alone), a chance of {} from noise alone",
+            shown5(self.cost / self.degrees_of_freedom),
+            shown5(self.degrees_of_freedom),
+            shown5(self.p_value)
+        )
+    }
+
     /// The finding in words, for the joints `joints`: residuals beyond the noise (a model
     /// error), or below it; None where the cost is within what the noise gives.
     pub fn finding(&self, joints: &[String]) -> Option<String> {

@@ -142,9 +142,10 @@ impl PyConsistentFit {
 /// is fitted as runs one after the other, as `identify_base_parameters` fits them (what each
 /// one's preprocessing found kept in the models' `logs`; one Recording's in the one-log
 /// fields); `offset_per_log` fits each one's own torque offset, as `identify_base_parameters`
-/// does. Returns a ConsistentFit.
+/// does; `noise` and `noise_correlation` as there (the noise weighting, and the residuals
+/// judged against the noise). Returns a ConsistentFit.
 #[pyfunction]
-#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, friction=None, weighting="wls", gravity=true, prior_weight=1e-6, max_iterations=2000, t=None, coulomb=None, offset_per_log=false))]
+#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, friction=None, weighting="wls", gravity=true, prior_weight=1e-6, max_iterations=2000, t=None, coulomb=None, offset_per_log=false, noise=None, noise_correlation=1.0))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_consistent_parameters<'py>(
     py: Python<'py>,
@@ -161,6 +162,8 @@ pub(crate) fn identify_consistent_parameters<'py>(
     t: Option<Bound<'py, PyAny>>,
     coulomb: Option<Bound<'py, PyAny>>,
     offset_per_log: bool,
+    noise: Option<super::arrays::ArrayLike<'py>>,
+    #[pyo3(from_py_with = scalars::real)] noise_correlation: f64,
 ) -> PyResult<PyConsistentFit> {
     let options = base_options(friction, weighting, gravity)?;
     let consistent = ConsistentOptions {
@@ -188,6 +191,17 @@ pub(crate) fn identify_consistent_parameters<'py>(
         None => (q.cast::<super::recording::PyRecording>().ok())
             .map(|r| vec![r.get().rec.clone()])
             .unwrap_or_default(),
+    };
+    let fitted: Vec<&crate::Recording> = recs.iter().map(|r| r.as_ref()).collect();
+    let options = crate::direct::BaseOptions {
+        noise: super::noise::torque_noise(
+            noise,
+            noise_correlation,
+            &fitted,
+            &model.joint_names,
+            options.weighting,
+        )?,
+        ..options
     };
     let findings = |c: ConsistentFit| -> ConsistentFit {
         // a list's in `logs`, as identify_base_parameters keeps them

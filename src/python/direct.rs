@@ -438,6 +438,20 @@ impl PyBaseModel {
             .map(|g| super::drive_gains::gains_dict(py, g))
             .transpose()
     }
+    /// The fit's residuals judged against the torques' noise measured apart from it (given as
+    /// `noise=`, or from a Recording's periods), else None: dict `noise` (N m a joint),
+    /// `correlation` (samples an independent noise value), `noise_degrees_of_freedom` (of
+    /// the levels measured, None where known exactly), `ratio` (a joint, the residual RMS over
+    /// the noise), `model_error` (a joint, sqrt(max(residual^2 - noise^2, 0)), N m), `cost`
+    /// (the weighted residual sum of squares over the correlation), `degrees_of_freedom`
+    /// (k n / correlation - p) and `p_value` (the chance of the cost or more from noise
+    /// alone; below 1e-3 a model error is warned of, above 1 - 1e-3 an overstated noise).
+    #[getter]
+    fn noise_fit<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        (self.fit.noise_fit.as_ref())
+            .map(|f| super::noise::noise_fit_dict(py, f))
+            .transpose()
+    }
     /// Where the data excite the base parameters weakly (cond beyond 2000), else None: dict
     /// `cond`, `weakest` (the least determined combination of base parameters: dicts
     /// `parameter`, the name it is kept as with ' (merged)' where others are merged into it,
@@ -643,9 +657,16 @@ impl PyBaseModel {
 /// fitted together, one after the other; what each one's preprocessing found kept in the
 /// model's `logs`; Recordings that share samples, one given twice, refused). A Recording's own
 /// findings (position rounding) were warned of by `preprocess` and are not warned of again.
-/// `friction`: True (viscous, Coulomb and offset per joint), False,
-/// or a list of those names; `weighting`: 'wls' (default) or 'ols'; `gravity`: whether `tau`
-/// includes gravity; `tolerance`: relative rank tolerance of the pivoted QR. `t` ((k,) s),
+/// `friction`: None (default: no joint terms), 'all' (viscous, Coulomb and offset per joint,
+/// and the armature where the robot has one), or names from 'viscous', 'coulomb', 'offset',
+/// 'armature' (a list, or comma separated); `weighting`: 'wls' (default, weights from the residuals), 'ols'
+/// or 'noise' (weights from the torques' noise measured apart, the standard errors from it);
+/// `gravity`: whether `tau` includes gravity; `tolerance`: relative rank tolerance of the
+/// pivoted QR. `noise` ((n,) N m a joint): the torques' noise a sample, measured apart from
+/// the fit (a log held still), with `noise_correlation` samples an independent value (1 for
+/// white noise); without it, a Recording averaged over its periods (`preprocess(...,
+/// excitation=...)`) gives the noise its periods measured. Where there is a noise, the fit's
+/// residuals are judged against it (`noise_fit`, a warning beyond or below it). `t` ((k,) s),
 /// when the samples are a log: its qd and qdd columns are checked against the derivatives of
 /// q and qd first (see `check_sample_derivatives`), refusing columns in other units, of
 /// another joint or of the opposite sign. `coulomb` ((k, n)), for torques low-pass filtered:
@@ -654,7 +675,7 @@ impl PyBaseModel {
 /// offset of each one's own fitted beside the parameters (a sensor zeroed anew between logs),
 /// whose offset terms are then the logs' mean (`log_offsets`); needs the offset term.
 #[pyfunction]
-#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, friction=None, weighting="wls", gravity=true, tolerance=1e-8, seed=0, t=None, coulomb=None, offset_per_log=false))]
+#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, friction=None, weighting="wls", gravity=true, tolerance=1e-8, seed=0, t=None, coulomb=None, offset_per_log=false, noise=None, noise_correlation=1.0))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_base_parameters<'py>(
     py: Python<'py>,
@@ -671,6 +692,8 @@ pub(crate) fn identify_base_parameters<'py>(
     t: Option<Bound<'py, PyAny>>,
     coulomb: Option<Bound<'py, PyAny>>,
     offset_per_log: bool,
+    noise: Option<ArrayLike<'py>>,
+    #[pyo3(from_py_with = scalars::real)] noise_correlation: f64,
 ) -> PyResult<PyBaseModel> {
     let model = &robot.model;
     let given = Given {
@@ -681,11 +704,27 @@ pub(crate) fn identify_base_parameters<'py>(
         coulomb,
     };
     let listed = recordings_given(&q, &given)?;
+    // a Recording's findings are kept with the model, as the command line keeps its log's
+    let recording = (q.cast::<super::recording::PyRecording>().ok()).map(|r| r.get().rec.clone());
     let options = with_offset_per_log(
         fit_options(friction, weighting, gravity, tolerance, seed)?,
         offset_per_log,
         listed.as_ref().map(Vec::len),
     )?;
+    let fitted: Vec<&crate::Recording> = match &listed {
+        Some(recs) => recs.iter().map(|r| r.as_ref()).collect(),
+        None => recording.iter().map(|r| r.as_ref()).collect(),
+    };
+    let options = BaseOptions {
+        noise: super::noise::torque_noise(
+            noise,
+            noise_correlation,
+            &fitted,
+            &model.joint_names,
+            options.weighting,
+        )?,
+        ..options
+    };
     if let Some(recs) = listed {
         let fit = detached(py, "identify_base_parameters", || {
             let (stacked, options) = stacked_recordings(model, &recs, &options)?;
@@ -699,8 +738,6 @@ pub(crate) fn identify_base_parameters<'py>(
             model: Arc::new(model.clone()),
         });
     }
-    // a Recording's findings are kept with the model, as the command line keeps its log's
-    let recording = (q.cast::<super::recording::PyRecording>().ok()).map(|r| r.get().rec.clone());
     let a = samples(q, given, true, true)?.arrays()?;
     let c = states(model.nv, &a.q, &a.qd, &a.qdd, a.tau.as_ref())?;
     let coulomb = coulomb_column(model.nv, a.coulomb.as_ref())?;

@@ -14,6 +14,7 @@ mod global_linear;
 mod linearization;
 mod local;
 mod local_model;
+mod noise;
 mod payload;
 mod preprocess;
 mod recording;

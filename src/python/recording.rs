@@ -396,7 +396,8 @@ impl PyRecording {
     /// What averaging the log over its excitation's periods found (`preprocess(...,
     /// excitation=...)` or `period=`): a dict with `period` (s), `start` (the log's time of the
     /// first period used, s), `periods` (averaged), `harmonics` (the positions'),
-    /// `torque_harmonics`, `samples` (a period, before decimation), per joint
+    /// `torque_harmonics`, `samples` (a period, before decimation), `kept_samples` (after
+    /// it: the recording's), per joint
     /// `position_noise` (rad), `velocity_noise` (rad/s), `acceleration_noise` (rad/s^2) and
     /// `torque_noise` (N m) of one period's samples within their band (the average's are these
     /// over sqrt(periods): `averaged_torque_noise`), `position_beyond` (rad RMS of the averaged
@@ -419,6 +420,7 @@ impl PyRecording {
         e.set_item("harmonics", a.harmonics)?;
         e.set_item("torque_harmonics", a.torque_harmonics)?;
         e.set_item("samples", a.samples)?;
+        e.set_item("kept_samples", a.kept_samples)?;
         e.set_item("position_noise", a.position_noise.clone())?;
         e.set_item("velocity_noise", a.velocity_noise.clone())?;
         e.set_item("acceleration_noise", a.acceleration_noise.clone())?;
