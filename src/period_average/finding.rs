@@ -92,7 +92,7 @@ impl PeriodAverage {
             return Err(bad("the log's period average was kept without its samples (saved by an older version): average the log anew".into()));
         }
         let sigma = self.averaged_torque_noise();
-        if let Some(j) = sigma.iter().position(|s| !(*s > 0.0)) {
+        if let Some(j) = sigma.iter().position(|s| !(s.is_finite() && *s > 0.0)) {
             let name = joints
                 .get(j)
                 .cloned()
