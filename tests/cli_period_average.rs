@@ -100,12 +100,15 @@ fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_f
         assert!(*r < 1.5 * n, "residual {r} against the averaged noise {n}");
     }
     // the model validated on the log averaged alike
+    let validation = d.join("validation");
     let out = ok(&[
         "validate",
         s(&model),
         s(&path),
         "--robot",
         "a465",
+        "--out",
+        s(&validation),
         "--average-periods",
         s(&excitation),
         "--decimate",
@@ -116,6 +119,10 @@ fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_f
         out.contains("RMS over the averaged torques' noise, a joint: "),
         "{out}"
     );
+    assert!(
+        out.contains("the errors against the torques' noise measured apart: their cost over its "),
+        "{out}"
+    );
     // periods given by hand, from the start found
     let out = ok(&[
         "validate",
@@ -123,6 +130,8 @@ fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_f
         s(&path),
         "--robot",
         "a465",
+        "--out",
+        s(&validation),
         "--period",
         "10",
         "--period-harmonics",
@@ -137,7 +146,15 @@ fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_f
         "{out}"
     );
     // what does not go together
-    let base = ["validate", s(&model), s(&path), "--robot", "a465"];
+    let base = [
+        "validate",
+        s(&model),
+        s(&path),
+        "--robot",
+        "a465",
+        "--out",
+        s(&validation),
+    ];
     for (extra, says) in [
         (
             vec!["--average-periods", s(&excitation), "--period", "10"],
@@ -189,7 +206,9 @@ fn an_averaged_log_is_weighted_by_its_noise() {
     let args = fit(&[&averaged[..], &["--weighting", "noise"]].concat());
     let out = ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(
-        out.contains("the residuals against the torques' noise measured apart: a cost of "),
+        out.contains(
+            "the residuals against the torques' noise measured apart: their cost over its "
+        ),
         "{out}"
     );
     let m = BaseModel::load(&model).unwrap();

@@ -363,7 +363,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         );
     }
     if let Some(n) = &fit.noise_fit {
-        let _ = writeln!(out, "{}", n.summary());
+        let _ = writeln!(out, "{}", n.summary("the residuals"));
     }
     // the parameter table: printed in full and saved as CSV and JSON beside the model; the
     // names last, as a base parameter's combination of a robot's parameters runs to hundreds

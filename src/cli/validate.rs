@@ -76,7 +76,8 @@ pub(crate) struct ValidateArgs {
     /// steps of whole turns taken out of its positions; `log_held_columns`, its columns logged
     /// at a lower rate and read again at their values' arrivals; `log_stamp_jitter`, its time
     /// stamps found jittering over a regular clock; `log_period_average`, what averaging it
-    /// over its excitation's periods found (`--average-periods`, `--period`);
+    /// over its excitation's periods found (`--average-periods`, `--period`), and `noise_fit`,
+    /// the errors' cost against the noise its periods measured;
     /// for a base-parameter model `torque_columns`, each torque column of the log against the
     /// robot's model, `torque_lag`, its torques shifted against its positions, and
     /// `position_range`, the joints whose positions leave their limits, and `position_offsets`,
@@ -302,6 +303,15 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     if let Some(a) = &rec.period_average {
         json["log_period_average"] = serde_json::to_value(a).expect("serialisable");
     }
+    // the errors against the noise the log's periods measured (no parameters fitted to them;
+    // the model's own uncertainty, its s.e., not counted)
+    let rms: Vec<f64> = v.joints.iter().map(|j| j.rms).collect();
+    let noise_fit = (rec.period_average.as_ref())
+        .and_then(|a| a.torque_noise(&joints).ok())
+        .and_then(|n| crate::direct::NoiseFit::of(&n, &rms, v.samples, 0));
+    if let Some(n) = &noise_fit {
+        json["noise_fit"] = serde_json::to_value(n).expect("serialisable");
+    }
     if !rec.position_rounding.is_empty() {
         json["position_rounding"] =
             serde_json::to_value(&rec.position_rounding).expect("serialisable");
@@ -347,8 +357,14 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
         );
     }
     if let Some(avg) = &rec.period_average {
-        let rms: Vec<f64> = v.joints.iter().map(|j| j.rms).collect();
         let _ = writeln!(out, "  {}", avg.model_error_line(&rms, "RMS"));
+    }
+    if let Some(n) = &noise_fit {
+        let _ = writeln!(
+            out,
+            "  {} (the model's own uncertainty, its s.e., not counted)",
+            n.summary("the errors")
+        );
     }
     match &stderr {
         Ok(_) => {

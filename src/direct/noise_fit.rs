@@ -78,12 +78,13 @@ impl NoiseFit {
         (self.cost / self.degrees_of_freedom).max(1.0).sqrt()
     }
 
-    /// One line on it: the cost over its degrees of freedom and its chance from noise alone.
-    pub fn summary(&self) -> String {
+    /// One line on it, of `what` (a fit's residuals, a validation's errors): the cost over its
+    /// degrees of freedom and its chance from noise alone.
+    pub fn summary(&self, what: &str) -> String {
         format!(
-            "the residuals against the torques' noise measured apart: a cost of {} over its {} degrees of freedom (1 for noise alone), a chance of {} from noise alone",
-            shown5(self.cost / self.degrees_of_freedom),
+            "{what} against the torques' noise measured apart: their cost over its {} degrees of freedom is {} (1 for noise alone), a chance of {} from noise alone",
             shown5(self.degrees_of_freedom),
+            shown5(self.cost / self.degrees_of_freedom),
             shown5(self.p_value)
         )
     }
