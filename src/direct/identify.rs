@@ -403,9 +403,13 @@ pub(super) fn fit_with_factors(
     // (and each run's mean: a torque offset that drifted between runs)
     (fit.residual_correlation, fit.run_offsets) =
         super::runs::run_residuals(model, &fit, states, tau, &options.runs)?;
-    // the noise weighting's standard errors are the noise's already
-    let inflation = match options.weighting {
-        Weighting::Noise => 1.0,
+    // the noise weighting's standard errors are the noise's already, with its correlation
+    // `c`; where the residuals measure a longer one (noise that is not white within its band,
+    // such as a slow ripple), theirs
+    let inflation = match (options.weighting, &fit.noise_fit) {
+        (Weighting::Noise, Some(n)) => (fit.stderr_inflation().powi(2) / n.noise.correlation)
+            .max(1.0)
+            .sqrt(),
         _ => fit.stderr_inflation(),
     };
     for se in &mut fit.stderr {

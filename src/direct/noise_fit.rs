@@ -14,7 +14,10 @@
 //! For the noise weighting ([`super::Weighting::Noise`]) the standard errors come from the
 //! noise, `sqrt(c)` times the weighted regressor's `(W Phi)^T (W Phi)` inverse's diagonal,
 //! scaled by `sqrt(V / dof)` where that exceeds 1 (the residuals then say more than the noise
-//! does; the usual convention for a model error of unknown form). For another weighting the
+//! does; the usual convention for a model error of unknown form), and by `sqrt(rho / c)` where
+//! the residuals' own long-run variance factor `rho` ([`super::residual_correlation`], the
+//! largest joint's) exceeds `c`: noise that is not white within its band (a slow ripple)
+//! holds fewer independent values than its band says. For another weighting the
 //! cost is at least the noise-weighted fit's, so the test reads model errors a little more
 //! readily, and the standard errors are the fit's own.
 

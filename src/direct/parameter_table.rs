@@ -229,6 +229,19 @@ impl BaseModel {
         let weak = (self.weak_excitation.as_ref()).map(|w| w.finding());
         // residuals against the noise measured apart: a model error, or an overstated noise
         let noise = (self.noise_fit.as_ref()).and_then(|f| f.finding(&self.joint_names));
+        // a noise that is not white, which the judgement against it takes flat
+        let colour = (self
+            .noise_fit
+            .as_ref()
+            .and(self.log_period_average.as_ref()))
+        .and_then(|a| {
+            crate::period_average::noise_colour::finding(
+                &a.torque_noise_tilt,
+                a.periods,
+                a.torque_harmonics,
+                &self.joint_names,
+            )
+        });
         let drifted = (self.run_offsets.iter())
             .filter(|_| !columns_wrong)
             .map(|o| o.finding(&log_names));
@@ -241,6 +254,7 @@ impl BaseModel {
             .chain(friction)
             .chain(weak)
             .chain(noise)
+            .chain(colour)
             .chain(disagree)
             .chain(drifted)
             .chain(rounding.filter(|_| log_findings))

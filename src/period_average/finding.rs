@@ -60,6 +60,12 @@ pub struct PeriodAverage {
     /// [`super::MIN_COEFFICIENTS`] coefficients in the torques' band).
     #[serde(default)]
     pub torque_drift: Vec<Option<f64>>,
+    /// Per joint, the torques' noise in the band's lower half of harmonics over its upper
+    /// half, a value each ([`super::noise_colour`]: 1 for white noise); None where not judged
+    /// (fewer than [`super::noise_colour::MIN_HARMONICS`] torque harmonics). Empty in a
+    /// finding saved before it was measured.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub torque_noise_tilt: Vec<Option<f64>>,
     /// Periods left out, in order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub left_out: Vec<LeftOutPeriod>,
@@ -182,6 +188,14 @@ impl PeriodAverage {
             return Some(format!(
                 "{} periods, {} and {} harmonics over {} samples, {} kept; expected at least 2 periods, harmonics >= 1 and torque harmonics no fewer, below half the samples, and no more kept than there are",
                 self.periods, self.harmonics, self.torque_harmonics, self.samples, self.kept_samples
+            ));
+        }
+        if !(self.torque_noise_tilt.is_empty() || self.torque_noise_tilt.len() == n)
+            || (self.torque_noise_tilt.iter().flatten()).any(|f| !(f.is_finite() && *f >= 0.0))
+        {
+            return Some(format!(
+                "torque_noise_tilt: {} values, expected one a joint ({n}), each finite and >= 0 or null",
+                self.torque_noise_tilt.len()
             ));
         }
         if !(self.torque_drift.is_empty() || self.torque_drift.len() == n)

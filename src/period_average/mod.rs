@@ -30,6 +30,7 @@
 mod drift;
 mod finding;
 mod layout;
+pub mod noise_colour;
 mod series;
 
 pub use drift::{DRIFT_RATIO, MIN_COEFFICIENTS};
@@ -216,6 +217,7 @@ pub fn average_periods(
         vec![0.0; n],
     );
     let mut drift = vec![None; n];
+    let mut tilt = vec![None; n];
     let mut q_mean = Vec::with_capacity(n);
     let mut tau_mean = Vec::with_capacity(n);
     for j in 0..n {
@@ -228,6 +230,7 @@ pub fn average_periods(
         let per: Vec<&[f64]> = keep.iter().map(|&k| coef_tau[k][j].as_slice()).collect();
         let place: Vec<f64> = keep.iter().map(|&k| layout.periods[k].0 as f64).collect();
         drift[j] = drift::trend_ratio(&per, &place);
+        tilt[j] = noise_colour::tilt(&coef_tau, &keep, j, h_tau, &tm);
         beyond[j] = weighted_power(&qm, &|k| if k > h_q { 1.0 } else { 0.0 }).sqrt();
         // the positions' motion (without their mean) against their spread from period to period
         let motion = weighted_power(&qm[..2 * h_q + 1], &|k| if k > 0 { 1.0 } else { 0.0 }).sqrt();
@@ -325,6 +328,7 @@ pub fn average_periods(
             torque_noise: tau_noise,
             position_beyond: beyond,
             torque_drift: drift,
+            torque_noise_tilt: tilt,
             left_out,
         }),
         ..out

@@ -403,7 +403,9 @@ impl PyRecording {
     /// over sqrt(periods): `averaged_torque_noise`), `position_beyond` (rad RMS of the averaged
     /// positions beyond the harmonics kept), `torque_drift` (per joint the F ratio of a linear
     /// trend of its torques over the periods, near 1 for noise, beyond 3 a drift; None where
-    /// not judged), and `left_out`, a list of dicts `period` (0-based),
+    /// not judged), `torque_noise_tilt` (per joint the noise's power in the lower half of the
+    /// torques' band over the upper half's, 1 for white noise; None where not judged), and
+    /// `left_out`, a list of dicts `period` (0-based),
     /// `t0`, `t1` (s) and `reason`. None for a recording not averaged so.
     #[getter]
     fn period_average<'py>(
@@ -428,6 +430,7 @@ impl PyRecording {
         e.set_item("averaged_torque_noise", a.averaged_torque_noise())?;
         e.set_item("position_beyond", a.position_beyond.clone())?;
         e.set_item("torque_drift", a.torque_drift.clone())?;
+        e.set_item("torque_noise_tilt", a.torque_noise_tilt.clone())?;
         let left = pyo3::types::PyList::empty(py);
         for l in &a.left_out {
             let d = pyo3::types::PyDict::new(py);
