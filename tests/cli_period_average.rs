@@ -9,8 +9,8 @@ use perturbid_rs::direct::BaseModel;
 use perturbid_rs::Document;
 
 /// A log of 4 periods of `excitation` simulated on the A465 at 500 Hz with torque noise of
-/// 0.02 N m, at `out`.
-fn simulated(excitation: &std::path::Path, out: &std::path::Path, seed: &str) {
+/// `noise` N m, at `out`.
+fn simulated(excitation: &std::path::Path, out: &std::path::Path, seed: &str, noise: &str) {
     ok(&[
         "simulate",
         "a465",
@@ -22,7 +22,7 @@ fn simulated(excitation: &std::path::Path, out: &std::path::Path, seed: &str) {
         "--periods",
         "4",
         "--torque-noise",
-        "0.02",
+        noise,
         "--seed",
         seed,
     ]);
@@ -35,7 +35,7 @@ fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_f
     excite_a465(&exc, 2);
     let excitation = exc.join("excitation.json");
     let raw = d.join("raw.csv");
-    simulated(&excitation, &raw, "3");
+    simulated(&excitation, &raw, "3", "0.02");
     // 2.5 s at rest where the excitation starts, before it: the logger ran first
     let text = std::fs::read_to_string(&raw).unwrap();
     let mut lines = text.lines();
@@ -185,8 +185,8 @@ fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_f
 }
 
 /// `--weighting noise`: the averaged log's rows weighted by the noise its periods measured,
-/// the residuals judged against it and kept with the model; refused for a log not averaged
-/// and for several logs, by name.
+/// the residuals judged against it and kept with the model; two logs' pooled noise; refused
+/// for a log not averaged and for logs whose noise differs, by name.
 #[test]
 fn an_averaged_log_is_weighted_by_its_noise() {
     let d = tmp("cli-noise-weighting");
@@ -194,7 +194,7 @@ fn an_averaged_log_is_weighted_by_its_noise() {
     excite_a465(&exc, 2);
     let excitation = exc.join("excitation.json");
     let log = d.join("log.csv");
-    simulated(&excitation, &log, "5");
+    simulated(&excitation, &log, "5", "0.02");
     let model = d.join("model.json");
     let fit = |extra: &[&str]| -> Vec<String> {
         let mut args = vec!["identify-direct", "a465", s(&log)];
@@ -228,14 +228,24 @@ fn an_averaged_log_is_weighted_by_its_noise() {
     let args = fit(&["--weighting", "noise"]);
     fails(
         &args.iter().map(String::as_str).collect::<Vec<_>>(),
-        &["the noise weighting needs the torques' noise measured apart"],
+        &["noise needs each log averaged over its excitation's periods"],
     );
+    // two logs of the same noise: weighted by their pooled noise
     let second = d.join("second.csv");
-    simulated(&excitation, &second, "6");
+    simulated(&excitation, &second, "6", "0.02");
     let mut args = fit(&[&averaged[..], &["--weighting", "noise"]].concat());
     args.insert(3, s(&second).to_string());
+    ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let m = BaseModel::load(&model).unwrap();
+    let n = m.noise_fit.as_ref().expect("kept with the model");
+    assert_eq!(n.noise.degrees_of_freedom, Some(2.0 * 3.0 * 201.0 * 6.0));
+    assert!(n.p_value > 1e-3, "{n:?}");
+    // one of twice the other's noise: not one weight a joint
+    let louder = d.join("louder.csv");
+    simulated(&excitation, &louder, "7", "0.04");
+    args[3] = s(&louder).to_string();
     fails(
         &args.iter().map(String::as_str).collect::<Vec<_>>(),
-        &["noise takes one log, 2 given"],
+        &["the torques' noise of joint 'joint1' differs between the logs"],
     );
 }

@@ -387,3 +387,57 @@ fn the_noise_fit_is_kept_with_the_model_and_checked_on_load() {
         .to_string();
     assert!(edited.contains("p in [0, 1]"), "{edited}");
 }
+
+/// Several logs' noise pooled: per joint the samples-weighted mean of the variances, the
+/// independent values kept (`sum K / sum (K / c)`), the degrees of freedom summed (none where a
+/// log's are known exactly); levels more than 1.5 times apart refused naming the joint and
+/// logs; a log without a noise refused under the noise weighting in its name, and none
+/// otherwise.
+#[test]
+fn several_logs_noise_is_pooled_or_refused() {
+    let joints: Vec<String> = (1..=2).map(|j| format!("joint{j}")).collect();
+    let a = TorqueNoise {
+        sigma: vec![0.1, 0.2],
+        correlation: 10.0,
+        degrees_of_freedom: Some(600.0),
+    };
+    let b = TorqueNoise {
+        sigma: vec![0.12, 0.16],
+        correlation: 5.0,
+        degrees_of_freedom: Some(400.0),
+    };
+    let p = TorqueNoise::pooled(&[("a.csv", &a, 1000), ("b.csv", &b, 3000)], &joints).unwrap();
+    let expected = |x: f64, y: f64| ((1000.0 * x * x + 3000.0 * y * y) / 4000.0f64).sqrt();
+    assert!((p.sigma[0] - expected(0.1, 0.12)).abs() < 1e-15);
+    assert!((p.sigma[1] - expected(0.2, 0.16)).abs() < 1e-15);
+    assert!((p.correlation - 4000.0 / (100.0 + 600.0)).abs() < 1e-12);
+    assert_eq!(p.degrees_of_freedom, Some(1000.0));
+    let known = TorqueNoise::white(vec![0.1, 0.2]);
+    let q = TorqueNoise::pooled(&[("a.csv", &a, 1000), ("c.csv", &known, 10)], &joints).unwrap();
+    assert_eq!(q.degrees_of_freedom, None);
+    let far = TorqueNoise::white(vec![0.1, 0.5]);
+    let e = TorqueNoise::pooled(&[("a.csv", &a, 1000), ("far.csv", &far, 10)], &joints)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("joint 'joint2' differs between the logs: 0.5 N m in far.csv, 0.2 N m in a.csv"),
+        "{e}"
+    );
+    let none = || {
+        Err(Error::InvalidArgument {
+            argument: "noise".into(),
+            message: "not averaged".into(),
+        })
+    };
+    let logs = || {
+        vec![
+            ("a.csv".to_string(), Ok(a.clone()), 10),
+            ("d.csv".to_string(), none(), 10),
+        ]
+    };
+    let e = TorqueNoise::of_logs(logs(), &joints, true)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("d.csv: ") && e.contains("not averaged"), "{e}");
+    assert_eq!(TorqueNoise::of_logs(logs(), &joints, false).unwrap(), None);
+}

@@ -127,7 +127,7 @@ pub(crate) struct FitArgs {
     friction: FrictionTerms,
     /// wls (weights from the per-joint residuals), ols, or noise: weights from the torques'
     /// noise the periods of a log averaged over them measured (--average-periods, --period;
-    /// one log), the standard errors from that noise. An averaged log's residuals are judged
+    /// several logs' pooled), the standard errors from that noise. An averaged log's residuals are judged
     /// against its noise with any weighting.
     #[arg(long, value_enum, default_value_t = Weighting::Wls)]
     weighting: Weighting,

@@ -499,33 +499,32 @@ pub(crate) fn excitation_of(
 }
 
 /// `--validate FRACTION` of `identify-direct` and `identify-payload`: refused outside [0, 1).
-/// The torques' noise the periods of the log `recs` holds measured, where it was averaged over
-/// them: the noise of the direct fit's [`crate::direct::BaseOptions::noise`] (its weights for
-/// `--weighting noise`, and the yardstick of its residuals with any weighting). None for a
-/// log not averaged, or several logs. Errors, for `--weighting noise` only: several logs, a
-/// log averaged whose periods measured no noise, naming it.
+/// The torques' noise the periods of the logs `recs` (read from `paths`) measured, where each
+/// was averaged over them: the noise of the direct fit's [`crate::direct::BaseOptions::noise`]
+/// (its weights for `--weighting noise`, and the yardstick of its residuals with any
+/// weighting); several logs' pooled ([`crate::direct::TorqueNoise::pooled`]). None where a log
+/// was not averaged. Errors, for `--weighting noise` only: a log not averaged, or whose
+/// periods measured no noise, naming it; logs whose noise differs too much to pool.
 pub(crate) fn averaged_noise(
     recs: &[crate::Recording],
     paths: &[PathBuf],
     joints: &[String],
     weighting: crate::direct::Weighting,
 ) -> Result<Option<crate::direct::TorqueNoise>> {
-    let weighted = weighting == crate::direct::Weighting::Noise;
-    match (recs, weighted) {
-        ([rec], _) => match (&rec.period_average, weighted) {
-            (Some(a), true) => a.torque_noise(joints).map(Some).map_err(in_log(&paths[0])),
-            (Some(a), false) => Ok(a.torque_noise(joints).ok()),
-            (None, _) => Ok(None),
-        },
-        (_, true) => Err(Error::InvalidArgument {
-            argument: "--weighting".into(),
-            message: format!(
-                "noise takes one log, {} given: each log's periods measure a noise of its own, which one weight a joint cannot hold; weight from the residuals (wls)",
-                recs.len()
-            ),
-        }),
-        (_, false) => Ok(None),
-    }
+    let logs = (recs.iter().zip(paths))
+        .map(|(rec, path)| {
+            let noise = match &rec.period_average {
+                Some(a) => a.torque_noise(joints),
+                None => Err(Error::InvalidArgument {
+                    argument: "--weighting".into(),
+                    message: "noise needs each log averaged over its excitation's periods (--average-periods, --period), whose spread measures the noise".into(),
+                }),
+            };
+            let name = path.display().to_string();
+            (name, noise.map_err(in_log(path)), rec.len())
+        })
+        .collect();
+    crate::direct::TorqueNoise::of_logs(logs, joints, weighting == crate::direct::Weighting::Noise)
 }
 
 pub(crate) fn check_validate_fraction(fraction: f64) -> Result<()> {

@@ -14,6 +14,10 @@ pub const MAX_NOISE: f64 = 1e100;
 /// The most samples a joint's noise may take for one independent value.
 pub const MAX_CORRELATION: f64 = 1e9;
 
+/// The most one log's noise level may differ from another's on a joint (either way) for the
+/// logs to be weighted by their pooled noise.
+pub const MAX_LOG_RATIO: f64 = 1.5;
+
 /// The torques' noise: its level per joint and how correlated it is from sample to sample.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -76,6 +80,107 @@ impl TorqueNoise {
             ));
         }
         None
+    }
+
+    /// The noise of several logs fitted together as runs one after the other, `logs` each
+    /// log's name, noise and samples: per joint the samples-weighted mean of their variances,
+    /// a correlation that keeps the independent values they hold (`sum K / sum (K / c)`), and
+    /// their degrees of freedom summed (None where one's levels are known exactly). Errors
+    /// naming the joint and the two logs: levels that differ by more than [`MAX_LOG_RATIO`],
+    /// which one weight a joint cannot hold.
+    pub fn pooled(logs: &[(&str, &TorqueNoise, usize)], joints: &[String]) -> Result<Self> {
+        let bad = |message: String| Error::InvalidArgument {
+            argument: "noise".into(),
+            message,
+        };
+        let Some(first) = logs.first() else {
+            return Err(bad("no logs to pool the noise of".into()));
+        };
+        for (name, noise, _) in logs {
+            noise
+                .check(joints)
+                .map_err(|e| bad(format!("{name}: {e}")))?;
+        }
+        for (j, joint) in joints.iter().enumerate() {
+            let level = |l: &(&str, &TorqueNoise, usize)| l.1.sigma[j];
+            let low = (logs.iter())
+                .min_by(|a, b| level(a).total_cmp(&level(b)))
+                .unwrap_or(first);
+            let high = (logs.iter())
+                .max_by(|a, b| level(a).total_cmp(&level(b)))
+                .unwrap_or(first);
+            if level(high) > MAX_LOG_RATIO * level(low) {
+                return Err(bad(format!(
+                    "the torques' noise of joint '{joint}' differs between the logs: {} N m in {}, {} N m in {} ({} times), beyond the {MAX_LOG_RATIO} one weight a joint may take for both; weight from the residuals (wls), or fit the logs apart",
+                    shown5(level(high)),
+                    high.0,
+                    shown5(level(low)),
+                    low.0,
+                    shown5(level(high) / level(low))
+                )));
+            }
+        }
+        let samples: f64 = logs.iter().map(|l| l.2 as f64).sum();
+        let values: f64 = logs.iter().map(|l| l.2 as f64 / l.1.correlation).sum();
+        if samples <= 0.0 {
+            return Err(bad("logs of no samples to pool the noise of".into()));
+        }
+        let sigma = (0..joints.len())
+            .map(|j| {
+                let v: f64 = logs.iter().map(|l| l.2 as f64 * l.1.sigma[j].powi(2)).sum();
+                (v / samples).sqrt()
+            })
+            .collect();
+        let degrees_of_freedom = logs
+            .iter()
+            .map(|l| l.1.degrees_of_freedom)
+            .sum::<Option<f64>>();
+        let pooled = Self {
+            sigma,
+            correlation: (samples / values).max(1.0),
+            degrees_of_freedom,
+        };
+        pooled.check(joints)?;
+        Ok(pooled)
+    }
+
+    /// The noise of logs fitted together, as each log's own was found (`logs`: its name, its
+    /// noise or why it has none, its samples): one log's, several logs' [`Self::pooled`].
+    /// Where `required` (the noise weighting), a log without a noise is an error in its name,
+    /// as are noises too far apart to pool; otherwise either gives None.
+    pub fn of_logs(
+        logs: Vec<(String, Result<TorqueNoise>, usize)>,
+        joints: &[String],
+        required: bool,
+    ) -> Result<Option<Self>> {
+        let several = logs.len() > 1;
+        let mut each = Vec::with_capacity(logs.len());
+        for (name, noise, samples) in logs {
+            match (noise, required) {
+                (Ok(n), _) => each.push((name, n, samples)),
+                (Err(e), true) if several => {
+                    return Err(Error::InvalidArgument {
+                        argument: "noise".into(),
+                        message: format!("{name}: {e}"),
+                    })
+                }
+                (Err(e), true) => return Err(e),
+                (Err(_), false) => return Ok(None),
+            }
+        }
+        match each.as_slice() {
+            [] => Ok(None),
+            [(_, noise, _)] => Ok(Some(noise.clone())),
+            _ => {
+                let logs: Vec<(&str, &TorqueNoise, usize)> =
+                    (each.iter()).map(|(p, n, k)| (p.as_str(), n, *k)).collect();
+                match Self::pooled(&logs, joints) {
+                    Ok(n) => Ok(Some(n)),
+                    Err(e) if required => Err(e),
+                    Err(_) => Ok(None),
+                }
+            }
+        }
     }
 
     /// [`Self::problem`] as an error of the argument `noise`.

@@ -11,9 +11,10 @@ use crate::Recording;
 
 /// The noise a direct fit takes ([`crate::direct::BaseOptions::noise`]): `noise` ((n,), N m a
 /// joint) with `correlation` (samples an independent value, 1 for white noise) where given;
-/// otherwise that of the one Recording fitted where it was averaged over its periods
-/// ([`crate::period_average::PeriodAverage::torque_noise`]). Errors, for the noise weighting
-/// only: several Recordings without `noise`, or an averaged one whose periods measured none.
+/// otherwise that of the Recordings fitted where each was averaged over its periods
+/// ([`crate::period_average::PeriodAverage::torque_noise`]; several pooled,
+/// [`TorqueNoise::pooled`]). Errors, for the noise weighting only: a Recording not averaged, or
+/// whose periods measured no noise, naming it; several whose noise differs too much to pool.
 pub(crate) fn torque_noise(
     noise: Option<ArrayLike<'_>>,
     correlation: f64,
@@ -38,23 +39,23 @@ pub(crate) fn torque_noise(
         }
         .into());
     }
-    let weighted = weighting == Weighting::Noise;
-    match recordings {
-        [rec] => match (&rec.period_average, weighted) {
-            (Some(a), true) => Ok(Some(a.torque_noise(joints)?)),
-            (Some(a), false) => Ok(a.torque_noise(joints).ok()),
-            (None, _) => Ok(None),
-        },
-        [_, _, ..] if weighted => Err(Error::InvalidArgument {
-            argument: "weighting".into(),
-            message: format!(
-                "'noise' with {} Recordings and no noise=: each one's periods measure a noise of its own, which one weight a joint cannot hold; give noise= (one level a joint for all), or weight from the residuals ('wls')",
-                recordings.len()
-            ),
-        }
-        .into()),
-        _ => Ok(None),
-    }
+    let logs = (recordings.iter().enumerate())
+        .map(|(i, rec)| {
+            let noise = match &rec.period_average {
+                Some(a) => a.torque_noise(joints),
+                None => Err(Error::InvalidArgument {
+                    argument: "weighting".into(),
+                    message: "'noise' needs noise= or a Recording averaged over its excitation's periods (preprocess(..., excitation=...) or period=), whose spread measures the noise".into(),
+                }),
+            };
+            (format!("Recording {i} ('{}')", rec.name), noise, rec.len())
+        })
+        .collect();
+    Ok(TorqueNoise::of_logs(
+        logs,
+        joints,
+        weighting == Weighting::Noise,
+    )?)
 }
 
 /// A fit's residuals against the noise as a dict (`BaseParameterModel.noise_fit`).

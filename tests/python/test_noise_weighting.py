@@ -101,3 +101,23 @@ def test_a_noise_that_cannot_weight_is_refused():
     for kwargs, said in cases:
         with pytest.raises(pr.InputError, match=said):
             pr.identify_base_parameters(robot, q, qd, qdd, tau, **kwargs)
+
+
+def test_several_averaged_recordings_are_weighted_by_their_pooled_noise():
+    robot = pr.robots.a465()
+    traj = trajectory(3)
+    recs = []
+    for seed, noise in [(8, 0.02), (9, 0.02), (10, 0.05)]:
+        log = pr.simulate(robot, traj, periods=4, rate=RATE, friction=None, torque_noise=noise, seed=seed)
+        recs.append(pr.preprocess(log.t, log.q, log.tau, excitation=traj, rate=RATE, decimate=5, name=f"day{seed}"))
+    fit = pr.identify_base_parameters(robot, recs[:2], weighting="noise")
+    f = fit.noise_fit
+    levels = np.array([r.period_average["averaged_torque_noise"] for r in recs[:2]])
+    np.testing.assert_allclose(f["noise"], np.sqrt((levels**2).mean(axis=0)), rtol=1e-12)
+    assert f["noise_degrees_of_freedom"] == pytest.approx(2 * 3 * 201 * 6)
+    assert 1e-3 < f["p_value"] < 1 - 1e-3, f
+    # a log of 2.5 times the noise cannot share one weight a joint with them
+    with pytest.raises(pr.InputError, match="differs between the logs"):
+        pr.identify_base_parameters(robot, [recs[0], recs[2]], weighting="noise")
+    # without the noise weighting, the residuals are then not judged against a noise
+    assert pr.identify_base_parameters(robot, [recs[0], recs[2]]).noise_fit is None
