@@ -194,8 +194,9 @@ impl Recording {
     /// This recording of a joint signal that is not a torque (motor currents) in torques: each
     /// `tau` column times its joint's gain (`gains`: one a joint, finite and other than 0; N m
     /// or N per unit of the signal, [`crate::direct::DriveGains`]). What was found in the log
-    /// is kept, the torques' clipping levels and glitches' values scaled alike (a negative gain
-    /// swaps a clipping's side). Errors on gains of the wrong number or value.
+    /// is kept, the torques' clipping levels, glitches' values and the noise their periods
+    /// measured (where averaged) scaled alike (a negative gain swaps a clipping's side).
+    /// Errors on gains of the wrong number or value.
     pub fn in_torques(&self, gains: &[f64]) -> Result<Self> {
         if gains.len() != self.n {
             return Err(self.error(format!(
@@ -233,10 +234,19 @@ impl Recording {
                 _ => g.clone(),
             })
             .collect();
+        // the noise its periods measured, in torques too (its ratios have no unit)
+        let period_average =
+            (self.period_average.as_ref()).map(|a| crate::period_average::PeriodAverage {
+                torque_noise: (a.torque_noise.iter().zip(gains))
+                    .map(|(x, g)| x * g.abs())
+                    .collect(),
+                ..a.clone()
+            });
         let r = Self {
             tau,
             torque_saturation,
             glitches,
+            period_average,
             ..self.clone()
         };
         r.check()?;

@@ -441,3 +441,62 @@ fn several_logs_noise_is_pooled_or_refused() {
     assert!(e.contains("d.csv: ") && e.contains("not averaged"), "{e}");
     assert_eq!(TorqueNoise::of_logs(logs(), &joints, false).unwrap(), None);
 }
+
+/// A payload's fit weighted by the noise known: its standard errors match the spread of its
+/// estimates over 30 draws of noise of a different level on each joint (the mass and the
+/// whole parameter vector), and its residuals are judged against that noise.
+#[test]
+fn a_payload_weighted_by_the_noise_has_the_standard_errors_of_its_spread() {
+    use common::gain_logs::{carrying, motion, payload, states, truth};
+    use perturbid_rs::direct::{identify_payload, PayloadOptions, Reference};
+    let (truth, p) = (truth(), payload());
+    let robot = carrying(&truth, Some(&p));
+    let s = motion(4);
+    let exact = torques_with_friction(&robot, &s, &mut Rng(0), |_| 0.0);
+    let mut options = PayloadOptions::new("link6", &Reference::Urdf);
+    options.weighting = Weighting::Noise;
+    options.noise = Some(TorqueNoise::white(SIGMA.to_vec()));
+    let fits: Vec<_> = (0..30)
+        .map(|d| {
+            let mut rng = Rng(900 + d);
+            let tau: Vec<f64> = (exact.iter().enumerate())
+                .map(|(i, t)| t + SIGMA[i % 6] * normal(&mut rng))
+                .collect();
+            identify_payload(&truth, Reference::Urdf, &states(&s), &tau, &options).unwrap()
+        })
+        .collect();
+    let n = fits.len() as f64;
+    let ratios: Vec<f64> = (0..fits[0].theta.len())
+        .map(|i| {
+            let mean = fits.iter().map(|f| f.theta[i]).sum::<f64>() / n;
+            let var = fits
+                .iter()
+                .map(|f| (f.theta[i] - mean).powi(2))
+                .sum::<f64>()
+                / (n - 1.0);
+            var.sqrt() / (fits.iter().map(|f| f.stderr[i]).sum::<f64>() / n)
+        })
+        .collect();
+    let mut sorted = ratios.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2];
+    assert!(
+        (0.85..1.15).contains(&median),
+        "median spread over stderr {median}"
+    );
+    assert!(
+        (0.6..1.5).contains(&ratios[0]),
+        "the mass's spread over its stderr {}",
+        ratios[0]
+    );
+    let f = &fits[0];
+    assert_eq!(f.sigma, SIGMA.to_vec());
+    let nf = f.noise_fit.as_ref().expect("judged against the noise");
+    assert!(nf.p_value > 1e-3 && nf.p_value < 1.0 - 1e-3, "{nf:?}");
+    // (with this noise the payload's small inertia is loosely determined, and said)
+    assert!(
+        !f.findings.iter().any(|w| w.contains("torques' noise")),
+        "{:?}",
+        f.findings
+    );
+}

@@ -912,6 +912,9 @@ class PayloadFit:
         """mass (kg), com ((3,) m), inertia ((6,) kg m^2): standard errors by the delta rule."""
         ...
     @property
+    def noise_fit(self) -> dict[str, Any] | None:
+        """The residuals against the torques' noise measured apart, as BaseParameterModel.noise_fit."""
+    @property
     def link(self) -> str: ...
     @property
     def reference(self) -> Literal["urdf", "base_model"]: ...
@@ -995,6 +998,8 @@ def identify_payload(
     t: Optional[ArrayLike] = None,
     coulomb: Optional[ArrayLike] = None,
     offset_per_log: bool = False,
+    noise: Optional[ArrayLike] = None,
+    noise_correlation: float = 1.0,
 ) -> PayloadFit:
     """The payload fixed to `link` from a log of the robot carrying it ((k, n) arrays, rad,
     rad/s, rad/s^2, N m, or a preprocessed Recording as q), against `model` (the robot alone,

@@ -41,7 +41,10 @@ pub(crate) struct IdentifyPayloadArgs {
     /// coulomb and offset without it (the URDF holds no friction to measure against).
     #[arg(long)]
     terms: Option<FrictionTerms>,
-    /// wls (weights from the per-joint residuals) or ols.
+    /// wls (weights from the per-joint residuals), ols, or noise: weights from the torques'
+    /// noise an averaged log's periods measured (--average-periods, --period), the standard
+    /// errors from it. An averaged log's residuals are judged against its noise with any
+    /// weighting.
     #[arg(long, value_enum, default_value_t = Weighting::Wls)]
     weighting: Weighting,
     /// The torques exclude gravity (the robot's controller compensates it in what it logs).
@@ -157,6 +160,8 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
             .collect::<Result<_>>()?;
     }
     let n = model.nv;
+    options.noise =
+        super::files::averaged_noise(&recs, &a.data, &model.joint_names, options.weighting)?;
     // each log's first samples are fitted to, its last validated on
     let splits = super::files::fit_splits(a.validate, &recs, &a.data)?;
     let states = (recs.iter().zip(&a.data))
@@ -358,6 +363,9 @@ fn report(fit: &PayloadFit, out: &std::path::Path, urdf: bool) -> String {
             "  {name:<16} {:>16.4} {:>16.4} {:>14.4}",
             fit.reference_rms[j], fit.payload_torque_rms[j], fit.residual_rms[j]
         );
+    }
+    if let Some(n) = &fit.noise_fit {
+        let _ = writeln!(s, "  {}", n.summary("the residuals"));
     }
     let written = match fit.usable_payload() {
         Some(_) if urdf => format!(

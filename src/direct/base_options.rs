@@ -86,16 +86,6 @@ impl BaseOptions {
     /// or WLS weighted from its residuals). Errors: the noise weighting without a noise, or a
     /// noise that is not one positive level a joint of `joints`.
     pub fn noise_weights(&self, joints: &[String]) -> crate::error::Result<Option<Vec<f64>>> {
-        if let Some(noise) = &self.noise {
-            noise.check(joints)?;
-        }
-        match (self.weighting, &self.noise) {
-            (Weighting::Noise, Some(noise)) => Ok(Some(noise.sigma.clone())),
-            (Weighting::Noise, None) => Err(crate::error::Error::InvalidArgument {
-                argument: "weighting".into(),
-                message: "the noise weighting needs the torques' noise measured apart from the fit: average the log over its excitation's periods (--average-periods, --period; preprocess(excitation=..., period=...)), or give the noise a joint (noise=)".into(),
-            }),
-            _ => Ok(None),
-        }
+        super::torque_noise::weights(self.weighting, self.noise.as_ref(), joints)
     }
 }

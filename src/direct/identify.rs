@@ -317,7 +317,7 @@ pub(super) fn fit_with_factors(
         rms,
         sigma,
     } = solve(model, states, tau, options)?;
-    let noise_fit = noise_fit(&mut ls, options, &rms, k, nv)?;
+    let noise_fit = super::noise_fit::judge(&mut ls, options, &rms, k, nv)?;
     let p = base.len();
     let (coef, se) = (ls.coef.row(0), ls.stderr.row(0));
     let log_offsets = options.offset_per_run.then(|| {
@@ -426,42 +426,6 @@ pub(super) fn fit_with_factors(
     fit.unmodelled_friction =
         super::unmodelled_friction::check_unmodelled_friction(model, &fit, states, tau, options)?;
     Ok((fit, factors))
-}
-
-/// The fit's residuals (RMS `rms` a joint over `k` samples of `nv` joints) against
-/// [`BaseOptions::noise`] where given; for [`Weighting::Noise`], `ls`'s standard errors
-/// replaced by the noise's, `sqrt(c cov_diag)` scaled by [`super::NoiseFit::scale`]. Errors:
-/// the noise weighting where the noise holds no more independent values than the unknowns.
-fn noise_fit(
-    ls: &mut crate::regression::LeastSquares,
-    options: &BaseOptions,
-    rms: &[f64],
-    k: usize,
-    nv: usize,
-) -> Result<Option<super::NoiseFit>> {
-    let Some(noise) = &options.noise else {
-        return Ok(None);
-    };
-    let unknowns = ls.coef.ncols();
-    let found = super::NoiseFit::of(noise, rms, k, unknowns);
-    if options.weighting != Weighting::Noise {
-        return Ok(found);
-    }
-    let Some(n) = found else {
-        return Err(Error::InvalidArgument {
-            argument: "noise".into(),
-            message: format!(
-                "the noise holds {} independent values ({k} samples x {nv} joints over a correlation of {} samples), no more than the {unknowns} unknowns: standard errors cannot be had from it; give more samples, or weight otherwise (wls)",
-                crate::error::shown5((k * nv) as f64 / noise.correlation),
-                crate::error::shown5(noise.correlation),
-            ),
-        });
-    };
-    let scale = n.scale();
-    ls.stderr = DMatrix::from_fn(1, unknowns, |_, j| {
-        (noise.correlation * ls.cov_diag[j]).sqrt() * scale
-    });
-    Ok(Some(n))
 }
 
 impl BaseModel {
@@ -646,18 +610,9 @@ impl Document for BaseModel {
                 return Err(invalid(Self::WHAT, format!("weak_excitation: {problem}")));
             }
         }
-        let noise = match (&m.noise_fit, m.weighting) {
-            (None, Weighting::Noise) => Some(
-                "the noise weighting without its noise_fit: the noise the rows were weighted by"
-                    .to_string(),
-            ),
-            (Some(f), w) => f.problem(&m.joint_names).or_else(|| {
-                (w == Weighting::Noise && f.noise.sigma != m.sigma)
-                    .then(|| "the noise weighting with a sigma other than its noise's".to_string())
-            }),
-            (None, _) => None,
-        };
-        if let Some(problem) = noise {
+        if let Some(problem) =
+            super::noise_fit::problem_in_model(&m.noise_fit, m.weighting, &m.sigma, &m.joint_names)
+        {
             return Err(invalid(Self::WHAT, format!("noise_fit: {problem}")));
         }
         if let Some(problem) = (m.position_offsets.as_ref()).and_then(|o| o.problem(&m.joint_names))

@@ -23,8 +23,11 @@
 
 use serde::{Deserialize, Serialize};
 
+use nalgebra::DMatrix;
+
 use super::torque_noise::TorqueNoise;
-use crate::error::shown5;
+use super::{BaseOptions, Weighting};
+use crate::error::{shown5, Error, Result};
 
 /// The chance the noise alone gives a cost beyond which (or below which) a finding is made.
 pub const FALSE_ALARM: f64 = 1e-3;
@@ -147,5 +150,63 @@ impl NoiseFit {
             }
             None
         })
+    }
+}
+
+/// The fit's residuals (RMS `rms` a joint over `k` samples of `nv` joints) against
+/// [`BaseOptions::noise`] where given; for [`Weighting::Noise`], `ls`'s standard errors
+/// replaced by the noise's, `sqrt(c cov_diag)` scaled by [`NoiseFit::scale`]. Errors:
+/// the noise weighting where the noise holds no more independent values than the unknowns.
+pub(super) fn judge(
+    ls: &mut crate::regression::LeastSquares,
+    options: &BaseOptions,
+    rms: &[f64],
+    k: usize,
+    nv: usize,
+) -> Result<Option<NoiseFit>> {
+    let Some(noise) = &options.noise else {
+        return Ok(None);
+    };
+    let unknowns = ls.coef.ncols();
+    let found = NoiseFit::of(noise, rms, k, unknowns);
+    if options.weighting != Weighting::Noise {
+        return Ok(found);
+    }
+    let Some(n) = found else {
+        return Err(Error::InvalidArgument {
+            argument: "noise".into(),
+            message: format!(
+                "the noise holds {} independent values ({k} samples x {nv} joints over a correlation of {} samples), no more than the {unknowns} unknowns: standard errors cannot be had from it; give more samples, or weight otherwise (wls)",
+                crate::error::shown5((k * nv) as f64 / noise.correlation),
+                crate::error::shown5(noise.correlation),
+            ),
+        });
+    };
+    let scale = n.scale();
+    ls.stderr = DMatrix::from_fn(1, unknowns, |_, j| {
+        (noise.correlation * ls.cov_diag[j]).sqrt() * scale
+    });
+    Ok(Some(n))
+}
+
+/// What is wrong with a base-parameter model's `noise_fit` beside its `weighting` and `sigma`
+/// (a document edited by hand); None where nothing: the noise weighting needs its noise, whose
+/// levels are the model's `sigma`.
+pub(super) fn problem_in_model(
+    noise_fit: &Option<NoiseFit>,
+    weighting: Weighting,
+    sigma: &[f64],
+    joints: &[String],
+) -> Option<String> {
+    match (noise_fit, weighting) {
+        (None, Weighting::Noise) => Some(
+            "the noise weighting without its noise_fit: the noise the rows were weighted by"
+                .to_string(),
+        ),
+        (Some(f), w) => f.problem(joints).or_else(|| {
+            (w == Weighting::Noise && f.noise.sigma != sigma)
+                .then(|| "the noise weighting with a sigma other than its noise's".to_string())
+        }),
+        (None, _) => None,
     }
 }

@@ -78,9 +78,14 @@ pub struct PayloadOptions {
     /// base-parameter reference a change of them (a sensor zeroed anew), on the URDF the terms
     /// themselves.
     pub terms: FrictionTerms,
-    /// OLS, or WLS with weights from the per-joint residuals of the OLS fit (default); the
-    /// noise weighting is refused.
+    /// OLS, WLS with weights from the per-joint residuals of the OLS fit (default), or the
+    /// noise weighting by `noise`.
     pub weighting: Weighting,
+    /// The torques' noise measured apart from the fit ([`super::TorqueNoise`]: from a log
+    /// averaged over its excitation's periods): the weights of [`Weighting::Noise`] (which
+    /// needs it, and takes its standard errors from it), and for any weighting the yardstick
+    /// of the residuals ([`PayloadFit::noise_fit`]). Default None.
+    pub noise: Option<super::TorqueNoise>,
     /// Gravity in the torques (default on); a base-parameter reference must agree.
     pub gravity: Gravity,
     /// How the payload's inertia about its centre of mass is taken (default: fitted).
@@ -124,6 +129,7 @@ impl PayloadOptions {
             log_names: vec![],
             consistent: false,
             offset_per_run: false,
+            noise: None,
         }
     }
 }
@@ -293,12 +299,11 @@ pub fn identify_payload(
         crate::torque_model::FOR_A_FIT,
     )?;
     super::runs::check_runs(&options.runs, states.len())?;
-    if options.weighting == Weighting::Noise {
-        return Err(Error::InvalidArgument {
-            argument: "weighting".into(),
-            message: "the noise weighting is not taken by the payload's fit yet: weight from the residuals (wls) or not (ols)".into(),
-        });
-    }
+    let fixed = super::torque_noise::weights(
+        options.weighting,
+        options.noise.as_ref(),
+        &model.joint_names,
+    )?;
     if !(options.log_names.is_empty() || options.log_names.len() == options.runs.len()) {
         return Err(Error::InvalidArgument {
             argument: "log_names".into(),
@@ -433,8 +438,12 @@ pub fn identify_payload(
     let mut sigma = vec![1.0; nv];
     let mut e = estimate(&sigma).map_err(in_context)?;
     let mut rms = factors.residual_rms(&e.theta)?;
-    if options.weighting == Weighting::Wls {
-        sigma = rms.iter().map(|&s| if s > 0.0 { s } else { 1.0 }).collect();
+    let weights = match (options.weighting, fixed) {
+        (Weighting::Wls, _) => Some(rms.iter().map(|&s| if s > 0.0 { s } else { 1.0 }).collect()),
+        (_, fixed) => fixed,
+    };
+    if let Some(weights) = weights {
+        sigma = weights;
         e = estimate(&sigma).map_err(in_context)?;
         rms = factors.residual_rms(&e.theta)?;
     }
@@ -481,12 +490,27 @@ pub fn identify_payload(
     }
     let head = heads;
     let residual_correlation = combine(&factors_of_runs, nv);
-    let inflation = residual_correlation
-        .iter()
-        .fold(1.0f64, |a, &f| a.max(f))
-        .sqrt();
+    let longest = residual_correlation.iter().fold(1.0f64, |a, &f| a.max(f));
+    // the residuals against the noise, where known; the noise weighting's variance the
+    // noise's (with its correlation, or the residuals' longer one), scaled where they exceed it
+    let noise_fit =
+        (options.noise.as_ref()).and_then(|n| super::NoiseFit::of(n, &rms, k, theta.len()));
+    let variance = match (options.weighting, &noise_fit) {
+        (Weighting::Noise, Some(n)) => n.scale().powi(2) * n.noise.correlation.max(longest),
+        (Weighting::Noise, None) => {
+            return Err(Error::InvalidArgument {
+                argument: "noise".into(),
+                message: format!(
+                    "the noise holds no more independent values ({k} samples x {nv} joints over a correlation of {} samples) than the {} unknowns: standard errors cannot be had from it; give more samples, or weight otherwise (wls)",
+                    crate::error::shown5(options.noise.as_ref().map_or(1.0, |n| n.correlation)),
+                    theta.len()
+                ),
+            })
+        }
+        _ => e.variance * longest,
+    };
     // covariance: the fit's (inflated), and the reference's carried through
-    let mut cov = &e.unit_covariance * (e.variance * inflation * inflation);
+    let mut cov = &e.unit_covariance * variance;
     let stderr_of_reference = match reference {
         Reference::Urdf => vec![0.0; m],
         Reference::Model(fit) if fit.correlation.shape() != (p_ref, p_ref) => vec![f64::NAN; m],
@@ -575,6 +599,7 @@ pub fn identify_payload(
         run_checks: vec![],
         findings: vec![],
         log_offsets,
+        noise_fit,
     };
     // the log against the robot's model, as every direct fit checks its log: a torque column
     // in other units, of another sign or joint, and positions beyond the limits (a log in
@@ -600,6 +625,8 @@ pub fn identify_payload(
             f
         }
     };
+    fit.findings
+        .extend((fit.noise_fit.as_ref()).and_then(|n| n.finding(&fit.joint_names)));
     fit.judge(&cov, &pose);
     Ok(fit)
 }

@@ -133,6 +133,11 @@ pub struct PayloadFit {
     /// log's offset less the logs' mean, per joint, with standard errors (the joint terms'
     /// offset is the mean); None otherwise.
     pub log_offsets: Option<super::log_offsets::LogOffsets>,
+    /// The residuals judged against the torques' noise measured apart
+    /// ([`super::PayloadOptions::noise`], [`super::noise_fit`]); beyond it or below, a finding.
+    /// For the noise weighting the standard errors come from it. None without a noise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise_fit: Option<super::NoiseFit>,
 }
 
 impl PayloadFit {

@@ -94,6 +94,14 @@ impl PyPayloadFit {
             })
             .transpose()
     }
+    /// The residuals against the torques' noise measured apart (a dict as
+    /// `BaseParameterModel.noise_fit`), else None.
+    #[getter]
+    fn noise_fit<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        (self.fit.noise_fit.as_ref())
+            .map(|f| super::noise::noise_fit_dict(py, f))
+            .transpose()
+    }
     #[getter]
     fn link(&self) -> &str {
         &self.fit.link
@@ -236,7 +244,9 @@ impl PyPayloadFit {
 /// against the URDF's own parameters, taken as exact. `terms`: the joint terms fitted beside
 /// the payload (None: an offset a joint with a model, viscous, Coulomb and offset without;
 /// or 'all', 'none', a list of 'viscous', 'coulomb', 'offset', 'armature'); `weighting`
-/// 'wls' or 'ols'; `gravity`: whether `tau` includes gravity (as the model's must);
+/// 'wls', 'ols' or 'noise' (by the torques' noise measured apart: `noise=` and
+/// `noise_correlation=` as `identify_base_parameters` takes them, or a Recording's periods;
+/// with a noise the residuals are judged against it, `noise_fit`); `gravity`: whether `tau` includes gravity (as the model's must);
 /// `inertia`: 'fitted' (all ten parameters) or 'point_mass' (the inertia about the centre of
 /// mass taken as 0, the mass and centre alone fitted: for a log that determines a small
 /// payload's inertia loosely or not at all, as poses held still do); `consistent`: a rigid
@@ -247,7 +257,7 @@ impl PyPayloadFit {
 /// torques low-pass filtered. Findings are warned of (`PerturbidWarning`) and kept in
 /// `findings`.
 #[pyfunction]
-#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, *, link, model=None, terms=None, weighting="wls", gravity=true, inertia="fitted", consistent=false, t=None, coulomb=None, offset_per_log=false))]
+#[pyo3(signature = (robot, q, qd=None, qdd=None, tau=None, *, link, model=None, terms=None, weighting="wls", gravity=true, inertia="fitted", consistent=false, t=None, coulomb=None, offset_per_log=false, noise=None, noise_correlation=1.0))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_payload<'py>(
     py: Python<'py>,
@@ -266,6 +276,8 @@ pub(crate) fn identify_payload<'py>(
     t: Option<Bound<'py, PyAny>>,
     coulomb: Option<Bound<'py, PyAny>>,
     offset_per_log: bool,
+    noise: Option<super::arrays::ArrayLike<'py>>,
+    #[pyo3(from_py_with = super::scalars::real)] noise_correlation: f64,
 ) -> PyResult<PyPayloadFit> {
     let robot_model = &robot.model;
     let n = robot_model.nv;
@@ -289,8 +301,21 @@ pub(crate) fn identify_payload<'py>(
         t,
         coulomb,
     };
+    let listed = recordings_given(&q, &given)?;
+    let one = (q.cast::<super::recording::PyRecording>().ok()).map(|r| r.get().rec.clone());
+    let fitted: Vec<&crate::Recording> = match &listed {
+        Some(recs) => recs.iter().map(|r| r.as_ref()).collect(),
+        None => one.iter().map(|r| r.as_ref()).collect(),
+    };
+    options.noise = super::noise::torque_noise(
+        noise,
+        noise_correlation,
+        &fitted,
+        &robot_model.joint_names,
+        options.weighting,
+    )?;
     // a list of Recordings: logs fitted together, each checked alone
-    if let Some(recs) = recordings_given(&q, &given)? {
+    if let Some(recs) = listed {
         let fit = detached(py, "identify_payload", || {
             let (stacked, stacked_options) =
                 stacked_recordings(robot_model, &recs, &Default::default())?;
