@@ -28,12 +28,17 @@ fn simulated(excitation: &std::path::Path, out: &std::path::Path, seed: &str, no
     ]);
 }
 
+/// A 2-harmonic excitation of the A465 designed into `d/exc`: its excitation.json.
+fn excitation_in(d: &std::path::Path) -> std::path::PathBuf {
+    let exc = d.join("exc");
+    excite_a465(&exc, 2);
+    exc.join("excitation.json")
+}
+
 #[test]
 fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_found() {
     let d = tmp("cli-periods");
-    let exc = d.join("exc");
-    excite_a465(&exc, 2);
-    let excitation = exc.join("excitation.json");
+    let excitation = excitation_in(&d);
     let raw = d.join("raw.csv");
     simulated(&excitation, &raw, "3", "0.02");
     // 2.5 s at rest where the excitation starts, before it: the logger ran first
@@ -190,9 +195,7 @@ fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_f
 #[test]
 fn an_averaged_log_is_weighted_by_its_noise() {
     let d = tmp("cli-noise-weighting");
-    let exc = d.join("exc");
-    excite_a465(&exc, 2);
-    let excitation = exc.join("excitation.json");
+    let excitation = excitation_in(&d);
     let log = d.join("log.csv");
     simulated(&excitation, &log, "5", "0.02");
     let model = d.join("model.json");

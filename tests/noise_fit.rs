@@ -82,6 +82,15 @@ fn spread_over_stderr(fits: &[BaseModel]) -> (f64, f64) {
     (ratios[ratios.len() / 2], ratios[ratios.len() - 1])
 }
 
+/// The A465, the test excitation at 100 Hz over 10 s and its torques with [`SIGMA`]'s noise
+/// (seeded by `seed`).
+fn one_log(seed: u64) -> (perturbid_rs::Model, Samples, Vec<f64>) {
+    let model = a465::model("kinsheel2010").unwrap();
+    let traj = a465_excitation(&mut Rng(21));
+    let (s, tau) = noisy(&traj, 100.0, 10.0, seed);
+    (model, s, tau)
+}
+
 fn reduced_cost(f: &BaseModel) -> f64 {
     let n = f.noise_fit.as_ref().unwrap();
     n.cost / n.degrees_of_freedom
@@ -166,9 +175,7 @@ fn with_the_noise_known_the_standard_errors_are_the_spread_of_the_estimates() {
 /// residuals' (within 10 % of the residual-weighted fit's).
 #[test]
 fn a_model_error_is_found_beyond_the_noise() {
-    let model = a465::model("kinsheel2010").unwrap();
-    let traj = a465_excitation(&mut Rng(21));
-    let (s, tau) = noisy(&traj, 100.0, 10.0, 3);
+    let (model, s, tau) = one_log(3);
     let states = States::new(6, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
     let noise = TorqueNoise::white(SIGMA.to_vec());
     for weighting in [Weighting::Noise, Weighting::Wls, Weighting::Ols] {
@@ -199,9 +206,7 @@ fn a_model_error_is_found_beyond_the_noise() {
 /// with too few samples for its correlation, is refused by name; drive gains refuse it.
 #[test]
 fn a_noise_that_cannot_weight_is_refused() {
-    let model = a465::model("kinsheel2010").unwrap();
-    let traj = a465_excitation(&mut Rng(21));
-    let (s, tau) = noisy(&traj, 100.0, 10.0, 3);
+    let (model, s, tau) = one_log(3);
     let states = States::new(6, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
     let fails = |noise: Option<TorqueNoise>, said: &str| {
         let options = viscous_and_coulomb(Weighting::Noise, noise);
@@ -355,9 +360,7 @@ fn a_noise_that_is_not_white_is_said_and_its_correlation_taken_from_the_residual
 /// a document edited to drop it, or to weight by other levels than its noise's, is refused.
 #[test]
 fn the_noise_fit_is_kept_with_the_model_and_checked_on_load() {
-    let model = a465::model("kinsheel2010").unwrap();
-    let traj = a465_excitation(&mut Rng(21));
-    let (s, tau) = noisy(&traj, 100.0, 10.0, 3);
+    let (model, s, tau) = one_log(3);
     let states = States::new(6, &s.q, Some(&s.qd), Some(&s.qdd)).unwrap();
     let options = viscous_and_coulomb(Weighting::Noise, Some(TorqueNoise::white(SIGMA.to_vec())));
     let fit = identify_base_parameters(&model, &states, &tau, &options).unwrap();

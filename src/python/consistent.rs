@@ -192,17 +192,8 @@ pub(crate) fn identify_consistent_parameters<'py>(
             .map(|r| vec![r.get().rec.clone()])
             .unwrap_or_default(),
     };
-    let fitted: Vec<&crate::Recording> = recs.iter().map(|r| r.as_ref()).collect();
-    let options = crate::direct::BaseOptions {
-        noise: super::noise::torque_noise(
-            noise,
-            noise_correlation,
-            &fitted,
-            &model.joint_names,
-            options.weighting,
-        )?,
-        ..options
-    };
+    let options =
+        super::noise::with_noise(options, noise, noise_correlation, &recs, &model.joint_names)?;
     let findings = |c: ConsistentFit| -> ConsistentFit {
         // a list's in `logs`, as identify_base_parameters keeps them
         let keep = |m: crate::direct::BaseModel| match (&listed, recs.as_slice()) {

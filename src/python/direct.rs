@@ -711,20 +711,16 @@ pub(crate) fn identify_base_parameters<'py>(
         offset_per_log,
         listed.as_ref().map(Vec::len),
     )?;
-    let fitted: Vec<&crate::Recording> = match &listed {
-        Some(recs) => recs.iter().map(|r| r.as_ref()).collect(),
-        None => recording.iter().map(|r| r.as_ref()).collect(),
-    };
-    let options = BaseOptions {
-        noise: super::noise::torque_noise(
-            noise,
-            noise_correlation,
-            &fitted,
-            &model.joint_names,
-            options.weighting,
-        )?,
-        ..options
-    };
+    let fitted = listed
+        .clone()
+        .unwrap_or_else(|| recording.iter().cloned().collect());
+    let options = super::noise::with_noise(
+        options,
+        noise,
+        noise_correlation,
+        &fitted,
+        &model.joint_names,
+    )?;
     if let Some(recs) = listed {
         let fit = detached(py, "identify_base_parameters", || {
             let (stacked, options) = stacked_recordings(model, &recs, &options)?;

@@ -8,6 +8,7 @@ use super::arrays::ArrayLike;
 use crate::direct::{NoiseFit, TorqueNoise, Weighting};
 use crate::error::Error;
 use crate::Recording;
+use std::sync::Arc;
 
 /// The noise a direct fit takes ([`crate::direct::BaseOptions::noise`]): `noise` ((n,), N m a
 /// joint) with `correlation` (samples an independent value, 1 for white noise) where given;
@@ -18,7 +19,7 @@ use crate::Recording;
 pub(crate) fn torque_noise(
     noise: Option<ArrayLike<'_>>,
     correlation: f64,
-    recordings: &[&Recording],
+    recordings: &[Arc<Recording>],
     joints: &[String],
     weighting: Weighting,
 ) -> PyResult<Option<TorqueNoise>> {
@@ -56,6 +57,19 @@ pub(crate) fn torque_noise(
         joints,
         weighting == Weighting::Noise,
     )?)
+}
+
+/// `options` with the noise [`torque_noise`] finds for them (`noise`, `correlation`, the
+/// Recordings fitted and the robot's `joints`).
+pub(crate) fn with_noise(
+    options: crate::direct::BaseOptions,
+    noise: Option<ArrayLike<'_>>,
+    correlation: f64,
+    recordings: &[Arc<Recording>],
+    joints: &[String],
+) -> PyResult<crate::direct::BaseOptions> {
+    let noise = torque_noise(noise, correlation, recordings, joints, options.weighting)?;
+    Ok(crate::direct::BaseOptions { noise, ..options })
 }
 
 /// A fit's residuals against the noise as a dict (`BaseParameterModel.noise_fit`).

@@ -303,10 +303,9 @@ pub(crate) fn identify_payload<'py>(
     };
     let listed = recordings_given(&q, &given)?;
     let one = (q.cast::<super::recording::PyRecording>().ok()).map(|r| r.get().rec.clone());
-    let fitted: Vec<&crate::Recording> = match &listed {
-        Some(recs) => recs.iter().map(|r| r.as_ref()).collect(),
-        None => one.iter().map(|r| r.as_ref()).collect(),
-    };
+    let fitted = listed
+        .clone()
+        .unwrap_or_else(|| one.iter().cloned().collect());
     options.noise = super::noise::torque_noise(
         noise,
         noise_correlation,
