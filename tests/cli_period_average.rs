@@ -106,7 +106,7 @@ fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_f
     }
     // the model validated on the log averaged alike
     let validation = d.join("validation");
-    let out = ok(&[
+    let base = [
         "validate",
         s(&model),
         s(&path),
@@ -114,11 +114,12 @@ fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_f
         "a465",
         "--out",
         s(&validation),
-        "--average-periods",
-        s(&excitation),
-        "--decimate",
-        "5",
-    ]);
+    ];
+    let out = ok(&[
+        &base[..],
+        &["--average-periods", s(&excitation), "--decimate", "5"],
+    ]
+    .concat());
     assert!(out.contains("averaged over 4 periods"), "{out}");
     assert!(
         out.contains("RMS over the averaged torques' noise, a joint: "),
@@ -130,36 +131,24 @@ fn a_log_is_averaged_over_its_excitations_periods_and_the_model_keeps_what_was_f
     );
     // periods given by hand, from the start found
     let out = ok(&[
-        "validate",
-        s(&model),
-        s(&path),
-        "--robot",
-        "a465",
-        "--out",
-        s(&validation),
-        "--period",
-        "10",
-        "--period-harmonics",
-        "5",
-        "--period-start",
-        "2.5",
-        "--skip-periods",
-        "1",
-    ]);
+        &base[..],
+        &[
+            "--period",
+            "10",
+            "--period-harmonics",
+            "5",
+            "--period-start",
+            "2.5",
+            "--skip-periods",
+            "1",
+        ],
+    ]
+    .concat());
     assert!(
         out.contains("averaged over 3 periods of 10 s from t = 12.5 s"),
         "{out}"
     );
     // what does not go together
-    let base = [
-        "validate",
-        s(&model),
-        s(&path),
-        "--robot",
-        "a465",
-        "--out",
-        s(&validation),
-    ];
     for (extra, says) in [
         (
             vec!["--average-periods", s(&excitation), "--period", "10"],
