@@ -1062,6 +1062,10 @@ def identify_consistent_parameters(
 class Validation:
     """A model's torques against measured ones, per joint."""
     @property
+    def noise_fit(self) -> dict[str, Any] | None:
+        """For a Recording averaged over its periods, the errors against the noise they
+        measured (as BaseParameterModel.noise_fit); None otherwise."""
+    @property
     def joints(self) -> list[str]: ...
     @property
     def rms(self) -> NDArray[np.float64]: ...

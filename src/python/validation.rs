@@ -32,7 +32,8 @@ use crate::validation::{stored_stderr, validate as validate_rs, Validation};
 /// BaseParameterModel: the joints' zero offsets of this data against its parameters, held; a
 /// dict as `BaseParameterModel.position_offsets`; None otherwise), `extrapolation` (for a
 /// LocalModel, where the states go beyond the region it was identified over; None
-/// otherwise). `to_dataframe()`: the
+/// otherwise), `noise_fit` (for a Recording averaged over its periods, the errors against the
+/// noise they measured; None otherwise). `to_dataframe()`: the
 /// per-joint table (pandas).
 #[pyclass(name = "Validation", module = "perturbid_rs", frozen)]
 pub(crate) struct PyValidation {
@@ -43,10 +44,20 @@ pub(crate) struct PyValidation {
     position_range: Vec<JointRange>,
     position_offsets: Option<PositionOffsets>,
     extrapolation: Option<Extrapolation>,
+    noise_fit: Option<crate::direct::NoiseFit>,
 }
 
 #[pymethods]
 impl PyValidation {
+    /// For a Recording averaged over its excitation's periods: the errors judged against the
+    /// noise its periods measured (a dict as `BaseParameterModel.noise_fit`, no parameters
+    /// fitted to these samples; the model's own uncertainty not counted); None otherwise.
+    #[getter]
+    fn noise_fit<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, pyo3::types::PyDict>>> {
+        (self.noise_fit.as_ref())
+            .map(|f| super::noise::noise_fit_dict(py, f))
+            .transpose()
+    }
     #[getter]
     fn joints(&self) -> Vec<String> {
         self.v.joints.iter().map(|j| j.joint.clone()).collect()
@@ -230,6 +241,8 @@ pub(crate) fn validate<'py>(
         t,
         coulomb,
     };
+    let averaged = (q.cast::<super::recording::PyRecording>().ok())
+        .and_then(|r| r.get().rec.period_average.clone());
     let s = super::samples::samples(q, given, true, true)?;
     // a recording's own Coulomb column goes to a base-parameter model only
     let s = super::samples::Samples {
@@ -353,6 +366,10 @@ pub(crate) fn validate<'py>(
     if let Some(se) = &stderr {
         v = v.with_model_stderr(se)?;
     }
+    let rms: Vec<f64> = v.joints.iter().map(|j| j.rms).collect();
+    let noise_fit = (averaged.as_ref())
+        .and_then(|a| a.torque_noise(&joints).ok())
+        .and_then(|noise| crate::direct::NoiseFit::of(&noise, &rms, v.samples, 0));
     Ok(PyValidation {
         v,
         n,
@@ -361,5 +378,6 @@ pub(crate) fn validate<'py>(
         position_range,
         position_offsets,
         extrapolation,
+        noise_fit,
     })
 }

@@ -59,6 +59,16 @@ def test_an_averaged_recording_is_weighted_by_the_noise_its_periods_measured():
     # the residuals' weighting: the noise judges them still, its weights are its own
     wls = pr.identify_base_parameters(robot, out)
     assert wls.noise_fit is not None and not np.array_equal(wls.sigma, fit.sigma)
+    # validated on another log averaged alike: its errors against its own periods' noise
+    other = pr.simulate(robot, traj, periods=4, rate=RATE, friction=None, torque_noise=0.02, seed=9)
+    held = pr.preprocess(other.t, other.q, other.tau, excitation=traj, rate=RATE, decimate=5)
+    v = pr.validate(fit, held)
+    g = v.noise_fit
+    errors = (held.tau - fit.predict(held)) / np.asarray(g["noise"])
+    assert g["cost"] == pytest.approx((errors**2).sum() / g["correlation"], rel=1e-9)
+    assert g["degrees_of_freedom"] == pytest.approx(1000 * 6 / g["correlation"], rel=1e-12)
+    assert 1e-3 < g["p_value"] < 1 - 1e-3, g
+    assert pr.validate(fit, held.q, held.qd, held.qdd, held.tau).noise_fit is None
 
 
 def test_arrays_are_weighted_by_the_noise_given_and_a_model_error_found():

@@ -67,24 +67,55 @@ def test_the_ten_parameters_are_pinocchios_of_the_payload(a465):
     assert doc["payload"]["mass"] == p["mass"]
 
 
-def test_the_fit_is_numpys_least_squares_over_pinocchios_regressor(a465):
-    """OLS over [Y_payload | viscous] of the torques less the robot alone's, built whole."""
-    pair, loaded = a465
-    t, q, qd, qdd, tau = log(loaded, 5, noise=0.05)
-    fit = pr.identify_payload(pair.ours, q, qd, qdd, tau, link="link6", terms="viscous",
-                              weighting="ols")
+def pin_system(pair, q, qd, qdd, tau):
+    """[Y_payload | viscous] over the samples (Pinocchio's regressor, rows sample by sample,
+    joint by joint) and the torques less the robot alone's."""
     data = pair.model.createData()
     jid = pair.model.getJointId("joint6")
     rows, rhs = [], []
     alone = pin_torques(pair.model, q, qd, qdd)
-    for s in range(len(t)):
+    for s in range(len(q)):
         y = pin.computeJointTorqueRegressor(pair.model, data, q[s], qd[s], qdd[s])
         x = np.zeros((6, 16))
         x[:, :10] = y[:, 10 * (jid - 1):10 * jid]
         x[:, 10:] = np.diag(qd[s])
         rows.append(x)
         rhs.append(tau[s] - alone[s])
-    x, b = np.vstack(rows), np.concatenate(rhs)
+    return np.vstack(rows), np.concatenate(rhs)
+
+
+def test_the_noise_weighting_is_numpys_weighted_least_squares_with_the_noises_errors(a465):
+    """Rows of joint j over its noise level sigma_j: numpy's least squares of the weighted
+    system, and standard errors of (X_w^T X_w)^-1 (scaled by one factor of at least 1: the
+    residuals' cost over its degrees of freedom, or their correlation, where beyond 1)."""
+    pair, loaded = a465
+    t, q, qd, qdd, tau = log(loaded, 5)
+    sigma = np.array([0.05, 0.2, 0.1, 0.02, 0.03, 0.01])
+    tau = tau + sigma * np.random.default_rng(12).standard_normal(tau.shape)
+    fit = pr.identify_payload(pair.ours, q, qd, qdd, tau, link="link6", terms="viscous",
+                              weighting="noise", noise=sigma)
+    x, b = pin_system(pair, q, qd, qdd, tau)
+    w = np.tile(1 / sigma, len(q))
+    theta, *_ = np.linalg.lstsq(x * w[:, None], b * w, rcond=None)
+    assert np.allclose(fit.theta, theta, rtol=1e-8, atol=1e-10)
+    np.testing.assert_array_equal(fit.sigma, sigma)
+    known = np.sqrt(np.diag(np.linalg.inv((x * w[:, None]).T @ (x * w[:, None]))))
+    ratio = np.asarray(fit.stderr) / known
+    assert np.allclose(ratio, ratio[0], rtol=1e-6) and 1 - 1e-9 < ratio[0] < 1.2, ratio
+    f = fit.noise_fit
+    r = ((b - x @ theta) * w).reshape(-1, 6)
+    assert f["cost"] == pytest.approx((r**2).sum(), rel=1e-8)
+    assert f["degrees_of_freedom"] == len(b) - len(theta)
+    assert 1e-3 < f["p_value"] < 1 - 1e-3
+
+
+def test_the_fit_is_numpys_least_squares_over_pinocchios_regressor(a465):
+    """OLS over [Y_payload | viscous] of the torques less the robot alone's, built whole."""
+    pair, loaded = a465
+    t, q, qd, qdd, tau = log(loaded, 5, noise=0.05)
+    fit = pr.identify_payload(pair.ours, q, qd, qdd, tau, link="link6", terms="viscous",
+                              weighting="ols")
+    x, b = pin_system(pair, q, qd, qdd, tau)
     theta, *_ = np.linalg.lstsq(x, b, rcond=None)
     assert np.allclose(fit.theta, theta, rtol=1e-8, atol=1e-10)
     r = (b - x @ theta).reshape(-1, 6)
