@@ -107,7 +107,7 @@ impl NoiseFit {
         };
         if self.p_value < FALSE_ALARM {
             return Some(format!(
-                "the residuals exceed the torques' noise (cost over its {} degrees of freedom {reduced}, a chance of {} from noise alone): the model lacks an effect the robot has (friction of another form, a flexible joint or drive, a torque lag, a payload), or the noise measured is too low. Residual over noise, a joint: {}; the model's own error (N m): {}",
+                "the residuals exceed the torques' noise (cost over its {} degrees of freedom {reduced}, a chance of {} from noise alone): the model lacks an effect the robot has (friction of another form, a flexible joint or drive, a torque lag, a payload), the states are noisy enough to count (the positions' noise through the velocities and accelerations, which the torques' noise does not hold), or the noise measured is too low. Residual over noise, a joint: {}; the model's own error (N m): {}",
                 shown5(self.degrees_of_freedom),
                 shown5(self.p_value),
                 list(&self.ratio),
