@@ -51,10 +51,32 @@ pub(crate) fn real_or_none(obj: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
     or_none(obj, real)
 }
 
+/// An unsigned integer as pyo3 extracts it, with a negative or too large integer refused as
+/// a `TypeError` saying so (pyo3's own `OverflowError` names neither the argument nor the
+/// value).
+fn unsigned(obj: &Bound<'_, PyAny>, expected: &str) -> PyResult<u64> {
+    not_bool(obj, expected)?;
+    obj.extract::<u64>().map_err(|e| {
+        if !e.is_instance_of::<pyo3::exceptions::PyOverflowError>(obj.py()) {
+            return e;
+        }
+        let shown = obj.str().map(|s| s.to_string()).unwrap_or_default();
+        let why = match obj.lt(0) {
+            Ok(true) => "a negative one",
+            _ => "one too large",
+        };
+        PyTypeError::new_err(format!("expected {expected}, got {why} ({shown})"))
+    })
+}
+
 /// A non-negative integer (`usize`): `int` or a numpy integer, not a `bool` nor a `float`.
 pub(crate) fn count(obj: &Bound<'_, PyAny>) -> PyResult<usize> {
-    not_bool(obj, "a non-negative integer")?;
-    obj.extract()
+    let n = unsigned(obj, "a non-negative integer")?;
+    usize::try_from(n).map_err(|_| {
+        PyTypeError::new_err(format!(
+            "expected a non-negative integer, got one too large ({n})"
+        ))
+    })
 }
 
 /// A non-negative integer or `None`.
@@ -64,6 +86,5 @@ pub(crate) fn count_or_none(obj: &Bound<'_, PyAny>) -> PyResult<Option<usize>> {
 
 /// A random seed (`u64`): a non-negative integer, not a `bool`.
 pub(crate) fn seed(obj: &Bound<'_, PyAny>) -> PyResult<u64> {
-    not_bool(obj, "a non-negative integer seed")?;
-    obj.extract()
+    unsigned(obj, "a non-negative integer seed")
 }

@@ -242,6 +242,13 @@ def test_scalar_arguments_refuse_bools(robot):
             with pytest.raises(TypeError, match=r"expected (a real number|a non-negative integer).*got a bool") as e:
                 call(value)
             assert any(name in note for note in getattr(e.value, "__notes__", [])), (name, e.value)
+    # counts and seeds below 0 or past 2^64: said so and named (pyo3 alone raised an
+    # OverflowError naming neither)
+    for name in ("n", "seed", "harmonics", "order", "count"):
+        for value, said in ((-1, "a negative one"), (np.int64(-3), "a negative one"), (2**70, "one too large")):
+            with pytest.raises(TypeError, match=f"expected a non-negative integer.*got {said}") as e:
+                calls[name](value)
+            assert any(name in note for note in getattr(e.value, "__notes__", [])), (name, e.value)
 
 
 def test_masked_arrays_are_refused_not_read_through(robot):
