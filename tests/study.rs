@@ -335,3 +335,55 @@ fn true_robots_sweep_over_their_parameters() {
     let e = bad("{ \"seed\" = [] }");
     assert!(e.contains("'seed' has no values"), "{e}");
 }
+
+/// The averaged direct method (Swevers' way) on a true robot with friction, a payload, torque
+/// noise and encoder counts: it fits, its linearisation at the point about as close to the
+/// plant's as the filtered log's by WLS on the reference states, and within one excitation
+/// period it fails alone, saying why.
+#[test]
+fn the_averaged_direct_method_runs_on_a_noisy_robot_and_fails_alone_on_one_period() {
+    let d = tmp("averaged");
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/a465_true_robot.json"),
+        d.join("robot.json"),
+    )
+    .unwrap();
+    let config = |periods: u32| {
+        STUDY
+            .replace(
+                r#"methods = ["local_separated", "direct_ols", "global_linear"]"#,
+                r#"methods = ["direct_wls", "direct_averaged"]"#,
+            )
+            .replace("seeds = 2", "seeds = 1")
+            .replace("periods = 1", &format!("periods = {periods}"))
+            + "\n[[true_robots]]\nname = \"noisy\"\nfile = \"robot.json\"\n"
+    };
+    for (periods, fits) in [(3, true), (1, false)] {
+        let text = config(periods);
+        let config: StudyConfig = perturbid_rs::io::config::parse_toml("s.toml", &text).unwrap();
+        let s = Study::resolve(config, &d, "s.toml").unwrap();
+        let out = d.join(format!("out{periods}"));
+        run_study(&s, &out, &mut |_, _| {}).unwrap();
+        let csv = read(&out.join("results.csv"));
+        let v = values(&csv, 0);
+        let get = |m: &str, k: &str| {
+            v.iter()
+                .find(|x| x.0 == m && x.1 == k && x.2.is_empty())
+                .map(|x| x.3)
+        };
+        match fits {
+            true => {
+                let (avg, wls) = (get("direct_averaged", "D_rel"), get("direct_wls", "D_rel"));
+                let (avg, wls) = (avg.expect("averaged D_rel"), wls.expect("WLS D_rel"));
+                assert!(avg < 2.0 * wls + 0.01, "averaged {avg}, WLS {wls}");
+            }
+            false => {
+                assert_eq!(get("direct_averaged", "failed"), Some(1.0), "{v:?}");
+                assert!(
+                    csv.contains("at least 2 are needed to average them"),
+                    "{csv}"
+                );
+            }
+        }
+    }
+}

@@ -116,10 +116,15 @@ pub fn run_case(study: &Study, index: usize) -> Result<CaseResult> {
             Err(e) => out.push(failed(method, &e)),
         }
     }
-    let direct: Vec<Method> = [Method::DirectOls, Method::DirectWls, Method::GlobalLinear]
-        .into_iter()
-        .filter(|m| methods.contains(m))
-        .collect();
+    let direct: Vec<Method> = [
+        Method::DirectOls,
+        Method::DirectWls,
+        Method::DirectAveraged,
+        Method::GlobalLinear,
+    ]
+    .into_iter()
+    .filter(|m| methods.contains(m))
+    .collect();
     if !direct.is_empty() {
         match direct_models(study, &case, &model, &plant, &op, local_time) {
             Ok(models) => {
@@ -265,18 +270,60 @@ fn direct_models(
                 ..BaseOptions::default()
             },
         );
-        let boxed = fit.map(|fit| {
-            Box::new(OwnedBase {
-                fit,
-                model: model.clone(),
-            }) as Box<dyn TorqueModel>
-        });
-        out.push((method, boxed, time));
+        out.push((method, owned(fit, model), time));
     }
+    let averaged = averaged_fit(study, case, model, &design.trajectory, &rec, gravity);
+    out.push((Method::DirectAveraged, owned(averaged, model), time));
     let global =
         identify_global_linear(op, &states, &rec.tau).map(|g| Box::new(g) as Box<dyn TorqueModel>);
     out.push((Method::GlobalLinear, global, time));
     Ok(out)
+}
+
+/// A fit's base-parameter model with its robot, as a [`TorqueModel`].
+fn owned(fit: Result<crate::direct::BaseModel>, model: &Model) -> Result<Box<dyn TorqueModel>> {
+    fit.map(|fit| {
+        Box::new(OwnedBase {
+            fit,
+            model: model.clone(),
+        }) as Box<dyn TorqueModel>
+    })
+}
+
+/// [`Method::DirectAveraged`]: the excitation's log `rec` averaged over the whole periods of
+/// `trajectory` (at the log's rate, the torques' band to the preprocessing's default 10 Hz),
+/// the base parameters weighted by the noise the periods measured, or by the residuals where
+/// they measured none.
+fn averaged_fit(
+    study: &Study,
+    case: &Case,
+    model: &Model,
+    trajectory: &crate::trajectory::FourierTrajectory,
+    rec: &crate::Recording,
+    gravity: Gravity,
+) -> Result<crate::direct::BaseModel> {
+    let options = crate::preprocess::PreprocessOptions {
+        rate: study.config.direct.rate,
+        decimate: 1,
+        periods: Some(crate::period_average::PeriodOptions::new(
+            trajectory.period(),
+            trajectory.harmonics(),
+        )),
+        ..crate::preprocess::PreprocessOptions::default()
+    };
+    let avg = crate::preprocess::preprocess(rec, &options)?;
+    let noise = (avg.period_average.as_ref()).and_then(|a| a.torque_noise(&model.joint_names).ok());
+    let options = BaseOptions {
+        weighting: match noise {
+            Some(_) => Weighting::Noise,
+            None => Weighting::Wls,
+        },
+        noise,
+        gravity,
+        seed: case.seed,
+        ..BaseOptions::default()
+    };
+    Ok(identify_base_parameters(model, &avg.states()?, &avg.tau, &options)?.with_findings_of(&avg))
 }
 
 /// A base-parameter model with its robot, as a [`TorqueModel`].

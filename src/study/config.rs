@@ -253,6 +253,12 @@ choice! {
         DirectOls = "direct_ols",
         /// The same by weighted least squares.
         DirectWls = "direct_wls",
+        /// Swevers' way: the excitation's log averaged over its whole periods (the measured
+        /// positions' harmonics and their derivatives, the torques' band, no filter), the
+        /// base parameters weighted by the noise the periods measured (by the residuals where
+        /// they measured none, as on a robot without noise). Fails alone where the log holds
+        /// fewer than 2 whole periods.
+        DirectAveraged = "direct_averaged",
         /// The direct method's globally linearised model about P.
         GlobalLinear = "global_linear",
     }
