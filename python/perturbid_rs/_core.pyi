@@ -661,6 +661,9 @@ class ExcitationDesign:
 @final
 class BaseParameterModel:
     @property
+    def joint_names(self) -> list[str]:
+        """The robot's joints the model is of, in its columns' order."""
+    @property
     def theta_base(self) -> NDArray[np.float64]: ...
     @property
     def stderr(self) -> NDArray[np.float64]: ...
@@ -914,6 +917,9 @@ class PayloadFit:
     @property
     def noise_fit(self) -> dict[str, Any] | None:
         """The residuals against the torques' noise measured apart, as BaseParameterModel.noise_fit."""
+    @property
+    def joint_names(self) -> list[str]:
+        """The robot's joints, in the columns' order."""
     @property
     def link(self) -> str: ...
     @property

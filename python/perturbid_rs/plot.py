@@ -11,7 +11,7 @@ from typing import Any, Optional, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["measured_and_predicted", "residuals"]
+__all__ = ["measured_and_predicted", "noise_fit", "residuals"]
 
 
 def _pyplot() -> Any:
@@ -75,5 +75,38 @@ def residuals(validation: Any, t: Optional[ArrayLike] = None) -> Any:
         ax.set_ylabel(f"{validation.joints[j]}\n(N m)")
     axes[0, 0].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     axes[-1, 0].set_xlabel("t (s)" if t is not None else "sample")
+    fig.tight_layout()
+    return fig
+
+
+def noise_fit(fitted: Any, joints: Optional[Sequence[str]] = None) -> Any:
+    """A fit's (or a validation's) residuals against the torques' noise measured apart, per
+    joint: the residual RMS (blue) beside the noise level (grey) in N m, the model's own error
+    ``sqrt(max(r^2 - noise^2, 0))`` marked (red), and the cost over its degrees of freedom with
+    its chance from noise alone in the title. ``fitted``: anything with a ``noise_fit`` dict (a
+    BaseParameterModel, PayloadFit or Validation); ``joints`` names the bars (the fit's
+    ``joint_names`` or ``joints`` when omitted)."""
+    plt = _pyplot()
+    f = getattr(fitted, "noise_fit", None)
+    if f is None:
+        raise ValueError("no noise_fit: the fit was given no noise (noise=, or a Recording averaged over its periods)")
+    noise = np.asarray(f["noise"], dtype=float)
+    rms = np.asarray(f["ratio"], dtype=float) * noise
+    error = np.asarray(f["model_error"], dtype=float)
+    names = list(joints) if joints is not None else list(
+        getattr(fitted, "joint_names", None) or getattr(fitted, "joints", None) or [f"joint {j + 1}" for j in range(len(noise))]
+    )
+    if len(names) != len(noise):
+        raise ValueError(f"{len(names)} joint names for {len(noise)} joints")
+    x = np.arange(len(noise))
+    fig, ax = plt.subplots(figsize=(max(6, 1.2 * len(noise)), 3.5))
+    ax.bar(x - 0.2, noise, 0.4, color="0.6", label="noise")
+    ax.bar(x + 0.2, rms, 0.4, color="tab:blue", label="residual RMS")
+    ax.plot(x + 0.2, error, "_", color="tab:red", ms=18, mew=2, label="model's own error")
+    ax.set_xticks(x, names)
+    ax.set_ylabel("N m")
+    ax.set_title(f"cost over {f['degrees_of_freedom']:.0f} degrees of freedom: {f['cost'] / f['degrees_of_freedom']:.3g} "
+                 f"(1 for noise alone), chance {f['p_value']:.3g}")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     fig.tight_layout()
     return fig

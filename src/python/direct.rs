@@ -490,6 +490,11 @@ impl PyBaseModel {
     fn position_range<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         position_range_dicts(py, &self.fit.position_range)
     }
+    /// The robot's joints the model is of, in its columns' order (as `Robot.joint_names`).
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        self.fit.joint_names.clone()
+    }
     #[getter]
     fn cond(&self) -> f64 {
         self.fit.cond

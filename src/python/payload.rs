@@ -102,6 +102,11 @@ impl PyPayloadFit {
             .map(|f| super::noise::noise_fit_dict(py, f))
             .transpose()
     }
+    /// The robot's joints, in the columns' order of `sigma`, `residual_rms` and the others.
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        self.fit.joint_names.clone()
+    }
     #[getter]
     fn link(&self) -> &str {
         &self.fit.link

@@ -69,6 +69,20 @@ def test_an_averaged_recording_is_weighted_by_the_noise_its_periods_measured():
     assert g["degrees_of_freedom"] == pytest.approx(1000 * 6 / g["correlation"], rel=1e-12)
     assert 1e-3 < g["p_value"] < 1 - 1e-3, g
     assert pr.validate(fit, held.q, held.qd, held.qdd, held.tau).noise_fit is None
+    # drawn for a notebook: the noise and the residuals a joint, their ratio in the title
+    import matplotlib
+    matplotlib.use("Agg")
+    from perturbid_rs import plot
+    fig = plot.noise_fit(fit)
+    (ax,) = fig.axes
+    heights = [p.get_height() for p in ax.patches]
+    np.testing.assert_allclose(heights[:6], f["noise"], rtol=1e-12)
+    np.testing.assert_allclose(heights[6:], np.asarray(f["ratio"]) * f["noise"], rtol=1e-12)
+    assert [t.get_text() for t in ax.get_xticklabels()] == fit.joint_names
+    assert f"{f['cost'] / f['degrees_of_freedom']:.3g}" in ax.get_title()
+    assert len(plot.noise_fit(v).axes) == 1
+    with pytest.raises(ValueError, match="no noise_fit"):
+        plot.noise_fit(pr.validate(fit, held.q, held.qd, held.qdd, held.tau))
 
 
 def test_arrays_are_weighted_by_the_noise_given_and_a_model_error_found():
