@@ -245,6 +245,11 @@ fn a_noise_that_cannot_weight_is_refused() {
         }),
         "12 independent values",
     );
+    // residuals of 1e202 noise levels: a cost past f64's range is no judgement
+    fails(
+        Some(TorqueNoise::white(vec![1e-200; 6])),
+        "the residuals are too large against the noise",
+    );
 }
 
 /// 24 logs of 4 periods of the excitation at 200 Hz with noise filtered by `a` ([`coloured`]),

@@ -54,7 +54,8 @@ pub struct NoiseFit {
 impl NoiseFit {
     /// The residuals of a fit of `unknowns` unknowns to `samples` samples, their RMS `rms` a
     /// joint (N m), against `noise` (checked already: one level a joint). None where the noise
-    /// holds no more independent values than there are unknowns.
+    /// holds no more independent values than there are unknowns, or where the residuals are
+    /// too large against it for their cost to stay within f64's range ([`Self::why_not`]).
     pub fn of(noise: &TorqueNoise, rms: &[f64], samples: usize, unknowns: usize) -> Option<Self> {
         let c = noise.correlation;
         let dof = (samples * rms.len()) as f64 / c - unknowns as f64;
@@ -63,6 +64,9 @@ impl NoiseFit {
         }
         let ratio: Vec<f64> = (rms.iter().zip(&noise.sigma)).map(|(r, s)| r / s).collect();
         let cost = ratio.iter().map(|x| x * x).sum::<f64>() * samples as f64 / c;
+        if !cost.is_finite() {
+            return None;
+        }
         let p_value = match noise.degrees_of_freedom {
             Some(d2) => crate::student_t::f_upper_tail(cost / dof, dof, d2),
             None => crate::student_t::chi_square_upper_tail(cost, dof),
@@ -77,6 +81,20 @@ impl NoiseFit {
             degrees_of_freedom: dof,
             p_value,
         })
+    }
+
+    /// Why [`Self::of`] gave no judgement for these arguments, in words: too few independent
+    /// noise values for the unknowns, or residuals too large against the noise.
+    pub fn why_not(noise: &TorqueNoise, samples: usize, joints: usize, unknowns: usize) -> String {
+        let values = (samples * joints) as f64 / noise.correlation;
+        match values - unknowns as f64 >= 1.0 {
+            true => "the residuals are too large against the noise for their cost to stay within f64's range (a noise level far too small, or torques in other units)".into(),
+            false => format!(
+                "the noise holds {} independent values ({samples} samples x {joints} joints over a correlation of {} samples), no more than the {unknowns} unknowns",
+                shown5(values),
+                shown5(noise.correlation)
+            ),
+        }
     }
 
     /// `sqrt(max(V / dof, 1))`: what the noise's standard errors are scaled by.
@@ -176,9 +194,8 @@ pub(super) fn judge(
         return Err(Error::InvalidArgument {
             argument: "noise".into(),
             message: format!(
-                "the noise holds {} independent values ({k} samples x {nv} joints over a correlation of {} samples), no more than the {unknowns} unknowns: standard errors cannot be had from it; give more samples, or weight otherwise (wls)",
-                crate::error::shown5((k * nv) as f64 / noise.correlation),
-                crate::error::shown5(noise.correlation),
+                "{}: standard errors cannot be had from it; give more samples, or weight otherwise (wls)",
+                NoiseFit::why_not(noise, k, nv, unknowns)
             ),
         });
     };

@@ -495,17 +495,16 @@ pub fn identify_payload(
     // noise's (with its correlation, or the residuals' longer one), scaled where they exceed it
     let noise_fit =
         (options.noise.as_ref()).and_then(|n| super::NoiseFit::of(n, &rms, k, theta.len()));
-    let variance = match (options.weighting, &noise_fit) {
-        (Weighting::Noise, Some(n)) => n.scale().powi(2) * n.noise.correlation.max(longest),
-        (Weighting::Noise, None) => {
+    let variance = match (options.weighting, &noise_fit, &options.noise) {
+        (Weighting::Noise, Some(n), _) => n.scale().powi(2) * n.noise.correlation.max(longest),
+        (Weighting::Noise, None, Some(noise)) => {
             return Err(Error::InvalidArgument {
                 argument: "noise".into(),
                 message: format!(
-                    "the noise holds no more independent values ({k} samples x {nv} joints over a correlation of {} samples) than the {} unknowns: standard errors cannot be had from it; give more samples, or weight otherwise (wls)",
-                    crate::error::shown5(options.noise.as_ref().map_or(1.0, |n| n.correlation)),
-                    theta.len()
+                    "{}: standard errors cannot be had from it; give more samples, or weight otherwise (wls)",
+                    super::NoiseFit::why_not(noise, k, nv, theta.len())
                 ),
-            })
+            });
         }
         _ => e.variance * longest,
     };
