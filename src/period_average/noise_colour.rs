@@ -83,7 +83,7 @@ pub fn finding(
                 true => crate::student_t::f_upper_tail(t, d_low, d_high),
                 false => crate::student_t::f_upper_tail(1.0 / t, d_high, d_low),
             };
-            let beyond = t > TILT || t < 1.0 / TILT;
+            let beyond = !(1.0 / TILT..=TILT).contains(&t);
             (beyond && chance < FALSE_ALARM).then(|| {
                 let name = joints
                     .get(j)
