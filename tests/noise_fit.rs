@@ -250,6 +250,15 @@ fn a_noise_that_cannot_weight_is_refused() {
         Some(TorqueNoise::white(vec![1e-200; 6])),
         "the residuals are too large against the noise",
     );
+    // drive gains: their torques are the gains times a signal, whose noise is not known first
+    let logs = common::gain_logs::logs(1e-3, true);
+    let options = viscous_and_coulomb(Weighting::Noise, Some(TorqueNoise::white(SIGMA.to_vec())));
+    match perturbid_rs::direct::identify_drive_gains(&logs.truth, &logs.runs(), &options) {
+        Err(Error::InvalidArgument { message, .. }) => {
+            assert!(message.contains("not taken with drive gains"), "{message}")
+        }
+        other => panic!("expected a refusal, got {:?}", other.map(|f| f.model.theta)),
+    }
 }
 
 /// 24 logs of 4 periods of the excitation at 200 Hz with noise filtered by `a` ([`coloured`]),
