@@ -8,16 +8,23 @@ use super::Lanes;
 /// (`rows[l] + dst.len() <= src.len()`; slice indexing panics otherwise, the callers size
 /// both from the same shapes).
 ///
-/// With AVX-512 (8 lanes) blocks of 8 quantities are transposed in 512-bit registers (8 loads,
-/// 24 shuffles, 8 stores), with AVX blocks of 4 by 4 in 256-bit ones, instead of gathering one
-/// value at a time (measured: the 60-dof tree's inverse dynamics spent 15 % of its time
-/// gathering its inputs).
+/// With AVX-512 (8 lanes, `wide`: the kernel runs on AVX-512, so that a kernel on AVX2's path
+/// never takes it, whatever else the processor has) blocks of 8 quantities are transposed in
+/// 512-bit registers (8 loads, 24 shuffles, 8 stores), with AVX blocks of 4 by 4 in 256-bit
+/// ones, instead of gathering one value at a time (measured: the 60-dof tree's inverse dynamics
+/// spent 15 % of its time gathering its inputs).
 #[inline(always)]
-pub(crate) fn read_rows<const W: usize>(src: &[f64], rows: &[usize; W], dst: &mut [Lanes<W>]) {
+pub(crate) fn read_rows<const W: usize>(
+    src: &[f64],
+    rows: &[usize; W],
+    dst: &mut [Lanes<W>],
+    wide: bool,
+) {
     let mut c = 0;
     #[cfg(target_arch = "x86_64")]
     if W.is_multiple_of(4) && std::arch::is_x86_feature_detected!("avx") {
         c = if W == 8
+            && wide
             && std::arch::is_x86_feature_detected!("avx512f")
             && std::arch::is_x86_feature_detected!("avx512dq")
         {
@@ -102,7 +109,10 @@ mod tests {
     use super::*;
 
     fn check<const W: usize>() {
-        for n in [0, 1, 3, 4, 5, 8, 9, 17, 60] {
+        for (n, wide) in [0, 1, 3, 4, 5, 8, 9, 17, 60]
+            .into_iter()
+            .flat_map(|n| [(n, false), (n, true)])
+        {
             for stride in [n, n + 3] {
                 let src: Vec<f64> = (0..W * stride + 5).map(|v| v as f64 * 0.5 - 7.0).collect();
                 // rows in any order, some repeated (the last sample again past a batch's end)
@@ -112,10 +122,14 @@ mod tests {
                 }
                 rows[W - 1] = rows[W / 2];
                 let mut dst = vec![Lanes::<W>::splat(f64::NAN); n];
-                read_rows(&src, &rows, &mut dst);
+                read_rows(&src, &rows, &mut dst, wide);
                 for (i, d) in dst.iter().enumerate() {
                     for l in 0..W {
-                        assert_eq!(d.0[l], src[rows[l] + i], "W {W} n {n} i {i} lane {l}");
+                        assert_eq!(
+                            d.0[l],
+                            src[rows[l] + i],
+                            "W {W} n {n} wide {wide} i {i} lane {l}"
+                        );
                     }
                 }
             }

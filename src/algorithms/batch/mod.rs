@@ -120,7 +120,7 @@ pub(crate) struct LaneBuffers<const W: usize> {
     /// matrix and of the torque derivatives, written without being read (a tree's matrices are
     /// mostly such zeros).
     pub(crate) m_zeros: ZeroPattern,
-    pub(crate) composite: Vec<mass_matrix::Composite<W>>,
+    pub(crate) composite: Vec<mass_matrix::SymmetricComposite<W>>,
     /// The derivatives' buffers, made on first use.
     pub(crate) derivatives: Option<Box<derivatives::Buffers<W>>>,
     /// Whether the last kernel run vouched that every value it wrote is finite (checked in
@@ -180,7 +180,7 @@ impl<const W: usize> LaneBuffers<W> {
             chain: regressor::Chain::default(),
             m: vec![Lanes::default(); nb * nb],
             m_zeros: ZeroPattern::new((0..nb * nb).map(|e| model.related(e / nb, e % nb))),
-            composite: vec![mass_matrix::Composite::default(); nb],
+            composite: vec![mass_matrix::SymmetricComposite::default(); nb],
             derivatives: None,
             finite: false,
             wide_stores,
@@ -233,11 +233,12 @@ impl<const W: usize> LaneBuffers<W> {
             *r = (first + l).min(k.max(1) - 1) * nv;
         }
         // each body its own degree of freedom, as most models: whole rows read into the lanes
-        // by register transposes, on 8 lanes from 16 dofs on (measured, AVX-512: the 60-dof
-        // tree's inverse dynamics 10 % faster, its derivatives 8 %, regressor 5 %; the arms'
-        // kernels 3-8 % slower, their few values not worth the transposes' calls; on AVX2's 4
-        // lanes the tree's derivatives 11 % slower)
-        let direct = W == 8
+        // by register transposes from 16 dofs on (measured, AVX-512: the 60-dof tree's inverse
+        // dynamics 10 % faster, its derivatives 8 %, regressor 5 %; the arms' kernels 3-8 %
+        // slower, their few values not worth the transposes' calls; AVX2's 4 lanes, in-process
+        // on a Zen 4: the tree's mass matrix and regressor 1-4 % faster, its derivatives and
+        // linearisation level)
+        let direct = W.is_multiple_of(4)
             && nv >= 16
             && model.bodies.len() == nv
             && (model.bodies.iter().enumerate())
@@ -247,7 +248,7 @@ impl<const W: usize> LaneBuffers<W> {
                 if x.is_empty() {
                     out.fill(Lanes::default());
                 } else {
-                    read_rows(x, &rows, out);
+                    read_rows(x, &rows, out, self.wide_stores);
                 }
             }
         } else {

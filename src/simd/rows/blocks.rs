@@ -564,11 +564,13 @@ unsafe fn transposed4<const W: usize>(
 }
 
 /// Quantities from `from` on, by blocks of 8, into those columns of all `W` rows of `dst` (row
-/// `l` at `l * stride`) with [`lines4`] (blocks that are all zeros by `zeros` not read); on 8
-/// lanes, runs of such blocks are written a row at a time ([`zero_run4`]; on 4 lanes that was
-/// 3-6 % slower). Their values are added to `sum` (see [`transpose4`]); returns where the
-/// blocks end. Kept out of line, the streamed outputs' own path (inlined into [`blocks_avx`],
-/// the tree's AVX2 mass matrix, which streams, measured 1-4 % slower: near the noise).
+/// `l` at `l * stride`) with [`lines4`] (blocks that are all zeros by `zeros` not read); runs of
+/// such blocks are written a row at a time ([`zero_run4`]; on 4 lanes too since measured
+/// in-process, alternating with the blocks in turn on a Zen 4: the tree's AVX2 mass matrix 3 %
+/// faster, its regressor 10 %, derivatives and linearisation 4-7 %). Their values are added to
+/// `sum` (see [`transpose4`]); returns where the blocks end. Kept out of line, the streamed
+/// outputs' own path (inlined into [`blocks_avx`], the tree's AVX2 mass matrix, which streams,
+/// measured 1-4 % slower: near the noise).
 ///
 /// # Safety
 /// The processor has AVX.
@@ -586,7 +588,7 @@ unsafe fn stream_lines4<const W: usize>(
     let zero = |c: usize| zeros.is_some_and(|z| z.zero(c, 8));
     let mut c = from;
     while c + 8 <= n {
-        if W == 8 && zero(c) {
+        if zero(c) {
             // a run of zero blocks, a row at a time (as in `blocks_avx512`)
             let mut end = c + 8;
             while end + 8 <= n && zero(end) {
