@@ -81,15 +81,19 @@ impl<const W: usize> SymmetricComposite<W> {
             upper: [x + o.upper[0], y + o.upper[1], z + o.upper[2]],
         }
     }
-    /// The rotational inertia times `v`.
+    /// The momentum `Y m` of this inertia (origin form, base frame) moving with twist `m`, as
+    /// `Composite::apply` in the derivatives.
     #[inline(always)]
-    pub(crate) fn i_mul(&self, v: &Vector3Lanes<W>) -> Vector3Lanes<W> {
-        let [xx, yy, zz] = self.diag;
-        let [xy, xz, yz] = self.upper;
-        Vector3Lanes {
-            x: xx.mul_add(v.x, xy.mul_add(v.y, xz * v.z)),
-            y: xy.mul_add(v.x, yy.mul_add(v.y, yz * v.z)),
-            z: xz.mul_add(v.x, yz.mul_add(v.y, zz * v.z)),
+    pub(crate) fn apply(&self, m: &SpatialLanes<W>) -> SpatialLanes<W> {
+        let ([xx, yy, zz], [xy, xz, yz], a) = (self.diag, self.upper, &m.ang);
+        let ia = Vector3Lanes {
+            x: xx.mul_add(a.x, xy.mul_add(a.y, xz * a.z)),
+            y: xy.mul_add(a.x, yy.mul_add(a.y, yz * a.z)),
+            z: xz.mul_add(a.x, yz.mul_add(a.y, zz * a.z)),
+        };
+        SpatialLanes {
+            ang: ia.add(&self.h.cross(&m.lin)),
+            lin: m.lin.scale_add(self.mass, &m.ang.cross(&self.h)),
         }
     }
 }
@@ -155,11 +159,7 @@ impl LaneKernel for MassMatrix<'_> {
                 if i + 1 < b.subtree_end {
                     c = c.add(&data.composite[i]);
                 }
-                let s = &data.o_s[i];
-                let f = SpatialLanes {
-                    ang: c.i_mul(&s.ang).add(&c.h.cross(&s.lin)),
-                    lin: s.lin.scale_add(c.mass, &s.ang.cross(&c.h)),
-                };
+                let f = c.apply(&data.o_s[i]);
                 let mut j = Some(i);
                 while let Some(k) = j {
                     let mik = data.o_s[k].dot(&f);

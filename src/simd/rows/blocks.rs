@@ -600,7 +600,7 @@ unsafe fn stream_lines4<const W: usize>(
             continue;
         }
         // SAFETY: as this function's
-        unsafe { lines4(src, zero(c), dst, stride, c, sum) };
+        unsafe { lines4(src, dst, stride, c, sum) };
         c += 8;
     }
     c
@@ -637,7 +637,7 @@ unsafe fn zero_run4<const W: usize>(dst: &mut [f64], stride: usize, from: usize,
     }
 }
 
-/// Quantities `c..c + 8` of `src` (zeros if `zero`) into columns `c..c + 8` of all `W` rows of
+/// Quantities `c..c + 8` of `src` into columns `c..c + 8` of all `W` rows of
 /// `dst` (row `l` at `l * stride`) by pairs of 4x4 transposes, each row's 8 values two 32-byte
 /// stores back to back: non-temporal where they make a whole cache line (the block's first row
 /// on a line, `stride` a multiple of 8 values). The values added to `sum` (see [`transpose4`]).
@@ -647,7 +647,6 @@ unsafe fn zero_run4<const W: usize>(dst: &mut [f64], stride: usize, from: usize,
 #[inline(always)]
 unsafe fn lines4<const W: usize>(
     src: &[Lanes<W>],
-    zero: bool,
     dst: &mut [f64],
     stride: usize,
     c: usize,
@@ -660,14 +659,8 @@ unsafe fn lines4<const W: usize>(
     // the block's own sum, then one add to the running one (as in `block4`)
     let mut values = _mm256_setzero_pd();
     for lb in (0..W).step_by(4) {
-        let (lo, hi) = if zero {
-            ([_mm256_setzero_pd(); 4], [_mm256_setzero_pd(); 4])
-        } else {
-            (
-                transposed4(&src[c..c + 4], lb, 4, &mut values),
-                transposed4(&src[c + 4..c + 8], lb, 4, &mut values),
-            )
-        };
+        let lo = transposed4(&src[c..c + 4], lb, 4, &mut values);
+        let hi = transposed4(&src[c + 4..c + 8], lb, 4, &mut values);
         for l in 0..4 {
             // SAFETY: `block` holds `(W - 1) * stride + 8` values, so `(lb + l) * stride + 8`
             // fit for lb + l < W; streamed only on a 64-byte boundary (checked above)
