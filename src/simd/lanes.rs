@@ -318,24 +318,29 @@ impl<const W: usize> Rotation3Lanes<W> {
             o.tr_mul(&self.0[2]),
         ])
     }
-    /// The constant matrix `m` in every lane.
+    /// The matrix of columns `x`, `y`, `z`.
     #[inline(always)]
-    pub(crate) fn splat(m: &Matrix3<f64>) -> Self {
+    pub(crate) fn from_columns(
+        x: &Vector3Lanes<W>,
+        y: &Vector3Lanes<W>,
+        z: &Vector3Lanes<W>,
+    ) -> Self {
         Rotation3Lanes([
-            Vector3Lanes::splat(&m.row(0).transpose()),
-            Vector3Lanes::splat(&m.row(1).transpose()),
-            Vector3Lanes::splat(&m.row(2).transpose()),
-        ])
-    }
-    /// `self * m` for a constant matrix `m`.
-    #[inline(always)]
-    pub(crate) fn mul_const_matrix(&self, m: &Matrix3<f64>) -> Self {
-        // row r of the product is m^T times row r of self
-        let mt = m.transpose();
-        Rotation3Lanes([
-            self.0[0].mul_const(&mt),
-            self.0[1].mul_const(&mt),
-            self.0[2].mul_const(&mt),
+            Vector3Lanes {
+                x: x.x,
+                y: y.x,
+                z: z.x,
+            },
+            Vector3Lanes {
+                x: x.y,
+                y: y.y,
+                z: z.y,
+            },
+            Vector3Lanes {
+                x: x.z,
+                y: y.z,
+                z: z.z,
+            },
         ])
     }
     /// `self * a` for a constant vector `a`.
