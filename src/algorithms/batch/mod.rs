@@ -132,6 +132,11 @@ pub(crate) struct LaneBuffers<const W: usize> {
     /// The bytes of output of the whole job the next kernel call is part of (see
     /// [`LaneData::set_job_output`]).
     pub(crate) job_output: usize,
+    /// Whether the model of the kernel call under way has 16 degrees of freedom or more, each
+    /// its own body's ([`rows_are_dofs`]): set once a call (checked once a group of lanes, it
+    /// read every body's record, cold in L1 after the group's stores, each time: the tree's
+    /// AVX2 mass matrix 2-3 % slower).
+    pub(crate) rows_are_dofs: bool,
 }
 
 impl<const W: usize> LaneBuffers<W> {
@@ -185,6 +190,7 @@ impl<const W: usize> LaneBuffers<W> {
             finite: false,
             wide_stores,
             job_output: 0,
+            rows_are_dofs: false,
         }
     }
 
@@ -238,11 +244,7 @@ impl<const W: usize> LaneBuffers<W> {
         // slower, their few values not worth the transposes' calls; AVX2's 4 lanes, in-process
         // on a Zen 4: the tree's mass matrix and regressor 1-4 % faster, its derivatives and
         // linearisation level)
-        let direct = W.is_multiple_of(4)
-            && nv >= 16
-            && model.bodies.len() == nv
-            && (model.bodies.iter().enumerate())
-                .all(|(i, b)| b.dof == i && b.multiplier == 1.0 && b.offset == 0.0);
+        let direct = W.is_multiple_of(4) && self.rows_are_dofs;
         if direct {
             for (x, out) in x.iter().zip([&mut self.qb, &mut self.vb, &mut self.ab]) {
                 if x.is_empty() {
@@ -493,27 +495,27 @@ pub(crate) fn dispatch<K: LaneKernel<Output = Result<T>>, T>(
 ) -> Result<T> {
     lanes.check(model)?;
     lanes.forget_finite();
-    let job = lanes.job_output;
+    let (job, direct) = (lanes.job_output, rows_are_dofs(model));
     let out = match &mut lanes.buffers {
         // SAFETY: `W8` and `W4` buffers are made only when the processor has the instruction
         // set (`LaneData::with_isa`, `Isa::detect`).
         #[cfg(target_arch = "x86_64")]
         Buffers::W8(b) if lanes.isa == Isa::Avx512 => {
-            b.job_output = job;
+            (b.job_output, b.rows_are_dofs) = (job, direct);
             unsafe { run_avx512(kernel, model, b) }
         }
         // 8 lanes in pairs of AVX2 registers: the 8-lane code tested where AVX-512 is missing
         // (`LaneData::eight_lanes_on_avx2`)
         #[cfg(target_arch = "x86_64")]
         Buffers::W8(b) => {
-            b.job_output = job;
+            (b.job_output, b.rows_are_dofs) = (job, direct);
             unsafe { run_avx2(kernel, model, b.as_mut()) }
         }
         #[cfg(target_arch = "x86_64")]
         Buffers::W4(b, paired) if K::PAIRS_ON_AVX2 => {
             let p = paired
                 .get_or_insert_with(|| Box::new(LaneBuffers::without_regressor(model, false)));
-            p.job_output = job;
+            (p.job_output, p.rows_are_dofs) = (job, direct);
             let out = unsafe { run_avx2(kernel, model, p.as_mut()) };
             // what `LaneData::wrote_finite` reads
             b.finite = p.finite;
@@ -521,7 +523,7 @@ pub(crate) fn dispatch<K: LaneKernel<Output = Result<T>>, T>(
         }
         #[cfg(target_arch = "x86_64")]
         Buffers::W4(b, _) => {
-            b.job_output = job;
+            (b.job_output, b.rows_are_dofs) = (job, direct);
             unsafe { run_avx2(kernel, model, b.as_mut()) }
         }
         Buffers::Scalar(d) => kernel.scalar(model, d),
@@ -530,6 +532,17 @@ pub(crate) fn dispatch<K: LaneKernel<Output = Result<T>>, T>(
     // thread of the batch engine signalling that its part is done)
     crate::simd::store_fence();
     out
+}
+
+/// Whether `model`'s samples are read into the lanes as whole rows (`LaneBuffers::load`):
+/// 16 degrees of freedom or more, each body its own, in order, as most models (below 16 the
+/// transposes' calls cost more than they save).
+fn rows_are_dofs(model: &Model) -> bool {
+    let nv = model.nv;
+    nv >= 16
+        && model.bodies.len() == nv
+        && (model.bodies.iter().enumerate())
+            .all(|(i, b)| b.dof == i && b.multiplier == 1.0 && b.offset == 0.0)
 }
 
 #[cfg(target_arch = "x86_64")]
