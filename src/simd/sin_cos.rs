@@ -15,34 +15,29 @@ const PIO2: [f64; 3] = [
 /// ones, the standard library's `sin_cos`.
 const SINCOS_RANGE: f64 = 1e6;
 
-/// Taylor coefficients of `sin(r) / r` and `cos(r)` in powers of `z = r^2`.
-const SIN: [f64; 9] = [
-    1.0,
-    -1.0 / 6.0,
-    1.0 / 120.0,
-    -1.0 / 5040.0,
-    1.0 / 362880.0,
-    -1.0 / 39916800.0,
-    1.0 / 6227020800.0,
-    -1.0 / 1307674368000.0,
-    1.0 / 355687428096000.0,
+/// Minimax coefficients on `[-pi/4, pi/4]` (fdlibm's `__kernel_sin` `S1..S6`): `sin r = r + r z
+/// (S1 + S2 z + ... + S6 z^5)`, `z = r^2`, within 2^-58 relative.
+const SIN: [f64; 6] = [
+    -1.666_666_666_666_663_2e-1,
+    8.333_333_333_322_49e-3,
+    -1.984_126_982_985_795e-4,
+    2.755_731_370_707_006_8e-6,
+    -2.505_076_025_340_686_3e-8,
+    1.589_690_995_211_55e-10,
 ];
-const COS: [f64; 10] = [
-    1.0,
-    -1.0 / 2.0,
-    1.0 / 24.0,
-    -1.0 / 720.0,
-    1.0 / 40320.0,
-    -1.0 / 3628800.0,
-    1.0 / 479001600.0,
-    -1.0 / 87178291200.0,
-    1.0 / 20922789888000.0,
-    -1.0 / 6402373705728000.0,
+/// fdlibm's `__kernel_cos` `C1..C6`: `cos r = 1 - z / 2 + z^2 (C1 + C2 z + ... + C6 z^5)`.
+const COS: [f64; 6] = [
+    4.166_666_666_666_66e-2,
+    -1.388_888_888_887_411e-3,
+    2.480_158_728_947_673e-5,
+    -2.755_731_435_139_066_3e-7,
+    2.087_572_321_298_175e-9,
+    -1.135_964_755_778_819_5e-11,
 ];
 
 /// `(sin x, cos x)` of every lane, within about 1 ulp of the standard library's: the argument is
-/// reduced by multiples of `pi / 2` (Cody-Waite, three parts) to `[-pi/4, pi/4]`, where Taylor
-/// series to degree 17 (sin) and 18 (cos) are exact to below half an ulp.
+/// reduced by multiples of `pi / 2` (Cody-Waite, three parts) to `[-pi/4, pi/4]`, where fdlibm's
+/// minimax polynomials (degree 13 and 14) are exact to below half an ulp.
 #[inline(always)]
 pub(crate) fn sin_cos<const W: usize>(x: Lanes<W>) -> (Lanes<W>, Lanes<W>) {
     if x.any_nan_or_beyond(SINCOS_RANGE) {
@@ -62,16 +57,20 @@ pub(crate) fn sin_cos<const W: usize>(x: Lanes<W>) -> (Lanes<W>, Lanes<W>) {
         ),
     );
     let z = r * r;
-    // sin r = r (1 - z/3! + z^2/5! - ...), cos r = 1 - z/2! + z^2/4! - ... (Horner, unrolled)
-    let mut ps = Lanes::splat(SIN[SIN.len() - 1]);
-    for &ci in SIN[..SIN.len() - 1].iter().rev() {
-        ps = ps.mul_add(z, Lanes::splat(ci));
-    }
-    let mut pc = Lanes::splat(COS[COS.len() - 1]);
-    for &ci in COS[..COS.len() - 1].iter().rev() {
-        pc = pc.mul_add(z, Lanes::splat(ci));
-    }
-    let s = r * ps;
+    // the polynomials in z by Estrin's scheme (pairs of terms, then pairs of pairs): each value
+    // three or four dependent operations from z where Horner's took six to eight, so that the
+    // kernels' passes, which wait on a joint's sine and cosine, wait less
+    let c = |v: f64| Lanes::splat(v);
+    let (z2, rz) = (z * z, r * z);
+    let z4 = z2 * z2;
+    let p = z2.mul_add(
+        z2.mul_add(c(SIN[5]).mul_add(z, c(SIN[4])), c(SIN[3]).mul_add(z, c(SIN[2]))),
+        c(SIN[1]).mul_add(z, c(SIN[0])),
+    );
+    let s = rz.mul_add(p, r);
+    let low = z2.mul_add(c(COS[1]).mul_add(z, c(COS[0])), c(-0.5).mul_add(z, c(1.0)));
+    let high = z2.mul_add(c(COS[5]).mul_add(z, c(COS[4])), c(COS[3]).mul_add(z, c(COS[2])));
+    let pc = z4.mul_add(high, low);
     let mut sin = [0.0; W];
     let mut cos = [0.0; W];
     for l in 0..W {
