@@ -9,12 +9,13 @@ runs from Python one call at a time (its figures then include Python's call over
 the table says so). perturbid_rs runs its batched kernels through the Python API on the same
 samples, writing into preallocated arrays (`out=`).
 
-For each robot and kernel: `rounds` rounds, each Pinocchio's passes and perturbid_rs's passes
-over the same samples in turn, so that a slow spell of the shared machine falls on both sides
-(a Pinocchio pass: every sample once, the median of `passes` taken; a perturbid_rs pass: one
-untimed call, then calls for at least 20 ms, since right after the peer's process the caches
-and the clock are cold and one call lasts well under a millisecond); figures are medians over
-the rounds, the noise the spread of the per-round ratios. One core:
+For each robot and kernel: `rounds` rounds, each `passes` passes of Pinocchio and of
+perturbid_rs over the same samples in alternation (Pinocchio's, ours, Pinocchio's, ...; the
+C++ peer stays running between its passes), so that a slow spell of the shared machine, which
+can last a fraction of a second, falls on both sides. Either side's pass is one untimed call
+over the samples (the caches and the clock are cold after the other side's), then calls for
+at least 20 ms, timed together; a round takes each side's median pass. Figures are medians
+over the rounds, the noise the spread of the per-round ratios. One core:
 batches below the library's parallel threshold run on the calling thread, and one Pinocchio
 process. All cores: a batch large enough for the parallel engine against one Pinocchio process
 per core. Results are checked to agree (torques and matrices to 1e-10 relative, the
@@ -51,7 +52,10 @@ import perturbid_rs as pr  # noqa: E402
 ROOT = Path(__file__).resolve().parent.parent
 PEER = ROOT / "benches" / "pinocchio_peer.cpp"
 OUTPUT_CAP = 128 << 20  # bytes of output per timed batch (a 60-dof regressor is 288 kB a sample)
+ROBOT_NAMES = ["a465", "panda", "tree60"]
 KERNELS = ["rnea", "mass_matrix", "regressor", "rnea_derivatives", "linearize", "forward_dynamics"]
+# each side's pass: one untimed call, then calls for at least this long (ms)
+WARM_MS = 20
 FLAGS = ["-O3", "-march=native", "-DNDEBUG", "-std=c++17", "-DBOOST_MPL_LIMIT_LIST_SIZE=30",
          "-DBOOST_MPL_LIMIT_VECTOR_SIZE=30", "-DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS",
          "-DBOOST_FUSION_INVOKE_MAX_ARITY=12"]
@@ -190,6 +194,7 @@ class Side:
             np.ascontiguousarray(v[:, inv]).tofile(self.dir / f"{key}.bin")
         model.saveToBinary(str(self.dir / "model.bin"))
         self.out = self.outputs(k)
+        self.server = None  # the C++ peer in its `serve` mode, started by the first pass
 
     def per_sample(self, kernel):
         """Output values per sample of `kernel`."""
@@ -253,17 +258,30 @@ class Side:
             return r.linearize(q, qd, qdd, out=out["linearize"])
         return r.forward_dynamics(q, qd, x["tau"], out=out["forward_dynamics"])
 
-    def peer_pass(self, kernel, passes):
-        """ns per call of `kernel` by Pinocchio, one entry per pass."""
+    def peer_pass(self, kernel):
+        """ns per call of `kernel` by Pinocchio over this side's samples, timed as
+        `our_pass` times ours: one untimed pass, then passes for at least 20 ms (the C++
+        peer kept running in its `serve` mode, so that its passes and ours alternate closely),
+        or one pass from Python without the C++ peer."""
         if self.peer is None:
-            return [self.python_pass(kernel) for _ in range(passes)]
-        done = subprocess.run([str(self.peer), str(self.dir / "model.bin"), str(self.dir),
-                               str(self.samples_for(kernel)), str(passes)],
-                              capture_output=True, text=True,
-                              env={**os.environ, "PEER_KERNELS": kernel}, check=True)
-        line = next(json.loads(x) for x in done.stdout.splitlines()
-                    if json.loads(x)["kernel"] == kernel)
-        return line["passes_ns"]
+            return self.python_pass(kernel)
+        if self.server is None:
+            self.server = subprocess.Popen(
+                [str(self.peer), str(self.dir / "model.bin"), str(self.dir), str(self.k),
+                 "serve"], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        self.server.stdin.write(f"{kernel} {self.samples_for(kernel)} {WARM_MS}\n")
+        self.server.stdin.flush()
+        reply = json.loads(self.server.stdout.readline() or '{"error": "the peer ended"}')
+        if "error" in reply:
+            raise SystemExit(f"{self.name}: the C++ peer: {reply['error']}")
+        return reply["ns_per_call"]
+
+    def close(self):
+        """Ends the C++ peer's process, if one was started."""
+        if self.server is not None:
+            self.server.stdin.close()
+            self.server.wait(timeout=60)
+            self.server = None
 
     def python_pass(self, kernel):
         m, d = self.model, self.model.createData()
@@ -325,7 +343,7 @@ def store_fill():
     return fn
 
 
-def warm_ns(call, samples, min_seconds=0.02):
+def warm_ns(call, samples, min_seconds=WARM_MS / 1000):
     """ns per sample of `call` (which computes `samples` samples): one call untimed (right after
     the peer's processes the caches and the clock are cold), then calls for `min_seconds`."""
     call()
@@ -390,11 +408,14 @@ def agree(side: Side) -> list[str]:
 
 def run_kernel(side: Side, kernel: str, rounds: int, passes: int):
     """Medians (ns per sample) of Pinocchio, of ours and of storing the output alone, and the
-    per-round ratios."""
+    per-round ratios. A round: `passes` passes of each side in alternation (Pinocchio's, ours,
+    Pinocchio's, ...: a spell of the shared machine, which lasts from a fraction of a second
+    to minutes, falls on both), each side's median."""
     t_pin, t_our, t_store, ratios = [], [], [], []
     for _ in range(rounds):
-        p = statistics.median(side.peer_pass(kernel, passes))
-        o = statistics.median(side.our_pass(kernel) for _ in range(passes))
+        pairs = [(side.peer_pass(kernel), side.our_pass(kernel)) for _ in range(passes)]
+        p = statistics.median(x[0] for x in pairs)
+        o = statistics.median(x[1] for x in pairs)
         t_store.append(min(side.store_pass(kernel) for _ in range(passes)))
         t_pin.append(p)
         t_our.append(o)
@@ -542,10 +563,14 @@ def main() -> int:
     ap.add_argument("--passes", type=int, default=5)
     ap.add_argument("--samples", type=int, default=2048, help="per one-core batch (< 4096)")
     ap.add_argument("--no-write", action="store_true", help="print only")
-    ap.add_argument("--robots", default="a465,panda,tree60")
+    ap.add_argument("--robots", default=",".join(ROBOT_NAMES))
     ap.add_argument("--cpu", type=int, default=None,
                     help="the core of the one-core rounds (default: the lowest allowed)")
     args = ap.parse_args()
+    known = ROBOT_NAMES
+    unknown = sorted(set(args.robots.split(",")) - set(known))
+    if unknown:
+        raise SystemExit(f"--robots: no robot {', '.join(unknown)} (known: {', '.join(known)})")
     peer = build_peer()
     flops = flop_counts()
     isa = pr.simd_isa()
@@ -570,6 +595,7 @@ def main() -> int:
                 # start with): a batch past the parallel threshold
                 side.ours("rnea", *side.big(8192, "rnea"))
             for kernel in KERNELS:
+                # (the peer's process, started by the first round, keeps this core)
                 with pinned(one):
                     t_pin, t_our, t_store, ratios = run_kernel(side, kernel, args.rounds,
                                                                args.passes)
@@ -582,6 +608,7 @@ def main() -> int:
                       f"store {t_store:8.1f} ns  "
                       f"x{statistics.median(ratios):5.2f} [{min(ratios):.2f}-{max(ratios):.2f}]"
                       f"  all cores {'n/a' if many is None else f'x{many:.2f}'}", file=sys.stderr)
+            side.close()
         with pinned(one):
             call = python_call(first)
     if failures:

@@ -3,12 +3,20 @@
 // the headers and libraries of the `pin` wheel (and Eigen); not part of the library.
 //
 //   pinocchio_peer MODEL.bin DIR K REPEATS
+//   pinocchio_peer MODEL.bin DIR K serve
 //
 // MODEL.bin: the model saved by pinocchio.Model.saveToBinary. DIR holds q.bin, qd.bin, qdd.bin
 // and tau.bin (K x nv float64, row-major). Each pass computes every sample with one call and
 // stores its results in a row-major K-sample output (both timed: what a batch costs), which is
 // written to DIR/pin_<kernel>.bin; prints one JSON line per kernel: {"kernel", "ns_per_call"
 // (median over REPEATS passes), "passes_ns"}. PEER_KERNELS (a list of names) limits the kernels.
+//
+// With `serve` in place of REPEATS the process stays, so that the script can take Pinocchio's
+// passes and its own in close turns: each line "KERNEL SAMPLES MIN_MS" on standard input runs
+// one untimed pass over the first SAMPLES samples (as the script's own untimed call), then
+// timed passes until MIN_MS milliseconds have gone, and prints {"kernel", "ns_per_call" (the
+// timed passes' mean)}; an unknown kernel or a bad line prints {"error"}. Nothing is written
+// to DIR. End of input ends the process.
 #include <pinocchio/multibody.hpp>
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/crba.hpp>
@@ -22,6 +30,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <iostream>
+#include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -57,10 +68,11 @@ int main(int argc, char** argv) {
   pinocchio::Data data(model);
   const std::string dir = argv[2];
   const long k = std::atol(argv[3]);
-  const int repeats = std::atoi(argv[4]);
+  const bool serve = std::string(argv[4]) == "serve";
+  const int repeats = serve ? 1 : std::atoi(argv[4]);
   const long n = model.nv;
   if (model.nq != model.nv || k <= 0 || repeats <= 0) {
-    std::fprintf(stderr, "needs nq == nv, K > 0, REPEATS > 0\n");
+    std::fprintf(stderr, "needs nq == nv, K > 0, REPEATS > 0 or serve\n");
     return 2;
   }
   auto q = read_all(dir + "/q.bin", k * n), qd = read_all(dir + "/qd.bin", k * n),
@@ -125,20 +137,56 @@ int main(int argc, char** argv) {
          copy(gs, o + n + 3 * n * n);
        }},
   };
+  // one pass: every sample of the first `count` computed and its results stored in the
+  // batch's output, as a user of a batch gets them (and as perturbid_rs's batched kernels
+  // deliver them); ns per sample
+  auto pass = [&](Kernel& kern, long count, std::vector<double>& out) {
+    auto t0 = Clock::now();
+    for (long s = 0; s < count; ++s) {
+      kern.compute(s);
+      kern.store(s, out.data() + s * kern.per_sample);
+    }
+    return std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / count;
+  };
+  if (serve) {
+    std::map<std::string, std::vector<double>> outs;  // kept from one request to the next
+    std::string line;
+    while (std::getline(std::cin, line)) {
+      std::istringstream words(line);
+      std::string name;
+      long count = 0;
+      double min_ms = 0;
+      words >> name >> count >> min_ms;
+      auto kern = std::find_if(kernels.begin(), kernels.end(),
+                               [&](const Kernel& x) { return x.name == name; });
+      if (!words || kern == kernels.end() || count <= 0 || count > k || !(min_ms >= 0)) {
+        std::printf("{\"error\": \"expected KERNEL SAMPLES MIN_MS, SAMPLES <= %ld\"}\n", k);
+        std::fflush(stdout);
+        continue;
+      }
+      auto& out = outs[name];
+      out.resize(count * kern->per_sample);
+      pass(*kern, count, out);  // untimed
+      double total = 0;
+      long passes = 0;
+      auto t0 = Clock::now();
+      do {
+        total += pass(*kern, count, out);
+        ++passes;
+      } while (std::chrono::duration<double, std::milli>(Clock::now() - t0).count() < min_ms);
+      std::printf("{\"kernel\": \"%s\", \"ns_per_call\": %.3f}\n", name.c_str(),
+                  total / passes);
+      std::fflush(stdout);
+    }
+    return 0;
+  }
   const char* only = std::getenv("PEER_KERNELS");
   for (auto& kern : kernels) {
     if (only && std::string(only).find(kern.name) == std::string::npos) continue;
     // timed: every sample computed and its results stored in the batch's output, as a user
     // of a batch gets them (and as perturbid_rs's batched kernels deliver them)
     std::vector<double> passes, out(k * kern.per_sample);
-    for (int r = 0; r < repeats; ++r) {
-      auto t0 = Clock::now();
-      for (long s = 0; s < k; ++s) {
-        kern.compute(s);
-        kern.store(s, out.data() + s * kern.per_sample);
-      }
-      passes.push_back(std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / k);
-    }
+    for (int r = 0; r < repeats; ++r) passes.push_back(pass(kern, k, out));
     write_all(dir + "/pin_" + kern.name + ".bin", out);
     std::vector<double> sorted = passes;
     std::sort(sorted.begin(), sorted.end());
