@@ -260,6 +260,12 @@ impl<const W: usize> Vector3Lanes<W> {
     pub(crate) fn dot_const(&self, a: &Vector3<f64>) -> Lanes<W> {
         self.x.mul_add_s(a.x, self.y.mul_add_s(a.y, self.z * a.z))
     }
+    /// `a . self + c` for a constant vector `a`, fused (three fused multiply-adds).
+    #[inline(always)]
+    pub(crate) fn dot_const_add(&self, a: &Vector3<f64>, c: Lanes<W>) -> Lanes<W> {
+        self.x
+            .mul_add_s(a.x, self.y.mul_add_s(a.y, self.z.mul_add_s(a.z, c)))
+    }
     /// `m * self` for a constant matrix `m`.
     #[inline(always)]
     pub(crate) fn mul_const(&self, m: &Matrix3<f64>) -> Self {
@@ -352,6 +358,30 @@ impl<const W: usize> Rotation3Lanes<W> {
             z: self.0[2].dot_const(a),
         }
     }
+    /// `self * a + c` for a constant vector `a`, fused (a point placed by this rotation and
+    /// the origin `c`: nine fused multiply-adds where the product and the sum took twelve
+    /// operations).
+    #[inline(always)]
+    pub(crate) fn mul_const_vector_add(
+        &self,
+        a: &Vector3<f64>,
+        c: &Vector3Lanes<W>,
+    ) -> Vector3Lanes<W> {
+        Vector3Lanes {
+            x: self.0[0].dot_const_add(a, c.x),
+            y: self.0[1].dot_const_add(a, c.y),
+            z: self.0[2].dot_const_add(a, c.z),
+        }
+    }
+    /// `self * v + c`, fused (nine fused multiply-adds).
+    #[inline(always)]
+    pub(crate) fn mul_add(&self, v: &Vector3Lanes<W>, c: &Vector3Lanes<W>) -> Vector3Lanes<W> {
+        Vector3Lanes {
+            x: self.0[0].dot_add(v, c.x),
+            y: self.0[1].dot_add(v, c.y),
+            z: self.0[2].dot_add(v, c.z),
+        }
+    }
     #[inline(always)]
     pub(crate) fn mul(&self, v: &Vector3Lanes<W>) -> Vector3Lanes<W> {
         Vector3Lanes {
@@ -409,6 +439,11 @@ impl<const W: usize> SpatialLanes<W> {
     #[inline(always)]
     pub(crate) fn dot(&self, o: &Self) -> Lanes<W> {
         self.ang.dot_add(&o.ang, self.lin.dot(&o.lin))
+    }
+    /// `<self, o> + c`, fused.
+    #[inline(always)]
+    pub(crate) fn dot_add(&self, o: &Self, c: Lanes<W>) -> Lanes<W> {
+        self.ang.dot_add(&o.ang, self.lin.dot_add(&o.lin, c))
     }
     /// `self * s` for a lane scalar.
     #[inline(always)]

@@ -225,7 +225,7 @@ impl<const W: usize> Composite<W> {
     #[inline(always)]
     fn apply(&self, m: &SpatialLanes<W>) -> SpatialLanes<W> {
         SpatialLanes {
-            ang: self.i.mul(&m.ang).add(&self.h.cross(&m.lin)),
+            ang: self.i.mul_add(&m.ang, &self.h.cross(&m.lin)),
             lin: m.lin.scale_add(self.mass, &m.ang.cross(&self.h)),
         }
     }
@@ -526,7 +526,7 @@ fn recursion<const W: usize>(
         d.dytj[i] = d.dycrb[i].tr_mul(&j);
         let (dadq, dvdq) = (d.dadq[i], d.dvdq[i]);
         for k in serial((i + 1)..end) {
-            d.dq[k * nb + i] = d.dfda[k].dot(&dadq) + d.dytj[k].dot(&dvdq);
+            d.dq[k * nb + i] = d.dfda[k].dot_add(&dadq, d.dytj[k].dot(&dvdq));
         }
         for k in serial(i..end) {
             d.dq[i * nb + k] = j.dot(&d.dfdq[k]);
@@ -537,7 +537,7 @@ fn recursion<const W: usize>(
         d.dfdv[i] = d.dycrb[i].mul(&j).add(&d.ycrb[i].apply(&d.dadv[i]));
         let dadv = d.dadv[i];
         for k in serial((i + 1)..end) {
-            d.dv[k * nb + i] = d.dfda[k].dot(&dadv) + d.dytj[k].dot(&j);
+            d.dv[k * nb + i] = d.dfda[k].dot_add(&dadv, d.dytj[k].dot(&j));
         }
         for k in serial(i..end) {
             d.dv[i * nb + k] = j.dot(&d.dfdv[k]);

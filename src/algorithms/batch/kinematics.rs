@@ -340,8 +340,8 @@ pub(crate) fn store_turned_pose_in_base<const W: usize>(
         Some(k) => {
             let (rp, pp) = (&data.o_rot[k], &data.o_pos[k]);
             let p = match &origin {
-                Some(o) => pp.add(&rp.mul(o)),
-                None => pp.add(&rp.mul_const_vector(&t.pos)),
+                Some(o) => rp.mul_add(o, pp),
+                None => rp.mul_const_vector_add(&t.pos, pp),
             };
             (
                 rp.mul(&x_axis),
@@ -399,7 +399,7 @@ pub(crate) fn aligned_pose_in_base<const W: usize>(
     // Rot_k e_a = cos e_a + sin e_b, Rot_k e_b = cos e_b - sin e_a
     let col_a = pa.mul_lanes_add(ca, &pb.mul_lanes(sb));
     let col_b = pb.mul_lanes(cb).sub(&pa.mul_lanes(sa));
-    let p = data.o_pos[parent].add(&rp.mul_const_vector(&b.placement.translation));
+    let p = rp.mul_const_vector_add(&b.placement.translation, &data.o_pos[parent]);
     let axis = pk.scale(al.sign);
     data.o_s[i] = SpatialLanes {
         ang: axis,
@@ -435,7 +435,7 @@ pub(crate) fn place_in_base<const W: usize>(
     let (r, p) = match b.parent {
         Some(k) => {
             let (rp, pp) = (&data.o_rot[k], &data.o_pos[k]);
-            (rp.compose(rot), pp.add(&rp.mul(pos)))
+            (rp.compose(rot), rp.mul_add(pos, pp))
         }
         None => (*rot, *pos),
     };

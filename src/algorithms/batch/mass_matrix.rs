@@ -86,13 +86,14 @@ impl<const W: usize> SymmetricComposite<W> {
     #[inline(always)]
     pub(crate) fn apply(&self, m: &SpatialLanes<W>) -> SpatialLanes<W> {
         let ([xx, yy, zz], [xy, xz, yz], a) = (self.diag, self.upper, &m.ang);
-        let ia = Vector3Lanes {
-            x: xx.mul_add(a.x, xy.mul_add(a.y, xz * a.z)),
-            y: xy.mul_add(a.x, yy.mul_add(a.y, yz * a.z)),
-            z: xz.mul_add(a.x, yz.mul_add(a.y, zz * a.z)),
-        };
+        // I a + h x lin, the sum fused into the product's multiply-adds
+        let hl = self.h.cross(&m.lin);
         SpatialLanes {
-            ang: ia.add(&self.h.cross(&m.lin)),
+            ang: Vector3Lanes {
+                x: xx.mul_add(a.x, xy.mul_add(a.y, xz.mul_add(a.z, hl.x))),
+                y: xy.mul_add(a.x, yy.mul_add(a.y, yz.mul_add(a.z, hl.y))),
+                z: xz.mul_add(a.x, yz.mul_add(a.y, zz.mul_add(a.z, hl.z))),
+            },
             lin: m.lin.scale_add(self.mass, &m.ang.cross(&self.h)),
         }
     }
