@@ -306,7 +306,7 @@ pub fn consistent_least_squares(
                 .map(|i| 1.0 / hess[(i, i)].max(1e-300).sqrt())
                 .collect();
             let scaled = DMatrix::from_fn(p, p, |i, j| hess[(i, j)] * d[i] * d[j]);
-            let Some(ch) = nalgebra::Cholesky::new(scaled) else {
+            let Some(ch) = newton_factor(scaled) else {
                 return Err(Error::Numerical {
                     operation: "consistent least squares".into(),
                     message: "the Newton system is not positive definite".into(),
@@ -545,4 +545,50 @@ pub fn identify_consistent_parameters(
         model: consistent_model,
         unconstrained: fit,
     })
+}
+
+/// The Cholesky factor of the Newton system `scaled` (unit diagonal), or of `scaled + lambda I`
+/// for the least `lambda` of 1e-14, 1e-13, ..., 1e-8 that makes it one where rounding has left
+/// the system (positive definite in exact arithmetic: a Gram matrix plus a positive diagonal
+/// plus the barrier's positive semidefinite Hessian) short of positive definite: at a large
+/// barrier weight the Gram matrix of ill-conditioned columns dominates, and a change of an
+/// ulp in the data can tip it. The damped step is still a descent direction, and the line
+/// search keeps every iterate inside and decreasing; `None` if even 1e-8 fails.
+fn newton_factor(scaled: DMatrix<f64>) -> Option<nalgebra::Cholesky<f64, nalgebra::Dyn>> {
+    if let Some(ch) = nalgebra::Cholesky::new(scaled.clone()) {
+        return Some(ch);
+    }
+    (6..=14).rev().find_map(|e| {
+        let lambda = 10f64.powi(-e);
+        let mut damped = scaled.clone();
+        for i in 0..damped.nrows() {
+            damped[(i, i)] += lambda;
+        }
+        nalgebra::Cholesky::new(damped)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_newton_system_left_singular_by_rounding_is_damped_an_indefinite_one_refused() {
+        // the Gram matrix of two columns 1e-17 apart: positive definite, singular once rounded
+        let near = DMatrix::from_row_slice(2, 2, &[1.0, 1.0 - 1e-17, 1.0 - 1e-17, 1.0]);
+        assert!(nalgebra::Cholesky::new(near.clone()).is_none());
+        let ch = newton_factor(near.clone()).expect("damped");
+        let l = ch.l();
+        let back = &l * l.transpose() - &near;
+        // the least damping that works: 1e-14 on the diagonal
+        assert!((back[(0, 0)] - 1e-14).abs() < 1e-15, "{back}");
+        assert!(back[(0, 1)].abs() < 1e-15, "{back}");
+        // a system with a negative eigenvalue (-1) is no rounding's doing
+        let indefinite = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
+        assert!(newton_factor(indefinite).is_none());
+        // a positive definite one is factored as it is
+        let spd = DMatrix::from_row_slice(2, 2, &[2.0, 1.0, 1.0, 2.0]);
+        let l = newton_factor(spd.clone()).unwrap().l();
+        assert!((&l * l.transpose() - spd).amax() < 1e-15);
+    }
 }

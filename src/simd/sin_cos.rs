@@ -64,12 +64,18 @@ pub(crate) fn sin_cos<const W: usize>(x: Lanes<W>) -> (Lanes<W>, Lanes<W>) {
     let (z2, rz) = (z * z, r * z);
     let z4 = z2 * z2;
     let p = z2.mul_add(
-        z2.mul_add(c(SIN[5]).mul_add(z, c(SIN[4])), c(SIN[3]).mul_add(z, c(SIN[2]))),
+        z2.mul_add(
+            c(SIN[5]).mul_add(z, c(SIN[4])),
+            c(SIN[3]).mul_add(z, c(SIN[2])),
+        ),
         c(SIN[1]).mul_add(z, c(SIN[0])),
     );
     let s = rz.mul_add(p, r);
     let low = z2.mul_add(c(COS[1]).mul_add(z, c(COS[0])), c(-0.5).mul_add(z, c(1.0)));
-    let high = z2.mul_add(c(COS[5]).mul_add(z, c(COS[4])), c(COS[3]).mul_add(z, c(COS[2])));
+    let high = z2.mul_add(
+        c(COS[5]).mul_add(z, c(COS[4])),
+        c(COS[3]).mul_add(z, c(COS[2])),
+    );
     let pc = z4.mul_add(high, low);
     let mut sin = [0.0; W];
     let mut cos = [0.0; W];

@@ -357,16 +357,7 @@ pub(crate) fn store_turned_pose_in_base<const W: usize>(
             origin.unwrap_or_else(|| Vector3Lanes::splat(&t.pos)),
         ),
     };
-    data.o_s[i] = match b.kind {
-        JointKind::Revolute => SpatialLanes {
-            ang: axis,
-            lin: p.cross(&axis),
-        },
-        JointKind::Prismatic => SpatialLanes {
-            ang: Vector3Lanes::default(),
-            lin: axis,
-        },
-    };
+    data.o_s[i] = subspace_of(b.kind, axis, &p);
     data.o_rot[i] = Rotation3Lanes::from_columns(&x, &y, &axis);
     data.o_pos[i] = p;
 }
@@ -452,8 +443,18 @@ pub(crate) fn subspace_in<const W: usize>(
     r: &Rotation3Lanes<W>,
     p: &Vector3Lanes<W>,
 ) -> SpatialLanes<W> {
-    let axis = r.mul_const_vector(&b.axis);
-    match b.kind {
+    subspace_of(b.kind, r.mul_const_vector(&b.axis), p)
+}
+
+/// A joint's motion subspace in the base frame from its unit axis `axis` there and its origin
+/// `p` (m): `(axis, p x axis)` for a revolute joint, `(0, axis)` for a prismatic one.
+#[inline(always)]
+fn subspace_of<const W: usize>(
+    kind: JointKind,
+    axis: Vector3Lanes<W>,
+    p: &Vector3Lanes<W>,
+) -> SpatialLanes<W> {
+    match kind {
         JointKind::Revolute => SpatialLanes {
             ang: axis,
             lin: p.cross(&axis),
