@@ -5,9 +5,9 @@
 //! A body's turned frame is its frame turned by a constant rotation `Q` with `Q e_z = a` (`a`
 //! the unit joint axis). Then the joint's rotation `Rot_a(x) = Q Rot_z(x) Q^T`, so the turned
 //! frame's pose in the base frame is `R'_p C Rot_z(x)`, with `R'_p` the parent's turned frame
-//! there and the constant `C = Q_p^T R0 Q`: one 3x3 product by a constant and a turn about z
-//! (two columns mixed by the cosine and sine), where the joint's own frame takes the
-//! Rodrigues terms and a 3x3 product of two variable matrices. The motion subspace in the base
+//! there and the constant `C = Q_p^T R0 Q`: `C Rot_z(x)` (two columns of `C` mixed by the
+//! cosine and sine) and one product by `R'_p`, where the joint's own frame takes the Rodrigues
+//! terms and a 3x3 product of two variable matrices. The motion subspace in the base
 //! frame is the turned frame's third column, read, not computed. Neither the mass matrix nor
 //! the derivatives depend on the frames the bodies are described in, only on the inertias
 //! being described in the frame used, so the inertias are turned too (`Q^T h`, `Q^T I Q`).
