@@ -345,7 +345,7 @@ def store_fill():
 
 def warm_ns(call, samples, min_seconds=WARM_MS / 1000):
     """ns per sample of `call` (which computes `samples` samples): one call untimed (right after
-    the peer's processes the caches and the clock are cold), then calls for `min_seconds`."""
+    the peer's passes the caches and the clock are cold), then calls for `min_seconds`."""
     call()
     calls, t = 0, time.perf_counter()
     while True:
@@ -567,10 +567,10 @@ def main() -> int:
     ap.add_argument("--cpu", type=int, default=None,
                     help="the core of the one-core rounds (default: the lowest allowed)")
     args = ap.parse_args()
-    known = ROBOT_NAMES
-    unknown = sorted(set(args.robots.split(",")) - set(known))
+    unknown = sorted(set(args.robots.split(",")) - set(ROBOT_NAMES))
     if unknown:
-        raise SystemExit(f"--robots: no robot {', '.join(unknown)} (known: {', '.join(known)})")
+        raise SystemExit(f"--robots: no robot {', '.join(unknown)} "
+                         f"(known: {', '.join(ROBOT_NAMES)})")
     peer = build_peer()
     flops = flop_counts()
     isa = pr.simd_isa()

@@ -7,16 +7,15 @@
 //
 // MODEL.bin: the model saved by pinocchio.Model.saveToBinary. DIR holds q.bin, qd.bin, qdd.bin
 // and tau.bin (K x nv float64, row-major). Each pass computes every sample with one call and
-// stores its results in a row-major K-sample output (both timed: what a batch costs), which is
-// written to DIR/pin_<kernel>.bin; prints one JSON line per kernel: {"kernel", "ns_per_call"
-// (median over REPEATS passes), "passes_ns"}. PEER_KERNELS (a list of names) limits the kernels.
+// stores its results in a row-major K-sample output (both timed: what a batch costs); prints
+// one JSON line per kernel: {"kernel", "ns_per_call" (median over REPEATS passes)}. PEER_KERNELS (a list of names) limits the kernels.
 //
 // With `serve` in place of REPEATS the process stays, so that the script can take Pinocchio's
 // passes and its own in close turns: each line "KERNEL SAMPLES MIN_MS" on standard input runs
 // one untimed pass over the first SAMPLES samples (as the script's own untimed call), then
 // timed passes until MIN_MS milliseconds have gone, and prints {"kernel", "ns_per_call" (the
-// timed passes' mean)}; an unknown kernel or a bad line prints {"error"}. Nothing is written
-// to DIR. End of input ends the process.
+// timed passes' mean)}; an unknown kernel or a bad line prints {"error"}. End of input ends
+// the process.
 #include <pinocchio/multibody.hpp>
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/crba.hpp>
@@ -47,15 +46,6 @@ static std::vector<double> read_all(const std::string& path, size_t count) {
   }
   std::fclose(f);
   return v;
-}
-
-static void write_all(const std::string& path, const std::vector<double>& v) {
-  FILE* f = std::fopen(path.c_str(), "wb");
-  if (!f || std::fwrite(v.data(), sizeof(double), v.size(), f) != v.size()) {
-    std::fprintf(stderr, "cannot write %s\n", path.c_str());
-    std::exit(2);
-  }
-  std::fclose(f);
 }
 
 int main(int argc, char** argv) {
@@ -183,17 +173,11 @@ int main(int argc, char** argv) {
   const char* only = std::getenv("PEER_KERNELS");
   for (auto& kern : kernels) {
     if (only && std::string(only).find(kern.name) == std::string::npos) continue;
-    // timed: every sample computed and its results stored in the batch's output, as a user
-    // of a batch gets them (and as perturbid_rs's batched kernels deliver them)
     std::vector<double> passes, out(k * kern.per_sample);
     for (int r = 0; r < repeats; ++r) passes.push_back(pass(kern, k, out));
-    write_all(dir + "/pin_" + kern.name + ".bin", out);
-    std::vector<double> sorted = passes;
-    std::sort(sorted.begin(), sorted.end());
-    std::printf("{\"kernel\": \"%s\", \"ns_per_call\": %.3f, \"passes_ns\": [", kern.name.c_str(),
-                sorted[sorted.size() / 2]);
-    for (size_t i = 0; i < passes.size(); ++i) std::printf("%s%.3f", i ? ", " : "", passes[i]);
-    std::printf("]}\n");
+    std::sort(passes.begin(), passes.end());
+    std::printf("{\"kernel\": \"%s\", \"ns_per_call\": %.3f}\n", kern.name.c_str(),
+                passes[passes.size() / 2]);
     std::fflush(stdout);
   }
   return 0;
