@@ -13,9 +13,9 @@
 // With `serve` in place of REPEATS the process stays, so that the script can take Pinocchio's
 // passes and its own in close turns: each line "KERNEL SAMPLES MIN_MS" on standard input runs
 // one untimed pass over the first SAMPLES samples (as the script's own untimed call), then
-// timed passes until MIN_MS milliseconds have gone, and prints {"kernel", "ns_per_call" (the
-// timed passes' mean)}; an unknown kernel or a bad line prints {"error"}. End of input ends
-// the process.
+// timed passes until MIN_MS milliseconds (at most 60,000) have gone, and prints {"kernel",
+// "ns_per_call" (the timed passes' mean)}; an unknown kernel or a bad line (NaN, a number out
+// of range, a word for a number) prints {"error"}. End of input ends the process.
 #include <pinocchio/multibody.hpp>
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/crba.hpp>
@@ -149,8 +149,11 @@ int main(int argc, char** argv) {
       words >> name >> count >> min_ms;
       auto kern = std::find_if(kernels.begin(), kernels.end(),
                                [&](const Kernel& x) { return x.name == name; });
-      if (!words || kern == kernels.end() || count <= 0 || count > k || !(min_ms >= 0)) {
-        std::printf("{\"error\": \"expected KERNEL SAMPLES MIN_MS, SAMPLES <= %ld\"}\n", k);
+      if (!words || kern == kernels.end() || count <= 0 || count > k || !(min_ms >= 0) ||
+          min_ms > 60000) {
+        std::printf(
+            "{\"error\": \"expected KERNEL SAMPLES MIN_MS, SAMPLES <= %ld, MIN_MS <= 60000\"}\n",
+            k);
         std::fflush(stdout);
         continue;
       }
