@@ -395,6 +395,42 @@ fn buffers_of_another_model_are_refused() {
     let e = mass_matrix_batch(&star, &mut lanes, &[0.0; 3], &mut m).unwrap_err();
     assert!(e.to_string().contains("other parents"), "{e}");
     mass_matrix_batch(&chain, &mut lanes, &[0.0; 3], &mut m).unwrap();
+    // the same sizes and tree, the bodies on other degrees of freedom: a chain of three whose
+    // last joint follows the first, against one whose last follows the second (the regressor's
+    // zero pattern is by degree of freedom)
+    let follower = |leader: &str| {
+        let mut s = String::from("<robot name=\"m\"><link name=\"base\"/>");
+        for (k, p) in ["base", "l0", "l1"].iter().enumerate() {
+            let mimic = if k == 2 {
+                format!("<mimic joint=\"{leader}\" multiplier=\"2\"/>")
+            } else {
+                String::new()
+            };
+            s += &format!(
+                "<link name=\"l{k}\"><inertial><mass value=\"1\"/><inertia ixx=\"0.1\" \
+                 ixy=\"0\" ixz=\"0\" iyy=\"0.1\" iyz=\"0\" izz=\"0.1\"/></inertial></link>\
+                 <joint name=\"j{k}\" type=\"continuous\"><parent link=\"{p}\"/>\
+                 <child link=\"l{k}\"/><origin xyz=\"0.1 0 0\"/><axis xyz=\"0 0 1\"/>{mimic}\
+                 </joint>"
+            );
+        }
+        model_from_urdf_str(&(s + "</robot>"), "m", &LoadOptions::default()).unwrap()
+    };
+    let (first, second) = (follower("j0"), follower("j1"));
+    assert_eq!((first.nv, second.nv), (2, 2));
+    let mut lanes = LaneData::new(&first);
+    let mut y = vec![0.0; 2 * 30];
+    let e = regressor_batch(
+        &second,
+        &mut lanes,
+        &[0.1, 0.2],
+        &[0.0; 2],
+        &[0.0; 2],
+        Gravity::Included,
+        &mut y,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("degrees of freedom"), "{e}");
 }
 
 #[test]

@@ -312,14 +312,7 @@ impl LaneKernel for Derivatives<'_> {
         while first < self.k {
             let used = (self.k - first).min(W);
             data.load(model, self.x, first, Trig::Loaded);
-            recursion(
-                model,
-                data,
-                &mut d,
-                &minus_g,
-                self.g_static.is_some(),
-                first == 0,
-            );
+            recursion(model, data, &mut d, &minus_g, self.g_static.is_some());
             let [tau, m, dq, dv] = &mut self.out;
             if !model.coupled {
                 armature_torques(model, &mut d.tau, &data.ab);
@@ -433,8 +426,9 @@ fn write_matrices<const W: usize>(
 }
 
 /// The recursion for the loaded lanes: body-level `tau`, `M`, `d tau / d q` and
-/// `d tau / d qd` into `d` (`Gs` too when `at_rest`); `clear` zeroes the matrices first (the
-/// pairs outside a subtree are never written: needed on the first group of a call only).
+/// `d tau / d qd` into `d` (`Gs` too when `at_rest`). The matrices' pairs of bodies of which
+/// neither is in the other's subtree (`LaneBuffers::m_zeros`) are never written: zero since
+/// the buffers were made.
 #[inline(always)]
 fn recursion<const W: usize>(
     model: &Model,
@@ -442,7 +436,6 @@ fn recursion<const W: usize>(
     d: &mut Buffers<W>,
     minus_g: &crate::spatial::Motion,
     at_rest: bool,
-    clear: bool,
 ) {
     let nb = model.nbodies();
     let base_a = SpatialLanes {
@@ -500,13 +493,6 @@ fn recursion<const W: usize>(
         }
     }
 
-    // only the pairs of a body and its subtree are written, the same in every group: the
-    // others are cleared once per call
-    if clear {
-        for x in [&mut d.m, &mut d.dq, &mut d.dv, &mut d.gs] {
-            x.fill(Lanes::default());
-        }
-    }
     for i in serial((0..nb).rev()) {
         let b = &model.bodies[i];
         let end = b.subtree_end;

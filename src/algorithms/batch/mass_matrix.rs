@@ -133,12 +133,9 @@ impl LaneKernel for MassMatrix<'_> {
                 }
             }
             let (m, zeros) = (&mut data.m, &data.m_zeros);
-            // only the pairs of a body and its ancestors are written, the same in every group:
-            // the others are cleared once per call (and those in blocks of structural zeros
-            // are not even read: `m_zeros`)
-            if first == 0 {
-                m.fill(Lanes::default());
-            }
+            // only the pairs of a body and its ancestors are written: the others (`m_zeros`)
+            // are zero since the buffer was made (and those in blocks of structural zeros are
+            // not even read)
             // composite inertias from the leaves up: each child's arrives in its parent's
             // `data.composite`, the first to arrive (the last child in depth-first order) by
             // assignment, so nothing is cleared

@@ -45,10 +45,12 @@ pub struct LaneData {
     isa: Isa,
     nv: usize,
     nbodies: usize,
-    /// The parent of every body of the model these buffers were made for: the kernels keep
-    /// structural facts in them (the mass matrix's zero blocks), so a model of the same sizes
-    /// but another tree is refused.
-    parents: Vec<Option<usize>>,
+    /// The parent and the degree of freedom of every body of the model these buffers were
+    /// made for: the kernels keep structural facts in them (the entries of the mass matrix and
+    /// the regressor that are zero for every sample, left zero since the buffers were made and
+    /// written out without being read), so a model of the same sizes but another tree, or
+    /// another assignment of bodies to degrees of freedom, is refused.
+    bodies: Vec<(Option<usize>, usize)>,
     /// See [`Self::set_job_output`].
     job_output: usize,
     buffers: Buffers,
@@ -352,7 +354,7 @@ impl LaneData {
             },
             nv: model.nv,
             nbodies: model.nbodies(),
-            parents: model.bodies.iter().map(|b| b.parent).collect(),
+            bodies: model.bodies.iter().map(|b| (b.parent, b.dof)).collect(),
             job_output: 0,
             buffers,
         }
@@ -441,14 +443,15 @@ impl LaneData {
     }
 
     /// Fails unless these buffers were made for a model of `model`'s sizes and tree (every
-    /// body's parent).
+    /// body's parent and degree of freedom).
     fn check(&self, model: &Model) -> Result<()> {
         let sizes = (self.nv, self.nbodies) == (model.nv, model.nbodies());
         if sizes
             && self
-                .parents
+                .bodies
                 .iter()
-                .eq(model.bodies.iter().map(|b| &b.parent))
+                .copied()
+                .eq(model.bodies.iter().map(|b| (b.parent, b.dof)))
         {
             return Ok(());
         }
@@ -460,7 +463,9 @@ impl LaneData {
                 model.nbodies()
             ),
             got: if sizes {
-                "buffers for a model of these sizes whose bodies have other parents".into()
+                "buffers for a model of these sizes whose bodies have other parents or degrees \
+                 of freedom"
+                    .into()
             } else {
                 format!("buffers for {} dofs and {} bodies", self.nv, self.nbodies)
             },

@@ -101,8 +101,7 @@ impl LaneKernel for Regressor<'_> {
         let stores = data.stores(self.out.as_deref().map_or(0, <[f64]>::len));
         while first < self.k {
             data.load(model, self.x, first, Trig::InPlace);
-            // the entries left zero are the same for every group: cleared once per call
-            regressor_lanes(model, data, self.gravity, first == 0);
+            regressor_lanes(model, data, self.gravity);
             if let Some(out) = self.out.as_deref_mut() {
                 let used = (self.k - first).min(W);
                 let out = &mut out[first * nv * p..];
@@ -318,19 +317,15 @@ fn raw_lin<const W: usize>(axes: &BodyAxes, m: &SpatialLanes<W>, j: usize) -> La
 /// The joint-torque regressor (see [`crate::algorithms::regressor::joint_torque_regressor`]) of
 /// the loaded group of lanes: `data.regressor` row-major `nv x 10 nbodies`, one lane per
 /// sample. `gravity` includes gravity. The entries of a degree of freedom that does not move
-/// the body of the column stay as they were: `clear` zeroes them first (needed on the first
-/// group of a call; a coupled model, whose entries accumulate, clears every time).
+/// the body of the column (`LaneBuffers::regressor_zeros`) are never written: zero since the
+/// buffer was made. A coupled model's entries accumulate, so its buffer is cleared every
+/// group.
 #[inline(always)]
-fn regressor_lanes<const W: usize>(
-    model: &Model,
-    data: &mut LaneBuffers<W>,
-    gravity: Gravity,
-    clear: bool,
-) {
+fn regressor_lanes<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, gravity: Gravity) {
     forward(model, data, &model.base_acceleration(gravity));
     let mut out = std::mem::take(&mut data.regressor);
     let mut chain = std::mem::take(&mut data.chain);
-    if clear || model.coupled {
+    if model.coupled {
         out.fill(Lanes::default());
     }
     for i in serial(0..model.nbodies()) {
