@@ -136,6 +136,18 @@ pub(crate) fn store_fence() {
 pub(crate) struct ZeroPattern {
     /// `written[c]`: how many of entries `0..c` the kernel writes (`n + 1` counts).
     written: Vec<u32>,
+    /// For each of the 8 places the blocks of 8 can start at (the writers' `head`), the blocks
+    /// from there on as runs of zero blocks and blocks holding values, so that the writers do
+    /// not scan the pattern block by block every group.
+    segments: Vec<Vec<Segment>>,
+}
+
+/// Blocks of 8 quantities from `start` on: `zero_blocks` blocks of structural zeros, or (0)
+/// one block holding values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Segment {
+    pub(crate) start: u32,
+    pub(crate) zero_blocks: u32,
 }
 
 impl ZeroPattern {
@@ -147,7 +159,55 @@ impl ZeroPattern {
             sum += u32::from(w);
             counts.push(sum);
         }
-        Self { written: counts }
+        let mut pattern = Self {
+            written: counts,
+            segments: Vec::new(),
+        };
+        pattern.segments = (0..8).map(|head| pattern.segments_from(head)).collect();
+        pattern
+    }
+
+    /// The blocks of 8 from `head` on, as [`Self::segments`] keeps them.
+    fn segments_from(&self, head: usize) -> Vec<Segment> {
+        let n = self.written.len() - 1;
+        let mut out: Vec<Segment> = Vec::new();
+        let mut c = head;
+        while c + 8 <= n {
+            let start = c as u32;
+            if self.zero(c, 8) {
+                match out.last_mut() {
+                    Some(last)
+                        if last.zero_blocks > 0 && last.start + 8 * last.zero_blocks == start =>
+                    {
+                        last.zero_blocks += 1
+                    }
+                    _ => out.push(Segment {
+                        start,
+                        zero_blocks: 1,
+                    }),
+                }
+            } else {
+                out.push(Segment {
+                    start,
+                    zero_blocks: 0,
+                });
+            }
+            c += 8;
+        }
+        out
+    }
+
+    /// The blocks of 8 quantities from `head` (below 8) on, in order: runs of structural zeros
+    /// and blocks holding values (see [`Segment`]); empty for a pattern made by `default`.
+    #[inline(always)]
+    pub(crate) fn segments(&self, head: usize) -> &[Segment] {
+        self.segments.get(head).map_or(&[], Vec::as_slice)
+    }
+
+    /// The number of entries the pattern covers.
+    #[inline(always)]
+    pub(crate) fn len(&self) -> usize {
+        self.written.len().saturating_sub(1)
     }
 
     /// Whether entries `c..c + len` are all structural zeros (false past the pattern's end).
@@ -490,6 +550,45 @@ mod tests {
         assert!(z.zero(1, 4) && !z.zero(0, 4) && !z.zero(2, 4) && z.zero(6, 1));
         assert!(!z.zero(5, 4), "past the end is not zero");
         assert!(z.zero(3, 0));
+    }
+
+    #[test]
+    fn segments_list_every_block_once_as_the_pattern_has_it() {
+        // from each head: the blocks of 8 up to the last whole one, in order, each zero block
+        // in a run and every other one alone; runs are maximal
+        let patterns: [fn(usize) -> bool; 4] = [
+            |c| (c / 8) % 3 != 0,
+            |c| c % 11 < 6,
+            |c| (5..60).contains(&c),
+            |_| false,
+        ];
+        for zero in patterns {
+            for n in [0, 7, 8, 9, 40, 75] {
+                let z = ZeroPattern::new((0..n).map(|c| !zero(c)));
+                assert_eq!(z.len(), n);
+                for head in 0..8 {
+                    let mut blocks = Vec::new();
+                    for s in z.segments(head) {
+                        let (start, k) = (s.start as usize, s.zero_blocks as usize);
+                        if k == 0 {
+                            assert!(!z.zero(start, 8), "n {n} head {head} {start}");
+                            blocks.push(start);
+                        }
+                        for b in 0..k {
+                            assert!(z.zero(start + 8 * b, 8), "n {n} head {head} {start}");
+                            blocks.push(start + 8 * b);
+                        }
+                    }
+                    let expected: Vec<usize> = (head..n.saturating_sub(7)).step_by(8).collect();
+                    assert_eq!(blocks, expected, "n {n} head {head}");
+                    for w in z.segments(head).windows(2) {
+                        let joined = w[0].zero_blocks > 0 && w[1].zero_blocks > 0;
+                        assert!(!joined, "n {n} head {head}: two runs side by side");
+                    }
+                }
+            }
+        }
+        assert!(ZeroPattern::default().segments(0).is_empty());
     }
 
     #[test]
