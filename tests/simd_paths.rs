@@ -376,35 +376,13 @@ fn buffers_of_another_model_are_refused() {
     assert!(e.to_string().contains("buffers for this model"), "{e}");
     // the same sizes, another tree: a chain of three against three links on the base (the
     // mass matrix kernel keeps the chain's zero pattern in its buffers)
-    let tree = |parents: [&str; 3]| {
+    // (the last joint following `leader` where one is given)
+    let tree_following = |parents: [&str; 3], leader: Option<&str>| {
         let mut s = String::from("<robot name=\"t\"><link name=\"base\"/>");
         for (k, p) in parents.iter().enumerate() {
-            s += &format!(
-                "<link name=\"l{k}\"><inertial><mass value=\"1\"/><inertia ixx=\"0.1\" \
-                 ixy=\"0\" ixz=\"0\" iyy=\"0.1\" iyz=\"0\" izz=\"0.1\"/></inertial></link>\
-                 <joint name=\"j{k}\" type=\"continuous\"><parent link=\"{p}\"/>\
-                 <child link=\"l{k}\"/><origin xyz=\"0.1 0 0\"/><axis xyz=\"0 0 1\"/></joint>"
-            );
-        }
-        let model = model_from_urdf_str(&(s + "</robot>"), "t", &LoadOptions::default());
-        model.unwrap()
-    };
-    let (chain, star) = (tree(["base", "l0", "l1"]), tree(["base"; 3]));
-    let mut lanes = LaneData::new(&chain);
-    let mut m = vec![0.0; 9];
-    let e = mass_matrix_batch(&star, &mut lanes, &[0.0; 3], &mut m).unwrap_err();
-    assert!(e.to_string().contains("other parents"), "{e}");
-    mass_matrix_batch(&chain, &mut lanes, &[0.0; 3], &mut m).unwrap();
-    // the same sizes and tree, the bodies on other degrees of freedom: a chain of three whose
-    // last joint follows the first, against one whose last follows the second (the regressor's
-    // zero pattern is by degree of freedom)
-    let follower = |leader: &str| {
-        let mut s = String::from("<robot name=\"m\"><link name=\"base\"/>");
-        for (k, p) in ["base", "l0", "l1"].iter().enumerate() {
-            let mimic = if k == 2 {
-                format!("<mimic joint=\"{leader}\" multiplier=\"2\"/>")
-            } else {
-                String::new()
+            let mimic = match leader {
+                Some(j) if k == 2 => format!("<mimic joint=\"{j}\" multiplier=\"2\"/>"),
+                _ => String::new(),
             };
             s += &format!(
                 "<link name=\"l{k}\"><inertial><mass value=\"1\"/><inertia ixx=\"0.1\" \
@@ -414,8 +392,20 @@ fn buffers_of_another_model_are_refused() {
                  </joint>"
             );
         }
-        model_from_urdf_str(&(s + "</robot>"), "m", &LoadOptions::default()).unwrap()
+        let model = model_from_urdf_str(&(s + "</robot>"), "t", &LoadOptions::default());
+        model.unwrap()
     };
+    let tree = |parents| tree_following(parents, None);
+    let (chain, star) = (tree(["base", "l0", "l1"]), tree(["base"; 3]));
+    let mut lanes = LaneData::new(&chain);
+    let mut m = vec![0.0; 9];
+    let e = mass_matrix_batch(&star, &mut lanes, &[0.0; 3], &mut m).unwrap_err();
+    assert!(e.to_string().contains("other parents"), "{e}");
+    mass_matrix_batch(&chain, &mut lanes, &[0.0; 3], &mut m).unwrap();
+    // the same sizes and tree, the bodies on other degrees of freedom: a chain of three whose
+    // last joint follows the first, against one whose last follows the second (the regressor's
+    // zero pattern is by degree of freedom)
+    let follower = |leader| tree_following(["base", "l0", "l1"], Some(leader));
     let (first, second) = (follower("j0"), follower("j1"));
     assert_eq!((first.nv, second.nv), (2, 2));
     let mut lanes = LaneData::new(&first);

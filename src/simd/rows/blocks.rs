@@ -42,13 +42,14 @@ pub(super) unsafe fn blocks_avx512<const W: usize>(
     }
     let mut bits = narrow(src, &zero, used, dst, stride, 0, head, &mut sum);
     let mut c = head;
-    if let Some(z) = zeros.filter(|z| stream && z.len() == n && head < 8) {
+    if let Some(z) = zeros.filter(|z| stream && z.len() == n) {
         // streaming: the blocks as the pattern lists them (runs of zeros, blocks holding
         // values), not scanned for every group (measured, whole builds alternated on a Zen 4:
         // the 60-dof tree's regressor 4.5 % faster, its mass matrix level; outputs kept in the
         // caches, such as the Panda's regressor, were 4 % slower so and are scanned below).
         // The blocks' sum in a register of this loop's own: one shared with the loop below
         // was kept in memory, a store and a load on every block's chain.
+        debug_assert!(head < 8, "the blocks start within the first line");
         let mut block_sum = _mm512_setzero_pd();
         for s in z.segments(head) {
             let c = s.start as usize;
@@ -606,8 +607,9 @@ unsafe fn stream_lines4<const W: usize>(
     let n = src.len();
     let zero = |c: usize| zeros.is_some_and(|z| z.zero(c, 8));
     let mut c = from;
-    if let Some(z) = zeros.filter(|z| z.len() == n && from < 8) {
+    if let Some(z) = zeros.filter(|z| z.len() == n) {
         // the blocks as the pattern lists them (runs of zeros, blocks holding values)
+        debug_assert!(from < 8, "the blocks start within the first line");
         for s in z.segments(from) {
             let c = s.start as usize;
             if s.zero_blocks > 0 {
