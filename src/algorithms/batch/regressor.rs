@@ -173,9 +173,6 @@ struct BodyAxes {
     parent_subspace: [[f64; 3]; 2],
     /// The joint axis in the body's held axes.
     axis: Vector3<f64>,
-    /// The regressor column (within the body's ten) of each of the ten entries computed in the
-    /// held axes: mass, first moment along each held axis, rotational inertia of each pair.
-    slots: [usize; PARAMS_PER_BODY],
 }
 
 impl<const W: usize> Chain<W> {
@@ -206,21 +203,6 @@ impl<const W: usize> Chain<W> {
                 }
             });
             let axis = Vector3::new(b.axis[order[0]], b.axis[order[1]], b.axis[order[2]]);
-            // [Ixx, Ixy, Iyy, Ixz, Iyz, Izz]: the column of the product of axes r and s
-            let inertia = |r: usize, s: usize| 4 + [[0, 1, 3], [1, 2, 4], [3, 4, 5]][r][s];
-            let [o0, o1, o2] = order;
-            let slots = [
-                0,
-                1 + o0,
-                1 + o1,
-                1 + o2,
-                inertia(o0, o0),
-                inertia(o0, o1),
-                inertia(o1, o1),
-                inertia(o0, o2),
-                inertia(o1, o2),
-                inertia(o2, o2),
-            ];
             bodies.push(BodyAxes {
                 depth: parent.map_or(0, |(_, a)| a.depth + 1),
                 order,
@@ -228,7 +210,6 @@ impl<const W: usize> Chain<W> {
                 p_parent,
                 parent_subspace,
                 axis,
-                slots,
             });
         }
         let deepest = bodies.iter().map(|a| a.depth).max().unwrap_or(0);
@@ -345,7 +326,7 @@ fn regressor_lanes<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, gra
         let first = PARAMS_PER_BODY * i;
         // its own joint's subspace is a constant of the model in its own frame
         let own = own_columns(b.kind, &axes.axis, &c, &w, &al, w2, &u);
-        put(model, &mut out, i, first, &axes.slots, &own);
+        put(model, &mut out, i, first, axes.order[0], &own);
         let Some(parent) = b.parent else { continue };
         let d = axes.depth;
         let (above, below) = chain.subspaces.split_at_mut(d * (d - 1) / 2);
@@ -392,7 +373,7 @@ fn regressor_lanes<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, gra
                 sa.dot(&u[4]),
                 sa.dot(&u[5]),
             ];
-            put(model, &mut out, k, first, &axes.slots, &y);
+            put(model, &mut out, k, first, axes.order[0], &y);
             j = model.bodies[k].parent;
         }
     }
@@ -401,22 +382,65 @@ fn regressor_lanes<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, gra
 }
 
 /// The ten entries `y` (in the held axes' order) into body columns `first..first + 10` of body
-/// `k`'s degree of freedom's row of the regressor `out` (row-major `nv x 10 nbodies`), at
-/// `slots`; for a coupled model times the body's multiplier, added. (A function, not a
-/// closure: one compiled out of line would lose the instruction set.)
+/// `k`'s degree of freedom's row of the regressor `out` (row-major `nv x 10 nbodies`), at the
+/// columns of the held axes `[r, r + 1, r + 2]` (cyclically; `r` the first); for a coupled
+/// model times the body's multiplier, added. (A function, not a closure: one compiled out of
+/// line would lose the instruction set.)
 #[inline(always)]
 fn put<const W: usize>(
     model: &Model,
     out: &mut [Lanes<W>],
     k: usize,
     first: usize,
-    slots: &[usize; PARAMS_PER_BODY],
+    r: usize,
     y: &[Lanes<W>; PARAMS_PER_BODY],
 ) {
+    // one copy per permutation, so that every column is a constant (measured: the columns
+    // read from a table, with their bounds checks, took as many instructions as the entries'
+    // arithmetic)
+    match r {
+        0 => put_held::<W, 0>(model, out, k, first, y),
+        1 => put_held::<W, 1>(model, out, k, first, y),
+        _ => put_held::<W, 2>(model, out, k, first, y),
+    }
+}
+
+/// The regressor column (within the body's ten) of each of the ten entries computed in the
+/// held axes `[r, r + 1, r + 2]` (cyclically): mass, first moment along each held axis,
+/// rotational inertia of each pair (columns `[Ixx, Ixy, Iyy, Ixz, Iyz, Izz]` from 4 on).
+const fn held_columns(r: usize) -> [usize; PARAMS_PER_BODY] {
+    let o = [r, (r + 1) % 3, (r + 2) % 3];
+    let pair = [[4, 5, 7], [5, 6, 8], [7, 8, 9]];
+    [
+        0,
+        1 + o[0],
+        1 + o[1],
+        1 + o[2],
+        pair[o[0]][o[0]],
+        pair[o[0]][o[1]],
+        pair[o[1]][o[1]],
+        pair[o[0]][o[2]],
+        pair[o[1]][o[2]],
+        pair[o[2]][o[2]],
+    ]
+}
+
+/// [`put`] for the held axes starting at `R`.
+#[inline(always)]
+fn put_held<const W: usize, const R: usize>(
+    model: &Model,
+    out: &mut [Lanes<W>],
+    k: usize,
+    first: usize,
+    y: &[Lanes<W>; PARAMS_PER_BODY],
+) {
+    let columns = const { held_columns(R) };
     let bk = &model.bodies[k];
     let at = bk.dof * PARAMS_PER_BODY * model.nbodies() + first;
-    let row = &mut out[at..at + PARAMS_PER_BODY];
-    for (&s, y) in slots.iter().zip(y) {
+    let row: &mut [Lanes<W>; PARAMS_PER_BODY] = (&mut out[at..at + PARAMS_PER_BODY])
+        .try_into()
+        .expect("ten columns");
+    for (&s, y) in columns.iter().zip(y) {
         row[s] = if model.coupled {
             y.mul_add_s(bk.multiplier, row[s])
         } else {
