@@ -143,11 +143,14 @@ pub(crate) struct ZeroPattern {
 }
 
 /// Blocks of 8 quantities from `start` on: `zero_blocks` blocks of structural zeros, or (0)
-/// one block holding values.
+/// one block holding values, of which the first four are all structural zeros if bit 0 of
+/// `zero_halves` is set, the last four if bit 1 is (so that a writer of 4x4 blocks need not
+/// read and transpose them).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Segment {
     pub(crate) start: u32,
     pub(crate) zero_blocks: u32,
+    pub(crate) zero_halves: u8,
 }
 
 impl ZeroPattern {
@@ -184,12 +187,14 @@ impl ZeroPattern {
                     _ => out.push(Segment {
                         start,
                         zero_blocks: 1,
+                        zero_halves: 0,
                     }),
                 }
             } else {
                 out.push(Segment {
                     start,
                     zero_blocks: 0,
+                    zero_halves: u8::from(self.zero(c, 4)) | u8::from(self.zero(c + 4, 4)) << 1,
                 });
             }
             c += 8;
@@ -477,9 +482,14 @@ mod tests {
         // is not read in full
         for n in [4, 7, 12, 13, 16, 21, 24, 35, 64] {
             let pattern = ZeroPattern::new((0..n).map(|c| !zero(c)));
-            let src: Vec<Lanes<W>> = (0..n)
-                .map(|c| Lanes::splat(if zero(c) { f64::NAN } else { c as f64 }))
-                .collect();
+            // each lane its own values (`100 c + l`), so that a lane written into another
+            // lane's row is caught
+            let mut src = numbered::<W>(n);
+            for (c, x) in src.iter_mut().enumerate() {
+                if zero(c) {
+                    *x = Lanes::splat(f64::NAN);
+                }
+            }
             let avx = W.is_multiple_of(4) && std::arch::is_x86_feature_detected!("avx");
             for used in 1..=W {
                 for stride in strides(n) {
@@ -496,7 +506,7 @@ mod tests {
                             let row = &dst[l * stride..l * stride + n];
                             for (c, got) in row.iter().enumerate() {
                                 if !zero(c) {
-                                    assert_eq!(*got, c as f64);
+                                    assert_eq!(*got, (100 * c + l) as f64, "W {W} n {n}");
                                 } else {
                                     assert!(*got == 0.0 || got.is_nan(), "W {W} n {n} c {c}");
                                     nan |= got.is_nan();
@@ -572,7 +582,15 @@ mod tests {
                         let (start, k) = (s.start as usize, s.zero_blocks as usize);
                         if k == 0 {
                             assert!(!z.zero(start, 8), "n {n} head {head} {start}");
+                            let halves = [z.zero(start, 4), z.zero(start + 4, 4)];
+                            assert_eq!(
+                                [s.zero_halves & 1 != 0, s.zero_halves & 2 != 0],
+                                halves,
+                                "n {n} head {head} {start}"
+                            );
                             blocks.push(start);
+                        } else {
+                            assert_eq!(s.zero_halves, 0);
                         }
                         for b in 0..k {
                             assert!(z.zero(start + 8 * b, 8), "n {n} head {head} {start}");

@@ -55,6 +55,9 @@ pub(super) unsafe fn blocks_avx512<const W: usize>(
             let c = s.start as usize;
             if s.zero_blocks > 0 {
                 zero_run(dst, stride, c, c + 8 * s.zero_blocks as usize, true);
+            } else if s.zero_halves != 0 {
+                // half of the block structural zeros: only the other half read and turned
+                half8(src, dst, stride, c, s.zero_halves & 1 != 0, &mut block_sum);
             } else {
                 transpose8(&src[c..c + 8], dst, stride, c, true, &mut block_sum);
             }
@@ -402,6 +405,76 @@ unsafe fn transpose8<const W: usize>(
     store8(dst, stride, c, out, stream);
 }
 
+/// As [`transpose8`] streamed, for quantities `c..c + 8` of `src` of which the first four
+/// (`low_zero`) or the last four are structural zeros: only the other four read (and added to
+/// `sum`), turned into rows by 16 shuffles instead of 24, the zeros put beside them.
+///
+/// # Safety
+/// As [`transpose8`].
+#[inline(always)]
+unsafe fn half8<const W: usize>(
+    src: &[Lanes<W>],
+    dst: &mut [f64],
+    stride: usize,
+    c: usize,
+    low_zero: bool,
+    sum: &mut std::arch::x86_64::__m512d,
+) {
+    use std::arch::x86_64::{
+        _mm512_add_pd, _mm512_loadu_pd, _mm512_setzero_pd, _mm512_shuffle_f64x2,
+        _mm512_unpackhi_pd, _mm512_unpacklo_pd,
+    };
+    let q = &src[if low_zero { c + 4 } else { c }..][..4];
+    let [a, b, x, y] = [
+        _mm512_loadu_pd(q[0].0[..8].as_ptr()),
+        _mm512_loadu_pd(q[1].0[..8].as_ptr()),
+        _mm512_loadu_pd(q[2].0[..8].as_ptr()),
+        _mm512_loadu_pd(q[3].0[..8].as_ptr()),
+    ];
+    *sum = _mm512_add_pd(
+        *sum,
+        _mm512_add_pd(_mm512_add_pd(a, b), _mm512_add_pd(x, y)),
+    );
+    // pairs of quantities by lane: even lanes (lo) and odd lanes (hi) of a, b and of x, y
+    let (t0, t1) = (_mm512_unpacklo_pd(a, b), _mm512_unpackhi_pd(a, b));
+    let (t2, t3) = (_mm512_unpacklo_pd(x, y), _mm512_unpackhi_pd(x, y));
+    // u[l] (l < 4): 128-bit pieces [a b of lane l, a b of lane l + 4, x y of lane l, x y of
+    // lane l + 4]
+    let u = [
+        _mm512_shuffle_f64x2::<0x88>(t0, t2),
+        _mm512_shuffle_f64x2::<0x88>(t1, t3),
+        _mm512_shuffle_f64x2::<0xdd>(t0, t2),
+        _mm512_shuffle_f64x2::<0xdd>(t1, t3),
+    ];
+    let z = _mm512_setzero_pd();
+    // lane l's row: u[l]'s pieces 0, 2 (lanes below 4) or 1, 3, into the row's half that
+    // holds values, zeros in the other
+    let rows = if low_zero {
+        [
+            _mm512_shuffle_f64x2::<0x80>(z, u[0]),
+            _mm512_shuffle_f64x2::<0x80>(z, u[1]),
+            _mm512_shuffle_f64x2::<0x80>(z, u[2]),
+            _mm512_shuffle_f64x2::<0x80>(z, u[3]),
+            _mm512_shuffle_f64x2::<0xd0>(z, u[0]),
+            _mm512_shuffle_f64x2::<0xd0>(z, u[1]),
+            _mm512_shuffle_f64x2::<0xd0>(z, u[2]),
+            _mm512_shuffle_f64x2::<0xd0>(z, u[3]),
+        ]
+    } else {
+        [
+            _mm512_shuffle_f64x2::<0x08>(u[0], z),
+            _mm512_shuffle_f64x2::<0x08>(u[1], z),
+            _mm512_shuffle_f64x2::<0x08>(u[2], z),
+            _mm512_shuffle_f64x2::<0x08>(u[3], z),
+            _mm512_shuffle_f64x2::<0x0d>(u[0], z),
+            _mm512_shuffle_f64x2::<0x0d>(u[1], z),
+            _mm512_shuffle_f64x2::<0x0d>(u[2], z),
+            _mm512_shuffle_f64x2::<0x0d>(u[3], z),
+        ]
+    };
+    store8(dst, stride, c, rows, true);
+}
+
 /// The 8 lanes of the 8 quantities `src` (`W == 8`; bounds-checked: fails unless `W >= 8` and
 /// `src` holds 8), loaded; their sum added to `sum` (8 adds; see [`transpose4`]).
 ///
@@ -617,7 +690,7 @@ unsafe fn stream_lines4<const W: usize>(
                 unsafe { zero_run4::<W>(dst, stride, c, c + 8 * s.zero_blocks as usize) };
             } else {
                 // SAFETY: as this function's
-                unsafe { lines4(src, dst, stride, c, sum) };
+                unsafe { lines4(src, dst, stride, c, s.zero_halves, sum) };
             }
         }
         c = from + (n - from) / 8 * 8;
@@ -635,7 +708,7 @@ unsafe fn stream_lines4<const W: usize>(
             continue;
         }
         // SAFETY: as this function's
-        unsafe { lines4(src, dst, stride, c, sum) };
+        unsafe { lines4(src, dst, stride, c, 0, sum) };
         c += 8;
     }
     c
@@ -676,6 +749,8 @@ unsafe fn zero_run4<const W: usize>(dst: &mut [f64], stride: usize, from: usize,
 /// `dst` (row `l` at `l * stride`) by pairs of 4x4 transposes, each row's 8 values two 32-byte
 /// stores back to back: non-temporal where they make a whole cache line (the block's first row
 /// on a line, `stride` a multiple of 8 values). The values added to `sum` (see [`transpose4`]).
+/// The quantities `c..c + 4` are zeros if bit 0 of `zero_halves` is set, `c + 4..c + 8` if
+/// bit 1 is: those are stored as zeros, neither read nor transposed.
 ///
 /// # Safety
 /// As [`transpose4`].
@@ -685,6 +760,7 @@ unsafe fn lines4<const W: usize>(
     dst: &mut [f64],
     stride: usize,
     c: usize,
+    zero_halves: u8,
     sum: &mut std::arch::x86_64::__m256d,
 ) {
     use std::arch::x86_64::{_mm256_add_pd, _mm256_setzero_pd, _mm256_storeu_pd, _mm256_stream_pd};
@@ -694,8 +770,15 @@ unsafe fn lines4<const W: usize>(
     // the block's own sum, then one add to the running one (as in `block4`)
     let mut values = _mm256_setzero_pd();
     for lb in (0..W).step_by(4) {
-        let lo = transposed4(&src[c..c + 4], lb, 4, &mut values);
-        let hi = transposed4(&src[c + 4..c + 8], lb, 4, &mut values);
+        let zero = [_mm256_setzero_pd(); 4];
+        let lo = match zero_halves & 1 {
+            0 => transposed4(&src[c..c + 4], lb, 4, &mut values),
+            _ => zero,
+        };
+        let hi = match zero_halves & 2 {
+            0 => transposed4(&src[c + 4..c + 8], lb, 4, &mut values),
+            _ => zero,
+        };
         for l in 0..4 {
             // SAFETY: `block` holds `(W - 1) * stride + 8` values, so `(lb + l) * stride + 8`
             // fit for lb + l < W; streamed only on a 64-byte boundary (checked above)
