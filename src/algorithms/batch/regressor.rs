@@ -7,7 +7,9 @@ use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::{Body, JointKind, Model};
-use crate::simd::{serial, write_rows_with_zeros, Lanes, SpatialLanes, Vector3Lanes};
+use crate::simd::{
+    serial, write_rows_with_zeros, Lanes, Rotation3Lanes, SpatialLanes, Vector3Lanes,
+};
 use nalgebra::Vector3;
 
 /// The joint-torque regressor of a batch, [`LaneData::width`] samples at a time: `out`
@@ -323,6 +325,7 @@ fn regressor_lanes<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, gra
         let c = held(&a.lin, &axes.order).add(&w.cross(&held(&v.lin, &axes.order)));
         let w2 = w.dot(&w);
         let u = unit_inertia_columns(&w, &al);
+        let moments = first_moment_map(&w, &al);
         let first = PARAMS_PER_BODY * i;
         // its own joint's subspace is a constant of the model in its own frame
         let own = own_columns(b.kind, &axes.axis, &c, &w, &al, w2, &u);
@@ -355,12 +358,9 @@ fn regressor_lanes<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, gra
                 to[e] = s;
             }
             let (sa, sl) = (&s.ang, &s.lin);
-            // the first-moment entries at once: sl x al - sa x c + w (sl . w) - sl |w|^2
-            let fm = sl
-                .cross(&al)
-                .sub(&sa.cross(&c))
-                .add(&w.mul_lanes(sl.dot(&w)))
-                .sub(&sl.mul_lanes(w2));
+            // the first-moment entries at once: sl x al - sa x c + w (sl . w) - sl |w|^2, as
+            // K sl + c x sa (15 operations a pair where the terms one by one took 32)
+            let fm = moments.mul_add(sl, &c.cross(sa));
             let y = [
                 sl.dot(&c),
                 fm.x,
@@ -498,6 +498,24 @@ fn own_columns<const W: usize>(
             ]
         }
     }
+}
+
+/// The matrix `K = w w^T - |w|^2 1 - [al]x` (body frame, by rows), for which
+/// `K s = s x al + w (w . s) - s |w|^2`: the part of the first-moment entries linear in a
+/// subspace's linear part `s`, made once a body instead of once per ancestor.
+#[inline(always)]
+fn first_moment_map<const W: usize>(
+    w: &Vector3Lanes<W>,
+    al: &Vector3Lanes<W>,
+) -> Rotation3Lanes<W> {
+    let (xy, xz, yz) = (w.x * w.y, w.x * w.z, w.y * w.z);
+    let (xx, yy, zz) = (w.x * w.x, w.y * w.y, w.z * w.z);
+    let v = |x, y, z| Vector3Lanes { x, y, z };
+    Rotation3Lanes([
+        v(-(yy + zz), xy + al.z, xz - al.y),
+        v(xy - al.z, -(xx + zz), yz + al.x),
+        v(xz + al.y, yz - al.x, -(xx + yy)),
+    ])
 }
 
 /// `I_q al + w x (I_q w)` (body frame) for the unit rotational inertias `I_q` of
