@@ -574,8 +574,7 @@ fn a_log_timed_in_hours_is_asked_about() {
 /// reader ignore it).
 #[test]
 fn text_not_in_utf8_is_named_and_a_byte_order_mark_is_ignored() {
-    let d = std::env::temp_dir().join(format!("perturbid-utf8-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
+    let d = common::temp_dir::TempDir::new("utf8");
     let joints = vec!["joint1".to_string()];
     let cases: [(&str, Vec<u8>, &str); 3] = [
         (
@@ -635,7 +634,6 @@ fn text_not_in_utf8_is_named_and_a_byte_order_mark_is_ignored() {
     std::fs::write(&path, format!("\u{feff}{text}")).unwrap();
     let loaded = perturbid_rs::direct::BaseModel::load(&path).unwrap();
     assert_eq!(loaded.theta, fit.theta);
-    std::fs::remove_dir_all(&d).ok();
 }
 
 #[test]
@@ -949,9 +947,7 @@ fn key_messages_word_for_word() {
     assert!(says(plan_experiments(&model, &crawling, &keep).unwrap_err())
         .contains("joint 'joint4' has qd* = 1e-12: every velocity perturbation of a size a sensor reads reverses it"));
     // a file of an output set whose writing was killed
-    let d = std::env::temp_dir().join(format!("perturbid-words-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
+    let d = common::temp_dir::TempDir::new("words");
     std::fs::write(d.join("x.csv"), "t,q1,tau1\n0,0,0\n").unwrap();
     std::fs::write(
         d.join("run.manifest.json"),
@@ -1247,8 +1243,7 @@ fn model_documents_hold_magnitudes_where_they_say_so() {
 #[test]
 fn files_are_read_only_up_to_a_bound() {
     use perturbid_rs::rehearsal::TrueRobot;
-    let dir = std::env::temp_dir().join(format!("perturbid-big-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::temp_dir::TempDir::new("big");
     let big = dir.join("big.json");
     // sparse: no disk space, 300 MiB of length
     std::fs::File::create(&big)
@@ -1264,7 +1259,6 @@ fn files_are_read_only_up_to_a_bound() {
         e.contains("larger than 256 MB, the most read for a document"),
         "{e}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
     if std::path::Path::new("/dev/zero").exists() {
         let e = TrueRobot::load("/dev/zero").unwrap_err().to_string();
         assert!(e.starts_with("/dev/zero: larger than 256 MB"), "{e}");

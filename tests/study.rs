@@ -2,7 +2,7 @@
 //! analytic linearisation; identical seeds give identical files; a rerun skips finished
 //! cases and a journal cut short resumes; bad configurations name the line.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use perturbid_rs::data::Data;
 use perturbid_rs::local::{
@@ -35,11 +35,11 @@ distances = [1, 4]
 samples = 4
 "#;
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("perturbid-study-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+#[path = "common/temp_dir.rs"]
+mod temp_dir;
+
+fn tmp(name: &str) -> temp_dir::TempDir {
+    temp_dir::TempDir::new(&format!("study-{name}"))
 }
 
 fn study() -> Study {

@@ -99,5 +99,6 @@ mod tests {
         assert!(foreign_table(&dir).unwrap().contains("metadata.yaml"));
         // a folder without one is left to the reader's error
         assert_eq!(foreign_table(dir.parent().unwrap().parent().unwrap()), None);
+        std::fs::remove_dir_all(dir.parent().unwrap().parent().unwrap()).unwrap();
     }
 }

@@ -356,6 +356,7 @@ mod tests {
         assert_eq!(m.state, "complete");
         assert_eq!(m.files, vec!["a.csv", "c.csv"]);
         check_not_partial(&d.join("a.csv")).unwrap();
+        std::fs::remove_dir_all(&d).unwrap();
     }
 
     #[test]
@@ -384,6 +385,7 @@ mod tests {
         s.add("a.csv", "y").unwrap();
         s.commit().unwrap();
         check_not_partial(&d.join("a.csv")).unwrap();
+        std::fs::remove_dir_all(&d).unwrap();
     }
 
     #[test]
@@ -401,6 +403,7 @@ mod tests {
         s.commit().unwrap();
         assert!(!dead.exists() && !legacy.exists());
         assert!(mine.exists(), "a temporary of a running process is kept");
+        std::fs::remove_dir_all(&d).unwrap();
     }
 
     #[test]
@@ -417,6 +420,7 @@ mod tests {
             std::fs::read_to_string(d.join("D.csv")).unwrap(),
             "trajectory"
         );
+        std::fs::remove_dir_all(&d).unwrap();
     }
 
     #[test]

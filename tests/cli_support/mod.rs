@@ -8,39 +8,14 @@ pub fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_perturbid"))
 }
 
+#[path = "../common/temp_dir.rs"]
+mod temp_dir;
+pub use temp_dir::TempDir;
+
 /// A fresh directory for one test's files, removed when the test is done with it (kept when
 /// the test fails, for a look at what it wrote: the failure message names it).
 pub fn tmp(name: &str) -> TempDir {
-    let d = std::env::temp_dir().join(format!("perturbid-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    TempDir(d)
-}
-
-/// See [`tmp`]: derefs to its path.
-pub struct TempDir(PathBuf);
-
-impl std::ops::Deref for TempDir {
-    type Target = PathBuf;
-    fn deref(&self) -> &PathBuf {
-        &self.0
-    }
-}
-
-impl AsRef<Path> for TempDir {
-    fn as_ref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        if std::thread::panicking() {
-            eprintln!("kept for a look: {}", self.0.display());
-        } else {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
+    TempDir::new(&format!("cli-{name}"))
 }
 
 /// Runs and expects success; returns stdout.

@@ -4,6 +4,7 @@
 use nalgebra::DMatrix;
 
 pub mod gain_logs;
+pub mod temp_dir;
 
 /// A deterministic pseudo-random generator (splitmix64) so helpers need no extra crate.
 pub struct Rng(pub u64);
