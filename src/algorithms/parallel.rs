@@ -203,7 +203,7 @@ where
             // pay again and again); should it not vouch there, the rest is read back
             block = block.max(PARALLEL_CHUNK);
         }
-        // between blocks, Ctrl-C: a batch below PARALLEL_BATCH runs here whole (4,000 of the
+        // Ctrl-C between blocks: a batch below PARALLEL_BATCH runs here whole (4,000 of the
         // 60-dof tree's regressors into a fresh array: 1.8-2.8 s of first touches)
         crate::interrupt::check(algorithm)?;
     }

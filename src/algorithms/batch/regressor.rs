@@ -323,12 +323,11 @@ fn regressor_lanes<const W: usize>(model: &Model, data: &mut LaneBuffers<W>, gra
         let (v, a) = (&data.v[i], &data.a[i]);
         let (w, al) = (held(&v.ang, &axes.order), held(&a.ang, &axes.order));
         let c = held(&a.lin, &axes.order).add(&w.cross(&held(&v.lin, &axes.order)));
-        let w2 = w.dot(&w);
         let u = unit_inertia_columns(&w, &al);
         let moments = first_moment_map(&w, &al);
         let first = PARAMS_PER_BODY * i;
         // its own joint's subspace is a constant of the model in its own frame
-        let own = own_columns(b.kind, &axes.axis, &c, &w, &al, w2, &u);
+        let own = own_columns(b.kind, &axes.axis, &c, &moments, &u);
         put(model, &mut out, i, first, axes.order[0], &own);
         let Some(parent) = b.parent else { continue };
         let d = axes.depth;
@@ -457,9 +456,7 @@ fn own_columns<const W: usize>(
     kind: JointKind,
     a: &Vector3<f64>,
     c: &Vector3Lanes<W>,
-    w: &Vector3Lanes<W>,
-    al: &Vector3Lanes<W>,
-    w2: Lanes<W>,
+    moments: &Rotation3Lanes<W>,
     u: &[Vector3Lanes<W>; 6],
 ) -> [Lanes<W>; PARAMS_PER_BODY] {
     match kind {
@@ -479,10 +476,8 @@ fn own_columns<const W: usize>(
             ]
         }
         JointKind::Prismatic => {
-            let fm = w
-                .mul_lanes(w.dot_const(a))
-                .sub(&al.cross_const(a))
-                .sub(&Vector3Lanes::of(a, w2));
+            // a x al + w (w . a) - a |w|^2, the pairs' `K sl` for `sl = a`
+            let fm = moments.mul_const_vector(a);
             let zero = Lanes::default();
             [
                 c.dot_const(a),
