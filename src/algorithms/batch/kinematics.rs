@@ -357,9 +357,9 @@ pub(crate) fn store_turned_pose_in_base<const W: usize>(
             origin.unwrap_or_else(|| Vector3Lanes::splat(&t.pos)),
         ),
     };
-    data.o_s[i] = subspace_of(b.kind, axis, &p);
-    data.o_rot[i] = Rotation3Lanes::from_columns(&x, &y, &axis);
-    data.o_pos[i] = p;
+    subspace_of(b.kind, axis, &p).put(&mut data.o_s[i]);
+    Rotation3Lanes::from_columns(&x, &y, &axis).put(&mut data.o_rot[i]);
+    p.put(&mut data.o_pos[i]);
 }
 
 /// [`store_pose_in_base`] for body `i` below `parent` with an aligned joint `al`, given the
@@ -392,11 +392,12 @@ pub(crate) fn aligned_pose_in_base<const W: usize>(
     let col_b = pb.mul_lanes(cb).sub(&pa.mul_lanes(sa));
     let p = rp.mul_const_vector_add(&b.placement.translation, &data.o_pos[parent]);
     let axis = pk.scale(al.sign);
-    data.o_s[i] = SpatialLanes {
+    SpatialLanes {
         ang: axis,
         lin: p.cross(&axis),
-    };
-    data.o_pos[i] = p;
+    }
+    .put(&mut data.o_s[i]);
+    p.put(&mut data.o_pos[i]);
     let r = &mut data.o_rot[i];
     for (row, (ea, eb, ek)) in [
         (col_a.x, col_b.x, pk.x),
@@ -407,7 +408,9 @@ pub(crate) fn aligned_pose_in_base<const W: usize>(
     .enumerate()
     {
         let row = &mut r.0[row];
-        (*row.at_mut(a), *row.at_mut(bb), *row.at_mut(k)) = (ea, eb, ek);
+        ea.put(row.at_mut(a));
+        eb.put(row.at_mut(bb));
+        ek.put(row.at_mut(k));
     }
 }
 
@@ -430,9 +433,9 @@ pub(crate) fn place_in_base<const W: usize>(
         }
         None => (*rot, *pos),
     };
-    data.o_s[i] = subspace_in(b, &r, &p);
-    data.o_rot[i] = r;
-    data.o_pos[i] = p;
+    subspace_in(b, &r, &p).put(&mut data.o_s[i]);
+    r.put(&mut data.o_rot[i]);
+    p.put(&mut data.o_pos[i]);
     (r, p)
 }
 
