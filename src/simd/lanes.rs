@@ -475,9 +475,10 @@ impl<const W: usize> Lanes<W> {
     /// `*dst = self`, on 4 lanes as one 32-byte store. A plain assignment of lanes assembled
     /// from parts (a rotation from its columns) was stored in pieces, 8 and 16 bytes at a time:
     /// a 32-byte load right after it (a child's pose reading its parent's) then could not be
-    /// forwarded from those stores and waited for them to reach the cache (measured, whole builds
-    /// alternated on a Zen 4: the tree's AVX2 mass matrix 3-5 % faster with the poses stored
-    /// so). 4 lanes are only used on AVX2's path, so AVX is there (checked in debug builds).
+    /// forwarded from those stores and waited for them to reach the cache (measured, wheels
+    /// alternated on a Zen 4: the tree's AVX2 mass matrix 3.5 % faster with the poses stored
+    /// so, the Panda's derivatives 3.7 %). 4 lanes are only used on AVX2's path, so AVX is
+    /// there (checked in debug builds).
     #[inline(always)]
     pub(crate) fn put(self, dst: &mut Lanes<W>) {
         #[cfg(target_arch = "x86_64")]
