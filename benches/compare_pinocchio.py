@@ -14,8 +14,12 @@ perturbid_rs over the same samples in alternation (Pinocchio's, ours, Pinocchio'
 C++ peer stays running between its passes), so that a slow spell of the shared machine, which
 can last a fraction of a second, falls on both sides. Either side's pass is one untimed call
 over the samples (the caches and the clock are cold after the other side's), then calls for
-at least 20 ms, timed together; a round takes each side's median pass. Figures are medians
-over the rounds, the noise the spread of the per-round ratios. One core:
+at least 20 ms, timed together; a round takes each side's median pass. Each round starts with
+both sides' memory allocated anew (our Robot with its buffers, the samples, the outputs; the
+peer's samples, Data and outputs), because where it lands in physical memory decides 10-20 %
+of a kernel's time on a virtual machine, now and then far more, and would otherwise hold for
+the whole run: the rounds sample it. Figures are medians over the rounds, the noise the spread of the per-round ratios
+(machine and placement together). One core:
 batches below the library's parallel threshold run on the calling thread, and one Pinocchio
 process. All cores: a batch large enough for the parallel engine against one Pinocchio process
 per core. Results are checked to agree (torques and matrices to 1e-10 relative, the
@@ -108,9 +112,14 @@ def verdict(rows, isa: str, call_ratio: float) -> str:
 
 
 def robots():
-    """(name, perturbid_rs Robot, Pinocchio model) of the A465, the Panda and the tree (with
-    our robots' armature: URDF has no element for it that Pinocchio reads)."""
-    return [(name, ours, with_armature(model, ours)) for name, ours, model in _robots()]
+    """(name, perturbid_rs Robot, Pinocchio model, a function that makes the Robot anew) of the
+    A465, the Panda and the tree (with our robots' armature: URDF has no element for it that
+    Pinocchio reads)."""
+    out = []
+    for name, make, model in _robots():
+        ours = make()
+        out.append((name, ours, with_armature(model, ours), make))
+    return out
 
 
 def with_armature(model, ours):
@@ -121,7 +130,7 @@ def with_armature(model, ours):
 
 def _robots():
     text = pr.robots.a465_urdf("kinsheel2010")
-    out = [("a465", pr.Robot.from_urdf_string(text, check_triangle_inequality=False),
+    out = [("a465", lambda: pr.Robot.from_urdf_string(text, check_triangle_inequality=False),
             pin.buildModelFromXML(text))]
     import sysconfig
 
@@ -133,12 +142,12 @@ def _robots():
         panda = pin.buildReducedModel(full, [full.getJointId(j) for j in fingers],
                                       pin.neutral(full))
         # ours: the mimic follower goes with the joint it follows
-        ours = pr.Robot.from_urdf(str(path), lock={fingers[0]: 0.0})
-        out.append(("panda", ours, panda))
+        out.append(("panda", lambda: pr.Robot.from_urdf(str(path), lock={fingers[0]: 0.0}),
+                     panda))
     else:
         print(f"skipped the Panda (no {path}): pip install example-robot-data", file=sys.stderr)
-    text = (ROOT / "benches" / "tree60.urdf").read_text()
-    out.append(("tree60", pr.Robot.from_urdf_string(text), pin.buildModelFromXML(text)))
+    tree = (ROOT / "benches" / "tree60.urdf").read_text()
+    out.append(("tree60", lambda: pr.Robot.from_urdf_string(tree), pin.buildModelFromXML(tree)))
     return out
 
 
@@ -176,8 +185,9 @@ def build_peer() -> Path | None:
 class Side:
     """The samples of one robot and both libraries' runs on them."""
 
-    def __init__(self, name, robot, model, k, workdir, peer):
+    def __init__(self, name, robot, model, k, workdir, peer, make=None):
         self.name, self.robot, self.model, self.k, self.peer = name, robot, model, k, peer
+        self.make = make  # makes `robot` anew (its buffers elsewhere), for `move`
         self.dir = Path(workdir) / name
         self.dir.mkdir(parents=True, exist_ok=True)
         n = robot.n
@@ -229,6 +239,21 @@ class Side:
             return (e((k, n)), *(e((k, n, n)) for _ in range(4)))
         return e((k, n))
 
+    def move(self, kernel):
+        """Our side's memory for `kernel` allocated anew: the Robot (its kernels' buffers), the
+        samples and the output, each made while the old is held (so that it cannot land in the
+        same blocks) and the old then dropped. Each round draws so the memory's placement,
+        which held for a whole run when it stayed put. Measured on a Zen 4 guest, one process
+        per draw, the same virtual addresses in each (ASLR off): the Panda's AVX2 regressor
+        222-253 ns a sample with 16 samples a call, its mass matrix 85-88 ns in most processes
+        and 97-150 ns in about one in ten, each steady within its process. The peer does the
+        same (`fresh`)."""
+        robot = self.make() if self.make is not None else self.robot
+        x = {key: v.copy() for key, v in self.x.items()}
+        out = self.output_for(kernel, min(self.k, self.samples_for(kernel)))
+        self.robot, self.x = robot, x
+        self.out = {**self.out, kernel: out}
+
     def big(self, k, kernel):
         """`k` samples (this side's, repeated) and an output of `kernel` for them."""
         reps = -(-k // self.k)
@@ -258,18 +283,20 @@ class Side:
             return r.linearize(q, qd, qdd, out=out["linearize"])
         return r.forward_dynamics(q, qd, x["tau"], out=out["forward_dynamics"])
 
-    def peer_pass(self, kernel):
+    def peer_pass(self, kernel, fresh=False):
         """ns per call of `kernel` by Pinocchio over this side's samples, timed as
         `our_pass` times ours: one untimed pass, then passes for at least 20 ms (the C++
         peer kept running in its `serve` mode, so that its passes and ours alternate closely),
-        or one pass from Python without the C++ peer."""
+        or one pass from Python without the C++ peer. `fresh`: the C++ peer's memory for it
+        allocated anew first (as `move` does ours)."""
         if self.peer is None:
             return self.python_pass(kernel)
         if self.server is None:
             self.server = subprocess.Popen(
                 [str(self.peer), str(self.dir / "model.bin"), str(self.dir), str(self.k),
                  "serve"], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
-        self.server.stdin.write(f"{kernel} {self.samples_for(kernel)} {WARM_MS}\n")
+        self.server.stdin.write(f"{kernel} {self.samples_for(kernel)} {WARM_MS}"
+                                f"{' fresh' if fresh else ''}\n")
         self.server.stdin.flush()
         reply = json.loads(self.server.stdout.readline() or '{"error": "the peer ended"}')
         if "error" in reply:
@@ -408,12 +435,15 @@ def agree(side: Side) -> list[str]:
 
 def run_kernel(side: Side, kernel: str, rounds: int, passes: int):
     """Medians (ns per sample) of Pinocchio, of ours and of storing the output alone, and the
-    per-round ratios. A round: `passes` passes of each side in alternation (Pinocchio's, ours,
+    per-round ratios. A round: both sides' memory allocated anew (`Side.move`, the peer's
+    `fresh`), then `passes` passes of each side in alternation (Pinocchio's, ours,
     Pinocchio's, ...: a spell of the shared machine, which lasts from a fraction of a second
     to minutes, falls on both), each side's median."""
     t_pin, t_our, t_store, ratios = [], [], [], []
     for _ in range(rounds):
-        pairs = [(side.peer_pass(kernel), side.our_pass(kernel)) for _ in range(passes)]
+        side.move(kernel)
+        pairs = [(side.peer_pass(kernel, fresh=i == 0), side.our_pass(kernel))
+                 for i in range(passes)]
         p = statistics.median(x[0] for x in pairs)
         o = statistics.median(x[1] for x in pairs)
         t_store.append(min(side.store_pass(kernel) for _ in range(passes)))
@@ -584,10 +614,10 @@ def main() -> int:
         peak = measured_peak(isa)
     rows, failures, first = [], [], None
     with tempfile.TemporaryDirectory() as work:
-        for name, robot, model in robots():
+        for name, robot, model, make in robots():
             if name not in args.robots.split(","):
                 continue
-            side = Side(name, robot, model, args.samples, work, peer)
+            side = Side(name, robot, model, args.samples, work, peer, make)
             first = first or side
             failures += agree(side)
             if first is side:

@@ -11,11 +11,16 @@
 // one JSON line per kernel: {"kernel", "ns_per_call" (median over REPEATS passes)}. PEER_KERNELS (a list of names) limits the kernels.
 //
 // With `serve` in place of REPEATS the process stays, so that the script can take Pinocchio's
-// passes and its own in close turns: each line "KERNEL SAMPLES MIN_MS" on standard input runs
-// one untimed pass over the first SAMPLES samples (as the script's own untimed call), then
+// passes and its own in close turns: each line "KERNEL SAMPLES MIN_MS [fresh]" on standard input
+// runs one untimed pass over the first SAMPLES samples (as the script's own untimed call), then
 // timed passes until MIN_MS milliseconds (at most 60,000) have gone, and prints {"kernel",
 // "ns_per_call" (the timed passes' mean)}; an unknown kernel or a bad line (NaN, a number out
-// of range, a word for a number) prints {"error"}. End of input ends the process.
+// of range, a word for a number or for `fresh`) prints {"error"}. With `fresh`, the pass first
+// moves its memory: the samples, Data and the kernel's output are allocated anew (the old
+// freed after), as the script does for its own side each round, so that each round draws the
+// memory's placement anew (which decides 10-20 % of a kernel's time on a virtual machine, now
+// and then far more, and held for a whole run when the memory stayed put). End of input ends
+// the process.
 #include <pinocchio/multibody.hpp>
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/crba.hpp>
@@ -146,18 +151,29 @@ int main(int argc, char** argv) {
       std::string name;
       long count = 0;
       double min_ms = 0;
+      std::string fresh, rest;
       words >> name >> count >> min_ms;
+      const bool read = static_cast<bool>(words);
+      words >> fresh >> rest;  // optional; nothing may follow it
       auto kern = std::find_if(kernels.begin(), kernels.end(),
                                [&](const Kernel& x) { return x.name == name; });
-      if (!words || kern == kernels.end() || count <= 0 || count > k || !(min_ms >= 0) ||
-          min_ms > 60000) {
+      if (!read || kern == kernels.end() || count <= 0 || count > k || !(min_ms >= 0) ||
+          min_ms > 60000 || !(fresh.empty() || fresh == "fresh") || !rest.empty()) {
         std::printf(
-            "{\"error\": \"expected KERNEL SAMPLES MIN_MS, SAMPLES <= %ld, MIN_MS <= 60000\"}\n",
+            "{\"error\": \"expected KERNEL SAMPLES MIN_MS [fresh], SAMPLES <= %ld, MIN_MS <= "
+            "60000\"}\n",
             k);
         std::fflush(stdout);
         continue;
       }
       auto& out = outs[name];
+      if (!fresh.empty()) {
+        // new blocks made while the old are held, so that they cannot be the same
+        std::vector<double> q2(q), qd2(qd), qdd2(qdd), tau2(tau), out2(count * kern->per_sample);
+        pinocchio::Data data2(model);
+        q.swap(q2), qd.swap(qd2), qdd.swap(qdd2), tau.swap(tau2), out.swap(out2);
+        data = std::move(data2);
+      }
       out.resize(count * kern->per_sample);
       pass(*kern, count, out);  // untimed
       double total = 0;
