@@ -2,30 +2,31 @@
 
     python benches/compare_pinocchio.py [--rounds 5] [--samples 2048] [--no-write]
 
-Needs `pip install pin` (and example-robot-data for the Panda). Pinocchio runs in C++ one
-call per sample (benches/pinocchio_peer.cpp, built here with g++ against the `pin` wheel's
-headers and libraries and Debian's Eigen, `-O3 -march=native`); without a compiler or Eigen it
-runs from Python one call at a time (its figures then include Python's call overhead, and
-the table says so). perturbid_rs runs its batched kernels through the Python API on the same
+Needs `pip install pin` (and example-robot-data for the Panda). Pinocchio runs in C++ one call
+per sample (benches/pinocchio_peer.cpp, built here with g++ against the `pin` wheel's headers
+and libraries and Debian's Eigen, `-O3 -march=native`, see `peer_flags`); without a compiler or
+Eigen it runs from Python one call at a time (its figures then include Python's call overhead,
+and the table says so). perturbid_rs runs its batched kernels through the Python API on the same
 samples, writing into preallocated arrays (`out=`).
 
 For each robot and kernel: `rounds` rounds, each `passes` passes of Pinocchio and of
-perturbid_rs over the same samples in alternation (Pinocchio's, ours, Pinocchio's, ...; the
-C++ peer stays running between its passes), so that a slow spell of the shared machine, which
-can last a fraction of a second, falls on both sides. Either side's pass is one untimed call
-over the samples (the caches and the clock are cold after the other side's), then calls for
-at least 20 ms, timed together; a round takes each side's median pass. Each round starts with
-both sides' memory allocated anew (our Robot with its buffers, the samples, the outputs; the
-peer's samples, Data and outputs), because where it lands in physical memory decides 10-20 %
-of a kernel's time on a virtual machine, now and then far more, and would otherwise hold for
-the whole run: the rounds sample it. Figures are medians over the rounds, the noise the spread of the per-round ratios
-(machine and placement together). One core:
-batches below the library's parallel threshold run on the calling thread, and one Pinocchio
-process. All cores: a batch large enough for the parallel engine against one Pinocchio process
-per core. Results are checked to agree (torques and matrices to 1e-10 relative, the
-parameters identified from either library's regressor to 1e-8 relative) before any time is
-reported. The Markdown table goes to stdout, benches/README.md and README.md (between the
-`speed-table` markers).
+perturbid_rs over the same samples in alternation (Pinocchio's, ours, Pinocchio's, ...; the C++
+peer stays running between its passes), so that a slow spell of the shared machine, which can
+last a fraction of a second, falls on both sides. Either side's pass is one untimed call over
+the samples (the caches and the clock are cold after the other side's), then calls for at least
+20 ms, timed together; a round takes each side's median pass. Each round starts with both sides'
+memory allocated anew (our Robot with its buffers, the samples, the outputs; the peer's samples,
+Data and outputs), because where it lands in physical memory decides 10-20 % of a kernel's time
+on a virtual machine, now and then far more, and would otherwise hold for the whole run: the
+rounds sample it. Figures are medians over the rounds, the noise the spread of the per-round
+ratios (machine and placement together). One core: batches below the library's parallel
+threshold run on the calling thread, and one Pinocchio process. The peer is built
+`-march=native`, without AVX-512 when our side's path is capped below it
+(`PERTURBID_SIMD=avx2+fma`, standing in for a processor without it: see `peer_flags`). All
+cores: a batch large enough for the parallel engine against one Pinocchio process per core.
+Results are checked to agree (torques and matrices to 1e-10 relative, the parameters identified
+from either library's regressor to 1e-8 relative) before any time is reported. The Markdown
+table goes to stdout, benches/README.md and README.md (between the `speed-table` markers).
 """
 
 from __future__ import annotations
@@ -151,8 +152,30 @@ def _robots():
     return out
 
 
-def build_peer() -> Path | None:
-    """The compiled C++ peer (cached by source, wheel and flags), or None when it cannot be."""
+def peer_flags(isa: str) -> list[str]:
+    """The peer's compiler flags for our side's `isa` path: `-march=native`, and
+    `-mno-avx512f` when our side runs below AVX-512 on a processor that has it (capped by
+    `PERTURBID_SIMD`, to stand in for a processor without AVX-512, such as a Zen 3): there
+    `-march=native` gives no AVX-512 to Pinocchio's Eigen either. (Measured on the Zen 4:
+    the peer without AVX-512 was up to 9 % faster for RNEA, 2-12 % for the regressor, 6-12 %
+    slower for the derivatives.)"""
+    if isa != "avx512" and "avx512f" in cpu_flags():
+        return [*FLAGS, "-mno-avx512f"]
+    return list(FLAGS)
+
+
+def cpu_flags() -> set[str]:
+    """The first processor's flags in /proc/cpuinfo (empty where there is none)."""
+    try:
+        text = Path("/proc/cpuinfo").read_text()
+    except OSError:
+        return set()
+    line = next((x for x in text.splitlines() if x.startswith("flags")), "")
+    return set(line.partition(":")[2].split())
+
+
+def build_peer(flags: list[str] = FLAGS) -> Path | None:
+    """The compiled C++ peer (cached by source, wheel and `flags`), or None when it cannot be."""
     prefix = Path(pin.__file__).resolve()
     while prefix.name != "cmeel.prefix" and prefix != prefix.parent:
         prefix = prefix.parent
@@ -163,14 +186,14 @@ def build_peer() -> Path | None:
               "from Python", file=sys.stderr)
         return None
     key = hashlib.sha256(PEER.read_bytes() + pin.__version__.encode()
-                         + " ".join(FLAGS).encode()).hexdigest()[:16]
+                         + " ".join(flags).encode()).hexdigest()[:16]
     exe = Path.home() / ".cache" / "perturbid_rs" / f"pinocchio_peer-{key}"
     if exe.exists():
         return exe
     exe.parent.mkdir(parents=True, exist_ok=True)
     print("building the Pinocchio C++ peer (about 2 minutes, once)...", file=sys.stderr)
     tmp = exe.with_suffix(".tmp")
-    cmd = ["g++", *FLAGS, f"-I{prefix / 'include'}", f"-I{eigen}", str(PEER), "-o", str(tmp),
+    cmd = ["g++", *flags, f"-I{prefix / 'include'}", f"-I{eigen}", str(PEER), "-o", str(tmp),
            f"-L{prefix / 'lib'}", f"-Wl,-rpath,{prefix / 'lib'}", "-lpinocchio_default",
            "-lboost_serialization"]
     done = subprocess.run(cmd, capture_output=True, text=True)
@@ -601,9 +624,10 @@ def main() -> int:
     if unknown:
         raise SystemExit(f"--robots: no robot {', '.join(unknown)} "
                          f"(known: {', '.join(ROBOT_NAMES)})")
-    peer = build_peer()
-    flops = flop_counts()
     isa = pr.simd_isa()
+    flags = peer_flags(isa)
+    peer = build_peer(flags)
+    flops = flop_counts()
     everywhere = os.sched_getaffinity(0) if hasattr(os, "sched_getaffinity") else set()
     # the one-core rounds: Pinocchio's process and our calls in turns on one core, so that a
     # slow spell of that core (on a shared host, a busy neighbour) falls on both sides
@@ -644,7 +668,8 @@ def main() -> int:
     if failures:
         print("RESULTS DIFFER:\n" + "\n".join(failures), file=sys.stderr)
         return 1
-    who = "Pinocchio C++ (one call per sample)" if peer else \
+    march = " ".join(x for x in flags if x.startswith("-m"))
+    who = f"Pinocchio C++ (one call per sample, built `{march}`)" if peer else \
         "Pinocchio from Python (one call per sample, Python's overhead included)"
     lines = [
         f"Measured {time.strftime('%Y-%m-%d')} on {os.cpu_count()} cores of "
