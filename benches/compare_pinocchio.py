@@ -676,7 +676,8 @@ def main() -> int:
         f"{cpu_model() or 'an unnamed processor'} ({isa} path, {isa_lanes(isa)} lanes; the "
         f"one-core rounds on core {min(one) if one else 'any'}), against {who}, "
         f"`python benches/compare_pinocchio.py` (medians of {args.rounds} rounds taken in turns;"
-        " the brackets are the lowest and highest per-round ratio: the machine's noise).",
+        " the brackets are the lowest and highest per-round ratio: the machine's noise and,"
+        " each round on memory allocated anew, its placement's).",
         "",
         "| robot | kernel | Pinocchio ns/sample | perturbid_rs ns/sample | speed-up, one core "
         "| goal | speed-up, all cores | GFlop/s (% of peak) | store-bound ceiling |",
