@@ -36,6 +36,7 @@
 #include <functional>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -60,7 +61,10 @@ int main(int argc, char** argv) {
   }
   pinocchio::Model model;
   model.loadFromBinary(argv[1]);
-  pinocchio::Data data(model);
+  // Pinocchio's work buffers, made anew by `fresh` (through the pointer: Data's assignment
+  // copies into the buffers it has, so it cannot move them)
+  auto held = std::make_unique<pinocchio::Data>(model);
+  pinocchio::Data* dp = held.get();
   const std::string dir = argv[2];
   const long k = std::atol(argv[3]);
   const bool serve = std::string(argv[4]) == "serve";
@@ -89,46 +93,46 @@ int main(int argc, char** argv) {
   };
   Eigen::MatrixXd gs(n, n);
   std::vector<Kernel> kernels = {
-      {"rnea", n, [&](long s) { pinocchio::rnea(model, data, at(q, s), at(qd, s), at(qdd, s)); },
-       [&](long, double* o) { Eigen::Map<Eigen::VectorXd>(o, n) = data.tau; }},
+      {"rnea", n, [&](long s) { pinocchio::rnea(model, *dp, at(q, s), at(qd, s), at(qdd, s)); },
+       [&](long, double* o) { Eigen::Map<Eigen::VectorXd>(o, n) = dp->tau; }},
       {"mass_matrix", n * n,
-       [&](long s) { pinocchio::crba(model, data, at(q, s), pinocchio::Convention::WORLD); },
+       [&](long s) { pinocchio::crba(model, *dp, at(q, s), pinocchio::Convention::WORLD); },
        [&](long, double* o) {
-         Eigen::MatrixXd m = data.M;
+         Eigen::MatrixXd m = dp->M;
          m.triangularView<Eigen::StrictlyLower>() = m.transpose().triangularView<Eigen::StrictlyLower>();
          copy(m, o);
        }},
       {"regressor", n * 10 * (model.njoints - 1),
        [&](long s) {
-         pinocchio::computeJointTorqueRegressor(model, data, at(q, s), at(qd, s), at(qdd, s));
+         pinocchio::computeJointTorqueRegressor(model, *dp, at(q, s), at(qd, s), at(qdd, s));
        },
-       [&](long, double* o) { copy(data.jointTorqueRegressor, o); }},
+       [&](long, double* o) { copy(dp->jointTorqueRegressor, o); }},
       {"forward_dynamics", n,
-       [&](long s) { pinocchio::aba(model, data, at(q, s), at(qd, s), at(tau, s), pinocchio::Convention::WORLD); },
-       [&](long, double* o) { Eigen::Map<Eigen::VectorXd>(o, n) = data.ddq; }},
+       [&](long s) { pinocchio::aba(model, *dp, at(q, s), at(qd, s), at(tau, s), pinocchio::Convention::WORLD); },
+       [&](long, double* o) { Eigen::Map<Eigen::VectorXd>(o, n) = dp->ddq; }},
       {"rnea_derivatives", n + 3 * n * n,
-       [&](long s) { pinocchio::computeRNEADerivatives(model, data, at(q, s), at(qd, s), at(qdd, s)); },
+       [&](long s) { pinocchio::computeRNEADerivatives(model, *dp, at(q, s), at(qd, s), at(qdd, s)); },
        [&](long, double* o) {
-         Eigen::Map<Eigen::VectorXd>(o, n) = data.tau;
-         copy(data.dtau_dq, o + n);
-         copy(data.dtau_dv, o + n + n * n);
-         Eigen::MatrixXd m = data.M;
+         Eigen::Map<Eigen::VectorXd>(o, n) = dp->tau;
+         copy(dp->dtau_dq, o + n);
+         copy(dp->dtau_dv, o + n + n * n);
+         Eigen::MatrixXd m = dp->M;
          m.triangularView<Eigen::StrictlyLower>() = m.transpose().triangularView<Eigen::StrictlyLower>();
          copy(m, o + n + 2 * n * n);
        }},
       // the local model: the derivatives at the point and the gravity derivative at rest
       {"linearize", n + 4 * n * n,
        [&](long s) {
-         pinocchio::computeRNEADerivatives(model, data, at(q, s), at(qd, s), at(qdd, s));
-         pinocchio::computeGeneralizedGravityDerivatives(model, data, at(q, s), gs);
+         pinocchio::computeRNEADerivatives(model, *dp, at(q, s), at(qd, s), at(qdd, s));
+         pinocchio::computeGeneralizedGravityDerivatives(model, *dp, at(q, s), gs);
        },
        [&](long, double* o) {
-         Eigen::Map<Eigen::VectorXd>(o, n) = data.tau;
-         Eigen::MatrixXd m = data.M;
+         Eigen::Map<Eigen::VectorXd>(o, n) = dp->tau;
+         Eigen::MatrixXd m = dp->M;
          m.triangularView<Eigen::StrictlyLower>() = m.transpose().triangularView<Eigen::StrictlyLower>();
          copy(m, o + n);
-         copy(data.dtau_dv, o + n + n * n);
-         copy(data.dtau_dq, o + n + 2 * n * n);
+         copy(dp->dtau_dv, o + n + n * n);
+         copy(dp->dtau_dq, o + n + 2 * n * n);
          copy(gs, o + n + 3 * n * n);
        }},
   };
@@ -170,9 +174,9 @@ int main(int argc, char** argv) {
       if (!fresh.empty()) {
         // new blocks made while the old are held, so that they cannot be the same
         std::vector<double> q2(q), qd2(qd), qdd2(qdd), tau2(tau), out2(count * kern->per_sample);
-        pinocchio::Data data2(model);
+        auto data2 = std::make_unique<pinocchio::Data>(model);
         q.swap(q2), qd.swap(qd2), qdd.swap(qdd2), tau.swap(tau2), out.swap(out2);
-        data = std::move(data2);
+        held.swap(data2), dp = held.get();
       }
       out.resize(count * kern->per_sample);
       pass(*kern, count, out);  // untimed
