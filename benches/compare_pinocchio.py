@@ -166,12 +166,7 @@ def peer_flags(isa: str) -> list[str]:
 
 def cpu_flags() -> set[str]:
     """The first processor's flags in /proc/cpuinfo (empty where there is none)."""
-    try:
-        text = Path("/proc/cpuinfo").read_text()
-    except OSError:
-        return set()
-    line = next((x for x in text.splitlines() if x.startswith("flags")), "")
-    return set(line.partition(":")[2].split())
+    return set(cpuinfo("flags").split())
 
 
 def build_peer(flags: list[str] = FLAGS) -> Path | None:
@@ -208,7 +203,7 @@ def build_peer(flags: list[str] = FLAGS) -> Path | None:
 class Side:
     """The samples of one robot and both libraries' runs on them."""
 
-    def __init__(self, name, robot, model, k, workdir, peer, make=None):
+    def __init__(self, name, robot, model, k, workdir, peer, make):
         self.name, self.robot, self.model, self.k, self.peer = name, robot, model, k, peer
         self.make = make  # makes `robot` anew (its buffers elsewhere), for `move`
         self.dir = Path(workdir) / name
@@ -267,11 +262,11 @@ class Side:
         samples and the output, each made while the old is held (so that it cannot land in the
         same blocks) and the old then dropped. Each round draws so the memory's placement,
         which held for a whole run when it stayed put. Measured on a Zen 4 guest, one process
-        per draw, the same virtual addresses in each (ASLR off): the Panda's AVX2 regressor
-        222-253 ns a sample with 16 samples a call, its mass matrix 85-88 ns in most processes
-        and 97-150 ns in about one in ten, each steady within its process. The peer does the
-        same (`fresh`)."""
-        robot = self.make() if self.make is not None else self.robot
+        per draw: the Panda's AVX2 regressor 222-253 ns a sample with 16 samples a call (the
+        same virtual addresses in each, ASLR off), its mass matrix 85-88 ns in most processes
+        and 91-150 ns in about one in six, each steady within its process (benches/README.md).
+        The peer does the same (`fresh`)."""
+        robot = self.make()
         x = {key: v.copy() for key, v in self.x.items()}
         out = self.output_for(kernel, min(self.k, self.samples_for(kernel)))
         self.robot, self.x = robot, x
@@ -550,11 +545,16 @@ def measured_peak(isa: str) -> float | None:
 
 def cpu_model() -> str:
     """The processor's name as /proc/cpuinfo gives it ("" where it does not)."""
+    return cpuinfo("model name")
+
+
+def cpuinfo(field: str) -> str:
+    """The first processor's `field` in /proc/cpuinfo ("" where there is none)."""
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
+            if line.startswith(field):
                 return line.split(":", 1)[1].strip()
-    except OSError:
+    except (OSError, IndexError):
         pass
     return ""
 
