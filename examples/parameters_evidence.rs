@@ -190,7 +190,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 }
 
 fn panda(csv: &str, urdf: &str) -> Result<(), Box<dyn std::error::Error>> {
-    use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+    use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions};
     use perturbid_rs::{LoadOptions, Recording};
     let text = std::fs::read_to_string(csv)?;
     let (mut t, mut q, mut qd, mut tau) = (vec![], vec![], vec![], vec![]);

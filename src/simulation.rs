@@ -9,7 +9,7 @@ use crate::algorithms::parallel;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 use crate::states::States;
 use crate::trajectory::{FourierTrajectory, Samples};
 

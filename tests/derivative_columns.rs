@@ -7,8 +7,8 @@
 mod common;
 
 use common::{a465_log, panda_log, A465Log};
-use perturbid_rs::derivative_columns::check_logged_derivatives;
-use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+use perturbid_rs::logs::derivative_columns::check_logged_derivatives;
+use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::{ErrorKind, Recording};
 
 /// The log with its velocities edited by `edit` (row-major, 6 a sample), preprocessed.

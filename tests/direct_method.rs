@@ -12,7 +12,7 @@ use perturbid_rs::direct::{
     Weighting,
 };
 use perturbid_rs::local::OperatingPoint;
-use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::robots::a465;
 use perturbid_rs::signal::{butterworth_lowpass, filtfilt};
 use perturbid_rs::trajectory::FourierTrajectory;

@@ -364,8 +364,8 @@ fn saved_gains_are_checked_on_load() {
 
 #[test]
 fn a_recording_of_currents_in_torques_keeps_what_was_found() {
-    use perturbid_rs::log_screening::LogGlitch;
-    use perturbid_rs::torque_saturation::TorqueSaturation;
+    use perturbid_rs::logs::log_screening::LogGlitch;
+    use perturbid_rs::logs::torque_saturation::TorqueSaturation;
     let t: Vec<f64> = (0..4).map(|i| i as f64 * 0.01).collect();
     let q = vec![0.1; 8];
     let current = vec![1.0, 2.0, -1.0, 0.5, 3.0, -2.0, 0.0, 1.0];

@@ -1,5 +1,5 @@
 //! The Coulomb friction term's column filtered as the torques were (parallel filtering;
-//! src/preprocess.rs, `Recording::coulomb`, `States::with_coulomb`): a low-pass filtered torque
+//! src/logs/preprocess.rs, `Recording::coulomb`, `States::with_coulomb`): a low-pass filtered torque
 //! steps smoothly where a joint reverses, and `sign(qd)` does not. On the A465's test log at
 //! 1 kHz, preprocessed at 10 Hz, the fit with the filtered column finds the friction the log
 //! was made with; with `sign(qd)` the Coulomb coefficients come out low and the viscous ones
@@ -9,7 +9,7 @@ mod common;
 
 use common::a465_log;
 use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions, FrictionTerms};
-use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::{Recording, States};
 
 /// The coefficient and standard error of the base parameter named `name`.

@@ -1,4 +1,4 @@
-//! Frozen readings (src/frozen_readings.rs): one joint's column holding its last value for
+//! Frozen readings (src/logs/frozen_readings.rs): one joint's column holding its last value for
 //! longer than a held reading while the joint moves (a stalled message stream). Found with
 //! their rows, removed before preprocessing so that the fit is the clean log's without those
 //! rows (and far off unremoved); a whole message stalled is listed once; a joint at rest,
@@ -11,9 +11,9 @@ mod common;
 use common::{a465_noisy_log, fit_preprocessed, moved_in_stderr, panda_log, refused_on_load};
 use perturbid_rs::direct::BaseModel;
 use perturbid_rs::document::Document;
-use perturbid_rs::frozen_readings::{find_frozen_readings, MIN_FROZEN};
-use perturbid_rs::log_dropouts::{dropout_warning, BRIDGED_BY_PREPROCESSING};
-use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+use perturbid_rs::logs::frozen_readings::{find_frozen_readings, MIN_FROZEN};
+use perturbid_rs::logs::log_dropouts::{dropout_warning, BRIDGED_BY_PREPROCESSING};
+use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::Recording;
 
 const N: usize = 6;
@@ -131,7 +131,7 @@ fn a_whole_message_stalled_is_listed_once() {
         "{found:?}"
     );
     let refs: Vec<_> = found.iter().collect();
-    let w = perturbid_rs::frozen_readings::describe(&refs, &[], "before preprocessing");
+    let w = perturbid_rs::logs::frozen_readings::describe(&refs, &[], "before preprocessing");
     assert!(
         w.starts_with("1 frozen reading(s)")
             && w.contains("q of joint 1, joint 2, joint 3, joint 4, joint 5, joint 6 held their values for 40 rows from sample 8000"),
@@ -195,7 +195,7 @@ fn a_stream_that_stops_before_the_log_is_removed_from_the_end() {
         moved_in_stderr(&fit, &cut)
     );
     let refs: Vec<_> = found.iter().collect();
-    let w = perturbid_rs::frozen_readings::describe(&refs, &[], "before preprocessing");
+    let w = perturbid_rs::logs::frozen_readings::describe(&refs, &[], "before preprocessing");
     assert!(
         w.contains("tau of joint 4 held")
             && w.contains(

@@ -1,4 +1,4 @@
-//! Columns logged at a lower rate and held on the log's grid (src/held_columns.rs): a torque
+//! Columns logged at a lower rate and held on the log's grid (src/logs/held_columns.rs): a torque
 //! and a position held for 10 samples at a time are found, read again at their values'
 //! arrivals, and the fit comes back near the clean log's (from 1.7 and 1.3 standard errors
 //! off); no frozen readings are made of them; coarse encoder counts, torques in coarse steps,
@@ -9,8 +9,8 @@ mod common;
 use common::{a465_noisy_log, fit_preprocessed, moved_in_stderr, panda_log, refused_on_load};
 use perturbid_rs::direct::BaseModel;
 use perturbid_rs::document::Document;
-use perturbid_rs::held_columns::{find_held_columns, warning};
-use perturbid_rs::preprocess::PreprocessOptions;
+use perturbid_rs::logs::held_columns::{find_held_columns, warning};
+use perturbid_rs::logs::preprocess::PreprocessOptions;
 use perturbid_rs::Recording;
 
 const N: usize = 6;

@@ -315,7 +315,7 @@ fn a_panic_at_the_boundary_becomes_an_internal_error() {
 #[test]
 fn sizes_from_input_are_bounded_before_allocation() {
     use perturbid_rs::direct::{design_excitation, ExcitationOptions};
-    use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+    use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions};
     use perturbid_rs::Recording;
     let model = robots::builtin("a465").unwrap();
     let op =
@@ -422,7 +422,7 @@ fn sizes_from_input_are_bounded_before_allocation() {
 
 #[test]
 fn a_gap_in_a_log_is_not_filled_with_invented_values() {
-    use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+    use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions};
     use perturbid_rs::Recording;
     // 1 kHz for 3 s, then nothing for 100 s, then 3 s more
     let mut t: Vec<f64> = (0..3000).map(|i| i as f64 * 1e-3).collect();
@@ -477,7 +477,7 @@ fn a_gap_in_a_log_is_not_filled_with_invented_values() {
 /// each named where it gives a robot's logging rate. 2.5 Hz passes this check.
 #[test]
 fn a_log_timed_in_milliseconds_is_asked_about() {
-    use perturbid_rs::preprocess::{preprocess, PreprocessOptions, SLOWEST_INTERVAL};
+    use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions, SLOWEST_INTERVAL};
     use perturbid_rs::Recording;
     let log = |name: &str, k: usize, dt: f64| {
         let t: Vec<f64> = (0..k).map(|i| i as f64 * dt).collect();
@@ -522,7 +522,7 @@ fn a_log_timed_in_milliseconds_is_asked_about() {
 /// 100 kHz passes this check.
 #[test]
 fn a_log_timed_in_hours_is_asked_about() {
-    use perturbid_rs::preprocess::{preprocess, PreprocessOptions, FASTEST_INTERVAL};
+    use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions, FASTEST_INTERVAL};
     use perturbid_rs::Recording;
     let log = |name: &str, k: usize, dt: f64| {
         let t: Vec<f64> = (0..k).map(|i| i as f64 * dt).collect();

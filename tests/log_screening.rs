@@ -1,4 +1,4 @@
-//! Glitches in a whole log, found and replaced before preprocessing (src/log_screening.rs):
+//! Glitches in a whole log, found and replaced before preprocessing (src/logs/log_screening.rs):
 //! spikes and rows of zeros leave the direct method's parameters where the clean log puts
 //! them (and move them by many standard errors unscreened); velocity reversals' Coulomb steps
 //! and clean noise are left alone; a replaced value is the cubic fit of the others in its
@@ -14,9 +14,9 @@ use common::{
 use nalgebra::{DMatrix, DVector};
 use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
 use perturbid_rs::document::Document;
-use perturbid_rs::log_dropouts::find_dropouts;
-use perturbid_rs::log_screening::{screen_recording, warning, LogGlitch, HALF_WINDOW};
-use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+use perturbid_rs::logs::log_dropouts::find_dropouts;
+use perturbid_rs::logs::log_screening::{screen_recording, warning, LogGlitch, HALF_WINDOW};
+use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::{Recording, States};
 
 fn identify(rec: &Recording, screen: bool) -> (Recording, BaseModel) {

@@ -9,8 +9,8 @@ use common::{a465_excitation, normal, torques_with_friction, Rng};
 use perturbid_rs::direct::{
     identify_base_parameters, BaseModel, BaseOptions, FrictionTerms, TorqueNoise, Weighting,
 };
-use perturbid_rs::period_average::PeriodOptions;
-use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+use perturbid_rs::logs::period_average::PeriodOptions;
+use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::robots::a465;
 use perturbid_rs::trajectory::{FourierTrajectory, Samples};
 use perturbid_rs::{Document, Error, Recording, States};

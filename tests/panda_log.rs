@@ -6,7 +6,7 @@ mod common;
 
 use common::{panda_log, panda_urdf};
 use perturbid_rs::direct::{identify_base_parameters, BaseOptions, Weighting};
-use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::{LoadOptions, States};
 
 /// Real data (the Panda log of Gaz et al. 2019, which lies beside the repository in

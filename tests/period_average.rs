@@ -1,5 +1,5 @@
-//! Averaging a log over the periods of its excitation (src/period_average.rs,
-//! src/excitation_start.rs; docs/method.md, section 8e), against the excitation's own
+//! Averaging a log over the periods of its excitation (src/logs/period_average/,
+//! src/logs/excitation_start.rs; docs/method.md, section 8e), against the excitation's own
 //! analytic positions, velocities and accelerations, the robot's own torques and the noise
 //! put in.
 
@@ -7,9 +7,9 @@ mod common;
 
 use common::{a465_excitation, torques_with_friction, Rng};
 use perturbid_rs::direct::{identify_base_parameters, BaseOptions, FrictionTerms};
-use perturbid_rs::excitation_start::excitation_start;
-use perturbid_rs::period_average::PeriodOptions;
-use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+use perturbid_rs::logs::excitation_start::excitation_start;
+use perturbid_rs::logs::period_average::PeriodOptions;
+use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::robots::a465;
 use perturbid_rs::trajectory::{FourierTrajectory, Samples};
 use perturbid_rs::Recording;
@@ -223,7 +223,7 @@ fn a_lead_in_is_found_and_a_disturbed_period_left_out() {
         "{}",
         a.left_out[0].reason
     );
-    let w = perturbid_rs::period_average::warning(&out.period_average, "log.csv", &[]).unwrap();
+    let w = perturbid_rs::logs::period_average::warning(&out.period_average, "log.csv", &[]).unwrap();
     assert!(
         w.contains("1 of its periods left out") && w.contains("period 3"),
         "{w}"
@@ -460,7 +460,7 @@ fn torques_that_drift_over_the_periods_are_said() {
         (0..6).filter(|&j| j != 2).all(|j| drift[j] < 2.0),
         "{drift:?}"
     );
-    let w = perturbid_rs::period_average::warning(&out.period_average, "log.csv", &[]).unwrap();
+    let w = perturbid_rs::logs::period_average::warning(&out.period_average, "log.csv", &[]).unwrap();
     assert!(
         w.contains("its torques drift from period to period (joint 3 (F = "),
         "{w}"

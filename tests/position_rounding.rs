@@ -1,12 +1,12 @@
 //! Positions logged in coarse encoder counts under velocities derived from them
-//! (`src/position_rounding.rs`): the noise the preprocessing's chain leaves in qd and qdd is
+//! (`src/logs/position_rounding.rs`): the noise the preprocessing's chain leaves in qd and qdd is
 //! estimated from the grid the positions lie on, checked here against the true noise (the
 //! same log preprocessed without the rounding), warned of in a direct fit, and checked on load.
 
 use nalgebra::DMatrix;
 use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
-use perturbid_rs::position_rounding::{warning, NOISE_RATIO};
-use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+use perturbid_rs::logs::position_rounding::{warning, NOISE_RATIO};
+use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::robots::a465;
 use perturbid_rs::simulation::{simulate_samples, SimulationOptions};
 use perturbid_rs::trajectory::FourierTrajectory;

@@ -1,4 +1,4 @@
-//! Joint positions logged within one turn (src/position_wraps.rs): a joint that passes the end
+//! Joint positions logged within one turn (src/logs/position_wraps.rs): a joint that passes the end
 //! of the range steps by a whole turn between two samples. The steps are found where the
 //! wrapped log has them, taken back out before preprocessing, and the fit is the unwrapped
 //! log's; a glitch of about a turn is stepped over and back, other steps are left alone; a log
@@ -10,8 +10,8 @@ mod common;
 use common::{a465_log, a465_noisy_log, fit_preprocessed, moved_in_stderr, refused_on_load};
 use perturbid_rs::direct::BaseModel;
 use perturbid_rs::document::Document;
-use perturbid_rs::position_wraps::{unwrap_positions, warning};
-use perturbid_rs::preprocess::PreprocessOptions;
+use perturbid_rs::logs::position_wraps::{unwrap_positions, warning};
+use perturbid_rs::logs::preprocess::PreprocessOptions;
 use perturbid_rs::Recording;
 use std::f64::consts::{PI, TAU};
 
@@ -122,7 +122,7 @@ fn wrapped_positions_pass_the_derivative_check() {
         Some(log.qdd.clone()),
     )
     .unwrap();
-    perturbid_rs::derivative_columns::check_logged_derivatives(&rec).unwrap();
+    perturbid_rs::logs::derivative_columns::check_logged_derivatives(&rec).unwrap();
 }
 
 #[test]

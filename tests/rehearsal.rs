@@ -559,7 +559,7 @@ fn friction_keeps_its_direction_where_a_joint_touches_zero_speed() {
             "sensors": {{"torque_noise": [0.05, 0.05, 0.05, 0.02, 0.02, 0.02]}}}}"#
     );
     let noisy = rehearse(&model, &doc(&json), &s, 0, "excitation").unwrap();
-    let (_, glitches) = perturbid_rs::log_screening::screen_recording(&noisy).unwrap();
+    let (_, glitches) = perturbid_rs::logs::log_screening::screen_recording(&noisy).unwrap();
     assert!(glitches.is_empty(), "{glitches:?}");
 }
 
@@ -568,7 +568,7 @@ fn friction_keeps_its_direction_where_a_joint_touches_zero_speed() {
 /// torques; the joints whose limits are not reached log what they would without one.
 #[test]
 fn a_saturated_drive_clips_its_command_and_the_log_shows_it() {
-    use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+    use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions};
     let model = a465::model("kinsheel2010").unwrap();
     let n = model.nv;
     let r = reference(n, 4.0, 500.0);

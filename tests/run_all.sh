@@ -12,14 +12,14 @@ PY=${PYTHON:-python3}
 deps=$("$PY" -c "import re, ast; print(' '.join(ast.literal_eval(re.search(r'^test = (\[.*\])$', open('pyproject.toml').read(), re.M).group(1))))")
 "$PY" -m pip install --quiet "maturin>=1.7,<2" $deps
 
-PYTHON="$PY" cargo test --release --features cli
+PYTHON="$PY" cargo test --release
 cargo bench --no-run --quiet
 # the Rust examples run (docs/parameters.md and docs/a465.md quote what they print)
 cargo run --release --quiet --example refit_a465 -- target/refit_a465.urdf
 cargo run --release --quiet --example parameters_evidence > target/parameters_evidence.md
 # the example study and pipeline through the command line (docs/study.md, docs/pipeline.md)
 rm -rf target/study_small
-cargo run --release --quiet --features cli --bin perturbid -- study examples/study_small.toml --out target/study_small > /dev/null
+cargo run --release --quiet --bin perturbid -- study examples/study_small.toml --out target/study_small > /dev/null
 # lints and docs without warnings, over every feature (python includes cli; count-flops builds
 # examples/flop_count.rs)
 cargo clippy --release --all-targets --features python,count-flops --quiet -- -D warnings

@@ -1,4 +1,4 @@
-//! Time stamps that jitter while the samples were taken on a regular clock (src/stamp_jitter.rs):
+//! Time stamps that jitter while the samples were taken on a regular clock (src/logs/stamp_jitter.rs):
 //! found from the positions, which lie on a smooth curve against the sample count and not
 //! against the stamps; a log sampled irregularly and stamped right, a regular one, encoder
 //! counts and the real Panda log (whose positions' noise hides its stamps' scatter) are left
@@ -7,8 +7,8 @@
 mod common;
 
 use common::{a465_excitation, a465_noisy_log, normal, panda_log, Rng};
-use perturbid_rs::preprocess::PreprocessOptions;
-use perturbid_rs::stamp_jitter::{find_stamp_jitter, warning, ROUGHER};
+use perturbid_rs::logs::preprocess::PreprocessOptions;
+use perturbid_rs::logs::stamp_jitter::{find_stamp_jitter, warning, ROUGHER};
 use perturbid_rs::Recording;
 
 const N: usize = 6;
@@ -72,7 +72,7 @@ fn stamps_that_jitter_over_a_regular_clock_are_found() {
             "{w}"
         );
         // kept by preprocess
-        let p = perturbid_rs::preprocess::preprocess(&rec, &PreprocessOptions::default()).unwrap();
+        let p = perturbid_rs::logs::preprocess::preprocess(&rec, &PreprocessOptions::default()).unwrap();
         assert_eq!(p.stamp_jitter, Some(found));
     }
 }

@@ -13,7 +13,7 @@ use perturbid_rs::direct::{
     BaseOptions,
 };
 use perturbid_rs::document::Document;
-use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
+use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::robots::a465;
 use perturbid_rs::trajectory::FourierTrajectory;
 use perturbid_rs::{Gravity, States};

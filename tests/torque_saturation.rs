@@ -5,8 +5,8 @@
 mod common;
 
 use common::{a465_log, fit_physical, panda_log, A465Log};
-use perturbid_rs::preprocess::{preprocess, PreprocessOptions};
-use perturbid_rs::torque_saturation::{find_torque_saturation, warning, MIN_RUN};
+use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions};
+use perturbid_rs::logs::torque_saturation::{find_torque_saturation, warning, MIN_RUN};
 use perturbid_rs::Recording;
 
 fn recording(log: &A465Log, tau: Vec<f64>) -> Recording {

@@ -234,7 +234,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
             })
             .collect();
         let names: Vec<String> = a.data.iter().map(|p| p.display().to_string()).collect();
-        crate::stacked_states::StackedStates::of_named(&parts, &names, "DATA")
+        crate::logs::stacked_states::StackedStates::of_named(&parts, &names, "DATA")
     };
     let stacked = match recs.len() {
         1 => None,

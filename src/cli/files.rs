@@ -194,7 +194,7 @@ impl ColumnArgs {
         path: &Path,
         joints: &[String],
         out: &mut String,
-    ) -> Result<crate::recording::Recording> {
+    ) -> Result<crate::logs::recording::Recording> {
         crate::io::read_recording(&self.table(path, joints, out)?, joints)
     }
 }
@@ -244,7 +244,7 @@ pub(crate) struct PreprocessArgs {
 /// How a log is averaged over periods, from the command line.
 enum Periods {
     None,
-    Given(crate::period_average::PeriodOptions),
+    Given(crate::logs::period_average::PeriodOptions),
     Excitation(Box<crate::trajectory::FourierTrajectory>, PathBuf),
 }
 
@@ -257,7 +257,7 @@ impl PreprocessArgs {
         joints: &[String],
         progress: &super::progress::Progress,
         out: &mut String,
-    ) -> Result<crate::recording::Recording> {
+    ) -> Result<crate::logs::recording::Recording> {
         let mut recs = self.read_logs(&[path], joints, "DATA", progress, out)?;
         Ok(recs.pop().expect("one log read"))
     }
@@ -265,7 +265,7 @@ impl PreprocessArgs {
     /// [`Self::read`] of every log of `paths`, the logs of one fit. Refused, as `argument`: a
     /// file given twice (the same file under two paths; before any is read), and two logs
     /// that share samples as read, positions and torques bit for bit
-    /// ([`crate::repeated_samples`]: a copy, or a part of a log given again).
+    /// ([`crate::logs::repeated_samples`]: a copy, or a part of a log given again).
     pub(crate) fn read_logs(
         &self,
         paths: &[&Path],
@@ -273,7 +273,7 @@ impl PreprocessArgs {
         argument: &str,
         progress: &super::progress::Progress,
         out: &mut String,
-    ) -> Result<Vec<crate::recording::Recording>> {
+    ) -> Result<Vec<crate::logs::recording::Recording>> {
         refuse_repeated_paths(paths, argument, "log")?;
         // the options checked, and an excitation read, once for all the logs
         let periods = self.periods()?;
@@ -285,7 +285,7 @@ impl PreprocessArgs {
             progress.update(&format!("reading {}", path.display()));
             let rec = self.columns.load(path, joints, out)?;
             if paths.len() > 1 {
-                prints.push(crate::repeated_samples::SamplePrints::of(
+                prints.push(crate::logs::repeated_samples::SamplePrints::of(
                     rec.n,
                     &[&rec.q, &rec.tau],
                 )?);
@@ -293,7 +293,7 @@ impl PreprocessArgs {
             recs.push(self.prepare(rec, path, &periods, joints, progress, out)?);
         }
         let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
-        crate::repeated_samples::refuse_shared_samples(&prints, &names, argument, "data rows")?;
+        crate::logs::repeated_samples::refuse_shared_samples(&prints, &names, argument, "data rows")?;
         Ok(recs)
     }
 
@@ -318,10 +318,10 @@ impl PreprocessArgs {
         if self.trim.is_some() {
             return refuse("--trim drops a filter's transients, and averaging over periods has none: leave it out");
         }
-        let options = |period: f64, harmonics: usize| crate::period_average::PeriodOptions {
+        let options = |period: f64, harmonics: usize| crate::logs::period_average::PeriodOptions {
             skip: self.skip_periods,
             start: self.period_start,
-            ..crate::period_average::PeriodOptions::new(period, harmonics)
+            ..crate::logs::period_average::PeriodOptions::new(period, harmonics)
         };
         match (&self.average_periods, self.period, self.period_harmonics) {
             (Some(_), Some(_), _) | (Some(_), _, Some(_)) => refuse(
@@ -344,26 +344,26 @@ impl PreprocessArgs {
     /// `--preprocess` asks), averaged over `periods` where given; says so in `out`.
     fn prepare(
         &self,
-        rec: crate::recording::Recording,
+        rec: crate::logs::recording::Recording,
         path: &Path,
         periods: &Periods,
         joints: &[String],
         progress: &super::progress::Progress,
         out: &mut String,
-    ) -> Result<crate::recording::Recording> {
+    ) -> Result<crate::logs::recording::Recording> {
         use std::fmt::Write;
-        let clipped = |rec: &crate::recording::Recording| {
+        let clipped = |rec: &crate::logs::recording::Recording| {
             let log = path.display().to_string();
-            if let Some(w) = crate::torque_saturation::warning(&rec.torque_saturation, joints, &log)
+            if let Some(w) = crate::logs::torque_saturation::warning(&rec.torque_saturation, joints, &log)
             {
                 eprintln!("perturbid: warning: {w}");
             }
         };
         if rec.qdd.is_some() && !self.preprocess && matches!(periods, Periods::None) {
             // taken as logged: its velocity and acceleration columns against the derivatives
-            crate::derivative_columns::check_logged_derivatives(&rec)?;
-            let rec = crate::recording::Recording {
-                torque_saturation: crate::torque_saturation::find_torque_saturation(&rec),
+            crate::logs::derivative_columns::check_logged_derivatives(&rec)?;
+            let rec = crate::logs::recording::Recording {
+                torque_saturation: crate::logs::torque_saturation::find_torque_saturation(&rec),
                 ..rec
             };
             clipped(&rec);
@@ -374,7 +374,7 @@ impl PreprocessArgs {
             Periods::None => None,
             Periods::Given(o) => Some(o.clone()),
             Periods::Excitation(traj, source) => Some(
-                crate::excitation_start::excitation_periods(&rec, traj, self.skip_periods)
+                crate::logs::excitation_start::excitation_periods(&rec, traj, self.skip_periods)
                     .map_err(|e| match e {
                         Error::Recording { recording, message } => Error::Recording {
                             recording,
@@ -385,40 +385,40 @@ impl PreprocessArgs {
             ),
         };
         let periodic = periods.is_some();
-        let o = crate::preprocess::PreprocessOptions {
+        let o = crate::logs::preprocess::PreprocessOptions {
             rate: self.rate,
             cutoff: Some(self.cutoff),
             decimate: self.decimate,
             trim: self.trim.unwrap_or(0.5),
             split_at_gaps: self.split_at_gaps,
             periods,
-            ..crate::preprocess::PreprocessOptions::default()
+            ..crate::logs::preprocess::PreprocessOptions::default()
         };
-        let rec = crate::preprocess::preprocess(&rec, &o)?;
+        let rec = crate::logs::preprocess::preprocess(&rec, &o)?;
         if let Some(w) =
-            crate::period_average::warning(&rec.period_average, &path.display().to_string(), joints)
+            crate::logs::period_average::warning(&rec.period_average, &path.display().to_string(), joints)
         {
             eprintln!("perturbid: warning: {w}");
         }
-        if let Some(w) = crate::log_screening::warning(
+        if let Some(w) = crate::logs::log_screening::warning(
             &rec.glitches,
             &path.display().to_string(),
             joints,
-            crate::log_screening::BEFORE_PREPROCESSING,
+            crate::logs::log_screening::BEFORE_PREPROCESSING,
         ) {
             eprintln!("perturbid: warning: {w}");
         }
         if let Some(w) =
-            crate::held_columns::warning(&rec.held_columns, &path.display().to_string(), joints)
+            crate::logs::held_columns::warning(&rec.held_columns, &path.display().to_string(), joints)
         {
             eprintln!("perturbid: warning: {w}");
         }
         if let Some(w) =
-            crate::stamp_jitter::warning(&rec.stamp_jitter, &path.display().to_string(), joints)
+            crate::logs::stamp_jitter::warning(&rec.stamp_jitter, &path.display().to_string(), joints)
         {
             eprintln!("perturbid: warning: {w}");
         }
-        if let Some(w) = crate::position_wraps::warning(
+        if let Some(w) = crate::logs::position_wraps::warning(
             &rec.position_wraps,
             &path.display().to_string(),
             joints,
@@ -426,11 +426,11 @@ impl PreprocessArgs {
         ) {
             eprintln!("perturbid: warning: {w}");
         }
-        if let Some(w) = crate::log_dropouts::dropout_warning(
+        if let Some(w) = crate::logs::log_dropouts::dropout_warning(
             &rec.dropouts,
             &path.display().to_string(),
             joints,
-            crate::log_dropouts::BRIDGED_BY_PREPROCESSING,
+            crate::logs::log_dropouts::BRIDGED_BY_PREPROCESSING,
         ) {
             eprintln!("perturbid: warning: {w}");
         }
@@ -545,7 +545,7 @@ pub(crate) fn check_validate_fraction(fraction: f64) -> Result<()> {
 /// log where there are several).
 pub(crate) fn fit_splits(
     fraction: f64,
-    recs: &[crate::recording::Recording],
+    recs: &[crate::logs::recording::Recording],
     paths: &[PathBuf],
 ) -> Result<Vec<usize>> {
     let mut splits = Vec::with_capacity(recs.len());

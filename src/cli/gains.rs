@@ -14,7 +14,7 @@ use super::progress::Progress;
 use crate::direct::{identify_drive_gains_with, GainEstimator, GainRun};
 use crate::document::Document;
 use crate::error::{Error, Result};
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 use crate::rehearsal::Payload;
 use crate::torque_model::ModelFile;
 

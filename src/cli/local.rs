@@ -16,7 +16,7 @@ use crate::local::{
     identify_local, plan_experiments, CrossingTimes, Design, Estimator, ExperimentKind,
     IdentifyOptions, LocalModel, OperatingPoint, Plan, PlanOptions, Size,
 };
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 use crate::rehearsal::{rehearse, rehearse_plan, TrueRobot};
 use crate::simulation::{simulate_plan, simulate_samples, Friction, SimulationOptions};
 use crate::trajectory::FourierTrajectory;

@@ -168,7 +168,7 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
         .map(|(r, path)| r.states().map_err(in_log(path)))
         .collect::<Result<Vec<_>>>()?;
     let names: Vec<String> = a.data.iter().map(|p| p.display().to_string()).collect();
-    let part = |held: bool| -> Result<crate::stacked_states::StackedStates> {
+    let part = |held: bool| -> Result<crate::logs::stacked_states::StackedStates> {
         let parts: Vec<(crate::states::States<'_>, &[f64])> = (states.iter().zip(&recs))
             .zip(&splits)
             .map(|((s, r), &split)| {
@@ -177,7 +177,7 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
             })
             .filter(|(s, _)| !s.is_empty())
             .collect();
-        crate::stacked_states::StackedStates::of_named(&parts, &names, "DATA")
+        crate::logs::stacked_states::StackedStates::of_named(&parts, &names, "DATA")
     };
     // several logs are stacked; one is read in place (a long log is not copied)
     let stacked = match recs.len() {

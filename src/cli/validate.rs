@@ -232,8 +232,8 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
         _ => (vec![], vec![], None, None),
     };
     progress.done();
-    let rounding = crate::position_rounding::warning(&rec.position_rounding, &joints)
-        .map(|w| format!("{w}{}", crate::position_rounding::IN_A_VALIDATION));
+    let rounding = crate::logs::position_rounding::warning(&rec.position_rounding, &joints)
+        .map(|w| format!("{w}{}", crate::logs::position_rounding::IN_A_VALIDATION));
     for w in validation_findings(
         &position_range,
         &torque_columns,

@@ -44,7 +44,7 @@ pub struct BaseOptions {
     pub seed: u64,
     /// The samples as several runs one after the other (logs of other excitations, other
     /// days): the number of samples of each, adding up to all of them
-    /// ([`crate::stacked_states::StackedStates::runs`]). Each run's residuals are a time
+    /// ([`crate::logs::stacked_states::StackedStates::runs`]). Each run's residuals are a time
     /// series of their own: their correlation from sample to sample is estimated within each
     /// run, not across the joins, where two logs' residuals may differ in mean (a torque
     /// offset that drifted between them read as correlation at every lag, and inflated the

@@ -435,7 +435,7 @@ pub fn identify_drive_gains_with(
     // the runs one after the other: states, the signal (its column's coefficient is -K) and
     // the right-hand side -tau_L
     let parts: Vec<(States<'_>, &[f64])> = runs.iter().map(|r| (r.states, r.signal)).collect();
-    let stacked = crate::stacked_states::StackedStates::of(&parts)?;
+    let stacked = crate::logs::stacked_states::StackedStates::of(&parts)?;
     let signal = &stacked.data;
     let mut rhs = vec![0.0; k * nv];
     // per joint, the payloads' squared torques summed over the loaded runs' samples

@@ -50,42 +50,42 @@ pub struct BaseModel {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub residual_correlation: Vec<f64>,
     /// Samples of the log the data were preprocessed from that were taken for glitches and
-    /// replaced first ([`crate::log_screening`]; set by the caller that preprocessed them,
+    /// replaced first ([`crate::logs::log_screening`]; set by the caller that preprocessed them,
     /// such as the command line); empty when none were, or the data came otherwise.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub log_glitches: Vec<crate::log_screening::LogGlitch>,
+    pub log_glitches: Vec<crate::logs::log_screening::LogGlitch>,
     /// Rows of that log removed first: dropouts (every joint of a signal read exactly 0 while
     /// the robot moved) and frozen readings (one joint's column held one value too long;
-    /// [`crate::log_dropouts::find_removed_rows`]), set likewise.
+    /// [`crate::logs::log_dropouts::find_removed_rows`]), set likewise.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub log_dropouts: Vec<crate::log_dropouts::LogDropout>,
-    /// The torques of that log that read clipped ([`crate::torque_saturation`]; set likewise):
+    pub log_dropouts: Vec<crate::logs::log_dropouts::LogDropout>,
+    /// The torques of that log that read clipped ([`crate::logs::torque_saturation`]; set likewise):
     /// the fit took them for the robot's, and was warned of them.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub log_torque_saturation: Vec<crate::torque_saturation::TorqueSaturation>,
+    pub log_torque_saturation: Vec<crate::logs::torque_saturation::TorqueSaturation>,
     /// Steps of whole turns in that log's positions, taken back out first
-    /// ([`crate::position_wraps`]; set likewise).
+    /// ([`crate::logs::position_wraps`]; set likewise).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub log_position_wraps: Vec<crate::position_wraps::PositionWrap>,
+    pub log_position_wraps: Vec<crate::logs::position_wraps::PositionWrap>,
     /// Columns of that log logged at a lower rate and held on its grid, read again at their
-    /// values' arrivals first ([`crate::held_columns`]; set likewise).
+    /// values' arrivals first ([`crate::logs::held_columns`]; set likewise).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub log_held_columns: Vec<crate::held_columns::HeldColumn>,
+    pub log_held_columns: Vec<crate::logs::held_columns::HeldColumn>,
     /// That log's time stamps, found jittering over the regular clock its samples were taken
-    /// on ([`crate::stamp_jitter`]; set likewise).
+    /// on ([`crate::logs::stamp_jitter`]; set likewise).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub log_stamp_jitter: Option<crate::stamp_jitter::StampJitter>,
+    pub log_stamp_jitter: Option<crate::logs::stamp_jitter::StampJitter>,
     /// What averaging that log over its excitation's periods found, where it was averaged
-    /// (`--period`, `--excitation`; [`crate::period_average`]; set likewise): the periods
+    /// (`--period`, `--excitation`; [`crate::logs::period_average`]; set likewise): the periods
     /// averaged and left out, and each signal's noise from their spread.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub log_period_average: Option<crate::period_average::PeriodAverage>,
+    pub log_period_average: Option<crate::logs::period_average::PeriodAverage>,
     /// Per joint of that log whose positions lie on a grid and whose velocity was derived
-    /// from them, the noise their rounding left in qd and qdd ([`crate::position_rounding`];
-    /// set likewise): ratios of [`crate::position_rounding::NOISE_RATIO`] or more are warned
+    /// from them, the noise their rounding left in qd and qdd ([`crate::logs::position_rounding`];
+    /// set likewise): ratios of [`crate::logs::position_rounding::NOISE_RATIO`] or more are warned
     /// of ([`BaseModel::warnings`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub position_rounding: Vec<crate::position_rounding::PositionRounding>,
+    pub position_rounding: Vec<crate::logs::position_rounding::PositionRounding>,
     /// Where the model was fitted to several logs (excitation runs, or drive-gain runs), what
     /// the preprocessing found in each, named by the log ([`super::log_findings`]); the
     /// `log_*` fields and `position_rounding` are then empty. Empty for a model of one log.

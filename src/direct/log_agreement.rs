@@ -59,7 +59,7 @@ impl LogAgreement {
         joint_names: &[String],
         offsets_fitted: bool,
     ) -> Option<String> {
-        let name = |r: usize| crate::stacked_states::run_name(names, r);
+        let name = |r: usize| crate::logs::stacked_states::run_name(names, r);
         let own = |r: usize, j: usize| self.own_rms[r].as_ref().map_or(f64::NAN, |o| o[j]);
         let apart: Vec<String> = (self.ratio.iter().enumerate())
             .filter_map(|(j, r)| r.filter(|r| *r >= AGREEMENT).map(|r| (j, r)))

@@ -7,7 +7,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::BaseModel;
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 
 /// One log's findings, named by the log (its path as given).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -15,33 +15,33 @@ use crate::recording::Recording;
 pub struct LogFindings {
     /// The log: its path as given on the command line, or the recording's name.
     pub log: String,
-    /// Samples taken for glitches and replaced ([`crate::log_screening`]).
+    /// Samples taken for glitches and replaced ([`crate::logs::log_screening`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub glitches: Vec<crate::log_screening::LogGlitch>,
-    /// Rows removed first: dropouts and frozen readings ([`crate::log_dropouts`]).
+    pub glitches: Vec<crate::logs::log_screening::LogGlitch>,
+    /// Rows removed first: dropouts and frozen readings ([`crate::logs::log_dropouts`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub dropouts: Vec<crate::log_dropouts::LogDropout>,
-    /// Torques that read clipped ([`crate::torque_saturation`]).
+    pub dropouts: Vec<crate::logs::log_dropouts::LogDropout>,
+    /// Torques that read clipped ([`crate::logs::torque_saturation`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub torque_saturation: Vec<crate::torque_saturation::TorqueSaturation>,
-    /// Steps of whole turns taken back out of the positions ([`crate::position_wraps`]).
+    pub torque_saturation: Vec<crate::logs::torque_saturation::TorqueSaturation>,
+    /// Steps of whole turns taken back out of the positions ([`crate::logs::position_wraps`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub position_wraps: Vec<crate::position_wraps::PositionWrap>,
+    pub position_wraps: Vec<crate::logs::position_wraps::PositionWrap>,
     /// Columns logged at a lower rate, read again at their values' arrivals
-    /// ([`crate::held_columns`]).
+    /// ([`crate::logs::held_columns`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub held_columns: Vec<crate::held_columns::HeldColumn>,
-    /// Time stamps found jittering over the regular clock ([`crate::stamp_jitter`]).
+    pub held_columns: Vec<crate::logs::held_columns::HeldColumn>,
+    /// Time stamps found jittering over the regular clock ([`crate::logs::stamp_jitter`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stamp_jitter: Option<crate::stamp_jitter::StampJitter>,
+    pub stamp_jitter: Option<crate::logs::stamp_jitter::StampJitter>,
     /// Per joint whose positions lie on a grid, the noise their rounding left in qd and qdd
-    /// ([`crate::position_rounding`]).
+    /// ([`crate::logs::position_rounding`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub position_rounding: Vec<crate::position_rounding::PositionRounding>,
+    pub position_rounding: Vec<crate::logs::position_rounding::PositionRounding>,
     /// What averaging over the excitation's periods found: the periods averaged and left
-    /// out, each signal's noise ([`crate::period_average`]).
+    /// out, each signal's noise ([`crate::logs::period_average`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub period_average: Option<crate::period_average::PeriodAverage>,
+    pub period_average: Option<crate::logs::period_average::PeriodAverage>,
 }
 
 /// The longest name of a log kept (characters): a path, or a Recording's name.

@@ -120,7 +120,7 @@ impl BaseModel {
     /// ([`super::weak_excitation`]), residuals beyond or below the torques' noise measured apart
     /// ([`super::noise_fit`]), runs of a fit over several logs whose residuals differ in
     /// mean ([`super::runs`]: a torque offset that drifted), positions logged in counts so coarse that their
-    /// rounding shows in the derived velocities ([`crate::position_rounding`]; in each log of
+    /// rounding shows in the derived velocities ([`crate::logs::position_rounding`]; in each log of
     /// several, named), and friction or
     /// armature coefficients identified on their own (not in a combination), negative beyond
     /// three standard errors and not negligible (a torque at least [`NEGLIGIBLE_TERM`] of the
@@ -211,12 +211,12 @@ impl BaseModel {
                 })
             });
         let rounding =
-            crate::position_rounding::warning(&self.position_rounding, &self.joint_names)
-                .map(|w| format!("{w}{}", crate::position_rounding::IN_A_FIT));
+            crate::logs::position_rounding::warning(&self.position_rounding, &self.joint_names)
+                .map(|w| format!("{w}{}", crate::logs::position_rounding::IN_A_FIT));
         // of each of several logs, named
         let rounding = rounding.into_iter().chain(self.logs.iter().filter_map(|l| {
-            crate::position_rounding::warning(&l.position_rounding, &self.joint_names)
-                .map(|w| format!("'{}': {w}{}", l.log, crate::position_rounding::IN_A_FIT))
+            crate::logs::position_rounding::warning(&l.position_rounding, &self.joint_names)
+                .map(|w| format!("'{}': {w}{}", l.log, crate::logs::position_rounding::IN_A_FIT))
         }));
         let offsets = self.position_offsets_finding();
         // friction terms fitted to a log that does not read as the robot's model take up
@@ -235,7 +235,7 @@ impl BaseModel {
             .as_ref()
             .and(self.log_period_average.as_ref()))
         .and_then(|a| {
-            crate::period_average::noise_colour::finding(
+            crate::logs::period_average::noise_colour::finding(
                 &a.torque_noise_tilt,
                 a.periods,
                 a.torque_harmonics,

@@ -592,7 +592,7 @@ pub fn identify_payload(
         logs: match options.runs.len() {
             0 | 1 => vec![],
             n => (0..n)
-                .map(|r| crate::stacked_states::run_name(&options.log_names, r))
+                .map(|r| crate::logs::stacked_states::run_name(&options.log_names, r))
                 .collect(),
         },
         run_checks: vec![],

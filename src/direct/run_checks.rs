@@ -98,7 +98,7 @@ pub fn check_runs_against_model(
 pub fn findings(checks: &[RunChecks], names: &[String]) -> Vec<String> {
     (checks.iter().enumerate())
         .flat_map(|(r, c)| {
-            let name = crate::stacked_states::run_name(names, r);
+            let name = crate::logs::stacked_states::run_name(names, r);
             c.findings(&name)
         })
         .collect()

@@ -87,7 +87,7 @@ impl RunOffsets {
 
     /// The finding, runs named by `names` (a log's path; `run i` where none is given).
     pub fn finding(&self, names: &[String]) -> String {
-        let name = |i: usize| crate::stacked_states::run_name(names, i);
+        let name = |i: usize| crate::logs::stacked_states::run_name(names, i);
         let (lo, hi) = extremes(&self.means);
         let apart = (self.means[hi] - self.means[lo])
             / (self.stderr[hi].powi(2) + self.stderr[lo].powi(2)).sqrt();

@@ -1,5 +1,5 @@
 //! The torques' noise measured apart from any fit: from the spread of an excitation's periods
-//! ([`crate::period_average`], [`crate::period_average::PeriodAverage::torque_noise`]), or
+//! ([`crate::logs::period_average`], [`crate::logs::period_average::PeriodAverage::torque_noise`]), or
 //! given by the caller (a log of the robot held still, a sensor's data sheet). It weights the
 //! rows of a [`super::Weighting::Noise`] fit, and is the yardstick a fit's residuals are
 //! judged against ([`super::noise_fit`]).

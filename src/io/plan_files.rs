@@ -8,7 +8,7 @@ use super::OutputSet;
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::local::Plan;
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 
 /// The files of `plan` in folder `dir`, not yet written ([`OutputSet::commit`] writes them
 /// whole or not at all): one `<experiment>.csv` per experiment (`nominal.csv`, `D.csv`, ...:

@@ -4,7 +4,7 @@
 
 use super::table::Table;
 use crate::error::{shown, Error, Result};
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 use crate::trajectory::Samples;
 
 /// The column of variable `var` (`q`, `qd`, `qdd`, `tau`) of joint `j`: `var{j+1}` or
@@ -66,7 +66,7 @@ impl<'a> Columns<'a> {
                     i + 1,
                     shown(t[i]),
                     shown(t[i - 1]),
-                    crate::recording::time_hint(t[i], t[i - 1])
+                    crate::logs::recording::time_hint(t[i], t[i - 1])
                 ),
             ));
         }

@@ -208,7 +208,7 @@ impl Table {
                         crate::error::shown(now),
                         crate::error::shown(previous.0),
                         previous.1,
-                        crate::recording::time_hint(now, previous.0)
+                        crate::logs::recording::time_hint(now, previous.0)
                     )));
                 }
                 previous = (now, line);

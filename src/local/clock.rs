@@ -7,7 +7,7 @@ use super::offset_search::{search_offset, CANDIDATES};
 use super::plan::Experiment;
 use super::FitOptions;
 use crate::error::{Error, Result};
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 
 /// The offset (s) between `rec`'s clock and `experiment`'s plan, found in the positions within
 /// `+-max_shift` s (see [`detect_offset_in`](super::detect_offset_in)) and checked: the positions must follow the plan

@@ -7,7 +7,7 @@ use nalgebra::DMatrix;
 use super::glitches::{self, Screened};
 use super::rounded_positions::band_state;
 use crate::error::{Error, Result};
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 
 pub use super::reversals::velocity_reversals;
 

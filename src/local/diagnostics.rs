@@ -163,14 +163,14 @@ pub struct Diagnostics {
     pub glitches: Vec<Glitch>,
     /// Rows of the recordings removed before their windows were read: every joint of a
     /// signal read exactly 0 while the robot moved, or one joint's column frozen
-    /// ([`crate::log_dropouts::find_removed_rows`]; each names its experiment).
+    /// ([`crate::logs::log_dropouts::find_removed_rows`]; each names its experiment).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub dropouts: Vec<crate::log_dropouts::LogDropout>,
+    pub dropouts: Vec<crate::logs::log_dropouts::LogDropout>,
     /// Samples of the recordings replaced before their windows were read: one joint's reading
     /// held (a run of one repeated value while it moved, off the curve either side; see
-    /// [`crate::log_screening::screen_held_readings`]; each names its experiment).
+    /// [`crate::logs::log_screening::screen_held_readings`]; each names its experiment).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub held_readings: Vec<crate::log_screening::LogGlitch>,
+    pub held_readings: Vec<crate::logs::log_screening::LogGlitch>,
     /// What the user should know: each is also given as a Python warning and printed by the
     /// command line.
     #[serde(default)]

@@ -3,7 +3,7 @@
 //! and the torque samples of the crossing windows they are told by.
 
 use super::plan::ExperimentKind;
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 
 /// Per joint, the torque samples (N m) of `rec` in the windows `[tc - half, tc + half]`, one
 /// per centre `tc` (the recording's clock), window after window.

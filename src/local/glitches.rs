@@ -1,10 +1,10 @@
 //! Isolated glitches in a crossing window (docs/method.md, section 7): each signal's window is
-//! screened with the fit that reads it (the same basis and samples) by [`crate::outliers`];
+//! screened with the fit that reads it (the same basis and samples) by [`crate::logs::outliers`];
 //! this module reports what it found, as diagnostics and warnings. One torque sample of 50 N m
 //! in a window of the A465's D experiment moved D* by 440 of its standard errors, silently,
 //! before the screening.
 
-pub use crate::outliers::{level, screen, Flagged, Screened, MAX_PER_WINDOW, NOISE_LEVELS};
+pub use crate::logs::outliers::{level, screen, Flagged, Screened, MAX_PER_WINDOW, NOISE_LEVELS};
 
 use super::crossing::{CrossingValues, WindowGlitch};
 use super::diagnostics::Glitch;

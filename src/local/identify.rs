@@ -27,7 +27,7 @@ use super::rounded_positions::{self, Resolution};
 use super::torque_offsets;
 use crate::document::Document;
 use crate::error::{Error, Result};
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 
 /// Where the crossing times come from.
 #[derive(Clone, Copy, Debug, PartialEq)]

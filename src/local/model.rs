@@ -516,7 +516,7 @@ impl Document for LocalModel {
         }
         for (i, g) in m.diagnostics.glitches.iter().enumerate() {
             let what = format!("diagnostics.glitches[{i}]");
-            if !crate::log_screening::SIGNALS.contains(&g.signal.as_str()) {
+            if !crate::logs::log_screening::SIGNALS.contains(&g.signal.as_str()) {
                 return Err(bad(format!(
                     "{what}.signal is '{}'; expected one of q, qd, qdd, tau",
                     g.signal

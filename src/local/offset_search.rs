@@ -5,7 +5,7 @@
 use super::clock::span_rows;
 use super::plan::Experiment;
 use crate::error::{Error, Result};
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 
 /// The coarsest grid over the offsets (s): the nominal passes go back and forth every 0.3 s
 /// at the paper's point, so a grid of `max_shift / 200` over a tolerance raised to 118 s (a

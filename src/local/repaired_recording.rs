@@ -1,20 +1,20 @@
 //! One experiment's recording made ready for its crossing windows: steps of whole turns taken
-//! out of its positions ([`crate::position_wraps`]), columns held at a lower rate read again
-//! at their values' arrivals ([`crate::held_columns`]), stamps that jitter over a regular
-//! clock found ([`crate::stamp_jitter`]), its logged velocities and
+//! out of its positions ([`crate::logs::position_wraps`]), columns held at a lower rate read again
+//! at their values' arrivals ([`crate::logs::held_columns`]), stamps that jitter over a regular
+//! clock found ([`crate::logs::stamp_jitter`]), its logged velocities and
 //! accelerations checked against the derivatives where they are to be used
-//! ([`crate::derivative_columns::check_logged_derivatives`]), one joint's held readings
+//! ([`crate::logs::derivative_columns::check_logged_derivatives`]), one joint's held readings
 //! (a lost message logged as its last value or zeros) replaced, rows of zeros and frozen
-//! readings while the robot moves removed ([`crate::log_dropouts`]), clipped torques found in
+//! readings while the robot moves removed ([`crate::logs::log_dropouts`]), clipped torques found in
 //! the recording as logged, and each told of in warnings that name the experiment. The samples
 //! the diagnostics name are counted in the recording as logged.
 
 use super::identify::{experiment_values, ExperimentValues, IdentifyOptions};
 use super::plan::Experiment;
 use crate::error::Result;
-use crate::log_dropouts::LogDropout;
-use crate::log_screening::LogGlitch;
-use crate::recording::Recording;
+use crate::logs::log_dropouts::LogDropout;
+use crate::logs::log_screening::LogGlitch;
+use crate::logs::recording::Recording;
 
 /// An experiment's recording read: its values, what was repaired or removed (each naming the
 /// experiment), and the warnings that tell of it.
@@ -38,15 +38,15 @@ pub(super) fn read_experiment(
     let name = e.kind.name();
     // what each step found, in words: each becomes a warning naming the experiment
     let mut said: Vec<Option<String>> = vec![];
-    let (unwrapped, wraps) = crate::position_wraps::unwrap_positions(r);
-    said.push(crate::position_wraps::warning(
+    let (unwrapped, wraps) = crate::logs::position_wraps::unwrap_positions(r);
+    said.push(crate::logs::position_wraps::warning(
         &wraps,
         &r.name,
         joint_names,
         "before the crossing windows were read",
     ));
-    let (reread, held_columns) = crate::held_columns::find_held_columns(&unwrapped)?;
-    said.push(crate::held_columns::warning(
+    let (reread, held_columns) = crate::logs::held_columns::find_held_columns(&unwrapped)?;
+    said.push(crate::logs::held_columns::warning(
         &held_columns,
         &r.name,
         joint_names,
@@ -56,30 +56,30 @@ pub(super) fn read_experiment(
     drop(unwrapped);
     let r = &reread;
     // the stamps against the positions: the windows' fits read the stamps as the samples' times
-    said.push(crate::stamp_jitter::warning(
-        &crate::stamp_jitter::find_stamp_jitter(r),
+    said.push(crate::logs::stamp_jitter::warning(
+        &crate::logs::stamp_jitter::find_stamp_jitter(r),
         &r.name,
         joint_names,
     ));
     if options.fit.recorded_derivatives {
-        crate::derivative_columns::check_logged_derivatives(r)?;
+        crate::logs::derivative_columns::check_logged_derivatives(r)?;
     }
-    let clipped = crate::torque_saturation::find_torque_saturation(r);
-    let (repaired, held) = crate::log_screening::screen_held_readings(r)?;
-    said.push(crate::log_screening::warning(
+    let clipped = crate::logs::torque_saturation::find_torque_saturation(r);
+    let (repaired, held) = crate::logs::log_screening::screen_held_readings(r)?;
+    said.push(crate::logs::log_screening::warning(
         &held,
         &r.name,
         joint_names,
         "before the crossing windows were read",
     ));
-    let found = crate::log_dropouts::find_removed_rows(r, &repaired)?;
+    let found = crate::logs::log_dropouts::find_removed_rows(r, &repaired)?;
     let values = if found.is_empty() {
         experiment_values(e, &repaired, joint_names, options)?
     } else {
-        let kept = crate::log_dropouts::without_dropouts(&repaired, &found)?;
+        let kept = crate::logs::log_dropouts::without_dropouts(&repaired, &found)?;
         let mut v = experiment_values(e, &kept, joint_names, options)
-            .map_err(|error| crate::log_dropouts::after_removing(error, &found))?;
-        let rows = crate::log_dropouts::kept_rows(repaired.len(), &found);
+            .map_err(|error| crate::logs::log_dropouts::after_removing(error, &found))?;
+        let rows = crate::logs::log_dropouts::kept_rows(repaired.len(), &found);
         for c in v.crossings.iter_mut().chain(v.reference.iter_mut()) {
             for g in &mut c.glitches {
                 g.sample = rows[g.sample];
@@ -88,13 +88,13 @@ pub(super) fn read_experiment(
         v
     };
     let times: Vec<f64> = values.crossings.iter().map(|c| c.time).collect();
-    said.push(crate::torque_saturation::crossing_warning(
+    said.push(crate::logs::torque_saturation::crossing_warning(
         &clipped,
         &times,
         e.window,
         joint_names,
     ));
-    said.push(crate::log_dropouts::dropout_warning(
+    said.push(crate::logs::log_dropouts::dropout_warning(
         &found,
         &r.name,
         joint_names,

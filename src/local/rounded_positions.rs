@@ -20,7 +20,7 @@
 use super::plan::Experiment;
 use crate::band_fit::coefficient_ranges;
 use crate::error::{Error, Result};
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 
 use super::quantisation::grid_step;
 

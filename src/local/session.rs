@@ -8,7 +8,7 @@ use super::clock::{follows_plan, misfit_shown, position_misfit};
 use super::offset_search::{search_offset, span_cost};
 use super::plan::{Experiment, Plan};
 use crate::error::{Error, Result};
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 
 /// How a session log is split ([`split_session`]).
 #[derive(Clone, Debug)]
@@ -239,7 +239,7 @@ pub fn repeated_runs(
 /// the log and on the plan's clock.
 pub fn gaps_in_runs(plan: &Plan, log: &Recording, runs: &[(Recording, f64)]) -> Vec<String> {
     let intervals: Vec<f64> = log.t.windows(2).map(|w| w[1] - w[0]).collect();
-    let Some(median) = crate::log_screening::median(intervals) else {
+    let Some(median) = crate::logs::log_screening::median(intervals) else {
         return vec![];
     };
     let longest = crate::limits::MAX_GAP_INTERVALS * median;

@@ -139,7 +139,7 @@ pub(crate) fn fit_states<'a>(
 /// With `t` given ((k,) s, read by the caller, strictly increasing, one per row of the samples `c`: q, qd, qdd,
 /// tau as [`states`] read them), the samples taken for a log: its velocity and acceleration
 /// columns are checked against the derivatives of its positions and velocities
-/// ([`crate::derivative_columns::check_logged_derivatives`]), so velocities in deg/s, swapped
+/// ([`crate::logs::derivative_columns::check_logged_derivatives`]), so velocities in deg/s, swapped
 /// or negated columns are refused naming the joint. Without `t` nothing is checked: states
 /// need not be a trajectory. `what` names the samples in messages.
 pub(crate) fn check_sample_derivatives(
@@ -159,7 +159,7 @@ pub(crate) fn check_sample_derivatives(
             got: format!("shape ({},)", t.len()),
         });
     }
-    let log = crate::recording::Recording::new(
+    let log = crate::logs::recording::Recording::new(
         what,
         n,
         t,
@@ -168,7 +168,7 @@ pub(crate) fn check_sample_derivatives(
         Some(c[1].to_vec()),
         Some(c[2].to_vec()),
     )?;
-    crate::derivative_columns::check_logged_derivatives(&log)
+    crate::logs::derivative_columns::check_logged_derivatives(&log)
 }
 
 /// The options of the direct method from its Python arguments (`friction`, `weighting`,

@@ -18,7 +18,7 @@ use crate::direct::drive_gains::{
     identify_drive_gains_with as gains_rs, DriveGains, GainEstimator, GainRun, MAX_RUNS,
 };
 use crate::error::{Error, Result};
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 use crate::rehearsal::Payload;
 use crate::states::States;
 

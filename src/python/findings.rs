@@ -102,7 +102,7 @@ pub(crate) fn run_check_dicts<'py>(
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
     (checks.iter().enumerate())
         .map(|(r, c)| {
-            let name = crate::stacked_states::run_name(names, r);
+            let name = crate::logs::stacked_states::run_name(names, r);
             let e = PyDict::new(py);
             e.set_item("log", &name)?;
             e.set_item("samples", c.samples)?;

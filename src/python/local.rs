@@ -24,7 +24,7 @@ use crate::local::{
     ExperimentKind, FitOptions, IdentifyOptions, LocalModel, OperatingPoint, Plan, PlanOptions,
     Size,
 };
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 
 /// An operating point `P = (q*, qd*, qdd*)`: joint positions (rad or m), velocities (rad/s or
 /// m/s) and accelerations (rad/s^2 or m/s^2), each of shape `(n,)`.

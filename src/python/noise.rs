@@ -13,7 +13,7 @@ use std::sync::Arc;
 /// The noise a direct fit takes ([`crate::direct::BaseOptions::noise`]): `noise` ((n,), N m a
 /// joint) with `correlation` (samples an independent value, 1 for white noise) where given;
 /// otherwise that of the Recordings fitted where each was averaged over its periods
-/// ([`crate::period_average::PeriodAverage::torque_noise`]; several pooled,
+/// ([`crate::logs::period_average::PeriodAverage::torque_noise`]; several pooled,
 /// [`TorqueNoise::pooled`]). Errors, for the noise weighting only: a Recording not averaged, or
 /// whose periods measured no noise, naming it; several whose noise differs too much to pool.
 pub(crate) fn torque_noise(

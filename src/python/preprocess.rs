@@ -1,5 +1,5 @@
 //! `preprocess` in Python: real logs to uniform, filtered, differentiated samples (mirrors
-//! `crate::preprocess`).
+//! `crate::logs::preprocess`).
 
 use pyo3::prelude::*;
 
@@ -10,8 +10,8 @@ use super::detached;
 use super::arrays::ArrayLike;
 use super::recording::PyRecording;
 
-use crate::preprocess::{preprocess as preprocess_rs, PreprocessOptions};
-use crate::recording::Recording;
+use crate::logs::preprocess::{preprocess as preprocess_rs, PreprocessOptions};
+use crate::logs::recording::Recording;
 
 /// Excitation, periods and harmonics of `preprocess`'s averaging over periods: an excitation
 /// (FourierTrajectory or ExcitationDesign) brings its period and harmonics.
@@ -115,10 +115,10 @@ pub(crate) fn preprocess(
         }
         // found in the log, below
         (Some(_), None, None) => None,
-        (None, Some(p), Some(h)) => Some(crate::period_average::PeriodOptions {
+        (None, Some(p), Some(h)) => Some(crate::logs::period_average::PeriodOptions {
             start: period_start,
             skip: skip_periods,
-            ..crate::period_average::PeriodOptions::new(p, h)
+            ..crate::logs::period_average::PeriodOptions::new(p, h)
         }),
         (None, Some(_), None) => {
             return Err(invalid(
@@ -141,7 +141,7 @@ pub(crate) fn preprocess(
     let out: Recording = detached(py, "preprocess", || match &traj {
         // the excitation's start and periods found in the log first
         Some(traj) => {
-            let periods = crate::excitation_start::excitation_periods(&rec, traj, skip_periods)?;
+            let periods = crate::logs::excitation_start::excitation_periods(&rec, traj, skip_periods)?;
             preprocess_rs(
                 &rec,
                 &PreprocessOptions {
@@ -153,25 +153,25 @@ pub(crate) fn preprocess(
         None => preprocess_rs(&rec, &options),
     })?;
     let warnings: Vec<String> = [
-        crate::log_screening::warning(
+        crate::logs::log_screening::warning(
             &out.glitches,
             name,
             &[],
-            crate::log_screening::BEFORE_PREPROCESSING,
+            crate::logs::log_screening::BEFORE_PREPROCESSING,
         ),
-        crate::log_dropouts::dropout_warning(
+        crate::logs::log_dropouts::dropout_warning(
             &out.dropouts,
             name,
             &[],
-            crate::log_dropouts::BRIDGED_BY_PREPROCESSING,
+            crate::logs::log_dropouts::BRIDGED_BY_PREPROCESSING,
         ),
-        crate::position_rounding::warning(&out.position_rounding, &[])
-            .map(|w| format!("{name}: {w}{}", crate::position_rounding::IN_A_FIT)),
-        crate::torque_saturation::warning(&out.torque_saturation, &[], name),
-        crate::position_wraps::warning(&out.position_wraps, name, &[], "before preprocessing"),
-        crate::held_columns::warning(&out.held_columns, name, &[]),
-        crate::stamp_jitter::warning(&out.stamp_jitter, name, &[]),
-        crate::period_average::warning(&out.period_average, name, &[]),
+        crate::logs::position_rounding::warning(&out.position_rounding, &[])
+            .map(|w| format!("{name}: {w}{}", crate::logs::position_rounding::IN_A_FIT)),
+        crate::logs::torque_saturation::warning(&out.torque_saturation, &[], name),
+        crate::logs::position_wraps::warning(&out.position_wraps, name, &[], "before preprocessing"),
+        crate::logs::held_columns::warning(&out.held_columns, name, &[]),
+        crate::logs::stamp_jitter::warning(&out.stamp_jitter, name, &[]),
+        crate::logs::period_average::warning(&out.period_average, name, &[]),
     ]
     .into_iter()
     .flatten()

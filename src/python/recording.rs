@@ -1,4 +1,4 @@
-//! `Recording` in Python: what a robot logs (mirrors `crate::recording`).
+//! `Recording` in Python: what a robot logs (mirrors `crate::logs::recording`).
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 
 use super::arrays::{rows, vec1, vector, ArrayLike};
 use crate::error::{Error, Result};
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 
 /// A recording of one run: `t` (s, `(m,)`, increasing), `q` (rad, `(m, n)`), `tau` (N m,
 /// `(m, n)`), and optionally `qd`, `qdd` when the robot logs them.
@@ -36,7 +36,7 @@ impl From<Recording> for PyRecording {
 /// where it has one).
 pub(crate) fn glitch_dict<'py>(
     py: Python<'py>,
-    g: &crate::log_screening::LogGlitch,
+    g: &crate::logs::log_screening::LogGlitch,
 ) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
     let e = pyo3::types::PyDict::new(py);
     if let Some(x) = &g.experiment {
@@ -56,7 +56,7 @@ pub(crate) fn glitch_dict<'py>(
 
 pub(crate) fn dropout_dict<'py>(
     py: Python<'py>,
-    d: &crate::log_dropouts::LogDropout,
+    d: &crate::logs::log_dropouts::LogDropout,
 ) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
     let e = pyo3::types::PyDict::new(py);
     if let Some(x) = &d.experiment {

@@ -50,7 +50,7 @@ pub(crate) fn with_offset_per_log(
 /// an array of numbers); a list of which some are Recordings and some not is a TypeError.
 pub(crate) fn recordings_of(
     q: &Bound<'_, PyAny>,
-) -> PyResult<Option<Vec<Arc<crate::recording::Recording>>>> {
+) -> PyResult<Option<Vec<Arc<crate::logs::recording::Recording>>>> {
     let items: Vec<Bound<'_, PyAny>> = match (
         q.cast::<pyo3::types::PyList>(),
         q.cast::<pyo3::types::PyTuple>(),
@@ -59,7 +59,7 @@ pub(crate) fn recordings_of(
         (_, Ok(t)) => t.iter().collect(),
         _ => return Ok(None),
     };
-    let recs: Vec<Option<Arc<crate::recording::Recording>>> = (items.iter())
+    let recs: Vec<Option<Arc<crate::logs::recording::Recording>>> = (items.iter())
         .map(|x| {
             x.cast::<super::recording::PyRecording>()
                 .ok()
@@ -80,7 +80,7 @@ pub(crate) fn recordings_of(
 pub(crate) fn recordings_given(
     q: &Bound<'_, PyAny>,
     given: &Given<'_>,
-) -> PyResult<Option<Vec<Arc<crate::recording::Recording>>>> {
+) -> PyResult<Option<Vec<Arc<crate::logs::recording::Recording>>>> {
     let Some(recs) = recordings_of(q)? else {
         return Ok(None);
     };
@@ -101,9 +101,9 @@ pub(crate) fn recordings_given(
 /// (each one's residuals a time series of their own). Errors name the Recording.
 pub(crate) fn stacked_recordings(
     model: &crate::model::Model,
-    recs: &[Arc<crate::recording::Recording>],
+    recs: &[Arc<crate::logs::recording::Recording>],
     options: &BaseOptions,
-) -> Result<(crate::stacked_states::StackedStates, BaseOptions)> {
+) -> Result<(crate::logs::stacked_states::StackedStates, BaseOptions)> {
     if recs.is_empty() || recs.len() > crate::direct::drive_gains::MAX_RUNS {
         return Err(Error::InvalidArgument {
             argument: "q".into(),
@@ -131,7 +131,7 @@ pub(crate) fn stacked_recordings(
                 ),
             }));
         }
-        crate::derivative_columns::check_logged_derivatives(r).map_err(at)?;
+        crate::logs::derivative_columns::check_logged_derivatives(r).map_err(at)?;
         states.push(r.states().map_err(at)?);
     }
     let parts: Vec<(States<'_>, &[f64])> = states
@@ -142,7 +142,7 @@ pub(crate) fn stacked_recordings(
     let names: Vec<String> = (recs.iter().enumerate())
         .map(|(i, r)| format!("Recording {i} ('{}')", r.name))
         .collect();
-    let stacked = crate::stacked_states::StackedStates::of_named(&parts, &names, "q")?;
+    let stacked = crate::logs::stacked_states::StackedStates::of_named(&parts, &names, "q")?;
     // each Recording's residuals a time series of their own
     let options = BaseOptions {
         runs: stacked.runs.clone(),
@@ -153,7 +153,7 @@ pub(crate) fn stacked_recordings(
 
 /// `fit` with what each of the Recordings `recs` it was fitted to found in its preprocessing,
 /// in its `logs` (named by it).
-pub(crate) fn with_logs(fit: BaseModel, recs: &[Arc<crate::recording::Recording>]) -> BaseModel {
+pub(crate) fn with_logs(fit: BaseModel, recs: &[Arc<crate::logs::recording::Recording>]) -> BaseModel {
     BaseModel {
         logs: (recs.iter())
             .map(|r| crate::direct::LogFindings::of(&r.name, r))

@@ -15,7 +15,7 @@ use super::rehearsal::PyTrueRobot;
 use super::robot::PyRobot;
 use super::trajectory::PyFourier;
 use crate::error::Error;
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 use crate::rehearsal::{rehearse, rehearse_plan};
 use crate::simulation::{
     excitation_samples, simulate_plan, simulate_samples, Friction, SimulationOptions,

@@ -26,7 +26,7 @@ use crate::error::{shown, Error, Result};
 use crate::gravity::Gravity;
 use crate::local::Plan;
 use crate::model::Model;
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 use crate::trajectory::Samples;
 
 /// What `robot` (the true robot built on `nominal`) logs while it follows `reference` (states

@@ -302,16 +302,16 @@ fn averaged_fit(
     rec: &crate::Recording,
     gravity: Gravity,
 ) -> Result<crate::direct::BaseModel> {
-    let options = crate::preprocess::PreprocessOptions {
+    let options = crate::logs::preprocess::PreprocessOptions {
         rate: study.config.direct.rate,
         decimate: 1,
-        periods: Some(crate::period_average::PeriodOptions::new(
+        periods: Some(crate::logs::period_average::PeriodOptions::new(
             trajectory.period(),
             trajectory.harmonics(),
         )),
-        ..crate::preprocess::PreprocessOptions::default()
+        ..crate::logs::preprocess::PreprocessOptions::default()
     };
-    let avg = crate::preprocess::preprocess(rec, &options)?;
+    let avg = crate::logs::preprocess::preprocess(rec, &options)?;
     let noise = (avg.period_average.as_ref()).and_then(|a| a.torque_noise(&model.joint_names).ok());
     let options = BaseOptions {
         weighting: match noise {

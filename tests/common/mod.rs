@@ -493,10 +493,10 @@ pub fn panda_preprocessed() -> Option<(perturbid_rs::Model, perturbid_rs::Record
         eprintln!("SKIPPED: the Panda URDF of example-robot-data is not installed");
         return None;
     };
-    let options = perturbid_rs::preprocess::PreprocessOptions::default();
+    let options = perturbid_rs::logs::preprocess::PreprocessOptions::default();
     Some((
         model,
-        perturbid_rs::preprocess::preprocess(&rec, &options).unwrap(),
+        perturbid_rs::logs::preprocess::preprocess(&rec, &options).unwrap(),
     ))
 }
 
@@ -592,9 +592,9 @@ pub fn normal(rng: &mut Rng) -> f64 {
 /// `options`, with the preprocessed recording.
 pub fn fit_preprocessed(
     rec: &perturbid_rs::Recording,
-    options: &perturbid_rs::preprocess::PreprocessOptions,
+    options: &perturbid_rs::logs::preprocess::PreprocessOptions,
 ) -> (perturbid_rs::Recording, perturbid_rs::direct::BaseModel) {
-    let p = perturbid_rs::preprocess::preprocess(rec, options).unwrap();
+    let p = perturbid_rs::logs::preprocess::preprocess(rec, options).unwrap();
     let states = perturbid_rs::States::new(6, &p.q, p.qd.as_deref(), p.qdd.as_deref()).unwrap();
     let fit = perturbid_rs::direct::identify_base_parameters(
         &perturbid_rs::robots::a465::model("physical").unwrap(),

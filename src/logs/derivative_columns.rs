@@ -22,8 +22,8 @@
 //! ([`check_logged_derivatives`], for a log used as logged: each stretch between gaps resampled
 //! at its median rate and filtered as preprocessing does, by default).
 
-use crate::preprocess::PreprocessOptions;
-use crate::recording::Recording;
+use crate::logs::preprocess::PreprocessOptions;
+use crate::logs::recording::Recording;
 use crate::signal::{butterworth_lowpass, differentiate, filtfilt, interpolate};
 
 use crate::error::{Error, Result};
@@ -221,7 +221,7 @@ fn check_columns(
 
 /// Checks the logged velocities and accelerations of `rec`, a log used as logged (not
 /// preprocessed), against the derivatives of its positions (steps of whole turns taken out:
-/// [`crate::position_wraps`]) and of its logged velocities: each
+/// [`crate::logs::position_wraps`]) and of its logged velocities: each
 /// stretch between gaps (longer than 20 median sample intervals) resampled at its median rate,
 /// both sides filtered alike by the default preprocessing's low-pass
 /// ([`PreprocessOptions::default`]) and trimmed by its trim; stretches too short or sampled too
@@ -233,11 +233,11 @@ pub fn check_logged_derivatives(rec: &Recording) -> Result<()> {
         return Ok(());
     };
     // a joint angle logged within one turn steps by a turn where it wraps: not motion
-    let (unwrapped, _) = crate::position_wraps::unwrap_positions(rec);
+    let (unwrapped, _) = crate::logs::position_wraps::unwrap_positions(rec);
     let rec = &unwrapped;
     let options = PreprocessOptions::default();
     let n = rec.n;
-    'parts: for (first, end) in crate::log_screening::segments(rec) {
+    'parts: for (first, end) in crate::logs::log_screening::segments(rec) {
         crate::interrupt::check("checking the log's velocity and acceleration columns")?;
         let t = &rec.t[first..end];
         if t.len() < 3 {

@@ -20,7 +20,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 
 /// One turn (rad).
 const TURN: f64 = std::f64::consts::TAU;
@@ -122,7 +122,7 @@ pub fn warning(
         .map(|w| {
             format!(
                 "{} at t = {:.4} s (sample {}) by {} turn(s)",
-                crate::log_screening::joint_called(joint_names, w.joint),
+                crate::logs::log_screening::joint_called(joint_names, w.joint),
                 w.time,
                 w.sample,
                 -w.turns

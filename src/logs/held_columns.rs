@@ -19,9 +19,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::log_screening::{column_floor, joint_called, median, segments, signals};
-use crate::outliers::NOISE_LEVELS;
-use crate::recording::Recording;
+use crate::logs::log_screening::{column_floor, joint_called, median, segments, signals};
+use crate::logs::outliers::NOISE_LEVELS;
+use crate::logs::recording::Recording;
 
 /// Samples either side over which a joint's position must change for it to move.
 pub const MOTION_SPAN: usize = 50;
@@ -51,7 +51,7 @@ impl HeldColumn {
     /// What is wrong with a held column read from a file, if anything: an unknown signal, a
     /// joint not one of the `n`, a share outside [0, 1] or a hold shorter than 1 sample.
     pub fn problem(&self, n: usize) -> Option<String> {
-        if !crate::log_screening::SIGNALS.contains(&self.signal.as_str()) {
+        if !crate::logs::log_screening::SIGNALS.contains(&self.signal.as_str()) {
             return Some(format!(
                 "signal '{}' is not one of q, qd, qdd, tau",
                 self.signal
@@ -175,7 +175,7 @@ pub fn find_held_columns(rec: &Recording) -> crate::error::Result<(Recording, Ve
     }
     found.sort_by_key(|h| {
         (
-            crate::log_screening::SIGNALS
+            crate::logs::log_screening::SIGNALS
                 .iter()
                 .position(|s| *s == h.signal),
             h.joint,

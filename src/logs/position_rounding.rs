@@ -1,7 +1,7 @@
 //! Positions logged in coarse encoder counts, seen through the direct method's preprocessing
 //! (docs/method.md, section 8).
 //!
-//! Where a log has no velocity channel, [`crate::preprocess`] differentiates the positions
+//! Where a log has no velocity channel, [`crate::logs::preprocess`] differentiates the positions
 //! twice (through its low-pass filter) for qd and qdd. Positions rounded to whole counts of `s`
 //! rad carry a rounding error of about `s / sqrt(12)` a sample, and what of it passes the
 //! filter is noise in qd and qdd: errors in the regressor's variables, which least squares

@@ -26,7 +26,7 @@ impl StackedStates {
     /// values a sample) one after the other. Errors: no part, parts of other joints than the
     /// first's, a part without velocities or accelerations (naming it, from 0), data of
     /// another shape, two parts that share samples (positions and data alike, bit for bit,
-    /// over [`crate::repeated_samples::RUN`] samples or more: a run given twice).
+    /// over [`crate::logs::repeated_samples::RUN`] samples or more: a run given twice).
     pub fn of(parts: &[(States<'_>, &[f64])]) -> Result<Self> {
         Self::of_named(parts, &[], "runs")
     }
@@ -83,10 +83,10 @@ impl StackedStates {
             out.data.extend_from_slice(data);
         }
         let prints = (parts.iter())
-            .map(|(s, data)| crate::repeated_samples::SamplePrints::of(nv, &[s.q(), data]))
+            .map(|(s, data)| crate::logs::repeated_samples::SamplePrints::of(nv, &[s.q(), data]))
             .collect::<Result<Vec<_>>>()?;
         let names: Vec<String> = (0..parts.len()).map(name).collect();
-        crate::repeated_samples::refuse_shared_samples(&prints, &names, argument, "samples")?;
+        crate::logs::repeated_samples::refuse_shared_samples(&prints, &names, argument, "samples")?;
         Ok(out)
     }
 

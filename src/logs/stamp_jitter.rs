@@ -17,8 +17,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::log_screening::{joint_called, median};
-use crate::recording::Recording;
+use crate::logs::log_screening::{joint_called, median};
+use crate::logs::recording::Recording;
 
 /// How many times farther from their neighbours' line a joint's positions must lie against
 /// the stamps than against the sample count, on average, for the stamps to be found jittering.

@@ -21,7 +21,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 
 /// The fewest samples reading exactly the extreme that make a run worth judging.
 pub const MIN_RUN: usize = 3;
@@ -97,7 +97,7 @@ pub fn find_torque_saturation(rec: &Recording) -> Vec<TorqueSaturation> {
         return found;
     }
     let mut bounds = vec![0];
-    bounds.extend(crate::preprocess::gap_positions(rec).iter().map(|&i| i + 1));
+    bounds.extend(crate::logs::preprocess::gap_positions(rec).iter().map(|&i| i + 1));
     bounds.push(k);
     for j in 0..n {
         let y: Vec<f64> = (0..k).map(|s| rec.tau[s * n + j]).collect();

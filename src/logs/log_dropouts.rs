@@ -1,17 +1,17 @@
 //! Rows removed from a log before preprocessing: runs of rows in which every joint of one
 //! signal reads exactly 0 while the robot moves (a lost message logged as zeros: a dropout),
 //! and runs in which one joint's reading holds one value too long to be replaced
-//! ([`crate::frozen_readings`]). What was logged there is not known, so the rows go; the
+//! ([`crate::logs::frozen_readings`]). What was logged there is not known, so the rows go; the
 //! preprocessing bridges them as it bridges irregular sampling, and a crossing window's fit
 //! uses the samples left.
 
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::frozen_readings::MIN_FROZEN;
-use crate::log_screening::{column_floor, signals, LISTED, SIGNALS};
-use crate::outliers::NOISE_LEVELS;
-use crate::recording::Recording;
+use crate::logs::frozen_readings::MIN_FROZEN;
+use crate::logs::log_screening::{column_floor, signals, LISTED, SIGNALS};
+use crate::logs::outliers::NOISE_LEVELS;
+use crate::logs::recording::Recording;
 
 /// The fewest rows a dropout has: a single row read as zeros is judged by the glitch screening
 /// like any other sample.
@@ -20,9 +20,9 @@ pub const MIN_DROPOUT: usize = 2;
 /// A run of rows of a log removed before preprocessing: rows in which every joint of one
 /// signal reads exactly 0 while the robot moves (a lost message logged as zeros; `joint` is
 /// None), or a frozen reading, in which one joint's column holds one value for more than
-/// [`MAX_HELD`](crate::log_screening::MAX_HELD) samples while the joint moves and then jumps
+/// [`MAX_HELD`](crate::logs::log_screening::MAX_HELD) samples while the joint moves and then jumps
 /// back to the signal (`joint`, `value` and `noise_levels` say which, what and how far:
-/// [`crate::frozen_readings`]).
+/// [`crate::logs::frozen_readings`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LogDropout {
@@ -183,15 +183,15 @@ pub fn find_dropouts(rec: &Recording) -> Vec<LogDropout> {
 }
 
 /// The rows to remove from a log before preprocessing: the frozen readings of `logged` (the
-/// log as logged: [`crate::frozen_readings::find_frozen_readings`]) and the dropouts of
+/// log as logged: [`crate::logs::frozen_readings::find_frozen_readings`]) and the dropouts of
 /// `screened` (the same log with its glitches or held readings replaced: [`find_dropouts`]),
 /// in log order. A frozen reading within a dropout of its signal (zeros held by every joint)
 /// is told of as the dropout.
 ///
-/// Errors: those of [`crate::frozen_readings::find_frozen_readings`].
+/// Errors: those of [`crate::logs::frozen_readings::find_frozen_readings`].
 pub fn find_removed_rows(logged: &Recording, screened: &Recording) -> Result<Vec<LogDropout>> {
     let dropouts = find_dropouts(screened);
-    let mut rows: Vec<LogDropout> = crate::frozen_readings::find_frozen_readings(logged)?
+    let mut rows: Vec<LogDropout> = crate::logs::frozen_readings::find_frozen_readings(logged)?
         .into_iter()
         .filter(|f| {
             !dropouts.iter().any(|d| {
@@ -283,7 +283,7 @@ pub fn without_dropouts(rec: &Recording, dropouts: &[LogDropout]) -> Result<Reco
 pub const BRIDGED_BY_PREPROCESSING: &str = "before preprocessing, which bridges them as it bridges irregular sampling (a stretch longer than 20 median sample intervals is a gap)";
 
 /// The warning that tells of the `dropouts` removed from the log `recording` (None for none):
-/// rows of zeros, and frozen readings ([`crate::frozen_readings::describe`]); `removed` says
+/// rows of zeros, and frozen readings ([`crate::logs::frozen_readings::describe`]); `removed` says
 /// when and with what consequence (such as [`BRIDGED_BY_PREPROCESSING`]); `joint_names` name
 /// the joints by index (where it has none, `joint 3` names index 2).
 pub fn dropout_warning(
@@ -316,7 +316,7 @@ pub fn dropout_warning(
         ));
     }
     if !frozen.is_empty() {
-        parts.push(crate::frozen_readings::describe(
+        parts.push(crate::logs::frozen_readings::describe(
             &frozen,
             joint_names,
             removed,

@@ -1,7 +1,7 @@
 //! Samples given twice to one fit: the same log twice, a copy of it under another name, or a
 //! part of one log given again as a log of its own.
 //!
-//! A fit over several runs ([`crate::stacked_states`], `identify-direct LOG LOG ...`,
+//! A fit over several runs ([`crate::logs::stacked_states`], `identify-direct LOG LOG ...`,
 //! `identify-gains`) counts every sample's noise as independent of every other's. A run given
 //! twice breaks that: its noise counts twice, the standard errors shrink by `sqrt(2)` for
 //! nothing, and the checks that read them see terms "beyond 3 standard errors" that are not
@@ -183,7 +183,7 @@ pub fn refuse_shared_samples(
     let Some(s) = find_shared_samples(runs) else {
         return Ok(());
     };
-    let name = |r: usize| crate::stacked_states::run_name(names, r);
+    let name = |r: usize| crate::logs::stacked_states::run_name(names, r);
     let span = |at: usize| format!("{} to {}", at + 1, at + s.len);
     let whole = s.len == runs[s.first].len() && s.len == runs[s.second].len();
     let what = if whole {

@@ -2,7 +2,7 @@
 
 use super::{LeftOutPeriod, PeriodOptions, MAX_PROJECTION_WORK, PERIOD_RANGE};
 use crate::error::{shown, shown5, Error, Result};
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 
 /// Where the periods of a log lie and how they are sampled.
 pub(super) struct Layout {
@@ -87,7 +87,7 @@ impl Layout {
         }
         let (t0, t1) = (rec.t[0], rec.t[rec.len() - 1]);
         let start = p.start.unwrap_or(t0);
-        let (dt, gaps) = crate::preprocess::gaps(rec);
+        let (dt, gaps) = crate::logs::preprocess::gaps(rec);
         let from = start + p.skip as f64 * p.period;
         if start < t0 - 0.5 * dt {
             return Err(Error::Recording {

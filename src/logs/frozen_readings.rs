@@ -7,8 +7,8 @@
 //!
 //! What the signal did during a long stall is not known (a held reading of up to
 //! [`MAX_HELD`] samples is bridged by the cubic through the samples either side of it, see
-//! [`crate::log_screening`]; over a longer stall that would be invention), so the rows are
-//! removed, as rows of zeros are ([`crate::log_dropouts`]): the preprocessing bridges them as
+//! [`crate::logs::log_screening`]; over a longer stall that would be invention), so the rows are
+//! removed, as rows of zeros are ([`crate::logs::log_dropouts`]): the preprocessing bridges them as
 //! it bridges irregular sampling, or splits the log at them when they are longer than a gap.
 //!
 //! A run of at least [`MIN_FROZEN`] exactly repeated values of one column (bit for bit) is a
@@ -44,12 +44,12 @@
 //! not a stall, and removing its rows would leave little.
 
 use crate::error::{Error, Result};
-use crate::log_dropouts::LogDropout;
-use crate::log_screening::{
+use crate::logs::log_dropouts::LogDropout;
+use crate::logs::log_screening::{
     column_floor, end_jump, joint_called, median, segments, signals, unit, LISTED, MAX_HELD,
 };
-use crate::outliers::NOISE_LEVELS;
-use crate::recording::Recording;
+use crate::logs::outliers::NOISE_LEVELS;
+use crate::logs::recording::Recording;
 
 /// The fewest repeated samples of a frozen reading: one more than a held reading's most.
 pub const MIN_FROZEN: usize = MAX_HELD + 1;
@@ -229,7 +229,7 @@ fn long_runs(y: &[f64]) -> Vec<std::ops::Range<usize>> {
 }
 
 /// The words of a warning that tell of `frozen` readings (each with a joint), removed
-/// `removed` (such as [`BRIDGED_BY_PREPROCESSING`](crate::log_dropouts::BRIDGED_BY_PREPROCESSING));
+/// `removed` (such as [`BRIDGED_BY_PREPROCESSING`](crate::logs::log_dropouts::BRIDGED_BY_PREPROCESSING));
 /// `joint_names` name the joints by index. Readings of several joints of one signal over the
 /// same rows (a whole message stalled) are listed together.
 pub fn describe(frozen: &[&LogDropout], joint_names: &[String], removed: &str) -> String {

@@ -2,7 +2,7 @@
 //! smooth signal, as a real robot's log gets them from a dropped or corrupted message, an
 //! encoder's missed count or a sensor's spike (docs/method.md, section 7). Used on the local
 //! method's crossing windows ([`crate::local::glitches`]) and on whole logs before
-//! preprocessing ([`crate::log_screening`]).
+//! preprocessing ([`crate::logs::log_screening`]).
 //!
 //! A window's samples are screened against a least-squares fit (a basis and its weights): a
 //! sample whose studentised residual, `r_i / (s sqrt(1 - h_ii))` with `h_ii` its leverage,

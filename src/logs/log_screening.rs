@@ -14,7 +14,7 @@
 //!    of a short burst sit on the line through their own kind).
 //! 2. **Judgement.** Each candidate is judged in the window of [`HALF_WINDOW`] samples either
 //!    side of it (shifted inside the log at its ends; never across a gap), against a cubic in
-//!    time, by [`crate::outliers::screen`]: it is a glitch when its studentised residual is more
+//!    time, by [`crate::logs::outliers::screen`]: it is a glitch when its studentised residual is more
 //!    than [`NOISE_LEVELS`] robust noise levels off the fit of the others, and at most
 //!    [`MAX_PER_WINDOW`] samples of its window are. The level is the window's own, with the
 //!    candidate left out, and at least the column's median level over evenly spread windows,
@@ -31,12 +31,12 @@
 //! of one column while its joint moves is judged as a whole against the cubic through the
 //! samples either side of it (`judge_run`), and replaced as a whole when off by more than
 //! [`NOISE_LEVELS`] (its farthest sample, or its mean against the standard error of that
-//! mean). Rows of zeros for every joint of a signal are left to [`crate::log_dropouts::find_dropouts`], and rows
+//! mean). Rows of zeros for every joint of a signal are left to [`crate::logs::log_dropouts::find_dropouts`], and rows
 //! that repeat the whole row before to the rule for stale rows below.
 //!
 //! What is not found: other bursts of more than [`MAX_PER_WINDOW`] samples (masked: see
 //! docs/limits.md), held runs longer than [`MAX_HELD`] (those that end with a jump are
-//! frozen readings, removed with their rows: [`crate::frozen_readings`]), and a log's repeated rows (a logger that writes its last message again:
+//! frozen readings, removed with their rows: [`crate::logs::frozen_readings`]), and a log's repeated rows (a logger that writes its last message again:
 //! the real Panda log of `../shared` repeats 6 % of its rows; replacing them moved the direct
 //! method's parameters by 0.02 standard errors, so they are left as logged unless a repeated
 //! position is itself far off, then it is a glitch like any other).
@@ -45,8 +45,8 @@ use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{shown, Result};
-use crate::outliers::{screen, Screened, MAX_PER_WINDOW, NOISE_LEVELS};
-use crate::recording::Recording;
+use crate::logs::outliers::{screen, Screened, MAX_PER_WINDOW, NOISE_LEVELS};
+use crate::logs::recording::Recording;
 
 /// Samples each side of a judged sample in its window (the window has `2 HALF_WINDOW + 1`).
 pub const HALF_WINDOW: usize = 10;
@@ -212,7 +212,7 @@ pub(crate) fn signals(rec: &Recording) -> Vec<(&'static str, &Vec<f64>)> {
 /// The stretches `[a, b)` of `rec`'s samples between gaps.
 pub(crate) fn segments(rec: &Recording) -> Vec<(usize, usize)> {
     let mut bounds = vec![0];
-    bounds.extend(crate::preprocess::gap_positions(rec).iter().map(|&i| i + 1));
+    bounds.extend(crate::logs::preprocess::gap_positions(rec).iter().map(|&i| i + 1));
     bounds.push(rec.len());
     bounds.windows(2).map(|w| (w[0], w[1])).collect()
 }
@@ -360,7 +360,7 @@ pub(crate) fn floors(t: &[f64], columns: &[Vec<f64>], candidate: &[Vec<bool>]) -
         let r = window(i);
         if let Some((v, w)) = basis(&t[r.clone()], t[i]) {
             for (c, y) in columns.iter().enumerate() {
-                levels[c].push(crate::outliers::level(&v, &w, &y[r.clone()]));
+                levels[c].push(crate::logs::outliers::level(&v, &w, &y[r.clone()]));
             }
         }
     }
@@ -389,7 +389,7 @@ pub(crate) fn column_floor(t: &[f64], y: &[f64]) -> f64 {
 /// The longest run of exactly repeated readings of one column that is judged as a held
 /// reading: a sensor or logger that wrote its last value again (or zeros) for up to 10 ms at
 /// 1 kHz. Longer runs are not bridged: those that end with a jump are frozen readings, removed
-/// with their rows ([`crate::frozen_readings`]).
+/// with their rows ([`crate::logs::frozen_readings`]).
 pub const MAX_HELD: usize = HALF_WINDOW;
 
 /// Fewest samples of the others on each side of a held run for its judgement: the cubic
@@ -468,7 +468,7 @@ fn judge_run(t: &[f64], y: &[f64], run: std::ops::Range<usize>, floor: f64) -> V
     if !s.isolated {
         return vec![];
     }
-    let level = crate::outliers::level(&v, &w, &s.values).max(floor);
+    let level = crate::logs::outliers::level(&v, &w, &s.values).max(floor);
     let coef = &w * DVector::from_column_slice(&s.values);
     let half = times.iter().fold(0.0f64, |m, x| m.max((x - tc).abs()));
     // (V^T V)^-1 = W W^T: the fit's variance at new times, in units of the noise's
@@ -546,7 +546,7 @@ pub(crate) fn end_jump(t: &[f64], y: &[f64], last: usize, level: f64) -> Option<
     // coefficient, and its variance (in units of the noise's) that coefficient's
     let back: f64 = (0..after.len()).map(|m| wa[(0, m)] * y_after[m]).sum();
     let variance: f64 = (0..after.len()).map(|m| wa[(0, m)].powi(2)).sum();
-    let level_after = crate::outliers::level(&va, &wa, &y_after).max(level);
+    let level_after = crate::logs::outliers::level(&va, &wa, &y_after).max(level);
     let jump = (y[last] - back).abs() / (level_after * (1.0 + variance).sqrt());
     Some(if jump.is_nan() { f64::INFINITY } else { jump })
 }

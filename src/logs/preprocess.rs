@@ -3,7 +3,7 @@
 //! trimming and decimation.
 
 use crate::error::{Error, Result};
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 use crate::signal::{butterworth_lowpass, differentiate, filtfilt, interpolate};
 
 /// Options of [`preprocess`]. The defaults follow the common protocol (and the reference
@@ -35,16 +35,16 @@ pub struct PreprocessOptions {
     /// Find the log's glitches (single samples far off the curve their neighbours follow)
     /// and replace them by the fit of their neighbours, and remove its dropouts (rows in which
     /// every joint of a signal reads exactly 0 while the robot moves), before anything else
-    /// (default true; [`crate::log_screening`]). They are listed in the result's
+    /// (default true; [`crate::logs::log_screening`]). They are listed in the result's
     /// [`Recording::glitches`] and [`Recording::dropouts`].
     pub screen_glitches: bool,
     /// Average the log over the periods of its excitation in place of the low-pass filter
-    /// and numerical derivatives (Swevers et al. 2007; [`crate::period_average`]): after the
+    /// and numerical derivatives (Swevers et al. 2007; [`crate::logs::period_average`]): after the
     /// screening, the result is one period, `q`, `qd`, `qdd` from the positions' first
     /// harmonics and `tau` from the torques' up to `cutoff`, sampled at `rate` and decimated;
     /// `trim`, `order` and `split_at_gaps` do not apply (a period holding a gap is left out),
     /// and `filter_position` is refused. None (the default): the filter.
-    pub periods: Option<crate::period_average::PeriodOptions>,
+    pub periods: Option<crate::logs::period_average::PeriodOptions>,
 }
 
 impl Default for PreprocessOptions {
@@ -64,13 +64,13 @@ impl Default for PreprocessOptions {
 }
 
 /// Preprocesses a recording: takes steps of whole turns out of its positions
-/// ([`crate::position_wraps`], listed in the result's [`Recording::position_wraps`]), reads
+/// ([`crate::logs::position_wraps`], listed in the result's [`Recording::position_wraps`]), reads
 /// columns logged at a lower rate and held on its grid again at their values' arrivals
-/// ([`crate::held_columns`], [`Recording::held_columns`]),
+/// ([`crate::logs::held_columns`], [`Recording::held_columns`]),
 /// replaces its glitches and removes its dropouts (when
 /// `options.screen_glitches`: single samples far off the curve their neighbours follow, and
 /// rows in which every joint of a signal reads exactly 0 while the robot moves, see
-/// [`crate::log_screening`]; listed in the result's [`Recording::glitches`] and
+/// [`crate::logs::log_screening`]; listed in the result's [`Recording::glitches`] and
 /// [`Recording::dropouts`]), resamples `q`, `tau` (and `qd` when logged; otherwise qd is the
 /// derivative of q) onto a uniform grid at `rate`, filters qd and tau (and q if asked) with a
 /// zero-phase Butterworth low-pass, differentiates the filtered qd into qdd, trims and
@@ -79,9 +79,9 @@ impl Default for PreprocessOptions {
 /// again as tau is, the Coulomb friction term's column for a fit of the filtered torques.
 /// Where a joint's logged positions lie on a grid (encoder counts) and its velocity is derived
 /// from them, the noise their rounding leaves in qd and qdd is estimated and kept in
-/// [`Recording::position_rounding`] ([`crate::position_rounding`]). Stamps that jitter while
+/// [`Recording::position_rounding`] ([`crate::logs::position_rounding`]). Stamps that jitter while
 /// the samples were taken on a regular clock are found and kept in
-/// [`Recording::stamp_jitter`] ([`crate::stamp_jitter`]); the log is not changed.
+/// [`Recording::stamp_jitter`] ([`crate::logs::stamp_jitter`]); the log is not changed.
 ///
 /// A gap in `t` longer than [`MAX_GAP_INTERVALS`] median sample intervals is an error naming
 /// its time, unless `options.split_at_gaps`: then each part between gaps is preprocessed on its
@@ -94,18 +94,18 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     // the grid, and would hide it (and whole turns taken out are no multiple of its step)
     let steps = crate::local::rounded_positions::position_steps(rec);
     // steps of whole turns taken back out before anything reads the positions' motion
-    let (unwrapped, position_wraps) = crate::position_wraps::unwrap_positions(rec);
+    let (unwrapped, position_wraps) = crate::logs::position_wraps::unwrap_positions(rec);
     // columns held at a lower rate read again at their values' arrivals, before anything
     // reads their motion (their holds would otherwise end as frozen readings here and there)
-    let (reread, held_columns) = crate::held_columns::find_held_columns(&unwrapped)?;
+    let (reread, held_columns) = crate::logs::held_columns::find_held_columns(&unwrapped)?;
     // each step's copy of the log is let go as soon as the next holds it (a long log's
     // copies are what a preprocessing holds most of)
     drop(unwrapped);
     let rec = &reread;
     // clipped torques, as logged: screening could replace a short clipped run
-    let torque_saturation = crate::torque_saturation::find_torque_saturation(rec);
+    let torque_saturation = crate::logs::torque_saturation::find_torque_saturation(rec);
     // the stamps against the positions, as logged: resampling reads them as the samples' times
-    let stamp_jitter = crate::stamp_jitter::find_stamp_jitter(rec);
+    let stamp_jitter = crate::logs::stamp_jitter::find_stamp_jitter(rec);
     if options.periods.is_some() && options.filter_position {
         return Err(Error::InvalidArgument {
             argument: "filter_position".into(),
@@ -124,20 +124,20 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     if !options.split_at_gaps && options.periods.is_none() {
         check_gaps(rec)?;
     }
-    let (screened, glitches) = crate::log_screening::screen_recording(rec)?;
-    let dropouts = crate::log_dropouts::find_removed_rows(rec, &screened)?;
+    let (screened, glitches) = crate::logs::log_screening::screen_recording(rec)?;
+    let dropouts = crate::logs::log_dropouts::find_removed_rows(rec, &screened)?;
     // a glitch in rows removed is not told of: its row is gone
-    let kept_rows = crate::log_dropouts::kept_rows(rec.len(), &dropouts);
+    let kept_rows = crate::logs::log_dropouts::kept_rows(rec.len(), &dropouts);
     drop(reread);
     let glitches: Vec<_> = glitches
         .into_iter()
         .filter(|g| kept_rows.binary_search(&g.sample).is_ok())
         .collect();
     drop(kept_rows);
-    let kept = crate::log_dropouts::without_dropouts(&screened, &dropouts)?;
+    let kept = crate::logs::log_dropouts::without_dropouts(&screened, &dropouts)?;
     drop(screened);
     let out = preprocess_screened(&kept, options, &steps)
-        .map_err(|e| crate::log_dropouts::after_removing(e, &dropouts))?;
+        .map_err(|e| crate::logs::log_dropouts::after_removing(e, &dropouts))?;
     Ok(Recording {
         glitches,
         dropouts,
@@ -150,7 +150,7 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
 }
 
 /// [`preprocess`] of a recording whose glitches were screened (or are not to be).
-/// `steps`: per joint, the grid its logged positions lie on (for [`crate::position_rounding`]).
+/// `steps`: per joint, the grid its logged positions lie on (for [`crate::logs::position_rounding`]).
 fn preprocess_screened(
     rec: &Recording,
     options: &PreprocessOptions,
@@ -158,7 +158,7 @@ fn preprocess_screened(
 ) -> Result<Recording> {
     if let Some(p) = &options.periods {
         check_sample_interval(rec)?;
-        return crate::period_average::average_periods(
+        return crate::logs::period_average::average_periods(
             rec,
             options.rate,
             options.cutoff,
@@ -212,7 +212,7 @@ fn preprocess_screened(
     )
     .map(|out| Recording {
         experiment: rec.experiment.clone(),
-        position_rounding: crate::position_rounding::worst_of(
+        position_rounding: crate::logs::position_rounding::worst_of(
             done.iter()
                 .flat_map(|r| r.position_rounding.iter().cloned()),
         ),
@@ -354,11 +354,11 @@ fn preprocess_part(
             .iter()
             .map(|v| v[skip..count - skip].to_vec())
             .collect();
-        crate::derivative_columns::check_velocity_columns(&rec.name, &logged, &derived)?;
+        crate::logs::derivative_columns::check_velocity_columns(&rec.name, &logged, &derived)?;
     }
     let keep: Vec<usize> = (skip..count - skip).step_by(o.decimate).collect();
     // positions in coarse counts under velocities derived from them: the noise of their
-    // rounding, through the same chain (crate::position_rounding)
+    // rounding, through the same chain (crate::logs::position_rounding)
     let at_keep = |c: &[f64]| -> Vec<f64> { keep.iter().map(|&i| c[i]).collect() };
     let mut rounding = Vec::new();
     if rec.qd.is_none() {
@@ -378,7 +378,7 @@ fn preprocess_part(
                 (Some(_), true) => Some(q_grid.clone()),
                 (Some(_), false) => smooth(q_grid.clone()).ok(),
             };
-            rounding.extend(crate::position_rounding::measure(
+            rounding.extend(crate::logs::position_rounding::measure(
                 j,
                 step,
                 smoothed.as_deref(),

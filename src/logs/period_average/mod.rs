@@ -1,5 +1,5 @@
 //! Averaging a log over the periods of a periodic excitation (Swevers et al. 2007), in place
-//! of the low-pass filter and numerical derivatives of [`crate::preprocess`].
+//! of the low-pass filter and numerical derivatives of [`crate::logs::preprocess`].
 //!
 //! A Fourier excitation repeats every period `T`, and so does everything the robot does while
 //! it runs one; only the noise differs from period to period. Each whole period of the log is
@@ -37,7 +37,7 @@ pub use drift::{DRIFT_RATIO, MIN_COEFFICIENTS};
 pub use finding::{LeftOutPeriod, PeriodAverage};
 
 use crate::error::{shown5, Error, Result};
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 use layout::{too_few, Layout};
 use series::{energy, median_coefficients, median_of, weighted_energy, weighted_power, Table};
 
@@ -51,7 +51,7 @@ pub struct PeriodOptions {
     /// [`crate::limits::MAX_HARMONICS`]): the positions are projected onto harmonics 0 to `L`.
     pub harmonics: usize,
     /// The log's time (s) at which a period starts (the excitation's `t = 0`, modulo the
-    /// period); None: the log's first sample. [`crate::excitation_start`] finds it from the
+    /// period); None: the log's first sample. [`crate::logs::excitation_start`] finds it from the
     /// excitation.
     pub start: Option<f64>,
     /// Whole periods left out after `start` (a lead-in, the first period's transient).
@@ -97,7 +97,7 @@ pub const OUTLIER_RATIO: f64 = 3.0;
 /// (RMS) do not repeat with the period.
 pub const MAX_POSITION_SPREAD: f64 = 0.1;
 
-/// The averaged period of `rec` (screened as [`crate::preprocess::preprocess`] screens, at
+/// The averaged period of `rec` (screened as [`crate::logs::preprocess::preprocess`] screens, at
 /// least two whole periods long): `M = round(period rate)` samples from the first period's
 /// start, every `decimate`-th kept (`rate`, `cutoff` and `decimate` from `options`; `cutoff`
 /// None keeps every harmonic the grid holds), `q`, `qd`, `qdd` from the positions' first

@@ -1,6 +1,6 @@
 //! Where in a log the robot runs its Fourier excitation: the time of a period's start, and the
 //! run of whole periods it follows the excitation through, for averaging over them
-//! ([`crate::period_average`]).
+//! ([`crate::logs::period_average`]).
 //!
 //! A log of an excitation rarely starts at the excitation's `t = 0`: the logger runs before
 //! the motion starts and after it ends, at rest. The excitation repeats every period `T`, so
@@ -11,7 +11,7 @@
 //! joint's mean distance taken off (a zero offset), is below a fifth of the excitation's motion.
 
 use crate::error::{shown5, Error, Result};
-use crate::recording::Recording;
+use crate::logs::recording::Recording;
 use crate::trajectory::FourierTrajectory;
 
 /// Where a log runs its excitation.
@@ -87,7 +87,7 @@ pub fn excitation_start(rec: &Recording, traj: &FourierTrajectory) -> Result<Exc
     };
     // the median sample interval: a period is whole where its last sample before the next
     // period's first lies in the log
-    let dt = crate::preprocess::gaps(rec).0;
+    let dt = crate::logs::preprocess::gaps(rec).0;
     let stride = rec.len().div_ceil(SEARCH_SAMPLES).max(1);
     let samples: Vec<usize> = (0..rec.len()).step_by(stride).collect();
     let mut best = (f64::INFINITY, 0.0);
@@ -234,7 +234,7 @@ pub fn excitation_start(rec: &Recording, traj: &FourierTrajectory) -> Result<Exc
     })
 }
 
-/// The periods of `rec` to average for the excitation `traj` ([`crate::period_average`]): its
+/// The periods of `rec` to average for the excitation `traj` ([`crate::logs::period_average`]): its
 /// period and harmonics, from the start [`excitation_start`] finds, over the whole periods
 /// that follow it, `skip` of them left out first.
 ///
@@ -243,12 +243,12 @@ pub fn excitation_periods(
     rec: &Recording,
     traj: &FourierTrajectory,
     skip: usize,
-) -> Result<crate::period_average::PeriodOptions> {
+) -> Result<crate::logs::period_average::PeriodOptions> {
     let found = excitation_start(rec, traj)?;
-    Ok(crate::period_average::PeriodOptions {
+    Ok(crate::logs::period_average::PeriodOptions {
         start: Some(found.start),
         count: Some(found.periods),
         skip,
-        ..crate::period_average::PeriodOptions::new(traj.period(), traj.harmonics())
+        ..crate::logs::period_average::PeriodOptions::new(traj.period(), traj.harmonics())
     })
 }
