@@ -17,6 +17,8 @@ use crate::error::{Error, Location, Result};
 use crate::gravity::Gravity;
 use crate::spatial::{skew, Inertia, Motion, OriginInertia, Se3, SplitInertia};
 
+pub mod payload;
+pub mod source;
 mod turned_frame;
 pub(crate) use turned_frame::TurnedFrame;
 
@@ -281,7 +283,7 @@ pub struct Model {
     pub(crate) joint_lines: Vec<Option<u32>>,
     /// The URDF text the model was built from, with the options it was built with: what
     /// [`crate::urdf::write_urdf`] writes the model's parameters into.
-    pub(crate) urdf: std::sync::Arc<crate::urdf::UrdfSource>,
+    pub(crate) urdf: std::sync::Arc<source::UrdfSource>,
 }
 
 impl Model {
@@ -487,7 +489,7 @@ pub(crate) fn check_finite_vector(argument: &str, x: &[f64], n: usize) -> Result
             got: format!("{} values", x.len()),
         });
     }
-    match crate::states::first_non_finite(x) {
+    match crate::finite::first_non_finite(x) {
         Some(index) => Err(Error::NonFiniteInput {
             argument: argument.to_string(),
             index,

@@ -302,3 +302,29 @@ fn describe_direction(d: &[f64], columns: &[String]) -> String {
     }
     out
 }
+
+/// The standard error of a variance summed from known terms: rounding below 0 is 0, and a
+/// sum that overflowed (inf, or NaN from inf - inf) is inf, for the caller to refuse.
+pub(crate) fn root(var: f64) -> f64 {
+    if var.is_finite() {
+        var.max(0.0).sqrt()
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// `stderr` (row-major `k x n`) returned, or refused naming the first joint and sample whose
+/// standard error overflowed (inf: [`root`]) for `operation`.
+pub(crate) fn refuse_overflow(stderr: Vec<f64>, n: usize, operation: &str) -> Result<Vec<f64>> {
+    match stderr.iter().position(|v| v.is_infinite()) {
+        Some(i) => Err(Error::Numerical {
+            operation: operation.into(),
+            message: format!(
+                "the standard error of joint {} at sample {} overflows: the state is too large to compute with",
+                i % n + 1,
+                i / n
+            ),
+        }),
+        None => Ok(stderr),
+    }
+}

@@ -13,8 +13,8 @@ use crate::algorithms::parallel::{self, Workspace};
 use crate::data::Data;
 use crate::error::Result;
 use crate::gravity::Gravity;
-use crate::local::OperatingPoint;
 use crate::model::Model;
+use crate::operating_point::OperatingPoint;
 use crate::states::States;
 use crate::torque_model::{Expansion, TorqueModel};
 
@@ -96,9 +96,7 @@ impl TorqueModel for RobotTorques<'_> {
         )?;
         let torque = DVector::from_fn(n, |j, _| {
             let l = &robot.limits[j];
-            data.tau[j]
-                + l.damping * op.qd[j]
-                + l.friction * crate::direct::parameters::sign0(op.qd[j])
+            data.tau[j] + l.damping * op.qd[j] + l.friction * crate::parameters::sign0(op.qd[j])
         });
         let (d, g) = (data.m.clone(), data.dtau_dq.clone());
         let h = &data.dtau_dv

@@ -8,8 +8,8 @@ use rand_distr::{Distribution, Normal};
 use crate::algorithms::parallel;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
-use crate::model::Model;
 use crate::logs::recording::Recording;
+use crate::model::Model;
 use crate::states::States;
 use crate::trajectory::{FourierTrajectory, Samples};
 
@@ -71,7 +71,7 @@ impl Friction {
 
     /// Friction torque of joint `j` at speed `qd`; see the type's documentation.
     pub fn torque(&self, j: usize, qd: f64) -> f64 {
-        self.torque_moving(j, qd, crate::direct::parameters::sign0(qd))
+        self.torque_moving(j, qd, crate::parameters::sign0(qd))
     }
 
     /// Friction torque of joint `j` at speed `qd` moving in `direction` (the sign of `qd`, or
@@ -208,7 +208,7 @@ pub const ROUNDING_SPEED: f64 = 1e-12;
 /// shows (and that the log screening rightly takes for a glitch). 0 at rest (a neighbour at
 /// zero speed too) and at a reversal (neighbours moving opposite ways).
 pub fn directions_of_motion(qd: &[f64], n: usize) -> Vec<f64> {
-    use crate::direct::parameters::sign0;
+    use crate::parameters::sign0;
     let k = qd.len().checked_div(n).unwrap_or(0);
     let mut own = vec![0.0; k * n];
     for j in 0..n {

@@ -1,15 +1,12 @@
 //! One interface for every identified model: [`TorqueModel::predict`] gives the joint torques
 //! at a batch of states, whether the model is local (the paper's method), base-parameter or
-//! globally linearised (the direct method). [`ModelFile`] loads any of them from JSON, picking
-//! the model by its format tag.
+//! globally linearised (the direct method); each model implements it beside its own type, and
+//! [`crate::model_file::ModelFile`] loads any of them from JSON.
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::direct::{BaseModel, GlobalLinearModel};
-use crate::document::Document;
 use crate::error::{Error, Result};
-use crate::local::{LocalModel, OperatingPoint};
-use crate::model::Model;
+use crate::operating_point::OperatingPoint;
 use crate::states::States;
 
 /// A model of the joint torques of a robot.
@@ -42,7 +39,7 @@ pub struct Expansion {
 }
 
 /// The torque of a linear model at `op`.
-fn torque_at(model: &dyn TorqueModel, op: &OperatingPoint) -> Result<DVector<f64>> {
+pub(crate) fn torque_at(model: &dyn TorqueModel, op: &OperatingPoint) -> Result<DVector<f64>> {
     let states = States::new(op.n(), &op.q, Some(&op.qd), Some(&op.qdd))?;
     Ok(DVector::from_vec(model.predict(&states)?))
 }
@@ -141,7 +138,7 @@ pub(crate) fn predict_linear(
 /// (read from a file) or a state so large that the arithmetic overflowed. No inf or NaN is
 /// handed back.
 pub(crate) fn check_prediction(tau: &[f64], nv: usize) -> Result<()> {
-    match crate::states::first_non_finite(tau) {
+    match crate::finite::first_non_finite(tau) {
         Some(i) => Err(Error::Numerical {
             operation: "prediction".into(),
             message: format!(
@@ -152,128 +149,5 @@ pub(crate) fn check_prediction(tau: &[f64], nv: usize) -> Result<()> {
             ),
         }),
         None => Ok(()),
-    }
-}
-
-/// A base-parameter model together with the robot whose regressor it needs
-/// ([`BaseModel::on`]).
-#[derive(Clone, Copy, Debug)]
-pub struct BaseModelOn<'a> {
-    pub fit: &'a BaseModel,
-    pub robot: &'a Model,
-}
-
-impl TorqueModel for BaseModelOn<'_> {
-    fn joint_names(&self) -> &[String] {
-        &self.fit.joint_names
-    }
-
-    fn predict(&self, states: &States<'_>) -> Result<Vec<f64>> {
-        self.fit.predict(self.robot, states)
-    }
-
-    fn linearize(&self, op: &OperatingPoint) -> Result<Expansion> {
-        let l = self.fit.linearize(self.robot, &op.q, &op.qd, &op.qdd)?;
-        Ok(Expansion {
-            torque: l.torque,
-            d: l.d,
-            h: l.h,
-            g: l.g,
-            g_static: Some(l.g_static),
-        })
-    }
-}
-
-impl TorqueModel for LocalModel {
-    fn joint_names(&self) -> &[String] {
-        &self.joint_names
-    }
-
-    fn predict(&self, states: &States<'_>) -> Result<Vec<f64>> {
-        LocalModel::predict(self, states)
-    }
-
-    fn linearize(&self, op: &OperatingPoint) -> Result<Expansion> {
-        let torque = torque_at(self, op)?;
-        let part = |e: &Option<crate::local::Estimate>| e.as_ref().map(|e| e.matrix.clone());
-        Ok(Expansion {
-            torque,
-            d: part(&self.d).expect("predict needs D"),
-            h: part(&self.h).expect("predict needs H"),
-            g: part(&self.g).expect("predict needs G"),
-            g_static: part(&self.g_static),
-        })
-    }
-}
-
-impl TorqueModel for GlobalLinearModel {
-    fn joint_names(&self) -> &[String] {
-        &self.joint_names
-    }
-
-    fn predict(&self, states: &States<'_>) -> Result<Vec<f64>> {
-        GlobalLinearModel::predict(self, states)
-    }
-
-    fn linearize(&self, op: &OperatingPoint) -> Result<Expansion> {
-        Ok(Expansion {
-            torque: torque_at(self, op)?,
-            d: self.d.clone(),
-            h: self.h.clone(),
-            g: self.g.clone(),
-            g_static: None,
-        })
-    }
-}
-
-/// Any model file of this library, told apart by its `format` tag.
-#[derive(Clone, Debug, PartialEq)]
-pub enum ModelFile {
-    Local(Box<LocalModel>),
-    Base(Box<BaseModel>),
-    GlobalLinear(Box<GlobalLinearModel>),
-}
-
-impl ModelFile {
-    /// Parses a model document: the `format` tag picks the kind, then the kind's own checks
-    /// run. `source` names the text in errors (a path).
-    pub fn from_json(text: &str, source: &str) -> Result<Self> {
-        let tag = crate::document::format_tag(text, source)?;
-        let kind = tag.split('/').next().unwrap_or_default();
-        Ok(if kind == LocalModel::FORMAT {
-            ModelFile::Local(Box::new(LocalModel::from_json_in(text, source)?))
-        } else if kind == BaseModel::FORMAT {
-            ModelFile::Base(Box::new(BaseModel::from_json_in(text, source)?))
-        } else if kind == GlobalLinearModel::FORMAT {
-            ModelFile::GlobalLinear(Box::new(GlobalLinearModel::from_json_in(text, source)?))
-        } else {
-            return Err(Error::Json {
-                context: source.into(),
-                message: format!(
-                    "format '{tag}' is not a model; expected {}, {} or {}",
-                    LocalModel::FORMAT,
-                    BaseModel::FORMAT,
-                    GlobalLinearModel::FORMAT
-                ),
-            });
-        })
-    }
-
-    /// Reads and parses a model file.
-    pub fn load(path: impl AsRef<std::path::Path>) -> Result<Self> {
-        let path = path.as_ref();
-        Self::from_json(
-            &crate::io::read_document(path)?,
-            &path.display().to_string(),
-        )
-    }
-
-    /// The names of the joints the model is for.
-    pub fn joint_names(&self) -> &[String] {
-        match self {
-            ModelFile::Local(m) => &m.joint_names,
-            ModelFile::Base(m) => &m.joint_names,
-            ModelFile::GlobalLinear(m) => &m.joint_names,
-        }
     }
 }

@@ -1,7 +1,8 @@
 //! The `perturbid` command line end to end on small cases, and its errors on bad input.
 
-use perturbid_rs::io::{recording_table, Table};
+use perturbid_rs::io::Table;
 use perturbid_rs::local::LocalModel;
+use perturbid_rs::logs::recording_table;
 use perturbid_rs::robots::a465;
 use perturbid_rs::simulation::{simulate_samples, SimulationOptions};
 use perturbid_rs::trajectory::FourierTrajectory;

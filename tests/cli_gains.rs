@@ -7,7 +7,7 @@ mod cli_support;
 use cli_support::{fails, nothing_written, ok, s, tmp, warnings_of, write};
 use nalgebra::DMatrix;
 use perturbid_rs::direct::BaseModel;
-use perturbid_rs::io::recording_table;
+use perturbid_rs::logs::recording_table;
 use perturbid_rs::rehearsal::{Payload, TrueRobot};
 use perturbid_rs::trajectory::FourierTrajectory;
 use perturbid_rs::{parallel, Document, Gravity, Recording, States};
@@ -361,7 +361,7 @@ fn a_local_model_in_torques_from_recordings_of_currents() {
     let joints: Vec<String> = (1..=6).map(|j| format!("joint{j}")).collect();
     for name in ["nominal", "D"] {
         let file = format!("{name}.csv");
-        let rec = perturbid_rs::io::load_recording(&d.join("rec").join(&file), &joints).unwrap();
+        let rec = perturbid_rs::logs::load_recording(&d.join("rec").join(&file), &joints).unwrap();
         let current: Vec<f64> = (rec.tau.iter().enumerate())
             .map(|(i, t)| t / GAINS[i % 6])
             .collect();

@@ -9,7 +9,7 @@ mod cli_support;
 use cli_support::{excitation_log, fails, ok, s, tmp, warnings_of};
 use perturbid_rs::direct::{identify_base_parameters, BaseModel, BaseOptions};
 use perturbid_rs::document::Document;
-use perturbid_rs::io::load_recording;
+use perturbid_rs::logs::load_recording;
 use perturbid_rs::logs::preprocess::{preprocess, PreprocessOptions};
 use perturbid_rs::logs::stacked_states::StackedStates;
 use std::path::Path;

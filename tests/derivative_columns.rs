@@ -283,7 +283,7 @@ fn the_command_line_refuses_a_log_whose_accelerations_are_not_the_velocities_der
     let log = a465_log();
     let rec = logged(&log, |_, qdd| column(qdd, 1, |v| v.to_degrees()));
     let path = dir.join("degrees.csv");
-    perturbid_rs::io::save_recording(&rec, &path).unwrap();
+    perturbid_rs::logs::save_recording(&rec, &path).unwrap();
     let run = |extra: &[&str]| {
         let out = std::process::Command::new(env!("CARGO_BIN_EXE_perturbid"))
             .args(["identify-direct", "a465", path.to_str().unwrap(), "--out"])

@@ -596,7 +596,7 @@ fn text_not_in_utf8_is_named_and_a_byte_order_mark_is_ignored() {
     for (name, bytes, expected) in cases {
         let path = d.join(name);
         std::fs::write(&path, bytes).unwrap();
-        let e = perturbid_rs::io::load_recording(&path, &joints)
+        let e = perturbid_rs::logs::load_recording(&path, &joints)
             .unwrap_err()
             .to_string();
         assert!(e.contains(name) && e.contains(expected), "{e}");

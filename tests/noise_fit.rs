@@ -283,7 +283,9 @@ fn averaged_fits(a: f64) -> Vec<BaseModel> {
                 (avg.samples, avg.kept_samples, avg.torque_harmonics),
                 (2000, 2000, 100)
             );
-            let noise = avg.torque_noise(&model.joint_names).unwrap();
+            let noise =
+                perturbid_rs::direct::TorqueNoise::from_period_average(avg, &model.joint_names)
+                    .unwrap();
             assert!((noise.correlation - 2000.0 / 201.0).abs() < 1e-12);
             assert_eq!(noise.degrees_of_freedom, Some(3.0 * 201.0 * 6.0));
             // white: the levels measured are the noise put in, the band's share of it, over

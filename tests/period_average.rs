@@ -223,7 +223,8 @@ fn a_lead_in_is_found_and_a_disturbed_period_left_out() {
         "{}",
         a.left_out[0].reason
     );
-    let w = perturbid_rs::logs::period_average::warning(&out.period_average, "log.csv", &[]).unwrap();
+    let w =
+        perturbid_rs::logs::period_average::warning(&out.period_average, "log.csv", &[]).unwrap();
     assert!(
         w.contains("1 of its periods left out") && w.contains("period 3"),
         "{w}"
@@ -460,7 +461,8 @@ fn torques_that_drift_over_the_periods_are_said() {
         (0..6).filter(|&j| j != 2).all(|j| drift[j] < 2.0),
         "{drift:?}"
     );
-    let w = perturbid_rs::logs::period_average::warning(&out.period_average, "log.csv", &[]).unwrap();
+    let w =
+        perturbid_rs::logs::period_average::warning(&out.period_average, "log.csv", &[]).unwrap();
     assert!(
         w.contains("its torques drift from period to period (joint 3 (F = "),
         "{w}"

@@ -72,7 +72,8 @@ fn stamps_that_jitter_over_a_regular_clock_are_found() {
             "{w}"
         );
         // kept by preprocess
-        let p = perturbid_rs::logs::preprocess::preprocess(&rec, &PreprocessOptions::default()).unwrap();
+        let p = perturbid_rs::logs::preprocess::preprocess(&rec, &PreprocessOptions::default())
+            .unwrap();
         assert_eq!(p.stamp_jitter, Some(found));
     }
 }

@@ -13,11 +13,11 @@ use nalgebra::DMatrix;
 
 use crate::algorithms::regressor::inertia_from_parameters;
 use crate::data::Data;
-use crate::direct::ParameterLayout;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::linearization::{linearize, Linearization};
 use crate::model::Model;
+use crate::parameters::ParameterLayout;
 
 /// `Y_X` for every part of the linearisation at one point: `torque` is `nv x p`; `d`, `h`, `g`,
 /// `g_static` are `nv^2 x p` with row `i * nv + j` for the entry `(i, j)` (row = torque,
@@ -120,7 +120,7 @@ pub fn linearization_regressor(
                     out.torque[(j, col)] = v;
                     out.h[(j * nv + j, col)] = 1.0;
                 }
-                "coulomb" => out.torque[(j, col)] = crate::direct::parameters::sign0(v),
+                "coulomb" => out.torque[(j, col)] = crate::parameters::sign0(v),
                 "armature" => {
                     out.torque[(j, col)] = qdd[j];
                     out.d[(j * nv + j, col)] = 1.0;

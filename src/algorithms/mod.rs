@@ -70,7 +70,7 @@ pub(crate) fn contract_matrix(model: &Model, body: &DMatrix<f64>, out: &mut DMat
 /// overflowed. No inf or NaN is handed back.
 #[inline]
 pub(crate) fn check_result(algorithm: &str, name: &str, values: &[f64]) -> Result<()> {
-    match crate::states::first_non_finite(values) {
+    match crate::finite::first_non_finite(values) {
         Some(i) => Err(overflow(algorithm, name, values[i], i)),
         None => Ok(()),
     }

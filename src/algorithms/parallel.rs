@@ -188,7 +188,7 @@ where
         // a lane kernel that checked its values in registers as it wrote them vouches for them
         let vouched = ws.lanes.wrote_finite();
         for (out, (name, per)) in parts.iter().zip(layout).filter(|_| !vouched) {
-            if let Some(i) = crate::states::first_non_finite_here(out) {
+            if let Some(i) = crate::finite::first_non_finite_here(out) {
                 let per = (*per).max(1);
                 return Err(samples.at(i / per, super::overflow(algorithm, name, out[i], i % per)));
             }

@@ -1,7 +1,7 @@
 //! The joint-torque regressor `tau = Phi(q, qd, qdd) theta`: inverse dynamics linear in the
 //! inertial parameters (Pinocchio's `computeJointTorqueRegressor`, same parameter order).
 
-use nalgebra::{DMatrix, DVector, Vector3};
+use nalgebra::{DMatrix, Vector3};
 
 use super::kinematics::motion_pass;
 use super::load_state;
@@ -9,61 +9,11 @@ use crate::data::Data;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
-use crate::spatial::{Force, Inertia, Motion, Se3};
+use crate::spatial::{Force, Motion, Se3};
 
-/// Number of inertial parameters per body.
-pub const PARAMS_PER_BODY: usize = 10;
-
-/// Names of the 10 parameters of a body, in order: `m, mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz,
-/// Izz`.
-pub const PARAMETER_NAMES: [&str; 10] = [
-    "m", "mcx", "mcy", "mcz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz",
-];
-
-/// The 10 inertial parameters of a body in Pinocchio's order `[m, m cx, m cy, m cz, Ixx, Ixy,
-/// Iyy, Ixz, Iyz, Izz]` (kg, kg m, kg m^2), the inertia about the body (joint) frame's origin.
-pub fn dynamic_parameters(inertia: &Inertia) -> [f64; 10] {
-    let h = inertia.com * inertia.mass;
-    let i = inertia.inertia_origin();
-    [
-        inertia.mass,
-        h.x,
-        h.y,
-        h.z,
-        i[(0, 0)],
-        i[(0, 1)],
-        i[(1, 1)],
-        i[(0, 2)],
-        i[(1, 2)],
-        i[(2, 2)],
-    ]
-}
-
-/// The inertia with the 10 parameters `p` (the inverse of [`dynamic_parameters`]); `None` when
-/// the mass is not positive (the centre of mass `h / m` is then undefined). The rotational
-/// inertia need not be one a rigid body can have: the algorithms are linear in it.
-pub fn inertia_from_parameters(p: &[f64; 10]) -> Option<Inertia> {
-    let m = p[0];
-    if !(m > 0.0 && m.is_finite()) {
-        return None;
-    }
-    let com = nalgebra::Vector3::new(p[1], p[2], p[3]) / m;
-    let origin = nalgebra::Matrix3::new(p[4], p[5], p[7], p[5], p[6], p[8], p[7], p[8], p[9]);
-    let shift = (nalgebra::Matrix3::identity() * com.norm_squared() - com * com.transpose()) * m;
-    Some(Inertia::new(m, com, origin - shift))
-}
-
-/// The inertial parameters of every moving body, stacked (`10 * nbodies`), so that
-/// `Phi theta = rnea` for the model's own inertias.
-pub fn model_parameters(model: &Model) -> DVector<f64> {
-    DVector::from_iterator(
-        PARAMS_PER_BODY * model.nbodies(),
-        model
-            .bodies
-            .iter()
-            .flat_map(|b| dynamic_parameters(&b.inertia)),
-    )
-}
+pub use crate::parameters::{
+    dynamic_parameters, inertia_from_parameters, model_parameters, PARAMETER_NAMES, PARAMS_PER_BODY,
+};
 
 /// The wrench (in the body frame) per unit of each of the 10 parameters of a body with twist
 /// `v` and spatial acceleration `a` (gravity included): `f = Y(v, a) theta_body`.

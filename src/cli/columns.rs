@@ -24,7 +24,7 @@ pub(crate) fn run(a: ColumnsArgs) -> Result<String> {
     let joints = &model.joint_names;
     let (table, read) = a.columns.map()?.read_explained(&a.log, joints)?;
     // refused as every command that reads the log would refuse it
-    let rec = crate::io::read_recording(&table, joints)?;
+    let rec = crate::logs::read_recording(&table, joints)?;
     let mut out = String::new();
     let _ = writeln!(
         out,

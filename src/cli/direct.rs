@@ -15,9 +15,11 @@ use crate::direct::{
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
-use crate::io::{read_states, samples_table, write_atomic, OutputSet, Table};
+use crate::io::{write_atomic, OutputSet, Table};
+use crate::logs::{read_states, samples_table};
+use crate::model_file::ModelFile;
 use crate::states::States;
-use crate::torque_model::{ModelFile, TorqueModel};
+use crate::torque_model::TorqueModel;
 
 #[derive(Args)]
 pub(crate) struct ExciteArgs {

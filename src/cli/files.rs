@@ -195,7 +195,7 @@ impl ColumnArgs {
         joints: &[String],
         out: &mut String,
     ) -> Result<crate::logs::recording::Recording> {
-        crate::io::read_recording(&self.table(path, joints, out)?, joints)
+        crate::logs::read_recording(&self.table(path, joints, out)?, joints)
     }
 }
 
@@ -293,7 +293,12 @@ impl PreprocessArgs {
             recs.push(self.prepare(rec, path, &periods, joints, progress, out)?);
         }
         let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
-        crate::logs::repeated_samples::refuse_shared_samples(&prints, &names, argument, "data rows")?;
+        crate::logs::repeated_samples::refuse_shared_samples(
+            &prints,
+            &names,
+            argument,
+            "data rows",
+        )?;
         Ok(recs)
     }
 
@@ -354,7 +359,8 @@ impl PreprocessArgs {
         use std::fmt::Write;
         let clipped = |rec: &crate::logs::recording::Recording| {
             let log = path.display().to_string();
-            if let Some(w) = crate::logs::torque_saturation::warning(&rec.torque_saturation, joints, &log)
+            if let Some(w) =
+                crate::logs::torque_saturation::warning(&rec.torque_saturation, joints, &log)
             {
                 eprintln!("perturbid: warning: {w}");
             }
@@ -395,9 +401,11 @@ impl PreprocessArgs {
             ..crate::logs::preprocess::PreprocessOptions::default()
         };
         let rec = crate::logs::preprocess::preprocess(&rec, &o)?;
-        if let Some(w) =
-            crate::logs::period_average::warning(&rec.period_average, &path.display().to_string(), joints)
-        {
+        if let Some(w) = crate::logs::period_average::warning(
+            &rec.period_average,
+            &path.display().to_string(),
+            joints,
+        ) {
             eprintln!("perturbid: warning: {w}");
         }
         if let Some(w) = crate::logs::log_screening::warning(
@@ -408,14 +416,18 @@ impl PreprocessArgs {
         ) {
             eprintln!("perturbid: warning: {w}");
         }
-        if let Some(w) =
-            crate::logs::held_columns::warning(&rec.held_columns, &path.display().to_string(), joints)
-        {
+        if let Some(w) = crate::logs::held_columns::warning(
+            &rec.held_columns,
+            &path.display().to_string(),
+            joints,
+        ) {
             eprintln!("perturbid: warning: {w}");
         }
-        if let Some(w) =
-            crate::logs::stamp_jitter::warning(&rec.stamp_jitter, &path.display().to_string(), joints)
-        {
+        if let Some(w) = crate::logs::stamp_jitter::warning(
+            &rec.stamp_jitter,
+            &path.display().to_string(),
+            joints,
+        ) {
             eprintln!("perturbid: warning: {w}");
         }
         if let Some(w) = crate::logs::position_wraps::warning(
@@ -514,7 +526,7 @@ pub(crate) fn averaged_noise(
     let logs = (recs.iter().zip(paths))
         .map(|(rec, path)| {
             let noise = match &rec.period_average {
-                Some(a) => a.torque_noise(joints),
+                Some(a) => crate::direct::TorqueNoise::from_period_average(a, joints),
                 None => Err(Error::InvalidArgument {
                     argument: "--weighting".into(),
                     message: "noise needs each log averaged over its excitation's periods (--average-periods, --period), whose spread measures the noise".into(),

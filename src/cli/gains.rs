@@ -15,8 +15,8 @@ use crate::direct::{identify_drive_gains_with, GainEstimator, GainRun};
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::logs::recording::Recording;
-use crate::rehearsal::Payload;
-use crate::torque_model::ModelFile;
+use crate::model::payload::Payload;
+use crate::model_file::ModelFile;
 
 #[derive(Args)]
 pub(crate) struct IdentifyGainsArgs {

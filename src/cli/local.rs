@@ -11,12 +11,13 @@ use super::out_dir;
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
-use crate::io::{plan_files, recording_files, save_recording};
+use crate::local::plan_files::{plan_files, recording_files};
 use crate::local::{
     identify_local, plan_experiments, CrossingTimes, Design, Estimator, ExperimentKind,
     IdentifyOptions, LocalModel, OperatingPoint, Plan, PlanOptions, Size,
 };
 use crate::logs::recording::Recording;
+use crate::logs::save_recording;
 use crate::rehearsal::{rehearse, rehearse_plan, TrueRobot};
 use crate::simulation::{simulate_plan, simulate_samples, Friction, SimulationOptions};
 use crate::trajectory::FourierTrajectory;

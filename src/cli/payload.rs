@@ -15,7 +15,7 @@ use crate::direct::{
 use crate::error::{shown, Error, Result};
 use crate::gravity::Gravity;
 use crate::io::OutputSet;
-use crate::torque_model::ModelFile;
+use crate::model_file::ModelFile;
 
 #[derive(Args)]
 pub(crate) struct IdentifyPayloadArgs {
@@ -137,7 +137,7 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
     options.offset_per_run = a.offset_per_log;
     super::files::check_validate_fraction(a.validate)?;
     // a link the robot lacks is named before the log is read
-    crate::rehearsal::Payload {
+    crate::model::payload::Payload {
         link: a.link.clone(),
         mass: 0.0,
         com: [0.0; 3],

@@ -10,7 +10,7 @@ use super::files::refuse_overwriting_inputs;
 use super::out_dir;
 use crate::document::Document;
 use crate::error::Result;
-use crate::io::recording_files;
+use crate::local::plan_files::recording_files;
 use crate::local::{gaps_in_runs, repeated_runs, split_session, Plan, SplitOptions};
 
 #[derive(Args)]

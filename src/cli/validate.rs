@@ -14,8 +14,9 @@ use crate::direct::torque_columns::check_torque_columns;
 use crate::direct::torque_lag::{check_torque_lag, validation_findings};
 use crate::error::{Error, Result};
 use crate::io::{OutputSet, Table};
+use crate::model_file::ModelFile;
 use crate::svg::{line_plot, Series};
-use crate::torque_model::{ModelFile, TorqueModel};
+use crate::torque_model::TorqueModel;
 use crate::validation::{stored_stderr, validate};
 
 /// What is validated: a saved model, or a robot's own parameters.
@@ -307,7 +308,7 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     // the model's own uncertainty, its s.e., not counted)
     let rms: Vec<f64> = v.joints.iter().map(|j| j.rms).collect();
     let noise_fit = (rec.period_average.as_ref())
-        .and_then(|a| a.torque_noise(&joints).ok())
+        .and_then(|a| crate::direct::TorqueNoise::from_period_average(a, &joints).ok())
         .and_then(|n| crate::direct::NoiseFit::of(&n, &rms, v.samples, 0));
     if let Some(n) = &noise_fit {
         json["noise_fit"] = serde_json::to_value(n).expect("serialisable");

@@ -28,8 +28,8 @@ use super::identify::{fit_with_factors, BaseModel, BaseOptions, Weighting};
 use super::streaming::JointFactors;
 use crate::document::{check_bounded, check_condition, check_magnitudes};
 use crate::error::{shown, Error, Result};
+use crate::model::payload::Payload;
 use crate::model::Model;
-use crate::rehearsal::Payload;
 use crate::states::States;
 
 /// Runs at most in one identification.

@@ -7,10 +7,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::document::{check_condition, check_magnitude_rows, check_magnitudes, invalid, Document};
 use crate::error::Result;
-use crate::local::OperatingPoint;
+use crate::operating_point::OperatingPoint;
 use crate::regression::least_squares;
 use crate::states::States;
 use crate::torque_model::{check_joints, predict_linear};
+use crate::torque_model::{torque_at, Expansion, TorqueModel};
 
 /// A globally linearised model about an operating point.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -119,5 +120,25 @@ impl Document for GlobalLinearModel {
         check_magnitude_rows(Self::WHAT, "stderr", &self.stderr, true)?;
         check_magnitudes(Self::WHAT, "residual_rms", &self.residual_rms, false)?;
         check_condition(Self::WHAT, "cond", self.cond)
+    }
+}
+
+impl TorqueModel for GlobalLinearModel {
+    fn joint_names(&self) -> &[String] {
+        &self.joint_names
+    }
+
+    fn predict(&self, states: &States<'_>) -> Result<Vec<f64>> {
+        GlobalLinearModel::predict(self, states)
+    }
+
+    fn linearize(&self, op: &OperatingPoint) -> Result<Expansion> {
+        Ok(Expansion {
+            torque: torque_at(self, op)?,
+            d: self.d.clone(),
+            h: self.h.clone(),
+            g: self.g.clone(),
+            g_static: None,
+        })
     }
 }

@@ -5,6 +5,7 @@ use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 use super::base::BaseParameters;
+use super::base_model_on::BaseModelOn;
 use super::parameters::{regressor_blocks, ParameterLayout};
 use super::streaming;
 use crate::document::{
@@ -14,7 +15,6 @@ use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
 use crate::states::States;
-use crate::torque_model::BaseModelOn;
 
 pub use super::base_options::{BaseOptions, Weighting};
 
@@ -707,7 +707,7 @@ impl BaseModel {
     /// [`Self::on`] refuses, for a model saved before the correlation was stored, and where
     /// the arithmetic overflows.
     pub fn predict_stderr(&self, model: &Model, states: &States<'_>) -> Result<Vec<f64>> {
-        use crate::local::prediction_uncertainty::root;
+        use crate::regression::root;
         self.check(model)?;
         let p = self.theta.len();
         if self.correlation.shape() != (p, p) {
@@ -734,11 +734,7 @@ impl BaseModel {
             }));
             Ok(())
         })?;
-        crate::local::prediction_uncertainty::refuse_overflow(
-            out,
-            model.nv,
-            "prediction's standard error",
-        )
+        crate::regression::refuse_overflow(out, model.nv, "prediction's standard error")
     }
 
     /// [`Self::predict`] on a robot [`Self::check`] accepted.

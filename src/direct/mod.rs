@@ -5,6 +5,7 @@
 
 pub mod base;
 pub mod base_linearization;
+pub mod base_model_on;
 pub mod base_options;
 pub mod consistency;
 pub mod consistent;
@@ -38,6 +39,7 @@ pub mod weak_excitation;
 pub mod workspace;
 
 pub use base::BaseParameters;
+pub use base_model_on::BaseModelOn;
 pub use consistency::{check_physical_consistency, BodyConsistency, ConsistencyReport};
 pub use consistent::{
     consistent_least_squares, identify_consistent_parameters, ConsistentFit, ConsistentOptions,

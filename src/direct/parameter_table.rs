@@ -215,8 +215,15 @@ impl BaseModel {
                 .map(|w| format!("{w}{}", crate::logs::position_rounding::IN_A_FIT));
         // of each of several logs, named
         let rounding = rounding.into_iter().chain(self.logs.iter().filter_map(|l| {
-            crate::logs::position_rounding::warning(&l.position_rounding, &self.joint_names)
-                .map(|w| format!("'{}': {w}{}", l.log, crate::logs::position_rounding::IN_A_FIT))
+            crate::logs::position_rounding::warning(&l.position_rounding, &self.joint_names).map(
+                |w| {
+                    format!(
+                        "'{}': {w}{}",
+                        l.log,
+                        crate::logs::position_rounding::IN_A_FIT
+                    )
+                },
+            )
         }));
         let offsets = self.position_offsets_finding();
         // friction terms fitted to a log that does not read as the robot's model take up

@@ -315,7 +315,7 @@ pub fn identify_payload(
         });
     }
     let (body, pose) =
-        crate::rehearsal::link_in_body(model, &options.link).map_err(|e| match e {
+        crate::model::payload::link_in_body(model, &options.link).map_err(|e| match e {
             Error::InvalidArgument { message, .. } => Error::InvalidArgument {
                 argument: "link".into(),
                 message,

@@ -11,8 +11,8 @@ use super::payload_quantities::{in_link_frame, payload_of_parameters};
 use crate::algorithms::regressor::PARAMS_PER_BODY;
 use crate::error::{shown, Error, Result};
 use crate::gravity::Gravity;
+use crate::model::payload::Payload;
 use crate::model::Model;
-use crate::rehearsal::Payload;
 use crate::spatial::Se3;
 use crate::states::States;
 

@@ -5,7 +5,7 @@
 
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
-use crate::rehearsal::Payload;
+use crate::model::payload::Payload;
 use crate::spatial::Se3;
 
 /// The payload's quantities `[m, cx, cy, cz, ixx, ixy, ixz, iyy, iyz, izz]` (inertia about the

@@ -15,8 +15,8 @@ use nalgebra::{DMatrix, DVector};
 use super::identify::BaseModel;
 use super::parameters::regressor_blocks;
 use crate::error::{Error, Result};
-use crate::local::prediction_uncertainty::{refuse_overflow, root};
 use crate::model::Model;
+use crate::regression::{refuse_overflow, root};
 use crate::states::States;
 
 impl BaseModel {

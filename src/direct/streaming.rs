@@ -461,9 +461,7 @@ impl JointFactors {
         // the Coulomb term's column: the states' own (filtered), or sign(qd)
         let coulomb: std::borrow::Cow<[f64]> = match states.coulomb() {
             Some(c) => c.into(),
-            None => (qd.iter())
-                .map(|&v| crate::direct::parameters::sign0(v))
-                .collect(),
+            None => (qd.iter()).map(|&v| crate::parameters::sign0(v)).collect(),
         };
         let batch = Batch {
             x: [states.q(), &qd[..], &qdd[..], &coulomb[..]],

@@ -307,7 +307,7 @@ pub(crate) fn joint_regressors(
         0 => weight[r * n + j],
         1 => inertial[r * n + j],
         2 => qd[r * n + j],
-        3 => crate::direct::parameters::sign0(qd[r * n + j]),
+        3 => crate::parameters::sign0(qd[r * n + j]),
         4 => qdd[r * n + j],
         _ => 1.0,
     })

@@ -7,6 +7,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{shown5, Error, Result};
+use crate::logs::period_average::PeriodAverage;
 
 /// The largest noise level taken (N m): its square must stay far inside f64's range.
 pub const MAX_NOISE: f64 = 1e100;
@@ -37,6 +38,46 @@ pub struct TorqueNoise {
 }
 
 impl TorqueNoise {
+    /// The noise of a log's torques averaged over the periods of its excitation, for the noise
+    /// weighting and the judgement of a fit's residuals ([`crate::direct::noise_fit`]):
+    /// [`PeriodAverage::averaged_torque_noise`] a joint (N m), correlated over
+    /// `kept_samples / (2 H + 1)` samples (at least 1; `H` the torque harmonics: the noise lies in their span), its
+    /// levels estimated with `(periods - 1) (2 H + 1)` degrees of freedom a joint. Errors
+    /// naming the joint whose torques' noise measured 0 (a log without noise, such as a
+    /// simulated one), or a finding saved without `kept_samples`.
+    pub fn from_period_average(
+        average: &PeriodAverage,
+        joints: &[String],
+    ) -> crate::error::Result<TorqueNoise> {
+        let bad = |message: String| crate::error::Error::InvalidArgument {
+            argument: "noise".into(),
+            message,
+        };
+        if average.kept_samples == 0 {
+            return Err(bad("the log's period average was kept without its samples (saved by an older version): average the log anew".into()));
+        }
+        let sigma = average.averaged_torque_noise();
+        if let Some(j) = sigma.iter().position(|s| !(s.is_finite() && *s > 0.0)) {
+            let name = joints
+                .get(j)
+                .cloned()
+                .unwrap_or_else(|| format!("joint {}", j + 1));
+            return Err(bad(format!(
+                "the {} periods averaged measured no noise in {name}'s torques ({}): identical periods (a simulated log without noise) give no noise to weight by or judge against",
+                average.periods,
+                crate::error::shown(sigma[j])
+            )));
+        }
+        let values = (2 * average.torque_harmonics + 1) as f64;
+        Ok(TorqueNoise {
+            sigma,
+            correlation: (average.kept_samples as f64 / values).max(1.0),
+            degrees_of_freedom: Some(
+                (average.periods - 1) as f64 * values * average.torque_noise.len() as f64,
+            ),
+        })
+    }
+
     /// Noise white at the samples' rate, `sigma` a joint (N m).
     pub fn white(sigma: Vec<f64>) -> Self {
         Self {

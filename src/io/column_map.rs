@@ -187,7 +187,7 @@ impl ColumnMap {
             recording: source.into(),
             message,
         };
-        let listed = || super::recording::listed(columns, 40);
+        let listed = || super::table::listed(columns, 40);
         // by name: a header of a hundred thousand columns is read in linear time
         let index: HashMap<&str, usize> = (columns.iter().enumerate())
             .map(|(c, name)| (name.as_str(), c))
@@ -310,7 +310,7 @@ pub fn left_out_note(path: &std::path::Path, left_out: &[String]) -> Option<Stri
         "{}: {} column(s) left out (--ignore-columns): {}",
         path.display(),
         left_out.len(),
-        super::recording::listed(left_out, 12)
+        super::table::listed(left_out, 12)
     ))
 }
 
@@ -368,7 +368,7 @@ mod tests {
             [1.0, 0.5, 1.0, 2.0, -6.0, 1.002, 0.6, 2.0, 4.0, -10.0]
         );
         assert_eq!(left, ["pos_elbow", "state", "actual_TCP_x"]);
-        let rec = super::super::read_recording(&t, &joints()).unwrap();
+        let rec = crate::logs::read_recording(&t, &joints()).unwrap();
         assert_eq!(rec.q, [0.5, 1.0, 0.6, 2.0]);
         // {j}, {joint} and degrees
         let m = map(&["q=pos_{joint}*deg", "qd=v{j}"], &[]).unwrap();

@@ -1,5 +1,5 @@
-//! Files: numeric CSV tables with a header, recordings and trajectories as CSV, JSON documents,
-//! all written atomically (a temporary file renamed into place), so no half-written output is
+//! Files: numeric CSV tables with a header, JSON documents and configuration files, all
+//! written atomically (a temporary file renamed into place), so no half-written output is
 //! ever left behind; files that belong together are written as one [`OutputSet`], which a
 //! reader sees whole or not at all.
 
@@ -8,16 +8,9 @@ pub mod column_map;
 pub mod config;
 pub(crate) mod foreign;
 pub mod output_set;
-pub mod plan_files;
-pub mod recording;
 pub mod table;
 
 pub use atomic::{read_document, read_text, write_atomic};
 pub use column_map::ColumnMap;
 pub use output_set::{check_not_partial, OutputSet};
-pub use plan_files::{plan_files, recording_files};
-pub use recording::{
-    load_recording, read_recording, read_states, recording_table, samples_table, save_recording,
-    States,
-};
 pub use table::{csv_text, Table};

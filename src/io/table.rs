@@ -208,7 +208,7 @@ impl Table {
                         crate::error::shown(now),
                         crate::error::shown(previous.0),
                         previous.1,
-                        crate::logs::recording::time_hint(now, previous.0)
+                        time_hint(now, previous.0)
                     )));
                 }
                 previous = (now, line);
@@ -351,6 +351,26 @@ where
     }
     let bytes = w.into_inner().unwrap_or_default();
     String::from_utf8(bytes).unwrap_or_default()
+}
+
+/// Names for a message: the first `most`, then "...".
+pub(crate) fn listed(columns: &[String], most: usize) -> String {
+    let mut names: Vec<&str> = columns.iter().take(most).map(String::as_str).collect();
+    if columns.len() > most {
+        names.push("...");
+    }
+    names.join(", ")
+}
+
+/// What a time `now` that does not increase on `before` is likely to be, and what to do, for
+/// messages (it begins with ": "): a repeated stamp (a message logged twice, or a clock
+/// coarser than the rate) or a step back (logs joined end to end, rows out of order).
+pub(crate) fn time_hint(now: f64, before: f64) -> &'static str {
+    if now == before {
+        ": a repeated time stamp (a message logged twice, or a clock coarser than the sample rate); drop the repeated rows, or give each its own time"
+    } else {
+        ": a step back (logs joined end to end, or rows out of order); split the log there, or sort its rows by time"
+    }
 }
 
 #[cfg(test)]

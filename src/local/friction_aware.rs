@@ -10,8 +10,8 @@ use super::model::{CoulombSteps, Estimate};
 use super::noise::{reading_variance, sample_variance, weighted_least_squares};
 use super::plan::{Experiment, Plan};
 use super::rounded_positions::{resolution_warning, Resolution};
-use crate::direct::parameters::sign0;
 use crate::error::{Error, Result};
+use crate::parameters::sign0;
 
 /// H* and the Coulomb steps from the differences of the H experiment's +- pairs; see
 /// [`IdentifyOptions::friction_aware_h`]. One least-squares solve per torque row: the columns

@@ -18,7 +18,6 @@ use super::friction_aware::friction_aware_h;
 use super::glitches;
 use super::model::{Estimate, Estimator, LocalModel};
 use super::noise::{nominal_noise, reading_variance, sample_variance, weighted_least_squares};
-use super::operating_point::OperatingPoint;
 use super::plan::{Experiment, ExperimentKind, Plan};
 use super::quantisation;
 use super::response;
@@ -28,6 +27,7 @@ use super::torque_offsets;
 use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::logs::recording::Recording;
+use crate::operating_point::OperatingPoint;
 
 /// Where the crossing times come from.
 #[derive(Clone, Copy, Debug, PartialEq)]

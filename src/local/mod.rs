@@ -43,11 +43,12 @@ pub mod identify;
 pub mod model;
 pub mod noise;
 pub mod offset_search;
-pub mod operating_point;
+
 pub mod parameters;
 pub mod perturbation;
 pub mod plan;
 mod plan_checks;
+pub mod plan_files;
 mod plan_warnings;
 pub mod point_design;
 pub mod predicted_response;
@@ -62,6 +63,7 @@ pub mod session;
 pub mod torque_offsets;
 mod trajectory_builder;
 
+pub use crate::operating_point::OperatingPoint;
 pub use clock::{check_clock, covering_offsets, overlap_offsets, position_misfit, PositionMisfit};
 pub use crossing::{
     noise_levels, values_at, values_at_with, values_in_windows, CrossingValues, FitOptions, Signal,
@@ -74,7 +76,6 @@ pub use diagnostics::{
 pub use identify::{identify_local, CrossingTimes, IdentifyOptions};
 pub use model::{Estimate, Estimator, LocalModel, SignalGains};
 pub use offset_search::{detect_offset, detect_offset_in};
-pub use operating_point::OperatingPoint;
 pub use parameters::{identify_parameters_from_local, FromLocalOptions, ParametersFromLocal};
 pub use perturbation::{Design, Size, Sizes};
 pub use plan::{plan_experiments, Crossing, Experiment, ExperimentKind, Plan, PlanOptions};

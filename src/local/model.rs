@@ -5,7 +5,6 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use super::diagnostics::Diagnostics;
-use super::operating_point::OperatingPoint;
 use super::reach::{Extrapolation, Perturbations};
 use crate::choice::choice;
 use crate::document::{
@@ -13,9 +12,11 @@ use crate::document::{
     check_magnitudes, invalid, Document,
 };
 use crate::error::{Error, Result};
+use crate::operating_point::OperatingPoint;
 use crate::regression::LeastSquares;
 use crate::states::States;
 use crate::torque_model::predict_linear;
+use crate::torque_model::{torque_at, Expansion, TorqueModel};
 
 /// One identified matrix with its statistics.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -244,11 +245,7 @@ impl LocalModel {
                 let relative = g.stderr[x % n] / g.gain[x % n].abs();
                 *se = se.hypot(t * relative);
             }
-            return super::prediction_uncertainty::refuse_overflow(
-                out,
-                n,
-                "prediction's standard error",
-            );
+            return crate::regression::refuse_overflow(out, n, "prediction's standard error");
         }
         Ok(out)
     }
@@ -590,5 +587,27 @@ impl Document for LocalModel {
             }
         }
         Ok(())
+    }
+}
+
+impl TorqueModel for LocalModel {
+    fn joint_names(&self) -> &[String] {
+        &self.joint_names
+    }
+
+    fn predict(&self, states: &States<'_>) -> Result<Vec<f64>> {
+        LocalModel::predict(self, states)
+    }
+
+    fn linearize(&self, op: &OperatingPoint) -> Result<Expansion> {
+        let torque = torque_at(self, op)?;
+        let part = |e: &Option<Estimate>| e.as_ref().map(|e| e.matrix.clone());
+        Ok(Expansion {
+            torque,
+            d: part(&self.d).expect("predict needs D"),
+            h: part(&self.h).expect("predict needs H"),
+            g: part(&self.g).expect("predict needs G"),
+            g_static: part(&self.g_static),
+        })
     }
 }

@@ -5,7 +5,6 @@
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-use super::operating_point::OperatingPoint;
 use super::perturbation::{perturbations, varying_perturbations, Design, Sizes};
 use super::plan_checks;
 use super::plan_warnings;
@@ -16,6 +15,7 @@ use crate::choice::choice;
 use crate::document::{invalid, Document};
 use crate::error::{shown, Error, Result};
 use crate::model::Model;
+use crate::operating_point::OperatingPoint;
 use crate::trajectory::{check_limits, SegmentKind, Trajectory, TransitionLimits};
 
 choice! {

@@ -4,11 +4,11 @@
 
 use nalgebra::DMatrix;
 
-use super::operating_point::OperatingPoint;
 use super::plan::{ExperimentKind, PlanOptions, DESIGN_COND_WARNING};
 use crate::error::Result;
 use crate::gravity::Gravity;
 use crate::model::Model;
+use crate::operating_point::OperatingPoint;
 use crate::trajectory::Samples;
 
 /// The warning for a perturbation design whose cond(X) exceeds [`DESIGN_COND_WARNING`], with

@@ -5,13 +5,13 @@ use nalgebra::DMatrix;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::operating_point::OperatingPoint;
 use super::parameters::FromLocalOptions;
 use crate::algorithms::linearization_regressor::linearization_regressor;
 use crate::direct::base::{BaseParameters, BASE_TOLERANCE};
-use crate::direct::ParameterLayout;
 use crate::error::{Error, Result};
 use crate::model::Model;
+use crate::operating_point::OperatingPoint;
+use crate::parameters::ParameterLayout;
 
 /// One suggested point and what the design reaches with it.
 #[derive(Clone, Debug, PartialEq)]

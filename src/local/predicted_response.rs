@@ -22,7 +22,6 @@ use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 
 use super::crossing::FitOptions;
-use super::operating_point::OperatingPoint;
 use super::plan::{Crossing, Experiment, ExperimentKind};
 use super::response::{
     design_basis, half_differences, resolved, shown_factor, test, Response, Sums,
@@ -32,6 +31,7 @@ use crate::data::Data;
 use crate::error::{shown, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
+use crate::operating_point::OperatingPoint;
 
 /// The fraction of runs in which the identification should find the experiment's response;
 /// a plan predicted below it is warned of.

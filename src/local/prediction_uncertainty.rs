@@ -14,6 +14,7 @@
 use super::model::{Estimate, Estimator, LocalModel};
 use crate::document::{check_correlation, invalid};
 use crate::error::{Error, Result};
+use crate::regression::root;
 use crate::states::States;
 use crate::torque_model::check_joints;
 
@@ -111,32 +112,6 @@ pub(crate) fn predict_stderr(model: &LocalModel, states: &States<'_>) -> Result<
 
 /// Samples whose deltas are laid out together ([`predict_stderr`]).
 const BLOCK: usize = 256;
-
-/// The standard error of a variance summed from known terms: rounding below 0 is 0, and a
-/// sum that overflowed (inf, or NaN from inf - inf) is inf, for the caller to refuse.
-pub(crate) fn root(var: f64) -> f64 {
-    if var.is_finite() {
-        var.max(0.0).sqrt()
-    } else {
-        f64::INFINITY
-    }
-}
-
-/// `stderr` (row-major `k x n`) returned, or refused naming the first joint and sample whose
-/// standard error overflowed (inf: [`root`]) for `operation`.
-pub(crate) fn refuse_overflow(stderr: Vec<f64>, n: usize, operation: &str) -> Result<Vec<f64>> {
-    match stderr.iter().position(|v| v.is_infinite()) {
-        Some(i) => Err(Error::Numerical {
-            operation: operation.into(),
-            message: format!(
-                "the standard error of joint {} at sample {} overflows: the state is too large to compute with",
-                i % n + 1,
-                i / n
-            ),
-        }),
-        None => Ok(stderr),
-    }
-}
 
 /// The estimate `name` of a model, with a correlation for each of its `n` rows.
 fn part<'a>(e: &'a Option<Estimate>, name: &str, n: usize) -> Result<&'a Estimate> {

@@ -20,22 +20,8 @@
 use super::plan::Experiment;
 use crate::band_fit::coefficient_ranges;
 use crate::error::{Error, Result};
-use crate::logs::recording::Recording;
 
-use super::quantisation::grid_step;
-
-/// Per joint, the step (rad) of the grid `rec`'s positions lie on (whole encoder counts, see
-/// [`grid_step`]), or None: positions off any grid (a continuous or resampled signal) or a
-/// joint that reads fewer than two values.
-pub fn position_steps(rec: &Recording) -> Vec<Option<f64>> {
-    let n = rec.n;
-    (0..n)
-        .map(|j| {
-            let column: Vec<f64> = rec.q.iter().skip(j).step_by(n.max(1)).copied().collect();
-            grid_step(&column)
-        })
-        .collect()
-}
+pub use crate::logs::position_rounding::position_steps;
 
 /// A crossing's state of one joint read from positions rounded to steps of `step` (rad):
 /// `values` (q in rad, qd in rad/s, qdd in rad/s^2 at `tc`) the midpoints of their ranges over
@@ -296,6 +282,7 @@ pub fn planned_resolution_warning(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::logs::recording::Recording;
 
     #[test]
     fn a_rounded_quadratic_is_inside_its_ranges() {

@@ -98,7 +98,7 @@ pub fn find_frozen_readings(rec: &Recording) -> Result<Vec<LogDropout>> {
                     continue;
                 }
                 let level = floor(&y);
-                let grid = crate::local::quantisation::grid_step(&y).unwrap_or(0.0);
+                let grid = crate::signal::grid_step(&y).unwrap_or(0.0);
                 let mut covered = 0;
                 for run in runs {
                     let moves = if signal == "q" {

@@ -135,7 +135,7 @@ pub fn find_held_columns(rec: &Recording) -> crate::error::Result<(Recording, Ve
                     .filter(|&&i| y[i] != y[i - 1])
                     .map(|&i| (y[i] - y[i - 1]).abs())
                     .collect();
-                let grid = crate::local::quantisation::grid_step(&y).unwrap_or(0.0);
+                let grid = crate::signal::grid_step(&y).unwrap_or(0.0);
                 match median(changes) {
                     Some(m) if m > MIN_GRID_STEPS * grid => {}
                     _ => continue,

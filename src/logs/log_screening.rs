@@ -212,7 +212,11 @@ pub(crate) fn signals(rec: &Recording) -> Vec<(&'static str, &Vec<f64>)> {
 /// The stretches `[a, b)` of `rec`'s samples between gaps.
 pub(crate) fn segments(rec: &Recording) -> Vec<(usize, usize)> {
     let mut bounds = vec![0];
-    bounds.extend(crate::logs::preprocess::gap_positions(rec).iter().map(|&i| i + 1));
+    bounds.extend(
+        crate::logs::preprocess::gap_positions(rec)
+            .iter()
+            .map(|&i| i + 1),
+    );
     bounds.push(rec.len());
     bounds.windows(2).map(|w| (w[0], w[1])).collect()
 }
@@ -371,7 +375,7 @@ pub(crate) fn floors(t: &[f64], columns: &[Vec<f64>], candidate: &[Vec<bool>]) -
         .map(|((y, cand), levels)| {
             let ordinary: Vec<f64> = (0..k).filter(|&i| !cand[i]).map(|i| y[i]).collect();
             let size = ordinary.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            let step = crate::local::quantisation::grid_step(&ordinary).unwrap_or(0.0);
+            let step = crate::signal::grid_step(&ordinary).unwrap_or(0.0);
             median(levels)
                 .unwrap_or(0.0)
                 .max(step / 12f64.sqrt())

@@ -13,6 +13,7 @@
 //! - the preprocessing: a filter and numerical derivatives ([`preprocess`]), or averaging over
 //!   the periods of a periodic excitation ([`period_average`], whose start [`excitation_start`]
 //!   finds);
+//! - recordings and trajectories as CSV ([`recording_csv`]);
 //! - several runs stacked for one fit ([`stacked_states`]).
 
 pub mod derivative_columns;
@@ -27,9 +28,13 @@ pub mod position_rounding;
 pub mod position_wraps;
 pub mod preprocess;
 pub mod recording;
+pub mod recording_csv;
 pub mod repeated_samples;
 pub mod stacked_states;
 pub mod stamp_jitter;
 pub mod torque_saturation;
 
 pub use recording::Recording;
+pub use recording_csv::{
+    load_recording, read_recording, read_states, recording_table, samples_table, save_recording,
+};

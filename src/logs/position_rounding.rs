@@ -12,7 +12,7 @@
 //! standard errors RMS.
 //!
 //! So where a joint's logged positions lie on a grid
-//! ([`grid_step`](crate::local::quantisation::grid_step)) and its velocity is derived from
+//! ([`grid_step`]) and its velocity is derived from
 //! them, a rounding error of the same motion (the filtered positions rounded again to the grid
 //! shifted by a random fraction of a step, [`REALISATIONS`] times, seeded) is passed through
 //! the same filter and differentiation, and its RMS compared with that of the preprocessed qd
@@ -23,6 +23,9 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
+
+use crate::logs::recording::Recording;
+use crate::signal::grid_step;
 
 /// The ratio of rounding noise to signal (RMS) in qd or qdd warned of: a bias of about 1 %
 /// (`0.1^2`) toward zero of the parameters that term carries.
@@ -74,7 +77,7 @@ impl PositionRounding {
 pub const REALISATIONS: u64 = 2;
 
 /// The rounding's noise in one joint's derived qd and qdd. `step` is the grid its logged
-/// positions lie on ([`grid_step`](crate::local::quantisation::grid_step), rad or m),
+/// positions lie on ([`grid_step`], rad or m),
 /// `smooth` the positions on the preprocessing's uniform grid low-pass filtered (None without
 /// a filter), `grid_len` that grid's length, `derive` the preprocessing's chain from a noise
 /// on that grid to `(qd, qdd)` over the samples it keeps, and `qd`, `qdd` what the chain gave
@@ -185,4 +188,17 @@ pub fn warning(all: &[PositionRounding], joint_names: &[String]) -> Option<Strin
         "positions logged in coarse counts, with velocities derived from them: their rounding leaves noise (RMS, after the filter, of the signal's RMS): {}",
         each.join("; ")
     ))
+}
+
+/// Per joint, the step (rad) of the grid `rec`'s positions lie on (whole encoder counts, see
+/// [`grid_step`]), or None: positions off any grid (a continuous or resampled signal) or a
+/// joint that reads fewer than two values.
+pub fn position_steps(rec: &Recording) -> Vec<Option<f64>> {
+    let n = rec.n;
+    (0..n)
+        .map(|j| {
+            let column: Vec<f64> = rec.q.iter().skip(j).step_by(n.max(1)).copied().collect();
+            grid_step(&column)
+        })
+        .collect()
 }

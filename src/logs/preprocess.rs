@@ -92,7 +92,7 @@ impl Default for PreprocessOptions {
 pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Recording> {
     // the grids of the positions as logged: a glitch replaced by its neighbours' fit is off
     // the grid, and would hide it (and whole turns taken out are no multiple of its step)
-    let steps = crate::local::rounded_positions::position_steps(rec);
+    let steps = crate::logs::position_rounding::position_steps(rec);
     // steps of whole turns taken back out before anything reads the positions' motion
     let (unwrapped, position_wraps) = crate::logs::position_wraps::unwrap_positions(rec);
     // columns held at a lower rate read again at their values' arrivals, before anything
@@ -321,10 +321,7 @@ fn preprocess_part(
         };
         let qd = smooth(qd)?;
         if filter.is_some() {
-            let sign: Vec<f64> = qd
-                .iter()
-                .map(|&v| crate::direct::parameters::sign0(v))
-                .collect();
+            let sign: Vec<f64> = qd.iter().map(|&v| crate::parameters::sign0(v)).collect();
             cols[4].push(smooth(sign)?);
         }
         cols[2].push(differentiate(&qd, dt));

@@ -1,6 +1,7 @@
 //! A recording: what a robot logs while it runs a trajectory.
 
 use crate::error::{shown, Error, Result};
+use crate::io::table::time_hint;
 
 /// Sampled measurements of one run, row-major (`q[i * n + j]` is joint `j` at sample `i`).
 ///
@@ -297,16 +298,5 @@ impl Recording {
 
     pub fn is_empty(&self) -> bool {
         self.t.is_empty()
-    }
-}
-
-/// What a time `now` that does not increase on `before` is likely to be, and what to do, for
-/// messages (it begins with ": "): a repeated stamp (a message logged twice, or a clock
-/// coarser than the rate) or a step back (logs joined end to end, rows out of order).
-pub(crate) fn time_hint(now: f64, before: f64) -> &'static str {
-    if now == before {
-        ": a repeated time stamp (a message logged twice, or a clock coarser than the sample rate); drop the repeated rows, or give each its own time"
-    } else {
-        ": a step back (logs joined end to end, or rows out of order); split the log there, or sort its rows by time"
     }
 }

@@ -97,7 +97,11 @@ pub fn find_torque_saturation(rec: &Recording) -> Vec<TorqueSaturation> {
         return found;
     }
     let mut bounds = vec![0];
-    bounds.extend(crate::logs::preprocess::gap_positions(rec).iter().map(|&i| i + 1));
+    bounds.extend(
+        crate::logs::preprocess::gap_positions(rec)
+            .iter()
+            .map(|&i| i + 1),
+    );
     bounds.push(k);
     for j in 0..n {
         let y: Vec<f64> = (0..k).map(|s| rec.tau[s * n + j]).collect();
@@ -198,10 +202,7 @@ fn noise_and_step(y: &[f64]) -> (f64, f64) {
         let mid = d.len() / 2;
         1.4826 * *d.select_nth_unstable_by(mid, f64::total_cmp).1 / 6f64.sqrt()
     };
-    (
-        scale,
-        crate::local::quantisation::grid_step(y).unwrap_or(0.0),
-    )
+    (scale, crate::signal::grid_step(y).unwrap_or(0.0))
 }
 
 /// The slope of the straight line through `(t, y)` and its standard error, from the larger of

@@ -19,7 +19,7 @@ use crate::direct::drive_gains::{
 };
 use crate::error::{Error, Result};
 use crate::logs::recording::Recording;
-use crate::rehearsal::Payload;
+use crate::model::payload::Payload;
 use crate::states::States;
 
 /// The payload a caller gave for run `r`: None, or a dict with the keys of the true robot's

@@ -153,7 +153,7 @@ impl PyPlan {
     fn save(&self, py: Python<'_>, folder: PathBuf) -> PyResult<Vec<PathBuf>> {
         let plan = self.plan.clone();
         Ok(detached(py, "Plan.save", || {
-            crate::io::plan_files(&plan, &folder)?.commit()
+            crate::local::plan_files::plan_files(&plan, &folder)?.commit()
         })?)
     }
     /// Splits `log`, one Recording of a whole session in which the robot ran this plan's

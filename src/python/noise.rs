@@ -43,7 +43,7 @@ pub(crate) fn torque_noise(
     let logs = (recordings.iter().enumerate())
         .map(|(i, rec)| {
             let noise = match &rec.period_average {
-                Some(a) => a.torque_noise(joints),
+                Some(a) => crate::direct::TorqueNoise::from_period_average(a, joints),
                 None => Err(Error::InvalidArgument {
                     argument: "weighting".into(),
                     message: "'noise' needs noise= or a Recording averaged over its excitation's periods (preprocess(..., excitation=...) or period=), whose spread measures the noise".into(),

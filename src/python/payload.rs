@@ -21,8 +21,8 @@ use crate::direct::{
     identify_payload as payload_rs, PayloadFit, PayloadOptions, Reference, Weighting,
 };
 use crate::gravity::Gravity;
+use crate::model::payload::Payload;
 use crate::model::Model;
-use crate::rehearsal::Payload;
 
 /// A payload identified from a log of the robot carrying it (`identify_payload`).
 ///

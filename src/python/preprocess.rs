@@ -141,7 +141,8 @@ pub(crate) fn preprocess(
     let out: Recording = detached(py, "preprocess", || match &traj {
         // the excitation's start and periods found in the log first
         Some(traj) => {
-            let periods = crate::logs::excitation_start::excitation_periods(&rec, traj, skip_periods)?;
+            let periods =
+                crate::logs::excitation_start::excitation_periods(&rec, traj, skip_periods)?;
             preprocess_rs(
                 &rec,
                 &PreprocessOptions {
@@ -168,7 +169,12 @@ pub(crate) fn preprocess(
         crate::logs::position_rounding::warning(&out.position_rounding, &[])
             .map(|w| format!("{name}: {w}{}", crate::logs::position_rounding::IN_A_FIT)),
         crate::logs::torque_saturation::warning(&out.torque_saturation, &[], name),
-        crate::logs::position_wraps::warning(&out.position_wraps, name, &[], "before preprocessing"),
+        crate::logs::position_wraps::warning(
+            &out.position_wraps,
+            name,
+            &[],
+            "before preprocessing",
+        ),
         crate::logs::held_columns::warning(&out.held_columns, name, &[]),
         crate::logs::stamp_jitter::warning(&out.stamp_jitter, name, &[]),
         crate::logs::period_average::warning(&out.period_average, name, &[]),

@@ -172,7 +172,7 @@ impl PyRecording {
         let map = column_map(columns, ignore_columns)?;
         let (mut rec, left_out) = super::detached(py, "Recording.load", || {
             let (table, left_out) = map.read(&path, &joints)?;
-            crate::io::read_recording(&table, &joints).map(|rec| (rec, left_out))
+            crate::logs::read_recording(&table, &joints).map(|rec| (rec, left_out))
         })?;
         if experiment.is_some() {
             rec.experiment = experiment;
@@ -190,7 +190,7 @@ impl PyRecording {
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let rec = self.rec.clone();
         Ok(super::detached(py, "Recording.save", || {
-            crate::io::save_recording(&rec, &path)
+            crate::logs::save_recording(&rec, &path)
         })?)
     }
     /// Reads a recording from a pandas DataFrame by the rules of the command line's CSV files
@@ -218,7 +218,7 @@ impl PyRecording {
         let map = column_map(columns, ignore_columns)?;
         let (columns, left_out) = super::tables::frame_columns(frame, name, &map, &joints)?;
         let mut rec = super::detached(py, "Recording.from_dataframe", || {
-            crate::io::read_recording(&crate::io::Table::from_columns(name, columns)?, &joints)
+            crate::logs::read_recording(&crate::io::Table::from_columns(name, columns)?, &joints)
         })?;
         rec.experiment = experiment;
         Ok(Self {
@@ -229,7 +229,7 @@ impl PyRecording {
     /// The recording as a pandas DataFrame with the columns of its CSV file: `t` (s), `q1..qN`,
     /// `qd1..qN` and `qdd1..qN` when present, `tau1..tauN`; `from_dataframe` reads it back.
     fn to_dataframe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let table = crate::io::recording_table(&self.rec, &self.rec.name);
+        let table = crate::logs::recording_table(&self.rec, &self.rec.name);
         let columns = (0..table.columns.len())
             .map(|c| {
                 let values = numpy::PyArray1::from_vec(py, table.column(c)).into_any();

@@ -153,7 +153,10 @@ pub(crate) fn stacked_recordings(
 
 /// `fit` with what each of the Recordings `recs` it was fitted to found in its preprocessing,
 /// in its `logs` (named by it).
-pub(crate) fn with_logs(fit: BaseModel, recs: &[Arc<crate::logs::recording::Recording>]) -> BaseModel {
+pub(crate) fn with_logs(
+    fit: BaseModel,
+    recs: &[Arc<crate::logs::recording::Recording>],
+) -> BaseModel {
     BaseModel {
         logs: (recs.iter())
             .map(|r| crate::direct::LogFindings::of(&r.name, r))

@@ -368,7 +368,7 @@ pub(crate) fn validate<'py>(
     }
     let rms: Vec<f64> = v.joints.iter().map(|j| j.rms).collect();
     let noise_fit = (averaged.as_ref())
-        .and_then(|a| a.torque_noise(&joints).ok())
+        .and_then(|a| crate::direct::TorqueNoise::from_period_average(a, &joints).ok())
         .and_then(|noise| crate::direct::NoiseFit::of(&noise, &rms, v.samples, 0));
     Ok(PyValidation {
         v,

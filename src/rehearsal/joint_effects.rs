@@ -49,7 +49,7 @@ impl JointEffects {
     /// Friction torque of joint `j` (N m) at position `q` (rad), speed `v` (rad/s), time `t`
     /// (s from the start); 0 at exactly zero speed.
     pub fn friction(&self, j: usize, q: f64, v: f64, t: f64) -> f64 {
-        self.friction_moving(j, q, v, crate::direct::parameters::sign0(v), t)
+        self.friction_moving(j, q, v, crate::parameters::sign0(v), t)
     }
 
     /// [`Self::friction`] moving in `direction` (the sign of `v`, or where `v` is zero the

@@ -14,10 +14,9 @@ pub mod sensors;
 pub mod tracking;
 pub mod true_robot;
 
+pub use crate::model::payload::{link_in_body, Payload};
 pub use joint_effects::JointEffects;
-pub use true_robot::{
-    link_in_body, Controller, FrictionSpec, Harmonic, LinkError, Payload, Sensors, TrueRobot,
-};
+pub use true_robot::{Controller, FrictionSpec, Harmonic, LinkError, Sensors, TrueRobot};
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -25,8 +24,8 @@ use rand_chacha::ChaCha8Rng;
 use crate::error::{shown, Error, Result};
 use crate::gravity::Gravity;
 use crate::local::Plan;
-use crate::model::Model;
 use crate::logs::recording::Recording;
+use crate::model::Model;
 use crate::trajectory::Samples;
 
 /// What `robot` (the true robot built on `nominal`) logs while it follows `reference` (states
@@ -85,7 +84,7 @@ pub fn rehearse(
         tau: &motion.command,
     };
     let (q, tau) = sensors::measure(&robot.sensors, &signals, &mut rng)?;
-    if let Some(i) = crate::states::first_non_finite(&tau) {
+    if let Some(i) = crate::finite::first_non_finite(&tau) {
         return Err(Error::Numerical {
             operation: format!("rehearsal '{name}'"),
             message: format!(

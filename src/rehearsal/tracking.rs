@@ -56,7 +56,7 @@ pub fn follow_exactly(
             let (x, v) = (q[i * n + j], reference.qd[i * n + j]);
             let direction = match &directions {
                 Some(d) => d[i * n + j],
-                None => crate::direct::parameters::sign0(v),
+                None => crate::parameters::sign0(v),
             };
             let t = reference.t[i] - reference.t[0];
             let need = command[i * n + j] + effects.friction_moving(j, x, v, direction, t);

@@ -312,7 +312,8 @@ fn averaged_fit(
         ..crate::logs::preprocess::PreprocessOptions::default()
     };
     let avg = crate::logs::preprocess::preprocess(rec, &options)?;
-    let noise = (avg.period_average.as_ref()).and_then(|a| a.torque_noise(&model.joint_names).ok());
+    let noise = (avg.period_average.as_ref())
+        .and_then(|a| crate::direct::TorqueNoise::from_period_average(a, &model.joint_names).ok());
     let options = BaseOptions {
         weighting: match noise {
             Some(_) => Weighting::Noise,

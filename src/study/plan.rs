@@ -86,12 +86,16 @@ impl Study {
             for p in &config.points {
                 if p.q.len() == model.nv && p.qd.len() == model.nv && p.qdd.len() == model.nv {
                     // within this robot's limits: a case at it could not be planned
-                    crate::local::OperatingPoint::new(p.q.clone(), p.qd.clone(), p.qdd.clone())
-                        .and_then(|op| op.check(&model))
-                        .map_err(|e| Error::Config {
-                            location: format!("{source}, points '{}'", p.name),
-                            message: e.to_string(),
-                        })?;
+                    crate::operating_point::OperatingPoint::new(
+                        p.q.clone(),
+                        p.qd.clone(),
+                        p.qdd.clone(),
+                    )
+                    .and_then(|op| op.check(&model))
+                    .map_err(|e| Error::Config {
+                        location: format!("{source}, points '{}'", p.name),
+                        message: e.to_string(),
+                    })?;
                     robot.points.push(StudyPoint {
                         name: p.name.clone(),
                         speed_class: "given".into(),

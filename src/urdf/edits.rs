@@ -6,8 +6,8 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::ops::Range;
 
+use crate::model::payload::Payload;
 use crate::model::Model;
-use crate::rehearsal::Payload;
 use crate::spatial::Inertia;
 
 /// One replacement of the source text.
@@ -292,7 +292,8 @@ pub(super) fn payload_edit(
             ),
         ));
     }
-    crate::rehearsal::link_in_body(model, &p.link).map_err(|e| (element.clone(), e.to_string()))?;
+    crate::model::payload::link_in_body(model, &p.link)
+        .map_err(|e| (element.clone(), e.to_string()))?;
     let inertia = p.spatial_inertia();
     let root = doc.root_element();
     let close = text[..root.range().end]

@@ -33,36 +33,16 @@ mod lines;
 mod roles;
 mod write;
 
+pub use crate::model::source::{LoadOptions, UrdfSource};
 pub use lines::{MAX_XML_DEPTH, MAX_XML_ELEMENTS};
-pub use write::{write_urdf, UrdfSource, WriteOptions, WrittenUrdf};
+pub use write::{write_urdf, WriteOptions, WrittenUrdf};
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::HashMap;
 use std::path::Path;
 
 use crate::error::{Error, Location, Result};
 use crate::model::Model;
 use lines::LineIndex;
-
-/// Options for building a model from a URDF.
-#[derive(Clone, Debug)]
-pub struct LoadOptions {
-    /// Joints held at a fixed position (rad or m), by URDF joint name. A locked joint becomes a
-    /// fixed joint (like Pinocchio's reduced model); mimic joints that follow it are locked too.
-    pub lock: BTreeMap<String, f64>,
-    /// Reject link inertias whose principal moments break the triangle inequality
-    /// (`I1 + I2 >= I3`). On by default; turn it off for models that lump rotor inertia into a
-    /// link about one axis only (the `kinsheel2010` A465 does).
-    pub check_triangle_inequality: bool,
-}
-
-impl Default for LoadOptions {
-    fn default() -> Self {
-        Self {
-            lock: BTreeMap::new(),
-            check_triangle_inequality: true,
-        }
-    }
-}
 
 /// Reads and builds a model from a URDF file.
 pub fn model_from_urdf_file(path: impl AsRef<Path>, options: &LoadOptions) -> Result<Model> {

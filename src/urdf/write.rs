@@ -25,31 +25,12 @@ use super::edits::{
     apply, child, header, number, payload_edit, remove_inertial, set_dynamics, set_inertial,
     Elements,
 };
-use super::{lines, model_from_urdf_str, LoadOptions};
-use crate::algorithms::regressor::{dynamic_parameters, inertia_from_parameters};
+use super::{lines, model_from_urdf_str};
 use crate::error::{Error, Result};
+use crate::model::payload::Payload;
 use crate::model::Model;
-use crate::rehearsal::Payload;
+use crate::parameters::{dynamic_parameters, inertia_from_parameters};
 use crate::spatial::{rigid_body_problem, Inertia};
-
-/// The URDF text a model was built from and the options it was built with: what
-/// [`write_urdf`] edits.
-#[derive(Clone)]
-pub struct UrdfSource {
-    pub(crate) text: String,
-    pub(crate) options: LoadOptions,
-}
-
-impl std::fmt::Debug for UrdfSource {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "UrdfSource({} bytes, lock {:?})",
-            self.text.len(),
-            self.options.lock
-        )
-    }
-}
 
 /// The longest note [`WriteOptions::note`] takes, in characters (a comment, not a log).
 pub const MAX_NOTE: usize = 65_536;

@@ -79,46 +79,6 @@ impl PeriodAverage {
         self.torque_noise.iter().map(|x| x / s).collect()
     }
 
-    /// The averaged torques' noise, for the noise weighting and the judgement of a fit's
-    /// residuals ([`crate::direct::TorqueNoise`], [`crate::direct::noise_fit`]):
-    /// [`Self::averaged_torque_noise`] a joint (N m), correlated over `kept_samples / (2 H +
-    /// 1)` samples (at least 1; `H` the torque harmonics: the noise lies in their span), its
-    /// levels estimated with `(periods - 1) (2 H + 1)` degrees of freedom a joint. Errors
-    /// naming the joint whose torques' noise measured 0 (a log without noise, such as a
-    /// simulated one), or a finding saved without `kept_samples`.
-    pub fn torque_noise(
-        &self,
-        joints: &[String],
-    ) -> crate::error::Result<crate::direct::TorqueNoise> {
-        let bad = |message: String| crate::error::Error::InvalidArgument {
-            argument: "noise".into(),
-            message,
-        };
-        if self.kept_samples == 0 {
-            return Err(bad("the log's period average was kept without its samples (saved by an older version): average the log anew".into()));
-        }
-        let sigma = self.averaged_torque_noise();
-        if let Some(j) = sigma.iter().position(|s| !(s.is_finite() && *s > 0.0)) {
-            let name = joints
-                .get(j)
-                .cloned()
-                .unwrap_or_else(|| format!("joint {}", j + 1));
-            return Err(bad(format!(
-                "the {} periods averaged measured no noise in {name}'s torques ({}): identical periods (a simulated log without noise) give no noise to weight by or judge against",
-                self.periods,
-                shown(sigma[j])
-            )));
-        }
-        let values = (2 * self.torque_harmonics + 1) as f64;
-        Ok(crate::direct::TorqueNoise {
-            sigma,
-            correlation: (self.kept_samples as f64 / values).max(1.0),
-            degrees_of_freedom: Some(
-                (self.periods - 1) as f64 * values * self.torque_noise.len() as f64,
-            ),
-        })
-    }
-
     /// Per joint, a fit's residual RMS (N m, of the averaged torques) against the averaged
     /// torques' noise: their ratio (1 where the fit leaves only noise), and the model's own
     /// error `sqrt(max(residual^2 - noise^2, 0))` (N m). The fit's parameters take up a small

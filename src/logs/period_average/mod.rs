@@ -283,10 +283,7 @@ pub fn average_periods(
     for j in 0..n {
         crate::interrupt::check("period averaging")?;
         let (x, v, acc) = table.series(&q_mean[j], h_q, w);
-        let sign: Vec<f64> = v
-            .iter()
-            .map(|&v| crate::direct::parameters::sign0(v))
-            .collect();
+        let sign: Vec<f64> = v.iter().map(|&v| crate::parameters::sign0(v)).collect();
         let c = table.values(&table.project(&sign, h_tau), h_tau);
         let t = table.values(&tau_mean[j], h_tau);
         for (r, &i) in rows.iter().enumerate() {

@@ -2,8 +2,8 @@
 //! `qdd1..qN`, `tau1..tauN`; or the same named after the joints (`q_<joint>`, `qd_<joint>`,
 //! `qdd_<joint>`, `tau_<joint>`).
 
-use super::table::Table;
 use crate::error::{shown, Error, Result};
+use crate::io::table::{listed, time_hint, Table};
 use crate::logs::recording::Recording;
 use crate::trajectory::Samples;
 
@@ -66,7 +66,7 @@ impl<'a> Columns<'a> {
                     i + 1,
                     shown(t[i]),
                     shown(t[i - 1]),
-                    crate::logs::recording::time_hint(t[i], t[i - 1])
+                    time_hint(t[i], t[i - 1])
                 ),
             ));
         }
@@ -130,15 +130,6 @@ impl<'a> Columns<'a> {
     }
 }
 
-/// Names for a message: the first `most`, then "...".
-pub(super) fn listed(columns: &[String], most: usize) -> String {
-    let mut names: Vec<&str> = columns.iter().take(most).map(String::as_str).collect();
-    if columns.len() > most {
-        names.push("...");
-    }
-    names.join(", ")
-}
-
 fn bad(table: &Table, message: String) -> Error {
     Error::Recording {
         recording: table.source.clone(),
@@ -171,7 +162,7 @@ pub fn load_recording(path: &std::path::Path, joints: &[String]) -> Result<Recor
 /// [`load_recording`] reads back to the same numbers (what a preprocessed recording knows of
 /// its log's glitches and dropouts is not kept).
 pub fn save_recording(rec: &Recording, path: &std::path::Path) -> Result<()> {
-    super::write_atomic(path, recording_table(rec, "").to_csv().as_bytes())
+    crate::io::write_atomic(path, recording_table(rec, "").to_csv().as_bytes())
 }
 
 /// States to evaluate a model at: `t`, `q`, `qd`, `qdd` required (row-major), `tau` optional

@@ -3,12 +3,12 @@
 
 use std::path::Path;
 
-use super::recording::{recording_table, samples_table};
-use super::OutputSet;
 use crate::document::Document;
 use crate::error::{Error, Result};
+use crate::io::OutputSet;
 use crate::local::Plan;
 use crate::logs::recording::Recording;
+use crate::logs::recording_csv::{recording_table, samples_table};
 
 /// The files of `plan` in folder `dir`, not yet written ([`OutputSet::commit`] writes them
 /// whole or not at all): one `<experiment>.csv` per experiment (`nominal.csv`, `D.csv`, ...:

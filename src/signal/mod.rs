@@ -1,6 +1,10 @@
 //! Signal processing for recordings: Butterworth low-pass filters applied forward and backward
 //! (zero phase, as scipy's `sosfiltfilt`), linear resampling and numerical differentiation.
 
+pub mod grid;
+
+pub use grid::grid_step;
+
 use crate::error::{Error, Result};
 
 /// One second-order section `b0 + b1 z^-1 + b2 z^-2 / (1 + a1 z^-1 + a2 z^-2)`.
