@@ -26,7 +26,7 @@ threshold run on the calling thread, and one Pinocchio process. The peer is buil
 cores: a batch large enough for the parallel engine against one Pinocchio process per core.
 Results are checked to agree (torques and matrices to 1e-10 relative, the parameters identified
 from either library's regressor to 1e-8 relative) before any time is reported. The Markdown
-table goes to stdout, benches/README.md and README.md (between the `speed-table` markers).
+table goes to stdout and to benches/README.md (between the `speed-table` markers).
 """
 
 from __future__ import annotations
@@ -66,7 +66,7 @@ FLAGS = ["-O3", "-march=native", "-DNDEBUG", "-std=c++17", "-DBOOST_MPL_LIMIT_LI
          "-DBOOST_FUSION_INVOKE_MAX_ARITY=12"]
 
 
-# issue 17's goals, one core, against Pinocchio's one-call throughput: the kernels of the
+# The goals, one core, against Pinocchio's one-call throughput: the kernels of the
 # lanes 10x with AVX-512 and 8x with AVX2 and FMA only; the derivatives and the linearisation 5x
 # on either; none for forward dynamics (ABA or CRBA, each where faster) or the scalar path; one
 # Python call within 1.1x of `pinocchio.rnea`'s time
@@ -74,7 +74,7 @@ PYTHON_CALL_TARGET = 1.1
 
 
 def target(kernel: str, isa: str) -> float | None:
-    """Issue 17's speed-up goal for `kernel` on the `isa` path, or None where it sets none."""
+    """The speed-up goal for `kernel` on the `isa` path, or None where it sets none."""
     if isa not in ("avx512", "avx2+fma"):
         return None
     if kernel in ("rnea", "mass_matrix", "regressor"):
@@ -85,7 +85,7 @@ def target(kernel: str, isa: str) -> float | None:
 
 
 def verdict(rows, isa: str, call_ratio: float) -> str:
-    """One sentence on issue 17's goals from the table's `rows` (robot, kernel, median ratio,
+    """One sentence on the goals from the table's `rows` (robot, kernel, median ratio,
     lowest round's ratio) and one Python call's time ratio: which are met by the median, and
     which of those also in every round."""
     met, short, edge = [], [], []
@@ -103,8 +103,8 @@ def verdict(rows, isa: str, call_ratio: float) -> str:
     call = f"one Python call {call_ratio:.2f}x of `pinocchio.rnea`'s time (goal <= {PYTHON_CALL_TARGET}x)"
     (met if call_ratio <= PYTHON_CALL_TARGET else short).append(call)
     if isa not in ("avx512", "avx2+fma"):
-        return f"Issue 17's goals: none for the {isa} path but the Python call: " + call + "."
-    out = f"Issue 17's goals on the {isa} path: {len(met) + len(edge)} of " \
+        return f"Goals: none for the {isa} path but the Python call: " + call + "."
+    out = f"Goals on the {isa} path: {len(met) + len(edge)} of " \
           f"{len(met) + len(edge) + len(short)} met by the median"
     if edge:
         out += "; in the median but not in every round: " + ", ".join(edge)
@@ -709,8 +709,7 @@ def main() -> int:
     table = "\n".join(lines)
     print(table)
     if not args.no_write:
-        for path in (ROOT / "benches" / "README.md", ROOT / "README.md"):
-            write_between(path, table)
+        write_between(ROOT / "benches" / "README.md", table)
     return 0
 
 

@@ -1,4 +1,4 @@
-"""benches/compare_pinocchio.py: issue 17's goals as the script applies them to its table."""
+"""benches/compare_pinocchio.py: the speed-up goals as the script applies them to its table."""
 
 from __future__ import annotations
 
@@ -41,7 +41,7 @@ def test_verdict_counts_met_edge_and_short(script):
         ("a465", "forward_dynamics", 1.5, 1.4),    # no goal: not counted
     ]
     text = script.verdict(rows, "avx512", 0.94)
-    assert text.startswith("Issue 17's goals on the avx512 path: 4 of 5 met by the median")
+    assert text.startswith("Goals on the avx512 path: 4 of 5 met by the median")
     assert "not in every round: tree60 mass_matrix (10.01x of 10x), a465 linearize (5.20x of 5x)" in text
     assert text.endswith("short: tree60 regressor (3.90x of 10x).")
     # on AVX2 the same ratios meet the 8x goal; a slow Python call is short

@@ -1,18 +1,22 @@
-"""The README's Python examples run as written, and its main command prints what it shows."""
+"""The Python examples of README.md and docs/python.md run as written, and the README's main
+command prints what it shows."""
 
 import re
 import subprocess
 import sysconfig
 from pathlib import Path
 
+import pytest
 
-def test_readme_python_example_runs(tmp_path, monkeypatch):
+
+@pytest.mark.parametrize("document", ["README.md", "docs/python.md"])
+def test_python_examples_run(document, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # the examples write files (plan/)
-    text = (Path(__file__).parents[2] / "README.md").read_text()
+    text = (Path(__file__).parents[2] / document).read_text()
     blocks = re.findall(r"```python\n(.*?)```", text, re.S)
-    assert blocks, "README has no python example"
+    assert blocks, f"{document} has no python example"
     for code in blocks:
-        exec(compile(code, "README.md", "exec"), {})
+        exec(compile(code, document, "exec"), {})
 
 
 def test_readme_main_command_prints_what_it_shows(tmp_path):
