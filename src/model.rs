@@ -160,7 +160,7 @@ impl Body {
         self.pose_terms = PoseTerms::new(self.kind, &self.placement, &self.axis);
         // an edited inertia reaches the turned frame's too (its placement needs the parent's)
         if let Some(mut t) = self.turned.take() {
-            t.turn_inertia(self);
+            t.turn_inertia(&self.axis, &self.origin_inertia);
             self.turned = Some(t);
         }
     }
@@ -293,7 +293,7 @@ impl Model {
         for b in &mut self.bodies {
             b.refresh();
         }
-        let turned = turned_frame::turned_frames(&self.bodies);
+        let turned = turned_frames(&self.bodies);
         for (b, t) in self.bodies.iter_mut().zip(turned) {
             b.turned = t;
         }
@@ -497,6 +497,39 @@ pub(crate) fn check_finite_vector(argument: &str, x: &[f64], n: usize) -> Result
         }),
         None => Ok(()),
     }
+}
+
+/// Every body's turned frame, in the bodies' order (parents first): `None` for a revolute joint
+/// with an axis-aligned placement (`AlignedRevolute`) below a body that is not turned (or on
+/// the base), which keeps its own frame.
+fn turned_frames(bodies: &[Body]) -> Vec<Option<TurnedFrame>> {
+    let mut turns: Vec<Option<Matrix3<f64>>> = Vec::with_capacity(bodies.len());
+    let mut out = Vec::with_capacity(bodies.len());
+    for b in bodies {
+        // (a parent after its child, which no builder makes, is taken as not turned)
+        let parent = b.parent.and_then(|p| turns.get(p).copied().flatten());
+        if b.pose_terms.aligned.is_some() && parent.is_none() {
+            turns.push(None);
+            out.push(None);
+            continue;
+        }
+        let qp_t = parent.unwrap_or_else(Matrix3::identity).transpose();
+        let q = turned_frame::turn_onto(&b.axis);
+        let r0 = &b.placement.rotation;
+        let mut t = TurnedFrame {
+            rot: qp_t * r0 * q,
+            pos: qp_t * b.placement.translation,
+            slide: match b.kind {
+                JointKind::Revolute => Vector3::zeros(),
+                JointKind::Prismatic => qp_t * r0 * b.axis,
+            },
+            ..TurnedFrame::default()
+        };
+        t.turn_inertia(&b.axis, &b.origin_inertia);
+        out.push(Some(t));
+        turns.push(Some(q));
+    }
+    out
 }
 
 #[cfg(test)]

@@ -33,7 +33,9 @@ pub fn aba(
     gravity: Gravity,
 ) -> Result<()> {
     if model.coupled || model.bodies.iter().any(|b| b.multiplier != 1.0) {
-        return super::forward_dynamics::forward_dynamics_crba(model, data, q, qd, tau, gravity);
+        return super::forward_dynamics_crba::forward_dynamics_crba(
+            model, data, q, qd, tau, gravity,
+        );
     }
     model.check_vector("tau", tau)?;
     load_state(model, data, q, Some(qd), None)?;

@@ -10,6 +10,7 @@ pub mod batch;
 pub mod crba;
 pub mod derivatives;
 pub mod forward_dynamics;
+pub mod forward_dynamics_crba;
 pub mod kinematics;
 pub mod linearization_regressor;
 pub mod parallel;

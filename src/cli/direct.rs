@@ -508,7 +508,7 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
     let joints = file.joint_names().to_vec();
     let gains = a
         .signal
-        .then(|| super::gains::model_gains(&file, &a.model, "--signal").map(|g| &g.gain[..]))
+        .then(|| super::files::model_gains(&file, &a.model, "--signal").map(|g| &g.gain[..]))
         .transpose()?;
     let mut notes = String::new();
     let rows = read_states(&a.columns.table(&a.data, &joints, &mut notes)?, &joints)?;

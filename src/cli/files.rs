@@ -621,3 +621,23 @@ pub(crate) fn log_offsets_table(
     }
     out
 }
+
+/// The drive gains of the saved model `file` (read from `path`) for the option `argument`
+/// (`--signal`, `--gains-from`): refused for a model that holds none.
+pub(crate) fn model_gains<'a>(
+    file: &'a crate::model_file::ModelFile,
+    path: &Path,
+    argument: &str,
+) -> Result<&'a crate::direct::DriveGains> {
+    match file {
+        crate::model_file::ModelFile::Base(fit) => fit.drive_gains.as_ref(),
+        _ => None,
+    }
+    .ok_or_else(|| Error::InvalidArgument {
+        argument: argument.into(),
+        message: format!(
+            "'{}' holds no drive gains: only a model from identify-gains has them",
+            path.display()
+        ),
+    })
+}

@@ -217,26 +217,6 @@ pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
     Ok(out)
 }
 
-/// The drive gains of the saved model `file` (read from `path`) for the option `argument`
-/// (`--signal`, `--gains-from`): refused for a model that holds none.
-pub(crate) fn model_gains<'a>(
-    file: &'a ModelFile,
-    path: &Path,
-    argument: &str,
-) -> Result<&'a crate::direct::DriveGains> {
-    match file {
-        ModelFile::Base(fit) => fit.drive_gains.as_ref(),
-        _ => None,
-    }
-    .ok_or_else(|| Error::InvalidArgument {
-        argument: argument.into(),
-        message: format!(
-            "'{}' holds no drive gains: only a model from identify-gains has them",
-            path.display()
-        ),
-    })
-}
-
 /// The drive gains saved in the model at `path` (`--gains-from`), for a robot of joints
 /// `joints`: refused, naming the file, for a model of other joints or without gains.
 pub(crate) fn gains_from_file(path: &Path, joints: &[String]) -> Result<crate::direct::DriveGains> {
@@ -252,5 +232,5 @@ pub(crate) fn gains_from_file(path: &Path, joints: &[String]) -> Result<crate::d
             ),
         });
     }
-    Ok(model_gains(&file, path, "--gains-from")?.clone())
+    Ok(super::files::model_gains(&file, path, "--gains-from")?.clone())
 }

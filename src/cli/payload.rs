@@ -114,7 +114,7 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
     let gains = match (a.signal, &file, &a.model) {
         (false, ..) => None,
         (true, Some(f), Some(path)) => {
-            Some(super::gains::model_gains(f, path, "--signal")?.gain.clone())
+            Some(super::files::model_gains(f, path, "--signal")?.gain.clone())
         }
         (true, ..) => {
             return Err(Error::InvalidArgument {

@@ -150,7 +150,7 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     let mut out = String::new();
     let gains = match &file {
         Subject::File(f) if a.signal => {
-            Some(super::gains::model_gains(f, &a.model, "--signal").map(|g| &g.gain[..])?)
+            Some(super::files::model_gains(f, &a.model, "--signal").map(|g| &g.gain[..])?)
         }
         _ => None,
     };

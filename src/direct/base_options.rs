@@ -6,7 +6,9 @@ use serde::{Deserialize, Serialize};
 
 use super::base::BASE_TOLERANCE;
 use super::parameters::FrictionTerms;
+use super::torque_noise::TorqueNoise;
 use crate::choice::choice;
+use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 
 choice! {
@@ -61,7 +63,7 @@ pub struct BaseOptions {
     /// of [`Weighting::Noise`] (which needs it), and for any weighting the yardstick the
     /// fit's residuals are judged against ([`super::NoiseFit`], [`super::BaseModel::noise_fit`]).
     /// Default None.
-    pub noise: Option<super::TorqueNoise>,
+    pub noise: Option<TorqueNoise>,
 }
 
 impl Default for BaseOptions {
@@ -86,6 +88,28 @@ impl BaseOptions {
     /// or WLS weighted from its residuals). Errors: the noise weighting without a noise, or a
     /// noise that is not one positive level a joint of `joints`.
     pub fn noise_weights(&self, joints: &[String]) -> crate::error::Result<Option<Vec<f64>>> {
-        super::torque_noise::weights(self.weighting, self.noise.as_ref(), joints)
+        weights(self.weighting, self.noise.as_ref(), joints)
+    }
+}
+
+/// The noise levels a joint (N m) that weight a fit's rows: `noise`'s for
+/// [`Weighting::Noise`], None for the other weightings (OLS, or WLS weighted from its
+/// residuals). Errors: the noise weighting without a noise, or a noise that is not one
+/// positive level a joint of `joints`.
+pub fn weights(
+    weighting: Weighting,
+    noise: Option<&TorqueNoise>,
+    joints: &[String],
+) -> Result<Option<Vec<f64>>> {
+    if let Some(noise) = noise {
+        noise.check(joints)?;
+    }
+    match (weighting, noise) {
+        (Weighting::Noise, Some(noise)) => Ok(Some(noise.sigma.clone())),
+        (Weighting::Noise, None) => Err(Error::InvalidArgument {
+            argument: "weighting".into(),
+            message: "the noise weighting needs the torques' noise measured apart from the fit: average the log over its excitation's periods (--average-periods, --period; preprocess(excitation=..., period=...)), or give the noise a joint (noise=)".into(),
+        }),
+        _ => Ok(None),
     }
 }

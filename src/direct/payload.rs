@@ -299,7 +299,7 @@ pub fn identify_payload(
         crate::torque_model::FOR_A_FIT,
     )?;
     super::runs::check_runs(&options.runs, states.len())?;
-    let fixed = super::torque_noise::weights(
+    let fixed = super::base_options::weights(
         options.weighting,
         options.noise.as_ref(),
         &model.joint_names,

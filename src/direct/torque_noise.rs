@@ -235,25 +235,3 @@ impl TorqueNoise {
         }
     }
 }
-
-/// The noise levels a joint (N m) that weight a fit's rows: `noise`'s for
-/// [`super::Weighting::Noise`], None for the other weightings (OLS, or WLS weighted from its
-/// residuals). Errors: the noise weighting without a noise, or a noise that is not one
-/// positive level a joint of `joints`.
-pub fn weights(
-    weighting: super::Weighting,
-    noise: Option<&TorqueNoise>,
-    joints: &[String],
-) -> Result<Option<Vec<f64>>> {
-    if let Some(noise) = noise {
-        noise.check(joints)?;
-    }
-    match (weighting, noise) {
-        (super::Weighting::Noise, Some(noise)) => Ok(Some(noise.sigma.clone())),
-        (super::Weighting::Noise, None) => Err(Error::InvalidArgument {
-            argument: "weighting".into(),
-            message: "the noise weighting needs the torques' noise measured apart from the fit: average the log over its excitation's periods (--average-periods, --period; preprocess(excitation=..., period=...)), or give the noise a joint (noise=)".into(),
-        }),
-        _ => Ok(None),
-    }
-}

@@ -8,9 +8,12 @@ pub mod column_map;
 pub mod config;
 pub(crate) mod foreign;
 pub mod output_set;
+pub mod read;
 pub mod table;
+pub(crate) mod temporaries;
 
-pub use atomic::{read_document, read_text, write_atomic};
+pub use atomic::write_atomic;
 pub use column_map::ColumnMap;
 pub use output_set::{check_not_partial, OutputSet};
+pub use read::{read_document, read_text};
 pub use table::{csv_text, Table};

@@ -20,20 +20,18 @@
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, SystemTime};
 
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 
 use super::atomic::{io_error, write_temporary};
+use super::temporaries::remove_stale_temporaries;
 
 const FORMAT: &str = "perturbid.manifest";
 const SUFFIX: &str = ".manifest.json";
 /// A manifest larger than this is not one of ours (it is not read when checking a file).
 const MAX_MANIFEST_BYTES: u64 = 16 << 20;
-/// A temporary file older than this is stale even if a process with its id runs.
-const STALE_AFTER: Duration = Duration::from_secs(3600);
 
 #[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -271,53 +269,10 @@ pub fn check_not_partial(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// The name of the temporary file for `path` written by this process.
-pub(crate) fn temporary_name(file_name: &str) -> String {
-    format!(".{file_name}.perturbid-{}.tmp", std::process::id())
-}
-
-/// The process id in a temporary file name written by [`temporary_name`] (or by earlier
-/// versions, `.NAME.PID.tmp`), if `name` is one.
-fn temporary_pid(name: &str) -> Option<u32> {
-    let stem = name.strip_prefix('.')?.strip_suffix(".tmp")?;
-    let (_, pid) = stem.rsplit_once('.')?;
-    let pid = pid.strip_prefix("perturbid-").unwrap_or(pid);
-    pid.parse().ok()
-}
-
-/// Removes temporaries in `dir` left by runs that were killed: their process is gone (checked
-/// in `/proc` where there is one) or they are older than an hour. Errors are ignored: this is
-/// housekeeping.
-pub(crate) fn remove_stale_temporaries(dir: &Path) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    let proc = Path::new("/proc/self").exists();
-    let me = std::process::id();
-    for e in entries.filter_map(|e| e.ok()) {
-        let name = e.file_name().to_string_lossy().into_owned();
-        let Some(pid) = temporary_pid(&name) else {
-            continue;
-        };
-        if pid == me {
-            continue;
-        }
-        let dead = proc && !Path::new(&format!("/proc/{pid}")).exists();
-        let old = e
-            .metadata()
-            .and_then(|m| m.modified())
-            .ok()
-            .and_then(|t| SystemTime::now().duration_since(t).ok())
-            .is_some_and(|age| age > STALE_AFTER);
-        if dead || old {
-            let _ = std::fs::remove_file(e.path());
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::temporaries::{temporary_name, temporary_pid};
 
     fn tmpdir(tag: &str) -> PathBuf {
         let d =

@@ -183,7 +183,7 @@ pub fn refuse_shared_samples(
     let Some(s) = find_shared_samples(runs) else {
         return Ok(());
     };
-    let name = |r: usize| crate::logs::stacked_states::run_name(names, r);
+    let name = |r: usize| run_name(names, r);
     let span = |at: usize| format!("{} to {}", at + 1, at + s.len);
     let whole = s.len == runs[s.first].len() && s.len == runs[s.second].len();
     let what = if whole {
@@ -231,6 +231,12 @@ fn window_hash(w: &[u64]) -> u64 {
 /// A window holding two samples that differ.
 fn varied(w: &[u64]) -> bool {
     w.iter().any(|&x| x != w[0])
+}
+
+/// Run `r`'s name among `names` (a log's path, a Recording's name), or `run r` (from 0) where
+/// none is given.
+pub fn run_name(names: &[String], r: usize) -> String {
+    names.get(r).cloned().unwrap_or_else(|| format!("run {r}"))
 }
 
 #[cfg(test)]

@@ -2,6 +2,7 @@
 //! (`identify-direct LOG LOG ...`, [`crate::direct::drive_gains`]).
 
 use crate::error::{Error, Result};
+pub use crate::logs::repeated_samples::run_name;
 use crate::states::States;
 
 /// States with velocities and accelerations, row-major `k x nv`, and per sample `nv` values of
@@ -98,10 +99,4 @@ impl StackedStates {
             None => Ok(states),
         }
     }
-}
-
-/// Run `r`'s name among `names` (a log's path, a Recording's name), or `run r` (from 0) where
-/// none is given.
-pub fn run_name(names: &[String], r: usize) -> String {
-    names.get(r).cloned().unwrap_or_else(|| format!("run {r}"))
 }

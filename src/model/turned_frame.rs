@@ -18,8 +18,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::{Body, JointKind};
-use crate::spatial::SplitInertia;
+use crate::spatial::{OriginInertia, SplitInertia};
 
 /// The constants of one body's turned frame (see the module's documentation). Frames: "the
 /// parent's turned frame" is the base frame for a root body.
@@ -39,13 +38,13 @@ pub(crate) struct TurnedFrame {
 }
 
 impl TurnedFrame {
-    /// Sets `h` and `split` from body `b`'s inertia and axis (the body's own terms, which
-    /// [`Body::refresh`] renews after an edit of the inertia; the frame's placement depends on
-    /// the parent's and is [`super::Model::refresh`]'s).
-    pub(crate) fn turn_inertia(&mut self, b: &Body) {
-        let q = turn_onto(&b.axis);
-        let i = q.transpose() * b.origin_inertia.i * q;
-        self.h = q.transpose() * b.origin_inertia.h;
+    /// Sets `h` and `split` from a body's inertia about its origin and its joint's unit axis
+    /// (the body's own terms, which `Body::refresh` renews after an edit of the inertia; the
+    /// frame's placement depends on the parent's and is `Model::refresh`'s).
+    pub(crate) fn turn_inertia(&mut self, axis: &Vector3<f64>, inertia: &OriginInertia) {
+        let q = turn_onto(axis);
+        let i = q.transpose() * inertia.i * q;
+        self.h = q.transpose() * inertia.h;
         self.split = SplitInertia::of(&((i + i.transpose()) * 0.5));
     }
 }
@@ -60,39 +59,6 @@ pub(crate) fn turn_onto(a: &Vector3<f64>) -> Matrix3<f64> {
     let k = a.iamin();
     let u = Vector3::ith(k, 1.0).cross(a).normalize();
     Matrix3::from_columns(&[u, a.cross(&u), *a])
-}
-
-/// Every body's turned frame, in the bodies' order (parents first): `None` for a revolute joint
-/// with an axis-aligned placement (`AlignedRevolute`) below a body that is not turned (or on
-/// the base), which keeps its own frame.
-pub(crate) fn turned_frames(bodies: &[Body]) -> Vec<Option<TurnedFrame>> {
-    let mut turns: Vec<Option<Matrix3<f64>>> = Vec::with_capacity(bodies.len());
-    let mut out = Vec::with_capacity(bodies.len());
-    for b in bodies {
-        // (a parent after its child, which no builder makes, is taken as not turned)
-        let parent = b.parent.and_then(|p| turns.get(p).copied().flatten());
-        if b.pose_terms.aligned.is_some() && parent.is_none() {
-            turns.push(None);
-            out.push(None);
-            continue;
-        }
-        let qp_t = parent.unwrap_or_else(Matrix3::identity).transpose();
-        let q = turn_onto(&b.axis);
-        let r0 = &b.placement.rotation;
-        let mut t = TurnedFrame {
-            rot: qp_t * r0 * q,
-            pos: qp_t * b.placement.translation,
-            slide: match b.kind {
-                JointKind::Revolute => Vector3::zeros(),
-                JointKind::Prismatic => qp_t * r0 * b.axis,
-            },
-            ..TurnedFrame::default()
-        };
-        t.turn_inertia(b);
-        out.push(Some(t));
-        turns.push(Some(q));
-    }
-    out
 }
 
 #[cfg(test)]

@@ -46,42 +46,13 @@ pub(crate) fn with_offset_per_log(
     }
 }
 
-/// The Recordings of `q` where it is a list or tuple of them (None where it is anything else:
-/// an array of numbers); a list of which some are Recordings and some not is a TypeError.
-pub(crate) fn recordings_of(
-    q: &Bound<'_, PyAny>,
-) -> PyResult<Option<Vec<Arc<crate::logs::recording::Recording>>>> {
-    let items: Vec<Bound<'_, PyAny>> = match (
-        q.cast::<pyo3::types::PyList>(),
-        q.cast::<pyo3::types::PyTuple>(),
-    ) {
-        (Ok(l), _) => l.iter().collect(),
-        (_, Ok(t)) => t.iter().collect(),
-        _ => return Ok(None),
-    };
-    let recs: Vec<Option<Arc<crate::logs::recording::Recording>>> = (items.iter())
-        .map(|x| {
-            x.cast::<super::recording::PyRecording>()
-                .ok()
-                .map(|r| r.get().rec.clone())
-        })
-        .collect();
-    match recs.iter().filter(|r| r.is_some()).count() {
-        0 => Ok(None),
-        k if k == recs.len() => Ok(Some(recs.into_iter().flatten().collect())),
-        _ => Err(pyo3::exceptions::PyTypeError::new_err(
-            "q: a list of Recordings (runs to fit together) or an array of positions, not a mix",
-        )),
-    }
-}
-
 /// The Recordings given as `q` (a list or tuple of them: runs to fit together), with nothing
 /// else given beside them (they carry their own); None for arrays or one Recording.
 pub(crate) fn recordings_given(
     q: &Bound<'_, PyAny>,
     given: &Given<'_>,
 ) -> PyResult<Option<Vec<Arc<crate::logs::recording::Recording>>>> {
-    let Some(recs) = recordings_of(q)? else {
+    let Some(recs) = super::recording::recordings_of(q)? else {
         return Ok(None);
     };
     if let Some(name) = given.first_given() {

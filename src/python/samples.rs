@@ -97,7 +97,7 @@ pub(crate) fn samples<'py>(
     wants_t: bool,
 ) -> PyResult<Samples<'py>> {
     let py = q.py();
-    if super::recording_list::recordings_of(&q)?.is_some() {
+    if super::recording::recordings_of(&q)?.is_some() {
         return Err(Error::InvalidArgument {
             argument: "q".into(),
             message: "a list of Recordings, which only the fits take (identify_base_parameters, identify_consistent_parameters: runs fitted together); give one Recording, or arrays".into(),

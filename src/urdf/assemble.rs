@@ -9,8 +9,8 @@ use nalgebra::Vector3;
 use super::bodies::Bodies;
 use super::convert::joint_limits;
 use super::graph::Graph;
+use super::reader::Builder;
 use super::roles::Role;
-use super::Builder;
 use crate::error::{Error, Result};
 use crate::model::{Model, STANDARD_GRAVITY};
 

@@ -6,8 +6,8 @@ use nalgebra::Vector3;
 
 use super::convert::{joint_kind, link_inertia};
 use super::graph::Graph;
+use super::reader::Builder;
 use super::roles::Role;
-use super::Builder;
 use crate::error::{Error, Result};
 use crate::model::{joint_pose, Body, Frame};
 use crate::spatial::{Inertia, Se3};

@@ -4,7 +4,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::convert::kind_name;
-use super::Builder;
+use super::reader::Builder;
 use crate::error::{shown, Error, Result};
 
 impl Builder<'_> {

@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 
 use super::convert::kind_name;
-use super::Builder;
+use super::reader::Builder;
 use crate::error::{Error, Result};
 
 /// The URDF's links and joints as a tree (indices into `robot.links` and `robot.joints`).

@@ -2,7 +2,7 @@
 
 use std::collections::HashMap;
 
-use super::Builder;
+use super::reader::Builder;
 use crate::error::{Error, Result};
 
 /// How a URDF joint enters the model once mimic couplings and locks are resolved.
