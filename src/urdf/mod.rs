@@ -1,4 +1,4 @@
-//! Building a [`Model`] from a URDF (parsed by urdf-rs).
+//! Building a [`Model`](crate::model::Model) from a URDF (parsed by urdf-rs).
 //!
 //! What is read: the kinematic tree (any tree, not only chains) of revolute, continuous,
 //! prismatic and fixed joints; joint origins (xyz, rpy); axes (normalised); link inertials with
@@ -19,7 +19,7 @@
 //! step: `lines` finds where each element stands in the file,
 //! `checks` refuses what no robot can have, `graph` links joints and links into a tree,
 //! `roles` resolves mimic couplings and locks, `bodies` merges links into moving bodies and
-//! `assemble` numbers the degrees of freedom into a [`Model`]; `convert` turns urdf-rs values
+//! `assemble` numbers the degrees of freedom into a [`Model`](crate::model::Model); `convert` turns urdf-rs values
 //! into ours. `write` writes a model back as URDF, its changed parameters in the file it came
 //! from, through the text edits of `edits`.
 
