@@ -98,54 +98,7 @@ pub(crate) struct ValidateArgs {
 
 pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     refuse_overwriting_inputs(&a.out, &[&a.model, &a.data])?;
-    let file = if is_a_robot(&a.model)? {
-        if a.signal {
-            return Err(Error::InvalidArgument {
-                argument: "--signal".into(),
-                message: format!(
-                    "{} is a robot, validated with its own parameters: --signal is for a saved model with drive gains",
-                    a.model.display()
-                ),
-            });
-        }
-        let own = load_robot(&a.model.display().to_string(), &a.lock)?;
-        // --robot (a pipeline's defaults give it to every step) must be the same robot
-        if let Some(r) = &a.robot {
-            let other = load_robot(r, &a.lock)?;
-            if other.joint_names != own.joint_names {
-                return Err(Error::InvalidArgument {
-                    argument: "--robot".into(),
-                    message: format!(
-                        "'{r}' has joints {:?}, MODEL {} {:?}: a robot given as MODEL is validated with its own parameters, and --robot, where given, must be the same robot",
-                        other.joint_names,
-                        a.model.display(),
-                        own.joint_names
-                    ),
-                });
-            }
-        }
-        Subject::Robot(Box::new(own))
-    } else {
-        Subject::File(ModelFile::load(&a.model)?)
-    };
-    let joints = match &file {
-        Subject::File(f) => f.joint_names().to_vec(),
-        Subject::Robot(r) => r.joint_names.clone(),
-    };
-    let robot = match (&file, &a.robot) {
-        (Subject::Robot(r), _) => Some((**r).clone()),
-        (Subject::File(ModelFile::Base(_)), None) => {
-            return Err(Error::InvalidArgument {
-                argument: "--robot".into(),
-                message: format!(
-                    "{} is a base-parameter model: give the robot it was identified for",
-                    a.model.display()
-                ),
-            })
-        }
-        (_, Some(r)) => Some(load_robot(r, &a.lock)?),
-        (_, None) => None,
-    };
+    let (file, joints, robot) = subject(&a)?;
     let progress = Progress::new();
     let mut out = String::new();
     let gains = match &file {
@@ -206,53 +159,9 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     if let Ok(se) = &stderr {
         v = v.with_model_stderr(se)?;
     }
-    // the log's torque columns against the robot's own model, as every direct fit checks
-    // its own log: swapped columns, another sign or other units show here by name, not only
-    // as large errors
-    let (position_range, torque_columns, torque_lag, offsets) = match (&file, &robot) {
-        (Subject::File(ModelFile::Base(fit)), Some(r)) => {
-            progress.update("checking the torque columns");
-            (
-                check_position_range(r, &states),
-                check_torque_columns(r, &states, &rec.tau, fit.gravity)?,
-                check_torque_lag(r, &states, &rec.tau, fit.gravity)?,
-                check_position_offsets_in_validation(r, fit, &states, &rec.tau)?,
-            )
-        }
-        // a robot's own: its columns, lag and range as a base-parameter model's; the zero
-        // offsets are estimated against a fit's parameters, which a robot has not
-        (Subject::Robot(r), _) => {
-            progress.update("checking the torque columns");
-            (
-                check_position_range(r, &states),
-                check_torque_columns(r, &states, &rec.tau, crate::gravity::Gravity::Included)?,
-                check_torque_lag(r, &states, &rec.tau, crate::gravity::Gravity::Included)?,
-                None,
-            )
-        }
-        _ => (vec![], vec![], None, None),
-    };
+    let checks = LogChecks::of(&file, robot.as_ref(), &states, &rec.tau, &progress)?;
     progress.done();
-    let rounding = crate::logs::position_rounding::warning(&rec.position_rounding, &joints)
-        .map(|w| format!("{w}{}", crate::logs::position_rounding::IN_A_VALIDATION));
-    for w in validation_findings(
-        &position_range,
-        &torque_columns,
-        torque_lag.as_ref(),
-        offsets.as_ref(),
-    )
-    .into_iter()
-    .chain(rounding)
-    .chain(match &file {
-        Subject::Robot(r) if !crate::robot_torques::RobotTorques::new(r).has_friction() => {
-            Some(crate::robot_torques::NO_FRICTION.to_string())
-        }
-        _ => None,
-    })
-    .chain(extrapolation.as_ref().map(|x| x.message()))
-    {
-        eprintln!("perturbid: warning: log '{}': {w}", a.data.display());
-    }
+    warn(&a, &file, &checks, &rec, &joints, extrapolation.as_ref());
     // the residuals, the table and the figure, as one output set
     let mut columns = vec!["t".to_string()];
     columns.extend(joints.iter().map(|j| format!("residual_{j}")));
@@ -264,8 +173,182 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
     }
     let mut set = OutputSet::new(&a.out, "validation");
     set.add("residuals.csv", table.to_csv())?;
-    // the log's glitches replaced before preprocessing beside the table, when there were any
-    let mut json = serde_json::to_value(&v).expect("serialisable");
+    // the errors against the noise the log's periods measured (no parameters fitted to them;
+    // the model's own uncertainty, its s.e., not counted)
+    let rms: Vec<f64> = v.joints.iter().map(|j| j.rms).collect();
+    let noise_fit = (rec.period_average.as_ref())
+        .and_then(|a| crate::direct::TorqueNoise::from_period_average(a, &joints).ok())
+        .and_then(|n| crate::direct::NoiseFit::of(&n, &rms, v.samples, 0));
+    let json = validation_json(
+        &v,
+        &rec,
+        &checks,
+        extrapolation.as_ref(),
+        noise_fit.as_ref(),
+    );
+    set.add(
+        "validation.json",
+        serde_json::to_string_pretty(&json).expect("serialisable"),
+    )?;
+    set.add(
+        "validation.svg",
+        figure(
+            &joints,
+            &rec.t,
+            &rec.tau,
+            &predicted,
+            stderr.as_deref().ok(),
+        ),
+    )?;
+    set.commit()?;
+    summary(&a, &v, &rec, &rms, noise_fit.as_ref(), &stderr, &mut out);
+    Ok(out)
+}
+
+/// What MODEL is (a saved model, or a robot validated with its own parameters), its joints,
+/// and the robot a base-parameter model needs (or the robot itself).
+fn subject(a: &ValidateArgs) -> Result<(Subject, Vec<String>, Option<crate::model::Model>)> {
+    let file = if is_a_robot(&a.model)? {
+        if a.signal {
+            return Err(Error::InvalidArgument {
+                argument: "--signal".into(),
+                message: format!(
+                    "{} is a robot, validated with its own parameters: --signal is for a saved model with drive gains",
+                    a.model.display()
+                ),
+            });
+        }
+        let own = load_robot(&a.model.display().to_string(), &a.lock)?;
+        // --robot (a pipeline's defaults give it to every step) must be the same robot
+        if let Some(r) = &a.robot {
+            let other = load_robot(r, &a.lock)?;
+            if other.joint_names != own.joint_names {
+                return Err(Error::InvalidArgument {
+                    argument: "--robot".into(),
+                    message: format!(
+                        "'{r}' has joints {:?}, MODEL {} {:?}: a robot given as MODEL is validated with its own parameters, and --robot, where given, must be the same robot",
+                        other.joint_names,
+                        a.model.display(),
+                        own.joint_names
+                    ),
+                });
+            }
+        }
+        Subject::Robot(Box::new(own))
+    } else {
+        Subject::File(ModelFile::load(&a.model)?)
+    };
+    let joints = match &file {
+        Subject::File(f) => f.joint_names().to_vec(),
+        Subject::Robot(r) => r.joint_names.clone(),
+    };
+    let robot = match (&file, &a.robot) {
+        (Subject::Robot(r), _) => Some((**r).clone()),
+        (Subject::File(ModelFile::Base(_)), None) => {
+            return Err(Error::InvalidArgument {
+                argument: "--robot".into(),
+                message: format!(
+                    "{} is a base-parameter model: give the robot it was identified for",
+                    a.model.display()
+                ),
+            })
+        }
+        (_, Some(r)) => Some(load_robot(r, &a.lock)?),
+        (_, None) => None,
+    };
+    Ok((file, joints, robot))
+}
+
+/// The log's torque columns against the robot's own model, as every direct fit checks its
+/// own log: swapped columns, another sign or other units show here by name, not only as large
+/// errors.
+struct LogChecks {
+    position_range: Vec<crate::direct::position_range::JointRange>,
+    torque_columns: Vec<crate::direct::torque_columns::TorqueColumn>,
+    torque_lag: Option<crate::direct::torque_lag::TorqueLag>,
+    offsets: Option<crate::direct::position_offsets::PositionOffsets>,
+}
+
+impl LogChecks {
+    fn of(
+        file: &Subject,
+        robot: Option<&crate::model::Model>,
+        states: &crate::states::States<'_>,
+        tau: &[f64],
+        progress: &Progress,
+    ) -> Result<Self> {
+        let (position_range, torque_columns, torque_lag, offsets) = match (file, robot) {
+            (Subject::File(ModelFile::Base(fit)), Some(r)) => {
+                progress.update("checking the torque columns");
+                (
+                    check_position_range(r, states),
+                    check_torque_columns(r, states, tau, fit.gravity)?,
+                    check_torque_lag(r, states, tau, fit.gravity)?,
+                    check_position_offsets_in_validation(r, fit, states, tau)?,
+                )
+            }
+            // a robot's own: its columns, lag and range as a base-parameter model's; the zero
+            // offsets are estimated against a fit's parameters, which a robot has not
+            (Subject::Robot(r), _) => {
+                progress.update("checking the torque columns");
+                (
+                    check_position_range(r, states),
+                    check_torque_columns(r, states, tau, crate::gravity::Gravity::Included)?,
+                    check_torque_lag(r, states, tau, crate::gravity::Gravity::Included)?,
+                    None,
+                )
+            }
+            _ => (vec![], vec![], None, None),
+        };
+        Ok(Self {
+            position_range,
+            torque_columns,
+            torque_lag,
+            offsets,
+        })
+    }
+}
+
+/// The warnings of the log `a.data`, on standard error.
+fn warn(
+    a: &ValidateArgs,
+    file: &Subject,
+    checks: &LogChecks,
+    rec: &crate::logs::Recording,
+    joints: &[String],
+    extrapolation: Option<&crate::local::reach::Extrapolation>,
+) {
+    let rounding = crate::logs::position_rounding::warning(&rec.position_rounding, joints)
+        .map(|w| format!("{w}{}", crate::logs::position_rounding::IN_A_VALIDATION));
+    for w in validation_findings(
+        &checks.position_range,
+        &checks.torque_columns,
+        checks.torque_lag.as_ref(),
+        checks.offsets.as_ref(),
+    )
+    .into_iter()
+    .chain(rounding)
+    .chain(match file {
+        Subject::Robot(r) if !crate::robot_torques::RobotTorques::new(r).has_friction() => {
+            Some(crate::robot_torques::NO_FRICTION.to_string())
+        }
+        _ => None,
+    })
+    .chain(extrapolation.map(|x| x.message()))
+    {
+        eprintln!("perturbid: warning: log '{}': {w}", a.data.display());
+    }
+}
+
+/// validation.json: the validation, with what the log's preprocessing and checks found.
+fn validation_json(
+    v: &crate::validation::Validation,
+    rec: &crate::logs::Recording,
+    checks: &LogChecks,
+    extrapolation: Option<&crate::local::reach::Extrapolation>,
+    noise_fit: Option<&crate::direct::NoiseFit>,
+) -> serde_json::Value {
+    let mut json = serde_json::to_value(v).expect("serialisable");
     if !rec.glitches.is_empty() {
         json["log_glitches"] = serde_json::to_value(&rec.glitches).expect("serialisable");
     }
@@ -286,52 +369,47 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
         json["log_torque_saturation"] =
             serde_json::to_value(&rec.torque_saturation).expect("serialisable");
     }
-    if !torque_columns.is_empty() {
-        json["torque_columns"] = serde_json::to_value(&torque_columns).expect("serialisable");
+    if !checks.torque_columns.is_empty() {
+        json["torque_columns"] =
+            serde_json::to_value(&checks.torque_columns).expect("serialisable");
     }
-    if let Some(lag) = &torque_lag {
+    if let Some(lag) = &checks.torque_lag {
         json["torque_lag"] = serde_json::to_value(lag).expect("serialisable");
     }
-    if !position_range.is_empty() {
-        json["position_range"] = serde_json::to_value(&position_range).expect("serialisable");
+    if !checks.position_range.is_empty() {
+        json["position_range"] =
+            serde_json::to_value(&checks.position_range).expect("serialisable");
     }
-    if let Some(x) = &extrapolation {
+    if let Some(x) = extrapolation {
         json["extrapolation"] = serde_json::to_value(x).expect("serialisable");
     }
-    if let Some(o) = &offsets {
+    if let Some(o) = &checks.offsets {
         json["position_offsets"] = serde_json::to_value(o).expect("serialisable");
     }
     if let Some(a) = &rec.period_average {
         json["log_period_average"] = serde_json::to_value(a).expect("serialisable");
     }
-    // the errors against the noise the log's periods measured (no parameters fitted to them;
-    // the model's own uncertainty, its s.e., not counted)
-    let rms: Vec<f64> = v.joints.iter().map(|j| j.rms).collect();
-    let noise_fit = (rec.period_average.as_ref())
-        .and_then(|a| crate::direct::TorqueNoise::from_period_average(a, &joints).ok())
-        .and_then(|n| crate::direct::NoiseFit::of(&n, &rms, v.samples, 0));
-    if let Some(n) = &noise_fit {
+    if let Some(n) = noise_fit {
         json["noise_fit"] = serde_json::to_value(n).expect("serialisable");
     }
     if !rec.position_rounding.is_empty() {
         json["position_rounding"] =
             serde_json::to_value(&rec.position_rounding).expect("serialisable");
     }
-    set.add(
-        "validation.json",
-        serde_json::to_string_pretty(&json).expect("serialisable"),
-    )?;
-    set.add(
-        "validation.svg",
-        figure(
-            &joints,
-            &rec.t,
-            &rec.tau,
-            &predicted,
-            stderr.as_deref().ok(),
-        ),
-    )?;
-    set.commit()?;
+    json
+}
+
+/// The table the command prints: each joint's errors, against the noise and the model's own
+/// uncertainty where known.
+fn summary(
+    a: &ValidateArgs,
+    v: &crate::validation::Validation,
+    rec: &crate::logs::Recording,
+    rms: &[f64],
+    noise_fit: Option<&crate::direct::NoiseFit>,
+    stderr: &std::result::Result<Vec<f64>, String>,
+    out: &mut String,
+) {
     let _ = writeln!(
         out,
         "{} against {} samples of {}:",
@@ -358,16 +436,16 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
         );
     }
     if let Some(avg) = &rec.period_average {
-        let _ = writeln!(out, "  {}", avg.model_error_line(&rms, "RMS"));
+        let _ = writeln!(out, "  {}", avg.model_error_line(rms, "RMS"));
     }
-    if let Some(n) = &noise_fit {
+    if let Some(n) = noise_fit {
         let _ = writeln!(
             out,
             "  {} (the model's own uncertainty, its s.e., not counted)",
             n.summary("the errors")
         );
     }
-    match &stderr {
+    match stderr {
         Ok(_) => {
             let _ = writeln!(
                 out,
@@ -383,7 +461,6 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
         "wrote residuals.csv, validation.json, validation.svg to {}",
         a.out.display()
     );
-    Ok(out)
 }
 
 /// Measured and predicted torques per joint, one panel each (measured solid, predicted

@@ -40,8 +40,10 @@ mod followed_plan;
 mod friction_aware;
 pub mod glitches;
 pub mod identify;
+mod identify_local;
 pub mod model;
 pub mod noise;
+mod nominal_point;
 pub mod offset_search;
 
 pub mod parameters;
@@ -55,6 +57,7 @@ pub mod predicted_response;
 pub(crate) mod prediction_uncertainty;
 pub mod quantisation;
 pub mod reach;
+mod regressions;
 mod repaired_recording;
 pub mod response;
 pub mod reversals;
@@ -73,7 +76,8 @@ pub use diagnostics::{
     BlockAgreement, ClockOffset, Diagnostics, Glitch, Reversal, ReversalHandling, TorqueNoise,
     Unmeasured,
 };
-pub use identify::{identify_local, CrossingTimes, IdentifyOptions};
+pub use identify::{CrossingTimes, IdentifyOptions};
+pub use identify_local::identify_local;
 pub use model::{Estimate, Estimator, LocalModel, SignalGains};
 pub use offset_search::{detect_offset, detect_offset_in};
 pub use parameters::{identify_parameters_from_local, FromLocalOptions, ParametersFromLocal};

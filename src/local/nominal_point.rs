@@ -1,0 +1,116 @@
+//! T* and the measured operating point: the means over the nominal experiment's crossings,
+//! with their standard errors and the variance of the point's error.
+
+use super::crossing::CrossingValues;
+use super::identify::ExperimentValues;
+use super::noise::sample_variance;
+use super::plan::{ExperimentKind, Plan};
+use super::quantisation;
+use crate::error::{Error, Result};
+use crate::operating_point::OperatingPoint;
+
+/// T* and the measured operating point: the means over the nominal crossings, with their
+/// standard errors.
+pub(super) struct NominalPoint {
+    /// The index of the nominal experiment among the values, if the plan has one.
+    pub(super) nominal: Option<usize>,
+    pub(super) torque: Vec<f64>,
+    pub(super) torque_stderr: Vec<f64>,
+    pub(super) op: OperatingPoint,
+    /// `[q, qd, qdd]` of `op`.
+    pub(super) state: [Vec<f64>; 3],
+    /// The variance of the operating point's error, per variable and joint.
+    pub(super) var: [Vec<f64>; 3],
+}
+
+impl NominalPoint {
+    pub(super) fn of(plan: &Plan, values: &[ExperimentValues]) -> Result<Self> {
+        let n = plan.n();
+        let index = values
+            .iter()
+            .position(|v| v.kind == ExperimentKind::Nominal);
+        let nominal = index.map(|i| &values[i]);
+        let needs_nominal = values.iter().any(|v| {
+            matches!(
+                v.kind,
+                ExperimentKind::GDynamic | ExperimentKind::H | ExperimentKind::D
+            )
+        });
+        let (torque, torque_stderr, op) = match nominal {
+            Some(v) => Self::means(v, n),
+            None if needs_nominal => return Err(Error::InvalidArgument {
+                argument: "plan".into(),
+                message:
+                    "the plan has no nominal experiment, which the G, H and D regressions need for T*"
+                        .into(),
+            }),
+            None => (vec![f64::NAN; n], vec![f64::NAN; n], plan.op.clone()),
+        };
+        let state = [op.q.clone(), op.qd.clone(), op.qdd.clone()];
+        // the variance of the operating point's error, the mean of the nominal crossings':
+        // noise averages over their K passes (/ K), but positions read by their band are
+        // rounded the same way in every pass of one trajectory, and need not average out
+        let var: [Vec<f64>; 3] = std::array::from_fn(|var| {
+            (0..n)
+                .map(|j| {
+                    nominal.map_or(0.0, |v| {
+                        let k = v.crossings.len().max(1) as f64;
+                        let mean = v
+                            .crossings
+                            .iter()
+                            .map(|c| c.state_stderr[var][j].powi(2))
+                            .sum::<f64>()
+                            / k;
+                        if v.crossings.iter().any(|c| c.position_band[j]) {
+                            mean
+                        } else {
+                            mean / k
+                        }
+                    })
+                })
+                .collect()
+        });
+        Ok(Self {
+            nominal: index,
+            torque,
+            torque_stderr,
+            op,
+            state,
+            var,
+        })
+    }
+
+    /// The mean torque, its standard error and the mean state over the nominal crossings `v`.
+    fn means(v: &ExperimentValues, n: usize) -> (Vec<f64>, Vec<f64>, OperatingPoint) {
+        let k = v.crossings.len() as f64;
+        let mean = |f: &dyn Fn(&CrossingValues) -> &[f64]| -> Vec<f64> {
+            (0..n)
+                .map(|j| v.crossings.iter().map(|c| f(c)[j]).sum::<f64>() / k)
+                .collect()
+        };
+        let tau = mean(&|c| &c.tau);
+        let samples = sample_variance(&v.crossings, n);
+        let se = (0..n)
+            .map(|j| {
+                let ss: f64 = v
+                    .crossings
+                    .iter()
+                    .map(|c| (c.tau[j] - tau[j]).powi(2))
+                    .sum();
+                let rounding = quantisation::undithered_step(v.torque_step[j], samples[j])
+                    .map_or(0.0, |q| quantisation::rounding_stderr(q) / k.sqrt());
+                if k > 1.0 {
+                    (ss / (k - 1.0) / k).sqrt().max(rounding)
+                } else {
+                    f64::NAN
+                }
+            })
+            .collect();
+        let op = OperatingPoint {
+            q: mean(&|c| &c.q),
+            qd: mean(&|c| &c.qd),
+            qdd: mean(&|c| &c.qdd),
+        };
+        (tau, se, op)
+    }
+}
