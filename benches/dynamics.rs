@@ -20,7 +20,7 @@ use perturbid_rs::algorithms::batch::{
 use perturbid_rs::algorithms::regressor::joint_torque_regressor;
 use perturbid_rs::{
     aba, forward_dynamics_crba, linearize_into, mass_matrix, mass_matrix_batch, parallel,
-    regressor_batch, rnea, rnea_derivatives, rnea_lanes, Data, Gravity, Isa, LaneData,
+    regressor_batch, rnea, rnea_batch, rnea_derivatives, Data, Gravity, Isa, LaneData,
     Linearization, Model, States,
 };
 use std::hint::black_box;
@@ -137,7 +137,7 @@ fn dynamics(c: &mut Criterion) {
             let mut lanes = LaneData::with_isa(&model, isa).unwrap();
             group.bench_function(format!("rnea/{isa}"), |b| {
                 b.iter(|| {
-                    rnea_lanes(
+                    rnea_batch(
                         &model,
                         &mut lanes,
                         &q,

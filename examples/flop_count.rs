@@ -13,7 +13,7 @@ use perturbid_rs::algorithms::batch::{
     derivatives_batch, linearize_batch, DerivativesOut, LinearizationsOut,
 };
 use perturbid_rs::simd::flops;
-use perturbid_rs::{mass_matrix_batch, regressor_batch, rnea_lanes, Gravity, Isa, LaneData};
+use perturbid_rs::{mass_matrix_batch, regressor_batch, rnea_batch, Gravity, Isa, LaneData};
 
 fn main() -> perturbid_rs::Result<()> {
     let isa = Isa::detect();
@@ -40,7 +40,7 @@ fn main() -> perturbid_rs::Result<()> {
             println!("{{\"robot\": \"{robot}\", \"kernel\": \"{kernel}\", \"flops_per_sample\": {per:.1}}}");
         };
         flops::take();
-        rnea_lanes(&model, &mut lanes, &q, Some(&qd), Some(&qdd), g, &mut tau)?;
+        rnea_batch(&model, &mut lanes, &q, Some(&qd), Some(&qdd), g, &mut tau)?;
         report("rnea");
         mass_matrix_batch(&model, &mut lanes, &q, &mut mats[0])?;
         report("mass_matrix");

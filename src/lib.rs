@@ -9,6 +9,27 @@
 //!
 //! Units: SI throughout (rad, m, s, kg, N m). Frames: the base frame with gravity along -z;
 //! spatial quantities as described in [`spatial`].
+//!
+//! The README's example (`tests/readme.rs` checks that it reads the same there):
+//!
+//! ```
+//! use perturbid_rs::{parallel, rnea, robots, Data, Gravity, States};
+//!
+//! let model = robots::builtin("a465")?;
+//! let mut data = Data::new(&model);
+//! let (q, qd, qdd) = (vec![0.1; 6], vec![0.2; 6], vec![0.3; 6]);
+//! rnea(&model, &mut data, &q, &qd, &qdd, Gravity::Included)?; // data.tau
+//!
+//! // many samples (row-major k x nv), in parallel over the cores:
+//! let k = 10_000;
+//! let (qs, qds, qdds) = (q.repeat(k), qd.repeat(k), qdd.repeat(k));
+//! let states = States::new(model.nv, &qs, Some(&qds), Some(&qdds))?; // checked once
+//! let mut ws = parallel::Workspace::new(&model); // reuse: it keeps every thread's buffers
+//! let mut taus = vec![0.0; k * model.nv];
+//! parallel::rnea(&model, &mut ws, &states, Gravity::Included, &mut taus)?;
+//! assert!((taus[6 * (k - 1)..].iter().zip(data.tau.iter())).all(|(a, b)| (a - b).abs() < 1e-9));
+//! # Ok::<(), perturbid_rs::Error>(())
+//! ```
 
 // Errors carry their context (file, line, joint, time) by value; they are the cold path.
 #![allow(clippy::result_large_err)]
@@ -59,7 +80,10 @@ pub mod validation;
 mod python;
 
 pub use algorithms::aba::aba;
-pub use algorithms::batch::{mass_matrix_batch, regressor_batch, rnea_lanes, LaneData, LANES};
+#[allow(deprecated)]
+pub use algorithms::batch::{
+    mass_matrix_batch, regressor_batch, rnea_batch, rnea_lanes, LaneData, LANES,
+};
 pub use algorithms::crba::mass_matrix;
 pub use algorithms::derivatives::rnea_derivatives;
 pub use algorithms::forward_dynamics::{forward_dynamics, forward_dynamics_crba};

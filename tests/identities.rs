@@ -294,7 +294,7 @@ fn check_lanes(model: &Model, rng: &mut Rng, k: usize) {
         (true, false, Gravity::Excluded),
     ] {
         let (v, a) = (with_v.then_some(&qd[..]), with_a.then_some(&qdd[..]));
-        perturbid_rs::rnea_lanes(model, &mut lanes, &q, v, a, gravity, &mut out).unwrap();
+        perturbid_rs::rnea_batch(model, &mut lanes, &q, v, a, gravity, &mut out).unwrap();
         let mut data = Data::new(model);
         for s in 0..k {
             let r = s * n..(s + 1) * n;
@@ -339,7 +339,7 @@ fn lanes_equal_one_sample_rnea_on_the_a465_and_a_mimic_pair() {
     let model = robots::builtin("a465").unwrap();
     let mut lanes = perturbid_rs::LaneData::new(&model);
     let mut out = vec![0.0; 12];
-    let e = perturbid_rs::rnea_lanes(
+    let e = perturbid_rs::rnea_batch(
         &model,
         &mut lanes,
         &[0.0; 12],

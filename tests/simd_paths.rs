@@ -14,7 +14,7 @@ use perturbid_rs::algorithms::batch::{
 use perturbid_rs::algorithms::regressor::joint_torque_regressor;
 use perturbid_rs::{
     linearize, mass_matrix, mass_matrix_batch, model_from_urdf_str, regressor_batch, rnea,
-    rnea_derivatives, rnea_lanes, robots, Data, Gravity, Isa, LaneData, LoadOptions, Model,
+    rnea_batch, rnea_derivatives, robots, Data, Gravity, Isa, LaneData, LoadOptions, Model,
 };
 use proptest::prelude::*;
 
@@ -106,7 +106,7 @@ fn check_rnea(model: &Model, path: Path, rng: &mut Rng, k: usize) {
     ] {
         let mut out = vec![f64::NAN; k * n];
         let (v, a) = (with_v.then_some(&qd[..]), with_a.then_some(&qdd[..]));
-        rnea_lanes(model, &mut lanes, &q, v, a, gravity, &mut out).unwrap();
+        rnea_batch(model, &mut lanes, &q, v, a, gravity, &mut out).unwrap();
         for s in 0..k {
             let r = s * n..(s + 1) * n;
             let vs = if with_v { &qd[r.clone()] } else { &zeros[..] };
@@ -363,7 +363,7 @@ fn buffers_of_another_model_are_refused() {
     let mimic = model_from_urdf_str(&mimic_pair(true), "mimic", &LoadOptions::default()).unwrap();
     let mut lanes = LaneData::new(&mimic);
     let mut out = vec![0.0; 6];
-    let e = rnea_lanes(
+    let e = rnea_batch(
         &a465,
         &mut lanes,
         &[0.0; 6],
@@ -468,7 +468,7 @@ fn a_kernel_vouches_for_its_output_only_when_every_value_is_finite() {
                 qd[s * n + 2] = 1e200;
             }
             let (v, a) = (Some(&qd[..]), Some(&qdd[..]));
-            let done = rnea_lanes(&model, &mut lanes, &q, v, a, Gravity::Included, &mut tau);
+            let done = rnea_batch(&model, &mut lanes, &q, v, a, Gravity::Included, &mut tau);
             qd.iter_mut().for_each(|v| *v = 0.2);
             if !vector_path && bad.is_some() {
                 // the one-sample algorithm refuses the overflow itself

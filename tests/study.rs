@@ -101,7 +101,7 @@ fn a_study_agrees_with_the_methods_one_by_one() {
         )
         .unwrap();
         let ideal = TrueRobot {
-            gravity: false,
+            gravity: perturbid_rs::Gravity::Excluded,
             seed: c.seed,
             ..TrueRobot::default()
         };

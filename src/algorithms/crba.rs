@@ -11,6 +11,19 @@ use crate::model::Model;
 
 /// Joint-space mass matrix `M(q)` (kg m^2, kg m or kg by joint pair), symmetric positive
 /// definite. `q`: length `model.nv`. Writes `data.m` (`nv x nv`, both triangles).
+///
+/// ```
+/// use perturbid_rs::{mass_matrix, rnea, robots, Data, Gravity};
+/// let model = robots::builtin("a465")?;
+/// let mut data = Data::new(&model);
+/// let (q, qdd) = ([0.3, -0.2, 0.5, 0.1, 0.4, -0.6], [1.0, -2.0, 0.5, 0.0, 3.0, 1.5]);
+/// mass_matrix(&model, &mut data, &q)?;
+/// let m_qdd = &data.m * nalgebra::DVector::from_column_slice(&qdd);
+/// rnea(&model, &mut data, &q, &[0.0; 6], &qdd, Gravity::Excluded)?; // M(q) qdd alone
+/// assert!((&data.tau - m_qdd).amax() < 1e-10);
+/// assert!((&data.m - data.m.transpose()).amax() < 1e-12);
+/// # Ok::<(), perturbid_rs::Error>(())
+/// ```
 pub fn mass_matrix(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
     load_state(model, data, q, None, None)?;
     update_placements(model, data);

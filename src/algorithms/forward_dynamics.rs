@@ -13,6 +13,19 @@ use crate::model::Model;
 ///
 /// `q`, `qd`, `tau` (N m or N): length `model.nv`. `gravity`: include `g(q)`. Writes `data.qdd`.
 /// Fails if the model's inertia is singular at `q`.
+///
+/// ```
+/// use perturbid_rs::{forward_dynamics, rnea, robots, Data, Gravity};
+/// let model = robots::builtin("a465")?;
+/// let mut data = Data::new(&model);
+/// let (q, qd) = ([0.3, -0.2, 0.5, 0.1, 0.4, -0.6], [0.5, 0.1, -0.3, 0.2, 0.0, 1.0]);
+/// let tau = [10.0, -5.0, 3.0, 0.5, -0.2, 0.1];
+/// forward_dynamics(&model, &mut data, &q, &qd, &tau, Gravity::Included)?;
+/// let qdd = data.qdd.clone();
+/// rnea(&model, &mut data, &q, &qd, qdd.as_slice(), Gravity::Included)?; // back to the torques
+/// assert!(data.tau.iter().zip(tau).all(|(a, b)| (a - b).abs() < 1e-9));
+/// # Ok::<(), perturbid_rs::Error>(())
+/// ```
 pub fn forward_dynamics(
     model: &Model,
     data: &mut Data,

@@ -17,7 +17,7 @@ use rayon::prelude::*;
 use std::sync::{Mutex, PoisonError};
 
 use super::batch::{
-    derivatives_batch, linearize_batch, mass_matrix_batch, regressor_batch, rnea_lanes, LaneData,
+    derivatives_batch, linearize_batch, mass_matrix_batch, regressor_batch, rnea_batch, LaneData,
 };
 pub use super::batch::{DerivativesOut, LinearizationsOut};
 use super::regressor::PARAMS_PER_BODY;
@@ -244,7 +244,7 @@ pub fn rnea(
             // on a Zen 4, level on the arms, the 60-dof tree's 35 % slower); two or more on the
             // lanes (from two on faster on every robot measured)
             if s.len() >= 2 {
-                return rnea_lanes(model, &mut w.lanes, s.q(), s.qd(), s.qdd(), gravity, out);
+                return rnea_batch(model, &mut w.lanes, s.q(), s.qd(), s.qdd(), gravity, out);
             }
             let zeros = vec![0.0; n];
             for (i, o) in out.chunks_mut(n).enumerate() {

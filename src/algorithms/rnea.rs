@@ -46,6 +46,18 @@ pub fn rnea(
 
 /// Gravity torque `g(q)` (N m or N): the torque that holds the robot at rest at `q`.
 /// Writes `data.g` (`nv`).
+///
+/// ```
+/// use perturbid_rs::{gravity_torque, rnea, robots, Data, Gravity};
+/// let model = robots::builtin("a465")?;
+/// let mut data = Data::new(&model);
+/// let q = [0.3, -0.2, 0.5, 0.1, 0.4, -0.6];
+/// gravity_torque(&model, &mut data, &q)?;
+/// let g = data.g.clone();
+/// rnea(&model, &mut data, &q, &[0.0; 6], &[0.0; 6], Gravity::Included)?; // at rest
+/// assert!((&data.tau - &g).amax() < 1e-12);
+/// # Ok::<(), perturbid_rs::Error>(())
+/// ```
 pub fn gravity_torque(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
     load_state(model, data, q, None, None)?;
     let mut out = std::mem::take(&mut data.g);

@@ -22,7 +22,6 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::error::{shown, Error, Result};
-use crate::gravity::Gravity;
 use crate::local::Plan;
 use crate::logs::recording::Recording;
 use crate::model::Model;
@@ -59,7 +58,7 @@ pub fn rehearse(
     let true_model = robot.rigid_body_model(nominal)?;
     let effects = JointEffects::new(robot, n)?;
     let offsets = true_robot::per_joint("joint_offsets", &robot.joint_offsets, n, 0.0)?;
-    let gravity = Gravity::from(robot.gravity);
+    let gravity = robot.gravity;
     let motion = match &robot.controller {
         None => {
             tracking::follow_exactly(&true_model, &effects, gravity, reference, &offsets, true)?
@@ -153,7 +152,7 @@ pub fn true_torques(
     let motion = tracking::follow_exactly(
         &true_model,
         &effects,
-        Gravity::from(robot.gravity),
+        robot.gravity,
         &reference,
         &offsets,
         false,

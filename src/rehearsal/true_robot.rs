@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::document::{invalid, Document};
 use crate::error::{Error, Result};
+use crate::gravity::Gravity;
 use crate::model::payload::{Payload, MAX_COM_OFFSET};
 use crate::model::Model;
 
@@ -130,9 +131,10 @@ pub struct TrueRobot {
     /// Seed of every random effect (noise, jitter, random parameter errors).
     #[serde(default)]
     pub seed: u64,
-    /// Gravity acts (default true); false as if it were compensated exactly.
-    #[serde(default = "yes")]
-    pub gravity: bool,
+    /// Gravity acts (default; `true` in the file), or is left out as if it were compensated
+    /// exactly (`false`).
+    #[serde(default)]
+    pub gravity: Gravity,
     #[serde(default)]
     pub payload: Option<Payload>,
     #[serde(default)]
@@ -164,7 +166,7 @@ impl Default for TrueRobot {
         TrueRobot {
             format: Self::tag(),
             seed: 0,
-            gravity: true,
+            gravity: Gravity::Included,
             payload: None,
             link_errors: vec![],
             parameter_error: 0.0,

@@ -312,7 +312,7 @@ impl StudyRobot {
 /// noise.
 fn ideal() -> TrueRobot {
     TrueRobot {
-        gravity: false,
+        gravity: crate::gravity::Gravity::Excluded,
         ..TrueRobot::default()
     }
 }

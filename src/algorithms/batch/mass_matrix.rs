@@ -17,7 +17,7 @@ use nalgebra::Vector3;
 /// to rounding.
 ///
 /// `q`: row-major `k x nv` (rad or m), finite (checked by the caller, as for
-/// [`super::rnea_lanes`]). `out`: row-major `k x nv x nv` (kg m^2, kg m or kg), both triangles
+/// [`super::rnea_batch`]). `out`: row-major `k x nv x nv` (kg m^2, kg m or kg), both triangles
 /// written. Runs on the instruction set of `data`.
 pub fn mass_matrix_batch(
     model: &Model,

@@ -5,7 +5,7 @@
 //! model's constants (placements, axes, inertias) are shared by the lanes. Without a vector
 //! instruction set the kernels run the one-sample algorithms in a loop.
 //!
-//! Kernels: [`rnea_lanes`] (inverse dynamics), [`mass_matrix_batch`], [`regressor_batch`] and
+//! Kernels: [`rnea_batch`] (inverse dynamics), [`mass_matrix_batch`], [`regressor_batch`] and
 //! [`regressor_group`] (the joint-torque regressor), [`derivatives_batch`] (the RNEA
 //! derivatives) and [`linearize_batch`] (`T*, D*, H*, G*, Gs`). Each takes a [`LaneData`] of
 //! buffers made once per model and thread.
@@ -22,7 +22,8 @@ mod rnea;
 pub use derivatives::{derivatives_batch, linearize_batch, DerivativesOut, LinearizationsOut};
 pub use mass_matrix::mass_matrix_batch;
 pub use regressor::{regressor_batch, regressor_group};
-pub use rnea::rnea_lanes;
+#[allow(deprecated)]
+pub use rnea::{rnea_batch, rnea_lanes};
 
 use crate::algorithms::regressor::PARAMS_PER_BODY;
 use crate::data::Data;

@@ -17,7 +17,7 @@ use nalgebra::Vector3;
 /// that [`crate::algorithms::regressor::joint_torque_regressor`] gives, up to rounding.
 ///
 /// `q`, `qd`, `qdd`: row-major `k x nv` (rad, rad/s, rad/s^2), finite (checked by the caller, as
-/// for [`super::rnea_lanes`]); `gravity` includes gravity. Runs on the instruction set of
+/// for [`super::rnea_batch`]); `gravity` includes gravity. Runs on the instruction set of
 /// `data`.
 pub fn regressor_batch(
     model: &Model,

@@ -20,7 +20,7 @@ use crate::simd::{serial, SpatialLanes};
 ///
 /// Equal to [`crate::rnea`] sample by sample up to rounding. Runs on the instruction set of
 /// `data` ([`LaneData::isa`]).
-pub fn rnea_lanes(
+pub fn rnea_batch(
     model: &Model,
     data: &mut LaneData,
     q: &[f64],
@@ -46,6 +46,21 @@ pub fn rnea_lanes(
         tau,
     };
     dispatch(model, data, kernel)
+}
+
+/// The former name of [`rnea_batch`], kept for code written against it.
+#[deprecated(note = "named like its siblings now: use rnea_batch")]
+#[inline]
+pub fn rnea_lanes(
+    model: &Model,
+    data: &mut LaneData,
+    q: &[f64],
+    qd: Option<&[f64]>,
+    qdd: Option<&[f64]>,
+    gravity: Gravity,
+    tau: &mut [f64],
+) -> Result<()> {
+    rnea_batch(model, data, q, qd, qdd, gravity, tau)
 }
 
 struct Rnea<'a> {
