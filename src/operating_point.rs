@@ -17,6 +17,14 @@ pub struct OperatingPoint {
 
 impl OperatingPoint {
     /// Checks that the three vectors have the same length and finite entries.
+    ///
+    /// ```
+    /// use perturbid_rs::OperatingPoint;
+    /// let op = OperatingPoint::new(vec![0.1, 0.2], vec![0.0, 0.5], vec![1.0, 0.0])?;
+    /// assert_eq!(op.n(), 2);
+    /// assert!(OperatingPoint::new(vec![0.1], vec![0.0, 0.5], vec![1.0]).is_err()); // lengths differ
+    /// # Ok::<(), perturbid_rs::Error>(())
+    /// ```
     pub fn new(q: Vec<f64>, qd: Vec<f64>, qdd: Vec<f64>) -> Result<Self> {
         let n = q.len();
         if n == 0 {

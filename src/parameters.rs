@@ -66,6 +66,14 @@ pub fn model_parameters(model: &Model) -> DVector<f64> {
 }
 
 /// Which per-joint friction parameters are identified with the inertial ones.
+///
+/// ```
+/// use perturbid_rs::parameters::FrictionTerms;
+/// let terms: FrictionTerms = "all".parse()?;
+/// assert_eq!(terms.to_string(), "viscous,coulomb,offset");
+/// assert!("stiction".parse::<FrictionTerms>().is_err()); // named in the error, with the choices
+/// # Ok::<(), perturbid_rs::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FrictionTerms {
@@ -171,6 +179,16 @@ impl std::fmt::Display for FrictionTerms {
 
 /// The full parameter layout for a model: `10 * nbodies` inertial parameters (body after body)
 /// and then, joint after joint, the friction terms switched on.
+///
+/// ```
+/// use perturbid_rs::parameters::{FrictionTerms, ParameterLayout};
+/// let model = perturbid_rs::robots::builtin("a465")?;
+/// let layout = ParameterLayout::new(&model, "viscous,coulomb".parse()?);
+/// assert_eq!(layout.len(), 10 * 6 + 2 * 6); // ten inertial parameters a body, two terms a joint
+/// assert_eq!(layout.names[0], format!("{}.m", model.bodies[0].link));
+/// assert_eq!(layout.friction, FrictionTerms { viscous: true, coulomb: true, ..FrictionTerms::NONE });
+/// # Ok::<(), perturbid_rs::Error>(())
+/// ```
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ParameterLayout {
@@ -227,6 +245,11 @@ impl ParameterLayout {
 
 /// `sign(x)` with `sign(0) = 0`: the Coulomb column of the friction terms (no torque at
 /// exactly zero speed).
+///
+/// ```
+/// use perturbid_rs::parameters::sign0;
+/// assert_eq!((sign0(-0.3), sign0(0.0), sign0(2.0)), (-1.0, 0.0, 1.0));
+/// ```
 pub fn sign0(x: f64) -> f64 {
     if x > 0.0 {
         1.0

@@ -62,6 +62,16 @@ impl Recording {
     /// Checks and builds a recording of `n` joints: `t` of length K >= 2, strictly increasing;
     /// `q`, `tau` (and `qd`, `qdd` when given) of length `K n`; every value finite. Errors name
     /// the sample (0-based) and joint.
+    ///
+    /// ```
+    /// use perturbid_rs::Recording;
+    /// let t = vec![0.0, 0.001, 0.002];
+    /// let rec = Recording::new("log.csv", 1, t, vec![0.0, 0.1, 0.2], vec![1.0, 1.1, 1.2], None, None)?;
+    /// assert_eq!(rec.len(), 3);
+    /// let back = Recording::new("log.csv", 1, vec![0.0, 0.002, 0.001], vec![0.0; 3], vec![0.0; 3], None, None);
+    /// assert!(back.unwrap_err().to_string().contains("log.csv")); // time that steps back, named
+    /// # Ok::<(), perturbid_rs::Error>(())
+    /// ```
     pub fn new(
         name: impl Into<String>,
         n: usize,

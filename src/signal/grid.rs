@@ -29,6 +29,14 @@ pub const MIN_RELATIVE_STEP: f64 = 1e-9;
 /// of a step), and at least [`MIN_RELATIVE_STEP`] of the largest magnitude. None for fewer than
 /// two distinct values, or values off any such grid (a continuous signal: its neighbours'
 /// differences are no multiples of a common step above its rounding errors).
+///
+/// ```
+/// use perturbid_rs::signal::grid_step;
+/// // torques logged in steps of 0.05 N m
+/// let step = grid_step(&[0.1, 0.15, 0.3, -0.05]).unwrap();
+/// assert!((step - 0.05).abs() < 1e-12);
+/// assert_eq!(grid_step(&[0.1, 0.1234567, 0.31415]), None); // a continuous signal
+/// ```
 pub fn grid_step(values: &[f64]) -> Option<f64> {
     let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
     v.sort_by(f64::total_cmp);
