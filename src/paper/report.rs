@@ -22,12 +22,29 @@ fn fmt_row(label: &str, v: &[f64], decimals: usize) -> Vec<String> {
 /// or the whole new one. Returns the paths.
 pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
     let mut set = OutputSet::new(dir, "report");
-    let mut put = |name: &str, bytes: &[u8]| -> Result<()> {
-        set.add(name, bytes)?;
-        Ok(())
-    };
+    set.add("table2.csv", table2_csv(r).as_bytes())?;
+    set.add("table3.csv", table3_csv(r).as_bytes())?;
+    let results = serde_json::to_string_pretty(r).expect("serialisable");
+    set.add("results.json", results.as_bytes())?;
+    if let Some(m) = &r.local_model {
+        set.add("local_model.json", Document::to_json(m).as_bytes())?;
+    }
+    set.add("figures.csv", figures_csv(r).as_bytes())?;
+    let mut fig_names = vec![];
+    for (name, svg) in figures(r) {
+        set.add(&name, svg.as_bytes())?;
+        fig_names.push(name);
+    }
+    if r.study.is_some() {
+        set.add("study.toml", super::study::PAPER_STUDY.as_bytes())?;
+    }
+    set.add("report.md", markdown_report(r, &fig_names).as_bytes())?;
+    set.commit()
+}
+
+/// table2.csv: the operating point, T* identified and the paper's Tn.
+fn table2_csv(r: &PaperResult) -> String {
     let n = r.op.q.len();
-    // tables as CSV
     let mut t2 = Table::new(
         "table2.csv",
         ["joint", "q", "qd", "qdd", "T_identified", "Tn_paper"]
@@ -44,7 +61,11 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
             r.torque_paper[j],
         ]);
     }
-    put("table2.csv", t2.to_csv().as_bytes())?;
+    t2.to_csv()
+}
+
+/// table3.csv: the first column of D by every method.
+fn table3_csv(r: &PaperResult) -> String {
     let (dg, db) = (&r.direct[0].d_global_linear, &r.direct[0].d_base_parameters);
     let (ag, ab) = (&r.direct[1].d_global_linear, &r.direct[1].d_base_parameters);
     let rows3: [(&str, &Vec<f64>); 19] = [
@@ -68,23 +89,16 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
         ("direct_global_linear", &r.d_global_linear),
         ("direct_base_parameters", &r.d_base_parameters),
     ];
-    let t3 = crate::io::csv_text(
+    crate::io::csv_text(
         &["row", "D11", "D21", "D31", "D41", "D51", "D61"],
         rows3.iter().map(|(name, v)| {
             std::iter::once(name.to_string()).chain(v.iter().map(|x| format!("{x}")))
         }),
-    );
-    put("table3.csv", t3.as_bytes())?;
-    put(
-        "results.json",
-        serde_json::to_string_pretty(r)
-            .expect("serialisable")
-            .as_bytes(),
-    )?;
-    if let Some(m) = &r.local_model {
-        put("local_model.json", Document::to_json(m).as_bytes())?;
-    }
-    // figures
+    )
+}
+
+/// figures.csv: every figure's curves against time.
+fn figures_csv(r: &PaperResult) -> String {
     let mut curves = Table::new("figures.csv", vec!["t".into()]);
     for f in &r.figures {
         for s in [
@@ -114,8 +128,12 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
         }
         curves.push(&row);
     }
-    put("figures.csv", curves.to_csv().as_bytes())?;
-    let mut fig_names = vec![];
+    curves.to_csv()
+}
+
+/// Figs. 3-5 as SVG, each with its file name.
+fn figures(r: &PaperResult) -> Vec<(String, String)> {
+    let mut out = vec![];
     let seeds = r.direct[0].seeds.len();
     for f in &r.figures {
         let number = f.joint + 1; // Figs. 3, 4, 5 show joints 2, 3, 4
@@ -169,27 +187,18 @@ pub fn write_report(r: &PaperResult, dir: &Path) -> Result<Vec<PathBuf>> {
                 "within q* +- 0.5 rad"
             }
         );
-        put(
-            &name,
-            svg::line_plot(
-                &title,
-                "time from the operating point (s)",
-                "torque (N m)",
-                &series,
-            )
-            .as_bytes(),
-        )?;
-        fig_names.push(name);
+        let plot = svg::line_plot(
+            &title,
+            "time from the operating point (s)",
+            "torque (N m)",
+            &series,
+        );
+        out.push((name, plot));
     }
-    if r.study.is_some() {
-        put("study.toml", super::study::PAPER_STUDY.as_bytes())?;
-    }
-    put("report.md", markdown_report(r, &fig_names).as_bytes())?;
-    set.commit()
+    out
 }
 
 fn markdown_report(r: &PaperResult, figs: &[String]) -> String {
-    let n = r.op.q.len();
     let mut s =
         String::from("# Kinsheel & Taha (ICARCV 2010) reproduced on the built-in CRS A465\n\n");
     s.push_str(
@@ -197,6 +206,19 @@ fn markdown_report(r: &PaperResult, figs: &[String]) -> String {
          torques, as the paper assumes them compensated. Everything below is computed by `perturbid paper`; \
          the numbers are also in `table2.csv`, `table3.csv` and `results.json`.\n\n",
     );
+    table2_section(r, &mut s);
+    table3_section(r, &mut s);
+    figures_section(r, figs, &mut s);
+    comparison_section(r, &mut s);
+    if let Some(study) = &r.study {
+        s.push_str(&study_section(study));
+    }
+    s
+}
+
+/// Table 2: the operating point, T* identified and the paper's Tn.
+fn table2_section(r: &PaperResult, s: &mut String) {
+    let n = r.op.q.len();
     s.push_str("## Table 2: the operating point and the nominal torque T*\n\n");
     let rows: Vec<Vec<String>> = (0..n)
         .map(|j| {
@@ -227,6 +249,10 @@ fn markdown_report(r: &PaperResult, figs: &[String]) -> String {
         ],
         &rows,
     ));
+}
+
+/// Table 3: the first column of D by every method, with the excitation's figures.
+fn table3_section(r: &PaperResult, s: &mut String) {
     s.push_str("\n## Table 3: first column of D at the operating point\n\n");
     let seeds = r.direct[0].seeds.len();
     let (dg, db, ag) = (
@@ -275,6 +301,11 @@ fn markdown_report(r: &PaperResult, figs: &[String]) -> String {
         r.excitation_cond,
         r.base_parameters
     ));
+}
+
+/// Figs. 3-5 and the RMS errors along their trajectory.
+fn figures_section(r: &PaperResult, figs: &[String], s: &mut String) {
+    let seeds = r.direct[0].seeds.len();
     s.push_str("\n## Figs. 3-5: torques along a trajectory through the operating point\n\n");
     s.push_str(&format!(
         "The trajectory is `q(t) = q* + qd* t + qdd* t²/2` for t in [-3, 3] s, which passes P at t = 0. \
@@ -320,6 +351,17 @@ fn markdown_report(r: &PaperResult, figs: &[String]) -> String {
         &rows,
     ));
     s.push_str("\n(RMS torque errors in N m, of the median direct models; near P: within 0.5 s of the operating point.)\n\n## Comparison with the paper\n\n");
+}
+
+/// What reproduces of the paper and what does not, every number computed.
+fn comparison_section(r: &PaperResult, s: &mut String) {
+    let n = r.op.q.len();
+    let seeds = r.direct[0].seeds.len();
+    let (dg, db, ag) = (
+        &r.direct[0].d_global_linear,
+        &r.direct[0].d_base_parameters,
+        &r.direct[1].d_global_linear,
+    );
     let max_t = (0..n)
         .map(|j| (r.torque_identified[j] - r.torque_paper[j]).abs())
         .fold(0.0, f64::max);
@@ -405,10 +447,6 @@ fn markdown_report(r: &PaperResult, figs: &[String]) -> String {
         verdict(&by("default")),
         verdict(&by("around_op")),
     ));
-    if let Some(study) = &r.study {
-        s.push_str(&study_section(study));
-    }
-    s
 }
 
 /// "When to use which method": the built-in study's table and what it shows, every number
