@@ -39,7 +39,7 @@ impl CrossingTimes {
     pub const DEFAULT_MAX_SHIFT: f64 = 0.5;
 }
 
-/// Options of [`identify_local`].
+/// Options of [`identify_local`](super::identify_local()).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IdentifyOptions {
     pub times: CrossingTimes,
@@ -51,7 +51,7 @@ pub struct IdentifyOptions {
     /// pairs that reverse joint j (its Coulomb step, `c_j` = the sum of its two Coulomb levels).
     /// Exact for viscous and (asymmetric) Coulomb friction; needs the plan's H perturbations in
     /// pairs, at least N + 1 of them (`PlanOptions::friction_aware_h`). The Coulomb levels are
-    /// in [`LocalModel::coulomb`].
+    /// in [`LocalModel::coulomb`](super::LocalModel::coulomb).
     pub friction_aware_h: bool,
 }
 

@@ -206,6 +206,21 @@ impl Document for TrueRobot {
     /// Checks every number is finite and in range (lengths are checked against the robot in
     /// [`TrueRobot::check`]).
     fn validate(&self) -> Result<()> {
+        self.validate_joint_arrays()?;
+        self.validate_sensors()?;
+        self.validate_effects()?;
+        self.validate_inertials()?;
+        if let Some(c) = &self.controller {
+            c.validate()?;
+        }
+        Ok(())
+    }
+}
+
+impl TrueRobot {
+    /// The per-joint arrays of friction, offsets and sensors: finite, of a sign and size a
+    /// robot can have (docs/limits.md).
+    fn validate_joint_arrays(&self) -> Result<()> {
         let bad = |m: String| invalid(Self::WHAT, m);
         let f = &self.friction;
         let s = &self.sensors;
@@ -280,7 +295,14 @@ impl Document for TrueRobot {
                 )));
             }
         }
-        // the simulated sensors' ranges (docs/limits.md): an encoder of 0 counts (none) or a
+        Ok(())
+    }
+
+    /// The simulated sensors' ranges (docs/limits.md).
+    fn validate_sensors(&self) -> Result<()> {
+        let bad = |m: String| invalid(Self::WHAT, m);
+        let s = &self.sensors;
+        // an encoder of 0 counts (none) or a
         // step of 1e-12 to 1 rad; a torque resolution of 0 (none) or 1e-12 to 1e6 N m
         use crate::limits::{MAX_TORQUE_NOISE, POSITION_RESOLUTION, TORQUE_RESOLUTION};
         // whole counts a revolution with steps in POSITION_RESOLUTION: 7 to 10^12
@@ -325,6 +347,14 @@ impl Document for TrueRobot {
                 crate::error::shown(s.delay)
             )));
         }
+        Ok(())
+    }
+
+    /// The parameter error, and the harmonics of position-dependent friction, ripple and
+    /// cogging.
+    fn validate_effects(&self) -> Result<()> {
+        let bad = |m: String| invalid(Self::WHAT, m);
+        let f = &self.friction;
         if !(self.parameter_error.is_finite() && (0.0..=0.5).contains(&self.parameter_error)) {
             return Err(bad(format!(
                 "parameter_error is {}, expected a relative standard deviation in [0, 0.5]",
@@ -363,6 +393,12 @@ impl Document for TrueRobot {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// The payload and the links' inertial errors.
+    fn validate_inertials(&self) -> Result<()> {
+        let bad = |m: String| invalid(Self::WHAT, m);
         // a centre of mass within reach of a robot (beyond, m c^2 overflows)
         let reach = |what: &str, com: &[f64; 3]| -> Result<()> {
             finite_all(what, com)?;
@@ -386,27 +422,34 @@ impl Document for TrueRobot {
                 )));
             }
         }
-        if let Some(c) = &self.controller {
-            finite_all("controller.kp", &c.kp)?;
-            finite_all("controller.kd", &c.kd)?;
-            if c.kp.iter().chain(&c.kd).any(|&g| g < 0.0) {
-                return Err(bad("controller gains must be >= 0".into()));
-            }
-            if let Some(effort) = &c.effort {
-                finite_all("controller.effort", effort)?;
-                if let Some(j) = effort.iter().position(|&e| e <= 0.0) {
-                    return Err(bad(format!(
-                        "controller.effort[{j}] is {}, expected a positive torque limit (N m)",
-                        effort[j]
-                    )));
-                }
-            }
-            if !(1..=1000).contains(&c.substeps) {
+        Ok(())
+    }
+}
+
+impl Controller {
+    /// Gains, effort limits and substeps a controller can have.
+    fn validate(&self) -> Result<()> {
+        let bad = |m: String| invalid(TrueRobot::WHAT, m);
+        let c = self;
+        finite_all("controller.kp", &c.kp)?;
+        finite_all("controller.kd", &c.kd)?;
+        if c.kp.iter().chain(&c.kd).any(|&g| g < 0.0) {
+            return Err(bad("controller gains must be >= 0".into()));
+        }
+        if let Some(effort) = &c.effort {
+            finite_all("controller.effort", effort)?;
+            if let Some(j) = effort.iter().position(|&e| e <= 0.0) {
                 return Err(bad(format!(
-                    "controller.substeps is {}, expected 1 to 1000",
-                    c.substeps
+                    "controller.effort[{j}] is {}, expected a positive torque limit (N m)",
+                    effort[j]
                 )));
             }
+        }
+        if !(1..=1000).contains(&c.substeps) {
+            return Err(bad(format!(
+                "controller.substeps is {}, expected 1 to 1000",
+                c.substeps
+            )));
         }
         Ok(())
     }

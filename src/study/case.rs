@@ -253,7 +253,7 @@ fn direct_models(
     let time = samples.t.last().copied().unwrap_or(0.0) - samples.t[0];
     let rec = rehearse(model, plant, &samples, 1_000, "excitation")?;
     let states = States::new(model.nv, &samples.q, Some(&samples.qd), Some(&samples.qdd))?;
-    let gravity = Gravity::from(plant.gravity);
+    let gravity = plant.gravity;
     let mut out: Fitted = Vec::new();
     for (method, weighting) in [
         (Method::DirectOls, Weighting::Ols),
