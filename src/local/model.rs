@@ -404,6 +404,15 @@ impl Document for LocalModel {
     /// Checks every shape against the number of joints, and that standard errors and
     /// residuals are magnitudes (`>= 0`, or unknown) and condition numbers at least 1.
     fn validate(&self) -> Result<()> {
+        self.validate_point()?;
+        self.validate_estimates()?;
+        self.validate_diagnostics()
+    }
+}
+
+impl LocalModel {
+    /// T*, the operating points and the per-joint parts: one entry a joint, within bounds.
+    fn validate_point(&self) -> Result<()> {
         let m = self;
         let bad = |message: String| invalid(Self::WHAT, message);
         let n = m.n();
@@ -444,6 +453,15 @@ impl Document for LocalModel {
         ] {
             check_bounded(Self::WHAT, kind, field, v.as_slice())?;
         }
+        Ok(())
+    }
+
+    /// Each estimate: its shape, magnitudes, bounds, condition and correlations.
+    fn validate_estimates(&self) -> Result<()> {
+        let m = self;
+        let bad = |message: String| invalid(Self::WHAT, message);
+        let n = m.n();
+        let kind = "a local model";
         for (what, e, cols) in [
             ("D", &m.d, n),
             ("H", &m.h, n),
@@ -470,6 +488,14 @@ impl Document for LocalModel {
                 super::prediction_uncertainty::check_correlations(Self::WHAT, what, e, n)?;
             }
         }
+        Ok(())
+    }
+
+    /// The diagnostics' entries: each names an experiment and a joint of this model, with
+    /// finite values and magnitudes where magnitudes are due.
+    fn validate_diagnostics(&self) -> Result<()> {
+        let m = self;
+        let bad = |message: String| invalid(Self::WHAT, message);
         // the diagnostics' entries name an experiment and a joint of this model
         let named = m
             .diagnostics
