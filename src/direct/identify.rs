@@ -450,6 +450,17 @@ impl Document for BaseModel {
     /// per-joint fields have one value a joint, and that standard errors, residuals and noise
     /// levels are magnitudes (the noise levels positive) and the condition number at least 1.
     fn validate(&self) -> Result<()> {
+        self.validate_base()?;
+        self.validate_numbers()?;
+        self.validate_logs()?;
+        self.validate_findings()
+    }
+}
+
+impl BaseModel {
+    /// The base parameters, their map and the layout: sizes that agree, each parameter kept or
+    /// dropped once.
+    fn validate_base(&self) -> Result<()> {
         let m = self;
         let p = m.base.kept.len();
         if m.theta.len() != p
@@ -496,6 +507,14 @@ impl Document for BaseModel {
                 ),
             ));
         }
+        Ok(())
+    }
+
+    /// The fit's numbers: bounded, one a joint where they are per joint, magnitudes and
+    /// correlations where they are due.
+    fn validate_numbers(&self) -> Result<()> {
+        let m = self;
+        let (p, n) = (m.base.kept.len(), m.joint_names.len());
         // no number beyond any robot's
         let kind = "a base-parameter model";
         for (field, values) in [
@@ -543,6 +562,14 @@ impl Document for BaseModel {
                 ),
             ));
         }
+        Ok(())
+    }
+
+    /// What the preprocessing found in the logs fitted to, and the checks of the logs against
+    /// the robot's model.
+    fn validate_logs(&self) -> Result<()> {
+        let m = self;
+        let n = m.joint_names.len();
         // the findings of the one log fitted to, or of each of several
         let flat = super::log_findings::LogFindings {
             log: "the log".into(),
@@ -600,6 +627,13 @@ impl Document for BaseModel {
         }) {
             return Err(invalid(Self::WHAT, problem));
         }
+        Ok(())
+    }
+
+    /// The findings of the fit's own checks, the drive gains and the weights.
+    fn validate_findings(&self) -> Result<()> {
+        let m = self;
+        let n = m.joint_names.len();
         if let Some(w) = &m.weak_excitation {
             let unknown = (w.motion.iter())
                 .find(|j| !m.joint_names.contains(&j.joint))
