@@ -282,6 +282,14 @@ pub const MAX_MULTIPLE: f64 = 100.0;
 impl StudyConfig {
     /// Checks what serde cannot: non-empty lists, positive finite numbers, bounds.
     pub fn check(&self, source: &str) -> Result<()> {
+        self.check_sizes(source)?;
+        self.check_listed_once(source)?;
+        self.check_multiples(source)?;
+        self.check_names(source)
+    }
+
+    /// Lists that are not empty, counts and numbers within their bounds.
+    fn check_sizes(&self, source: &str) -> Result<()> {
         let bad = |key: &str, message: String| Error::Config {
             location: format!("{source}, {key}"),
             message,
@@ -367,7 +375,15 @@ impl StudyConfig {
                 format!("{}; expected 1..=100000", self.direct.max_evaluations),
             ));
         }
-        // a value listed twice would run the same cases twice and count them twice
+        Ok(())
+    }
+
+    /// No value listed twice: it would run the same cases twice and count them twice.
+    fn check_listed_once(&self, source: &str) -> Result<()> {
+        let bad = |key: &str, message: String| Error::Config {
+            location: format!("{source}, {key}"),
+            message,
+        };
         fn twice<T: PartialEq>(v: &[T]) -> Option<&T> {
             v.iter()
                 .enumerate()
@@ -404,8 +420,16 @@ impl StudyConfig {
                 return Err(bad(key, format!("'{value}' is listed twice")));
             }
         }
-        // multiples of the default perturbations and distances in them: past 100 the states
-        // leave any robot's range
+        Ok(())
+    }
+
+    /// Perturbations and distances as multiples of the defaults: past 100 the states leave
+    /// any robot's range.
+    fn check_multiples(&self, source: &str) -> Result<()> {
+        let bad = |key: &str, message: String| Error::Config {
+            location: format!("{source}, {key}"),
+            message,
+        };
         for (key, v) in [
             ("local.perturbation", &self.local.perturbation),
             ("evaluation.distances", &self.evaluation.distances),
@@ -420,7 +444,16 @@ impl StudyConfig {
                 ));
             }
         }
-        // the names label the report's rows, tables and figure: something to read, on one line
+        Ok(())
+    }
+
+    /// The names label the report's rows, tables and figure: something to read, on one line,
+    /// each true robot and point named once.
+    fn check_names(&self, source: &str) -> Result<()> {
+        let bad = |key: &str, message: String| Error::Config {
+            location: format!("{source}, {key}"),
+            message,
+        };
         let named = std::iter::once(("name", &self.name))
             .chain(self.true_robots.iter().map(|t| ("true_robots", &t.name)))
             .chain(self.points.iter().map(|p| ("points", &p.name)));
