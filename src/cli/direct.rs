@@ -190,29 +190,7 @@ pub(crate) struct IdentifyDirectArgs {
 }
 
 pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
-    let mut inputs: Vec<&std::path::Path> = a.data.iter().map(PathBuf::as_path).collect();
-    inputs.push(a.robot.path());
-    refuse_overwriting_inputs(&a.out, &inputs)?;
-    if let Some(urdf) = &a.urdf {
-        if !a.consistent {
-            return Err(Error::InvalidArgument {
-                argument: "--urdf".into(),
-                message: "needs --consistent: base parameters are sums of several links' parameters and give no link its own".into(),
-            });
-        }
-        inputs.push(&a.out);
-        refuse_overwriting_inputs(urdf, &inputs)?;
-    }
-    if a.data.len() > crate::direct::drive_gains::MAX_RUNS {
-        return Err(Error::InvalidArgument {
-            argument: "DATA".into(),
-            message: format!(
-                "{} logs, expected at most {}",
-                a.data.len(),
-                crate::direct::drive_gains::MAX_RUNS
-            ),
-        });
-    }
+    check_direct_inputs(&a)?;
     let model = a.robot.load()?;
     let progress = Progress::new();
     let mut out = String::new();
@@ -266,60 +244,9 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         noise: super::files::averaged_noise(&recs, &a.data, &model.joint_names, a.fit.weighting)?,
         ..a.fit.options()
     };
-    let most = crate::direct::streaming::MAX_OFFSET_RUNS;
-    let refused = match (recs.len(), options.friction.offset) {
-        (1, _) => Some("one log given: an offset of each log's own needs two or more".to_string()),
-        (k, _) if k > most => Some(format!(
-            "{k} logs, expected at most {most} for an offset of each log's own"
-        )),
-        (_, false) => {
-            Some("an offset of each log's own needs the offset among --friction".to_string())
-        }
-        _ => None,
-    };
-    if let Some(message) = refused.filter(|_| a.offset_per_log) {
-        return Err(Error::InvalidArgument {
-            argument: "--offset-per-log".into(),
-            message,
-        });
-    }
+    refuse_offset_per_log(&a, recs.len(), options.friction.offset)?;
     progress.update(&format!("identifying on {split} samples"));
-    // with the Coulomb term's column filtered as the torques were
-    let mut urdf = None;
-    let fit = if a.consistent {
-        let c = crate::direct::identify_consistent_parameters(
-            &model,
-            &train.0,
-            train.1,
-            &options,
-            &crate::direct::ConsistentOptions::default(),
-        )
-        .map_err(in_data)?;
-        let s = &c.solution;
-        let _ = writeln!(
-            out,
-            "physically consistent: the weighted residual grows by a factor {:.4} over the unconstrained fit ({} Newton steps{}); {} constraint(s) active{}",
-            c.residual_growth(),
-            s.iterations,
-            if s.converged { "" } else { ", stopped at the limit before converging" },
-            s.active.len(),
-            if s.active.is_empty() { String::new() } else { format!(": {}", s.active.join("; ")) }
-        );
-        if a.urdf.is_some() {
-            let note = format!(
-                "Identified by `perturbid identify-direct --consistent` from {}.",
-                super::files::logs_named(&a.data)
-            );
-            let options = crate::urdf::WriteOptions {
-                note: &note,
-                ..Default::default()
-            };
-            urdf = Some(crate::urdf::write_urdf(&c.robot(&model)?, &options)?);
-        }
-        c.model
-    } else {
-        identify_base_parameters(&model, &train.0, train.1, &options).map_err(in_data)?
-    };
+    let (fit, urdf) = fit_direct(&a, &model, &train, &options, &in_data, &mut out)?;
     progress.done();
     let fit = match recs.as_slice() {
         [rec] => fit.with_findings_of(rec),
@@ -335,14 +262,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     }
     fit.save(&a.out)?;
     if let (Some(path), Some(written)) = (&a.urdf, &urdf) {
-        crate::io::write_atomic(path, written.text.as_bytes())?;
-        let _ = writeln!(out, "the identified robot as URDF -> {}", path.display());
-        for note in &written.notes {
-            let _ = writeln!(out, "  {note}");
-        }
-        for w in &written.warnings {
-            eprintln!("perturbid: warning: {}: {w}", path.display());
-        }
+        write_identified_urdf(path, written, &mut out)?;
     }
     let _ = writeln!(
         out,
@@ -367,9 +287,144 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     if let Some(n) = &fit.noise_fit {
         let _ = writeln!(out, "{}", n.summary("the residuals"));
     }
-    // the parameter table: printed in full and saved as CSV and JSON beside the model; the
-    // names last, as a base parameter's combination of a robot's parameters runs to hundreds
-    // of characters and would push every number past the terminal's edge
+    print_parameter_table(&fit, &a.out, &mut out)?;
+    if let Some(o) = &fit.log_offsets {
+        out.push_str(&super::files::log_offsets_table(
+            o,
+            &a.data,
+            "the model's offset terms",
+        ));
+    }
+    if split < k {
+        validate_held_out(&model, &fit, &held, &recs, &splits, &a.data, &mut out)?;
+    }
+    Ok(out)
+}
+
+/// The checks of `identify-direct`'s arguments that need no file read: outputs that are no
+/// inputs, --urdf only with --consistent, the number of logs.
+fn check_direct_inputs(a: &IdentifyDirectArgs) -> Result<()> {
+    let mut inputs: Vec<&std::path::Path> = a.data.iter().map(PathBuf::as_path).collect();
+    inputs.push(a.robot.path());
+    refuse_overwriting_inputs(&a.out, &inputs)?;
+    if let Some(urdf) = &a.urdf {
+        if !a.consistent {
+            return Err(Error::InvalidArgument {
+                argument: "--urdf".into(),
+                message: "needs --consistent: base parameters are sums of several links' parameters and give no link its own".into(),
+            });
+        }
+        inputs.push(&a.out);
+        refuse_overwriting_inputs(urdf, &inputs)?;
+    }
+    if a.data.len() > crate::direct::drive_gains::MAX_RUNS {
+        return Err(Error::InvalidArgument {
+            argument: "DATA".into(),
+            message: format!(
+                "{} logs, expected at most {}",
+                a.data.len(),
+                crate::direct::drive_gains::MAX_RUNS
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// --offset-per-log refused where it cannot be had: one log, too many, or no offset term.
+fn refuse_offset_per_log(a: &IdentifyDirectArgs, logs: usize, offset: bool) -> Result<()> {
+    let most = crate::direct::streaming::MAX_OFFSET_RUNS;
+    let refused = match (logs, offset) {
+        (1, _) => Some("one log given: an offset of each log's own needs two or more".to_string()),
+        (k, _) if k > most => Some(format!(
+            "{k} logs, expected at most {most} for an offset of each log's own"
+        )),
+        (_, false) => {
+            Some("an offset of each log's own needs the offset among --friction".to_string())
+        }
+        _ => None,
+    };
+    if let Some(message) = refused.filter(|_| a.offset_per_log) {
+        return Err(Error::InvalidArgument {
+            argument: "--offset-per-log".into(),
+            message,
+        });
+    }
+    Ok(())
+}
+
+/// The base-parameter fit on the samples `train`, physically consistent where asked (then
+/// with the identified robot as URDF where --urdf asks for it).
+fn fit_direct(
+    a: &IdentifyDirectArgs,
+    model: &crate::model::Model,
+    train: &(States<'_>, &[f64]),
+    options: &crate::direct::BaseOptions,
+    in_data: &dyn Fn(Error) -> Error,
+    out: &mut String,
+) -> Result<(crate::direct::BaseModel, Option<crate::urdf::WrittenUrdf>)> {
+    let mut urdf = None;
+    let fit = if a.consistent {
+        let c = crate::direct::identify_consistent_parameters(
+            model,
+            &train.0,
+            train.1,
+            options,
+            &crate::direct::ConsistentOptions::default(),
+        )
+        .map_err(in_data)?;
+        let s = &c.solution;
+        let _ = writeln!(
+            out,
+            "physically consistent: the weighted residual grows by a factor {:.4} over the unconstrained fit ({} Newton steps{}); {} constraint(s) active{}",
+            c.residual_growth(),
+            s.iterations,
+            if s.converged { "" } else { ", stopped at the limit before converging" },
+            s.active.len(),
+            if s.active.is_empty() { String::new() } else { format!(": {}", s.active.join("; ")) }
+        );
+        if a.urdf.is_some() {
+            let note = format!(
+                "Identified by `perturbid identify-direct --consistent` from {}.",
+                super::files::logs_named(&a.data)
+            );
+            let options = crate::urdf::WriteOptions {
+                note: &note,
+                ..Default::default()
+            };
+            urdf = Some(crate::urdf::write_urdf(&c.robot(model)?, &options)?);
+        }
+        c.model
+    } else {
+        identify_base_parameters(model, &train.0, train.1, options).map_err(in_data)?
+    };
+    Ok((fit, urdf))
+}
+
+/// The identified robot written as URDF to `path`, with its notes and warnings.
+fn write_identified_urdf(
+    path: &std::path::Path,
+    written: &crate::urdf::WrittenUrdf,
+    out: &mut String,
+) -> Result<()> {
+    crate::io::write_atomic(path, written.text.as_bytes())?;
+    let _ = writeln!(out, "the identified robot as URDF -> {}", path.display());
+    for note in &written.notes {
+        let _ = writeln!(out, "  {note}");
+    }
+    for w in &written.warnings {
+        eprintln!("perturbid: warning: {}: {w}", path.display());
+    }
+    Ok(())
+}
+
+/// The parameter table: printed in full and saved as CSV and JSON beside the model at `path`;
+/// the names last, as a base parameter's combination of a robot's parameters runs to hundreds
+/// of characters and would push every number past the terminal's edge.
+fn print_parameter_table(
+    fit: &crate::direct::BaseModel,
+    path: &std::path::Path,
+    out: &mut String,
+) -> Result<()> {
     let rows = fit.parameter_table();
     let _ = writeln!(
         out,
@@ -391,75 +446,78 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
             r.name
         );
     }
-    let (csv, json) = write_parameter_table(&a.out, &rows)?;
+    let (csv, json) = write_parameter_table(path, &rows)?;
     let _ = writeln!(
         out,
         "parameter table -> {}, {}",
         csv.display(),
         json.display()
     );
+    Ok(())
+}
+
+/// The fit against the held-out samples `held`: per joint, and per log where there are
+/// several.
+fn validate_held_out(
+    model: &crate::model::Model,
+    fit: &crate::direct::BaseModel,
+    held: &(States<'_>, &[f64]),
+    recs: &[crate::logs::Recording],
+    splits: &[usize],
+    data: &[PathBuf],
+    out: &mut String,
+) -> Result<()> {
+    let n = model.nv;
+    let k_held = held.0.len();
+    let held_out = held.0;
+    let mut p = fit.on(model)?.predict(&held_out)?;
+    // each log's held-out samples with its own offset, where one was fitted
     if let Some(o) = &fit.log_offsets {
-        out.push_str(&super::files::log_offsets_table(
-            o,
-            &a.data,
-            "the model's offset terms",
-        ));
+        let held_runs: Vec<usize> = recs.iter().zip(splits).map(|(r, s)| r.len() - s).collect();
+        p = o.added(&p, &held_runs);
     }
-    if split < k {
-        let held_out = held.0;
-        let mut p = fit.on(&model)?.predict(&held_out)?;
-        // each log's held-out samples with its own offset, where one was fitted
-        if let Some(o) = &fit.log_offsets {
-            let held_runs: Vec<usize> =
-                recs.iter().zip(&splits).map(|(r, s)| r.len() - s).collect();
-            p = o.added(&p, &held_runs);
-        }
-        let _ = writeln!(
+    let _ = writeln!(
             out,
             "validation on the last {} samples{}: per joint RMS (N m), relative RMS (%) and the RMS of the predictions' standard errors (N m)",
-            k - split,
+            k_held,
             match (recs.len(), &fit.log_offsets) {
                 (1, _) => "",
                 (_, None) => " of each log",
                 (_, Some(_)) => " of each log, each with its own offset",
             }
         );
-        let mut v = crate::validation::validate(&model.joint_names, &p, held.1)?;
-        if let Ok(se) = crate::validation::stored_stderr(fit.predict_stderr(&model, &held_out))? {
-            v = v.with_model_stderr(&se)?;
-        }
-        for e in &v.joints {
-            let _ = writeln!(
-                out,
-                "  {:<16} {:>10} {:>8} {:>12}",
-                e.joint,
-                number(e.rms),
-                e.relative_rms
-                    .map_or("-".to_string(), |r| format!("{:.2}", 100.0 * r)),
-                e.model_stderr_rms.map_or("-".to_string(), number)
-            );
-        }
-        // several logs: each one's own, to tell a log the model fits worse
-        if recs.len() > 1 {
-            let _ = writeln!(out, "per log, per joint RMS (N m):");
-            let mut start = 0;
-            for ((rec, &split), path) in recs.iter().zip(&splits).zip(&a.data) {
-                let rows = start * n..(start + rec.len() - split) * n;
-                start += rec.len() - split;
-                if rows.is_empty() {
-                    continue;
-                }
-                let v = crate::validation::validate(
-                    &model.joint_names,
-                    &p[rows.clone()],
-                    &held.1[rows],
-                )?;
-                let rms: Vec<String> = v.joints.iter().map(|e| number(e.rms)).collect();
-                let _ = writeln!(out, "  {}: {}", path.display(), rms.join(" "));
+    let mut v = crate::validation::validate(&model.joint_names, &p, held.1)?;
+    if let Ok(se) = crate::validation::stored_stderr(fit.predict_stderr(model, &held_out))? {
+        v = v.with_model_stderr(&se)?;
+    }
+    for e in &v.joints {
+        let _ = writeln!(
+            out,
+            "  {:<16} {:>10} {:>8} {:>12}",
+            e.joint,
+            number(e.rms),
+            e.relative_rms
+                .map_or("-".to_string(), |r| format!("{:.2}", 100.0 * r)),
+            e.model_stderr_rms.map_or("-".to_string(), number)
+        );
+    }
+    // several logs: each one's own, to tell a log the model fits worse
+    if recs.len() > 1 {
+        let _ = writeln!(out, "per log, per joint RMS (N m):");
+        let mut start = 0;
+        for ((rec, &split), path) in recs.iter().zip(splits).zip(data) {
+            let rows = start * n..(start + rec.len() - split) * n;
+            start += rec.len() - split;
+            if rows.is_empty() {
+                continue;
             }
+            let v =
+                crate::validation::validate(&model.joint_names, &p[rows.clone()], &held.1[rows])?;
+            let rms: Vec<String> = v.joints.iter().map(|e| number(e.rms)).collect();
+            let _ = writeln!(out, "  {}: {}", path.display(), rms.join(" "));
         }
     }
-    Ok(out)
+    Ok(())
 }
 
 /// A torque error for a table: four decimals, or an exponent past a million.
