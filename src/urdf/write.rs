@@ -22,7 +22,7 @@ use std::collections::HashMap;
 
 use super::convert::link_inertia;
 use super::edits::{
-    apply, child, header, number, payload_edit, remove_inertial, set_dynamics, set_inertial,
+    apply, child, header, number, payload_edit, remove_inertial, set_dynamics, set_inertial, Edit,
     Elements,
 };
 use super::{lines, model_from_urdf_str};
@@ -107,31 +107,114 @@ pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUr
     let source = &model.urdf;
     let text = source.text.as_str();
     let original = model_from_urdf_str(text, &model.source, &source.options)?;
-    let refuse = |element: String, message: String| Error::UrdfExport {
-        robot: model.name.clone(),
-        element,
-        message,
-    };
+    let refuse = |element: String, message: String| refusal(model, element, message);
     same_kinematics(model, &original).map_err(|(e, m)| refuse(e, m))?;
     let doc = lines::parse_xml(text, &model.source)?;
     let robot = urdf_rs::read_from_string(text).map_err(|e| Error::UrdfSyntax {
         source_name: model.source.clone(),
         message: e.to_string(),
     })?;
-    let elements = Elements::of(&doc);
-    // each link by name, and the joint each link hangs from
-    let links: HashMap<&str, &urdf_rs::Link> =
-        robot.links.iter().map(|l| (l.name.as_str(), l)).collect();
-    let parent_joint: HashMap<&str, &urdf_rs::Joint> = (robot.joints.iter())
-        .map(|j| (j.child.link.as_str(), j))
-        .collect();
-    let mut edits = Vec::new();
-    let mut notes = Vec::new();
-    let mut warnings = Vec::new();
-    let triangle = source.options.check_triangle_inequality.then_some("");
-    for (b, body) in model.bodies.iter().enumerate() {
+    let file = File {
+        model,
+        original: &original,
+        text,
+        elements: Elements::of(&doc),
+        // each link by name, and the joint each link hangs from
+        links: robot.links.iter().map(|l| (l.name.as_str(), l)).collect(),
+        parent_joint: (robot.joints.iter())
+            .map(|j| (j.child.link.as_str(), j))
+            .collect(),
+    };
+    let mut changes = Changes::default();
+    for b in 0..model.bodies.len() {
+        file.inertial_edits(b, &mut changes)?;
+    }
+    for j in 0..model.nv {
+        file.dynamics_edits(j, &mut changes)?;
+    }
+    let Changes {
+        mut edits,
+        mut notes,
+        mut warnings,
+    } = changes;
+    let elements = &file.elements;
+    if let Some(p) = options.payload {
+        edits.push(
+            payload_edit(text, model, elements, &doc, p, options.payload_link)
+                .map_err(|(e, m)| refuse(e, m))?,
+        );
+        notes.push(format!(
+            "link '{}': the payload ({} kg), fixed to link '{}' by joint '{}_joint'",
+            options.payload_link,
+            number(p.mass),
+            p.link,
+            options.payload_link
+        ));
+    }
+    // a URDF holds neither gravity's direction nor its size (readers take 9.81 m/s^2 down z)
+    if model.gravity != nalgebra::Vector3::new(0.0, 0.0, -crate::model::STANDARD_GRAVITY) {
+        warnings.push(format!(
+            "gravity ({}, {}, {}) m/s^2 in the base frame: a URDF has no place for it",
+            number(model.gravity.x),
+            number(model.gravity.y),
+            number(model.gravity.z)
+        ));
+    }
+    edits.push(header(text, &doc, &model.source, options.note));
+    let written = apply(text, edits);
+    check_read_back(model, &written, options)?;
+    Ok(WrittenUrdf {
+        text: written,
+        notes,
+        warnings,
+    })
+}
+
+/// A refusal to write `model`'s URDF, naming the element.
+fn refusal(model: &Model, element: String, message: String) -> Error {
+    Error::UrdfExport {
+        robot: model.name.clone(),
+        element,
+        message,
+    }
+}
+
+/// The edits of a URDF file, with what they did and what they could not keep.
+#[derive(Default)]
+struct Changes {
+    edits: Vec<Edit>,
+    notes: Vec<String>,
+    warnings: Vec<String>,
+}
+
+/// The URDF a model came from, read for its edits.
+struct File<'a, 'input> {
+    model: &'a Model,
+    /// The model the file itself builds.
+    original: &'a Model,
+    text: &'input str,
+    elements: Elements<'a, 'input>,
+    links: HashMap<&'a str, &'a urdf_rs::Link>,
+    parent_joint: HashMap<&'a str, &'a urdf_rs::Joint>,
+}
+
+impl File<'_, '_> {
+    /// Body `b`'s inertial rewritten where the model's differs from the file's: its own link
+    /// holds what the links moving with it leave, or takes theirs over where the rest would be
+    /// no rigid body.
+    fn inertial_edits(&self, b: usize, changes: &mut Changes) -> Result<()> {
+        let (model, original, text) = (self.model, self.original, self.text);
+        let (links, parent_joint, elements) = (&self.links, &self.parent_joint, &self.elements);
+        let refuse = |element: String, message: String| refusal(model, element, message);
+        let triangle = (model.urdf.options.check_triangle_inequality).then_some("");
+        let body = &model.bodies[b];
+        let Changes {
+            edits,
+            notes,
+            warnings,
+        } = changes;
         if same_inertia(&body.inertia, &original.bodies[b].inertia) {
-            continue;
+            return Ok(());
         }
         let others: Vec<Other> = (model.frames.iter())
             .filter(|f| f.body == Some(b) && f.link != body.link)
@@ -139,7 +222,7 @@ pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUr
                 link: f.link.clone(),
                 inertia: (links.get(f.link.as_str()))
                     .map_or(Inertia::zeros(), |l| f.pose.act_inertia(&link_inertia(l))),
-                behind_locked: behind_locked(&parent_joint, &body.link, &f.link),
+                behind_locked: behind_locked(parent_joint, &body.link, &f.link),
             })
             .collect();
         // the allocations tried in turn: the other links keep theirs; those behind fixed
@@ -205,14 +288,22 @@ pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUr
                 }
             ));
         }
+        Ok(())
     }
-    for j in 0..model.nv {
+
+    /// Joint `j`'s <dynamics> rewritten where the model's damping, friction or armature
+    /// differ from the file's.
+    fn dynamics_edits(&self, j: usize, changes: &mut Changes) -> Result<()> {
+        let (model, original, text, elements) =
+            (self.model, self.original, self.text, &self.elements);
+        let refuse = |element: String, message: String| refusal(model, element, message);
+        let Changes { edits, notes, .. } = changes;
         let (l, o) = (&model.limits[j], &original.limits[j]);
         let changed = l.damping != o.damping
             || l.friction != o.friction
             || model.armature[j] != original.armature[j];
         if !changed {
-            continue;
+            return Ok(());
         }
         let name = &model.joint_names[j];
         let element = format!("joint '{name}'");
@@ -259,37 +350,8 @@ pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUr
                 .collect::<Vec<_>>()
                 .join(" ")
         ));
+        Ok(())
     }
-    if let Some(p) = options.payload {
-        edits.push(
-            payload_edit(text, model, &elements, &doc, p, options.payload_link)
-                .map_err(|(e, m)| refuse(e, m))?,
-        );
-        notes.push(format!(
-            "link '{}': the payload ({} kg), fixed to link '{}' by joint '{}_joint'",
-            options.payload_link,
-            number(p.mass),
-            p.link,
-            options.payload_link
-        ));
-    }
-    // a URDF holds neither gravity's direction nor its size (readers take 9.81 m/s^2 down z)
-    if model.gravity != nalgebra::Vector3::new(0.0, 0.0, -crate::model::STANDARD_GRAVITY) {
-        warnings.push(format!(
-            "gravity ({}, {}, {}) m/s^2 in the base frame: a URDF has no place for it",
-            number(model.gravity.x),
-            number(model.gravity.y),
-            number(model.gravity.z)
-        ));
-    }
-    edits.push(header(text, &doc, &model.source, options.note));
-    let written = apply(text, edits);
-    check_read_back(model, &written, options)?;
-    Ok(WrittenUrdf {
-        text: written,
-        notes,
-        warnings,
-    })
 }
 
 /// A link moving with a body besides the body's own, with its URDF inertia in the body frame.
