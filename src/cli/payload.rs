@@ -98,36 +98,8 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
     refuse_overwriting_inputs(&a.out, &inputs)?;
     let model = a.robot.load()?;
     let file = a.model.as_ref().map(ModelFile::load).transpose()?;
-    let base = match (&file, &a.model) {
-        (Some(ModelFile::Base(fit)), _) => Some(fit),
-        (Some(_), Some(path)) => {
-            return Err(Error::InvalidArgument {
-                argument: "--model".into(),
-                message: format!(
-                    "{} is not a base-parameter model (identify-direct, identify-gains): a local or globally linearised model holds near its operating point, not along the log's motion",
-                    path.display()
-                ),
-            })
-        }
-        _ => None,
-    };
-    let gains = match (a.signal, &file, &a.model) {
-        (false, ..) => None,
-        (true, Some(f), Some(path)) => {
-            Some(super::files::model_gains(f, path, "--signal")?.gain.clone())
-        }
-        (true, ..) => {
-            return Err(Error::InvalidArgument {
-                argument: "--signal".into(),
-                message: "needs --model: the drive gains come from a model of identify-gains"
-                    .into(),
-            })
-        }
-    };
-    let reference = match base {
-        Some(fit) => Reference::Model(fit),
-        None => Reference::Urdf,
-    };
+    let reference = reference_of(&a, file.as_ref())?;
+    let gains = signal_gains(&a, file.as_ref())?;
     let mut options = PayloadOptions::new(&a.link, &reference);
     options.terms = a.terms.unwrap_or(options.terms);
     options.weighting = a.weighting;
@@ -239,6 +211,66 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
             _ => eprintln!("perturbid: warning: {w}"),
         }
     }
+    write_outputs(&a, &model, &fit)?;
+    out.push_str(&report(&fit, &a.out, a.urdf));
+    if let Some(o) = &fit.log_offsets {
+        out.push_str(&super::files::log_offsets_table(
+            o,
+            &a.data,
+            "the joint terms' offset",
+        ));
+    }
+    if let Some(v) = validation {
+        print_validation(&v, a.data.len(), &mut out);
+    }
+    Ok(out)
+}
+
+/// The drive gains of the model given where --signal asks for them.
+fn signal_gains(a: &IdentifyPayloadArgs, file: Option<&ModelFile>) -> Result<Option<Vec<f64>>> {
+    Ok(match (a.signal, file, &a.model) {
+        (false, ..) => None,
+        (true, Some(f), Some(path)) => {
+            Some(super::files::model_gains(f, path, "--signal")?.gain.clone())
+        }
+        (true, ..) => {
+            return Err(Error::InvalidArgument {
+                argument: "--signal".into(),
+                message: "needs --model: the drive gains come from a model of identify-gains"
+                    .into(),
+            })
+        }
+    })
+}
+
+/// What the payload is fitted against: the base-parameter model given, or the URDF.
+fn reference_of<'a>(a: &IdentifyPayloadArgs, file: Option<&'a ModelFile>) -> Result<Reference<'a>> {
+    let base = match (file, &a.model) {
+        (Some(ModelFile::Base(fit)), _) => Some(fit),
+        (Some(_), Some(path)) => {
+            return Err(Error::InvalidArgument {
+                argument: "--model".into(),
+                message: format!(
+                    "{} is not a base-parameter model (identify-direct, identify-gains): a local or globally linearised model holds near its operating point, not along the log's motion",
+                    path.display()
+                ),
+            })
+        }
+        _ => None,
+    };
+    Ok(match base {
+        Some(fit) => Reference::Model(fit),
+        None => Reference::Urdf,
+    })
+}
+
+/// payload.json (and the robot carrying it as URDF, where asked) and payload_fit.json, as
+/// one output set.
+fn write_outputs(
+    a: &IdentifyPayloadArgs,
+    model: &crate::model::Model,
+    fit: &PayloadFit,
+) -> Result<()> {
     let mut set = OutputSet::new(&a.out, "payload");
     if let Some(p) = fit.usable_payload() {
         set.add(
@@ -257,42 +289,36 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
             };
             set.add(
                 "robot_with_payload.urdf",
-                crate::urdf::write_urdf(&model, &options)?.text,
+                crate::urdf::write_urdf(model, &options)?.text,
             )?;
         }
     }
     set.add(
         "payload_fit.json",
-        serde_json::to_string_pretty(&fit).expect("serialisable") + "\n",
+        serde_json::to_string_pretty(fit).expect("serialisable") + "\n",
     )?;
     set.commit()?;
-    out.push_str(&report(&fit, &a.out, a.urdf));
-    if let Some(o) = &fit.log_offsets {
-        out.push_str(&super::files::log_offsets_table(
-            o,
-            &a.data,
-            "the joint terms' offset",
-        ));
-    }
-    if let Some(v) = validation {
+    Ok(())
+}
+
+/// The validation on the held-out samples of `logs` logs, per joint.
+fn print_validation(v: &crate::validation::Validation, logs: usize, out: &mut String) {
+    let _ = writeln!(
+        out,
+        "validation of the robot carrying the payload on the last {} samples{}: per joint RMS (N m) and relative RMS (%)",
+        v.samples,
+        if logs > 1 { " of each log" } else { "" }
+    );
+    for e in &v.joints {
         let _ = writeln!(
             out,
-            "validation of the robot carrying the payload on the last {} samples{}: per joint RMS (N m) and relative RMS (%)",
-            v.samples,
-            if a.data.len() > 1 { " of each log" } else { "" }
+            "  {:<16} {:>10.4} {:>8}",
+            e.joint,
+            e.rms,
+            e.relative_rms
+                .map_or("-".to_string(), |r| format!("{:.2}", 100.0 * r))
         );
-        for e in &v.joints {
-            let _ = writeln!(
-                out,
-                "  {:<16} {:>10.4} {:>8}",
-                e.joint,
-                e.rms,
-                e.relative_rms
-                    .map_or("-".to_string(), |r| format!("{:.2}", 100.0 * r))
-            );
-        }
     }
-    Ok(out)
 }
 
 /// The fit in words: the payload with its standard errors, the joint terms, the residuals.
