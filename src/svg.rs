@@ -131,36 +131,9 @@ pub fn scaled_plot(
     series: &[Series<'_>],
     scale: Scale,
 ) -> String {
-    let (w, h) = (960.0, 480.0);
-    // the legend's column as wide as its longest name (about 7 px a character at 13 px),
-    // within half the width
-    let longest = series
-        .iter()
-        .map(|s| s.name.chars().count())
-        .max()
-        .unwrap_or(0);
-    let right = (46.0 + 7.0 * longest as f64).clamp(180.0, w / 2.0);
-    let (left, top, bottom) = (80.0, 40.0, 60.0);
-    let finite = |v: &&f64| v.is_finite();
-    let xs = series.iter().flat_map(|s| s.x.iter()).filter(finite);
-    let (x0, x1) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-        (a.min(v), b.max(v))
-    });
     let bands: Vec<Vec<(f64, f64, f64)>> = series.iter().map(|s| s.band_points(scale)).collect();
-    let band_ys = bands.iter().flatten().flat_map(|&(_, a, b)| [a, b]);
-    let ys = series
-        .iter()
-        .flat_map(|s| s.y.iter().map(|&v| scale.of(v)))
-        .chain(band_ys)
-        .filter(|v| v.is_finite());
-    let (mut y0, mut y1) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-        (a.min(v), b.max(v))
-    });
-    let pad = 0.05 * (y1 - y0).max(1e-9);
-    y0 -= pad;
-    y1 += pad;
-    let px = |x: f64| left + (x - x0) / (x1 - x0).max(1e-12) * (w - left - right);
-    let py = |y: f64| top + (y1 - y) / (y1 - y0).max(1e-12) * (h - top - bottom);
+    let f = Frame::of(series, &bands, scale);
+    let (w, h) = (f.w, f.h);
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -173,108 +146,198 @@ pub fn scaled_plot(
         w / 2.0,
         escape(title)
     );
-    for t in ticks(x0, x1) {
-        let x = px(t);
-        let _ = writeln!(
-            s,
-            r##"<line x1="{x:.1}" y1="{top}" x2="{x:.1}" y2="{}" stroke="#e4e4e4"/>"##,
-            h - bottom
-        );
-        let _ = writeln!(
-            s,
-            r#"<text x="{x:.1}" y="{}" text-anchor="middle">{}</text>"#,
-            h - bottom + 18.0,
-            fmt_tick(t)
-        );
+    f.axes(scale, xlabel, ylabel, &mut s);
+    f.curves(series, &bands, scale, &mut s);
+    s.push_str("</svg>\n");
+    s
+}
+
+/// The plot's size, margins and the data's ranges on it.
+struct Frame {
+    w: f64,
+    h: f64,
+    left: f64,
+    right: f64,
+    top: f64,
+    bottom: f64,
+    x0: f64,
+    x1: f64,
+    y0: f64,
+    y1: f64,
+}
+
+impl Frame {
+    /// The frame of `series` (with their `bands`, on `scale`): 960 x 480 px, the legend's
+    /// column as wide as its longest name (about 7 px a character at 13 px), within half the
+    /// width, the y range padded by 5 %.
+    fn of(series: &[Series<'_>], bands: &[Vec<(f64, f64, f64)>], scale: Scale) -> Self {
+        let (w, h) = (960.0, 480.0);
+        let longest = series
+            .iter()
+            .map(|s| s.name.chars().count())
+            .max()
+            .unwrap_or(0);
+        let right = (46.0 + 7.0 * longest as f64).clamp(180.0, w / 2.0);
+        let finite = |v: &&f64| v.is_finite();
+        let xs = series.iter().flat_map(|s| s.x.iter()).filter(finite);
+        let (x0, x1) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+        let band_ys = bands.iter().flatten().flat_map(|&(_, a, b)| [a, b]);
+        let ys = series
+            .iter()
+            .flat_map(|s| s.y.iter().map(|&v| scale.of(v)))
+            .chain(band_ys)
+            .filter(|v| v.is_finite());
+        let (y0, y1) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+        let pad = 0.05 * (y1 - y0).max(1e-9);
+        Self {
+            w,
+            h,
+            left: 80.0,
+            right,
+            top: 40.0,
+            bottom: 60.0,
+            x0,
+            x1,
+            y0: y0 - pad,
+            y1: y1 + pad,
+        }
     }
-    for (t, label) in scale.ticks(y0, y1) {
-        let y = py(t);
-        let _ = writeln!(
-            s,
-            r##"<line x1="{left}" y1="{y:.1}" x2="{}" y2="{y:.1}" stroke="#e4e4e4"/>"##,
-            w - right
-        );
-        let _ = writeln!(
-            s,
-            r#"<text x="{}" y="{:.1}" text-anchor="end">{}</text>"#,
-            left - 6.0,
-            y + 4.0,
-            label
-        );
+
+    fn px(&self, x: f64) -> f64 {
+        self.left
+            + (x - self.x0) / (self.x1 - self.x0).max(1e-12) * (self.w - self.left - self.right)
     }
-    let _ = writeln!(
-        s,
-        r#"<rect x="{left}" y="{top}" width="{}" height="{}" fill="none" stroke="black"/>"#,
-        w - left - right,
-        h - top - bottom
-    );
-    let _ = writeln!(
-        s,
-        r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
-        (left + w - right) / 2.0,
-        h - 14.0,
-        escape(xlabel)
-    );
-    let _ = writeln!(
-        s,
-        r#"<text x="18" y="{}" text-anchor="middle" transform="rotate(-90 18 {})">{}</text>"#,
-        (top + h - bottom) / 2.0,
-        (top + h - bottom) / 2.0,
-        escape(ylabel)
-    );
-    // the bands first, under every curve
-    for (se, band) in series.iter().zip(&bands) {
-        if band.len() >= 2 {
-            let upper = band.iter().map(|&(x, _, b)| (x, b));
-            let lower = band.iter().rev().map(|&(x, a, _)| (x, a));
-            let pts: Vec<String> = upper
-                .chain(lower)
-                .map(|(x, y)| format!("{:.2},{:.2}", px(x), py(y)))
-                .collect();
+
+    fn py(&self, y: f64) -> f64 {
+        self.top
+            + (self.y1 - y) / (self.y1 - self.y0).max(1e-12) * (self.h - self.top - self.bottom)
+    }
+
+    /// The grid with its tick labels, the plot's box and the axes' labels.
+    fn axes(&self, scale: Scale, xlabel: &str, ylabel: &str, s: &mut String) {
+        let (w, h, left, right, top, bottom) =
+            (self.w, self.h, self.left, self.right, self.top, self.bottom);
+        let (x0, x1, y0, y1) = (self.x0, self.x1, self.y0, self.y1);
+        let px = |x: f64| self.px(x);
+        let py = |y: f64| self.py(y);
+        for t in ticks(x0, x1) {
+            let x = px(t);
             let _ = writeln!(
                 s,
-                r#"<polygon fill="{}" fill-opacity="0.15" stroke="none" points="{}"/>"#,
+                r##"<line x1="{x:.1}" y1="{top}" x2="{x:.1}" y2="{}" stroke="#e4e4e4"/>"##,
+                h - bottom
+            );
+            let _ = writeln!(
+                s,
+                r#"<text x="{x:.1}" y="{}" text-anchor="middle">{}</text>"#,
+                h - bottom + 18.0,
+                fmt_tick(t)
+            );
+        }
+        for (t, label) in scale.ticks(y0, y1) {
+            let y = py(t);
+            let _ = writeln!(
+                s,
+                r##"<line x1="{left}" y1="{y:.1}" x2="{}" y2="{y:.1}" stroke="#e4e4e4"/>"##,
+                w - right
+            );
+            let _ = writeln!(
+                s,
+                r#"<text x="{}" y="{:.1}" text-anchor="end">{}</text>"#,
+                left - 6.0,
+                y + 4.0,
+                label
+            );
+        }
+        let _ = writeln!(
+            s,
+            r#"<rect x="{left}" y="{top}" width="{}" height="{}" fill="none" stroke="black"/>"#,
+            w - left - right,
+            h - top - bottom
+        );
+        let _ = writeln!(
+            s,
+            r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
+            (left + w - right) / 2.0,
+            h - 14.0,
+            escape(xlabel)
+        );
+        let _ = writeln!(
+            s,
+            r#"<text x="18" y="{}" text-anchor="middle" transform="rotate(-90 18 {})">{}</text>"#,
+            (top + h - bottom) / 2.0,
+            (top + h - bottom) / 2.0,
+            escape(ylabel)
+        );
+    }
+
+    /// The bands (first, under every curve), the curves and the legend.
+    fn curves(
+        &self,
+        series: &[Series<'_>],
+        bands: &[Vec<(f64, f64, f64)>],
+        scale: Scale,
+        s: &mut String,
+    ) {
+        let (w, right, top) = (self.w, self.right, self.top);
+        let px = |x: f64| self.px(x);
+        let py = |y: f64| self.py(y);
+        // the bands first, under every curve
+        for (se, band) in series.iter().zip(bands) {
+            if band.len() >= 2 {
+                let upper = band.iter().map(|&(x, _, b)| (x, b));
+                let lower = band.iter().rev().map(|&(x, a, _)| (x, a));
+                let pts: Vec<String> = upper
+                    .chain(lower)
+                    .map(|(x, y)| format!("{:.2},{:.2}", px(x), py(y)))
+                    .collect();
+                let _ = writeln!(
+                    s,
+                    r#"<polygon fill="{}" fill-opacity="0.15" stroke="none" points="{}"/>"#,
+                    se.color,
+                    pts.join(" ")
+                );
+            }
+        }
+        for (k, se) in series.iter().enumerate() {
+            let pts: Vec<String> =
+                se.x.iter()
+                    .zip(se.y.iter().map(|&v| scale.of(v)))
+                    .filter(|(x, y)| x.is_finite() && y.is_finite())
+                    .map(|(&x, y)| format!("{:.2},{:.2}", px(x), py(y)))
+                    .collect();
+            let dash = if se.dash.is_empty() {
+                String::new()
+            } else {
+                format!(r#" stroke-dasharray="{}""#, se.dash)
+            };
+            let _ = writeln!(
+                s,
+                r#"<polyline fill="none" stroke="{}" stroke-width="2"{dash} points="{}"/>"#,
                 se.color,
                 pts.join(" ")
             );
+            let ly = top + 16.0 + 18.0 * k as f64;
+            let lx = w - right + 12.0;
+            let _ = writeln!(
+                s,
+                r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{}" stroke-width="2"{dash}/>"#,
+                lx + 28.0,
+                se.color
+            );
+            let _ = writeln!(
+                s,
+                r#"<text x="{}" y="{}">{}</text>"#,
+                lx + 34.0,
+                ly + 4.0,
+                escape(se.name)
+            );
         }
     }
-    for (k, se) in series.iter().enumerate() {
-        let pts: Vec<String> =
-            se.x.iter()
-                .zip(se.y.iter().map(|&v| scale.of(v)))
-                .filter(|(x, y)| x.is_finite() && y.is_finite())
-                .map(|(&x, y)| format!("{:.2},{:.2}", px(x), py(y)))
-                .collect();
-        let dash = if se.dash.is_empty() {
-            String::new()
-        } else {
-            format!(r#" stroke-dasharray="{}""#, se.dash)
-        };
-        let _ = writeln!(
-            s,
-            r#"<polyline fill="none" stroke="{}" stroke-width="2"{dash} points="{}"/>"#,
-            se.color,
-            pts.join(" ")
-        );
-        let ly = top + 16.0 + 18.0 * k as f64;
-        let lx = w - right + 12.0;
-        let _ = writeln!(
-            s,
-            r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{}" stroke-width="2"{dash}/>"#,
-            lx + 28.0,
-            se.color
-        );
-        let _ = writeln!(
-            s,
-            r#"<text x="{}" y="{}">{}</text>"#,
-            lx + 34.0,
-            ly + 4.0,
-            escape(se.name)
-        );
-    }
-    s.push_str("</svg>\n");
-    s
 }
 
 /// SVG documents of [`line_plot`] stacked into one, top to bottom.
