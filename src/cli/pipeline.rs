@@ -128,37 +128,7 @@ fn steps(p: &Pipeline, source: &str, text: &str, base: &Path) -> Result<Vec<Step
             k + 1
         );
         let keys = step.get_ref();
-        let Some(run) = keys.get("run") else {
-            return Err(Error::Config {
-                location: at,
-                message:
-                    "no 'run' key: say which command the step runs, e.g. run = \"identify-direct\""
-                        .into(),
-            });
-        };
-        let Value::String(command) = run.get_ref() else {
-            return Err(Error::Config {
-                location: location(source, text, run.span().start),
-                message: "'run' must be a command name in quotes".into(),
-            });
-        };
-        let names: Vec<&str> = root
-            .get_subcommands()
-            .map(|c| c.get_name())
-            .filter(|n| *n != "run")
-            .collect();
-        let Some(sub) = root
-            .get_subcommands()
-            .find(|c| c.get_name() == command && command != "run")
-        else {
-            return Err(Error::Config {
-                location: location(source, text, run.span().start),
-                message: format!(
-                    "'{command}' is not a command a pipeline can run; expected one of: {}",
-                    names.join(", ")
-                ),
-            });
-        };
+        let (command, sub) = step_command(&root, keys, source, text, &at)?;
         let mut positional: Vec<(usize, Vec<String>)> = Vec::new();
         let mut options: Vec<String> = Vec::new();
         let mut given = std::collections::BTreeSet::new();
@@ -257,6 +227,48 @@ fn steps(p: &Pipeline, source: &str, text: &str, base: &Path) -> Result<Vec<Step
         });
     }
     Ok(out)
+}
+
+/// The command a step's `run` key names, among those a pipeline can run (not `run` itself).
+fn step_command<'c, 'k>(
+    root: &'c clap::Command,
+    keys: &'k std::collections::BTreeMap<String, toml::Spanned<Value>>,
+    source: &str,
+    text: &str,
+    at: &str,
+) -> Result<(&'k String, &'c clap::Command)> {
+    let Some(run) = keys.get("run") else {
+        return Err(Error::Config {
+            location: at.into(),
+            message:
+                "no 'run' key: say which command the step runs, e.g. run = \"identify-direct\""
+                    .into(),
+        });
+    };
+    let Value::String(command) = run.get_ref() else {
+        return Err(Error::Config {
+            location: location(source, text, run.span().start),
+            message: "'run' must be a command name in quotes".into(),
+        });
+    };
+    let names: Vec<&str> = root
+        .get_subcommands()
+        .map(|c| c.get_name())
+        .filter(|n| *n != "run")
+        .collect();
+    let Some(sub) = root
+        .get_subcommands()
+        .find(|c| c.get_name() == command && command != "run")
+    else {
+        return Err(Error::Config {
+            location: location(source, text, run.span().start),
+            message: format!(
+                "'{command}' is not a command a pipeline can run; expected one of: {}",
+                names.join(", ")
+            ),
+        });
+    };
+    Ok((command, sub))
 }
 
 /// The command-line words of one TOML value for `arg`: a scalar gives one, a list one per
