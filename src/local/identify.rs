@@ -1,5 +1,6 @@
-//! The separated least-squares identification of the local model (docs/method.md, section 4) from a
-//! plan and one recording per experiment.
+//! What the local identification (docs/method.md, section 4; [`super::identify_local()`])
+//! reads of each experiment: its options, the values a recording gives at the experiment's
+//! crossings, and the recordings matched to the plan's experiments.
 
 use nalgebra::DMatrix;
 
