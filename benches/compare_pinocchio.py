@@ -672,7 +672,7 @@ def main() -> int:
     who = f"Pinocchio C++ (one call per sample, built `{march}`)" if peer else \
         "Pinocchio from Python (one call per sample, Python's overhead included)"
     lines = [
-        f"Measured {time.strftime('%Y-%m-%d')} on {os.cpu_count()} cores of "
+        f"Measured on {os.cpu_count()} cores of "
         f"{cpu_model() or 'an unnamed processor'} ({isa} path, {isa_lanes(isa)} lanes; the "
         f"one-core rounds on core {min(one) if one else 'any'}), against {who}, "
         f"`python benches/compare_pinocchio.py` (medians of {args.rounds} rounds taken in turns;"
