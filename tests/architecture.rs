@@ -357,8 +357,8 @@ fn find_word(text: &str, word: &str) -> Option<usize> {
 }
 
 struct Crate {
-    /// Per file, the code that counts.
-    code: BTreeMap<String, String>,
+    /// Per file, the module paths its code refers to.
+    paths: BTreeMap<String, Vec<Vec<String>>>,
     /// Per module file, the names its `pub use` makes visible and where they come from.
     faces: BTreeMap<String, BTreeMap<String, Vec<String>>>,
 }
@@ -367,16 +367,16 @@ impl Crate {
     fn read() -> Self {
         let mut files = Vec::new();
         source_files(&root().join("src"), &mut files);
-        let mut code = BTreeMap::new();
+        let mut paths = BTreeMap::new();
         let mut faces = BTreeMap::new();
         for f in files {
             let text = code_of(&std::fs::read_to_string(root().join("src").join(&f)).unwrap());
             let mut face = BTreeMap::new();
-            paths_of(&text, &module_of(&f), Some(&mut face));
+            let used = paths_of(&text, &module_of(&f), Some(&mut face));
             faces.insert(f.clone(), face);
-            code.insert(f, text);
+            paths.insert(f, used);
         }
-        Self { code, faces }
+        Self { paths, faces }
     }
 
     /// The file that defines what `path` names: the deepest module file on it, followed
@@ -402,9 +402,8 @@ impl Crate {
     /// Per file, the files it uses.
     fn edges(&self) -> BTreeMap<String, BTreeSet<String>> {
         let mut out = BTreeMap::new();
-        for (f, code) in &self.code {
-            let module = module_of(f);
-            let targets: BTreeSet<String> = paths_of(code, &module, None)
+        for (f, paths) in &self.paths {
+            let targets: BTreeSet<String> = paths
                 .iter()
                 .map(|p| self.resolve(p, 0))
                 .filter(|t| t != f && t != "lib.rs")
