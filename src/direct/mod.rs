@@ -5,6 +5,7 @@
 
 pub mod base;
 pub mod base_linearization;
+mod base_model_checks;
 pub mod base_model_on;
 pub mod base_options;
 pub mod consistency;
