@@ -24,12 +24,14 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::base::BaseParameters;
 use super::identify::{fit_with_factors, BaseModel, BaseOptions, Weighting};
 use super::streaming::JointFactors;
 use crate::document::{check_bounded, check_condition, check_magnitudes};
 use crate::error::{shown, Error, Result};
 use crate::model::payload::Payload;
 use crate::model::Model;
+use crate::regression::LeastSquares;
 use crate::states::States;
 
 /// Runs at most in one identification.
@@ -373,10 +375,129 @@ pub fn identify_drive_gains_with(
     estimator: GainEstimator,
 ) -> Result<DriveGainFit> {
     let nv = model.nv;
-    let bad = |message: String| Error::InvalidArgument {
+    let k = check_runs(model, runs, options)?;
+    let (stacked, rhs, loaded) = stack_runs(model, runs, options)?;
+    let signal = &stacked.data;
+    let states = stacked.states()?;
+    crate::torque_model::refuse_flat_torques(
+        &states,
+        signal,
+        &model.joint_names,
+        "a fit would take it for a signal that does not follow the motion",
+    )?;
+
+    // the joint fit of base parameters and gains: OLS, then WLS on its residuals
+    let base = super::identify::base_parameters(model, options)?;
+    let p = base.len();
+    // each run is read alone too (the agreement), so each must determine the parameters
+    if let Some((r, run)) = (runs.iter().enumerate()).find(|(_, run)| run.states.len() <= p) {
+        return Err(bad_runs(format!(
+            "run {r} has {} samples; at least {} are needed to read it against the others",
+            run.states.len(),
+            p + 1
+        )));
+    }
+    let factors =
+        JointFactors::with_columns(model, &base, &states, &rhs, &[signal], options.gravity)?;
+    let names: Vec<String> = base
+        .names()
+        .into_iter()
+        .chain(model.joint_names.iter().map(|j| format!("{j}.drive_gain")))
+        .collect();
+    let mut sigma = vec![1.0; nv];
+    let mut ls = factors.solve(&sigma, &names)?;
+    let mut rms = factors.residual_rms(ls.coef.as_slice())?;
+    if options.weighting == Weighting::Wls {
+        sigma = rms
+            .iter()
+            .map(|&s| if s.is_finite() && s > 0.0 { s } else { 1.0 })
+            .collect();
+        ls = factors.solve(&sigma, &names)?;
+        rms = factors.residual_rms(ls.coef.as_slice())?;
+    }
+    let ls_coef: Vec<f64> = ls.coef.row(0).iter().copied().collect();
+    let ls_gain: Vec<f64> = ls_coef[p..].iter().map(|c| -c).collect();
+    refuse_undetermined(model, &ls_gain, &rms)?;
+    // by instrumental variables the model is theirs; the least-squares fit keeps the gains'
+    // noise bias (below)
+    let iv = match estimator {
+        GainEstimator::LeastSquares => None,
+        GainEstimator::Instrumental => Some(super::instrumental::instrumental(
+            &factors, &sigma, &ls_coef, &names,
+        )?),
+    };
+    let fit = iv.as_ref().unwrap_or(&ls);
+    let coef: Vec<f64> = fit.coef.row(0).iter().copied().collect();
+    let fit_rms: Vec<f64> = match &iv {
+        Some(iv) => iv.residual_rms.iter().copied().collect(),
+        None => rms.clone(),
+    };
+    let gain: Vec<f64> = coef[p..].iter().map(|c| -c).collect();
+    refuse_undetermined(model, &gain, &fit_rms)?;
+
+    // the robot alone: its torques are the gains' times the signal less the payload's
+    let tau: Vec<f64> = (0..k * nv)
+        .map(|x| gain[x % nv] * signal[x] + rhs[x])
+        .collect();
+    // each run's residuals a time series of their own
+    let options = &BaseOptions {
+        runs: stacked.runs.clone(),
+        ..options.clone()
+    };
+    let (mut model_fit, _) = fit_with_factors(model, &states, &tau, options)?;
+    let inflation = model_fit.stderr_inflation();
+    let stderr: Vec<f64> = fit.stderr.row(0).iter().map(|s| s * inflation).collect();
+    model_fit.theta = coef[..p].to_vec();
+    model_fit.stderr = stderr[..p].to_vec();
+    model_fit.correlation = fit.correlation.view((0, 0), (p, p)).into_owned();
+    model_fit.residual_rms = fit_rms.clone();
+    model_fit.sigma = sigma;
+    let noise_bias = noise_bias(model, &ls, p, &rms, &model_fit.sigma, &ls_gain, k)?;
+    let agreement = agreement(model, &base, runs, signal, &fit_rms, &gain, options)?;
+    let payload_torque_rms = (loaded.squares.iter())
+        .map(|sum| (sum / loaded.rows.max(1) as f64).sqrt())
+        .collect();
+    model_fit.drive_gains = Some(DriveGains {
+        gain,
+        stderr: stderr[p..].to_vec(),
+        noise_bias,
+        payload_torque_rms,
+        agreement,
+        cond: ls.cond,
+        runs: runs.len(),
+        loaded_runs: loaded.runs,
+        estimator,
+        // the fit's coefficients are -K: the gains' correlation with the parameters is the
+        // negated one
+        correlation: nalgebra::DMatrix::from_fn(nv, p + nv, |j, a| {
+            let r = fit.correlation[(p + j, a)];
+            if a < p {
+                -r
+            } else {
+                r
+            }
+        }),
+        least_squares_gain: match estimator {
+            GainEstimator::LeastSquares => Vec::new(),
+            GainEstimator::Instrumental => ls_gain,
+        },
+    });
+    Ok(DriveGainFit { model: model_fit })
+}
+
+/// An error in the runs given.
+fn bad_runs(message: String) -> Error {
+    Error::InvalidArgument {
         argument: "runs".into(),
         message,
-    };
+    }
+}
+
+/// The options and runs checked before any work: their count, joints, derivatives, signals,
+/// payloads (not all alike) and total size. Returns the number of samples in all.
+fn check_runs(model: &Model, runs: &[GainRun<'_>], options: &BaseOptions) -> Result<usize> {
+    let nv = model.nv;
+    let bad = bad_runs;
     if options.weighting == Weighting::Noise || options.noise.is_some() {
         // the torques are the gains times the signal: a noise in its units is not known
         // before the gains are
@@ -432,12 +553,32 @@ pub fn identify_drive_gains_with(
             }
         )));
     }
-    // the runs one after the other: states, the signal (its column's coefficient is -K) and
-    // the right-hand side -tau_L
+    Ok(k)
+}
+
+/// The payloads' squared torques per joint summed over the loaded runs' samples, with the
+/// counts of those samples and runs.
+struct LoadedTorques {
+    squares: Vec<f64>,
+    rows: usize,
+    runs: usize,
+}
+
+/// The runs one after the other: states, the signal (its column's coefficient is -K) and the
+/// right-hand side -tau_L, with the payloads' torques summed.
+fn stack_runs<'a>(
+    model: &Model,
+    runs: &[GainRun<'a>],
+    options: &BaseOptions,
+) -> Result<(
+    crate::logs::stacked_states::StackedStates,
+    Vec<f64>,
+    LoadedTorques,
+)> {
+    let nv = model.nv;
     let parts: Vec<(States<'_>, &[f64])> = runs.iter().map(|r| (r.states, r.signal)).collect();
     let stacked = crate::logs::stacked_states::StackedStates::of(&parts)?;
-    let signal = &stacked.data;
-    let mut rhs = vec![0.0; k * nv];
+    let mut rhs = vec![0.0; stacked.data.len()];
     // per joint, the payloads' squared torques summed over the loaded runs' samples
     let (mut loaded_squares, mut loaded_rows, mut loaded_runs) = (vec![0.0; nv], 0, 0);
     let mut first = 0;
@@ -455,107 +596,55 @@ pub fn identify_drive_gains_with(
         }
         first += s.len();
     }
-    let states = stacked.states()?;
-    crate::torque_model::refuse_flat_torques(
-        &states,
-        signal,
-        &model.joint_names,
-        "a fit would take it for a signal that does not follow the motion",
-    )?;
+    let loaded = LoadedTorques {
+        squares: loaded_squares,
+        rows: loaded_rows,
+        runs: loaded_runs,
+    };
+    Ok((stacked, rhs, loaded))
+}
 
-    // the joint fit of base parameters and gains: OLS, then WLS on its residuals
-    let base = super::identify::base_parameters(model, options)?;
-    let p = base.len();
-    // each run is read alone too (the agreement), so each must determine the parameters
-    if let Some((r, run)) = (runs.iter().enumerate()).find(|(_, run)| run.states.len() <= p) {
-        return Err(bad(format!(
-            "run {r} has {} samples; at least {} are needed to read it against the others",
-            run.states.len(),
-            p + 1
-        )));
+/// Refuses gains that are not finite and non-zero, or residuals that are not finite.
+fn refuse_undetermined(model: &Model, gain: &[f64], rms: &[f64]) -> Result<()> {
+    match (0..model.nv).find(|&j| !(gain[j].is_finite() && gain[j] != 0.0 && rms[j].is_finite())) {
+        Some(j) => Err(Error::Numerical {
+            operation: "drive-gain identification".into(),
+            message: format!(
+                "joint '{}': gain {} with residual RMS {}: the signal does not determine it (a signal of 0 or one too large for f64 arithmetic?)",
+                model.joint_names[j],
+                shown(gain[j]),
+                shown(rms[j])
+            ),
+        }),
+        None => Ok(()),
     }
-    let factors =
-        JointFactors::with_columns(model, &base, &states, &rhs, &[signal], options.gravity)?;
-    let names: Vec<String> = base
-        .names()
-        .into_iter()
-        .chain(model.joint_names.iter().map(|j| format!("{j}.drive_gain")))
-        .collect();
-    let mut sigma = vec![1.0; nv];
-    let mut ls = factors.solve(&sigma, &names)?;
-    let mut rms = factors.residual_rms(ls.coef.as_slice())?;
-    if options.weighting == Weighting::Wls {
-        sigma = rms
-            .iter()
-            .map(|&s| if s.is_finite() && s > 0.0 { s } else { 1.0 })
-            .collect();
-        ls = factors.solve(&sigma, &names)?;
-        rms = factors.residual_rms(ls.coef.as_slice())?;
-    }
-    let undetermined = |gain: &[f64], rms: &[f64]| -> Result<()> {
-        match (0..nv).find(|&j| !(gain[j].is_finite() && gain[j] != 0.0 && rms[j].is_finite())) {
-            Some(j) => Err(Error::Numerical {
-                operation: "drive-gain identification".into(),
-                message: format!(
-                    "joint '{}': gain {} with residual RMS {}: the signal does not determine it (a signal of 0 or one too large for f64 arithmetic?)",
-                    model.joint_names[j],
-                    shown(gain[j]),
-                    shown(rms[j])
-                ),
-            }),
-            None => Ok(()),
-        }
-    };
-    let ls_coef: Vec<f64> = ls.coef.row(0).iter().copied().collect();
-    let ls_gain: Vec<f64> = ls_coef[p..].iter().map(|c| -c).collect();
-    undetermined(&ls_gain, &rms)?;
-    // by instrumental variables the model is theirs; the least-squares fit keeps the gains'
-    // noise bias (below)
-    let iv = match estimator {
-        GainEstimator::LeastSquares => None,
-        GainEstimator::Instrumental => Some(super::instrumental::instrumental(
-            &factors, &sigma, &ls_coef, &names,
-        )?),
-    };
-    let fit = iv.as_ref().unwrap_or(&ls);
-    let coef: Vec<f64> = fit.coef.row(0).iter().copied().collect();
-    let fit_rms: Vec<f64> = match &iv {
-        Some(iv) => iv.residual_rms.iter().copied().collect(),
-        None => rms.clone(),
-    };
-    let gain: Vec<f64> = coef[p..].iter().map(|c| -c).collect();
-    undetermined(&gain, &fit_rms)?;
+}
 
-    // the robot alone: its torques are the gains' times the signal less the payload's
-    let tau: Vec<f64> = (0..k * nv)
-        .map(|x| gain[x % nv] * signal[x] + rhs[x])
-        .collect();
-    // each run's residuals a time series of their own
-    let options = &BaseOptions {
-        runs: stacked.runs.clone(),
-        ..options.clone()
-    };
-    let (mut model_fit, _) = fit_with_factors(model, &states, &tau, options)?;
-    let inflation = model_fit.stderr_inflation();
-    let stderr: Vec<f64> = fit.stderr.row(0).iter().map(|s| s * inflation).collect();
-    model_fit.theta = coef[..p].to_vec();
-    model_fit.stderr = stderr[..p].to_vec();
-    model_fit.correlation = fit.correlation.view((0, 0), (p, p)).into_owned();
-    model_fit.residual_rms = fit_rms.clone();
-    model_fit.sigma = sigma;
-
-    // the gains' noise bias: errors in the columns bias least squares by -(X^T W^2 X)^-1
-    // Sigma_uu theta, Sigma_uu holding k (noise / sigma)^2 at each joint's signal column (its
-    // rows weighted by 1 / sigma); the gains share one scale with each other and the
-    // parameters, so every joint's noise biases every gain. The noise taken for the whole
-    // residual, rms / |K|. (The fit's coefficients are -K: their covariance is K's.)
+/// The gains' noise bias from the least-squares fit `ls` of `p` base parameters and the gains
+/// (residual RMS `rms`, weights `sigma`, gains `ls_gain`, `k` samples).
+///
+/// Errors in the columns bias least squares by -(X^T W^2 X)^-1 Sigma_uu theta, Sigma_uu holding
+/// k (noise / sigma)^2 at each joint's signal column (its rows weighted by 1 / sigma); the
+/// gains share one scale with each other and the parameters, so every joint's noise biases
+/// every gain. The noise taken for the whole residual, rms / |K|. (The fit's coefficients are
+/// -K: their covariance is K's.)
+fn noise_bias(
+    model: &Model,
+    ls: &LeastSquares,
+    p: usize,
+    rms: &[f64],
+    sigma: &[f64],
+    ls_gain: &[f64],
+    k: usize,
+) -> Result<Vec<f64>> {
+    let nv = model.nv;
     let cov =
         |a: usize, b: usize| ls.correlation[(a, b)] * (ls.cov_diag[a] * ls.cov_diag[b]).sqrt();
-    let noise_bias = (0..nv)
+    (0..nv)
         .map(|m| {
             let sum: f64 = (0..nv)
                 .map(|j| {
-                    let w = rms[j] / model_fit.sigma[j];
+                    let w = rms[j] / sigma[j];
                     cov(p + m, p + j) * k as f64 * w * w / ls_gain[j]
                 })
                 .sum();
@@ -572,52 +661,38 @@ pub fn identify_drive_gains_with(
                 })
             }
         })
-        .collect::<Result<Vec<f64>>>()?;
+        .collect::<Result<Vec<f64>>>()
+}
+
+/// Per joint, how well the runs agree: the joint fit's residual (in signal units) over each
+/// run's signal fitted alone.
+fn agreement(
+    model: &Model,
+    base: &BaseParameters,
+    runs: &[GainRun<'_>],
+    signal: &[f64],
+    fit_rms: &[f64],
+    gain: &[f64],
+    options: &BaseOptions,
+) -> Result<Vec<f64>> {
+    let nv = model.nv;
+    let k = signal.len() / nv;
     // each run's signal fitted alone, joint by joint, for the agreement
     let mut alone = vec![0.0; nv];
     for run in runs {
-        let f = JointFactors::new(model, &base, &run.states, run.signal, options.gravity)?;
+        let f = JointFactors::new(model, base, &run.states, run.signal, options.gravity)?;
         for (a, r) in alone.iter_mut().zip(&f.factors) {
             *a += beyond_the_rest(r).powi(2);
         }
     }
-    let agreement = (0..nv)
+    Ok((0..nv)
         .map(|j| {
             let scale: f64 = (0..k).map(|s| signal[s * nv + j].powi(2)).sum::<f64>() / k as f64;
             let floor = 1e-9 * scale.sqrt();
             let own = (alone[j] / k as f64).sqrt();
             (fit_rms[j] / gain[j].abs() + floor) / (own + floor)
         })
-        .collect();
-    let payload_torque_rms = (loaded_squares.iter())
-        .map(|sum| (sum / loaded_rows.max(1) as f64).sqrt())
-        .collect();
-    model_fit.drive_gains = Some(DriveGains {
-        gain,
-        stderr: stderr[p..].to_vec(),
-        noise_bias,
-        payload_torque_rms,
-        agreement,
-        cond: ls.cond,
-        runs: runs.len(),
-        loaded_runs,
-        estimator,
-        // the fit's coefficients are -K: the gains' correlation with the parameters is the
-        // negated one
-        correlation: nalgebra::DMatrix::from_fn(nv, p + nv, |j, a| {
-            let r = fit.correlation[(p + j, a)];
-            if a < p {
-                -r
-            } else {
-                r
-            }
-        }),
-        least_squares_gain: match estimator {
-            GainEstimator::LeastSquares => Vec::new(),
-            GainEstimator::Instrumental => ls_gain,
-        },
-    });
-    Ok(DriveGainFit { model: model_fit })
+        .collect())
 }
 
 /// The norm of the last column of the triangular factor `r` (`n x n`) beyond the span of the

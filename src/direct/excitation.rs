@@ -286,7 +286,15 @@ pub fn design_excitation(
     options: &ExcitationOptions,
     progress: Option<Progress<'_>>,
 ) -> Result<ExcitationDesign> {
-    let o = options;
+    check_options(options)?;
+    let p = Problem::new(model, options)?;
+    let (x, bounds) = feasible_start(&p);
+    let (x, evaluations) = search(&p, x, &bounds, progress)?;
+    finish(p, &x, evaluations)
+}
+
+/// The options' counts and ranges, before any work.
+fn check_options(o: &ExcitationOptions) -> Result<()> {
     use crate::limits::{
         check_count, check_range, MAX_EVALUATIONS, MAX_FIT_SAMPLES, MAX_HARMONICS,
     };
@@ -326,87 +334,98 @@ pub fn design_excitation(
             message: format!("{}; expected a fraction in (0, 1]", o.margin),
         });
     }
-    let n = model.nv;
-    let layout = ParameterLayout::new(model, o.friction.for_model(model));
-    let values = (o.samples * n) as f64 * layout.len() as f64;
-    crate::limits::check_values("samples", values, || {
-        format!(
-            "the criterion's regressor of {} samples of {n} joints and {} parameters",
-            o.samples,
-            layout.len()
-        )
-    })?;
-    let base = BaseParameters::from_random_states(
-        model,
-        &layout,
-        Gravity::Included,
-        200.max(layout.len()),
-        BASE_TOLERANCE,
-        o.seed,
-    )?;
-    if o.samples * n < base.len() {
-        return Err(Error::InvalidArgument {
-            argument: "samples".into(),
-            message: format!(
-                "{} samples x {n} joints cannot determine {} base parameters",
+    Ok(())
+}
+
+impl<'a> Problem<'a> {
+    /// The search's limits (times the margin), sample times and constraints for `model`.
+    fn new(model: &'a Model, o: &'a ExcitationOptions) -> Result<Problem<'a>> {
+        let n = model.nv;
+        let layout = ParameterLayout::new(model, o.friction.for_model(model));
+        let values = (o.samples * n) as f64 * layout.len() as f64;
+        crate::limits::check_values("samples", values, || {
+            format!(
+                "the criterion's regressor of {} samples of {n} joints and {} parameters",
                 o.samples,
-                base.len()
-            ),
-        });
-    }
-    let w_f = 2.0 * std::f64::consts::PI * o.base_frequency;
-    let period = 1.0 / o.base_frequency;
-    let m = o.margin;
-    let (mut lower, mut upper) = (vec![0.0; n], vec![0.0; n]);
-    for (i, lim) in model.limits.iter().enumerate() {
-        let (lo, hi) = if lim.lower.is_finite() && lim.upper.is_finite() {
-            (lim.lower, lim.upper)
-        } else {
-            (-std::f64::consts::PI, std::f64::consts::PI)
-        };
-        let (c, h) = (0.5 * (lo + hi), 0.5 * (hi - lo) * m);
-        (lower[i], upper[i]) = (c - h, c + h);
-    }
-    // The speeds the excitation can use. A Fourier series of L harmonics that stays within a
-    // position half-range h moves at most h w_f L fast (Bernstein's inequality): a speed limit
-    // above that cannot be reached, and taken as it is (1e300 from a careless URDF) it would
-    // only scale the search (its bounds and first step) into overflow. Accelerations enter the
-    // constraints only, as ratios to their limits, where a huge limit does no harm.
-    let given = |limit: f64, default: f64| if limit.is_finite() { limit } else { default };
-    let vel: Vec<f64> = (0..n)
-        .map(|i| {
-            let reach = 0.5 * (upper[i] - lower[i]) * w_f * o.harmonics as f64;
-            (m * given(model.limits[i].velocity, o.default_velocity)).min(reach)
+                layout.len()
+            )
+        })?;
+        let base = BaseParameters::from_random_states(
+            model,
+            &layout,
+            Gravity::Included,
+            200.max(layout.len()),
+            BASE_TOLERANCE,
+            o.seed,
+        )?;
+        if o.samples * n < base.len() {
+            return Err(Error::InvalidArgument {
+                argument: "samples".into(),
+                message: format!(
+                    "{} samples x {n} joints cannot determine {} base parameters",
+                    o.samples,
+                    base.len()
+                ),
+            });
+        }
+        let w_f = 2.0 * std::f64::consts::PI * o.base_frequency;
+        let period = 1.0 / o.base_frequency;
+        let m = o.margin;
+        let (mut lower, mut upper) = (vec![0.0; n], vec![0.0; n]);
+        for (i, lim) in model.limits.iter().enumerate() {
+            let (lo, hi) = if lim.lower.is_finite() && lim.upper.is_finite() {
+                (lim.lower, lim.upper)
+            } else {
+                (-std::f64::consts::PI, std::f64::consts::PI)
+            };
+            let (c, h) = (0.5 * (lo + hi), 0.5 * (hi - lo) * m);
+            (lower[i], upper[i]) = (c - h, c + h);
+        }
+        // The speeds the excitation can use. A Fourier series of L harmonics that stays within a
+        // position half-range h moves at most h w_f L fast (Bernstein's inequality): a speed limit
+        // above that cannot be reached, and taken as it is (1e300 from a careless URDF) it would
+        // only scale the search (its bounds and first step) into overflow. Accelerations enter the
+        // constraints only, as ratios to their limits, where a huge limit does no harm.
+        let given = |limit: f64, default: f64| if limit.is_finite() { limit } else { default };
+        let vel: Vec<f64> = (0..n)
+            .map(|i| {
+                let reach = 0.5 * (upper[i] - lower[i]) * w_f * o.harmonics as f64;
+                (m * given(model.limits[i].velocity, o.default_velocity)).min(reach)
+            })
+            .collect();
+        let acc: Vec<f64> = (0..n)
+            .map(|i| m * given(model.limits[i].acceleration, o.default_acceleration))
+            .collect();
+        Ok(Problem {
+            model,
+            base,
+            o,
+            w_f,
+            vel,
+            acc,
+            lower,
+            upper,
+            t_fit: (0..o.samples)
+                .map(|k| period * k as f64 / o.samples as f64)
+                .collect(),
+            t_check: (0..400).map(|k| period * k as f64 / 400.0).collect(),
+            points: o
+                .workspace
+                .iter()
+                .map(|w| w.resolve(model))
+                .collect::<Result<_>>()?,
+            effort: model
+                .limits
+                .iter()
+                .map(|l| (o.effort && l.effort.is_finite()).then_some(m * l.effort))
+                .collect(),
         })
-        .collect();
-    let acc: Vec<f64> = (0..n)
-        .map(|i| m * given(model.limits[i].acceleration, o.default_acceleration))
-        .collect();
-    let p = Problem {
-        model,
-        base,
-        o,
-        w_f,
-        vel,
-        acc,
-        lower,
-        upper,
-        t_fit: (0..o.samples)
-            .map(|k| period * k as f64 / o.samples as f64)
-            .collect(),
-        t_check: (0..400).map(|k| period * k as f64 / 400.0).collect(),
-        points: o
-            .workspace
-            .iter()
-            .map(|w| w.resolve(model))
-            .collect::<Result<_>>()?,
-        effort: model
-            .limits
-            .iter()
-            .map(|l| (o.effort && l.effort.is_finite()).then_some(m * l.effort))
-            .collect(),
-    };
-    // seeded random start, shrunk until feasible
+    }
+}
+
+/// A seeded random start, shrunk until feasible, and the coefficients' bounds.
+fn feasible_start(p: &Problem<'_>) -> (Vec<f64>, Vec<(f64, f64)>) {
+    let (n, o) = (p.model.nv, p.o);
     let f = p.free_per_joint();
     let mut rng = ChaCha8Rng::seed_from_u64(o.seed);
     let mut x = vec![0.0; n * f];
@@ -430,6 +449,17 @@ pub fn design_excitation(
             }
         }
     }
+    (x, bounds)
+}
+
+/// COBYLA from `x`: the coefficients it ends at and the number of evaluations; Ctrl-C stops it.
+fn search(
+    p: &Problem<'_>,
+    x: Vec<f64>,
+    bounds: &[(f64, f64)],
+    progress: Option<Progress<'_>>,
+) -> Result<(Vec<f64>, usize)> {
+    let o = p.o;
     let evaluations = RefCell::new(0usize);
     let best = RefCell::new(f64::INFINITY);
     let progress = RefCell::new(progress);
@@ -479,7 +509,7 @@ pub fn design_excitation(
         cobyla::minimize(
             objective,
             &x,
-            &bounds,
+            bounds,
             &cons,
             (),
             o.max_evaluations,
@@ -502,10 +532,18 @@ pub fn design_excitation(
     let x = match result {
         Ok((_, x, _)) | Err((_, x, _)) => x,
     };
+    let evaluations = *evaluations.borrow();
+    Ok((x, evaluations))
+}
+
+/// The trajectory of `x` brought within the full limits and checked at 1 kHz over a period.
+fn finish(p: Problem<'_>, x: &[f64], evaluations: usize) -> Result<ExcitationDesign> {
+    let (model, o, n) = (p.model, p.o, p.model.nv);
+    let period = 1.0 / o.base_frequency;
     // make sure of the limits: COBYLA may end with an offset outside its bounds (narrow
     // ranges), so the offsets go back within the limits; then the amplitudes shrink about q0
     // until the full check passes
-    let mut traj = p.trajectory(&x);
+    let mut traj = p.trajectory(x);
     for i in 0..n {
         traj.q0[i] = traj.q0[i].clamp(p.lower[i], p.upper[i]);
     }
@@ -552,7 +590,6 @@ pub fn design_excitation(
             ),
         });
     }
-    let evaluations = *evaluations.borrow();
     Ok(ExcitationDesign {
         trajectory: traj,
         value,

@@ -12,6 +12,7 @@ use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::model::Model;
+use crate::regression::LeastSquares;
 use crate::states::States;
 
 pub use super::base_options::{BaseOptions, Weighting};
@@ -331,29 +332,9 @@ pub(super) fn fit_with_factors(
         )
     });
     let mut fit = BaseModel {
-        format: BaseModel::tag(),
-        robot: model.name.clone(),
-        joint_names: model.joint_names.clone(),
-        gravity: options.gravity,
-        weighting: options.weighting,
-        theta: coef.iter().take(p).copied().collect(),
-        stderr: se.iter().take(p).copied().collect(),
-        correlation: ls.correlation.view((0, 0), (p, p)).into_owned(),
         residual_rms: rms,
         sigma,
-        cond: ls.cond,
         samples: k,
-        base,
-        residual_correlation: vec![],
-        log_glitches: vec![],
-        log_torque_saturation: vec![],
-        log_position_wraps: vec![],
-        log_held_columns: vec![],
-        log_stamp_jitter: None,
-        log_period_average: None,
-        log_dropouts: vec![],
-        position_rounding: vec![],
-        logs: vec![],
         torque_columns: super::torque_columns::check_torque_columns(
             model,
             states,
@@ -366,9 +347,6 @@ pub(super) fn fit_with_factors(
             _ => None,
         },
         position_range: super::position_range::check_position_range(model, states),
-        position_offsets: None,
-        unmodelled_friction: vec![],
-        run_offsets: vec![],
         run_checks: super::run_checks::check_runs_against_model(
             model,
             states,
@@ -376,15 +354,12 @@ pub(super) fn fit_with_factors(
             &options.runs,
             options.gravity,
         )?,
-        log_offsets: None,
-        log_agreement: None,
-        weak_excitation: None,
-        drive_gains: None,
         joint_term_rms: super::parameter_table::joint_term_rms(
             states,
             options.friction.for_model(model).names(),
         ),
         noise_fit,
+        ..BaseModel::without_checks(model, base, options.gravity, options.weighting, &ls)
     };
     fit.weak_excitation =
         super::weak_excitation::check_excitation(model, states, &fit.base, ls.cond, &ls.weakest);
@@ -427,6 +402,57 @@ pub(super) fn fit_with_factors(
 }
 
 impl BaseModel {
+    /// A model of `base` for `robot`'s joints fitted from `ls` (its first column; `p` base
+    /// parameters first), with none of the checks of a log: every finding empty, for the fit
+    /// to fill in.
+    pub(crate) fn without_checks(
+        robot: &Model,
+        base: BaseParameters,
+        gravity: Gravity,
+        weighting: Weighting,
+        ls: &LeastSquares,
+    ) -> BaseModel {
+        let p = base.len();
+        BaseModel {
+            format: BaseModel::tag(),
+            robot: robot.name.clone(),
+            joint_names: robot.joint_names.clone(),
+            base,
+            gravity,
+            weighting,
+            theta: ls.coef.row(0).iter().take(p).copied().collect(),
+            stderr: ls.stderr.row(0).iter().take(p).copied().collect(),
+            correlation: ls.correlation.view((0, 0), (p, p)).into_owned(),
+            residual_rms: vec![],
+            sigma: vec![1.0; robot.nv],
+            cond: ls.cond,
+            samples: ls.rows,
+            residual_correlation: vec![],
+            log_glitches: vec![],
+            log_dropouts: vec![],
+            log_torque_saturation: vec![],
+            log_position_wraps: vec![],
+            log_held_columns: vec![],
+            log_stamp_jitter: None,
+            log_period_average: None,
+            noise_fit: None,
+            position_rounding: vec![],
+            logs: vec![],
+            torque_columns: vec![],
+            torque_lag: None,
+            position_range: vec![],
+            position_offsets: None,
+            unmodelled_friction: vec![],
+            run_offsets: vec![],
+            run_checks: vec![],
+            log_offsets: None,
+            log_agreement: None,
+            weak_excitation: None,
+            drive_gains: None,
+            joint_term_rms: vec![],
+        }
+    }
+
     /// The factor the standard errors are inflated by for residuals correlated from sample to
     /// sample: the square root of the largest joint's [`Self::residual_correlation`] (at
     /// least 1).

@@ -78,37 +78,6 @@ pub struct ParametersFromLocal {
 /// models) are raised to it, so that no row gets an infinite weight.
 const WEIGHT_FLOOR: f64 = 1e-9;
 
-#[allow(clippy::too_many_arguments)]
-fn push_block(
-    x: &mut Vec<Vec<f64>>,
-    y: &mut Vec<f64>,
-    w: &mut Vec<f64>,
-    joint_of_row: &mut Vec<usize>,
-    regressor: &DMatrix<f64>,
-    values: &[f64],
-    stderr: &[f64],
-    nv: usize,
-    unmeasured: &[bool],
-) {
-    let scale = values.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    let floor = WEIGHT_FLOOR * scale + 1e-12;
-    for (r, (&v, &se)) in values.iter().zip(stderr).enumerate() {
-        let torque_row = if values.len() == nv { r } else { r / nv };
-        if unmeasured.get(torque_row).copied().unwrap_or(false) {
-            continue;
-        }
-        let se = if se.is_finite() {
-            se.max(floor)
-        } else {
-            floor.max(scale)
-        };
-        x.push(regressor.row(r).iter().map(|a| a / se).collect());
-        y.push(v / se);
-        w.push(se);
-        joint_of_row.push(torque_row);
-    }
-}
-
 /// Refuses a model of `models` that is another one again (the same document: estimates,
 /// standard errors and operating point, bit for bit), naming both: its estimates' noise would
 /// count as independent twice. Two models identified at one point from other recordings pass.
@@ -172,79 +141,11 @@ pub fn identify_parameters_from_local(
     }
     refuse_repeated_models(models)?;
     let layout = ParameterLayout::new(robot, options.friction.for_model(robot));
-    let (mut x, mut y, mut w, mut joint) = (vec![], vec![], vec![], vec![]);
+    let mut stacked = Rows::default();
     for (i, m) in models.iter().enumerate() {
-        crate::interrupt::check("parameters from local models")?;
-        if m.joint_names != robot.joint_names {
-            return Err(Error::InvalidArgument {
-                argument: format!("models[{i}]"),
-                message: format!(
-                    "identified for joints [{}]; the robot '{}' has [{}]",
-                    m.joint_names.join(", "),
-                    robot.name,
-                    robot.joint_names.join(", ")
-                ),
-            });
-        }
-        let op = &m.planned_op;
-        let reg = linearization_regressor(robot, &layout, &op.q, &op.qd, &op.qdd, options.gravity)?;
-        if options.use_torque {
-            push_block(
-                &mut x,
-                &mut y,
-                &mut w,
-                &mut joint,
-                &reg.torque,
-                &m.torque,
-                &m.torque_stderr,
-                nv,
-                &[],
-            );
-        }
-        // the rows of a torque that did not change (the combined estimate's D, H and G share
-        // theirs)
-        let unmeasured = |experiment: &str| -> Vec<bool> {
-            let combined = m.estimator == Estimator::Combined && experiment != "G_static";
-            robot
-                .joint_names
-                .iter()
-                .map(|j| {
-                    m.diagnostics.unmeasured.iter().any(|u| {
-                        &u.joint == j
-                            && (u.experiment == experiment
-                                || (combined && u.experiment != "G_static"))
-                    })
-                })
-                .collect()
-        };
-        let mut block = |e: &Option<Estimate>, r: &DMatrix<f64>, experiment: &str| {
-            if let Some(e) = e {
-                push_block(
-                    &mut x,
-                    &mut y,
-                    &mut w,
-                    &mut joint,
-                    r,
-                    &entries(&e.matrix),
-                    &entries(&e.stderr),
-                    nv,
-                    &unmeasured(experiment),
-                );
-            }
-        };
-        if options.use_d {
-            block(&m.d, &reg.d, "D");
-        }
-        if options.use_h {
-            block(&m.h, &reg.h, "H");
-        }
-        if options.use_g {
-            block(&m.g, &reg.g, "G");
-        }
-        if options.use_g_static && options.gravity == Gravity::Included {
-            block(&m.g_static, &reg.g_static, "G_static");
-        }
+        stacked.push_model(robot, &layout, i, m, options)?;
     }
+    let Rows { x, y, w, joint } = stacked;
     let rows = x.len();
     let p = layout.len();
     let phi = DMatrix::from_fn(rows, p, |r, c| x[r][c]);
@@ -262,8 +163,6 @@ pub fn identify_parameters_from_local(
         "parameters from local models",
         &columns,
     )?;
-    let theta: Vec<f64> = ls.coef.row(0).iter().copied().collect();
-    let stderr: Vec<f64> = ls.stderr.row(0).iter().copied().collect();
     // residuals in N m (unweighted), by the torque row they belong to
     let phi_base = base.select(&phi);
     let residual_rms = |theta_base: &[f64]| {
@@ -286,73 +185,17 @@ pub fn identify_parameters_from_local(
         BASE_TOLERANCE,
         1,
     )?;
-    // which of the robot's base columns the data cannot separate: the pivoted QR of the data
-    // restricted to those columns drops exactly them
-    let unidentified = if base.len() < robot_base.len() {
-        let mut masked = padded.clone();
-        for c in 0..p {
-            if !robot_base.kept.contains(&c) {
-                masked.column_mut(c).fill(0.0);
-            }
-        }
-        let within = BaseParameters::from_regressor(layout.clone(), &masked, BASE_TOLERANCE)?;
-        let names = robot_base.names();
-        robot_base
-            .kept
-            .iter()
-            .zip(names)
-            .filter(|(k, _)| within.dropped.contains(k))
-            .map(|(_, n)| n)
-            .collect()
-    } else {
-        vec![]
-    };
+    let unidentified = unidentified(&layout, &padded, &base, &robot_base)?;
     let rank = base.len();
     // the data's map is the robot's where they identify every base parameter
     let base = BaseParameters {
         structural: rank == robot_base.len(),
         ..base
     };
+    let unchecked = BaseModel::without_checks(robot, base, options.gravity, Weighting::Wls, &ls);
     let model = BaseModel {
-        format: BaseModel::tag(),
-        robot: robot.name.clone(),
-        joint_names: robot.joint_names.clone(),
-        base,
-        gravity: options.gravity,
-        weighting: Weighting::Wls,
-        residual_rms: residual_rms(&theta),
-        theta,
-        stderr,
-        correlation: ls.correlation.clone(),
-        sigma: vec![1.0; nv],
-        cond: ls.cond,
-        samples: rows,
-        // rows from local models, not a time series
-        residual_correlation: vec![],
-        log_glitches: vec![],
-        log_dropouts: vec![],
-        log_torque_saturation: vec![],
-        log_position_wraps: vec![],
-        log_held_columns: vec![],
-        log_stamp_jitter: None,
-        log_period_average: None,
-        noise_fit: None,
-        position_rounding: vec![],
-        logs: vec![],
-        // rows from local models: no log's torque columns
-        torque_columns: vec![],
-        torque_lag: None,
-        position_range: vec![],
-        position_offsets: None,
-        unmodelled_friction: vec![],
-        run_offsets: vec![],
-        run_checks: vec![],
-        log_offsets: None,
-        log_agreement: None,
-        // rows from local models: their own diagnostics say what they leave unidentified
-        weak_excitation: None,
-        drive_gains: None,
-        joint_term_rms: vec![],
+        residual_rms: residual_rms(&unchecked.theta),
+        ..unchecked
     };
     let consistent = match &options.consistent {
         None => None,
@@ -392,4 +235,143 @@ pub fn identify_parameters_from_local(
         rows,
         consistent,
     })
+}
+
+/// The stacked rows of the local models: each row of the regressor and its value divided by
+/// the value's standard error `w`, and the joint (torque row) it belongs to.
+#[derive(Default)]
+struct Rows {
+    x: Vec<Vec<f64>>,
+    y: Vec<f64>,
+    w: Vec<f64>,
+    joint: Vec<usize>,
+}
+
+impl Rows {
+    /// Adds the rows of one block: `values` (row-major, `nv` or `nv x nv`) with their
+    /// standard errors and the regressor's rows, less the rows of unmeasured torques.
+    fn push_block(
+        &mut self,
+        regressor: &DMatrix<f64>,
+        values: &[f64],
+        stderr: &[f64],
+        nv: usize,
+        unmeasured: &[bool],
+    ) {
+        let scale = values.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let floor = WEIGHT_FLOOR * scale + 1e-12;
+        for (r, (&v, &se)) in values.iter().zip(stderr).enumerate() {
+            let torque_row = if values.len() == nv { r } else { r / nv };
+            if unmeasured.get(torque_row).copied().unwrap_or(false) {
+                continue;
+            }
+            let se = if se.is_finite() {
+                se.max(floor)
+            } else {
+                floor.max(scale)
+            };
+            self.x
+                .push(regressor.row(r).iter().map(|a| a / se).collect());
+            self.y.push(v / se);
+            self.w.push(se);
+            self.joint.push(torque_row);
+        }
+    }
+
+    /// Adds the rows of model `i`, `m`, as `options` choose them.
+    fn push_model(
+        &mut self,
+        robot: &Model,
+        layout: &ParameterLayout,
+        i: usize,
+        m: &LocalModel,
+        options: &FromLocalOptions,
+    ) -> Result<()> {
+        let nv = robot.nv;
+        crate::interrupt::check("parameters from local models")?;
+        if m.joint_names != robot.joint_names {
+            return Err(Error::InvalidArgument {
+                argument: format!("models[{i}]"),
+                message: format!(
+                    "identified for joints [{}]; the robot '{}' has [{}]",
+                    m.joint_names.join(", "),
+                    robot.name,
+                    robot.joint_names.join(", ")
+                ),
+            });
+        }
+        let op = &m.planned_op;
+        let reg = linearization_regressor(robot, layout, &op.q, &op.qd, &op.qdd, options.gravity)?;
+        if options.use_torque {
+            self.push_block(&reg.torque, &m.torque, &m.torque_stderr, nv, &[]);
+        }
+        // the rows of a torque that did not change (the combined estimate's D, H and G share
+        // theirs)
+        let unmeasured = |experiment: &str| -> Vec<bool> {
+            let combined = m.estimator == Estimator::Combined && experiment != "G_static";
+            robot
+                .joint_names
+                .iter()
+                .map(|j| {
+                    m.diagnostics.unmeasured.iter().any(|u| {
+                        &u.joint == j
+                            && (u.experiment == experiment
+                                || (combined && u.experiment != "G_static"))
+                    })
+                })
+                .collect()
+        };
+        let mut block = |e: &Option<Estimate>, r: &DMatrix<f64>, experiment: &str| {
+            if let Some(e) = e {
+                self.push_block(
+                    r,
+                    &entries(&e.matrix),
+                    &entries(&e.stderr),
+                    nv,
+                    &unmeasured(experiment),
+                );
+            }
+        };
+        if options.use_d {
+            block(&m.d, &reg.d, "D");
+        }
+        if options.use_h {
+            block(&m.h, &reg.h, "H");
+        }
+        if options.use_g {
+            block(&m.g, &reg.g, "G");
+        }
+        if options.use_g_static && options.gravity == Gravity::Included {
+            block(&m.g_static, &reg.g_static, "G_static");
+        }
+        Ok(())
+    }
+}
+
+/// Which of the robot's base columns the data cannot separate: the pivoted QR of the data
+/// (`padded`, whose base is `base`) restricted to those columns drops exactly them.
+fn unidentified(
+    layout: &ParameterLayout,
+    padded: &DMatrix<f64>,
+    base: &BaseParameters,
+    robot_base: &BaseParameters,
+) -> Result<Vec<String>> {
+    if base.len() >= robot_base.len() {
+        return Ok(vec![]);
+    }
+    let mut masked = padded.clone();
+    for c in 0..layout.len() {
+        if !robot_base.kept.contains(&c) {
+            masked.column_mut(c).fill(0.0);
+        }
+    }
+    let within = BaseParameters::from_regressor(layout.clone(), &masked, BASE_TOLERANCE)?;
+    let names = robot_base.names();
+    Ok(robot_base
+        .kept
+        .iter()
+        .zip(names)
+        .filter(|(k, _)| within.dropped.contains(k))
+        .map(|(_, n)| n)
+        .collect())
 }

@@ -411,72 +411,132 @@ impl Document for Plan {
 /// limits; a plan that breaks one is refused with the experiment, joint, time and limit.
 pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOptions) -> Result<Plan> {
     op.check(model)?;
-    let n = model.nv;
-    let o = options;
-    use crate::limits::{check_count, check_range, MAX_PERTURBATIONS, MAX_RATE};
-    check_range("rate", o.rate, f64::MIN_POSITIVE, MAX_RATE)?;
-    check_range("window", o.window, 0.0, 60.0)?;
-    check_range("dwell", o.dwell, 0.0, 3600.0)?;
-    check_range("min_transition", o.min_transition, 0.0, 3600.0)?;
-    if let Some(k) = o.count {
-        check_count("n (perturbations per experiment)", k, 2, MAX_PERTURBATIONS)?;
-    }
-    let per_joint = |name: &str, values: &Option<Vec<f64>>, largest: f64| -> Result<()> {
-        let Some(values) = values else { return Ok(()) };
-        if values.len() != n {
-            return Err(Error::Shape {
-                argument: name.into(),
-                expected: format!("{n} values (one per joint)"),
-                got: format!("{} values", values.len()),
+    let setup = Setup::new(model, op, options)?;
+    let mut experiments = Vec::new();
+    let mut warnings = Vec::new();
+    for (index, &kind) in options.experiments.iter().enumerate() {
+        if options.experiments[..index].contains(&kind) {
+            return Err(Error::InvalidArgument {
+                argument: "experiments".into(),
+                message: format!("'{}' is listed twice", kind.name()),
             });
         }
-        for (j, v) in values.iter().enumerate() {
-            check_range(&format!("{name}[{j}]"), *v, 0.0, largest)?;
+        experiments.push(plan_experiment(&setup, index, kind, &mut warnings)?);
+    }
+    Ok(Plan {
+        format: Plan::tag(),
+        robot: model.name.clone(),
+        joint_names: model.joint_names.clone(),
+        op: op.clone(),
+        rate: options.rate,
+        design: options.design,
+        seed: options.seed,
+        experiments,
+        warnings,
+    })
+}
+
+/// What every experiment of a plan shares: the checked options, the perturbation sizes, the
+/// transitions' limits and the windows in samples.
+struct Setup<'a> {
+    model: &'a Model,
+    op: &'a OperatingPoint,
+    o: &'a PlanOptions,
+    /// Perturbations per experiment.
+    count: usize,
+    /// Position, velocity and acceleration perturbation sizes per joint.
+    sizes: [Vec<f64>; 3],
+    lim: TransitionLimits,
+    window_samples: usize,
+    dwell_samples: usize,
+}
+
+impl<'a> Setup<'a> {
+    /// The options checked against `model` and `op`, before any work.
+    fn new(model: &'a Model, op: &'a OperatingPoint, o: &'a PlanOptions) -> Result<Setup<'a>> {
+        let n = model.nv;
+        use crate::limits::{check_count, check_range, MAX_PERTURBATIONS, MAX_RATE};
+        check_range("rate", o.rate, f64::MIN_POSITIVE, MAX_RATE)?;
+        check_range("window", o.window, 0.0, 60.0)?;
+        check_range("dwell", o.dwell, 0.0, 3600.0)?;
+        check_range("min_transition", o.min_transition, 0.0, 3600.0)?;
+        if let Some(k) = o.count {
+            check_count("n (perturbations per experiment)", k, 2, MAX_PERTURBATIONS)?;
         }
-        Ok(())
-    };
-    per_joint("encoder_step", &o.encoder_step, 1.0)?;
-    per_joint(
-        "torque_noise",
-        &o.torque_noise,
-        crate::limits::MAX_TORQUE_NOISE,
-    )?;
-    per_joint(
-        "torque_pass_noise",
-        &o.torque_pass_noise,
-        crate::limits::MAX_TORQUE_NOISE,
-    )?;
-    predicted_response::check_pass_noise(model, &o.torque_noise, &o.torque_pass_noise)?;
-    if o.experiments.is_empty() {
-        return Err(Error::InvalidArgument {
-            argument: "experiments".into(),
-            message: "none asked for; expected some of nominal, G_static, G, H, D".into(),
-        });
+        let per_joint = |name: &str, values: &Option<Vec<f64>>, largest: f64| -> Result<()> {
+            let Some(values) = values else { return Ok(()) };
+            if values.len() != n {
+                return Err(Error::Shape {
+                    argument: name.into(),
+                    expected: format!("{n} values (one per joint)"),
+                    got: format!("{} values", values.len()),
+                });
+            }
+            for (j, v) in values.iter().enumerate() {
+                check_range(&format!("{name}[{j}]"), *v, 0.0, largest)?;
+            }
+            Ok(())
+        };
+        per_joint("encoder_step", &o.encoder_step, 1.0)?;
+        per_joint(
+            "torque_noise",
+            &o.torque_noise,
+            crate::limits::MAX_TORQUE_NOISE,
+        )?;
+        per_joint(
+            "torque_pass_noise",
+            &o.torque_pass_noise,
+            crate::limits::MAX_TORQUE_NOISE,
+        )?;
+        predicted_response::check_pass_noise(model, &o.torque_noise, &o.torque_pass_noise)?;
+        if o.experiments.is_empty() {
+            return Err(Error::InvalidArgument {
+                argument: "experiments".into(),
+                message: "none asked for; expected some of nominal, G_static, G, H, D".into(),
+            });
+        }
+        let window_samples = (o.window * o.rate).round() as usize;
+        if window_samples < 2 {
+            return Err(Error::InvalidArgument {
+                argument: "window".into(),
+                message: format!(
+                    "{} s holds fewer than 2 samples each side at {} Hz",
+                    o.window, o.rate
+                ),
+            });
+        }
+        let dwell_samples = (o.dwell * o.rate).round() as usize;
+        if dwell_samples < 4 {
+            return Err(Error::InvalidArgument {
+                argument: "dwell".into(),
+                message: format!("{} s is too short at {} Hz", o.dwell, o.rate),
+            });
+        }
+        if !(o.margin > 0.0 && o.margin <= 1.0) {
+            return Err(Error::InvalidArgument {
+                argument: "margin".into(),
+                message: format!("{}; expected a fraction in (0, 1]", o.margin),
+            });
+        }
+        Ok(Setup {
+            model,
+            op,
+            o,
+            count: o.count.unwrap_or(2 * n),
+            sizes: perturbation_sizes(model, op, o)?,
+            lim: transition_limits(model, o),
+            window_samples,
+            dwell_samples,
+        })
     }
-    let window_samples = (o.window * o.rate).round() as usize;
-    if window_samples < 2 {
-        return Err(Error::InvalidArgument {
-            argument: "window".into(),
-            message: format!(
-                "{} s holds fewer than 2 samples each side at {} Hz",
-                o.window, o.rate
-            ),
-        });
-    }
-    let dwell_samples = (o.dwell * o.rate).round() as usize;
-    if dwell_samples < 4 {
-        return Err(Error::InvalidArgument {
-            argument: "dwell".into(),
-            message: format!("{} s is too short at {} Hz", o.dwell, o.rate),
-        });
-    }
-    if !(o.margin > 0.0 && o.margin <= 1.0) {
-        return Err(Error::InvalidArgument {
-            argument: "margin".into(),
-            message: format!("{}; expected a fraction in (0, 1]", o.margin),
-        });
-    }
-    let count = o.count.unwrap_or(2 * n);
+}
+
+/// The perturbation sizes asked for, the velocity ones kept below |qd*| when the sign is kept.
+fn perturbation_sizes(
+    model: &Model,
+    op: &OperatingPoint,
+    o: &PlanOptions,
+) -> Result<[Vec<f64>; 3]> {
     let mut sizes = o.sizes.resolve_for(model)?;
     if o.keep_velocity_sign {
         for (j, size) in sizes[1].iter_mut().enumerate() {
@@ -494,7 +554,12 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
             *size = size.min(limit);
         }
     }
-    let lim = TransitionLimits {
+    Ok(sizes)
+}
+
+/// The transitions' limits: the model's, times the margin (defaults where the model has none).
+fn transition_limits(model: &Model, o: &PlanOptions) -> TransitionLimits {
+    TransitionLimits {
         lower: model.lower(),
         upper: model.upper(),
         velocity: model
@@ -521,150 +586,143 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
                     }
             })
             .collect(),
-    };
-    let mut experiments = Vec::new();
-    let mut warnings = Vec::new();
-    for (index, &kind) in o.experiments.iter().enumerate() {
-        if o.experiments[..index].contains(&kind) {
+    }
+}
+
+/// Experiment `index` of the plan, of `kind`: its perturbations, its trajectory through the
+/// crossings (or dwells), checked against the limits, and its warnings added to `warnings`.
+fn plan_experiment(
+    setup: &Setup<'_>,
+    index: usize,
+    kind: ExperimentKind,
+    warnings: &mut Vec<String>,
+) -> Result<Experiment> {
+    let (model, op, o, n) = (setup.model, setup.op, setup.o, setup.model.nv);
+    let count = setup.count;
+    let sizes = &setup.sizes;
+    let seed = o.seed.wrapping_add(1000 * index as u64 + 1);
+    let count = if kind == ExperimentKind::H && o.friction_aware_h {
+        if !o.symmetric {
             return Err(Error::InvalidArgument {
-                argument: "experiments".into(),
-                message: format!("'{}' is listed twice", kind.name()),
+                argument: "friction_aware_h".into(),
+                message: "the friction-aware H regression needs the perturbations in +- pairs (symmetric)".into(),
             });
         }
-        let seed = o.seed.wrapping_add(1000 * index as u64 + 1);
-        let count = if kind == ExperimentKind::H && o.friction_aware_h {
-            if !o.symmetric {
-                return Err(Error::InvalidArgument {
-                    argument: "friction_aware_h".into(),
-                    message: "the friction-aware H regression needs the perturbations in +- pairs (symmetric)".into(),
-                });
-            }
-            // N + 1 unknowns per torque row, and one pair more for its standard errors
-            count.max(2 * (n + 2))
-        } else {
-            count
-        };
-        let deltas = match kind.perturbed() {
-            None => DMatrix::zeros(count, n),
-            Some(v) if kind == ExperimentKind::H && o.friction_aware_h => {
-                varying_perturbations(o.design, count, &sizes[v], o.symmetric, seed)?
-            }
-            Some(v) => perturbations(o.design, count, &sizes[v], o.symmetric, seed)?,
-        };
-        if kind == ExperimentKind::H {
-            warnings.extend(plan_warnings::velocity_reversal(model, op, &deltas, o));
+        // N + 1 unknowns per torque row, and one pair more for its standard errors
+        count.max(2 * (n + 2))
+    } else {
+        count
+    };
+    let deltas = match kind.perturbed() {
+        None => DMatrix::zeros(count, n),
+        Some(v) if kind == ExperimentKind::H && o.friction_aware_h => {
+            varying_perturbations(o.design, count, &sizes[v], o.symmetric, seed)?
         }
-        if kind.perturbed().is_some() {
-            warnings.extend(plan_warnings::design(kind, &deltas));
-        }
-        let mut b = TrajectoryBuilder::new(n, o.rate, &lim, o.min_transition, &op.q);
-        let rest_at = |q: &[f64]| Crossing {
-            time: 0.0,
-            q: q.to_vec(),
-            qd: vec![0.0; n],
-            qdd: vec![0.0; n],
-        };
-        let (crossings, reference, window) = if kind == ExperimentKind::GStatic {
-            let reference = b.dwell(SegmentKind::Reference, rest_at(&op.q), dwell_samples);
-            let crossings = (0..count)
-                .map(|k| {
-                    let q: Vec<f64> = (0..n).map(|j| op.q[j] + deltas[(k, j)]).collect();
-                    b.dwell(SegmentKind::Dwell { index: k }, rest_at(&q), dwell_samples)
-                })
-                .collect();
-            // Fit windows: the middle 80 % of each dwell.
-            (
-                crossings,
-                Some(reference),
-                0.4 * dwell_samples as f64 / o.rate,
-            )
-        } else {
-            let crossings = (0..count)
-                .map(|k| {
-                    let mut c = Crossing {
-                        time: 0.0,
-                        q: op.q.clone(),
-                        qd: op.qd.clone(),
-                        qdd: op.qdd.clone(),
-                    };
-                    let target = match kind.perturbed() {
-                        Some(0) => &mut c.q,
-                        Some(1) => &mut c.qd,
-                        Some(_) => &mut c.qdd,
-                        None => &mut c.q,
-                    };
-                    for j in 0..n {
-                        target[j] += deltas[(k, j)];
-                    }
-                    b.crossing(k, c, window_samples)
-                })
-                .collect();
-            (crossings, None, window_samples as f64 / o.rate)
-        };
-        let trajectory = b.finish(&op.q);
-        let context = format!("experiment '{}' of the plan", kind.name());
-        crate::limits::sample_count(
-            &context,
-            trajectory.end() - trajectory.start(),
-            o.rate,
-            1 + 4 * n,
-        )?;
-        let sampled = trajectory.sample(o.rate);
-        check_limits(model, &sampled, &context, LIMITS_ADVICE)?;
-        plan_warnings::effort(model, op, kind, &sampled, &mut warnings)?;
-        let experiment = Experiment {
-            kind,
-            deltas,
-            crossings,
-            reference,
-            window,
-            trajectory,
-        };
-        if let (Some(steps), Some(var)) = (&o.encoder_step, kind.perturbed()) {
-            let joints = rounded_positions::planned_resolution(
-                &experiment,
-                &model.joint_names,
-                steps,
-                o.rate,
-            )?;
-            warnings.extend(rounded_positions::planned_resolution_warning(
-                kind.name(),
-                var,
-                &joints,
-                experiment.window,
-            ));
-        }
-        if let Some(noise) = &o.torque_noise {
-            // the nominal crossings: T* is their mean, their scatter the noise between passes
-            let nominal = o.experiments.contains(&ExperimentKind::Nominal);
-            let readings = if nominal { o.count.unwrap_or(2 * n) } else { 0 };
-            let passes = o.torque_pass_noise.as_deref().unwrap_or_default();
-            let prediction = predicted_response::predict(
-                model,
-                op,
-                &experiment,
-                noise,
-                passes,
-                o.rate,
-                readings,
-            )?;
-            warnings.extend(
-                prediction.and_then(|p| predicted_response::warning(kind, &p, noise, passes)),
-            );
-        }
-        experiments.push(experiment);
+        Some(v) => perturbations(o.design, count, &sizes[v], o.symmetric, seed)?,
+    };
+    if kind == ExperimentKind::H {
+        warnings.extend(plan_warnings::velocity_reversal(model, op, &deltas, o));
     }
-    Ok(Plan {
-        format: Plan::tag(),
-        robot: model.name.clone(),
-        joint_names: model.joint_names.clone(),
-        op: op.clone(),
-        rate: o.rate,
-        design: o.design,
-        seed: o.seed,
-        experiments,
-        warnings,
-    })
+    if kind.perturbed().is_some() {
+        warnings.extend(plan_warnings::design(kind, &deltas));
+    }
+    let (trajectory, crossings, reference, window) = lay_out(setup, kind, &deltas);
+    let context = format!("experiment '{}' of the plan", kind.name());
+    crate::limits::sample_count(
+        &context,
+        trajectory.end() - trajectory.start(),
+        o.rate,
+        1 + 4 * n,
+    )?;
+    let sampled = trajectory.sample(o.rate);
+    check_limits(model, &sampled, &context, LIMITS_ADVICE)?;
+    plan_warnings::effort(model, op, kind, &sampled, warnings)?;
+    let experiment = Experiment {
+        kind,
+        deltas,
+        crossings,
+        reference,
+        window,
+        trajectory,
+    };
+    if let (Some(steps), Some(var)) = (&o.encoder_step, kind.perturbed()) {
+        let joints =
+            rounded_positions::planned_resolution(&experiment, &model.joint_names, steps, o.rate)?;
+        warnings.extend(rounded_positions::planned_resolution_warning(
+            kind.name(),
+            var,
+            &joints,
+            experiment.window,
+        ));
+    }
+    if let Some(noise) = &o.torque_noise {
+        // the nominal crossings: T* is their mean, their scatter the noise between passes
+        let nominal = o.experiments.contains(&ExperimentKind::Nominal);
+        let readings = if nominal { o.count.unwrap_or(2 * n) } else { 0 };
+        let passes = o.torque_pass_noise.as_deref().unwrap_or_default();
+        let prediction =
+            predicted_response::predict(model, op, &experiment, noise, passes, o.rate, readings)?;
+        warnings
+            .extend(prediction.and_then(|p| predicted_response::warning(kind, &p, noise, passes)));
+    }
+    Ok(experiment)
+}
+
+/// The trajectory of one experiment: quintic transitions into each crossing window (or dwell
+/// for G-static) and back to rest at q*; with its crossings, reference dwell and fit window.
+fn lay_out(
+    setup: &Setup<'_>,
+    kind: ExperimentKind,
+    deltas: &DMatrix<f64>,
+) -> (Trajectory, Vec<Crossing>, Option<Crossing>, f64) {
+    let (op, o, n) = (setup.op, setup.o, setup.model.nv);
+    let (window_samples, dwell_samples) = (setup.window_samples, setup.dwell_samples);
+    let count = deltas.nrows();
+    let mut b = TrajectoryBuilder::new(n, o.rate, &setup.lim, o.min_transition, &op.q);
+    let rest_at = |q: &[f64]| Crossing {
+        time: 0.0,
+        q: q.to_vec(),
+        qd: vec![0.0; n],
+        qdd: vec![0.0; n],
+    };
+    let (crossings, reference, window) = if kind == ExperimentKind::GStatic {
+        let reference = b.dwell(SegmentKind::Reference, rest_at(&op.q), dwell_samples);
+        let crossings = (0..count)
+            .map(|k| {
+                let q: Vec<f64> = (0..n).map(|j| op.q[j] + deltas[(k, j)]).collect();
+                b.dwell(SegmentKind::Dwell { index: k }, rest_at(&q), dwell_samples)
+            })
+            .collect();
+        // Fit windows: the middle 80 % of each dwell.
+        (
+            crossings,
+            Some(reference),
+            0.4 * dwell_samples as f64 / o.rate,
+        )
+    } else {
+        let crossings = (0..count)
+            .map(|k| {
+                let mut c = Crossing {
+                    time: 0.0,
+                    q: op.q.clone(),
+                    qd: op.qd.clone(),
+                    qdd: op.qdd.clone(),
+                };
+                let target = match kind.perturbed() {
+                    Some(0) => &mut c.q,
+                    Some(1) => &mut c.qd,
+                    Some(_) => &mut c.qdd,
+                    None => &mut c.q,
+                };
+                for j in 0..n {
+                    target[j] += deltas[(k, j)];
+                }
+                b.crossing(k, c, window_samples)
+            })
+            .collect();
+        (crossings, None, window_samples as f64 / o.rate)
+    };
+    (b.finish(&op.q), crossings, reference, window)
 }
 
 /// What a plan that breaks a limit is told to do.

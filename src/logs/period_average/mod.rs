@@ -119,11 +119,79 @@ pub fn average_periods(
     let layout = Layout::of(rec, rate, cutoff, decimate, p)?;
     let (m, h_q, h_tau) = (layout.samples, p.harmonics, layout.torque_harmonics);
     let table = Table::new(m);
+    let (coef_q, coef_tau) = period_coefficients(rec, &layout, &table, p)?;
+    let (keep, left_out) = leave_out_far_periods(&layout, &coef_q, &coef_tau, n, p);
+    if keep.len() < 2 {
+        return Err(too_few(rec, &layout, &left_out, p));
+    }
+    let count = keep.len();
+    let w = std::f64::consts::TAU / p.period;
+    let spread = Spread::of(rec, &layout, p, &keep, &coef_q, &coef_tau)?;
+    let rows: Vec<usize> = (0..m).step_by(decimate).collect();
+    let k_out = rows.len();
+    let [q, qd, qdd, tau, coulomb] = averaged_signals(&table, &spread, &rows, n, h_q, h_tau, w)?;
+    let first = layout.periods[keep[0]].1;
+    let t: Vec<f64> = rows
+        .iter()
+        .map(|&i| first + i as f64 * p.period / m as f64)
+        .collect();
+    let out = Recording::new(
+        format!("{} (averaged over {count} periods)", rec.name),
+        n,
+        t,
+        q,
+        tau,
+        Some(qd),
+        Some(qdd),
+    )?;
+    let Spread {
+        pos_noise,
+        vel_noise,
+        acc_noise,
+        tau_noise,
+        beyond,
+        drift,
+        tilt,
+        ..
+    } = spread;
+    Ok(Recording {
+        experiment: rec.experiment.clone(),
+        coulomb: Some(coulomb),
+        period_average: Some(PeriodAverage {
+            period: p.period,
+            start: first,
+            periods: count,
+            harmonics: h_q,
+            torque_harmonics: h_tau,
+            samples: m,
+            kept_samples: k_out,
+            position_noise: pos_noise,
+            velocity_noise: vel_noise,
+            acceleration_noise: acc_noise,
+            torque_noise: tau_noise,
+            position_beyond: beyond,
+            torque_drift: drift,
+            torque_noise_tilt: tilt,
+            left_out,
+        }),
+        ..out
+    })
+}
+
+/// Per period of `layout`, per joint, the Fourier coefficients of the positions and the
+/// torques up to the torques' harmonics (positions that far to see beyond the harmonics kept).
+#[allow(clippy::type_complexity)]
+fn period_coefficients(
+    rec: &Recording,
+    layout: &Layout,
+    table: &Table,
+    p: &PeriodOptions,
+) -> Result<(Vec<Vec<Vec<f64>>>, Vec<Vec<Vec<f64>>>)> {
+    let (n, m, h_tau) = (rec.n, layout.samples, layout.torque_harmonics);
     let column =
         |x: &[f64], j: usize| -> Vec<f64> { (0..rec.len()).map(|i| x[i * n + j]).collect() };
     let q_cols: Vec<Vec<f64>> = (0..n).map(|j| column(&rec.q, j)).collect();
     let tau_cols: Vec<Vec<f64>> = (0..n).map(|j| column(&rec.tau, j)).collect();
-    // each period's coefficients: [period][joint] -> positions (to h_tau, to see beyond L) and torques
     let mut coef_q = Vec::with_capacity(layout.periods.len());
     let mut coef_tau = Vec::with_capacity(layout.periods.len());
     for &(_, a) in &layout.periods {
@@ -137,13 +205,24 @@ pub fn average_periods(
         coef_q.push(project(&q_cols, h_tau));
         coef_tau.push(project(&tau_cols, h_tau));
     }
-    // periods far off the others, from the coefficient-wise median
+    Ok((coef_q, coef_tau))
+}
+
+/// The periods kept and those left out: the layout's, and periods far off the others (from
+/// the coefficient-wise median, with at least 3 periods).
+fn leave_out_far_periods(
+    layout: &Layout,
+    coef_q: &[Vec<Vec<f64>>],
+    coef_tau: &[Vec<Vec<f64>>],
+    n: usize,
+    p: &PeriodOptions,
+) -> (Vec<usize>, Vec<LeftOutPeriod>) {
     let mut left_out = layout.left_out.clone();
     let mut keep: Vec<usize> = (0..layout.periods.len()).collect();
     if keep.len() >= 3 {
         let names = [("positions", "rad"), ("torques", "N m")];
         let mut far: Vec<(usize, String)> = Vec::new();
-        for (signal, coefs) in [&coef_q, &coef_tau].into_iter().enumerate() {
+        for (signal, coefs) in [coef_q, coef_tau].into_iter().enumerate() {
             for j in 0..n {
                 let per: Vec<&[f64]> = coefs.iter().map(|c| c[j].as_slice()).collect();
                 let median = median_coefficients(&per);
@@ -183,95 +262,148 @@ pub fn average_periods(
         }
         left_out.sort_by_key(|l| l.period);
     }
-    if keep.len() < 2 {
-        return Err(too_few(rec, &layout, &left_out, p));
-    }
-    let count = keep.len();
-    let mean = |coefs: &[Vec<Vec<f64>>], j: usize| -> Vec<f64> {
-        let len = coefs[0][j].len();
-        (0..len)
-            .map(|c| keep.iter().map(|&k| coefs[k][j][c]).sum::<f64>() / count as f64)
-            .collect()
-    };
-    // each signal's noise a sample of one period within its band, from the periods' spread
-    // about their mean, weighted a harmonic by `weight(k)` (a derivative's `(k w)^2`)
-    let noise = |coefs: &[Vec<Vec<f64>>],
-                 j: usize,
-                 h: usize,
-                 mean: &[f64],
-                 weight: &dyn Fn(usize) -> f64|
-     -> f64 {
-        let sum: f64 = keep
-            .iter()
-            .map(|&k| weighted_energy(&coefs[k][j][..2 * h + 1], &mean[..2 * h + 1], weight))
-            .sum();
-        (sum / (count - 1) as f64).sqrt()
-    };
-    let w = std::f64::consts::TAU / p.period;
-    let one = |_k: usize| 1.0;
-    let (mut pos_noise, mut vel_noise, mut acc_noise, mut tau_noise, mut beyond) = (
-        vec![0.0; n],
-        vec![0.0; n],
-        vec![0.0; n],
-        vec![0.0; n],
-        vec![0.0; n],
-    );
-    let mut drift = vec![None; n];
-    let mut tilt = vec![None; n];
-    let mut q_mean = Vec::with_capacity(n);
-    let mut tau_mean = Vec::with_capacity(n);
-    for j in 0..n {
-        let qm = mean(&coef_q, j);
-        let tm = mean(&coef_tau, j);
-        pos_noise[j] = noise(&coef_q, j, h_q, &qm, &one);
-        vel_noise[j] = noise(&coef_q, j, h_q, &qm, &|k| (k as f64 * w).powi(2));
-        acc_noise[j] = noise(&coef_q, j, h_q, &qm, &|k| (k as f64 * w).powi(4));
-        tau_noise[j] = noise(&coef_tau, j, h_tau, &tm, &one);
-        let per: Vec<&[f64]> = keep.iter().map(|&k| coef_tau[k][j].as_slice()).collect();
-        let place: Vec<f64> = keep.iter().map(|&k| layout.periods[k].0 as f64).collect();
-        drift[j] = drift::trend_ratio(&per, &place);
-        tilt[j] = noise_colour::tilt(&coef_tau, &keep, j, h_tau, &tm);
-        beyond[j] = weighted_power(&qm, &|k| if k > h_q { 1.0 } else { 0.0 }).sqrt();
-        // the positions' motion (without their mean) against their spread from period to period
-        let motion = weighted_power(&qm[..2 * h_q + 1], &|k| if k > 0 { 1.0 } else { 0.0 }).sqrt();
-        let spread = noise(&coef_q, j, h_tau, &qm, &one);
-        if motion > 0.0 && spread > MAX_POSITION_SPREAD * motion {
-            return Err(Error::Recording {
-                recording: rec.name.clone(),
-                message: format!(
-                    "joint {}'s positions differ from period to period by {} rad RMS, {:.0} % of their motion ({} rad RMS) over the {count} periods of {} s from t = {} s: the log does not repeat with that period. Is the period the excitation's (its base frequency's inverse), and did the robot run the excitation through these periods (a start, skip_periods or --skip-periods past a lead-in)?",
-                    j + 1,
-                    shown5(spread),
-                    100.0 * spread / motion,
-                    shown5(motion),
-                    shown5(p.period),
-                    shown5(layout.periods[keep[0]].1)
-                ),
-            });
+    (keep, left_out)
+}
+
+/// The kept periods' mean coefficients per joint and their spread: each signal's noise (a
+/// sample of one period within its band), the torques' drift and noise colour, and the
+/// positions' motion beyond the harmonics kept.
+struct Spread {
+    q_mean: Vec<Vec<f64>>,
+    tau_mean: Vec<Vec<f64>>,
+    pos_noise: Vec<f64>,
+    vel_noise: Vec<f64>,
+    acc_noise: Vec<f64>,
+    tau_noise: Vec<f64>,
+    beyond: Vec<f64>,
+    drift: Vec<Option<f64>>,
+    tilt: Vec<Option<f64>>,
+}
+
+impl Spread {
+    /// The spread of the periods `keep`; refuses positions that do not repeat and sums of
+    /// squares past f64's range.
+    fn of(
+        rec: &Recording,
+        layout: &Layout,
+        p: &PeriodOptions,
+        keep: &[usize],
+        coef_q: &[Vec<Vec<f64>>],
+        coef_tau: &[Vec<Vec<f64>>],
+    ) -> Result<Spread> {
+        let (n, h_q, h_tau) = (rec.n, p.harmonics, layout.torque_harmonics);
+        let count = keep.len();
+        let mean = |coefs: &[Vec<Vec<f64>>], j: usize| -> Vec<f64> {
+            let len = coefs[0][j].len();
+            (0..len)
+                .map(|c| keep.iter().map(|&k| coefs[k][j][c]).sum::<f64>() / count as f64)
+                .collect()
+        };
+        // each signal's noise a sample of one period within its band, from the periods' spread
+        // about their mean, weighted a harmonic by `weight(k)` (a derivative's `(k w)^2`)
+        let noise = |coefs: &[Vec<Vec<f64>>],
+                     j: usize,
+                     h: usize,
+                     mean: &[f64],
+                     weight: &dyn Fn(usize) -> f64|
+         -> f64 {
+            let sum: f64 = keep
+                .iter()
+                .map(|&k| weighted_energy(&coefs[k][j][..2 * h + 1], &mean[..2 * h + 1], weight))
+                .sum();
+            (sum / (count - 1) as f64).sqrt()
+        };
+        let w = std::f64::consts::TAU / p.period;
+        let one = |_k: usize| 1.0;
+        let (mut pos_noise, mut vel_noise, mut acc_noise, mut tau_noise, mut beyond) = (
+            vec![0.0; n],
+            vec![0.0; n],
+            vec![0.0; n],
+            vec![0.0; n],
+            vec![0.0; n],
+        );
+        let mut drift = vec![None; n];
+        let mut tilt = vec![None; n];
+        let mut q_mean = Vec::with_capacity(n);
+        let mut tau_mean = Vec::with_capacity(n);
+        for j in 0..n {
+            let qm = mean(coef_q, j);
+            let tm = mean(coef_tau, j);
+            pos_noise[j] = noise(coef_q, j, h_q, &qm, &one);
+            vel_noise[j] = noise(coef_q, j, h_q, &qm, &|k| (k as f64 * w).powi(2));
+            acc_noise[j] = noise(coef_q, j, h_q, &qm, &|k| (k as f64 * w).powi(4));
+            tau_noise[j] = noise(coef_tau, j, h_tau, &tm, &one);
+            let per: Vec<&[f64]> = keep.iter().map(|&k| coef_tau[k][j].as_slice()).collect();
+            let place: Vec<f64> = keep.iter().map(|&k| layout.periods[k].0 as f64).collect();
+            drift[j] = drift::trend_ratio(&per, &place);
+            tilt[j] = noise_colour::tilt(coef_tau, keep, j, h_tau, &tm);
+            beyond[j] = weighted_power(&qm, &|k| if k > h_q { 1.0 } else { 0.0 }).sqrt();
+            // the positions' motion (without their mean) against their spread from period to period
+            let motion =
+                weighted_power(&qm[..2 * h_q + 1], &|k| if k > 0 { 1.0 } else { 0.0 }).sqrt();
+            let spread = noise(coef_q, j, h_tau, &qm, &one);
+            if motion > 0.0 && spread > MAX_POSITION_SPREAD * motion {
+                return Err(Error::Recording {
+                    recording: rec.name.clone(),
+                    message: format!(
+                        "joint {}'s positions differ from period to period by {} rad RMS, {:.0} % of their motion ({} rad RMS) over the {count} periods of {} s from t = {} s: the log does not repeat with that period. Is the period the excitation's (its base frequency's inverse), and did the robot run the excitation through these periods (a start, skip_periods or --skip-periods past a lead-in)?",
+                        j + 1,
+                        shown5(spread),
+                        100.0 * spread / motion,
+                        shown5(motion),
+                        shown5(p.period),
+                        shown5(layout.periods[keep[0]].1)
+                    ),
+                });
+            }
+            // sums of squares past f64's range (values near 1e300) cannot be vouched for
+            let levels = [
+                ("positions", pos_noise[j]),
+                ("velocities", vel_noise[j]),
+                ("accelerations", acc_noise[j]),
+                ("torques", tau_noise[j]),
+                ("positions beyond the harmonics kept", beyond[j]),
+                ("positions' motion", motion),
+            ];
+            if let Some((what, x)) = levels.iter().find(|(_, x)| !x.is_finite()) {
+                return Err(Error::Numerical {
+                    operation: "period averaging".into(),
+                    message: format!(
+                        "joint {}'s {what}: their spread from period to period is {x}, past f64's range: the log's values are too large for f64 arithmetic (near 1e300?); rescale the log to SI units",
+                        j + 1
+                    ),
+                });
+            }
+            q_mean.push(qm);
+            tau_mean.push(tm);
         }
-        // sums of squares past f64's range (values near 1e300) cannot be vouched for
-        let levels = [
-            ("positions", pos_noise[j]),
-            ("velocities", vel_noise[j]),
-            ("accelerations", acc_noise[j]),
-            ("torques", tau_noise[j]),
-            ("positions beyond the harmonics kept", beyond[j]),
-            ("positions' motion", motion),
-        ];
-        if let Some((what, x)) = levels.iter().find(|(_, x)| !x.is_finite()) {
-            return Err(Error::Numerical {
-                operation: "period averaging".into(),
-                message: format!(
-                    "joint {}'s {what}: their spread from period to period is {x}, past f64's range: the log's values are too large for f64 arithmetic (near 1e300?); rescale the log to SI units",
-                    j + 1
-                ),
-            });
-        }
-        q_mean.push(qm);
-        tau_mean.push(tm);
+        Ok(Spread {
+            q_mean,
+            tau_mean,
+            pos_noise,
+            vel_noise,
+            acc_noise,
+            tau_noise,
+            beyond,
+            drift,
+            tilt,
+        })
     }
-    // the averaged period, from its coefficients
-    let rows: Vec<usize> = (0..m).step_by(decimate).collect();
+}
+
+/// The averaged period at the samples `rows` of the period's grid, from the mean coefficients:
+/// positions, velocities and accelerations (to `h_q`), torques and the sign of the velocity's
+/// Coulomb column (to `h_tau`), row-major.
+fn averaged_signals(
+    table: &Table,
+    spread: &Spread,
+    rows: &[usize],
+    n: usize,
+    h_q: usize,
+    h_tau: usize,
+    w: f64,
+) -> Result<[Vec<f64>; 5]> {
+    let (q_mean, tau_mean) = (&spread.q_mean, &spread.tau_mean);
     let k_out = rows.len();
     let (mut q, mut qd, mut qdd, mut tau, mut coulomb) = (
         vec![0.0; k_out * n],
@@ -294,42 +426,7 @@ pub fn average_periods(
             coulomb[r * n + j] = c[i];
         }
     }
-    let first = layout.periods[keep[0]].1;
-    let t: Vec<f64> = rows
-        .iter()
-        .map(|&i| first + i as f64 * p.period / m as f64)
-        .collect();
-    let out = Recording::new(
-        format!("{} (averaged over {count} periods)", rec.name),
-        n,
-        t,
-        q,
-        tau,
-        Some(qd),
-        Some(qdd),
-    )?;
-    Ok(Recording {
-        experiment: rec.experiment.clone(),
-        coulomb: Some(coulomb),
-        period_average: Some(PeriodAverage {
-            period: p.period,
-            start: first,
-            periods: count,
-            harmonics: h_q,
-            torque_harmonics: h_tau,
-            samples: m,
-            kept_samples: k_out,
-            position_noise: pos_noise,
-            velocity_noise: vel_noise,
-            acceleration_noise: acc_noise,
-            torque_noise: tau_noise,
-            position_beyond: beyond,
-            torque_drift: drift,
-            torque_noise_tilt: tilt,
-            left_out,
-        }),
-        ..out
-    })
+    Ok([q, qd, qdd, tau, coulomb])
 }
 
 /// The warning for what averaging found in the log `log` (joints named `joints`, or numbered
