@@ -183,6 +183,59 @@ pub fn consistent_least_squares(
     options: &ConsistentOptions,
 ) -> Result<ConsistentSolution> {
     let p = layout.len();
+    check_system(p, a, y, constant, prior, options)?;
+    let s = prior_weights(a, options.prior_weight);
+    let theta0 = DVector::from_column_slice(prior);
+    let (theta_u, least) = unconstrained(a, y, &theta0, &s, options.prior_weight.sqrt())?;
+    let unconstrained_cost = (a * &least - y).norm_squared() + constant;
+    let (theta, iterations, converged) =
+        barrier_solve(layout, a, y, &theta0, &s, &theta_u, options)?;
+    let data_cost = (a * &theta - y).norm_squared();
+    let theta_v: Vec<f64> = theta.iter().copied().collect();
+    let report = check_physical_consistency(layout, &theta_v)?;
+    let mut active: Vec<String> = report
+        .bodies
+        .iter()
+        .filter(|b| b.relative_min < 1e-6)
+        .map(|b| {
+            format!(
+                "{}: pseudo-inertia at the boundary (smallest eigenvalue {:.1e} of the largest)",
+                b.link, b.relative_min
+            )
+        })
+        .collect();
+    for i in 10 * layout.nbodies..p {
+        if !layout.names[i].ends_with(".offset")
+            && theta_u[i] < 0.0
+            && theta_v[i] < 1e-3 * theta_u[i].abs()
+        {
+            active.push(format!(
+                "{} = {:.2e} (unconstrained {:.4e})",
+                layout.names[i], theta_v[i], theta_u[i]
+            ));
+        }
+    }
+    Ok(ConsistentSolution {
+        theta: theta_v,
+        cost: data_cost + constant,
+        unconstrained_cost,
+        unconstrained_theta: theta_u.iter().copied().collect(),
+        iterations,
+        converged,
+        active,
+        report,
+    })
+}
+
+/// Refuses shapes that disagree, options out of range and non-finite entries.
+fn check_system(
+    p: usize,
+    a: &DMatrix<f64>,
+    y: &DVector<f64>,
+    constant: f64,
+    prior: &[f64],
+    options: &ConsistentOptions,
+) -> Result<()> {
     if a.ncols() != p || a.nrows() != y.len() || prior.len() != p || a.nrows() == 0 {
         return Err(Error::Shape {
             argument: "consistent least squares".into(),
@@ -212,8 +265,13 @@ pub fn consistent_least_squares(
             message: "the system or the prior holds a non-finite number".into(),
         });
     }
-    // the prior's weight per parameter: its column norm (the mean of the others where the
-    // column is zero up to rounding: 1e-8 of the largest)
+    Ok(())
+}
+
+/// The prior's weight per parameter, times `sqrt(prior_weight)`: its column norm in `a` (the
+/// mean of the others where the column is zero up to rounding: 1e-8 of the largest).
+fn prior_weights(a: &DMatrix<f64>, prior_weight: f64) -> Vec<f64> {
+    let p = a.ncols();
     let norms: Vec<f64> = (0..p).map(|c| a.column(c).norm()).collect();
     let largest = norms.iter().fold(0.0f64, |m, v| m.max(*v));
     let norms: Vec<f64> = norms
@@ -226,17 +284,28 @@ pub fn consistent_least_squares(
     } else {
         nonzero.iter().sum::<f64>() / nonzero.len() as f64
     };
-    let w = options.prior_weight.sqrt();
-    let s: Vec<f64> = norms
+    let w = prior_weight.sqrt();
+    norms
         .iter()
         .map(|&v| w * if v > 0.0 { v } else { mean })
-        .collect();
-    let theta0 = DVector::from_column_slice(prior);
+        .collect()
+}
 
-    // the unconstrained solution nearest to the prior: with every column scaled to unit norm
-    // (theta_i = phi_i / n_i) the prior rows are w (phi - phi0), and the stacked problem
-    // [A N^-1; w I] phi = [y; w phi0] is solved by an SVD (normal equations would square a
-    // condition number that gravity and inertia columns already make large)
+/// The unconstrained solution nearest to the prior `theta0` (prior weights `s`, `w` the root
+/// of the prior's weight), and the least-squares solution of the data alone.
+///
+/// With every column scaled to unit norm (theta_i = phi_i / n_i) the prior rows are
+/// w (phi - phi0), and the stacked problem [A N^-1; w I] phi = [y; w phi0] is solved by an SVD
+/// (normal equations would square a condition number that gravity and inertia columns already
+/// make large).
+fn unconstrained(
+    a: &DMatrix<f64>,
+    y: &DVector<f64>,
+    theta0: &DVector<f64>,
+    s: &[f64],
+    w: f64,
+) -> Result<(DVector<f64>, DVector<f64>)> {
+    let p = a.ncols();
     let scale: Vec<f64> = s.iter().map(|v| w / v).collect(); // theta_i = scale_i phi_i
     let mut stacked = DMatrix::zeros(a.nrows() + p, p);
     let mut rhs = DVector::zeros(a.nrows() + p);
@@ -257,11 +326,23 @@ pub fn consistent_least_squares(
         1e-12,
     )?;
     let least = DVector::from_iterator(p, (0..p).map(|c| least[c] * scale[c]));
-    let unconstrained_cost = (a * &least - y).norm_squared() + constant;
+    Ok((theta_u, least))
+}
 
-    // primal log-barrier method: minimise t f(theta) - sum_b log det J_b - sum log c over
-    // the interior, by damped Newton steps, for t growing tenfold until the duality gap
-    // (constraint dimensions) / t is below the tolerance
+/// The primal log-barrier method: minimises t f(theta) - sum_b log det J_b - sum log c over the
+/// interior, by damped Newton steps, for t growing tenfold until the duality gap (constraint
+/// dimensions) / t is below the tolerance. Returns theta, the Newton steps taken and whether
+/// the gap closed.
+fn barrier_solve(
+    layout: &ParameterLayout,
+    a: &DMatrix<f64>,
+    y: &DVector<f64>,
+    theta0: &DVector<f64>,
+    s: &[f64],
+    theta_u: &DVector<f64>,
+    options: &ConsistentOptions,
+) -> Result<(DVector<f64>, usize, bool)> {
+    let p = layout.len();
     let h = a.transpose() * a
         + DMatrix::from_diagonal(&DVector::from_iterator(p, s.iter().map(|v| v * v)));
     let rhs =
@@ -299,48 +380,21 @@ pub fn consistent_least_squares(
                     message: "an iterate left the interior".into(),
                 });
             };
-            let grad = (&h * &theta - &rhs) * (2.0 * t) + bg;
-            let hess = &h * (2.0 * t) + bh;
-            // scaled to a unit diagonal for the factorisation
-            let d: Vec<f64> = (0..p)
-                .map(|i| 1.0 / hess[(i, i)].max(1e-300).sqrt())
-                .collect();
-            let scaled = DMatrix::from_fn(p, p, |i, j| hess[(i, j)] * d[i] * d[j]);
-            let Some(ch) = newton_factor(scaled) else {
-                return Err(Error::Numerical {
-                    operation: "consistent least squares".into(),
-                    message: "the Newton system is not positive definite".into(),
-                });
-            };
-            let g_scaled = DVector::from_iterator(p, (0..p).map(|i| grad[i] * d[i]));
-            let step_scaled = -ch.solve(&g_scaled);
-            let step = DVector::from_iterator(p, (0..p).map(|i| step_scaled[i] * d[i]));
-            let decrement = -grad.dot(&step); // the Newton decrement squared
-            if decrement <= 1e-9 {
-                break;
-            }
             // backtracking: stay inside, decrease the barrier objective
             let value = |x: &DVector<f64>| -> Option<f64> {
                 let b = barrier_value(layout, &squares, &basis, x)?;
                 Some(t * objective(x) + b)
             };
-            let now = value(&theta).unwrap_or(f64::INFINITY);
-            let mut alpha = 1.0;
-            loop {
-                let trial = &theta + &step * alpha;
-                if let Some(v) = value(&trial) {
-                    if v <= now - 0.25 * alpha * decrement {
-                        theta = trial;
-                        break;
-                    }
-                }
-                alpha *= 0.5;
-                if alpha < 1e-12 {
-                    break;
-                }
-            }
-            if alpha < 1e-12 {
-                break; // no progress possible at this t: rounding
+            let system = NewtonSystem {
+                h: &h,
+                rhs: &rhs,
+                bg: &bg,
+                bh: &bh,
+                t,
+            };
+            match system.step(&theta, &value)? {
+                Some(next) => theta = next,
+                None => break,
             }
         }
         let f = objective(&theta);
@@ -350,41 +404,63 @@ pub fn consistent_least_squares(
         }
         t *= 10.0;
     }
-    let data_cost = (a * &theta - y).norm_squared();
-    let theta_v: Vec<f64> = theta.iter().copied().collect();
-    let report = check_physical_consistency(layout, &theta_v)?;
-    let mut active: Vec<String> = report
-        .bodies
-        .iter()
-        .filter(|b| b.relative_min < 1e-6)
-        .map(|b| {
-            format!(
-                "{}: pseudo-inertia at the boundary (smallest eigenvalue {:.1e} of the largest)",
-                b.link, b.relative_min
-            )
-        })
-        .collect();
-    for i in 10 * layout.nbodies..p {
-        if !layout.names[i].ends_with(".offset")
-            && theta_u[i] < 0.0
-            && theta_v[i] < 1e-3 * theta_u[i].abs()
-        {
-            active.push(format!(
-                "{} = {:.2e} (unconstrained {:.4e})",
-                layout.names[i], theta_v[i], theta_u[i]
-            ));
+    Ok((theta, iterations, converged))
+}
+
+/// The Newton system of the barrier objective at an iterate: the data's Hessian `h` and
+/// right-hand side `rhs`, the barrier's gradient `bg` and Hessian `bh`, the data's weight `t`.
+struct NewtonSystem<'a> {
+    h: &'a DMatrix<f64>,
+    rhs: &'a DVector<f64>,
+    bg: &'a DVector<f64>,
+    bh: &'a DMatrix<f64>,
+    t: f64,
+}
+
+impl NewtonSystem<'_> {
+    /// One damped Newton step of the barrier objective `value` from `theta`: the next iterate,
+    /// or None where the step makes no progress (the decrement is rounding, or backtracking
+    /// finds no decrease).
+    fn step(
+        &self,
+        theta: &DVector<f64>,
+        value: &dyn Fn(&DVector<f64>) -> Option<f64>,
+    ) -> Result<Option<DVector<f64>>> {
+        let p = theta.len();
+        let grad = (self.h * theta - self.rhs) * (2.0 * self.t) + self.bg;
+        let hess = self.h * (2.0 * self.t) + self.bh;
+        // scaled to a unit diagonal for the factorisation
+        let d: Vec<f64> = (0..p)
+            .map(|i| 1.0 / hess[(i, i)].max(1e-300).sqrt())
+            .collect();
+        let scaled = DMatrix::from_fn(p, p, |i, j| hess[(i, j)] * d[i] * d[j]);
+        let Some(ch) = newton_factor(scaled) else {
+            return Err(Error::Numerical {
+                operation: "consistent least squares".into(),
+                message: "the Newton system is not positive definite".into(),
+            });
+        };
+        let g_scaled = DVector::from_iterator(p, (0..p).map(|i| grad[i] * d[i]));
+        let step_scaled = -ch.solve(&g_scaled);
+        let step = DVector::from_iterator(p, (0..p).map(|i| step_scaled[i] * d[i]));
+        let decrement = -grad.dot(&step); // the Newton decrement squared
+        if decrement <= 1e-9 {
+            return Ok(None);
         }
+        let now = value(theta).unwrap_or(f64::INFINITY);
+        let mut alpha = 1.0;
+        while alpha >= 1e-12 {
+            let trial = theta + &step * alpha;
+            if let Some(v) = value(&trial) {
+                if v <= now - 0.25 * alpha * decrement {
+                    return Ok(Some(trial));
+                }
+            }
+            alpha *= 0.5;
+        }
+        // no progress possible at this t: rounding
+        Ok(None)
     }
-    Ok(ConsistentSolution {
-        theta: theta_v,
-        cost: data_cost + constant,
-        unconstrained_cost,
-        unconstrained_theta: theta_u.iter().copied().collect(),
-        iterations,
-        converged,
-        active,
-        report,
-    })
 }
 
 /// A consistent identification: the full parameters, the same as a base-parameter model (to
