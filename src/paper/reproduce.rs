@@ -234,86 +234,9 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
     progress(&format!(
         "direct method: {seeds} excitations (10 harmonics of 0.05 Hz) within the limits and {seeds} around the point, designed, simulated and fitted"
     ));
-    let around = around_op(&model, &op, 0.5);
-    let jobs: Vec<(usize, u64)> = (0..2)
-        .flat_map(|v| (0..seeds as u64).map(move |s| (v, options.seed + s)))
-        .collect();
-    use rayon::prelude::*;
-    let runs: Vec<DirectRun> = jobs
-        .par_iter()
-        .map(|&(v, seed)| {
-            crate::error::catch_panics("paper direct method", || {
-                direct_run(
-                    &model,
-                    (v, if v == 0 { &model } else { &around }),
-                    &sim,
-                    &op,
-                    seed,
-                    options.design_evaluations,
-                    &states,
-                )
-            })
-        })
-        .collect::<Result<_>>()?;
+    let runs = direct_runs(&model, &sim, &op, options, &states)?;
     crate::interrupt::check("paper")?;
-
-    let pick = |v: &[f64], j: usize| -> Vec<f64> { (0..ts.len()).map(|k| v[k * n + j]).collect() };
-    let rms = |a: &[f64], b: &[f64], mask: &dyn Fn(f64) -> bool| -> f64 {
-        let e: Vec<f64> = ts
-            .iter()
-            .zip(a.iter().zip(b))
-            .filter(|(t, _)| mask(**t))
-            .map(|(_, (x, y))| (x - y).powi(2))
-            .collect();
-        (e.iter().sum::<f64>() / e.len() as f64).sqrt()
-    };
-    let near = 0.5;
-    let mut figures = vec![];
-    let mut errors = vec![];
-    let mut direct = vec![];
-    for (v, name) in ["default", "around_op"].iter().enumerate() {
-        let these: Vec<&DirectRun> = runs.iter().filter(|r| r.variant == v).collect();
-        let column = |f: &dyn Fn(&DirectRun) -> &Vec<f64>| -> Vec<Vec<f64>> {
-            these.iter().map(|r| f(r).clone()).collect()
-        };
-        direct.push(DirectOverSeeds {
-            excitation: name.to_string(),
-            seeds: these.iter().map(|r| r.seed).collect(),
-            cond: these.iter().map(|r| r.cond).collect(),
-            d_global_linear: OverSeeds::of(&column(&|r| &r.d_global_linear)),
-            d_base_parameters: OverSeeds::of(&column(&|r| &r.d_base_parameters)),
-        });
-        let global = OverSeeds::of(&column(&|r| &r.global_tau));
-        let base = OverSeeds::of(&column(&|r| &r.base_tau));
-        for joint in [2usize, 3, 4] {
-            let j = joint - 1;
-            let f = Figure {
-                joint,
-                excitation: name.to_string(),
-                t: ts.clone(),
-                actual: pick(&actual_tau, j),
-                local: pick(&local_tau, j),
-                global_linear: pick(&global.median, j),
-                global_linear_min: pick(&global.min, j),
-                global_linear_max: pick(&global.max, j),
-                base_parameters: pick(&base.median, j),
-            };
-            let is_near = |t: f64| t.abs() <= near;
-            let all = |_: f64| true;
-            errors.push(FigureErrors {
-                joint,
-                excitation: name.to_string(),
-                near,
-                local_near: rms(&f.local, &f.actual, &is_near),
-                global_linear_near: rms(&f.global_linear, &f.actual, &is_near),
-                base_parameters_near: rms(&f.base_parameters, &f.actual, &is_near),
-                local_all: rms(&f.local, &f.actual, &all),
-                global_linear_all: rms(&f.global_linear, &f.actual, &all),
-                base_parameters_all: rms(&f.base_parameters, &f.actual, &all),
-            });
-            figures.push(f);
-        }
-    }
+    let (figures, errors, direct) = figures(&runs, &ts, &actual_tau, &local_tau, n);
     let study = if options.study {
         progress("the built-in study: when to use which method");
         Some(super::study::when_to_use(&mut |done, total| {
@@ -354,6 +277,107 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
         op,
         local_model: Some(local),
     })
+}
+
+/// The direct method's runs: one per excitation seed, within the limits (variant 0) and
+/// around the point (variant 1), in parallel.
+fn direct_runs(
+    model: &crate::model::Model,
+    sim: &SimulationOptions,
+    op: &OperatingPoint,
+    options: &PaperOptions,
+    states: &States<'_>,
+) -> Result<Vec<DirectRun>> {
+    let seeds = options.excitation_seeds;
+    let around = around_op(model, op, 0.5);
+    let jobs: Vec<(usize, u64)> = (0..2)
+        .flat_map(|v| (0..seeds as u64).map(move |s| (v, options.seed + s)))
+        .collect();
+    use rayon::prelude::*;
+    jobs.par_iter()
+        .map(|&(v, seed)| {
+            crate::error::catch_panics("paper direct method", || {
+                direct_run(
+                    model,
+                    (v, if v == 0 { model } else { &around }),
+                    sim,
+                    op,
+                    seed,
+                    options.design_evaluations,
+                    states,
+                )
+            })
+        })
+        .collect::<Result<_>>()
+}
+
+/// Figs. 3-5 of each excitation (joints 2-4 along the path through P at times `ts`), their
+/// errors near P and over the path, and each excitation's results over the seeds.
+fn figures(
+    runs: &[DirectRun],
+    ts: &[f64],
+    actual_tau: &[f64],
+    local_tau: &[f64],
+    n: usize,
+) -> (Vec<Figure>, Vec<FigureErrors>, Vec<DirectOverSeeds>) {
+    let pick = |v: &[f64], j: usize| -> Vec<f64> { (0..ts.len()).map(|k| v[k * n + j]).collect() };
+    let rms = |a: &[f64], b: &[f64], mask: &dyn Fn(f64) -> bool| -> f64 {
+        let e: Vec<f64> = ts
+            .iter()
+            .zip(a.iter().zip(b))
+            .filter(|(t, _)| mask(**t))
+            .map(|(_, (x, y))| (x - y).powi(2))
+            .collect();
+        (e.iter().sum::<f64>() / e.len() as f64).sqrt()
+    };
+    let near = 0.5;
+    let mut figures = vec![];
+    let mut errors = vec![];
+    let mut direct = vec![];
+    for (v, name) in ["default", "around_op"].iter().enumerate() {
+        let these: Vec<&DirectRun> = runs.iter().filter(|r| r.variant == v).collect();
+        let column = |f: &dyn Fn(&DirectRun) -> &Vec<f64>| -> Vec<Vec<f64>> {
+            these.iter().map(|r| f(r).clone()).collect()
+        };
+        direct.push(DirectOverSeeds {
+            excitation: name.to_string(),
+            seeds: these.iter().map(|r| r.seed).collect(),
+            cond: these.iter().map(|r| r.cond).collect(),
+            d_global_linear: OverSeeds::of(&column(&|r| &r.d_global_linear)),
+            d_base_parameters: OverSeeds::of(&column(&|r| &r.d_base_parameters)),
+        });
+        let global = OverSeeds::of(&column(&|r| &r.global_tau));
+        let base = OverSeeds::of(&column(&|r| &r.base_tau));
+        for joint in [2usize, 3, 4] {
+            let j = joint - 1;
+            let f = Figure {
+                joint,
+                excitation: name.to_string(),
+                t: ts.to_vec(),
+                actual: pick(actual_tau, j),
+                local: pick(local_tau, j),
+                global_linear: pick(&global.median, j),
+                global_linear_min: pick(&global.min, j),
+                global_linear_max: pick(&global.max, j),
+                base_parameters: pick(&base.median, j),
+            };
+            let is_near = |t: f64| t.abs() <= near;
+            let all = |_: f64| true;
+            errors.push(FigureErrors {
+                joint,
+                excitation: name.to_string(),
+                near,
+                local_near: rms(&f.local, &f.actual, &is_near),
+                global_linear_near: rms(&f.global_linear, &f.actual, &is_near),
+                base_parameters_near: rms(&f.base_parameters, &f.actual, &is_near),
+                local_all: rms(&f.local, &f.actual, &all),
+                global_linear_all: rms(&f.global_linear, &f.actual, &all),
+                base_parameters_all: rms(&f.base_parameters, &f.actual, &all),
+            });
+            figures.push(f);
+        }
+    }
+    (figures, errors, direct)
 }
 
 fn sorted(v: &[f64]) -> Vec<f64> {
