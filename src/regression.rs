@@ -3,7 +3,7 @@
 //! design reported with the directions it does not excite.
 
 use faer::linalg::solvers::Svd;
-use faer::Mat;
+use faer::{Mat, MatRef};
 use nalgebra::{DMatrix, DVector};
 
 use crate::error::{Error, Result};
@@ -56,6 +56,52 @@ pub fn least_squares(
     columns: &[String],
 ) -> Result<LeastSquares> {
     let (k, p) = x.shape();
+    let scale = check_system(x, y, context, columns)?;
+    let xs = Mat::<f64>::from_fn(k, p, |i, j| x[(i, j)] / scale[j]);
+    let svd = Svd::new_thin(xs.as_ref()).map_err(|e| Error::Numerical {
+        operation: context.into(),
+        message: format!("the SVD did not converge: {e:?}"),
+    })?;
+    let (u, v) = (svd.U(), svd.V());
+    let s: Vec<f64> = (0..p).map(|i| svd.S().column_vector()[i]).collect();
+    let smax = s.iter().cloned().fold(0.0, f64::max);
+    let smin = s.iter().cloned().fold(f64::INFINITY, f64::min);
+    refuse_weak_directions(k, v, &s, &scale, context, columns)?;
+    let solution = solve(x, y, u, v, &s, &scale, context)?;
+    let leverage = (0..k)
+        .map(|r| (0..p).map(|i| u[(r, i)] * u[(r, i)]).sum())
+        .collect();
+    let cov_scaled = &solution.cov_scaled;
+    // (X^T X)^-1 of the scaled X is V S^-2 V^T; its correlation is that of the unscaled one
+    let correlation = DMatrix::from_fn(p, p, |a, b| {
+        if a == b {
+            return 1.0;
+        }
+        let c: f64 = (0..p).map(|i| v[(a, i)] * v[(b, i)] / (s[i] * s[i])).sum();
+        (c / (cov_scaled[a] * cov_scaled[b]).sqrt()).clamp(-1.0, 1.0)
+    });
+    Ok(LeastSquares {
+        weakest: weakest_direction(v, &s),
+        cond: smax / smin,
+        rows: k,
+        leverage,
+        correlation,
+        coef: solution.coef,
+        residual_rms: solution.residual_rms,
+        stderr: solution.stderr,
+        cov_diag: solution.cov_diag,
+    })
+}
+
+/// Refuses shapes that disagree, fewer equations than unknowns, non-finite values and a column
+/// of zeros; returns X's column norms.
+fn check_system(
+    x: &DMatrix<f64>,
+    y: &DMatrix<f64>,
+    context: &str,
+    columns: &[String],
+) -> Result<Vec<f64>> {
+    let (k, p) = x.shape();
     let m = y.ncols();
     if y.nrows() != k || columns.len() != p {
         return Err(Error::Shape {
@@ -89,15 +135,21 @@ pub fn least_squares(
             missing: format!("{} (the column is all zeros)", columns[j]),
         });
     }
-    let xs = Mat::<f64>::from_fn(k, p, |i, j| x[(i, j)] / scale[j]);
-    let svd = Svd::new_thin(xs.as_ref()).map_err(|e| Error::Numerical {
-        operation: context.into(),
-        message: format!("the SVD did not converge: {e:?}"),
-    })?;
-    let (u, v) = (svd.U(), svd.V());
-    let s: Vec<f64> = (0..p).map(|i| svd.S().column_vector()[i]).collect();
+    Ok(scale)
+}
+
+/// Refuses a design whose scaled singular values `s` fall below [`RANK_TOLERANCE`] of the
+/// largest, naming (up to three of) the directions it misses.
+fn refuse_weak_directions(
+    k: usize,
+    v: MatRef<'_, f64>,
+    s: &[f64],
+    scale: &[f64],
+    context: &str,
+    columns: &[String],
+) -> Result<()> {
+    let p = s.len();
     let smax = s.iter().cloned().fold(0.0, f64::max);
-    let smin = s.iter().cloned().fold(f64::INFINITY, f64::min);
     let weak: Vec<usize> = (0..p).filter(|&i| s[i] <= RANK_TOLERANCE * smax).collect();
     if !weak.is_empty() {
         let mut missing = weak
@@ -122,6 +174,33 @@ pub fn least_squares(
             missing,
         });
     }
+    Ok(())
+}
+
+/// The coefficients, their variances and standard errors and the residuals of the fit from
+/// the SVD `u s v^T` of the column-scaled X.
+struct Solution {
+    coef: DMatrix<f64>,
+    /// The diagonal of (X^T X)^-1 for the scaled X.
+    cov_scaled: Vec<f64>,
+    cov_diag: Vec<f64>,
+    residual_rms: DVector<f64>,
+    stderr: DMatrix<f64>,
+}
+
+/// Solves for the coefficients from the SVD; refuses coefficients or standard errors that
+/// overflow.
+fn solve(
+    x: &DMatrix<f64>,
+    y: &DMatrix<f64>,
+    u: MatRef<'_, f64>,
+    v: MatRef<'_, f64>,
+    s: &[f64],
+    scale: &[f64],
+    context: &str,
+) -> Result<Solution> {
+    let (k, p) = x.shape();
+    let m = y.ncols();
     // Y's columns scaled to a largest magnitude of 1 (a torque of 1e300 N m squares to inf)
     let yscale: Vec<f64> = (0..m)
         .map(|c| {
@@ -195,17 +274,19 @@ pub fn least_squares(
             ),
         });
     }
-    let leverage = (0..k)
-        .map(|r| (0..p).map(|i| u[(r, i)] * u[(r, i)]).sum())
-        .collect();
-    // (X^T X)^-1 of the scaled X is V S^-2 V^T; its correlation is that of the unscaled one
-    let correlation = DMatrix::from_fn(p, p, |a, b| {
-        if a == b {
-            return 1.0;
-        }
-        let c: f64 = (0..p).map(|i| v[(a, i)] * v[(b, i)] / (s[i] * s[i])).sum();
-        (c / (cov_scaled[a] * cov_scaled[b]).sqrt()).clamp(-1.0, 1.0)
-    });
+    Ok(Solution {
+        coef,
+        cov_scaled,
+        cov_diag,
+        residual_rms,
+        stderr,
+    })
+}
+
+/// The direction of the coefficients the data determine least well (the right singular vector
+/// of the smallest singular value), its largest entry positive.
+fn weakest_direction(v: MatRef<'_, f64>, s: &[f64]) -> Vec<f64> {
+    let p = s.len();
     let least = (0..p).min_by(|&a, &b| s[a].total_cmp(&s[b])).unwrap_or(0);
     let mut weakest: Vec<f64> = (0..p).map(|j| v[(j, least)]).collect();
     let largest = weakest
@@ -215,21 +296,9 @@ pub fn least_squares(
     if largest < 0.0 {
         weakest.iter_mut().for_each(|w| *w = -*w);
     }
-    Ok(LeastSquares {
-        coef,
-        weakest,
-        cond: smax / smin,
-        residual_rms,
-        stderr,
-        rows: k,
-        cov_diag,
-        leverage,
-        correlation,
-    })
+    weakest
 }
 
-/// `0.71 dq1 - 0.71 dq2`: a direction in terms of named columns (the 6 largest entries, largest
-/// first; entries below 5 % of the largest left out).
 /// The singular values of `x` (K x p, K >= p) with every column scaled to unit norm, largest
 /// first: all 1 for an orthogonal design; their extremes' ratio is [`LeastSquares::cond`], and
 /// `1 / s_min` is how many times the least well determined combination of the coefficients
@@ -265,6 +334,8 @@ pub(crate) fn column_norms(x: &DMatrix<f64>) -> Vec<f64> {
         .collect()
 }
 
+/// `0.71 dq1 - 0.71 dq2`: a direction in terms of named columns (the 6 largest entries, largest
+/// first; entries below 5 % of the largest left out).
 fn describe_direction(d: &[f64], columns: &[String]) -> String {
     let norm = d.iter().map(|v| v * v).sum::<f64>().sqrt();
     let max = d.iter().fold(0.0f64, |a, v| a.max(v.abs()));
