@@ -112,6 +112,55 @@ impl Table {
         let columns: Vec<String> = header.iter().map(str::to_string).collect();
         let width = columns.len();
         let mut t = Table::new(source, columns);
+        t.check_header(header_line)?;
+        let selection = select(&t.columns)?;
+        let original = std::mem::take(&mut t.columns);
+        t.columns = selection.keep.iter().map(|k| k.name.clone()).collect();
+        if let Some(problem) = t.header_problem() {
+            return Err(t.error(format!(
+                "line {header_line}, as the columns are renamed: {problem}"
+            )));
+        }
+        // time must increase: checked here, where the line is known (a log whose clock
+        // stepped back was named by its data row, which blank and comment lines shift)
+        let time = t.index("t");
+        let mut previous = (f64::NEG_INFINITY, 0);
+        for record in records {
+            let (line, fields) = record.map_err(csv_error)?;
+            if fields.len() != width {
+                return Err(t.error(format!(
+                    "line {line}: {} fields, the header has {width} columns",
+                    fields.len(),
+                )));
+            }
+            for k in &selection.keep {
+                let scaled = t.read_field(line, &fields[k.source], k, &original)?;
+                t.values.push(scaled);
+            }
+            if let Some(c) = time {
+                let now = t.values[t.values.len() - t.columns.len() + c];
+                if now <= previous.0 {
+                    return Err(t.error(format!(
+                        "line {line}, column 't': time does not increase (t = {} after {} on line {}){}",
+                        crate::error::shown(now),
+                        crate::error::shown(previous.0),
+                        previous.1,
+                        time_hint(now, previous.0)
+                    )));
+                }
+                previous = (now, line);
+            }
+        }
+        if t.rows() == 0 {
+            return Err(t.error("no data rows after the header".into()));
+        }
+        Ok(t)
+    }
+
+    /// Refuses a header that ends in a comma, names a column twice or not at all, or is one
+    /// column whose name holds another separator.
+    fn check_header(&self, header_line: usize) -> Result<()> {
+        let t = self;
         if t.columns.len() > 1 && t.columns.last().is_some_and(String::is_empty) {
             // a logger that ends every line with a comma
             return Err(t.error(format!(
@@ -141,83 +190,50 @@ impl Table {
                 )));
             }
         }
-        let selection = select(&t.columns)?;
-        let original = std::mem::take(&mut t.columns);
-        t.columns = selection.keep.iter().map(|k| k.name.clone()).collect();
-        if let Some(problem) = t.header_problem() {
-            return Err(t.error(format!(
-                "line {header_line}, as the columns are renamed: {problem}"
-            )));
-        }
+        Ok(())
+    }
+
+    /// The value of field `f` on line `line` for the kept column `k`, scaled (`original`: the
+    /// file's column names); refuses a field that is not a finite number or whose scaled value
+    /// is not finite.
+    fn read_field(&self, line: usize, f: &str, k: &Kept, original: &[String]) -> Result<f64> {
+        let t = self;
         // a column by its name in the file, and by the one it is read as where that differs
         let named = |k: &Kept| match &original[k.source] {
             name if *name == k.name => format!("'{name}'"),
             name => format!("'{name}' (read as {})", k.name),
         };
-        // time must increase: checked here, where the line is known (a log whose clock
-        // stepped back was named by its data row, which blank and comment lines shift)
-        let time = t.index("t");
-        let mut previous = (f64::NEG_INFINITY, 0);
-        for record in records {
-            let (line, fields) = record.map_err(csv_error)?;
-            if fields.len() != width {
-                return Err(t.error(format!(
-                    "line {line}: {} fields, the header has {width} columns",
-                    fields.len(),
-                )));
-            }
-            for k in &selection.keep {
-                let f = &fields[k.source];
-                let v: f64 = f.parse().map_err(|_| {
-                    // a column of words (a robot's mode, a date) is no recording's
-                    let words = if f.chars().any(|c| c.is_ascii_digit()) {
-                        String::new()
-                    } else {
-                        format!(
-                            " (a column that holds no numbers is left out with --ignore-columns '{}', Python ignore_columns=)",
-                            original[k.source]
-                        )
-                    };
-                    t.error(format!(
-                        "line {line}, column {}: '{f}' is not a number{words}",
-                        named(k)
-                    ))
-                })?;
-                if !v.is_finite() {
-                    return Err(t.error(format!(
-                        "line {line}, column {}: {v} is not a finite number",
-                        named(k)
-                    )));
-                }
-                let scaled = v * k.scale;
-                if !scaled.is_finite() {
-                    return Err(t.error(format!(
-                        "line {line}, column {}: {} times {} is beyond the largest number",
-                        named(k),
-                        crate::error::shown(v),
-                        crate::error::shown(k.scale)
-                    )));
-                }
-                t.values.push(scaled);
-            }
-            if let Some(c) = time {
-                let now = t.values[t.values.len() - t.columns.len() + c];
-                if now <= previous.0 {
-                    return Err(t.error(format!(
-                        "line {line}, column 't': time does not increase (t = {} after {} on line {}){}",
-                        crate::error::shown(now),
-                        crate::error::shown(previous.0),
-                        previous.1,
-                        time_hint(now, previous.0)
-                    )));
-                }
-                previous = (now, line);
-            }
+        let v: f64 = f.parse().map_err(|_| {
+            // a column of words (a robot's mode, a date) is no recording's
+            let words = if f.chars().any(|c| c.is_ascii_digit()) {
+                String::new()
+            } else {
+                format!(
+                    " (a column that holds no numbers is left out with --ignore-columns '{}', Python ignore_columns=)",
+                    original[k.source]
+                )
+            };
+            t.error(format!(
+                "line {line}, column {}: '{f}' is not a number{words}",
+                named(k)
+            ))
+        })?;
+        if !v.is_finite() {
+            return Err(t.error(format!(
+                "line {line}, column {}: {v} is not a finite number",
+                named(k)
+            )));
         }
-        if t.rows() == 0 {
-            return Err(t.error("no data rows after the header".into()));
+        let scaled = v * k.scale;
+        if !scaled.is_finite() {
+            return Err(t.error(format!(
+                "line {line}, column {}: {} times {} is beyond the largest number",
+                named(k),
+                crate::error::shown(v),
+                crate::error::shown(k.scale)
+            )));
         }
-        Ok(t)
+        Ok(scaled)
     }
 
     /// A column named twice or not at all, if any. One pass with a set: a header of a million
