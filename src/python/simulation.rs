@@ -15,7 +15,9 @@ use super::rehearsal::PyTrueRobot;
 use super::robot::PyRobot;
 use super::trajectory::PyFourier;
 use crate::error::Error;
+use crate::local::Plan;
 use crate::logs::recording::Recording;
+use crate::model::Model;
 use crate::rehearsal::{rehearse, rehearse_plan};
 use crate::simulation::{
     excitation_samples, simulate_plan, simulate_samples, Friction, SimulationOptions,
@@ -97,6 +99,61 @@ pub(crate) fn simulate<'py>(
         .into());
     }
     let model = &robot.model;
+    let reference = reference(model, plan, rate, periods)?;
+    let one = |rec: Recording| -> PyResult<Bound<'py, PyAny>> {
+        Ok(Bound::new(py, PyRecording::from(rec))?.into_any())
+    };
+    let many = |recs: Vec<Recording>| -> PyResult<Bound<'py, PyAny>> {
+        let list: Vec<PyRecording> = recs.into_iter().map(PyRecording::from).collect();
+        Ok(list.into_pyobject(py)?.into_any())
+    };
+    if let Some(t) = &true_robot {
+        let t = t.robot.clone();
+        return match reference {
+            Reference::Plan(p) => many(detached(py, "simulate", || rehearse_plan(model, &t, &p))?),
+            Reference::Samples(s) => one(detached(py, "simulate", || {
+                rehearse(model, &t, &s, 0, "rehearsal")
+            })?),
+        };
+    }
+    let model = &robot.model;
+    let n = model.nv;
+    let mut o = SimulationOptions::new(model);
+    o.gravity = gravity.into();
+    o.seed = seed;
+    o.friction = friction_of(model, &friction)?;
+    for (target, name, value) in [
+        (&mut o.torque_noise, "torque_noise", &torque_noise),
+        (&mut o.position_noise, "position_noise", &position_noise),
+        (&mut o.quantization, "quantization", &quantization),
+    ] {
+        if let Some(v) = value {
+            *target = per_joint(name, v, n)?;
+        }
+    }
+    match reference {
+        Reference::Plan(p) => many(detached(py, "simulate", || simulate_plan(model, &p, &o))?),
+        Reference::Samples(s) => one(detached(py, "simulate", || {
+            simulate_samples(model, &s, &o, 0, "simulation")
+        })?),
+    }
+}
+
+/// What [`simulate`] runs: a plan's experiments, or samples of a reference.
+enum Reference {
+    Plan(std::sync::Arc<Plan>),
+    Samples(Samples),
+}
+
+/// The reference `plan` as samples (an excitation over `periods` at `rate`, or the arrays
+/// checked as a recording is) or as a plan; `rate` and `periods` refused but for an
+/// excitation.
+fn reference(
+    model: &Model,
+    plan: ReferenceArg<'_>,
+    rate: Option<f64>,
+    periods: Option<f64>,
+) -> PyResult<Reference> {
     let excitation = matches!(plan, ReferenceArg::Fourier(_) | ReferenceArg::Design(_));
     if let (false, Some((name, value))) = (
         excitation,
@@ -119,21 +176,17 @@ pub(crate) fn simulate<'py>(
         .into());
     }
     let (periods, rate) = (periods.unwrap_or(1.0), rate.unwrap_or(1000.0));
-    let (plan, samples) = match plan {
-        ReferenceArg::Plan(p) => (Some(p.plan.clone()), None),
-        ReferenceArg::Fourier(f) => (
-            None,
-            Some(excitation_samples(model, &f.traj, periods, rate)?),
-        ),
-        ReferenceArg::Design(d) => (
-            None,
-            Some(excitation_samples(
-                model,
-                d.trajectory_ref(),
-                periods,
-                rate,
-            )?),
-        ),
+    Ok(match plan {
+        ReferenceArg::Plan(p) => Reference::Plan(p.plan.clone()),
+        ReferenceArg::Fourier(f) => {
+            Reference::Samples(excitation_samples(model, &f.traj, periods, rate)?)
+        }
+        ReferenceArg::Design(d) => Reference::Samples(excitation_samples(
+            model,
+            d.trajectory_ref(),
+            periods,
+            rate,
+        )?),
         ReferenceArg::Arrays((t, q, qd, qdd)) => {
             let t = vector("t", &t)?;
             let k = t.len();
@@ -150,38 +203,22 @@ pub(crate) fn simulate<'py>(
                 Some(qdd.clone()),
                 None,
             )?;
-            (None, Some(Samples { n, t, q, qd, qdd }))
+            Reference::Samples(Samples { n, t, q, qd, qdd })
         }
-    };
-    let one = |rec: Recording| -> PyResult<Bound<'py, PyAny>> {
-        Ok(Bound::new(py, PyRecording::from(rec))?.into_any())
-    };
-    let many = |recs: Vec<Recording>| -> PyResult<Bound<'py, PyAny>> {
-        let list: Vec<PyRecording> = recs.into_iter().map(PyRecording::from).collect();
-        Ok(list.into_pyobject(py)?.into_any())
-    };
-    if let Some(t) = &true_robot {
-        let t = t.robot.clone();
-        return match (plan, samples) {
-            (Some(p), _) => many(detached(py, "simulate", || rehearse_plan(model, &t, &p))?),
-            (_, Some(s)) => one(detached(py, "simulate", || {
-                rehearse(model, &t, &s, 0, "rehearsal")
-            })?),
-            _ => unreachable!("samples exist for every reference but a plan"),
-        };
-    }
-    let model = &robot.model;
+    })
+}
+
+/// The simulation's friction from the `friction` argument: 'urdf' (the model's), None or a
+/// dict of per-joint values.
+fn friction_of(model: &Model, friction: &Option<FrictionArg<'_>>) -> PyResult<Friction> {
     let n = model.nv;
-    let mut o = SimulationOptions::new(model);
-    o.gravity = gravity.into();
-    o.seed = seed;
     let refuse = |what: String| {
         Error::InvalidArgument {
         argument: "friction".into(),
         message: format!("{what}; expected 'urdf', None or a dict with 'viscous', 'coulomb' and optionally 'coulomb_negative', 'stribeck', 'stribeck_velocity'"),
     }
     };
-    o.friction = match &friction {
+    Ok(match friction {
         None => Friction::none(n),
         Some(FrictionArg::Name(name)) if name == "urdf" => Friction::from_model(model),
         Some(FrictionArg::Name(name)) => return Err(refuse(format!("'{name}'")).into()),
@@ -219,21 +256,5 @@ pub(crate) fn simulate<'py>(
             }
             f
         }
-    };
-    for (target, name, value) in [
-        (&mut o.torque_noise, "torque_noise", &torque_noise),
-        (&mut o.position_noise, "position_noise", &position_noise),
-        (&mut o.quantization, "quantization", &quantization),
-    ] {
-        if let Some(v) = value {
-            *target = per_joint(name, v, n)?;
-        }
-    }
-    match (plan, samples) {
-        (Some(p), _) => many(detached(py, "simulate", || simulate_plan(model, &p, &o))?),
-        (_, Some(s)) => one(detached(py, "simulate", || {
-            simulate_samples(model, &s, &o, 0, "simulation")
-        })?),
-        _ => unreachable!("samples exist for every reference but a plan"),
-    }
+    })
 }
