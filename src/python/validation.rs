@@ -256,21 +256,7 @@ pub(crate) fn validate<'py>(
         message: "missing: the measured torques are what a model is validated against".into(),
     })?;
     let (t, coulomb) = (&a.t, &a.coulomb);
-    let measured = {
-        let array = tau.as_array();
-        let n = *array.shape().last().unwrap_or(&0);
-        if n == 0 {
-            return Err(crate::Error::Shape {
-                argument: "tau".into(),
-                expected: "(k, n) measured torques".into(),
-                got: format!("shape {:?}", array.shape()),
-            }
-            .into());
-        }
-        let batch = read_batch(n, &[("tau", tau)])?;
-        (n, batch.columns[0].to_vec())
-    };
-    let (n, measured) = measured;
+    let (n, measured) = measured_torques(tau)?;
     if let Some(t) = &t {
         let args = [("q", &a.q), ("qd", &a.qd), ("qdd", &a.qdd), ("tau", tau)];
         let batch = read_batch(n, &args)?;
@@ -296,73 +282,15 @@ pub(crate) fn validate<'py>(
         Err(_) => (1..=n).map(|j| format!("joint{j}")).collect(),
     };
     let mut v = validate_rs(&joints, &predicted, &measured)?;
-    // the predictions' standard errors, where the model gives them, and the measured torque
-    // columns against a base-parameter model's robot, as a direct fit checks its own data
-    let (local, base) = (model.cast::<PyLocalModel>(), model.cast::<PyBaseModel>());
-    let robot = model.cast::<super::robot::PyRobot>();
-    let mut stderr = None;
-    let (mut position_range, mut torque_columns) = (vec![], vec![]);
-    let (mut torque_lag, mut position_offsets) = (None, None);
-    let mut extrapolation = None;
-    if local.is_ok() || base.is_ok() || robot.is_ok() {
-        let mut args = vec![("q", &a.q), ("qd", &a.qd), ("qdd", &a.qdd)];
-        args.extend(coulomb.as_ref().map(|c| ("coulomb", c)));
-        let batch = read_batch(n, &args)?;
-        let states = batch.states(n)?;
-        crate::torque_model::refuse_flat_torques(
-            &states,
-            &measured,
-            &joints,
-            crate::torque_model::FOR_A_VALIDATION,
-        )?;
-        if let Ok(local) = &local {
-            let m = &local.get().model;
-            stderr = stored_stderr(m.predict_stderr(&states))?.ok();
-            extrapolation = m.extrapolation(&states)?;
-        }
-        // a robot's own parameters: its torque columns, lag and range checked as a
-        // base-parameter model's robot (the zero offsets need a fit's parameters)
-        if let Ok(robot) = &robot {
-            let r = &robot.get().model;
-            let (ranges, columns, lag) = detached(model.py(), "validate", || {
-                let g = crate::gravity::Gravity::Included;
-                Ok((
-                    check_position_range(r, &states),
-                    check_torque_columns(r, &states, &measured, g)?,
-                    check_torque_lag(r, &states, &measured, g)?,
-                ))
-            })?;
-            let mut findings = validation_findings(&ranges, &columns, lag.as_ref(), None);
-            if !crate::robot_torques::RobotTorques::new(r).has_friction() {
-                findings.push(crate::robot_torques::NO_FRICTION.to_string());
-            }
-            warn_all(model.py(), &findings)?;
-            (position_range, torque_columns, torque_lag) = (ranges, columns, lag);
-        }
-        if let Ok(base) = &base {
-            let base = base.get();
-            let (se, ranges, columns, lag, offsets) = detached(model.py(), "validate", || {
-                let g = base.fit.gravity;
-                Ok((
-                    stored_stderr(base.fit.predict_stderr(&base.model, &states))?,
-                    check_position_range(&base.model, &states),
-                    check_torque_columns(&base.model, &states, &measured, g)?,
-                    check_torque_lag(&base.model, &states, &measured, g)?,
-                    check_position_offsets_in_validation(
-                        &base.model,
-                        &base.fit,
-                        &states,
-                        &measured,
-                    )?,
-                ))
-            })?;
-            let findings = validation_findings(&ranges, &columns, lag.as_ref(), offsets.as_ref());
-            warn_all(model.py(), &findings)?;
-            stderr = se.ok();
-            (position_range, torque_columns) = (ranges, columns);
-            (torque_lag, position_offsets) = (lag, offsets);
-        }
-    }
+    let checks = model_checks(&model, &a, n, &measured, &joints)?;
+    let ModelChecks {
+        stderr,
+        position_range,
+        torque_columns,
+        torque_lag,
+        position_offsets,
+        extrapolation,
+    } = checks;
     if let Some(se) = &stderr {
         v = v.with_model_stderr(se)?;
     }
@@ -380,4 +308,107 @@ pub(crate) fn validate<'py>(
         extrapolation,
         noise_fit,
     })
+}
+
+/// The measured torques `tau` ((k, n)): n and the values, row-major.
+fn measured_torques(tau: &super::arrays::ArrayLike<'_>) -> PyResult<(usize, Vec<f64>)> {
+    let array = tau.as_array();
+    let n = *array.shape().last().unwrap_or(&0);
+    if n == 0 {
+        return Err(crate::Error::Shape {
+            argument: "tau".into(),
+            expected: "(k, n) measured torques".into(),
+            got: format!("shape {:?}", array.shape()),
+        }
+        .into());
+    }
+    let batch = read_batch(n, &[("tau", tau)])?;
+    Ok((n, batch.columns[0].to_vec()))
+}
+
+/// What validate learns of the model beside its predictions: their standard errors, where
+/// the model gives them, and the measured torque columns checked against a base-parameter
+/// model's robot (or a Robot's own parameters), as a direct fit checks its own data.
+#[derive(Default)]
+struct ModelChecks {
+    stderr: Option<Vec<f64>>,
+    position_range: Vec<JointRange>,
+    torque_columns: Vec<TorqueColumn>,
+    torque_lag: Option<TorqueLag>,
+    position_offsets: Option<PositionOffsets>,
+    extrapolation: Option<Extrapolation>,
+}
+
+/// The [`ModelChecks`] of `model` on the samples `a` (n joints named `joints`) against the
+/// torques `measured`; refuses a torque column that holds one value while the robot moves.
+fn model_checks(
+    model: &Bound<'_, PyAny>,
+    a: &super::samples::SampleArrays<'_>,
+    n: usize,
+    measured: &[f64],
+    joints: &[String],
+) -> PyResult<ModelChecks> {
+    let (local, base) = (model.cast::<PyLocalModel>(), model.cast::<PyBaseModel>());
+    let robot = model.cast::<super::robot::PyRobot>();
+    let mut c = ModelChecks::default();
+    if local.is_ok() || base.is_ok() || robot.is_ok() {
+        let mut args = vec![("q", &a.q), ("qd", &a.qd), ("qdd", &a.qdd)];
+        args.extend(a.coulomb.as_ref().map(|c| ("coulomb", c)));
+        let batch = read_batch(n, &args)?;
+        let states = batch.states(n)?;
+        crate::torque_model::refuse_flat_torques(
+            &states,
+            measured,
+            joints,
+            crate::torque_model::FOR_A_VALIDATION,
+        )?;
+        if let Ok(local) = &local {
+            let m = &local.get().model;
+            c.stderr = stored_stderr(m.predict_stderr(&states))?.ok();
+            c.extrapolation = m.extrapolation(&states)?;
+        }
+        // a robot's own parameters: its torque columns, lag and range checked as a
+        // base-parameter model's robot (the zero offsets need a fit's parameters)
+        if let Ok(robot) = &robot {
+            let r = &robot.get().model;
+            let (ranges, columns, lag) = detached(model.py(), "validate", || {
+                let g = crate::gravity::Gravity::Included;
+                Ok((
+                    check_position_range(r, &states),
+                    check_torque_columns(r, &states, measured, g)?,
+                    check_torque_lag(r, &states, measured, g)?,
+                ))
+            })?;
+            let mut findings = validation_findings(&ranges, &columns, lag.as_ref(), None);
+            if !crate::robot_torques::RobotTorques::new(r).has_friction() {
+                findings.push(crate::robot_torques::NO_FRICTION.to_string());
+            }
+            warn_all(model.py(), &findings)?;
+            (c.position_range, c.torque_columns, c.torque_lag) = (ranges, columns, lag);
+        }
+        if let Ok(base) = &base {
+            let base = base.get();
+            let (se, ranges, columns, lag, offsets) = detached(model.py(), "validate", || {
+                let g = base.fit.gravity;
+                Ok((
+                    stored_stderr(base.fit.predict_stderr(&base.model, &states))?,
+                    check_position_range(&base.model, &states),
+                    check_torque_columns(&base.model, &states, measured, g)?,
+                    check_torque_lag(&base.model, &states, measured, g)?,
+                    check_position_offsets_in_validation(
+                        &base.model,
+                        &base.fit,
+                        &states,
+                        measured,
+                    )?,
+                ))
+            })?;
+            let findings = validation_findings(&ranges, &columns, lag.as_ref(), offsets.as_ref());
+            warn_all(model.py(), &findings)?;
+            c.stderr = se.ok();
+            (c.position_range, c.torque_columns) = (ranges, columns);
+            (c.torque_lag, c.position_offsets) = (lag, offsets);
+        }
+    }
+    Ok(c)
 }
