@@ -34,6 +34,8 @@ pub const MAX_FILTER_ORDER: usize = 32;
 pub const MIN_PERTURBATION: f64 = 1e-9;
 /// Harmonics per joint of a Fourier excitation.
 pub const MAX_HARMONICS: usize = 1_000;
+/// Logs (or runs) fitted together in one identification.
+pub const MAX_LOGS: usize = 1000;
 /// Samples per period at which an excitation's criterion is evaluated.
 pub const MAX_FIT_SAMPLES: usize = 1_000_000;
 /// Criterion evaluations of one excitation design.

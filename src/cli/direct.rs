@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::files::{in_log, load_robot, refuse_overwriting_inputs, PreprocessArgs, RobotArg};
+use super::files::{load_robot, refuse_overwriting_inputs, PreprocessArgs, RobotArg};
 use super::out_dir;
 use super::progress::Progress;
 use crate::direct::{
@@ -16,6 +16,7 @@ use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::io::{write_atomic, OutputSet, Table};
+use crate::logs::log_set::LogSet;
 use crate::logs::{read_states, samples_table};
 use crate::model_file::ModelFile;
 use crate::states::States;
@@ -198,48 +199,22 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     let paths: Vec<&std::path::Path> = a.data.iter().map(PathBuf::as_path).collect();
     let recs =
         (a.preprocessing).read_logs(&paths, &model.joint_names, "DATA", &progress, &mut out)?;
-    let n = model.nv;
-    // each log's first samples are fitted to, its last validated on
-    let splits = super::files::fit_splits(a.validate, &recs, &a.data)?;
-    let logs_states = (recs.iter().zip(&a.data))
-        .map(|(r, path)| r.states().map_err(in_log(path)))
-        .collect::<Result<Vec<_>>>()?;
-    // several logs are stacked, their parts to fit to and to validate on; one is read in place
-    // (a long log is not copied)
-    let stack = |range: &dyn Fn(usize, usize) -> std::ops::Range<usize>| {
-        let parts: Vec<(States<'_>, &[f64])> = (logs_states.iter().zip(&recs).zip(&splits))
-            .map(|((s, r), &split)| {
-                let rows = range(split, r.len());
-                (s.slice(rows.clone()), &r.tau[rows.start * n..rows.end * n])
-            })
-            .collect();
-        let names: Vec<String> = a.data.iter().map(|p| p.display().to_string()).collect();
-        crate::logs::stacked_states::StackedStates::of_named(&parts, &names, "DATA")
-    };
-    let stacked = match recs.len() {
-        1 => None,
-        _ => Some((stack(&|split, _| 0..split)?, stack(&|split, k| split..k)?)),
-    };
-    type Part<'a> = (States<'a>, &'a [f64]);
-    let (train, held): (Part<'_>, Part<'_>) = match &stacked {
-        None => {
-            let (s, r, split) = (&logs_states[0], &recs[0], splits[0]);
-            (
-                (s.slice(0..split), &r.tau[..split * n]),
-                (s.slice(split..r.len()), &r.tau[split * n..]),
-            )
-        }
-        Some((t, h)) => ((t.states()?, &t.data[..]), (h.states()?, &h.data[..])),
-    };
+    // each log's first samples are fitted to, its last validated on; several logs are
+    // stacked, one is read in place (a long log is not copied)
+    let names: Vec<String> = a.data.iter().map(|p| p.display().to_string()).collect();
+    let set = LogSet::new(
+        recs.iter().collect(),
+        names,
+        a.validate,
+        "DATA",
+        "--validate",
+    )?;
+    let (train, held) = (set.train()?, set.held()?);
     let (split, k) = (train.0.len(), train.0.len() + held.0.len());
-    // one log: the errors name it
-    let in_data = |e: Error| match recs.len() {
-        1 => in_log(&a.data[0])(e),
-        _ => e,
-    };
+    let in_data = |e: Error| set.in_data(e);
     // each log's residuals a time series of their own
     let options = crate::direct::BaseOptions {
-        runs: stacked.as_ref().map_or(vec![], |(t, _)| t.runs.clone()),
+        runs: set.runs(),
         offset_per_run: a.offset_per_log,
         noise: super::files::averaged_noise(&recs, &a.data, &model.joint_names, a.fit.weighting)?,
         ..a.fit.options()
@@ -248,15 +223,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     progress.update(&format!("identifying on {split} samples"));
     let (fit, urdf) = fit_direct(&a, &model, &train, &options, &in_data, &mut out)?;
     progress.done();
-    let fit = match recs.as_slice() {
-        [rec] => fit.with_findings_of(rec),
-        recs => crate::direct::BaseModel {
-            logs: (recs.iter().zip(&a.data))
-                .map(|(r, path)| crate::direct::LogFindings::of(&path.display().to_string(), r))
-                .collect(),
-            ..fit
-        },
-    };
+    let fit = fit.with_findings_of_logs(&set);
     for w in fit.warnings() {
         eprintln!("perturbid: warning: {w}");
     }
@@ -296,7 +263,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         ));
     }
     if split < k {
-        validate_held_out(&model, &fit, &held, &recs, &splits, &a.data, &mut out)?;
+        validate_held_out(&model, &fit, &held, &recs, set.splits(), &a.data, &mut out)?;
     }
     Ok(out)
 }

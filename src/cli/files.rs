@@ -90,17 +90,7 @@ pub(crate) fn is_inline_json(arg: &Path) -> bool {
 /// channel, for one) as one about the file `path` it was read from, which the library's
 /// functions do not know.
 pub(crate) fn in_log(path: &Path) -> impl Fn(Error) -> Error + '_ {
-    move |e| match e {
-        Error::InvalidArgument { argument, message }
-            if ["q", "qd", "qdd", "tau"].contains(&argument.as_str()) =>
-        {
-            Error::Recording {
-                recording: path.display().to_string(),
-                message: format!("{argument}: {message}"),
-            }
-        }
-        e => e,
-    }
+    move |e| crate::logs::log_set::in_log(&path.display().to_string(), e)
 }
 
 /// Refuses an output file that is one of the inputs (it would be destroyed before, or while,
@@ -550,43 +540,6 @@ pub(crate) fn check_validate_fraction(fraction: f64) -> Result<()> {
             crate::error::shown(fraction)
         ),
     })
-}
-
-/// Each log's samples to fit to, its first (1 - `fraction`); the rest are validated on.
-/// Refused where the fraction leaves a log none to validate on, or none to fit to (naming the
-/// log where there are several).
-pub(crate) fn fit_splits(
-    fraction: f64,
-    recs: &[crate::logs::recording::Recording],
-    paths: &[PathBuf],
-) -> Result<Vec<usize>> {
-    let mut splits = Vec::with_capacity(recs.len());
-    for (rec, path) in recs.iter().zip(paths) {
-        let k = rec.len();
-        let split = ((1.0 - fraction) * k as f64).round() as usize;
-        let of = match recs.len() {
-            1 => String::new(),
-            _ => format!(" of {}", path.display()),
-        };
-        let problem = match split {
-            s if fraction > 0.0 && s >= k => {
-                Some("leaves none to validate on; give a larger fraction, or 0 for none")
-            }
-            0 => Some("leaves none to fit to; give a smaller fraction"),
-            _ => None,
-        };
-        if let Some(problem) = problem {
-            return Err(Error::InvalidArgument {
-                argument: "--validate".into(),
-                message: format!(
-                    "{} of {k} samples{of} {problem}",
-                    crate::error::shown(fraction)
-                ),
-            });
-        }
-        splits.push(split);
-    }
-    Ok(splits)
 }
 
 /// The logs given, for a note in a file written from them: their paths, or where they are

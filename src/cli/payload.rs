@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::files::{in_log, refuse_overwriting_inputs, PreprocessArgs, RobotArg};
+use super::files::{refuse_overwriting_inputs, PreprocessArgs, RobotArg};
 use super::progress::Progress;
 use crate::direct::{
     identify_payload, FrictionTerms, PayloadFit, PayloadInertia, PayloadOptions, Reference,
@@ -15,6 +15,7 @@ use crate::direct::{
 use crate::error::{shown, Error, Result};
 use crate::gravity::Gravity;
 use crate::io::OutputSet;
+use crate::logs::log_set::LogSet;
 use crate::model_file::ModelFile;
 
 #[derive(Args)]
@@ -131,61 +132,24 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
             .map(|r| r.in_torques(g))
             .collect::<Result<_>>()?;
     }
-    let n = model.nv;
     options.noise =
         super::files::averaged_noise(&recs, &a.data, &model.joint_names, options.weighting)?;
-    // each log's first samples are fitted to, its last validated on
-    let splits = super::files::fit_splits(a.validate, &recs, &a.data)?;
-    let states = (recs.iter().zip(&a.data))
-        .map(|(r, path)| r.states().map_err(in_log(path)))
-        .collect::<Result<Vec<_>>>()?;
+    // each log's first samples are fitted to, its last validated on; several logs are
+    // stacked, one is read in place (a long log is not copied)
     let names: Vec<String> = a.data.iter().map(|p| p.display().to_string()).collect();
-    let part = |held: bool| -> Result<crate::logs::stacked_states::StackedStates> {
-        let parts: Vec<(crate::states::States<'_>, &[f64])> = (states.iter().zip(&recs))
-            .zip(&splits)
-            .map(|((s, r), &split)| {
-                let rows = if held { split..r.len() } else { 0..split };
-                (s.slice(rows.clone()), &r.tau[rows.start * n..rows.end * n])
-            })
-            .filter(|(s, _)| !s.is_empty())
-            .collect();
-        crate::logs::stacked_states::StackedStates::of_named(&parts, &names, "DATA")
-    };
-    // several logs are stacked; one is read in place (a long log is not copied)
-    let stacked = match recs.len() {
-        1 => None,
-        _ => Some((
-            part(false)?,
-            (a.validate > 0.0).then(|| part(true)).transpose()?,
-        )),
-    };
-    type Part<'a> = (crate::states::States<'a>, &'a [f64]);
-    let (train, held): (Part<'_>, Part<'_>) = match &stacked {
-        None => {
-            let (s, r, split) = (&states[0], &recs[0], splits[0]);
-            (
-                (s.slice(0..split), &r.tau[..split * n]),
-                (s.slice(split..r.len()), &r.tau[split * n..]),
-            )
-        }
-        Some((t, h)) => {
-            let train = t.states()?;
-            let held = match h {
-                Some(h) => (h.states()?, &h.data[..]),
-                None => (train.slice(0..0), &[][..]),
-            };
-            ((train, &t.data[..]), held)
-        }
-    };
-    if let Some((t, _)) = &stacked {
-        options.runs = t.runs.clone();
-        options.log_names = names.clone();
+    let set = LogSet::new(
+        recs.iter().collect(),
+        names,
+        a.validate,
+        "DATA",
+        "--validate",
+    )?;
+    let (train, held) = (set.train()?, set.held()?);
+    if set.len() > 1 {
+        options.runs = set.runs();
+        options.log_names = set.names().to_vec();
     }
-    // one log: the errors name it
-    let in_data = |e: Error| match recs.len() {
-        1 => in_log(&a.data[0])(e),
-        _ => e,
-    };
+    let in_data = |e: Error| set.in_data(e);
     progress.update(&format!("identifying on {} samples", train.0.len()));
     let fit = identify_payload(&model, reference, &train.0, train.1, &options)
         .map_err(|e| crate::direct::log_offsets::as_argument(e, "--offset-per-log"))
@@ -196,8 +160,7 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
             let mut predicted = fit.predict(&model, reference, &held.0)?;
             // each log's held-out samples with its own offset, where one was fitted
             if let Some(o) = &fit.log_offsets {
-                let held_runs: Vec<usize> =
-                    recs.iter().zip(&splits).map(|(r, s)| r.len() - s).collect();
+                let held_runs: Vec<usize> = set.held_runs();
                 predicted = o.added(&predicted, &held_runs);
             }
             crate::validation::validate(&model.joint_names, &predicted, held.1)

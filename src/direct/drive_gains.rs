@@ -35,7 +35,7 @@ use crate::regression::LeastSquares;
 use crate::states::States;
 
 /// Runs at most in one identification.
-pub const MAX_RUNS: usize = 1000;
+pub const MAX_RUNS: usize = crate::limits::MAX_LOGS;
 
 /// A gain's standard error, relative to it, beyond which it is warned of as poorly determined.
 pub const LOOSE_GAIN: f64 = 0.05;

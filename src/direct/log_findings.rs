@@ -148,6 +148,20 @@ impl BaseModel {
         }
     }
 
+    /// The model with what the preprocessing found in the logs of `set` it was fitted to:
+    /// one log's in the model's own fields, several logs' in [`Self::logs`], each named.
+    pub fn with_findings_of_logs(self, set: &crate::logs::log_set::LogSet<'_>) -> Self {
+        match set.recordings() {
+            [rec] => self.with_findings_of(rec),
+            recs => Self {
+                logs: (recs.iter().zip(set.names()))
+                    .map(|(r, name)| LogFindings::of(name, r))
+                    .collect(),
+                ..self
+            },
+        }
+    }
+
     /// The names of the logs the model was fitted to, in the fit's order (their paths or
     /// Recordings' names; empty for a model of one log).
     pub fn log_names(&self) -> Vec<String> {

@@ -14,7 +14,8 @@
 //!   the periods of a periodic excitation ([`period_average`], whose start [`excitation_start`]
 //!   finds);
 //! - recordings and trajectories as CSV ([`recording_csv`]);
-//! - several runs stacked for one fit ([`stacked_states`]).
+//! - several runs stacked for one fit ([`stacked_states`]), and several logs split into the
+//!   samples to fit to and those to validate on ([`log_set`]).
 
 pub mod derivative_columns;
 pub mod excitation_start;
@@ -22,6 +23,7 @@ pub mod frozen_readings;
 pub mod held_columns;
 pub mod log_dropouts;
 pub mod log_screening;
+pub mod log_set;
 pub mod outliers;
 pub mod period_average;
 pub mod position_rounding;

@@ -209,15 +209,9 @@ pub(crate) fn identify_consistent_parameters<'py>(
     };
     if listed.is_some() {
         let fit = detached(py, "identify_consistent_parameters", || {
-            let (stacked, options) =
-                super::recording_list::stacked_recordings(model, &recs, &options)?;
-            let c = consistent_rs(
-                model,
-                &stacked.states()?,
-                &stacked.data,
-                &options,
-                &consistent,
-            )?;
+            let (set, options) = super::recording_list::recording_set(model, &recs, &options)?;
+            let (states, tau) = set.train()?;
+            let c = consistent_rs(model, &states, tau, &options, &consistent)?;
             Ok::<_, crate::error::Error>(findings(c))
         })?;
         // the Recordings' own findings were warned of by the preprocessing that made them

@@ -23,7 +23,7 @@ use super::findings::{
     torque_lag_dict,
 };
 use super::local::PyOperatingPoint;
-use super::recording_list::{recordings_given, stacked_recordings, with_logs, with_offset_per_log};
+use super::recording_list::{recording_set, recordings_given, with_logs, with_offset_per_log};
 use super::robot::PyRobot;
 use super::samples::{samples, Given};
 use crate::direct::{
@@ -728,8 +728,9 @@ pub(crate) fn identify_base_parameters<'py>(
     )?;
     if let Some(recs) = listed {
         let fit = detached(py, "identify_base_parameters", || {
-            let (stacked, options) = stacked_recordings(model, &recs, &options)?;
-            let fit = base_rs(model, &stacked.states()?, &stacked.data, &options)?;
+            let (set, options) = recording_set(model, &recs, &options)?;
+            let (states, tau) = set.train()?;
+            let fit = base_rs(model, &states, tau, &options)?;
             Ok::<_, Error>(with_logs(fit, &recs))
         })?;
         // the Recordings' own findings were warned of by the preprocessing that made them

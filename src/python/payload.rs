@@ -13,7 +13,7 @@ use super::direct::{
     check_sample_derivatives, coulomb_column, fit_states, friction_terms, states, states_of,
     FrictionNames, PyBaseModel,
 };
-use super::recording_list::{recordings_given, stacked_recordings};
+use super::recording_list::{recording_set, recordings_given};
 use super::robot::PyRobot;
 use super::samples::{samples, Given};
 use crate::direct::BaseModel;
@@ -321,20 +321,14 @@ pub(crate) fn identify_payload<'py>(
     // a list of Recordings: logs fitted together, each checked alone
     if let Some(recs) = listed {
         let fit = detached(py, "identify_payload", || {
-            let (stacked, stacked_options) =
-                stacked_recordings(robot_model, &recs, &Default::default())?;
+            let (set, set_options) = recording_set(robot_model, &recs, &Default::default())?;
             if recs.len() > 1 {
-                options.runs = stacked_options.runs;
+                options.runs = set_options.runs;
                 options.log_names = recs.iter().map(|r| r.name.clone()).collect();
             }
-            payload_rs(
-                robot_model,
-                reference,
-                &stacked.states()?,
-                &stacked.data,
-                &options,
-            )
-            .map_err(|e| crate::direct::log_offsets::as_argument(e, "offset_per_log"))
+            let (states, tau) = set.train()?;
+            payload_rs(robot_model, reference, &states, tau, &options)
+                .map_err(|e| crate::direct::log_offsets::as_argument(e, "offset_per_log"))
         })?;
         super::errors::warn_all(py, &fit.findings)?;
         return Ok(PyPayloadFit {

@@ -1,5 +1,5 @@
 //! Several Recordings fitted together (runs one after the other: `identify_base_parameters`,
-//! `identify_consistent_parameters`): the list read, its Recordings stacked with their runs,
+//! `identify_consistent_parameters`): the list read, its Recordings as one set of logs,
 //! the fit's option of an offset a log, and what each one's preprocessing found kept in the
 //! model's `logs`.
 
@@ -10,7 +10,8 @@ use pyo3::prelude::*;
 use super::samples::Given;
 use crate::direct::{BaseModel, BaseOptions};
 use crate::error::{Error, Result};
-use crate::states::States;
+use crate::logs::log_set::LogSet;
+use crate::logs::recording::Recording;
 
 /// `options` with an offset a log where `offset_per_log` asks for one: refused unless the
 /// data are a list of two or more Recordings (`listed`, their number) and the joint terms have
@@ -51,7 +52,7 @@ pub(crate) fn with_offset_per_log(
 pub(crate) fn recordings_given(
     q: &Bound<'_, PyAny>,
     given: &Given<'_>,
-) -> PyResult<Option<Vec<Arc<crate::logs::recording::Recording>>>> {
+) -> PyResult<Option<Vec<Arc<Recording>>>> {
     let Some(recs) = super::recording::recordings_of(q)? else {
         return Ok(None);
     };
@@ -67,25 +68,15 @@ pub(crate) fn recordings_given(
     Ok(Some(recs))
 }
 
-/// The Recordings `recs` (preprocessed: with velocities and accelerations) one after the
-/// other, each one's logged derivatives checked as a log's, and `options` with their runs
-/// (each one's residuals a time series of their own). Errors name the Recording.
-pub(crate) fn stacked_recordings(
+/// The Recordings `recs` (preprocessed: with velocities and accelerations) as one set of logs
+/// fitted together whole, each one's logged derivatives checked as a log's, and `options`
+/// with their runs (each one's residuals a time series of their own). Errors name the
+/// Recording.
+pub(crate) fn recording_set<'a>(
     model: &crate::model::Model,
-    recs: &[Arc<crate::logs::recording::Recording>],
+    recs: &'a [Arc<Recording>],
     options: &BaseOptions,
-) -> Result<(crate::logs::stacked_states::StackedStates, BaseOptions)> {
-    if recs.is_empty() || recs.len() > crate::direct::drive_gains::MAX_RUNS {
-        return Err(Error::InvalidArgument {
-            argument: "q".into(),
-            message: format!(
-                "{} Recordings, expected 1 to {}",
-                recs.len(),
-                crate::direct::drive_gains::MAX_RUNS
-            ),
-        });
-    }
-    let mut states = Vec::with_capacity(recs.len());
+) -> Result<(LogSet<'a>, BaseOptions)> {
     for (i, r) in recs.iter().enumerate() {
         let at = |e: Error| Error::InvalidArgument {
             argument: "q".into(),
@@ -103,31 +94,28 @@ pub(crate) fn stacked_recordings(
             }));
         }
         crate::logs::derivative_columns::check_logged_derivatives(r).map_err(at)?;
-        states.push(r.states().map_err(at)?);
     }
-    let parts: Vec<(States<'_>, &[f64])> = states
-        .iter()
-        .zip(recs)
-        .map(|(s, r)| (*s, &r.tau[..]))
-        .collect();
     let names: Vec<String> = (recs.iter().enumerate())
         .map(|(i, r)| format!("Recording {i} ('{}')", r.name))
         .collect();
-    let stacked = crate::logs::stacked_states::StackedStates::of_named(&parts, &names, "q")?;
-    // each Recording's residuals a time series of their own
+    let set = LogSet::new(
+        recs.iter().map(Arc::as_ref).collect(),
+        names,
+        0.0,
+        "q",
+        "validate",
+    )?;
+    // each Recording's residuals a time series of their own (all its samples are fitted to)
     let options = BaseOptions {
-        runs: stacked.runs.clone(),
+        runs: set.splits().to_vec(),
         ..options.clone()
     };
-    Ok((stacked, options))
+    Ok((set, options))
 }
 
 /// `fit` with what each of the Recordings `recs` it was fitted to found in its preprocessing,
 /// in its `logs` (named by it).
-pub(crate) fn with_logs(
-    fit: BaseModel,
-    recs: &[Arc<crate::logs::recording::Recording>],
-) -> BaseModel {
+pub(crate) fn with_logs(fit: BaseModel, recs: &[Arc<Recording>]) -> BaseModel {
     BaseModel {
         logs: (recs.iter())
             .map(|r| crate::direct::LogFindings::of(&r.name, r))
