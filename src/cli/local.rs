@@ -456,21 +456,6 @@ pub(crate) struct IdentifyArgs {
     columns: super::files::ColumnArgs,
 }
 
-fn fmt_matrix(
-    out: &mut String,
-    name: &str,
-    m: &nalgebra::DMatrix<f64>,
-    se: &nalgebra::DMatrix<f64>,
-) {
-    let _ = writeln!(out, "{name} (standard errors in brackets):");
-    for i in 0..m.nrows() {
-        let cells: Vec<String> = (0..m.ncols())
-            .map(|j| format!("{:>9.4} [{:.1e}]", m[(i, j)], se[(i, j)]))
-            .collect();
-        let _ = writeln!(out, "  {}", cells.join(" "));
-    }
-}
-
 pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
     let plan = Plan::load(&a.plan)?;
     if let [only] = a.recordings.as_slice() {
@@ -562,85 +547,6 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
             worst
         );
     }
-    let offsets: Vec<String> = model
-        .diagnostics
-        .offsets
-        .iter()
-        .map(|o| format!("{} {:+.2} ms", o.experiment, 1e3 * o.offset))
-        .collect();
-    let _ = writeln!(out, "clock offsets: {}", offsets.join(", "));
-    let reversals = &model.diagnostics.reversals;
-    if !reversals.is_empty() {
-        let stepped = reversals
-            .iter()
-            .filter(|r| r.handling == crate::local::ReversalHandling::Step)
-            .count();
-        let _ = writeln!(
-            out,
-            "velocity reversals near crossings: {} torque fit(s) narrowed to leave the friction step out, {stepped} with the step modelled; see \"diagnostics\" in {}",
-            reversals.len() - stepped,
-            a.out.display()
-        );
-    }
-    let t: Vec<String> = model
-        .torque
-        .iter()
-        .zip(&model.torque_stderr)
-        .map(|(t, s)| format!("{t:.4} [{s:.1e}]"))
-        .collect();
-    let _ = writeln!(out, "T* (N m): {}", t.join(", "));
-    for (name, e) in [
-        ("D*", &model.d),
-        ("H*", &model.h),
-        ("G*", &model.g),
-        ("Gs", &model.g_static),
-    ] {
-        if let Some(e) = e {
-            let _ = writeln!(
-                out,
-                "{name}: cond(X) {:.3}, {} crossings, residual RMS max {:.2e} N m",
-                e.cond,
-                e.crossings,
-                e.residual_rms.iter().cloned().fold(0.0, f64::max)
-            );
-            fmt_matrix(&mut out, name, &e.matrix, &e.stderr);
-        }
-    }
-    fmt_noise(&mut out, &model.diagnostics.noise, &model.joint_names);
+    out.push_str(&model.summary(&a.out.display().to_string()));
     Ok(out)
-}
-
-/// The torque noise per experiment and joint: one sample's, and what varied from pass to
-/// pass beyond it (`-` where not estimated).
-fn fmt_noise(out: &mut String, noise: &[crate::local::TorqueNoise], joints: &[String]) {
-    if noise.is_empty() {
-        return;
-    }
-    let _ = writeln!(
-        out,
-        "torque noise (N m; one sample's / what varied from pass to pass beyond it; the steps of a torque logged coarser than its noise; the encoder steps of positions read by their band):"
-    );
-    let mut experiments: Vec<&str> = noise.iter().map(|e| e.experiment.as_str()).collect();
-    experiments.dedup();
-    for x in experiments {
-        let cells: Vec<String> = joints
-            .iter()
-            .map(|j| {
-                noise
-                    .iter()
-                    .find(|e| e.experiment == x && &e.joint == j)
-                    .map_or("-".into(), |e| {
-                        let passes = e.passes.map_or("-".into(), |p| format!("{p:.1e}"));
-                        let step = e
-                            .step
-                            .map_or(String::new(), |q| format!(" (steps {q:.1e})"));
-                        let encoder = e
-                            .position_step
-                            .map_or(String::new(), |q| format!(" (encoder {q:.1e} rad)"));
-                        format!("{:.1e} / {passes}{step}{encoder}", e.samples)
-                    })
-            })
-            .collect();
-        let _ = writeln!(out, "  {x:<9} {}", cells.join(", "));
-    }
 }

@@ -42,6 +42,7 @@ pub mod glitches;
 pub mod identify;
 mod identify_local;
 pub mod model;
+mod model_summary;
 pub mod noise;
 mod nominal_point;
 pub mod offset_search;
