@@ -51,13 +51,13 @@ macro_rules! choice {
             fn from_str(text: &str) -> $crate::error::Result<Self> {
                 match text {
                     $($text $(| $alias)* => Ok($name::$variant),)+
-                    other => Err($crate::error::Error::InvalidArgument {
-                        argument: $argument.into(),
-                        message: format!(
+                    other => Err($crate::error::Error::invalid(
+                        $argument,
+                        format!(
                             "'{other}'; expected one of {}",
                             [$($text),+].join(", ")
                         ),
-                    }),
+                    )),
                 }
             }
         }

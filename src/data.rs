@@ -140,18 +140,18 @@ impl Data {
         if self.fits(model) {
             return Ok(());
         }
-        Err(crate::error::Error::Shape {
-            argument: "data".into(),
-            expected: format!(
+        Err(crate::error::Error::shape(
+            "data",
+            format!(
                 "buffers for this model ({} dofs, {} bodies): Data::new(&model)",
                 model.nv,
                 model.nbodies()
             ),
-            got: format!(
+            format!(
                 "buffers for {} dofs and {} bodies",
                 self.tau.len(),
                 self.qb.len()
             ),
-        })
+        ))
     }
 }

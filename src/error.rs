@@ -359,6 +359,43 @@ pub enum Error {
 }
 
 impl Error {
+    /// An argument outside its admissible range: [`Error::InvalidArgument`].
+    pub fn invalid(argument: impl Into<String>, message: impl Into<String>) -> Error {
+        Error::InvalidArgument {
+            argument: argument.into(),
+            message: message.into(),
+        }
+    }
+
+    /// An argument of the wrong length or shape: [`Error::Shape`].
+    pub fn shape(
+        argument: impl Into<String>,
+        expected: impl Into<String>,
+        got: impl Into<String>,
+    ) -> Error {
+        Error::Shape {
+            argument: argument.into(),
+            expected: expected.into(),
+            got: got.into(),
+        }
+    }
+
+    /// A numerical failure in `operation`: [`Error::Numerical`].
+    pub fn numerical(operation: impl Into<String>, message: impl Into<String>) -> Error {
+        Error::Numerical {
+            operation: operation.into(),
+            message: message.into(),
+        }
+    }
+
+    /// A recording that cannot be used: [`Error::Recording`].
+    pub fn recording(recording: impl Into<String>, message: impl Into<String>) -> Error {
+        Error::Recording {
+            recording: recording.into(),
+            message: message.into(),
+        }
+    }
+
     /// The kind of problem.
     pub fn kind(&self) -> ErrorKind {
         match self {

@@ -105,10 +105,10 @@ pub fn check_range(name: &str, value: f64, low: f64, high: f64) -> Result<()> {
     } else {
         format!("a finite number in [{}, {}]", bound(low), bound(high))
     };
-    Err(Error::InvalidArgument {
-        argument: name.into(),
-        message: format!("{}; expected {expected}", crate::error::shown(value)),
-    })
+    Err(Error::invalid(
+        name,
+        format!("{}; expected {expected}", crate::error::shown(value)),
+    ))
 }
 
 /// A range bound as a person reads it: `1e-9`, `0.5`, `1e7`.
@@ -125,10 +125,10 @@ pub fn check_count(name: &str, value: usize, low: usize, high: usize) -> Result<
     if (low..=high).contains(&value) {
         return Ok(());
     }
-    Err(Error::InvalidArgument {
-        argument: name.into(),
-        message: format!("{value}; expected {low} to {high}"),
-    })
+    Err(Error::invalid(
+        name,
+        format!("{value}; expected {low} to {high}"),
+    ))
 }
 
 /// The number of samples of `duration` seconds at `rate` Hz (both checked: finite, positive,
@@ -155,13 +155,13 @@ pub fn check_values(what: &str, values: f64, given: impl FnOnce() -> String) -> 
     if values <= MAX_VALUES {
         return Ok(());
     }
-    Err(Error::InvalidArgument {
-        argument: what.into(),
-        message: format!(
+    Err(Error::invalid(
+        what,
+        format!(
             "{} is {values:.3e} values; at most 2^28 (2 GiB) are made (docs/limits.md)",
             given()
         ),
-    })
+    ))
 }
 
 /// Fails unless `intervals + 1` samples (`intervals` finite, not negative) of `columns` values
@@ -178,13 +178,13 @@ pub fn check_samples(
     if intervals.is_finite() && intervals >= 0.0 && samples <= MAX_SAMPLES && values <= MAX_VALUES {
         return Ok(());
     }
-    Err(Error::InvalidArgument {
-        argument: what.into(),
-        message: format!(
+    Err(Error::invalid(
+        what,
+        format!(
             "{} give {samples:.3e} samples of {columns} values ({values:.3e} values); at most {MAX_SAMPLES:e} samples and 2^28 values (2 GiB) are made (docs/limits.md)",
             given()
         ),
-    })
+    ))
 }
 
 #[cfg(test)]

@@ -77,11 +77,11 @@ pub fn linearize_into(
     out: &mut Linearization,
 ) -> Result<()> {
     if out.torque.len() != model.nv || out.d.shape() != (model.nv, model.nv) {
-        return Err(Error::Shape {
-            argument: "out".to_string(),
-            expected: format!("a Linearization of {} joints", model.nv),
-            got: format!("{} joints", out.torque.len()),
-        });
+        return Err(Error::shape(
+            "out",
+            format!("a Linearization of {} joints", model.nv),
+            format!("{} joints", out.torque.len()),
+        ));
     }
     derivatives_at(model, data, q, Some(qd), Some(qdd), gravity)?;
     out.torque.copy_from(&data.tau);

@@ -483,11 +483,11 @@ impl Model {
 /// Checks length `n` and finiteness of a vector argument.
 pub(crate) fn check_finite_vector(argument: &str, x: &[f64], n: usize) -> Result<()> {
     if x.len() != n {
-        return Err(Error::Shape {
-            argument: argument.to_string(),
-            expected: format!("{n} values (one per degree of freedom)"),
-            got: format!("{} values", x.len()),
-        });
+        return Err(Error::shape(
+            argument.to_string(),
+            format!("{n} values (one per degree of freedom)"),
+            format!("{} values", x.len()),
+        ));
     }
     match crate::finite::first_non_finite(x) {
         Some(index) => Err(Error::NonFiniteInput {

@@ -28,10 +28,10 @@ impl OperatingPoint {
     pub fn new(q: Vec<f64>, qd: Vec<f64>, qdd: Vec<f64>) -> Result<Self> {
         let n = q.len();
         if n == 0 {
-            return Err(Error::InvalidArgument {
-                argument: "q".into(),
-                message: "an operating point needs at least one joint".into(),
-            });
+            return Err(Error::invalid(
+                "q",
+                "an operating point needs at least one joint",
+            ));
         }
         check_finite_vector("q", &q, n)?;
         check_finite_vector("qd", &qd, n)?;
@@ -52,9 +52,11 @@ impl OperatingPoint {
         model.check_vector("operating point qdd", &self.qdd)?;
         for (j, lim) in model.limits.iter().enumerate() {
             let name = &model.joint_names[j];
-            let bad = |what: &str, value: f64, range: String| Error::InvalidArgument {
-                argument: format!("operating point {what}[{j}] (joint '{name}')"),
-                message: format!("{} is outside {range}", crate::error::shown(value)),
+            let bad = |what: &str, value: f64, range: String| {
+                Error::invalid(
+                    format!("operating point {what}[{j}] (joint '{name}')"),
+                    format!("{} is outside {range}", crate::error::shown(value)),
+                )
             };
             if self.q[j] < lim.lower || self.q[j] > lim.upper {
                 return Err(bad(

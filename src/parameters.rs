@@ -121,12 +121,12 @@ impl FrictionTerms {
                 }
                 "none" | "" => {}
                 other => {
-                    return Err(Error::InvalidArgument {
-                        argument: "friction".into(),
-                        message: format!(
+                    return Err(Error::invalid(
+                        "friction",
+                        format!(
                             "'{other}' is not a joint term; expected viscous, coulomb, offset, armature, all (the three friction terms) or none"
                         ),
-                    })
+                    ))
                 }
             }
         }

@@ -58,10 +58,8 @@ pub fn least_squares(
     let (k, p) = x.shape();
     let scale = check_system(x, y, context, columns)?;
     let xs = Mat::<f64>::from_fn(k, p, |i, j| x[(i, j)] / scale[j]);
-    let svd = Svd::new_thin(xs.as_ref()).map_err(|e| Error::Numerical {
-        operation: context.into(),
-        message: format!("the SVD did not converge: {e:?}"),
-    })?;
+    let svd = Svd::new_thin(xs.as_ref())
+        .map_err(|e| Error::numerical(context, format!("the SVD did not converge: {e:?}")))?;
     let (u, v) = (svd.U(), svd.V());
     let s: Vec<f64> = (0..p).map(|i| svd.S().column_vector()[i]).collect();
     let smax = s.iter().cloned().fold(0.0, f64::max);
@@ -104,11 +102,11 @@ fn check_system(
     let (k, p) = x.shape();
     let m = y.ncols();
     if y.nrows() != k || columns.len() != p {
-        return Err(Error::Shape {
-            argument: format!("{context}: least squares"),
-            expected: format!("Y with {k} rows like X and {p} column names"),
-            got: format!("Y {} x {m}, {} names", y.nrows(), columns.len()),
-        });
+        return Err(Error::shape(
+            format!("{context}: least squares"),
+            format!("Y with {k} rows like X and {p} column names"),
+            format!("Y {} x {m}, {} names", y.nrows(), columns.len()),
+        ));
     }
     if p == 0 || k < p {
         return Err(Error::RankDeficient {
@@ -120,10 +118,10 @@ fn check_system(
         });
     }
     if let Some(i) = x.iter().chain(y.iter()).position(|v| !v.is_finite()) {
-        return Err(Error::Numerical {
-            operation: context.into(),
-            message: format!("non-finite value in the least-squares data (entry {i})"),
-        });
+        return Err(Error::numerical(
+            context,
+            format!("non-finite value in the least-squares data (entry {i})"),
+        ));
     }
     let scale = column_norms(x);
     if let Some(j) = scale.iter().position(|&s| s == 0.0) {
@@ -265,14 +263,14 @@ fn solve(
         || residual_rms.iter().any(|v| !v.is_finite())
         || (k > p && stderr.iter().any(|v| !v.is_finite()));
     if overflow {
-        return Err(Error::Numerical {
-            operation: context.into(),
-            message: format!(
+        return Err(Error::numerical(
+            context,
+            format!(
                 "the fit's coefficients or standard errors overflow (outputs up to {} against regressors as small as {}): rescale the data",
                 crate::error::shown(yscale.iter().cloned().fold(0.0, f64::max)),
                 crate::error::shown(x.iter().fold(f64::INFINITY, |a, v| if *v != 0.0 { a.min(v.abs()) } else { a }))
             ),
-        });
+        ));
     }
     Ok(Solution {
         coef,
@@ -388,14 +386,14 @@ pub(crate) fn root(var: f64) -> f64 {
 /// standard error overflowed (inf: [`root`]) for `operation`.
 pub(crate) fn refuse_overflow(stderr: Vec<f64>, n: usize, operation: &str) -> Result<Vec<f64>> {
     match stderr.iter().position(|v| v.is_infinite()) {
-        Some(i) => Err(Error::Numerical {
-            operation: operation.into(),
-            message: format!(
+        Some(i) => Err(Error::numerical(
+            operation,
+            format!(
                 "the standard error of joint {} at sample {} overflows: the state is too large to compute with",
                 i % n + 1,
                 i / n
             ),
-        }),
+        )),
         None => Ok(stderr),
     }
 }

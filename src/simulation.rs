@@ -105,37 +105,37 @@ impl Friction {
         ] {
             crate::model::check_finite_vector(what, v, n)?;
             if let Some(j) = v.iter().position(|x| x.abs() > crate::limits::MAX_FRICTION) {
-                return Err(Error::InvalidArgument {
-                    argument: format!("{what}[{j}]"),
-                    message: format!(
+                return Err(Error::invalid(
+                    format!("{what}[{j}]"),
+                    format!(
                         "{}; expected at most {} in magnitude (docs/limits.md)",
                         crate::error::shown(v[j]),
                         crate::error::shown(crate::limits::MAX_FRICTION)
                     ),
-                });
+                ));
             }
             if what != "friction viscous" {
                 if let Some(j) = v.iter().position(|&x| x < 0.0) {
-                    return Err(Error::InvalidArgument {
-                        argument: format!("{what}[{j}]"),
-                        message: format!(
+                    return Err(Error::invalid(
+                        format!("{what}[{j}]"),
+                        format!(
                             "{}; expected a level >= 0 (the sign follows the speed)",
                             v[j]
                         ),
-                    });
+                    ));
                 }
             }
         }
         if let Some(j) =
             (0..n).find(|&j| self.stribeck[j] != 0.0 && self.stribeck_velocity[j] <= 0.0)
         {
-            return Err(Error::InvalidArgument {
-                argument: format!("friction stribeck_velocity[{j}]"),
-                message: format!(
+            return Err(Error::invalid(
+                format!("friction stribeck_velocity[{j}]"),
+                format!(
                     "{}; expected a positive speed where stribeck[{j}] = {} is not 0",
                     self.stribeck_velocity[j], self.stribeck[j]
                 ),
-            });
+            ));
         }
         Ok(())
     }
@@ -183,10 +183,10 @@ impl SimulationOptions {
             crate::model::check_finite_vector(what, v, n)?;
             // a resolution is 0 (none) or in its range
             if let Some((j, expected)) = crate::limits::outside_sensor_range(v, range) {
-                return Err(Error::InvalidArgument {
-                    argument: format!("{what}[{j}]"),
-                    message: format!("{}; expected {expected}", crate::error::shown(v[j])),
-                });
+                return Err(Error::invalid(
+                    format!("{what}[{j}]"),
+                    format!("{}; expected {expected}", crate::error::shown(v[j])),
+                ));
             }
         }
         Ok(())
@@ -253,11 +253,11 @@ pub fn simulate_samples(
 ) -> Result<Recording> {
     let n = model.nv;
     if samples.n != n {
-        return Err(Error::Shape {
-            argument: "samples".into(),
-            expected: format!("{n} joints"),
-            got: format!("{} joints", samples.n),
-        });
+        return Err(Error::shape(
+            "samples",
+            format!("{n} joints"),
+            format!("{} joints", samples.n),
+        ));
     }
     options.check(n)?;
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
@@ -293,16 +293,16 @@ pub fn simulate_samples(
 /// Refuses a plan made for other joints than `model`'s.
 pub(crate) fn check_plan_robot(model: &Model, plan: &crate::local::Plan) -> Result<()> {
     if plan.joint_names != model.joint_names {
-        return Err(Error::InvalidArgument {
-            argument: "plan".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "plan",
+            format!(
                 "the plan is for joints [{}] of '{}', the robot '{}' has [{}]",
                 plan.joint_names.join(", "),
                 plan.robot,
                 model.name,
                 model.joint_names.join(", ")
             ),
-        });
+        ));
     }
     Ok(())
 }
@@ -337,15 +337,15 @@ pub fn excitation_samples(
     rate: f64,
 ) -> Result<Samples> {
     if traj.n() != model.nv {
-        return Err(Error::InvalidArgument {
-            argument: "excitation".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "excitation",
+            format!(
                 "it is for {} joints; robot '{}' has {}",
                 traj.n(),
                 model.name,
                 model.nv
             ),
-        });
+        ));
     }
     let samples = traj.sample_periods(periods, rate)?;
     crate::trajectory::check_limits(

@@ -73,11 +73,11 @@ impl<'a> States<'a> {
     ) -> Result<Self> {
         let states = Self::build(nv, q, qd, qdd, true)?;
         if states.k != 1 {
-            return Err(Error::Shape {
-                argument: "q".into(),
-                expected: format!("{nv} values (one per degree of freedom)"),
-                got: format!("{} values", q.len()),
-            });
+            return Err(Error::shape(
+                "q",
+                format!("{nv} values (one per degree of freedom)"),
+                format!("{} values", q.len()),
+            ));
         }
         Ok(states)
     }
@@ -90,28 +90,28 @@ impl<'a> States<'a> {
         single: bool,
     ) -> Result<Self> {
         if nv == 0 {
-            return Err(Error::Shape {
-                argument: "q".into(),
-                expected: "a robot with at least one degree of freedom".into(),
-                got: "a robot with none".into(),
-            });
+            return Err(Error::shape(
+                "q",
+                "a robot with at least one degree of freedom",
+                "a robot with none",
+            ));
         }
         let k = q.len() / nv;
         if k * nv != q.len() {
-            return Err(Error::Shape {
-                argument: "q".into(),
-                expected: format!("a whole number of samples of {nv} joints"),
-                got: format!("{} values", q.len()),
-            });
+            return Err(Error::shape(
+                "q",
+                format!("a whole number of samples of {nv} joints"),
+                format!("{} values", q.len()),
+            ));
         }
         for (name, x) in [("qd", qd), ("qdd", qdd)] {
             if let Some(x) = x {
                 if x.len() != q.len() {
-                    return Err(Error::Shape {
-                        argument: name.into(),
-                        expected: format!("{k} samples x {nv} joints, like q"),
-                        got: format!("{} values", x.len()),
-                    });
+                    return Err(Error::shape(
+                        name,
+                        format!("{k} samples x {nv} joints, like q"),
+                        format!("{} values", x.len()),
+                    ));
                 }
             }
         }
@@ -244,15 +244,15 @@ impl<'a> States<'a> {
     pub fn with_coulomb(self, coulomb: &'a [f64]) -> Result<Self> {
         self.check_companion("coulomb", coulomb, self.nv)?;
         if let Some(i) = coulomb.iter().position(|v| v.abs() > 2.0) {
-            return Err(Error::InvalidArgument {
-                argument: "coulomb".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "coulomb",
+                format!(
                     "sample {}, joint {}: {}, expected a value within [-2, 2] (sign(qd), filtered)",
                     self.first + i / self.nv,
                     i % self.nv + 1,
                     crate::error::shown(coulomb[i])
                 ),
-            });
+            ));
         }
         Ok(Self {
             coulomb: Some(coulomb),
@@ -291,11 +291,11 @@ impl<'a> States<'a> {
     /// each sample.
     pub fn check_companion(&self, name: &str, x: &[f64], per_sample: usize) -> Result<()> {
         if x.len() != self.k * per_sample {
-            return Err(Error::Shape {
-                argument: name.into(),
-                expected: format!("{} samples x {per_sample} values, like q", self.k),
-                got: format!("{} values", x.len()),
-            });
+            return Err(Error::shape(
+                name,
+                format!("{} samples x {per_sample} values, like q", self.k),
+                format!("{} values", x.len()),
+            ));
         }
         self.check_values(name, x, per_sample)
     }

@@ -47,11 +47,11 @@ pub(crate) fn torque_at(model: &dyn TorqueModel, op: &OperatingPoint) -> Result<
 /// Fails unless `states` has `nv` joints per sample.
 pub(crate) fn check_joints(states: &States<'_>, nv: usize) -> Result<()> {
     if states.nv() != nv {
-        return Err(Error::Shape {
-            argument: "q".into(),
-            expected: format!("{nv} joints per sample (the model's)"),
-            got: format!("{} joints per sample", states.nv()),
-        });
+        return Err(Error::shape(
+            "q",
+            format!("{nv} joints per sample (the model's)"),
+            format!("{} joints per sample", states.nv()),
+        ));
     }
     Ok(())
 }
@@ -94,15 +94,15 @@ pub(crate) fn refuse_flat_torques(
                 .get(j)
                 .cloned()
                 .unwrap_or_else(|| format!("{}", j + 1));
-            return Err(Error::InvalidArgument {
-                argument: "tau".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "tau",
+                format!(
                     "the torque of joint '{name}' (column {}) is {} N m in all {k} samples{}: a dead or saturated channel, or one far coarser than the motion's effect; {use_}",
                     j + 1,
                     crate::error::shown(first),
                     if moving { " while the robot moves" } else { "" }
                 ),
-            });
+            ));
         }
     }
     Ok(())
@@ -139,15 +139,15 @@ pub(crate) fn predict_linear(
 /// handed back.
 pub(crate) fn check_prediction(tau: &[f64], nv: usize) -> Result<()> {
     match crate::finite::first_non_finite(tau) {
-        Some(i) => Err(Error::Numerical {
-            operation: "prediction".into(),
-            message: format!(
+        Some(i) => Err(Error::numerical(
+            "prediction",
+            format!(
                 "the torque of joint {} at sample {} is {}: the model's coefficients or the state are too large to compute with",
                 i % nv.max(1) + 1,
                 i / nv.max(1),
                 tau[i]
             ),
-        }),
+        )),
         None => Ok(()),
     }
 }

@@ -76,15 +76,15 @@ pub fn validate(joint_names: &[String], predicted: &[f64], measured: &[f64]) -> 
         || !measured.len().is_multiple_of(n)
         || measured.is_empty()
     {
-        return Err(Error::Shape {
-            argument: "validation".into(),
-            expected: format!("predicted and measured torques of the same k x {n} samples, k >= 1"),
-            got: format!(
+        return Err(Error::shape(
+            "validation",
+            format!("predicted and measured torques of the same k x {n} samples, k >= 1"),
+            format!(
                 "{} predicted and {} measured values",
                 predicted.len(),
                 measured.len()
             ),
-        });
+        ));
     }
     for (what, v) in [("predicted", predicted), ("measured", measured)] {
         if let Some(i) = v.iter().position(|x| !x.is_finite()) {
@@ -103,16 +103,16 @@ pub fn validate(joint_names: &[String], predicted: &[f64], measured: &[f64]) -> 
     let residuals: Vec<f64> = measured.iter().zip(predicted).map(|(m, p)| m - p).collect();
     // two finite torques of opposite signs past 9e307 differ by more than any f64
     if let Some(i) = residuals.iter().position(|r| !r.is_finite()) {
-        return Err(Error::Numerical {
-            operation: "validation".into(),
-            message: format!(
+        return Err(Error::numerical(
+            "validation",
+            format!(
                 "the error of sample {}, joint {} overflows (measured {}, predicted {}): torques this large cannot be compared",
                 i / n,
                 joint_names[i % n],
                 crate::error::shown(measured[i]),
                 crate::error::shown(predicted[i])
             ),
-        });
+        ));
     }
     let joints = (0..n)
         .map(|j| {
@@ -145,22 +145,22 @@ impl Validation {
     pub fn with_model_stderr(mut self, stderr: &[f64]) -> Result<Self> {
         let n = self.joints.len();
         if stderr.len() != self.samples * n {
-            return Err(Error::Shape {
-                argument: "model standard errors".into(),
-                expected: format!("{} x {n} like the torques", self.samples),
-                got: format!("{} values", stderr.len()),
-            });
+            return Err(Error::shape(
+                "model standard errors",
+                format!("{} x {n} like the torques", self.samples),
+                format!("{} values", stderr.len()),
+            ));
         }
         if let Some(i) = stderr.iter().position(|v| *v < 0.0 || v.is_infinite()) {
-            return Err(Error::InvalidArgument {
-                argument: "model standard errors".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "model standard errors",
+                format!(
                     "sample {}, joint {} is {}: expected a standard error (>= 0, or NaN where unknown)",
                     i / n,
                     self.joints[i % n].joint,
                     stderr[i]
                 ),
-            });
+            ));
         }
         for (j, e) in self.joints.iter_mut().enumerate() {
             let column = (0..self.samples).map(|s| stderr[s * n + j]);

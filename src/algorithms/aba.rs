@@ -64,14 +64,14 @@ pub fn aba(
         let u = ia * s;
         let d = s.dot(&u) + model.armature[b.dof];
         if d.is_nan() || d <= 0.0 {
-            return Err(Error::Numerical {
-                operation: "aba".into(),
-                message: format!(
+            return Err(Error::numerical(
+                "aba",
+                format!(
                     "joint '{}' has articulated inertia {d:e} (not positive): nothing it moves \
                      has mass or inertia about its axis",
                     b.joint
                 ),
-            });
+            ));
         }
         let dinv = 1.0 / d;
         let ui = tau[b.dof] - s.dot(&data.aba_pa[i]);

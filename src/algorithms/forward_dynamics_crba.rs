@@ -35,12 +35,12 @@ pub fn forward_dynamics_crba(
         }
         // NaN fails too
         if d.is_nan() || d <= 0.0 {
-            return Err(Error::Numerical {
-                operation: "forward_dynamics".to_string(),
-                message: format!(
+            return Err(Error::numerical(
+                "forward_dynamics",
+                format!(
                     "the mass matrix is not positive definite at q = {q:?} (pivot {j} is {d:e})"
                 ),
-            });
+            ));
         }
         let d = d.sqrt();
         l[(j, j)] = d;

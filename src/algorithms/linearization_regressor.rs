@@ -65,15 +65,15 @@ pub fn linearization_regressor(
 ) -> Result<LinearizationRegressor> {
     let nv = model.nv;
     if layout.nv != nv || layout.nbodies != model.nbodies() {
-        return Err(Error::InvalidArgument {
-            argument: "layout".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "layout",
+            format!(
                 "for {} joints and {} bodies; the model has {nv} and {}",
                 layout.nv,
                 layout.nbodies,
                 model.nbodies()
             ),
-        });
+        ));
     }
     for (name, x) in [("q", q), ("qd", qd), ("qdd", qdd)] {
         crate::model::check_finite_vector(name, x, nv)?;

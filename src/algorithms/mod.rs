@@ -79,10 +79,8 @@ pub(crate) fn check_result(algorithm: &str, name: &str, values: &[f64]) -> Resul
 
 /// The error for a result `name` of `algorithm` that came out as `value` (inf or NaN) at `entry`.
 pub(crate) fn overflow(algorithm: &str, name: &str, value: f64, entry: usize) -> crate::Error {
-    crate::error::Error::Numerical {
-        operation: algorithm.into(),
-        message: format!(
-            "{name} is {value} at entry {entry}: the state is too large to compute with"
-        ),
-    }
+    crate::error::Error::numerical(
+        algorithm,
+        format!("{name} is {value} at entry {entry}: the state is too large to compute with"),
+    )
 }

@@ -88,20 +88,20 @@ where
     F: Fn(&mut Workspace, &States<'_>, &mut [&mut [f64]]) -> Result<()> + Sync,
 {
     if states.nv() != model.nv {
-        return Err(Error::Shape {
-            argument: "q".into(),
-            expected: format!("{} joints per sample (the model's)", model.nv),
-            got: format!("{} joints per sample", states.nv()),
-        });
+        return Err(Error::shape(
+            "q",
+            format!("{} joints per sample (the model's)", model.nv),
+            format!("{} joints per sample", states.nv()),
+        ));
     }
     let k = states.len();
     for (name, out, per) in outs.iter() {
         if out.len() != k * per {
-            return Err(Error::Shape {
-                argument: (*name).into(),
-                expected: format!("{k} samples x {per} values"),
-                got: format!("{} values", out.len()),
-            });
+            return Err(Error::shape(
+                *name,
+                format!("{k} samples x {per} values"),
+                format!("{} values", out.len()),
+            ));
         }
     }
     let layout: Vec<(&str, usize)> = outs.iter().map(|o| (o.0, o.2)).collect();

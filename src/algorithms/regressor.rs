@@ -105,11 +105,11 @@ pub fn joint_torque_regressor(
 ) -> Result<()> {
     let nb = model.nbodies();
     if out.shape() != (model.nv, PARAMS_PER_BODY * nb) {
-        return Err(Error::Shape {
-            argument: "regressor output".into(),
-            expected: format!("{} x {}", model.nv, PARAMS_PER_BODY * nb),
-            got: format!("{} x {}", out.nrows(), out.ncols()),
-        });
+        return Err(Error::shape(
+            "regressor output",
+            format!("{} x {}", model.nv, PARAMS_PER_BODY * nb),
+            format!("{} x {}", out.nrows(), out.ncols()),
+        ));
     }
     load_state(model, data, q, Some(qd), Some(qdd))?;
     motion_pass(model, data, gravity);

@@ -276,23 +276,23 @@ fn check_direct_inputs(a: &IdentifyDirectArgs) -> Result<()> {
     refuse_overwriting_inputs(&a.out, &inputs)?;
     if let Some(urdf) = &a.urdf {
         if !a.consistent {
-            return Err(Error::InvalidArgument {
-                argument: "--urdf".into(),
-                message: "needs --consistent: base parameters are sums of several links' parameters and give no link its own".into(),
-            });
+            return Err(Error::invalid(
+                "--urdf",
+                "needs --consistent: base parameters are sums of several links' parameters and give no link its own",
+            ));
         }
         inputs.push(&a.out);
         refuse_overwriting_inputs(urdf, &inputs)?;
     }
     if a.data.len() > crate::direct::drive_gains::MAX_RUNS {
-        return Err(Error::InvalidArgument {
-            argument: "DATA".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "DATA",
+            format!(
                 "{} logs, expected at most {}",
                 a.data.len(),
                 crate::direct::drive_gains::MAX_RUNS
             ),
-        });
+        ));
     }
     Ok(())
 }
@@ -540,13 +540,13 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
     let states = States::new(joints.len(), &rows.q, Some(&rows.qd), Some(&rows.qdd))?;
     let (tau, stderr) = match &file {
         ModelFile::Base(fit) => {
-            let robot = a.robot.as_deref().ok_or_else(|| Error::InvalidArgument {
-                argument: "--robot".into(),
-                message: format!(
+            let robot = a.robot.as_deref().ok_or_else(|| Error::invalid(
+                "--robot",
+                format!(
                     "a base-parameter model needs its robot ('{}'): give --robot",
                     fit.robot
                 ),
-            })?;
+            ))?;
             let robot = load_robot(robot, &a.lock)?;
             // states the robot cannot take: predicted, and said
             let ranges = crate::direct::position_range::check_position_range(&robot, &states);
@@ -572,13 +572,13 @@ pub(crate) fn predict(a: PredictArgs) -> Result<String> {
             (m.predict(&states)?, se.transpose()?)
         }
         ModelFile::GlobalLinear(_) if a.stderr => {
-            return Err(Error::InvalidArgument {
-                argument: "--stderr".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "--stderr",
+                format!(
                     "'{}' is a globally linearised model, which stores no covariance of its coefficients: only a local or base-parameter model's predictions have standard errors",
                     a.model.display()
                 ),
-            })
+            ))
         }
         ModelFile::GlobalLinear(m) => (m.predict(&states)?, None),
     };

@@ -101,14 +101,14 @@ pub(crate) fn refuse_overwriting_inputs(out: &Path, inputs: &[&Path]) -> Result<
         _ => a == b,
     };
     match inputs.iter().find(|i| same(out, i)) {
-        Some(input) => Err(Error::InvalidArgument {
-            argument: "--out".into(),
-            message: format!(
+        Some(input) => Err(Error::invalid(
+            "--out",
+            format!(
                 "{} is also an input; writing it would destroy {}: choose another output",
                 out.display(),
                 input.display()
             ),
-        }),
+        )),
         None => Ok(()),
     }
 }
@@ -122,9 +122,9 @@ pub(crate) fn refuse_repeated_paths(paths: &[&Path], argument: &str, what: &str)
     for (b, file) in files.iter().enumerate() {
         let Some(file) = file else { continue };
         if let Some(&a) = seen.get(file) {
-            return Err(Error::InvalidArgument {
-                argument: argument.into(),
-                message: format!(
+            return Err(Error::invalid(
+                argument,
+                format!(
                     "{} is given twice{}: each {what} once (its noise would count as independent twice)",
                     paths[a].display(),
                     match paths[a].as_os_str() == paths[b].as_os_str() {
@@ -132,7 +132,7 @@ pub(crate) fn refuse_repeated_paths(paths: &[&Path], argument: &str, what: &str)
                         false => format!(" (again as {})", paths[b].display()),
                     }
                 ),
-            });
+            ));
         }
         seen.insert(file, b);
     }
@@ -294,12 +294,7 @@ impl PreprocessArgs {
 
     /// How the logs are averaged over periods, the options checked against each other.
     fn periods(&self) -> Result<Periods> {
-        let refuse = |message: &str| {
-            Err(Error::InvalidArgument {
-                argument: "--average-periods, --period".into(),
-                message: message.into(),
-            })
-        };
+        let refuse = |message: &str| Err(Error::invalid("--average-periods, --period", message));
         let periodic = self.average_periods.is_some() || self.period.is_some();
         if !periodic {
             if self.period_harmonics.is_some()
@@ -517,10 +512,10 @@ pub(crate) fn averaged_noise(
         .map(|(rec, path)| {
             let noise = match &rec.period_average {
                 Some(a) => crate::direct::TorqueNoise::from_period_average(a, joints),
-                None => Err(Error::InvalidArgument {
-                    argument: "--weighting".into(),
-                    message: "noise needs each log averaged over its excitation's periods (--average-periods, --period), whose spread measures the noise".into(),
-                }),
+                None => Err(Error::invalid(
+                    "--weighting",
+                    "noise needs each log averaged over its excitation's periods (--average-periods, --period), whose spread measures the noise",
+                )),
             };
             let name = path.display().to_string();
             (name, noise.map_err(in_log(path)), rec.len())
@@ -533,13 +528,13 @@ pub(crate) fn check_validate_fraction(fraction: f64) -> Result<()> {
     if (0.0..1.0).contains(&fraction) {
         return Ok(());
     }
-    Err(Error::InvalidArgument {
-        argument: "--validate".into(),
-        message: format!(
+    Err(Error::invalid(
+        "--validate",
+        format!(
             "{}; expected a fraction in [0, 1)",
             crate::error::shown(fraction)
         ),
-    })
+    ))
 }
 
 /// The logs given, for a note in a file written from them: their paths, or where they are
@@ -586,11 +581,13 @@ pub(crate) fn model_gains<'a>(
         crate::model_file::ModelFile::Base(fit) => fit.drive_gains.as_ref(),
         _ => None,
     }
-    .ok_or_else(|| Error::InvalidArgument {
-        argument: argument.into(),
-        message: format!(
-            "'{}' holds no drive gains: only a model from identify-gains has them",
-            path.display()
-        ),
+    .ok_or_else(|| {
+        Error::invalid(
+            argument,
+            format!(
+                "'{}' holds no drive gains: only a model from identify-gains has them",
+                path.display()
+            ),
+        )
     })
 }

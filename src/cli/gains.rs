@@ -89,14 +89,14 @@ pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
     refuse_overwriting_inputs(&a.out, &inputs)?;
     let model = a.robot.load()?;
     if !(a.payload.len() == 1 || a.payload.len() == a.loaded.len()) {
-        return Err(Error::InvalidArgument {
-            argument: "--payload".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "--payload",
+            format!(
                 "{} payloads for {} --loaded runs: give one for them all, or one for each in their order",
                 a.payload.len(),
                 a.loaded.len()
             ),
-        });
+        ));
     }
     let payloads = (a.payload.iter())
         .map(|arg| {
@@ -222,15 +222,15 @@ pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
 pub(crate) fn gains_from_file(path: &Path, joints: &[String]) -> Result<crate::direct::DriveGains> {
     let file = ModelFile::load(path)?;
     if file.joint_names() != joints {
-        return Err(Error::InvalidArgument {
-            argument: "--gains-from".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "--gains-from",
+            format!(
                 "{}: a model of joints [{}]; the plan's are [{}]",
                 path.display(),
                 file.joint_names().join(", "),
                 joints.join(", ")
             ),
-        });
+        ));
     }
     Ok(super::files::model_gains(&file, path, "--gains-from")?.clone())
 }

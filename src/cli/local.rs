@@ -327,10 +327,10 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<String> {
                 || a.quantization != 0.0
                 || a.seed != 0
             {
-                return Err(Error::InvalidArgument {
-                    argument: "--true-robot".into(),
-                    message: "gravity, friction, noise, quantisation and seed come from the true-robot document; leave --no-gravity, --no-friction, --torque-noise, --position-noise, --quantization and --seed out".into(),
-                });
+                return Err(Error::invalid(
+                    "--true-robot",
+                    "gravity, friction, noise, quantisation and seed come from the true-robot document; leave --no-gravity, --no-friction, --torque-noise, --position-noise, --quantization and --seed out",
+                ));
             }
             let t = TrueRobot::load(path)?;
             t.check(&model)?;
@@ -352,29 +352,29 @@ pub(crate) fn simulate(a: SimulateArgs) -> Result<String> {
                 .into_iter()
                 .find_map(|(o, v)| v.map(|v| (o, v)))
             {
-                return Err(Error::InvalidArgument {
-                    argument: option.into(),
-                    message: format!(
+                return Err(Error::invalid(
+                    option,
+                    format!(
                         "{} given for a plan ({}): it applies to an excitation; a plan's experiments run once each, sampled at the plan's rate ({} Hz; perturbid plan --rate)",
                         crate::error::shown(value),
                         a.input.display(),
                         plan.rate
                     ),
-                });
+                ));
             }
             plan
         }
         Reference::Excitation(traj) => {
             if traj.n() != n {
-                return Err(Error::InvalidArgument {
-                    argument: "excitation".into(),
-                    message: format!(
+                return Err(Error::invalid(
+                    "excitation",
+                    format!(
                         "{} is for {} joints; robot '{}' has {n}",
                         a.input.display(),
                         traj.n(),
                         model.name
                     ),
-                });
+                ));
             }
             let samples = crate::simulation::excitation_samples(
                 &model,
@@ -481,15 +481,15 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
         .collect();
     super::files::refuse_overwriting_inputs(&a.out, &inputs)?;
     if files.len() != plan.experiments.len() {
-        return Err(Error::InvalidArgument {
-            argument: "RECORDINGS".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "RECORDINGS",
+            format!(
                 "{} files for {} experiments ({}); give one CSV per experiment, named after it (D.csv), or a folder of them; one log of the whole session is split into them first (perturbid split PLAN LOG --out FOLDER)",
                 files.len(),
                 plan.experiments.len(),
                 plan.kinds()
             ),
-        });
+        ));
     }
     let gains = a
         .gains_from

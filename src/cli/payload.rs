@@ -197,11 +197,10 @@ fn signal_gains(a: &IdentifyPayloadArgs, file: Option<&ModelFile>) -> Result<Opt
             Some(super::files::model_gains(f, path, "--signal")?.gain.clone())
         }
         (true, ..) => {
-            return Err(Error::InvalidArgument {
-                argument: "--signal".into(),
-                message: "needs --model: the drive gains come from a model of identify-gains"
-                    .into(),
-            })
+            return Err(Error::invalid(
+                "--signal",
+                "needs --model: the drive gains come from a model of identify-gains",
+            ))
         }
     })
 }
@@ -211,13 +210,13 @@ fn reference_of<'a>(a: &IdentifyPayloadArgs, file: Option<&'a ModelFile>) -> Res
     let base = match (file, &a.model) {
         (Some(ModelFile::Base(fit)), _) => Some(fit),
         (Some(_), Some(path)) => {
-            return Err(Error::InvalidArgument {
-                argument: "--model".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "--model",
+                format!(
                     "{} is not a base-parameter model (identify-direct, identify-gains): a local or globally linearised model holds near its operating point, not along the log's motion",
                     path.display()
                 ),
-            })
+            ))
         }
         _ => None,
     };

@@ -26,10 +26,10 @@ pub(crate) struct StudyArgs {
 
 pub(crate) fn run(a: StudyArgs) -> Result<String> {
     if a.scheduler.is_some() {
-        return Err(Error::InvalidArgument {
-            argument: "--scheduler".into(),
-            message: "this perturbid was built without Python; a Dask cluster is reached through the Python package: pip install 'perturbid_rs[dask]', then run the perturbid it installs, or perturbid_rs.study(..., client=Client(ADDRESS))".into(),
-        });
+        return Err(Error::invalid(
+            "--scheduler",
+            "this perturbid was built without Python; a Dask cluster is reached through the Python package: pip install 'perturbid_rs[dask]', then run the perturbid it installs, or perturbid_rs.study(..., client=Client(ADDRESS))",
+        ));
     }
     let study = Study::from_file(&a.study)?;
     let total = study.len();
@@ -45,19 +45,11 @@ pub(crate) fn run(a: StudyArgs) -> Result<String> {
         e => e,
     };
     let md = match a.threads {
-        Some(0) => {
-            return Err(Error::InvalidArgument {
-                argument: "--threads".into(),
-                message: "0; expected at least 1".into(),
-            })
-        }
+        Some(0) => return Err(Error::invalid("--threads", "0; expected at least 1")),
         Some(t) => rayon::ThreadPoolBuilder::new()
             .num_threads(t)
             .build()
-            .map_err(|e| Error::InvalidArgument {
-                argument: "--threads".into(),
-                message: e.to_string(),
-            })?
+            .map_err(|e| Error::invalid("--threads", e.to_string()))?
             .install(|| run_study(&study, &a.out, &mut report))
             .map_err(resumable)?,
         None => run_study(&study, &a.out, &mut report).map_err(resumable)?,

@@ -210,28 +210,28 @@ pub(crate) fn run(a: ValidateArgs) -> Result<String> {
 fn subject(a: &ValidateArgs) -> Result<(Subject, Vec<String>, Option<crate::model::Model>)> {
     let file = if is_a_robot(&a.model)? {
         if a.signal {
-            return Err(Error::InvalidArgument {
-                argument: "--signal".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "--signal",
+                format!(
                     "{} is a robot, validated with its own parameters: --signal is for a saved model with drive gains",
                     a.model.display()
                 ),
-            });
+            ));
         }
         let own = load_robot(&a.model.display().to_string(), &a.lock)?;
         // --robot (a pipeline's defaults give it to every step) must be the same robot
         if let Some(r) = &a.robot {
             let other = load_robot(r, &a.lock)?;
             if other.joint_names != own.joint_names {
-                return Err(Error::InvalidArgument {
-                    argument: "--robot".into(),
-                    message: format!(
+                return Err(Error::invalid(
+                    "--robot",
+                    format!(
                         "'{r}' has joints {:?}, MODEL {} {:?}: a robot given as MODEL is validated with its own parameters, and --robot, where given, must be the same robot",
                         other.joint_names,
                         a.model.display(),
                         own.joint_names
                     ),
-                });
+                ));
             }
         }
         Subject::Robot(Box::new(own))
@@ -245,13 +245,13 @@ fn subject(a: &ValidateArgs) -> Result<(Subject, Vec<String>, Option<crate::mode
     let robot = match (&file, &a.robot) {
         (Subject::Robot(r), _) => Some((**r).clone()),
         (Subject::File(ModelFile::Base(_)), None) => {
-            return Err(Error::InvalidArgument {
-                argument: "--robot".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "--robot",
+                format!(
                     "{} is a base-parameter model: give the robot it was identified for",
                     a.model.display()
                 ),
-            })
+            ))
         }
         (_, Some(r)) => Some(load_robot(r, &a.lock)?),
         (_, None) => None,

@@ -92,11 +92,11 @@ impl BaseParameters {
     /// The base parameters of a full parameter vector.
     pub fn from_full(&self, theta: &DVector<f64>) -> Result<DVector<f64>> {
         if theta.len() != self.layout.len() {
-            return Err(Error::Shape {
-                argument: "theta".into(),
-                expected: format!("{} full parameters", self.layout.len()),
-                got: format!("{}", theta.len()),
-            });
+            return Err(Error::shape(
+                "theta",
+                format!("{} full parameters", self.layout.len()),
+                format!("{}", theta.len()),
+            ));
         }
         let kept = DVector::from_iterator(self.kept.len(), self.kept.iter().map(|&i| theta[i]));
         let dropped =
@@ -175,9 +175,9 @@ impl BaseParameters {
     /// combinations on the other.
     pub fn check_on(&self, model: &Model, gravity: Gravity) -> Result<()> {
         if self.layout.nv != model.nv || self.layout.nbodies != model.nbodies() {
-            return Err(Error::InvalidArgument {
-                argument: "robot".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "robot",
+                format!(
                     "the base parameters are for {} joints and {} bodies, '{}' has {} and {}",
                     self.layout.nv,
                     self.layout.nbodies,
@@ -185,7 +185,7 @@ impl BaseParameters {
                     model.nv,
                     model.nbodies()
                 ),
-            });
+            ));
         }
         if self.dropped.is_empty() || !self.structural {
             return Ok(());
@@ -223,15 +223,15 @@ impl BaseParameters {
             })
             .max_by(|a, b| a.1.total_cmp(&b.1));
         match worst {
-            Some((c, miss)) if miss > MAP_TOLERANCE || miss.is_nan() => Err(Error::InvalidArgument {
-                argument: "robot".into(),
-                message: format!(
+            Some((c, miss)) if miss > MAP_TOLERANCE || miss.is_nan() => Err(Error::invalid(
+                "robot",
+                format!(
                     "the saved base parameters do not hold for '{}': its regressor's column '{}' differs from the combination of kept columns the model saved by {} of their size (at most {MAP_TOLERANCE:e} on the robot the model was identified on). Was the model identified on other kinematics (link lengths, axes), or its base.k edited?",
                     model.name,
                     self.layout.names[c],
                     crate::error::shown(miss)
                 ),
-            }),
+            )),
             _ => Ok(()),
         }
     }
@@ -245,11 +245,11 @@ impl BaseParameters {
     ) -> Result<Self> {
         let (m, p) = phi.shape();
         if p != layout.len() || m < p {
-            return Err(Error::Shape {
-                argument: "regressor".into(),
-                expected: format!("at least {p} rows and {} columns", layout.len()),
-                got: format!("{m} x {p}"),
-            });
+            return Err(Error::shape(
+                "regressor",
+                format!("at least {p} rows and {} columns", layout.len()),
+                format!("{m} x {p}"),
+            ));
         }
         let a = Mat::<f64>::from_fn(m, p, |i, j| phi[(i, j)]);
         let qr = ColPivQr::new(a.as_ref());
@@ -260,20 +260,14 @@ impl BaseParameters {
             .take_while(|&i| r[(i, i)].abs() > tolerance * r00)
             .count();
         if rank == 0 {
-            return Err(Error::Numerical {
-                operation: "base parameters".into(),
-                message: "the regressor is zero".into(),
-            });
+            return Err(Error::numerical("base parameters", "the regressor is zero"));
         }
         // K (pivot order) = R11^-1 R12
         let r11 = DMatrix::from_fn(rank, rank, |i, j| if j >= i { r[(i, j)] } else { 0.0 });
         let r12 = DMatrix::from_fn(rank, p - rank, |i, j| r[(i, rank + j)]);
         let kp = r11
             .solve_upper_triangular(&r12)
-            .ok_or_else(|| Error::Numerical {
-                operation: "base parameters".into(),
-                message: "singular triangular factor".into(),
-            })?;
+            .ok_or_else(|| Error::numerical("base parameters", "singular triangular factor"))?;
         let mut kept: Vec<(usize, usize)> = (0..rank).map(|i| (perm[i], i)).collect();
         let mut dropped: Vec<(usize, usize)> = (rank..p).map(|i| (perm[i], i - rank)).collect();
         kept.sort();

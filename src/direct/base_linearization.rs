@@ -30,9 +30,11 @@ fn with_parameters(model: &Model, theta: &[f64], shift: &[f64]) -> Result<Model>
         let mut p = [0.0; PER_BODY];
         p.copy_from_slice(&theta[i * PER_BODY..(i + 1) * PER_BODY]);
         p[0] += shift[i];
-        b.inertia = inertia_from_parameters(&p).ok_or_else(|| Error::Numerical {
-            operation: "linearize".into(),
-            message: format!("body '{}': shifted mass {} is not positive", b.link, p[0]),
+        b.inertia = inertia_from_parameters(&p).ok_or_else(|| {
+            Error::numerical(
+                "linearize",
+                format!("body '{}': shifted mass {} is not positive", b.link, p[0]),
+            )
         })?;
     }
     m.refresh();
@@ -108,10 +110,10 @@ impl BaseModel {
             && finite(&out.h)
             && finite(&out.g))
         {
-            return Err(Error::Numerical {
-                operation: "linearize".into(),
-                message: "the identified parameters give a non-finite linearisation here".into(),
-            });
+            return Err(Error::numerical(
+                "linearize",
+                "the identified parameters give a non-finite linearisation here",
+            ));
         }
         Ok(out)
     }

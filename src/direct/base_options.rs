@@ -106,10 +106,10 @@ pub fn weights(
     }
     match (weighting, noise) {
         (Weighting::Noise, Some(noise)) => Ok(Some(noise.sigma.clone())),
-        (Weighting::Noise, None) => Err(Error::InvalidArgument {
-            argument: "weighting".into(),
-            message: "the noise weighting needs the torques' noise measured apart from the fit: average the log over its excitation's periods (--average-periods, --period; preprocess(excitation=..., period=...)), or give the noise a joint (noise=)".into(),
-        }),
+        (Weighting::Noise, None) => Err(Error::invalid(
+            "weighting",
+            "the noise weighting needs the torques' noise measured apart from the fit: average the log over its excitation's periods (--average-periods, --period; preprocess(excitation=..., period=...)), or give the noise a joint (noise=)",
+        )),
         _ => Ok(None),
     }
 }

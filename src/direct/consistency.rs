@@ -81,11 +81,11 @@ pub fn check_physical_consistency(
     theta: &[f64],
 ) -> Result<ConsistencyReport> {
     if theta.len() != layout.len() {
-        return Err(Error::Shape {
-            argument: "theta".into(),
-            expected: format!("{} parameters (the layout's)", layout.len()),
-            got: theta.len().to_string(),
-        });
+        return Err(Error::shape(
+            "theta",
+            format!("{} parameters (the layout's)", layout.len()),
+            theta.len().to_string(),
+        ));
     }
     if let Some(i) = theta.iter().position(|v| !v.is_finite()) {
         return Err(Error::NonFiniteInput {

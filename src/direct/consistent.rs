@@ -237,19 +237,17 @@ fn check_system(
     options: &ConsistentOptions,
 ) -> Result<()> {
     if a.ncols() != p || a.nrows() != y.len() || prior.len() != p || a.nrows() == 0 {
-        return Err(Error::Shape {
-            argument: "consistent least squares".into(),
-            expected: format!(
-                "A with {p} columns (the layout's), y as long as A has rows, a prior of {p}"
-            ),
-            got: format!(
+        return Err(Error::shape(
+            "consistent least squares",
+            format!("A with {p} columns (the layout's), y as long as A has rows, a prior of {p}"),
+            format!(
                 "A {} x {}, y {}, prior {}",
                 a.nrows(),
                 a.ncols(),
                 y.len(),
                 prior.len()
             ),
-        });
+        ));
     }
     crate::limits::check_range("prior_weight", options.prior_weight, 1e-12, 1.0)?;
     crate::limits::check_count("max_iterations", options.max_iterations, 1, 1_000_000)?;
@@ -260,10 +258,10 @@ fn check_system(
         .any(|v| !v.is_finite())
         || !constant.is_finite()
     {
-        return Err(Error::Numerical {
-            operation: "consistent least squares".into(),
-            message: "the system or the prior holds a non-finite number".into(),
-        });
+        return Err(Error::numerical(
+            "consistent least squares",
+            "the system or the prior holds a non-finite number",
+        ));
     }
     Ok(())
 }
@@ -435,10 +433,10 @@ impl NewtonSystem<'_> {
             .collect();
         let scaled = DMatrix::from_fn(p, p, |i, j| hess[(i, j)] * d[i] * d[j]);
         let Some(ch) = newton_factor(scaled) else {
-            return Err(Error::Numerical {
-                operation: "consistent least squares".into(),
-                message: "the Newton system is not positive definite".into(),
-            });
+            return Err(Error::numerical(
+                "consistent least squares",
+                "the Newton system is not positive definite",
+            ));
         };
         let g_scaled = DVector::from_iterator(p, (0..p).map(|i| grad[i] * d[i]));
         let step_scaled = -ch.solve(&g_scaled);
@@ -498,9 +496,9 @@ impl ConsistentFit {
     pub fn robot(&self, robot: &crate::model::Model) -> Result<crate::model::Model> {
         let layout = &self.layout;
         if robot.nbodies() != layout.nbodies || robot.nv != layout.nv {
-            return Err(Error::InvalidArgument {
-                argument: "robot".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "robot",
+                format!(
                     "the parameters are for {} bodies and {} joints; '{}' has {} and {}",
                     layout.nbodies,
                     layout.nv,
@@ -508,7 +506,7 @@ impl ConsistentFit {
                     robot.nbodies(),
                     robot.nv
                 ),
-            });
+            ));
         }
         let mut out = robot.clone();
         let theta = &self.solution.theta;
@@ -542,15 +540,15 @@ impl ConsistentFit {
 /// The least-squares solution of `a x = b` by a thin SVD, singular values below `relative`
 /// times the largest dropped.
 fn solve_svd(a: DMatrix<f64>, b: &DVector<f64>, relative: f64) -> Result<DVector<f64>> {
-    let svd = crate::decomposition::svd(a, true, true).ok_or_else(|| Error::Numerical {
-        operation: "consistent least squares".into(),
-        message: "the system is not finite, or its SVD did not converge".into(),
+    let svd = crate::decomposition::svd(a, true, true).ok_or_else(|| {
+        Error::numerical(
+            "consistent least squares",
+            "the system is not finite, or its SVD did not converge",
+        )
     })?;
     let eps = relative * svd.singular_values.max();
-    svd.solve(b, eps).map_err(|m| Error::Numerical {
-        operation: "consistent least squares".into(),
-        message: m.to_string(),
-    })
+    svd.solve(b, eps)
+        .map_err(|m| Error::numerical("consistent least squares", m.to_string()))
 }
 
 /// Identifies physically consistent parameters of `model` from the same data as

@@ -76,10 +76,10 @@ impl GainEstimator {
         match name {
             "least_squares" => Ok(Self::LeastSquares),
             "instrumental" => Ok(Self::Instrumental),
-            other => Err(Error::InvalidArgument {
-                argument: "estimator".into(),
-                message: format!("'{other}', expected 'least_squares' or 'instrumental'"),
-            }),
+            other => Err(Error::invalid(
+                "estimator",
+                format!("'{other}', expected 'least_squares' or 'instrumental'"),
+            )),
         }
     }
 }
@@ -501,18 +501,18 @@ fn check_runs(model: &Model, runs: &[GainRun<'_>], options: &BaseOptions) -> Res
     if options.weighting == Weighting::Noise || options.noise.is_some() {
         // the torques are the gains times the signal: a noise in its units is not known
         // before the gains are
-        return Err(Error::InvalidArgument {
-            argument: "weighting".into(),
-            message: "the noise weighting is not taken with drive gains: the torques are the gains times the logged signal, so their noise is not known before the gains are; weight from the residuals (wls) or not (ols)".into(),
-        });
+        return Err(Error::invalid(
+            "weighting",
+            "the noise weighting is not taken with drive gains: the torques are the gains times the logged signal, so their noise is not known before the gains are; weight from the residuals (wls) or not (ols)",
+        ));
     }
     if options.offset_per_run {
         // each loaded run's mean payload torque, part of what sets the gains' scale, would
         // go into that run's offset
-        return Err(Error::InvalidArgument {
-            argument: "offset_per_run".into(),
-            message: "not taken with drive gains: an offset of each run's own would take up each loaded run's mean payload torque, part of what sets the gains' scale".into(),
-        });
+        return Err(Error::invalid(
+            "offset_per_run",
+            "not taken with drive gains: an offset of each run's own would take up each loaded run's mean payload torque, part of what sets the gains' scale",
+        ));
     }
     if !(2..=MAX_RUNS).contains(&runs.len()) {
         return Err(bad(format!(
@@ -607,15 +607,15 @@ fn stack_runs<'a>(
 /// Refuses gains that are not finite and non-zero, or residuals that are not finite.
 fn refuse_undetermined(model: &Model, gain: &[f64], rms: &[f64]) -> Result<()> {
     match (0..model.nv).find(|&j| !(gain[j].is_finite() && gain[j] != 0.0 && rms[j].is_finite())) {
-        Some(j) => Err(Error::Numerical {
-            operation: "drive-gain identification".into(),
-            message: format!(
+        Some(j) => Err(Error::numerical(
+            "drive-gain identification",
+            format!(
                 "joint '{}': gain {} with residual RMS {}: the signal does not determine it (a signal of 0 or one too large for f64 arithmetic?)",
                 model.joint_names[j],
                 shown(gain[j]),
                 shown(rms[j])
             ),
-        }),
+        )),
         None => Ok(()),
     }
 }
@@ -652,13 +652,13 @@ fn noise_bias(
             if bias.is_finite() {
                 Ok(bias.max(0.0))
             } else {
-                Err(Error::Numerical {
-                    operation: "drive-gain identification".into(),
-                    message: format!(
+                Err(Error::numerical(
+                    "drive-gain identification",
+                    format!(
                         "joint '{}': its signal is explained whole by the model's other columns, so its gain is not determined",
                         model.joint_names[m]
                     ),
-                })
+                ))
             }
         })
         .collect::<Result<Vec<f64>>>()

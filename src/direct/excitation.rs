@@ -317,22 +317,22 @@ fn check_options(o: &ExcitationOptions) -> Result<()> {
         1e9,
     )?;
     if o.harmonics == 0 || (o.rest && o.harmonics < 2) {
-        return Err(Error::InvalidArgument {
-            argument: "harmonics".into(),
-            message: format!("{}; need at least 2 to start at rest", o.harmonics),
-        });
+        return Err(Error::invalid(
+            "harmonics",
+            format!("{}; need at least 2 to start at rest", o.harmonics),
+        ));
     }
     if !(o.base_frequency.is_finite() && o.base_frequency > 0.0) {
-        return Err(Error::InvalidArgument {
-            argument: "base_frequency".into(),
-            message: format!("{} Hz; expected a positive number", o.base_frequency),
-        });
+        return Err(Error::invalid(
+            "base_frequency",
+            format!("{} Hz; expected a positive number", o.base_frequency),
+        ));
     }
     if !(o.margin > 0.0 && o.margin <= 1.0) {
-        return Err(Error::InvalidArgument {
-            argument: "margin".into(),
-            message: format!("{}; expected a fraction in (0, 1]", o.margin),
-        });
+        return Err(Error::invalid(
+            "margin",
+            format!("{}; expected a fraction in (0, 1]", o.margin),
+        ));
     }
     Ok(())
 }
@@ -359,14 +359,14 @@ impl<'a> Problem<'a> {
             o.seed,
         )?;
         if o.samples * n < base.len() {
-            return Err(Error::InvalidArgument {
-                argument: "samples".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "samples",
+                format!(
                     "{} samples x {n} joints cannot determine {} base parameters",
                     o.samples,
                     base.len()
                 ),
-            });
+            ));
         }
         let w_f = 2.0 * std::f64::consts::PI * o.base_frequency;
         let period = 1.0 / o.base_frequency;
@@ -572,23 +572,23 @@ fn finish(p: Problem<'_>, x: &[f64], evaluations: usize) -> Result<ExcitationDes
     let names = fine.constraint_names();
     let margins: Vec<(String, f64)> = names.into_iter().zip(slack).skip(4 * n).collect();
     if let Some((what, s)) = margins.iter().find(|(_, s)| *s < 0.0) {
-        return Err(Error::InvalidArgument {
-            argument: "workspace".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "workspace",
+            format!(
                 "the designed excitation breaks '{what}' by {:.4}: no excitation within the other limits keeps it; move the constraint, lower its margin, or give the design more evaluations",
                 -s
             ),
-        });
+        ));
     }
     let (value, cond) = fine.criterion(&traj);
     if !cond.is_finite() {
-        return Err(Error::Numerical {
-            operation: "excitation design".into(),
-            message: format!(
+        return Err(Error::numerical(
+            "excitation design",
+            format!(
                 "the best excitation found does not excite every base parameter (cond(Phi_base) {cond}): the motion the limits leave it (margin {m}) is too small or too uniform; widen the margin or the joint limits, or give the design more evaluations",
                 m = crate::error::shown(o.margin)
             ),
-        });
+        ));
     }
     Ok(ExcitationDesign {
         trajectory: traj,

@@ -263,13 +263,13 @@ pub(super) fn solve(
     // residuals past f64's range (torques or states near 1e300) can be neither weighted nor
     // vouched for
     if let Some(j) = rms.iter().position(|r| !r.is_finite()) {
-        return Err(Error::Numerical {
-            operation: "base-parameter identification".into(),
-            message: format!(
+        return Err(Error::numerical(
+            "base-parameter identification",
+            format!(
                 "the residuals of joint '{}' overflow (RMS {}): the torques or states are too large for f64 arithmetic (near 1e300?); rescale the log to SI units",
                 model.joint_names[j], rms[j]
             ),
-        });
+        ));
     }
     let weights = match (options.weighting, fixed) {
         (Weighting::Wls, _) => Some(rms.iter().map(|&s| if s > 0.0 { s } else { 1.0 }).collect()),
@@ -491,14 +491,14 @@ impl BaseModel {
 
     pub(super) fn check(&self, model: &Model) -> Result<()> {
         if model.joint_names != self.joint_names || model.nbodies() != self.base.layout.nbodies {
-            return Err(Error::InvalidArgument {
-                argument: "robot".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "robot",
+                format!(
                     "the model was identified for '{}' with joints [{}]",
                     self.robot,
                     self.joint_names.join(", ")
                 ),
-            });
+            ));
         }
         // the parameters are named after the robot's links and joints, in its order
         let own = ParameterLayout::new(model, self.base.layout.friction);
@@ -510,13 +510,13 @@ impl BaseModel {
             .zip(&own.names)
             .find(|(a, b)| a != b)
         {
-            return Err(Error::InvalidArgument {
-                argument: "robot".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "robot",
+                format!(
                     "the model's parameters are not the robot's: '{saved}' where '{}' has '{robot}' (the model was identified for '{}')",
                     model.name, self.robot
                 ),
-            });
+            ));
         }
         // and its base parameters are the robot's combinations
         self.base.check_on(model, self.gravity)
@@ -542,10 +542,10 @@ impl BaseModel {
         self.check(model)?;
         let p = self.theta.len();
         if self.correlation.shape() != (p, p) {
-            return Err(Error::InvalidArgument {
-                argument: "predict_stderr".into(),
-                message: "the model holds no correlation of its parameters' estimates (a model saved before it was stored): identify it again from its log".into(),
-            });
+            return Err(Error::invalid(
+                "predict_stderr",
+                "the model holds no correlation of its parameters' estimates (a model saved before it was stored): identify it again from its log",
+            ));
         }
         let mut out = Vec::with_capacity(states.len() * model.nv);
         regressor_blocks(model, &self.base.layout, states, self.gravity, |_, phi| {

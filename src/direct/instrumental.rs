@@ -45,28 +45,26 @@ pub(super) fn instrumental(
     let unknowns = p + nv;
     let context = "drive-gain identification (instrumental variables)";
     if factors.extra != 1 || first.len() != unknowns || names.len() != unknowns {
-        return Err(Error::Shape {
-            argument: context.into(),
-            expected: format!(
-                "one column of data a joint and {unknowns} first-fit unknowns and names"
-            ),
-            got: format!(
+        return Err(Error::shape(
+            context,
+            format!("one column of data a joint and {unknowns} first-fit unknowns and names"),
+            format!(
                 "{} columns a joint, {} unknowns, {} names",
                 factors.extra,
                 first.len(),
                 names.len()
             ),
-        });
+        ));
     }
     if let Some(j) = (0..nv).find(|&j| !(first[p + j].is_finite() && first[p + j] != 0.0)) {
-        return Err(Error::Numerical {
-            operation: context.into(),
-            message: format!(
+        return Err(Error::numerical(
+            context,
+            format!(
                 "the first fit's coefficient of joint {}'s signal is {}: no instrument can be predicted from it",
                 j + 1,
                 first[p + j]
             ),
-        });
+        ));
     }
     // each joint's factor with the predicted signal's column: [Phi_j | s_hat_j | s_j | y_j]
     let augmented: Vec<DMatrix<f64>> = (factors.factors.iter().zip(&factors.active))

@@ -191,13 +191,13 @@ pub(super) fn judge(
         return Ok(found);
     }
     let Some(n) = found else {
-        return Err(Error::InvalidArgument {
-            argument: "noise".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "noise",
+            format!(
                 "{}: standard errors cannot be had from it; give more samples, or weight otherwise (wls)",
                 NoiseFit::why_not(noise, k, nv, unknowns)
             ),
-        });
+        ));
     };
     let scale = n.scale();
     ls.stderr = DMatrix::from_fn(1, unknowns, |_, j| {

@@ -160,14 +160,14 @@ impl<'a> ReferenceParts<'a> {
             Reference::Model(fit) => {
                 fit.check(model)?;
                 if fit.gravity != gravity {
-                    return Err(Error::InvalidArgument {
-                        argument: "gravity".into(),
-                        message: format!(
+                    return Err(Error::invalid(
+                        "gravity",
+                        format!(
                             "the reference model was identified with gravity {} of its torques, the payload's log is read with it {}: both must agree",
                             if fit.gravity.is_included() { "in" } else { "out" },
                             if gravity.is_included() { "in" } else { "out" }
                         ),
-                    });
+                    ));
                 }
                 Self {
                     layout: fit.base.layout.clone(),
@@ -300,13 +300,13 @@ pub fn identify_payload(
     let variance = match (options.weighting, &noise_fit, &options.noise) {
         (Weighting::Noise, Some(n), _) => n.scale().powi(2) * n.noise.correlation.max(longest),
         (Weighting::Noise, None, Some(noise)) => {
-            return Err(Error::InvalidArgument {
-                argument: "noise".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "noise",
+                format!(
                     "{}: standard errors cannot be had from it; give more samples, or weight otherwise (wls)",
                     super::NoiseFit::why_not(noise, k, model.nv, theta.len())
                 ),
-            });
+            ));
         }
         _ => e.variance * longest,
     };
@@ -399,10 +399,10 @@ fn check_payload_inputs(
     crate::torque_model::check_joints(states, nv)?;
     states.check_companion("tau", tau, nv)?;
     if states.qd().is_none() || states.qdd().is_none() {
-        return Err(Error::InvalidArgument {
-            argument: "states".into(),
-            message: "the log has no velocities and accelerations: preprocess it first".into(),
-        });
+        return Err(Error::invalid(
+            "states",
+            "the log has no velocities and accelerations: preprocess it first",
+        ));
     }
     crate::torque_model::refuse_flat_torques(
         states,
@@ -417,20 +417,20 @@ fn check_payload_inputs(
         &model.joint_names,
     )?;
     if !(options.log_names.is_empty() || options.log_names.len() == options.runs.len()) {
-        return Err(Error::InvalidArgument {
-            argument: "log_names".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "log_names",
+            format!(
                 "{} names for {} logs, expected one a log or none",
                 options.log_names.len(),
                 options.runs.len()
             ),
-        });
+        ));
     }
     if options.consistent && options.inertia == PayloadInertia::PointMass {
-        return Err(Error::InvalidArgument {
-            argument: "consistent".into(),
-            message: "not with a point mass, which is a rigid body already".into(),
-        });
+        return Err(Error::invalid(
+            "consistent",
+            "not with a point mass, which is a rigid body already",
+        ));
     }
     Ok(fixed)
 }
@@ -605,13 +605,13 @@ impl<'a> PayloadProblem<'a> {
             },
         )?;
         if let Some(j) = (0..nv).find(|&j| y.iter().skip(j).step_by(nv).any(|v| !v.is_finite())) {
-            return Err(Error::Numerical {
-                operation: "payload identification".into(),
-                message: format!(
+            return Err(Error::numerical(
+                "payload identification",
+                format!(
                     "the torques of joint '{}' less the reference's overflow: the torques or states are too large for f64 arithmetic; rescale the log to SI units",
                     model.joint_names[j]
                 ),
-            });
+            ));
         }
         Ok((y, cross))
     }

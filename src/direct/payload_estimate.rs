@@ -160,10 +160,10 @@ pub fn point_mass_estimate(
         }
     }
     if x.iter().any(|v| !v.is_finite()) {
-        return Err(Error::Numerical {
-            operation: "payload identification".into(),
-            message: "the point mass's fit did not converge to finite values".into(),
-        });
+        return Err(Error::numerical(
+            "payload identification",
+            "the point mass's fit did not converge to finite values",
+        ));
     }
     let (theta, p) = match x[0] > 0.0 {
         true => point_mass_theta(&x),
@@ -259,9 +259,11 @@ pub fn rigid_body_estimate(
         let d = others
             .solve_upper_triangular(&rhs)
             .filter(|d| d.iter().all(|v| v.is_finite()))
-            .ok_or_else(|| Error::Numerical {
-                operation: "payload identification".into(),
-                message: "the data do not determine the joint terms beside the payload".into(),
+            .ok_or_else(|| {
+                Error::numerical(
+                    "payload identification",
+                    "the data do not determine the joint terms beside the payload",
+                )
             })?;
         theta.extend(d.iter());
     }

@@ -45,10 +45,10 @@ impl BaseModel {
         let (p, nv) = (self.theta.len(), model.nv);
         self.check(model)?;
         if self.correlation.shape() != (p, p) || gains.correlation.shape() != (nv, p + nv) {
-            return Err(Error::InvalidArgument {
-                argument: "predict_signal_stderr".into(),
-                message: "the model holds no correlation of its parameters' and gains' estimates (a model saved before it was stored): identify it again from its logs".into(),
-            });
+            return Err(Error::invalid(
+                "predict_signal_stderr",
+                "the model holds no correlation of its parameters' and gains' estimates (a model saved before it was stored): identify it again from its logs",
+            ));
         }
         let theta = DVector::from_column_slice(&self.theta);
         // the correlation of the gains with the parameters: row j gain j's
@@ -86,13 +86,13 @@ impl BaseModel {
     fn gains_for(&self, operation: &str) -> Result<&super::DriveGains> {
         self.drive_gains
             .as_ref()
-            .ok_or_else(|| Error::InvalidArgument {
-                argument: operation.into(),
-                message: format!(
+            .ok_or_else(|| Error::invalid(
+                operation,
+                format!(
                     "the model of '{}' holds no drive gains: it was identified from torques, not from a logged signal (identify_drive_gains)",
                     self.robot
                 ),
-            })
+            ))
     }
 }
 

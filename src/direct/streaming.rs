@@ -417,23 +417,23 @@ impl JointFactors {
     ) -> Result<Self> {
         let nv = model.nv;
         if runs.len() == 1 || runs.len() > MAX_OFFSET_RUNS {
-            return Err(Error::InvalidArgument {
-                argument: "runs".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "runs",
+                format!(
                     "{} runs, expected 2 to {MAX_OFFSET_RUNS} for an offset a run",
                     runs.len()
                 ),
-            });
+            ));
         }
         if !runs.is_empty() && (runs.contains(&0) || runs.iter().sum::<usize>() != states.len()) {
-            return Err(Error::InvalidArgument {
-                argument: "runs".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "runs",
+                format!(
                     "runs of {} samples in all (none of 0 expected), for {} samples",
                     runs.iter().sum::<usize>(),
                     states.len()
                 ),
-            });
+            ));
         }
         let starts: Vec<usize> = (runs.iter())
             .scan(0, |first, &len| {
@@ -444,13 +444,13 @@ impl JointFactors {
             .collect();
         states.check_companion("tau", tau, nv)?;
         if extra.len() > 4 {
-            return Err(Error::InvalidArgument {
-                argument: "extra".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "extra",
+                format!(
                     "{} columns of data a joint, expected at most 4",
                     extra.len()
                 ),
-            });
+            ));
         }
         for x in extra {
             states.check_companion("a joint's column of data", x, nv)?;
@@ -554,10 +554,10 @@ impl JointFactors {
         let nv = self.factors.len();
         let (p, e) = (self.unknowns(), self.extra);
         if sigma.len() != nv || sigma.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
-            return Err(Error::InvalidArgument {
-                argument: "sigma".into(),
-                message: format!("expected {nv} positive finite weights, got {sigma:?}"),
-            });
+            return Err(Error::invalid(
+                "sigma",
+                format!("expected {nv} positive finite weights, got {sigma:?}"),
+            ));
         }
         // every joint's factor, weighted and scattered onto the p base columns and the torque
         let r = triangular_of_stacked(&self.factors, sigma, p + 1, |j, c| {
@@ -623,11 +623,11 @@ impl JointFactors {
     pub fn residual_rms(&self, theta: &[f64]) -> Result<Vec<f64>> {
         let (p, e) = (self.unknowns(), self.extra);
         if theta.len() != p {
-            return Err(Error::Shape {
-                argument: "theta".into(),
-                expected: format!("{p} base parameters"),
-                got: format!("{} values", theta.len()),
-            });
+            return Err(Error::shape(
+                "theta",
+                format!("{p} base parameters"),
+                format!("{} values", theta.len()),
+            ));
         }
         let k = self.samples.max(1) as f64;
         let data = &theta[self.parameters..];
@@ -671,20 +671,20 @@ impl Profiled {
     pub fn others(&self, theta: &[f64]) -> Result<Vec<f64>> {
         let p = self.coupling.ncols();
         if theta.len() != p {
-            return Err(Error::Shape {
-                argument: "theta".into(),
-                expected: format!("{p} base parameters"),
-                got: format!("{} values", theta.len()),
-            });
+            return Err(Error::shape(
+                "theta",
+                format!("{p} base parameters"),
+                format!("{} values", theta.len()),
+            ));
         }
         let rhs = &self.others_z - &self.coupling * DMatrix::from_column_slice(p, 1, theta);
         let d = (self.others.rows(0, self.others.nrows()))
             .solve_upper_triangular(&rhs)
             .filter(|d| d.iter().all(|v| v.is_finite()))
-            .ok_or_else(|| Error::Numerical {
-                operation: "base-parameter identification".into(),
-                message: "the data do not determine the joints' other unknowns (runs' offsets, columns of data)".into(),
-            })?;
+            .ok_or_else(|| Error::numerical(
+                "base-parameter identification",
+                "the data do not determine the joints' other unknowns (runs' offsets, columns of data)",
+            ))?;
         Ok(d.iter().copied().collect())
     }
 }

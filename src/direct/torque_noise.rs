@@ -200,10 +200,7 @@ impl TorqueNoise {
             match (noise, required) {
                 (Ok(n), _) => each.push((name, n, samples)),
                 (Err(e), true) if several => {
-                    return Err(Error::InvalidArgument {
-                        argument: "noise".into(),
-                        message: format!("{name}: {e}"),
-                    })
+                    return Err(Error::invalid("noise", format!("{name}: {e}")))
                 }
                 (Err(e), true) => return Err(e),
                 (Err(_), false) => return Ok(None),

@@ -157,12 +157,12 @@ impl ColumnMap {
         for pattern in ignore.iter().flat_map(|p| p.split(',')) {
             let pattern = pattern.trim();
             if pattern.is_empty() || pattern == "*" {
-                return Err(Error::InvalidArgument {
-                    argument: "--ignore-columns".into(),
-                    message: format!(
+                return Err(Error::invalid(
+                    "--ignore-columns",
+                    format!(
                         "'{pattern}': expected a column's name, or the start of names followed by '*' (leaving out every column is no recording)"
                     ),
-                });
+                ));
             }
             map.ignore.push(pattern.into());
         }

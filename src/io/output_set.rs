@@ -90,10 +90,7 @@ impl OutputSet {
     /// Errors: a name with a path separator, empty, `.`/`..`, hidden, a manifest name, or a
     /// name already in the set.
     pub fn add(&mut self, name: &str, bytes: impl Into<Vec<u8>>) -> Result<&mut OutputSet> {
-        let bad = |why: &str| Error::InvalidArgument {
-            argument: "output file name".into(),
-            message: format!("'{name}' {why}"),
-        };
+        let bad = |why: &str| Error::invalid("output file name", format!("'{name}' {why}"));
         if !is_plain_name(name) {
             return Err(bad(
                 "must be a plain, visible file name (no folder, not hidden)",
@@ -205,16 +202,16 @@ impl OutputSet {
                 continue;
             }
             if let Some((name, _)) = self.files.iter().find(|(n, _)| other.lists(n)) {
-                return Err(Error::InvalidArgument {
-                    argument: "output folder".into(),
-                    message: format!(
+                return Err(Error::invalid(
+                    "output folder",
+                    format!(
                         "{} belongs to the output set '{}' ({}); writing the set '{}' there would replace it: choose another output folder",
                         dir.join(name).display(),
                         other.set,
                         other_path.display(),
                         self.set
                     ),
-                });
+                ));
             }
         }
         Ok(())

@@ -22,13 +22,13 @@ pub(super) fn align(
     max_shift: f64,
 ) -> Result<f64> {
     if !(max_shift.is_finite() && max_shift > 0.0) {
-        return Err(Error::InvalidArgument {
-            argument: "max_shift".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "max_shift",
+            format!(
                 "{}; expected a positive number of seconds",
                 crate::error::shown(max_shift)
             ),
-        });
+        ));
     }
     check_clock(experiment, rec, max_shift)?;
     // the offsets within 1.25 times the tolerance at which the recording holds every
@@ -65,27 +65,27 @@ pub(super) fn align(
             } else {
                 ""
             };
-            return Err(Error::Recording {
-                recording: rec.name.clone(),
-                message: format!(
+            return Err(Error::recording(
+                rec.name.clone(),
+                format!(
                     "its positions follow the plan of experiment '{}' best with its clock {wide:+.3} s ahead of the plan's (found over its whole span), more than the {} s of clock offset accepted: if the run starts that late in the log, raise max_shift (--max-shift) to at least {}{session}",
                     experiment.kind.name(),
                     crate::error::shown(max_shift),
                     crate::error::shown((wide.abs() * 1.1 * 10.0).ceil() / 10.0),
                 ),
-            });
+            ));
         }
     }
     positions?;
     if offset.abs() > max_shift {
-        return Err(Error::Recording {
-            recording: rec.name.clone(),
-            message: format!(
+        return Err(Error::recording(
+            rec.name.clone(),
+            format!(
                 "its clock is {offset:+.4} s off the plan of experiment '{}' (found in its positions), more than the {} s accepted: check that it is a run of this experiment, or raise max_shift (--max-shift)",
                 experiment.kind.name(),
                 crate::error::shown(max_shift)
             ),
-        });
+        ));
     }
     Ok(offset)
 }
@@ -110,14 +110,14 @@ pub(super) fn check_sample_interval(rec: &Recording, half: f64, fit: &FitOptions
     if held >= needed as f64 {
         return Ok(());
     }
-    Err(Error::Recording {
-        recording: rec.name.clone(),
-        message: format!(
+    Err(Error::recording(
+        rec.name.clone(),
+        format!(
             "its median sample interval is {} s, so a crossing window of +-{} s holds at most {held} samples where the fits need {needed}: check that its times are in seconds (a log stamped in milliseconds or nanoseconds reads as a sample every second or every 10^6 s), or record faster, or widen the window",
             crate::error::shown(format!("{median:.3e}").parse().unwrap_or(median)),
             crate::error::shown(half),
         ),
-    })
+    ))
 }
 
 /// How far a joint's recorded positions may stray from the plan on average once aligned (rad
@@ -197,16 +197,16 @@ fn check_positions(
     if off.is_empty() {
         return Ok(());
     }
-    Err(Error::Recording {
-        recording: rec.name.clone(),
-        message: format!(
+    Err(Error::recording(
+        rec.name.clone(),
+        format!(
             "its positions do not follow the plan of experiment '{}' at any clock offset within +-{} s: at the best ({offset:+.4} s) the joints {} (rad or m), where a robot that tracks its encoders stays within {POSITION_MISFIT} on average and within half the planned motion about that, and moves about as much as planned: check that it is a run of this experiment (not of the robot standing still), that its columns follow the plan's joints ({}) and that its positions are in radians (metres for prismatic joints)",
             experiment.kind.name(),
             crate::error::shown(searched),
             off.join(", "),
             joint_names.join(", "),
         ),
-    })
+    ))
 }
 
 /// Checks that `rec` can be a run of `experiment` with its clock within `max_shift` s of the
@@ -220,9 +220,9 @@ pub fn check_clock(experiment: &Experiment, rec: &Recording, max_shift: f64) -> 
         return Ok(());
     }
     let rounded = |v: f64| crate::error::shown((v * 1e3).round() / 1e3);
-    Err(Error::Recording {
-        recording: rec.name.clone(),
-        message: format!(
+    Err(Error::recording(
+        rec.name.clone(),
+        format!(
             "its time stamps run from {} to {} s and experiment '{}' from {} to {} s of the plan's clock, {} s apart, more than the {} s of clock offset accepted: its time must count from the start of the experiment (subtract the time of the run's start, as for a log stamped in seconds since 1970 or since the controller started)",
             rounded(first),
             rounded(last),
@@ -232,7 +232,7 @@ pub fn check_clock(experiment: &Experiment, rec: &Recording, max_shift: f64) -> 
             rounded(if first > end { first - end } else { start - last }),
             crate::error::shown(max_shift),
         ),
-    })
+    ))
 }
 
 /// How far one joint's recorded positions stray from the planned ones (rad or m; see

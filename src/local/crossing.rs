@@ -177,10 +177,10 @@ impl WindowFit {
         let cols = degree + 1 + usize::from(step.is_some());
         let v = DMatrix::from_fn(t.len(), cols, |i, d| basis(t[i], tc, half, degree, step, d));
         let weights = crate::decomposition::pseudo_inverse(v.clone(), 1e-12).ok_or_else(|| {
-            Error::Numerical {
-                operation: "crossing fit".into(),
-                message: "the window's basis is not finite, or its SVD did not converge".into(),
-            }
+            Error::numerical(
+                "crossing fit",
+                "the window's basis is not finite, or its SVD did not converge",
+            )
         })?;
         Ok(Self { basis: v, weights })
     }
@@ -408,23 +408,23 @@ impl<'a> Window<'a> {
     ) -> Result<Self> {
         let n = rec.n;
         if torque.len() != n {
-            return Err(Error::Shape {
-                argument: "torque fits".into(),
-                expected: format!("{n} (one per joint)"),
-                got: torque.len().to_string(),
-            });
+            return Err(Error::shape(
+                "torque fits",
+                format!("{n} (one per joint)"),
+                torque.len().to_string(),
+            ));
         }
         let (first, last) = (rec.t[0], rec.t[rec.len() - 1]);
         let eps = 1e-9 * half;
         if tc - half < first - eps || tc + half > last + eps {
-            return Err(Error::Recording {
-                recording: rec.name.clone(),
-                message: format!(
+            return Err(Error::recording(
+                rec.name.clone(),
+                format!(
                     "{what} at t = {tc:.4} s needs data from {:.4} to {:.4} s; the recording covers {first:.4} to {last:.4} s (too short, or its clock is offset from the plan's: align it with detected crossing times)",
                     tc - half,
                     tc + half
                 ),
-            });
+            ));
         }
         let span = |h: f64| {
             let e = 1e-9 * h;
@@ -444,12 +444,12 @@ impl<'a> Window<'a> {
                 .map(|i| (rec.t[i], rec.t[i + 1]))
                 .max_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
                 .unwrap_or((rec.t[a], rec.t[b]));
-            Error::Recording {
-                recording: rec.name.clone(),
-                message: format!(
+            Error::recording(
+                rec.name.clone(),
+                format!(
                     "{what} at t = {tc:.4} s: {count} samples in the +-{h:.4} s window, need at least {needed}; the recording has no sample from {from:.4} to {to:.4} s there (a gap in the log, or too low a rate)"
                 ),
-            }
+            )
         };
         if count < needed {
             return Err(too_few(count, half));
@@ -597,11 +597,11 @@ fn check_scales(scales: &SignalScales, n: usize) -> Result<()> {
         ("noise levels", scales.noise.len()),
     ] {
         if !(len == 0 || len == n) {
-            return Err(Error::Shape {
-                argument: name.into(),
-                expected: format!("{n} (one per joint) or none"),
-                got: len.to_string(),
-            });
+            return Err(Error::shape(
+                name,
+                format!("{n} (one per joint) or none"),
+                len.to_string(),
+            ));
         }
     }
     Ok(())

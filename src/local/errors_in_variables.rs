@@ -37,17 +37,17 @@ pub fn floor_stderr(
 ) -> Result<()> {
     let (k, p) = x.shape();
     if row_var.shape() != (k, p) || common_var.len() != p || fit.coef.ncols() != p {
-        return Err(Error::Shape {
-            argument: "errors of the regressors".into(),
-            expected: format!("{k} x {p} variances and {p} common ones, like X"),
-            got: format!(
+        return Err(Error::shape(
+            "errors of the regressors",
+            format!("{k} x {p} variances and {p} common ones, like X"),
+            format!(
                 "{} x {} and {} ({} coefficients a row)",
                 row_var.nrows(),
                 row_var.ncols(),
                 common_var.len(),
                 fit.coef.ncols()
             ),
-        });
+        ));
     }
     let finite = |v: f64| if v.is_finite() { v } else { 0.0 };
     // X^+ from the columns scaled to unit norm (their units differ by orders of magnitude in
@@ -58,10 +58,10 @@ pub fn floor_stderr(
     }
     let scaled = DMatrix::from_fn(k, p, |i, c| x[(i, c)] / norms[c]);
     let b = crate::decomposition::pseudo_inverse(scaled, RANK_TOLERANCE).ok_or_else(|| {
-        Error::Numerical {
-            operation: "errors of the regressors".into(),
-            message: "the regressors are not finite, or their SVD did not converge".into(),
-        }
+        Error::numerical(
+            "errors of the regressors",
+            "the regressors are not finite, or their SVD did not converge",
+        )
     })?;
     let sums: Vec<f64> = (0..p)
         .map(|c| b.row(c).iter().sum::<f64>() / norms[c])

@@ -158,10 +158,10 @@ pub fn experiment_values(
     let half = options.fit.window.unwrap_or(experiment.window);
     crate::limits::check_range("window", half, 0.0, 60.0)?;
     if !(half.is_finite() && half > 0.0) {
-        return Err(Error::InvalidArgument {
-            argument: "window".into(),
-            message: format!("{half}; expected a positive number of seconds"),
-        });
+        return Err(Error::invalid(
+            "window",
+            format!("{half}; expected a positive number of seconds"),
+        ));
     }
     check_sample_interval(rec, half, &options.fit)?;
     let steps = rounded_positions::position_steps(rec);

@@ -51,10 +51,10 @@ pub fn identify_local(
             (Some(h), Some(c))
         }
         (true, None) => {
-            return Err(Error::InvalidArgument {
-                argument: "friction_aware_h".into(),
-                message: "the plan has no H experiment".into(),
-            })
+            return Err(Error::invalid(
+                "friction_aware_h",
+                "the plan has no H experiment",
+            ))
         }
         (false, _) => (fits.separated(ExperimentKind::H, "dqd")?, None),
     };
@@ -130,14 +130,14 @@ fn read_experiments(
     {
         crate::interrupt::check("identification")?;
         if r.n != n {
-            return Err(Error::Recording {
-                recording: r.name.clone(),
-                message: format!(
+            return Err(Error::recording(
+                r.name.clone(),
+                format!(
                     "{} joints; the plan (experiment '{}') has {n}",
                     r.n,
                     e.kind.name()
                 ),
-            });
+            ));
         }
         let read = super::repaired_recording::read_experiment(e, r, &plan.joint_names, options)?;
         out.warnings.extend(read.warnings);
@@ -223,10 +223,10 @@ impl Estimates {
                 let block = |b: usize| Some(c.columns(b * n, n));
                 Ok((block(0), block(1), block(2)))
             }
-            (Estimator::Combined, None) => Err(Error::InvalidArgument {
-                argument: "estimator".into(),
-                message: "the combined estimator needs the nominal, G, H and D experiments".into(),
-            }),
+            (Estimator::Combined, None) => Err(Error::invalid(
+                "estimator",
+                "the combined estimator needs the nominal, G, H and D experiments",
+            )),
         }
     }
 }

@@ -202,12 +202,12 @@ impl LocalModel {
     }
 
     fn part<'a>(e: &'a Option<Estimate>, name: &str) -> Result<&'a DMatrix<f64>> {
-        e.as_ref()
-            .map(|e| &e.matrix)
-            .ok_or_else(|| Error::InvalidArgument {
-                argument: "predict".into(),
-                message: format!("the model has no {name}: its plan had no {name} experiment"),
-            })
+        e.as_ref().map(|e| &e.matrix).ok_or_else(|| {
+            Error::invalid(
+                "predict",
+                format!("the model has no {name}: its plan had no {name} experiment"),
+            )
+        })
     }
 
     /// Predicted torques (row-major `k x N`, N m) at the `k` samples of `states`:
@@ -256,15 +256,12 @@ impl LocalModel {
     /// the model was identified over. Refused for a model saved before its perturbations were
     /// stored (identify it again).
     pub fn reach(&self, states: &States<'_>) -> Result<Vec<f64>> {
-        let p = self
-            .perturbations
-            .as_ref()
-            .ok_or_else(|| Error::InvalidArgument {
-                argument: "reach".into(),
-                message:
-                    "the model was saved before its perturbations were stored: identify it again"
-                        .into(),
-            })?;
+        let p = self.perturbations.as_ref().ok_or_else(|| {
+            Error::invalid(
+                "reach",
+                "the model was saved before its perturbations were stored: identify it again",
+            )
+        })?;
         Ok(Extrapolation::of(p, &self.planned_op, &self.joint_names, states)?.0)
     }
 
@@ -297,14 +294,14 @@ impl LocalModel {
                 .filter(|e| e.experiment == nominal && &e.joint == joint)
                 .collect();
             let [entry] = found[..] else {
-                return Err(Error::InvalidArgument {
-                    argument: "diagnostics.noise".into(),
-                    message: format!(
+                return Err(Error::invalid(
+                    "diagnostics.noise",
+                    format!(
                         "the local model of '{}' has {} entries of the nominal passes' noise for joint '{joint}'; expected one (a model identified from a plan with a nominal experiment, by a version that reports it)",
                         self.robot,
                         found.len()
                     ),
-                });
+                ));
             };
             let noisy = entry.samples >= 1e-9;
             samples.push(if noisy { entry.samples } else { 0.0 });
@@ -337,11 +334,10 @@ impl LocalModel {
         name: impl Fn(usize) -> String,
     ) -> Result<(Vec<f64>, Vec<f64>)> {
         let Some(first) = models.first() else {
-            return Err(Error::InvalidArgument {
-                argument: "models".into(),
-                message: "no local model to pool the nominal noise of; expected at least one"
-                    .into(),
-            });
+            return Err(Error::invalid(
+                "models",
+                "no local model to pool the nominal noise of; expected at least one",
+            ));
         };
         let n = first.joint_names.len();
         let (mut samples, mut passes) = (vec![0.0; n], vec![0.0; n]);
@@ -349,9 +345,9 @@ impl LocalModel {
         let (mut quiet, mut noisy) = (vec![None; n], vec![None; n]);
         for (i, m) in models.iter().enumerate() {
             if m.joint_names != first.joint_names {
-                return Err(Error::InvalidArgument {
-                    argument: name(i),
-                    message: format!(
+                return Err(Error::invalid(
+                    name(i),
+                    format!(
                         "a local model of joints [{}] of '{}'; {} is of [{}] of '{}': pool identifications of one robot's joints",
                         m.joint_names.join(", "),
                         m.robot,
@@ -359,12 +355,11 @@ impl LocalModel {
                         first.joint_names.join(", "),
                         first.robot
                     ),
-                });
+                ));
             }
-            let (s, p) = m.nominal_noise().map_err(|e| Error::InvalidArgument {
-                argument: name(i),
-                message: e.to_string(),
-            })?;
+            let (s, p) = m
+                .nominal_noise()
+                .map_err(|e| Error::invalid(name(i), e.to_string()))?;
             for j in 0..n {
                 samples[j] += s[j] * s[j];
                 passes[j] += p[j] * p[j];
@@ -375,15 +370,15 @@ impl LocalModel {
                 };
                 seen.get_or_insert((i, s[j]));
                 if let (Some((q, _)), Some((k, level))) = (quiet[j], noisy[j]) {
-                    return Err(Error::InvalidArgument {
-                        argument: name(q.max(k)),
-                        message: format!(
+                    return Err(Error::invalid(
+                        name(q.max(k)),
+                        format!(
                             "{} read no torque noise in the nominal passes at joint '{}' (data without noise: a simulation?) and {} read {level:.3e}; pool identifications of one robot's recordings",
                             name(q),
                             first.joint_names[j],
                             name(k)
                         ),
-                    });
+                    ));
                 }
             }
         }

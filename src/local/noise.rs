@@ -122,11 +122,11 @@ pub fn weighted_least_squares(
     let (k, p) = x.shape();
     let m = y.ncols();
     if u.shape() != y.shape() {
-        return Err(crate::error::Error::Shape {
-            argument: format!("{context}: sample variances"),
-            expected: format!("{k} x {m} like Y"),
-            got: format!("{} x {}", u.nrows(), u.ncols()),
-        });
+        return Err(crate::error::Error::shape(
+            format!("{context}: sample variances"),
+            format!("{k} x {m} like Y"),
+            format!("{} x {}", u.nrows(), u.ncols()),
+        ));
     }
     let mut common = vec![f64::NAN; m];
     let mut correlation = vec![ordinary.correlation.clone(); m];

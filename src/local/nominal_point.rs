@@ -38,12 +38,10 @@ impl NominalPoint {
         });
         let (torque, torque_stderr, op) = match nominal {
             Some(v) => Self::means(v, n),
-            None if needs_nominal => return Err(Error::InvalidArgument {
-                argument: "plan".into(),
-                message:
-                    "the plan has no nominal experiment, which the G, H and D regressions need for T*"
-                        .into(),
-            }),
+            None if needs_nominal => return Err(Error::invalid(
+                "plan",
+                "the plan has no nominal experiment, which the G, H and D regressions need for T*",
+            )),
             None => (vec![f64::NAN; n], vec![f64::NAN; n], plan.op.clone()),
         };
         let state = [op.q.clone(), op.qd.clone(), op.qdd.clone()];

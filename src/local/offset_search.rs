@@ -27,10 +27,10 @@ pub(super) const CANDIDATES: usize = 8;
 /// on about 20,000 (sub-sample: exact on noise-free data).
 pub fn detect_offset(experiment: &Experiment, rec: &Recording, max_shift: f64) -> Result<f64> {
     if !(max_shift.is_finite() && max_shift > 0.0) {
-        return Err(Error::InvalidArgument {
-            argument: "max_shift".into(),
-            message: format!("{max_shift}; expected a positive number of seconds"),
-        });
+        return Err(Error::invalid(
+            "max_shift",
+            format!("{max_shift}; expected a positive number of seconds"),
+        ));
     }
     Ok(detect_offset_in(experiment, rec, -max_shift, max_shift, 200).0)
 }

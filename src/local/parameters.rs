@@ -86,12 +86,12 @@ fn refuse_repeated_models(models: &[LocalModel]) -> Result<()> {
     let mut seen: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
     for (b, text) in texts.iter().enumerate() {
         if let Some(&a) = seen.get(text.as_str()) {
-            return Err(Error::InvalidArgument {
-                argument: format!("models[{b}]"),
-                message: format!(
+            return Err(Error::invalid(
+                format!("models[{b}]"),
+                format!(
                     "the same local model as models[{a}] (the same estimates at the same operating point): give each model once (its noise would count as independent twice)"
                 ),
-            });
+            ));
         }
         seen.insert(text, b);
     }
@@ -134,10 +134,7 @@ pub fn identify_parameters_from_local(
 ) -> Result<ParametersFromLocal> {
     let nv = robot.nv;
     if models.is_empty() {
-        return Err(Error::InvalidArgument {
-            argument: "models".into(),
-            message: "no local model given".into(),
-        });
+        return Err(Error::invalid("models", "no local model given"));
     }
     refuse_repeated_models(models)?;
     let layout = ParameterLayout::new(robot, options.friction.for_model(robot));
@@ -290,15 +287,15 @@ impl Rows {
         let nv = robot.nv;
         crate::interrupt::check("parameters from local models")?;
         if m.joint_names != robot.joint_names {
-            return Err(Error::InvalidArgument {
-                argument: format!("models[{i}]"),
-                message: format!(
+            return Err(Error::invalid(
+                format!("models[{i}]"),
+                format!(
                     "identified for joints [{}]; the robot '{}' has [{}]",
                     m.joint_names.join(", "),
                     robot.name,
                     robot.joint_names.join(", ")
                 ),
-            });
+            ));
         }
         let op = &m.planned_op;
         let reg = linearization_regressor(robot, layout, &op.q, &op.qd, &op.qdd, options.gravity)?;

@@ -42,11 +42,11 @@ impl Size {
         let sizes: Vec<f64> = match self {
             Size::Absolute(v) => {
                 if v.len() != limits.len() {
-                    return Err(Error::Shape {
-                        argument: argument.into(),
-                        expected: format!("{} sizes (one per joint)", limits.len()),
-                        got: format!("{} sizes", v.len()),
-                    });
+                    return Err(Error::shape(
+                        argument,
+                        format!("{} sizes (one per joint)", limits.len()),
+                        format!("{} sizes", v.len()),
+                    ));
                 }
                 v.clone()
             }
@@ -60,24 +60,24 @@ impl Size {
             .enumerate()
             .find(|(_, s)| !(s.is_finite() && **s > 0.0))
         {
-            return Err(Error::InvalidArgument {
-                argument: format!("{argument}[{j}]"),
-                message: format!("perturbation size {s}; expected a positive finite number"),
-            });
+            return Err(Error::invalid(
+                format!("{argument}[{j}]"),
+                format!("perturbation size {s}; expected a positive finite number"),
+            ));
         }
         if let Some((j, s)) = sizes
             .iter()
             .enumerate()
             .find(|(_, s)| **s < crate::limits::MIN_PERTURBATION)
         {
-            return Err(Error::InvalidArgument {
-                argument: format!("{argument}[{j}]"),
-                message: format!(
+            return Err(Error::invalid(
+                format!("{argument}[{j}]"),
+                format!(
                     "perturbation size {}; expected at least {:e}, a hundredth of the finest encoders' step: a smaller one moves no torque a sensor reads",
                     crate::error::shown(*s),
                     crate::limits::MIN_PERTURBATION
                 ),
-            });
+            ));
         }
         Ok(sizes)
     }
@@ -166,14 +166,14 @@ fn perturbations_of(
     let n = size.len();
     let needed = if symmetric { 2 * n } else { n };
     if count < needed || (symmetric && count % 2 == 1) {
-        return Err(Error::InvalidArgument {
-            argument: "n (perturbations per experiment)".into(),
-            message: if symmetric {
+        return Err(Error::invalid(
+            "n (perturbations per experiment)",
+            if symmetric {
                 format!("{count}; symmetric pairs need an even number >= 2N = {needed}")
             } else {
                 format!("{count}; need at least N = {n}")
             },
-        });
+        ));
     }
     let m = if symmetric { count / 2 } else { count };
     let mut rng = ChaCha8Rng::seed_from_u64(seed);

@@ -416,10 +416,10 @@ pub fn plan_experiments(model: &Model, op: &OperatingPoint, options: &PlanOption
     let mut warnings = Vec::new();
     for (index, &kind) in options.experiments.iter().enumerate() {
         if options.experiments[..index].contains(&kind) {
-            return Err(Error::InvalidArgument {
-                argument: "experiments".into(),
-                message: format!("'{}' is listed twice", kind.name()),
-            });
+            return Err(Error::invalid(
+                "experiments",
+                format!("'{}' is listed twice", kind.name()),
+            ));
         }
         experiments.push(plan_experiment(&setup, index, kind, &mut warnings)?);
     }
@@ -466,11 +466,11 @@ impl<'a> Setup<'a> {
         let per_joint = |name: &str, values: &Option<Vec<f64>>, largest: f64| -> Result<()> {
             let Some(values) = values else { return Ok(()) };
             if values.len() != n {
-                return Err(Error::Shape {
-                    argument: name.into(),
-                    expected: format!("{n} values (one per joint)"),
-                    got: format!("{} values", values.len()),
-                });
+                return Err(Error::shape(
+                    name,
+                    format!("{n} values (one per joint)"),
+                    format!("{} values", values.len()),
+                ));
             }
             for (j, v) in values.iter().enumerate() {
                 check_range(&format!("{name}[{j}]"), *v, 0.0, largest)?;
@@ -490,33 +490,33 @@ impl<'a> Setup<'a> {
         )?;
         predicted_response::check_pass_noise(model, &o.torque_noise, &o.torque_pass_noise)?;
         if o.experiments.is_empty() {
-            return Err(Error::InvalidArgument {
-                argument: "experiments".into(),
-                message: "none asked for; expected some of nominal, G_static, G, H, D".into(),
-            });
+            return Err(Error::invalid(
+                "experiments",
+                "none asked for; expected some of nominal, G_static, G, H, D",
+            ));
         }
         let window_samples = (o.window * o.rate).round() as usize;
         if window_samples < 2 {
-            return Err(Error::InvalidArgument {
-                argument: "window".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "window",
+                format!(
                     "{} s holds fewer than 2 samples each side at {} Hz",
                     o.window, o.rate
                 ),
-            });
+            ));
         }
         let dwell_samples = (o.dwell * o.rate).round() as usize;
         if dwell_samples < 4 {
-            return Err(Error::InvalidArgument {
-                argument: "dwell".into(),
-                message: format!("{} s is too short at {} Hz", o.dwell, o.rate),
-            });
+            return Err(Error::invalid(
+                "dwell",
+                format!("{} s is too short at {} Hz", o.dwell, o.rate),
+            ));
         }
         if !(o.margin > 0.0 && o.margin <= 1.0) {
-            return Err(Error::InvalidArgument {
-                argument: "margin".into(),
-                message: format!("{}; expected a fraction in (0, 1]", o.margin),
-            });
+            return Err(Error::invalid(
+                "margin",
+                format!("{}; expected a fraction in (0, 1]", o.margin),
+            ));
         }
         Ok(Setup {
             model,
@@ -542,14 +542,14 @@ fn perturbation_sizes(
         for (j, size) in sizes[1].iter_mut().enumerate() {
             let limit = 0.9 * op.qd[j].abs();
             if limit < crate::limits::MIN_PERTURBATION {
-                return Err(Error::InvalidArgument {
-                    argument: "keep_velocity_sign".into(),
-                    message: format!(
+                return Err(Error::invalid(
+                    "keep_velocity_sign",
+                    format!(
                         "joint '{}' has qd* = {}: every velocity perturbation of a size a sensor reads reverses it; identify H with the friction-aware regression (friction_aware_h) instead",
                         model.joint_names[j],
                         crate::error::shown(op.qd[j])
                     ),
-                });
+                ));
             }
             *size = size.min(limit);
         }
@@ -603,10 +603,10 @@ fn plan_experiment(
     let seed = o.seed.wrapping_add(1000 * index as u64 + 1);
     let count = if kind == ExperimentKind::H && o.friction_aware_h {
         if !o.symmetric {
-            return Err(Error::InvalidArgument {
-                argument: "friction_aware_h".into(),
-                message: "the friction-aware H regression needs the perturbations in +- pairs (symmetric)".into(),
-            });
+            return Err(Error::invalid(
+                "friction_aware_h",
+                "the friction-aware H regression needs the perturbations in +- pairs (symmetric)",
+            ));
         }
         // N + 1 unknowns per torque row, and one pair more for its standard errors
         count.max(2 * (n + 2))

@@ -32,15 +32,15 @@ pub fn plan_files(plan: &Plan, dir: &Path) -> Result<OutputSet> {
 /// tau1..tauN`. The output set is named `recordings`. Refused when the counts differ.
 pub fn recording_files(plan: &Plan, recs: &[Recording], dir: &Path) -> Result<OutputSet> {
     if recs.len() != plan.experiments.len() {
-        return Err(Error::InvalidArgument {
-            argument: "recordings".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "recordings",
+            format!(
                 "{} recordings for the plan's {} experiments ({}); expected one each",
                 recs.len(),
                 plan.experiments.len(),
                 plan.kinds()
             ),
-        });
+        ));
     }
     let mut set = OutputSet::new(dir, "recordings");
     for (e, r) in plan.experiments.iter().zip(recs) {

@@ -109,11 +109,11 @@ pub fn suggest_operating_points(
     let mut info = DMatrix::zeros(p, p);
     for op in existing {
         if op.n() != robot.nv {
-            return Err(Error::Shape {
-                argument: "existing operating point".into(),
-                expected: format!("{} joints", robot.nv),
-                got: format!("{} joints", op.n()),
-            });
+            return Err(Error::shape(
+                "existing operating point",
+                format!("{} joints", robot.nv),
+                format!("{} joints", op.n()),
+            ));
         }
         let x = rows_at(robot, &layout, &base.kept, op, options)?;
         info += x.transpose() * &x;

@@ -210,15 +210,15 @@ pub(super) fn check_pass_noise(
     let samples = noise.as_deref().unwrap_or_default();
     let unknown = |j: usize| samples.get(j).is_none_or(|s| *s == 0.0);
     match (0..passes.len()).find(|&j| passes[j] > 0.0 && unknown(j)) {
-        Some(j) => Err(crate::error::Error::InvalidArgument {
-            argument: format!("torque_pass_noise[{j}]"),
-            message: format!(
+        Some(j) => Err(crate::error::Error::invalid(
+            format!("torque_pass_noise[{j}]"),
+            format!(
                 "{} for joint '{}', whose torque_noise is not given: the prediction reads the \
                  noise from pass to pass against the samples' noise; give both",
                 shown(passes[j]),
                 model.joint_names.get(j).map_or("?", String::as_str)
             ),
-        }),
+        )),
         None => Ok(()),
     }
 }

@@ -98,14 +98,14 @@ pub(crate) fn predict_stderr(model: &LocalModel, states: &States<'_>) -> Result<
         }
     }
     if let Some(i) = out.iter().position(|v| v.is_infinite()) {
-        return Err(Error::Numerical {
-            operation: "prediction's standard error".into(),
-            message: format!(
+        return Err(Error::numerical(
+            "prediction's standard error",
+            format!(
                 "the standard error of joint {} at sample {} overflows: the model's standard errors or the state are too large to compute with",
                 i % n.max(1) + 1,
                 i / n.max(1)
             ),
-        });
+        ));
     }
     Ok(out)
 }

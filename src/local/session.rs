@@ -59,21 +59,21 @@ pub fn split_session(
     o: &SplitOptions,
 ) -> Result<Vec<(Recording, f64)>> {
     if log.n != plan.n() {
-        return Err(Error::Recording {
-            recording: log.name.clone(),
-            message: format!(
+        return Err(Error::recording(
+            log.name.clone(),
+            format!(
                 "{} joint columns; the plan is of {} joints ({})",
                 log.n,
                 plan.n(),
                 plan.joint_names.join(", ")
             ),
-        });
+        ));
     }
     if !(o.margin.is_finite() && (0.0..=60.0).contains(&o.margin)) {
-        return Err(Error::InvalidArgument {
-            argument: "margin".into(),
-            message: format!("{}; expected 0 to 60 s", crate::error::shown(o.margin)),
-        });
+        return Err(Error::invalid(
+            "margin",
+            format!("{}; expected 0 to 60 s", crate::error::shown(o.margin)),
+        ));
     }
     let (first, last) = (log.t[0], log.t[log.len() - 1]);
     let mut cursor = first;
@@ -82,9 +82,11 @@ pub fn split_session(
         let (start, end) = (e.trajectory.start(), e.trajectory.end());
         let lo = cursor - start;
         let mut hi = last - end;
-        let refuse = |message: String| Error::Recording {
-            recording: log.name.clone(),
-            message: format!("experiment '{}': {message}", e.kind.name()),
+        let refuse = |message: String| {
+            Error::recording(
+                log.name.clone(),
+                format!("experiment '{}': {message}", e.kind.name()),
+            )
         };
         // the later experiment whose run the search was kept before, and where it starts
         let mut before: Option<(&str, f64)> = None;
@@ -171,15 +173,15 @@ pub fn repeated_runs(
     runs: &[(Recording, f64)],
 ) -> Result<Vec<String>> {
     if runs.len() != plan.experiments.len() {
-        return Err(Error::InvalidArgument {
-            argument: "runs".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "runs",
+            format!(
                 "{} runs for the plan's {} experiments ({}); expected split_session's, one each",
                 runs.len(),
                 plan.experiments.len(),
                 plan.kinds()
             ),
-        });
+        ));
     }
     let (first, last) = (log.t[0], log.t[log.len() - 1]);
     let mut out = vec![];

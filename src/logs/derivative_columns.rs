@@ -206,9 +206,9 @@ fn check_columns(
             format!("joint{plural} {}: {what}", names.join(", "))
         })
         .collect();
-    Err(Error::Recording {
-        recording: recording.to_string(),
-        message: format!(
+    Err(Error::recording(
+        recording.to_string(),
+        format!(
             "logged {} that are not their {}' derivative ({}), {}. {}",
             kind.columns(),
             kind.of(),
@@ -216,7 +216,7 @@ fn check_columns(
             problems.join("; "),
             kind.remedy()
         ),
-    })
+    ))
 }
 
 /// Checks the logged velocities and accelerations of `rec`, a log used as logged (not

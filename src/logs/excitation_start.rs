@@ -61,9 +61,9 @@ pub fn excitation_start(rec: &Recording, traj: &FourierTrajectory) -> Result<Exc
     }
     if best_run.1 == 0 {
         let nearest = periods.iter().map(|p| p.2).fold(f64::INFINITY, f64::min);
-        return Err(Error::Recording {
-            recording: rec.name.clone(),
-            message: format!(
+        return Err(Error::recording(
+            rec.name.clone(),
+            format!(
                 "none of its {} whole periods of {} s follows the excitation: the nearest is {} rad RMS from it (offsets taken off), against the excitation's motion of {} rad RMS (at most {} of it is taken as following). Is it a log of this excitation, with the joints in its order?",
                 periods.len(),
                 shown5(al.period),
@@ -71,7 +71,7 @@ pub fn excitation_start(rec: &Recording, traj: &FourierTrajectory) -> Result<Exc
                 shown5(al.motion),
                 MAX_TRACKING
             ),
-        });
+        ));
     }
     let start = periods[best_run.0].0;
     let mut tracking = vec![0.0; al.n];
@@ -120,23 +120,23 @@ impl<'a> Alignment<'a> {
     fn new(rec: &'a Recording, traj: &'a FourierTrajectory) -> Result<Alignment<'a>> {
         let n = rec.n;
         if traj.n() != n {
-            return Err(Error::Shape {
-                argument: "excitation".into(),
-                expected: format!("{n} joints, the log's"),
-                got: format!("{} joints", traj.n()),
-            });
+            return Err(Error::shape(
+                "excitation",
+                format!("{n} joints, the log's"),
+                format!("{} joints", traj.n()),
+            ));
         }
         let period = traj.period();
         let (t0, t1) = (rec.t[0], rec.t[rec.len() - 1]);
         if t1 - t0 < period * (1.0 - 1e-9) || (t1 - t0).is_nan() {
-            return Err(Error::Recording {
-                recording: rec.name.clone(),
-                message: format!(
+            return Err(Error::recording(
+                rec.name.clone(),
+                format!(
                     "{} s long, shorter than one period of the excitation ({} s)",
                     shown5(t1 - t0),
                     shown5(period)
                 ),
-            });
+            ));
         }
         let table: Vec<Vec<f64>> = (0..n)
             .map(|j| {

@@ -155,9 +155,9 @@ pub fn find_frozen_readings(rec: &Recording) -> Result<Vec<LogDropout>> {
                     found.push(reading(signal, j, run.clone(), y[run.start], jump, false));
                 }
                 if covered as f64 > MAX_FROZEN_SHARE * (b - a) as f64 {
-                    return Err(Error::Recording {
-                        recording: rec.name.clone(),
-                        message: format!(
+                    return Err(Error::recording(
+                        rec.name.clone(),
+                        format!(
                             "column {signal}{} holds one value for more than {MAX_HELD} samples and then jumps, while the joint moves, over {covered} of the {} samples from t = {} s to {} s (more than {:.0} %): a signal logged at a lower rate and held on the log's grid, or a sensor that failed, rather than a stalled message stream. Resample the column at the instants its values change, or log it at the log's rate",
                             j + 1,
                             b - a,
@@ -165,7 +165,7 @@ pub fn find_frozen_readings(rec: &Recording) -> Result<Vec<LogDropout>> {
                             crate::error::shown(rec.t[b - 1]),
                             100.0 * MAX_FROZEN_SHARE
                         ),
-                    });
+                    ));
                 }
             }
         }

@@ -42,10 +42,10 @@ impl<'a> LogSet<'a> {
         validate_argument: &str,
     ) -> Result<Self> {
         if recs.is_empty() || recs.len() > MAX_LOGS {
-            return Err(Error::InvalidArgument {
-                argument: argument.into(),
-                message: format!("{} logs, expected 1 to {MAX_LOGS}", recs.len()),
-            });
+            return Err(Error::invalid(
+                argument,
+                format!("{} logs, expected 1 to {MAX_LOGS}", recs.len()),
+            ));
         }
         if names.len() != recs.len() {
             return Err(Error::Internal {
@@ -176,10 +176,7 @@ pub fn in_log(name: &str, e: Error) -> Error {
         Error::InvalidArgument { argument, message }
             if ["q", "qd", "qdd", "tau"].contains(&argument.as_str()) =>
         {
-            Error::Recording {
-                recording: name.into(),
-                message: format!("{argument}: {message}"),
-            }
+            Error::recording(name, format!("{argument}: {message}"))
         }
         e => e,
     }
@@ -195,10 +192,10 @@ pub fn fit_splits(
     argument: &str,
 ) -> Result<Vec<usize>> {
     if !(0.0..1.0).contains(&fraction) {
-        return Err(Error::InvalidArgument {
-            argument: argument.into(),
-            message: format!("{}; expected a fraction in [0, 1)", shown(fraction)),
-        });
+        return Err(Error::invalid(
+            argument,
+            format!("{}; expected a fraction in [0, 1)", shown(fraction)),
+        ));
     }
     let mut splits = Vec::with_capacity(recs.len());
     for (rec, name) in recs.iter().zip(names) {
@@ -216,10 +213,10 @@ pub fn fit_splits(
             _ => None,
         };
         if let Some(problem) = problem {
-            return Err(Error::InvalidArgument {
-                argument: argument.into(),
-                message: format!("{} of {k} samples{of} {problem}", shown(fraction)),
-            });
+            return Err(Error::invalid(
+                argument,
+                format!("{} of {k} samples{of} {problem}", shown(fraction)),
+            ));
         }
         splits.push(split);
     }
@@ -269,10 +266,7 @@ mod tests {
         let (train, tau) = set.train().unwrap();
         assert_eq!((train.len(), tau.as_ptr()), (40, a.tau.as_ptr()));
         assert!(set.held().unwrap().0.is_empty());
-        let e = Error::InvalidArgument {
-            argument: "tau".into(),
-            message: "dead".into(),
-        };
+        let e = Error::invalid("tau", "dead");
         assert_eq!(set.in_data(e).to_string(), "a.csv: tau: dead");
     }
 

@@ -107,10 +107,10 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     // the stamps against the positions, as logged: resampling reads them as the samples' times
     let stamp_jitter = crate::logs::stamp_jitter::find_stamp_jitter(rec);
     if options.periods.is_some() && options.filter_position {
-        return Err(Error::InvalidArgument {
-            argument: "filter_position".into(),
-            message: "averaging over periods takes the positions' first harmonics, which filters them: filter_position does not apply".into(),
-        });
+        return Err(Error::invalid(
+            "filter_position",
+            "averaging over periods takes the positions' first harmonics, which filters them: filter_position does not apply",
+        ));
     }
     if !options.screen_glitches {
         return preprocess_screened(rec, options, &steps).map(|out| Recording {
@@ -184,16 +184,16 @@ fn preprocess_screened(
     let mut done = Vec::with_capacity(parts.len());
     for (k, part) in parts.iter().enumerate() {
         let p = preprocess_part(part, options, steps).map_err(|e| match e {
-            Error::Recording { message, .. } => Error::Recording {
-                recording: rec.name.clone(),
-                message: format!(
+            Error::Recording { message, .. } => Error::recording(
+                rec.name.clone(),
+                format!(
                     "part {} of {} (t = {} s to {} s, between gaps): {message}",
                     k + 1,
                     parts.len(),
                     time(part.t[0]),
                     time(part.t[part.len() - 1])
                 ),
-            },
+            ),
             other => other,
         })?;
         done.push(p);
@@ -243,13 +243,13 @@ pub fn split_at_gaps(rec: &Recording) -> Result<Vec<Recording>> {
     for w in bounds.windows(2) {
         let (a, b) = (w[0], w[1]);
         if b - a < 2 {
-            return Err(Error::Recording {
-                recording: rec.name.clone(),
-                message: format!(
+            return Err(Error::recording(
+                rec.name.clone(),
+                format!(
                     "the sample at t = {:.6} s stands alone between two gaps; remove it or the gaps",
                     rec.t[a]
                 ),
-            });
+            ));
         }
         let rows = |x: &[f64]| x[a * n..b * n].to_vec();
         let part = Recording::new(
@@ -276,13 +276,13 @@ fn preprocess_part(
 ) -> Result<Recording> {
     let o = options;
     if !(o.rate.is_finite() && o.rate > 0.0) || o.decimate == 0 || o.trim.is_nan() || o.trim < 0.0 {
-        return Err(Error::InvalidArgument {
-            argument: "preprocess options".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "preprocess options",
+            format!(
                 "rate {} Hz, decimate {}, trim {} s; expected rate > 0, decimate >= 1, trim >= 0",
                 o.rate, o.decimate, o.trim
             ),
-        });
+        ));
     }
     let n = rec.n;
     let (t0, t1) = (rec.t[0], rec.t[rec.len() - 1]);
@@ -299,13 +299,15 @@ fn preprocess_part(
         |x: &[f64], j: usize| -> Vec<f64> { (0..rec.len()).map(|i| x[i * n + j]).collect() };
     let smooth = |x: Vec<f64>| -> Result<Vec<f64>> {
         match &filter {
-            Some(f) => filtfilt(f, &x).map_err(|e| Error::Recording {
-                recording: rec.name.clone(),
-                message: format!(
-                    "{} s long, {count} samples at {} Hz: too short to filter ({e})",
-                    crate::error::shown5(t1 - t0),
-                    crate::error::shown(o.rate)
-                ),
+            Some(f) => filtfilt(f, &x).map_err(|e| {
+                Error::recording(
+                    rec.name.clone(),
+                    format!(
+                        "{} s long, {count} samples at {} Hz: too short to filter ({e})",
+                        crate::error::shown5(t1 - t0),
+                        crate::error::shown(o.rate)
+                    ),
+                )
             }),
             None => Ok(x),
         }
@@ -331,14 +333,14 @@ fn preprocess_part(
     }
     let skip = (o.trim * o.rate).round() as usize;
     if count <= 2 * skip + 1 {
-        return Err(Error::Recording {
-            recording: rec.name.clone(),
-            message: format!(
+        return Err(Error::recording(
+            rec.name.clone(),
+            format!(
                 "{:.3} s long; trimming {} s at both ends leaves nothing (a shorter trim keeps more: trim, --trim; it drops the low-pass filter's transients at each end)",
                 t1 - t0,
                 o.trim
             ),
-        });
+        ));
     }
     // logged velocities against the positions' derivative, filtered alike, where kept
     if rec.qd.is_some() {
@@ -489,14 +491,14 @@ fn check_sample_interval(rec: &Recording) -> Result<()> {
     } else {
         format!("Is the time column in {}?", units.join(" or "))
     };
-    Err(Error::Recording {
-        recording: rec.name.clone(),
-        message: format!(
+    Err(Error::recording(
+        rec.name.clone(),
+        format!(
             "its samples are {} s apart (the median interval; {} Hz): {verdict}. {question} It is read in seconds",
             crate::error::shown5(median),
             crate::error::shown5(1.0 / median)
         ),
-    })
+    ))
 }
 
 /// Refuses a log with a gap longer than [`MAX_GAP_INTERVALS`] times its median sample
@@ -509,9 +511,9 @@ fn check_gaps(rec: &Recording) -> Result<()> {
     match at.first() {
         Some(&i) => {
             let d = rec.t[i + 1] - rec.t[i];
-            Err(Error::Recording {
-                recording: rec.name.clone(),
-                message: format!(
+            Err(Error::recording(
+                rec.name.clone(),
+                format!(
                     "a gap of {:.6} s after t = {:.6} s, {:.0} times the median sample interval ({:.3e} s); resampling would invent the values in it (at most {} intervals are bridged): split the log there (split_at_gaps, --split-at-gaps) or remove the gap",
                     d,
                     rec.t[i],
@@ -519,7 +521,7 @@ fn check_gaps(rec: &Recording) -> Result<()> {
                     median,
                     crate::limits::MAX_GAP_INTERVALS
                 ),
-            })
+            ))
         }
         None => Ok(()),
     }

@@ -25,20 +25,20 @@ struct Columns<'a> {
 impl<'a> Columns<'a> {
     fn new(table: &'a Table, joints: &'a [String]) -> Result<(Self, Vec<f64>)> {
         if joints.is_empty() {
-            return Err(Error::InvalidArgument {
-                argument: "joints".into(),
-                message: format!("no joint names to read {} with", table.source),
-            });
+            return Err(Error::invalid(
+                "joints",
+                format!("no joint names to read {} with", table.source),
+            ));
         }
         if let Some(j) = (1..joints.len()).find(|&j| joints[..j].contains(&joints[j])) {
-            return Err(Error::InvalidArgument {
-                argument: "joints".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "joints",
+                format!(
                     "joint '{}' named twice ([{}]); expected the robot's joint names",
                     joints[j],
                     joints.join(", ")
                 ),
-            });
+            ));
         }
         let t_col = table.index("t").ok_or_else(|| {
             // a header in capitals (T, Q1, TAU1) is not read as the names it spells

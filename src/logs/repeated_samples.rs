@@ -43,14 +43,14 @@ impl SamplePrints {
     pub fn of(n: usize, columns: &[&[f64]]) -> Result<Self> {
         let k = columns.first().map_or(0, |c| c.len() / n.max(1));
         if n == 0 || columns.iter().any(|c| c.len() != k * n) {
-            return Err(Error::Shape {
-                argument: "samples".into(),
-                expected: format!("columns of k x {n} values alike"),
-                got: format!(
+            return Err(Error::shape(
+                "samples",
+                format!("columns of k x {n} values alike"),
+                format!(
                     "{:?} values",
                     columns.iter().map(|c| c.len()).collect::<Vec<_>>()
                 ),
-            });
+            ));
         }
         let rows = (0..k)
             .map(|s| {
@@ -204,12 +204,12 @@ pub fn refuse_shared_samples(
             runs[s.first].len()
         )
     };
-    Err(Error::InvalidArgument {
-        argument: argument.into(),
-        message: format!(
+    Err(Error::invalid(
+        argument,
+        format!(
             "{what}, bit for bit: the same data given twice, whose noise a fit would count as independent twice (standard errors too small by up to sqrt(2)); give each run's samples once"
         ),
-    })
+    ))
 }
 
 /// A finaliser of 64-bit hashes (MurmurHash3's): every bit of `h` moves every bit of the result.

@@ -40,10 +40,7 @@ impl StackedStates {
         argument: &str,
     ) -> Result<Self> {
         let Some((first, _)) = parts.first() else {
-            return Err(Error::InvalidArgument {
-                argument: argument.into(),
-                message: "no run to stack".into(),
-            });
+            return Err(Error::invalid(argument, "no run to stack"));
         };
         let name = |r: usize| run_name(names, r);
         let nv = first.nv();
@@ -60,19 +57,19 @@ impl StackedStates {
         };
         for (r, (s, data)) in parts.iter().enumerate() {
             let (Some(qd), Some(qdd)) = (s.qd(), s.qdd()) else {
-                return Err(Error::InvalidArgument {
-                    argument: argument.into(),
-                    message: format!(
+                return Err(Error::invalid(
+                    argument,
+                    format!(
                         "{} has no velocities and accelerations: preprocess its log first",
                         name(r)
                     ),
-                });
+                ));
             };
             if s.nv() != nv {
-                return Err(Error::InvalidArgument {
-                    argument: argument.into(),
-                    message: format!("{} has {} joints, {} {nv}", name(r), s.nv(), name(0)),
-                });
+                return Err(Error::invalid(
+                    argument,
+                    format!("{} has {} joints, {} {nv}", name(r), s.nv(), name(0)),
+                ));
             }
             s.check_companion("data", data, nv)?;
             out.q.extend_from_slice(s.q());

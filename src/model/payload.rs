@@ -91,9 +91,9 @@ pub fn link_in_body(model: &Model, link: &str) -> Result<(usize, crate::spatial:
             pose,
             ..
         }) => Ok((*b, *pose)),
-        found => Err(Error::InvalidArgument {
-            argument: "true robot: link".into(),
-            message: format!(
+        found => Err(Error::invalid(
+            "true robot: link",
+            format!(
                 "'{link}' {} '{}'; links that move: {}",
                 if found.is_some() {
                     "is fixed to the base (a payload there moves no joint) of"
@@ -107,7 +107,7 @@ pub fn link_in_body(model: &Model, link: &str) -> Result<(usize, crate::spatial:
                     .collect::<Vec<_>>()
                     .join(", ")
             ),
-        }),
+        )),
     }
 }
 

@@ -172,10 +172,10 @@ fn column0(m: &DMatrix<f64>) -> Vec<f64> {
 /// Runs the reproduction. `progress` hears each step's name.
 pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Result<PaperResult> {
     if !(1..=1000).contains(&options.excitation_seeds) {
-        return Err(crate::error::Error::InvalidArgument {
-            argument: "excitation_seeds".into(),
-            message: format!("{}; expected 1..=1000", options.excitation_seeds),
-        });
+        return Err(crate::error::Error::invalid(
+            "excitation_seeds",
+            format!("{}; expected 1..=1000", options.excitation_seeds),
+        ));
     }
     let model = a465::model("kinsheel2010")?;
     let n = model.nv;

@@ -128,12 +128,11 @@ impl Samples<'_> {
         let start = out.data() as usize;
         let end = start + 8 * out.len();
         if start < memory.end && memory.start < end {
-            return Err(Error::Shape {
-                argument: "out".into(),
-                expected: "writeable arrays that share no memory with the inputs or each other"
-                    .into(),
-                got: "an array that is also an input".into(),
-            });
+            return Err(Error::shape(
+                "out",
+                "writeable arrays that share no memory with the inputs or each other",
+                "an array that is also an input",
+            ));
         }
         Ok(())
     }
@@ -208,25 +207,25 @@ pub(crate) fn read_batch<'a, A: ArrayArg>(n: usize, args: &[(&str, &'a A)]) -> R
             [len] if *len == n => (1, false),
             [rows, len] if *len == n => (*rows, true),
             _ => {
-                return Err(Error::Shape {
-                    argument: name.to_string(),
-                    expected: format!("shape ({n},) or (k, {n})"),
-                    got: format!("shape {shape:?}"),
-                })
+                return Err(Error::shape(
+                    name.to_string(),
+                    format!("shape ({n},) or (k, {n})"),
+                    format!("shape {shape:?}"),
+                ))
             }
         };
         match first {
             None => first = Some(this),
             Some(prev) if prev != this => {
-                return Err(Error::Shape {
-                    argument: name.to_string(),
-                    expected: if prev.1 {
+                return Err(Error::shape(
+                    name.to_string(),
+                    if prev.1 {
                         format!("shape ({}, {n}) like the first argument", prev.0)
                     } else {
                         format!("shape ({n},) like the first argument")
                     },
-                    got: format!("shape {shape:?}"),
-                });
+                    format!("shape {shape:?}"),
+                ));
             }
             _ => {}
         }
@@ -301,11 +300,11 @@ pub(crate) fn output_array<'py>(
                 empty.cast_into::<PyArrayDyn<f64>>()?
             }
             _ => {
-                return Err(Error::Shape {
-                    argument: "the result".into(),
-                    expected: "an array that fits in memory".into(),
-                    got: format!("shape {shape:?}"),
-                }
+                return Err(Error::shape(
+                    "the result",
+                    "an array that fits in memory",
+                    format!("shape {shape:?}"),
+                )
                 .into())
             }
         };
@@ -384,17 +383,16 @@ pub(crate) fn write_into_all<T, const N: usize>(
     }
     let mut guards = Vec::with_capacity(N);
     for out in lent() {
-        guards.push(out.array.try_readwrite().map_err(|e| Error::Shape {
-            argument: "out".into(),
-            expected: "writeable arrays that share no memory with the inputs or each other".into(),
-            got: format!("an array numpy refuses to lend for writing: {e}"),
+        guards.push(out.array.try_readwrite().map_err(|e| {
+            Error::shape(
+                "out",
+                "writeable arrays that share no memory with the inputs or each other",
+                format!("an array numpy refuses to lend for writing: {e}"),
+            )
         })?);
     }
-    let not_contiguous = |e: numpy::AsSliceError| Error::Shape {
-        argument: "out".into(),
-        expected: "C-contiguous arrays".into(),
-        got: e.to_string(),
-    };
+    let not_contiguous =
+        |e: numpy::AsSliceError| Error::shape("out", "C-contiguous arrays", e.to_string());
     let mut lent_slices = Vec::with_capacity(N);
     for guard in &mut guards {
         lent_slices.push(guard.as_slice_mut().map_err(not_contiguous)?);
@@ -482,9 +480,8 @@ pub(crate) fn rows<'py>(py: Python<'py>, v: &[f64], n: usize) -> PyResult<Bound<
 
 /// A 1-D array-like of length `n` (or a scalar broadcast to `n`).
 pub(crate) fn per_joint(name: &str, value: &Bound<'_, PyAny>, n: usize) -> PyResult<Vec<f64>> {
-    let arr: ArrayLike<'_> = value.extract().map_err(|_| Error::InvalidArgument {
-        argument: name.into(),
-        message: "expected a real number or a sequence of real numbers".into(),
+    let arr: ArrayLike<'_> = value.extract().map_err(|_| {
+        Error::invalid(name, "expected a real number or a sequence of real numbers")
     })?;
     if arr.ndim() == 0 {
         return Ok(vec![
@@ -497,11 +494,11 @@ pub(crate) fn per_joint(name: &str, value: &Bound<'_, PyAny>, n: usize) -> PyRes
         ]);
     }
     if arr.shape() != [n] {
-        return Err(Error::Shape {
-            argument: name.into(),
-            expected: format!("a number or shape ({n},)"),
-            got: format!("shape {:?}", arr.shape()),
-        }
+        return Err(Error::shape(
+            name,
+            format!("a number or shape ({n},)"),
+            format!("shape {:?}", arr.shape()),
+        )
         .into());
     }
     Ok(arr.as_array().iter().copied().collect())
@@ -509,11 +506,11 @@ pub(crate) fn per_joint(name: &str, value: &Bound<'_, PyAny>, n: usize) -> PyRes
 
 pub(crate) fn vector(name: &str, a: &ArrayLike<'_>) -> Result<Vec<f64>> {
     if a.ndim() != 1 {
-        return Err(Error::Shape {
-            argument: name.into(),
-            expected: "a 1-D array".into(),
-            got: format!("shape {:?}", a.shape()),
-        });
+        return Err(Error::shape(
+            name,
+            "a 1-D array",
+            format!("shape {:?}", a.shape()),
+        ));
     }
     Ok(a.as_array().iter().copied().collect())
 }
@@ -526,11 +523,11 @@ pub(crate) fn matrix(name: &str, a: &ArrayLike<'_>) -> Result<DMatrix<f64>> {
             *c,
             a.as_array().iter().copied(),
         )),
-        s => Err(Error::Shape {
-            argument: name.into(),
-            expected: "a 2-D array (joints x harmonics)".into(),
-            got: format!("shape {s:?}"),
-        }),
+        s => Err(Error::shape(
+            name,
+            "a 2-D array (joints x harmonics)",
+            format!("shape {s:?}"),
+        )),
     }
 }
 
@@ -575,10 +572,10 @@ pub(crate) fn local_parts(
     let Some(parts) = parts else { return Ok(()) };
     const KNOWN: [&str; 5] = ["torque", "D", "H", "G", "G_static"];
     if let Some(bad) = parts.iter().find(|p| !KNOWN.contains(&p.as_str())) {
-        return Err(crate::error::Error::InvalidArgument {
-            argument: "use".into(),
-            message: format!("'{bad}'; expected some of {}", KNOWN.join(", ")),
-        });
+        return Err(crate::error::Error::invalid(
+            "use",
+            format!("'{bad}'; expected some of {}", KNOWN.join(", ")),
+        ));
     }
     let on = |k: &str| parts.iter().any(|p| p == k);
     options.use_torque = on("torque");

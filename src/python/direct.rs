@@ -53,12 +53,12 @@ pub(crate) fn friction_terms(value: Option<FrictionNames<'_>>) -> PyResult<Frict
         Some(FrictionNames::One(names)) => names.parse()?,
         Some(FrictionNames::Many(names)) => FrictionTerms::from_names(&names)?,
         Some(FrictionNames::Other(v)) => {
-            return Err(Error::InvalidArgument {
-                argument: "friction".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "friction",
+                format!(
                     "{v}; expected None, 'all', or a list of 'viscous', 'coulomb', 'offset', 'armature'"
                 ),
-            }
+            )
             .into())
         }
     })
@@ -153,11 +153,11 @@ pub(crate) fn check_sample_derivatives(
     };
     let k = c[0].len() / n;
     if t.len() != k {
-        return Err(Error::Shape {
-            argument: "t".into(),
-            expected: format!("({k},): one time per row of q"),
-            got: format!("shape ({},)", t.len()),
-        });
+        return Err(Error::shape(
+            "t",
+            format!("({k},): one time per row of q"),
+            format!("shape ({},)", t.len()),
+        ));
     }
     let log = crate::logs::recording::Recording::new(
         what,

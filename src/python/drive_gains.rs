@@ -109,17 +109,15 @@ fn entries<'py>(name: &str, v: &Bound<'py, PyAny>) -> PyResult<Vec<Bound<'py, Py
     } else if let Ok(t) = v.cast::<PyTuple>() {
         t.iter().collect()
     } else {
-        return Err(Error::InvalidArgument {
-            argument: name.into(),
-            message: format!("a {}, expected a list", v.get_type().name()?),
-        }
-        .into());
+        return Err(
+            Error::invalid(name, format!("a {}, expected a list", v.get_type().name()?)).into(),
+        );
     };
     if items.len() > MAX_RUNS {
-        return Err(Error::InvalidArgument {
-            argument: name.into(),
-            message: format!("{} entries, expected at most {MAX_RUNS}", items.len()),
-        }
+        return Err(Error::invalid(
+            name,
+            format!("{} entries, expected at most {MAX_RUNS}", items.len()),
+        )
         .into());
     }
     Ok(items)
@@ -129,23 +127,23 @@ fn entries<'py>(name: &str, v: &Bound<'py, PyAny>) -> PyResult<Vec<Bound<'py, Py
 /// required.
 fn run_arrays(r: usize, rec: &Recording, nv: usize) -> Result<(&[f64], &[f64])> {
     if rec.n != nv {
-        return Err(Error::InvalidArgument {
-            argument: format!("runs[{r}]"),
-            message: format!(
+        return Err(Error::invalid(
+            format!("runs[{r}]"),
+            format!(
                 "the Recording '{}' has {} joints, expected the robot's {nv}",
                 rec.name, rec.n
             ),
-        });
+        ));
     }
     match (&rec.qd, &rec.qdd) {
         (Some(qd), Some(qdd)) => Ok((qd, qdd)),
-        _ => Err(Error::InvalidArgument {
-            argument: format!("runs[{r}]"),
-            message: format!(
+        _ => Err(Error::invalid(
+            format!("runs[{r}]"),
+            format!(
                 "the Recording '{}' has no velocities and accelerations (a log as read): preprocess it first (perturbid_rs.preprocess)",
                 rec.name
             ),
-        }),
+        )),
     }
 }
 
@@ -190,26 +188,26 @@ pub(crate) fn identify_drive_gains(
     let model = &robot.model;
     let (runs, payloads) = (entries("runs", &runs)?, entries("payloads", &payloads)?);
     if runs.len() != payloads.len() {
-        return Err(Error::InvalidArgument {
-            argument: "payloads".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "payloads",
+            format!(
                 "{} payloads for {} runs, expected one a run (None for a run without)",
                 payloads.len(),
                 runs.len()
             ),
-        }
+        )
         .into());
     }
     let mut recordings: Vec<Arc<Recording>> = Vec::with_capacity(runs.len());
     for (r, run) in runs.iter().enumerate() {
         let Ok(rec) = run.cast::<PyRecording>() else {
-            return Err(Error::InvalidArgument {
-                argument: format!("runs[{r}]"),
-                message: format!(
+            return Err(Error::invalid(
+                format!("runs[{r}]"),
+                format!(
                     "a {}, expected a Recording (perturbid_rs.Recording, preprocessed)",
                     run.get_type().name()?
                 ),
-            }
+            )
             .into());
         };
         recordings.push(rec.get().rec.clone());

@@ -122,9 +122,8 @@ impl PyPlan {
             .experiments
             .iter()
             .position(|e| e.kind == k)
-            .ok_or_else(|| Error::InvalidArgument {
-                argument: "kind".into(),
-                message: format!("the plan has no '{kind}' experiment"),
+            .ok_or_else(|| {
+                Error::invalid("kind", format!("the plan has no '{kind}' experiment"))
             })?;
         Ok(PyExperiment {
             plan: self.plan.clone(),
@@ -449,10 +448,10 @@ pub(crate) fn identify_local(
         "planned" => CrossingTimes::Planned,
         "detected" => CrossingTimes::Detected { max_shift },
         other => {
-            return Err(Error::InvalidArgument {
-                argument: "crossing_times".into(),
-                message: format!("'{other}'; expected 'planned' or 'detected'"),
-            }
+            return Err(Error::invalid(
+                "crossing_times",
+                format!("'{other}'; expected 'planned' or 'detected'"),
+            )
             .into())
         }
     };

@@ -32,22 +32,20 @@ pub(crate) fn torque_noise(
         return Ok(Some(given));
     }
     if correlation != 1.0 {
-        return Err(Error::InvalidArgument {
-            argument: "noise_correlation".into(),
-            message:
-                "given without noise: it is the correlation of the noise levels given as noise="
-                    .into(),
-        }
+        return Err(Error::invalid(
+            "noise_correlation",
+            "given without noise: it is the correlation of the noise levels given as noise=",
+        )
         .into());
     }
     let logs = (recordings.iter().enumerate())
         .map(|(i, rec)| {
             let noise = match &rec.period_average {
                 Some(a) => crate::direct::TorqueNoise::from_period_average(a, joints),
-                None => Err(Error::InvalidArgument {
-                    argument: "weighting".into(),
-                    message: "'noise' needs noise= or a Recording averaged over its excitation's periods (preprocess(..., excitation=...) or period=), whose spread measures the noise".into(),
-                }),
+                None => Err(Error::invalid(
+                    "weighting",
+                    "'noise' needs noise= or a Recording averaged over its excitation's periods (preprocess(..., excitation=...) or period=), whose spread measures the noise",
+                )),
             };
             (format!("Recording {i} ('{}')", rec.name), noise, rec.len())
         })

@@ -79,11 +79,7 @@ pub(crate) fn preprocess(
 ) -> PyResult<PyRecording> {
     let rec = PyRecording::build(t, q, tau, qd, None, name)?;
     let invalid = |argument: &str, message: &str| -> PyErr {
-        crate::error::Error::InvalidArgument {
-            argument: argument.into(),
-            message: message.into(),
-        }
-        .into()
+        crate::error::Error::invalid(argument, message).into()
     };
     let periodic = excitation.is_some() || period.is_some();
     if !periodic && (harmonics.is_some() || period_start.is_some() || skip_periods > 0) {

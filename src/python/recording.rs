@@ -87,14 +87,14 @@ pub(crate) fn matrix_rows(
         [rows, cols] if *rows == m && n.is_none_or(|n| n == *cols) => {
             Ok((*cols, a.as_array().iter().copied().collect()))
         }
-        _ => Err(Error::Shape {
-            argument: name.into(),
-            expected: format!(
+        _ => Err(Error::shape(
+            name,
+            format!(
                 "shape ({m}, {}) like t",
                 n.map_or("n".to_string(), |n| n.to_string())
             ),
-            got: format!("shape {shape:?}"),
-        }),
+            format!("shape {shape:?}"),
+        )),
     }
 }
 
@@ -502,25 +502,25 @@ impl PyRecording {
     /// of a log and validating on another.
     fn __getitem__(&self, index: &Bound<'_, PyAny>) -> PyResult<Self> {
         let Ok(slice) = index.cast::<pyo3::types::PySlice>() else {
-            return Err(Error::InvalidArgument {
-                argument: "index".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "index",
+                format!(
                     "{}; expected a slice of samples (rec[a:b]): a recording indexes rows by slices only",
                     index.repr()?
                 ),
-            }
+            )
             .into());
         };
         let k = self.rec.len();
         let s = slice.indices(k as isize)?;
         if s.step != 1 {
-            return Err(Error::InvalidArgument {
-                argument: "index".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "index",
+                format!(
                     "a slice of step {}; expected step 1 (a recording's samples stay evenly spaced and in order)",
                     s.step
                 ),
-            }
+            )
             .into());
         }
         let (start, stop) = (s.start as usize, (s.stop.max(s.start)) as usize);

@@ -57,12 +57,10 @@ pub(crate) fn recordings_given(
         return Ok(None);
     };
     if let Some(name) = given.first_given() {
-        return Err(Error::InvalidArgument {
-            argument: name.into(),
-            message:
-                "given with a list of Recordings as q, which carry their own: pass the list alone"
-                    .into(),
-        }
+        return Err(Error::invalid(
+            name,
+            "given with a list of Recordings as q, which carry their own: pass the list alone",
+        )
         .into());
     }
     Ok(Some(recs))
@@ -78,20 +76,17 @@ pub(crate) fn recording_set<'a>(
     options: &BaseOptions,
 ) -> Result<(LogSet<'a>, BaseOptions)> {
     for (i, r) in recs.iter().enumerate() {
-        let at = |e: Error| Error::InvalidArgument {
-            argument: "q".into(),
-            message: format!("Recording {i} ('{}'): {e}", r.name),
-        };
+        let at = |e: Error| Error::invalid("q", format!("Recording {i} ('{}'): {e}", r.name));
         if r.n != model.nv || r.qd.is_none() || r.qdd.is_none() {
-            return Err(at(Error::InvalidArgument {
-                argument: "q".into(),
-                message: format!(
+            return Err(at(Error::invalid(
+                "q",
+                format!(
                     "{} joints{}, expected the robot's {} with velocities and accelerations: preprocess it first (perturbid_rs.preprocess)",
                     r.n,
                     if r.qdd.is_none() { " without velocities and accelerations" } else { "" },
                     model.nv
                 ),
-            }));
+            )));
         }
         crate::logs::derivative_columns::check_logged_derivatives(r).map_err(at)?;
     }

@@ -98,18 +98,18 @@ pub(crate) fn samples<'py>(
 ) -> PyResult<Samples<'py>> {
     let py = q.py();
     if super::recording::recordings_of(&q)?.is_some() {
-        return Err(Error::InvalidArgument {
-            argument: "q".into(),
-            message: "a list of Recordings, which only the fits take (identify_base_parameters, identify_consistent_parameters: runs fitted together); give one Recording, or arrays".into(),
-        }
+        return Err(Error::invalid(
+            "q",
+            "a list of Recordings, which only the fits take (identify_base_parameters, identify_consistent_parameters: runs fitted together); give one Recording, or arrays",
+        )
         .into());
     }
     let Ok(recording) = q.cast::<PyRecording>() else {
         let missing = |name: &str| {
-            Error::InvalidArgument {
-            argument: name.into(),
-            message: "missing: with arrays as q, give qd, qdd and tau as arrays too (or a Recording as q, alone)".into(),
-        }
+            Error::invalid(
+                name,
+                "missing: with arrays as q, give qd, qdd and tau as arrays too (or a Recording as q, alone)",
+            )
         };
         let tau = match given.tau {
             None if wants_tau => return Err(missing("tau").into()),
@@ -125,21 +125,21 @@ pub(crate) fn samples<'py>(
         });
     };
     if let Some(name) = given.first_given() {
-        return Err(Error::InvalidArgument {
-            argument: name.into(),
-            message: "given with a Recording as q, which carries its own: pass the Recording alone, or arrays for all".into(),
-        }
+        return Err(Error::invalid(
+            name,
+            "given with a Recording as q, which carries its own: pass the Recording alone, or arrays for all",
+        )
         .into());
     }
     let rec = &recording.get().rec;
     let (Some(qd), Some(qdd)) = (&rec.qd, &rec.qdd) else {
-        return Err(Error::InvalidArgument {
-            argument: "q".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "q",
+            format!(
                 "the Recording '{}' has no velocities and accelerations (a log as read): preprocess it first (perturbid_rs.preprocess), or read one with qd and qdd columns",
                 rec.name
             ),
-        }
+        )
         .into());
     };
     let n = rec.n;

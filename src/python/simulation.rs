@@ -92,10 +92,10 @@ pub(crate) fn simulate<'py>(
             || quantization.is_some()
             || seed != 0)
     {
-        return Err(Error::InvalidArgument {
-            argument: "true_robot".into(),
-            message: "gravity, friction, noise, quantization and seed come from the true robot; leave them out".into(),
-        }
+        return Err(Error::invalid(
+            "true_robot",
+            "gravity, friction, noise, quantization and seed come from the true robot; leave them out",
+        )
         .into());
     }
     let model = &robot.model;
@@ -161,9 +161,9 @@ fn reference(
             .into_iter()
             .find_map(|(o, v)| v.map(|v| (o, v))),
     ) {
-        return Err(Error::InvalidArgument {
-            argument: name.into(),
-            message: format!(
+        return Err(Error::invalid(
+            name,
+            format!(
                 "{} given with {}: it applies to an excitation (FourierTrajectory or ExcitationDesign)",
                 crate::error::shown(value),
                 if matches!(plan, ReferenceArg::Plan(_)) {
@@ -172,7 +172,7 @@ fn reference(
                     "arrays, which give the times themselves"
                 }
             ),
-        }
+        )
         .into());
     }
     let (periods, rate) = (periods.unwrap_or(1.0), rate.unwrap_or(1000.0));
@@ -213,10 +213,10 @@ fn reference(
 fn friction_of(model: &Model, friction: &Option<FrictionArg<'_>>) -> PyResult<Friction> {
     let n = model.nv;
     let refuse = |what: String| {
-        Error::InvalidArgument {
-        argument: "friction".into(),
-        message: format!("{what}; expected 'urdf', None or a dict with 'viscous', 'coulomb' and optionally 'coulomb_negative', 'stribeck', 'stribeck_velocity'"),
-    }
+        Error::invalid(
+            "friction",
+            format!("{what}; expected 'urdf', None or a dict with 'viscous', 'coulomb' and optionally 'coulomb_negative', 'stribeck', 'stribeck_velocity'"),
+        )
     };
     Ok(match friction {
         None => Friction::none(n),

@@ -43,11 +43,9 @@ pub(crate) fn study_resolve(
             })?
         }
         other => {
-            return Err(Error::InvalidArgument {
-                argument: "format".into(),
-                message: format!("'{other}'; expected 'toml' or 'json'"),
-            }
-            .into())
+            return Err(
+                Error::invalid("format", format!("'{other}'; expected 'toml' or 'json'")).into(),
+            )
         }
     };
     let s = Study::resolve(config, &base, source)?;
@@ -105,13 +103,13 @@ pub(crate) fn study_finish(py: Python<'_>, study: &str, out: PathBuf) -> PyResul
     let md = detached(py, "study_finish", || {
         let (results, missing) = study::collected(&s, &out)?;
         if missing > 0 {
-            return Err(Error::InvalidArgument {
-                argument: "study".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "study",
+                format!(
                     "{missing} of {} cases have no result in the journal yet",
                     s.len()
                 ),
-            });
+            ));
         }
         study::write_report(&s, &results, &out)
     })?;

@@ -31,11 +31,7 @@ impl PyFourier {
     ) -> PyResult<Self> {
         let w_f = match (w_f, base_frequency) {
             (Some(_), Some(_)) => {
-                return Err(Error::InvalidArgument {
-                    argument: "w_f".into(),
-                    message: "give w_f or base_frequency, not both".into(),
-                }
-                .into())
+                return Err(Error::invalid("w_f", "give w_f or base_frequency, not both").into())
             }
             (Some(w), None) => w,
             (None, f) => 2.0 * std::f64::consts::PI * f.unwrap_or(0.1),
@@ -60,10 +56,10 @@ impl PyFourier {
             }
         };
         if let Some(i) = times.iter().position(|x| !x.is_finite()) {
-            return Err(Error::InvalidArgument {
-                argument: format!("t[{i}]"),
-                message: format!("{}; expected a finite time (s)", times[i]),
-            }
+            return Err(Error::invalid(
+                format!("t[{i}]"),
+                format!("{}; expected a finite time (s)", times[i]),
+            )
             .into());
         }
         let n = self.traj.n();

@@ -228,10 +228,10 @@ pub(crate) fn validate<'py>(
 ) -> PyResult<PyValidation> {
     let base_model = model.cast::<PyBaseModel>().is_ok();
     if coulomb.is_some() && !base_model {
-        return Err(crate::Error::InvalidArgument {
-            argument: "coulomb".into(),
-            message: "the Coulomb term's column is a BaseParameterModel's; this model has no Coulomb term to give it to".into(),
-        }
+        return Err(crate::Error::invalid(
+            "coulomb",
+            "the Coulomb term's column is a BaseParameterModel's; this model has no Coulomb term to give it to",
+        )
         .into());
     }
     let given = super::samples::Given {
@@ -251,9 +251,11 @@ pub(crate) fn validate<'py>(
     };
     let a = s.arrays()?;
     let (q, qd, qdd) = (&s.q, &s.qd, &s.qdd);
-    let tau = (a.tau.as_ref()).ok_or_else(|| crate::Error::InvalidArgument {
-        argument: "tau".into(),
-        message: "missing: the measured torques are what a model is validated against".into(),
+    let tau = (a.tau.as_ref()).ok_or_else(|| {
+        crate::Error::invalid(
+            "tau",
+            "missing: the measured torques are what a model is validated against",
+        )
     })?;
     let (t, coulomb) = (&a.t, &a.coulomb);
     let (n, measured) = measured_torques(tau)?;
@@ -315,11 +317,11 @@ fn measured_torques(tau: &super::arrays::ArrayLike<'_>) -> PyResult<(usize, Vec<
     let array = tau.as_array();
     let n = *array.shape().last().unwrap_or(&0);
     if n == 0 {
-        return Err(crate::Error::Shape {
-            argument: "tau".into(),
-            expected: "(k, n) measured torques".into(),
-            got: format!("shape {:?}", array.shape()),
-        }
+        return Err(crate::Error::shape(
+            "tau",
+            "(k, n) measured torques",
+            format!("shape {:?}", array.shape()),
+        )
         .into());
     }
     let batch = read_batch(n, &[("tau", tau)])?;

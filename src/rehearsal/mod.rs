@@ -43,17 +43,17 @@ pub fn rehearse(
 ) -> Result<Recording> {
     let n = nominal.nv;
     if reference.n != n {
-        return Err(Error::Shape {
-            argument: "reference".into(),
-            expected: format!("{n} joints"),
-            got: format!("{} joints", reference.n),
-        });
+        return Err(Error::shape(
+            "reference",
+            format!("{n} joints"),
+            format!("{} joints", reference.n),
+        ));
     }
     if reference.len() < 2 {
-        return Err(Error::InvalidArgument {
-            argument: "reference".into(),
-            message: format!("{} samples; expected at least 2", reference.len()),
-        });
+        return Err(Error::invalid(
+            "reference",
+            format!("{} samples; expected at least 2", reference.len()),
+        ));
     }
     let true_model = robot.rigid_body_model(nominal)?;
     let effects = JointEffects::new(robot, n)?;
@@ -84,15 +84,15 @@ pub fn rehearse(
     };
     let (q, tau) = sensors::measure(&robot.sensors, &signals, &mut rng)?;
     if let Some(i) = crate::finite::first_non_finite(&tau) {
-        return Err(Error::Numerical {
-            operation: format!("rehearsal '{name}'"),
-            message: format!(
+        return Err(Error::numerical(
+            format!("rehearsal '{name}'"),
+            format!(
                 "the torque of joint {} at t = {} s is {}: the true robot's numbers overflow",
                 i % n + 1,
                 shown(reference.t[i / n]),
                 tau[i]
             ),
-        });
+        ));
     }
     Recording::new(name, n, reference.t.clone(), q, tau, None, None)
 }
@@ -131,11 +131,11 @@ pub fn true_torques(
 ) -> Result<Vec<f64>> {
     let n = nominal.nv;
     if states.nv() != n {
-        return Err(Error::Shape {
-            argument: "states".into(),
-            expected: format!("{n} joints"),
-            got: format!("{} joints", states.nv()),
-        });
+        return Err(Error::shape(
+            "states",
+            format!("{n} joints"),
+            format!("{} joints", states.nv()),
+        ));
     }
     robot.check(nominal)?;
     let true_model = robot.rigid_body_model(nominal)?;

@@ -132,13 +132,13 @@ pub fn follow_closed_loop(
             crate::interrupt::check("closed-loop simulation")?;
         }
         if q.iter().chain(&qd).any(|x| !x.is_finite() || x.abs() > 1e6) {
-            return Err(Error::Numerical {
-                operation: "closed-loop simulation".into(),
-                message: format!(
+            return Err(Error::numerical(
+                "closed-loop simulation",
+                format!(
                     "the tracked robot diverges at t = {:.4} s: the controller is unstable at this sample rate and these gains (lower kp/kd or raise substeps)",
                     reference.t[i]
                 ),
-            });
+            ));
         }
         for j in 0..n {
             let r = i * n + j;

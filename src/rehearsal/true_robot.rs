@@ -465,11 +465,11 @@ pub(crate) fn per_joint(
     match v {
         None => Ok(vec![default; n]),
         Some(v) if v.len() == n => Ok(v.clone()),
-        Some(v) => Err(Error::Shape {
-            argument: format!("true robot: {what}"),
-            expected: format!("{n} values (one per joint)"),
-            got: format!("{} values", v.len()),
-        }),
+        Some(v) => Err(Error::shape(
+            format!("true robot: {what}"),
+            format!("{n} values (one per joint)"),
+            format!("{} values", v.len()),
+        )),
     }
 }
 
@@ -507,24 +507,24 @@ impl TrueRobot {
         ] {
             if let Some(h) = h {
                 if h.len() != n {
-                    return Err(Error::Shape {
-                        argument: format!("true robot: {what}"),
-                        expected: format!("{n} lists of harmonics (one per joint)"),
-                        got: format!("{} lists", h.len()),
-                    });
+                    return Err(Error::shape(
+                        format!("true robot: {what}"),
+                        format!("{n} lists of harmonics (one per joint)"),
+                        format!("{} lists", h.len()),
+                    ));
                 }
             }
         }
         let level = per_joint("friction.stribeck", &f.stribeck, n, 0.0)?;
         let speed = per_joint("friction.stribeck_velocity", &f.stribeck_velocity, n, 0.0)?;
         if let Some(j) = (0..n).find(|&j| level[j] != 0.0 && speed[j] <= 0.0) {
-            return Err(Error::InvalidArgument {
-                argument: format!("true robot: friction.stribeck_velocity[{j}]"),
-                message: format!(
+            return Err(Error::invalid(
+                format!("true robot: friction.stribeck_velocity[{j}]"),
+                format!(
                     "{}; expected a positive speed (rad/s) where friction.stribeck[{j}] = {} is given",
                     speed[j], level[j]
                 ),
-            });
+            ));
         }
         if let Some(c) = &self.controller {
             for (what, g) in [("controller.kp", &c.kp), ("controller.kd", &c.kd)] {
@@ -583,17 +583,19 @@ fn body_of(model: &Model, link: &str) -> Result<usize> {
         .bodies
         .iter()
         .position(|b| b.link == link)
-        .ok_or_else(|| Error::InvalidArgument {
-            argument: "true robot: link".into(),
-            message: format!(
-                "'{link}' is not a moving link of '{}'; moving links: {}",
-                model.name,
-                model
-                    .bodies
-                    .iter()
-                    .map(|b| b.link.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
+        .ok_or_else(|| {
+            Error::invalid(
+                "true robot: link",
+                format!(
+                    "'{link}' is not a moving link of '{}'; moving links: {}",
+                    model.name,
+                    model
+                        .bodies
+                        .iter()
+                        .map(|b| b.link.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            )
         })
 }

@@ -28,14 +28,14 @@ impl Biquad {
 pub fn butterworth_lowpass(order: usize, cutoff: f64, rate: f64) -> Result<Vec<Biquad>> {
     let max = crate::limits::MAX_FILTER_ORDER;
     if !((1..=max).contains(&order) && cutoff > 0.0 && cutoff < 0.5 * rate) {
-        return Err(Error::InvalidArgument {
-            argument: "filter".into(),
-            message: format!(
+        return Err(Error::invalid(
+            "filter",
+            format!(
                 "order {order}, cutoff {} Hz at {} Hz; need 1 <= order <= {max} and 0 < cutoff < rate / 2",
                 crate::error::shown(cutoff),
                 crate::error::shown(rate)
             ),
-        });
+        ));
     }
     let fs2 = 2.0 * rate;
     let wc = fs2 * (std::f64::consts::PI * cutoff / rate).tan();
@@ -86,10 +86,10 @@ pub fn filtfilt(sections: &[Biquad], x: &[f64]) -> Result<Vec<f64>> {
     let pad = 3 * (2 * sections.len() + 1);
     let n = x.len();
     if n <= pad {
-        return Err(Error::InvalidArgument {
-            argument: "signal".into(),
-            message: format!("{n} samples; zero-phase filtering needs more than {pad}"),
-        });
+        return Err(Error::invalid(
+            "signal",
+            format!("{n} samples; zero-phase filtering needs more than {pad}"),
+        ));
     }
     let mut ext = Vec::with_capacity(n + 2 * pad);
     ext.extend((1..=pad).rev().map(|i| 2.0 * x[0] - x[i]));

@@ -35,13 +35,13 @@ pub fn read(out: &Path) -> Result<HashMap<String, CaseResult>> {
             }
             Err(_) if i + 1 == lines.len() && !text.ends_with('\n') => {} // cut short
             Err(e) => {
-                return Err(Error::Recording {
-                    recording: p.display().to_string(),
-                    message: format!(
+                return Err(Error::recording(
+                    p.display().to_string(),
+                    format!(
                         "line {}: not a case result ({e}); remove the line (its case is rerun) or the file (every case is rerun)",
                         i + 1
                     ),
-                })
+                ))
             }
         }
     }

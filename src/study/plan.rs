@@ -234,10 +234,10 @@ impl Study {
             rest -= here;
         }
         let Some(robot) = robot else {
-            return Err(Error::InvalidArgument {
-                argument: "case".into(),
-                message: format!("{index}; the study has {} cases", self.len()),
-            });
+            return Err(Error::invalid(
+                "case",
+                format!("{index}; the study has {} cases", self.len()),
+            ));
         };
         let c = &self.config;
         let mut take = |size: usize| {

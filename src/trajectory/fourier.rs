@@ -30,24 +30,22 @@ impl FourierTrajectory {
         let hz = w_f / std::f64::consts::TAU;
         // (a designed frequency at a bound may come back a rounding below it)
         if !(w_f.is_finite() && (low * (1.0 - 1e-12)..=high * (1.0 + 1e-12)).contains(&hz)) {
-            return Err(Error::InvalidArgument {
-                argument: "base pulsation".into(),
-                message: format!(
+            return Err(Error::invalid(
+                "base pulsation",
+                format!(
                     "{} rad/s (a base frequency of {} Hz); expected a base frequency in [{low}, {high}] Hz",
                     crate::error::shown(w_f),
                     crate::error::shown(hz)
                 ),
-            });
+            ));
         }
         for (name, m) in [("a", &a), ("b", &b)] {
             if m.nrows() != n || m.ncols() == 0 || m.ncols() != a.ncols() {
-                return Err(Error::Shape {
-                    argument: name.into(),
-                    expected: format!(
-                        "{n} x L (one row per joint, L >= 1 harmonics, a and b alike)"
-                    ),
-                    got: format!("{} x {}", m.nrows(), m.ncols()),
-                });
+                return Err(Error::shape(
+                    name,
+                    format!("{n} x L (one row per joint, L >= 1 harmonics, a and b alike)"),
+                    format!("{} x {}", m.nrows(), m.ncols()),
+                ));
             }
         }
         for (name, v) in [
@@ -79,14 +77,14 @@ impl FourierTrajectory {
                 .into_iter()
                 .find(|(_, x)| !x.is_finite())
             {
-                return Err(Error::InvalidArgument {
-                    argument: "a, b".into(),
-                    message: format!(
+                return Err(Error::invalid(
+                    "a, b",
+                    format!(
                         "joint {}: the coefficients (with w_f = {}) give {what} beyond f64's range; expected an excitation a robot can run",
                         i + 1,
                         crate::error::shown(w_f)
                     ),
-                });
+                ));
             }
         }
         Ok(Self { w_f, q0, a, b })

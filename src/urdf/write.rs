@@ -98,10 +98,10 @@ pub fn write_urdf(model: &Model, options: &WriteOptions<'_>) -> Result<WrittenUr
     ] {
         let length = value.chars().count();
         if length > most {
-            return Err(Error::InvalidArgument {
-                argument: argument.into(),
-                message: format!("{length} characters, expected at most {most}"),
-            });
+            return Err(Error::invalid(
+                argument,
+                format!("{length} characters, expected at most {most}"),
+            ));
         }
     }
     let source = &model.urdf;

@@ -311,9 +311,9 @@ impl LaneData {
     /// not have it (to compare the paths, or to pin one).
     pub fn with_isa(model: &Model, isa: Isa) -> Result<Self> {
         if !isa.is_available() {
-            return Err(Error::Numerical {
-                operation: "LaneData::with_isa".into(),
-                message: format!(
+            return Err(Error::numerical(
+                "LaneData::with_isa",
+                format!(
                     "this processor has no {isa} (it has: {})",
                     Isa::available()
                         .iter()
@@ -321,7 +321,7 @@ impl LaneData {
                         .collect::<Vec<_>>()
                         .join(", ")
                 ),
-            });
+            ));
         }
         Ok(Self::for_isa(model, isa))
     }
@@ -456,21 +456,21 @@ impl LaneData {
         {
             return Ok(());
         }
-        Err(Error::Shape {
-            argument: "lane data".into(),
-            expected: format!(
+        Err(Error::shape(
+            "lane data",
+            format!(
                 "buffers for this model ({} dofs, {} bodies): LaneData::new(&model)",
                 model.nv,
                 model.nbodies()
             ),
-            got: if sizes {
+            if sizes {
                 "buffers for a model of these sizes whose bodies have other parents or degrees \
                  of freedom"
                     .into()
             } else {
                 format!("buffers for {} dofs and {} bodies", self.nv, self.nbodies)
             },
-        })
+        ))
     }
 }
 
@@ -571,10 +571,12 @@ unsafe fn run_avx2<K: LaneKernel, const W: usize>(
 /// `(name, length, values per sample)` holds `k` samples too.
 pub(crate) fn samples(nv: usize, q_len: usize, others: &[(&str, usize, usize)]) -> Result<usize> {
     let k = q_len / nv.max(1);
-    let shape = |name: &str, len: usize, per: usize| Error::Shape {
-        argument: name.into(),
-        expected: format!("{k} samples x {per} values, like q"),
-        got: format!("{len} values"),
+    let shape = |name: &str, len: usize, per: usize| {
+        Error::shape(
+            name,
+            format!("{k} samples x {per} values, like q"),
+            format!("{len} values"),
+        )
     };
     if k * nv != q_len {
         return Err(shape("q", q_len, nv));

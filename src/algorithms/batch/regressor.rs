@@ -66,11 +66,11 @@ pub fn regressor_group(
     let nv = model.nv;
     let k = samples(nv, q.len(), &[("qd", qd.len(), nv), ("qdd", qdd.len(), nv)])?;
     if k == 0 || k > data.width() {
-        return Err(Error::Shape {
-            argument: "q".into(),
-            expected: format!("1 to {} samples of {nv} joints", data.width()),
-            got: format!("{k} samples"),
-        });
+        return Err(Error::shape(
+            "q",
+            format!("1 to {} samples of {nv} joints", data.width()),
+            format!("{k} samples"),
+        ));
     }
     let kernel = Regressor {
         k,

@@ -90,14 +90,14 @@ impl Layout {
         let (dt, gaps) = crate::logs::preprocess::gaps(rec);
         let from = start + p.skip as f64 * p.period;
         if start < t0 - 0.5 * dt {
-            return Err(Error::Recording {
-                recording: rec.name.clone(),
-                message: format!(
+            return Err(Error::recording(
+                rec.name.clone(),
+                format!(
                     "the periods start at t = {} s, before the log's first sample ({} s)",
                     shown5(start),
                     shown5(t0)
                 ),
-            });
+            ));
         }
         // a period is whole where its grid's last point, a grid step before the next period,
         // lies within the log
@@ -175,9 +175,9 @@ pub(super) fn too_few(
     let reasons: Vec<String> = (left_out.iter().take(3))
         .map(|l| format!("period {}: {}", l.period + 1, l.reason))
         .collect();
-    Error::Recording {
-        recording: rec.name.clone(),
-        message: format!(
+    Error::recording(
+        rec.name.clone(),
+        format!(
             "it holds {} whole periods of {} s from t = {} s (its samples run from {} to {} s){}; at least 2 are needed to average them and to tell their noise from their motion",
             layout.whole,
             shown5(p.period),
@@ -190,5 +190,5 @@ pub(super) fn too_few(
                 format!(", {} of them left out ({})", left_out.len(), reasons.join("; "))
             }
         ),
-    }
+    )
 }

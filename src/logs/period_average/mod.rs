@@ -343,9 +343,9 @@ impl Spread {
                 weighted_power(&qm[..2 * h_q + 1], &|k| if k > 0 { 1.0 } else { 0.0 }).sqrt();
             let spread = noise(coef_q, j, h_tau, &qm, &one);
             if motion > 0.0 && spread > MAX_POSITION_SPREAD * motion {
-                return Err(Error::Recording {
-                    recording: rec.name.clone(),
-                    message: format!(
+                return Err(Error::recording(
+                    rec.name.clone(),
+                    format!(
                         "joint {}'s positions differ from period to period by {} rad RMS, {:.0} % of their motion ({} rad RMS) over the {count} periods of {} s from t = {} s: the log does not repeat with that period. Is the period the excitation's (its base frequency's inverse), and did the robot run the excitation through these periods (a start, skip_periods or --skip-periods past a lead-in)?",
                         j + 1,
                         shown5(spread),
@@ -354,7 +354,7 @@ impl Spread {
                         shown5(p.period),
                         shown5(layout.periods[keep[0]].1)
                     ),
-                });
+                ));
             }
             // sums of squares past f64's range (values near 1e300) cannot be vouched for
             let levels = [
@@ -366,13 +366,13 @@ impl Spread {
                 ("positions' motion", motion),
             ];
             if let Some((what, x)) = levels.iter().find(|(_, x)| !x.is_finite()) {
-                return Err(Error::Numerical {
-                    operation: "period averaging".into(),
-                    message: format!(
+                return Err(Error::numerical(
+                    "period averaging",
+                    format!(
                         "joint {}'s {what}: their spread from period to period is {x}, past f64's range: the log's values are too large for f64 arithmetic (near 1e300?); rescale the log to SI units",
                         j + 1
                     ),
-                });
+                ));
             }
             q_mean.push(qm);
             tau_mean.push(tm);
