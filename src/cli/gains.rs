@@ -43,8 +43,8 @@ pub(crate) struct IdentifyGainsArgs {
     /// the signal's noise, as the table's noise bias says) or instrumental (instrumental
     /// variables, the signal predicted by the least-squares fit for instrument: unbiased by
     /// the signal's noise, at a larger variance).
-    #[arg(long, default_value = "least_squares", value_parser = ["least_squares", "instrumental"])]
-    estimator: String,
+    #[arg(long, default_value = "least_squares")]
+    estimator: GainEstimator,
     #[command(flatten)]
     fit: FitArgs,
     #[command(flatten)]
@@ -130,7 +130,7 @@ pub(crate) fn identify_gains(a: IdentifyGainsArgs) -> Result<String> {
         "identifying on {k} samples of {} runs",
         runs.len()
     ));
-    let estimator = GainEstimator::parse(&a.estimator)?;
+    let estimator = a.estimator;
     let fit =
         identify_drive_gains_with(&model, &runs, &options, estimator).map_err(|e| match e {
             // an error about one run's data names its file

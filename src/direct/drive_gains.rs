@@ -27,6 +27,7 @@ use serde::{Deserialize, Serialize};
 use super::base::BaseParameters;
 use super::identify::{fit_with_factors, BaseModel, BaseOptions, Weighting};
 use super::streaming::JointFactors;
+use crate::choice::choice;
 use crate::document::{check_bounded, check_condition, check_magnitudes};
 use crate::error::{shown, Error, Result};
 use crate::model::payload::Payload;
@@ -47,40 +48,21 @@ pub const NOISE_BIAS: f64 = 0.01;
 /// payload given.
 pub const AGREEMENT: f64 = 2.0;
 
-/// How the gains and the base parameters are estimated ([`identify_drive_gains_with`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum GainEstimator {
-    /// Least squares (OLS, then WLS where the options say): the smallest variance, biased
-    /// towards 0 by the signal's noise ([`DriveGains::noise_bias`] says by how much).
-    #[default]
-    LeastSquares,
-    /// Instrumental variables, the signal predicted by the least-squares fit for its
-    /// instrument (weighted as the least-squares fit was): consistent under the signal's
-    /// noise, at a larger variance. For logs whose noise is not small against what the
-    /// payload explains.
-    Instrumental,
-}
-
-impl GainEstimator {
-    /// Its name in files and on the command line: `least_squares`, `instrumental`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::LeastSquares => "least_squares",
-            Self::Instrumental => "instrumental",
-        }
-    }
-
-    /// The estimator of `name` ([`GainEstimator::name`]).
-    pub fn parse(name: &str) -> Result<Self> {
-        match name {
-            "least_squares" => Ok(Self::LeastSquares),
-            "instrumental" => Ok(Self::Instrumental),
-            other => Err(Error::invalid(
-                "estimator",
-                format!("'{other}', expected 'least_squares' or 'instrumental'"),
-            )),
-        }
+choice! {
+    /// How the gains and the base parameters are estimated ([`identify_drive_gains_with`]).
+    /// Named in files and on the command line `least_squares`, `instrumental`.
+    #[derive(Default, Serialize, Deserialize)]
+    #[serde(rename_all = "snake_case")]
+    pub enum GainEstimator ("estimator") {
+        /// Least squares (OLS, then WLS where the options say): the smallest variance, biased
+        /// towards 0 by the signal's noise ([`DriveGains::noise_bias`] says by how much).
+        #[default]
+        LeastSquares = "least_squares",
+        /// Instrumental variables, the signal predicted by the least-squares fit for its
+        /// instrument (weighted as the least-squares fit was): consistent under the signal's
+        /// noise, at a larger variance. For logs whose noise is not small against what the
+        /// payload explains.
+        Instrumental = "instrumental",
     }
 }
 

@@ -17,6 +17,7 @@ use super::plan::{Experiment, ExperimentKind, Plan};
 use super::quantisation;
 use super::reversals::narrowed_window;
 use super::rounded_positions::{self};
+use crate::choice::choice;
 use crate::error::{Error, Result};
 use crate::logs::recording::Recording;
 
@@ -38,6 +39,25 @@ pub enum CrossingTimes {
 impl CrossingTimes {
     /// The default tolerance of [`CrossingTimes::Detected`] (s).
     pub const DEFAULT_MAX_SHIFT: f64 = 0.5;
+
+    /// The crossing times from `source`, detected ones within `max_shift` s of the plan's.
+    pub fn new(source: TimesSource, max_shift: f64) -> Self {
+        match source {
+            TimesSource::Planned => CrossingTimes::Planned,
+            TimesSource::Detected => CrossingTimes::Detected { max_shift },
+        }
+    }
+}
+
+choice! {
+    /// Where the crossing times come from, by name ([`CrossingTimes`] without its tolerance).
+    pub enum TimesSource ("crossing_times") {
+        /// The plan's times: [`CrossingTimes::Planned`].
+        Planned = "planned",
+        /// The plan's times shifted by the offset found in the recording:
+        /// [`CrossingTimes::Detected`].
+        Detected = "detected",
+    }
 }
 
 /// Options of [`identify_local`](super::identify_local()).

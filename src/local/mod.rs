@@ -77,7 +77,7 @@ pub use diagnostics::{
     BlockAgreement, ClockOffset, Diagnostics, Glitch, Reversal, ReversalHandling, TorqueNoise,
     Unmeasured,
 };
-pub use identify::{CrossingTimes, IdentifyOptions};
+pub use identify::{CrossingTimes, IdentifyOptions, TimesSource};
 pub use identify_local::identify_local;
 pub use model::{Estimate, Estimator, LocalModel, SignalGains};
 pub use offset_search::{detect_offset, detect_offset_in};

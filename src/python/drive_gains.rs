@@ -184,7 +184,7 @@ pub(crate) fn identify_drive_gains(
     estimator: &str,
 ) -> PyResult<PyBaseModel> {
     let options = fit_options(friction, weighting, gravity, tolerance, seed)?;
-    let estimator = GainEstimator::parse(estimator)?;
+    let estimator: GainEstimator = estimator.parse()?;
     let model = &robot.model;
     let (runs, payloads) = (entries("runs", &runs)?, entries("payloads", &payloads)?);
     if runs.len() != payloads.len() {

@@ -444,17 +444,7 @@ pub(crate) fn identify_local(
     friction_aware_h: bool,
     drive_gains: Option<PyRef<'_, super::direct::PyBaseModel>>,
 ) -> PyResult<PyLocalModel> {
-    let times = match crossing_times {
-        "planned" => CrossingTimes::Planned,
-        "detected" => CrossingTimes::Detected { max_shift },
-        other => {
-            return Err(Error::invalid(
-                "crossing_times",
-                format!("'{other}'; expected 'planned' or 'detected'"),
-            )
-            .into())
-        }
-    };
+    let times = CrossingTimes::new(crossing_times.parse()?, max_shift);
     let options = IdentifyOptions {
         times,
         fit: FitOptions {
