@@ -342,11 +342,9 @@ impl PreprocessArgs {
         out: &mut String,
     ) -> Result<crate::logs::recording::Recording> {
         use std::fmt::Write;
-        let clipped = |rec: &crate::logs::recording::Recording| {
-            let log = path.display().to_string();
-            if let Some(w) =
-                crate::logs::torque_saturation::warning(&rec.torque_saturation, joints, &log)
-            {
+        // what the preprocessing (or, of a log taken as logged, the check of its torques) found
+        let warn = |rec: &crate::logs::recording::Recording| {
+            for w in crate::logs::preprocess::warnings(rec, &path.display().to_string(), joints) {
                 eprintln!("perturbid: warning: {w}");
             }
         };
@@ -357,7 +355,7 @@ impl PreprocessArgs {
                 torque_saturation: crate::logs::torque_saturation::find_torque_saturation(&rec),
                 ..rec
             };
-            clipped(&rec);
+            warn(&rec);
             return Ok(rec);
         }
         progress.update("preprocessing");
@@ -386,52 +384,7 @@ impl PreprocessArgs {
             ..crate::logs::preprocess::PreprocessOptions::default()
         };
         let rec = crate::logs::preprocess::preprocess(&rec, &o)?;
-        if let Some(w) = crate::logs::period_average::warning(
-            &rec.period_average,
-            &path.display().to_string(),
-            joints,
-        ) {
-            eprintln!("perturbid: warning: {w}");
-        }
-        if let Some(w) = crate::logs::log_screening::warning(
-            &rec.glitches,
-            &path.display().to_string(),
-            joints,
-            crate::logs::log_screening::BEFORE_PREPROCESSING,
-        ) {
-            eprintln!("perturbid: warning: {w}");
-        }
-        if let Some(w) = crate::logs::held_columns::warning(
-            &rec.held_columns,
-            &path.display().to_string(),
-            joints,
-        ) {
-            eprintln!("perturbid: warning: {w}");
-        }
-        if let Some(w) = crate::logs::stamp_jitter::warning(
-            &rec.stamp_jitter,
-            &path.display().to_string(),
-            joints,
-        ) {
-            eprintln!("perturbid: warning: {w}");
-        }
-        if let Some(w) = crate::logs::position_wraps::warning(
-            &rec.position_wraps,
-            &path.display().to_string(),
-            joints,
-            "before preprocessing",
-        ) {
-            eprintln!("perturbid: warning: {w}");
-        }
-        if let Some(w) = crate::logs::log_dropouts::dropout_warning(
-            &rec.dropouts,
-            &path.display().to_string(),
-            joints,
-            crate::logs::log_dropouts::BRIDGED_BY_PREPROCESSING,
-        ) {
-            eprintln!("perturbid: warning: {w}");
-        }
-        clipped(&rec);
+        warn(&rec);
         match (&rec.period_average, periodic) {
             (Some(a), true) => {
                 let noise: Vec<String> = (a.averaged_torque_noise().iter())

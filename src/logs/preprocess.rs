@@ -149,6 +149,45 @@ pub fn preprocess(rec: &Recording, options: &PreprocessOptions) -> Result<Record
     })
 }
 
+/// What [`preprocess`] found in the log `name` (its joints named `joint_names`, numbered where
+/// empty), in words, one warning a finding: periods averaged and left out, glitches replaced,
+/// columns held at a lower rate, jittering stamps, whole turns taken out, rows removed and
+/// clipped torques. (The noise that rounded positions leave, [`Recording::position_rounding`],
+/// is a fit's to tell of: it biases the terms a fit reads from qd and qdd.)
+pub fn warnings(rec: &Recording, name: &str, joint_names: &[String]) -> Vec<String> {
+    use crate::logs::{
+        held_columns, log_dropouts, log_screening, period_average, position_wraps, stamp_jitter,
+        torque_saturation,
+    };
+    [
+        period_average::warning(&rec.period_average, name, joint_names),
+        log_screening::warning(
+            &rec.glitches,
+            name,
+            joint_names,
+            log_screening::BEFORE_PREPROCESSING,
+        ),
+        held_columns::warning(&rec.held_columns, name, joint_names),
+        stamp_jitter::warning(&rec.stamp_jitter, name, joint_names),
+        position_wraps::warning(
+            &rec.position_wraps,
+            name,
+            joint_names,
+            "before preprocessing",
+        ),
+        log_dropouts::dropout_warning(
+            &rec.dropouts,
+            name,
+            joint_names,
+            log_dropouts::BRIDGED_BY_PREPROCESSING,
+        ),
+        torque_saturation::warning(&rec.torque_saturation, joint_names, name),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
+}
+
 /// [`preprocess`] of a recording whose glitches were screened (or are not to be).
 /// `steps`: per joint, the grid its logged positions lie on (for [`crate::logs::position_rounding`]).
 fn preprocess_screened(

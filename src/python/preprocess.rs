@@ -149,35 +149,12 @@ pub(crate) fn preprocess(
         }
         None => preprocess_rs(&rec, &options),
     })?;
-    let warnings: Vec<String> = [
-        crate::logs::log_screening::warning(
-            &out.glitches,
-            name,
-            &[],
-            crate::logs::log_screening::BEFORE_PREPROCESSING,
-        ),
-        crate::logs::log_dropouts::dropout_warning(
-            &out.dropouts,
-            name,
-            &[],
-            crate::logs::log_dropouts::BRIDGED_BY_PREPROCESSING,
-        ),
+    let mut warnings = crate::logs::preprocess::warnings(&out, name, &[]);
+    // a Recording is fitted later, by functions that do not warn of its findings again
+    warnings.extend(
         crate::logs::position_rounding::warning(&out.position_rounding, &[])
             .map(|w| format!("{name}: {w}{}", crate::logs::position_rounding::IN_A_FIT)),
-        crate::logs::torque_saturation::warning(&out.torque_saturation, &[], name),
-        crate::logs::position_wraps::warning(
-            &out.position_wraps,
-            name,
-            &[],
-            "before preprocessing",
-        ),
-        crate::logs::held_columns::warning(&out.held_columns, name, &[]),
-        crate::logs::stamp_jitter::warning(&out.stamp_jitter, name, &[]),
-        crate::logs::period_average::warning(&out.period_average, name, &[]),
-    ]
-    .into_iter()
-    .flatten()
-    .collect();
+    );
     super::errors::warn_all(py, &warnings)?;
     Ok(PyRecording::from(out))
 }
