@@ -25,6 +25,7 @@ pub mod payload;
 pub mod payload_estimate;
 pub mod payload_fit;
 pub mod payload_quantities;
+pub mod payload_reference;
 pub mod position_offsets;
 pub mod position_range;
 pub mod residual_correlation;

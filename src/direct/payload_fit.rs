@@ -6,8 +6,8 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use super::parameters::{regressor_blocks, FrictionTerms};
-use super::payload::{Columns, PayloadInertia, Reference, ReferenceParts};
 use super::payload_quantities::{in_link_frame, payload_of_parameters};
+use super::payload_reference::{Columns, PayloadInertia, Reference, ReferenceParts};
 use crate::algorithms::regressor::PARAMS_PER_BODY;
 use crate::error::{shown, Error, Result};
 use crate::gravity::Gravity;
