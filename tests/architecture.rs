@@ -535,7 +535,6 @@ const KNOWN_KNOTS: &[&str] = &[
     "logs/",
     "direct/",
     "local/",
-    "python/",
 ];
 
 /// Whether `file` belongs to the knot `known` ([`KNOWN_KNOTS`]).

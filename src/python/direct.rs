@@ -22,7 +22,7 @@ use super::findings::{
     position_offsets_dict, position_range_dicts, run_check_dicts, torque_column_dicts,
     torque_lag_dict,
 };
-use super::local::PyOperatingPoint;
+use super::operating_point::PyOperatingPoint;
 use super::recording_list::{recording_set, recordings_given, with_logs, with_offset_per_log};
 use super::robot::PyRobot;
 use super::samples::{samples, Given};
@@ -435,7 +435,7 @@ impl PyBaseModel {
     #[getter]
     fn drive_gains<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
         (self.fit.drive_gains.as_ref())
-            .map(|g| super::drive_gains::gains_dict(py, g))
+            .map(|g| super::findings::gains_dict(py, g))
             .transpose()
     }
     /// The fit's residuals judged against the torques' noise measured apart from it (given as

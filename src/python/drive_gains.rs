@@ -6,16 +6,15 @@ use std::borrow::Cow;
 use std::sync::Arc;
 
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyTuple};
+use pyo3::types::{PyList, PyTuple};
 
-use super::arrays::vec1;
 use super::detached;
 use super::direct::{check_sample_derivatives, fit_options, FrictionNames, PyBaseModel};
 use super::recording::PyRecording;
 use super::robot::PyRobot;
 use super::scalars;
 use crate::direct::drive_gains::{
-    identify_drive_gains_with as gains_rs, DriveGains, GainEstimator, GainRun, MAX_RUNS,
+    identify_drive_gains_with as gains_rs, GainEstimator, GainRun, MAX_RUNS,
 };
 use crate::error::{Error, Result};
 use crate::logs::recording::Recording;
@@ -26,80 +25,7 @@ use crate::states::States;
 /// `payload` (`link`, `mass`, `com`, `inertia`); unknown keys, and values of another type or
 /// length, refused by key (values out of range by [`Payload::problem`]).
 fn payload_of(r: usize, value: &Bound<'_, PyAny>) -> PyResult<Option<Payload>> {
-    payload_argument(&format!("payloads[{r}]"), value)
-}
-
-/// A payload given as argument `argument`: None, or a dict as [`payload_of`] reads it.
-pub(crate) fn payload_argument(
-    argument: &str,
-    value: &Bound<'_, PyAny>,
-) -> PyResult<Option<Payload>> {
-    if value.is_none() {
-        return Ok(None);
-    }
-    let bad = |message: String| -> PyErr {
-        Error::InvalidArgument {
-            argument: argument.to_string(),
-            message,
-        }
-        .into()
-    };
-    let Ok(dict) = value.cast::<PyDict>() else {
-        return Err(bad(format!(
-            "a {}, expected None or a dict with 'link', 'mass' (kg), 'com' (m) and 'inertia' ([ixx, ixy, ixz, iyy, iyz, izz] about the centre of mass, kg m^2)",
-            value.get_type().name()?
-        )));
-    };
-    let mut payload = Payload {
-        link: String::new(),
-        mass: f64::NAN,
-        com: [0.0; 3],
-        inertia: [0.0; 6],
-    };
-    let (mut link, mut mass) = (false, false);
-    for (key, v) in dict.iter() {
-        let key: String = key
-            .extract()
-            .map_err(|_| bad("its keys must be strings".into()))?;
-        let numbers = |len: usize| -> PyResult<Vec<f64>> {
-            let x: Vec<Bound<'_, PyAny>> = if v.cast::<pyo3::types::PyString>().is_ok() {
-                vec![]
-            } else {
-                v.extract().unwrap_or_default()
-            };
-            let x = (x.iter())
-                .map(scalars::real)
-                .collect::<PyResult<Vec<f64>>>();
-            match x {
-                Ok(x) if x.len() == len => Ok(x),
-                _ => Err(bad(format!("'{key}' must be {len} real numbers"))),
-            }
-        };
-        match key.as_str() {
-            "link" => {
-                payload.link = v
-                    .extract()
-                    .map_err(|_| bad("'link' must be a string".into()))?;
-                link = true;
-            }
-            "mass" => {
-                payload.mass = scalars::real(&v)
-                    .map_err(|_| bad("'mass' must be a real number (kg)".into()))?;
-                mass = true;
-            }
-            "com" => payload.com.copy_from_slice(&numbers(3)?),
-            "inertia" => payload.inertia.copy_from_slice(&numbers(6)?),
-            other => {
-                return Err(bad(format!(
-                    "unknown key '{other}', expected 'link', 'mass', 'com' and 'inertia'"
-                )))
-            }
-        }
-    }
-    if !(link && mass) {
-        return Err(bad("'link' and 'mass' are required".into()));
-    }
-    Ok(Some(payload))
+    super::payload_argument::payload_argument(&format!("payloads[{r}]"), value)
 }
 
 /// The entries of a list or tuple argument `name`, at most [`MAX_RUNS`].
@@ -258,23 +184,4 @@ pub(crate) fn identify_drive_gains(
         fit,
         model: Arc::new(model.clone()),
     })
-}
-
-/// The gains as a dict (see `BaseParameterModel.drive_gains`).
-pub(crate) fn gains_dict<'py>(py: Python<'py>, g: &DriveGains) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("gain", vec1(py, &g.gain))?;
-    d.set_item("stderr", vec1(py, &g.stderr))?;
-    d.set_item("noise_bias", vec1(py, &g.noise_bias))?;
-    d.set_item("payload_torque_rms", vec1(py, &g.payload_torque_rms))?;
-    d.set_item("agreement", vec1(py, &g.agreement))?;
-    d.set_item("cond", g.cond)?;
-    d.set_item("runs", g.runs)?;
-    d.set_item("loaded_runs", g.loaded_runs)?;
-    d.set_item("estimator", g.estimator.name())?;
-    match g.least_squares_gain.is_empty() {
-        true => d.set_item("least_squares_gain", py.None())?,
-        false => d.set_item("least_squares_gain", vec1(py, &g.least_squares_gain))?,
-    }
-    Ok(d)
 }

@@ -7,7 +7,7 @@ use pyo3::types::PyDict;
 
 use crate::direct::position_offsets::PositionOffsets;
 use crate::direct::position_range::JointRange;
-use crate::direct::{TorqueColumn, TorqueLag};
+use crate::direct::{DriveGains, TorqueColumn, TorqueLag};
 
 /// The joints' zero offsets as a dict (`BaseParameterModel.position_offsets`,
 /// `Validation.position_offsets`), with its `finding`.
@@ -120,4 +120,29 @@ pub(crate) fn run_check_dicts<'py>(
             Ok(e)
         })
         .collect()
+}
+
+/// The gains as a dict (see `BaseParameterModel.drive_gains`).
+pub(crate) fn gains_dict<'py>(py: Python<'py>, g: &DriveGains) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("gain", super::arrays::vec1(py, &g.gain))?;
+    d.set_item("stderr", super::arrays::vec1(py, &g.stderr))?;
+    d.set_item("noise_bias", super::arrays::vec1(py, &g.noise_bias))?;
+    d.set_item(
+        "payload_torque_rms",
+        super::arrays::vec1(py, &g.payload_torque_rms),
+    )?;
+    d.set_item("agreement", super::arrays::vec1(py, &g.agreement))?;
+    d.set_item("cond", g.cond)?;
+    d.set_item("runs", g.runs)?;
+    d.set_item("loaded_runs", g.loaded_runs)?;
+    d.set_item("estimator", g.estimator.name())?;
+    match g.least_squares_gain.is_empty() {
+        true => d.set_item("least_squares_gain", py.None())?,
+        false => d.set_item(
+            "least_squares_gain",
+            super::arrays::vec1(py, &g.least_squares_gain),
+        )?,
+    }
+    Ok(d)
 }

@@ -8,7 +8,7 @@ use pyo3::types::PyDict;
 use super::arrays::{at_states, expansion_dict, matrix_to_numpy as mat, ArrayLike};
 use super::detached;
 use super::direct::states;
-use super::local::PyOperatingPoint;
+use super::operating_point::PyOperatingPoint;
 use super::samples::{samples, Given};
 use crate::direct::{identify_global_linear as global_rs, GlobalLinearModel};
 use crate::document::Document;

@@ -1,4 +1,4 @@
-//! The paper's method in Python: `OperatingPoint`, `Plan` and `Experiment`, and the functions
+//! The paper's method in Python: `Plan` and `Experiment`, and the functions
 //! `plan_experiments`, `identify_local`, `identify_parameters_from_local` and
 //! `suggest_operating_points` (mirrors `crate::local`; the `LocalModel` they return and take is
 //! in `local_model.rs`).
@@ -13,8 +13,9 @@ use super::scalars;
 use super::detached;
 use pyo3::types::PyDict;
 
-use super::arrays::{matrix_to_numpy as mat, per_joint, rows, vec1, vector, ArrayLike};
+use super::arrays::{matrix_to_numpy as mat, per_joint, rows, vec1};
 use super::local_model::PyLocalModel;
+use super::operating_point::PyOperatingPoint;
 use super::recording::PyRecording;
 use super::robot::PyRobot;
 use crate::document::Document;
@@ -25,47 +26,6 @@ use crate::local::{
     Size,
 };
 use crate::logs::recording::Recording;
-
-/// An operating point `P = (q*, qd*, qdd*)`: joint positions (rad or m), velocities (rad/s or
-/// m/s) and accelerations (rad/s^2 or m/s^2), each of shape `(n,)`.
-#[pyclass(name = "OperatingPoint", module = "perturbid_rs", frozen)]
-#[derive(Clone)]
-pub(crate) struct PyOperatingPoint {
-    pub op: OperatingPoint,
-}
-
-#[pymethods]
-impl PyOperatingPoint {
-    #[new]
-    fn new(q: ArrayLike<'_>, qd: ArrayLike<'_>, qdd: ArrayLike<'_>) -> PyResult<Self> {
-        Ok(Self {
-            op: OperatingPoint::new(vector("q", &q)?, vector("qd", &qd)?, vector("qdd", &qdd)?)?,
-        })
-    }
-    #[getter]
-    fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        vec1(py, &self.op.q)
-    }
-    #[getter]
-    fn qd<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        vec1(py, &self.op.qd)
-    }
-    #[getter]
-    fn qdd<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        vec1(py, &self.op.qdd)
-    }
-    /// Number of joints.
-    #[getter]
-    fn n(&self) -> usize {
-        self.op.n()
-    }
-    fn __repr__(&self) -> String {
-        format!(
-            "OperatingPoint(q={:?}, qd={:?}, qdd={:?})",
-            self.op.q, self.op.qd, self.op.qdd
-        )
-    }
-}
 
 /// A plan of experiments at an operating point (from `plan_experiments`). `experiments` lists
 /// them in order; `to_json()` / `Plan.from_json(text)` save and load it.

@@ -8,7 +8,7 @@ use pyo3::types::{PyDict, PyList};
 
 use super::arrays::{at_states, matrix_to_numpy as mat, read_batch, to_numpy, vec1, ArrayLike};
 use super::errors::warn_all;
-use super::local::PyOperatingPoint;
+use super::operating_point::PyOperatingPoint;
 use crate::document::Document;
 use crate::local::{Estimate, Estimator, LocalModel, ReversalHandling};
 

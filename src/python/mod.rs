@@ -15,7 +15,9 @@ mod linearization;
 mod local;
 mod local_model;
 mod noise;
+mod operating_point;
 mod payload;
+mod payload_argument;
 mod preprocess;
 mod recording;
 mod recording_list;
@@ -75,7 +77,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(study::study_finish, m)?)?;
     m.add_function(wrap_pyfunction!(study::study_run, m)?)?;
     m.add_class::<linearization::PyLinearization>()?;
-    m.add_class::<local::PyOperatingPoint>()?;
+    m.add_class::<operating_point::PyOperatingPoint>()?;
     m.add_class::<local::PyPlan>()?;
     m.add_class::<local::PyExperiment>()?;
     m.add_class::<recording::PyRecording>()?;

@@ -191,7 +191,7 @@ impl PyRobot {
         note: &str,
     ) -> PyResult<String> {
         let payload = match &payload {
-            Some(p) => super::drive_gains::payload_argument("payload", p)?,
+            Some(p) => super::payload_argument::payload_argument("payload", p)?,
             None => None,
         };
         let written = detached(py, "Robot.to_urdf", || {
