@@ -2,7 +2,9 @@
 //! registers (4x4 in 256-bit ones with AVX, 8x8 in 512-bit ones with AVX-512), stored a row at a
 //! time (non-temporally where asked), with the finiteness test of the values on the way.
 
-use super::{scalars, Stores, ZeroPattern};
+use super::scalars::scalars;
+use super::stores::Stores;
+use super::zero_pattern::ZeroPattern;
 use crate::simd::Lanes;
 
 /// [`super::write_rows_with_zeros`]'s work with AVX-512 (8 full lanes, `W == 8`): blocks of 8
