@@ -16,6 +16,7 @@ pub mod linearization_regressor;
 pub mod parallel;
 pub mod regressor;
 pub mod rnea;
+pub(crate) mod row_major;
 
 use nalgebra::{DMatrix, DVector};
 

@@ -12,7 +12,6 @@
 //!
 //! Results equal the one-sample algorithms up to rounding. Errors name the sample of the batch.
 
-use nalgebra::DMatrix;
 use rayon::prelude::*;
 use std::sync::{Mutex, PoisonError};
 
@@ -422,14 +421,4 @@ pub fn linearize(
         }
         unreachable!("five outputs")
     })
-}
-
-/// `m` written row by row into `out` (`nrows * ncols` values).
-pub(crate) fn copy_row_major(m: &DMatrix<f64>, out: &mut [f64]) {
-    let n = m.ncols();
-    for r in 0..m.nrows() {
-        for c in 0..n {
-            out[r * n + c] = m[(r, c)];
-        }
-    }
 }

@@ -342,7 +342,7 @@ impl LaneKernel for Derivatives<'_> {
     fn scalar(self, model: &Model, data: &mut Data) -> Result<()> {
         let (n, nn) = (model.nv, model.nv * model.nv);
         let [tau, m, dq, dv] = self.out;
-        let copy = crate::algorithms::parallel::copy_row_major;
+        let copy = crate::algorithms::row_major::copy_row_major;
         let mut lin = Linearization::zeros(n);
         let mut gs = self.g_static;
         for s in 0..self.k {

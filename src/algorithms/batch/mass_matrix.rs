@@ -202,7 +202,7 @@ impl LaneKernel for MassMatrix<'_> {
         let nv = model.nv;
         for (s, o) in self.out.chunks_mut(nv * nv).enumerate() {
             crate::algorithms::crba::mass_matrix(model, data, &self.q[s * nv..(s + 1) * nv])?;
-            crate::algorithms::parallel::copy_row_major(&data.m, o);
+            crate::algorithms::row_major::copy_row_major(&data.m, o);
         }
         Ok(())
     }

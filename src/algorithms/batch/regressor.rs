@@ -125,7 +125,7 @@ impl LaneKernel for Regressor<'_> {
             let [q, qd, qdd] = self.x.map(|x| &x[r.clone()]);
             joint_torque_regressor(model, data, q, qd, qdd, self.gravity, &mut y)?;
             if let Some(out) = self.out.as_deref_mut() {
-                crate::algorithms::parallel::copy_row_major(&y, &mut out[s * nv * p..][..nv * p]);
+                crate::algorithms::row_major::copy_row_major(&y, &mut out[s * nv * p..][..nv * p]);
             }
             Ok(())
         });
