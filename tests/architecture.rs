@@ -537,7 +537,7 @@ fn no_file_uses_a_higher_layer() {
 /// within one of these, and an entry no cycle lies in any more must go. The list only
 /// shrinks; the goal is none.
 const KNOWN_KNOTS: &[&str] = &[
-    "algorithms/batch/ algorithms/parallel.rs",
+    "algorithms/batch/",
     "logs/",
     "direct/",
     "local/",
