@@ -8,6 +8,15 @@ use crate::operating_point::OperatingPoint;
 use crate::states::States;
 use crate::torque_model::{Expansion, TorqueModel};
 
+impl BaseModel {
+    /// The model bound to the robot it was identified for, as a [`crate::TorqueModel`]; fails when
+    /// `robot` has other joints.
+    pub fn on<'a>(&'a self, robot: &'a Model) -> Result<BaseModelOn<'a>> {
+        self.check(robot)?;
+        Ok(BaseModelOn { fit: self, robot })
+    }
+}
+
 /// A base-parameter model together with the robot whose regressor it needs
 /// ([`BaseModel::on`]).
 #[derive(Clone, Copy, Debug)]

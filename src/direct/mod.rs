@@ -5,13 +5,16 @@
 
 pub mod base;
 pub mod base_linearization;
+pub mod base_model;
 mod base_model_checks;
 pub mod base_model_on;
 pub mod base_options;
+pub(crate) mod base_solve;
 pub mod consistency;
 pub mod consistent;
 pub mod drive_gains;
 pub mod excitation;
+pub mod findings;
 pub mod global_linear;
 pub mod identify;
 pub mod instrumental;

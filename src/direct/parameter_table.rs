@@ -228,7 +228,7 @@ impl BaseModel {
         let offsets = self.position_offsets_finding();
         // friction terms fitted to a log that does not read as the robot's model take up
         // part of what is wrong with it, as offsets do: the columns first
-        let friction = super::unmodelled_friction::finding(
+        let friction = super::findings::unmodelled_friction::finding(
             &self.unmodelled_friction,
             self.base.layout.friction,
         )

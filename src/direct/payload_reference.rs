@@ -41,7 +41,7 @@ choice! {
     }
 }
 
-/// How a payload is identified ([`identify_payload`]).
+/// How a payload is identified ([`identify_payload`](super::identify_payload)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PayloadOptions {
     /// The URDF link the payload is fixed to (a moving body's own, or one behind fixed joints
@@ -57,7 +57,7 @@ pub struct PayloadOptions {
     /// The torques' noise measured apart from the fit ([`super::TorqueNoise`]: from a log
     /// averaged over its excitation's periods): the weights of [`Weighting::Noise`] (which
     /// needs it, and takes its standard errors from it), and for any weighting the yardstick
-    /// of the residuals ([`PayloadFit::noise_fit`]). Default None.
+    /// of the residuals ([`PayloadFit::noise_fit`](super::PayloadFit::noise_fit)). Default None.
     pub noise: Option<super::TorqueNoise>,
     /// Gravity in the torques (default on); a base-parameter reference must agree.
     pub gravity: Gravity,

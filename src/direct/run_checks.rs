@@ -143,7 +143,7 @@ pub(crate) fn data_checks_problem(
 
 /// What is wrong with a model's `checks` read from a file, for a model of `joint_names` fitted
 /// to `samples` samples of `logs` logs (0 where it names none): none, or one a run, at most
-/// [`super::drive_gains::MAX_RUNS`], two or more, their samples adding up to the model's,
+/// [`super::findings::drive_gains::MAX_RUNS`], two or more, their samples adding up to the model's,
 /// each run's checks as [`data_checks_problem`] reads them.
 pub(crate) fn problem(
     checks: &[RunChecks],
@@ -154,7 +154,7 @@ pub(crate) fn problem(
     if checks.is_empty() {
         return None;
     }
-    let most = super::drive_gains::MAX_RUNS;
+    let most = super::findings::drive_gains::MAX_RUNS;
     let total = checks
         .iter()
         .try_fold(0usize, |t, c| t.checked_add(c.samples));

@@ -20,7 +20,7 @@
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
-use super::position_offsets::PositionOffsets;
+use super::findings::position_offsets::PositionOffsets;
 use super::position_range::JointRange;
 use super::torque_columns::{joint_regressors, model_torques, TorqueColumn, JUDGED};
 use crate::error::Result;

@@ -14,6 +14,7 @@
 //!   the periods of a periodic excitation ([`period_average`], whose start [`excitation_start`]
 //!   finds);
 //! - recordings and trajectories as CSV ([`recording_csv`]);
+//! - what the preprocessing found in a log, named by it ([`log_findings`]);
 //! - several runs stacked for one fit ([`stacked_states`]), and several logs split into the
 //!   samples to fit to and those to validate on ([`log_set`]).
 
@@ -22,6 +23,7 @@ pub mod excitation_start;
 pub mod frozen_readings;
 pub mod held_columns;
 pub mod log_dropouts;
+pub mod log_findings;
 pub mod log_screening;
 pub mod log_set;
 pub mod outliers;
