@@ -12,7 +12,7 @@
 
 use nalgebra::DMatrix;
 
-use super::identify::BaseModel;
+use super::base_model::BaseModel;
 use super::parameters::sign0;
 use crate::algorithms::regressor::inertia_from_parameters;
 use crate::data::Data;

@@ -2,7 +2,7 @@
 //! map, the fit's numbers, the logs' findings and the fit's own findings, each named by its
 //! field (what [`Document::validate`] runs for a [`BaseModel`]).
 
-use super::identify::BaseModel;
+use super::base_model::BaseModel;
 use crate::document::{
     check_bounded, check_bounded_rows, check_condition, check_magnitudes, invalid, Document,
 };

@@ -1,7 +1,7 @@
 //! A base-parameter model on the robot whose regressor it needs: what answers
 //! [`TorqueModel`] for a [`BaseModel`].
 
-use super::identify::BaseModel;
+use super::base_model::BaseModel;
 use crate::error::Result;
 use crate::model::Model;
 use crate::operating_point::OperatingPoint;

@@ -23,8 +23,10 @@
 //! variables ([`super::instrumental`]).
 
 use super::base::BaseParameters;
+use super::base_model::BaseModel;
+use super::base_options::{BaseOptions, Weighting};
 pub use super::findings::drive_gains::*;
-use super::identify::{fit_with_factors, BaseModel, BaseOptions, Weighting};
+use super::identify::fit_with_factors;
 use super::streaming::JointFactors;
 use crate::error::{shown, Error, Result};
 use crate::model::payload::Payload;

@@ -16,8 +16,8 @@
 //! logs' parameters: under that the own fits take up much
 //! of the noise and the ratio says little (the real Panda log in thirds leaves its wrist unjudged). Beyond [`AGREEMENT`] it is a finding.
 
+use super::base_model::BaseModel;
 pub use super::findings::log_agreement::*;
-use super::identify::BaseModel;
 use super::residual_correlation::{combine, long_run_factors};
 use super::streaming::JointFactors;
 use crate::error::Result;

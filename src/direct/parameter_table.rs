@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use super::identify::BaseModel;
+use super::base_model::BaseModel;
 use crate::states::States;
 
 /// One base parameter.

@@ -25,7 +25,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::base::BaseParameters;
-use super::identify::Weighting;
+use super::base_options::Weighting;
 use super::parameters::regressor_blocks;
 use super::payload_estimate as estimate;
 use super::payload_fit::rigid_body_problem;

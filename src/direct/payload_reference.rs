@@ -7,7 +7,8 @@ use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 use super::base::{BaseParameters, BASE_TOLERANCE};
-use super::identify::{BaseModel, Weighting};
+use super::base_model::BaseModel;
+use super::base_options::Weighting;
 use super::parameters::{FrictionTerms, ParameterLayout};
 use crate::algorithms::regressor::PARAMS_PER_BODY;
 use crate::choice::choice;

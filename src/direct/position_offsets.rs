@@ -25,8 +25,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use super::base_model::BaseModel;
 pub use super::findings::position_offsets::*;
-use super::identify::BaseModel;
 use super::parameters::regressor_blocks;
 use crate::error::Result;
 use crate::{Model, States};

@@ -8,8 +8,8 @@
 //! a step at the join that no parameter can take, which bends the others and widens their
 //! standard errors (docs/method.md, "Several logs").
 
+use super::base_model::BaseModel;
 pub use super::findings::runs::*;
-use super::identify::BaseModel;
 use super::residual_correlation::{combine, long_run_factors, SAMPLES, SAMPLES_A_RUN};
 use crate::error::{Error, Result};
 use crate::model::Model;

@@ -12,7 +12,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::identify::BaseModel;
+use super::base_model::BaseModel;
 use super::parameters::regressor_blocks;
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -94,16 +94,4 @@ impl BaseModel {
                 ),
             ))
     }
-}
-
-/// The correlation of the joint fit's estimates, `(p + nv)` square: the parameters' (`theta`,
-/// `p x p`) and the gains' rows (`gains`, `nv x (p + nv)`).
-pub(crate) fn joint_correlation(theta: &DMatrix<f64>, gains: &DMatrix<f64>) -> DMatrix<f64> {
-    let p = theta.nrows();
-    let n = gains.ncols();
-    DMatrix::from_fn(n, n, |a, b| match (a < p, b < p) {
-        (true, true) => theta[(a, b)],
-        (false, _) => gains[(a - p, b)],
-        (true, false) => gains[(b - p, a)],
-    })
 }

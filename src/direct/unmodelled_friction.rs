@@ -21,8 +21,9 @@
 //! gravity barely changes over a joint's motion is absorbed by the gravity parameters, and the
 //! terms are not judged where the refit's parameters are not determined.
 
+use super::base_model::BaseModel;
+use super::base_options::BaseOptions;
 pub use super::findings::unmodelled_friction::*;
-use super::identify::{BaseModel, BaseOptions};
 use super::parameters::FrictionTerms;
 use crate::error::Result;
 use crate::model::Model;

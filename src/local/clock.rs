@@ -3,7 +3,7 @@
 //! against the planned ones), and the offset between the two clocks found in the positions.
 
 use super::crossing::samples_needed;
-use super::offset_search::{search_offset, CANDIDATES};
+use super::offset_search::{search_offset, span_rows, CANDIDATES};
 use super::plan::Experiment;
 use super::FitOptions;
 use crate::error::{Error, Result};
@@ -248,22 +248,6 @@ pub struct PositionMisfit {
     /// The RMS of the recorded positions about their mean over the same samples: how much the
     /// joint moved.
     pub recorded: f64,
-}
-
-/// The rows of `rec` whose times lie within `experiment`'s planned span placed `d` s later (log
-/// time = plan time + `d`), every so many so as to take at most about `samples` of them: the
-/// same rows however much else the log holds (a run's check in a 10-minute session read a
-/// dozen samples when they were spread over the whole log).
-pub(super) fn span_rows(
-    experiment: &Experiment,
-    rec: &Recording,
-    d: f64,
-    samples: usize,
-) -> std::iter::StepBy<std::ops::Range<usize>> {
-    let traj = &experiment.trajectory;
-    let i0 = rec.t.partition_point(|&t| t < traj.start() + d);
-    let i1 = rec.t.partition_point(|&t| t <= traj.end() + d).max(i0);
-    (i0..i1).step_by(((i1 - i0) / samples.max(1)).max(1))
 }
 
 /// Per joint, how far the recorded positions stray from `experiment`'s planned ones with the

@@ -4,105 +4,11 @@
 
 use nalgebra::DMatrix;
 
+pub use super::crossing_values::{CrossingValues, Signal, WindowGlitch};
 use super::glitches::{self, Screened};
 use super::rounded_positions::band_state;
 use crate::error::{Error, Result};
 use crate::logs::recording::Recording;
-
-pub use super::reversals::velocity_reversals;
-
-/// The state and torque at one crossing, estimated from a recording (length N each; rad, rad/s,
-/// rad/s^2, N m).
-#[derive(Clone, Debug, PartialEq)]
-pub struct CrossingValues {
-    /// Crossing time in the recording's clock (s).
-    pub time: f64,
-    pub q: Vec<f64>,
-    pub qd: Vec<f64>,
-    pub qdd: Vec<f64>,
-    pub tau: Vec<f64>,
-    /// Standard errors of `q`, `qd`, `qdd` from the scatter of the positions about their
-    /// quadratic fit (measurement noise, quantisation; NaN with no residual degree of freedom).
-    pub state_stderr: [Vec<f64>; 3],
-    /// Per joint, the noise gain of `tau`: its standard error per unit of white noise on the
-    /// torque samples (the root sum of squares of the fit's weights at the crossing; about
-    /// `sqrt(4.8 / samples)` for the default fit). Windows narrowed at a velocity reversal hold
-    /// fewer samples and have larger gains.
-    pub tau_gain: Vec<f64>,
-    /// Per joint, the scatter of the torque samples about their fit: the sum of squared
-    /// residuals (N^2 m^2) and its degrees of freedom. Pooled over an experiment's crossings
-    /// it estimates the torque samples' noise level.
-    pub tau_scatter: Vec<(f64, usize)>,
-    /// Per joint, whether `q`, `qd`, `qdd` and their standard errors were read from positions
-    /// rounded to encoder counts by the band of half a count about them
-    /// ([`super::rounded_positions`]) rather than by least squares.
-    pub position_band: Vec<bool>,
-    /// Samples of this crossing's windows found far off their fits ([`super::glitches`]):
-    /// replaced by the fit of the others where isolated, left in otherwise.
-    pub glitches: Vec<WindowGlitch>,
-}
-
-/// A recorded signal of a joint.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Signal {
-    /// Position (rad).
-    Q,
-    /// Recorded velocity (rad/s).
-    Qd,
-    /// Recorded acceleration (rad/s^2).
-    Qdd,
-    /// Torque (N m).
-    Tau,
-}
-
-impl Signal {
-    /// The signals in the order of [`SignalScales::noise`].
-    pub const ALL: [Signal; 4] = [Signal::Q, Signal::Qd, Signal::Qdd, Signal::Tau];
-
-    /// The signal's place in [`Signal::ALL`].
-    pub fn index(self) -> usize {
-        self as usize
-    }
-
-    /// The column prefix of the signal in recordings (`q`, `qd`, `qdd`, `tau`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Signal::Q => "q",
-            Signal::Qd => "qd",
-            Signal::Qdd => "qdd",
-            Signal::Tau => "tau",
-        }
-    }
-
-    /// The signal's unit.
-    pub fn unit(self) -> &'static str {
-        match self {
-            Signal::Q => "rad",
-            Signal::Qd => "rad/s",
-            Signal::Qdd => "rad/s^2",
-            Signal::Tau => "N m",
-        }
-    }
-}
-
-/// A sample found far off its window's fit (see [`super::glitches`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct WindowGlitch {
-    pub signal: Signal,
-    /// Joint index (0-based).
-    pub joint: usize,
-    /// Index of the sample in the recording (0-based).
-    pub sample: usize,
-    /// Its time in the recording's clock (s).
-    pub time: f64,
-    /// Its recorded value (the signal's unit).
-    pub value: f64,
-    /// How far off the fit of the others, in the window's robust noise levels.
-    pub noise_levels: f64,
-    /// Whether it was replaced by the fit of the others (an isolated glitch) or left in (one
-    /// of more than [`super::glitches::MAX_PER_WINDOW`] such samples in the window).
-    pub replaced: bool,
-}
 
 /// What is known of a recording's signals before its crossings are read, per joint (empty
 /// vectors: nothing known): the grids (steps) they lie on, found over the whole recording or

@@ -6,9 +6,8 @@
 
 pub use crate::logs::outliers::{level, screen, Flagged, Screened, MAX_PER_WINDOW, NOISE_LEVELS};
 
-use super::crossing::{CrossingValues, WindowGlitch};
+use super::crossing_values::{CrossingValues, ExperimentValues, WindowGlitch};
 use super::diagnostics::Glitch;
-use super::identify::ExperimentValues;
 use crate::error::shown;
 
 /// How many glitches a warning lists before "and N more".

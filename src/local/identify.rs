@@ -8,12 +8,13 @@ use super::clock::{align, check_sample_interval, lagged_half};
 use super::crossing::{
     samples_needed, values_in_windows, CrossingValues, FitOptions, SignalScales, TorqueFit,
 };
+pub use super::crossing_values::ExperimentValues;
 use super::diagnostics::{Reversal, ReversalHandling};
 use super::flat_channels::flat;
 pub use super::flat_channels::{flat_torques, window_torques};
 use super::model::Estimator;
 use super::noise::{reading_variance, sample_variance};
-use super::plan::{Experiment, ExperimentKind, Plan};
+use super::plan::{Experiment, Plan};
 use super::quantisation;
 use super::reversals::narrowed_window;
 use super::rounded_positions::{self};
@@ -89,30 +90,6 @@ impl Default for IdentifyOptions {
             friction_aware_h: false,
         }
     }
-}
-
-/// The values read at every crossing of one experiment (and its reference posture).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ExperimentValues {
-    pub kind: ExperimentKind,
-    /// Offset (s) added to the planned times.
-    pub offset: f64,
-    pub crossings: Vec<CrossingValues>,
-    pub reference: Option<CrossingValues>,
-    /// The crossings at which a joint's velocity reverses within the fit window, and how its
-    /// torque was read there.
-    pub reversals: Vec<Reversal>,
-    /// Per joint, the value (N m) every torque sample read for this experiment had, when all
-    /// of them (every crossing's window and the reference posture's) had the same one: a torque
-    /// signal that did not change (see [`flat_torques`]).
-    pub flat_torque: Vec<Option<f64>>,
-    /// Per joint, the step (N m) of the grid the torque samples read for this experiment lie
-    /// on, if any (see [`super::quantisation::torque_steps`]).
-    pub torque_step: Vec<Option<f64>>,
-    /// Per joint, the encoder step (rad) of the recording's positions where the state of at
-    /// least one crossing (or the reference posture) was read by the band of half a step
-    /// ([`super::rounded_positions`]); None otherwise.
-    pub position_step: Vec<Option<f64>>,
 }
 
 /// How to read the torque of each joint at the crossing at plan time `tp` (the recording's

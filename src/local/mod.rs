@@ -32,6 +32,7 @@
 
 pub mod clock;
 pub mod crossing;
+pub mod crossing_values;
 mod diagnose;
 pub mod diagnostics;
 pub mod errors_in_variables;
@@ -53,6 +54,7 @@ pub mod plan;
 mod plan_checks;
 pub mod plan_files;
 mod plan_warnings;
+pub mod planning;
 pub mod point_design;
 pub mod predicted_response;
 pub(crate) mod prediction_uncertainty;
@@ -83,7 +85,8 @@ pub use model::{Estimate, Estimator, LocalModel, SignalGains};
 pub use offset_search::{detect_offset, detect_offset_in};
 pub use parameters::{identify_parameters_from_local, FromLocalOptions, ParametersFromLocal};
 pub use perturbation::{Design, Size, Sizes};
-pub use plan::{plan_experiments, Crossing, Experiment, ExperimentKind, Plan, PlanOptions};
+pub use plan::{Crossing, Experiment, ExperimentKind, Plan, PlanOptions};
+pub use planning::plan_experiments;
 pub use point_design::{suggest_operating_points, SuggestedPoint};
 pub use reach::{Extrapolation, Perturbations, REACH_LIMIT};
 pub use session::{gaps_in_runs, repeated_runs, split_session, SplitOptions};

@@ -24,9 +24,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::crossing::CrossingValues;
+use super::crossing_values::{CrossingValues, ExperimentValues};
 use super::diagnostics::TorqueNoise;
-use super::identify::ExperimentValues;
 use crate::error::Result;
 use crate::regression::{least_squares, LeastSquares};
 

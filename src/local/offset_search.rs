@@ -2,7 +2,6 @@
 //! section 7): a grid over the offsets fine enough for motion that repeats, on the plan's span
 //! read the same however long the log, and its lowest minima refined by Gauss-Newton.
 
-use super::clock::span_rows;
 use super::plan::Experiment;
 use crate::error::{Error, Result};
 use crate::logs::recording::Recording;
@@ -260,4 +259,20 @@ fn refine(
         }
     }
     d
+}
+
+/// The rows of `rec` whose times lie within `experiment`'s planned span placed `d` s later (log
+/// time = plan time + `d`), every so many so as to take at most about `samples` of them: the
+/// same rows however much else the log holds (a run's check in a 10-minute session read a
+/// dozen samples when they were spread over the whole log).
+pub(super) fn span_rows(
+    experiment: &Experiment,
+    rec: &Recording,
+    d: f64,
+    samples: usize,
+) -> std::iter::StepBy<std::ops::Range<usize>> {
+    let traj = &experiment.trajectory;
+    let i0 = rec.t.partition_point(|&t| t < traj.start() + d);
+    let i1 = rec.t.partition_point(|&t| t <= traj.end() + d).max(i0);
+    (i0..i1).step_by(((i1 - i0) / samples.max(1)).max(1))
 }

@@ -1,10 +1,150 @@
-//! The checks a plan read from a file must pass beyond its shapes and its trajectory's
-//! smoothness ([`super::plan`]'s `Plan::validate`): its parts agree with each other, so that
+//! A plan as a JSON document, and the checks a plan read from a file must pass: its shapes and
+//! its trajectories' smoothness, and beyond them that its parts agree with each other, so that
 //! no hand edit of one part is fitted by one part and diagnosed by another.
 
 use super::plan::{Crossing, Experiment, ExperimentKind, Plan};
+use crate::document::{invalid, Document};
 use crate::error::shown;
+use crate::error::Result;
 use crate::trajectory::SegmentKind;
+
+impl Document for Plan {
+    const FORMAT: &'static str = "perturbid-plan";
+    const VERSION: u32 = 1;
+    const WHAT: &'static str = "plan";
+
+    /// Checks that every experiment is for the plan's joints and the rate is positive; that each
+    /// trajectory is finite, smooth and passes its crossings; that the crossings are the
+    /// operating point moved by the perturbations (`plan_checks`); and that no
+    /// experiment is planned twice.
+    fn validate(&self) -> Result<()> {
+        let plan = self;
+        let n = plan.n();
+        let bad = |m: String| invalid(Self::WHAT, m);
+        if plan.joint_names.len() != n || plan.op.qd.len() != n || plan.op.qdd.len() != n {
+            return Err(bad(format!(
+                "the operating point and joint names disagree on the number of joints ({n})"
+            )));
+        }
+        for e in &plan.experiments {
+            if e.trajectory.n != n || e.deltas.ncols() != n || e.trajectory.segments.is_empty() {
+                return Err(bad(format!(
+                    "experiment '{}' is not for {n} joints",
+                    e.kind.name()
+                )));
+            }
+            if e.trajectory.segments.iter().any(|s| s.coeffs.len() != n) {
+                return Err(bad(format!(
+                    "experiment '{}' has a segment that is not for {n} joints",
+                    e.kind.name()
+                )));
+            }
+        }
+        if !(plan.rate.is_finite() && plan.rate > 0.0 && plan.rate <= crate::limits::MAX_RATE) {
+            return Err(bad(format!(
+                "rate {} Hz; expected a positive number up to {:e}",
+                plan.rate,
+                crate::limits::MAX_RATE
+            )));
+        }
+        if plan.experiments.is_empty() {
+            return Err(bad("the plan has no experiment".into()));
+        }
+        crate::document::check_joint_names(Self::WHAT, &plan.joint_names)?;
+        for (k, e) in plan.experiments.iter().enumerate() {
+            let at = |what: &str| format!("experiments[{k}] ('{}'): {what}", e.kind.name());
+            // segments in time order, end to end, finite: what sampling walks through
+            let mut previous: Option<f64> = None;
+            for (i, seg) in e.trajectory.segments.iter().enumerate() {
+                let ordered = seg.t0.is_finite() && seg.t1.is_finite() && seg.t0 <= seg.t1;
+                let joined = previous.is_none_or(|t| (seg.t0 - t).abs() <= 1e-9 * t.abs().max(1.0));
+                if !ordered || !joined {
+                    return Err(bad(at(&format!(
+                        "trajectory.segments[{i}] runs from {} to {} s; segments must be finite, in time order and end to end",
+                        seg.t0, seg.t1
+                    ))));
+                }
+                if seg.coeffs.iter().flatten().any(|c| !c.is_finite()) {
+                    return Err(bad(at(&format!(
+                        "trajectory.segments[{i}] has a coefficient that is not finite"
+                    ))));
+                }
+                previous = Some(seg.t1);
+            }
+            // t, q, qd, qdd and the torques a recording of it adds
+            crate::limits::sample_count(&at("trajectory"), e.duration(), plan.rate, 1 + 4 * n)?;
+            e.trajectory
+                .check_smooth()
+                .map_err(|m| bad(at(&format!("trajectory: {m}"))))?;
+            if e.deltas.nrows() != e.crossings.len() && e.kind != ExperimentKind::Nominal {
+                return Err(bad(at(&format!(
+                    "{} perturbations for {} crossings",
+                    e.deltas.nrows(),
+                    e.crossings.len()
+                ))));
+            }
+            let (start, end) = (e.trajectory.start(), e.trajectory.end());
+            if let Some(k) =
+                (1..e.crossings.len()).find(|&k| e.crossings[k].time < e.crossings[k - 1].time)
+            {
+                return Err(bad(at(&format!(
+                    "crossings[{k}] at t = {} s comes before crossings[{}] at {} s; crossings are in time order",
+                    shown(e.crossings[k].time),
+                    k - 1,
+                    shown(e.crossings[k - 1].time)
+                ))));
+            }
+            // every crossing (and the reference posture) is a state the trajectory passes
+            let named = e
+                .crossings
+                .iter()
+                .enumerate()
+                .map(|(k, c)| (format!("crossings[{k}]"), c))
+                .chain(e.reference.iter().map(|c| ("reference".to_string(), c)));
+            for (name, c) in named {
+                if [&c.q, &c.qd, &c.qdd].iter().any(|v| v.len() != n) {
+                    return Err(bad(at(&format!("{name} is not for {n} joints"))));
+                }
+                if !(c.time >= start && c.time <= end) {
+                    return Err(bad(at(&format!(
+                        "{name} at t = {} s is outside the trajectory ({} to {} s)",
+                        shown(c.time),
+                        shown(start),
+                        shown(end)
+                    ))));
+                }
+                let (q, qd, qdd) = e.trajectory.segment_at(c.time).state(c.time);
+                for (what, planned, passed) in
+                    [("q", &c.q, &q), ("qd", &c.qd, &qd), ("qdd", &c.qdd, &qdd)]
+                {
+                    if let Some(j) = (0..n).find(|&j| {
+                        let off = (planned[j] - passed[j]).abs();
+                        off.is_nan() || off > 1e-6 * (1.0 + planned[j].abs())
+                    }) {
+                        return Err(bad(at(&format!(
+                            "{name}.{what}[{j}] is {}, but the trajectory passes {} at t = {} s: the crossing and the trajectory disagree",
+                            shown(planned[j]),
+                            shown(passed[j]),
+                            shown(c.time)
+                        ))));
+                    }
+                }
+            }
+            if !(e.window.is_finite() && e.window > 0.0) {
+                return Err(bad(at(&format!("window {} s is not positive", e.window))));
+            }
+            check_planned_states(plan, e).map_err(|m| bad(at(&m)))?;
+            check_windows(e).map_err(|m| bad(at(&m)))?;
+            if let Some(first) = plan.experiments[..k].iter().position(|o| o.kind == e.kind) {
+                return Err(bad(format!(
+                    "experiments[{first}] and experiments[{k}] are both '{}'; a plan holds each experiment once",
+                    e.kind.name()
+                )));
+            }
+        }
+        Ok(())
+    }
+}
 
 /// Checks that an experiment's crossings (and G-static's reference) are the states its kind and
 /// perturbations say: the operating point with the perturbed variable moved by the row of

@@ -12,7 +12,7 @@
 //! `T*`.
 
 use super::model::{Estimate, Estimator, LocalModel};
-use crate::document::{check_correlation, invalid};
+
 use crate::error::{Error, Result};
 use crate::regression::root;
 use crate::states::States;
@@ -132,29 +132,29 @@ fn part<'a>(e: &'a Option<Estimate>, name: &str, n: usize) -> Result<&'a Estimat
     Ok(e)
 }
 
-/// Checks the correlations of an estimate `what` read from a file (`cols` columns, `n` rows):
-/// none (a model saved before they were stored), or one per row, each `cols x cols`, symmetric
-/// with a unit diagonal, entries in [-1, 1] and positive semi-definite (else a prediction's
-/// variance could come out negative).
-pub(crate) fn check_correlations(kind: &str, what: &str, e: &Estimate, n: usize) -> Result<()> {
-    let cols = e.matrix.ncols();
-    if e.correlation.is_empty() {
-        return Ok(());
+impl LocalModel {
+    /// The standard errors (row-major `k x N`, N m, or N for a prismatic joint) of the torques
+    /// [`Self::predict`] gives at the samples of `states`: from those of `T*` and of the
+    /// matrices' entries with their correlation within each row (docs/method.md, section 5).
+    /// NaN for a joint where the model holds an unknown standard error that the state weights.
+    /// Refused for a model without the D, H or G experiment, or saved before the correlations
+    /// were stored.
+    ///
+    /// A model whose recordings were currents put in torques ([`Self::drive_gains`]) adds the
+    /// gains' relative standard errors: joint `j`'s every coefficient is `K_j` times the
+    /// signal's, so its prediction `tau_j` varies by `tau_j se_K_j / |K_j|` more, independent
+    /// of the local fit (the gains came from other data).
+    pub fn predict_stderr(&self, states: &States<'_>) -> Result<Vec<f64>> {
+        let mut out = predict_stderr(self, states)?;
+        if let Some(g) = &self.drive_gains {
+            let n = self.n();
+            let tau = self.predict(states)?;
+            for (x, (se, t)) in out.iter_mut().zip(&tau).enumerate() {
+                let relative = g.stderr[x % n] / g.gain[x % n].abs();
+                *se = se.hypot(t * relative);
+            }
+            return crate::regression::refuse_overflow(out, n, "prediction's standard error");
+        }
+        Ok(out)
     }
-    let bad = |message: String| invalid(kind, format!("{what}.correlation: {message}"));
-    if e.correlation.len() != n {
-        return Err(bad(format!(
-            "{} matrices; expected one per torque ({n}) or none",
-            e.correlation.len()
-        )));
-    }
-    for (j, r) in e.correlation.iter().enumerate() {
-        check_correlation(
-            kind,
-            &format!("{what}.correlation matrix {}", j + 1),
-            r,
-            cols,
-        )?;
-    }
-    Ok(())
 }

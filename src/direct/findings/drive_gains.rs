@@ -206,7 +206,7 @@ impl DriveGains {
         crate::document::check_correlation(
             what,
             "correlation with drive_gains.correlation",
-            &crate::direct::signal_prediction::joint_correlation(theta, r),
+            &joint_correlation(theta, r),
             p + n,
         )
     }
@@ -248,4 +248,19 @@ impl DriveGains {
         }
         out
     }
+}
+
+/// The correlation of the joint fit's estimates, `(p + nv)` square: the parameters' (`theta`,
+/// `p x p`) and the gains' rows (`gains`, `nv x (p + nv)`).
+fn joint_correlation(
+    theta: &nalgebra::DMatrix<f64>,
+    gains: &nalgebra::DMatrix<f64>,
+) -> nalgebra::DMatrix<f64> {
+    let p = theta.nrows();
+    let n = gains.ncols();
+    nalgebra::DMatrix::from_fn(n, n, |a, b| match (a < p, b < p) {
+        (true, true) => theta[(a, b)],
+        (false, _) => gains[(a - p, b)],
+        (true, false) => gains[(b - p, a)],
+    })
 }

@@ -81,12 +81,12 @@ impl LogAgreement {
             && self.own_rms.iter().flatten().all(|r| r.len() == nv);
         if self.ratio.len() != nv
             || !shaped
-            || !(2..=crate::direct::drive_gains::MAX_RUNS).contains(&logs)
+            || !(2..=crate::limits::MAX_LOGS).contains(&logs)
             || (runs > 0 && runs != logs)
         {
             return Some(format!(
                 "log_agreement: expected a ratio a joint ({nv}) and two RMS a joint and log (2 to {} logs{})",
-                crate::direct::drive_gains::MAX_RUNS,
+                crate::limits::MAX_LOGS,
                 if runs > 0 { format!(", as the model's {runs}") } else { String::new() }
             ));
         }

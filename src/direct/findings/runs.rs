@@ -33,14 +33,14 @@ impl RunOffsets {
         let count = self.means.len();
         if !joint_names.contains(&self.joint) {
             Some(format!("joint '{}' is not one of the model's", self.joint))
-        } else if !(2..=crate::direct::drive_gains::MAX_RUNS).contains(&count)
+        } else if !(2..=crate::limits::MAX_LOGS).contains(&count)
             || self.stderr.len() != count
             || (runs > 0 && runs != count)
         {
             Some(format!(
                 "{count} means and {} standard errors, expected one of each a run (2 to {}{})",
                 self.stderr.len(),
-                crate::direct::drive_gains::MAX_RUNS,
+                crate::limits::MAX_LOGS,
                 if runs > 0 {
                     format!("; the model has {runs} logs")
                 } else {
