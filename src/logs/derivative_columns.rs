@@ -22,7 +22,7 @@
 //! ([`check_logged_derivatives`], for a log used as logged: each stretch between gaps resampled
 //! at its median rate and filtered as preprocessing does, by default).
 
-use crate::logs::preprocess::PreprocessOptions;
+use crate::logs::preprocess_options::PreprocessOptions;
 use crate::logs::recording::Recording;
 use crate::signal::{butterworth_lowpass, differentiate, filtfilt, interpolate};
 

@@ -162,7 +162,7 @@ impl<'a> Alignment<'a> {
             motion,
             t0,
             t1,
-            dt: crate::logs::preprocess::gaps(rec).0,
+            dt: crate::logs::gaps::gaps(rec).0,
             stride: rec.len().div_ceil(SEARCH_SAMPLES).max(1),
         })
     }

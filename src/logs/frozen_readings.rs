@@ -44,15 +44,13 @@
 //! not a stall, and removing its rows would leave little.
 
 use crate::error::{Error, Result};
-use crate::logs::log_dropouts::LogDropout;
+use crate::logs::findings::log_dropouts::LogDropout;
+pub use crate::logs::findings::log_dropouts::MIN_FROZEN;
 use crate::logs::log_screening::{
     column_floor, end_jump, joint_called, median, segments, signals, unit, LISTED, MAX_HELD,
 };
 use crate::logs::outliers::NOISE_LEVELS;
 use crate::logs::recording::Recording;
-
-/// The fewest repeated samples of a frozen reading: one more than a held reading's most.
-pub const MIN_FROZEN: usize = MAX_HELD + 1;
 
 /// The largest share of a stretch's samples a column's frozen readings may cover; more is
 /// refused (see the module documentation).

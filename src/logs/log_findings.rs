@@ -13,27 +13,27 @@ pub struct LogFindings {
     pub log: String,
     /// Samples taken for glitches and replaced ([`crate::logs::log_screening`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub glitches: Vec<crate::logs::log_screening::LogGlitch>,
+    pub glitches: Vec<crate::logs::findings::log_screening::LogGlitch>,
     /// Rows removed first: dropouts and frozen readings ([`crate::logs::log_dropouts`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub dropouts: Vec<crate::logs::log_dropouts::LogDropout>,
+    pub dropouts: Vec<crate::logs::findings::log_dropouts::LogDropout>,
     /// Torques that read clipped ([`crate::logs::torque_saturation`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub torque_saturation: Vec<crate::logs::torque_saturation::TorqueSaturation>,
+    pub torque_saturation: Vec<crate::logs::findings::torque_saturation::TorqueSaturation>,
     /// Steps of whole turns taken back out of the positions ([`crate::logs::position_wraps`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub position_wraps: Vec<crate::logs::position_wraps::PositionWrap>,
+    pub position_wraps: Vec<crate::logs::findings::position_wraps::PositionWrap>,
     /// Columns logged at a lower rate, read again at their values' arrivals
     /// ([`crate::logs::held_columns`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub held_columns: Vec<crate::logs::held_columns::HeldColumn>,
+    pub held_columns: Vec<crate::logs::findings::held_columns::HeldColumn>,
     /// Time stamps found jittering over the regular clock ([`crate::logs::stamp_jitter`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stamp_jitter: Option<crate::logs::stamp_jitter::StampJitter>,
+    pub stamp_jitter: Option<crate::logs::findings::stamp_jitter::StampJitter>,
     /// Per joint whose positions lie on a grid, the noise their rounding left in qd and qdd
     /// ([`crate::logs::position_rounding`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub position_rounding: Vec<crate::logs::position_rounding::PositionRounding>,
+    pub position_rounding: Vec<crate::logs::findings::position_rounding::PositionRounding>,
     /// What averaging over the excitation's periods found: the periods averaged and left
     /// out, each signal's noise ([`crate::logs::period_average`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]

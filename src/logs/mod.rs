@@ -20,7 +20,9 @@
 
 pub mod derivative_columns;
 pub mod excitation_start;
+pub mod findings;
 pub mod frozen_readings;
+pub mod gaps;
 pub mod held_columns;
 pub mod log_dropouts;
 pub mod log_findings;
@@ -31,6 +33,7 @@ pub mod period_average;
 pub mod position_rounding;
 pub mod position_wraps;
 pub mod preprocess;
+pub mod preprocess_options;
 pub mod recording;
 pub mod recording_csv;
 pub mod repeated_samples;

@@ -22,25 +22,25 @@ pub struct Recording {
     pub experiment: Option<String>,
     /// Samples of the log this recording was preprocessed from that were taken for glitches
     /// and replaced first ([`crate::logs::log_screening`]); empty for a recording as logged.
-    pub glitches: Vec<crate::logs::log_screening::LogGlitch>,
+    pub glitches: Vec<crate::logs::findings::log_screening::LogGlitch>,
     /// Runs of rows of the log this recording was preprocessed from in which every joint of a
     /// signal read exactly 0 while the robot moved, removed first
     /// ([`crate::logs::log_dropouts::find_dropouts`]); empty for a recording as logged.
-    pub dropouts: Vec<crate::logs::log_dropouts::LogDropout>,
+    pub dropouts: Vec<crate::logs::findings::log_dropouts::LogDropout>,
     /// Per joint whose logged positions lie on a grid and whose velocity the preprocessing
     /// derived from them, the noise their rounding leaves in qd and qdd
     /// ([`crate::logs::position_rounding`]); empty for a recording as logged.
-    pub position_rounding: Vec<crate::logs::position_rounding::PositionRounding>,
+    pub position_rounding: Vec<crate::logs::findings::position_rounding::PositionRounding>,
     /// Per joint and side, the torques of the log this recording was preprocessed from that
     /// read clipped ([`crate::logs::torque_saturation`]); empty for a recording as logged.
-    pub torque_saturation: Vec<crate::logs::torque_saturation::TorqueSaturation>,
+    pub torque_saturation: Vec<crate::logs::findings::torque_saturation::TorqueSaturation>,
     /// Steps of whole turns in the positions of the log this recording was preprocessed from,
     /// taken back out first ([`crate::logs::position_wraps`]); empty for a recording as logged.
-    pub position_wraps: Vec<crate::logs::position_wraps::PositionWrap>,
+    pub position_wraps: Vec<crate::logs::findings::position_wraps::PositionWrap>,
     /// Columns of the log this recording was preprocessed from that were logged at a lower
     /// rate and held on its grid, read again at their values' arrivals first
     /// ([`crate::logs::held_columns`]); empty for a recording as logged.
-    pub held_columns: Vec<crate::logs::held_columns::HeldColumn>,
+    pub held_columns: Vec<crate::logs::findings::held_columns::HeldColumn>,
     /// The Coulomb friction term's regressor column of every joint (row-major `k x n`, within
     /// [-2, 2]: a filter overshoots): `sign(qd)` low-pass filtered as `tau` was, which a direct fit of these torques
     /// uses in place of `sign(qd)` ([`crate::States::with_coulomb`]): filtered torques step
@@ -51,7 +51,7 @@ pub struct Recording {
     /// The time stamps of the log this recording was preprocessed from, found jittering while
     /// its samples were taken on a regular clock ([`crate::logs::stamp_jitter`]); None for a
     /// recording as logged, or stamps found sound.
-    pub stamp_jitter: Option<crate::logs::stamp_jitter::StampJitter>,
+    pub stamp_jitter: Option<crate::logs::findings::stamp_jitter::StampJitter>,
     /// What averaging the log over the periods of its excitation found (the periods averaged
     /// and left out, each signal's noise from their spread; [`crate::logs::period_average`]); None
     /// for a recording as logged, or one preprocessed by the filter.
@@ -228,16 +228,18 @@ impl Recording {
             .map(|(i, t)| t * gains[i % n])
             .collect();
         let torque_saturation = (self.torque_saturation.iter())
-            .map(|c| crate::logs::torque_saturation::TorqueSaturation {
-                level: c.level * gains[c.joint],
-                beyond: c.beyond * gains[c.joint].abs(),
-                upper: c.upper == (gains[c.joint] > 0.0),
-                ..c.clone()
-            })
+            .map(
+                |c| crate::logs::findings::torque_saturation::TorqueSaturation {
+                    level: c.level * gains[c.joint],
+                    beyond: c.beyond * gains[c.joint].abs(),
+                    upper: c.upper == (gains[c.joint] > 0.0),
+                    ..c.clone()
+                },
+            )
             .collect();
         let glitches = (self.glitches.iter())
             .map(|g| match g.signal.as_str() {
-                "tau" => crate::logs::log_screening::LogGlitch {
+                "tau" => crate::logs::findings::log_screening::LogGlitch {
                     value: g.value * gains[g.joint],
                     replaced_by: g.replaced_by * gains[g.joint],
                     ..g.clone()

@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::PERIOD_RANGE;
+use super::options::PERIOD_RANGE;
 use crate::error::shown;
 
 /// A period of the log left out of the average, and why.

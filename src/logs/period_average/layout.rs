@@ -1,6 +1,7 @@
 //! Where the periods of a log lie, how they are sampled, and which a gap leaves out.
 
-use super::{LeftOutPeriod, PeriodOptions, MAX_PROJECTION_WORK, PERIOD_RANGE};
+use super::finding::LeftOutPeriod;
+use super::options::{PeriodOptions, MAX_PERIODS, MAX_PROJECTION_WORK, PERIOD_RANGE};
 use crate::error::{shown, shown5, Error, Result};
 use crate::logs::recording::Recording;
 
@@ -87,7 +88,7 @@ impl Layout {
         }
         let (t0, t1) = (rec.t[0], rec.t[rec.len() - 1]);
         let start = p.start.unwrap_or(t0);
-        let (dt, gaps) = crate::logs::preprocess::gaps(rec);
+        let (dt, gaps) = crate::logs::gaps::gaps(rec);
         let from = start + p.skip as f64 * p.period;
         if start < t0 - 0.5 * dt {
             return Err(Error::recording(
@@ -108,11 +109,11 @@ impl Layout {
             0
         };
         let wanted = p.count.map_or(whole, |c| c.min(whole));
-        if wanted > super::MAX_PERIODS {
+        if wanted > MAX_PERIODS {
             return Err(invalid(format!(
                 "{wanted} whole periods of {} s to average, more than {}: give a count of periods (count, or --skip-periods and a shorter log)",
                 shown5(p.period),
-                super::MAX_PERIODS
+                MAX_PERIODS
             )));
         }
         // every period's coefficients are held: positions' and torques' for every joint
