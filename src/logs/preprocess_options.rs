@@ -2,9 +2,9 @@
 //! decimation, the screening, and averaging over periods.
 
 /// Options of [`preprocess`](super::preprocess::preprocess). The defaults follow the common
-/// protocol (and the reference result on the real Panda log, docs/data.md): 1 kHz, 4th-order Butterworth at 10 Hz applied
-/// zero-phase to qd and tau, qdd from the filtered qd, 0.5 s dropped at both ends, every 10th
-/// sample kept.
+/// protocol (and the reference result on the real Panda log, docs/data.md): 1 kHz, 4th-order
+/// Butterworth at 10 Hz applied zero-phase to qd and tau, qdd from the filtered qd, 0.5 s
+/// dropped at both ends, every 10th sample kept.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PreprocessOptions {
     /// Uniform sampling rate after resampling (Hz).
