@@ -16,7 +16,6 @@ use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::io::{write_atomic, OutputSet, Table};
-use crate::logs::log_set::LogSet;
 use crate::logs::{read_states, samples_table};
 use crate::model_file::ModelFile;
 use crate::states::States;
@@ -199,16 +198,8 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     let paths: Vec<&std::path::Path> = a.data.iter().map(PathBuf::as_path).collect();
     let recs =
         (a.preprocessing).read_logs(&paths, &model.joint_names, "DATA", &progress, &mut out)?;
-    // each log's first samples are fitted to, its last validated on; several logs are
-    // stacked, one is read in place (a long log is not copied)
-    let names: Vec<String> = a.data.iter().map(|p| p.display().to_string()).collect();
-    let set = LogSet::new(
-        recs.iter().collect(),
-        names,
-        a.validate,
-        "DATA",
-        "--validate",
-    )?;
+    // each log's first samples are fitted to, its last validated on
+    let set = super::files::log_set(&recs, &a.data, a.validate)?;
     let (train, held) = (set.train()?, set.held()?);
     let (split, k) = (train.0.len(), train.0.len() + held.0.len());
     let in_data = |e: Error| set.in_data(e);

@@ -86,6 +86,18 @@ pub(crate) fn is_inline_json(arg: &Path) -> bool {
         && !arg.exists()
 }
 
+/// The logs `recs` read from `paths` (the command's `DATA`) as one set to fit: each log's last
+/// `validate` fraction held out (`--validate`); several logs are stacked, one is read in place
+/// (a long log is not copied).
+pub(crate) fn log_set<'a>(
+    recs: &'a [crate::logs::recording::Recording],
+    paths: &[PathBuf],
+    validate: f64,
+) -> Result<crate::logs::log_set::LogSet<'a>> {
+    let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    crate::logs::log_set::LogSet::new(recs.iter().collect(), names, validate, "DATA", "--validate")
+}
+
 /// The library's error about a log's columns (`q`, `qd`, `qdd`, `tau`: a dead torque
 /// channel, for one) as one about the file `path` it was read from, which the library's
 /// functions do not know.

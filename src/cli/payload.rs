@@ -15,7 +15,6 @@ use crate::direct::{
 use crate::error::{shown, Error, Result};
 use crate::gravity::Gravity;
 use crate::io::OutputSet;
-use crate::logs::log_set::LogSet;
 use crate::model_file::ModelFile;
 
 #[derive(Args)]
@@ -134,16 +133,8 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
     }
     options.noise =
         super::files::averaged_noise(&recs, &a.data, &model.joint_names, options.weighting)?;
-    // each log's first samples are fitted to, its last validated on; several logs are
-    // stacked, one is read in place (a long log is not copied)
-    let names: Vec<String> = a.data.iter().map(|p| p.display().to_string()).collect();
-    let set = LogSet::new(
-        recs.iter().collect(),
-        names,
-        a.validate,
-        "DATA",
-        "--validate",
-    )?;
+    // each log's first samples are fitted to, its last validated on
+    let set = super::files::log_set(&recs, &a.data, a.validate)?;
     let (train, held) = (set.train()?, set.held()?);
     if set.len() > 1 {
         options.runs = set.runs();
