@@ -88,25 +88,6 @@ pub(super) fn fit_with_factors(
         residual_rms: rms,
         sigma,
         samples: k,
-        torque_columns: super::torque_columns::check_torque_columns(
-            model,
-            states,
-            tau,
-            options.gravity,
-        )?,
-        // over several runs each run's lag (a shift of the stacked samples reads across joins)
-        torque_lag: match options.runs.len() {
-            0 | 1 => super::torque_lag::check_torque_lag(model, states, tau, options.gravity)?,
-            _ => None,
-        },
-        position_range: super::position_range::check_position_range(model, states),
-        run_checks: super::run_checks::check_runs_against_model(
-            model,
-            states,
-            tau,
-            &options.runs,
-            options.gravity,
-        )?,
         joint_term_rms: super::parameter_table::joint_term_rms(
             states,
             options.friction.for_model(model).names(),
@@ -114,8 +95,7 @@ pub(super) fn fit_with_factors(
         noise_fit,
         ..BaseModel::without_checks(model, base, options.gravity, options.weighting, &ls)
     };
-    fit.weak_excitation =
-        super::weak_excitation::check_excitation(model, states, &fit.base, ls.cond, &ls.weakest);
+    check_the_data(model, &mut fit, states, tau, options, &ls)?;
     // what follows reads the torques as the model with the runs' mean offset fits them: each
     // run's own offset taken out where one was fitted
     let adjusted = (log_offsets.as_ref()).map(|o| o.taken_out(tau, &options.runs));
@@ -145,11 +125,51 @@ pub(super) fn fit_with_factors(
         o.inflate(inflation);
         o
     });
-    fit.log_agreement =
-        super::log_agreement::check_log_agreement(model, &fit, states, tau, &options.runs)?;
-    fit.position_offsets =
-        super::position_offsets::check_position_offsets(model, &fit, states, tau)?;
-    fit.unmodelled_friction =
-        super::unmodelled_friction::check_unmodelled_friction(model, &fit, states, tau, options)?;
+    check_against_the_fit(model, &mut fit, states, tau, options)?;
     Ok((fit, factors))
+}
+
+/// The checks of the data a fit needs only its base parameters and conditioning for: the
+/// torque columns against the model, their lag behind the positions (one run: over several,
+/// a shift of the stacked samples reads across their joins), the joints' range, each run
+/// against the model, and the excitation of every base parameter.
+fn check_the_data(
+    model: &Model,
+    fit: &mut BaseModel,
+    states: &States<'_>,
+    tau: &[f64],
+    options: &BaseOptions,
+    ls: &crate::regression::LeastSquares,
+) -> Result<()> {
+    let g = options.gravity;
+    fit.torque_columns = super::torque_columns::check_torque_columns(model, states, tau, g)?;
+    fit.torque_lag = match options.runs.len() {
+        0 | 1 => super::torque_lag::check_torque_lag(model, states, tau, g)?,
+        _ => None,
+    };
+    fit.position_range = super::position_range::check_position_range(model, states);
+    fit.run_checks =
+        super::run_checks::check_runs_against_model(model, states, tau, &options.runs, g)?;
+    fit.weak_excitation =
+        super::weak_excitation::check_excitation(model, states, &fit.base, ls.cond, &ls.weakest);
+    Ok(())
+}
+
+/// The checks that read the fitted model against the data (`tau` with each run's own offset
+/// taken out where one was fitted): whether the logs agree under one model, the joints' zero
+/// offsets, and joint terms the model leaves out.
+fn check_against_the_fit(
+    model: &Model,
+    fit: &mut BaseModel,
+    states: &States<'_>,
+    tau: &[f64],
+    options: &BaseOptions,
+) -> Result<()> {
+    fit.log_agreement =
+        super::log_agreement::check_log_agreement(model, fit, states, tau, &options.runs)?;
+    fit.position_offsets =
+        super::position_offsets::check_position_offsets(model, fit, states, tau)?;
+    fit.unmodelled_friction =
+        super::unmodelled_friction::check_unmodelled_friction(model, fit, states, tau, options)?;
+    Ok(())
 }

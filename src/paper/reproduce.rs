@@ -202,7 +202,12 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
     )?;
     let recordings = simulate_plan(&model, &plan, &sim)?;
     let local = identify_local(&plan, &recordings, &IdentifyOptions::default())?;
-    let d_local = &local.d.as_ref().expect("planned").matrix;
+    // the plan holds the D experiment, so the model holds D*
+    let d = local.d.as_ref().ok_or_else(|| crate::error::Error::Internal {
+        context: "paper".into(),
+        message: "the local model has no D* though its plan has the D experiment".into(),
+    })?;
+    let (d_local, d_stderr) = (d.matrix.clone(), d.stderr.clone());
 
     let mut data = Data::new(&model);
     mass_matrix(&model, &mut data, &op.q)?;
@@ -245,14 +250,13 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
     } else {
         None
     };
-    let d_stderr = &local.d.as_ref().expect("planned").stderr;
     Ok(PaperResult {
         torque_identified: local.torque.clone(),
         torque_paper: a465::TABLE2_TORQUE.to_vec(),
         d_actual: column0(&actual),
         d_actual_paper: a465::TABLE3_D_COLUMN1.to_vec(),
-        d_perturbation: column0(d_local),
-        d_perturbation_stderr: column0(d_stderr),
+        d_perturbation: column0(&d_local),
+        d_perturbation_stderr: column0(&d_stderr),
         d_perturbation_paper: TABLE3_PERTURBATION.to_vec(),
         d_global_linear: direct[0].d_global_linear.median.clone(),
         d_base_parameters: direct[0].d_base_parameters.median.clone(),
