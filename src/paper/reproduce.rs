@@ -203,10 +203,13 @@ pub fn reproduce(options: &PaperOptions, progress: &mut dyn FnMut(&str)) -> Resu
     let recordings = simulate_plan(&model, &plan, &sim)?;
     let local = identify_local(&plan, &recordings, &IdentifyOptions::default())?;
     // the plan holds the D experiment, so the model holds D*
-    let d = local.d.as_ref().ok_or_else(|| crate::error::Error::Internal {
-        context: "paper".into(),
-        message: "the local model has no D* though its plan has the D experiment".into(),
-    })?;
+    let d = local
+        .d
+        .as_ref()
+        .ok_or_else(|| crate::error::Error::Internal {
+            context: "paper".into(),
+            message: "the local model has no D* though its plan has the D experiment".into(),
+        })?;
     let (d_local, d_stderr) = (d.matrix.clone(), d.stderr.clone());
 
     let mut data = Data::new(&model);
