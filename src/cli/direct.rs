@@ -16,6 +16,7 @@ use crate::document::Document;
 use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::io::{write_atomic, OutputSet, Table};
+use crate::logs::log_set::LogSet;
 use crate::logs::{read_states, samples_table};
 use crate::model_file::ModelFile;
 use crate::states::States;
@@ -194,7 +195,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
     let model = a.robot.load()?;
     let progress = Progress::new();
     let mut out = String::new();
-    super::files::check_validate_fraction(a.validate)?;
+    crate::logs::log_set::check_fraction(a.validate, "--validate")?;
     let paths: Vec<&std::path::Path> = a.data.iter().map(PathBuf::as_path).collect();
     let recs =
         (a.preprocessing).read_logs(&paths, &model.joint_names, "DATA", &progress, &mut out)?;
@@ -254,7 +255,7 @@ pub(crate) fn identify_direct(a: IdentifyDirectArgs) -> Result<String> {
         ));
     }
     if split < k {
-        validate_held_out(&model, &fit, &held, &recs, set.splits(), &a.data, &mut out)?;
+        validate_held_out(&model, &fit, &set, &mut out)?;
     }
     Ok(out)
 }
@@ -419,26 +420,22 @@ fn print_parameter_table(
 fn validate_held_out(
     model: &crate::model::Model,
     fit: &crate::direct::BaseModel,
-    held: &(States<'_>, &[f64]),
-    recs: &[crate::logs::Recording],
-    splits: &[usize],
-    data: &[PathBuf],
+    set: &LogSet<'_>,
     out: &mut String,
 ) -> Result<()> {
     let n = model.nv;
-    let k_held = held.0.len();
-    let held_out = held.0;
+    let held = set.held()?;
+    let (held_out, k_held, held_runs) = (held.0, held.0.len(), set.held_runs());
     let mut p = fit.on(model)?.predict(&held_out)?;
     // each log's held-out samples with its own offset, where one was fitted
     if let Some(o) = &fit.log_offsets {
-        let held_runs: Vec<usize> = recs.iter().zip(splits).map(|(r, s)| r.len() - s).collect();
         p = o.added(&p, &held_runs);
     }
     let _ = writeln!(
             out,
             "validation on the last {} samples{}: per joint RMS (N m), relative RMS (%) and the RMS of the predictions' standard errors (N m)",
             k_held,
-            match (recs.len(), &fit.log_offsets) {
+            match (set.len(), &fit.log_offsets) {
                 (1, _) => "",
                 (_, None) => " of each log",
                 (_, Some(_)) => " of each log, each with its own offset",
@@ -460,19 +457,19 @@ fn validate_held_out(
         );
     }
     // several logs: each one's own, to tell a log the model fits worse
-    if recs.len() > 1 {
+    if set.len() > 1 {
         let _ = writeln!(out, "per log, per joint RMS (N m):");
         let mut start = 0;
-        for ((rec, &split), path) in recs.iter().zip(splits).zip(data) {
-            let rows = start * n..(start + rec.len() - split) * n;
-            start += rec.len() - split;
+        for (&k, name) in held_runs.iter().zip(set.names()) {
+            let rows = start * n..(start + k) * n;
+            start += k;
             if rows.is_empty() {
                 continue;
             }
             let v =
                 crate::validation::validate(&model.joint_names, &p[rows.clone()], &held.1[rows])?;
             let rms: Vec<String> = v.joints.iter().map(|e| number(e.rms)).collect();
-            let _ = writeln!(out, "  {}: {}", path.display(), rms.join(" "));
+            let _ = writeln!(out, "  {name}: {}", rms.join(" "));
         }
     }
     Ok(())

@@ -489,19 +489,6 @@ pub(crate) fn averaged_noise(
     crate::direct::TorqueNoise::of_logs(logs, joints, weighting == crate::direct::Weighting::Noise)
 }
 
-pub(crate) fn check_validate_fraction(fraction: f64) -> Result<()> {
-    if (0.0..1.0).contains(&fraction) {
-        return Ok(());
-    }
-    Err(Error::invalid(
-        "--validate",
-        format!(
-            "{}; expected a fraction in [0, 1)",
-            crate::error::shown(fraction)
-        ),
-    ))
-}
-
 /// The logs given, for a note in a file written from them: their paths, or where they are
 /// many or long, their count and the first.
 pub(crate) fn logs_named(paths: &[PathBuf]) -> String {

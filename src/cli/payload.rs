@@ -107,7 +107,7 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
     options.consistent = a.consistent;
     options.inertia = a.inertia;
     options.offset_per_run = a.offset_per_log;
-    super::files::check_validate_fraction(a.validate)?;
+    crate::logs::log_set::check_fraction(a.validate, "--validate")?;
     // a link the robot lacks is named before the log is read
     crate::model::payload::Payload {
         link: a.link.clone(),
@@ -151,8 +151,7 @@ pub(crate) fn run(a: IdentifyPayloadArgs) -> Result<String> {
             let mut predicted = fit.predict(&model, reference, &held.0)?;
             // each log's held-out samples with its own offset, where one was fitted
             if let Some(o) = &fit.log_offsets {
-                let held_runs: Vec<usize> = set.held_runs();
-                predicted = o.added(&predicted, &held_runs);
+                predicted = o.added(&predicted, &set.held_runs());
             }
             crate::validation::validate(&model.joint_names, &predicted, held.1)
         })

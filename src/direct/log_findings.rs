@@ -30,12 +30,26 @@ impl BaseModel {
     pub fn with_findings_of_logs(self, set: &crate::logs::log_set::LogSet<'_>) -> Self {
         match set.recordings() {
             [rec] => self.with_findings_of(rec),
-            recs => Self {
-                logs: (recs.iter().zip(set.names()))
-                    .map(|(r, name)| LogFindings::of(name, r))
-                    .collect(),
-                ..self
-            },
+            recs => self.with_findings_of_each(
+                set.names()
+                    .iter()
+                    .map(String::as_str)
+                    .zip(recs.iter().copied()),
+            ),
+        }
+    }
+
+    /// The model with what the preprocessing found in each of the logs `logs` (its name, and
+    /// the recording) in [`Self::logs`], in their order.
+    pub fn with_findings_of_each<'r>(
+        self,
+        logs: impl IntoIterator<Item = (&'r str, &'r Recording)>,
+    ) -> Self {
+        Self {
+            logs: (logs.into_iter())
+                .map(|(name, r)| LogFindings::of(name, r))
+                .collect(),
+            ..self
         }
     }
 

@@ -27,6 +27,9 @@ use nalgebra::{DMatrix, DVector};
 
 use super::base_model::BaseModel;
 pub use super::findings::position_offsets::*;
+
+/// The step (rad or m) of the forward difference of the fitted torques in a position.
+const STEP: f64 = 1e-6;
 use super::parameters::regressor_blocks;
 use crate::error::Result;
 use crate::{Model, States};

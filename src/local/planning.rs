@@ -274,7 +274,7 @@ fn plan_experiment(
     if let Some(noise) = &o.torque_noise {
         // the nominal crossings: T* is their mean, their scatter the noise between passes
         let nominal = o.experiments.contains(&ExperimentKind::Nominal);
-        let readings = if nominal { o.count.unwrap_or(2 * n) } else { 0 };
+        let readings = if nominal { setup.count } else { 0 };
         let passes = o.torque_pass_noise.as_deref().unwrap_or_default();
         let prediction =
             predicted_response::predict(model, op, &experiment, noise, passes, o.rate, readings)?;

@@ -45,6 +45,16 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::error::{shown, Result};
 pub use crate::logs::findings::log_screening::*;
+
+/// How many evenly spread windows of a column give its median noise level (the floor of every
+/// window's level).
+const LEVEL_WINDOWS: usize = 400;
+
+/// A candidate whose studentised residual from the fit of its whole window is below this
+/// fraction of [`NOISE_LEVELS`] times its column's floor is not screened further: screening
+/// divides by a level at least that floor, and leaving other glitches of the window out
+/// could only raise the residual that far where they happened to cancel it.
+const QUICK_LOOK: f64 = 0.3;
 use crate::logs::outliers::{screen, Screened, MAX_PER_WINDOW, NOISE_LEVELS};
 use crate::logs::recording::Recording;
 

@@ -182,21 +182,28 @@ pub fn in_log(name: &str, e: Error) -> Error {
     }
 }
 
+/// Refuses a fraction of samples to validate on (given as `argument`) outside [0, 1): what a
+/// front end checks before it reads any log.
+pub fn check_fraction(fraction: f64, argument: &str) -> Result<()> {
+    if (0.0..1.0).contains(&fraction) {
+        return Ok(());
+    }
+    Err(Error::invalid(
+        argument,
+        format!("{}; expected a fraction in [0, 1)", shown(fraction)),
+    ))
+}
+
 /// Per log, the first sample validated on: the last `fraction` of its samples held out.
-/// Errors: a fraction that leaves a log nothing to fit to, or (above 0) nothing to validate
-/// on, naming the log where there are several.
-pub fn fit_splits(
+/// Errors: a fraction outside [0, 1), or one that leaves a log nothing to fit to, or (above 0)
+/// nothing to validate on, naming the log where there are several.
+fn fit_splits(
     fraction: f64,
     recs: &[&Recording],
     names: &[String],
     argument: &str,
 ) -> Result<Vec<usize>> {
-    if !(0.0..1.0).contains(&fraction) {
-        return Err(Error::invalid(
-            argument,
-            format!("{}; expected a fraction in [0, 1)", shown(fraction)),
-        ));
-    }
+    check_fraction(fraction, argument)?;
     let mut splits = Vec::with_capacity(recs.len());
     for (rec, name) in recs.iter().zip(names) {
         let k = rec.len();

@@ -19,6 +19,9 @@
 //! unwrapped by both steps: it is left for the glitch screening as it was.
 
 pub use crate::logs::findings::position_wraps::*;
+
+/// One turn (rad).
+const TURN: f64 = std::f64::consts::TAU;
 use crate::logs::recording::Recording;
 
 /// `rec` with the wraps of its positions taken back out (see the module documentation), and

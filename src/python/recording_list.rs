@@ -111,10 +111,5 @@ pub(crate) fn recording_set<'a>(
 /// `fit` with what each of the Recordings `recs` it was fitted to found in its preprocessing,
 /// in its `logs` (named by it).
 pub(crate) fn with_logs(fit: BaseModel, recs: &[Arc<Recording>]) -> BaseModel {
-    BaseModel {
-        logs: (recs.iter())
-            .map(|r| crate::direct::LogFindings::of(&r.name, r))
-            .collect(),
-        ..fit
-    }
+    fit.with_findings_of_each(recs.iter().map(|r| (r.name.as_str(), r.as_ref())))
 }

@@ -31,9 +31,6 @@ pub const FINDING_RATIO: f64 = 0.8;
 /// offset is not determined by the log).
 pub const ABSORBED: f64 = 1e-4;
 
-/// The step (rad or m) of the forward difference of the fitted torques in a position.
-pub(in crate::direct) const STEP: f64 = 1e-6;
-
 /// The joint offsets the log's torques point to.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

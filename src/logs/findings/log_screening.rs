@@ -12,16 +12,6 @@ pub const DEGREE: usize = 3;
 /// levels of that difference (over its column) is a candidate, judged in its window.
 pub const CANDIDATE_LEVELS: f64 = 5.0;
 
-/// A candidate whose studentised residual from the fit of its whole window is below this
-/// fraction of [`NOISE_LEVELS`] times its column's floor is not screened further: screening
-/// divides by a level at least that floor, and leaving other glitches of the window out
-/// could only raise the residual that far where they happened to cancel it.
-pub(in crate::logs) const QUICK_LOOK: f64 = 0.3;
-
-/// How many evenly spread windows of a column give its median noise level (the floor of every
-/// window's level).
-pub(in crate::logs) const LEVEL_WINDOWS: usize = 400;
-
 /// A sample of a log taken for a glitch and replaced before preprocessing.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -3,9 +3,6 @@
 
 use serde::{Deserialize, Serialize};
 
-/// One turn (rad).
-pub(in crate::logs) const TURN: f64 = std::f64::consts::TAU;
-
 /// The largest part of a wrap's step taken for the joint's own motion in one sample interval
 /// (rad): an eighth of a turn.
 pub const MAX_MOTION_AT_WRAP: f64 = std::f64::consts::FRAC_PI_4;
