@@ -310,7 +310,7 @@ pub(crate) fn check_plan_robot(model: &Model, plan: &crate::local::Plan) -> Resu
 /// Experiment `e` of `plan` sampled at the plan's rate, checked against `model`'s limits as
 /// [`crate::local::plan_experiments`] checks a plan it makes: a plan read from a file (edited
 /// by hand, or made for a robot with wider limits) runs on a robot only within its limits.
-pub(crate) fn experiment_samples(
+pub fn experiment_samples(
     model: &Model,
     plan: &crate::local::Plan,
     e: &crate::local::Experiment,

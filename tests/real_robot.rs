@@ -455,10 +455,13 @@ fn the_combined_estimate_reports_when_it_is_not_to_be_trusted() {
     assert!(rel(mat(&m.h), &truth.h) > 1.0, "the combined H* is far off");
     let w = &m.diagnostics.warnings;
     assert!(
-        w.iter().any(|w| w.starts_with("the model's D, H, G (estimator 'combined') disagree with the separated regressions in H by")
-            && w.contains("trust the separated estimate")),
+        w.iter().any(|w| w.starts_with("the model's D, H, G (estimator 'combined') disagree with the separated estimate in H by")
+            && w.contains("which the combined regression takes for motion")
+            && w.ends_with("trust it (estimator 'separated')")),
         "{w:?}"
     );
+    let evidence = m.diagnostics.estimator_evidence.as_ref().unwrap();
+    assert_eq!(evidence.favours_combined(), Some(false), "{evidence:?}");
     let h = m
         .diagnostics
         .combined
@@ -466,12 +469,9 @@ fn the_combined_estimate_reports_when_it_is_not_to_be_trusted() {
         .find(|b| b.block == "H")
         .unwrap();
     assert!(h.relative > 1.0, "{h:?}");
-    // the separated model keeps the combined estimate too, and says so
-    assert!(separated
-        .diagnostics
-        .warnings
-        .iter()
-        .any(|w| w.starts_with("the combined estimate kept in the model disagrees")));
+    // the separated model, favoured by the evidence, advises nothing
+    let w = &separated.diagnostics.warnings;
+    assert!(!w.iter().any(|w| w.contains("disagree")), "{w:?}");
 }
 
 /// A robot that tracks its plan under a PD controller with a payload its model lacks: the
@@ -540,11 +540,14 @@ fn closed_loop_tracking_errors_favour_the_combined_estimate() {
     let w = &separated.diagnostics.warnings;
     assert!(
         w.iter().any(|w| w.starts_with(
-            "the model's D, H, G (estimator 'separated') disagree with the combined regressions"
-        ) && w.contains("the robot did not follow its plan")
-            && w.ends_with("trust the combined estimate (estimator 'combined')")),
+            "the model's D, H, G (estimator 'separated') disagree with the combined estimate"
+        ) && w.contains("(tracking errors)")
+            && w.ends_with("trust it (estimator 'combined')")),
         "{w:?}"
     );
+    // the combined model, favoured by the evidence, never advises the estimator it used
+    let w = &combined.diagnostics.warnings;
+    assert!(!w.iter().any(|w| w.contains("disagree")), "{w:?}");
 }
 
 /// A robot in closed loop (400 N m/rad) with friction, a payload, torque noise and encoder

@@ -459,7 +459,8 @@ class LocalModel:
     @property
     def diagnostics(self) -> dict[str, Any]:
         """offsets (experiment -> clock offset, s), reversals (list of dicts), combined,
-        unperturbed_deviation, unmeasured (list of dicts: experiment, joint, value in N m, for
+        unperturbed_deviation, estimator_evidence (crossings, separated, combined, p_value: the
+        held-out prediction errors the estimator advice rests on), unmeasured (list of dicts: experiment, joint, value in N m, for
         torques that read one value throughout), noise (list of dicts, the nominal passes'
         first, then each separated regression's: experiment, joint, samples (N m, one torque sample's noise), passes (N m, what varied from pass to pass
         beyond it, or None), step (N m, the step the torque was logged in where it is coarser
@@ -486,6 +487,13 @@ class LocalModel:
         operating point in units of the largest perturbation the experiments gave that joint's
         q, qd or qdd: at most 1 inside the identified region. InputError for a model saved
         before its perturbations were stored."""
+    @property
+    def miss(self) -> Optional[dict[str, NDArray[np.float64]]]:
+        """How far the nominal passes missed the planned operating point: q, qd, qdd (measured -
+        planned), q_perturbations, qd_perturbations, qdd_perturbations (in planned
+        perturbations), measured_torque, measured_stderr (the mean at the nominal crossings),
+        correction, correction_stderr (N m, carried to the planned point), (n,) each; None
+        without the G, H and D experiments."""
     @property
     def perturbations(self) -> Optional[dict[str, NDArray[np.float64]]]:
         """The largest perturbation per joint: q (rad, G experiment), qd (rad/s, H), qdd

@@ -3,7 +3,9 @@
 //! unperturbed variables strayed, and the combined estimate against the separated one, with
 //! the warnings that follow (see [`super::diagnostics`] for the types).
 
-use super::diagnostics::{BlockAgreement, ClockOffset, Diagnostics, Reversal, ReversalHandling};
+use super::diagnostics::{
+    BlockAgreement, ClockOffset, Diagnostics, EstimatorEvidence, Reversal, ReversalHandling,
+};
 use super::identify::{state, ExperimentValues};
 use super::model::{Estimate, Estimator};
 use super::plan::ExperimentKind;
@@ -76,13 +78,16 @@ pub(super) fn unperturbed_deviation(
 }
 
 /// A warning when the combined estimate disagrees with the separated one beyond its noise in
-/// some block (by more than half, or by more than 5 % and 10 standard errors), saying which to
-/// trust: the separated one when the deviations of the unperturbed variables are measurement
-/// noise (`deviation` about 1), the combined one when they are tracking errors.
+/// some block (by more than half, or by more than 5 % and 10 standard errors), with advice from
+/// `evidence` (which predicts the crossings left out of its fit better): to switch to the other
+/// estimator where it predicts significantly better, none where neither does. None where the
+/// estimator in use predicts better: the other one is the worse. `deviation` says why they
+/// differ: tracking errors (far above 1) or measurement noise (about 1).
 pub(super) fn disagreement_warning(
     blocks: &[BlockAgreement],
     estimator: Estimator,
     deviation: Option<f64>,
+    evidence: Option<&EstimatorEvidence>,
 ) -> Option<String> {
     let bad: Vec<String> = blocks
         .iter()
@@ -99,29 +104,32 @@ pub(super) fn disagreement_warning(
     if bad.is_empty() {
         return None;
     }
-    let deviation = deviation.unwrap_or(f64::NAN);
-    let tracking = deviation > 3.0;
-    let subject = match (estimator, tracking) {
-        (Estimator::Combined, _) => "the model's D, H, G (estimator 'combined') disagree",
-        (Estimator::Separated, true) => "the model's D, H, G (estimator 'separated') disagree",
-        (Estimator::Separated, false) => "the combined estimate kept in the model disagrees",
+    let (used, other) = match estimator {
+        Estimator::Separated => ("separated", "combined"),
+        Estimator::Combined => ("combined", "separated"),
     };
-    let cause = if tracking {
-        format!(
-            "the robot did not follow its plan: the variables an experiment did not perturb stray from the operating point by {deviation:.0} times their measurement noise (tracking errors), which the separated regressions ignore and the combined one accounts for; trust the combined estimate (estimator 'combined')"
-        )
+    let deviation = deviation.unwrap_or(f64::NAN);
+    let why = if deviation > 3.0 {
+        format!("the variables an experiment did not perturb stray from the operating point by {deviation:.0} times their measurement noise (tracking errors), which the separated regressions leave out and the combined one fits")
     } else {
-        format!(
-            "the variables an experiment did not perturb deviate only by their measurement noise ({deviation:.1} standard errors RMS), which the combined regression takes for motion (encoder quantisation, or stamps that jitter, reach qdd through two derivatives and leak D* into the smaller H* and G*); trust the separated estimate"
-        )
+        format!("the variables an experiment did not perturb deviate from the operating point by {deviation:.1} times their measurement noise (RMS), which the combined regression takes for motion")
+    };
+    let advice = match evidence {
+        Some(e) => {
+            let numbers = format!(
+                "held-out RMS error {:.3} separated, {:.3} combined, over {} crossings, p = {:.1e}",
+                e.separated, e.combined, e.crossings, e.p_value
+            );
+            match e.favours_combined() {
+                Some(c) if c == (estimator == Estimator::Combined) => return None,
+                Some(_) => format!("the {other} estimate predicts the crossings left out of its fit better ({numbers}): trust it (estimator '{other}')"),
+                None => format!("neither predicts the crossings left out of its fit better ({numbers}): the data do not tell which is nearer, so count the difference as uncertainty of the model"),
+            }
+        }
+        None => "too few crossings to tell which predicts better".to_string(),
     };
     Some(format!(
-        "{subject} with the {} regressions in {}: {cause}",
-        if estimator == Estimator::Combined || !tracking {
-            "separated"
-        } else {
-            "combined"
-        },
+        "the model's D, H, G (estimator '{used}') disagree with the {other} estimate in {}: {why}; {advice}",
         bad.join(", ")
     ))
 }

@@ -124,6 +124,31 @@ pub struct Glitch {
     pub replaced: bool,
 }
 
+/// The held-out prediction errors of both estimators.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EstimatorEvidence {
+    /// Crossings predicted (each once, by fits made without its fold).
+    pub crossings: usize,
+    /// RMS prediction error of the separated and the combined estimates, each joint's error in
+    /// units of the RMS of its torque changes.
+    pub separated: f64,
+    pub combined: f64,
+    /// Two-sided p value of the paired difference of the crossings' error norms (Student's t).
+    pub p_value: f64,
+}
+
+/// p value below which one estimator counts as the better predictor.
+pub const EVIDENCE_LEVEL: f64 = 0.01;
+
+impl EstimatorEvidence {
+    /// The estimator the evidence favours at [`EVIDENCE_LEVEL`]: `Some(true)` combined,
+    /// `Some(false)` separated, `None` no difference.
+    pub fn favours_combined(&self) -> Option<bool> {
+        (self.p_value < EVIDENCE_LEVEL).then_some(self.combined < self.separated)
+    }
+}
+
 /// Diagnostics of a local identification; see the module documentation.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -142,6 +167,11 @@ pub struct Diagnostics {
     /// The combined estimate against the separated one, block by block (when both exist).
     #[serde(default)]
     pub combined: Vec<BlockAgreement>,
+    /// How well each estimator predicts the crossings left out of its fit: the evidence the
+    /// advice between them rests on ([`super::estimator_evidence`]). `None` without the
+    /// nominal, G, H and D experiments.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub estimator_evidence: Option<EstimatorEvidence>,
     /// The rows not measured (their standard errors NaN), with a warning: a torque that did
     /// not change. [`super::identify_parameters_from_local`] leaves them out.
     #[serde(default)]

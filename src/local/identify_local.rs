@@ -77,8 +77,9 @@ pub fn identify_local(
     });
     let (d, h, g) = estimates.chosen(options.estimator, plan.n())?;
     let found = fits.findings();
+    let nominal = point.nominal.map(|i| read.values[i].clone());
     let diagnostics = model_diagnostics(plan, options, read, &point, found, flat, disagreement, &d);
-    Ok(LocalModel {
+    let mut model = LocalModel {
         format: LocalModel::tag(),
         robot: plan.robot.clone(),
         joint_names: plan.joint_names.clone(),
@@ -96,7 +97,19 @@ pub fn identify_local(
         perturbations: super::Perturbations::of_plan(plan),
         diagnostics,
         drive_gains: None,
-    })
+        miss: None,
+    };
+    if let Some(nominal) = nominal {
+        let band: Vec<bool> = (0..plan.n())
+            .map(|j| nominal.crossings.iter().any(|c| c.position_band[j]))
+            .collect();
+        model.carry_to_plan(&nominal, &band, &point.rounding)?;
+        model
+            .diagnostics
+            .warnings
+            .extend(super::carry_to_plan::miss_warning(&model));
+    }
+    Ok(model)
 }
 
 /// What the experiments' recordings gave, in the plan's order of experiments.
@@ -254,7 +267,15 @@ fn model_diagnostics(
         diagnostics.warnings.extend(warnings);
     }
     let deviation = unperturbed_deviation(values, &point.state, &point.var);
-    if let Some(w) = disagreement_warning(&disagreement, options.estimator, deviation) {
+    let evidence = super::estimator_evidence::held_out_evidence(values, point, plan.n());
+    let advice = disagreement_warning(
+        &disagreement,
+        options.estimator,
+        deviation,
+        evidence.as_ref(),
+    );
+    diagnostics.estimator_evidence = evidence;
+    if let Some(w) = advice {
         diagnostics.warnings.push(w);
     }
     if let Some(w) = d

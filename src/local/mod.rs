@@ -30,18 +30,21 @@
 //! # Ok::<(), perturbid_rs::Error>(())
 //! ```
 
+mod carry_to_plan;
 pub mod clock;
 pub mod crossing;
 pub mod crossing_values;
 mod diagnose;
 pub mod diagnostics;
 pub mod errors_in_variables;
+pub mod estimator_evidence;
 mod flat_channels;
 mod followed_plan;
 mod friction_aware;
 pub mod glitches;
 pub mod identify;
 mod identify_local;
+pub mod miss;
 pub mod model;
 mod model_summary;
 pub mod noise;
@@ -76,11 +79,12 @@ pub use crossing::{
     SignalScales, TorqueFit, WindowGlitch,
 };
 pub use diagnostics::{
-    BlockAgreement, ClockOffset, Diagnostics, Glitch, Reversal, ReversalHandling, TorqueNoise,
-    Unmeasured,
+    BlockAgreement, ClockOffset, Diagnostics, EstimatorEvidence, Glitch, Reversal,
+    ReversalHandling, TorqueNoise, Unmeasured,
 };
 pub use identify::{CrossingTimes, IdentifyOptions, TimesSource};
 pub use identify_local::identify_local;
+pub use miss::Miss;
 pub use model::{Estimate, Estimator, LocalModel, SignalGains};
 pub use offset_search::{detect_offset, detect_offset_in};
 pub use parameters::{identify_parameters_from_local, FromLocalOptions, ParametersFromLocal};

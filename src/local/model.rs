@@ -118,10 +118,12 @@ pub struct LocalModel {
     /// holds there and predictions are deltas from it.
     pub planned_op: OperatingPoint,
     pub estimator: Estimator,
-    /// `T*` (N m): mean torque at the nominal crossings.
+    /// `T*` (N m): the torque at the planned operating point, the mean torque at the nominal
+    /// crossings carried there from the point they measured by D*, H*, G* ([`Self::miss`]).
     pub torque: Vec<f64>,
-    /// Standard error of `T*` (sample standard deviation / sqrt(K)); NaN (`null` in JSON) with
-    /// one nominal crossing.
+    /// Standard error of `T*`: the scatter of the carried readings / sqrt(K), with what the
+    /// matrices' uncertainty and repeated encoder rounding give the carrying; NaN (`null` in
+    /// JSON) with one nominal crossing.
     #[serde(with = "crate::json::stderr_vec")]
     pub torque_stderr: Vec<f64>,
     /// `D*`, `H*`, `G*` (dynamic) and `Gs` (static), when their experiment was run.
@@ -150,6 +152,11 @@ pub struct LocalModel {
     /// coefficients'. None for recordings of torques.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub drive_gains: Option<SignalGains>,
+    /// How far the nominal passes missed the planned operating point, and the correction that
+    /// carried T* to it ([`super::miss`]). `None` without the G, H and D experiments (T* is
+    /// then the mean at the nominal crossings), or in a model saved before it was stored.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub miss: Option<super::miss::Miss>,
 }
 
 /// The drive gains a local model's recordings were put in torques by ([`LocalModel::drive_gains`]).
@@ -408,6 +415,9 @@ impl LocalModel {
         }
         if let Some(g) = &m.drive_gains {
             g.check(Self::WHAT, n)?;
+        }
+        if let Some(miss) = &m.miss {
+            miss.check(Self::WHAT, n)?;
         }
         // and no number beyond any robot's
         let kind = "a local model";

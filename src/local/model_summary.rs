@@ -33,6 +33,27 @@ impl LocalModel {
             .map(|(t, s)| format!("{t:.4} [{s:.1e}]"))
             .collect();
         let _ = writeln!(out, "T* (N m): {}", t.join(", "));
+        if let Some(m) = &self.miss {
+            let units = |v: &[f64]| -> String {
+                let cells: Vec<String> = v.iter().map(|x| format!("{x:+.2}")).collect();
+                cells.join(", ")
+            };
+            let _ = writeln!(
+                out,
+                "the nominal passes missed the operating point by (in perturbations, per joint): q {}; qd {}; qdd {}",
+                units(&m.q_perturbations),
+                units(&m.qd_perturbations),
+                units(&m.qdd_perturbations)
+            );
+            let c: Vec<String> = (m.correction.iter().zip(&m.correction_stderr))
+                .map(|(c, s)| format!("{c:+.4} [{s:.1e}]"))
+                .collect();
+            let _ = writeln!(
+                out,
+                "T* carried to the planned point by (N m): {}",
+                c.join(", ")
+            );
+        }
         for (name, e) in [
             ("D*", &self.d),
             ("H*", &self.h),

@@ -21,6 +21,9 @@ pub(super) struct NominalPoint {
     pub(super) state: [Vec<f64>; 3],
     /// The variance of the operating point's error, per variable and joint.
     pub(super) var: [Vec<f64>; 3],
+    /// Per joint, the floor the torque's rounding to its logged steps puts under the standard
+    /// error of `torque` (0 where the torque is not logged coarser than its noise).
+    pub(super) rounding: Vec<f64>,
 }
 
 impl NominalPoint {
@@ -44,6 +47,7 @@ impl NominalPoint {
             )),
             None => (vec![f64::NAN; n], vec![f64::NAN; n], plan.op.clone()),
         };
+        let rounding = nominal.map_or_else(|| vec![0.0; n], |v| rounding_floor(v, n));
         let state = [op.q.clone(), op.qd.clone(), op.qdd.clone()];
         // the variance of the operating point's error, the mean of the nominal crossings':
         // noise averages over their K passes (/ K), but positions read by their band are
@@ -75,6 +79,7 @@ impl NominalPoint {
             op,
             state,
             var,
+            rounding,
         })
     }
 
@@ -87,20 +92,15 @@ impl NominalPoint {
                 .collect()
         };
         let tau = mean(&|c| &c.tau);
-        let samples = sample_variance(&v.crossings, n);
+        let rounding = rounding_floor(v, n);
         let se = (0..n)
             .map(|j| {
-                let ss: f64 = v
-                    .crossings
-                    .iter()
-                    .map(|c| (c.tau[j] - tau[j]).powi(2))
-                    .sum();
-                let rounding = quantisation::undithered_step(v.torque_step[j], samples[j])
-                    .map_or(0.0, |q| quantisation::rounding_stderr(q) / k.sqrt());
-                if k > 1.0 {
-                    (ss / (k - 1.0) / k).sqrt().max(rounding)
+                let readings = v.crossings.iter().map(|c| c.tau[j]);
+                let se = mean_stderr(readings, tau[j], v.crossings.len());
+                if se.is_nan() {
+                    se
                 } else {
-                    f64::NAN
+                    se.max(rounding[j])
                 }
             })
             .collect();
@@ -111,4 +111,29 @@ impl NominalPoint {
         };
         (tau, se, op)
     }
+}
+
+/// Per joint, the floor that rounding to the logged torque steps puts under the standard error
+/// of the mean torque over the crossings of `v` (0 where the torque is not logged coarser than
+/// its noise).
+fn rounding_floor(v: &ExperimentValues, n: usize) -> Vec<f64> {
+    let k = v.crossings.len().max(1) as f64;
+    let samples = sample_variance(&v.crossings, n);
+    (0..n)
+        .map(|j| {
+            quantisation::undithered_step(v.torque_step[j], samples[j])
+                .map_or(0.0, |q| quantisation::rounding_stderr(q) / k.sqrt())
+        })
+        .collect()
+}
+
+/// The standard error of the mean `mean` of `k` readings from their scatter; NaN for fewer
+/// than two.
+pub(super) fn mean_stderr(readings: impl Iterator<Item = f64>, mean: f64, k: usize) -> f64 {
+    if k < 2 {
+        return f64::NAN;
+    }
+    let ss: f64 = readings.map(|x| (x - mean).powi(2)).sum();
+    let k = k as f64;
+    (ss / (k - 1.0) / k).sqrt()
 }

@@ -77,7 +77,10 @@ impl PyLocalModel {
     /// (relative difference, largest difference in standard errors) of the combined estimate
     /// against the separated one), `unperturbed_deviation` (how far the variables an experiment
     /// did not perturb stray, in standard errors of their measurement: ~1 for noise, far above
-    /// for tracking errors), `unmeasured` (list of dicts: `experiment`, `joint`, `value` in N m,
+    /// for tracking errors), `estimator_evidence` (dict `crossings`, `separated`, `combined`,
+    /// `p_value`: each estimator's RMS error predicting the crossings left out of its fit, the
+    /// evidence the advice between them rests on; absent without the G, H and D experiments),
+    /// `unmeasured` (list of dicts: `experiment`, `joint`, `value` in N m,
     /// for torques that read one value throughout), `noise` (list of dicts, the nominal
     /// passes' first (their `passes` is what `plan_experiments(torque_pass_noise=)` takes),
     /// then each separated regression's: `experiment`, `joint`, `samples` (N m, one torque sample's noise), `passes` (N m, what varied from pass
@@ -134,6 +137,14 @@ impl PyLocalModel {
         }
         out.set_item("combined", combined)?;
         out.set_item("unperturbed_deviation", d.unperturbed_deviation)?;
+        if let Some(e) = &d.estimator_evidence {
+            let evidence = PyDict::new(py);
+            evidence.set_item("crossings", e.crossings)?;
+            evidence.set_item("separated", e.separated)?;
+            evidence.set_item("combined", e.combined)?;
+            evidence.set_item("p_value", e.p_value)?;
+            out.set_item("estimator_evidence", evidence)?;
+        }
         let unmeasured = d
             .unmeasured
             .iter()
@@ -424,6 +435,35 @@ impl PyLocalModel {
     /// experiment), `qd` (rad/s; H), `qdd` (rad/s^2; D), each `(n,)` (m, m/s, m/s^2 for a
     /// prismatic joint): the region the model was identified over. None for a model saved
     /// before they were stored.
+    /// How far the nominal passes missed the planned operating point, and what carried T* to
+    /// it: a dict of `(n,)` arrays `q`, `qd`, `qdd` (measured - planned: rad, rad/s, rad/s^2),
+    /// `q_perturbations`, `qd_perturbations`, `qdd_perturbations` (the same in units of the
+    /// largest planned perturbation; NaN where that is 0), `measured_torque` and
+    /// `measured_stderr` (N m: the mean at the nominal crossings, before the correction),
+    /// `correction` and `correction_stderr` (N m: subtracted to give `torque`, and its matrices'
+    /// share of `torque_stderr`). None without the G, H and D experiments.
+    #[getter]
+    fn miss<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(m) = &self.model.miss else {
+            return Ok(None);
+        };
+        let out = PyDict::new(py);
+        for (k, v) in [
+            ("q", &m.q),
+            ("qd", &m.qd),
+            ("qdd", &m.qdd),
+            ("q_perturbations", &m.q_perturbations),
+            ("qd_perturbations", &m.qd_perturbations),
+            ("qdd_perturbations", &m.qdd_perturbations),
+            ("measured_torque", &m.measured_torque),
+            ("measured_stderr", &m.measured_stderr),
+            ("correction", &m.correction),
+            ("correction_stderr", &m.correction_stderr),
+        ] {
+            out.set_item(k, vec1(py, v))?;
+        }
+        Ok(Some(out))
+    }
     #[getter]
     fn perturbations<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
         let Some(p) = &self.model.perturbations else {

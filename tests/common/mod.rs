@@ -315,6 +315,7 @@ pub fn exact_local(
         perturbations: None,
         diagnostics: Default::default(),
         drive_gains: None,
+        miss: None,
     }
 }
 

@@ -700,3 +700,27 @@ def test_coarse_encoders_are_reported_by_the_friction_aware_h_regression_too():
         coarse = [w for w in model.diagnostics["warnings"] if w.startswith("experiment 'H': the encoders of joint(s) 'joint3' (steps of 1.53e-3 rad: velocities known to")]
         assert len(coarse) == 1, (aware, model.diagnostics["warnings"])
         assert (model.coulomb is not None) == aware
+
+
+def test_a_tracking_robots_miss_and_the_estimator_evidence():
+    """A robot under PD tracking with a payload its model lacks misses P: the model reports
+    the miss per joint, T* carried to the planned point (measured mean - correction), and the
+    held-out evidence the estimator advice rests on."""
+    robot = pr.robots.a465()
+    op = pr.OperatingPoint(TABLE2[0], [0.5, -0.4, 0.45, 0.6, -0.5, 0.55], TABLE2[2])
+    plan = pr.plan_experiments(robot, op)
+    true = pr.TrueRobot({
+        "payload": {"link": "link6", "mass": 0.5, "com": [0.0, 0.0, 0.05]},
+        "controller": {"kp": [400.0] * 6, "kd": [40.0] * 6, "substeps": 2},
+        "sensors": {"torque_noise": [0.01] * 6},
+    })
+    model = pr.identify_local(plan, pr.simulate(robot, plan, true_robot=true))
+    miss = model.miss
+    assert set(miss) >= {"q", "qd", "qdd", "q_perturbations", "measured_torque", "correction", "correction_stderr"}
+    np.testing.assert_allclose(miss["q"], model.op.q - model.planned_op.q, atol=1e-12)
+    np.testing.assert_allclose(miss["measured_torque"] - miss["correction"], model.torque, atol=1e-9)
+    assert np.abs(miss["q"]).max() > 1e-4
+    evidence = model.diagnostics["estimator_evidence"]
+    assert evidence["crossings"] > 20 and 0.0 <= evidence["p_value"] <= 1.0
+    # the separated estimate is the worse predictor under tracking errors
+    assert evidence["combined"] < evidence["separated"]

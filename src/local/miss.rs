@@ -1,0 +1,101 @@
+//! How far the nominal passes missed the planned operating point ([`Miss`]).
+//!
+//! Every nominal pass of a tracking robot misses the operating point alike, so the mean torque
+//! over them is the torque at the measured point; the model keeps how far it was and what
+//! carried T* to the planned point (docs/method.md, "Closed-loop identification").
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::Result;
+
+/// How far the nominal passes missed the planned operating point, and what that did to T*.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Miss {
+    /// Per joint, the mean state at the nominal crossings less the planned operating point
+    /// (rad, rad/s, rad/s^2; m for a prismatic joint).
+    pub q: Vec<f64>,
+    pub qd: Vec<f64>,
+    pub qdd: Vec<f64>,
+    /// The same in units of the largest perturbation the experiments gave each joint's
+    /// variable ([`LocalModel::perturbations`]): past 1 the correction extrapolates beyond the
+    /// region the matrices were identified over. NaN (`null`) where that perturbation is 0.
+    #[serde(with = "crate::json::stderr_vec")]
+    pub q_perturbations: Vec<f64>,
+    #[serde(with = "crate::json::stderr_vec")]
+    pub qd_perturbations: Vec<f64>,
+    #[serde(with = "crate::json::stderr_vec")]
+    pub qdd_perturbations: Vec<f64>,
+    /// The mean torque at the nominal crossings (N m): the torque at the measured point.
+    pub measured_torque: Vec<f64>,
+    /// Its standard error from the readings' scatter (N m), which counts noise only: as an
+    /// estimate of T* at the planned point it is off by the correction.
+    #[serde(with = "crate::json::stderr_vec")]
+    pub measured_stderr: Vec<f64>,
+    /// The correction `D* dqdd + H* dqd + G* dq` at the mean miss, subtracted from
+    /// `measured_torque` to give the model's `torque` (N m).
+    pub correction: Vec<f64>,
+    /// The part of the model's `torque_stderr` that the matrices' uncertainty gives the
+    /// correction (N m); NaN where a weighted entry's standard error is unknown.
+    #[serde(with = "crate::json::stderr_vec")]
+    pub correction_stderr: Vec<f64>,
+}
+
+/// Misses past this many perturbations are named in a warning: the first-order correction
+/// extrapolates past the region its matrices were identified over.
+pub const MISS_WARNING: f64 = 1.0;
+
+impl Miss {
+    /// The largest miss in perturbation units: `(joint, variable name, value)`.
+    pub fn largest(&self) -> Option<(usize, &'static str, f64)> {
+        let mut best: Option<(usize, &'static str, f64)> = None;
+        for (name, v) in [
+            ("q", &self.q_perturbations),
+            ("qd", &self.qd_perturbations),
+            ("qdd", &self.qdd_perturbations),
+        ] {
+            for (j, x) in v.iter().enumerate().filter(|(_, x)| x.is_finite()) {
+                if best.is_none_or(|b| x.abs() > b.2.abs()) {
+                    best = Some((j, name, *x));
+                }
+            }
+        }
+        best
+    }
+
+    /// Checks a stored miss of `n` joints (`what` names the document).
+    pub(crate) fn check(&self, what: &str, n: usize) -> Result<()> {
+        for (field, v) in [
+            ("q", &self.q),
+            ("qd", &self.qd),
+            ("qdd", &self.qdd),
+            ("q_perturbations", &self.q_perturbations),
+            ("qd_perturbations", &self.qd_perturbations),
+            ("qdd_perturbations", &self.qdd_perturbations),
+            ("measured_torque", &self.measured_torque),
+            ("measured_stderr", &self.measured_stderr),
+            ("correction", &self.correction),
+            ("correction_stderr", &self.correction_stderr),
+        ] {
+            if v.len() != n {
+                return Err(crate::document::invalid(
+                    what,
+                    format!("miss.{field} has {} entries for {n} joints", v.len()),
+                ));
+            }
+            crate::document::check_bounded(what, "a local model", &format!("miss.{field}"), v)?;
+        }
+        crate::document::check_magnitudes(
+            what,
+            "miss.measured_stderr",
+            &self.measured_stderr,
+            true,
+        )?;
+        crate::document::check_magnitudes(
+            what,
+            "miss.correction_stderr",
+            &self.correction_stderr,
+            true,
+        )
+    }
+}
