@@ -2,8 +2,9 @@
 //! an operating point where every joint is fast, open loop and under PD tracking, with the
 //! realistic true robot of `perturbid_rs::rehearsal::realistic_robot` (payload, link errors,
 //! asymmetric Coulomb + Stribeck + viscous friction, 1 % ripple, 2^18 counts, torque noise, a
-//! 1.5 ms torque delay, a 7 ms clock offset) over several seeds: T* in units of its standard
-//! errors, D*, H*, G* against the truth.
+//! 1.5 ms torque delay, a 7 ms clock offset) over several seeds, and open loop with the delay
+//! given to the identification (`FitOptions::torque_delay`): T* in units of its standard errors,
+//! D*, H*, G* against the truth.
 //!
 //!     cargo run --release --example closed_loop_campaign [-- --seeds 5] [--out FILE]
 //!
@@ -68,7 +69,9 @@ fn main() -> perturbid_rs::Result<()> {
             eprintln!("skipped {name}: example-robot-data is not installed");
             continue;
         };
-        for bandwidth in [None, Some(25.0)] {
+        for (bandwidth, read_past) in [(None, 0.0), (Some(25.0), 0.0), (None, 1.5e-3)] {
+            let mut identify = IdentifyOptions::default();
+            identify.fit.torque_delay = read_past;
             let mut rows = vec![];
             for seed in 0..seeds {
                 let realism = Realism {
@@ -82,7 +85,7 @@ fn main() -> perturbid_rs::Result<()> {
                     &robot,
                     &op,
                     &PlanOptions::default(),
-                    &IdentifyOptions::default(),
+                    &identify,
                     0.007,
                 )?;
                 eprintln!(
@@ -128,7 +131,8 @@ fn main() -> perturbid_rs::Result<()> {
             let worst = |v: &[f64]| v.iter().cloned().fold(0.0, f64::max);
             lines.push(format!(
                 "| {name} | {} | {} | {:.0} % | {:.1} | {:.1} | {:.1} % | {:.1} % | {:.1} % | {:.0} % | {:.1} % | {:.2} | {} | {} |",
-                bandwidth.map_or("open loop".to_string(), |b| format!("PD {b:.0} Hz")),
+                bandwidth.map_or("open loop".to_string(), |b| format!("PD {b:.0} Hz"))
+                    + if read_past > 0.0 { ", delay read past" } else { "" },
                 rows.len(),
                 100.0 * t.iter().filter(|x| **x <= 3.0).count() as f64 / t.len() as f64,
                 worst(&t),

@@ -188,3 +188,77 @@ fn a_tracking_ur5_states_t_star_within_its_standard_errors() {
         "the controller misses P: {miss:?}"
     );
 }
+
+/// The Panda of example-robot-data (skipped where it is not installed) at a point where every
+/// joint is fast, open loop, with a 1.5 ms torque delay: T* read at the crossings' times is
+/// off by the delay times the torque's rate, beyond its standard errors; read 1.5 ms later
+/// (`FitOptions::torque_delay`), within them.
+#[test]
+fn a_known_torque_delay_is_read_past() {
+    let Some(model) = common::panda_model() else {
+        eprintln!("skipped: example-robot-data is not installed (pip install example-robot-data)");
+        return;
+    };
+    let op = OperatingPoint::new(
+        vec![0.3, -0.5, 0.2, -2.0, 0.3, 1.6, 0.5],
+        vec![0.5, -0.4, 0.45, 0.6, -0.5, 0.55, 0.4],
+        vec![1.0, -0.8, 0.9, 1.2, -1.0, 0.7, 0.8],
+    )
+    .unwrap();
+    let worst = |delay: f64| {
+        let realism = Realism {
+            bandwidth: None,
+            delay: 1.5e-3,
+            ..Realism::default()
+        };
+        let robot = realistic_robot(&model, &op.q, &realism).unwrap();
+        let mut options = IdentifyOptions::default();
+        options.fit.torque_delay = delay;
+        let case = local_case(&model, &robot, &op, &PlanOptions::default(), &options, 0.0).unwrap();
+        case.torque_errors
+            .iter()
+            .fold(0.0f64, |a, e| a.max(e.abs()))
+    };
+    let (ignored, read) = (worst(0.0), worst(1.5e-3));
+    assert!(
+        ignored > 3.0,
+        "ignored, the delay leaves T* {ignored:.1} standard errors off"
+    );
+    assert!(
+        read < 3.0 && read < 0.6 * ignored,
+        "read past, T* is {read:.1} standard errors off"
+    );
+}
+
+/// A delay beyond any drive's is refused, naming the option.
+#[test]
+fn an_impossible_torque_delay_is_refused() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let robot = realistic_robot(
+        &model,
+        &all_fast().q,
+        &Realism {
+            bandwidth: None,
+            ..Realism::default()
+        },
+    )
+    .unwrap();
+    for delay in [0.5, f64::NAN] {
+        let mut options = IdentifyOptions::default();
+        options.fit.torque_delay = delay;
+        let e = local_case(
+            &model,
+            &robot,
+            &all_fast(),
+            &PlanOptions::default(),
+            &options,
+            0.0,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("torque_delay") && e.contains("expected a finite delay within +-0.05 s"),
+            "{e}"
+        );
+    }
+}

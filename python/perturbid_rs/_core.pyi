@@ -599,10 +599,13 @@ def identify_local(
     estimator: str = "separated",
     friction_aware_h: bool = False,
     drive_gains: Optional[BaseParameterModel] = None,
+    torque_delay: float = 0.0,
 ) -> LocalModel:
     """The local model from a plan and one recording per experiment. drive_gains: a model
     from identify_drive_gains, for recordings of motor currents (put in torques by its
-    gains, which the local model keeps)."""
+    gains, which the local model keeps). torque_delay: how long after the positions the
+    torque logs what belongs with them (s; a sensor's or filter's delay): each torque is
+    read that much later."""
 
 def identify_parameters_from_local(
     robot: Robot,

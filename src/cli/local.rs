@@ -438,6 +438,10 @@ pub(crate) struct IdentifyArgs {
     /// Half-width of the fits around each crossing (s; default: the plan's window).
     #[arg(long)]
     window: Option<f64>,
+    /// How long after the positions the torque logs what belongs with them (s; a sensor's or
+    /// filter's delay): each crossing's torque is read that much later.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    torque_delay: f64,
     /// separated (the paper) or combined (all crossings in one regression).
     #[arg(long, value_enum, default_value_t = Estimator::Separated)]
     estimator: Estimator,
@@ -517,6 +521,7 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
         },
         fit: crate::local::FitOptions {
             window: a.window,
+            torque_delay: a.torque_delay,
             ..Default::default()
         },
         estimator: a.estimator,

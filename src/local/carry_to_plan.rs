@@ -17,15 +17,24 @@ use super::nominal_point::mean_stderr;
 use crate::error::Result;
 use crate::states::States;
 
+/// A miss component is corrected where it exceeds this many standard errors of its measurement.
+pub const SIGNIFICANT_MISS: f64 = 3.0;
+
 impl LocalModel {
     /// Carries T* from the point the nominal passes `nominal` measured (the model's `op`) to
-    /// the planned one, with the model's D*, H*, G*; records the [`Miss`]. `band` marks the
-    /// joints whose states were read by the band of their encoder counts (their rounding
-    /// repeats in every pass and does not average out) and `rounding` the floor the torque's
-    /// logged steps put under T*'s standard error. Nothing changes without D, H or G.
+    /// the planned one, with the model's D*, H*, G*; records the [`Miss`]. `var` is the
+    /// variance of the measured point's error per variable (`q`, `qd`, `qdd`) and joint: a
+    /// component of the miss within [`SIGNIFICANT_MISS`] of its standard error is not
+    /// corrected (a measurement error of the point, which positions rounded alike in every
+    /// pass need not average out of, would enter T* whole), and its possible size counts in
+    /// T*'s standard error instead. `band` marks the joints whose states were read by the band
+    /// of their encoder counts (their rounding repeats in every pass) and `rounding` the floor
+    /// the torque's logged steps put under T*'s standard error. Nothing changes without D, H or
+    /// G.
     pub(super) fn carry_to_plan(
         &mut self,
         nominal: &ExperimentValues,
+        var: &[Vec<f64>; 3],
         band: &[bool],
         rounding: &[f64],
     ) -> Result<()> {
@@ -34,17 +43,32 @@ impl LocalModel {
         };
         let n = self.n();
         let p = &self.planned_op;
+        let planned = [&p.q, &p.qd, &p.qdd];
+        let measured = [&self.op.q, &self.op.qd, &self.op.qdd];
+        let miss: [Vec<f64>; 3] =
+            std::array::from_fn(|v| (0..n).map(|j| measured[v][j] - planned[v][j]).collect());
+        let corrected: Vec<[bool; 3]> = (0..n)
+            .map(|j| {
+                std::array::from_fn(|v| miss[v][j].abs() > SIGNIFICANT_MISS * var[v][j].sqrt())
+            })
+            .collect();
+        let coef = |i: usize, v: usize, j: usize| match v {
+            0 => g.matrix[(i, j)],
+            1 => h.matrix[(i, j)],
+            _ => d.matrix[(i, j)],
+        };
+        // each reading carried to the planned point along the corrected components
         let k = nominal.crossings.len();
-        // each reading corrected to the planned point
-        let corrected: Vec<Vec<f64>> = (nominal.crossings.iter())
+        let readings: Vec<Vec<f64>> = (nominal.crossings.iter())
             .map(|c| {
+                let state = [&c.q, &c.qd, &c.qdd];
                 (0..n)
                     .map(|i| {
                         let mut x = c.tau[i];
-                        for j in 0..n {
-                            x -= d.matrix[(i, j)] * (c.qdd[j] - p.qdd[j])
-                                + h.matrix[(i, j)] * (c.qd[j] - p.qd[j])
-                                + g.matrix[(i, j)] * (c.q[j] - p.q[j]);
+                        for (j, fixed) in corrected.iter().enumerate() {
+                            for v in (0..3).filter(|&v| fixed[v]) {
+                                x -= coef(i, v, j) * (state[v][j] - planned[v][j]);
+                            }
                         }
                         x
                     })
@@ -52,72 +76,79 @@ impl LocalModel {
             })
             .collect();
         let torque: Vec<f64> = (0..n)
-            .map(|i| corrected.iter().map(|c| c[i]).sum::<f64>() / k as f64)
+            .map(|i| readings.iter().map(|c| c[i]).sum::<f64>() / k as f64)
             .collect();
-        let correction_stderr = self.correction_stderr()?;
-        let mut stderr = Vec::with_capacity(n);
-        for i in 0..n {
-            let scatter = mean_stderr(corrected.iter().map(|c| c[i]), torque[i], k);
-            // encoder rounding that every pass repeats, through the matrices
-            let repeated: f64 = (0..n)
-                .filter(|&j| band[j])
-                .map(|j| {
-                    let var = |v: usize| {
-                        (nominal.crossings.iter())
-                            .map(|c| c.state_stderr[v][j].powi(2))
-                            .sum::<f64>()
-                            / k as f64
-                    };
-                    g.matrix[(i, j)].powi(2) * var(0)
-                        + h.matrix[(i, j)].powi(2) * var(1)
-                        + d.matrix[(i, j)].powi(2) * var(2)
-                })
-                .sum();
-            let se = (scatter.powi(2) + repeated + correction_stderr[i].powi(2)).sqrt();
-            stderr.push(if se.is_nan() { se } else { se.max(rounding[i]) });
-        }
-        let units = |miss: &[f64], size: Option<&Vec<f64>>| -> Vec<f64> {
+        let correction_stderr = self.correction_stderr(&miss, &corrected)?;
+        let stderr = (0..n)
+            .map(|i| {
+                let scatter = mean_stderr(readings.iter().map(|c| c[i]), torque[i], k);
+                let mut variance = scatter.powi(2) + correction_stderr[i].powi(2);
+                for (j, fixed) in corrected.iter().enumerate() {
+                    for v in 0..3 {
+                        // rounding every pass repeats, through a corrected component; the
+                        // possible size of one left uncorrected
+                        if !fixed[v] || band[j] {
+                            variance += coef(i, v, j).powi(2) * var[v][j];
+                        }
+                    }
+                }
+                let se = variance.sqrt();
+                if se.is_nan() {
+                    se
+                } else {
+                    se.max(rounding[i])
+                }
+            })
+            .collect();
+        let units = |v: usize, size: Option<&Vec<f64>>| -> Vec<f64> {
             (0..n)
                 .map(|j| match size.map(|s| s[j]) {
-                    Some(s) if s > 0.0 => miss[j] / s,
+                    Some(s) if s > 0.0 => miss[v][j] / s,
                     _ => f64::NAN,
                 })
                 .collect()
         };
-        let diff =
-            |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(x, y)| x - y).collect() };
-        let (mq, mqd, mqdd) = (
-            diff(&self.op.q, &p.q),
-            diff(&self.op.qd, &p.qd),
-            diff(&self.op.qdd, &p.qdd),
-        );
         let sizes = self.perturbations.as_ref();
-        let miss = Miss {
-            q_perturbations: units(&mq, sizes.map(|s| &s.q)),
-            qd_perturbations: units(&mqd, sizes.map(|s| &s.qd)),
-            qdd_perturbations: units(&mqdd, sizes.map(|s| &s.qdd)),
+        let [q_perturbations, qd_perturbations, qdd_perturbations] = [
+            units(0, sizes.map(|s| &s.q)),
+            units(1, sizes.map(|s| &s.qd)),
+            units(2, sizes.map(|s| &s.qdd)),
+        ];
+        let [mq, mqd, mqdd] = miss;
+        self.miss = Some(Miss {
             q: mq,
             qd: mqd,
             qdd: mqdd,
+            q_perturbations,
+            qd_perturbations,
+            qdd_perturbations,
+            corrected,
             correction: (self.torque.iter().zip(&torque))
                 .map(|(m, t)| m - t)
                 .collect(),
             measured_torque: std::mem::replace(&mut self.torque, torque),
             measured_stderr: std::mem::replace(&mut self.torque_stderr, stderr),
             correction_stderr,
-        };
-        self.miss = Some(miss);
+        });
         Ok(())
     }
 
-    /// The standard error the matrices' uncertainty gives the correction at the mean miss:
-    /// [`LocalModel::predict_stderr`] at the measured point without T*'s own.
-    fn correction_stderr(&self) -> Result<Vec<f64>> {
+    /// The standard error the matrices' uncertainty gives the correction at the mean miss
+    /// along its `corrected` components: [`LocalModel::predict_stderr`] there without T*'s
+    /// own.
+    fn correction_stderr(&self, miss: &[Vec<f64>; 3], corrected: &[[bool; 3]]) -> Result<Vec<f64>> {
+        let n = self.n();
         let mut without_t = self.clone();
-        without_t.torque_stderr = vec![0.0; self.n()];
+        without_t.torque_stderr = vec![0.0; n];
         without_t.drive_gains = None;
-        let op = &self.op;
-        let states = States::new(self.n(), &op.q, Some(&op.qd), Some(&op.qdd))?;
+        let p = &self.planned_op;
+        let at = |v: usize, base: &[f64]| -> Vec<f64> {
+            (0..n)
+                .map(|j| base[j] + if corrected[j][v] { miss[v][j] } else { 0.0 })
+                .collect()
+        };
+        let (q, qd, qdd) = (at(0, &p.q), at(1, &p.qd), at(2, &p.qdd));
+        let states = States::new(n, &q, Some(&qd), Some(&qdd))?;
         super::prediction_uncertainty::predict_stderr(&without_t, &states)
     }
 }

@@ -41,6 +41,10 @@ pub struct FitOptions {
     /// Take qd (and qdd) from the recording's own columns, fitted like the torque, instead of
     /// differentiating the position fit (default false).
     pub recorded_derivatives: bool,
+    /// How long after the positions the torque channel logs what belongs with them (s;
+    /// default 0): each crossing's torque is read at its time plus this, over a window moved
+    /// with it. A sensor's or filter's delay is positive.
+    pub torque_delay: f64,
 }
 
 impl Default for FitOptions {
@@ -49,6 +53,7 @@ impl Default for FitOptions {
             window: None,
             torque_degree: 6,
             recorded_derivatives: false,
+            torque_delay: 0.0,
         }
     }
 }
@@ -362,35 +367,37 @@ impl<'a> Window<'a> {
         }
         let t = &rec.t[lo..hi];
         let degree = options.torque_degree;
+        // the torque's window, moved by its delay
+        let delay = options.torque_delay;
+        let tt = tc + delay;
+        let span_at = |h: f64| {
+            let e = 1e-9 * h;
+            let lo = rec.t.partition_point(|&t| t < tt - h - e);
+            let hi = rec.t.partition_point(|&t| t <= tt + h + e);
+            (lo, hi)
+        };
+        let own = |h: f64, step: Option<(f64, f64)>| -> Result<JointTorqueFit> {
+            let (lo_j, hi_j) = span_at(h);
+            if hi_j - lo_j < needed {
+                return Err(too_few(hi_j - lo_j, h));
+            }
+            Ok(JointTorqueFit {
+                fit: Some(WindowFit::new(&rec.t[lo_j..hi_j], tt, h, degree, step)?),
+                range: (lo_j, hi_j - lo_j),
+                step,
+            })
+        };
         let torque = torque
             .iter()
-            .map(|fit| {
-                Ok(match *fit {
-                    TorqueFit::Window(h) if h >= half => JointTorqueFit {
-                        fit: None,
-                        range: (lo, count),
-                        step: None,
-                    },
-                    TorqueFit::Window(h) => {
-                        let (lo_j, hi_j) = span(h);
-                        if hi_j - lo_j < needed {
-                            return Err(too_few(hi_j - lo_j, h));
-                        }
-                        JointTorqueFit {
-                            fit: Some(WindowFit::new(&rec.t[lo_j..hi_j], tc, h, degree, None)?),
-                            range: (lo_j, hi_j - lo_j),
-                            step: None,
-                        }
-                    }
-                    TorqueFit::Step { reversal, slope } => {
-                        let step = Some((reversal, slope));
-                        JointTorqueFit {
-                            fit: Some(WindowFit::new(t, tc, half, degree, step)?),
-                            range: (lo, count),
-                            step,
-                        }
-                    }
-                })
+            .map(|fit| match *fit {
+                TorqueFit::Window(h) if h >= half && delay == 0.0 => Ok(JointTorqueFit {
+                    fit: None,
+                    range: (lo, count),
+                    step: None,
+                }),
+                TorqueFit::Window(h) => own(h.min(half), None),
+                // the torque's step comes with its delay
+                TorqueFit::Step { reversal, slope } => own(half, Some((reversal + delay, slope))),
             })
             .collect::<Result<Vec<_>>>()?;
         Ok(Self {
@@ -631,7 +638,8 @@ fn read(
             Signal::Tau,
             torque_step,
         );
-        let reading = read_torque(w.torque_fit(j), &y.values, tc, jt.step, y.replaced());
+        let tt = tc + options.torque_delay;
+        let reading = read_torque(w.torque_fit(j), &y.values, tt, jt.step, y.replaced());
         out.tau[j] = reading.value;
         out.tau_gain[j] = reading.gain;
         out.tau_scatter[j] = reading.scatter;

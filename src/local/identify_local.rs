@@ -36,6 +36,13 @@ pub fn identify_local(
     recordings: &[Recording],
     options: &IdentifyOptions,
 ) -> Result<LocalModel> {
+    let delay = options.fit.torque_delay;
+    if !(delay.is_finite() && delay.abs() <= MAX_TORQUE_DELAY) {
+        return Err(Error::invalid(
+            "torque_delay",
+            format!("{delay} s; expected a finite delay within +-{MAX_TORQUE_DELAY} s"),
+        ));
+    }
     let read = read_experiments(plan, recordings, options)?;
     let point = NominalPoint::of(plan, &read.values)?;
     let mut fits = Regressions::new(plan, &read.values, &point);
@@ -103,7 +110,7 @@ pub fn identify_local(
         let band: Vec<bool> = (0..plan.n())
             .map(|j| nominal.crossings.iter().any(|c| c.position_band[j]))
             .collect();
-        model.carry_to_plan(&nominal, &band, &point.rounding)?;
+        model.carry_to_plan(&nominal, &point.var, &band, &point.rounding)?;
         model
             .diagnostics
             .warnings
@@ -111,6 +118,9 @@ pub fn identify_local(
     }
     Ok(model)
 }
+
+/// The largest torque delay accepted (s): far past any drive's or sensor's.
+pub const MAX_TORQUE_DELAY: f64 = 0.05;
 
 /// What the experiments' recordings gave, in the plan's order of experiments.
 struct ReadExperiments {

@@ -18,7 +18,7 @@ pub struct Miss {
     pub qd: Vec<f64>,
     pub qdd: Vec<f64>,
     /// The same in units of the largest perturbation the experiments gave each joint's
-    /// variable ([`LocalModel::perturbations`]): past 1 the correction extrapolates beyond the
+    /// variable ([`super::LocalModel::perturbations`]): past 1 the correction extrapolates beyond the
     /// region the matrices were identified over. NaN (`null`) where that perturbation is 0.
     #[serde(with = "crate::json::stderr_vec")]
     pub q_perturbations: Vec<f64>,
@@ -26,13 +26,19 @@ pub struct Miss {
     pub qd_perturbations: Vec<f64>,
     #[serde(with = "crate::json::stderr_vec")]
     pub qdd_perturbations: Vec<f64>,
+    /// Per joint, which of its `[q, qd, qdd]` misses were corrected: those beyond
+    /// 3 standard errors of their measurement (a
+    /// smaller one may be the measurement's own error; its possible size counts in T*'s
+    /// standard error instead).
+    pub corrected: Vec<[bool; 3]>,
     /// The mean torque at the nominal crossings (N m): the torque at the measured point.
     pub measured_torque: Vec<f64>,
     /// Its standard error from the readings' scatter (N m), which counts noise only: as an
     /// estimate of T* at the planned point it is off by the correction.
     #[serde(with = "crate::json::stderr_vec")]
     pub measured_stderr: Vec<f64>,
-    /// The correction `D* dqdd + H* dqd + G* dq` at the mean miss, subtracted from
+    /// The correction `D* dqdd + H* dqd + G* dq` at the mean miss (its corrected components),
+    /// subtracted from
     /// `measured_torque` to give the model's `torque` (N m).
     pub correction: Vec<f64>,
     /// The part of the model's `torque_stderr` that the matrices' uncertainty gives the
@@ -65,6 +71,15 @@ impl Miss {
 
     /// Checks a stored miss of `n` joints (`what` names the document).
     pub(crate) fn check(&self, what: &str, n: usize) -> Result<()> {
+        if self.corrected.len() != n {
+            return Err(crate::document::invalid(
+                what,
+                format!(
+                    "miss.corrected has {} entries for {n} joints",
+                    self.corrected.len()
+                ),
+            ));
+        }
         for (field, v) in [
             ("q", &self.q),
             ("qd", &self.qd),

@@ -379,6 +379,8 @@ pub(crate) fn plan_experiments(
 /// - `window`: half-width (s) of the fits around each crossing (default: the plan's);
 /// - `torque_degree`: degree of the torque fit (default 6);
 /// - `recorded_derivatives`: use the recordings' qd/qdd columns instead of differentiating q;
+/// - `torque_delay`: how long after the positions the torque logs what belongs with them (s;
+///   default 0; a sensor's or filter's delay): each torque is read that much later;
 /// - `estimator`: 'separated' (the paper) or 'combined' (all crossings in one regression);
 /// - `friction_aware_h`: H* from the differences of the H passes' +- pairs with each joint's
 ///   Coulomb step as its own column (exact for viscous and Coulomb friction that reverses
@@ -389,7 +391,7 @@ pub(crate) fn plan_experiments(
 ///   `Recording.in_torques`), the model keeps them (`LocalModel.drive_gains`) and their
 ///   standard errors enter its predictions' (as `perturbid identify --gains-from`).
 #[pyfunction]
-#[pyo3(signature = (plan, recordings, crossing_times="detected", max_shift=0.5, window=None, torque_degree=6, recorded_derivatives=false, estimator="separated", friction_aware_h=false, drive_gains=None))]
+#[pyo3(signature = (plan, recordings, crossing_times="detected", max_shift=0.5, window=None, torque_degree=6, recorded_derivatives=false, estimator="separated", friction_aware_h=false, drive_gains=None, torque_delay=0.0))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_local(
     py: Python<'_>,
@@ -403,6 +405,7 @@ pub(crate) fn identify_local(
     estimator: &str,
     friction_aware_h: bool,
     drive_gains: Option<PyRef<'_, super::direct::PyBaseModel>>,
+    #[pyo3(from_py_with = scalars::real)] torque_delay: f64,
 ) -> PyResult<PyLocalModel> {
     let times = CrossingTimes::new(crossing_times.parse()?, max_shift);
     let options = IdentifyOptions {
@@ -411,6 +414,7 @@ pub(crate) fn identify_local(
             window,
             torque_degree,
             recorded_derivatives,
+            torque_delay,
         },
         estimator: estimator.parse::<Estimator>()?,
         friction_aware_h,

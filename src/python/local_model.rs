@@ -441,7 +441,9 @@ impl PyLocalModel {
     /// largest planned perturbation; NaN where that is 0), `measured_torque` and
     /// `measured_stderr` (N m: the mean at the nominal crossings, before the correction),
     /// `correction` and `correction_stderr` (N m: subtracted to give `torque`, and its matrices'
-    /// share of `torque_stderr`). None without the G, H and D experiments.
+    /// share of `torque_stderr`), `corrected` (per joint, which of its `[q, qd, qdd]` misses
+    /// were corrected: those beyond 3 standard errors of their measurement). None without the
+    /// G, H and D experiments.
     #[getter]
     fn miss<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
         let Some(m) = &self.model.miss else {
@@ -462,6 +464,8 @@ impl PyLocalModel {
         ] {
             out.set_item(k, vec1(py, v))?;
         }
+        let corrected: Vec<Vec<bool>> = m.corrected.iter().map(|c| c.to_vec()).collect();
+        out.set_item("corrected", corrected)?;
         Ok(Some(out))
     }
     #[getter]

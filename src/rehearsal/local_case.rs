@@ -39,7 +39,7 @@ pub fn local_case(
     clock_offset: f64,
 ) -> Result<LocalCase> {
     let plan = plan_experiments(nominal, op, plan_options)?;
-    let recordings: Vec<Recording> = super::rehearse::rehearse_plan(nominal, robot, &plan)?
+    let recordings: Vec<Recording> = super::recorded::rehearse_plan(nominal, robot, &plan)?
         .into_iter()
         .map(|mut r| {
             r.t.iter_mut().for_each(|t| *t += clock_offset);

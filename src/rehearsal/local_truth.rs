@@ -30,7 +30,7 @@ pub fn true_local(nominal: &Model, robot: &TrueRobot, op: &OperatingPoint) -> Re
     op.check(nominal)?;
     let torque_at = |state: &[Vec<f64>; 3]| -> Result<Vec<f64>> {
         let states = States::new(n, &state[0], Some(&state[1]), Some(&state[2]))?;
-        super::rehearse::true_torques(nominal, robot, &states)
+        super::recorded::true_torques(nominal, robot, &states)
     };
     let base = [op.q.clone(), op.qd.clone(), op.qdd.clone()];
     let torque = torque_at(&base)?;

@@ -3,7 +3,7 @@
 //! zero offsets), its joints add friction, ripple and cogging, its sensors quantise, delay and
 //! add noise, and it tracks the reference under a controller. The true robot is one JSON
 //! document ([`TrueRobot`], `docs/rehearsal.md`); [`rehearse`] turns a reference (a plan's
-//! trajectory, a Fourier excitation, any sampled states) into the [`Recording`] the robot
+//! trajectory, a Fourier excitation, any sampled states) into the [`crate::Recording`] the robot
 //! would log, which the identifications read like a real one.
 //!
 //! The simpler [`crate::simulation`] (friction, white noise, quantisation, exact tracking of
@@ -13,7 +13,7 @@ pub mod joint_effects;
 pub mod local_case;
 pub mod local_truth;
 pub mod realistic;
-pub mod rehearse;
+pub mod recorded;
 pub mod sensors;
 pub mod tracking;
 pub mod true_robot;
@@ -23,5 +23,5 @@ pub use joint_effects::JointEffects;
 pub use local_case::{compare, local_case, LocalCase};
 pub use local_truth::{true_local, TrueLocal};
 pub use realistic::{realistic_robot, tracking_controller, Realism};
-pub use rehearse::{rehearse, rehearse_plan, true_torques};
+pub use recorded::{rehearse, rehearse_plan, true_torques};
 pub use true_robot::{Controller, FrictionSpec, Harmonic, LinkError, Sensors, TrueRobot};

@@ -724,3 +724,10 @@ def test_a_tracking_robots_miss_and_the_estimator_evidence():
     assert evidence["crossings"] > 20 and 0.0 <= evidence["p_value"] <= 1.0
     # the separated estimate is the worse predictor under tracking errors
     assert evidence["combined"] < evidence["separated"]
+    # a torque logged late is read past by a given delay; one beyond any drive's is refused
+    recs = pr.simulate(robot, plan, true_robot=true)
+    later = pr.identify_local(plan, recs, torque_delay=0.001)
+    assert np.abs(later.torque - model.torque).max() > 0.0
+    with pytest.raises(ValueError, match="torque_delay"):
+        pr.identify_local(plan, recs, torque_delay=1.0)
+    assert [len(c) for c in miss["corrected"]] == [3] * 6
