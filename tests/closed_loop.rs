@@ -262,3 +262,57 @@ fn an_impossible_torque_delay_is_refused() {
         );
     }
 }
+
+/// A robot under soft PD tracking (10 Hz) misses P; the plan refined by its recordings twice
+/// (`refine_plan`) commands the references off the crossings so that its passes go through
+/// P: the miss shrinks at least 10 times, the crossings and their times are the plan's, and
+/// T* at P is within 3 of its standard errors.
+#[test]
+fn two_rounds_of_refinement_bring_the_passes_to_p() {
+    use perturbid_rs::local::refine_plan;
+    use perturbid_rs::rehearsal::rehearse_plan;
+    let model = a465::model("kinsheel2010").unwrap();
+    let op = all_fast();
+    let realism = Realism {
+        bandwidth: Some(10.0),
+        delay: 0.0,
+        ..Realism::default()
+    };
+    let robot = realistic_robot(&model, &op.q, &realism).unwrap();
+    let mut plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+    let options = IdentifyOptions::default();
+    let worst_miss = |m: &LocalModel| {
+        let miss = m.miss.as_ref().unwrap();
+        miss.q_perturbations
+            .iter()
+            .chain(&miss.qd_perturbations)
+            .fold(0.0f64, |a, x| a.max(x.abs()))
+    };
+    let mut misses = vec![];
+    for round in 0..3 {
+        let recordings = rehearse_plan(&model, &robot, &plan).unwrap();
+        let local = identify_local(&plan, &recordings, &options).unwrap();
+        misses.push(worst_miss(&local));
+        let truth = true_local(&model, &robot, &op).unwrap();
+        let inside = (0..6)
+            .filter(|&j| (local.torque[j] - truth.torque[j]).abs() <= 3.0 * local.torque_stderr[j])
+            .count();
+        eprintln!(
+            "round {round}: miss {:.4} perturbations, T* inside {inside} of 6",
+            misses[round]
+        );
+        if round < 2 {
+            let refined = refine_plan(&plan, &recordings, &options, Some(&model)).unwrap();
+            for (a, b) in plan.experiments.iter().zip(&refined.experiments) {
+                assert_eq!(a.crossings, b.crossings);
+                assert_eq!(a.deltas, b.deltas);
+            }
+            assert_eq!(
+                refined.experiments[0].commanded.as_ref().unwrap().rounds,
+                round + 1
+            );
+            plan = refined;
+        }
+    }
+    assert!(misses[2] < 0.1 * misses[0], "the miss went {misses:?}");
+}

@@ -293,6 +293,9 @@ struct Window<'a> {
     count: usize,
     t: &'a [f64],
     fq: WindowFit,
+    /// The positions' fit of degree [`POSITION_DEGREE_HIGH`], where the window holds enough
+    /// samples to test it against the quadratic.
+    fq_high: Option<WindowFit>,
     ft: WindowFit,
     torque: Vec<JointTorqueFit>,
 }
@@ -405,6 +408,11 @@ impl<'a> Window<'a> {
             count,
             t,
             fq: WindowFit::new(t, tc, half, 2, None)?,
+            fq_high: if count > POSITION_DEGREE_HIGH + 4 {
+                Some(WindowFit::new(t, tc, half, POSITION_DEGREE_HIGH, None)?)
+            } else {
+                None
+            },
             ft: WindowFit::new(t, tc, half, degree, None)?,
             torque,
         })
@@ -544,6 +552,36 @@ pub fn values_at_with(
     Ok(read(rec, &w, tc, half, scales, options))
 }
 
+/// Degree of the positions' fit where the quadratic leaves motion it does not follow.
+pub const POSITION_DEGREE_HIGH: usize = 6;
+
+/// The p value below which the positions' scatter about the quadratic counts as motion the
+/// quadratic does not follow (F-test against [`POSITION_DEGREE_HIGH`]).
+pub const POSITION_DEGREE_LEVEL: f64 = 1e-3;
+
+/// The positions' fit of window `w` for the samples `y`: the quadratic, exact on a planned
+/// crossing segment, unless the higher-degree fit explains significantly more of them (a robot
+/// whose controller moves it off the quadratic within the window: the quadratic's second
+/// derivative would then be off the motion's at the crossing by more than its noise says).
+fn position_fit<'w>(w: &'w Window, y: &[f64]) -> &'w WindowFit {
+    let Some(high) = &w.fq_high else {
+        return &w.fq;
+    };
+    let k = y.len() as f64;
+    let (low_rss, high_rss) = (w.fq.scatter(y), high.scatter(y));
+    let extra = (POSITION_DEGREE_HIGH - 2) as f64;
+    let dof = k - (POSITION_DEGREE_HIGH + 1) as f64;
+    if !(high_rss > 0.0 && low_rss > high_rss) {
+        return &w.fq;
+    }
+    let f = ((low_rss - high_rss) / extra) / (high_rss / dof);
+    if crate::student_t::f_upper_tail(f, extra, dof) < POSITION_DEGREE_LEVEL {
+        high
+    } else {
+        &w.fq
+    }
+}
+
 /// The values at `tc` read from the window `w` (see [`values_at_with`]).
 fn read(
     rec: &Recording,
@@ -567,15 +605,6 @@ fn read(
         position_band: vec![false; n],
         glitches: vec![],
     };
-    // sum of squared weights per coefficient: the variance factor of each estimate
-    let gain: Vec<f64> = (0..3)
-        .map(|d| {
-            (0..count)
-                .map(|i| w.fq.weights[(d, i)].powi(2))
-                .sum::<f64>()
-                .sqrt()
-        })
-        .collect();
     for j in 0..n {
         let noise = |signal: Signal| scales.noise.get(j).map_or(0.0, |l| l[signal.index()]);
         let position_step = scales.position_step.get(j).copied().flatten();
@@ -595,14 +624,24 @@ fn read(
                 &mut out.glitches,
             )
         };
-        let q = screen(&w.fq, &rec.q, (lo, count), Signal::Q, position_step);
-        let c = [0, 1, 2].map(|d| w.fq.coefficient(d, &q.values));
+        let fq = position_fit(w, &samples(&rec.q, (lo, count), n, j));
+        let q = screen(fq, &rec.q, (lo, count), Signal::Q, position_step);
+        let c = [0, 1, 2].map(|d| fq.coefficient(d, &q.values));
         out.q[j] = c[0];
         out.qd[j] = c[1] / half;
         out.qdd[j] = 2.0 * c[2] / (half * half);
-        let dof = count.saturating_sub(3 + q.replaced());
+        // sum of squared weights per coefficient: the variance factor of each estimate
+        let gain: Vec<f64> = (0..3)
+            .map(|d| {
+                (0..count)
+                    .map(|i| fq.weights[(d, i)].powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            })
+            .collect();
+        let dof = count.saturating_sub(fq.weights.nrows() + q.replaced());
         let sigma = if dof > 0 {
-            (w.fq.scatter(&q.values) / dof as f64).sqrt()
+            (fq.scatter(&q.values) / dof as f64).sqrt()
         } else {
             f64::NAN
         };

@@ -123,8 +123,8 @@ pub fn identify_local(
 pub const MAX_TORQUE_DELAY: f64 = 0.05;
 
 /// What the experiments' recordings gave, in the plan's order of experiments.
-struct ReadExperiments {
-    values: Vec<ExperimentValues>,
+pub(super) struct ReadExperiments {
+    pub(super) values: Vec<ExperimentValues>,
     names: Vec<String>,
     dropouts: Vec<LogDropout>,
     held: Vec<LogGlitch>,
@@ -133,7 +133,7 @@ struct ReadExperiments {
 
 /// Each experiment's recording matched, checked against the plan, repaired and read at its
 /// crossings.
-fn read_experiments(
+pub(super) fn read_experiments(
     plan: &Plan,
     recordings: &[Recording],
     options: &IdentifyOptions,

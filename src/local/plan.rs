@@ -94,6 +94,60 @@ pub struct Experiment {
     /// exactly the crossing's quadratic (or the rest posture).
     pub window: f64,
     pub trajectory: Trajectory,
+    /// A refined plan's departure of the commanded trajectory from the crossings, learned from
+    /// the recordings of earlier rounds ([`super::refine`]); `None` where the trajectory passes
+    /// the crossings themselves.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub commanded: Option<Commanded>,
+}
+
+/// How far a refined experiment's trajectory is commanded off its crossings, so that a robot
+/// that tracks it with the errors it showed passes them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Commanded {
+    /// Per crossing, in order, the commanded state less the crossing's.
+    pub crossings: Vec<StateOffset>,
+    /// G-static only: the same for the reference posture.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference: Option<StateOffset>,
+    /// How many rounds of recordings refined it.
+    pub rounds: usize,
+}
+
+/// A state's offset per joint: rad, rad/s, rad/s^2 (m for a prismatic joint).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StateOffset {
+    pub q: Vec<f64>,
+    pub qd: Vec<f64>,
+    pub qdd: Vec<f64>,
+}
+
+impl Experiment {
+    /// The state the trajectory is commanded through at crossing `k` (`None`: the reference
+    /// posture): the crossing's, plus the refinement's offset.
+    pub fn commanded_state(&self, k: Option<usize>) -> Option<[Vec<f64>; 3]> {
+        let c = match k {
+            Some(k) => self.crossings.get(k)?,
+            None => self.reference.as_ref()?,
+        };
+        let offset = self.commanded.as_ref().and_then(|m| match k {
+            Some(k) => m.crossings.get(k),
+            None => m.reference.as_ref(),
+        });
+        let add = |a: &[f64], b: Option<&Vec<f64>>| -> Vec<f64> {
+            a.iter()
+                .enumerate()
+                .map(|(j, x)| x + b.map_or(0.0, |b| b[j]))
+                .collect()
+        };
+        Some([
+            add(&c.q, offset.map(|o| &o.q)),
+            add(&c.qd, offset.map(|o| &o.qd)),
+            add(&c.qdd, offset.map(|o| &o.qdd)),
+        ])
+    }
 }
 
 impl Experiment {

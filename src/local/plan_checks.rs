@@ -94,14 +94,20 @@ impl Document for Plan {
                     shown(e.crossings[k - 1].time)
                 ))));
             }
-            // every crossing (and the reference posture) is a state the trajectory passes
+            check_commanded(e, n).map_err(|m| bad(at(&m)))?;
+            // every crossing (and the reference posture), with its refinement's offset, is a
+            // state the trajectory passes
             let named = e
                 .crossings
                 .iter()
                 .enumerate()
-                .map(|(k, c)| (format!("crossings[{k}]"), c))
-                .chain(e.reference.iter().map(|c| ("reference".to_string(), c)));
-            for (name, c) in named {
+                .map(|(k, c)| (format!("crossings[{k}]"), c, Some(k)))
+                .chain(
+                    e.reference
+                        .iter()
+                        .map(|c| ("reference".to_string(), c, None)),
+                );
+            for (name, c, index) in named {
                 if [&c.q, &c.qd, &c.qdd].iter().any(|v| v.len() != n) {
                     return Err(bad(at(&format!("{name} is not for {n} joints"))));
                 }
@@ -113,16 +119,19 @@ impl Document for Plan {
                         shown(end)
                     ))));
                 }
+                let [cq, cqd, cqdd] = e
+                    .commanded_state(index)
+                    .expect("a crossing of the experiment");
                 let (q, qd, qdd) = e.trajectory.segment_at(c.time).state(c.time);
                 for (what, planned, passed) in
-                    [("q", &c.q, &q), ("qd", &c.qd, &qd), ("qdd", &c.qdd, &qdd)]
+                    [("q", &cq, &q), ("qd", &cqd, &qd), ("qdd", &cqdd, &qdd)]
                 {
                     if let Some(j) = (0..n).find(|&j| {
                         let off = (planned[j] - passed[j]).abs();
                         off.is_nan() || off > 1e-6 * (1.0 + planned[j].abs())
                     }) {
                         return Err(bad(at(&format!(
-                            "{name}.{what}[{j}] is {}, but the trajectory passes {} at t = {} s: the crossing and the trajectory disagree",
+                            "{name}.{what}[{j}] is {} (commanded), but the trajectory passes {} at t = {} s: the crossing and the trajectory disagree",
                             shown(planned[j]),
                             shown(passed[j]),
                             shown(c.time)
@@ -295,4 +304,51 @@ fn segment_label(kind: SegmentKind) -> String {
         SegmentKind::Reference => "a 'reference' segment".into(),
         SegmentKind::Transition => "a 'transition' segment".into(),
     }
+}
+
+/// Checks a refined experiment's offsets: one per crossing (and one for a reference posture,
+/// none without), each of `n` finite values per variable, within what a robot's tracking
+/// misses by (docs/limits.md).
+fn check_commanded(e: &Experiment, n: usize) -> std::result::Result<(), String> {
+    let Some(c) = &e.commanded else {
+        return Ok(());
+    };
+    if c.crossings.len() != e.crossings.len() {
+        return Err(format!(
+            "commanded.crossings has {} offsets for {} crossings",
+            c.crossings.len(),
+            e.crossings.len()
+        ));
+    }
+    if c.reference.is_some() != e.reference.is_some() {
+        return Err("commanded.reference is given where the experiment has no reference posture, or missing where it has one".into());
+    }
+    let named = (c.crossings.iter().enumerate())
+        .map(|(k, o)| (format!("commanded.crossings[{k}]"), o))
+        .chain(
+            c.reference
+                .iter()
+                .map(|o| ("commanded.reference".to_string(), o)),
+        );
+    for (name, o) in named {
+        for (what, v, max) in [
+            ("q", &o.q, 1.0),
+            ("qd", &o.qd, 10.0),
+            ("qdd", &o.qdd, 100.0),
+        ] {
+            if v.len() != n {
+                return Err(format!(
+                    "{name}.{what} has {} entries for {n} joints",
+                    v.len()
+                ));
+            }
+            if let Some(j) = v.iter().position(|x| !(x.is_finite() && x.abs() <= max)) {
+                return Err(format!(
+                    "{name}.{what}[{j}] is {}; expected an offset within +-{max} (a tracking error)",
+                    v[j]
+                ));
+            }
+        }
+    }
+    Ok(())
 }

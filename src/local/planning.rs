@@ -260,6 +260,7 @@ fn plan_experiment(
         reference,
         window,
         trajectory,
+        commanded: None,
     };
     if let (Some(steps), Some(var)) = (&o.encoder_step, kind.perturbed()) {
         let joints =

@@ -74,6 +74,30 @@ impl PyPlan {
             })
             .collect()
     }
+    /// The next round's plan from this round's recordings (one per experiment): every
+    /// experiment's trajectory commanded off its crossings by what the robot missed them by
+    /// (`commanded += planned - measured`, on top of earlier rounds'), its crossings and their
+    /// times kept, so that a robot tracking it with the same errors passes them. With
+    /// `robot`, each refined trajectory is checked against its limits. Identify the next
+    /// round's recordings with the refined plan.
+    #[pyo3(signature = (recordings, robot=None))]
+    fn refine(
+        &self,
+        py: Python<'_>,
+        recordings: Vec<Bound<'_, PyRecording>>,
+        robot: Option<PyRef<'_, super::robot::PyRobot>>,
+    ) -> PyResult<PyPlan> {
+        let recs: Vec<Recording> = recordings.iter().map(|r| (*r.get().rec).clone()).collect();
+        let plan = self.plan.clone();
+        let model = robot.map(|r| r.model.clone());
+        let refined = detached(py, "refine", || {
+            crate::local::refine_plan(&plan, &recs, &IdentifyOptions::default(), model.as_ref())
+        })?;
+        Ok(PyPlan {
+            plan: Arc::new(refined),
+        })
+    }
+
     /// The experiment named `kind` ('nominal', 'G_static', 'G', 'H' or 'D').
     fn experiment(&self, kind: &str) -> PyResult<PyExperiment> {
         let k = kind.parse::<ExperimentKind>()?;

@@ -731,3 +731,7 @@ def test_a_tracking_robots_miss_and_the_estimator_evidence():
     with pytest.raises(ValueError, match="torque_delay"):
         pr.identify_local(plan, recs, torque_delay=1.0)
     assert [len(c) for c in miss["corrected"]] == [3] * 6
+    # the next round's plan commands the references off the crossings by the miss
+    refined = plan.refine(recs, robot=robot)
+    again = pr.identify_local(refined, pr.simulate(robot, refined, true_robot=true))
+    assert np.abs(again.miss["q"]).max() < 0.5 * np.abs(miss["q"]).max()
