@@ -138,9 +138,6 @@ impl LocalModel {
     /// own.
     fn correction_stderr(&self, miss: &[Vec<f64>; 3], corrected: &[[bool; 3]]) -> Result<Vec<f64>> {
         let n = self.n();
-        let mut without_t = self.clone();
-        without_t.torque_stderr = vec![0.0; n];
-        without_t.drive_gains = None;
         let p = &self.planned_op;
         let at = |v: usize, base: &[f64]| -> Vec<f64> {
             (0..n)
@@ -149,7 +146,7 @@ impl LocalModel {
         };
         let (q, qd, qdd) = (at(0, &p.q), at(1, &p.qd), at(2, &p.qdd));
         let states = States::new(n, &q, Some(&qd), Some(&qdd))?;
-        super::prediction_uncertainty::predict_stderr(&without_t, &states)
+        super::prediction_uncertainty::stderr_of_prediction(self, &states, false)
     }
 }
 

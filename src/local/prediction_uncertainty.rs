@@ -26,6 +26,16 @@ use crate::torque_model::check_joints;
 /// count. Refused for a model without the D, H or G experiment, or saved before the
 /// correlations were stored (identify it again), and where the arithmetic overflows.
 pub(crate) fn predict_stderr(model: &LocalModel, states: &States<'_>) -> Result<Vec<f64>> {
+    stderr_of_prediction(model, states, true)
+}
+
+/// [`predict_stderr`], with `T*`'s own standard error counted or not (`with_t_star`): without
+/// it, what the matrices' uncertainty alone gives the deltas of `states`.
+pub(crate) fn stderr_of_prediction(
+    model: &LocalModel,
+    states: &States<'_>,
+    with_t_star: bool,
+) -> Result<Vec<f64>> {
     let n = model.n();
     check_joints(states, n)?;
     // each estimate with the block of deltas its first column weighs
@@ -64,7 +74,11 @@ pub(crate) fn predict_stderr(model: &LocalModel, states: &States<'_>) -> Result<
         for j in 0..n {
             // an unknown standard error counts only where the state weights it (T*'s always);
             // kept apart from the sums, so that a sum which overflows is told from it
-            let t_star = model.torque_stderr[j];
+            let t_star = if with_t_star {
+                model.torque_stderr[j]
+            } else {
+                0.0
+            };
             unknown[..b].fill(t_star.is_nan());
             var[..b].fill(if t_star.is_nan() {
                 0.0
