@@ -1616,3 +1616,45 @@ fn options_that_would_be_ignored_or_invent_data_are_refused() {
         &["--validate: 1e-9 of", "leaves none to validate on"],
     );
 }
+
+/// `identify --torque-delay estimate --robot` finds the delay in the recordings (none here:
+/// a simulation logs each torque with its positions) and prints it; without the robot, or
+/// with the robot and a delay given, it refuses before any work.
+#[test]
+fn identify_estimates_the_torque_delay() {
+    let d = tmp("torque-delay");
+    let op = table2_op(&d);
+    let plan = d.join("plan");
+    ok(&["plan", "a465", "--op", s(&op), "--out", s(&plan)]);
+    let plan_json = plan.join("plan.json");
+    let rec = d.join("rec");
+    ok(&[
+        "simulate",
+        "a465",
+        s(&plan_json),
+        "--out",
+        s(&rec),
+        "--torque-noise",
+        "0.01",
+    ]);
+    let out_json = d.join("model.json");
+    let base = ["identify", s(&plan_json), s(&rec), "--out", s(&out_json)];
+    let with = |extra: &[&'static str]| -> Vec<&str> {
+        base.iter().copied().chain(extra.iter().copied()).collect()
+    };
+    fails(&with(&["--torque-delay", "estimate"]), &["--robot"]);
+    fails(
+        &with(&["--torque-delay", "0.001", "--robot", "a465"]),
+        &["--robot", "only --torque-delay estimate"],
+    );
+    fails(
+        &with(&["--torque-delay", "soon"]),
+        &["'soon'", "'estimate'"],
+    );
+    nothing_written(&d, "model.json");
+    let out = ok(&with(&["--torque-delay", "estimate", "--robot", "a465"]));
+    assert!(out.contains("torque delay "), "{out}");
+    let model = LocalModel::from_json(&std::fs::read_to_string(&out_json).unwrap()).unwrap();
+    let found = model.diagnostics.torque_delay.unwrap();
+    assert!(found.delay.abs() < 1e-4, "{found:?}");
+}

@@ -7,12 +7,13 @@
 mod common;
 
 use common::{rel, table2};
+use perturbid_rs::direct::torque_delay::{estimate_torque_delay, DelayOptions};
 use perturbid_rs::local::{
-    identify_local, plan_experiments, ExperimentKind, IdentifyOptions, LocalModel, Perturbations,
-    PlanOptions,
+    identify_local, identify_local_with_delay, plan_experiments, ExperimentKind, IdentifyOptions,
+    LocalModel, Perturbations, PlanOptions,
 };
 use perturbid_rs::rehearsal::{
-    local_case, realistic_robot, rehearse, true_local, Realism, TrueRobot,
+    compare, local_case, realistic_robot, rehearse, rehearse_plan, true_local, Realism, TrueRobot,
 };
 use perturbid_rs::robots::a465;
 use perturbid_rs::simulation::experiment_samples;
@@ -22,6 +23,16 @@ use perturbid_rs::{linearize, Data, Gravity, OperatingPoint};
 fn all_fast() -> OperatingPoint {
     let p = table2();
     OperatingPoint::new(p.q, vec![0.5, -0.4, 0.45, 0.6, -0.5, 0.55], p.qdd).unwrap()
+}
+
+/// A posture of the Panda with every joint fast.
+fn panda_all_fast() -> OperatingPoint {
+    OperatingPoint::new(
+        vec![0.3, -0.5, 0.2, -2.0, 0.3, 1.6, 0.5],
+        vec![0.5, -0.4, 0.45, 0.6, -0.5, 0.55, 0.4],
+        vec![1.0, -0.8, 0.9, 1.2, -1.0, 0.7, 0.8],
+    )
+    .unwrap()
 }
 
 /// On the nominal robot without friction the true expansion is the rigid-body linearisation.
@@ -199,12 +210,7 @@ fn a_known_torque_delay_is_read_past() {
         eprintln!("skipped: example-robot-data is not installed (pip install example-robot-data)");
         return;
     };
-    let op = OperatingPoint::new(
-        vec![0.3, -0.5, 0.2, -2.0, 0.3, 1.6, 0.5],
-        vec![0.5, -0.4, 0.45, 0.6, -0.5, 0.55, 0.4],
-        vec![1.0, -0.8, 0.9, 1.2, -1.0, 0.7, 0.8],
-    )
-    .unwrap();
+    let op = panda_all_fast();
     let worst = |delay: f64| {
         let realism = Realism {
             bandwidth: None,
@@ -315,4 +321,86 @@ fn two_rounds_of_refinement_bring_the_passes_to_p() {
         }
     }
     assert!(misses[2] < 0.1 * misses[0], "the miss went {misses:?}");
+}
+
+/// The recordings' torque delay, found with the robot's rigid-body model
+/// (`direct::torque_delay`): on the A465 (link errors, payload, friction, ripple, counts,
+/// noise; open loop) 0 where there is none and 1.5 ms where the torque lags by that, each
+/// within 0.3 ms; read past, T* is within 3 of its standard errors.
+#[test]
+fn the_torque_delay_is_found_from_the_rigid_body_fit() {
+    let model = a465::model("kinsheel2010").unwrap();
+    let op = all_fast();
+    let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+    for delay in [0.0, 1.5e-3] {
+        let realism = Realism {
+            bandwidth: None,
+            delay,
+            ..Realism::default()
+        };
+        let robot = realistic_robot(&model, &op.q, &realism).unwrap();
+        let recs = rehearse_plan(&model, &robot, &plan).unwrap();
+        let local = identify_local_with_delay(
+            &model,
+            &plan,
+            &recs,
+            &IdentifyOptions::default(),
+            &DelayOptions::default(),
+        )
+        .unwrap();
+        let found = local.diagnostics.torque_delay.clone().unwrap();
+        assert!(
+            (found.delay - delay).abs() < 3e-4 && found.stderr > 0.0 && found.stderr < 3e-4,
+            "{delay} s: {found:?}"
+        );
+        assert!(found.unexplained <= found.unexplained_at_zero);
+        assert!(local.summary("m.json").contains("torque delay "));
+        let case = compare(&model, &robot, local).unwrap();
+        let worst = (case.torque_errors.iter()).fold(0.0f64, |a, e| a.max(e.abs()));
+        assert!(worst < 3.0, "{delay} s: T* {worst:.1} standard errors off");
+    }
+    // a robot of other joints than the plan's is refused, naming it
+    let mut other = plan.clone();
+    other.joint_names[0] = "elsewhere".into();
+    let e = identify_local_with_delay(
+        &model,
+        &other,
+        &[],
+        &IdentifyOptions::default(),
+        &DelayOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("robot") && e.contains("elsewhere"), "{e}");
+}
+
+/// Under PD tracking the logged torque is the command, held over each sample period: it acts
+/// half a sample after its stamp, so the delay found is the sensor's less half a sample (the
+/// Panda of example-robot-data, skipped where it is not installed; 1 kHz, 1.5 ms).
+#[test]
+fn a_held_command_reads_half_a_sample_early() {
+    let Some(model) = common::panda_model() else {
+        eprintln!("skipped: example-robot-data is not installed (pip install example-robot-data)");
+        return;
+    };
+    let op = panda_all_fast();
+    let plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+    let robot = realistic_robot(&model, &op.q, &Realism::default()).unwrap();
+    let recs = rehearse_plan(&model, &robot, &plan).unwrap();
+    let refs: Vec<_> = recs.iter().collect();
+    let found = estimate_torque_delay(&model, &refs, &DelayOptions::default()).unwrap();
+    let expected = Realism::default().delay - 0.5 / plan.rate;
+    assert!(
+        (found.delay - expected).abs() < 3e-4,
+        "{found:?}, expected {expected}"
+    );
+    // a search range the delay lies outside of says so
+    let narrow = DelayOptions {
+        range: 2e-4,
+        ..DelayOptions::default()
+    };
+    let e = estimate_torque_delay(&model, &refs, &narrow)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("edge of the delays tried"), "{e}");
 }

@@ -603,13 +603,15 @@ def identify_local(
     estimator: str = "separated",
     friction_aware_h: bool = False,
     drive_gains: Optional[BaseParameterModel] = None,
-    torque_delay: float = 0.0,
+    torque_delay: Union[float, str, None] = None,
+    robot: Optional[Robot] = None,
 ) -> LocalModel:
     """The local model from a plan and one recording per experiment. drive_gains: a model
     from identify_drive_gains, for recordings of motor currents (put in torques by its
     gains, which the local model keeps). torque_delay: how long after the positions the
-    torque logs what belongs with them (s; a sensor's or filter's delay): each torque is
-    read that much later."""
+    torque logs what belongs with them (s; a sensor's or filter's delay; None: 0): each
+    torque is read that much later; or 'estimate' with the plan's `robot`: found in the
+    recordings with its rigid-body model, kept in diagnostics['torque_delay']."""
 
 def identify_parameters_from_local(
     robot: Robot,

@@ -13,8 +13,8 @@ use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::local::plan_files::{plan_files, recording_files};
 use crate::local::{
-    identify_local, plan_experiments, CrossingTimes, Design, Estimator, ExperimentKind,
-    IdentifyOptions, LocalModel, OperatingPoint, Plan, PlanOptions, Size,
+    identify_local, identify_local_with_delay, plan_experiments, CrossingTimes, Design, Estimator,
+    ExperimentKind, IdentifyOptions, LocalModel, OperatingPoint, Plan, PlanOptions, Size,
 };
 use crate::logs::recording::Recording;
 use crate::logs::save_recording;
@@ -438,10 +438,18 @@ pub(crate) struct IdentifyArgs {
     /// Half-width of the fits around each crossing (s; default: the plan's window).
     #[arg(long)]
     window: Option<f64>,
-    /// How long after the positions the torque logs what belongs with them (s; a sensor's or
-    /// filter's delay): each crossing's torque is read that much later.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    torque_delay: f64,
+    /// How long after the positions the torque logs what belongs with them: seconds (a
+    /// sensor's or filter's delay), or `estimate` (found in the recordings with the robot's
+    /// rigid-body model, --robot; a held drive command reads as half a sample early). Each
+    /// crossing's torque is read that much later.
+    #[arg(long, default_value = "0", allow_hyphen_values = true, value_parser = parse_delay)]
+    torque_delay: TorqueDelayArg,
+    /// The robot (a URDF file, or a built-in robot) for `--torque-delay estimate`.
+    #[arg(long)]
+    robot: Option<String>,
+    /// With --robot: hold a joint at a position and leave it out of the model (as in `plan`).
+    #[arg(long = "lock", value_name = "JOINT=VALUE", value_parser = super::files::parse_lock)]
+    lock: Vec<(String, f64)>,
     /// separated (the paper) or combined (all crossings in one regression).
     #[arg(long, value_enum, default_value_t = Estimator::Separated)]
     estimator: Estimator,
@@ -460,8 +468,40 @@ pub(crate) struct IdentifyArgs {
     columns: super::files::ColumnArgs,
 }
 
+/// `--torque-delay`: seconds or `estimate`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum TorqueDelayArg {
+    Seconds(f64),
+    Estimate,
+}
+
+fn parse_delay(text: &str) -> std::result::Result<TorqueDelayArg, String> {
+    match text {
+        "estimate" => Ok(TorqueDelayArg::Estimate),
+        _ => text
+            .parse()
+            .map(TorqueDelayArg::Seconds)
+            .map_err(|_| format!("'{text}': expected a delay in seconds, or 'estimate'")),
+    }
+}
+
 pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
     let plan = Plan::load(&a.plan)?;
+    let robot =
+        match (a.torque_delay, &a.robot) {
+            (TorqueDelayArg::Estimate, Some(r)) => Some(super::files::load_robot(r, &a.lock)?),
+            (TorqueDelayArg::Estimate, None) => {
+                return Err(Error::invalid(
+                    "--torque-delay",
+                    "estimate needs the robot's model: give --robot URDF (or a built-in robot)",
+                ))
+            }
+            (TorqueDelayArg::Seconds(_), Some(_)) => return Err(Error::invalid(
+                "--robot",
+                "only --torque-delay estimate uses the robot; leave it out, or estimate the delay",
+            )),
+            (TorqueDelayArg::Seconds(_), None) => None,
+        };
     if let [only] = a.recordings.as_slice() {
         // a ROS 2 bag's folder is not a folder of recordings
         if let Some(message) = crate::io::foreign::foreign_table(only) {
@@ -482,6 +522,7 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
     let inputs: Vec<&std::path::Path> = std::iter::once(a.plan.as_path())
         .chain(files.iter().map(PathBuf::as_path))
         .chain(a.gains_from.as_deref())
+        .chain(a.robot.as_deref().map(Path::new))
         .collect();
     super::files::refuse_overwriting_inputs(&a.out, &inputs)?;
     if files.len() != plan.experiments.len() {
@@ -521,13 +562,19 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
         },
         fit: crate::local::FitOptions {
             window: a.window,
-            torque_delay: a.torque_delay,
+            torque_delay: match a.torque_delay {
+                TorqueDelayArg::Seconds(s) => s,
+                TorqueDelayArg::Estimate => 0.0,
+            },
             ..Default::default()
         },
         estimator: a.estimator,
         friction_aware_h: a.friction_aware_h,
     };
-    let mut model: LocalModel = identify_local(&plan, &recs, &options)?;
+    let mut model: LocalModel = match &robot {
+        Some(r) => identify_local_with_delay(r, &plan, &recs, &options, &Default::default())?,
+        None => identify_local(&plan, &recs, &options)?,
+    };
     model.drive_gains = gains.as_ref().map(crate::local::SignalGains::from);
     model.save(&a.out)?;
     for w in &model.diagnostics.warnings {

@@ -37,6 +37,7 @@ pub mod runs;
 pub mod signal_prediction;
 pub mod streaming;
 pub mod torque_columns;
+pub mod torque_delay;
 pub mod torque_lag;
 pub mod torque_noise;
 pub mod unmodelled_friction;

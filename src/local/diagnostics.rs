@@ -172,6 +172,10 @@ pub struct Diagnostics {
     /// nominal, G, H and D experiments.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub estimator_evidence: Option<EstimatorEvidence>,
+    /// The torque delay estimated from the recordings and read past
+    /// ([`super::identify_local_with_delay`]); `None` where it was given or left at 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub torque_delay: Option<crate::direct::torque_delay::TorqueDelay>,
     /// The rows not measured (their standard errors NaN), with a warning: a torque that did
     /// not change. [`super::identify_parameters_from_local`] leaves them out.
     #[serde(default)]

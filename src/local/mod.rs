@@ -44,6 +44,7 @@ mod friction_aware;
 pub mod glitches;
 pub mod identify;
 mod identify_local;
+mod identify_with_delay;
 pub mod miss;
 pub mod model;
 mod model_summary;
@@ -85,6 +86,7 @@ pub use diagnostics::{
 };
 pub use identify::{CrossingTimes, IdentifyOptions, TimesSource};
 pub use identify_local::identify_local;
+pub use identify_with_delay::identify_local_with_delay;
 pub use miss::Miss;
 pub use model::{Estimate, Estimator, LocalModel, SignalGains};
 pub use offset_search::{detect_offset, detect_offset_in};

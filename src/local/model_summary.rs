@@ -33,6 +33,9 @@ impl LocalModel {
             .map(|(t, s)| format!("{t:.4} [{s:.1e}]"))
             .collect();
         let _ = writeln!(out, "T* (N m): {}", t.join(", "));
+        if let Some(d) = &self.diagnostics.torque_delay {
+            let _ = writeln!(out, "{}", d.line());
+        }
         if let Some(m) = &self.miss {
             let units = |v: &[f64]| -> String {
                 let cells: Vec<String> = v.iter().map(|x| format!("{x:+.2}")).collect();

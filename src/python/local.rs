@@ -404,7 +404,10 @@ pub(crate) fn plan_experiments(
 /// - `torque_degree`: degree of the torque fit (default 6);
 /// - `recorded_derivatives`: use the recordings' qd/qdd columns instead of differentiating q;
 /// - `torque_delay`: how long after the positions the torque logs what belongs with them (s;
-///   default 0; a sensor's or filter's delay): each torque is read that much later;
+///   default 0; a sensor's or filter's delay): each torque is read that much later; or
+///   'estimate': found in the recordings with `robot`'s rigid-body model (a held drive
+///   command reads as half a sample early), kept in `diagnostics['torque_delay']`;
+/// - `robot`: the plan's Robot, for `torque_delay='estimate'`;
 /// - `estimator`: 'separated' (the paper) or 'combined' (all crossings in one regression);
 /// - `friction_aware_h`: H* from the differences of the H passes' +- pairs with each joint's
 ///   Coulomb step as its own column (exact for viscous and Coulomb friction that reverses
@@ -415,7 +418,7 @@ pub(crate) fn plan_experiments(
 ///   `Recording.in_torques`), the model keeps them (`LocalModel.drive_gains`) and their
 ///   standard errors enter its predictions' (as `perturbid identify --gains-from`).
 #[pyfunction]
-#[pyo3(signature = (plan, recordings, crossing_times="detected", max_shift=0.5, window=None, torque_degree=6, recorded_derivatives=false, estimator="separated", friction_aware_h=false, drive_gains=None, torque_delay=0.0))]
+#[pyo3(signature = (plan, recordings, crossing_times="detected", max_shift=0.5, window=None, torque_degree=6, recorded_derivatives=false, estimator="separated", friction_aware_h=false, drive_gains=None, torque_delay=None, robot=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_local(
     py: Python<'_>,
@@ -429,8 +432,41 @@ pub(crate) fn identify_local(
     estimator: &str,
     friction_aware_h: bool,
     drive_gains: Option<PyRef<'_, super::direct::PyBaseModel>>,
-    #[pyo3(from_py_with = scalars::real)] torque_delay: f64,
+    torque_delay: Option<Bound<'_, PyAny>>,
+    robot: Option<PyRef<'_, super::robot::PyRobot>>,
 ) -> PyResult<PyLocalModel> {
+    let estimate = match &torque_delay {
+        Some(d) if d.extract::<String>().is_ok_and(|s| s == "estimate") => true,
+        Some(d) if d.is_instance_of::<pyo3::types::PyString>() => {
+            return Err(Error::invalid(
+                "torque_delay",
+                format!("'{d}'; expected a delay in seconds, or 'estimate'"),
+            )
+            .into())
+        }
+        _ => false,
+    };
+    let torque_delay = match (&torque_delay, estimate) {
+        (Some(d), false) => scalars::real(d)?,
+        _ => 0.0,
+    };
+    let robot =
+        match (robot, estimate) {
+            (Some(r), true) => Some(r.model.clone()),
+            (None, true) => {
+                return Err(Error::invalid(
+                    "robot",
+                    "torque_delay='estimate' needs the plan's Robot: give robot=",
+                )
+                .into())
+            }
+            (Some(_), false) => return Err(Error::invalid(
+                "robot",
+                "only torque_delay='estimate' uses the robot; leave it out, or estimate the delay",
+            )
+            .into()),
+            (None, false) => None,
+        };
     let times = CrossingTimes::new(crossing_times.parse()?, max_shift);
     let options = IdentifyOptions {
         times,
@@ -473,7 +509,12 @@ pub(crate) fn identify_local(
         })
         .collect::<Result<_>>()?;
     let plan = plan.plan.clone();
-    let mut model = detached(py, "identify_local", || identify_rs(&plan, &recs, &options))?;
+    let mut model = detached(py, "identify_local", || match &robot {
+        Some(r) => {
+            crate::local::identify_local_with_delay(r, &plan, &recs, &options, &Default::default())
+        }
+        None => identify_rs(&plan, &recs, &options),
+    })?;
     model.drive_gains = gains;
     super::errors::warn_all(py, &model.diagnostics.warnings)?;
     Ok(PyLocalModel { model })

@@ -137,6 +137,15 @@ impl PyLocalModel {
         }
         out.set_item("combined", combined)?;
         out.set_item("unperturbed_deviation", d.unperturbed_deviation)?;
+        if let Some(t) = &d.torque_delay {
+            let delay = PyDict::new(py);
+            delay.set_item("delay", t.delay)?;
+            delay.set_item("stderr", t.stderr)?;
+            delay.set_item("rows", t.rows)?;
+            delay.set_item("unexplained", t.unexplained)?;
+            delay.set_item("unexplained_at_zero", t.unexplained_at_zero)?;
+            out.set_item("torque_delay", delay)?;
+        }
         if let Some(e) = &d.estimator_evidence {
             let evidence = PyDict::new(py);
             evidence.set_item("crossings", e.crossings)?;

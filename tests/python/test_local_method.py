@@ -730,6 +730,19 @@ def test_a_tracking_robots_miss_and_the_estimator_evidence():
     assert np.abs(later.torque - model.torque).max() > 0.0
     with pytest.raises(ValueError, match="torque_delay"):
         pr.identify_local(plan, recs, torque_delay=1.0)
+    # or found in the recordings with the robot's rigid-body model, and read past
+    found = pr.identify_local(plan, recs, torque_delay="estimate", robot=robot)
+    delay = found.diagnostics["torque_delay"]
+    assert set(delay) == {"delay", "stderr", "rows", "unexplained", "unexplained_at_zero"}
+    # no sensor delay: the held command reads as half a sample early
+    assert abs(delay["delay"] + 0.5 / plan.rate) < 3e-4 and delay["stderr"] > 0.0
+    assert "torque_delay" not in later.diagnostics
+    with pytest.raises(ValueError, match="robot"):
+        pr.identify_local(plan, recs, torque_delay="estimate")
+    with pytest.raises(ValueError, match="robot"):
+        pr.identify_local(plan, recs, torque_delay=0.001, robot=robot)
+    with pytest.raises(ValueError, match="expected a delay in seconds, or 'estimate'"):
+        pr.identify_local(plan, recs, torque_delay="guess")
     assert [len(c) for c in miss["corrected"]] == [3] * 6
     # the next round's plan commands the references off the crossings by the miss
     refined = plan.refine(recs, robot=robot)
