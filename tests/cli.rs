@@ -1658,3 +1658,101 @@ fn identify_estimates_the_torque_delay() {
     let found = model.diagnostics.torque_delay.unwrap();
     assert!(found.delay.abs() < 1e-4, "{found:?}");
 }
+
+/// `plan --refine` on a robot that tracks under PD control: the next round's plan commands
+/// each experiment off its crossings, and its nominal passes miss P by less than the first
+/// round's. Without --plan, or with --op beside it, it refuses; it never overwrites the plan
+/// the recordings ran.
+#[test]
+fn plan_refine_commands_the_next_round_off_the_miss() {
+    let d = tmp("refine");
+    let op = table2_op(&d);
+    let true_robot = d.join("true_robot.json");
+    write(
+        &true_robot,
+        r#"{"format": "perturbid-true-robot/1", "controller": {"kp": [400, 400, 400, 100, 100, 100], "kd": [40, 40, 40, 10, 10, 10], "substeps": 2}}"#,
+    );
+    let (plan, rec) = (d.join("plan"), d.join("rec"));
+    let plan_json = plan.join("plan.json");
+    ok(&[
+        "plan",
+        "a465",
+        "--op",
+        s(&op),
+        "--out",
+        s(&plan),
+        "--experiments",
+        "nominal,D",
+    ]);
+    let simulate = |plan: &std::path::Path, rec: &std::path::Path| {
+        ok(&[
+            "simulate",
+            "a465",
+            s(plan),
+            "--out",
+            s(rec),
+            "--true-robot",
+            s(&true_robot),
+        ]);
+    };
+    simulate(&plan_json, &rec);
+    fails(&["plan", "a465", "--refine", s(&rec)], &["--plan"]);
+    fails(
+        &[
+            "plan",
+            "a465",
+            "--refine",
+            s(&rec),
+            "--plan",
+            s(&plan_json),
+            "--op",
+            s(&op),
+        ],
+        &["--op"],
+    );
+    fails(
+        &[
+            "plan",
+            "a465",
+            "--refine",
+            s(&rec),
+            "--plan",
+            s(&plan_json),
+            "--out",
+            s(&plan),
+        ],
+        &["plan.json"],
+    );
+    let next = d.join("plan2");
+    let out = ok(&[
+        "plan",
+        "a465",
+        "--refine",
+        s(&rec),
+        "--plan",
+        s(&plan_json),
+        "--out",
+        s(&next),
+    ]);
+    assert!(
+        out.contains("nominal   refined 1 time(s): commanded off its crossings by up to"),
+        "{out}"
+    );
+    let miss = |plan: &std::path::Path, rec: &std::path::Path, name: &str| {
+        let model = d.join(name);
+        ok(&["identify", s(plan), s(rec), "--out", s(&model)]);
+        let local = LocalModel::from_json(&std::fs::read_to_string(&model).unwrap()).unwrap();
+        // the nominal passes' mean state against the plan's
+        (local.op.q.iter().zip(&local.planned_op.q)).fold(0.0f64, |a, (m, p)| a.max((m - p).abs()))
+    };
+    let rec2 = d.join("rec2");
+    simulate(&next.join("plan.json"), &rec2);
+    let (before, after) = (
+        miss(&plan_json, &rec, "m1.json"),
+        miss(&next.join("plan.json"), &rec2, "m2.json"),
+    );
+    assert!(
+        before > 1e-5 && after < 0.1 * before,
+        "the miss went from {before} to {after} rad"
+    );
+}

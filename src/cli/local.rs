@@ -13,8 +13,9 @@ use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::local::plan_files::{plan_files, recording_files};
 use crate::local::{
-    identify_local, identify_local_with_delay, plan_experiments, CrossingTimes, Design, Estimator,
-    ExperimentKind, IdentifyOptions, LocalModel, OperatingPoint, Plan, PlanOptions, Size,
+    identify_local, identify_local_with_delay, plan_experiments, refine_plan, CrossingTimes,
+    Design, Estimator, ExperimentKind, IdentifyOptions, LocalModel, OperatingPoint, Plan,
+    PlanOptions, Size,
 };
 use crate::logs::recording::Recording;
 use crate::logs::save_recording;
@@ -28,8 +29,20 @@ pub(crate) struct PlanArgs {
     robot: RobotArg,
     /// The operating point: a JSON file, or the JSON itself, {"q": [...], "qd": [...], "qdd":
     /// [...]} (rad, rad/s, rad/s^2).
-    #[arg(long)]
-    op: PathBuf,
+    #[arg(long, required_unless_present = "refine", conflicts_with = "refine")]
+    op: Option<PathBuf>,
+    /// Refine a plan instead of planning anew: the folder of <experiment>.csv the robot
+    /// recorded running --plan. The output is the next round's plan, each experiment
+    /// commanded off its crossings by what the robot missed them by (an iterative learning
+    /// update; docs/method.md, "Closed-loop identification"); the plan's crossings,
+    /// perturbations and options stay.
+    #[arg(long, value_name = "RECORDINGS_DIR", requires = "plan")]
+    refine: Option<PathBuf>,
+    /// The plan the recordings of --refine ran (plan.json).
+    #[arg(long, value_name = "PLAN.json", requires = "refine")]
+    plan: Option<PathBuf>,
+    #[command(flatten)]
+    columns: super::files::ColumnArgs,
     /// Output folder: plan.json and <experiment>.csv (t, q1..qN, qd1..qN, qdd1..qN).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -178,8 +191,18 @@ fn size(abs: Option<f64>, fraction: f64, n: usize) -> Size {
 }
 
 pub(crate) fn plan(a: PlanArgs) -> Result<String> {
+    let op_arg = match (&a.op, &a.refine) {
+        (_, Some(dir)) => return refine(&a, dir),
+        (Some(op), None) => op,
+        (None, None) => {
+            return Err(Error::invalid(
+                "--op",
+                "expected the operating point (or --refine with the recordings of a plan)",
+            ))
+        }
+    };
     let model = a.robot.load()?;
-    let op = load_op(&a.op)?;
+    let op = load_op(op_arg)?;
     let n = model.nv;
     let mut o = PlanOptions {
         design: a.design,
@@ -242,6 +265,64 @@ pub(crate) fn plan(a: PlanArgs) -> Result<String> {
     let _ = writeln!(out, "plan -> {}", set.path_of("plan.json").display());
     set.commit()?;
     Ok(out)
+}
+
+/// `plan --refine`: the next round's plan from the recordings of the round `--plan` planned.
+fn refine(a: &PlanArgs, dir: &Path) -> Result<String> {
+    let plan_path = a.plan.as_deref().ok_or_else(|| {
+        Error::invalid(
+            "--refine",
+            "needs the plan the recordings ran: --plan PLAN.json",
+        )
+    })?;
+    let plan = Plan::load(plan_path)?;
+    let model = a.robot.load()?;
+    crate::simulation::check_plan_robot(&model, &plan)?;
+    let files: Vec<PathBuf> = (plan.experiments.iter())
+        .map(|e| dir.join(format!("{}.csv", e.kind.name())))
+        .collect();
+    let out = out_dir(&a.out);
+    let inputs: Vec<&Path> = (files.iter().map(PathBuf::as_path))
+        .chain([plan_path, a.robot.path()])
+        .collect();
+    let outputs = std::iter::once("plan.json".to_string()).chain(
+        plan.experiments
+            .iter()
+            .map(|e| format!("{}.csv", e.kind.name())),
+    );
+    for name in outputs {
+        super::files::refuse_overwriting_inputs(&out.join(name), &inputs)?;
+    }
+    let mut notes = String::new();
+    let recs: Vec<Recording> = files
+        .iter()
+        .map(|f| a.columns.load(f, &plan.joint_names, &mut notes))
+        .collect::<Result<_>>()?;
+    let refined = refine_plan(&plan, &recs, &IdentifyOptions::default(), Some(&model))?;
+    let set = plan_files(&refined, &out)?;
+    let mut text = notes;
+    for e in &refined.experiments {
+        let name = format!("{}.csv", e.kind.name());
+        let Some(c) = &e.commanded else { continue };
+        let largest = |f: &dyn Fn(&crate::local::plan::StateOffset) -> &Vec<f64>| {
+            (c.crossings.iter().chain(&c.reference))
+                .flat_map(|o| f(o).iter().map(|v| v.abs()))
+                .fold(0.0, f64::max)
+        };
+        let _ = writeln!(
+            text,
+            "{:<9} refined {} time(s): commanded off its crossings by up to {:.2e} rad, {:.2e} rad/s, {:.2e} rad/s^2 -> {}",
+            e.kind.name(),
+            c.rounds,
+            largest(&|o| &o.q),
+            largest(&|o| &o.qd),
+            largest(&|o| &o.qdd),
+            set.path_of(&name).display()
+        );
+    }
+    let _ = writeln!(text, "plan -> {}", set.path_of("plan.json").display());
+    set.commit()?;
+    Ok(text)
 }
 
 #[derive(Args)]
