@@ -14,7 +14,7 @@
 
 use perturbid_rs::direct::torque_delay::DelayOptions;
 use perturbid_rs::local::{
-    identify_local_with_delay, plan_experiments, IdentifyOptions, PlanOptions,
+    identify_local_with_delay, plan_experiments, refine_plan, IdentifyOptions, PlanOptions,
 };
 use perturbid_rs::rehearsal::{compare, local_case, realistic_robot, rehearse_plan, Realism};
 use perturbid_rs::{LoadOptions, Model, OperatingPoint};
@@ -62,6 +62,8 @@ enum Delay {
     Ignored,
     Given,
     Estimated,
+    /// Estimated, after two rounds of `refine_plan`.
+    Refined,
 }
 
 impl Delay {
@@ -71,6 +73,7 @@ impl Delay {
             Delay::Ignored => format!(", {ms:.1} ms delay ignored"),
             Delay::Given => format!(", {ms:.1} ms delay given"),
             Delay::Estimated => format!(", {ms:.1} ms delay, estimated"),
+            Delay::Refined => format!(", {ms:.1} ms delay, estimated, plan refined twice"),
         }
     }
 }
@@ -92,11 +95,21 @@ fn one_case(
     match mode {
         Delay::Ignored => {}
         Delay::Given => identify.fit.torque_delay = delay,
-        Delay::Estimated => {
-            let plan = plan_experiments(model, op, &PlanOptions::default())?;
-            let mut recordings = rehearse_plan(model, robot, &plan)?;
-            for r in &mut recordings {
-                r.t.iter_mut().for_each(|t| *t += 0.007);
+        Delay::Estimated | Delay::Refined => {
+            let rehearsed = |plan: &perturbid_rs::local::Plan| {
+                let mut recordings = rehearse_plan(model, robot, plan)?;
+                for r in &mut recordings {
+                    r.t.iter_mut().for_each(|t| *t += 0.007);
+                }
+                Ok::<_, perturbid_rs::Error>(recordings)
+            };
+            let mut plan = plan_experiments(model, op, &PlanOptions::default())?;
+            let mut recordings = rehearsed(&plan)?;
+            if let Delay::Refined = mode {
+                for _ in 0..2 {
+                    plan = refine_plan(&plan, &recordings, &identify, Some(model))?;
+                    recordings = rehearsed(&plan)?;
+                }
             }
             let local = identify_local_with_delay(
                 model,
@@ -135,6 +148,7 @@ fn main() -> perturbid_rs::Result<()> {
             (None, 1.5e-3, Delay::Given),
             (None, 1.5e-3, Delay::Estimated),
             (Some(25.0), 1.5e-3, Delay::Estimated),
+            (Some(25.0), 1.5e-3, Delay::Refined),
             (None, 0.0, Delay::Estimated),
             (Some(25.0), 0.0, Delay::Estimated),
         ] {

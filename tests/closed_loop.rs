@@ -9,8 +9,8 @@ mod common;
 use common::{rel, table2};
 use perturbid_rs::direct::torque_delay::{estimate_torque_delay, DelayOptions};
 use perturbid_rs::local::{
-    identify_local, identify_local_with_delay, plan_experiments, ExperimentKind, IdentifyOptions,
-    LocalModel, Perturbations, PlanOptions,
+    identify_local, identify_local_rounds, identify_local_with_delay, plan_experiments,
+    ExperimentKind, IdentifyOptions, LocalModel, Perturbations, PlanOptions,
 };
 use perturbid_rs::rehearsal::{
     compare, local_case, realistic_robot, rehearse, rehearse_plan, true_local, Realism, TrueRobot,
@@ -295,8 +295,10 @@ fn two_rounds_of_refinement_bring_the_passes_to_p() {
             .fold(0.0f64, |a, x| a.max(x.abs()))
     };
     let mut misses = vec![];
+    let mut rounds = vec![];
     for round in 0..3 {
         let recordings = rehearse_plan(&model, &robot, &plan).unwrap();
+        rounds.push((plan.clone(), recordings.clone()));
         let local = identify_local(&plan, &recordings, &options).unwrap();
         misses.push(worst_miss(&local));
         let truth = true_local(&model, &robot, &op).unwrap();
@@ -321,6 +323,27 @@ fn two_rounds_of_refinement_bring_the_passes_to_p() {
         }
     }
     assert!(misses[2] < 0.1 * misses[0], "the miss went {misses:?}");
+    // the three rounds pooled: three times the crossings, T* within 3 standard errors
+    let pooled: Vec<_> = (rounds.iter()).map(|(p, r)| (p, r.as_slice())).collect();
+    let local = identify_local_rounds(&pooled, &options).unwrap();
+    let alone = identify_local(&rounds[2].0, &rounds[2].1, &options).unwrap();
+    let (d, d_alone) = (local.d.as_ref().unwrap(), alone.d.as_ref().unwrap());
+    assert_eq!(d.crossings, 3 * d_alone.crossings);
+    let truth = true_local(&model, &robot, &op).unwrap();
+    for j in 0..6 {
+        let off = (local.torque[j] - truth.torque[j]).abs() / local.torque_stderr[j];
+        assert!(off < 3.0, "joint {j}: T* {off:.1} standard errors off");
+    }
+    // a round of another plan is refused, naming it
+    let other = plan_experiments(&model, &table2(), &PlanOptions::default()).unwrap();
+    let mixed = [pooled[0], (&other, pooled[1].1)];
+    let e = identify_local_rounds(&mixed, &options)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("round 2") && e.contains("another operating point"),
+        "{e}"
+    );
 }
 
 /// The recordings' torque delay, found with the robot's rigid-body model

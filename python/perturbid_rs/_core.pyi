@@ -605,8 +605,10 @@ def identify_local(
     drive_gains: Optional[BaseParameterModel] = None,
     torque_delay: Union[float, str, None] = None,
     robot: Optional[Robot] = None,
+    rounds: Optional[list[tuple[Plan, list[Recording]]]] = None,
 ) -> LocalModel:
-    """The local model from a plan and one recording per experiment. drive_gains: a model
+    """The local model from a plan and one recording per experiment (rounds: earlier rounds
+    of the plan, the plans Plan.refine gave, pooled with this one). drive_gains: a model
     from identify_drive_gains, for recordings of motor currents (put in torques by its
     gains, which the local model keeps). torque_delay: how long after the positions the
     torque logs what belongs with them (s; a sensor's or filter's delay; None: 0): each

@@ -44,6 +44,15 @@ pub fn identify_local(
         ));
     }
     let read = read_experiments(plan, recordings, options)?;
+    identify_read(plan, read, options)
+}
+
+/// The stages of [`identify_local`] after the recordings were read.
+pub(super) fn identify_read(
+    plan: &Plan,
+    read: ReadExperiments,
+    options: &IdentifyOptions,
+) -> Result<LocalModel> {
     let point = NominalPoint::of(plan, &read.values)?;
     let mut fits = Regressions::new(plan, &read.values, &point);
     let d = fits.separated(ExperimentKind::D, "dqdd")?;
@@ -125,10 +134,10 @@ pub const MAX_TORQUE_DELAY: f64 = 0.05;
 /// What the experiments' recordings gave, in the plan's order of experiments.
 pub(super) struct ReadExperiments {
     pub(super) values: Vec<ExperimentValues>,
-    names: Vec<String>,
-    dropouts: Vec<LogDropout>,
-    held: Vec<LogGlitch>,
-    warnings: Vec<String>,
+    pub(super) names: Vec<String>,
+    pub(super) dropouts: Vec<LogDropout>,
+    pub(super) held: Vec<LogGlitch>,
+    pub(super) warnings: Vec<String>,
 }
 
 /// Each experiment's recording matched, checked against the plan, repaired and read at its

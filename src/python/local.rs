@@ -393,6 +393,41 @@ pub(crate) fn plan_experiments(
     })
 }
 
+/// `identify_local`'s `torque_delay` and `robot`: the delay in seconds, or 0 and the robot
+/// whose model estimates it (`torque_delay='estimate'`); either without the other refused.
+fn delay_choice(
+    torque_delay: Option<&Bound<'_, PyAny>>,
+    robot: Option<PyRef<'_, PyRobot>>,
+) -> PyResult<(f64, Option<crate::model::Model>)> {
+    let estimate = match torque_delay {
+        Some(d) if d.extract::<String>().is_ok_and(|s| s == "estimate") => true,
+        Some(d) if d.is_instance_of::<pyo3::types::PyString>() => {
+            return Err(Error::invalid(
+                "torque_delay",
+                format!("'{d}'; expected a delay in seconds, or 'estimate'"),
+            )
+            .into())
+        }
+        _ => false,
+    };
+    let seconds = match (torque_delay, estimate) {
+        (Some(d), false) => scalars::real(d)?,
+        _ => 0.0,
+    };
+    let refuse = |message: &str| Err(Error::invalid("robot", message).into());
+    match (robot, estimate) {
+        (Some(r), true) => Ok((seconds, Some(r.model.clone()))),
+        (None, true) => refuse("torque_delay='estimate' needs the plan's Robot: give robot="),
+        (Some(_), false) => refuse(
+            "only torque_delay='estimate' uses the robot; leave it out, or estimate the delay",
+        ),
+        (None, false) => Ok((seconds, None)),
+    }
+}
+
+/// One earlier round of `identify_local(rounds=)`: its plan and recordings.
+type Round<'py> = (PyRef<'py, PyPlan>, Vec<Bound<'py, PyRecording>>);
+
 /// Identifies the local model from `plan` and `recordings`: one per experiment, in any order,
 /// each saying which experiment it is a run of (`Recording.experiment`, set by `simulate`, or a
 /// name such as `D.csv`).
@@ -408,6 +443,9 @@ pub(crate) fn plan_experiments(
 ///   'estimate': found in the recordings with `robot`'s rigid-body model (a held drive
 ///   command reads as half a sample early), kept in `diagnostics['torque_delay']`;
 /// - `robot`: the plan's Robot, for `torque_delay='estimate'`;
+/// - `rounds`: earlier rounds of the plan to pool with this one, `[(plan, recordings), ...]`
+///   (the plans `Plan.refine` gave, or the first): their crossings are read against their own
+///   plans and joined with these (`identify_local_rounds`);
 /// - `estimator`: 'separated' (the paper) or 'combined' (all crossings in one regression);
 /// - `friction_aware_h`: H* from the differences of the H passes' +- pairs with each joint's
 ///   Coulomb step as its own column (exact for viscous and Coulomb friction that reverses
@@ -418,7 +456,7 @@ pub(crate) fn plan_experiments(
 ///   `Recording.in_torques`), the model keeps them (`LocalModel.drive_gains`) and their
 ///   standard errors enter its predictions' (as `perturbid identify --gains-from`).
 #[pyfunction]
-#[pyo3(signature = (plan, recordings, crossing_times="detected", max_shift=0.5, window=None, torque_degree=6, recorded_derivatives=false, estimator="separated", friction_aware_h=false, drive_gains=None, torque_delay=None, robot=None))]
+#[pyo3(signature = (plan, recordings, crossing_times="detected", max_shift=0.5, window=None, torque_degree=6, recorded_derivatives=false, estimator="separated", friction_aware_h=false, drive_gains=None, torque_delay=None, robot=None, rounds=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn identify_local(
     py: Python<'_>,
@@ -434,39 +472,9 @@ pub(crate) fn identify_local(
     drive_gains: Option<PyRef<'_, super::direct::PyBaseModel>>,
     torque_delay: Option<Bound<'_, PyAny>>,
     robot: Option<PyRef<'_, super::robot::PyRobot>>,
+    rounds: Option<Vec<Round<'_>>>,
 ) -> PyResult<PyLocalModel> {
-    let estimate = match &torque_delay {
-        Some(d) if d.extract::<String>().is_ok_and(|s| s == "estimate") => true,
-        Some(d) if d.is_instance_of::<pyo3::types::PyString>() => {
-            return Err(Error::invalid(
-                "torque_delay",
-                format!("'{d}'; expected a delay in seconds, or 'estimate'"),
-            )
-            .into())
-        }
-        _ => false,
-    };
-    let torque_delay = match (&torque_delay, estimate) {
-        (Some(d), false) => scalars::real(d)?,
-        _ => 0.0,
-    };
-    let robot =
-        match (robot, estimate) {
-            (Some(r), true) => Some(r.model.clone()),
-            (None, true) => {
-                return Err(Error::invalid(
-                    "robot",
-                    "torque_delay='estimate' needs the plan's Robot: give robot=",
-                )
-                .into())
-            }
-            (Some(_), false) => return Err(Error::invalid(
-                "robot",
-                "only torque_delay='estimate' uses the robot; leave it out, or estimate the delay",
-            )
-            .into()),
-            (None, false) => None,
-        };
+    let (torque_delay, robot) = delay_choice(torque_delay.as_ref(), robot)?;
     let times = CrossingTimes::new(crossing_times.parse()?, max_shift);
     let options = IdentifyOptions {
         times,
@@ -509,7 +517,36 @@ pub(crate) fn identify_local(
         })
         .collect::<Result<_>>()?;
     let plan = plan.plan.clone();
+    let earlier: Vec<(Arc<Plan>, Vec<Recording>)> = match rounds {
+        Some(_) if robot.is_some() => {
+            return Err(Error::invalid(
+                "rounds",
+                "pooled rounds take a torque delay in seconds: estimate it on one round first",
+            )
+            .into())
+        }
+        Some(rounds) => rounds
+            .into_iter()
+            .map(|(p, recs)| {
+                let recs = (recs.iter())
+                    .map(|r| match &gains {
+                        Some(g) => r.get().rec.in_torques(&g.gain),
+                        None => Ok((*r.get().rec).clone()),
+                    })
+                    .collect::<Result<Vec<_>>>()?;
+                Ok((p.plan.clone(), recs))
+            })
+            .collect::<Result<_>>()?,
+        None => vec![],
+    };
     let mut model = detached(py, "identify_local", || match &robot {
+        None if !earlier.is_empty() => {
+            let all: Vec<(&Plan, &[Recording])> = (earlier.iter())
+                .map(|(p, r)| (p.as_ref(), r.as_slice()))
+                .chain([(plan.as_ref(), recs.as_slice())])
+                .collect();
+            crate::local::identify_local_rounds(&all, &options)
+        }
         Some(r) => {
             crate::local::identify_local_with_delay(r, &plan, &recs, &options, &Default::default())
         }

@@ -746,5 +746,15 @@ def test_a_tracking_robots_miss_and_the_estimator_evidence():
     assert [len(c) for c in miss["corrected"]] == [3] * 6
     # the next round's plan commands the references off the crossings by the miss
     refined = plan.refine(recs, robot=robot)
-    again = pr.identify_local(refined, pr.simulate(robot, refined, true_robot=true))
+    recs2 = pr.simulate(robot, refined, true_robot=true)
+    again = pr.identify_local(refined, recs2)
     assert np.abs(again.miss["q"]).max() < 0.5 * np.abs(miss["q"]).max()
+    # rounds pooled: a repeat of the refined round halves the variance of D*
+    pooled = pr.identify_local(refined, recs2, rounds=[(refined, recs2)])
+    assert np.median(pooled.stderr["D"]) < 0.8 * np.median(again.stderr["D"])
+    # the first round's crossings join the refined round's, and bring its tracking errors
+    # into the separated regressions (docs/method.md: pool repeats of the refined round)
+    both = pr.identify_local(refined, recs2, rounds=[(plan, recs)])
+    assert np.median(both.stderr["D"]) > np.median(again.stderr["D"])
+    with pytest.raises(ValueError, match="rounds"):
+        pr.identify_local(refined, recs2, rounds=[(plan, recs)], torque_delay="estimate", robot=robot)
