@@ -1697,43 +1697,14 @@ fn plan_refine_commands_the_next_round_off_the_miss() {
     };
     simulate(&plan_json, &rec);
     fails(&["plan", "a465", "--refine", s(&rec)], &["--plan"]);
+    let refine = ["plan", "a465", "--refine", s(&rec), "--plan", s(&plan_json)];
+    fails(&[&refine[..], &["--op", s(&op)]].concat(), &["--op"]);
     fails(
-        &[
-            "plan",
-            "a465",
-            "--refine",
-            s(&rec),
-            "--plan",
-            s(&plan_json),
-            "--op",
-            s(&op),
-        ],
-        &["--op"],
-    );
-    fails(
-        &[
-            "plan",
-            "a465",
-            "--refine",
-            s(&rec),
-            "--plan",
-            s(&plan_json),
-            "--out",
-            s(&plan),
-        ],
+        &[&refine[..], &["--out", s(&plan)]].concat(),
         &["plan.json"],
     );
     let next = d.join("plan2");
-    let out = ok(&[
-        "plan",
-        "a465",
-        "--refine",
-        s(&rec),
-        "--plan",
-        s(&plan_json),
-        "--out",
-        s(&next),
-    ]);
+    let out = ok(&[&refine[..], &["--out", s(&next)]].concat());
     assert!(
         out.contains("nominal   refined 1 time(s): commanded off its crossings by up to"),
         "{out}"

@@ -123,15 +123,13 @@ pub fn estimate_torque_delay(
     // joints weighted first by their torques' spread, then by what the fit leaves of them
     let spread = design.joint_rms(&design.torques(&series, 0.0));
     let first = Projection::new(&design, &spread)?;
-    let (delay, _) = first.search(&design, &series, options.range)?;
+    let (delay, ..) = first.search(&design, &series, options.range)?;
     let left = first.residual(&design.weighted(&design.torques(&series, delay), &spread));
     let fit = Projection::new(
         &design,
         &design.joint_rms(&unweight(&design, &left, &spread)),
     )?;
-    let weights = fit.weights.clone();
-    let (delay, unexplained) = fit.search(&design, &series, options.range)?;
-    let at_zero = fit.unexplained(&design.weighted(&design.torques(&series, 0.0), &weights));
+    let (delay, unexplained, at_zero) = fit.search(&design, &series, options.range)?;
     let stderr = fit.stderr(&design, &series, delay);
     crate::interrupt::check("the torque delay")?;
     Ok(TorqueDelay {
@@ -194,9 +192,7 @@ fn filtered(model: &Model, rec: &Recording, options: &DelayOptions) -> Result<Se
             format!("{} joints; the robot has {}", rec.n, model.nv),
         ));
     }
-    let mut steps: Vec<f64> = rec.t.windows(2).map(|w| w[1] - w[0]).collect();
-    steps.sort_by(f64::total_cmp);
-    let dt = steps.get(steps.len() / 2).copied().unwrap_or(f64::NAN);
+    let (dt, _) = crate::logs::gaps::gaps(rec);
     if !(dt.is_finite() && dt > 0.0) {
         return Err(Error::recording(
             rec.name.clone(),
@@ -532,9 +528,10 @@ impl Projection {
         left / total.max(f64::MIN_POSITIVE)
     }
 
-    /// The delay within `+-range` whose torques the fit explains best, and the fraction it
-    /// leaves unexplained: tried half a sample apart, the best refined by a parabola.
-    fn search(&self, design: &Design, series: &[Series], range: f64) -> Result<(f64, f64)> {
+    /// The delay within `+-range` whose torques the fit explains best, the fraction it leaves
+    /// unexplained, and the fraction left at no delay: tried half a sample apart (0 among
+    /// them), the best refined by a parabola.
+    fn search(&self, design: &Design, series: &[Series], range: f64) -> Result<(f64, f64, f64)> {
         let step = 0.5 * series.iter().map(|s| s.dt).fold(f64::INFINITY, f64::min);
         let half = (range / step).floor() as i64;
         let left =
@@ -565,7 +562,7 @@ impl Projection {
             0.0
         };
         let delay = tried[best].0 + offset * step;
-        Ok((delay, left(delay)))
+        Ok((delay, left(delay), tried[half as usize].1))
     }
 
     /// The standard error of `delay`: the residual's projection on the torques' rate, summed
