@@ -200,6 +200,60 @@ fn a_tracking_ur5_states_t_star_within_its_standard_errors() {
     );
 }
 
+/// A Panda (example-robot-data; skipped where it is not installed) that repeats its motion
+/// exactly from pass to pass (PD tracking at 25 Hz, no torque noise or ripple) and logs its
+/// positions in 2^18 counts per revolution: every nominal pass rounds alike, so the reading
+/// error of the measured point does not average out of their mean. Over two rounds of
+/// refinement T* stays within 3 of its standard errors, which count that error
+/// (`local::repeated_reading`; counted as if it averaged out, T* was up to 7 standard errors
+/// off), and the miss is reported in the standard errors of its measurement.
+#[test]
+fn rounding_every_pass_repeats_is_counted_in_t_star() {
+    use perturbid_rs::local::refine_plan;
+    let Some(path) = common::panda_urdf() else {
+        eprintln!("skipped: example-robot-data is not installed (pip install example-robot-data)");
+        return;
+    };
+    let mut load = perturbid_rs::LoadOptions::default();
+    load.lock.insert("panda_finger_joint1".into(), 0.0);
+    let model = perturbid_rs::model_from_urdf_file(&path, &load).unwrap();
+    let op = panda_all_fast();
+    let realism = Realism {
+        ripple: 0.0,
+        ..Realism::default()
+    };
+    let mut robot = realistic_robot(&model, &op.q, &realism).unwrap();
+    robot.sensors.torque_noise = None;
+    let mut options = IdentifyOptions::default();
+    // the sensor's 1.5 ms less the held command's half sample
+    options.fit.torque_delay = 1.0e-3;
+    let mut plan = plan_experiments(&model, &op, &PlanOptions::default()).unwrap();
+    let truth = true_local(&model, &robot, &op).unwrap();
+    let mut errors = vec![];
+    for round in 0..3 {
+        let recordings = rehearse_plan(&model, &robot, &plan).unwrap();
+        let local = identify_local(&plan, &recordings, &options).unwrap();
+        let off: Vec<f64> = (0..7)
+            .map(|j| (local.torque[j] - truth.torque[j]) / local.torque_stderr[j])
+            .collect();
+        eprintln!("round {round}: T* in standard errors {off:?}");
+        errors.extend(off);
+        let miss = local.miss.as_ref().unwrap();
+        assert!(miss.qdd_stderr.iter().all(|s| *s > 0.0), "{miss:?}");
+        assert!(local
+            .summary("m.json")
+            .contains("standard errors of its measurement"));
+        if round < 2 {
+            plan = refine_plan(&plan, &recordings, &options, Some(&model)).unwrap();
+        }
+    }
+    let worst = errors.iter().fold(0.0f64, |a, e| a.max(e.abs()));
+    assert!(
+        worst < 3.0,
+        "T* up to {worst:.1} standard errors off: {errors:?}"
+    );
+}
+
 /// The Panda of example-robot-data (skipped where it is not installed) at a point where every
 /// joint is fast, open loop, with a 1.5 ms torque delay: T* read at the crossings' times is
 /// off by the delay times the torque's rate, beyond its standard errors; read 1.5 ms later

@@ -495,7 +495,8 @@ class LocalModel:
     def miss(self) -> Optional[dict[str, NDArray[np.float64]]]:
         """How far the nominal passes missed the planned operating point: q, qd, qdd (measured -
         planned), q_perturbations, qd_perturbations, qdd_perturbations (in planned
-        perturbations), measured_torque, measured_stderr (the mean at the nominal crossings),
+        perturbations), q_stderr, qd_stderr, qdd_stderr (the standard errors of the measured
+        miss), measured_torque, measured_stderr (the mean at the nominal crossings),
         correction, correction_stderr (N m, carried to the planned point), (n,) each; None
         without the G, H and D experiments."""
     @property

@@ -27,15 +27,15 @@ impl LocalModel {
     /// component of the miss within [`SIGNIFICANT_MISS`] of its standard error is not
     /// corrected (a measurement error of the point, which positions rounded alike in every
     /// pass need not average out of, would enter T* whole), and its possible size counts in
-    /// T*'s standard error instead. `band` marks the joints whose states were read by the band
-    /// of their encoder counts (their rounding repeats in every pass) and `rounding` the floor
-    /// the torque's logged steps put under T*'s standard error. Nothing changes without D, H or
-    /// G.
+    /// T*'s standard error instead. `common` is the part of `var` every pass repeats (encoder
+    /// rounding alike in every pass, see [`super::repeated_reading`]): a corrected reading
+    /// keeps it whole. `rounding` is the floor the torque's logged steps put under T*'s
+    /// standard error. Nothing changes without D, H or G.
     pub(super) fn carry_to_plan(
         &mut self,
         nominal: &ExperimentValues,
         var: &[Vec<f64>; 3],
-        band: &[bool],
+        common: &[Vec<f64>; 3],
         rounding: &[f64],
     ) -> Result<()> {
         let (Some(d), Some(h), Some(g)) = (&self.d, &self.h, &self.g) else {
@@ -85,11 +85,10 @@ impl LocalModel {
                 let mut variance = scatter.powi(2) + correction_stderr[i].powi(2);
                 for (j, fixed) in corrected.iter().enumerate() {
                     for v in 0..3 {
-                        // rounding every pass repeats, through a corrected component; the
-                        // possible size of one left uncorrected
-                        if !fixed[v] || band[j] {
-                            variance += coef(i, v, j).powi(2) * var[v][j];
-                        }
+                        // the possible size of a component left uncorrected; the error every
+                        // pass repeats, through a corrected one
+                        let part = if fixed[v] { common[v][j] } else { var[v][j] };
+                        variance += coef(i, v, j).powi(2) * part;
                     }
                 }
                 let se = variance.sqrt();
@@ -122,6 +121,9 @@ impl LocalModel {
             q_perturbations,
             qd_perturbations,
             qdd_perturbations,
+            q_stderr: var[0].iter().map(|v| v.sqrt()).collect(),
+            qd_stderr: var[1].iter().map(|v| v.sqrt()).collect(),
+            qdd_stderr: var[2].iter().map(|v| v.sqrt()).collect(),
             corrected,
             correction: (self.torque.iter().zip(&torque))
                 .map(|(m, t)| m - t)

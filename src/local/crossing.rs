@@ -104,22 +104,26 @@ impl WindowFit {
             .sum()
     }
 
-    /// The sum of squared residuals of `y` about its fit.
-    fn scatter(&self, y: &[f64]) -> f64 {
+    /// The residuals of `y` about its fit.
+    fn residuals(&self, y: &[f64]) -> Vec<f64> {
         let c: Vec<f64> = (0..self.weights.nrows())
             .map(|d| self.coefficient(d, y))
             .collect();
         y.iter()
             .enumerate()
             .map(|(i, v)| {
-                let fit: f64 = c
+                v - c
                     .iter()
                     .enumerate()
                     .map(|(d, c)| c * self.basis[(i, d)])
-                    .sum();
-                (v - fit).powi(2)
+                    .sum::<f64>()
             })
-            .sum()
+            .collect()
+    }
+
+    /// The sum of squared residuals of `y` about its fit.
+    fn scatter(&self, y: &[f64]) -> f64 {
+        self.residuals(y).iter().map(|r| r * r).sum()
     }
 
     /// Screens `y` for glitches ([`super::glitches`]), with a noise level of at least the
@@ -603,6 +607,10 @@ fn read(
         tau_gain: vec![0.0; n],
         tau_scatter: vec![(0.0, 0); n],
         position_band: vec![false; n],
+        position_residuals: vec![vec![]; n],
+        centre: (0..count)
+            .min_by(|&a, &b| (t[a] - tc).abs().total_cmp(&(t[b] - tc).abs()))
+            .unwrap_or(0),
         glitches: vec![],
     };
     for j in 0..n {
@@ -640,8 +648,11 @@ fn read(
             })
             .collect();
         let dof = count.saturating_sub(fq.weights.nrows() + q.replaced());
+        let residuals = fq.residuals(&q.values);
+        let ss: f64 = residuals.iter().map(|r| r * r).sum();
+        out.position_residuals[j] = residuals;
         let sigma = if dof > 0 {
-            (fq.scatter(&q.values) / dof as f64).sqrt()
+            (ss / dof as f64).sqrt()
         } else {
             f64::NAN
         };

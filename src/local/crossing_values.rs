@@ -31,6 +31,12 @@ pub struct CrossingValues {
     /// rounded to encoder counts by the band of half a count about them
     /// ([`super::rounded_positions`]) rather than by least squares.
     pub position_band: Vec<bool>,
+    /// Per joint, the positions' residuals about the fit `q`, `qd`, `qdd` were read from, one
+    /// per sample of the window (rad): what [`super::repeated_reading`] compares across passes.
+    pub position_residuals: Vec<Vec<f64>>,
+    /// The index in the window of the sample nearest the crossing time, which lines up the
+    /// residuals of passes whose windows start at different samples.
+    pub centre: usize,
     /// Samples of this crossing's windows found far off their fits ([`super::glitches`]):
     /// replaced by the fit of the others where isolated, left in otherwise.
     pub glitches: Vec<WindowGlitch>,

@@ -116,10 +116,7 @@ pub(super) fn identify_read(
         miss: None,
     };
     if let Some(nominal) = nominal {
-        let band: Vec<bool> = (0..plan.n())
-            .map(|j| nominal.crossings.iter().any(|c| c.position_band[j]))
-            .collect();
-        model.carry_to_plan(&nominal, &point.var, &band, &point.rounding)?;
+        model.carry_to_plan(&nominal, &point.var, &point.common, &point.rounding)?;
         model
             .diagnostics
             .warnings

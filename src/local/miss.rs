@@ -26,6 +26,16 @@ pub struct Miss {
     pub qd_perturbations: Vec<f64>,
     #[serde(with = "crate::json::stderr_vec")]
     pub qdd_perturbations: Vec<f64>,
+    /// Per joint, the standard errors of the measured `q`, `qd`, `qdd` miss (the positions'
+    /// reading error, counting what every pass repeats, see [`super::repeated_reading`]):
+    /// below about 3 of them a miss may be the measurement's own error, which no refinement
+    /// removes. Empty for a model saved before they were stored.
+    #[serde(default, with = "crate::json::stderr_vec")]
+    pub q_stderr: Vec<f64>,
+    #[serde(default, with = "crate::json::stderr_vec")]
+    pub qd_stderr: Vec<f64>,
+    #[serde(default, with = "crate::json::stderr_vec")]
+    pub qdd_stderr: Vec<f64>,
     /// Per joint, which of its `[q, qd, qdd]` misses were corrected: those beyond
     /// 3 standard errors of their measurement (a
     /// smaller one may be the measurement's own error; its possible size counts in T*'s
@@ -54,19 +64,23 @@ pub const MISS_WARNING: f64 = 1.0;
 impl Miss {
     /// The largest miss in perturbation units: `(joint, variable name, value)`.
     pub fn largest(&self) -> Option<(usize, &'static str, f64)> {
-        let mut best: Option<(usize, &'static str, f64)> = None;
-        for (name, v) in [
-            ("q", &self.q_perturbations),
-            ("qd", &self.qd_perturbations),
-            ("qdd", &self.qdd_perturbations),
-        ] {
-            for (j, x) in v.iter().enumerate().filter(|(_, x)| x.is_finite()) {
-                if best.is_none_or(|b| x.abs() > b.2.abs()) {
-                    best = Some((j, name, *x));
-                }
-            }
-        }
-        best
+        largest_of([
+            ("q", self.q_perturbations.clone()),
+            ("qd", self.qd_perturbations.clone()),
+            ("qdd", self.qdd_perturbations.clone()),
+        ])
+    }
+
+    /// The largest miss in units of its standard errors: `(joint, variable name, value)`;
+    /// None for a model saved before they were stored.
+    pub fn largest_in_stderr(&self) -> Option<(usize, &'static str, f64)> {
+        let z =
+            |x: &[f64], s: &[f64]| -> Vec<f64> { x.iter().zip(s).map(|(x, s)| x / s).collect() };
+        largest_of([
+            ("q", z(&self.q, &self.q_stderr)),
+            ("qd", z(&self.qd, &self.qd_stderr)),
+            ("qdd", z(&self.qdd, &self.qdd_stderr)),
+        ])
     }
 
     /// Checks a stored miss of `n` joints (`what` names the document).
@@ -100,6 +114,19 @@ impl Miss {
             }
             crate::document::check_bounded(what, "a local model", &format!("miss.{field}"), v)?;
         }
+        for (field, v) in [
+            ("q_stderr", &self.q_stderr),
+            ("qd_stderr", &self.qd_stderr),
+            ("qdd_stderr", &self.qdd_stderr),
+        ] {
+            if !v.is_empty() && v.len() != n {
+                return Err(crate::document::invalid(
+                    what,
+                    format!("miss.{field} has {} entries for {n} joints", v.len()),
+                ));
+            }
+            crate::document::check_magnitudes(what, &format!("miss.{field}"), v, true)?;
+        }
         crate::document::check_magnitudes(
             what,
             "miss.measured_stderr",
@@ -113,4 +140,18 @@ impl Miss {
             true,
         )
     }
+}
+
+/// The entry of largest magnitude among the finite ones of `parts` (named variables, one value
+/// per joint): `(joint, name, value)`.
+fn largest_of(parts: [(&'static str, Vec<f64>); 3]) -> Option<(usize, &'static str, f64)> {
+    let mut best: Option<(usize, &'static str, f64)> = None;
+    for (name, v) in parts {
+        for (j, x) in v.into_iter().enumerate().filter(|(_, x)| x.is_finite()) {
+            if best.is_none_or(|b| x.abs() > b.2.abs()) {
+                best = Some((j, name, x));
+            }
+        }
+    }
+    best
 }

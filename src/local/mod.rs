@@ -68,6 +68,7 @@ pub mod reach;
 pub mod refine;
 mod regressions;
 mod repaired_recording;
+pub mod repeated_reading;
 pub mod response;
 pub mod reversals;
 pub mod rounded_positions;
@@ -87,7 +88,7 @@ pub use diagnostics::{
 };
 pub use identify::{CrossingTimes, IdentifyOptions, TimesSource};
 pub use identify_local::identify_local;
-pub use identify_with_delay::identify_local_with_delay;
+pub use identify_with_delay::{identify_local_rounds_with_delay, identify_local_with_delay};
 pub use miss::Miss;
 pub use model::{Estimate, Estimator, LocalModel, SignalGains};
 pub use offset_search::{detect_offset, detect_offset_in};

@@ -48,6 +48,19 @@ impl LocalModel {
                 units(&m.qd_perturbations),
                 units(&m.qdd_perturbations)
             );
+            if let Some((j, var, z)) = m.largest_in_stderr() {
+                let _ = writeln!(
+                    out,
+                    "the largest miss is {:.1} standard errors of its measurement ({var} of joint '{}'){}",
+                    z.abs(),
+                    self.joint_names[j],
+                    if z.abs() < 3.0 {
+                        ": within what the readings may be off by, which refining the plan does not remove"
+                    } else {
+                        ""
+                    }
+                );
+            }
             let c: Vec<String> = (m.correction.iter().zip(&m.correction_stderr))
                 .map(|(c, s)| format!("{c:+.4} [{s:.1e}]"))
                 .collect();

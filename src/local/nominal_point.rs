@@ -6,6 +6,7 @@ use super::identify::ExperimentValues;
 use super::noise::sample_variance;
 use super::plan::{ExperimentKind, Plan};
 use super::quantisation;
+use super::repeated_reading::{mean_variance, repeated_share};
 use crate::error::{Error, Result};
 use crate::operating_point::OperatingPoint;
 
@@ -21,6 +22,9 @@ pub(super) struct NominalPoint {
     pub(super) state: [Vec<f64>; 3],
     /// The variance of the operating point's error, per variable and joint.
     pub(super) var: [Vec<f64>; 3],
+    /// The part of `var` that every nominal pass repeats ([`super::repeated_reading`]): it
+    /// stays whole in a reading carried to the planned point.
+    pub(super) common: [Vec<f64>; 3],
     /// Per joint, the floor the torque's rounding to its logged steps puts under the standard
     /// error of `torque` (0 where the torque is not logged coarser than its noise).
     pub(super) rounding: Vec<f64>,
@@ -50,28 +54,27 @@ impl NominalPoint {
         let rounding = nominal.map_or_else(|| vec![0.0; n], |v| rounding_floor(v, n));
         let state = [op.q.clone(), op.qd.clone(), op.qdd.clone()];
         // the variance of the operating point's error, the mean of the nominal crossings':
-        // noise averages over their K passes (/ K), but positions read by their band are
-        // rounded the same way in every pass of one trajectory, and need not average out
-        let var: [Vec<f64>; 3] = std::array::from_fn(|var| {
-            (0..n)
-                .map(|j| {
-                    nominal.map_or(0.0, |v| {
-                        let k = v.crossings.len().max(1) as f64;
-                        let mean = v
-                            .crossings
-                            .iter()
-                            .map(|c| c.state_stderr[var][j].powi(2))
-                            .sum::<f64>()
-                            / k;
-                        if v.crossings.iter().any(|c| c.position_band[j]) {
-                            mean
-                        } else {
-                            mean / k
-                        }
-                    })
-                })
-                .collect()
-        });
+        // noise averages over their K passes (/ K), but an error every pass repeats does not
+        // (positions read by their band are rounded the same way in every pass of one
+        // trajectory; otherwise the passes' residuals say how much repeats)
+        let [mut var, mut common]: [[Vec<f64>; 3]; 2] =
+            std::array::from_fn(|_| std::array::from_fn(|_| vec![0.0; n]));
+        if let Some(v) = nominal {
+            let k = v.crossings.len().max(1);
+            for j in 0..n {
+                let share = if v.crossings.iter().any(|c| c.position_band[j]) {
+                    1.0
+                } else {
+                    repeated_share(&v.crossings, j)
+                };
+                for x in 0..3 {
+                    let each = v.crossings.iter().map(|c| c.state_stderr[x][j].powi(2));
+                    let each = each.sum::<f64>() / k as f64;
+                    var[x][j] = mean_variance(each, share, k);
+                    common[x][j] = each * share;
+                }
+            }
+        }
         Ok(Self {
             nominal: index,
             torque,
@@ -79,6 +82,7 @@ impl NominalPoint {
             op,
             state,
             var,
+            common,
             rounding,
         })
     }

@@ -445,7 +445,8 @@ type Round<'py> = (PyRef<'py, PyPlan>, Vec<Bound<'py, PyRecording>>);
 /// - `robot`: the plan's Robot, for `torque_delay='estimate'`;
 /// - `rounds`: earlier rounds of the plan to pool with this one, `[(plan, recordings), ...]`
 ///   (the plans `Plan.refine` gave, or the first): their crossings are read against their own
-///   plans and joined with these (`identify_local_rounds`);
+///   plans and joined with these (`identify_local_rounds`); with `torque_delay='estimate'`
+///   the delay is found over every round's recordings;
 /// - `estimator`: 'separated' (the paper) or 'combined' (all crossings in one regression);
 /// - `friction_aware_h`: H* from the differences of the H passes' +- pairs with each joint's
 ///   Coulomb step as its own column (exact for viscous and Coulomb friction that reverses
@@ -518,13 +519,6 @@ pub(crate) fn identify_local(
         .collect::<Result<_>>()?;
     let plan = plan.plan.clone();
     let earlier: Vec<(Arc<Plan>, Vec<Recording>)> = match rounds {
-        Some(_) if robot.is_some() => {
-            return Err(Error::invalid(
-                "rounds",
-                "pooled rounds take a torque delay in seconds: estimate it on one round first",
-            )
-            .into())
-        }
         Some(rounds) => rounds
             .into_iter()
             .map(|(p, recs)| {
@@ -539,18 +533,21 @@ pub(crate) fn identify_local(
             .collect::<Result<_>>()?,
         None => vec![],
     };
-    let mut model = detached(py, "identify_local", || match &robot {
-        None if !earlier.is_empty() => {
-            let all: Vec<(&Plan, &[Recording])> = (earlier.iter())
-                .map(|(p, r)| (p.as_ref(), r.as_slice()))
-                .chain([(plan.as_ref(), recs.as_slice())])
-                .collect();
-            crate::local::identify_local_rounds(&all, &options)
+    let mut model = detached(py, "identify_local", || {
+        let all: Vec<(&Plan, &[Recording])> = (earlier.iter())
+            .map(|(p, r)| (p.as_ref(), r.as_slice()))
+            .chain([(plan.as_ref(), recs.as_slice())])
+            .collect();
+        match &robot {
+            Some(r) => crate::local::identify_local_rounds_with_delay(
+                r,
+                &all,
+                &options,
+                &Default::default(),
+            ),
+            None if all.len() > 1 => crate::local::identify_local_rounds(&all, &options),
+            None => identify_rs(&plan, &recs, &options),
         }
-        Some(r) => {
-            crate::local::identify_local_with_delay(r, &plan, &recs, &options, &Default::default())
-        }
-        None => identify_rs(&plan, &recs, &options),
     })?;
     model.drive_gains = gains;
     super::errors::warn_all(py, &model.diagnostics.warnings)?;

@@ -447,7 +447,9 @@ impl PyLocalModel {
     /// How far the nominal passes missed the planned operating point, and what carried T* to
     /// it: a dict of `(n,)` arrays `q`, `qd`, `qdd` (measured - planned: rad, rad/s, rad/s^2),
     /// `q_perturbations`, `qd_perturbations`, `qdd_perturbations` (the same in units of the
-    /// largest planned perturbation; NaN where that is 0), `measured_torque` and
+    /// largest planned perturbation; NaN where that is 0), `q_stderr`, `qd_stderr`, `qdd_stderr`
+    /// (the standard errors of the measured miss; empty for a model saved before they were
+    /// stored), `measured_torque` and
     /// `measured_stderr` (N m: the mean at the nominal crossings, before the correction),
     /// `correction` and `correction_stderr` (N m: subtracted to give `torque`, and its matrices'
     /// share of `torque_stderr`), `corrected` (per joint, which of its `[q, qd, qdd]` misses
@@ -466,6 +468,9 @@ impl PyLocalModel {
             ("q_perturbations", &m.q_perturbations),
             ("qd_perturbations", &m.qd_perturbations),
             ("qdd_perturbations", &m.qdd_perturbations),
+            ("q_stderr", &m.q_stderr),
+            ("qd_stderr", &m.qd_stderr),
+            ("qdd_stderr", &m.qdd_stderr),
             ("measured_torque", &m.measured_torque),
             ("measured_stderr", &m.measured_stderr),
             ("correction", &m.correction),

@@ -23,8 +23,10 @@ pub struct LocalCase {
     pub combined_relative: [f64; 3],
     /// Per block D, H, G, the share of entries within 3 of their standard errors.
     pub covered: [f64; 3],
-    /// The largest miss of the nominal passes, in perturbations.
-    pub miss: f64,
+    /// The largest miss of the nominal passes in `q`, `qd`, `qdd`, in perturbations.
+    pub miss: [f64; 3],
+    /// The same in the standard errors of their measurement (NaN without them).
+    pub miss_stderr: [f64; 3],
     pub model: LocalModel,
 }
 
@@ -78,13 +80,41 @@ pub fn compare(nominal: &Model, robot: &TrueRobot, model: LocalModel) -> Result<
             inside as f64 / (n * n) as f64
         })
     });
-    let miss = (model.miss.as_ref().and_then(|m| m.largest())).map_or(0.0, |(_, _, x)| x.abs());
+    let largest = |x: Vec<f64>| {
+        x.iter()
+            .filter(|v| v.is_finite())
+            .fold(0.0, |a: f64, v| a.max(v.abs()))
+    };
+    let (miss, miss_stderr) = match &model.miss {
+        None => ([0.0; 3], [f64::NAN; 3]),
+        Some(m) => {
+            let z = |x: &[f64], s: &[f64]| -> Vec<f64> {
+                match s.len() == x.len() {
+                    true => x.iter().zip(s).map(|(x, s)| x / s).collect(),
+                    false => vec![f64::NAN],
+                }
+            };
+            (
+                [
+                    largest(m.q_perturbations.clone()),
+                    largest(m.qd_perturbations.clone()),
+                    largest(m.qdd_perturbations.clone()),
+                ],
+                [
+                    largest(z(&m.q, &m.q_stderr)),
+                    largest(z(&m.qd, &m.qd_stderr)),
+                    largest(z(&m.qdd, &m.qdd_stderr)),
+                ],
+            )
+        }
+    };
     Ok(LocalCase {
         torque_errors,
         relative,
         combined_relative,
         covered,
         miss,
+        miss_stderr,
         model,
     })
 }

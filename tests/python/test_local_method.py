@@ -716,7 +716,9 @@ def test_a_tracking_robots_miss_and_the_estimator_evidence():
     })
     model = pr.identify_local(plan, pr.simulate(robot, plan, true_robot=true))
     miss = model.miss
-    assert set(miss) >= {"q", "qd", "qdd", "q_perturbations", "measured_torque", "correction", "correction_stderr"}
+    assert set(miss) >= {"q", "qd", "qdd", "q_perturbations", "q_stderr", "qd_stderr", "qdd_stderr", "measured_torque", "correction", "correction_stderr"}
+    # the miss is measured far beyond its standard errors: a miss to correct, not noise
+    assert np.abs(miss["q"] / miss["q_stderr"]).max() > 10.0
     np.testing.assert_allclose(miss["q"], model.op.q - model.planned_op.q, atol=1e-12)
     np.testing.assert_allclose(miss["measured_torque"] - miss["correction"], model.torque, atol=1e-9)
     assert np.abs(miss["q"]).max() > 1e-4
@@ -753,8 +755,9 @@ def test_a_tracking_robots_miss_and_the_estimator_evidence():
     pooled = pr.identify_local(refined, recs2, rounds=[(refined, recs2)])
     assert np.median(pooled.stderr["D"]) < 0.8 * np.median(again.stderr["D"])
     # the first round's crossings join the refined round's, and bring its tracking errors
-    # into the separated regressions (docs/method.md: pool repeats of the refined round)
+    # into the separated regressions (docs/method.md, "Plans that reach P")
     both = pr.identify_local(refined, recs2, rounds=[(plan, recs)])
     assert np.median(both.stderr["D"]) > np.median(again.stderr["D"])
-    with pytest.raises(ValueError, match="rounds"):
-        pr.identify_local(refined, recs2, rounds=[(plan, recs)], torque_delay="estimate", robot=robot)
+    # the delay estimated over every round's recordings at once
+    found_both = pr.identify_local(refined, recs2, rounds=[(plan, recs)], torque_delay="estimate", robot=robot)
+    assert abs(found_both.diagnostics["torque_delay"]["delay"] + 0.5 / plan.rate) < 3e-4
