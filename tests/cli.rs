@@ -1726,4 +1726,38 @@ fn plan_refine_commands_the_next_round_off_the_miss() {
         before > 1e-5 && after < 0.1 * before,
         "the miss went from {before} to {after} rad"
     );
+    // the two rounds pooled: twice the crossings, each round read against its own plan
+    let pooled = d.join("pooled.json");
+    let round = format!("{}={}", plan_json.display(), rec.display());
+    let next_json = next.join("plan.json");
+    let identify = ["identify", s(&next_json), s(&rec2), "--out", s(&pooled)];
+    ok(&[&identify[..], &["--round", &round]].concat());
+    let load =
+        |p: &std::path::Path| LocalModel::from_json(&std::fs::read_to_string(p).unwrap()).unwrap();
+    let (both, alone) = (load(&pooled), load(&d.join("m2.json")));
+    let crossings = |m: &LocalModel| m.d.as_ref().unwrap().crossings;
+    assert_eq!(crossings(&both), 2 * crossings(&alone));
+    fails(
+        &[&identify[..], &["--round", s(&rec)]].concat(),
+        &["--round", "PLAN.json=FOLDER"],
+    );
+    let missing = format!("{}={}", plan_json.display(), d.join("nowhere").display());
+    fails(
+        &[&identify[..], &["--round", &missing]].concat(),
+        &["--round", "nowhere"],
+    );
+    // the delay estimated over both rounds' recordings
+    let out = ok(&[
+        &identify[..],
+        &[
+            "--round",
+            &round,
+            "--torque-delay",
+            "estimate",
+            "--robot",
+            "a465",
+        ],
+    ]
+    .concat());
+    assert!(out.contains("torque delay "), "{out}");
 }

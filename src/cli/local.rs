@@ -13,9 +13,9 @@ use crate::error::{Error, Result};
 use crate::gravity::Gravity;
 use crate::local::plan_files::{plan_files, recording_files};
 use crate::local::{
-    identify_local, identify_local_with_delay, plan_experiments, refine_plan, CrossingTimes,
-    Design, Estimator, ExperimentKind, IdentifyOptions, LocalModel, OperatingPoint, Plan,
-    PlanOptions, Size,
+    identify_local, identify_local_rounds, identify_local_rounds_with_delay, plan_experiments,
+    refine_plan, CrossingTimes, Design, Estimator, ExperimentKind, IdentifyOptions, LocalModel,
+    OperatingPoint, Plan, PlanOptions, Size,
 };
 use crate::logs::recording::Recording;
 use crate::logs::save_recording;
@@ -545,8 +545,26 @@ pub(crate) struct IdentifyArgs {
     /// in the local model's.
     #[arg(long, value_name = "MODEL.json")]
     gains_from: Option<PathBuf>,
+    /// An earlier round of this plan to pool with these recordings: the round's plan (the
+    /// first, or one `plan --refine` gave) and its folder of recordings; repeatable. Each
+    /// round is read against its own plan and the crossings of all are joined (with
+    /// `--torque-delay estimate`, the delay is found over every round's recordings).
+    #[arg(long = "round", value_name = "PLAN.json=FOLDER", value_parser = parse_round)]
+    rounds: Vec<(PathBuf, PathBuf)>,
     #[command(flatten)]
     columns: super::files::ColumnArgs,
+}
+
+/// `--round PLAN.json=FOLDER`.
+fn parse_round(text: &str) -> std::result::Result<(PathBuf, PathBuf), String> {
+    match text.split_once('=') {
+        Some((plan, folder)) if !plan.is_empty() && !folder.is_empty() => {
+            Ok((PathBuf::from(plan), PathBuf::from(folder)))
+        }
+        _ => Err(format!(
+            "'{text}': expected PLAN.json=FOLDER (a round's plan and its folder of recordings)"
+        )),
+    }
 }
 
 /// `--torque-delay`: seconds or `estimate`.
@@ -564,6 +582,29 @@ fn parse_delay(text: &str) -> std::result::Result<TorqueDelayArg, String> {
             .map(TorqueDelayArg::Seconds)
             .map_err(|_| format!("'{text}': expected a delay in seconds, or 'estimate'")),
     }
+}
+
+/// The recording files of `plan`'s experiments: `given` one per experiment, or one folder
+/// holding `<experiment>.csv` for each.
+fn recording_paths(plan: &Plan, given: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    let files: Vec<PathBuf> = match given {
+        [folder] if folder.is_dir() => (plan.experiments.iter())
+            .map(|e| folder.join(format!("{}.csv", e.kind.name())))
+            .collect(),
+        _ => given.to_vec(),
+    };
+    if files.len() != plan.experiments.len() {
+        return Err(Error::invalid(
+            "RECORDINGS",
+            format!(
+                "{} files for {} experiments ({}); give one CSV per experiment, named after it (D.csv), or a folder of them; one log of the whole session is split into them first (perturbid split PLAN LOG --out FOLDER)",
+                files.len(),
+                plan.experiments.len(),
+                plan.kinds()
+            ),
+        ));
+    }
+    Ok(files)
 }
 
 pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
@@ -592,46 +633,55 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
             });
         }
     }
-    let files: Vec<PathBuf> = if a.recordings.len() == 1 && a.recordings[0].is_dir() {
-        plan.experiments
-            .iter()
-            .map(|e| a.recordings[0].join(format!("{}.csv", e.kind.name())))
-            .collect()
-    } else {
-        a.recordings.clone()
-    };
+    let files = recording_paths(&plan, &a.recordings)?;
+    let rounds: Vec<(Plan, Vec<PathBuf>)> = (a.rounds.iter())
+        .map(|(p, folder)| {
+            if !folder.is_dir() {
+                return Err(Error::invalid(
+                    "--round",
+                    format!(
+                        "{}: no such folder; expected the round's folder of recordings",
+                        folder.display()
+                    ),
+                ));
+            }
+            let round = Plan::load(p)?;
+            let files = recording_paths(&round, std::slice::from_ref(folder))?;
+            Ok((round, files))
+        })
+        .collect::<Result<_>>()?;
     let inputs: Vec<&std::path::Path> = std::iter::once(a.plan.as_path())
         .chain(files.iter().map(PathBuf::as_path))
         .chain(a.gains_from.as_deref())
         .chain(a.robot.as_deref().map(Path::new))
+        .chain(a.rounds.iter().map(|(p, _)| p.as_path()))
+        .chain(
+            rounds
+                .iter()
+                .flat_map(|(_, f)| f.iter().map(PathBuf::as_path)),
+        )
         .collect();
     super::files::refuse_overwriting_inputs(&a.out, &inputs)?;
-    if files.len() != plan.experiments.len() {
-        return Err(Error::invalid(
-            "RECORDINGS",
-            format!(
-                "{} files for {} experiments ({}); give one CSV per experiment, named after it (D.csv), or a folder of them; one log of the whole session is split into them first (perturbid split PLAN LOG --out FOLDER)",
-                files.len(),
-                plan.experiments.len(),
-                plan.kinds()
-            ),
-        ));
-    }
     let gains = a
         .gains_from
         .as_deref()
         .map(|path| super::gains::gains_from_file(path, &plan.joint_names))
         .transpose()?;
     let mut notes = String::new();
-    let recs: Vec<Recording> = files
-        .iter()
-        .map(|f| {
-            let rec = a.columns.load(f, &plan.joint_names, &mut notes)?;
-            match &gains {
-                Some(g) => rec.in_torques(&g.gain),
-                None => Ok(rec),
-            }
-        })
+    let mut load = |plan: &Plan, files: &[PathBuf]| -> Result<Vec<Recording>> {
+        (files.iter())
+            .map(|f| {
+                let rec = a.columns.load(f, &plan.joint_names, &mut notes)?;
+                match &gains {
+                    Some(g) => rec.in_torques(&g.gain),
+                    None => Ok(rec),
+                }
+            })
+            .collect()
+    };
+    let recs = load(&plan, &files)?;
+    let earlier: Vec<(&Plan, Vec<Recording>)> = (rounds.iter())
+        .map(|(p, f)| Ok((p, load(p, f)?)))
         .collect::<Result<_>>()?;
     let options = IdentifyOptions {
         times: if a.planned_times {
@@ -652,8 +702,13 @@ pub(crate) fn identify(a: IdentifyArgs) -> Result<String> {
         estimator: a.estimator,
         friction_aware_h: a.friction_aware_h,
     };
+    let all: Vec<(&Plan, &[Recording])> = (earlier.iter())
+        .map(|(p, r)| (*p, r.as_slice()))
+        .chain([(&plan, recs.as_slice())])
+        .collect();
     let mut model: LocalModel = match &robot {
-        Some(r) => identify_local_with_delay(r, &plan, &recs, &options, &Default::default())?,
+        Some(r) => identify_local_rounds_with_delay(r, &all, &options, &Default::default())?,
+        None if all.len() > 1 => identify_local_rounds(&all, &options)?,
         None => identify_local(&plan, &recs, &options)?,
     };
     model.drive_gains = gains.as_ref().map(crate::local::SignalGains::from);
