@@ -65,22 +65,33 @@ impl Miss {
     /// The largest miss in perturbation units: `(joint, variable name, value)`.
     pub fn largest(&self) -> Option<(usize, &'static str, f64)> {
         largest_of([
-            ("q", self.q_perturbations.clone()),
-            ("qd", self.qd_perturbations.clone()),
-            ("qdd", self.qdd_perturbations.clone()),
+            &self.q_perturbations,
+            &self.qd_perturbations,
+            &self.qdd_perturbations,
         ])
+    }
+
+    /// The miss of `q`, `qd`, `qdd` per joint in units of its standard errors; empty for a
+    /// model saved before they were stored.
+    pub fn in_stderr(&self) -> [Vec<f64>; 3] {
+        let z = |x: &[f64], s: &[f64]| -> Vec<f64> {
+            match s.len() == x.len() {
+                true => x.iter().zip(s).map(|(x, s)| x / s).collect(),
+                false => vec![],
+            }
+        };
+        [
+            z(&self.q, &self.q_stderr),
+            z(&self.qd, &self.qd_stderr),
+            z(&self.qdd, &self.qdd_stderr),
+        ]
     }
 
     /// The largest miss in units of its standard errors: `(joint, variable name, value)`;
     /// None for a model saved before they were stored.
     pub fn largest_in_stderr(&self) -> Option<(usize, &'static str, f64)> {
-        let z =
-            |x: &[f64], s: &[f64]| -> Vec<f64> { x.iter().zip(s).map(|(x, s)| x / s).collect() };
-        largest_of([
-            ("q", z(&self.q, &self.q_stderr)),
-            ("qd", z(&self.qd, &self.qd_stderr)),
-            ("qdd", z(&self.qdd, &self.qdd_stderr)),
-        ])
+        let [q, qd, qdd] = self.in_stderr();
+        largest_of([&q, &qd, &qdd])
     }
 
     /// Checks a stored miss of `n` joints (`what` names the document).
@@ -142,12 +153,12 @@ impl Miss {
     }
 }
 
-/// The entry of largest magnitude among the finite ones of `parts` (named variables, one value
-/// per joint): `(joint, name, value)`.
-fn largest_of(parts: [(&'static str, Vec<f64>); 3]) -> Option<(usize, &'static str, f64)> {
+/// The entry of largest magnitude among the finite ones of `parts` (`q`, `qd`, `qdd`, one
+/// value per joint): `(joint, variable name, value)`.
+fn largest_of(parts: [&[f64]; 3]) -> Option<(usize, &'static str, f64)> {
     let mut best: Option<(usize, &'static str, f64)> = None;
-    for (name, v) in parts {
-        for (j, x) in v.into_iter().enumerate().filter(|(_, x)| x.is_finite()) {
+    for (name, v) in ["q", "qd", "qdd"].into_iter().zip(parts) {
+        for (j, &x) in v.iter().enumerate().filter(|(_, x)| x.is_finite()) {
             if best.is_none_or(|b| x.abs() > b.2.abs()) {
                 best = Some((j, name, x));
             }

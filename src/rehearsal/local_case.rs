@@ -80,31 +80,21 @@ pub fn compare(nominal: &Model, robot: &TrueRobot, model: LocalModel) -> Result<
             inside as f64 / (n * n) as f64
         })
     });
-    let largest = |x: Vec<f64>| {
-        x.iter()
-            .filter(|v| v.is_finite())
-            .fold(0.0, |a: f64, v| a.max(v.abs()))
-    };
+    // per variable, the largest finite magnitude
+    let largest =
+        |x: &[f64]| (x.iter().filter(|v| v.is_finite()).map(|v| v.abs())).reduce(f64::max);
     let (miss, miss_stderr) = match &model.miss {
         None => ([0.0; 3], [f64::NAN; 3]),
         Some(m) => {
-            let z = |x: &[f64], s: &[f64]| -> Vec<f64> {
-                match s.len() == x.len() {
-                    true => x.iter().zip(s).map(|(x, s)| x / s).collect(),
-                    false => vec![f64::NAN],
-                }
-            };
+            let sizes = [
+                &m.q_perturbations,
+                &m.qd_perturbations,
+                &m.qdd_perturbations,
+            ];
+            let z = m.in_stderr();
             (
-                [
-                    largest(m.q_perturbations.clone()),
-                    largest(m.qd_perturbations.clone()),
-                    largest(m.qdd_perturbations.clone()),
-                ],
-                [
-                    largest(z(&m.q, &m.q_stderr)),
-                    largest(z(&m.qd, &m.qd_stderr)),
-                    largest(z(&m.qdd, &m.qdd_stderr)),
-                ],
+                sizes.map(|x| largest(x).unwrap_or(0.0)),
+                std::array::from_fn(|v| largest(&z[v]).unwrap_or(f64::NAN)),
             )
         }
     };
